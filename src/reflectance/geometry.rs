@@ -1,0 +1,97 @@
+//! The paper's reconstructed geometry (Fig. 1 of the paper is lost; see NOTES.md).
+//!
+//! `N = +Y`. `theta` is the angle between `N` and `L`, `gamma` the azimuth of `L` measured from
+//! the X axis, and `phi` the signed angle between `N` and `V`, with `V` in the XY plane:
+//!
+//! ```text
+//! L = (sin t cos g, cos t, sin t sin g),  t in [0, pi/2], g in [-pi/2, pi/2]
+//! V = (sin p, cos p, 0),                  p in [-pi/2, pi/2]
+//! ```
+//!
+//! This module states the integrand literally, with vectors. It is the definition that the
+//! fast reduced integrals of [`super::exact`] are checked against.
+
+use glam::DVec3;
+
+use super::ShadingModel;
+
+/// Light direction for polar angle `theta` and azimuth `gamma` (radians).
+pub fn light_dir(theta: f64, gamma: f64) -> DVec3 {
+    DVec3::new(
+        theta.sin() * gamma.cos(),
+        theta.cos(),
+        theta.sin() * gamma.sin(),
+    )
+}
+
+/// View direction for the signed angle `phi` from the normal (radians).
+pub fn view_dir(phi: f64) -> DVec3 {
+    DVec3::new(phi.sin(), phi.cos(), 0.0)
+}
+
+/// The cosine that the specular lobe raises to the power `n`: `R.V` for original Phong
+/// (eq. 4, `R` the mirror of `L` about `N`) and `N.H` for Blinn-Phong (eq. 9).
+pub fn lobe_cosine(model: ShadingModel, theta: f64, gamma: f64, phi: f64) -> f64 {
+    let l = light_dir(theta, gamma);
+    let v = view_dir(phi);
+    match model {
+        ShadingModel::Phong => {
+            let r = DVec3::new(-l.x, l.y, -l.z);
+            r.dot(v)
+        }
+        ShadingModel::BlinnPhong => {
+            let sum = l + v;
+            let len = sum.length();
+            if len > 0.0 { sum.y / len } else { 0.0 }
+        }
+    }
+}
+
+/// The specular reflectance `rho_s = max(0, cos)^n`, with `0^0` taken as 0: at `n = 0` the
+/// lobe is the indicator of the set where the cosine is positive, which is the limit of
+/// `max(0, cos)^n` as `n -> 0`.
+pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f64 {
+    let c = lobe_cosine(model, theta, gamma, phi);
+    if c <= 0.0 {
+        0.0
+    } else if n == 0.0 {
+        1.0
+    } else {
+        c.powf(n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn phong_cosine_matches_the_closed_form_in_notes() {
+        for &(t, g, p) in &[(0.3_f64, 0.2_f64, -0.7_f64), (1.2, -1.0, 0.4), (FRAC_PI_2, 0.0, 1.0)] {
+            let closed = t.cos() * p.cos() - t.sin() * p.sin() * g.cos();
+            let c = lobe_cosine(ShadingModel::Phong, t, g, p);
+            assert!((c - closed).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn blinn_cosine_matches_the_closed_form_in_notes() {
+        for &(t, g, p) in &[(0.3_f64, 0.2_f64, -0.7_f64), (1.2, -1.0, 0.4)] {
+            let l = light_dir(t, g);
+            let v = view_dir(p);
+            let closed = (t.cos() + p.cos()) / (l + v).length();
+            let c = lobe_cosine(ShadingModel::BlinnPhong, t, g, p);
+            assert!((c - closed).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn the_lobe_peaks_on_the_mirror_direction() {
+        // g = 0, p = -t puts V on the mirror of L: both cosines are 1.
+        for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+            let c = lobe_cosine(model, 0.6, 0.0, -0.6);
+            assert!((c - 1.0).abs() < 1e-15, "{model:?}: {c}");
+        }
+    }
+}
