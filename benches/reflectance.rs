@@ -1,1 +1,72 @@
-fn main() {}
+#![allow(missing_docs)] // criterion_main! generates an undocumented main.
+//! Criterion benches for the reflectance kernels: `chi` per method, and the k_a derive of a
+//! map on one thread and on all threads against a plain copy of the same input bytes.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use kapaint::reflectance::{AmbientApprox, ShadingModel, chi_f32, derive_ka, derive_ka_par};
+use kapaint::report::bench::BenchMaps;
+use rayon::prelude::*;
+
+const SIDE: usize = 1024;
+
+fn chi(c: &mut Criterion) {
+    let ns: Vec<f32> = (0..4096).map(|i| (i as f32 * 0.0023).exp() - 1.0).collect();
+    let mut group = c.benchmark_group("chi_f32");
+    group.throughput(Throughput::Elements(ns.len() as u64));
+    for model in ShadingModel::ALL {
+        for approx in AmbientApprox::ALL {
+            let id = BenchmarkId::new(model.name(), approx.name());
+            group.bench_function(id, |b| {
+                b.iter(|| {
+                    ns.iter()
+                        .map(|&n| chi_f32(model, approx, black_box(n)))
+                        .sum::<f32>()
+                });
+            });
+        }
+    }
+    group.finish();
+}
+
+fn derive(c: &mut Criterion) {
+    let texels = SIDE * SIDE;
+    let maps = BenchMaps::new(texels);
+    let mut out = vec![Vec3::ZERO; texels];
+    let mut group = c.benchmark_group("derive_ka_1024x1024");
+    group.throughput(Throughput::Elements(texels as u64));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(3));
+    for model in ShadingModel::ALL {
+        for approx in AmbientApprox::ALL {
+            let name = format!("{}_{}", model.name(), approx.name());
+            group.bench_function(BenchmarkId::new("one_thread", &name), |b| {
+                b.iter(|| derive_ka(model, approx, &maps.kd, &maps.ks, &maps.n, &mut out));
+            });
+            group.bench_function(BenchmarkId::new("all_threads", &name), |b| {
+                b.iter(|| derive_ka_par(model, approx, &maps.kd, &maps.ks, &maps.n, &mut out));
+            });
+        }
+    }
+    let bytes = texels * BenchMaps::BYTES_PER_TEXEL_READ;
+    let src = vec![1u8; bytes];
+    let mut dst = vec![0u8; bytes];
+    group.bench_function("copy_inputs_one_thread", |b| {
+        b.iter(|| dst.copy_from_slice(black_box(&src)));
+    });
+    group.bench_function("copy_inputs_all_threads", |b| {
+        b.iter(|| {
+            dst.par_chunks_mut(1 << 20)
+                .zip(src.par_chunks(1 << 20))
+                .for_each(|(d, s)| d.copy_from_slice(s));
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, chi, derive);
+criterion_main!(benches);

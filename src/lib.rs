@@ -1,3 +1,8 @@
 //! kapaint: paint per-texel Phong reflectance and preview it with a derived ambient term.
+//!
+//! The library holds all logic; the `kapaint` binary is a thin shell around [`cli::main`].
+//! [`reflectance`] is the numerical core (no GUI or GPU code), [`report`] measures it.
 
+pub mod cli;
 pub mod reflectance;
+pub mod report;

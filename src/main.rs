@@ -1,1 +1,5 @@
-fn main() {}
+//! The `kapaint` binary: everything lives in the library.
+
+fn main() {
+    std::process::exit(kapaint::cli::main());
+}

@@ -313,7 +313,11 @@ mod tests {
         // Check the closed p-integral against direct quadrature of the vector definition,
         // split at the kink where R.V crosses zero.
         let rule = TanhSinh::new(12);
-        for &(n, t, g) in &[(0.5_f64, 0.4_f64, 0.3_f64), (3.0, 1.1, 0.9), (40.0, 0.7, 0.05)] {
+        for &(n, t, g) in &[
+            (0.5_f64, 0.4_f64, 0.3_f64),
+            (3.0, 1.1, 0.9),
+            (40.0, 0.7, 0.05),
+        ] {
             let m = (1.0 - (t.sin() * g.sin()).powi(2)).sqrt();
             let to_kink = t.cos().atan2(t.sin() * g.cos());
             let reduced = m.powf(n)

@@ -68,7 +68,11 @@ mod tests {
 
     #[test]
     fn phong_cosine_matches_the_closed_form_in_notes() {
-        for &(t, g, p) in &[(0.3_f64, 0.2_f64, -0.7_f64), (1.2, -1.0, 0.4), (FRAC_PI_2, 0.0, 1.0)] {
+        for &(t, g, p) in &[
+            (0.3_f64, 0.2_f64, -0.7_f64),
+            (1.2, -1.0, 0.4),
+            (FRAC_PI_2, 0.0, 1.0),
+        ] {
             let closed = t.cos() * p.cos() - t.sin() * p.sin() * g.cos();
             let c = lobe_cosine(ShadingModel::Phong, t, g, p);
             assert!((c - closed).abs() < 1e-15);

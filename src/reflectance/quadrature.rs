@@ -153,7 +153,7 @@ pub fn break_points(a: f64, b: f64, interior: impl IntoIterator<Item = f64>) -> 
 pub fn graded_from(start: f64, sign: f64, scale: f64, span: f64) -> impl Iterator<Item = f64> {
     let mut offset = scale;
     std::iter::from_fn(move || {
-        if !(offset < span) || scale <= 0.0 {
+        if offset >= span || offset.is_nan() || scale <= 0.0 {
             return None;
         }
         let point = start + sign * offset;

@@ -1,0 +1,161 @@
+//! Accuracy of every approximation against the exact integrator.
+
+use std::fmt::Write as _;
+
+use rayon::prelude::*;
+
+use crate::reflectance::{AmbientApprox, ShadingModel, chi_f32, exact::chi_exact};
+
+/// A range of `n` sampled for an accuracy report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid {
+    /// Human-readable name of the range, e.g. `[1, 200]`.
+    pub label: String,
+    /// Sample points, ascending.
+    pub points: Vec<f64>,
+}
+
+impl Grid {
+    /// `count` points on `[lo, hi]`, spaced evenly in `ln(n + 1)` so that small `n`, where
+    /// `chi` changes fastest, is sampled as densely as large `n`; both ends included.
+    pub fn log_spaced(lo: f64, hi: f64, count: usize) -> Self {
+        let (a, b) = ((lo + 1.0).ln(), (hi + 1.0).ln());
+        let count = count.max(2);
+        let points = (0..count)
+            .map(|i| {
+                if i == count - 1 {
+                    hi
+                } else {
+                    (a + (b - a) * i as f64 / (count - 1) as f64).exp() - 1.0
+                }
+            })
+            .collect();
+        Self {
+            label: format!("[{lo}, {hi}]"),
+            points,
+        }
+    }
+
+    /// The two ranges the acceptance criteria name: the paper's `[1, 200]` and the product's
+    /// `[0, 16384]`, with `points` samples each.
+    pub fn standard(points: usize) -> Vec<Self> {
+        vec![
+            Self::log_spaced(1.0, 200.0, points),
+            Self::log_spaced(0.0, 16384.0, points),
+        ]
+    }
+}
+
+/// Exact `chi` at every point of a grid, for one model.
+#[derive(Clone, Debug)]
+pub struct ExactSamples {
+    /// The model sampled.
+    pub model: ShadingModel,
+    /// `(n, chi_exact(n))`, ascending in `n`.
+    pub samples: Vec<(f64, f64)>,
+}
+
+impl ExactSamples {
+    /// Evaluates the exact integrator on the grid (in parallel across points).
+    pub fn compute(model: ShadingModel, grid: &Grid) -> Self {
+        let samples = grid
+            .points
+            .par_iter()
+            .map(|&n| (n, chi_exact(model, n)))
+            .collect();
+        Self { model, samples }
+    }
+}
+
+/// Error statistics of one approximation over one grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ErrorStats {
+    /// Largest relative error `|approx / exact - 1|`.
+    pub max_rel: f64,
+    /// Where the largest error occurs.
+    pub max_at_n: f64,
+    /// Mean relative error over the grid points.
+    pub mean_rel: f64,
+}
+
+/// The relative error statistics of `approx` (evaluated in `f32`, as a renderer would).
+pub fn error_stats(approx: AmbientApprox, exact: &ExactSamples) -> ErrorStats {
+    let mut stats = ErrorStats {
+        max_rel: 0.0,
+        max_at_n: 0.0,
+        mean_rel: 0.0,
+    };
+    for &(n, chi) in &exact.samples {
+        let approx_chi = f64::from(chi_f32(exact.model, approx, n as f32));
+        let err = (approx_chi / chi - 1.0).abs();
+        stats.mean_rel += err;
+        if err > stats.max_rel {
+            stats.max_rel = err;
+            stats.max_at_n = n;
+        }
+    }
+    stats.mean_rel /= exact.samples.len().max(1) as f64;
+    stats
+}
+
+/// One row of the accuracy table.
+#[derive(Clone, Debug)]
+pub struct AccuracyRow {
+    /// The lobe.
+    pub model: ShadingModel,
+    /// The approximation measured.
+    pub approx: AmbientApprox,
+    /// The grid's label.
+    pub range: String,
+    /// The measured errors.
+    pub stats: ErrorStats,
+}
+
+/// Measures every model and approximation on every grid.
+pub fn accuracy_rows(grids: &[Grid]) -> Vec<AccuracyRow> {
+    let mut rows = Vec::new();
+    for model in ShadingModel::ALL {
+        for grid in grids {
+            let exact = ExactSamples::compute(model, grid);
+            for approx in AmbientApprox::ALL {
+                rows.push(AccuracyRow {
+                    model,
+                    approx,
+                    range: grid.label.clone(),
+                    stats: error_stats(approx, &exact),
+                });
+            }
+        }
+    }
+    rows
+}
+
+/// Renders the rows as a markdown table.
+pub fn markdown(rows: &[AccuracyRow]) -> String {
+    let mut out = String::from(
+        "| model | method | n range | max rel error | at n | mean rel error |\n\
+         |---|---|---|---|---|---|\n",
+    );
+    for row in rows {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.3e} | {} | {:.3e} |",
+            row.model.name(),
+            row.approx.name(),
+            row.range,
+            row.stats.max_rel,
+            format_n(row.stats.max_at_n),
+            row.stats.mean_rel,
+        );
+    }
+    out
+}
+
+/// Formats a sample point compactly (grid points are not round numbers).
+pub fn format_n(n: f64) -> String {
+    if n == n.round() {
+        format!("{n}")
+    } else {
+        format!("{n:.4}")
+    }
+}

@@ -1,0 +1,240 @@
+//! Run time against error: the `kapaint bench` report.
+//!
+//! For every model and approximation, derives a full `size x size` k_a map on one thread and
+//! on all threads, and compares both with a plain copy of the derive's input bytes measured in
+//! the same run (the memory-bandwidth limit of the machine).
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::Vec3;
+use std::fmt::Write as _;
+
+use rayon::prelude::*;
+
+use super::accuracy::{ExactSamples, Grid, error_stats};
+use crate::reflectance::{AmbientApprox, ShadingModel, derive_ka, derive_ka_par};
+
+/// One row of the bench table.
+#[derive(Clone, Debug)]
+pub struct BenchRow {
+    /// The lobe.
+    pub model: ShadingModel,
+    /// The approximation timed.
+    pub approx: AmbientApprox,
+    /// Nanoseconds per texel, one thread.
+    pub ns_per_texel_1t: f64,
+    /// Nanoseconds per texel, all threads.
+    pub ns_per_texel_mt: f64,
+    /// Maximum relative error of `chi` on `n in [0, 16384]`.
+    pub max_rel_error: f64,
+    /// Derive time over copy time, one thread.
+    pub copy_ratio_1t: f64,
+    /// Derive time over copy time, all threads.
+    pub copy_ratio_mt: f64,
+}
+
+/// The input maps of a derive: `k_d`, `k_s`, `n` with realistic spreads.
+pub struct BenchMaps {
+    /// Diffuse coefficients.
+    pub kd: Vec<Vec3>,
+    /// Specular coefficients.
+    pub ks: Vec<Vec3>,
+    /// Exponents, spread log-uniformly over `[0, 16384]`.
+    pub n: Vec<f32>,
+}
+
+impl BenchMaps {
+    /// Deterministic pseudo-random maps of `texels` texels.
+    pub fn new(texels: usize) -> Self {
+        let hash = |i: usize, salt: u64| -> f32 {
+            let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ salt;
+            z = (z ^ (z >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z ^= z >> 29;
+            (z >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let kd = (0..texels)
+            .into_par_iter()
+            .map(|i| Vec3::new(hash(i, 1), hash(i, 2), hash(i, 3)))
+            .collect();
+        let ks = (0..texels)
+            .into_par_iter()
+            .map(|i| Vec3::splat(hash(i, 4)))
+            .collect();
+        let n = (0..texels)
+            .into_par_iter()
+            .map(|i| (hash(i, 5) * 16385.0_f32.ln()).exp() - 1.0)
+            .collect();
+        Self { kd, ks, n }
+    }
+
+    /// Bytes the derive reads per texel.
+    pub const BYTES_PER_TEXEL_READ: usize = 2 * 12 + 4;
+}
+
+/// Best of `repeats` wall-clock timings of `f`, in seconds.
+pub fn best_of(repeats: usize, mut f: impl FnMut()) -> f64 {
+    (0..repeats.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Times one thread and all threads copying `bytes` bytes: `(one, all)` in seconds.
+pub fn copy_baseline(bytes: usize, repeats: usize) -> (f64, f64) {
+    let src = vec![1u8; bytes];
+    let mut dst = vec![0u8; bytes];
+    let one = best_of(repeats, || dst.copy_from_slice(std::hint::black_box(&src)));
+    let chunk = (bytes / (4 * rayon::current_num_threads())).max(1 << 20);
+    let all = best_of(repeats, || {
+        dst.par_chunks_mut(chunk)
+            .zip(src.par_chunks(chunk))
+            .for_each(|(d, s)| d.copy_from_slice(s));
+    });
+    std::hint::black_box(&dst);
+    (one, all)
+}
+
+/// Runs the whole bench on `size x size` maps.
+pub fn run(size: usize, repeats: usize, error_points: usize) -> Vec<BenchRow> {
+    let texels = size * size;
+    let maps = BenchMaps::new(texels);
+    let mut out = vec![Vec3::ZERO; texels];
+    let (copy_1t, copy_mt) = copy_baseline(texels * BenchMaps::BYTES_PER_TEXEL_READ, repeats);
+    let grid = Grid::log_spaced(0.0, 16384.0, error_points);
+    let mut rows = Vec::new();
+    for model in ShadingModel::ALL {
+        let exact = ExactSamples::compute(model, &grid);
+        for approx in AmbientApprox::ALL {
+            let one = best_of(repeats, || {
+                derive_ka(model, approx, &maps.kd, &maps.ks, &maps.n, &mut out);
+            });
+            let all = best_of(repeats, || {
+                derive_ka_par(model, approx, &maps.kd, &maps.ks, &maps.n, &mut out);
+            });
+            std::hint::black_box(&out);
+            rows.push(BenchRow {
+                model,
+                approx,
+                ns_per_texel_1t: one * 1e9 / texels as f64,
+                ns_per_texel_mt: all * 1e9 / texels as f64,
+                max_rel_error: error_stats(approx, &exact).max_rel,
+                copy_ratio_1t: one / copy_1t,
+                copy_ratio_mt: all / copy_mt,
+            });
+        }
+    }
+    rows
+}
+
+/// The table as markdown.
+pub fn markdown(rows: &[BenchRow], size: usize) -> String {
+    let mut out = format!(
+        "k_a derive of a {size}x{size} map, {} threads\n\n\
+         | model | method | ns/texel (1 thread) | ns/texel (all threads) | max rel error | \
+         derive/copy (1 thread) | derive/copy (all threads) |\n|---|---|---|---|---|---|---|\n",
+        rayon::current_num_threads()
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.2} | {:.2} | {:.2e} | {:.2} | {:.2} |",
+            r.model.name(),
+            r.approx.name(),
+            r.ns_per_texel_1t,
+            r.ns_per_texel_mt,
+            r.max_rel_error,
+            r.copy_ratio_1t,
+            r.copy_ratio_mt
+        );
+    }
+    out
+}
+
+/// The table as CSV, one row per model and method.
+pub fn csv(rows: &[BenchRow]) -> String {
+    let mut out = String::from(
+        "model,method,ns_per_texel_1t,ns_per_texel_mt,max_rel_error,copy_ratio_1t,copy_ratio_mt\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{}",
+            r.model.name(),
+            r.approx.name(),
+            r.ns_per_texel_1t,
+            r.ns_per_texel_mt,
+            r.max_rel_error,
+            r.copy_ratio_1t,
+            r.copy_ratio_mt
+        );
+    }
+    out
+}
+
+/// Draws the error-vs-time plot (log-log, one point per model and method) as a PNG.
+pub fn plot(rows: &[BenchRow], path: &Path) -> Result<(), String> {
+    use plotters::prelude::*;
+    register_font()?;
+    let err = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
+    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let xs = rows.iter().map(|r| r.ns_per_texel_1t);
+    let ys = rows.iter().map(|r| r.max_rel_error.max(1e-9));
+    let (x_lo, x_hi) = xs.fold((f64::INFINITY, 0.0_f64), |(a, b), x| (a.min(x), b.max(x)));
+    let (y_lo, y_hi) = ys.fold((f64::INFINITY, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption("k_a derive: error vs time (one thread)", ("sans-serif", 24))
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(
+            (x_lo / 2.0..x_hi * 2.0).log_scale(),
+            (y_lo / 10.0..y_hi * 10.0).log_scale(),
+        )
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("ns per texel")
+        .y_desc("max relative error of chi on [0, 16384]")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (i, r) in rows.iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        let point = (r.ns_per_texel_1t, r.max_rel_error.max(1e-9));
+        chart
+            .draw_series([Circle::new(point, 6, colour.filled())])
+            .map_err(|e| err(&e))?
+            .label(format!("{} {}", r.model.name(), r.approx.name()))
+            .legend(move |(x, y)| Circle::new((x, y), 5, colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// Registers egui's bundled sans-serif font with plotters (no system fonts needed).
+fn register_font() -> Result<(), String> {
+    use std::sync::OnceLock;
+    static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font(
+                "sans-serif",
+                plotters::style::FontStyle::Normal,
+                epaint_default_fonts::UBUNTU_LIGHT,
+            )
+            .map_err(|_| "the bundled plot font is unreadable".to_string())
+        })
+        .clone()
+}

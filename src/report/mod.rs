@@ -1,0 +1,4 @@
+//! Reports the CLI prints: accuracy against the exact integral, and run time against error.
+
+pub mod accuracy;
+pub mod bench;
