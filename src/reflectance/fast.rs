@@ -16,19 +16,40 @@ use super::fast_coeffs::{BLINN_OCTAVES, BLINN_TAIL, DEGREE, OCTAVES, PHONG_OCTAV
 /// `x = n + 1` from which the asymptotic tail is used.
 pub const TAIL_START_X: f32 = (1u32 << OCTAVES) as f32;
 
+/// The coefficient table and tail of one model.
+#[derive(Clone, Copy, Debug)]
+pub struct FastTable {
+    /// Per-octave polynomial coefficients, lowest power first.
+    pub octaves: &'static [[f32; DEGREE + 1]; OCTAVES],
+    /// `[A, B, C]` of the asymptotic tail.
+    pub tail: &'static [f32; 3],
+}
+
 /// The coefficient table and tail of a model.
 #[inline]
-pub fn table(model: ShadingModel) -> (&'static [[f32; DEGREE + 1]; OCTAVES], &'static [f32; 3]) {
+pub fn table(model: ShadingModel) -> FastTable {
     match model {
-        ShadingModel::Phong => (&PHONG_OCTAVES, &PHONG_TAIL),
-        ShadingModel::BlinnPhong => (&BLINN_OCTAVES, &BLINN_TAIL),
+        ShadingModel::Phong => FastTable {
+            octaves: &PHONG_OCTAVES,
+            tail: &PHONG_TAIL,
+        },
+        ShadingModel::BlinnPhong => FastTable {
+            octaves: &BLINN_OCTAVES,
+            tail: &BLINN_TAIL,
+        },
     }
 }
 
 /// `chi(n)` in `f32` for a sanitized `n >= 0`.
 #[inline]
 pub fn chi_f32(model: ShadingModel, n: f32) -> f32 {
-    let (octaves, tail) = table(model);
+    chi_f32_with(table(model), n)
+}
+
+/// [`chi_f32`] with the model's table already selected (for hot loops).
+#[inline]
+pub fn chi_f32_with(table: FastTable, n: f32) -> f32 {
+    let FastTable { octaves, tail } = table;
     let x = n + 1.0;
     if x >= TAIL_START_X {
         let [a, b, c] = *tail;
@@ -49,7 +70,7 @@ pub fn chi_f32(model: ShadingModel, n: f32) -> f32 {
 
 /// `chi(n)` in `f64` for a sanitized `n >= 0`, from the same constants as [`chi_f32`].
 pub fn chi_f64(model: ShadingModel, n: f64) -> f64 {
-    let (octaves, tail) = table(model);
+    let FastTable { octaves, tail } = table(model);
     let x = n + 1.0;
     if x >= f64::from(TAIL_START_X) {
         let [a, b, c] = tail.map(f64::from);

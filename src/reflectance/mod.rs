@@ -18,6 +18,7 @@ mod fast_coeffs;
 pub mod fit;
 pub mod geometry;
 pub mod quadrature;
+pub mod wgsl;
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -169,10 +170,14 @@ pub fn ka(model: ShadingModel, approx: AmbientApprox, kd: Vec3, ks: Vec3, n: f32
 /// small enough to balance two to sixty-four cores on a 4096^2 map.
 pub const DERIVE_CHUNK_TEXELS: usize = 1 << 14;
 
+/// Texels per block of the derive: the block's `chi` values stay in L1 between the two passes.
+const DERIVE_BLOCK_TEXELS: usize = 256;
+
 /// Derives a `k_a` buffer from `k_d`, `k_s` and `n` buffers on the calling thread.
 ///
-/// All slices must have the same length. The loop body is branch-free apart from the
-/// approximation's own piece selection, so the compiler can pipeline it.
+/// All slices must have the same length. Works in blocks of 256 texels: a scalar pass
+/// evaluates `chi` (table lookups do not vectorise), then a flat pass over the `f32`
+/// components computes `(2/pi) k_d + k_s chi`, which the compiler vectorises.
 pub fn derive_ka(
     model: ShadingModel,
     approx: AmbientApprox,
@@ -187,9 +192,12 @@ pub fn derive_ka(
     );
     match approx {
         // Monomorphise the hot loop per approximation so the choice is made once per buffer.
-        AmbientApprox::Fast => derive_with(kd, ks, n, out, TWO_OVER_PI as f32, |n| {
-            fast::chi_f32(model, sanitize_n_f32(n))
-        }),
+        AmbientApprox::Fast => {
+            let table = fast::table(model);
+            derive_with(kd, ks, n, out, TWO_OVER_PI as f32, |n| {
+                fast::chi_f32_with(table, sanitize_n_f32(n))
+            });
+        }
         AmbientApprox::PaperPrinted | AmbientApprox::PaperCorrected => {
             let (a, b, c) = paper_constants(model, approx);
             let (a, b, c) = (a as f32, b as f32, c as f32);
@@ -209,10 +217,22 @@ fn derive_with(
     diffuse: f32,
     chi: impl Fn(f32) -> f32,
 ) {
-    for (((o, &d), &s), &e) in out.iter_mut().zip(kd).zip(ks).zip(n) {
-        let d = d.map(sanitize_coefficient);
-        let s = s.map(sanitize_coefficient);
-        *o = diffuse * d + s * chi(e);
+    let kd: &[f32] = bytemuck::cast_slice(kd);
+    let ks: &[f32] = bytemuck::cast_slice(ks);
+    let out: &mut [f32] = bytemuck::cast_slice_mut(out);
+    let mut chi3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS];
+    for (block, n_block) in n.chunks(DERIVE_BLOCK_TEXELS).enumerate() {
+        let start = 3 * block * DERIVE_BLOCK_TEXELS;
+        let len = 3 * n_block.len();
+        for (c, &e) in chi3.chunks_exact_mut(3).zip(n_block) {
+            c.fill(chi(e));
+        }
+        let o = &mut out[start..start + len];
+        let d = &kd[start..start + len];
+        let s = &ks[start..start + len];
+        for (((o, &d), &s), &c) in o.iter_mut().zip(d).zip(s).zip(&chi3[..len]) {
+            *o = diffuse * sanitize_coefficient(d) + sanitize_coefficient(s) * c;
+        }
     }
 }
 
