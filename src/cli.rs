@@ -209,8 +209,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             if points < 2 {
                 return Err(CliError::usage("--points must be at least 2"));
             }
-            let rows = accuracy::accuracy_rows(&accuracy::Grid::standard(points));
-            Ok(accuracy::markdown(&rows))
+            Ok(accuracy::accuracy_report(&accuracy::Grid::standard(points)).markdown())
         }
         Command::Bench { size, out, repeats } => {
             if !(16..=16384).contains(&size) {

@@ -111,11 +111,22 @@ pub struct AccuracyRow {
     pub stats: ErrorStats,
 }
 
-/// Measures every model and approximation on every grid.
-pub fn accuracy_rows(grids: &[Grid]) -> Vec<AccuracyRow> {
+/// The whole accuracy report.
+#[derive(Clone, Debug)]
+pub struct AccuracyReport {
+    /// Every model and approximation on every grid.
+    pub rows: Vec<AccuracyRow>,
+    /// Eq. (11)'s exponent on the first grid (the paper's `[1, 200]`).
+    pub exponent: ExponentCheck,
+}
+
+/// Measures every model and approximation on every grid (at least one), evaluating the
+/// exact integrator once per model and grid.
+pub fn accuracy_report(grids: &[Grid]) -> AccuracyReport {
     let mut rows = Vec::new();
+    let mut exponent = None;
     for model in ShadingModel::ALL {
-        for grid in grids {
+        for (i, grid) in grids.iter().enumerate() {
             let exact = ExactSamples::compute(model, grid);
             for approx in AmbientApprox::ALL {
                 rows.push(AccuracyRow {
@@ -125,9 +136,29 @@ pub fn accuracy_rows(grids: &[Grid]) -> Vec<AccuracyRow> {
                     stats: error_stats(approx, &exact),
                 });
             }
+            if model == ShadingModel::BlinnPhong && i == 0 {
+                exponent = Some(exponent_check(&exact));
+            }
         }
     }
-    rows
+    let exponent = exponent.unwrap_or_else(|| {
+        exponent_check(&ExactSamples::compute(
+            ShadingModel::BlinnPhong,
+            &Grid::log_spaced(1.0, 200.0, 32),
+        ))
+    });
+    AccuracyReport { rows, exponent }
+}
+
+impl AccuracyReport {
+    /// Both tables as markdown.
+    pub fn markdown(&self) -> String {
+        format!(
+            "{}\n{}",
+            markdown(&self.rows),
+            exponent_markdown(&self.exponent)
+        )
+    }
 }
 
 /// Renders the rows as a markdown table.
@@ -147,6 +178,49 @@ pub fn markdown(rows: &[AccuracyRow]) -> String {
             format_n(row.stats.max_at_n),
             row.stats.mean_rel,
         );
+    }
+    out
+}
+
+/// The paper's eq. (11) exponent check: with the printed `a` and `b`, the exponent that
+/// minimises the max relative error on `exact` (Blinn-Phong samples on `[1, 200]`), beside
+/// the printed one.
+#[derive(Clone, Debug)]
+pub struct ExponentCheck {
+    /// The printed exponent and its max relative error.
+    pub printed: (f64, f64),
+    /// The minimax exponent and its max relative error.
+    pub minimax: (f64, f64),
+    /// The shipped corrected exponent and its max relative error.
+    pub shipped: (f64, f64),
+}
+
+/// Runs the exponent check on Blinn-Phong samples.
+pub fn exponent_check(exact: &ExactSamples) -> ExponentCheck {
+    use crate::reflectance::{PAPER_BLINN, PAPER_BLINN_CORRECTED_EXPONENT, fit};
+    let (a, b, c) = PAPER_BLINN;
+    let err = |c: f64| fit::power_law_max_error(a, b, c, &exact.samples);
+    ExponentCheck {
+        printed: (c, err(c)),
+        minimax: fit::paper_exponent_minimax(a, b, &exact.samples, (-0.95, -0.8)),
+        shipped: (
+            PAPER_BLINN_CORRECTED_EXPONENT,
+            err(PAPER_BLINN_CORRECTED_EXPONENT),
+        ),
+    }
+}
+
+/// Renders the exponent check as a markdown table.
+pub fn exponent_markdown(check: &ExponentCheck) -> String {
+    let mut out = String::from(
+        "| eq. (11), a = 2.5235, b = 3 | exponent c | max rel error on [1, 200] |\n|---|---|---|\n",
+    );
+    for (label, (c, e)) in [
+        ("as printed", check.printed),
+        ("minimax (our integrator)", check.minimax),
+        ("shipped correction", check.shipped),
+    ] {
+        let _ = writeln!(out, "| {label} | {c:.4} | {:.3} % |", 100.0 * e);
     }
     out
 }

@@ -175,64 +175,98 @@ pub fn csv(rows: &[BenchRow]) -> String {
     out
 }
 
-/// Draws the error-vs-time plot (log-log, one point per model and method) as a PNG.
+/// Plot size in pixels.
+const PLOT_SIZE: (u32, u32) = (960, 640);
+
+/// Draws the error-vs-time plot (log-log; filled markers one thread, rings all threads) and
+/// writes it as a PNG.
 pub fn plot(rows: &[BenchRow], path: &Path) -> Result<(), String> {
+    let (w, h) = PLOT_SIZE;
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    draw_plot(rows, &mut rgb).map_err(|e| format!("cannot draw the plot: {e}"))?;
+    let image = image::RgbImage::from_raw(w, h, rgb).ok_or("plot buffer has the wrong size")?;
+    let mut png = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
+    crate::cli::write_atomic(path, &png).map_err(|e| e.message)
+}
+
+fn draw_plot(rows: &[BenchRow], rgb: &mut [u8]) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::prelude::*;
     register_font()?;
-    let err = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
-    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let xs = rows.iter().map(|r| r.ns_per_texel_1t);
-    let ys = rows.iter().map(|r| r.max_rel_error.max(1e-9));
-    let (x_lo, x_hi) = xs.fold((f64::INFINITY, 0.0_f64), |(a, b), x| (a.min(x), b.max(x)));
-    let (y_lo, y_hi) = ys.fold((f64::INFINITY, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
+    let root = BitMapBackend::with_buffer(rgb, PLOT_SIZE).into_drawing_area();
+    root.fill(&WHITE)?;
+    // Log-log through log10 coordinates on linear axes: plotters then picks useful ticks.
+    let times = rows
+        .iter()
+        .flat_map(|r| [r.ns_per_texel_1t, r.ns_per_texel_mt]);
+    let errors = rows.iter().map(|r| r.max_rel_error.max(1e-9));
+    let (x_lo, x_hi) = times.fold((f64::INFINITY, 0.0_f64), |(a, b), x| (a.min(x), b.max(x)));
+    let (y_lo, y_hi) = errors.fold((f64::INFINITY, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
     let mut chart = ChartBuilder::on(&root)
-        .caption("k_a derive: error vs time (one thread)", ("sans-serif", 24))
+        .caption(
+            "k_a derive: max error of chi on [0, 16384] vs time",
+            (FONT, 22),
+        )
         .margin(20)
         .x_label_area_size(50)
-        .y_label_area_size(80)
+        .y_label_area_size(70)
         .build_cartesian_2d(
-            (x_lo / 2.0..x_hi * 2.0).log_scale(),
-            (y_lo / 10.0..y_hi * 10.0).log_scale(),
-        )
-        .map_err(|e| err(&e))?;
+            x_lo.log10() - 0.1..x_hi.log10() + 0.1,
+            y_lo.log10().floor() - 0.5..y_hi.log10().ceil() + 0.5,
+        )?;
     chart
         .configure_mesh()
-        .x_desc("ns per texel")
-        .y_desc("max relative error of chi on [0, 16384]")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(|e| err(&e))?;
+        .x_desc("ns per texel, log scale (filled: 1 thread, ring: all threads)")
+        .y_desc("max relative error, log scale")
+        .x_label_formatter(&|x| format!("{:.1}", 10f64.powf(*x)))
+        .y_label_formatter(&|y| format!("{:.0e}", 10f64.powf(*y)))
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 15))
+        .draw()?;
     for (i, r) in rows.iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();
-        let point = (r.ns_per_texel_1t, r.max_rel_error.max(1e-9));
+        let error = r.max_rel_error.max(1e-9).log10();
+        // Phong's two paper rows coincide; vary the marker size so both show.
+        let size = 7 + (i % 3) as i32;
         chart
-            .draw_series([Circle::new(point, 6, colour.filled())])
-            .map_err(|e| err(&e))?
+            .draw_series([
+                Circle::new((r.ns_per_texel_1t.log10(), error), size, colour.filled()),
+                Circle::new(
+                    (r.ns_per_texel_mt.log10(), error),
+                    size,
+                    colour.stroke_width(2),
+                ),
+            ])?
             .label(format!("{} {}", r.model.name(), r.approx.name()))
-            .legend(move |(x, y)| Circle::new((x, y), 5, colour.filled()));
+            .legend(move |(x, y)| Circle::new((x, y), 6, colour.filled()));
     }
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::MiddleRight)
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
+        .label_font((FONT, 14))
+        .draw()?;
+    root.present()?;
     Ok(())
 }
 
-/// Registers egui's bundled sans-serif font with plotters (no system fonts needed).
+/// The font family name the plot registers.
+const FONT: &str = "kapaint-mono";
+
+/// Registers egui's bundled monospace font with plotters (no system fonts needed; plotters
+/// lays proportional fonts out with collapsed spaces, a monospace font reads cleanly).
 fn register_font() -> Result<(), String> {
     use std::sync::OnceLock;
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
             plotters::style::register_font(
-                "sans-serif",
+                FONT,
                 plotters::style::FontStyle::Normal,
-                epaint_default_fonts::UBUNTU_LIGHT,
+                epaint_default_fonts::HACK_REGULAR,
             )
             .map_err(|_| "the bundled plot font is unreadable".to_string())
         })

@@ -1,0 +1,258 @@
+//! The command line as scripts see it: formats, ordering, exit codes, no partial output.
+#![allow(clippy::expect_used)] // Test helpers: a failed expectation is a failed test.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn kapaint(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(args)
+        .output()
+        .expect("kapaint runs")
+}
+
+fn kapaint_stdin(args: &[&str], input: &str) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("kapaint starts");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(input.as_bytes())
+        .expect("write stdin");
+    child.wait_with_output().expect("kapaint ends")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("utf-8 output")
+}
+
+fn parse_csv(text: &str) -> Vec<(f64, f64)> {
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("n,chi"));
+    lines
+        .map(|l| {
+            let (n, chi) = l.split_once(',').expect("two columns");
+            (n.parse().expect("n"), chi.parse().expect("chi"))
+        })
+        .collect()
+}
+
+/// Asserts a clean usage failure: exit 2, one line on stderr, nothing on stdout.
+fn assert_usage_error(o: &Output, mentions: &str) {
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(o.stdout.is_empty(), "partial output: {}", stdout(o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "stderr: {err}");
+    assert!(
+        err.contains(mentions),
+        "stderr {err:?} should mention {mentions:?}"
+    );
+}
+
+#[test]
+fn chi_exact_matches_the_notes_check_values() {
+    let o = kapaint(&[
+        "chi", "--model", "phong", "--method", "exact", "1", "10", "200",
+    ]);
+    assert!(o.status.success());
+    let rows = parse_csv(&stdout(&o));
+    let want = [(1.0, 0.470_676), (10.0, 0.116_724), (200.0, 0.009_377_5)];
+    assert_eq!(rows.len(), 3);
+    for ((n, chi), (wn, wchi)) in rows.iter().zip(want) {
+        assert_eq!(*n, wn);
+        assert!((chi / wchi - 1.0).abs() < 1e-5, "chi({n}) = {chi}");
+    }
+}
+
+#[test]
+fn chi_prints_17_significant_digits_in_input_order() {
+    let o = kapaint(&[
+        "chi", "--model", "blinn", "--method", "fast", "200", "0", "3.5",
+    ]);
+    let text = stdout(&o);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[1].split(',').next(), Some("200"));
+    assert_eq!(lines[2].split(',').next(), Some("0"));
+    assert_eq!(lines[3].split(',').next(), Some("3.5"));
+    for line in &lines[1..] {
+        let chi = line.split(',').nth(1).expect("chi column");
+        let mantissa = chi.split('e').next().expect("mantissa");
+        let digits = mantissa.chars().filter(char::is_ascii_digit).count();
+        assert_eq!(digits, 17, "{chi}");
+    }
+}
+
+#[test]
+fn chi_reads_values_from_stdin() {
+    let o = kapaint_stdin(
+        &["chi", "--model", "phong", "--method", "paper", "-"],
+        "1\n2\n\n4\n",
+    );
+    assert!(o.status.success(), "{o:?}");
+    let rows = parse_csv(&stdout(&o));
+    assert_eq!(
+        rows.iter().map(|r| r.0).collect::<Vec<_>>(),
+        vec![1.0, 2.0, 4.0]
+    );
+    let bad = kapaint_stdin(
+        &["chi", "--model", "phong", "--method", "paper", "-"],
+        "1\nfoo\n",
+    );
+    assert_usage_error(&bad, "line 2");
+}
+
+#[test]
+fn bad_arguments_exit_2_with_one_line_and_no_table() {
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "phong", "--method", "exact", "1", "-3"]),
+        ">= 0",
+    );
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "phong", "--method", "fast", "1", "abc"]),
+        "number",
+    );
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "cook", "--method", "fast", "1"]),
+        "cook",
+    );
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "phong", "--method", "fast", "nan"]),
+        "finite",
+    );
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "phong", "--method", "exact", "2e6"]),
+        "limit",
+    );
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "phong", "--method", "fast"]),
+        "required",
+    );
+    assert_usage_error(
+        &kapaint(&[
+            "ka", "--model", "phong", "--method", "fast", "--kd", "1,2", "--ks", "0.5", "--n", "3",
+        ]),
+        "--kd",
+    );
+    assert_usage_error(
+        &kapaint(&[
+            "ka",
+            "--model",
+            "phong",
+            "--method",
+            "fast",
+            "--kd",
+            "0.5,0.5,1.5",
+            "--ks",
+            "0.5",
+            "--n",
+            "3",
+        ]),
+        "[0, 1]",
+    );
+    assert_usage_error(&kapaint(&["bench", "--size", "3"]), "--size");
+}
+
+#[test]
+fn ka_prints_rgb_of_the_formula() {
+    let o = kapaint(&[
+        "ka",
+        "--model",
+        "phong",
+        "--method",
+        "exact",
+        "--kd",
+        "0.5,0.25,0",
+        "--ks",
+        "1",
+        "--n",
+        "10",
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    let rgb: Vec<f64> = text
+        .trim()
+        .split(',')
+        .map(|v| v.parse().expect("number"))
+        .collect();
+    let chi = 0.116_724_291_692_596_77;
+    let two_over_pi = std::f64::consts::FRAC_2_PI;
+    for (got, kd) in rgb.iter().zip([0.5, 0.25, 0.0]) {
+        assert!((got - (two_over_pi * kd + chi)).abs() < 1e-12, "{text}");
+    }
+    // Scalar and RGB k_s agree.
+    let scalar = kapaint(&[
+        "ka",
+        "--model",
+        "blinn",
+        "--method",
+        "fast",
+        "--kd",
+        "0.1,0.2,0.3",
+        "--ks",
+        "0.4",
+        "--n",
+        "50",
+    ]);
+    let rgb = kapaint(&[
+        "ka",
+        "--model",
+        "blinn",
+        "--method",
+        "fast",
+        "--kd",
+        "0.1,0.2,0.3",
+        "--ks",
+        "0.4,0.4,0.4",
+        "--n",
+        "50",
+    ]);
+    assert_eq!(stdout(&scalar), stdout(&rgb));
+}
+
+#[test]
+fn accuracy_prints_a_markdown_table_for_every_model_and_method() {
+    let o = kapaint(&["accuracy", "--points", "6"]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    let rows = text
+        .lines()
+        .filter(|l| l.starts_with("| phong") || l.starts_with("| blinn"))
+        .count();
+    assert_eq!(rows, 2 * 3 * 2, "{text}");
+    assert!(text.contains("| blinn | paper-corrected | [1, 200] |"));
+    assert!(text.contains("minimax (our integrator)"));
+}
+
+#[test]
+fn bench_writes_csv_and_a_decodable_plot() {
+    let dir = std::env::temp_dir().join(format!("kapaint-bench-{}", std::process::id()));
+    let o = kapaint(&[
+        "bench",
+        "--size",
+        "64",
+        "--repeats",
+        "1",
+        "--out",
+        dir.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    assert_eq!(
+        stdout(&o)
+            .lines()
+            .filter(|l| l.starts_with("| phong") || l.starts_with("| blinn"))
+            .count(),
+        6
+    );
+    let csv = std::fs::read_to_string(dir.join("bench.csv")).expect("csv written");
+    assert_eq!(csv.lines().count(), 7);
+    assert!(csv.starts_with("model,method,ns_per_texel_1t"));
+    let png = image::open(dir.join("bench.png")).expect("plot decodes");
+    assert!(png.width() > 100 && png.height() > 100);
+    let _ = std::fs::remove_dir_all(&dir);
+}
