@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 
+use crate::model::{self, Channel, Document, DocumentSettings, ModelError, import, project};
 use crate::reflectance::{
     self, AmbientApprox, ShadingModel, TWO_OVER_PI,
     exact::{EXACT_N_MAX, chi_exact},
@@ -85,6 +86,51 @@ pub enum Command {
         /// Sample points per n range (spaced evenly in ln(n + 1)).
         #[arg(long, default_value_t = 96)]
         points: usize,
+    },
+    /// Create a project of one material everywhere.
+    New {
+        /// Map size, `W` or `WxH` (each 1 to 8192).
+        #[arg(long)]
+        size: String,
+        /// Material preset (file stem or name), e.g. `brass`.
+        #[arg(long, default_value = "default")]
+        preset: String,
+        /// Project file to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Overwrite an existing file.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Print a project's resolution, per-channel min/mean/max and memory.
+    Info {
+        /// Project file.
+        file: PathBuf,
+    },
+    /// Import an image (PNG, JPEG, TGA, EXR) into one channel of a project.
+    Import {
+        /// Project file (rewritten atomically unless --out is given).
+        file: PathBuf,
+        /// Channel to replace.
+        #[arg(long, value_parser = ["kd", "ks", "n"])]
+        channel: String,
+        /// Image file.
+        #[arg(long)]
+        image: PathBuf,
+        /// Write the result here instead of over FILE.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Replay a paint script (RON list of commands) on a project and save it.
+    Paint {
+        /// Project file (rewritten atomically unless --out is given).
+        file: PathBuf,
+        /// Script of commands (see README).
+        #[arg(long)]
+        script: PathBuf,
+        /// Write the result here instead of over FILE.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Time the k_a derive of a full map per method against its error and a memory copy.
     Bench {
@@ -180,6 +226,7 @@ pub fn main() -> i32 {
 }
 
 /// Runs a parsed command and returns everything it prints, or the error to report.
+#[allow(clippy::too_many_lines)] // One arm per subcommand, each short.
 pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError> {
     match command {
         Command::Chi { model, method, n } => {
@@ -211,6 +258,75 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             }
             Ok(accuracy::accuracy_report(&accuracy::Grid::standard(points)).markdown())
         }
+        Command::New {
+            size,
+            preset,
+            out,
+            force,
+        } => {
+            let (w, h) = parse_size(&size)?;
+            if out.exists() && !force {
+                return Err(CliError::usage(format!(
+                    "{} exists; pass --force to overwrite it",
+                    out.display()
+                )));
+            }
+            let preset = model::preset::find(&preset).map_err(model_error)?;
+            let settings = DocumentSettings {
+                base: preset.value(),
+                secondary: preset.value(),
+                preset: Some(preset.name.clone()),
+                ..DocumentSettings::default()
+            };
+            let doc = Document::new(w, h, settings).map_err(model_error)?;
+            project::save(&doc, &out).map_err(model_error)?;
+            Ok(format!(
+                "created {} ({w}x{h}, {})\n",
+                out.display(),
+                preset.name
+            ))
+        }
+        Command::Info { file } => {
+            let doc = project::load(&file).map_err(model_error)?;
+            let bytes = std::fs::metadata(&file).map_or(0, |m| m.len());
+            Ok(info_text(&file, &doc, bytes))
+        }
+        Command::Import {
+            file,
+            channel,
+            image,
+            out,
+        } => {
+            let channel = Channel::from_name(&channel)
+                .ok_or_else(|| CliError::usage(format!("unknown channel {channel:?}")))?;
+            let mut doc = project::load(&file).map_err(model_error)?;
+            import::import_file(&mut doc, channel, &image).map_err(model_error)?;
+            let target = out.unwrap_or(file);
+            project::save(&doc, &target).map_err(model_error)?;
+            Ok(format!(
+                "imported {} into {} of {}\n",
+                image.display(),
+                channel.name(),
+                target.display()
+            ))
+        }
+        Command::Paint { file, script, out } => {
+            let commands = read_script(&script)?;
+            let mut doc = project::load(&file).map_err(model_error)?;
+            let count = commands.len();
+            for (i, command) in commands.into_iter().enumerate() {
+                doc.apply(command).map_err(|e| {
+                    CliError::usage(format!("{}: command {}: {e}", script.display(), i + 1))
+                })?;
+            }
+            doc.apply(model::Command::EndStroke).map_err(model_error)?;
+            let target = out.unwrap_or(file);
+            project::save(&doc, &target).map_err(model_error)?;
+            Ok(format!(
+                "applied {count} commands, saved {}\n",
+                target.display()
+            ))
+        }
         Command::Bench { size, out, repeats } => {
             if !(16..=16384).contains(&size) {
                 return Err(CliError::usage("--size must be in [16, 16384]"));
@@ -233,6 +349,93 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             Ok(table)
         }
     }
+}
+
+/// Every model-layer error is reported in one line with exit code 2.
+#[allow(clippy::needless_pass_by_value)] // Used as `map_err(model_error)`.
+fn model_error(e: ModelError) -> CliError {
+    CliError::usage(e.to_string())
+}
+
+/// Parses `W` or `WxH`.
+fn parse_size(text: &str) -> Result<(u32, u32), CliError> {
+    let bad = || {
+        CliError::usage(format!(
+            "--size must be W or WxH with sides 1 to 8192, got {text:?}"
+        ))
+    };
+    let (w, h) = text.split_once(['x', 'X']).unwrap_or((text, text));
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
+    if w == 0 || h == 0 || w > model::maps::MAX_SIDE || h > model::maps::MAX_SIDE {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// A paint script: `(commands: [ ... ])` in RON.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PaintScript {
+    /// Commands applied in order.
+    pub commands: Vec<model::Command>,
+}
+
+fn read_script(path: &std::path::Path) -> Result<Vec<model::Command>, CliError> {
+    let text = std::fs::read_to_string(path).map_err(|e| model_error(ModelError::io(path, e)))?;
+    let script: PaintScript = ron::from_str(&text).map_err(|e| {
+        model_error(ModelError::Script {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })
+    })?;
+    Ok(script.commands)
+}
+
+/// `kapaint info` output: `key: value` lines, then one line per channel component.
+pub fn info_text(path: &std::path::Path, doc: &Document, file_bytes: u64) -> String {
+    let maps = &doc.maps;
+    let s = &doc.settings;
+    let mut out = String::new();
+    let _ = writeln!(out, "file: {}", path.display());
+    let _ = writeln!(out, "size: {}x{}", maps.width(), maps.height());
+    let _ = writeln!(
+        out,
+        "tiles: {} ({}x{} of 64x64)",
+        maps.tile_count(),
+        maps.tiles_x(),
+        maps.tiles_y()
+    );
+    let _ = writeln!(out, "model: {}", s.model.name());
+    let _ = writeln!(out, "method: {}", s.approx.name());
+    let _ = writeln!(
+        out,
+        "mesh: {}",
+        match &s.mesh {
+            model::document::MeshRef::Sphere => "sphere".to_string(),
+            model::document::MeshRef::File(f) => f.clone(),
+        }
+    );
+    let _ = writeln!(out, "preset: {}", s.preset.as_deref().unwrap_or("-"));
+    let expanded = maps.tile_count() * model::tile::TILE_TEXELS * 14;
+    let _ = writeln!(
+        out,
+        "memory: {} bytes in maps ({} bytes if every tile were expanded)",
+        maps.heap_bytes(),
+        expanded
+    );
+    let _ = writeln!(out, "file bytes: {file_bytes}");
+    let _ = writeln!(out, "channel min mean max");
+    for stat in model::stats::channel_stats(maps) {
+        let _ = writeln!(
+            out,
+            "{} {:.6} {:.6} {:.6}",
+            stat.label, stat.min, stat.mean, stat.max
+        );
+    }
+    out
 }
 
 /// `chi` with 17 significant digits, enough to round-trip an `f64`.

@@ -4,5 +4,6 @@
 //! [`reflectance`] is the numerical core (no GUI or GPU code), [`report`] measures it.
 
 pub mod cli;
+pub mod model;
 pub mod reflectance;
 pub mod report;

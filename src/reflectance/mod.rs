@@ -30,11 +30,16 @@ pub const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
 pub const PAPER_TWO_OVER_PI: f64 = 0.637;
 
 /// Which specular lobe the surface uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
 pub enum ShadingModel {
     /// Original Phong, `rho_s = max(0, R.V)^n` (eq. 4); its ambient is eq. (8).
+    #[default]
     Phong,
     /// Modified (Blinn-)Phong, `rho_s = max(0, N.H)^n` (eq. 9); its ambient is eq. (11).
+    #[serde(rename = "blinn")]
     BlinnPhong,
 }
 
@@ -52,16 +57,21 @@ impl ShadingModel {
 }
 
 /// How `chi(n)` is approximated when `k_a` is derived per texel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
 pub enum AmbientApprox {
     /// Eq. (8) and (11) exactly as printed, `0.637 k_d + a k_s (n + b)^c`.
+    #[serde(rename = "paper")]
     PaperPrinted,
     /// The printed constants with the Blinn-Phong exponent corrected (`-0.875` is a misprint;
     /// our integrator puts the minimax exponent at [`PAPER_BLINN_CORRECTED_EXPONENT`]).
+    #[serde(rename = "paper-corrected")]
     PaperCorrected,
     /// kapaint's own approximation: per-octave polynomials, max relative error <= 1e-4 on
     /// `n in [0, 16384]` for both models (see [`fast`]).
     #[default]
+    #[serde(rename = "fast")]
     Fast,
 }
 

@@ -1,0 +1,351 @@
+//! `MaterialMaps`: the per-texel `k_d`, `k_s` and `n` of a material, tiled, with versions.
+
+use std::sync::{Arc, OnceLock};
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::ModelError;
+use super::texel::{MaterialValue, Texel, decode_n, decode_rgb};
+use super::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile};
+use crate::reflectance::{self, AmbientApprox, PAPER_TWO_OVER_PI, ShadingModel, TWO_OVER_PI};
+
+/// Largest map side in texels.
+pub const MAX_SIDE: u32 = 8192;
+
+/// Index of a tile in row-major tile order.
+pub type TileId = usize;
+
+/// The maps of one material: any size up to `MAX_SIDE` square, stored as 64 x 64 tiles.
+///
+/// Tiles are shared (`Arc`) so that history can keep old versions without copying: writing
+/// to a tile clones it only if history still holds it. Every write bumps the tile's version,
+/// so consumers (the GPU mirror, k_a caches) can ask what changed since they last looked.
+#[derive(Clone, Debug)]
+pub struct MaterialMaps {
+    width: u32,
+    height: u32,
+    tiles_x: u32,
+    tiles_y: u32,
+    tiles: Vec<Arc<Tile>>,
+    versions: Vec<u64>,
+    clock: u64,
+}
+
+impl MaterialMaps {
+    /// Maps of `width x height` texels, every texel `base`.
+    pub fn new(width: u32, height: u32, base: MaterialValue) -> Result<Self, ModelError> {
+        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+            return Err(ModelError::InvalidSize { width, height });
+        }
+        let tiles_x = width.div_ceil(TILE_SIZE as u32);
+        let tiles_y = height.div_ceil(TILE_SIZE as u32);
+        let count = (tiles_x * tiles_y) as usize;
+        let tile = Arc::new(Tile::uniform(Texel::encode(base.sanitized())));
+        Ok(Self {
+            width,
+            height,
+            tiles_x,
+            tiles_y,
+            tiles: vec![tile; count],
+            versions: vec![1; count],
+            clock: 1,
+        })
+    }
+
+    /// Width in texels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in texels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Tiles per row.
+    pub fn tiles_x(&self) -> u32 {
+        self.tiles_x
+    }
+
+    /// Tiles per column.
+    pub fn tiles_y(&self) -> u32 {
+        self.tiles_y
+    }
+
+    /// Number of tiles.
+    pub fn tile_count(&self) -> usize {
+        self.tiles.len()
+    }
+
+    /// Texels in the maps.
+    pub fn texel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// The tile holding texel `(x, y)` and the texel's index inside it.
+    #[inline]
+    pub fn locate(&self, x: u32, y: u32) -> (TileId, usize) {
+        let (tx, ty) = (x as usize / TILE_SIZE, y as usize / TILE_SIZE);
+        let (ix, iy) = (x as usize % TILE_SIZE, y as usize % TILE_SIZE);
+        (ty * self.tiles_x as usize + tx, iy * TILE_SIZE + ix)
+    }
+
+    /// The texel rectangle `(x0, y0, x1, y1)` (exclusive ends) a tile covers in the maps.
+    pub fn tile_rect(&self, id: TileId) -> (u32, u32, u32, u32) {
+        let tx = (id % self.tiles_x as usize) as u32;
+        let ty = (id / self.tiles_x as usize) as u32;
+        let (x0, y0) = (tx * TILE_SIZE as u32, ty * TILE_SIZE as u32);
+        (
+            x0,
+            y0,
+            (x0 + TILE_SIZE as u32).min(self.width),
+            (y0 + TILE_SIZE as u32).min(self.height),
+        )
+    }
+
+    /// The stored texel at `(x, y)`; panics outside the maps.
+    #[inline]
+    pub fn texel(&self, x: u32, y: u32) -> Texel {
+        assert!(
+            x < self.width && y < self.height,
+            "texel ({x}, {y}) outside the maps"
+        );
+        let (id, i) = self.locate(x, y);
+        self.tiles[id].texel(i)
+    }
+
+    /// The linear value at `(x, y)`; panics outside the maps.
+    pub fn value(&self, x: u32, y: u32) -> MaterialValue {
+        self.texel(x, y).decode()
+    }
+
+    /// A tile, shared.
+    pub fn tile(&self, id: TileId) -> &Arc<Tile> {
+        &self.tiles[id]
+    }
+
+    /// A tile for writing: cloned first if anything else (history) holds it. Bumps its version.
+    pub fn tile_mut(&mut self, id: TileId) -> &mut Tile {
+        self.clock += 1;
+        self.versions[id] = self.clock;
+        Arc::make_mut(&mut self.tiles[id])
+    }
+
+    /// Puts `tile` in place of tile `id` and returns the previous one (undo and redo).
+    pub fn replace_tile(&mut self, id: TileId, tile: Arc<Tile>) -> Arc<Tile> {
+        self.clock += 1;
+        self.versions[id] = self.clock;
+        std::mem::replace(&mut self.tiles[id], tile)
+    }
+
+    /// The current version: it grows with every write.
+    pub fn version(&self) -> u64 {
+        self.clock
+    }
+
+    /// The version of one tile.
+    pub fn tile_version(&self, id: TileId) -> u64 {
+        self.versions[id]
+    }
+
+    /// Tiles written after `version` (pass 0 for all), ascending.
+    pub fn tiles_changed_since(&self, version: u64) -> Vec<TileId> {
+        (0..self.tiles.len())
+            .filter(|&id| self.versions[id] > version)
+            .collect()
+    }
+
+    /// Heap bytes of the tiles currently in the maps (uniform planes cost nothing).
+    pub fn heap_bytes(&self) -> usize {
+        self.tiles.iter().map(|t| t.heap_bytes()).sum()
+    }
+
+    /// Whether every texel of a channel plane holds the same value; returns it if so.
+    pub fn uniform_texel(&self) -> Option<Texel> {
+        let first = self.tiles.first()?;
+        let t = Texel {
+            kd: first.kd.uniform()?,
+            ks: first.ks.uniform()?,
+            n: first.n.uniform()?,
+        };
+        self.tiles
+            .iter()
+            .all(|tile| {
+                tile.kd.uniform() == Some(t.kd)
+                    && tile.ks.uniform() == Some(t.ks)
+                    && tile.n.uniform() == Some(t.n)
+            })
+            .then_some(t)
+    }
+
+    /// Visits every texel row by row in tile order: `f(x, y, texel)`.
+    pub fn for_each_texel(&self, mut f: impl FnMut(u32, u32, Texel)) {
+        for id in 0..self.tiles.len() {
+            let (x0, y0, x1, y1) = self.tile_rect(id);
+            let tile = &self.tiles[id];
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let i = (y - y0) as usize * TILE_SIZE + (x - x0) as usize;
+                    f(x, y, tile.texel(i));
+                }
+            }
+        }
+    }
+
+    /// Derives `k_a` for the given tiles: per tile, `TILE_TEXELS` values in row-major tile
+    /// order (texels beyond the map edge included, they are well defined). Never stored.
+    pub fn derive_ka_tiles(
+        &self,
+        model: ShadingModel,
+        approx: AmbientApprox,
+        ids: &[TileId],
+    ) -> Vec<(TileId, Vec<Vec3>)> {
+        let lut = chi_lut(model, approx);
+        let diffuse = diffuse_factor(approx);
+        ids.par_iter()
+            .map(|&id| {
+                let mut out = vec![Vec3::ZERO; TILE_TEXELS];
+                derive_tile(&self.tiles[id], lut, diffuse, &mut out);
+                (id, out)
+            })
+            .collect()
+    }
+
+    /// Derives `k_a` for the whole map into `out` (row-major, `width * height` values), in
+    /// parallel over tile rows.
+    pub fn derive_ka_into(&self, model: ShadingModel, approx: AmbientApprox, out: &mut [Vec3]) {
+        assert_eq!(
+            out.len(),
+            self.texel_count(),
+            "derive_ka_into: wrong output size"
+        );
+        let lut = chi_lut(model, approx);
+        let diffuse = diffuse_factor(approx);
+        let width = self.width as usize;
+        let band = width * TILE_SIZE;
+        out.par_chunks_mut(band).enumerate().for_each(|(ty, rows)| {
+            let mut scratch = vec![Vec3::ZERO; TILE_TEXELS];
+            let row_count = rows.len() / width;
+            for tx in 0..self.tiles_x as usize {
+                let id = ty * self.tiles_x as usize + tx;
+                derive_tile(&self.tiles[id], lut, diffuse, &mut scratch);
+                let x0 = tx * TILE_SIZE;
+                let w = TILE_SIZE.min(width - x0);
+                for r in 0..row_count {
+                    rows[r * width + x0..r * width + x0 + w]
+                        .copy_from_slice(&scratch[r * TILE_SIZE..r * TILE_SIZE + w]);
+                }
+            }
+        });
+    }
+}
+
+fn diffuse_factor(approx: AmbientApprox) -> f32 {
+    match approx {
+        AmbientApprox::Fast => TWO_OVER_PI as f32,
+        AmbientApprox::PaperPrinted | AmbientApprox::PaperCorrected => PAPER_TWO_OVER_PI as f32,
+    }
+}
+
+/// `k_a` of one tile. `n` is stored as a half float, so `chi` of every possible code is a
+/// 65,536-entry table (256 KiB, built once per model and approximation): one load per texel.
+fn derive_tile(tile: &Tile, lut: &[f32], diffuse: f32, out: &mut [Vec3]) {
+    const SCALE: f32 = 1.0 / 65535.0;
+    let out: &mut [f32] = bytemuck::cast_slice_mut(out);
+    match (&tile.kd, &tile.ks, &tile.n) {
+        (Plane::Uniform(kd), Plane::Uniform(ks), Plane::Uniform(n)) => {
+            let ka = diffuse * decode_rgb(*kd) + decode_rgb(*ks) * lut[*n as usize];
+            for o in out.chunks_exact_mut(3) {
+                o.copy_from_slice(&ka.to_array());
+            }
+        }
+        _ => {
+            for (i, o) in out.chunks_exact_mut(3).enumerate() {
+                let kd = tile.kd.get(i);
+                let ks = tile.ks.get(i);
+                let chi = lut[tile.n.get(i) as usize] * SCALE;
+                let d = diffuse * SCALE;
+                o[0] = d * f32::from(kd[0]) + chi * f32::from(ks[0]);
+                o[1] = d * f32::from(kd[1]) + chi * f32::from(ks[1]);
+                o[2] = d * f32::from(kd[2]) + chi * f32::from(ks[2]);
+            }
+        }
+    }
+}
+
+/// `chi` of every half-float code, for a model and approximation (built on first use).
+pub fn chi_lut(model: ShadingModel, approx: AmbientApprox) -> &'static [f32] {
+    static LUTS: [OnceLock<Vec<f32>>; 6] = [const { OnceLock::new() }; 6];
+    let index = ShadingModel::ALL
+        .iter()
+        .position(|&m| m == model)
+        .unwrap_or(0)
+        * 3
+        + AmbientApprox::ALL
+            .iter()
+            .position(|&a| a == approx)
+            .unwrap_or(0);
+    LUTS[index].get_or_init(|| {
+        (0..=u16::MAX)
+            .map(|bits| reflectance::chi_f32(model, approx, decode_n(bits)))
+            .collect()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_validated() {
+        let base = MaterialValue::default();
+        assert!(MaterialMaps::new(0, 10, base).is_err());
+        assert!(MaterialMaps::new(8193, 10, base).is_err());
+        let maps = MaterialMaps::new(100, 70, base).unwrap();
+        assert_eq!((maps.tiles_x(), maps.tiles_y()), (2, 2));
+        assert_eq!(maps.tile_rect(3), (64, 64, 100, 70));
+        assert_eq!(maps.heap_bytes(), 0);
+        assert_eq!(maps.value(99, 69), base.quantized());
+    }
+
+    #[test]
+    fn writes_bump_versions_and_copy_on_write() {
+        let mut maps = MaterialMaps::new(128, 128, MaterialValue::default()).unwrap();
+        let v0 = maps.version();
+        let held = Arc::clone(maps.tile(1));
+        maps.tile_mut(1).n.data_mut()[0] = 7;
+        assert_eq!(maps.tiles_changed_since(v0), vec![1]);
+        assert_eq!(
+            held.n.uniform(),
+            Some(Texel::encode(MaterialValue::default()).n)
+        );
+        assert_eq!(maps.tile(1).n.get(0), 7);
+    }
+
+    #[test]
+    fn derive_matches_the_reflectance_core() {
+        let mut maps = MaterialMaps::new(70, 65, MaterialValue::default()).unwrap();
+        for (i, (x, y)) in [(0, 0), (69, 64), (10, 3)].into_iter().enumerate() {
+            let v = MaterialValue::new(
+                Vec3::new(0.1 * i as f32, 0.5, 0.9),
+                Vec3::new(0.3, 0.2 * i as f32, 0.7),
+                [0.0, 37.5, 9000.0][i],
+            );
+            let (id, j) = maps.locate(x, y);
+            maps.tile_mut(id).set_texel(j, Texel::encode(v));
+        }
+        let mut out = vec![Vec3::ZERO; maps.texel_count()];
+        for model in ShadingModel::ALL {
+            for approx in AmbientApprox::ALL {
+                maps.derive_ka_into(model, approx, &mut out);
+                for (x, y) in [(0, 0), (69, 64), (10, 3), (5, 5)] {
+                    let v = maps.value(x, y);
+                    let want = reflectance::ka(model, approx, v.kd, v.ks, v.n);
+                    let got = out[(y * 70 + x) as usize];
+                    assert!((got - want).abs().max_element() < 1e-6, "{got} vs {want}");
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,22 @@
+//! The material model: per-texel maps, painting, undo, presets and project files.
+//!
+//! Nothing here knows about egui or wgpu: the editor reads the model and issues
+//! [`document::Command`]s; the GPU mirrors the maps' dirty tiles.
+
+pub mod brush;
+pub mod document;
+mod error;
+pub mod history;
+pub mod import;
+pub mod maps;
+pub mod paint;
+pub mod preset;
+pub mod project;
+pub mod stats;
+pub mod texel;
+pub mod tile;
+
+pub use document::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
+pub use error::ModelError;
+pub use maps::MaterialMaps;
+pub use texel::{Channel, Channels, MaterialValue};

@@ -1,0 +1,572 @@
+//! Dabs and fills: where they land ([`Footprint`]) and what they write ([`PaintTarget`]).
+//!
+//! A stroke keeps a coverage value per texel, the alpha it has reached so far. Each dab raises
+//! coverage towards the brush opacity by its flow; the texel is then the blend of its value
+//! *before the stroke* (kept by the open history transaction) with the target at that
+//! coverage. Overlapping dabs (or mirrored copies of one) therefore never exceed the opacity,
+//! and a stroke's result does not depend on dab order.
+
+use std::collections::HashMap;
+use std::sync::{Arc, OnceLock};
+
+use glam::{Vec2, Vec3};
+
+use super::brush::{BlendMode, BrushSettings};
+use super::history::History;
+use super::maps::{MaterialMaps, TileId};
+use super::texel::{
+    MaterialValue, Texel, decode_n, decode_unorm, encode_unorm, n_from_blend, n_to_blend,
+};
+use super::tile::{TILE_SIZE, TILE_TEXELS, Tile};
+
+/// A tile's texel rectangle `(x0, y0, x1, y1)`, exclusive ends.
+pub type TileRect = (u32, u32, u32, u32);
+
+/// The texels a dab touches, grouped by tile, each with a weight in `(0, 1]`.
+///
+/// The 2D brush is a disc in texel space ([`DiscFootprint`]); the 3D brush on meshes is a
+/// ball in object space whose texels come from a spatial index of the UV bake, and
+/// implements the same trait.
+pub trait Footprint {
+    /// The tiles the footprint may touch.
+    fn tiles(&self, maps: &MaterialMaps) -> Vec<TileId>;
+    /// Calls `f(index_in_tile, weight)` for every texel of tile `id` with a positive weight.
+    fn visit_tile(&self, id: TileId, rect: TileRect, f: impl FnMut(usize, f32));
+}
+
+/// A round dab in texel space, shaped by the brush's hardness and optional stamp.
+pub struct DiscFootprint<'a> {
+    /// Centre in texel units.
+    pub center: Vec2,
+    /// Radius in texels.
+    pub radius: f32,
+    /// Falloff and stamp.
+    pub brush: &'a BrushSettings,
+}
+
+impl DiscFootprint<'_> {
+    fn bounds(&self, maps: &MaterialMaps) -> Option<(u32, u32, u32, u32)> {
+        let lo = (self.center - self.radius).floor().max(Vec2::ZERO);
+        let hi = (self.center + self.radius).ceil();
+        let (w, h) = (maps.width() as f32, maps.height() as f32);
+        if !(lo.is_finite() && hi.is_finite())
+            || lo.x >= w
+            || lo.y >= h
+            || hi.x <= 0.0
+            || hi.y <= 0.0
+        {
+            return None;
+        }
+        Some((
+            lo.x as u32,
+            lo.y as u32,
+            hi.x.min(w) as u32,
+            hi.y.min(h) as u32,
+        ))
+    }
+}
+
+impl Footprint for DiscFootprint<'_> {
+    fn tiles(&self, maps: &MaterialMaps) -> Vec<TileId> {
+        let Some((x0, y0, x1, y1)) = self.bounds(maps) else {
+            return Vec::new();
+        };
+        let t = TILE_SIZE as u32;
+        let mut ids = Vec::new();
+        for ty in y0 / t..=(y1 - 1) / t {
+            for tx in x0 / t..=(x1 - 1) / t {
+                ids.push((ty * maps.tiles_x() + tx) as usize);
+            }
+        }
+        ids
+    }
+
+    fn visit_tile(&self, _id: TileId, rect: TileRect, mut f: impl FnMut(usize, f32)) {
+        let (x0, y0, x1, y1) = rect;
+        let r = self.radius;
+        let r2 = r * r;
+        let inv_r = 1.0 / r;
+        let ys = ((self.center.y - r).floor().max(y0 as f32) as u32).max(y0);
+        let ye = ((self.center.y + r).ceil().min(y1 as f32) as u32).min(y1);
+        for y in ys..ye {
+            let dy = y as f32 + 0.5 - self.center.y;
+            let rem = r2 - dy * dy;
+            if rem <= 0.0 {
+                continue;
+            }
+            let half = rem.sqrt();
+            let xs = ((self.center.x - half - 0.5).ceil().max(x0 as f32) as u32).max(x0);
+            let xe = ((self.center.x + half - 0.5).floor() as i64 + 1)
+                .clamp(i64::from(x0), i64::from(x1)) as u32;
+            let row = (y - y0) as usize * TILE_SIZE;
+            for x in xs..xe {
+                let dx = x as f32 + 0.5 - self.center.x;
+                let d = (dx * dx + dy * dy).sqrt();
+                let mut w = self.brush.falloff(d, r);
+                if let Some(stamp) = &self.brush.stamp {
+                    w *= stamp.sample(dx * inv_r, dy * inv_r);
+                }
+                if w > 0.0 {
+                    f(row + (x - x0) as usize, w);
+                }
+            }
+        }
+    }
+}
+
+/// Lookup tables between stored `n` bits and the perceptual blend space.
+struct NTables {
+    to_blend: Vec<f32>,
+    from_blend: Vec<u16>,
+}
+
+/// Resolution of the blend-space to bits table: finer than a half float's step everywhere.
+const FROM_BLEND_STEPS: usize = 1 << 18;
+
+fn n_tables() -> &'static NTables {
+    static TABLES: OnceLock<NTables> = OnceLock::new();
+    TABLES.get_or_init(|| NTables {
+        to_blend: (0..=u16::MAX).map(|b| n_to_blend(decode_n(b))).collect(),
+        from_blend: (0..=FROM_BLEND_STEPS)
+            .map(|i| super::texel::encode_n(n_from_blend(i as f32 / FROM_BLEND_STEPS as f32)))
+            .collect(),
+    })
+}
+
+#[inline]
+fn n_bits_to_blend(bits: u16) -> f32 {
+    n_tables().to_blend[bits as usize]
+}
+
+#[inline]
+fn n_bits_from_blend(u: f32) -> u16 {
+    let i = (super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as usize;
+    n_tables().from_blend[i.min(FROM_BLEND_STEPS)]
+}
+
+/// What a paint operation writes: per-channel targets in blend space, which channels, how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaintTarget {
+    /// Target `k_d`.
+    pub kd: Vec3,
+    /// Target `k_s`.
+    pub ks: Vec3,
+    /// Target `n` in blend space.
+    pub n_blend: f32,
+    /// Channels written.
+    pub channels: super::texel::Channels,
+    /// Blend mode.
+    pub mode: BlendMode,
+    /// Keep `k_d + k_s <= 1` per colour channel.
+    pub energy_guard: bool,
+}
+
+impl PaintTarget {
+    /// A target from a material value.
+    pub fn new(
+        value: MaterialValue,
+        channels: super::texel::Channels,
+        mode: BlendMode,
+        energy_guard: bool,
+    ) -> Self {
+        let v = value.sanitized();
+        Self {
+            kd: v.kd,
+            ks: v.ks,
+            n_blend: n_to_blend(v.n),
+            channels,
+            mode,
+            energy_guard,
+        }
+    }
+
+    /// The texel `pre` blended towards the target at alpha `a`.
+    #[inline]
+    pub fn blend(&self, pre: Texel, a: f32) -> Texel {
+        let mut out = pre;
+        let mode = self.mode;
+        let mut kd = [0.0; 3];
+        let mut ks = [0.0; 3];
+        for c in 0..3 {
+            kd[c] = decode_unorm(pre.kd[c]);
+            ks[c] = decode_unorm(pre.ks[c]);
+            if self.channels.kd {
+                kd[c] = mode.apply(kd[c], self.kd[c], a);
+            }
+            if self.channels.ks {
+                ks[c] = mode.apply(ks[c], self.ks[c], a);
+            }
+        }
+        if self.energy_guard && (self.channels.kd || self.channels.ks) {
+            guard_energy(&mut kd, &mut ks, self.channels.kd, self.channels.ks);
+        }
+        for c in 0..3 {
+            out.kd[c] = encode_unorm(kd[c]);
+            out.ks[c] = encode_unorm(ks[c]);
+        }
+        if self.channels.n {
+            out.n = n_bits_from_blend(mode.apply(n_bits_to_blend(pre.n), self.n_blend, a));
+        }
+        out
+    }
+}
+
+/// Keeps `k_d + k_s <= 1` per colour channel: the channel being painted gives way to the
+/// other; when both are painted, both scale down together.
+fn guard_energy(kd: &mut [f32; 3], ks: &mut [f32; 3], painting_kd: bool, painting_ks: bool) {
+    for c in 0..3 {
+        let sum = kd[c] + ks[c];
+        if sum <= 1.0 {
+            continue;
+        }
+        match (painting_kd, painting_ks) {
+            (true, false) => kd[c] = 1.0 - ks[c],
+            (false, true) => ks[c] = 1.0 - kd[c],
+            _ => {
+                kd[c] /= sum;
+                ks[c] /= sum;
+            }
+        }
+    }
+}
+
+/// Per-texel stroke coverage for the tiles a stroke touched.
+#[derive(Default, Debug)]
+pub struct Coverage {
+    tiles: HashMap<TileId, Box<[f32]>>,
+}
+
+impl Coverage {
+    fn tile(&mut self, id: TileId) -> &mut [f32] {
+        self.tiles
+            .entry(id)
+            .or_insert_with(|| vec![0.0; TILE_TEXELS].into_boxed_slice())
+    }
+}
+
+/// The pre-operation version of a tile: the one the open transaction saved, else the current.
+fn pre_tile(history: &History, maps: &MaterialMaps, id: TileId) -> Arc<Tile> {
+    history
+        .saved_tile(id)
+        .cloned()
+        .unwrap_or_else(|| Arc::clone(maps.tile(id)))
+}
+
+/// Applies one paint dab with footprint `fp` and dab alpha `alpha` (flow times pressure).
+pub fn paint_dab(
+    maps: &mut MaterialMaps,
+    history: &mut History,
+    coverage: &mut Coverage,
+    target: &PaintTarget,
+    opacity: f32,
+    alpha: f32,
+    fp: &impl Footprint,
+) {
+    if alpha <= 0.0 || opacity <= 0.0 || target.channels.is_empty() {
+        return;
+    }
+    for id in fp.tiles(maps) {
+        let rect = maps.tile_rect(id);
+        let pre = pre_tile(history, maps, id);
+        let cov = coverage.tile(id);
+        let tile = history.tile_for_write(maps, id);
+        fp.visit_tile(id, rect, |i, w| {
+            let c = cov[i];
+            if c >= opacity {
+                return;
+            }
+            let next = c + (opacity - c) * (w * alpha).min(1.0);
+            cov[i] = next;
+            tile.set_texel(i, target.blend(pre.texel(i), next));
+        });
+    }
+}
+
+/// Applies one blur dab: enabled channels move towards their local box average by the dab
+/// weight times `strength`.
+pub fn blur_dab(
+    maps: &mut MaterialMaps,
+    history: &mut History,
+    channels: super::texel::Channels,
+    kernel_px: u32,
+    strength: f32,
+    fp: &DiscFootprint<'_>,
+) {
+    if channels.is_empty() || strength <= 0.0 {
+        return;
+    }
+    let k = i64::from(kernel_px.max(1));
+    let (w, h) = (i64::from(maps.width()), i64::from(maps.height()));
+    // Blurred values are computed from the state before this dab, then written.
+    let mut writes: Vec<(TileId, usize, Texel)> = Vec::new();
+    for id in fp.tiles(maps) {
+        let rect = maps.tile_rect(id);
+        fp.visit_tile(id, rect, |i, weight| {
+            let x = i64::from(rect.0) + (i % TILE_SIZE) as i64;
+            let y = i64::from(rect.1) + (i / TILE_SIZE) as i64;
+            let mut sum = [0.0_f32; 7];
+            let mut count = 0.0;
+            for yy in (y - k).max(0)..=(y + k).min(h - 1) {
+                for xx in (x - k).max(0)..=(x + k).min(w - 1) {
+                    let t = maps.texel(xx as u32, yy as u32);
+                    for c in 0..3 {
+                        sum[c] += decode_unorm(t.kd[c]);
+                        sum[3 + c] += decode_unorm(t.ks[c]);
+                    }
+                    sum[6] += n_bits_to_blend(t.n);
+                    count += 1.0;
+                }
+            }
+            let avg = sum.map(|s| s / count);
+            let target = PaintTarget {
+                kd: Vec3::new(avg[0], avg[1], avg[2]),
+                ks: Vec3::new(avg[3], avg[4], avg[5]),
+                n_blend: avg[6],
+                channels,
+                mode: BlendMode::Normal,
+                energy_guard: false,
+            };
+            let pre = maps.tile(id).texel(i);
+            writes.push((id, i, target.blend(pre, (weight * strength).min(1.0))));
+        });
+    }
+    for (id, i, t) in writes {
+        history.tile_for_write(maps, id).set_texel(i, t);
+    }
+}
+
+/// Writes `target` over every texel of the maps at alpha `opacity`. A full-opacity normal
+/// fill makes the written planes uniform: no per-texel work and no memory.
+pub fn fill_all(
+    maps: &mut MaterialMaps,
+    history: &mut History,
+    target: &PaintTarget,
+    opacity: f32,
+) {
+    use super::tile::Plane;
+    let uniform = opacity >= 1.0 && target.mode == BlendMode::Normal && !target.energy_guard;
+    let value = Texel::encode(MaterialValue {
+        kd: target.kd,
+        ks: target.ks,
+        n: n_from_blend(target.n_blend),
+    });
+    let value = Texel {
+        n: n_bits_from_blend(target.n_blend),
+        ..value
+    };
+    for id in 0..maps.tile_count() {
+        if uniform {
+            let tile = history.tile_for_write(maps, id);
+            if target.channels.kd {
+                tile.kd = Plane::Uniform(value.kd);
+            }
+            if target.channels.ks {
+                tile.ks = Plane::Uniform(value.ks);
+            }
+            if target.channels.n {
+                tile.n = Plane::Uniform(value.n);
+            }
+        } else {
+            let pre = pre_tile(history, maps, id);
+            let tile = history.tile_for_write(maps, id);
+            for i in 0..TILE_TEXELS {
+                tile.set_texel(i, target.blend(pre.texel(i), opacity));
+            }
+        }
+    }
+}
+
+/// The 4-connected region around `(x, y)` whose `channel` stays within `tolerance` of the
+/// seed's (in blend space, max over colour components), as a bit per texel.
+pub fn flood_region(
+    maps: &MaterialMaps,
+    x: u32,
+    y: u32,
+    channel: super::texel::Channel,
+    tolerance: f32,
+) -> Vec<bool> {
+    use super::texel::Channel;
+    let (w, h) = (maps.width(), maps.height());
+    let key = |t: Texel| -> [f32; 3] {
+        match channel {
+            Channel::Kd => t.kd.map(decode_unorm),
+            Channel::Ks => t.ks.map(decode_unorm),
+            Channel::N => [n_bits_to_blend(t.n); 3],
+        }
+    };
+    let seed = key(maps.texel(x, y));
+    let within = |t: Texel| {
+        key(t)
+            .iter()
+            .zip(&seed)
+            .all(|(a, b)| (a - b).abs() <= tolerance)
+    };
+    let mut inside = vec![false; (w * h) as usize];
+    let mut stack = vec![(x, y)];
+    while let Some((sx, sy)) = stack.pop() {
+        // Scanline fill: extend left and right, queue the rows above and below.
+        let row = (sy * w) as usize;
+        if inside[row + sx as usize] || !within(maps.texel(sx, sy)) {
+            continue;
+        }
+        let mut l = sx;
+        while l > 0 && !inside[row + l as usize - 1] && within(maps.texel(l - 1, sy)) {
+            l -= 1;
+        }
+        let mut r = sx;
+        while r + 1 < w && !inside[row + r as usize + 1] && within(maps.texel(r + 1, sy)) {
+            r += 1;
+        }
+        for xx in l..=r {
+            inside[row + xx as usize] = true;
+            if sy > 0 && !inside[row - w as usize + xx as usize] {
+                stack.push((xx, sy - 1));
+            }
+            if sy + 1 < h && !inside[row + w as usize + xx as usize] {
+                stack.push((xx, sy + 1));
+            }
+        }
+    }
+    inside
+}
+
+/// Writes `target` at alpha `opacity` over the texels of `mask` (row-major, one per texel).
+pub fn fill_mask(
+    maps: &mut MaterialMaps,
+    history: &mut History,
+    target: &PaintTarget,
+    opacity: f32,
+    mask: &[bool],
+) {
+    let w = maps.width() as usize;
+    for id in 0..maps.tile_count() {
+        let (x0, y0, x1, y1) = maps.tile_rect(id);
+        let any = (y0..y1).any(|y| {
+            mask[y as usize * w + x0 as usize..y as usize * w + x1 as usize].contains(&true)
+        });
+        if !any {
+            continue;
+        }
+        let pre = pre_tile(history, maps, id);
+        let tile = history.tile_for_write(maps, id);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                if mask[y as usize * w + x as usize] {
+                    let i = (y - y0) as usize * TILE_SIZE + (x - x0) as usize;
+                    tile.set_texel(i, target.blend(pre.texel(i), opacity));
+                }
+            }
+        }
+    }
+}
+
+/// Shape of a gradient.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum GradientShape {
+    /// Along the line from start to end.
+    Linear,
+    /// Around the start, reaching the end value at the end point's distance.
+    Radial,
+}
+
+/// Writes a gradient from `from` (at `start`) to `to` (at `end`) over the whole map, blended
+/// at `opacity` with the targets' mode and channels.
+#[allow(clippy::too_many_arguments)] // One call site per tool; a struct would only rename them.
+pub fn gradient(
+    maps: &mut MaterialMaps,
+    history: &mut History,
+    from: &PaintTarget,
+    to: &PaintTarget,
+    shape: GradientShape,
+    start: Vec2,
+    end: Vec2,
+    opacity: f32,
+) {
+    let axis = end - start;
+    let len2 = axis.length_squared().max(1e-12);
+    for id in 0..maps.tile_count() {
+        let (x0, y0, x1, y1) = maps.tile_rect(id);
+        let pre = pre_tile(history, maps, id);
+        let tile = history.tile_for_write(maps, id);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - start;
+                let t = match shape {
+                    GradientShape::Linear => p.dot(axis) / len2,
+                    GradientShape::Radial => (p.length_squared() / len2).sqrt(),
+                }
+                .clamp(0.0, 1.0);
+                let target = PaintTarget {
+                    kd: from.kd.lerp(to.kd, t),
+                    ks: from.ks.lerp(to.ks, t),
+                    n_blend: from.n_blend + (to.n_blend - from.n_blend) * t,
+                    ..*from
+                };
+                let i = (y - y0) as usize * TILE_SIZE + (x - x0) as usize;
+                tile.set_texel(i, target.blend(pre.texel(i), opacity));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::texel::Channels;
+
+    #[test]
+    fn disc_footprint_covers_the_disc_exactly() {
+        let maps = MaterialMaps::new(300, 200, MaterialValue::default()).unwrap();
+        let brush = BrushSettings {
+            hardness: 1.0,
+            ..BrushSettings::default()
+        };
+        let fp = DiscFootprint {
+            center: Vec2::new(63.7, 64.2),
+            radius: 20.3,
+            brush: &brush,
+        };
+        let mut hits = std::collections::HashSet::new();
+        for id in fp.tiles(&maps) {
+            let rect = maps.tile_rect(id);
+            fp.visit_tile(id, rect, |i, _| {
+                hits.insert((
+                    rect.0 + (i % TILE_SIZE) as u32,
+                    rect.1 + (i / TILE_SIZE) as u32,
+                ));
+            });
+        }
+        for y in 0..200 {
+            for x in 0..300 {
+                let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5).distance(fp.center);
+                assert_eq!(hits.contains(&(x, y)), d < fp.radius, "({x}, {y}) at {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn n_blend_tables_are_accurate() {
+        for n in [0.0_f32, 0.3, 1.0, 77.0, 5000.0, 16384.0] {
+            let bits = super::super::texel::encode_n(n);
+            assert_eq!(n_bits_from_blend(n_bits_to_blend(bits)), bits, "n = {n}");
+        }
+    }
+
+    #[test]
+    fn energy_guard_keeps_the_sum_at_most_one() {
+        let target = PaintTarget::new(
+            MaterialValue::new(Vec3::splat(0.9), Vec3::splat(0.8), 10.0),
+            Channels {
+                kd: true,
+                ks: false,
+                n: false,
+            },
+            BlendMode::Normal,
+            true,
+        );
+        let pre = Texel::encode(MaterialValue::new(Vec3::splat(0.1), Vec3::splat(0.8), 10.0));
+        let out = target.blend(pre, 1.0).decode();
+        assert!((out.kd.x + out.ks.x) <= 1.0 + 1e-4);
+        assert!((out.ks.x - 0.8).abs() < 1e-4, "k_s untouched");
+    }
+}

@@ -1,0 +1,250 @@
+//! Material presets: `presets/materials/*.ron`, built into the binary, plus user files.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::Deserialize;
+
+use super::ModelError;
+use super::texel::{MaterialValue, N_MAX};
+
+/// A material preset as written in a `.ron` file.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialPreset {
+    /// Display name.
+    pub name: String,
+    /// Where the values come from.
+    pub source: String,
+    /// Diffuse coefficient, linear RGB in `[0, 1]`.
+    pub kd: [f32; 3],
+    /// Specular coefficient, linear RGB in `[0, 1]`.
+    pub ks: [f32; 3],
+    /// Phong exponent in `[0, 16384]`.
+    pub n: f32,
+    /// The ambient a published table gives (compared against the derived one in docs).
+    #[serde(default)]
+    pub table_ambient: Option<[f32; 3]>,
+}
+
+impl MaterialPreset {
+    /// Parses and validates preset text; errors name `path`.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
+        let fail = |reason: String| ModelError::Preset {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let preset: Self = ron::from_str(text).map_err(|e| fail(e.to_string()))?;
+        let unit = |label: &str, v: [f32; 3]| -> Result<(), ModelError> {
+            if v.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c)) {
+                Ok(())
+            } else {
+                Err(fail(format!(
+                    "{label} components must be in [0, 1], got {v:?}"
+                )))
+            }
+        };
+        unit("kd", preset.kd)?;
+        unit("ks", preset.ks)?;
+        if let Some(a) = preset.table_ambient {
+            unit("table_ambient", a)?;
+        }
+        if !(preset.n.is_finite() && (0.0..=N_MAX).contains(&preset.n)) {
+            return Err(fail(format!("n must be in [0, {N_MAX}], got {}", preset.n)));
+        }
+        if preset.name.trim().is_empty() {
+            return Err(fail("name is empty".into()));
+        }
+        Ok(preset)
+    }
+
+    /// Reads and parses a preset file.
+    pub fn load(path: &Path) -> Result<Self, ModelError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError::io(path, e))?;
+        Self::parse(path, &text)
+    }
+
+    /// The preset's material value.
+    pub fn value(&self) -> MaterialValue {
+        MaterialValue::new(Vec3::from(self.kd), Vec3::from(self.ks), self.n)
+    }
+}
+
+macro_rules! builtin {
+    ($($stem:literal),* $(,)?) => {
+        /// The file stems and texts of the presets shipped in `presets/materials/`.
+        pub const BUILTIN_FILES: &[(&str, &str)] = &[
+            $(($stem, include_str!(concat!("../../presets/materials/", $stem, ".ron")))),*
+        ];
+    };
+}
+
+builtin!(
+    "black-plastic",
+    "black-rubber",
+    "brass",
+    "bronze",
+    "chrome",
+    "clay",
+    "copper",
+    "cyan-plastic",
+    "cyan-rubber",
+    "default",
+    "emerald",
+    "gold",
+    "green-plastic",
+    "green-rubber",
+    "jade",
+    "mirror",
+    "obsidian",
+    "pearl",
+    "red-plastic",
+    "red-rubber",
+    "ruby",
+    "silver",
+    "turquoise",
+    "white-plastic",
+    "white-rubber",
+    "yellow-plastic",
+    "yellow-rubber",
+);
+
+/// The built-in presets by file stem, sorted.
+pub fn builtin() -> Vec<(String, MaterialPreset)> {
+    BUILTIN_FILES
+        .iter()
+        .filter_map(|(stem, text)| {
+            let path = PathBuf::from(format!("presets/materials/{stem}.ron"));
+            MaterialPreset::parse(&path, text)
+                .ok()
+                .map(|p| ((*stem).to_string(), p))
+        })
+        .collect()
+}
+
+/// The user's preset directory: `$KAPAINT_PRESET_DIR`, if set.
+pub fn user_dir() -> Option<PathBuf> {
+    std::env::var_os("KAPAINT_PRESET_DIR").map(PathBuf::from)
+}
+
+/// Every `.ron` file in `dir`, sorted by name, each parsed or with its error.
+pub fn load_dir(dir: &Path) -> Vec<Result<(String, MaterialPreset), ModelError>> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|p| {
+            let stem = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            MaterialPreset::load(&p).map(|preset| (stem, preset))
+        })
+        .collect()
+}
+
+/// Finds a preset by file stem or display name (case-insensitive): user presets first, then
+/// built-in ones. A malformed user file with that name is an error naming the file.
+pub fn find(name: &str) -> Result<MaterialPreset, ModelError> {
+    let matches = |stem: &str, p: &MaterialPreset| {
+        stem.eq_ignore_ascii_case(name) || p.name.eq_ignore_ascii_case(name)
+    };
+    if let Some(dir) = user_dir() {
+        for entry in load_dir(&dir) {
+            match entry {
+                Ok((stem, preset)) if matches(&stem, &preset) => return Ok(preset),
+                Err(ModelError::Preset { path, reason })
+                    if path
+                        .file_stem()
+                        .is_some_and(|s| s.eq_ignore_ascii_case(name)) =>
+                {
+                    return Err(ModelError::Preset { path, reason });
+                }
+                _ => {}
+            }
+        }
+    }
+    let all = builtin();
+    all.iter()
+        .find(|(stem, p)| matches(stem, p))
+        .map(|(_, p)| p.clone())
+        .ok_or_else(|| ModelError::UnknownPreset {
+            name: name.to_string(),
+            known: all
+                .iter()
+                .map(|(s, _)| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_shipped_preset_is_built_in_and_valid() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/materials");
+        let on_disk: Vec<_> = load_dir(&dir);
+        assert!(on_disk.len() >= 16);
+        for entry in &on_disk {
+            assert!(entry.is_ok(), "{entry:?}");
+        }
+        let built_in = builtin();
+        assert_eq!(
+            built_in.len(),
+            on_disk.len(),
+            "add new preset files to builtin!()"
+        );
+        for ((a, pa), (b, pb)) in built_in.iter().zip(on_disk.iter().flatten()) {
+            assert_eq!((a, pa), (b, pb));
+        }
+        assert!(built_in.iter().all(|(_, p)| !p.source.is_empty()));
+    }
+
+    #[test]
+    fn find_by_stem_or_name() {
+        assert_eq!(find("brass").unwrap().name, "Brass");
+        assert_eq!(find("Black Plastic").unwrap().n, 32.0);
+        let err = find("unobtainium").unwrap_err().to_string();
+        assert!(
+            err.contains("unobtainium") && err.contains("brass"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn malformed_presets_name_the_file_and_the_problem() {
+        let path = Path::new("bad.ron");
+        for (text, needle) in [
+            (
+                "(name: \"x\", source: \"s\", kd: (1, 0, 0), ks: (0, 0, 0))",
+                "n",
+            ),
+            (
+                "(name: \"x\", source: \"s\", kd: (2, 0, 0), ks: (0, 0, 0), n: 1)",
+                "kd",
+            ),
+            (
+                "(name: \"x\", source: \"s\", kd: (1, 0, 0), ks: (0, 0, 0), n: -1)",
+                "n must",
+            ),
+            (
+                "(name: \"x\", source: \"s\", kd: (1, 0, 0), ks: (0, 0, 0), n: 1, extra: 3)",
+                "extra",
+            ),
+            ("not ron at all", ""),
+        ] {
+            let err = MaterialPreset::parse(path, text).unwrap_err().to_string();
+            assert!(err.starts_with("preset bad.ron"), "{err}");
+            assert!(err.contains(needle), "{err} should mention {needle}");
+        }
+    }
+}

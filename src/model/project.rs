@@ -1,0 +1,510 @@
+//! The `.kapaint` project file.
+//!
+//! A zip archive holding `manifest.json` (format name, version, size, document settings, and
+//! how each channel is stored) and one 16-bit lossless PNG per channel that is not uniform:
+//! `kd.png` and `ks.png` as linear unorm16 RGB, `n.png` as 16-bit gray holding half-float
+//! bits. A channel that is the same everywhere is a constant in the manifest instead.
+//!
+//! Saving writes a temporary file beside the target, flushes it to disk and renames it over
+//! the target, so a crash or a full disk never leaves a half-written project. Loading checks
+//! everything (zip and PNG checksums, sizes, colour types, every stored value) and reports
+//! the first problem as one error; it never panics on any input.
+
+use std::fs::File;
+use std::io::{Read, Seek, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use image::{ImageBuffer, Luma, Rgb};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::ModelError;
+use super::document::{Document, DocumentSettings};
+use super::maps::{MAX_SIDE, MaterialMaps};
+use super::texel::{MaterialValue, N_MAX};
+use super::tile::{Plane, TILE_SIZE, Tile};
+
+/// The format name in the manifest.
+pub const FORMAT: &str = "kapaint-project";
+
+/// The manifest version this build writes and reads.
+pub const VERSION: u32 = 1;
+
+/// Largest manifest accepted (bytes).
+const MAX_MANIFEST_BYTES: u64 = 4 << 20;
+
+/// How one channel is stored.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum ChannelEntry {
+    /// The same stored value at every texel (unorm16 RGB, or half-float bits for `n`).
+    Uniform {
+        /// The stored value: three components for `kd`/`ks`, one for `n`.
+        value: Vec<u16>,
+    },
+    /// A PNG in the archive.
+    Image {
+        /// Entry name in the archive.
+        file: String,
+        /// How the PNG's samples are to be read.
+        encoding: String,
+    },
+}
+
+/// `manifest.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// Manifest version.
+    pub version: u32,
+    /// Map width in texels.
+    pub width: u32,
+    /// Map height in texels.
+    pub height: u32,
+    /// Model, approximation, materials, brush, mesh reference.
+    pub settings: DocumentSettings,
+    /// `k_d` storage.
+    pub kd: ChannelEntry,
+    /// `k_s` storage.
+    pub ks: ChannelEntry,
+    /// `n` storage.
+    pub n: ChannelEntry,
+}
+
+const RGB_ENCODING: &str = "png-rgb16-unorm-linear";
+const N_ENCODING: &str = "png-gray16-half-float-bits";
+
+/// One channel of the whole map, row-major.
+enum Raster {
+    Uniform(Vec<u16>),
+    Rgb(Vec<u16>),
+    Gray(Vec<u16>),
+}
+
+fn channel_uniform<T: Copy + PartialEq>(
+    maps: &MaterialMaps,
+    plane: impl Fn(&Tile) -> &Plane<T>,
+) -> Option<T> {
+    let first = plane(maps.tile(0)).uniform()?;
+    (0..maps.tile_count())
+        .all(|id| plane(maps.tile(id)).uniform() == Some(first))
+        .then_some(first)
+}
+
+/// Copies a channel of every tile into a row-major raster of `C` samples per texel.
+fn rasterize<const C: usize, T: Copy + PartialEq + Send + Sync>(
+    maps: &MaterialMaps,
+    plane: impl Fn(&Tile) -> &Plane<T> + Sync,
+    samples: impl Fn(T) -> [u16; C] + Sync,
+) -> Vec<u16> {
+    let (w, h) = (maps.width() as usize, maps.height() as usize);
+    let mut out = vec![0u16; w * h * C];
+    out.par_chunks_mut(w * C * TILE_SIZE)
+        .enumerate()
+        .for_each(|(ty, band)| {
+            let rows = band.len() / (w * C);
+            for tx in 0..maps.tiles_x() as usize {
+                let tile = maps.tile(ty * maps.tiles_x() as usize + tx);
+                let p = plane(tile);
+                let x0 = tx * TILE_SIZE;
+                let cols = TILE_SIZE.min(w - x0);
+                for r in 0..rows {
+                    for c in 0..cols {
+                        let s = samples(p.get(r * TILE_SIZE + c));
+                        let at = (r * w + x0 + c) * C;
+                        band[at..at + C].copy_from_slice(&s);
+                    }
+                }
+            }
+        });
+    out
+}
+
+fn encode_png(raster: &Raster, width: u32, height: u32) -> Result<Vec<u8>, String> {
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let mut bytes = Vec::new();
+    let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Up);
+    let result = match raster {
+        Raster::Rgb(data) => {
+            ImageBuffer::<Rgb<u16>, &[u16]>::from_raw(width, height, data.as_slice())
+                .ok_or("raster size mismatch")?
+                .write_with_encoder(encoder)
+        }
+        Raster::Gray(data) => {
+            ImageBuffer::<Luma<u16>, &[u16]>::from_raw(width, height, data.as_slice())
+                .ok_or("raster size mismatch")?
+                .write_with_encoder(encoder)
+        }
+        Raster::Uniform(_) => return Ok(Vec::new()),
+    };
+    result.map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// Serialises a document into project bytes (what [`save`] writes).
+pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
+    let maps = &doc.maps;
+    let (w, h) = (maps.width(), maps.height());
+    let rasters: Vec<(&str, Raster)> = vec![
+        (
+            "kd",
+            channel_uniform(maps, |t| &t.kd).map_or_else(
+                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.kd, |v| v)),
+                |v| Raster::Uniform(v.to_vec()),
+            ),
+        ),
+        (
+            "ks",
+            channel_uniform(maps, |t| &t.ks).map_or_else(
+                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.ks, |v| v)),
+                |v| Raster::Uniform(v.to_vec()),
+            ),
+        ),
+        (
+            "n",
+            channel_uniform(maps, |t| &t.n).map_or_else(
+                || Raster::Gray(rasterize::<1, _>(maps, |t| &t.n, |v| [v])),
+                |v| Raster::Uniform(vec![v]),
+            ),
+        ),
+    ];
+    let pngs: Vec<Result<Vec<u8>, String>> = rasters
+        .par_iter()
+        .map(|(_, r)| encode_png(r, w, h))
+        .collect();
+    let entry = |(name, raster): &(&str, Raster)| match raster {
+        Raster::Uniform(v) => ChannelEntry::Uniform { value: v.clone() },
+        Raster::Rgb(_) => ChannelEntry::Image {
+            file: format!("{name}.png"),
+            encoding: RGB_ENCODING.into(),
+        },
+        Raster::Gray(_) => ChannelEntry::Image {
+            file: format!("{name}.png"),
+            encoding: N_ENCODING.into(),
+        },
+    };
+    let manifest = Manifest {
+        format: FORMAT.into(),
+        version: VERSION,
+        width: w,
+        height: h,
+        settings: doc.settings.clone(),
+        kd: entry(&rasters[0]),
+        ks: entry(&rasters[1]),
+        n: entry(&rasters[2]),
+    };
+    let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let deflated = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let stored = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Stored)
+        .large_file(true);
+    zip.start_file("manifest.json", deflated)
+        .map_err(|e| e.to_string())?;
+    zip.write_all(&json).map_err(|e| e.to_string())?;
+    for ((name, raster), png) in rasters.iter().zip(pngs) {
+        let png = png?;
+        if !matches!(raster, Raster::Uniform(_)) {
+            zip.start_file(format!("{name}.png"), stored)
+                .map_err(|e| e.to_string())?;
+            zip.write_all(&png).map_err(|e| e.to_string())?;
+        }
+    }
+    Ok(zip.finish().map_err(|e| e.to_string())?.into_inner())
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed to
+/// disk, renamed over `path`, and the directory flushed. On any failure the temporary file
+/// is removed and `path` is untouched.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ModelError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| -> std::io::Result<()> {
+        let mut file = File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&tmp, path)?;
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
+        }
+        Ok(())
+    })();
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        ModelError::io(path, e)
+    })
+}
+
+/// Saves a document to `path` atomically.
+pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
+    let bytes = to_bytes(doc).map_err(|reason| ModelError::Project {
+        path: path.to_path_buf(),
+        reason,
+    })?;
+    write_atomic(path, &bytes)
+}
+
+/// Loads and validates a project file.
+pub fn load(path: &Path) -> Result<Document, ModelError> {
+    let file = File::open(path).map_err(|e| ModelError::io(path, e))?;
+    from_reader(file).map_err(|reason| ModelError::Project {
+        path: path.to_path_buf(),
+        reason,
+    })
+}
+
+/// Loads and validates a project from any seekable reader; the error is a reason text.
+pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
+    let mut zip = zip::ZipArchive::new(reader).map_err(|e| format!("not a zip archive ({e})"))?;
+    let manifest: Manifest = {
+        let entry = zip
+            .by_name("manifest.json")
+            .map_err(|e| format!("manifest.json: {e}"))?;
+        if entry.size() > MAX_MANIFEST_BYTES {
+            return Err(format!(
+                "manifest.json is {} bytes, more than the limit",
+                entry.size()
+            ));
+        }
+        let mut text = Vec::new();
+        entry
+            .take(MAX_MANIFEST_BYTES)
+            .read_to_end(&mut text)
+            .map_err(|e| format!("manifest.json: {e}"))?;
+        serde_json::from_slice(&text).map_err(|e| format!("manifest.json: {e}"))?
+    };
+    if manifest.format != FORMAT {
+        return Err(format!(
+            "manifest format is {:?}, expected {FORMAT:?}",
+            manifest.format
+        ));
+    }
+    if manifest.version != VERSION {
+        return Err(format!(
+            "project version {} is not supported (this build reads version {VERSION})",
+            manifest.version
+        ));
+    }
+    let (w, h) = (manifest.width, manifest.height);
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        return Err(format!("map size {w}x{h} is out of range"));
+    }
+    let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
+    let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
+    let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
+    let n_samples = match &n {
+        Raster::Uniform(v) | Raster::Gray(v) | Raster::Rgb(v) => v,
+    };
+    if let Some(bad) = n_samples.par_iter().find_any(|&&bits| !valid_n_bits(bits)) {
+        return Err(format!(
+            "n holds an invalid exponent (half-float bits {bad:#06x})"
+        ));
+    }
+    let settings = sanitize_settings(manifest.settings);
+    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
+    fill_maps(&mut maps, &kd, &ks, &n);
+    Ok(Document::from_parts(maps, settings))
+}
+
+/// Whether half-float bits hold a storable exponent: finite, not negative, at most `N_MAX`.
+fn valid_n_bits(bits: u16) -> bool {
+    let v = half::f16::from_bits(bits).to_f32();
+    v.is_finite() && (0.0..=N_MAX).contains(&v) && bits & 0x8000 == 0
+}
+
+fn sanitize_settings(mut s: DocumentSettings) -> DocumentSettings {
+    s.base = s.base.sanitized();
+    s.primary = s.primary.sanitized();
+    s.secondary = s.secondary.sanitized();
+    s.brush = s.brush.sanitized();
+    s
+}
+
+fn read_channel<R: Read + Seek>(
+    zip: &mut zip::ZipArchive<R>,
+    entry: &ChannelEntry,
+    name: &str,
+    w: u32,
+    h: u32,
+    components: usize,
+) -> Result<Raster, String> {
+    match entry {
+        ChannelEntry::Uniform { value } => {
+            if value.len() != components {
+                return Err(format!(
+                    "{name}: uniform value has {} components, expected {components}",
+                    value.len()
+                ));
+            }
+            Ok(Raster::Uniform(value.clone()))
+        }
+        ChannelEntry::Image { file, encoding } => {
+            let expected = if components == 3 {
+                RGB_ENCODING
+            } else {
+                N_ENCODING
+            };
+            if encoding != expected {
+                return Err(format!(
+                    "{file}: encoding {encoding:?} is not supported for {name}"
+                ));
+            }
+            let mut entry = zip.by_name(file).map_err(|e| format!("{file}: {e}"))?;
+            // A 16-bit PNG of this size can never need more than this.
+            let limit = u64::from(w) * u64::from(h) * components as u64 * 2 * 2 + (1 << 20);
+            if entry.size() > limit {
+                return Err(format!(
+                    "{file} claims {} bytes, more than a {w}x{h} map can need",
+                    entry.size()
+                ));
+            }
+            let mut bytes = Vec::with_capacity(entry.size() as usize);
+            (&mut entry)
+                .take(limit)
+                .read_to_end(&mut bytes)
+                .map_err(|e| format!("{file}: {e}"))?;
+            let mut reader = image::ImageReader::with_format(
+                std::io::Cursor::new(bytes),
+                image::ImageFormat::Png,
+            );
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(w);
+            limits.max_image_height = Some(h);
+            limits.max_alloc = Some(limit);
+            reader.limits(limits);
+            let image = reader.decode().map_err(|e| format!("{file}: {e}"))?;
+            if (image.width(), image.height()) != (w, h) {
+                return Err(format!(
+                    "{file} is {}x{}, the manifest says {w}x{h}",
+                    image.width(),
+                    image.height()
+                ));
+            }
+            match (components, image) {
+                (3, image::DynamicImage::ImageRgb16(img)) => Ok(Raster::Rgb(img.into_raw())),
+                (1, image::DynamicImage::ImageLuma16(img)) => Ok(Raster::Gray(img.into_raw())),
+                (_, other) => Err(format!(
+                    "{file} has colour type {:?}, expected 16-bit {}",
+                    other.color(),
+                    if components == 3 { "RGB" } else { "gray" }
+                )),
+            }
+        }
+    }
+}
+
+fn fill_maps(maps: &mut MaterialMaps, kd: &Raster, ks: &Raster, n: &Raster) {
+    let w = maps.width() as usize;
+    let rgb_plane =
+        |r: &Raster, x0: usize, y0: usize, cols: usize, rows: usize| -> Plane<[u16; 3]> {
+            match r {
+                Raster::Uniform(v) => Plane::Uniform([v[0], v[1], v[2]]),
+                Raster::Rgb(d) | Raster::Gray(d) => {
+                    let mut p = Plane::Uniform([0; 3]);
+                    let data = p.data_mut();
+                    for y in 0..rows {
+                        for x in 0..cols {
+                            let at = ((y0 + y) * w + x0 + x) * 3;
+                            data[y * TILE_SIZE + x] = [d[at], d[at + 1], d[at + 2]];
+                        }
+                    }
+                    p.compact();
+                    p
+                }
+            }
+        };
+    let tiles: Vec<Tile> = (0..maps.tile_count())
+        .into_par_iter()
+        .map(|id| {
+            let (x0, y0, x1, y1) = maps.tile_rect(id);
+            let (x0, y0, cols, rows) = (
+                x0 as usize,
+                y0 as usize,
+                (x1 - x0) as usize,
+                (y1 - y0) as usize,
+            );
+            let n_plane = match n {
+                Raster::Uniform(v) => Plane::Uniform(v[0]),
+                Raster::Gray(d) | Raster::Rgb(d) => {
+                    let mut p = Plane::Uniform(0);
+                    let data = p.data_mut();
+                    for y in 0..rows {
+                        data[y * TILE_SIZE..y * TILE_SIZE + cols]
+                            .copy_from_slice(&d[(y0 + y) * w + x0..(y0 + y) * w + x0 + cols]);
+                    }
+                    p.compact();
+                    p
+                }
+            };
+            Tile {
+                kd: rgb_plane(kd, x0, y0, cols, rows),
+                ks: rgb_plane(ks, x0, y0, cols, rows),
+                n: n_plane,
+            }
+        })
+        .collect();
+    for (id, tile) in tiles.into_iter().enumerate() {
+        *maps.tile_mut(id) = tile;
+    }
+}
+
+/// Where the recovery copy of a project lives: beside it as `.NAME.kapaint-recovery`, or for
+/// an unsaved document in `$XDG_STATE_HOME/kapaint` (or `~/.local/state/kapaint`).
+pub fn recovery_path(project: Option<&Path>) -> PathBuf {
+    if let Some(p) = project {
+        let dir = p.parent().unwrap_or(Path::new("."));
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        return dir.join(format!(".{name}-recovery"));
+    }
+    let state = std::env::var_os("XDG_STATE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/state")))
+        .unwrap_or_else(std::env::temp_dir);
+    state.join("kapaint").join("untitled.kapaint-recovery")
+}
+
+/// Autosave timing: a recovery copy is due when the document changed since the last one and
+/// the interval has passed. The caller saves (on a worker thread in the editor) and reports.
+#[derive(Clone, Debug)]
+pub struct Autosave {
+    /// Time between recovery copies.
+    pub interval: Duration,
+    last_time: Instant,
+    last_version: u64,
+}
+
+impl Autosave {
+    /// Autosave every `interval`, counting from `now`, with `version` already safe.
+    pub fn new(interval: Duration, now: Instant, version: u64) -> Self {
+        Self {
+            interval,
+            last_time: now,
+            last_version: version,
+        }
+    }
+
+    /// Whether a recovery copy should be written now.
+    pub fn due(&self, now: Instant, version: u64) -> bool {
+        version != self.last_version && now.duration_since(self.last_time) >= self.interval
+    }
+
+    /// Records that `version` was saved at `now`.
+    pub fn saved(&mut self, now: Instant, version: u64) {
+        self.last_time = now;
+        self.last_version = version;
+    }
+}

@@ -1,0 +1,142 @@
+//! 64 x 64 tiles, each channel plane either uniform (one value, no memory) or full.
+
+use super::texel::Texel;
+
+/// Tile side in texels.
+pub const TILE_SIZE: usize = 64;
+
+/// Texels per tile.
+pub const TILE_TEXELS: usize = TILE_SIZE * TILE_SIZE;
+
+/// One channel of a tile: a single value for every texel, or one value per texel.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Plane<T: Copy> {
+    /// Every texel holds this value.
+    Uniform(T),
+    /// Row-major values, `TILE_TEXELS` of them.
+    Data(Box<[T]>),
+}
+
+impl<T: Copy + PartialEq> Plane<T> {
+    /// The value at texel index `i` (row-major within the tile).
+    #[inline]
+    pub fn get(&self, i: usize) -> T {
+        match self {
+            Self::Uniform(v) => *v,
+            Self::Data(d) => d[i],
+        }
+    }
+
+    /// The per-texel values, materialising a uniform plane first.
+    pub fn data_mut(&mut self) -> &mut [T] {
+        if let Self::Uniform(v) = *self {
+            *self = Self::Data(vec![v; TILE_TEXELS].into_boxed_slice());
+        }
+        match self {
+            Self::Data(d) => d,
+            Self::Uniform(_) => unreachable!("materialised above"),
+        }
+    }
+
+    /// The uniform value, if the plane is uniform.
+    pub fn uniform(&self) -> Option<T> {
+        match self {
+            Self::Uniform(v) => Some(*v),
+            Self::Data(_) => None,
+        }
+    }
+
+    /// Turns a full plane whose texels are all equal back into a uniform one.
+    pub fn compact(&mut self) {
+        if let Self::Data(d) = self
+            && let Some(&first) = d.first()
+            && d.iter().all(|&v| v == first)
+        {
+            *self = Self::Uniform(first);
+        }
+    }
+
+    /// Heap bytes held by the plane.
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            Self::Uniform(_) => 0,
+            Self::Data(d) => std::mem::size_of_val(&**d),
+        }
+    }
+}
+
+/// One tile of every channel.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Tile {
+    /// `k_d` (unorm16 RGB).
+    pub kd: Plane<[u16; 3]>,
+    /// `k_s` (unorm16 RGB).
+    pub ks: Plane<[u16; 3]>,
+    /// `n` (half-float bits).
+    pub n: Plane<u16>,
+}
+
+impl Tile {
+    /// A tile where every texel is `texel`.
+    pub fn uniform(texel: Texel) -> Self {
+        Self {
+            kd: Plane::Uniform(texel.kd),
+            ks: Plane::Uniform(texel.ks),
+            n: Plane::Uniform(texel.n),
+        }
+    }
+
+    /// The texel at index `i` (row-major within the tile).
+    #[inline]
+    pub fn texel(&self, i: usize) -> Texel {
+        Texel {
+            kd: self.kd.get(i),
+            ks: self.ks.get(i),
+            n: self.n.get(i),
+        }
+    }
+
+    /// Writes texel `i`.
+    #[inline]
+    pub fn set_texel(&mut self, i: usize, t: Texel) {
+        self.kd.data_mut()[i] = t.kd;
+        self.ks.data_mut()[i] = t.ks;
+        self.n.data_mut()[i] = t.n;
+    }
+
+    /// Heap bytes held by the tile's planes.
+    pub fn heap_bytes(&self) -> usize {
+        self.kd.heap_bytes() + self.ks.heap_bytes() + self.n.heap_bytes()
+    }
+
+    /// Compacts every plane (see [`Plane::compact`]).
+    pub fn compact(&mut self) {
+        self.kd.compact();
+        self.ks.compact();
+        self.n.compact();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_planes_materialise_on_write_and_compact_back() {
+        let mut tile = Tile::uniform(Texel {
+            kd: [1, 2, 3],
+            ks: [4, 5, 6],
+            n: 7,
+        });
+        assert_eq!(tile.heap_bytes(), 0);
+        assert_eq!(tile.texel(100).ks, [4, 5, 6]);
+        tile.kd.data_mut()[5] = [9, 9, 9];
+        assert_eq!(tile.kd.get(5), [9, 9, 9]);
+        assert_eq!(tile.kd.get(6), [1, 2, 3]);
+        assert_eq!(tile.heap_bytes(), TILE_TEXELS * 6);
+        tile.kd.data_mut()[5] = [1, 2, 3];
+        tile.compact();
+        assert_eq!(tile.kd.uniform(), Some([1, 2, 3]));
+        assert_eq!(tile.heap_bytes(), 0);
+    }
+}
