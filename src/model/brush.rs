@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 /// space: `k_d`, `k_s` as they are, `n` in log space ([`super::texel::n_to_blend`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum BlendMode {
-    /// `v + (target - v) a`.
+    /// `v (1 - a) + target a` (exactly `target` at full alpha).
     #[default]
     Normal,
     /// `v + target a`.
@@ -31,7 +31,7 @@ impl BlendMode {
     #[inline]
     pub fn apply(self, v: f32, target: f32, a: f32) -> f32 {
         let out = match self {
-            Self::Normal => v + (target - v) * a,
+            Self::Normal => v * (1.0 - a) + target * a,
             Self::Add => v + target * a,
             Self::Subtract => v - target * a,
             Self::Multiply => v * (1.0 + (target - 1.0) * a),
