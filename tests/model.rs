@@ -404,8 +404,8 @@ fn importing_the_spot_texture_converts_srgb_to_linear() {
     let png = image::open(&path).expect("decodes").to_rgb8();
     for (x, y) in [(100, 100), (512, 300), (900, 950), (0, 0)] {
         let p = png.get_pixel(x, y).0;
-        let want =
-            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32).map(|c| srgb_to_linear(c / 255.0));
+        let want = Vec3::new(f32::from(p[0]), f32::from(p[1]), f32::from(p[2]))
+            .map(|c| srgb_to_linear(c / 255.0));
         let got = d.maps.value(x, y).kd;
         assert!(
             (got - want).abs().max_element() < 2e-3,

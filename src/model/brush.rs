@@ -165,14 +165,19 @@ impl BrushSettings {
     /// Dab weight at distance `r` from the centre for radius `radius` (hardness falloff).
     #[inline]
     pub fn falloff(&self, r: f32, radius: f32) -> f32 {
-        if r >= radius {
-            return 0.0;
+        self.falloff_sq(r * r, radius * radius)
+    }
+
+    /// The falloff on squared distances: 1 inside `hardness * radius`, then
+    /// `smoothstep((R^2 - d^2) / (R^2 - (hR)^2))` down to 0 at the radius. Defined on `d^2` so
+    /// the per-texel cost has no square root and no division.
+    #[inline]
+    pub fn falloff_sq(&self, d2: f32, r2: f32) -> f32 {
+        let inner2 = self.hardness * self.hardness * r2;
+        if d2 <= inner2 {
+            return if d2 < r2 { 1.0 } else { 0.0 };
         }
-        let inner = self.hardness * radius;
-        if r <= inner {
-            return 1.0;
-        }
-        let t = (radius - r) / (radius - inner);
+        let t = ((r2 - d2) / (r2 - inner2)).max(0.0);
         t * t * (3.0 - 2.0 * t)
     }
 }
@@ -360,7 +365,9 @@ mod tests {
         };
         assert_eq!(b.falloff(0.0, 10.0), 1.0);
         assert_eq!(b.falloff(5.0, 10.0), 1.0);
-        assert!((b.falloff(7.5, 10.0) - 0.5).abs() < 1e-6);
+        // Half-way in d^2 between the core (25) and the rim (100).
+        assert!((b.falloff(62.5_f32.sqrt(), 10.0) - 0.5).abs() < 1e-6);
+        assert!(b.falloff(9.0, 10.0) < b.falloff(7.0, 10.0));
         assert_eq!(b.falloff(10.0, 10.0), 0.0);
         assert_eq!(BlendMode::Normal.apply(0.2, 0.8, 0.5), 0.5);
         assert_eq!(BlendMode::Add.apply(0.9, 0.5, 1.0), 1.0);

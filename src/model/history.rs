@@ -120,6 +120,29 @@ impl History {
         maps.tile_mut(id)
     }
 
+    /// Saves the pre-transaction version of each tile in `ids` that the open transaction has
+    /// not touched yet (call before writing them through [`MaterialMaps::tiles_mut_many`]).
+    pub fn save_before_write(&mut self, maps: &MaterialMaps, ids: &[TileId]) {
+        if let Some(open) = &mut self.open {
+            for &id in ids {
+                open.saved
+                    .entry(id)
+                    .or_insert_with(|| Arc::clone(maps.tile(id)));
+            }
+        }
+    }
+
+    /// Puts a new tile in place of tile `id`, saving the old one on first touch like
+    /// [`Self::tile_for_write`], but without copying it first (for whole-tile writes).
+    pub fn replace_for_write(&mut self, maps: &mut MaterialMaps, id: TileId, tile: Tile) {
+        if let Some(open) = &mut self.open {
+            open.saved
+                .entry(id)
+                .or_insert_with(|| Arc::clone(maps.tile(id)));
+        }
+        maps.replace_tile(id, Arc::new(tile));
+    }
+
     /// Ends the open transaction; a transaction that touched nothing leaves no step.
     pub fn end(&mut self) {
         let Some(open) = self.open.take() else { return };

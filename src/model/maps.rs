@@ -132,6 +132,32 @@ impl MaterialMaps {
         Arc::make_mut(&mut self.tiles[id])
     }
 
+    /// Several tiles for writing at once (each cloned first if shared), for parallel work on
+    /// disjoint tiles. `ids` must be sorted ascending without duplicates; bumps versions.
+    pub fn tiles_mut_many(&mut self, ids: &[TileId]) -> Vec<&mut Tile> {
+        debug_assert!(
+            ids.windows(2).all(|w| w[0] < w[1]),
+            "ids must be sorted and unique"
+        );
+        for &id in ids {
+            self.clock += 1;
+            self.versions[id] = self.clock;
+        }
+        let mut wanted = ids.iter().peekable();
+        self.tiles
+            .iter_mut()
+            .enumerate()
+            .filter_map(|(id, tile)| {
+                if wanted.peek() == Some(&&id) {
+                    wanted.next();
+                    Some(Arc::make_mut(tile))
+                } else {
+                    None
+                }
+            })
+            .collect()
+    }
+
     /// Puts `tile` in place of tile `id` and returns the previous one (undo and redo).
     pub fn replace_tile(&mut self, id: TileId, tile: Arc<Tile>) -> Arc<Tile> {
         self.clock += 1;
@@ -213,7 +239,7 @@ impl MaterialMaps {
     }
 
     /// Derives `k_a` for the whole map into `out` (row-major, `width * height` values), in
-    /// parallel over tile rows.
+    /// parallel over bands of tile rows, writing straight into the output rows.
     pub fn derive_ka_into(&self, model: ShadingModel, approx: AmbientApprox, out: &mut [Vec3]) {
         assert_eq!(
             out.len(),
@@ -223,21 +249,20 @@ impl MaterialMaps {
         let lut = chi_lut(model, approx);
         let diffuse = diffuse_factor(approx);
         let width = self.width as usize;
-        let band = width * TILE_SIZE;
-        out.par_chunks_mut(band).enumerate().for_each(|(ty, rows)| {
-            let mut scratch = vec![Vec3::ZERO; TILE_TEXELS];
-            let row_count = rows.len() / width;
-            for tx in 0..self.tiles_x as usize {
-                let id = ty * self.tiles_x as usize + tx;
-                derive_tile(&self.tiles[id], lut, diffuse, &mut scratch);
-                let x0 = tx * TILE_SIZE;
-                let w = TILE_SIZE.min(width - x0);
-                for r in 0..row_count {
-                    rows[r * width + x0..r * width + x0 + w]
-                        .copy_from_slice(&scratch[r * TILE_SIZE..r * TILE_SIZE + w]);
+        out.par_chunks_mut(width * TILE_SIZE)
+            .enumerate()
+            .for_each(|(ty, band)| {
+                let rows = band.len() / width;
+                for tx in 0..self.tiles_x as usize {
+                    let tile = &self.tiles[ty * self.tiles_x as usize + tx];
+                    let x0 = tx * TILE_SIZE;
+                    let cols = TILE_SIZE.min(width - x0);
+                    for r in 0..rows {
+                        let dst = &mut band[r * width + x0..r * width + x0 + cols];
+                        derive_row(tile, r * TILE_SIZE, lut, diffuse, dst);
+                    }
                 }
-            }
-        });
+            });
     }
 }
 
@@ -251,24 +276,46 @@ fn diffuse_factor(approx: AmbientApprox) -> f32 {
 /// `k_a` of one tile. `n` is stored as a half float, so `chi` of every possible code is a
 /// 65,536-entry table (256 KiB, built once per model and approximation): one load per texel.
 fn derive_tile(tile: &Tile, lut: &[f32], diffuse: f32, out: &mut [Vec3]) {
+    for (r, row) in out.chunks_exact_mut(TILE_SIZE).enumerate() {
+        derive_row(tile, r * TILE_SIZE, lut, diffuse, row);
+    }
+}
+
+/// `k_a` of `out.len()` texels of a tile starting at texel index `start`.
+#[inline]
+fn derive_row(tile: &Tile, start: usize, lut: &[f32], diffuse: f32, out: &mut [Vec3]) {
     const SCALE: f32 = 1.0 / 65535.0;
-    let out: &mut [f32] = bytemuck::cast_slice_mut(out);
+    let d = diffuse * SCALE;
+    let len = out.len();
     match (&tile.kd, &tile.ks, &tile.n) {
-        (Plane::Uniform(kd), Plane::Uniform(ks), Plane::Uniform(n)) => {
-            let ka = diffuse * decode_rgb(*kd) + decode_rgb(*ks) * lut[*n as usize];
-            for o in out.chunks_exact_mut(3) {
-                o.copy_from_slice(&ka.to_array());
+        (Plane::Data(kd), Plane::Data(ks), Plane::Data(n)) => {
+            let (kd, ks, n) = (
+                &kd[start..start + len],
+                &ks[start..start + len],
+                &n[start..start + len],
+            );
+            for (((o, kd), ks), &n) in out.iter_mut().zip(kd).zip(ks).zip(n) {
+                let chi = lut[n as usize] * SCALE;
+                *o = Vec3::new(
+                    d * f32::from(kd[0]) + chi * f32::from(ks[0]),
+                    d * f32::from(kd[1]) + chi * f32::from(ks[1]),
+                    d * f32::from(kd[2]) + chi * f32::from(ks[2]),
+                );
             }
         }
+        (Plane::Uniform(kd), Plane::Uniform(ks), Plane::Uniform(n)) => {
+            out.fill(diffuse * decode_rgb(*kd) + decode_rgb(*ks) * lut[*n as usize]);
+        }
         _ => {
-            for (i, o) in out.chunks_exact_mut(3).enumerate() {
-                let kd = tile.kd.get(i);
-                let ks = tile.ks.get(i);
+            for (k, o) in out.iter_mut().enumerate() {
+                let i = start + k;
+                let (kd, ks) = (tile.kd.get(i), tile.ks.get(i));
                 let chi = lut[tile.n.get(i) as usize] * SCALE;
-                let d = diffuse * SCALE;
-                o[0] = d * f32::from(kd[0]) + chi * f32::from(ks[0]);
-                o[1] = d * f32::from(kd[1]) + chi * f32::from(ks[1]);
-                o[2] = d * f32::from(kd[2]) + chi * f32::from(ks[2]);
+                *o = Vec3::new(
+                    d * f32::from(kd[0]) + chi * f32::from(ks[0]),
+                    d * f32::from(kd[1]) + chi * f32::from(ks[1]),
+                    d * f32::from(kd[2]) + chi * f32::from(ks[2]),
+                );
             }
         }
     }

@@ -6,7 +6,6 @@
 //! coverage. Overlapping dabs (or mirrored copies of one) therefore never exceed the opacity,
 //! and a stroke's result does not depend on dab order.
 
-use std::collections::HashMap;
 use std::sync::{Arc, OnceLock};
 
 use glam::{Vec2, Vec3};
@@ -27,11 +26,23 @@ pub type TileRect = (u32, u32, u32, u32);
 /// The 2D brush is a disc in texel space ([`DiscFootprint`]); the 3D brush on meshes is a
 /// ball in object space whose texels come from a spatial index of the UV bake, and
 /// implements the same trait.
-pub trait Footprint {
+pub trait Footprint: Sync {
     /// The tiles the footprint may touch.
     fn tiles(&self, maps: &MaterialMaps) -> Vec<TileId>;
+    /// Calls `f(start, weights)` for runs of consecutive texels of tile `id`: texel indices
+    /// `start..start + weights.len()` (row-major in the tile) with those weights (zero allowed).
+    fn visit_runs(&self, id: TileId, rect: TileRect, f: impl FnMut(usize, &[f32]));
+
     /// Calls `f(index_in_tile, weight)` for every texel of tile `id` with a positive weight.
-    fn visit_tile(&self, id: TileId, rect: TileRect, f: impl FnMut(usize, f32));
+    fn visit_tile(&self, id: TileId, rect: TileRect, mut f: impl FnMut(usize, f32)) {
+        self.visit_runs(id, rect, |start, weights| {
+            for (k, &w) in weights.iter().enumerate() {
+                if w > 0.0 {
+                    f(start + k, w);
+                }
+            }
+        });
+    }
 }
 
 /// A round dab in texel space, shaped by the brush's hardness and optional stamp.
@@ -81,13 +92,14 @@ impl Footprint for DiscFootprint<'_> {
         ids
     }
 
-    fn visit_tile(&self, _id: TileId, rect: TileRect, mut f: impl FnMut(usize, f32)) {
+    fn visit_runs(&self, _id: TileId, rect: TileRect, mut f: impl FnMut(usize, &[f32])) {
         let (x0, y0, x1, y1) = rect;
         let r = self.radius;
         let r2 = r * r;
         let inv_r = 1.0 / r;
         let ys = ((self.center.y - r).floor().max(y0 as f32) as u32).max(y0);
         let ye = ((self.center.y + r).ceil().min(y1 as f32) as u32).min(y1);
+        let mut weights = [0.0_f32; TILE_SIZE];
         for y in ys..ye {
             let dy = y as f32 + 0.5 - self.center.y;
             let rem = r2 - dy * dy;
@@ -98,18 +110,22 @@ impl Footprint for DiscFootprint<'_> {
             let xs = ((self.center.x - half - 0.5).ceil().max(x0 as f32) as u32).max(x0);
             let xe = ((self.center.x + half - 0.5).floor() as i64 + 1)
                 .clamp(i64::from(x0), i64::from(x1)) as u32;
-            let row = (y - y0) as usize * TILE_SIZE;
-            for x in xs..xe {
-                let dx = x as f32 + 0.5 - self.center.x;
-                let d = (dx * dx + dy * dy).sqrt();
-                let mut w = self.brush.falloff(d, r);
-                if let Some(stamp) = &self.brush.stamp {
-                    w *= stamp.sample(dx * inv_r, dy * inv_r);
-                }
-                if w > 0.0 {
-                    f(row + (x - x0) as usize, w);
+            if xe <= xs {
+                continue;
+            }
+            let run = &mut weights[..(xe - xs) as usize];
+            let dy2 = dy * dy;
+            for (k, w) in run.iter_mut().enumerate() {
+                let dx = (xs + k as u32) as f32 + 0.5 - self.center.x;
+                *w = self.brush.falloff_sq(dx * dx + dy2, r2);
+            }
+            if let Some(stamp) = &self.brush.stamp {
+                for (k, w) in run.iter_mut().enumerate() {
+                    let dx = (xs + k as u32) as f32 + 0.5 - self.center.x;
+                    *w *= stamp.sample(dx * inv_r, dy * inv_r);
                 }
             }
+            f((y - y0) as usize * TILE_SIZE + (xs - x0) as usize, run);
         }
     }
 }
@@ -230,17 +246,34 @@ fn guard_energy(kd: &mut [f32; 3], ks: &mut [f32; 3], painting_kd: bool, paintin
     }
 }
 
-/// Per-texel stroke coverage for the tiles a stroke touched.
+/// Per-texel stroke coverage for the tiles a stroke touched, indexed by tile.
 #[derive(Default, Debug)]
 pub struct Coverage {
-    tiles: HashMap<TileId, Box<[f32]>>,
+    tiles: Vec<Option<Box<[f32]>>>,
 }
 
 impl Coverage {
-    fn tile(&mut self, id: TileId) -> &mut [f32] {
+    /// Coverage slices for several tiles (sorted, unique ids), created at zero on first use.
+    fn tiles_mut(&mut self, tile_count: usize, ids: &[TileId]) -> Vec<&mut [f32]> {
+        if self.tiles.len() < tile_count {
+            self.tiles.resize_with(tile_count, || None);
+        }
+        for &id in ids {
+            self.tiles[id].get_or_insert_with(|| vec![0.0; TILE_TEXELS].into_boxed_slice());
+        }
+        let mut wanted = ids.iter().peekable();
         self.tiles
-            .entry(id)
-            .or_insert_with(|| vec![0.0; TILE_TEXELS].into_boxed_slice())
+            .iter_mut()
+            .enumerate()
+            .filter_map(|(id, slot)| {
+                if wanted.peek() == Some(&&id) {
+                    wanted.next();
+                    slot.as_deref_mut()
+                } else {
+                    None
+                }
+            })
+            .collect()
     }
 }
 
@@ -253,6 +286,9 @@ fn pre_tile(history: &History, maps: &MaterialMaps, id: TileId) -> Arc<Tile> {
 }
 
 /// Applies one paint dab with footprint `fp` and dab alpha `alpha` (flow times pressure).
+///
+/// The tiles under the dab are independent, so they are painted in parallel; each writes
+/// only the enabled channels.
 pub fn paint_dab(
     maps: &mut MaterialMaps,
     history: &mut History,
@@ -262,23 +298,166 @@ pub fn paint_dab(
     alpha: f32,
     fp: &impl Footprint,
 ) {
+    use rayon::prelude::*;
     if alpha <= 0.0 || opacity <= 0.0 || target.channels.is_empty() {
         return;
     }
-    for id in fp.tiles(maps) {
-        let rect = maps.tile_rect(id);
-        let pre = pre_tile(history, maps, id);
-        let cov = coverage.tile(id);
-        let tile = history.tile_for_write(maps, id);
+    let mut ids = fp.tiles(maps);
+    ids.sort_unstable();
+    ids.dedup();
+    if ids.is_empty() {
+        return;
+    }
+    let rects: Vec<TileRect> = ids.iter().map(|&id| maps.tile_rect(id)).collect();
+    let pres: Vec<Arc<Tile>> = ids.iter().map(|&id| pre_tile(history, maps, id)).collect();
+    history.save_before_write(maps, &ids);
+    let covs = coverage.tiles_mut(maps.tile_count(), &ids);
+    let tiles = maps.tiles_mut_many(&ids);
+    let tables = n_tables();
+    let work: Vec<_> = tiles
+        .into_iter()
+        .zip(covs)
+        .zip(pres)
+        .zip(rects)
+        .zip(ids)
+        .collect();
+    work.into_par_iter()
+        .for_each(|((((tile, cov), pre), rect), id)| {
+            paint_tile(
+                tile,
+                cov,
+                &pre,
+                target,
+                opacity,
+                alpha,
+                tables,
+                (fp, id, rect),
+            );
+        });
+}
+
+/// Paints one tile: coverage update and blend of the enabled channels, run by run.
+#[allow(clippy::too_many_arguments)] // The hot loop's inputs, passed once per tile.
+fn paint_tile(
+    tile: &mut Tile,
+    cov: &mut [f32],
+    pre: &Tile,
+    target: &PaintTarget,
+    opacity: f32,
+    alpha: f32,
+    tables: &NTables,
+    (fp, id, rect): (&impl Footprint, TileId, TileRect),
+) {
+    if target.energy_guard {
+        // The guard couples k_d and k_s: take the general per-texel path.
         fp.visit_tile(id, rect, |i, w| {
             let c = cov[i];
-            if c >= opacity {
-                return;
+            if c < opacity {
+                let next = c + (opacity - c) * (w * alpha).min(1.0);
+                cov[i] = next;
+                tile.set_texel(i, target.blend(pre.texel(i), next));
             }
-            let next = c + (opacity - c) * (w * alpha).min(1.0);
-            cov[i] = next;
-            tile.set_texel(i, target.blend(pre.texel(i), next));
         });
+        return;
+    }
+    let mode = target.mode;
+    let ch = target.channels;
+    let Tile { kd, ks, n } = tile;
+    let mut kd = ch.kd.then(|| kd.data_mut());
+    let mut ks = ch.ks.then(|| ks.data_mut());
+    let mut n = ch.n.then(|| n.data_mut());
+    let (kd_t, ks_t) = (
+        super::texel::encode_rgb(target.kd),
+        super::texel::encode_rgb(target.ks),
+    );
+    let mut a_run = [0.0_f32; TILE_SIZE];
+    fp.visit_runs(id, rect, |start, weights| {
+        let len = weights.len();
+        let a_run = &mut a_run[..len];
+        // Coverage rises towards the opacity; a texel already at it keeps its value (and
+        // re-blending it at the same coverage rewrites the same stored value).
+        for ((c, &w), a) in cov[start..start + len]
+            .iter_mut()
+            .zip(weights)
+            .zip(a_run.iter_mut())
+        {
+            let next = *c + (opacity - *c) * (w * alpha).min(1.0);
+            *c = c.max(next);
+            *a = *c;
+        }
+        if let Some(kd) = kd.as_deref_mut() {
+            blend_rgb_run(
+                &mut kd[start..start + len],
+                &pre.kd,
+                start,
+                kd_t,
+                target.kd,
+                a_run,
+                mode,
+            );
+        }
+        if let Some(ks) = ks.as_deref_mut() {
+            blend_rgb_run(
+                &mut ks[start..start + len],
+                &pre.ks,
+                start,
+                ks_t,
+                target.ks,
+                a_run,
+                mode,
+            );
+        }
+        if let Some(n) = n.as_deref_mut() {
+            for (k, (out, &a)) in n[start..start + len]
+                .iter_mut()
+                .zip(a_run.iter())
+                .enumerate()
+            {
+                let u = mode.apply(
+                    tables.to_blend[pre.n.get(start + k) as usize],
+                    target.n_blend,
+                    a,
+                );
+                let idx = (u * FROM_BLEND_STEPS as f32 + 0.5) as usize;
+                *out = tables.from_blend[idx.min(FROM_BLEND_STEPS)];
+            }
+        }
+    });
+}
+
+/// Blends a run of unorm16 RGB texels towards a target. Normal mode mixes in fixed point,
+/// exact at alpha 0 and 1 and free of clamping (a convex mix stays in range).
+fn blend_rgb_run(
+    out: &mut [[u16; 3]],
+    pre: &super::tile::Plane<[u16; 3]>,
+    start: usize,
+    target16: [u16; 3],
+    target: Vec3,
+    alpha: &[f32],
+    mode: BlendMode,
+) {
+    use super::tile::Plane;
+    let pre_at = |k: usize| match pre {
+        Plane::Uniform(v) => *v,
+        Plane::Data(d) => d[start + k],
+    };
+    if mode == BlendMode::Normal {
+        let t = target16.map(i32::from);
+        for (k, (o, &a)) in out.iter_mut().zip(alpha).enumerate() {
+            let a15 = (a * 32768.0) as i32;
+            let p = pre_at(k);
+            for c in 0..3 {
+                let pc = i32::from(p[c]);
+                o[c] = (pc + (((t[c] - pc) * a15 + 16384) >> 15)) as u16;
+            }
+        }
+    } else {
+        for (k, (o, &a)) in out.iter_mut().zip(alpha).enumerate() {
+            let p = pre_at(k);
+            for c in 0..3 {
+                o[c] = encode_unorm(mode.apply(decode_unorm(p[c]), target[c], a));
+            }
+        }
     }
 }
 
@@ -356,16 +535,27 @@ pub fn fill_all(
     };
     for id in 0..maps.tile_count() {
         if uniform {
-            let tile = history.tile_for_write(maps, id);
-            if target.channels.kd {
-                tile.kd = Plane::Uniform(value.kd);
-            }
-            if target.channels.ks {
-                tile.ks = Plane::Uniform(value.ks);
-            }
-            if target.channels.n {
-                tile.n = Plane::Uniform(value.n);
-            }
+            // Build the new tile from the old one's untouched planes: no copy of what is
+            // overwritten.
+            let old = maps.tile(id);
+            let tile = Tile {
+                kd: if target.channels.kd {
+                    Plane::Uniform(value.kd)
+                } else {
+                    old.kd.clone()
+                },
+                ks: if target.channels.ks {
+                    Plane::Uniform(value.ks)
+                } else {
+                    old.ks.clone()
+                },
+                n: if target.channels.n {
+                    Plane::Uniform(value.n)
+                } else {
+                    old.n.clone()
+                },
+            };
+            history.replace_for_write(maps, id, tile);
         } else {
             let pre = pre_tile(history, maps, id);
             let tile = history.tile_for_write(maps, id);

@@ -145,6 +145,13 @@ fn encode_png(raster: &Raster, width: u32, height: u32) -> Result<Vec<u8>, Strin
 
 /// Serialises a document into project bytes (what [`save`] writes).
 pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    write_to(doc, &mut cursor)?;
+    Ok(cursor.into_inner())
+}
+
+/// Serialises a document as a project into `out`.
+pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
     let maps = &doc.maps;
     let (w, h) = (maps.width(), maps.height());
     let rasters: Vec<(&str, Raster)> = vec![
@@ -196,7 +203,7 @@ pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
         n: entry(&rasters[2]),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
-    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let mut zip = zip::ZipWriter::new(out);
     let deflated = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated);
     let stored = zip::write::SimpleFileOptions::default()
@@ -213,13 +220,24 @@ pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
             zip.write_all(&png).map_err(|e| e.to_string())?;
         }
     }
-    Ok(zip.finish().map_err(|e| e.to_string())?.into_inner())
+    zip.finish().map_err(|e| e.to_string())?;
+    Ok(())
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed to
-/// disk, renamed over `path`, and the directory flushed. On any failure the temporary file
-/// is removed and `path` is untouched.
+/// Writes `bytes` to `path` atomically (see [`write_atomic_with`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ModelError> {
+    write_atomic_with(path, |file| {
+        file.write_all(bytes).map_err(|e| e.to_string())
+    })
+}
+
+/// Writes a file atomically: `write` fills a temporary file in the same directory, which is
+/// flushed to disk, renamed over `path`, and the directory flushed. On any failure the
+/// temporary file is removed and `path` is untouched.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<File>) -> Result<(), String>,
+) -> Result<(), ModelError> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -229,30 +247,31 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ModelError> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| -> std::io::Result<()> {
-        let mut file = File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
+    let result = (|| -> Result<(), ModelError> {
+        let io = |e: std::io::Error| ModelError::io(path, e);
+        let mut file = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp).map_err(io)?);
+        write(&mut file).map_err(|reason| ModelError::Project {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+        let file = file.into_inner().map_err(|e| io(e.into_error()))?;
+        file.sync_all().map_err(io)?;
         drop(file);
-        std::fs::rename(&tmp, path)?;
+        std::fs::rename(&tmp, path).map_err(io)?;
         if let Ok(d) = File::open(dir) {
             let _ = d.sync_all();
         }
         Ok(())
     })();
-    result.map_err(|e| {
+    if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
-        ModelError::io(path, e)
-    })
+    }
+    result
 }
 
 /// Saves a document to `path` atomically.
 pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
-    let bytes = to_bytes(doc).map_err(|reason| ModelError::Project {
-        path: path.to_path_buf(),
-        reason,
-    })?;
-    write_atomic(path, &bytes)
+    write_atomic_with(path, |file| write_to(doc, file))
 }
 
 /// Loads and validates a project file.

@@ -1,0 +1,219 @@
+//! Criterion benches for the material model's targets (issue 3), on 4096^2 maps with all
+//! channels: a 128 px dab, a 100-dab stroke, a whole-map fill and its undo, the full k_a
+//! derive against a copy of the same bytes, and project save/load.
+
+#![allow(missing_docs)] // criterion_main! generates an undocumented main.
+#![allow(clippy::expect_used)]
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use glam::{Vec2, Vec3};
+use kapaint::model::brush::{BrushSettings, StrokePoint};
+use kapaint::model::history::History;
+use kapaint::model::paint::{Coverage, DiscFootprint, PaintTarget, paint_dab};
+use kapaint::model::texel::{MaterialValue, Texel};
+use kapaint::model::tile::TILE_TEXELS;
+use kapaint::model::{
+    Channels, Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool, project,
+};
+use kapaint::reflectance::{AmbientApprox, ShadingModel};
+use rayon::prelude::*;
+
+const SIDE: u32 = 4096;
+
+/// A document whose every tile holds varied data (nothing uniform).
+fn painted_document(side: u32) -> Document {
+    let mut doc = Document::new(side, side, DocumentSettings::default()).expect("size");
+    let count = doc.maps.tile_count();
+    for id in 0..count {
+        let tile = doc.maps.tile_mut(id);
+        for i in 0..TILE_TEXELS {
+            let h = (id * TILE_TEXELS + i) as u32;
+            let f =
+                |k: u32| ((h.wrapping_mul(2_654_435_761).rotate_left(k)) % 1000) as f32 / 1000.0;
+            tile.set_texel(
+                i,
+                Texel::encode(MaterialValue::new(
+                    Vec3::new(f(1), f(5), f(9)),
+                    Vec3::splat(f(13)),
+                    f(17) * 2000.0,
+                )),
+            );
+        }
+    }
+    doc
+}
+
+fn brush128() -> BrushSettings {
+    BrushSettings {
+        radius_px: 128.0,
+        hardness: 0.5,
+        flow: 0.5,
+        ..BrushSettings::default()
+    }
+}
+
+fn dabs(c: &mut Criterion) {
+    let mut group = c.benchmark_group("model_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(4));
+    let brush = brush128();
+    let target = PaintTarget::new(
+        MaterialValue::new(Vec3::new(1.0, 0.2, 0.1), Vec3::splat(0.6), 300.0),
+        Channels::ALL,
+        brush.blend,
+        false,
+    );
+    // One dab inside a stroke: tiles already private to the stroke, fresh coverage (every
+    // texel of the dab written).
+    let mut maps = MaterialMaps::new(SIDE, SIDE, MaterialValue::default()).expect("size");
+    let mut history = History::default();
+    history.begin("bench stroke");
+    let fp = DiscFootprint {
+        center: Vec2::new(2000.5, 1500.5),
+        radius: 128.0,
+        brush: &brush,
+    };
+    paint_dab(
+        &mut maps,
+        &mut history,
+        &mut Coverage::default(),
+        &target,
+        1.0,
+        0.5,
+        &fp,
+    );
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("dab_128px_all_channels", |b| {
+        b.iter_batched_ref(
+            Coverage::default,
+            |coverage| paint_dab(&mut maps, &mut history, coverage, &target, 1.0, 0.5, &fp),
+            BatchSize::SmallInput,
+        );
+    });
+    // A whole stroke of 100 dabs (spacing 25 % of 128 px) on a fresh document, including
+    // the copy-on-write of every tile it touches.
+    let base = Document::new(
+        SIDE,
+        SIDE,
+        DocumentSettings {
+            brush: brush128(),
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("size");
+    let points = vec![
+        StrokePoint {
+            pos: Vec2::new(400.0, 2048.0),
+            pressure: 1.0,
+        },
+        StrokePoint {
+            pos: Vec2::new(400.0 + 99.0 * 32.0, 2048.0),
+            pressure: 1.0,
+        },
+    ];
+    group.bench_function("stroke_100_dabs_128px", |b| {
+        b.iter_batched(
+            || Document::from_parts(base.maps.clone(), base.settings.clone()),
+            |mut doc| {
+                doc.apply(Command::Stroke {
+                    tool: StrokeTool::Brush,
+                    points: points.clone(),
+                })
+                .expect("stroke");
+                doc
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    group.finish();
+}
+
+fn fills_and_derive(c: &mut Criterion) {
+    let mut group = c.benchmark_group("model_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(4));
+    let painted = painted_document(SIDE);
+    group.bench_function("fill_whole_map", |b| {
+        b.iter_batched(
+            || Document::from_parts(painted.maps.clone(), painted.settings.clone()),
+            |mut doc| {
+                doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+                doc
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    group.bench_function("undo_whole_map_fill", |b| {
+        b.iter_batched(
+            || {
+                let mut doc = Document::from_parts(painted.maps.clone(), painted.settings.clone());
+                doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+                doc
+            },
+            |mut doc| {
+                doc.apply(Command::Undo).expect("undo");
+                doc
+            },
+            BatchSize::LargeInput,
+        );
+    });
+    let texels = (SIDE * SIDE) as usize;
+    let mut out = vec![Vec3::ZERO; texels];
+    group.throughput(Throughput::Elements(texels as u64));
+    group.bench_function("derive_ka_full_map", |b| {
+        b.iter(|| {
+            painted
+                .maps
+                .derive_ka_into(ShadingModel::Phong, AmbientApprox::Fast, &mut out);
+        });
+    });
+    // The same bytes as the stored maps (14 per texel), copied on all threads.
+    let bytes = texels * 14;
+    let src = vec![1u8; bytes];
+    let mut dst = vec![0u8; bytes];
+    group.bench_function("memcpy_same_bytes", |b| {
+        b.iter(|| {
+            dst.par_chunks_mut(1 << 20)
+                .zip(src.par_chunks(1 << 20))
+                .for_each(|(d, s)| d.copy_from_slice(s));
+            black_box(&dst);
+        });
+    });
+    group.finish();
+}
+
+fn project_io(c: &mut Criterion) {
+    let mut group = c.benchmark_group("project_8192");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
+    // A typical project (the spot texture in k_d, an n gradient, 50 strokes); uniformly
+    // random maps, which no PNG compresses, are the worst case and are reported separately.
+    let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot/spot_texture.png");
+    let doc = kapaint::report::typical::typical_document(
+        8192,
+        texture.exists().then_some(texture.as_path()),
+        50,
+    )
+    .expect("typical document");
+    let dir = std::env::temp_dir().join(format!("kapaint-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("big.kapaint");
+    group.bench_function("save", |b| {
+        b.iter(|| project::save(&doc, &path).expect("save"));
+    });
+    group.bench_function("load", |b| {
+        b.iter(|| black_box(project::load(&path).expect("load")));
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    group.finish();
+}
+
+criterion_group!(benches, dabs, fills_and_derive, project_io);
+criterion_main!(benches);
