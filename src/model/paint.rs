@@ -100,6 +100,9 @@ impl Footprint for DiscFootprint<'_> {
         let ys = ((self.center.y - r).floor().max(y0 as f32) as u32).max(y0);
         let ye = ((self.center.y + r).ceil().min(y1 as f32) as u32).min(y1);
         let mut weights = [0.0_f32; TILE_SIZE];
+        let inner2 = self.brush.hardness * self.brush.hardness * r2;
+        let hard = r2 - inner2 <= r2 * 1e-4;
+        let inv_ring = if hard { 0.0 } else { 1.0 / (r2 - inner2) };
         for y in ys..ye {
             let dy = y as f32 + 0.5 - self.center.y;
             let rem = r2 - dy * dy;
@@ -115,9 +118,20 @@ impl Footprint for DiscFootprint<'_> {
             }
             let run = &mut weights[..(xe - xs) as usize];
             let dy2 = dy * dy;
-            for (k, w) in run.iter_mut().enumerate() {
-                let dx = (xs + k as u32) as f32 + 0.5 - self.center.x;
-                *w = self.brush.falloff_sq(dx * dx + dy2, r2);
+            let x_start = xs as f32 + 0.5 - self.center.x;
+            if hard {
+                for (k, w) in run.iter_mut().enumerate() {
+                    let dx = x_start + k as f32;
+                    *w = if dx * dx + dy2 < r2 { 1.0 } else { 0.0 };
+                }
+            } else {
+                // BrushSettings::falloff_sq with its constants hoisted: clamping
+                // (R^2 - d^2) / (R^2 - (hR)^2) into [0, 1] covers the core and the rim.
+                for (k, w) in run.iter_mut().enumerate() {
+                    let dx = x_start + k as f32;
+                    let t = ((r2 - (dx * dx + dy2)) * inv_ring).clamp(0.0, 1.0);
+                    *w = t * t * (3.0 - 2.0 * t);
+                }
             }
             if let Some(stamp) = &self.brush.stamp {
                 for (k, w) in run.iter_mut().enumerate() {
@@ -408,19 +422,15 @@ fn paint_tile(
             );
         }
         if let Some(n) = n.as_deref_mut() {
-            for (k, (out, &a)) in n[start..start + len]
-                .iter_mut()
-                .zip(a_run.iter())
-                .enumerate()
-            {
-                let u = mode.apply(
-                    tables.to_blend[pre.n.get(start + k) as usize],
-                    target.n_blend,
-                    a,
-                );
-                let idx = (u * FROM_BLEND_STEPS as f32 + 0.5) as usize;
-                *out = tables.from_blend[idx.min(FROM_BLEND_STEPS)];
-            }
+            blend_n_run(
+                &mut n[start..start + len],
+                &pre.n,
+                start,
+                target.n_blend,
+                a_run,
+                mode,
+                tables,
+            );
         }
     });
 }
@@ -437,25 +447,74 @@ fn blend_rgb_run(
     mode: BlendMode,
 ) {
     use super::tile::Plane;
-    let pre_at = |k: usize| match pre {
-        Plane::Uniform(v) => *v,
-        Plane::Data(d) => d[start + k],
-    };
-    if mode == BlendMode::Normal {
-        let t = target16.map(i32::from);
-        for (k, (o, &a)) in out.iter_mut().zip(alpha).enumerate() {
+    let t = target16.map(i32::from);
+    let mix = |p: [u16; 3], a: f32| -> [u16; 3] {
+        if mode == BlendMode::Normal {
             let a15 = (a * 32768.0) as i32;
-            let p = pre_at(k);
-            for c in 0..3 {
+            let m = |c: usize| {
                 let pc = i32::from(p[c]);
-                o[c] = (pc + (((t[c] - pc) * a15 + 16384) >> 15)) as u16;
+                (pc + (((t[c] - pc) * a15 + 16384) >> 15)) as u16
+            };
+            [m(0), m(1), m(2)]
+        } else {
+            let m = |c: usize| encode_unorm(mode.apply(decode_unorm(p[c]), target[c], a));
+            [m(0), m(1), m(2)]
+        }
+    };
+    match pre {
+        Plane::Uniform(p) => {
+            for (o, &a) in out.iter_mut().zip(alpha) {
+                *o = mix(*p, a);
             }
         }
-    } else {
-        for (k, (o, &a)) in out.iter_mut().zip(alpha).enumerate() {
-            let p = pre_at(k);
-            for c in 0..3 {
-                o[c] = encode_unorm(mode.apply(decode_unorm(p[c]), target[c], a));
+        Plane::Data(d) => {
+            for ((o, &p), &a) in out
+                .iter_mut()
+                .zip(&d[start..start + alpha.len()])
+                .zip(alpha)
+            {
+                *o = mix(p, a);
+            }
+        }
+    }
+}
+
+/// Blends a run of half-float `n` texels in log space through the lookup tables.
+fn blend_n_run(
+    out: &mut [u16],
+    pre: &super::tile::Plane<u16>,
+    start: usize,
+    target: f32,
+    alpha: &[f32],
+    mode: BlendMode,
+    tables: &NTables,
+) {
+    use super::tile::Plane;
+    let to_bits = |u: f32| {
+        let idx = (u * FROM_BLEND_STEPS as f32 + 0.5) as usize;
+        tables.from_blend[idx.min(FROM_BLEND_STEPS)]
+    };
+    let mix = |u: f32, a: f32| {
+        if mode == BlendMode::Normal {
+            u * (1.0 - a) + target * a
+        } else {
+            mode.apply(u, target, a)
+        }
+    };
+    match pre {
+        Plane::Uniform(bits) => {
+            let u = tables.to_blend[*bits as usize];
+            for (o, &a) in out.iter_mut().zip(alpha) {
+                *o = to_bits(mix(u, a));
+            }
+        }
+        Plane::Data(d) => {
+            for ((o, &bits), &a) in out
+                .iter_mut()
+                .zip(&d[start..start + alpha.len()])
+                .zip(alpha)
+            {
+                *o = to_bits(mix(tables.to_blend[bits as usize], a));
             }
         }
     }
