@@ -256,3 +256,134 @@ fn bench_writes_csv_and_a_decodable_plot() {
     assert!(png.width() > 100 && png.height() > 100);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+fn temp_dir(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-cli-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+#[test]
+fn new_info_paint_and_import_work_end_to_end() {
+    let dir = temp_dir("project");
+    let file = dir.join("a.kapaint");
+    let path = file.to_str().expect("path");
+    let o = kapaint(&[
+        "new", "--size", "200x120", "--preset", "gold", "--out", path,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let info = stdout(&kapaint(&["info", path]));
+    assert!(info.contains("size: 200x120"), "{info}");
+    assert!(info.contains("preset: Gold"), "{info}");
+    assert!(info.contains("kd.r 0.7516"), "{info}");
+    // Refuses to overwrite without --force.
+    assert_usage_error(&kapaint(&["new", "--size", "8", "--out", path]), "--force");
+
+    let script = dir.join("s.ron");
+    std::fs::write(
+        &script,
+        "(commands: [SetPrimary((kd: (0.0, 0.0, 1.0), ks: (0.1, 0.1, 0.1), n: 9.0)), \
+         Stroke(tool: Brush, points: [(pos: (10.0, 60.0), pressure: 1.0), (pos: (190.0, 60.0), pressure: 1.0)])])",
+    )
+    .expect("write script");
+    let o = kapaint(&["paint", path, "--script", script.to_str().expect("path")]);
+    assert!(o.status.success(), "{o:?}");
+    let info = stdout(&kapaint(&["info", path]));
+    assert!(
+        info.contains("kd.r 0.000000"),
+        "the stroke reached pure blue somewhere: {info}"
+    );
+
+    let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot/spot_texture.png");
+    let out = dir.join("b.kapaint");
+    let o = kapaint(&[
+        "import",
+        path,
+        "--channel",
+        "ks",
+        "--image",
+        texture.to_str().expect("path"),
+        "--out",
+        out.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    assert!(stdout(&kapaint(&["info", out.to_str().expect("path")])).contains("size: 200x120"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn failures_leave_the_input_file_untouched() {
+    let dir = temp_dir("untouched");
+    let file = dir.join("a.kapaint");
+    let path = file.to_str().expect("path");
+    assert!(
+        kapaint(&["new", "--size", "64", "--out", path])
+            .status
+            .success()
+    );
+    let before = std::fs::read(&file).expect("read");
+
+    let bad_script = dir.join("bad.ron");
+    std::fs::write(&bad_script, "(commands: [Teleport(1, 2)])").expect("write");
+    assert_usage_error(
+        &kapaint(&[
+            "paint",
+            path,
+            "--script",
+            bad_script.to_str().expect("path"),
+        ]),
+        "bad.ron",
+    );
+
+    let outside = dir.join("outside.ron");
+    std::fs::write(&outside, "(commands: [Fill(All), Pick(x: 999, y: 0)])").expect("write");
+    assert_usage_error(
+        &kapaint(&["paint", path, "--script", outside.to_str().expect("path")]),
+        "command 2",
+    );
+
+    let not_image = dir.join("x.png");
+    std::fs::write(&not_image, b"nope").expect("write");
+    assert_usage_error(
+        &kapaint(&[
+            "import",
+            path,
+            "--channel",
+            "kd",
+            "--image",
+            not_image.to_str().expect("path"),
+        ]),
+        "x.png",
+    );
+
+    assert_usage_error(
+        &kapaint(&[
+            "new",
+            "--size",
+            "64",
+            "--preset",
+            "nope",
+            "--out",
+            dir.join("c.kapaint").to_str().expect("path"),
+        ]),
+        "nope",
+    );
+    assert_usage_error(
+        &kapaint(&["info", dir.join("missing.kapaint").to_str().expect("path")]),
+        "missing.kapaint",
+    );
+    let garbage = dir.join("garbage.kapaint");
+    std::fs::write(&garbage, b"PK\x03\x04 truncated").expect("write");
+    assert_usage_error(
+        &kapaint(&["info", garbage.to_str().expect("path")]),
+        "not a valid kapaint project",
+    );
+
+    assert_eq!(
+        std::fs::read(&file).expect("read"),
+        before,
+        "the input file changed"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
