@@ -135,26 +135,13 @@ impl MaterialMaps {
     /// Several tiles for writing at once (each cloned first if shared), for parallel work on
     /// disjoint tiles. `ids` must be sorted ascending without duplicates; bumps versions.
     pub fn tiles_mut_many(&mut self, ids: &[TileId]) -> Vec<&mut Tile> {
-        debug_assert!(
-            ids.windows(2).all(|w| w[0] < w[1]),
-            "ids must be sorted and unique"
-        );
         for &id in ids {
             self.clock += 1;
             self.versions[id] = self.clock;
         }
-        let mut wanted = ids.iter().peekable();
-        self.tiles
-            .iter_mut()
-            .enumerate()
-            .filter_map(|(id, tile)| {
-                if wanted.peek() == Some(&&id) {
-                    wanted.next();
-                    Some(Arc::make_mut(tile))
-                } else {
-                    None
-                }
-            })
+        super::tile::select_mut(&mut self.tiles, ids)
+            .into_iter()
+            .map(Arc::make_mut)
             .collect()
     }
 
@@ -187,7 +174,8 @@ impl MaterialMaps {
         self.tiles.iter().map(|t| t.heap_bytes()).sum()
     }
 
-    /// Whether every texel of a channel plane holds the same value; returns it if so.
+    /// The texel every texel of the maps holds, if the maps are uniform (lets the GPU and the
+    /// exporter replace a map with a constant).
     pub fn uniform_texel(&self) -> Option<Texel> {
         let first = self.tiles.first()?;
         let t = Texel {

@@ -275,18 +275,9 @@ impl Coverage {
         for &id in ids {
             self.tiles[id].get_or_insert_with(|| vec![0.0; TILE_TEXELS].into_boxed_slice());
         }
-        let mut wanted = ids.iter().peekable();
-        self.tiles
-            .iter_mut()
-            .enumerate()
-            .filter_map(|(id, slot)| {
-                if wanted.peek() == Some(&&id) {
-                    wanted.next();
-                    slot.as_deref_mut()
-                } else {
-                    None
-                }
-            })
+        super::tile::select_mut(&mut self.tiles, ids)
+            .into_iter()
+            .filter_map(|slot| slot.as_deref_mut())
             .collect()
     }
 }

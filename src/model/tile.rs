@@ -8,6 +8,28 @@ pub const TILE_SIZE: usize = 64;
 /// Texels per tile.
 pub const TILE_TEXELS: usize = TILE_SIZE * TILE_SIZE;
 
+/// Disjoint mutable references to the elements of `items` at `ids` (sorted ascending, no
+/// duplicates), for parallel work on several tiles at once.
+pub fn select_mut<'a, T>(items: &'a mut [T], ids: &[usize]) -> Vec<&'a mut T> {
+    debug_assert!(
+        ids.windows(2).all(|w| w[0] < w[1]),
+        "ids must be sorted and unique"
+    );
+    let mut wanted = ids.iter().peekable();
+    items
+        .iter_mut()
+        .enumerate()
+        .filter_map(|(i, item)| {
+            if wanted.peek() == Some(&&i) {
+                wanted.next();
+                Some(item)
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
 /// One channel of a tile: a single value for every texel, or one value per texel.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Plane<T: Copy> {

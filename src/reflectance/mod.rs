@@ -196,10 +196,7 @@ pub fn derive_ka(
     n: &[f32],
     out: &mut [Vec3],
 ) {
-    assert!(
-        kd.len() == out.len() && ks.len() == out.len() && n.len() == out.len(),
-        "derive_ka: buffer lengths differ"
-    );
+    assert_same_lengths(kd, ks, n, out);
     match approx {
         // Monomorphise the hot loop per approximation so the choice is made once per buffer.
         AmbientApprox::Fast => {
@@ -216,6 +213,13 @@ pub fn derive_ka(
             });
         }
     }
+}
+
+fn assert_same_lengths(kd: &[Vec3], ks: &[Vec3], n: &[f32], out: &[Vec3]) {
+    assert!(
+        kd.len() == out.len() && ks.len() == out.len() && n.len() == out.len(),
+        "derive_ka: buffer lengths differ"
+    );
 }
 
 #[inline]
@@ -256,10 +260,7 @@ pub fn derive_ka_par(
     n: &[f32],
     out: &mut [Vec3],
 ) {
-    assert!(
-        kd.len() == out.len() && ks.len() == out.len() && n.len() == out.len(),
-        "derive_ka_par: buffer lengths differ"
-    );
+    assert_same_lengths(kd, ks, n, out);
     out.par_chunks_mut(DERIVE_CHUNK_TEXELS)
         .enumerate()
         .for_each(|(i, chunk)| {
