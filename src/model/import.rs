@@ -92,6 +92,33 @@ pub fn import_into(doc: &mut Document, channel: Channel, image: &DynamicImage) {
     doc.history.end();
 }
 
+/// Reads a grayscale brush stamp from an image file (luminance of the decoded image; an
+/// alpha channel, if present, multiplies it), at most 1024 x 1024 pixels.
+pub fn read_stamp(path: &Path) -> Result<super::brush::Stamp, ModelError> {
+    let image = read_image(path)?;
+    if image.width() > 1024 || image.height() > 1024 {
+        return Err(ModelError::Image {
+            path: path.to_path_buf(),
+            reason: format!(
+                "a stamp is at most 1024x1024 pixels, this one is {}x{}",
+                image.width(),
+                image.height()
+            ),
+        });
+    }
+    let rgba = image.to_rgba32f();
+    let alpha = rgba
+        .pixels()
+        .map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) * p[3])
+        .collect();
+    super::brush::Stamp::new(image.width(), image.height(), alpha).ok_or_else(|| {
+        ModelError::Image {
+            path: path.to_path_buf(),
+            reason: "the stamp image is empty".into(),
+        }
+    })
+}
+
 /// Reads `path` and imports it into `channel`.
 pub fn import_file(doc: &mut Document, channel: Channel, path: &Path) -> Result<(), ModelError> {
     let image = read_image(path)?;

@@ -527,3 +527,29 @@ impl Autosave {
         self.last_version = version;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn autosave_is_due_only_after_a_change_and_the_interval() {
+        let t0 = Instant::now();
+        let mut autosave = Autosave::new(Duration::from_mins(1), t0, 5);
+        assert!(
+            !autosave.due(t0 + Duration::from_mins(2), 5),
+            "nothing changed"
+        );
+        assert!(!autosave.due(t0 + Duration::from_secs(30), 6), "too soon");
+        assert!(autosave.due(t0 + Duration::from_secs(61), 6));
+        autosave.saved(t0 + Duration::from_secs(61), 6);
+        assert!(!autosave.due(t0 + Duration::from_secs(100), 6));
+    }
+
+    #[test]
+    fn recovery_files_sit_beside_the_project() {
+        let p = recovery_path(Some(Path::new("/work/art/cow.kapaint")));
+        assert_eq!(p, Path::new("/work/art/.cow.kapaint-recovery"));
+        assert!(recovery_path(None).ends_with("kapaint/untitled.kapaint-recovery"));
+    }
+}
