@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 
+use crate::mesh;
 use crate::model::{self, Channel, Document, DocumentSettings, ModelError, import, project};
 use crate::reflectance::{
     self, AmbientApprox, ShadingModel, TWO_OVER_PI,
@@ -131,6 +132,12 @@ pub enum Command {
         /// Write the result here instead of over FILE.
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Print a mesh's vertices, triangles, UV islands, bounds, and whether normals and UVs were
+    /// present (FILE is an .obj file, or sphere, plane, cube, torus).
+    MeshInfo {
+        /// Mesh file or built-in name.
+        file: PathBuf,
     },
     /// Time the k_a derive of a full map per method against its error and a memory copy.
     Bench {
@@ -326,6 +333,20 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                 "applied {count} commands, saved {}\n",
                 target.display()
             ))
+        }
+        Command::MeshInfo { file } => {
+            let builtin = match file.to_str() {
+                Some("sphere") if !file.exists() => Some(mesh::uv_sphere(64, 32)),
+                Some("plane") if !file.exists() => Some(mesh::plane()),
+                Some("cube") if !file.exists() => Some(mesh::cube()),
+                Some("torus") if !file.exists() => Some(mesh::torus(1.0, 0.35, 64, 32)),
+                _ => None,
+            };
+            let mesh = match builtin {
+                Some(m) => m,
+                None => mesh::load(&file).map_err(|e| CliError::usage(e.to_string()))?,
+            };
+            Ok(mesh::info_text(&file, &mesh))
         }
         Command::Bench { size, out, repeats } => {
             if !(16..=16384).contains(&size) {

@@ -4,6 +4,7 @@
 //! [`reflectance`] is the numerical core (no GUI or GPU code), [`report`] measures it.
 
 pub mod cli;
+pub mod mesh;
 pub mod model;
 pub mod reflectance;
 pub mod report;

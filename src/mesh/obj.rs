@@ -1,0 +1,153 @@
+//! Wavefront OBJ import (through `tobj`): every object and group, polygons triangulated.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::{MAX_FILE_BYTES, Mesh, MeshError, smooth_normals};
+
+/// Loads an OBJ file. Vertices are split per distinct (position, UV, normal) index triple;
+/// missing normals are computed smooth per position index.
+#[allow(clippy::too_many_lines)] // One pass over the file's objects; splitting it hides the flow.
+pub fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
+    let invalid = |reason: String| MeshError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(invalid(format!(
+            "the file is {} bytes, more than the 2 GiB supported",
+            meta.len()
+        )));
+    }
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _materials) = tobj::load_obj(path, &options)
+        .map_err(|e| invalid(format!("not a valid OBJ file: {e}")))?;
+
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    let mut normals = Vec::new();
+    let mut group = Vec::new();
+    let mut triangles = Vec::new();
+    let mut position_base = 0usize;
+    let (mut any_uv, mut all_uv, mut all_normals) = (false, true, true);
+    for model in &models {
+        let m = &model.mesh;
+        let count = m.positions.len() / 3;
+        if m.indices.len() % 3 != 0 {
+            return Err(invalid(format!(
+                "object {:?} has a face that did not triangulate",
+                model.name
+            )));
+        }
+        let has_uv = !m.texcoord_indices.is_empty();
+        let has_n = !m.normal_indices.is_empty();
+        if (has_uv && m.texcoord_indices.len() != m.indices.len())
+            || (has_n && m.normal_indices.len() != m.indices.len())
+        {
+            return Err(invalid(format!(
+                "object {:?} mixes faces with and without UVs or normals",
+                model.name
+            )));
+        }
+        any_uv |= has_uv;
+        all_uv &= has_uv;
+        all_normals &= has_n;
+        let mut map: HashMap<(u32, u32, u32), u32> = HashMap::new();
+        let mut corner = |k: usize| -> Result<u32, MeshError> {
+            let p = m.indices[k];
+            let t = if has_uv {
+                m.texcoord_indices[k]
+            } else {
+                u32::MAX
+            };
+            let nn = if has_n { m.normal_indices[k] } else { u32::MAX };
+            if p as usize >= count {
+                return Err(invalid(format!(
+                    "a face refers to vertex {} of {count}",
+                    p + 1
+                )));
+            }
+            if let Some(&v) = map.get(&(p, t, nn)) {
+                return Ok(v);
+            }
+            let v =
+                u32::try_from(positions.len()).map_err(|_| invalid("too many vertices".into()))?;
+            let pi = p as usize * 3;
+            positions.push(Vec3::new(
+                m.positions[pi],
+                m.positions[pi + 1],
+                m.positions[pi + 2],
+            ));
+            group.push(position_base + p as usize);
+            if has_uv {
+                let ti = t as usize * 2;
+                let uv = m.texcoords.get(ti..ti + 2).ok_or_else(|| {
+                    invalid(format!(
+                        "a face refers to UV {} of {}",
+                        t + 1,
+                        m.texcoords.len() / 2
+                    ))
+                })?;
+                uvs.push(Vec2::new(uv[0], uv[1]));
+            } else {
+                uvs.push(Vec2::ZERO);
+            }
+            if has_n {
+                let ni = nn as usize * 3;
+                let n = m.normals.get(ni..ni + 3).ok_or_else(|| {
+                    invalid(format!(
+                        "a face refers to normal {} of {}",
+                        nn + 1,
+                        m.normals.len() / 3
+                    ))
+                })?;
+                normals.push(Vec3::new(n[0], n[1], n[2]));
+            } else {
+                normals.push(Vec3::ZERO);
+            }
+            map.insert((p, t, nn), v);
+            Ok(v)
+        };
+        for k in (0..m.indices.len()).step_by(3) {
+            triangles.push([corner(k)?, corner(k + 1)?, corner(k + 2)?]);
+        }
+        position_base += count;
+    }
+    if any_uv && !all_uv {
+        return Err(invalid("some objects have UVs and others do not".into()));
+    }
+    let name = path
+        .file_name()
+        .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned());
+    let had_normals = all_normals
+        && !triangles.is_empty()
+        && normals
+            .iter()
+            .all(|n: &Vec3| n.is_finite() && n.length_squared() > 0.0);
+    let normals = if had_normals {
+        normals.into_iter().map(Vec3::normalize).collect()
+    } else {
+        smooth_normals(&positions, &triangles, &group, position_base)
+    };
+    let mesh = Mesh {
+        name,
+        positions,
+        normals,
+        uvs: any_uv.then_some(uvs),
+        triangles,
+        had_normals,
+    };
+    mesh.validate().map_err(invalid)?;
+    Ok(mesh)
+}

@@ -1,0 +1,158 @@
+//! Mesh import against the real spot files of `../shared/testdata`, and corrupted copies.
+
+#![allow(clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+
+use kapaint::mesh::{self, Mesh};
+
+fn spot(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot")
+        .join(name)
+}
+
+fn temp(name: &str, text: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(name);
+    std::fs::write(&path, text).expect("write");
+    path
+}
+
+#[test]
+fn spot_loads_with_uvs_and_computed_normals() {
+    let tri = mesh::load(&spot("spot_triangulated.obj")).expect("loads");
+    let quad = mesh::load(&spot("spot_quadrangulated.obj")).expect("loads");
+    for m in [&tri, &quad] {
+        assert_eq!(m.triangles.len(), 5856);
+        assert!(m.uvs.is_some());
+        assert!(!m.had_normals);
+        m.validate().expect("valid");
+        assert!(m.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
+        assert!(m.paintable().is_ok());
+    }
+    assert_eq!(tri.bounds(), quad.bounds());
+    assert_eq!(tri.uv_islands(), quad.uv_islands());
+    assert!(tri.uv_islands() >= 1);
+}
+
+#[test]
+fn normals_are_smooth_across_uv_seams() {
+    let m = mesh::load(&spot("spot_triangulated.obj")).expect("loads");
+    // Vertices split only by UV (same position) carry the same normal.
+    let mut by_position = std::collections::HashMap::new();
+    let mut split = 0;
+    for (p, n) in m.positions.iter().zip(&m.normals) {
+        let key = (p.x.to_bits(), p.y.to_bits(), p.z.to_bits());
+        if let Some(first) = by_position.insert(key, *n) {
+            split += 1;
+            assert!((first - *n).length() < 1e-6, "seam normal differs");
+        }
+    }
+    assert!(split > 0, "spot has UV seams");
+    // They agree with the winding of the faces around them...
+    let agree = m
+        .triangles
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let face = (b - a).cross(c - a);
+            t.iter().all(|&i| face.dot(m.normals[i as usize]) > 0.0)
+        })
+        .count();
+    assert!(
+        agree * 100 > m.triangles.len() * 98,
+        "{agree} of {}",
+        m.triangles.len()
+    );
+    // ...and the faces wind outwards: a closed surface with positive signed volume.
+    let volume: f32 = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum();
+    assert!(volume > 0.0, "signed volume {volume}");
+}
+
+#[test]
+fn meshes_without_uvs_preview_but_refuse_painting() {
+    let path = temp("nouv.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let m = mesh::load(&path).expect("loads");
+    let err = m.paintable().expect_err("no UVs");
+    assert!(
+        err.contains("no UV coordinates") && err.contains("nouv.obj"),
+        "{err}"
+    );
+    assert_eq!(m.uv_islands(), 0);
+}
+
+#[test]
+fn corrupt_obj_files_are_clear_errors_naming_the_file() {
+    let text = std::fs::read(spot("spot_triangulated.obj")).expect("read");
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("empty.obj", Vec::new(), "no triangles"),
+        ("range.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 9\n".to_vec(), ""),
+        (
+            "nan.obj",
+            b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
+            "",
+        ),
+        (
+            "garbage.obj",
+            vec![0xff, 0xfe, 0x00, 0x41, 0x42, 0x0a, 0x66, 0x20, 0x31],
+            "",
+        ),
+        ("points.obj", b"v 0 0 0\nv 1 0 0\n".to_vec(), "no triangles"),
+        ("cut.obj", text[..text.len() * 2 / 3].to_vec(), ""),
+    ];
+    for (name, bytes, needle) in cases {
+        let path = temp(name, &bytes);
+        match mesh::load(&path) {
+            Err(e) => {
+                let e = e.to_string();
+                assert!(e.contains(name), "{e}");
+                assert!(e.contains(needle), "{e} should mention {needle}");
+            }
+            // A file cut between lines can be a smaller valid mesh; it must then be valid.
+            Ok(m) => {
+                assert_eq!(name, "cut.obj", "{name} should not load");
+                m.validate().expect("a loaded mesh is valid");
+            }
+        }
+    }
+    let unknown = temp("model.fbx", b"whatever");
+    assert!(
+        mesh::load(&unknown)
+            .expect_err("unsupported")
+            .to_string()
+            .contains("unsupported")
+    );
+}
+
+#[test]
+fn mesh_info_cli_reports_the_spot_mesh() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args([
+            "mesh-info",
+            spot("spot_quadrangulated.obj").to_str().expect("path"),
+        ])
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(text.contains("triangles: 5856"), "{text}");
+    assert!(
+        text.contains("normals: computed") && text.contains("uvs: present"),
+        "{text}"
+    );
+    let sphere = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(["mesh-info", "sphere"])
+        .output()
+        .expect("runs");
+    assert!(String::from_utf8_lossy(&sphere.stdout).contains("uv islands: 1"));
+    let _: Option<Mesh> = None;
+}
