@@ -156,3 +156,106 @@ fn mesh_info_cli_reports_the_spot_mesh() {
     assert!(String::from_utf8_lossy(&sphere.stdout).contains("uv islands: 1"));
     let _: Option<Mesh> = None;
 }
+
+/// Exact (f64) point-in-triangle test, inclusive of edges.
+fn inside(p: (f64, f64), a: (f64, f64), b: (f64, f64), c: (f64, f64)) -> bool {
+    let cross = |o: (f64, f64), u: (f64, f64), v: (f64, f64)| {
+        (u.0 - o.0) * (v.1 - o.1) - (u.1 - o.1) * (v.0 - o.0)
+    };
+    let (d1, d2, d3) = (cross(a, b, p), cross(b, c, p), cross(c, a, p));
+    let neg = d1 < 0.0 || d2 < 0.0 || d3 < 0.0;
+    let pos = d1 > 0.0 || d2 > 0.0 || d3 > 0.0;
+    !(neg && pos)
+}
+
+fn check_coverage(m: &Mesh, w: u32, h: u32) {
+    use kapaint::mesh::bake::{Coverage, bake};
+    let baked = bake(m, w, h, 0).expect("bakes");
+    let uvs = m.uvs.as_ref().expect("uvs");
+    let mut must = vec![false; (w * h) as usize];
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| {
+            let uv = uvs[i as usize];
+            (
+                f64::from(uv.x) * f64::from(w),
+                (1.0 - f64::from(uv.y)) * f64::from(h),
+            )
+        });
+        let x0 = a.0.min(b.0).min(c.0).floor().max(0.0) as u32;
+        let x1 = (a.0.max(b.0).max(c.0).ceil() as u32).min(w - 1);
+        let y0 = a.1.min(b.1).min(c.1).floor().max(0.0) as u32;
+        let y1 = (a.1.max(b.1).max(c.1).ceil() as u32).min(h - 1);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                if inside((f64::from(x) + 0.5, f64::from(y) + 0.5), a, b, c) {
+                    must[(y * w + x) as usize] = true;
+                }
+            }
+        }
+    }
+    let missed = must
+        .iter()
+        .zip(&baked.coverage)
+        .filter(|(m, c)| **m && **c == Coverage::Empty)
+        .count();
+    assert_eq!(
+        missed, 0,
+        "{missed} texels whose centre lies in a triangle are not covered"
+    );
+    // Every covered texel holds a finite point of the surface and a unit normal.
+    for k in 0..must.len() {
+        if baked.coverage[k] != Coverage::Empty {
+            assert!(baked.position[k].is_finite());
+            assert!((baked.normal[k].length() - 1.0).abs() < 1e-3);
+            assert!(baked.triangle[k] != u32::MAX && baked.island[k] != u32::MAX);
+        }
+    }
+    // Conservative, not sloppy: covered texels beyond the centre-inside set are a thin rim.
+    let extra = baked
+        .coverage
+        .iter()
+        .zip(&must)
+        .filter(|(c, m)| **c != Coverage::Empty && !**m)
+        .count();
+    let inner = must.iter().filter(|m| **m).count();
+    assert!(extra < inner, "{extra} rim texels for {inner} inside");
+}
+
+#[test]
+fn bake_covers_every_texel_inside_a_uv_triangle() {
+    check_coverage(
+        &mesh::load(&spot("spot_triangulated.obj")).expect("loads"),
+        512,
+        512,
+    );
+    check_coverage(&mesh::uv_sphere(48, 24), 256, 128);
+    check_coverage(&mesh::cube(), 300, 200);
+}
+
+#[test]
+fn bake_padding_grows_islands() {
+    use kapaint::mesh::bake::{Coverage, bake};
+    let cube = mesh::cube();
+    let plain = bake(&cube, 256, 256, 0).expect("bakes");
+    let padded = bake(&cube, 256, 256, 3).expect("bakes");
+    let count = |b: &kapaint::mesh::bake::UvBake, c: Coverage| {
+        b.coverage.iter().filter(|x| **x == c).count()
+    };
+    assert_eq!(count(&plain, Coverage::Padding), 0);
+    assert!(count(&padded, Coverage::Padding) > 0);
+    assert_eq!(
+        count(&plain, Coverage::Surface),
+        count(&padded, Coverage::Surface)
+    );
+    // Padding copies a neighbour's surface point: its island is a real one.
+    for (k, c) in padded.coverage.iter().enumerate() {
+        if *c == Coverage::Padding {
+            assert!(padded.island[k] < 6);
+        }
+    }
+    let no_uv = Mesh {
+        uvs: None,
+        ..mesh::plane()
+    };
+    assert!(bake(&no_uv, 16, 16, 0).is_err());
+}

@@ -5,6 +5,7 @@
 //! upwards (texel row = `(1 - v) * height`). Vertices are split wherever an attribute differs,
 //! so a UV seam is two vertices at one position.
 
+pub mod bake;
 mod builtin;
 mod obj;
 
