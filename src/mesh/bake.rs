@@ -223,54 +223,67 @@ pub fn bake(mesh: &Mesh, width: u32, height: u32, padding: u32) -> Result<UvBake
 }
 
 /// Grows every island by `rings` texels: each empty texel next to a filled one (8 neighbours,
-/// first found in a fixed order) copies it.
+/// taken in a fixed order) copies it. Works on the frontier only, so the cost is the islands'
+/// perimeter times `rings`, not the whole map per ring.
 fn dilate(bake: &mut UvBake, rings: u32) {
+    const NEIGHBOURS: [(i64, i64); 8] = [
+        (-1, 0),
+        (1, 0),
+        (0, -1),
+        (0, 1),
+        (-1, -1),
+        (1, -1),
+        (-1, 1),
+        (1, 1),
+    ];
     let (w, h) = (i64::from(bake.width), i64::from(bake.height));
+    let neighbours = move |k: usize| {
+        let (x, y) = (k as i64 % w, k as i64 / w);
+        NEIGHBOURS.iter().filter_map(move |&(dx, dy)| {
+            let (nx, ny) = (x + dx, y + dy);
+            (nx >= 0 && ny >= 0 && nx < w && ny < h).then(|| (ny * w + nx) as usize)
+        })
+    };
+    // Empty texels touching a filled one, found in parallel over rows.
+    let mut frontier: Vec<usize> = bake
+        .coverage
+        .par_iter()
+        .enumerate()
+        .filter(|&(k, c)| {
+            *c == Coverage::Empty && neighbours(k).any(|n| bake.coverage[n] != Coverage::Empty)
+        })
+        .map(|(k, _)| k)
+        .collect();
     for _ in 0..rings {
-        let filled: Vec<bool> = bake
-            .coverage
-            .iter()
-            .map(|c| *c != Coverage::Empty)
-            .collect();
-        let sources: Vec<Option<usize>> = (0..(w * h) as usize)
-            .into_par_iter()
-            .map(|k| {
-                if filled[k] {
-                    return None;
-                }
-                let (x, y) = (k as i64 % w, k as i64 / w);
-                for (dx, dy) in [
-                    (-1, 0),
-                    (1, 0),
-                    (0, -1),
-                    (0, 1),
-                    (-1, -1),
-                    (1, -1),
-                    (-1, 1),
-                    (1, 1),
-                ] {
-                    let (nx, ny) = (x + dx, y + dy);
-                    if nx >= 0 && ny >= 0 && nx < w && ny < h && filled[(ny * w + nx) as usize] {
-                        return Some((ny * w + nx) as usize);
-                    }
-                }
-                None
-            })
-            .collect();
-        let mut any = false;
-        for (k, source) in sources.into_iter().enumerate() {
-            if let Some(s) = source {
-                any = true;
-                bake.position[k] = bake.position[s];
-                bake.normal[k] = bake.normal[s];
-                bake.triangle[k] = bake.triangle[s];
-                bake.island[k] = bake.island[s];
-                bake.coverage[k] = Coverage::Padding;
-            }
-        }
-        if !any {
+        if frontier.is_empty() {
             break;
         }
+        // Sources are chosen against the state before this ring, then written.
+        let fills: Vec<(usize, usize)> = frontier
+            .iter()
+            .filter_map(|&k| {
+                neighbours(k)
+                    .find(|&n| bake.coverage[n] != Coverage::Empty)
+                    .map(|s| (k, s))
+            })
+            .collect();
+        for &(k, src) in &fills {
+            bake.position[k] = bake.position[src];
+            bake.normal[k] = bake.normal[src];
+            bake.triangle[k] = bake.triangle[src];
+            bake.island[k] = bake.island[src];
+        }
+        for &(k, _) in &fills {
+            bake.coverage[k] = Coverage::Padding;
+        }
+        let mut next: Vec<usize> = fills
+            .iter()
+            .flat_map(|&(k, _)| neighbours(k))
+            .filter(|&n| bake.coverage[n] == Coverage::Empty)
+            .collect();
+        next.sort_unstable();
+        next.dedup();
+        frontier = next;
     }
 }
 
