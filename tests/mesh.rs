@@ -259,3 +259,46 @@ fn bake_padding_grows_islands() {
     };
     assert!(bake(&no_uv, 16, 16, 0).is_err());
 }
+
+#[test]
+fn picking_agrees_with_brute_force_on_random_rays() {
+    use glam::Vec3;
+    use kapaint::mesh::pick::{Bvh, intersect};
+    for m in [
+        mesh::load(&spot("spot_triangulated.obj")).expect("loads"),
+        mesh::torus(1.0, 0.3, 40, 20),
+    ] {
+        let bvh = Bvh::build(&m);
+        let (lo, hi) = m.bounds();
+        let (center, size) = ((lo + hi) / 2.0, (hi - lo).length());
+        let mut state = 0x9E37_79B9_u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin =
+                center + Vec3::new(next(), next(), next()).normalize_or(Vec3::X) * size * 1.5;
+            let aim = center + Vec3::new(next(), next(), next()) * (hi - lo) * 0.5;
+            let dir = aim - origin;
+            let brute = (0..m.triangles.len() as u32)
+                .filter_map(|t| intersect(&m, t, origin, dir).map(|(d, _, _)| (d, t)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let fast = bvh.pick(&m, origin, dir);
+            match (brute, fast) {
+                (None, None) => {}
+                (Some((d, _)), Some(hit)) => {
+                    hits += 1;
+                    assert!((hit.t - d).abs() <= 1e-5 * d.max(1.0), "t {} vs {d}", hit.t);
+                    assert!((origin + dir * hit.t - hit.position).length() < 1e-3 * size);
+                    assert!(hit.uv.is_some() && (hit.barycentric.element_sum() - 1.0).abs() < 1e-5);
+                }
+                (b, f) => panic!("brute force {b:?} but BVH {f:?}"),
+            }
+        }
+        assert!(hits > 500, "only {hits} rays hit");
+    }
+}

@@ -8,6 +8,7 @@
 pub mod bake;
 mod builtin;
 mod obj;
+pub mod pick;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
