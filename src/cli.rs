@@ -360,7 +360,13 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             let rows = bench::run(size, repeats, 48);
             let table = bench::markdown(&rows, size);
             if let Some(dir) = out {
-                write_atomic(&dir.join("bench.csv"), bench::csv(&rows).as_bytes())?;
+                let csv = dir.join("bench.csv");
+                crate::atomic::write_atomic(&csv, bench::csv(&rows).as_bytes()).map_err(|e| {
+                    CliError {
+                        message: format!("cannot write {}: {e}", csv.display()),
+                        code: 1,
+                    }
+                })?;
                 let png = dir.join("bench.png");
                 bench::plot(&rows, &png).map_err(|e| CliError {
                     message: e,
@@ -557,24 +563,4 @@ fn parse_rgb(flag: &str, text: &str, allow_scalar: bool) -> Result<DVec3, CliErr
             "{flag} must be R,G,B, got {text:?}"
         ))),
     }
-}
-
-/// Writes a file atomically: a temporary file beside it, flushed to disk, then renamed.
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<(), CliError> {
-    let fail = |e: std::io::Error| CliError {
-        message: format!("cannot write {}: {e}", path.display()),
-        code: 1,
-    };
-    let tmp = path.with_extension("tmp-kapaint");
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(fail(e));
-    }
-    Ok(())
 }

@@ -3,6 +3,7 @@
 //! The library holds all logic; the `kapaint` binary is a thin shell around [`cli::main`].
 //! [`reflectance`] is the numerical core (no GUI or GPU code), [`report`] measures it.
 
+pub mod atomic;
 pub mod cli;
 pub mod mesh;
 pub mod model;

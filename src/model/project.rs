@@ -224,54 +224,14 @@ pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes `bytes` to `path` atomically (see [`write_atomic_with`]).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ModelError> {
-    write_atomic_with(path, |file| {
-        file.write_all(bytes).map_err(|e| e.to_string())
-    })
-}
-
-/// Writes a file atomically: `write` fills a temporary file in the same directory, which is
-/// flushed to disk, renamed over `path`, and the directory flushed. On any failure the
-/// temporary file is removed and `path` is untouched.
-pub fn write_atomic_with(
-    path: &Path,
-    write: impl FnOnce(&mut std::io::BufWriter<File>) -> Result<(), String>,
-) -> Result<(), ModelError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| -> Result<(), ModelError> {
-        let io = |e: std::io::Error| ModelError::io(path, e);
-        let mut file = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp).map_err(io)?);
-        write(&mut file).map_err(|reason| ModelError::Project {
-            path: path.to_path_buf(),
-            reason,
-        })?;
-        let file = file.into_inner().map_err(|e| io(e.into_error()))?;
-        file.sync_all().map_err(io)?;
-        drop(file);
-        std::fs::rename(&tmp, path).map_err(io)?;
-        if let Ok(d) = File::open(dir) {
-            let _ = d.sync_all();
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
 /// Saves a document to `path` atomically.
 pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
-    write_atomic_with(path, |file| write_to(doc, file))
+    // A serialisation failure (e.g. the disk filling up inside the zip writer) is reported as
+    // an I/O error on the file, like any other write failure.
+    crate::atomic::write_atomic_with(path, |file| {
+        write_to(doc, file).map_err(std::io::Error::other)
+    })
+    .map_err(|e| ModelError::io(path, e))
 }
 
 /// Loads and validates a project file.

@@ -189,7 +189,8 @@ pub fn plot(rows: &[BenchRow], path: &Path) -> Result<(), String> {
     image
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
-    crate::cli::write_atomic(path, &png).map_err(|e| e.message)
+    crate::atomic::write_atomic(path, &png)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 fn draw_plot(rows: &[BenchRow], rgb: &mut [u8]) -> Result<(), Box<dyn std::error::Error>> {
