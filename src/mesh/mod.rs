@@ -10,7 +10,6 @@ mod builtin;
 mod obj;
 pub mod pick;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
@@ -126,30 +125,14 @@ impl Mesh {
     /// Number of UV islands: groups of triangles connected through shared UV points (0 without
     /// UVs).
     pub fn uv_islands(&self) -> usize {
-        let Some(uvs) = &self.uvs else { return 0 };
-        // One node per distinct UV point (bitwise), joined along every triangle.
-        let mut ids: HashMap<(u32, u32), usize> = HashMap::new();
-        let node: Vec<usize> = uvs
-            .iter()
-            .map(|t| {
-                let next = ids.len();
-                *ids.entry((t.x.to_bits(), t.y.to_bits())).or_insert(next)
-            })
-            .collect();
-        let mut parent: Vec<usize> = (0..ids.len()).collect();
-        let mut used = vec![false; ids.len()];
-        for t in &self.triangles {
-            let a = root(&mut parent, node[t[0] as usize]);
-            used[node[t[0] as usize]] = true;
-            for &v in &t[1..] {
-                used[node[v as usize]] = true;
-                let b = root(&mut parent, node[v as usize]);
-                parent[b] = a;
-            }
+        if self.uvs.is_none() {
+            return 0;
         }
-        (0..ids.len())
-            .filter(|&i| used[i] && root(&mut parent, i) == i)
-            .count()
+        // Labels are dense from 0, so the count is one more than the largest.
+        bake::triangle_islands(self)
+            .iter()
+            .max()
+            .map_or(0, |&m| m as usize + 1)
     }
 }
 
