@@ -267,6 +267,13 @@ pub struct Coverage {
 }
 
 impl Coverage {
+    /// Resets every texel to zero, keeping the allocations (a new stroke on the same tiles).
+    pub fn clear(&mut self) {
+        for tile in self.tiles.iter_mut().flatten() {
+            tile.fill(0.0);
+        }
+    }
+
     /// Coverage slices for several tiles (sorted, unique ids), created at zero on first use.
     fn tiles_mut(&mut self, tile_count: usize, ids: &[TileId]) -> Vec<&mut [f32]> {
         if self.tiles.len() < tile_count {
@@ -371,11 +378,13 @@ fn paint_tile(
     let mut kd = ch.kd.then(|| kd.data_mut());
     let mut ks = ch.ks.then(|| ks.data_mut());
     let mut n = ch.n.then(|| n.data_mut());
-    let (kd_t, ks_t) = (
-        super::texel::encode_rgb(target.kd),
-        super::texel::encode_rgb(target.ks),
-    );
+    let rgb_pattern =
+        |t: [u16; 3]| -> [f32; 3 * TILE_SIZE] { std::array::from_fn(|k| f32::from(t[k % 3])) };
+    let kd_t = rgb_pattern(super::texel::encode_rgb(target.kd));
+    let ks_t = rgb_pattern(super::texel::encode_rgb(target.ks));
+    let (pre_kd, pre_ks) = (PreRgb::new(&pre.kd), PreRgb::new(&pre.ks));
     let mut a_run = [0.0_f32; TILE_SIZE];
+    let mut a3 = [0.0_f32; 3 * TILE_SIZE];
     fp.visit_runs(id, rect, |start, weights| {
         let len = weights.len();
         let a_run = &mut a_run[..len];
@@ -390,25 +399,27 @@ fn paint_tile(
             *c = c.max(next);
             *a = *c;
         }
+        if ch.kd || ch.ks {
+            for (a3, &a) in a3.chunks_exact_mut(3).zip(a_run.iter()) {
+                a3.fill(a);
+            }
+        }
+        let a3 = &a3[..3 * len];
         if let Some(kd) = kd.as_deref_mut() {
             blend_rgb_run(
                 &mut kd[start..start + len],
-                &pre.kd,
-                start,
-                kd_t,
-                target.kd,
-                a_run,
+                pre_kd.run(start, len),
+                (&kd_t, target.kd),
+                (a_run, a3),
                 mode,
             );
         }
         if let Some(ks) = ks.as_deref_mut() {
             blend_rgb_run(
                 &mut ks[start..start + len],
-                &pre.ks,
-                start,
-                ks_t,
-                target.ks,
-                a_run,
+                pre_ks.run(start, len),
+                (&ks_t, target.ks),
+                (a_run, a3),
                 mode,
             );
         }
@@ -426,48 +437,58 @@ fn paint_tile(
     });
 }
 
-/// Blends a run of unorm16 RGB texels towards a target. Normal mode mixes in fixed point,
-/// exact at alpha 0 and 1 and free of clamping (a convex mix stays in range).
-fn blend_rgb_run(
-    out: &mut [[u16; 3]],
-    pre: &super::tile::Plane<[u16; 3]>,
-    start: usize,
-    target16: [u16; 3],
-    target: Vec3,
-    alpha: &[f32],
-    mode: BlendMode,
-) {
-    use super::tile::Plane;
-    let t = target16.map(i32::from);
-    let mix = |p: [u16; 3], a: f32| -> [u16; 3] {
-        if mode == BlendMode::Normal {
-            let a15 = (a * 32768.0) as i32;
-            let m = |c: usize| {
-                let pc = i32::from(p[c]);
-                (pc + (((t[c] - pc) * a15 + 16384) >> 15)) as u16
-            };
-            [m(0), m(1), m(2)]
-        } else {
-            let m = |c: usize| encode_unorm(mode.apply(decode_unorm(p[c]), target[c], a));
-            [m(0), m(1), m(2)]
-        }
-    };
-    match pre {
-        Plane::Uniform(p) => {
-            for (o, &a) in out.iter_mut().zip(alpha) {
-                *o = mix(*p, a);
-            }
-        }
-        Plane::Data(d) => {
-            for ((o, &p), &a) in out
-                .iter_mut()
-                .zip(&d[start..start + alpha.len()])
-                .zip(alpha)
-            {
-                *o = mix(p, a);
-            }
+/// The pre-stroke RGB values of a tile as flat components, a uniform plane expanded once
+/// per tile so runs can read it like data.
+#[allow(clippy::large_enum_variant)] // Lives on the stack, once per painted tile.
+enum PreRgb<'a> {
+    Uniform([u16; 3 * TILE_SIZE]),
+    Data(&'a [[u16; 3]]),
+}
+
+impl<'a> PreRgb<'a> {
+    fn new(plane: &'a super::tile::Plane<[u16; 3]>) -> Self {
+        match plane {
+            super::tile::Plane::Uniform(p) => Self::Uniform(std::array::from_fn(|k| p[k % 3])),
+            super::tile::Plane::Data(d) => Self::Data(d),
         }
     }
+
+    fn run(&self, start: usize, len: usize) -> &[u16] {
+        match self {
+            Self::Uniform(row) => &row[..3 * len],
+            Self::Data(d) => d[start..start + len].as_flattened(),
+        }
+    }
+}
+
+/// Blends a run of unorm16 RGB texels towards a target. Normal mode works on the flat
+/// components (`target16` repeats the target's three, `alpha.1` each texel's alpha three
+/// times) so it vectorises; it is exact at alpha 0 and 1, and a convex mix stays in range.
+fn blend_rgb_run(
+    out: &mut [[u16; 3]],
+    pre: &[u16],
+    (target16, target): (&[f32; 3 * TILE_SIZE], Vec3),
+    (alpha, alpha3): (&[f32], &[f32]),
+    mode: BlendMode,
+) {
+    if mode == BlendMode::Normal {
+        let out = out.as_flattened_mut();
+        for (((o, &p), &t), &a) in out.iter_mut().zip(pre).zip(target16).zip(alpha3) {
+            let p = f32::from(p);
+            *o = round_u16(p + (t - p) * a);
+        }
+    } else {
+        for ((o, p), &a) in out.iter_mut().zip(pre.chunks_exact(3)).zip(alpha) {
+            *o = [0, 1, 2].map(|c| encode_unorm(mode.apply(decode_unorm(p[c]), target[c], a)));
+        }
+    }
+}
+
+/// Rounds `v` in `[0, 65535]` to the nearest integer (ties to even) without a saturating
+/// conversion: adding 2^23 leaves the integer in the low mantissa bits, which vectorises.
+#[inline]
+fn round_u16(v: f32) -> u16 {
+    (v + 8_388_608.0).to_bits() as u16
 }
 
 /// Blends a run of half-float `n` texels in log space through the lookup tables.
@@ -481,31 +502,35 @@ fn blend_n_run(
     tables: &NTables,
 ) {
     use super::tile::Plane;
+    let from = &tables.from_blend[..=FROM_BLEND_STEPS];
+    // Normal mode mixes convexly, so `u` stays in [0, 1]; the other modes clamp in `apply`.
+    // The table index is rounded with the 2^23 trick (see `round_u16`), clamped by `min`.
     let to_bits = |u: f32| {
-        let idx = (u * FROM_BLEND_STEPS as f32 + 0.5) as usize;
-        tables.from_blend[idx.min(FROM_BLEND_STEPS)]
+        let i = (u.max(0.0) * FROM_BLEND_STEPS as f32 + 8_388_608.0).to_bits() & 0x7F_FFFF;
+        from[(i as usize).min(FROM_BLEND_STEPS)]
     };
-    let mix = |u: f32, a: f32| {
-        if mode == BlendMode::Normal {
-            u * (1.0 - a) + target * a
-        } else {
-            mode.apply(u, target, a)
-        }
-    };
-    match pre {
-        Plane::Uniform(bits) => {
+    match (pre, mode) {
+        (Plane::Uniform(bits), BlendMode::Normal) => {
             let u = tables.to_blend[*bits as usize];
+            let d = target - u;
             for (o, &a) in out.iter_mut().zip(alpha) {
-                *o = to_bits(mix(u, a));
+                *o = to_bits(u + d * a);
             }
         }
-        Plane::Data(d) => {
+        (Plane::Data(d), BlendMode::Normal) => {
             for ((o, &bits), &a) in out
                 .iter_mut()
                 .zip(&d[start..start + alpha.len()])
                 .zip(alpha)
             {
-                *o = to_bits(mix(tables.to_blend[bits as usize], a));
+                let u = tables.to_blend[bits as usize];
+                *o = to_bits(u + (target - u) * a);
+            }
+        }
+        _ => {
+            for (k, (o, &a)) in out.iter_mut().zip(alpha).enumerate() {
+                let u = tables.to_blend[pre.get(start + k) as usize];
+                *o = to_bits(mode.apply(u, target, a));
             }
         }
     }
@@ -808,5 +833,89 @@ mod tests {
         let out = target.blend(pre, 1.0).decode();
         assert!((out.kd.x + out.ks.x) <= 1.0 + 1e-4);
         assert!((out.ks.x - 0.8).abs() < 1e-4, "k_s untouched");
+    }
+
+    #[test]
+    fn run_blends_agree_with_the_per_texel_reference() {
+        use super::super::tile::Plane;
+        let tables = n_tables();
+        let alphas: Vec<f32> = (0..TILE_SIZE).map(|k| k as f32 / 63.0).collect();
+        let mut alpha3 = [0.0; 3 * TILE_SIZE];
+        for (a3, &a) in alpha3.chunks_exact_mut(3).zip(&alphas) {
+            a3.fill(a);
+        }
+        let pre_data: Vec<[u16; 3]> = (0..TILE_TEXELS)
+            .map(|i| {
+                let h = (i as u32).wrapping_mul(2_654_435_761);
+                [h as u16, (h >> 8) as u16, (h >> 16) as u16]
+            })
+            .collect();
+        let n_data: Vec<u16> = (0..TILE_TEXELS)
+            .map(|i| super::super::texel::encode_n((i % 997) as f32 * 9.7))
+            .collect();
+        let planes = [
+            (
+                Plane::Uniform([12_345, 0, 65_535]),
+                Plane::Uniform(n_data[5]),
+            ),
+            (
+                Plane::Data(pre_data.into_boxed_slice()),
+                Plane::Data(n_data.into_boxed_slice()),
+            ),
+        ];
+        for mode in [
+            BlendMode::Normal,
+            BlendMode::Add,
+            BlendMode::Subtract,
+            BlendMode::Multiply,
+        ] {
+            let target = PaintTarget::new(
+                MaterialValue::new(Vec3::new(0.9, 0.1, 0.5), Vec3::splat(0.3), 700.0),
+                Channels::ALL,
+                mode,
+                false,
+            );
+            let pattern: [f32; 3 * TILE_SIZE] = std::array::from_fn(|k| {
+                f32::from(super::super::texel::encode_rgb(target.kd)[k % 3])
+            });
+            for (rgb_plane, n_plane) in &planes {
+                let start = 2 * TILE_SIZE;
+                let pre = PreRgb::new(rgb_plane);
+                let mut out = [[0_u16; 3]; TILE_SIZE];
+                blend_rgb_run(
+                    &mut out,
+                    pre.run(start, TILE_SIZE),
+                    (&pattern, target.kd),
+                    (&alphas, &alpha3),
+                    mode,
+                );
+                let mut out_n = [0_u16; TILE_SIZE];
+                blend_n_run(
+                    &mut out_n,
+                    n_plane,
+                    start,
+                    target.n_blend,
+                    &alphas,
+                    mode,
+                    tables,
+                );
+                for k in 0..TILE_SIZE {
+                    let p = Texel {
+                        kd: rgb_plane.get(start + k),
+                        ks: [0; 3],
+                        n: n_plane.get(start + k),
+                    };
+                    let want = target.blend(p, alphas[k]);
+                    for (got, want) in out[k].iter().zip(want.kd) {
+                        let diff = (i32::from(*got) - i32::from(want)).abs();
+                        assert!(diff <= 1, "{mode:?} k_d at alpha {}", alphas[k]);
+                    }
+                    assert_eq!(out_n[k], want.n, "{mode:?} n at alpha {}", alphas[k]);
+                    if mode == BlendMode::Normal && (k == 0 || k == TILE_SIZE - 1) {
+                        assert_eq!(out[k], want.kd, "exact at alpha 0 and 1");
+                    }
+                }
+            }
+        }
     }
 }
