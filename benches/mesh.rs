@@ -1,5 +1,6 @@
 //! Criterion benches for the mesh targets (issue 4): a 4096^2 UV bake of a ~100k-triangle
-//! mesh (target <= 1 s) and of the spot mesh.
+//! mesh (target <= 1 s) and of the spot mesh; BVH build and pick on 1M triangles; the
+//! object-space index and a 128 px-equivalent dab on 4096^2 maps (target <= 1 ms).
 
 #![allow(missing_docs)] // criterion_main! generates an undocumented main.
 #![allow(clippy::expect_used)]
@@ -59,5 +60,83 @@ fn picking(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bakes, picking);
+fn surface_dabs(c: &mut Criterion) {
+    use glam::Vec3;
+    use kapaint::model::brush::BrushSettings;
+    use kapaint::model::history::History;
+    use kapaint::model::paint::{Coverage, PaintTarget, paint_dab};
+    use kapaint::model::surface::{BallFootprint, Surface};
+    use kapaint::model::texel::MaterialValue;
+    use kapaint::model::{Channels, MaterialMaps};
+    let mut group = c.benchmark_group("surface_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(5));
+    let sphere = mesh::uv_sphere(64, 32);
+    group.bench_function("surface_index_sphere", |b| {
+        b.iter(|| Surface::new(sphere.clone(), 4096, 4096).expect("bakes"));
+    });
+    let brush = BrushSettings {
+        radius_px: 128.0,
+        hardness: 0.5,
+        flow: 0.5,
+        ..BrushSettings::default()
+    };
+    let target = PaintTarget::new(
+        MaterialValue::new(Vec3::new(1.0, 0.2, 0.1), Vec3::splat(0.6), 300.0),
+        Channels::ALL,
+        brush.blend,
+        false,
+    );
+    let mut maps = MaterialMaps::new(4096, 4096, MaterialValue::default()).expect("size");
+    let mut history = History::default();
+    history.begin("bench stroke");
+    let mut coverage = Coverage::default();
+    let spot = mesh::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/testdata/spot/spot_triangulated.obj"),
+    )
+    .expect("spot loads");
+    for (name, mesh) in [("dab_128px_sphere", sphere), ("dab_128px_spot", spot)] {
+        // A vertex half-way through the file: somewhere on the body.
+        let center = mesh.positions[mesh.positions.len() / 2];
+        let surface = Surface::new(mesh, 4096, 4096).expect("bakes");
+        let radius = 128.0 * surface.units_per_texel;
+        let normal = surface.normal_near(center, radius).expect("on the surface");
+        let fp = BallFootprint {
+            surface: &surface,
+            center,
+            radius,
+            normal,
+            brush: &brush,
+        };
+        // As the 2D dab bench: tiles already private to the stroke, coverage zeroed.
+        paint_dab(
+            &mut maps,
+            &mut history,
+            &mut coverage,
+            &target,
+            1.0,
+            0.5,
+            &fp,
+        );
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                coverage.clear();
+                paint_dab(
+                    &mut maps,
+                    &mut history,
+                    &mut coverage,
+                    &target,
+                    1.0,
+                    0.5,
+                    &fp,
+                );
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bakes, picking, surface_dabs);
 criterion_main!(benches);

@@ -99,6 +99,9 @@ pub enum Command {
         /// Project file to write.
         #[arg(long)]
         out: PathBuf,
+        /// Mesh the material is painted on: sphere, plane, cube, torus or a mesh file.
+        #[arg(long, default_value = "sphere")]
+        mesh: String,
         /// Overwrite an existing file.
         #[arg(long)]
         force: bool,
@@ -129,6 +132,9 @@ pub enum Command {
         /// Script of commands (see README).
         #[arg(long)]
         script: PathBuf,
+        /// Mesh for strokes on the surface and island/part fills (default: the project's).
+        #[arg(long)]
+        mesh: Option<String>,
         /// Write the result here instead of over FILE.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -269,9 +275,12 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             size,
             preset,
             out,
+            mesh,
             force,
         } => {
             let (w, h) = parse_size(&size)?;
+            // A mesh file must exist and load now, not at the first stroke on it.
+            mesh::open(std::path::Path::new(&mesh)).map_err(|e| CliError::usage(e.to_string()))?;
             if out.exists() && !force {
                 return Err(CliError::usage(format!(
                     "{} exists; pass --force to overwrite it",
@@ -283,6 +292,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                 base: preset.value(),
                 secondary: preset.value(),
                 preset: Some(preset.name.clone()),
+                mesh: model::document::MeshRef::from_spec(&mesh),
                 ..DocumentSettings::default()
             };
             let doc = Document::new(w, h, settings).map_err(model_error)?;
@@ -317,9 +327,17 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                 target.display()
             ))
         }
-        Command::Paint { file, script, out } => {
+        Command::Paint {
+            file,
+            script,
+            mesh,
+            out,
+        } => {
             let commands = read_script(&script)?;
             let mut doc = project::load(&file).map_err(model_error)?;
+            if commands.iter().any(model::Command::needs_surface) {
+                attach_surface(&mut doc, &file, mesh.as_deref())?;
+            }
             let count = commands.len();
             for (i, command) in commands.into_iter().enumerate() {
                 doc.apply(command).map_err(|e| {
@@ -335,17 +353,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             ))
         }
         Command::MeshInfo { file } => {
-            let builtin = match file.to_str() {
-                Some("sphere") if !file.exists() => Some(mesh::uv_sphere(64, 32)),
-                Some("plane") if !file.exists() => Some(mesh::plane()),
-                Some("cube") if !file.exists() => Some(mesh::cube()),
-                Some("torus") if !file.exists() => Some(mesh::torus(1.0, 0.35, 64, 32)),
-                _ => None,
-            };
-            let mesh = match builtin {
-                Some(m) => m,
-                None => mesh::load(&file).map_err(|e| CliError::usage(e.to_string()))?,
-            };
+            let mesh = mesh::open(&file).map_err(|e| CliError::usage(e.to_string()))?;
             Ok(mesh::info_text(&file, &mesh))
         }
         Command::Bench { size, out, repeats } => {
@@ -376,6 +384,32 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             Ok(table)
         }
     }
+}
+
+/// Loads the mesh (`spec`, else the project's own, a relative path taken from the project's
+/// folder), bakes it at the map size and attaches it to `doc`.
+fn attach_surface(
+    doc: &mut Document,
+    project_file: &std::path::Path,
+    spec: Option<&str>,
+) -> Result<(), CliError> {
+    let spec = spec.map_or_else(
+        || {
+            let own = std::path::PathBuf::from(doc.settings.mesh.spec());
+            match project_file.parent() {
+                Some(dir) if own.is_relative() && !own.exists() && dir.join(&own).exists() => {
+                    dir.join(own)
+                }
+                _ => own,
+            }
+        },
+        std::path::PathBuf::from,
+    );
+    let mesh = mesh::open(&spec).map_err(|e| CliError::usage(e.to_string()))?;
+    let surface = model::surface::Surface::new(mesh, doc.maps.width(), doc.maps.height())
+        .map_err(|e| CliError::usage(format!("{}: {e}", spec.display())))?;
+    doc.set_surface(Some(std::sync::Arc::new(surface)))
+        .map_err(model_error)
 }
 
 /// Every model-layer error is reported in one line with exit code 2.
@@ -437,14 +471,7 @@ pub fn info_text(path: &std::path::Path, doc: &Document, file_bytes: u64) -> Str
     );
     let _ = writeln!(out, "model: {}", s.model.name());
     let _ = writeln!(out, "method: {}", s.approx.name());
-    let _ = writeln!(
-        out,
-        "mesh: {}",
-        match &s.mesh {
-            model::document::MeshRef::Sphere => "sphere".to_string(),
-            model::document::MeshRef::File(f) => f.clone(),
-        }
-    );
+    let _ = writeln!(out, "mesh: {}", s.mesh.spec());
     let _ = writeln!(out, "preset: {}", s.preset.as_deref().unwrap_or("-"));
     let expanded = maps.tile_count() * model::tile::TILE_TEXELS * 14;
     let _ = writeln!(

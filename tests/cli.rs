@@ -387,3 +387,59 @@ fn failures_leave_the_input_file_untouched() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn paint_scripts_take_strokes_on_the_mesh() {
+    let dir = temp_dir("surface");
+    let file = dir.join("spot.kapaint");
+    let path = file.to_str().expect("path");
+    let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot/spot_triangulated.obj");
+    let o = kapaint(&[
+        "new",
+        "--size",
+        "256",
+        "--mesh",
+        spot.to_str().expect("path"),
+        "--out",
+        path,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    assert!(stdout(&kapaint(&["info", path])).contains("spot_triangulated.obj"));
+    let before = std::fs::read(&file).expect("read");
+    let script = dir.join("s.ron");
+    // A stroke over spot's back (object-space points with pressure), mirrored in X.
+    std::fs::write(
+        &script,
+        "(commands: [SetPrimary((kd: (0.0, 0.0, 1.0), ks: (0.1, 0.1, 0.1), n: 9.0)), \
+         SetBrush((radius_px: 12.0, mirror_x: true)), \
+         SurfaceStroke(tool: Brush, points: [(pos: (point: (0.3, 0.6, 0.0)), pressure: 1.0), \
+         (pos: (point: (0.3, 0.6, -0.4), normal: (0.0, 1.0, 0.0)), pressure: 0.5)])])",
+    )
+    .expect("write script");
+    let o = kapaint(&["paint", path, "--script", script.to_str().expect("path")]);
+    assert!(o.status.success(), "{o:?}");
+    assert_ne!(
+        std::fs::read(&file).expect("read"),
+        before,
+        "the stroke changed the maps"
+    );
+    let info = stdout(&kapaint(&["info", path]));
+    assert!(info.contains("kd.r 0.000000"), "{info}");
+
+    // Strokes on the mesh with a mesh that cannot be painted: one clear line, file untouched.
+    let painted = std::fs::read(&file).expect("read");
+    let no_uvs = dir.join("no_uvs.obj");
+    std::fs::write(&no_uvs, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("write");
+    let o = kapaint(&[
+        "paint",
+        path,
+        "--script",
+        script.to_str().expect("path"),
+        "--mesh",
+        no_uvs.to_str().expect("path"),
+    ]);
+    assert_usage_error(&o, "no UV coordinates");
+    assert_eq!(std::fs::read(&file).expect("read"), painted);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -52,31 +52,10 @@ pub fn triangle_islands(mesh: &Mesh) -> Vec<u32> {
     let Some(uvs) = &mesh.uvs else {
         return vec![u32::MAX; mesh.triangles.len()];
     };
-    let mut ids = std::collections::HashMap::new();
-    let node: Vec<usize> = uvs
-        .iter()
-        .map(|t| {
-            let next = ids.len();
-            *ids.entry((t.x.to_bits(), t.y.to_bits())).or_insert(next)
-        })
-        .collect();
-    let mut parent: Vec<usize> = (0..ids.len()).collect();
-    for t in &mesh.triangles {
-        let a = super::root(&mut parent, node[t[0] as usize]);
-        for &v in &t[1..] {
-            let b = super::root(&mut parent, node[v as usize]);
-            parent[b] = a;
-        }
-    }
-    let mut labels = std::collections::HashMap::new();
-    mesh.triangles
-        .iter()
-        .map(|t| {
-            let r = super::root(&mut parent, node[t[0] as usize]);
-            let next = labels.len() as u32;
-            *labels.entry(r).or_insert(next)
-        })
-        .collect()
+    super::connected_triangles(mesh, |v| {
+        let t = uvs[v as usize];
+        [t.x.to_bits(), t.y.to_bits(), 0]
+    })
 }
 
 /// Barycentrics of the point of triangle `(a, b, c)` nearest to `p`, and its squared distance.

@@ -122,6 +122,14 @@ impl Mesh {
         )
     }
 
+    /// Per-triangle part labels: pieces of surface connected through shared positions (so a
+    /// UV seam does not split a part, but separate objects of a file are separate parts).
+    pub fn parts(&self) -> Vec<u32> {
+        connected_triangles(self, |v| {
+            self.positions[v as usize].to_array().map(f32::to_bits)
+        })
+    }
+
     /// Number of UV islands: groups of triangles connected through shared UV points (0 without
     /// UVs).
     pub fn uv_islands(&self) -> usize {
@@ -134,6 +142,35 @@ impl Mesh {
             .max()
             .map_or(0, |&m| m as usize + 1)
     }
+}
+
+/// Dense labels (from 0, in order of first appearance) of the groups of triangles connected
+/// through vertices with equal `key(vertex)`.
+fn connected_triangles(mesh: &Mesh, key: impl Fn(u32) -> [u32; 3]) -> Vec<u32> {
+    let mut ids = std::collections::HashMap::new();
+    let node: Vec<usize> = (0..mesh.vertex_count() as u32)
+        .map(|v| {
+            let next = ids.len();
+            *ids.entry(key(v)).or_insert(next)
+        })
+        .collect();
+    let mut parent: Vec<usize> = (0..ids.len()).collect();
+    for t in &mesh.triangles {
+        let a = root(&mut parent, node[t[0] as usize]);
+        for &v in &t[1..] {
+            let b = root(&mut parent, node[v as usize]);
+            parent[b] = a;
+        }
+    }
+    let mut labels = std::collections::HashMap::new();
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let r = root(&mut parent, node[t[0] as usize]);
+            let next = labels.len() as u32;
+            *labels.entry(r).or_insert(next)
+        })
+        .collect()
 }
 
 /// The root of `i` in a union-find forest, halving paths on the way.
@@ -167,6 +204,30 @@ pub fn smooth_normals(
         .iter()
         .map(|&g| sums[g].try_normalize().unwrap_or(Vec3::Y))
         .collect()
+}
+
+/// Names of the built-in meshes.
+pub const BUILTIN_NAMES: [&str; 4] = ["sphere", "plane", "cube", "torus"];
+
+/// The built-in mesh of that name, at the resolution the editor uses.
+pub fn builtin(name: &str) -> Option<Mesh> {
+    match name {
+        "sphere" => Some(uv_sphere(64, 32)),
+        "plane" => Some(plane()),
+        "cube" => Some(cube()),
+        "torus" => Some(torus(1.0, 0.35, 64, 32)),
+        _ => None,
+    }
+}
+
+/// A mesh by name or path: a built-in name (unless a file of that name exists), else a file.
+pub fn open(spec: &Path) -> Result<Mesh, MeshError> {
+    if !spec.exists()
+        && let Some(m) = spec.to_str().and_then(builtin)
+    {
+        return Ok(m);
+    }
+    load(spec)
 }
 
 /// Loads a mesh file by extension (`.obj`).

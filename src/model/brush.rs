@@ -5,7 +5,7 @@
 //! brush's base radius (not the pressure-modulated one) so that dab positions depend only on
 //! the path.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// How a stroke's target combines with what is under it. Every channel blends in `[0, 1]`
@@ -110,6 +110,15 @@ pub struct BrushSettings {
     pub mirror_u: bool,
     /// Mirror dabs across the horizontal centre line of UV space (`v = 0.5`).
     pub mirror_v: bool,
+    /// On a mesh: mirror dabs across the object's X = 0 plane.
+    pub mirror_x: bool,
+    /// On a mesh: mirror dabs across the object's Y = 0 plane.
+    pub mirror_y: bool,
+    /// On a mesh: mirror dabs across the object's Z = 0 plane.
+    pub mirror_z: bool,
+    /// On a mesh: paint only where the surface faces the brush (not through thin walls to
+    /// the far side).
+    pub front_faces_only: bool,
     /// Optional alpha stamp.
     pub stamp: Option<Stamp>,
     /// Kernel radius of the blur tool in texels.
@@ -132,6 +141,10 @@ impl Default for BrushSettings {
             energy_guard: false,
             mirror_u: false,
             mirror_v: false,
+            mirror_x: false,
+            mirror_y: false,
+            mirror_z: false,
+            front_faces_only: true,
             stamp: None,
             blur_radius_px: 2,
         }
@@ -182,50 +195,115 @@ impl BrushSettings {
     }
 }
 
+/// A position strokes move through: texel coordinates ([`Vec2`]) on the UV canvas, or a
+/// point on a mesh with its normal ([`SurfacePos`]).
+pub trait StrokePos: Copy {
+    /// The point a fraction `t` of the way to `other`.
+    #[must_use]
+    fn lerp_to(self, other: Self, t: f32) -> Self;
+    /// Distance to `other` (texels, or object units on a mesh).
+    fn distance_to(self, other: Self) -> f32;
+    /// Whether every coordinate is finite.
+    fn finite(self) -> bool;
+    /// Where a stroke whose first input is not finite starts.
+    fn origin() -> Self;
+}
+
+impl StrokePos for Vec2 {
+    fn lerp_to(self, other: Self, t: f32) -> Self {
+        self + (other - self) * t
+    }
+    fn distance_to(self, other: Self) -> f32 {
+        self.distance(other)
+    }
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+    fn origin() -> Self {
+        Self::ZERO
+    }
+}
+
+/// A point on a mesh surface in object space, with the direction the brush faces.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurfacePos {
+    /// Object-space point (on or very near the surface).
+    pub point: Vec3,
+    /// Surface normal there; zero (the default) means "take it from the mesh".
+    #[serde(default)]
+    pub normal: Vec3,
+}
+
+impl StrokePos for SurfacePos {
+    fn lerp_to(self, other: Self, t: f32) -> Self {
+        let normal = self.normal.lerp(other.normal, t);
+        Self {
+            point: self.point + (other.point - self.point) * t,
+            normal: normal.try_normalize().unwrap_or(self.normal),
+        }
+    }
+    fn distance_to(self, other: Self) -> f32 {
+        self.point.distance(other.point)
+    }
+    fn finite(self) -> bool {
+        self.point.is_finite() && self.normal.is_finite()
+    }
+    fn origin() -> Self {
+        Self {
+            point: Vec3::ZERO,
+            normal: Vec3::ZERO,
+        }
+    }
+}
+
 /// One input sample of a stroke.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct StrokePoint {
-    /// Position in texel units (texel `(i, j)` has its centre at `(i + 0.5, j + 0.5)`).
-    pub pos: Vec2,
+pub struct StrokePoint<P = Vec2> {
+    /// Position: in texel units on the canvas (texel `(i, j)` has its centre at
+    /// `(i + 0.5, j + 0.5)`), or a [`SurfacePos`] on a mesh.
+    pub pos: P,
     /// Pen pressure in `[0, 1]` (1 for a mouse).
     pub pressure: f32,
 }
 
+/// An input sample on a mesh surface.
+pub type SurfacePoint = StrokePoint<SurfacePos>;
+
 /// Where one dab goes.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DabPoint {
-    /// Centre in texel units.
-    pub pos: Vec2,
+pub struct DabPoint<P = Vec2> {
+    /// Centre.
+    pub pos: P,
     /// Interpolated pressure.
     pub pressure: f32,
 }
 
 /// Places dabs every `spacing` along the polyline of input points.
 #[derive(Clone, Debug)]
-pub struct Resampler {
+pub struct Resampler<P = Vec2> {
     spacing: f32,
-    last: Option<StrokePoint>,
+    last: Option<StrokePoint<P>>,
     /// Arc length since the last dab.
     travelled: f32,
 }
 
-impl Resampler {
-    /// A resampler for dabs `spacing` texels apart.
+impl<P: StrokePos> Resampler<P> {
+    /// A resampler for dabs `spacing` apart (texels, or object units on a mesh).
     pub fn new(spacing: f32) -> Self {
         Self {
-            spacing: spacing.max(0.05),
+            spacing: if spacing > 0.0 { spacing } else { 1e-6 },
             last: None,
             travelled: 0.0,
         }
     }
 
     /// Adds an input point and appends the dabs it completes.
-    pub fn push(&mut self, point: StrokePoint, out: &mut Vec<DabPoint>) {
+    pub fn push(&mut self, point: StrokePoint<P>, out: &mut Vec<DabPoint<P>>) {
         let point = StrokePoint {
-            pos: if point.pos.is_finite() {
+            pos: if point.pos.finite() {
                 point.pos
             } else {
-                self.last.map_or(Vec2::ZERO, |l| l.pos)
+                self.last.map_or_else(P::origin, |l| l.pos)
             },
             pressure: if point.pressure.is_nan() {
                 1.0
@@ -241,9 +319,8 @@ impl Resampler {
             self.last = Some(point);
             return;
         };
-        let delta = point.pos - last.pos;
-        let length = delta.length();
-        if length <= 0.0 {
+        let length = last.pos.distance_to(point.pos);
+        if length <= 0.0 || !length.is_finite() {
             return;
         }
         // Distance along this segment to the next dab.
@@ -251,7 +328,7 @@ impl Resampler {
         while at <= length {
             let t = at / length;
             out.push(DabPoint {
-                pos: last.pos + delta * t,
+                pos: last.pos.lerp_to(point.pos, t),
                 pressure: last.pressure + (point.pressure - last.pressure) * t,
             });
             at += self.spacing;
@@ -263,13 +340,13 @@ impl Resampler {
 
 /// Lazy mouse: the brush follows the pointer on a string of length `radius`.
 #[derive(Clone, Debug)]
-pub struct Smoother {
+pub struct Smoother<P = Vec2> {
     radius: f32,
-    brush: Option<Vec2>,
+    brush: Option<P>,
 }
 
-impl Smoother {
-    /// A smoother with the given string length in texels (0: pass-through).
+impl<P: StrokePos> Smoother<P> {
+    /// A smoother with the given string length (texels, or object units; 0: pass-through).
     pub fn new(radius: f32) -> Self {
         Self {
             radius: radius.max(0.0),
@@ -279,17 +356,16 @@ impl Smoother {
 
     /// The brush position after the pointer moved to `pointer`; `None` while the pointer is
     /// still within the string's reach (the brush does not move).
-    pub fn follow(&mut self, pointer: Vec2) -> Option<Vec2> {
+    pub fn follow(&mut self, pointer: P) -> Option<P> {
         let Some(brush) = self.brush else {
             self.brush = Some(pointer);
             return Some(pointer);
         };
-        let offset = pointer - brush;
-        let distance = offset.length();
+        let distance = brush.distance_to(pointer);
         if distance <= self.radius {
             return (self.radius == 0.0 && distance > 0.0).then_some(pointer);
         }
-        let moved = brush + offset * (1.0 - self.radius / distance);
+        let moved = brush.lerp_to(pointer, 1.0 - self.radius / distance);
         self.brush = Some(moved);
         Some(moved)
     }

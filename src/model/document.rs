@@ -4,14 +4,19 @@
 //! [`Document::apply`]. Every command leaves the maps valid (every texel decodes to finite,
 //! in-range values) and every stroke, fill, gradient or import is one undo step.
 
-use glam::Vec2;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 use super::ModelError;
-use super::brush::{BrushSettings, Resampler, Smoother, StrokePoint};
+use super::brush::{
+    BrushSettings, DabPoint, Resampler, Smoother, StrokePoint, SurfacePoint, SurfacePos,
+};
 use super::history::History;
 use super::maps::MaterialMaps;
-use super::paint::{self, Coverage, DiscFootprint, GradientShape, PaintTarget};
+use super::paint::{self, Coverage, DiscFootprint, Footprint, GradientShape, PaintTarget};
+use super::surface::{BallFootprint, Surface};
 use super::texel::{Channel, Channels, MaterialValue};
 use crate::reflectance::{AmbientApprox, ShadingModel};
 
@@ -23,6 +28,27 @@ pub enum MeshRef {
     Sphere,
     /// A mesh file, by path.
     File(String),
+    /// Another built-in mesh (plane, cube, torus), by name.
+    Builtin(String),
+}
+
+impl MeshRef {
+    /// What `kapaint` commands take for it: a built-in name or a path.
+    pub fn spec(&self) -> &str {
+        match self {
+            Self::Sphere => "sphere",
+            Self::File(p) | Self::Builtin(p) => p,
+        }
+    }
+
+    /// From a built-in name or a path.
+    pub fn from_spec(spec: &str) -> Self {
+        match spec {
+            "sphere" => Self::Sphere,
+            s if crate::mesh::BUILTIN_NAMES.contains(&s) => Self::Builtin(s.to_string()),
+            s => Self::File(s.to_string()),
+        }
+    }
 }
 
 /// Everything about a document that is not the maps; saved with the project.
@@ -97,6 +123,20 @@ pub enum FillRegion {
         /// Largest difference still filled, in `[0, 1]`.
         tolerance: f32,
     },
+    /// The UV island under a texel (needs the document's mesh surface).
+    Island {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+    /// The mesh part (connected piece of surface, across UV seams) under a texel.
+    Part {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
 }
 
 /// Everything that changes a document.
@@ -131,6 +171,15 @@ pub enum Command {
         /// Input points in texel units.
         points: Vec<StrokePoint>,
     },
+    /// Moves the stroke to a new point on the mesh (object-space brush; needs a surface).
+    SurfaceStrokeTo(SurfacePoint),
+    /// A whole stroke on the mesh at once (scripts).
+    SurfaceStroke {
+        /// The tool.
+        tool: StrokeTool,
+        /// Input points in object space.
+        points: Vec<SurfacePoint>,
+    },
     /// Fills with the primary material.
     Fill(FillRegion),
     /// A gradient from the primary (at `start`) to the secondary material (at `end`).
@@ -155,6 +204,18 @@ pub enum Command {
     Redo,
 }
 
+impl Command {
+    /// Whether the command paints on the mesh (and so needs [`Document::set_surface`]).
+    pub fn needs_surface(&self) -> bool {
+        matches!(
+            self,
+            Self::SurfaceStrokeTo(_)
+                | Self::SurfaceStroke { .. }
+                | Self::Fill(FillRegion::Island { .. } | FillRegion::Part { .. })
+        )
+    }
+}
+
 /// A stroke in progress.
 struct ActiveStroke {
     tool: StrokeTool,
@@ -163,9 +224,31 @@ struct ActiveStroke {
     channels: Channels,
     resampler: Resampler,
     smoother: Smoother,
+    surface_resampler: Resampler<SurfacePos>,
+    surface_smoother: Smoother<SurfacePos>,
     coverage: Coverage,
     rng: u64,
-    dabs: Vec<super::brush::DabPoint>,
+}
+
+/// The parts of a stroke a dab reads, borrowed apart so a footprint can hold the brush.
+struct StrokeParts<'a> {
+    tool: StrokeTool,
+    target: &'a PaintTarget,
+    brush: &'a BrushSettings,
+    channels: Channels,
+    coverage: &'a mut Coverage,
+}
+
+impl ActiveStroke {
+    fn parts(&mut self) -> StrokeParts<'_> {
+        StrokeParts {
+            tool: self.tool,
+            target: &self.target,
+            brush: &self.brush,
+            channels: self.channels,
+            coverage: &mut self.coverage,
+        }
+    }
 }
 
 /// A material being painted.
@@ -176,6 +259,7 @@ pub struct Document {
     pub history: History,
     /// Settings saved with the project.
     pub settings: DocumentSettings,
+    surface: Option<Arc<Surface>>,
     stroke: Option<ActiveStroke>,
 }
 
@@ -197,6 +281,7 @@ impl Document {
             maps,
             history: History::default(),
             settings,
+            surface: None,
             stroke: None,
         })
     }
@@ -207,8 +292,44 @@ impl Document {
             maps,
             history: History::default(),
             settings,
+            surface: None,
             stroke: None,
         }
+    }
+
+    /// Attaches the mesh surface that object-space strokes and island/part fills paint on
+    /// (baked at the map size), or detaches it.
+    ///
+    /// # Errors
+    /// When the bake's size differs from the maps'.
+    pub fn set_surface(&mut self, surface: Option<Arc<Surface>>) -> Result<(), ModelError> {
+        if let Some(s) = &surface
+            && (s.width(), s.height()) != (self.maps.width(), self.maps.height())
+        {
+            return Err(ModelError::Command(format!(
+                "the mesh is baked at {}x{} but the maps are {}x{}",
+                s.width(),
+                s.height(),
+                self.maps.width(),
+                self.maps.height()
+            )));
+        }
+        self.end_stroke();
+        self.surface = surface;
+        Ok(())
+    }
+
+    /// The attached mesh surface.
+    pub fn surface(&self) -> Option<&Arc<Surface>> {
+        self.surface.as_ref()
+    }
+
+    fn require_surface(&self, what: &str) -> Result<Arc<Surface>, ModelError> {
+        self.surface.clone().ok_or_else(|| {
+            ModelError::Command(format!(
+                "{what} needs a mesh to paint on, and this document has none attached"
+            ))
+        })
     }
 
     /// Whether a stroke is in progress.
@@ -217,6 +338,10 @@ impl Document {
     }
 
     /// Applies a command.
+    ///
+    /// # Errors
+    /// When the command cannot apply (outside the map, a mesh command with no mesh): the
+    /// document is unchanged.
     pub fn apply(&mut self, command: Command) -> Result<(), ModelError> {
         match command {
             Command::SetBrush(b) => self.settings.brush = b.sanitized(),
@@ -236,6 +361,18 @@ impl Document {
                 self.begin_stroke(tool);
                 for p in points {
                     self.stroke_to(p);
+                }
+                self.end_stroke();
+            }
+            Command::SurfaceStrokeTo(p) => {
+                let surface = self.require_surface("a stroke on the mesh")?;
+                self.surface_stroke_to(&surface, p);
+            }
+            Command::SurfaceStroke { tool, points } => {
+                let surface = self.require_surface("a stroke on the mesh")?;
+                self.begin_stroke(tool);
+                for p in points {
+                    self.surface_stroke_to(&surface, p);
                 }
                 self.end_stroke();
             }
@@ -281,16 +418,19 @@ impl Document {
             target.mode = super::brush::BlendMode::Normal;
         }
         self.history.begin(label);
+        // On a mesh, sizes in texels become object units at the mesh's texel density.
+        let units = self.surface.as_ref().map_or(1.0, |s| s.units_per_texel);
         self.stroke = Some(ActiveStroke {
             tool,
             target,
             channels: self.settings.channels,
             resampler: Resampler::new(brush.spacing_px()),
             smoother: Smoother::new(brush.smoothing_px),
+            surface_resampler: Resampler::new(brush.spacing_px() * units),
+            surface_smoother: Smoother::new(brush.smoothing_px * units),
             coverage: Coverage::default(),
             rng: 0x5EED_0F4A_9A1E_5700,
             brush,
-            dabs: Vec::new(),
         });
     }
 
@@ -301,20 +441,130 @@ impl Document {
         let Some(pos) = stroke.smoother.follow(point.pos) else {
             return;
         };
-        stroke.dabs.clear();
+        let mut dabs = Vec::new();
         stroke.resampler.push(
             StrokePoint {
                 pos,
                 pressure: point.pressure,
             },
-            &mut stroke.dabs,
+            &mut dabs,
         );
-        let dabs = std::mem::take(&mut stroke.dabs);
         for dab in &dabs {
             self.apply_dab(dab.pos, dab.pressure);
         }
-        if let Some(stroke) = &mut self.stroke {
-            stroke.dabs = dabs;
+    }
+
+    fn surface_stroke_to(&mut self, surface: &Surface, point: SurfacePoint) {
+        let Some(stroke) = &mut self.stroke else {
+            return;
+        };
+        let Some(pos) = stroke.surface_smoother.follow(point.pos) else {
+            return;
+        };
+        let mut dabs = Vec::new();
+        stroke.surface_resampler.push(
+            StrokePoint {
+                pos,
+                pressure: point.pressure,
+            },
+            &mut dabs,
+        );
+        for dab in dabs {
+            self.apply_surface_dab(surface, dab);
+        }
+    }
+
+    /// Radius and alpha of a dab at `pressure`, in texels.
+    fn dab_size(brush: &BrushSettings, pressure: f32) -> (f32, f32) {
+        let radius = if brush.pressure_size {
+            brush.radius_px * pressure.max(0.05)
+        } else {
+            brush.radius_px
+        };
+        let alpha = if brush.pressure_opacity {
+            brush.flow * pressure
+        } else {
+            brush.flow
+        };
+        (radius, alpha)
+    }
+
+    /// One object-space dab and its mirrored copies.
+    fn apply_surface_dab(&mut self, surface: &Surface, dab: DabPoint<SurfacePos>) {
+        let Some(stroke) = &mut self.stroke else {
+            return;
+        };
+        let b = &stroke.brush;
+        let (radius_px, alpha) = Self::dab_size(b, dab.pressure);
+        let radius = radius_px * surface.units_per_texel;
+        let mut center = dab.pos.point;
+        let normal = if dab.pos.normal.length_squared() > 0.0 {
+            dab.pos.normal.normalize_or_zero()
+        } else {
+            surface.normal_near(center, radius).unwrap_or(Vec3::ZERO)
+        };
+        if b.jitter > 0.0 {
+            let (dx, dy) = (next_unit(&mut stroke.rng), next_unit(&mut stroke.rng));
+            let (t, u) = if normal == Vec3::ZERO {
+                (Vec3::X, Vec3::Y)
+            } else {
+                normal.any_orthonormal_pair()
+            };
+            center += (t * dx + u * dy) * (b.jitter * radius);
+        }
+        let mut dabs = vec![(center, normal)];
+        for (on, axis) in [(b.mirror_x, 0), (b.mirror_y, 1), (b.mirror_z, 2)] {
+            if on {
+                let flip = |mut v: Vec3| {
+                    v[axis] = -v[axis];
+                    v
+                };
+                let mirrored: Vec<_> = dabs.iter().map(|&(c, n)| (flip(c), flip(n))).collect();
+                dabs.extend(mirrored);
+            }
+        }
+        let front = b.front_faces_only;
+        for (center, normal) in dabs {
+            let parts = stroke.parts();
+            let brush = parts.brush;
+            let fp = BallFootprint {
+                surface,
+                center,
+                radius,
+                normal: if front { normal } else { Vec3::ZERO },
+                brush,
+            };
+            Self::dab_with(&mut self.maps, &mut self.history, parts, alpha, &fp);
+        }
+    }
+
+    /// Applies the stroke's tool through footprint `fp` (which may borrow `stroke.brush`).
+    fn dab_with(
+        maps: &mut MaterialMaps,
+        history: &mut History,
+        stroke: StrokeParts<'_>,
+        alpha: f32,
+        fp: &impl Footprint,
+    ) {
+        let StrokeParts {
+            tool,
+            target,
+            brush,
+            channels,
+            coverage,
+        } = stroke;
+        match tool {
+            StrokeTool::Brush | StrokeTool::Eraser => {
+                paint::paint_dab(maps, history, coverage, target, brush.opacity, alpha, fp);
+            }
+            StrokeTool::Blur => paint::blur_dab(
+                maps,
+                history,
+                channels,
+                brush.blur_radius_px,
+                alpha * brush.opacity,
+                fp,
+            ),
         }
     }
 
@@ -325,16 +575,7 @@ impl Document {
             return;
         };
         let b = &stroke.brush;
-        let radius = if b.pressure_size {
-            b.radius_px * pressure.max(0.05)
-        } else {
-            b.radius_px
-        };
-        let alpha = if b.pressure_opacity {
-            b.flow * pressure
-        } else {
-            b.flow
-        };
+        let (radius, alpha) = Self::dab_size(b, pressure);
         let mut center = pos;
         if b.jitter > 0.0 {
             let (dx, dy) = (next_unit(&mut stroke.rng), next_unit(&mut stroke.rng));
@@ -351,30 +592,14 @@ impl Document {
             centers.push(Vec2::new(w - center.x, h - center.y));
         }
         for c in centers {
+            let parts = stroke.parts();
+            let brush = parts.brush;
             let fp = DiscFootprint {
                 center: c,
                 radius,
-                brush: &stroke.brush,
+                brush,
             };
-            match stroke.tool {
-                StrokeTool::Brush | StrokeTool::Eraser => paint::paint_dab(
-                    &mut self.maps,
-                    &mut self.history,
-                    &mut stroke.coverage,
-                    &stroke.target,
-                    stroke.brush.opacity,
-                    alpha,
-                    &fp,
-                ),
-                StrokeTool::Blur => paint::blur_dab(
-                    &mut self.maps,
-                    &mut self.history,
-                    stroke.channels,
-                    stroke.brush.blur_radius_px,
-                    alpha * stroke.brush.opacity,
-                    &fp,
-                ),
-            }
+            Self::dab_with(&mut self.maps, &mut self.history, parts, alpha, &fp);
         }
     }
 
@@ -413,6 +638,19 @@ impl Document {
                 let mask =
                     paint::flood_region(&self.maps, x, y, channel, tolerance.clamp(0.0, 1.0));
                 self.history.begin("Fill similar");
+                paint::fill_mask(&mut self.maps, &mut self.history, &target, opacity, &mask);
+            }
+            FillRegion::Island { x, y } | FillRegion::Part { x, y } => {
+                let surface = self.require_surface("filling a UV island or mesh part")?;
+                let (mask, label) = if matches!(region, FillRegion::Island { .. }) {
+                    (surface.island_mask(x, y), "Fill island")
+                } else {
+                    (surface.part_mask(x, y), "Fill part")
+                };
+                let mask = mask.ok_or_else(|| {
+                    ModelError::Command(format!("no part of the mesh is at texel ({x}, {y})"))
+                })?;
+                self.history.begin(label);
                 paint::fill_mask(&mut self.maps, &mut self.history, &target, opacity, &mask);
             }
         }

@@ -13,6 +13,7 @@ pub mod paint;
 pub mod preset;
 pub mod project;
 pub mod stats;
+pub mod surface;
 pub mod texel;
 pub mod tile;
 

@@ -544,7 +544,7 @@ pub fn blur_dab(
     channels: super::texel::Channels,
     kernel_px: u32,
     strength: f32,
-    fp: &DiscFootprint<'_>,
+    fp: &impl Footprint,
 ) {
     if channels.is_empty() || strength <= 0.0 {
         return;
