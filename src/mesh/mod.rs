@@ -7,6 +7,7 @@
 
 pub mod bake;
 mod builtin;
+mod gltf_import;
 mod obj;
 pub mod pick;
 
@@ -15,6 +16,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 
 pub use builtin::{cube, plane, torus, uv_sphere};
+pub use gltf_import::load_gltf;
 pub use obj::load_obj;
 
 /// Largest mesh file accepted (bytes).
@@ -230,7 +232,7 @@ pub fn open(spec: &Path) -> Result<Mesh, MeshError> {
     load(spec)
 }
 
-/// Loads a mesh file by extension (`.obj`).
+/// Loads a mesh file by extension (`.obj`, `.gltf`, `.glb`).
 pub fn load(path: &Path) -> Result<Mesh, MeshError> {
     let ext = path
         .extension()
@@ -238,9 +240,10 @@ pub fn load(path: &Path) -> Result<Mesh, MeshError> {
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("obj") => load_obj(path),
+        Some("gltf" | "glb") => load_gltf(path),
         _ => Err(MeshError::Invalid {
             path: path.to_path_buf(),
-            reason: "unsupported mesh format (supported: .obj)".into(),
+            reason: "unsupported mesh format (supported: .obj, .gltf, .glb)".into(),
         }),
     }
 }

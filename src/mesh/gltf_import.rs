@@ -1,0 +1,334 @@
+//! glTF 2.0 import (`.gltf` with its buffers, or `.glb`) through the `gltf` crate.
+//!
+//! Every mesh and primitive the scene instantiates, with node transforms applied (normals by
+//! the inverse transpose; mirrored nodes keep their triangles facing out). Triangle strips
+//! and fans are unrolled; points and lines are skipped. Per the glTF specification, a
+//! primitive without normals gets flat normals. Accessors are checked against their buffers
+//! before anything is read, so a hostile file is an error, never a panic.
+
+use std::path::Path;
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::Semantic;
+use gltf::accessor::{DataType as T, Dimensions as D};
+use gltf::mesh::Mode;
+
+use super::{MAX_FILE_BYTES, MAX_TRIANGLES, Mesh, MeshError};
+
+/// Deepest node hierarchy followed (deeper means a cycle or an absurd file).
+const MAX_DEPTH: usize = 64;
+
+/// Loads a `.gltf` or `.glb` file.
+pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
+    let invalid = |reason: String| MeshError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(invalid(format!(
+            "the file is {} bytes, more than the 2 GiB supported",
+            meta.len()
+        )));
+    }
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    let not_gltf = |e: gltf::Error| invalid(format!("not a valid glTF file: {e}"));
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(&bytes).map_err(not_gltf)?;
+    // gltf-json 1.4.1's own validation indexes the accessor list with the POSITION
+    // attribute unchecked (and panics on a dangling one): check references first.
+    check_references(document.as_json()).map_err(&invalid)?;
+    let document = gltf::Document::from_json(document.into_json()).map_err(not_gltf)?;
+    let buffers = gltf::import_buffers(&document, path.parent(), blob)
+        .map_err(|e| invalid(format!("cannot read the glTF buffers: {e}")))?;
+    let buffers: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
+
+    // The default scene (else the first; else every mesh once, untransformed).
+    let mut instances: Vec<(gltf::Mesh<'_>, Mat4)> = Vec::new();
+    match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => {
+            for node in scene.nodes() {
+                collect(&node, Mat4::IDENTITY, 0, &mut instances).map_err(&invalid)?;
+            }
+        }
+        None => instances.extend(document.meshes().map(|m| (m, Mat4::IDENTITY))),
+    }
+
+    let mut out = Builder::default();
+    for (mesh, transform) in &instances {
+        for (k, primitive) in mesh.primitives().enumerate() {
+            let what = format!("mesh {:?} primitive {k}", mesh.name().unwrap_or("unnamed"));
+            out.add(&primitive, *transform, &buffers)
+                .map_err(|e| invalid(format!("{what}: {e}")))?;
+        }
+    }
+    let name = path
+        .file_name()
+        .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned());
+    let mesh = out.finish(name);
+    mesh.validate().map_err(invalid)?;
+    Ok(mesh)
+}
+
+/// Every accessor a primitive names exists.
+fn check_references(root: &gltf::json::Root) -> Result<(), String> {
+    let count = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (k, primitive) in mesh.primitives.iter().enumerate() {
+            let named = primitive
+                .attributes
+                .values()
+                .chain(primitive.indices.as_ref());
+            if let Some(bad) = named.map(gltf::json::Index::value).find(|&i| i >= count) {
+                return Err(format!(
+                    "mesh {m} primitive {k} uses accessor {bad}, but there are {count}"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Walks the node tree, accumulating transforms.
+fn collect<'a>(
+    node: &gltf::Node<'a>,
+    parent: Mat4,
+    depth: usize,
+    out: &mut Vec<(gltf::Mesh<'a>, Mat4)>,
+) -> Result<(), String> {
+    if depth > MAX_DEPTH {
+        return Err(format!(
+            "the node hierarchy is deeper than {MAX_DEPTH} (a cycle?)"
+        ));
+    }
+    let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+    let world = parent * local;
+    if !world.is_finite() {
+        return Err(format!("node {} has a non-finite transform", node.index()));
+    }
+    if let Some(mesh) = node.mesh() {
+        out.push((mesh, world));
+    }
+    for child in node.children() {
+        collect(&child, world, depth + 1, out)?;
+    }
+    Ok(())
+}
+
+/// Checks that an accessor has a type `allowed` and that its elements lie inside its buffer view and the view inside its
+/// buffer, with overflow-free arithmetic, before the reader touches them.
+fn check_accessor(
+    accessor: &gltf::Accessor<'_>,
+    buffers: &[&[u8]],
+    allowed: &[(T, D)],
+) -> Result<(), String> {
+    let name = format!("accessor {}", accessor.index());
+    let kind = (accessor.data_type(), accessor.dimensions());
+    if !allowed.contains(&kind) {
+        return Err(format!(
+            "{name} holds {:?} {:?}, which this attribute cannot be",
+            kind.0, kind.1
+        ));
+    }
+    if accessor.sparse().is_some() {
+        return Err(format!(
+            "{name} is sparse, which is not supported for geometry"
+        ));
+    }
+    let view = accessor
+        .view()
+        .ok_or_else(|| format!("{name} has no buffer view (no data)"))?;
+    let count = accessor.count();
+    if count == 0 {
+        return Err(format!("{name} is empty"));
+    }
+    let size = accessor.size();
+    let stride = view.stride().unwrap_or(size);
+    let end = stride
+        .checked_mul(count - 1)
+        .and_then(|v| v.checked_add(size))
+        .and_then(|v| v.checked_add(accessor.offset()))
+        .ok_or_else(|| format!("{name} claims an absurd size ({count} elements)"))?;
+    if end > view.length() {
+        return Err(format!(
+            "{name} needs {end} bytes but its buffer view holds {}",
+            view.length()
+        ));
+    }
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("{name} refers to a missing buffer"))?;
+    let view_end = view
+        .offset()
+        .checked_add(view.length())
+        .ok_or_else(|| format!("buffer view {} claims an absurd size", view.index()))?;
+    if view_end > buffer.len() {
+        return Err(format!(
+            "buffer view {} ends at byte {view_end} but its buffer holds {} (truncated?)",
+            view.index(),
+            buffer.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Merges primitives into one mesh.
+#[derive(Default)]
+struct Builder {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    triangles: Vec<[u32; 3]>,
+    any_uv: bool,
+    missing_normals: bool,
+}
+
+impl Builder {
+    fn add(
+        &mut self,
+        primitive: &gltf::Primitive<'_>,
+        transform: Mat4,
+        buffers: &[&[u8]],
+    ) -> Result<(), String> {
+        let mode = primitive.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            return Ok(()); // points and lines have no surface
+        }
+        // The reader hits `unreachable!` on a type the specification does not allow, so the
+        // types of what is read are checked here as well as the bounds.
+        for (semantic, accessor) in primitive.attributes() {
+            let allowed: &[(T, D)] = match semantic {
+                Semantic::Positions | Semantic::Normals => &[(T::F32, D::Vec3)],
+                Semantic::TexCoords(0) => &[(T::F32, D::Vec2), (T::U8, D::Vec2), (T::U16, D::Vec2)],
+                _ => continue, // not read
+            };
+            check_accessor(&accessor, buffers, allowed)?;
+        }
+        if let Some(indices) = primitive.indices() {
+            check_accessor(
+                &indices,
+                buffers,
+                &[(T::U8, D::Scalar), (T::U16, D::Scalar), (T::U32, D::Scalar)],
+            )?;
+        }
+        let reader = primitive.reader(|b| buffers.get(b.index()).copied());
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or("has no POSITION attribute")?
+            .map(Vec3::from)
+            .collect();
+        let count = positions.len();
+        let normals: Option<Vec<Vec3>> = reader.read_normals().map(|n| n.map(Vec3::from).collect());
+        let uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
+        if normals.as_ref().is_some_and(|n| n.len() != count)
+            || uvs.as_ref().is_some_and(|t| t.len() != count)
+        {
+            return Err("attribute counts differ".into());
+        }
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..u32::try_from(count).map_err(|_| "too many vertices")?).collect(),
+        };
+        if let Some(bad) = indices.iter().find(|&&i| i as usize >= count) {
+            return Err(format!("index {bad} is out of range for {count} vertices"));
+        }
+        let corners = unroll(mode, &indices);
+        if self.triangles.len() + corners.len() > MAX_TRIANGLES {
+            return Err(format!("more than the {MAX_TRIANGLES} triangles supported"));
+        }
+        let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+        let flip = transform.determinant() < 0.0;
+        let base = u32::try_from(self.positions.len()).map_err(|_| "too many vertices")?;
+        let world: Vec<Vec3> = positions
+            .iter()
+            .map(|&p| transform.transform_point3(p))
+            .collect();
+        self.missing_normals |= normals.is_none();
+        self.any_uv |= uvs.is_some();
+        // A missing UV set reads as (0, 0): those triangles have no texels to paint.
+        let uv_of = |i: usize| uvs.as_ref().map_or(Vec2::ZERO, |t| t[i]);
+        match &normals {
+            Some(n) => {
+                for i in 0..count {
+                    self.positions.push(world[i]);
+                    self.normals
+                        .push((normal_matrix * n[i]).try_normalize().unwrap_or(Vec3::Y));
+                    self.uvs.push(uv_of(i));
+                }
+                for t in corners {
+                    let [a, b, c] = t.map(|i| base + i);
+                    self.triangles
+                        .push(if flip { [a, c, b] } else { [a, b, c] });
+                }
+            }
+            None => {
+                // Flat normals, as the specification asks: each triangle its own corners.
+                for t in corners {
+                    let t = if flip { [t[0], t[2], t[1]] } else { t };
+                    let [p, q, r] = t.map(|i| world[i as usize]);
+                    let n = (q - p).cross(r - p).try_normalize().unwrap_or(Vec3::Y);
+                    let first =
+                        u32::try_from(self.positions.len()).map_err(|_| "too many vertices")?;
+                    for i in t {
+                        self.positions.push(world[i as usize]);
+                        self.normals.push(n);
+                        self.uvs.push(uv_of(i as usize));
+                    }
+                    self.triangles.push([first, first + 1, first + 2]);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(self, name: String) -> Mesh {
+        Mesh {
+            name,
+            positions: self.positions,
+            normals: self.normals,
+            uvs: self.any_uv.then_some(self.uvs),
+            triangles: self.triangles,
+            had_normals: !self.missing_normals,
+        }
+    }
+}
+
+/// Triangles of a triangle list, strip or fan.
+fn unroll(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => indices
+            .windows(3)
+            .enumerate()
+            .map(|(k, w)| {
+                if k % 2 == 0 {
+                    [w[0], w[1], w[2]]
+                } else {
+                    [w[1], w[0], w[2]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => indices
+            .windows(2)
+            .skip(1)
+            .map(|w| [indices[0], w[0], w[1]])
+            .collect(),
+        _ => indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    }
+}

@@ -1,0 +1,327 @@
+//! glTF 2.0 import: files built here (GLB, .gltf with a .bin, data: URIs), the spot mesh
+//! converted to GLB, and corrupted copies of them.
+
+#![allow(clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+use kapaint::mesh::{self, Mesh};
+
+fn temp(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).expect("write");
+    path
+}
+
+/// A GLB container: the JSON chunk and the binary chunk, each padded to 4 bytes.
+fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut j = json.as_bytes().to_vec();
+    while !j.len().is_multiple_of(4) {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    let total = 12 + 8 + j.len() + if b.is_empty() { 0 } else { 8 + b.len() };
+    let mut out = Vec::new();
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    if !b.is_empty() {
+        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&b);
+    }
+    out
+}
+
+fn f32_bytes(values: impl IntoIterator<Item = f32>) -> Vec<u8> {
+    values.into_iter().flat_map(f32::to_le_bytes).collect()
+}
+
+/// The binary data and JSON of one mesh (positions, optional normals and UVs, u32
+/// indices), instanced by `nodes` (a JSON array) in scene 0.
+fn mesh_gltf(m: &Mesh, with_normals: bool, nodes: &str, mode: u32) -> (String, Vec<u8>) {
+    let mut bin = f32_bytes(m.positions.iter().flat_map(Vec3::to_array));
+    let (lo, hi) = m.bounds();
+    let n = m.positions.len();
+    let mut views = vec![format!(
+        r#"{{"buffer":0,"byteOffset":0,"byteLength":{}}}"#,
+        12 * n
+    )];
+    let mut accessors = vec![format!(
+        r#"{{"bufferView":0,"componentType":5126,"count":{n},"type":"VEC3","min":[{},{},{}],"max":[{},{},{}]}}"#,
+        lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+    )];
+    let mut attributes = vec![r#""POSITION":0"#.to_string()];
+    if with_normals {
+        let offset = bin.len();
+        bin.extend(f32_bytes(m.normals.iter().flat_map(Vec3::to_array)));
+        views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#,
+            12 * n
+        ));
+        accessors.push(format!(
+            r#"{{"bufferView":{},"componentType":5126,"count":{n},"type":"VEC3"}}"#,
+            views.len() - 1
+        ));
+        attributes.push(format!(r#""NORMAL":{}"#, accessors.len() - 1));
+    }
+    if let Some(uvs) = &m.uvs {
+        let offset = bin.len();
+        // glTF's v runs down the texture.
+        bin.extend(f32_bytes(uvs.iter().flat_map(|t| [t.x, 1.0 - t.y])));
+        views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#,
+            8 * n
+        ));
+        accessors.push(format!(
+            r#"{{"bufferView":{},"componentType":5126,"count":{n},"type":"VEC2"}}"#,
+            views.len() - 1
+        ));
+        attributes.push(format!(r#""TEXCOORD_0":{}"#, accessors.len() - 1));
+    }
+    let offset = bin.len();
+    let indices: Vec<u32> = m.triangles.iter().flatten().copied().collect();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    views.push(format!(
+        r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#,
+        4 * indices.len()
+    ));
+    accessors.push(format!(
+        r#"{{"bufferView":{},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
+        views.len() - 1,
+        indices.len()
+    ));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[{nodes_idx}]}}],"nodes":{nodes},
+"meshes":[{{"name":"m","primitives":[{{"attributes":{{{attrs}}},"indices":{idx},"mode":{mode}}}]}}],
+"accessors":[{acc}],"bufferViews":[{views}],"buffers":[{{"byteLength":{len}}}]}}"#,
+        nodes_idx = (0..nodes.matches("\"mesh\"").count())
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(","),
+        attrs = attributes.join(","),
+        idx = accessors.len() - 1,
+        acc = accessors.join(","),
+        views = views.join(","),
+        len = bin.len(),
+    );
+    (json, bin)
+}
+
+fn spot() -> Mesh {
+    mesh::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/testdata/spot/spot_triangulated.obj"),
+    )
+    .expect("spot")
+}
+
+#[test]
+fn spot_as_glb_loads_like_the_obj() {
+    let obj = spot();
+    let (json, bin) = mesh_gltf(&obj, true, r#"[{"mesh":0}]"#, 4);
+    let path = temp("spot.glb", &glb(&json, &bin));
+    let m = mesh::load(&path).expect("loads");
+    assert_eq!(m.triangles, obj.triangles);
+    assert_eq!(m.positions, obj.positions);
+    assert!(m.had_normals);
+    let (a, b) = (m.uvs.expect("uvs"), obj.uvs.clone().expect("uvs"));
+    assert!(a.iter().zip(&b).all(|(x, y)| (*x - *y).length() < 1e-6));
+    assert_eq!(m.normals.len(), obj.normals.len());
+    // Same UV islands, so the same seams and bake.
+    let info = mesh::info_text(&path, &mesh::load(&path).expect("loads"));
+    assert!(info.contains("triangles: 5856"), "{info}");
+    assert_eq!(
+        mesh::load(&path).expect("loads").uv_islands(),
+        obj.uv_islands()
+    );
+}
+
+#[test]
+fn node_transforms_apply_and_mirrored_nodes_keep_facing_out() {
+    let quad = mesh::plane(); // 2 x 2 in XZ facing +Y
+    // Two instances: translated and scaled, and mirrored in X (negative determinant).
+    let nodes = r#"[{"mesh":0,"translation":[1,2,3],"scale":[2,2,2]},{"mesh":0,"scale":[-1,1,1]}]"#;
+    let (json, bin) = mesh_gltf(&quad, true, nodes, 4);
+    let m = mesh::load(&temp("quad.glb", &glb(&json, &bin))).expect("loads");
+    assert_eq!(m.triangles.len(), 2 * quad.triangles.len());
+    let (lo, hi) = m.bounds();
+    assert!((lo - Vec3::new(-1.0, 0.0, -1.0)).length() < 1e-5, "{lo}");
+    assert!((hi - Vec3::new(3.0, 2.0, 5.0)).length() < 1e-5, "{hi}");
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.positions[i as usize]);
+        let face = (b - a).cross(c - a);
+        let normal = m.normals[t[0] as usize];
+        assert!(face.dot(normal) > 0.0, "winding agrees with the normal");
+        assert!((normal - Vec3::Y).length() < 1e-5);
+    }
+    assert!(m.paintable().is_ok());
+}
+
+#[test]
+fn missing_normals_are_flat_and_strips_unroll() {
+    let quad = mesh::plane();
+    let (json, bin) = mesh_gltf(&quad, false, r#"[{"mesh":0}]"#, 4);
+    let m = mesh::load(&temp("flat.glb", &glb(&json, &bin))).expect("loads");
+    assert!(!m.had_normals);
+    assert!(m.normals.iter().all(|n| (*n - Vec3::Y).length() < 1e-6));
+    // The same 4 vertices as a strip: indices 0 1 2 3 give two triangles.
+    let strip = Mesh {
+        triangles: vec![[2, 0, 3], [3, 0, 1]],
+        ..quad.clone()
+    };
+    let (json, bin) = mesh_gltf(&strip, true, r#"[{"mesh":0}]"#, 5);
+    let m = mesh::load(&temp("strip.glb", &glb(&json, &bin))).expect("loads");
+    assert_eq!(m.triangles.len(), 4, "6 indices make 4 strip triangles");
+}
+
+#[test]
+fn gltf_with_a_bin_file_and_with_a_data_uri() {
+    let quad = mesh::plane();
+    let (json, bin) = mesh_gltf(&quad, true, r#"[{"mesh":0}]"#, 4);
+    let with_file = json.replace(r#""buffers":[{"#, r#""buffers":[{"uri":"quad.bin","#);
+    temp("quad.bin", &bin);
+    let m = mesh::load(&temp("quad.gltf", with_file.as_bytes())).expect("loads");
+    assert_eq!(m.triangles.len(), 2);
+    let uvs = m.uvs.expect("uvs");
+    assert!(uvs.contains(&Vec2::new(0.0, 0.0)) && uvs.contains(&Vec2::new(1.0, 1.0)));
+
+    let encoded = base64_encode(&bin);
+    let with_uri = json.replace(
+        r#""buffers":[{"#,
+        &format!(r#""buffers":[{{"uri":"data:application/octet-stream;base64,{encoded}","#),
+    );
+    let m = mesh::load(&temp("inline.gltf", with_uri.as_bytes())).expect("loads");
+    assert_eq!(m.triangles.len(), 2);
+}
+
+/// Standard base64 (the test builds its own data: URI).
+fn base64_encode(bytes: &[u8]) -> String {
+    const ABC: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(ABC[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+fn load_err(name: &str, bytes: &[u8]) -> String {
+    let path = temp(name, bytes);
+    let err = mesh::load(&path).expect_err("must fail").to_string();
+    assert!(err.contains(name), "the error names the file: {err}");
+    err
+}
+
+#[test]
+fn corrupt_gltf_files_are_clear_errors_naming_the_file() {
+    let quad = mesh::plane();
+    let (json, bin) = mesh_gltf(&quad, true, r#"[{"mesh":0}]"#, 4);
+
+    // Indices out of range.
+    let mut bad = bin.clone();
+    let last = bad.len() - 4;
+    bad[last..].copy_from_slice(&99u32.to_le_bytes());
+    assert!(load_err("index.glb", &glb(&json, &bad)).contains("out of range"));
+
+    // A NaN position.
+    let mut bad = bin.clone();
+    bad[0..4].copy_from_slice(&f32::NAN.to_le_bytes());
+    assert!(load_err("nan.glb", &glb(&json, &bad)).contains("non-finite"));
+
+    // An accessor claiming 2^40 elements.
+    let absurd = json.replacen(r#""count":4,"#, r#""count":1099511627776,"#, 1);
+    assert_ne!(absurd, json);
+    let err = load_err("absurd.glb", &glb(&absurd, &bin));
+    assert!(err.contains("accessor") || err.contains("glTF"), "{err}");
+
+    // Points only: no triangles.
+    let points = json.replace(r#""mode":4"#, r#""mode":0"#);
+    assert!(load_err("points.glb", &glb(&points, &bin)).contains("no triangles"));
+
+    // A node that is its own child.
+    let cycle = json.replace(
+        r#""nodes":[{"mesh":0}]"#,
+        r#""nodes":[{"mesh":0,"children":[0]}]"#,
+    );
+    load_err("cycle.glb", &glb(&cycle, &bin));
+
+    // Not JSON at all, and a missing .bin.
+    assert!(load_err("junk.gltf", b"{ this is not json").contains("glTF"));
+    let missing = json.replace(r#""buffers":[{"#, r#""buffers":[{"uri":"nothere.bin","#);
+    load_err("missing.gltf", missing.as_bytes());
+}
+
+#[test]
+fn every_truncation_and_byte_flip_of_a_glb_is_an_error_or_a_valid_mesh() {
+    let quad = mesh::plane();
+    let (json, bin) = mesh_gltf(&quad, true, r#"[{"mesh":0}]"#, 4);
+    let file = glb(&json, &bin);
+    for len in 0..file.len() {
+        let path = temp("cut.glb", &file[..len]);
+        assert!(mesh::load(&path).is_err(), "prefix of {len} bytes");
+    }
+    let mut state = 0x1234_5678_u32;
+    for _ in 0..2000 {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        let mut copy = file.clone();
+        let at = (state >> 8) as usize % copy.len();
+        copy[at] ^= 1 << (state % 8);
+        let path = temp("flip.glb", &copy);
+        // Any outcome but a panic: a valid mesh must pass validation.
+        if let Ok(m) = mesh::load(&path) {
+            m.validate().expect("a loaded mesh is valid");
+        }
+    }
+}
+
+#[test]
+fn byte_flips_in_the_json_of_spot_as_glb_never_panic() {
+    let (json, bin) = mesh_gltf(&spot(), true, r#"[{"mesh":0}]"#, 4);
+    let file = glb(&json, &bin);
+    let json_end = 20 + json.len();
+    let mut state = 0x9E37_79B9_u32;
+    for _ in 0..1500 {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        let mut copy = file.clone();
+        let at = 20 + (state >> 8) as usize % (json_end - 20);
+        copy[at] = b"0123456789-e.,:[]{}\" x"[(state % 21) as usize];
+        if let Ok(m) = mesh::load(&temp("spot_flip.glb", &copy)) {
+            m.validate().expect("a loaded mesh is valid");
+        }
+    }
+}
+
+#[test]
+fn mesh_info_reads_glb() {
+    let (json, bin) = mesh_gltf(&spot(), false, r#"[{"mesh":0}]"#, 4);
+    let path = temp("spot_flat.glb", &glb(&json, &bin));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(["mesh-info", path.to_str().expect("path")])
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(text.contains("triangles: 5856"), "{text}");
+    assert!(text.contains("normals: computed"), "{text}");
+}
