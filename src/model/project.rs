@@ -488,9 +488,105 @@ impl Autosave {
     }
 }
 
+/// Autosave on a timer: [`Autosaver::poll`] (each frame, or from any loop) snapshots the
+/// document when a recovery copy is due and writes it atomically on a named background
+/// thread, so painting never waits on the disk. A snapshot costs no copy of the maps: tiles
+/// are shared copy-on-write.
+#[derive(Debug)]
+pub struct Autosaver {
+    timing: Autosave,
+    path: PathBuf,
+    job: Option<(u64, std::thread::JoinHandle<Result<(), ModelError>>)>,
+}
+
+impl Autosaver {
+    /// Writes recovery copies to `path` every `interval` while the document changes; the
+    /// document's current state (`doc.maps.version()`) counts as saved.
+    pub fn new(interval: Duration, path: PathBuf, doc: &Document) -> Self {
+        Self {
+            timing: Autosave::new(interval, Instant::now(), doc.maps.version()),
+            path,
+            job: None,
+        }
+    }
+
+    /// Where recovery copies go.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Reports a finished recovery save (its result), and starts a new one if one is due.
+    pub fn poll(&mut self, doc: &Document, now: Instant) -> Option<Result<PathBuf, ModelError>> {
+        let finished = if self.job.as_ref().is_some_and(|(_, h)| h.is_finished()) {
+            self.finish()
+        } else {
+            None
+        };
+        let version = doc.maps.version();
+        if self.job.is_none() && self.timing.due(now, version) {
+            let snapshot = Document::from_parts(doc.maps.clone(), doc.settings.clone());
+            let path = self.path.clone();
+            let spawned = std::thread::Builder::new()
+                .name("kapaint-autosave".into())
+                .spawn(move || save(&snapshot, &path));
+            match spawned {
+                Ok(handle) => self.job = Some((version, handle)),
+                Err(e) => return Some(Err(ModelError::io(&self.path, e))),
+            }
+            // Counted from the start, so a failing disk is retried one interval later.
+            self.timing.saved(now, version);
+        }
+        finished
+    }
+
+    /// Waits for a save in flight, if any, and reports it.
+    pub fn wait(&mut self) -> Option<Result<PathBuf, ModelError>> {
+        self.finish()
+    }
+
+    fn finish(&mut self) -> Option<Result<PathBuf, ModelError>> {
+        let (_, handle) = self.job.take()?;
+        Some(match handle.join() {
+            Ok(result) => result.map(|()| self.path.clone()),
+            Err(_) => Err(ModelError::io(
+                &self.path,
+                std::io::Error::other("the autosave thread stopped unexpectedly"),
+            )),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn autosaver_writes_a_loadable_recovery_copy_in_the_background() {
+        let dir = std::env::temp_dir().join(format!("kapaint-autosave-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(".a.kapaint-recovery");
+        let mut doc = Document::new(96, 64, crate::model::DocumentSettings::default()).unwrap();
+        let mut saver = Autosaver::new(Duration::from_mins(1), path.clone(), &doc);
+        let t0 = Instant::now();
+        assert!(saver.poll(&doc, t0 + Duration::from_mins(2)).is_none());
+        assert!(saver.wait().is_none(), "nothing changed, nothing written");
+        assert!(!path.exists());
+        doc.apply(crate::model::Command::Fill(crate::model::FillRegion::All))
+            .unwrap();
+        assert!(saver.poll(&doc, t0 + Duration::from_secs(121)).is_none());
+        assert_eq!(saver.wait().unwrap().unwrap(), path);
+        let back = load(&path).unwrap();
+        assert_eq!(back.maps.texel(5, 5), doc.maps.texel(5, 5));
+        assert!(saver.poll(&doc, t0 + Duration::from_secs(500)).is_none());
+        assert!(saver.wait().is_none(), "saved state is not saved again");
+
+        // A folder that does not exist: an error to show, never a panic.
+        let mut bad = Autosaver::new(Duration::ZERO, dir.join("no/such/dir/x"), &doc);
+        doc.apply(crate::model::Command::Undo).unwrap();
+        assert!(bad.poll(&doc, Instant::now()).is_none());
+        assert!(bad.wait().unwrap().is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn autosave_is_due_only_after_a_change_and_the_interval() {
