@@ -5,7 +5,9 @@
 
 pub mod atomic;
 pub mod cli;
+pub mod gpu;
 pub mod mesh;
 pub mod model;
 pub mod reflectance;
+pub mod render;
 pub mod report;

@@ -15,7 +15,20 @@ fn every_wgsl_file_validates() {
     files.sort();
     assert!(!files.is_empty(), "no shaders found in {}", dir.display());
     for path in files {
-        let source = std::fs::read_to_string(&path).expect("shader is readable");
+        let mut source = std::fs::read_to_string(&path).expect("shader is readable");
+        // A shader that uses another starts with `// requires: a.wgsl, b.wgsl`; they are
+        // prepended, as the renderer does.
+        if let Some(list) = source
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("// requires:"))
+        {
+            let mut full = String::new();
+            for name in list.split(',') {
+                full += &std::fs::read_to_string(dir.join(name.trim())).expect("required shader");
+            }
+            source = full + &source;
+        }
         let module = naga::front::wgsl::parse_str(&source)
             .unwrap_or_else(|e| panic!("{}: {}", path.display(), e.emit_to_string(&source)));
         naga::valid::Validator::new(

@@ -1,0 +1,101 @@
+//! The shader's `chi` evaluated on the GPU (`shaders/chi_check.wgsl`), to check it against
+//! the Rust core.
+
+use crate::reflectance::{AmbientApprox, ShadingModel};
+
+use super::{Gpu, GpuError, shader_source};
+
+/// `chi(model, approx, n)` for every `n`, computed by the WGSL the preview uses.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn chi_on_gpu(
+    gpu: &Gpu,
+    model: ShadingModel,
+    approx: AmbientApprox,
+    n: &[f32],
+) -> Result<Vec<f32>, GpuError> {
+    use wgpu::util::DeviceExt;
+    if n.is_empty() {
+        return Ok(Vec::new());
+    }
+    let device = &gpu.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("chi_check.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(
+            shader_source(include_str!("../../shaders/chi_check.wgsl")).into(),
+        ),
+    });
+    let constants = [
+        (
+            "MODEL",
+            match model {
+                ShadingModel::Phong => 0.0,
+                ShadingModel::BlinnPhong => 1.0,
+            },
+        ),
+        (
+            "APPROX",
+            match approx {
+                AmbientApprox::PaperPrinted => 0.0,
+                AmbientApprox::PaperCorrected => 1.0,
+                AmbientApprox::Fast => 2.0,
+            },
+        ),
+    ];
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("chi check"),
+        layout: None,
+        module: &module,
+        entry_point: Some("cs_main"),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            zero_initialize_workgroup_memory: false,
+        },
+        cache: None,
+    });
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("n"),
+        contents: bytemuck::cast_slice(n),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let bytes = std::mem::size_of_val(n) as u64;
+    let output = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("chi"),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("chi readback"),
+        size: bytes,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("chi check"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: output.as_entire_binding(),
+            },
+        ],
+    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups((n.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
+    gpu.queue.submit([encoder.finish()]);
+    let out = super::preview::read_buffer(gpu, &readback)?;
+    Ok(bytemuck::pod_collect_to_vec(&out))
+}

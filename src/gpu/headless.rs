@@ -1,0 +1,249 @@
+//! `kapaint render`: a frame rendered with no window and no display, written as an image.
+//! Data views are raw linear values (16-bit PNG, or float EXR) so images can be checked
+//! numerically; shaded views are sRGB PNGs (or linear EXR).
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::{Gpu, GpuError, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
+use crate::mesh::Mesh;
+use crate::model::MaterialMaps;
+use crate::reflectance::ShadingModel;
+use crate::render::{FrameSettings, ViewMode};
+
+/// How the two models are shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    /// One model (the settings').
+    Single,
+    /// Phong left of the middle, Blinn-Phong right.
+    Split,
+    /// `|Phong - Blinn-Phong|` as a heatmap (PNG) or raw (EXR).
+    Difference,
+}
+
+/// One headless render.
+pub struct Request<'a> {
+    /// The mesh.
+    pub mesh: &'a Mesh,
+    /// The maps.
+    pub maps: &'a MaterialMaps,
+    /// Model, approximation, view, lights, camera.
+    pub settings: FrameSettings,
+    /// Single model or a comparison.
+    pub compare: Compare,
+    /// Image size.
+    pub size: (u32, u32),
+    /// `.png` or `.exr`.
+    pub out: PathBuf,
+}
+
+/// Image file kinds written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Png,
+    Exr,
+}
+
+fn kind_of(path: &Path) -> Result<Kind, GpuError> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => Ok(Kind::Png),
+        Some("exr") => Ok(Kind::Exr),
+        _ => Err(GpuError(format!(
+            "{}: --out must end in .png or .exr",
+            path.display()
+        ))),
+    }
+}
+
+/// Renders and writes the image atomically; returns the report line.
+///
+/// # Errors
+/// No adapter, a bad size or output name, or a failed write.
+pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
+    let kind = kind_of(&req.out)?;
+    let (width, height) = req.size;
+    let mut preview = Preview::new(gpu);
+    let mesh = MeshBuffers::new(gpu, req.mesh);
+    let maps = MapTextures::new(gpu, req.maps);
+    let linear = kind == Kind::Exr || req.settings.view.is_data();
+    let mut note = String::new();
+    let pixels: RenderedImage = match req.compare {
+        Compare::Single | Compare::Split => {
+            let split = (req.compare == Compare::Split).then_some(width / 2);
+            preview.render_offscreen(
+                gpu,
+                &mesh,
+                &maps,
+                &req.settings,
+                Offscreen {
+                    size: req.size,
+                    linear,
+                    split,
+                },
+            )?
+        }
+        Compare::Difference => {
+            let mut render = |model| {
+                let settings = FrameSettings {
+                    model,
+                    ..req.settings
+                };
+                let offscreen = Offscreen {
+                    size: req.size,
+                    linear: true,
+                    split: None,
+                };
+                preview.render_offscreen(gpu, &mesh, &maps, &settings, offscreen)
+            };
+            let (a, b) = (
+                render(ShadingModel::Phong)?,
+                render(ShadingModel::BlinnPhong)?,
+            );
+            let (RenderedImage::Linear { pixels: a, .. }, RenderedImage::Linear { pixels: b, .. }) =
+                (a, b)
+            else {
+                return Err(GpuError("difference needs linear renders".into()));
+            };
+            let diff: Vec<f32> = a
+                .chunks_exact(4)
+                .zip(b.chunks_exact(4))
+                .flat_map(|(p, q)| {
+                    let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0_f32, f32::max);
+                    [d, d, d, p[3].max(q[3])]
+                })
+                .collect();
+            let max = diff.chunks_exact(4).map(|p| p[0]).fold(0.0_f32, f32::max);
+            note = format!(", max |phong - blinn| {max:.6}");
+            if kind == Kind::Exr {
+                RenderedImage::Linear {
+                    width,
+                    height,
+                    pixels: diff,
+                }
+            } else {
+                heatmap(&diff, width, height, max)
+            }
+        }
+    };
+    let mut pixels = pixels;
+    if req.settings.view == ViewMode::N
+        && kind == Kind::Png
+        && let RenderedImage::Linear { pixels: p, .. } = &mut pixels
+    {
+        // n does not fit [0, 1]: a PNG holds it on the log scale of the painting engine.
+        for px in p.chunks_exact_mut(4) {
+            for v in &mut px[..3] {
+                *v = crate::model::texel::n_to_blend(*v);
+            }
+        }
+    }
+    let bytes = encode(&pixels, kind)?;
+    crate::atomic::write_atomic(&req.out, &bytes)
+        .map_err(|e| GpuError(format!("cannot write {}: {e}", req.out.display())))?;
+    Ok(format!(
+        "wrote {} ({width}x{height}, view {}, {}{note}, adapter {} ({:?}))\n",
+        req.out.display(),
+        req.settings.view.name(),
+        match req.compare {
+            Compare::Single => req.settings.model.name(),
+            Compare::Split => "phong | blinn",
+            Compare::Difference => "|phong - blinn|",
+        },
+        gpu.info.name,
+        gpu.info.backend,
+    ))
+}
+
+/// A heatmap of `diff` (black, red, yellow, white up to `max`) with a scale bar along the
+/// bottom rows, sRGB bytes.
+fn heatmap(diff: &[f32], width: u32, height: u32, max: f32) -> RenderedImage {
+    let ramp = |t: f32| {
+        let t = t.clamp(0.0, 1.0);
+        Vec3::new(
+            (t * 3.0).min(1.0),
+            (t * 3.0 - 1.0).clamp(0.0, 1.0),
+            (t * 3.0 - 2.0).clamp(0.0, 1.0),
+        )
+    };
+    let scale = if max > 0.0 { 1.0 / max } else { 0.0 };
+    let bar = (height / 24).max(2);
+    let mut pixels = Vec::with_capacity((width * height * 4) as usize);
+    for (i, p) in diff.chunks_exact(4).enumerate() {
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        let (c, a) = if y >= height - bar {
+            (ramp(x as f32 / (width.max(2) - 1) as f32), 1.0)
+        } else {
+            (ramp(p[0] * scale), p[3])
+        };
+        let byte = |v: f32| (crate::model::texel::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+        pixels.extend_from_slice(&[byte(c.x), byte(c.y), byte(c.z), (a * 255.0 + 0.5) as u8]);
+    }
+    RenderedImage::Srgb8 {
+        width,
+        height,
+        pixels,
+    }
+}
+
+/// Encodes an image: sRGB bytes as an 8-bit RGBA PNG; linear data as a 16-bit RGBA PNG
+/// (values clamped into [0, 1]; `n` through the log blend scale) or a float RGBA EXR.
+fn encode(image: &RenderedImage, kind: Kind) -> Result<Vec<u8>, GpuError> {
+    let fail = |e: image::ImageError| GpuError(format!("cannot encode the image: {e}"));
+    let mut out = std::io::Cursor::new(Vec::new());
+    match (image, kind) {
+        (
+            RenderedImage::Srgb8 {
+                width,
+                height,
+                pixels,
+            },
+            Kind::Png,
+        ) => {
+            image::RgbaImage::from_raw(*width, *height, pixels.clone())
+                .ok_or_else(|| GpuError("image size mismatch".into()))?
+                .write_to(&mut out, image::ImageFormat::Png)
+                .map_err(fail)?;
+        }
+        (
+            RenderedImage::Linear {
+                width,
+                height,
+                pixels,
+            },
+            Kind::Exr,
+        ) => {
+            image::Rgba32FImage::from_raw(*width, *height, pixels.clone())
+                .ok_or_else(|| GpuError("image size mismatch".into()))?
+                .write_to(&mut out, image::ImageFormat::OpenExr)
+                .map_err(fail)?;
+        }
+        (
+            RenderedImage::Linear {
+                width,
+                height,
+                pixels,
+            },
+            Kind::Png,
+        ) => {
+            let words: Vec<u16> = pixels
+                .iter()
+                .map(|&v| (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16)
+                .collect();
+            image::ImageBuffer::<image::Rgba<u16>, _>::from_raw(*width, *height, words)
+                .ok_or_else(|| GpuError("image size mismatch".into()))?
+                .write_to(&mut out, image::ImageFormat::Png)
+                .map_err(fail)?;
+        }
+        (RenderedImage::Srgb8 { .. }, Kind::Exr) => {
+            return Err(GpuError("an EXR needs a linear render".into()));
+        }
+    }
+    Ok(out.into_inner())
+}

@@ -1,0 +1,273 @@
+//! What a preview shows, independent of the GPU: the camera, the view modes, the lighting, and
+//! the shading equation itself ([`shade`]), which the WGSL preview shader evaluates per
+//! fragment and the CPU reference renderer ([`reference`]) per pixel.
+
+pub mod reference;
+
+use glam::{Mat4, Vec3, Vec4};
+use serde::{Deserialize, Serialize};
+
+use crate::reflectance::{self, AmbientApprox, ShadingModel};
+
+/// What the preview shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ViewMode {
+    /// The lit material (sRGB).
+    Shaded,
+    /// Derived `k_a` (linear data).
+    Ka,
+    /// `k_d` (linear data).
+    Kd,
+    /// `k_s` (linear data).
+    Ks,
+    /// `n` (raw value).
+    N,
+    /// Diffuse term only: `I_l k_d max(0, N.L)`.
+    Diffuse,
+    /// Specular term only: `I_l k_s rho_s`.
+    Specular,
+    /// Ambient term only: `I_a k_a`.
+    Ambient,
+    /// A UV checker.
+    Checker,
+}
+
+impl ViewMode {
+    /// Every view, in the order the shader numbers them.
+    pub const ALL: [Self; 9] = [
+        Self::Shaded,
+        Self::Ka,
+        Self::Kd,
+        Self::Ks,
+        Self::N,
+        Self::Diffuse,
+        Self::Specular,
+        Self::Ambient,
+        Self::Checker,
+    ];
+
+    /// The shader's `VIEW` constant.
+    pub fn index(self) -> u32 {
+        Self::ALL.iter().position(|&v| v == self).unwrap_or(0) as u32
+    }
+
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Shaded => "shaded",
+            Self::Ka => "ka",
+            Self::Kd => "kd",
+            Self::Ks => "ks",
+            Self::N => "n",
+            Self::Diffuse => "diffuse",
+            Self::Specular => "specular",
+            Self::Ambient => "ambient",
+            Self::Checker => "checker",
+        }
+    }
+
+    /// From the CLI name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|v| v.name() == name)
+    }
+
+    /// Whether the view is linear data (written raw) rather than a picture (sRGB).
+    pub fn is_data(self) -> bool {
+        !matches!(self, Self::Shaded | Self::Checker)
+    }
+}
+
+/// The paper's lighting: a uniform sky of intensity `I_a` and one directional light.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Lighting {
+    /// Direction towards the light (normalised when used).
+    pub light: Vec3,
+    /// Ambient (sky) intensity `I_a`.
+    pub ia: f32,
+    /// Directional light intensity `I_l`.
+    pub il: f32,
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Self {
+            light: Vec3::new(0.5, 0.8, 0.6),
+            ia: 0.3,
+            il: 0.8,
+        }
+    }
+}
+
+impl Lighting {
+    /// The unit light direction (straight up when the given one is zero or not finite).
+    pub fn direction(&self) -> Vec3 {
+        self.light
+            .try_normalize()
+            .filter(|d| d.is_finite())
+            .unwrap_or(Vec3::Y)
+    }
+}
+
+/// An orbit camera around a target, Y up.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    /// The point orbited.
+    pub target: Vec3,
+    /// Distance from the target.
+    pub distance: f32,
+    /// Angle around Y, radians (0 looks down -Z from +Z).
+    pub yaw: f32,
+    /// Angle above the horizon, radians.
+    pub pitch: f32,
+    /// Vertical field of view, radians.
+    pub fov_y: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self {
+            target: Vec3::ZERO,
+            distance: 3.5,
+            yaw: 0.0,
+            pitch: 0.0,
+            fov_y: 35f32.to_radians(),
+        }
+    }
+}
+
+impl Camera {
+    /// A camera that frames `points` (a mesh's positions) from the current direction: the
+    /// target is the centre of their bounds, the distance fits the sphere around it that
+    /// holds them all.
+    #[must_use]
+    pub fn framing(mut self, points: &[Vec3]) -> Self {
+        let (min, max) = points.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        if !(min.is_finite() && max.is_finite()) {
+            return self;
+        }
+        let center = (min + max) / 2.0;
+        let radius = points
+            .iter()
+            .map(|p| p.distance(center))
+            .fold(1e-3_f32, f32::max);
+        self.target = center;
+        self.distance = radius / (self.fov_y / 2.0).sin() * 1.05;
+        self
+    }
+
+    /// The eye position.
+    pub fn eye(&self) -> Vec3 {
+        let dir = Vec3::new(
+            self.pitch.cos() * self.yaw.sin(),
+            self.pitch.sin(),
+            self.pitch.cos() * self.yaw.cos(),
+        );
+        self.target + dir * self.distance
+    }
+
+    /// View-projection matrix for an image of `aspect` = width / height (depth 0..1).
+    pub fn view_proj(&self, aspect: f32) -> Mat4 {
+        let view = glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y);
+        let near = (self.distance * 0.01).max(1e-4);
+        let far = self.distance * 10.0 + 10.0;
+        // wgpu's clip space: Y up, depth in [0, 1] (the Direct3D convention).
+        glam::camera::rh::proj::directx::perspective(self.fov_y, aspect.max(1e-3), near, far) * view
+    }
+
+    /// The ray through pixel centre `(px + 0.5, py + 0.5)` of a `width x height` image:
+    /// origin and unit direction, in object space.
+    pub fn ray(&self, px: f32, py: f32, width: u32, height: u32) -> (Vec3, Vec3) {
+        let inv = self.view_proj(width as f32 / height as f32).inverse();
+        let x = (px + 0.5) / width as f32 * 2.0 - 1.0;
+        let y = 1.0 - (py + 0.5) / height as f32 * 2.0;
+        let unproject = |z: f32| {
+            let p: Vec4 = inv * Vec4::new(x, y, z, 1.0);
+            p.truncate() / p.w
+        };
+        let (near, far) = (unproject(0.0), unproject(1.0));
+        (near, (far - near).normalize_or_zero())
+    }
+}
+
+/// Everything a frame needs besides the mesh and the maps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSettings {
+    /// Shading model.
+    pub model: ShadingModel,
+    /// Approximation of `chi` for `k_a`.
+    pub approx: AmbientApprox,
+    /// What to show.
+    pub view: ViewMode,
+    /// Lights.
+    pub lighting: Lighting,
+    /// Camera.
+    pub camera: Camera,
+}
+
+/// One material sample: linear `k_d`, `k_s` and `n`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Diffuse coefficient.
+    pub kd: Vec3,
+    /// Specular coefficient.
+    pub ks: Vec3,
+    /// Phong exponent.
+    pub n: f32,
+}
+
+/// `x^n` for `x` in `[0, 1]` as the shader computes it: 0 for `x <= 0`, 1 for `n == 0`.
+pub fn spec_pow(x: f32, n: f32) -> f32 {
+    if x.is_nan() || x <= 0.0 {
+        return 0.0;
+    }
+    (n * x.min(1.0).log2()).exp2()
+}
+
+/// The value a view shows at a surface point with unit `normal`, seen along unit `to_eye`:
+/// the equation of `shaders/preview.wgsl`, in linear light (not yet sRGB-encoded).
+pub fn shade(s: &FrameSettings, m: Sample, normal: Vec3, to_eye: Vec3, uv: glam::Vec2) -> Vec3 {
+    let kd = m.kd.map(reflectance::sanitize_coefficient);
+    let ks = m.ks.map(reflectance::sanitize_coefficient);
+    let n = reflectance::sanitize_n_f32(m.n);
+    let finite = |c: Vec3| c.map(|v| if v.is_finite() { v } else { 0.0 });
+    match s.view {
+        ViewMode::Kd => return kd,
+        ViewMode::Ks => return ks,
+        ViewMode::N => return Vec3::splat(n),
+        ViewMode::Checker => {
+            let cell = (uv * 16.0).floor();
+            let odd = (cell.x as i32 + cell.y as i32) & 1;
+            return Vec3::splat(0.25 + 0.5 * odd as f32);
+        }
+        _ => {}
+    }
+    let ka = reflectance::ka(s.model, s.approx, kd, ks, n);
+    if s.view == ViewMode::Ka {
+        return finite(ka);
+    }
+    let ambient = s.lighting.ia * ka;
+    if s.view == ViewMode::Ambient {
+        return finite(ambient);
+    }
+    let l = s.lighting.direction();
+    let n_dot_l = normal.dot(l);
+    let diffuse = s.lighting.il * kd * n_dot_l.max(0.0);
+    if s.view == ViewMode::Diffuse {
+        return finite(diffuse);
+    }
+    let mut specular = Vec3::ZERO;
+    if n_dot_l > 0.0 {
+        let cosine = match s.model {
+            ShadingModel::Phong => (2.0 * n_dot_l * normal - l).dot(to_eye),
+            ShadingModel::BlinnPhong => normal.dot((l + to_eye).normalize()),
+        };
+        specular = s.lighting.il * ks * spec_pow(cosine, n);
+    }
+    if s.view == ViewMode::Specular {
+        return finite(specular);
+    }
+    finite(ambient + diffuse + specular).clamp(Vec3::ZERO, Vec3::ONE)
+}
