@@ -570,6 +570,17 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
     use crate::gpu::headless::{self, Compare};
     use crate::render::{Camera, FrameSettings, Lighting, ViewMode};
     let (width, height) = parse_size(&a.size)?;
+    let ext = a
+        .out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "exr")) {
+        return Err(CliError::usage(format!(
+            "{}: --out must end in .png or .exr",
+            a.out.display()
+        )));
+    }
     let (maps, own_mesh) = render_material(&a)?;
     let mesh_spec = a.mesh.map_or(own_mesh, std::path::PathBuf::from);
     let mesh = mesh::open(&mesh_spec).map_err(|e| CliError::usage(e.to_string()))?;

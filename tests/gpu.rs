@@ -357,3 +357,68 @@ fn extreme_maps_shade_to_finite_colours() {
         }
     }
 }
+
+#[test]
+fn render_cli_writes_numerically_checkable_data_views() {
+    let Some(_gpu) = gpu() else { return };
+    let dir = std::env::temp_dir().join(format!("kapaint-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let exr = dir.join("ka.exr");
+    let material = ["--kd", "0.6,0.3,0.2", "--ks", "0.4", "--n", "80"];
+    let mut args = vec![
+        "render", "--model", "blinn", "--view", "ka", "--size", "48x32",
+    ];
+    args.extend(material);
+    args.extend(["--out", exr.to_str().expect("path")]);
+    let o = run(&args);
+    assert!(o.status.success(), "{o:?}");
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("wrote "));
+    let image = image::open(&exr).expect("EXR decodes").to_rgba32f();
+    assert_eq!(image.dimensions(), (48, 32));
+    let want = reflectance::ka(
+        ShadingModel::BlinnPhong,
+        AmbientApprox::Fast,
+        MaterialValue::new(Vec3::new(0.6, 0.3, 0.2), Vec3::splat(0.4), 80.0).kd,
+        Vec3::splat(0.4),
+        80.0,
+    );
+    let covered: Vec<_> = image.pixels().filter(|p| p[3] > 0.0).collect();
+    assert!(!covered.is_empty());
+    for p in covered {
+        for c in 0..3 {
+            assert!((p[c] - want[c]).abs() <= 1e-4 * want[c], "{p:?} vs {want}");
+        }
+    }
+    // A 16-bit PNG of k_d, and a shaded sRGB PNG of the split compare.
+    let png = dir.join("kd.png");
+    let mut args = vec!["render", "--model", "phong", "--view", "kd", "--size", "40"];
+    args.extend(material);
+    args.extend(["--out", png.to_str().expect("path")]);
+    assert!(run(&args).status.success());
+    let kd = image::open(&png).expect("PNG decodes").to_rgba16();
+    let p = kd.pixels().find(|p| p[3] > 0).expect("covered");
+    assert!((f32::from(p[0]) / 65535.0 - 0.6).abs() < 1e-4, "{p:?}");
+    let split = dir.join("split.png");
+    let mut args = vec!["render", "--model", "compare-split", "--view", "shaded"];
+    args.extend(material);
+    args.extend(["--out", split.to_str().expect("path")]);
+    assert!(run(&args).status.success());
+    // Errors: one line, exit 2, nothing written.
+    let bad = dir.join("x.jpg");
+    let mut args = vec!["render", "--model", "phong", "--view", "ka"];
+    args.extend(["--out", bad.to_str().expect("path")]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(!bad.exists());
+    let o = run(&[
+        "render", "--model", "phong", "--view", "ka", "--light", "0,0,0", "--out", "y.png",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,243 @@
+//! Criterion benches for the preview renderer (issue 5), on whatever adapter wgpu finds
+//! (lavapipe on the 2-core CI machine; a real GPU through the device tool when lent):
+//! a 1920x1080 frame of a 1M-triangle mesh with 4096^2 maps, the skip variants against the
+//! full shader, and a 256x256 dirty-region upload.
+
+#![allow(missing_docs)] // criterion_main! generates an undocumented main.
+#![allow(clippy::expect_used)]
+
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::{Vec2, Vec3};
+use kapaint::gpu::preview::PipelineKey;
+use kapaint::gpu::{Gpu, MapTextures, MeshBuffers, Preview};
+use kapaint::mesh;
+use kapaint::model::brush::{BrushSettings, StrokePoint};
+use kapaint::model::texel::MaterialValue;
+use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+use kapaint::reflectance::{AmbientApprox, ShadingModel};
+use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
+
+fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+/// A 4096^2 document with strokes in every channel, and one whose k_s is zero everywhere.
+fn documents() -> (Document, Document) {
+    let mut painted = Document::new(
+        4096,
+        4096,
+        DocumentSettings {
+            brush: BrushSettings {
+                radius_px: 200.0,
+                ..BrushSettings::default()
+            },
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("doc");
+    for k in 0..8 {
+        let y = 300.0 + 480.0 * k as f32;
+        painted
+            .apply(Command::Stroke {
+                tool: StrokeTool::Brush,
+                points: vec![
+                    StrokePoint {
+                        pos: Vec2::new(100.0, y),
+                        pressure: 1.0,
+                    },
+                    StrokePoint {
+                        pos: Vec2::new(4000.0, y + 200.0),
+                        pressure: 1.0,
+                    },
+                ],
+            })
+            .expect("stroke");
+    }
+    let matte = Document::new(
+        4096,
+        4096,
+        DocumentSettings {
+            base: MaterialValue::new(Vec3::splat(0.5), Vec3::ZERO, 1.0),
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("doc");
+    (painted, matte)
+}
+
+fn frames(c: &mut Criterion) {
+    let Ok(gpu) = Gpu::headless() else {
+        eprintln!("SKIPPED: no GPU adapter");
+        return;
+    };
+    eprintln!("adapter: {} ({:?})", gpu.info.name, gpu.info.backend);
+    let mut group = c.benchmark_group("render_1080p_1m_triangles");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(8));
+    let sphere = mesh::uv_sphere(1000, 500);
+    let buffers = MeshBuffers::new(&gpu, &sphere);
+    let (painted, matte) = documents();
+    let painted_maps = MapTextures::new(&gpu, &painted.maps);
+    let matte_maps = MapTextures::new(&gpu, &matte.maps);
+    let mut preview = Preview::new(&gpu);
+    let (w, h) = (1920, 1080);
+    let color = target(&gpu, w, h, wgpu::TextureFormat::Rgba8UnormSrgb);
+    let depth = target(&gpu, w, h, wgpu::TextureFormat::Depth32Float);
+    let settings = |view| FrameSettings {
+        model: ShadingModel::BlinnPhong,
+        approx: AmbientApprox::Fast,
+        view,
+        lighting: Lighting::default(),
+        camera: Camera::default().framing(&sphere.positions),
+    };
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let cases = [
+        (
+            "shaded_painted_maps",
+            &painted_maps,
+            ViewMode::Shaded,
+            false,
+        ),
+        (
+            "shaded_full_shader_on_uniform_maps",
+            &matte_maps,
+            ViewMode::Shaded,
+            true,
+        ),
+        (
+            "shaded_uniform_maps_no_specular",
+            &matte_maps,
+            ViewMode::Shaded,
+            false,
+        ),
+        ("view_ka_painted_maps", &painted_maps, ViewMode::Ka, false),
+        ("view_kd_painted_maps", &painted_maps, ViewMode::Kd, false),
+    ];
+    for (name, maps, view, full) in cases {
+        let s = settings(view);
+        let key = PipelineKey::for_frame(&s, &maps.uniform, format);
+        let key = if full { key.full() } else { key };
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut encoder = gpu
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+                preview.draw(
+                    &gpu,
+                    &mut encoder,
+                    &color,
+                    &depth,
+                    (w, h),
+                    &buffers,
+                    maps,
+                    &s,
+                    &[(key, (0, 0, w, h))],
+                );
+                gpu.queue.submit([encoder.finish()]);
+                gpu.wait();
+            });
+        });
+    }
+    // The split compare shades each half once.
+    let s = settings(ViewMode::Shaded);
+    let key = PipelineKey::for_frame(&s, &painted_maps.uniform, format);
+    let parts = [
+        (
+            PipelineKey {
+                model: ShadingModel::Phong,
+                ..key
+            },
+            (0, 0, w / 2, h),
+        ),
+        (key, (w / 2, 0, w - w / 2, h)),
+    ];
+    group.bench_function("compare_split_painted_maps", |b| {
+        b.iter(|| {
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            preview.draw(
+                &gpu,
+                &mut encoder,
+                &color,
+                &depth,
+                (w, h),
+                &buffers,
+                &painted_maps,
+                &s,
+                &parts,
+            );
+            gpu.queue.submit([encoder.finish()]);
+            gpu.wait();
+        });
+    });
+    group.finish();
+}
+
+fn uploads(c: &mut Criterion) {
+    let Ok(gpu) = Gpu::headless() else {
+        eprintln!("SKIPPED: no GPU adapter");
+        return;
+    };
+    let (painted, _) = documents();
+    let mut group = c.benchmark_group("upload_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(4));
+    let mut doc = painted;
+    let mut maps = MapTextures::new(&gpu, &doc.maps);
+    let mut k = 0_u32;
+    // Each iteration paints a hard 128 px dab inside one 256x256 square (16 tiles), then the
+    // timed part: sync (upload the dirty tiles) and wait for the queue.
+    doc.apply(Command::SetBrush(BrushSettings {
+        radius_px: 128.0,
+        hardness: 1.0,
+        ..BrushSettings::default()
+    }))
+    .expect("brush");
+    group.bench_function("dirty_256x256_region", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                k += 1;
+                let x0 = f32::from((k % 15) as u16) * 256.0;
+                doc.apply(Command::Stroke {
+                    tool: StrokeTool::Brush,
+                    points: vec![StrokePoint {
+                        pos: Vec2::new(x0 + 128.0, 128.0 + 256.0 * (k % 7) as f32),
+                        pressure: 1.0,
+                    }],
+                })
+                .expect("dab");
+                let start = std::time::Instant::now();
+                let n = maps.sync(&gpu, &doc.maps);
+                gpu.wait();
+                total += start.elapsed();
+                assert!(n > 0);
+            }
+            total
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, frames, uploads);
+criterion_main!(benches);
