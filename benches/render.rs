@@ -38,6 +38,43 @@ fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::Textu
         .create_view(&wgpu::TextureViewDescriptor::default())
 }
 
+/// A target and mesh to draw frames into, waiting for each.
+struct Frame<'a> {
+    gpu: &'a Gpu,
+    color: &'a wgpu::TextureView,
+    depth: &'a wgpu::TextureView,
+    size: (u32, u32),
+    mesh: &'a MeshBuffers,
+}
+
+impl Frame<'_> {
+    fn draw(
+        &self,
+        preview: &mut Preview,
+        maps: &MapTextures,
+        settings: &FrameSettings,
+        parts: &[kapaint::gpu::preview::DrawPart],
+    ) {
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        preview.draw(
+            self.gpu,
+            &mut encoder,
+            self.color,
+            self.depth,
+            self.size,
+            self.mesh,
+            maps,
+            settings,
+            parts,
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.wait();
+    }
+}
+
 /// A 4096^2 document with strokes in every channel, and one whose k_s is zero everywhere.
 fn documents() -> (Document, Document) {
     let mut painted = Document::new(
@@ -135,25 +172,15 @@ fn frames(c: &mut Criterion) {
         let s = settings(view);
         let key = PipelineKey::for_frame(&s, &maps.uniform, format);
         let key = if full { key.full() } else { key };
+        let frame = Frame {
+            gpu: &gpu,
+            color: &color,
+            depth: &depth,
+            size: (w, h),
+            mesh: &buffers,
+        };
         group.bench_function(name, |b| {
-            b.iter(|| {
-                let mut encoder = gpu
-                    .device
-                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-                preview.draw(
-                    &gpu,
-                    &mut encoder,
-                    &color,
-                    &depth,
-                    (w, h),
-                    &buffers,
-                    maps,
-                    &s,
-                    &[(key, (0, 0, w, h))],
-                );
-                gpu.queue.submit([encoder.finish()]);
-                gpu.wait();
-            });
+            b.iter(|| frame.draw(&mut preview, maps, &s, &[(key, (0, 0, w, h))]));
         });
     }
     // The split compare shades each half once.
@@ -169,25 +196,15 @@ fn frames(c: &mut Criterion) {
         ),
         (key, (w / 2, 0, w - w / 2, h)),
     ];
+    let frame = Frame {
+        gpu: &gpu,
+        color: &color,
+        depth: &depth,
+        size: (w, h),
+        mesh: &buffers,
+    };
     group.bench_function("compare_split_painted_maps", |b| {
-        b.iter(|| {
-            let mut encoder = gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-            preview.draw(
-                &gpu,
-                &mut encoder,
-                &color,
-                &depth,
-                (w, h),
-                &buffers,
-                &painted_maps,
-                &s,
-                &parts,
-            );
-            gpu.queue.submit([encoder.finish()]);
-            gpu.wait();
-        });
+        b.iter(|| frame.draw(&mut preview, &painted_maps, &s, &parts));
     });
     group.finish();
 }
