@@ -139,6 +139,15 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// The exponent of the other model whose highlight matches (CSV "n,equivalent").
+    EquivalentN {
+        /// The model the given exponents belong to.
+        #[arg(long, value_enum)]
+        from: ModelArg,
+        /// Exponents (n >= 0).
+        #[arg(required = true, allow_hyphen_values = true)]
+        n: Vec<String>,
+    },
     /// Render the preview headless (no window, no display) into a PNG or EXR.
     Render {
         /// Project whose maps to render.
@@ -399,6 +408,18 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                 "applied {count} commands, saved {}\n",
                 target.display()
             ))
+        }
+        Command::EquivalentN { from, n } => {
+            let values = n
+                .iter()
+                .map(|t| parse_n(t, MethodArg::Fast))
+                .collect::<Result<Vec<f64>, _>>()?;
+            let mut out = String::from("n,equivalent\n");
+            for v in values {
+                let m = crate::reflectance::equivalent::equivalent_exponent(from.into(), v);
+                let _ = writeln!(out, "{v},{m:.6}");
+            }
+            Ok(out)
         }
         Command::Render {
             project,

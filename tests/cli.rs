@@ -443,3 +443,25 @@ fn paint_scripts_take_strokes_on_the_mesh() {
     assert_eq!(std::fs::read(&file).expect("read"), painted);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn equivalent_n_maps_between_the_models() {
+    let o = kapaint(&["equivalent-n", "--from", "phong", "0", "1", "10000"]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("n,equivalent"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let (a, b) = l.split_once(',').expect("two columns");
+            (a.parse().expect("n"), b.parse().expect("m"))
+        })
+        .collect();
+    assert_eq!(rows[0], (0.0, 0.0));
+    assert!(rows[1].1 > 4.0 && rows[1].1 < 16.0, "{rows:?}");
+    assert!((rows[2].1 / 10000.0 - 4.0).abs() < 0.01, "{rows:?}");
+    assert_usage_error(
+        &kapaint(&["equivalent-n", "--from", "blinn", "-1"]),
+        "n must be >= 0",
+    );
+}

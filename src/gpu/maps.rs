@@ -155,26 +155,41 @@ impl MapTextures {
                 );
             };
             for (plane, texture) in [(&tile.kd, &self.kd), (&tile.ks, &self.ks)] {
-                for y in 0..h {
-                    for x in 0..w {
-                        let v = plane.get(y * TILE_SIZE + x);
-                        let o = (y * w + x) * 4;
-                        for c in 0..3 {
-                            rgba[o + c] = if self.unorm16 {
-                                v[c]
-                            } else {
-                                half::f16::from_f32(crate::model::texel::decode_unorm(v[c]))
-                                    .to_bits()
-                            };
+                let alpha = if self.unorm16 { u16::MAX } else { 0x3c00 };
+                let convert = |v: [u16; 3]| -> [u16; 4] {
+                    if self.unorm16 {
+                        [v[0], v[1], v[2], alpha]
+                    } else {
+                        let h = |c: u16| {
+                            half::f16::from_f32(crate::model::texel::decode_unorm(c)).to_bits()
+                        };
+                        [h(v[0]), h(v[1]), h(v[2]), alpha]
+                    }
+                };
+                let out: &mut [[u16; 4]] = bytemuck::cast_slice_mut(&mut rgba[..w * h * 4]);
+                match plane {
+                    Plane::Uniform(v) => out.fill(convert(*v)),
+                    Plane::Data(d) => {
+                        for (row_out, row_in) in
+                            out.chunks_exact_mut(w).zip(d.chunks_exact(TILE_SIZE))
+                        {
+                            for (o, &v) in row_out.iter_mut().zip(&row_in[..w]) {
+                                *o = convert(v);
+                            }
                         }
-                        rgba[o + 3] = if self.unorm16 { u16::MAX } else { 0x3c00 };
                     }
                 }
                 write(texture, &rgba, 8);
             }
-            for y in 0..h {
-                for x in 0..w {
-                    n_bits[y * w + x] = tile.n.get(y * TILE_SIZE + x);
+            match &tile.n {
+                Plane::Uniform(v) => n_bits[..w * h].fill(*v),
+                Plane::Data(d) => {
+                    for (row_out, row_in) in n_bits[..w * h]
+                        .chunks_exact_mut(w)
+                        .zip(d.chunks_exact(TILE_SIZE))
+                    {
+                        row_out.copy_from_slice(&row_in[..w]);
+                    }
                 }
             }
             write(&self.n, &n_bits, 2);
