@@ -269,6 +269,7 @@ impl Preview {
             address_mode_v: wgpu::AddressMode::ClampToEdge,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
@@ -561,7 +562,7 @@ impl Preview {
             &parts,
         );
         let texel = if linear { 16 } else { 4 };
-        let packed = read_texture(gpu, encoder, &color, texel)?;
+        let packed = read_texture(gpu, encoder, &color, texel, 0)?;
         Ok(if linear {
             RenderedImage::Linear {
                 width,
@@ -578,7 +579,8 @@ impl Preview {
     }
 }
 
-/// Copies `texture` (`texel` bytes per texel) out after the work in `encoder`, rows packed.
+/// Copies mip `level` of `texture` (`texel` bytes per texel) out after the work in
+/// `encoder`, rows packed.
 ///
 /// # Errors
 /// When the read-back fails.
@@ -587,8 +589,11 @@ pub fn read_texture(
     mut encoder: wgpu::CommandEncoder,
     texture: &wgpu::Texture,
     texel: u32,
+    level: u32,
 ) -> Result<Vec<u8>, GpuError> {
-    let extent = texture.size();
+    let extent = texture
+        .size()
+        .mip_level_size(level, wgpu::TextureDimension::D2);
     let (width, height) = (extent.width, extent.height);
     let row = (width * texel).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -598,7 +603,12 @@ pub fn read_texture(
         mapped_at_creation: false,
     });
     encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: level,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: &readback,
             layout: wgpu::TexelCopyBufferLayout {
