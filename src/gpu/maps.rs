@@ -4,6 +4,8 @@
 //! one, one sub-rectangle write per tile, then rebuilds only those tiles' footprint in every
 //! mip level (box means computed on the CPU from the tile, rounded once per level).
 
+use rayon::prelude::*;
+
 use crate::model::MaterialMaps;
 use crate::model::tile::{Plane, TILE_SIZE};
 
@@ -75,7 +77,60 @@ pub struct MapTextures {
 }
 
 /// Sums of a mip texel's level-0 texels: `k_d` RGB, `k_s` RGB, `n`, and how many.
-type Sums = [f64; 8];
+type Sums = [f32; 8];
+
+/// One mip level's texels over one tile: level, origin, size, sums.
+type MipPatch = (u32, (u32, u32), (u32, u32), Vec<Sums>);
+
+/// The mip levels `1..levels` over tile `id` (box sums on the tile-local grid, each level from
+/// the one below), and the whole tile's sums.
+fn tile_mips(
+    maps: &MaterialMaps,
+    id: usize,
+    levels: u32,
+    size: (u32, u32),
+) -> (Sums, Vec<MipPatch>) {
+    let rect = maps.tile_rect(id);
+    let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
+    let tile = maps.tile(id);
+    let mut grid: Vec<Sums> = (0..w * h)
+        .map(|i| {
+            let t = tile.texel((i / w) * TILE_SIZE + i % w);
+            let kd = t.kd.map(crate::model::texel::decode_unorm);
+            let ks = t.ks.map(crate::model::texel::decode_unorm);
+            let n = crate::model::texel::decode_n(t.n);
+            [kd[0], kd[1], kd[2], ks[0], ks[1], ks[2], n, 1.0]
+        })
+        .collect();
+    let (mut gw, mut gh) = (w, h);
+    let mut patches = Vec::new();
+    for level in 1..levels {
+        let (nw, nh) = (gw.div_ceil(2), gh.div_ceil(2));
+        let mut next = vec![[0.0; 8]; nw * nh];
+        for (i, s) in grid.iter().enumerate() {
+            let o = &mut next[(i / gw / 2) * nw + (i % gw) / 2];
+            for (o, s) in o.iter_mut().zip(s) {
+                *o += s;
+            }
+        }
+        grid = next;
+        (gw, gh) = (nw, nh);
+        let r = level_rect(rect, level, size);
+        let (lw, lh) = ((r.2 - r.0) as usize, (r.3 - r.1) as usize);
+        if lw == 0 || lh == 0 {
+            break;
+        }
+        let texels: Vec<Sums> = (0..lw * lh).map(|i| grid[(i / lw) * gw + i % lw]).collect();
+        patches.push((level, (r.0, r.1), (lw as u32, lh as u32), texels));
+    }
+    let mut total = [0.0; 8];
+    for s in &grid {
+        for (t, s) in total.iter_mut().zip(s) {
+            *t += s;
+        }
+    }
+    (total, patches)
+}
 
 /// A tile's texel rectangle at a mip level, in texels of that level.
 fn level_rect(rect: (u32, u32, u32, u32), level: u32, size: (u32, u32)) -> (u32, u32, u32, u32) {
@@ -203,7 +258,7 @@ impl MapTextures {
                 .flat_map(|t| {
                     let count = t[7].max(1.0);
                     let c = |k: usize| {
-                        let v = (t[offset + k] / count) as f32;
+                        let v = t[offset + k] / count;
                         if self.unorm16 {
                             crate::model::texel::encode_unorm(v)
                         } else {
@@ -222,7 +277,7 @@ impl MapTextures {
         let (kd, ks) = (rgba(0), rgba(3));
         let n: Vec<u16> = texels
             .iter()
-            .map(|t| half::f16::from_f64(t[6] / t[7].max(1.0)).to_bits())
+            .map(|t| half::f16::from_f32(t[6] / t[7].max(1.0)).to_bits())
             .collect();
         for (texture, data, texel_bytes) in
             [(&self.kd, &kd, 8), (&self.ks, &ks, 8), (&self.n, &n, 2)]
@@ -261,48 +316,17 @@ impl MapTextures {
         let levels = self.kd.mip_level_count();
         let size = self.size;
         let tile_level = TILE_SIZE.trailing_zeros(); // 6: one texel per tile
-        for &id in tiles {
-            let rect = maps.tile_rect(id);
-            let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
-            let tile = maps.tile(id);
-            // Level 0 sums on the tile-local grid.
-            let mut grid: Vec<Sums> = (0..w * h)
-                .map(|i| {
-                    let t = tile.texel((i / w) * TILE_SIZE + i % w);
-                    let kd = t.kd.map(crate::model::texel::decode_unorm);
-                    let ks = t.ks.map(crate::model::texel::decode_unorm);
-                    let n = crate::model::texel::decode_n(t.n);
-                    [kd[0], kd[1], kd[2], ks[0], ks[1], ks[2], n, 1.0].map(f64::from)
-                })
-                .collect();
-            let (mut gw, mut gh) = (w, h);
-            for level in 1..levels.min(tile_level + 1) {
-                let (nw, nh) = (gw.div_ceil(2), gh.div_ceil(2));
-                let mut next = vec![[0.0; 8]; nw * nh];
-                for (i, s) in grid.iter().enumerate() {
-                    let (x, y) = (i % gw, i / gw);
-                    let o = &mut next[(y / 2) * nw + x / 2];
-                    for k in 0..8 {
-                        o[k] += s[k];
-                    }
-                }
-                grid = next;
-                (gw, gh) = (nw, nh);
-                let r = level_rect(rect, level, size);
-                let (lw, lh) = ((r.2 - r.0) as usize, (r.3 - r.1) as usize);
-                if lw == 0 || lh == 0 {
-                    break;
-                }
-                let texels: Vec<Sums> =
-                    (0..lw * lh).map(|i| grid[(i / lw) * gw + i % lw]).collect();
-                self.write_level(gpu, level, (r.0, r.1), (lw as u32, lh as u32), &texels);
-            }
-            // The whole tile's sums.
-            let mut total = [0.0; 8];
-            for s in &grid {
-                for k in 0..8 {
-                    total[k] += s[k];
-                }
+        // Each dirty tile's levels, computed in parallel, then written in order.
+        let per_tile: Vec<(usize, Sums, Vec<MipPatch>)> = tiles
+            .par_iter()
+            .map(|&id| {
+                let (total, patches) = tile_mips(maps, id, levels.min(tile_level + 1), size);
+                (id, total, patches)
+            })
+            .collect();
+        for (id, total, patches) in per_tile {
+            for (level, origin, extent, texels) in patches {
+                self.write_level(gpu, level, origin, extent, &texels);
             }
             self.tile_sums[id] = total;
         }
