@@ -158,6 +158,40 @@ impl Camera {
         self
     }
 
+    /// Orbits by `yaw` and `pitch` radians (pitch kept short of the poles).
+    #[must_use]
+    pub fn orbit(mut self, yaw: f32, pitch: f32) -> Self {
+        if yaw.is_finite() && pitch.is_finite() {
+            self.yaw = (self.yaw + yaw).rem_euclid(std::f32::consts::TAU);
+            self.pitch = (self.pitch + pitch).clamp(-1.55, 1.55);
+        }
+        self
+    }
+
+    /// Moves the target in the view plane by `(dx, dy)` fractions of the view height (a
+    /// drag of the full height moves by what the view shows at the target's distance).
+    #[must_use]
+    pub fn pan(mut self, dx: f32, dy: f32) -> Self {
+        if !(dx.is_finite() && dy.is_finite()) {
+            return self;
+        }
+        let forward = (self.target - self.eye()).normalize_or_zero();
+        let right = forward.cross(Vec3::Y).normalize_or_zero();
+        let up = right.cross(forward);
+        let height = 2.0 * self.distance * (self.fov_y / 2.0).tan();
+        self.target += (right * -dx + up * dy) * height;
+        self
+    }
+
+    /// Zooms by `factor` (above 1 moves closer), within sane distances.
+    #[must_use]
+    pub fn zoom(mut self, factor: f32) -> Self {
+        if factor.is_finite() && factor > 0.0 {
+            self.distance = (self.distance / factor).clamp(1e-4, 1e6);
+        }
+        self
+    }
+
     /// The eye position.
     pub fn eye(&self) -> Vec3 {
         let dir = Vec3::new(
@@ -189,6 +223,36 @@ impl Camera {
         };
         let (near, far) = (unproject(0.0), unproject(1.0));
         (near, (far - near).normalize_or_zero())
+    }
+}
+
+/// Decides whether a frame must be drawn: only when the settings, the maps (their version)
+/// or the mesh (an id the caller bumps) changed since the last frame drawn.
+#[derive(Clone, Debug, Default)]
+pub struct RedrawGate {
+    last: Option<(FrameSettings, u64, u64, (u32, u32))>,
+}
+
+impl RedrawGate {
+    /// Whether this frame differs from the last one drawn; records it if so.
+    pub fn needs_redraw(
+        &mut self,
+        settings: &FrameSettings,
+        maps_version: u64,
+        mesh_id: u64,
+        size: (u32, u32),
+    ) -> bool {
+        let now = (*settings, maps_version, mesh_id, size);
+        if self.last == Some(now) {
+            return false;
+        }
+        self.last = Some(now);
+        true
+    }
+
+    /// Forces the next frame to be drawn (a lost surface, a resize the caller can't see).
+    pub fn invalidate(&mut self) {
+        self.last = None;
     }
 }
 
@@ -270,4 +334,74 @@ pub fn shade(s: &FrameSettings, m: Sample, normal: Vec3, to_eye: Vec3, uv: glam:
         return finite(specular);
     }
     finite(ambient + diffuse + specular).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camera_orbit_pan_zoom_and_framing() {
+        let points = [Vec3::new(-1.0, 2.0, 0.0), Vec3::new(3.0, 4.0, 1.0)];
+        let cam = Camera::default().framing(&points);
+        assert_eq!(cam.target, Vec3::new(1.0, 3.0, 0.5));
+        // Every point is inside the view cone.
+        for p in points {
+            let to = (p - cam.eye()).normalize();
+            let axis = (cam.target - cam.eye()).normalize();
+            assert!(to.dot(axis) >= (cam.fov_y / 2.0).cos() - 1e-6);
+        }
+        let orbited = cam.orbit(0.3, 10.0);
+        assert!((orbited.eye().distance(orbited.target) - cam.distance).abs() < 1e-4);
+        assert!(orbited.pitch <= 1.55, "pitch stops short of the pole");
+        let panned = cam.pan(0.5, 0.0);
+        assert!((panned.target - cam.target).length() > 0.0);
+        assert!(
+            ((panned.target - cam.target).y).abs() < 1e-5,
+            "a sideways pan stays level"
+        );
+        assert!((cam.zoom(2.0).distance - cam.distance / 2.0).abs() < 1e-5);
+        assert_eq!(cam.zoom(f32::NAN), cam);
+        assert_eq!(cam.orbit(f32::INFINITY, 0.0), cam);
+    }
+
+    #[test]
+    fn ray_through_the_centre_points_at_the_target() {
+        let cam = Camera::default().orbit(0.7, 0.4);
+        let (origin, dir) = cam.ray(49.5, 49.5, 100, 100);
+        let to_target = (cam.target - origin).normalize();
+        assert!(dir.dot(to_target) > 0.999_999, "{dir} vs {to_target}");
+    }
+
+    #[test]
+    fn redraw_only_when_something_changed() {
+        let settings = FrameSettings {
+            model: ShadingModel::Phong,
+            approx: AmbientApprox::Fast,
+            view: ViewMode::Shaded,
+            lighting: Lighting::default(),
+            camera: Camera::default(),
+        };
+        let mut gate = RedrawGate::default();
+        assert!(gate.needs_redraw(&settings, 1, 0, (10, 10)));
+        assert!(
+            !gate.needs_redraw(&settings, 1, 0, (10, 10)),
+            "idle: no redraw"
+        );
+        assert!(
+            gate.needs_redraw(&settings, 2, 0, (10, 10)),
+            "the maps changed"
+        );
+        let moved = FrameSettings {
+            camera: settings.camera.orbit(0.1, 0.0),
+            ..settings
+        };
+        assert!(
+            gate.needs_redraw(&moved, 2, 0, (10, 10)),
+            "the camera moved"
+        );
+        assert!(gate.needs_redraw(&moved, 2, 0, (12, 10)), "resized");
+        gate.invalidate();
+        assert!(gate.needs_redraw(&moved, 2, 0, (12, 10)));
+    }
 }
