@@ -28,6 +28,24 @@ const VIEW_DIFFUSE: u32 = 5u;
 const VIEW_SPECULAR: u32 = 6u;
 const VIEW_AMBIENT: u32 = 7u;
 const VIEW_CHECKER: u32 = 8u;
+const VIEW_N_FALSE_COLOUR: u32 = 9u;
+
+// n's false-colour scale: ln(1 + n) / ln(1 + 16384) through five colours (dark blue, blue,
+// teal, green, yellow; linear RGB), as `render::N_RAMP`.
+const N_LOG_SPAN: f32 = 9.704121561132915f;
+const N_RAMP = array<vec3<f32>, 5>(
+    vec3<f32>(0.0331, 0.0006, 0.0622),
+    vec3<f32>(0.0482, 0.0785, 0.3712),
+    vec3<f32>(0.0123, 0.3016, 0.2756),
+    vec3<f32>(0.1946, 0.6172, 0.0284),
+    vec3<f32>(0.9473, 0.7991, 0.0091),
+);
+
+fn n_false_colour(n: f32) -> vec3<f32> {
+    let t = clamp(log(1.0 + n) / N_LOG_SPAN, 0.0, 1.0) * 4.0;
+    let i = min(u32(t), 3u);
+    return mix(N_RAMP[i], N_RAMP[i + 1u], t - f32(i));
+}
 
 struct Frame {
     view_proj: mat4x4<f32>,
@@ -115,6 +133,9 @@ fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
     }
     if VIEW == VIEW_N {
         return vec4<f32>(n, n, n, 1.0);
+    }
+    if VIEW == VIEW_N_FALSE_COLOUR {
+        return vec4<f32>(n_false_colour(n), 1.0);
     }
     if VIEW == VIEW_CHECKER {
         let cell = vec2<i32>(floor(f.uv * 16.0));

@@ -168,8 +168,8 @@ pub enum Command {
         /// phong, blinn, compare-split (Phong left, Blinn-Phong right) or compare-diff.
         #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-diff"])]
         model: String,
-        /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker).
-        #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker"])]
+        /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
+        #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
         view: String,
         /// How k_a's chi is computed.
         #[arg(long, value_parser = ["fast", "paper", "paper-corrected"], default_value = "fast")]

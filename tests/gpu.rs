@@ -125,6 +125,33 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
                 .expect("render"),
         );
         let stored = maps.value(0, 0);
+        // The false-colour view of n agrees with the CPU scale too.
+        let false_colour = FrameSettings {
+            view: ViewMode::NFalseColour,
+            ..s
+        };
+        let (_, _, colours) = linear(
+            preview
+                .render_offscreen(
+                    &gpu,
+                    &buffers,
+                    &textures,
+                    &false_colour,
+                    Offscreen {
+                        size: (16, 16),
+                        linear: true,
+                        split: None,
+                    },
+                )
+                .expect("render"),
+        );
+        let ramp = kapaint::render::n_false_colour(stored.n);
+        for p in colours.chunks_exact(4).filter(|p| p[3] > 0.0) {
+            assert!(
+                (Vec3::new(p[0], p[1], p[2]) - ramp).length() < 1e-4,
+                "{p:?} vs {ramp}"
+            );
+        }
         let want = reflectance::ka(model, AmbientApprox::Fast, stored.kd, stored.ks, stored.n);
         let mut covered = 0;
         for p in pixels.chunks_exact(4).filter(|p| p[3] > 0.0) {

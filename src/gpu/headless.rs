@@ -133,6 +133,10 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
         }
     };
     let mut pixels = pixels;
+    if req.settings.view == ViewMode::NFalseColour {
+        draw_n_legend(&mut pixels);
+        note = ", legend: n = 0 (left) to 16384 (right), log scale".into();
+    }
     if req.settings.view == ViewMode::N
         && kind == Kind::Png
         && let RenderedImage::Linear { pixels: p, .. } = &mut pixels
@@ -159,6 +163,33 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
         gpu.info.name,
         gpu.info.backend,
     ))
+}
+
+/// Draws the false-colour scale of `n` along the bottom rows (n = 0 left, 16384 right, log).
+fn draw_n_legend(image: &mut RenderedImage) {
+    let (width, height) = match image {
+        RenderedImage::Srgb8 { width, height, .. }
+        | RenderedImage::Linear { width, height, .. } => (*width, *height),
+    };
+    let bar = (height / 24).max(2).min(height);
+    for y in height - bar..height {
+        for x in 0..width {
+            let t = x as f32 / (width.max(2) - 1) as f32;
+            let n = ((1.0 + crate::model::texel::N_MAX).ln() * t).exp() - 1.0;
+            let c = crate::render::n_false_colour(n);
+            let i = (y * width + x) as usize * 4;
+            match image {
+                RenderedImage::Srgb8 { pixels, .. } => {
+                    let byte =
+                        |v: f32| (crate::model::texel::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+                    pixels[i..i + 4].copy_from_slice(&[byte(c.x), byte(c.y), byte(c.z), 255]);
+                }
+                RenderedImage::Linear { pixels, .. } => {
+                    pixels[i..i + 4].copy_from_slice(&[c.x, c.y, c.z, 1.0]);
+                }
+            }
+        }
+    }
 }
 
 /// A heatmap of `diff` (black, red, yellow, white up to `max`) with a scale bar along the

@@ -30,11 +30,31 @@ pub enum ViewMode {
     Ambient,
     /// A UV checker.
     Checker,
+    /// `n` in false colour on the log scale [`N_RAMP`] (a picture, not data).
+    NFalseColour,
+}
+
+/// The false-colour scale of `n`: `ln(1 + n) / ln(1 + 16384)` through these linear-RGB
+/// colours (dark blue, blue, teal, green, yellow), evenly spaced. The shader holds the same.
+pub const N_RAMP: [[f32; 3]; 5] = [
+    [0.0331, 0.0006, 0.0622],
+    [0.0482, 0.0785, 0.3712],
+    [0.0123, 0.3016, 0.2756],
+    [0.1946, 0.6172, 0.0284],
+    [0.9473, 0.7991, 0.0091],
+];
+
+/// The false colour of `n` (linear RGB).
+pub fn n_false_colour(n: f32) -> Vec3 {
+    let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln() as f32;
+    let t = ((1.0 + n).ln() / span).clamp(0.0, 1.0) * 4.0;
+    let i = (t as usize).min(3);
+    Vec3::from(N_RAMP[i]).lerp(Vec3::from(N_RAMP[i + 1]), t - i as f32)
 }
 
 impl ViewMode {
     /// Every view, in the order the shader numbers them.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::Shaded,
         Self::Ka,
         Self::Kd,
@@ -44,6 +64,7 @@ impl ViewMode {
         Self::Specular,
         Self::Ambient,
         Self::Checker,
+        Self::NFalseColour,
     ];
 
     /// The shader's `VIEW` constant.
@@ -63,6 +84,7 @@ impl ViewMode {
             Self::Specular => "specular",
             Self::Ambient => "ambient",
             Self::Checker => "checker",
+            Self::NFalseColour => "n-false-colour",
         }
     }
 
@@ -73,7 +95,7 @@ impl ViewMode {
 
     /// Whether the view is linear data (written raw) rather than a picture (sRGB).
     pub fn is_data(self) -> bool {
-        !matches!(self, Self::Shaded | Self::Checker)
+        !matches!(self, Self::Shaded | Self::Checker | Self::NFalseColour)
     }
 }
 
@@ -301,6 +323,7 @@ pub fn shade(s: &FrameSettings, m: Sample, normal: Vec3, to_eye: Vec3, uv: glam:
         ViewMode::Kd => return kd,
         ViewMode::Ks => return ks,
         ViewMode::N => return Vec3::splat(n),
+        ViewMode::NFalseColour => return n_false_colour(n),
         ViewMode::Checker => {
             let cell = (uv * 16.0).floor();
             let odd = (cell.x as i32 + cell.y as i32) & 1;
@@ -371,6 +394,22 @@ mod tests {
         let (origin, dir) = cam.ray(49.5, 49.5, 100, 100);
         let to_target = (cam.target - origin).normalize();
         assert!(dir.dot(to_target) > 0.999_999, "{dir} vs {to_target}");
+    }
+
+    #[test]
+    fn the_shader_holds_the_same_false_colour_scale() {
+        let wgsl = include_str!("../../shaders/preview.wgsl");
+        for c in N_RAMP {
+            let text = format!("vec3<f32>({:?}, {:?}, {:?})", c[0], c[1], c[2]);
+            assert!(wgsl.contains(&text), "{text} missing from preview.wgsl");
+        }
+        let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln();
+        assert!(
+            wgsl.contains(&format!("const N_LOG_SPAN: f32 = {span:?}f;")),
+            "{span}"
+        );
+        assert_eq!(n_false_colour(0.0), Vec3::from(N_RAMP[0]));
+        assert!((n_false_colour(16384.0) - Vec3::from(N_RAMP[4])).length() < 1e-5);
     }
 
     #[test]
