@@ -5,6 +5,7 @@
 
 pub mod atomic;
 pub mod cli;
+pub mod export;
 pub mod gpu;
 pub mod mesh;
 pub mod model;
