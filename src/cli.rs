@@ -139,6 +139,32 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Export projects as compact texture sets (images + material.json).
+    Export {
+        /// Project files (several: one set per project, in OUT/<project name>/).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Export preset: compact, 16-bit, separate, exr, with-ka, or a user preset.
+        #[arg(long, default_value = "compact")]
+        preset: String,
+        /// Target folder (must not exist, or be empty).
+        #[arg(long)]
+        out: PathBuf,
+        /// Print the memory report, the n encoding and the k_a error.
+        #[arg(long)]
+        report: bool,
+    },
+    /// Rebuild a project from an exported set.
+    ImportSet {
+        /// The set's material.json.
+        manifest: PathBuf,
+        /// Project file to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Overwrite an existing file.
+        #[arg(long)]
+        force: bool,
+    },
     /// The exponent of the other model whose highlight matches (CSV "n,equivalent").
     EquivalentN {
         /// The model the given exponents belong to.
@@ -409,6 +435,34 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                 target.display()
             ))
         }
+        Command::Export {
+            files,
+            preset,
+            out,
+            report,
+        } => export_command(&files, &preset, &out, report),
+        Command::ImportSet {
+            manifest,
+            out,
+            force,
+        } => {
+            if out.exists() && !force {
+                return Err(CliError::usage(format!(
+                    "{} exists; pass --force to overwrite it",
+                    out.display()
+                )));
+            }
+            let doc = crate::export::set::import(&manifest)
+                .map_err(|e| CliError::usage(e.to_string()))?;
+            project::save(&doc, &out).map_err(model_error)?;
+            Ok(format!(
+                "imported {} into {} ({}x{})\n",
+                manifest.display(),
+                out.display(),
+                doc.maps.width(),
+                doc.maps.height()
+            ))
+        }
         Command::EquivalentN { from, n } => {
             let values = n
                 .iter()
@@ -512,6 +566,103 @@ fn attach_surface(
         .map_err(|e| CliError::usage(format!("{}: {e}", spec.display())))?;
     doc.set_surface(Some(std::sync::Arc::new(surface)))
         .map_err(model_error)
+}
+
+/// `kapaint export`: every project into its set; one line each, plus the report.
+fn export_command(
+    files: &[PathBuf],
+    preset: &str,
+    out: &std::path::Path,
+    report: bool,
+) -> Result<String, CliError> {
+    use std::io::IsTerminal as _;
+    let preset = crate::export::preset::find(preset).map_err(|e| CliError::usage(e.to_string()))?;
+    // Load (and so validate) every project before writing anything.
+    let docs = files
+        .iter()
+        .map(|f| project::load(f).map_err(model_error))
+        .collect::<Result<Vec<_>, _>>()?;
+    let targets: Vec<PathBuf> = if files.len() == 1 {
+        vec![out.to_path_buf()]
+    } else {
+        files
+            .iter()
+            .map(|f| out.join(f.file_stem().unwrap_or_default()))
+            .collect()
+    };
+    let progress = files.len() > 1 && std::io::stderr().is_terminal();
+    let mut text = String::new();
+    for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
+        if progress {
+            let done = i * 30 / files.len();
+            eprint!(
+                "\r[{}{}] {}/{} {}",
+                "#".repeat(done),
+                " ".repeat(30 - done),
+                i + 1,
+                files.len(),
+                file.display()
+            );
+        }
+        let m = crate::export::set::export(doc, &preset, target)
+            .map_err(|e| CliError::usage(e.to_string()))?;
+        let _ = writeln!(
+            text,
+            "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
+            file.display(),
+            target.display(),
+            m.files.len(),
+            m.bytes.exported,
+            m.ka_error.max,
+            m.ka_error.mean
+        );
+        if report {
+            let _ = writeln!(text, "  preset: {}", m.preset);
+            match m.n_encoding {
+                Some(e) => {
+                    let _ = writeln!(
+                        text,
+                        "  n: {:?} over [{}, {}] in {} bits",
+                        e.curve, e.lo, e.hi, e.bits
+                    );
+                }
+                None => {
+                    let _ = writeln!(
+                        text,
+                        "  n: {}",
+                        m.constants
+                            .n
+                            .map_or_else(|| "stored as float".into(), |n| format!("constant {n}"))
+                    );
+                }
+            }
+            for f in &m.files {
+                let _ = writeln!(
+                    text,
+                    "  {}: {} ({} bit, {}), {} bytes",
+                    f.path,
+                    f.layout.join(" "),
+                    f.bit_depth,
+                    f.colour_space,
+                    f.bytes
+                );
+            }
+            let b = m.bytes;
+            let _ = writeln!(
+                text,
+                "  bytes: set {} vs naive k_a+k_d+k_s+n {} ({:.1}x) vs project maps {} ({:.1}x)",
+                b.exported,
+                b.naive,
+                b.naive as f64 / b.exported.max(1) as f64,
+                b.project,
+                b.project as f64 / b.exported.max(1) as f64
+            );
+        }
+    }
+    if progress {
+        eprintln!();
+    }
+    Ok(text)
 }
 
 /// The arguments of `kapaint render`.

@@ -1,4 +1,7 @@
-//! Exporting compact texture sets (issue 6). So far: the choice of `n`'s encoding by the
-//! `k_a` error it causes ([`encoding`]).
+//! Exporting compact texture sets (issue 6): presets ([`preset`]), the choice of `n`'s
+//! encoding by the `k_a` error it causes ([`encoding`]), and sets of images with a
+//! `material.json` manifest written atomically and read back ([`set`]).
 
 pub mod encoding;
+pub mod preset;
+pub mod set;

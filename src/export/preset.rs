@@ -1,0 +1,182 @@
+//! Export presets: `presets/export/*.ron`, built into the binary, plus the user's own from
+//! `$KAPAINT_EXPORT_PRESET_DIR`.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// Image format of the exported files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Format {
+    /// 8-bit PNG (colour in sRGB).
+    Png8,
+    /// 16-bit PNG (linear).
+    Png16,
+    /// Float OpenEXR (linear; `n` as is).
+    Exr,
+}
+
+/// How channels are packed into files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Layout {
+    /// `k_d` RGB with `n` in alpha; `k_s` alone (one channel when monochrome).
+    Packed,
+    /// One file per channel.
+    Separate,
+}
+
+/// An export preset.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExportPreset {
+    /// Name (what `--preset` takes, with the file stem).
+    pub name: String,
+    /// One line for menus.
+    #[serde(default)]
+    pub description: String,
+    /// Image format.
+    pub format: Format,
+    /// Channel packing.
+    pub layout: Layout,
+    /// Bits per stored `n` code (8 or 16; EXR stores `n` as is).
+    pub n_bits: u8,
+    /// Also write a baked `k_a` map.
+    #[serde(default)]
+    pub include_ka: bool,
+}
+
+/// Why a preset could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum PresetError {
+    /// The file is malformed.
+    #[error("{path}: {reason}")]
+    Malformed {
+        /// The preset file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// No preset of that name.
+    #[error("unknown export preset {name:?} (known: {known})")]
+    Unknown {
+        /// The name asked for.
+        name: String,
+        /// The names there are.
+        known: String,
+    },
+}
+
+const BUILTIN: &[(&str, &str)] = &[
+    ("16-bit", include_str!("../../presets/export/16-bit.ron")),
+    ("compact", include_str!("../../presets/export/compact.ron")),
+    ("exr", include_str!("../../presets/export/exr.ron")),
+    (
+        "separate",
+        include_str!("../../presets/export/separate.ron"),
+    ),
+    ("with-ka", include_str!("../../presets/export/with-ka.ron")),
+];
+
+impl ExportPreset {
+    /// Parses and checks a preset's text (`path` names it in errors).
+    ///
+    /// # Errors
+    /// Malformed RON, unknown fields, or values out of range.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, PresetError> {
+        let malformed = |reason: String| PresetError::Malformed {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let preset: Self = ron::from_str(text).map_err(|e| malformed(e.to_string()))?;
+        if !matches!(preset.n_bits, 8 | 16) {
+            return Err(malformed(format!(
+                "n_bits must be 8 or 16, got {}",
+                preset.n_bits
+            )));
+        }
+        if preset.format == Format::Png16 && preset.n_bits != 16 {
+            return Err(malformed(
+                "16-bit PNGs store n in 16 bits (n_bits: 16)".into(),
+            ));
+        }
+        if preset.name.trim().is_empty() {
+            return Err(malformed("name is empty".into()));
+        }
+        Ok(preset)
+    }
+}
+
+/// The built-in presets.
+pub fn builtin() -> Vec<ExportPreset> {
+    BUILTIN
+        .iter()
+        .filter_map(|(stem, text)| {
+            ExportPreset::parse(&PathBuf::from(format!("presets/export/{stem}.ron")), text).ok()
+        })
+        .collect()
+}
+
+/// Finds a preset by name or file stem: a user file (`$KAPAINT_EXPORT_PRESET_DIR/NAME.ron`)
+/// first, then the built-in ones.
+///
+/// # Errors
+/// A malformed user preset, or no preset of that name.
+pub fn find(name: &str) -> Result<ExportPreset, PresetError> {
+    if let Some(dir) = std::env::var_os("KAPAINT_EXPORT_PRESET_DIR").map(PathBuf::from) {
+        let path = dir.join(format!("{name}.ron"));
+        if path.is_file() {
+            let text = std::fs::read_to_string(&path).map_err(|e| PresetError::Malformed {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
+            return ExportPreset::parse(&path, &text);
+        }
+    }
+    let all = builtin();
+    if let Some((_, text)) = BUILTIN
+        .iter()
+        .find(|(stem, _)| stem.eq_ignore_ascii_case(name))
+    {
+        return ExportPreset::parse(&PathBuf::from(format!("presets/export/{name}.ron")), text);
+    }
+    all.iter()
+        .find(|p| p.name.eq_ignore_ascii_case(name))
+        .cloned()
+        .ok_or_else(|| PresetError::Unknown {
+            name: name.to_string(),
+            known: all
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_parses_and_is_found() {
+        assert_eq!(builtin().len(), BUILTIN.len());
+        for name in ["compact", "16-bit", "separate", "exr", "with-ka"] {
+            assert_eq!(find(name).unwrap().name, name);
+        }
+        assert!(matches!(find("nope"), Err(PresetError::Unknown { .. })));
+    }
+
+    #[test]
+    fn malformed_presets_name_the_file() {
+        let path = Path::new("x.ron");
+        for text in [
+            "(",
+            "(name: \"a\", format: Png8, layout: Packed, n_bits: 7)",
+            "(name: \"a\", format: Png16, layout: Packed, n_bits: 8)",
+            "(name: \"a\", format: Gif, layout: Packed, n_bits: 8)",
+            "(name: \"a\", format: Png8, layout: Packed, n_bits: 8, extra: 1)",
+        ] {
+            let err = ExportPreset::parse(path, text).unwrap_err().to_string();
+            assert!(err.starts_with("x.ron: "), "{err}");
+        }
+    }
+}

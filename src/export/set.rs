@@ -1,0 +1,684 @@
+//! Writing and reading texture sets: images plus `material.json`.
+//!
+//! A set is written into a temporary folder beside the target and renamed into place at the
+//! end, so a half-written set is never left where the target should be.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::encoding::{KaError, NEncoding, rank_encodings};
+use super::preset::{ExportPreset, Format, Layout};
+use crate::model::texel::{
+    MaterialValue, Texel, decode_n, decode_unorm, linear_to_srgb, srgb_to_linear,
+};
+use crate::model::tile::Plane;
+use crate::model::{Document, DocumentSettings, MaterialMaps};
+use crate::reflectance::{self, AmbientApprox, ShadingModel};
+
+/// Manifest format name and version.
+pub const MANIFEST_FORMAT: &str = "kapaint-material";
+/// Manifest version written.
+pub const MANIFEST_VERSION: u32 = 1;
+
+/// One image of a set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileEntry {
+    /// File name inside the set's folder.
+    pub path: String,
+    /// What each component holds, in order: `kd.r`, `kd.g`, `kd.b`, `ks` (monochrome), `ks.r`,
+    /// ..., `n`, `ka.r`, ...
+    pub layout: Vec<String>,
+    /// `srgb` (colour components of 8-bit PNGs) or `linear`.
+    pub colour_space: String,
+    /// Bits per component (8, 16, or 32 for float EXR).
+    pub bit_depth: u32,
+    /// `png` (deflate) or `exr`.
+    pub compression: String,
+    /// Size in texels.
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+    /// File size.
+    pub bytes: u64,
+}
+
+/// Channels that are one value everywhere: stored here, not as images.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Constants {
+    /// `k_d` (linear), if constant.
+    pub kd: Option<[f32; 3]>,
+    /// `k_s` (linear), if constant.
+    pub ks: Option<[f32; 3]>,
+    /// `n`, if constant.
+    pub n: Option<f32>,
+}
+
+/// How to recompute `k_a` as kapaint does.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Approximation {
+    /// `fast`, `paper` or `paper-corrected`.
+    pub name: String,
+    /// The factor of `k_d` in `k_a` (2/pi, or the paper's 0.637).
+    pub diffuse_factor: f64,
+    /// For the paper's forms: `chi(n) = a (n + b)^c`.
+    pub paper_constants: Option<[f64; 3]>,
+}
+
+/// Bytes of the set against the alternatives.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MemoryReport {
+    /// The exported files.
+    pub exported: u64,
+    /// The same maps stored naively: `k_a`, `k_d`, `k_s` RGB and `n`, uncompressed, at the
+    /// set's depth.
+    pub naive: u64,
+    /// The project's uncompressed maps (14 bytes per texel).
+    pub project: u64,
+}
+
+/// `material.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Always [`MANIFEST_FORMAT`].
+    pub format: String,
+    /// [`MANIFEST_VERSION`].
+    pub version: u32,
+    /// Map size.
+    pub width: u32,
+    /// Map size.
+    pub height: u32,
+    /// Shading model.
+    pub model: ShadingModel,
+    /// How `k_a` is computed.
+    pub approximation: Approximation,
+    /// Constant channels.
+    pub constants: Constants,
+    /// How stored `n` codes decode (absent when `n` is constant or stored as float).
+    pub n_encoding: Option<NEncoding>,
+    /// The images.
+    pub files: Vec<FileEntry>,
+    /// Relative `k_a` error of the set (decoded as a consumer would) against the project.
+    pub ka_error: KaError,
+    /// Sizes.
+    pub bytes: MemoryReport,
+    /// The preset used.
+    pub preset: String,
+}
+
+/// Why an export or import failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SetError {
+    /// A file could not be written or read.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The set is malformed.
+    #[error("{path}: {reason}")]
+    Invalid {
+        /// The manifest or image.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+fn io(path: &Path, e: impl std::fmt::Display) -> SetError {
+    SetError::Io {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+}
+
+/// The value every texel of a plane has, if all tiles agree.
+fn constant<T: Copy + PartialEq>(
+    maps: &MaterialMaps,
+    plane: impl Fn(&crate::model::tile::Tile) -> &Plane<T>,
+) -> Option<T> {
+    let mut value = None;
+    for id in 0..maps.tile_count() {
+        let v = plane(maps.tile(id)).uniform()?;
+        if *value.get_or_insert(v) != v {
+            return None;
+        }
+    }
+    value
+}
+
+/// Whether `k_s` is grey everywhere.
+fn ks_monochrome(maps: &MaterialMaps) -> bool {
+    (0..maps.tile_count())
+        .into_par_iter()
+        .all(|id| match &maps.tile(id).ks {
+            Plane::Uniform(v) => v[0] == v[1] && v[1] == v[2],
+            Plane::Data(d) => d.iter().all(|v| v[0] == v[1] && v[1] == v[2]),
+        })
+}
+
+/// Texels of the map in row-major order, read in parallel by rows.
+fn rows(maps: &MaterialMaps) -> Vec<Texel> {
+    let w = maps.width() as usize;
+    let mut out = vec![Texel::encode(MaterialValue::default()); w * maps.height() as usize];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, t) in row.iter_mut().enumerate() {
+            *t = maps.texel(x as u32, y as u32);
+        }
+    });
+    out
+}
+
+/// A component source: which channel component of a texel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Comp {
+    Kd(usize),
+    Ks(usize),
+    N,
+    Ka(usize),
+}
+
+impl Comp {
+    fn name(self, mono_ks: bool) -> String {
+        const RGB: [&str; 3] = ["r", "g", "b"];
+        match self {
+            Self::Kd(c) => format!("kd.{}", RGB[c]),
+            Self::Ks(_) if mono_ks => "ks".into(),
+            Self::Ks(c) => format!("ks.{}", RGB[c]),
+            Self::N => "n".into(),
+            Self::Ka(c) => format!("ka.{}", RGB[c]),
+        }
+    }
+
+    fn parse(name: &str) -> Option<Self> {
+        let rgb = |s: &str| ["r", "g", "b"].iter().position(|c| *c == s);
+        match name.split_once('.') {
+            Some(("kd", c)) => rgb(c).map(Self::Kd),
+            Some(("ks", c)) => rgb(c).map(Self::Ks),
+            Some(("ka", c)) => rgb(c).map(Self::Ka),
+            None if name == "ks" => Some(Self::Ks(3)),
+            None if name == "n" => Some(Self::N),
+            _ => None,
+        }
+    }
+}
+
+/// What the export stores for one texel component, as a value in `[0, 1]` (PNG) or raw.
+fn component(t: &Texel, ka: Vec3, comp: Comp, n_enc: Option<NEncoding>) -> f32 {
+    match comp {
+        Comp::Kd(c) => decode_unorm(t.kd[c]),
+        Comp::Ks(c) => decode_unorm(t.ks[c.min(2)]),
+        Comp::Ka(c) => ka[c],
+        Comp::N => {
+            let n = decode_n(t.n);
+            match n_enc {
+                Some(e) => f32::from(e.encode(n)) / ((1_u32 << e.bits) - 1) as f32,
+                None => n,
+            }
+        }
+    }
+}
+
+/// Whether a component is a colour (sRGB-encoded in 8-bit files).
+fn is_colour(comp: Comp) -> bool {
+    !matches!(comp, Comp::N)
+}
+
+fn approximation(approx: AmbientApprox, model: ShadingModel) -> Approximation {
+    Approximation {
+        name: approx.name().to_string(),
+        diffuse_factor: reflectance::diffuse_factor(approx),
+        paper_constants: (approx != AmbientApprox::Fast).then(|| {
+            let (a, b, c) = reflectance::paper_constants(model, approx);
+            [a, b, c]
+        }),
+    }
+}
+
+/// Encodes one image of `comps` components from the texels.
+fn encode_image(
+    texels: &[Texel],
+    ka: &[Vec3],
+    (width, height): (u32, u32),
+    comps: &[Comp],
+    format: Format,
+    n_enc: Option<NEncoding>,
+) -> Result<Vec<u8>, String> {
+    let channels = comps.len();
+    let value = |i: usize, k: usize| {
+        let comp = comps[k];
+        let v = component(
+            &texels[i],
+            ka.get(i).copied().unwrap_or(Vec3::ZERO),
+            comp,
+            n_enc,
+        );
+        (comp, v)
+    };
+    let mut out = std::io::Cursor::new(Vec::new());
+    let count = texels.len();
+    let fail = |e: image::ImageError| e.to_string();
+    match format {
+        Format::Png8 => {
+            let data: Vec<u8> = (0..count * channels)
+                .into_par_iter()
+                .map(|j| {
+                    let (comp, v) = value(j / channels, j % channels);
+                    let v = if is_colour(comp) {
+                        linear_to_srgb(v)
+                    } else {
+                        v
+                    };
+                    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+                })
+                .collect();
+            let color = match channels {
+                1 => image::ExtendedColorType::L8,
+                3 => image::ExtendedColorType::Rgb8,
+                _ => image::ExtendedColorType::Rgba8,
+            };
+            image::ImageEncoder::write_image(
+                image::codecs::png::PngEncoder::new(&mut out),
+                &data,
+                width,
+                height,
+                color,
+            )
+            .map_err(fail)?;
+        }
+        Format::Png16 => {
+            let data: Vec<u8> = (0..count * channels)
+                .into_par_iter()
+                .flat_map_iter(|j| {
+                    let (_, v) = value(j / channels, j % channels);
+                    ((v.clamp(0.0, 1.0) * 65535.0).round() as u16).to_ne_bytes()
+                })
+                .collect();
+            let color = match channels {
+                1 => image::ExtendedColorType::L16,
+                3 => image::ExtendedColorType::Rgb16,
+                _ => image::ExtendedColorType::Rgba16,
+            };
+            image::ImageEncoder::write_image(
+                image::codecs::png::PngEncoder::new(&mut out),
+                &data,
+                width,
+                height,
+                color,
+            )
+            .map_err(fail)?;
+        }
+        Format::Exr => {
+            // RGB floats; a one-component image repeats its value in all three.
+            let data: Vec<f32> = (0..count * 3)
+                .into_par_iter()
+                .map(|j| value(j / 3, (j % 3).min(channels - 1)).1)
+                .collect();
+            image::Rgb32FImage::from_raw(width, height, data)
+                .ok_or("image size")?
+                .write_to(&mut out, image::ImageFormat::OpenExr)
+                .map_err(fail)?;
+        }
+    }
+    Ok(out.into_inner())
+}
+
+/// Which images a set holds, with which components: what is constant is left out, `k_s` is
+/// one channel when grey, and the packed layout puts `n` in `k_d`'s alpha.
+fn plan_images(
+    preset: &ExportPreset,
+    constants: &Constants,
+    mono_ks: bool,
+) -> Vec<(&'static str, Vec<Comp>)> {
+    let kd: Vec<Comp> = (0..3).map(Comp::Kd).collect();
+    let ks: Vec<Comp> = if mono_ks {
+        vec![Comp::Ks(0)]
+    } else {
+        (0..3).map(Comp::Ks).collect()
+    };
+    let (with_kd, with_n) = (constants.kd.is_none(), constants.n.is_none());
+    let mut images: Vec<(&'static str, Vec<Comp>)> = Vec::new();
+    if preset.layout == Layout::Packed && with_kd && with_n {
+        images.push(("kd_n", [kd, vec![Comp::N]].concat()));
+    } else {
+        if with_kd {
+            images.push(("kd", kd));
+        }
+        if with_n {
+            images.push(("n", vec![Comp::N]));
+        }
+    }
+    if constants.ks.is_none() {
+        images.push(("ks", ks));
+    }
+    if preset.include_ka {
+        images.push(("ka", (0..3).map(Comp::Ka).collect()));
+    }
+    images
+}
+
+/// An encoded image: file name, components, bytes.
+type Encoded = (String, Vec<Comp>, Vec<u8>);
+
+/// Exports `doc` with `preset` into the folder `out` (which must not exist or be empty).
+///
+/// # Errors
+/// An unwritable or non-empty target, or a failed encode or write: nothing is left at `out`.
+#[allow(clippy::too_many_lines)] // One pass: analyse, encode in parallel, measure, commit.
+pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manifest, SetError> {
+    if out.exists()
+        && (!out.is_dir()
+            || std::fs::read_dir(out)
+                .map_err(|e| io(out, e))?
+                .next()
+                .is_some())
+    {
+        return Err(io(out, "exists and is not an empty folder"));
+    }
+    let maps = &doc.maps;
+    let (model, approx) = (doc.settings.model, doc.settings.approx);
+    let (w, h) = (maps.width(), maps.height());
+    let constants = Constants {
+        kd: constant(maps, |t| &t.kd).map(|v| v.map(decode_unorm)),
+        ks: constant(maps, |t| &t.ks).map(|v| v.map(decode_unorm)),
+        n: constant(maps, |t| &t.n).map(decode_n),
+    };
+    let mono_ks = ks_monochrome(maps);
+    let n_enc = match (constants.n, preset.format) {
+        (Some(_), _) | (None, Format::Exr) => None,
+        (None, _) => rank_encodings(maps, model, approx, preset.n_bits)
+            .first()
+            .map(|(e, _)| *e),
+    };
+    let texels = rows(maps);
+    let ka: Vec<Vec3> = if preset.include_ka {
+        texels
+            .par_iter()
+            .map(|t| {
+                let v = t.decode();
+                reflectance::ka(model, approx, v.kd, v.ks, v.n)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+
+    let images = plan_images(preset, &constants, mono_ks);
+    let ext = if preset.format == Format::Exr {
+        "exr"
+    } else {
+        "png"
+    };
+
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
+    let name = out
+        .file_name()
+        .map_or_else(|| "set".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir(&tmp).map_err(|e| io(&tmp, e))?;
+    let result = (|| {
+        let encoded: Vec<Result<Encoded, SetError>> = images
+            .par_iter()
+            .map(|(stem, comps)| {
+                let file = format!("{stem}.{ext}");
+                encode_image(&texels, &ka, (w, h), comps, preset.format, n_enc)
+                    .map(|bytes| (file.clone(), comps.clone(), bytes))
+                    .map_err(|e| io(&tmp.join(&file), e))
+            })
+            .collect();
+        let mut files = Vec::new();
+        for item in encoded {
+            let (file, comps, bytes) = item?;
+            let path = tmp.join(&file);
+            crate::atomic::write_atomic(&path, &bytes).map_err(|e| io(&path, e))?;
+            let colour_space =
+                if preset.format == Format::Png8 && comps.iter().any(|c| is_colour(*c)) {
+                    "srgb"
+                } else {
+                    "linear"
+                };
+            files.push(FileEntry {
+                path: file,
+                layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
+                colour_space: colour_space.into(),
+                bit_depth: match preset.format {
+                    Format::Png8 => 8,
+                    Format::Png16 => 16,
+                    Format::Exr => 32,
+                },
+                compression: ext.into(),
+                width: w,
+                height: h,
+                bytes: bytes.len() as u64,
+            });
+        }
+        let depth = match preset.format {
+            Format::Png8 => 1,
+            Format::Png16 => 2,
+            Format::Exr => 4,
+        };
+        let texel_count = u64::from(w) * u64::from(h);
+        let mut manifest = Manifest {
+            format: MANIFEST_FORMAT.into(),
+            version: MANIFEST_VERSION,
+            width: w,
+            height: h,
+            model,
+            approximation: approximation(approx, model),
+            constants,
+            n_encoding: n_enc,
+            files,
+            ka_error: KaError::default(),
+            bytes: MemoryReport {
+                exported: 0,
+                naive: texel_count * 10 * depth,
+                project: texel_count * 14,
+            },
+            preset: preset.name.clone(),
+        };
+        // The k_a error, measured on the set as a consumer decodes it.
+        let decoded = read_maps(&manifest, &tmp)?;
+        manifest.ka_error = ka_error_between(maps, &decoded, model, approx);
+        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
+        manifest.bytes.exported =
+            manifest.files.iter().map(|f| f.bytes).sum::<u64>() + json.len() as u64;
+        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
+        let path = tmp.join("material.json");
+        crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
+        Ok(manifest)
+    })();
+    match result {
+        Ok(manifest) => {
+            if out.exists() {
+                std::fs::remove_dir(out).map_err(|e| io(out, e))?;
+            }
+            std::fs::rename(&tmp, out).map_err(|e| {
+                let _ = std::fs::remove_dir_all(&tmp);
+                io(out, e)
+            })?;
+            Ok(manifest)
+        }
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&tmp);
+            Err(e)
+        }
+    }
+}
+
+/// Relative `k_a` error of `b` against `a` (per texel and colour channel).
+fn ka_error_between(
+    a: &MaterialMaps,
+    b: &MaterialMaps,
+    model: ShadingModel,
+    approx: AmbientApprox,
+) -> KaError {
+    let w = a.width();
+    let (max, sum, count) = (0..a.height())
+        .into_par_iter()
+        .map(|y| {
+            let (mut max, mut sum) = (0.0_f64, 0.0_f64);
+            for x in 0..w {
+                let (p, q) = (a.value(x, y), b.value(x, y));
+                let ka = reflectance::ka(model, approx, p.kd, p.ks, p.n);
+                let kb = reflectance::ka(model, approx, q.kd, q.ks, q.n);
+                for c in 0..3 {
+                    let err = if ka[c] > 0.0 {
+                        f64::from((kb[c] - ka[c]).abs() / ka[c])
+                    } else {
+                        0.0
+                    };
+                    max = max.max(err);
+                    sum += err;
+                }
+            }
+            (max, sum, u64::from(w) * 3)
+        })
+        .reduce(
+            || (0.0, 0.0, 0),
+            |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2),
+        );
+    KaError {
+        max,
+        mean: if count > 0 { sum / count as f64 } else { 0.0 },
+    }
+}
+
+/// Reads a set's maps back as a consumer would (no settings).
+fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> {
+    let invalid = |path: &Path, reason: String| SetError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let (w, h) = (manifest.width, manifest.height);
+    let mut values = vec![
+        MaterialValue::new(
+            Vec3::from(manifest.constants.kd.unwrap_or([0.0; 3])),
+            Vec3::from(manifest.constants.ks.unwrap_or([0.0; 3])),
+            manifest.constants.n.unwrap_or(0.0),
+        );
+        (w as usize) * (h as usize)
+    ];
+    for file in &manifest.files {
+        let path = dir.join(&file.path);
+        if file.path.contains(['/', '\\']) || file.path.starts_with('.') {
+            return Err(invalid(&path, "file names must stay inside the set".into()));
+        }
+        let image =
+            crate::model::import::read_image(&path).map_err(|e| invalid(&path, e.to_string()))?;
+        if (image.width(), image.height()) != (w, h) {
+            return Err(invalid(
+                &path,
+                format!(
+                    "is {}x{}, the manifest says {w}x{h}",
+                    image.width(),
+                    image.height()
+                ),
+            ));
+        }
+        let comps: Vec<Comp> = file
+            .layout
+            .iter()
+            .map(|c| {
+                Comp::parse(c).ok_or_else(|| invalid(&path, format!("unknown component {c:?}")))
+            })
+            .collect::<Result<_, _>>()?;
+        let pixels = image.to_rgba32f();
+        let srgb = file.colour_space == "srgb";
+        let exr = file.compression == "exr";
+        let n_enc = manifest.n_encoding;
+        values
+            .par_iter_mut()
+            .zip(pixels.par_chunks(4))
+            .for_each(|(v, px)| {
+                for (k, comp) in comps.iter().enumerate() {
+                    // EXR one-component images repeat the value; others hold components in order.
+                    let raw = if exr && comps.len() == 1 {
+                        px[0]
+                    } else {
+                        px[k.min(3)]
+                    };
+                    let colour = |x: f32| if srgb { srgb_to_linear(x) } else { x };
+                    match *comp {
+                        Comp::Kd(c) => v.kd[c] = colour(raw),
+                        Comp::Ks(3) => v.ks = Vec3::splat(colour(raw)),
+                        Comp::Ks(c) => v.ks[c] = colour(raw),
+                        Comp::N => {
+                            v.n = match n_enc {
+                                Some(e) => {
+                                    e.decode((raw * ((1_u32 << e.bits) - 1) as f32).round() as u16)
+                                }
+                                None => raw,
+                            };
+                        }
+                        Comp::Ka(_) => {}
+                    }
+                }
+            });
+    }
+    let mut maps = MaterialMaps::new(w, h, MaterialValue::default())
+        .map_err(|e| invalid(dir, e.to_string()))?;
+    for (i, v) in values.iter().enumerate() {
+        let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+        let (id, k) = maps.locate(x, y);
+        maps.tile_mut(id).set_texel(k, Texel::encode(v.sanitized()));
+    }
+    for id in 0..maps.tile_count() {
+        maps.tile_mut(id).compact();
+    }
+    Ok(maps)
+}
+
+/// Reads a set (`material.json` and its images) back into a document.
+///
+/// # Errors
+/// A missing, malformed or inconsistent manifest or image.
+pub fn import(manifest_path: &Path) -> Result<Document, SetError> {
+    let text = std::fs::read(manifest_path).map_err(|e| io(manifest_path, e))?;
+    let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| SetError::Invalid {
+        path: manifest_path.to_path_buf(),
+        reason: format!("not a kapaint material manifest: {e}"),
+    })?;
+    if manifest.format != MANIFEST_FORMAT || manifest.version > MANIFEST_VERSION {
+        return Err(SetError::Invalid {
+            path: manifest_path.to_path_buf(),
+            reason: format!(
+                "format {:?} version {} is not one this kapaint reads",
+                manifest.format, manifest.version
+            ),
+        });
+    }
+    if manifest.width == 0
+        || manifest.height == 0
+        || manifest.width > crate::model::maps::MAX_SIDE
+        || manifest.height > crate::model::maps::MAX_SIDE
+    {
+        return Err(SetError::Invalid {
+            path: manifest_path.to_path_buf(),
+            reason: format!(
+                "size {}x{} is outside 1..=8192",
+                manifest.width, manifest.height
+            ),
+        });
+    }
+    let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    let maps = read_maps(&manifest, dir)?;
+    let approx = AmbientApprox::ALL
+        .into_iter()
+        .find(|a| a.name() == manifest.approximation.name)
+        .unwrap_or(AmbientApprox::Fast);
+    let settings = DocumentSettings {
+        model: manifest.model,
+        approx,
+        ..DocumentSettings::default()
+    };
+    Ok(Document::from_parts(maps, settings))
+}

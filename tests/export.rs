@@ -1,0 +1,266 @@
+//! Exported texture sets: layouts, elided channels, the manifest, round trips, k_a error, and
+//! failures that leave nothing behind.
+
+#![allow(clippy::expect_used)]
+
+use std::path::PathBuf;
+
+use glam::{Vec2, Vec3};
+use kapaint::export::preset::{self, Format};
+use kapaint::export::set;
+use kapaint::model::brush::StrokePoint;
+use kapaint::model::texel::MaterialValue;
+use kapaint::model::{Channels, Command, Document, DocumentSettings, StrokeTool};
+use kapaint::reflectance;
+
+fn temp(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-export-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    dir
+}
+
+/// k_d painted in colour, n in a gradient, k_s grey and constant.
+fn painted() -> Document {
+    let mut doc = Document::new(
+        200,
+        120,
+        DocumentSettings {
+            base: MaterialValue::new(Vec3::new(0.6, 0.5, 0.4), Vec3::splat(0.3), 20.0),
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("doc");
+    doc.apply(Command::SetChannels(Channels {
+        kd: true,
+        ks: false,
+        n: true,
+    }))
+    .expect("channels");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.9, 0.1, 0.05),
+        Vec3::splat(0.3),
+        900.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::Stroke {
+        tool: StrokeTool::Brush,
+        points: vec![
+            StrokePoint {
+                pos: Vec2::new(10.0, 60.0),
+                pressure: 1.0,
+            },
+            StrokePoint {
+                pos: Vec2::new(190.0, 70.0),
+                pressure: 1.0,
+            },
+        ],
+    })
+    .expect("stroke");
+    doc
+}
+
+fn max_rel_ka_error(a: &Document, b: &Document) -> f32 {
+    let (m, x) = (a.settings.model, a.settings.approx);
+    let mut worst = 0.0_f32;
+    for y in 0..a.maps.height() {
+        for xx in 0..a.maps.width() {
+            let (p, q) = (a.maps.value(xx, y), b.maps.value(xx, y));
+            let (ka, kb) = (
+                reflectance::ka(m, x, p.kd, p.ks, p.n),
+                reflectance::ka(m, x, q.kd, q.ks, q.n),
+            );
+            for c in 0..3 {
+                worst = worst.max((kb[c] - ka[c]).abs() / ka[c]);
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn compact_sets_elide_what_is_constant_and_round_trip() {
+    let dir = temp("compact");
+    let doc = painted();
+    let out = dir.join("set");
+    let m = set::export(&doc, &preset::find("compact").expect("preset"), &out).expect("export");
+    // k_s is constant: a manifest constant, no image. k_d and n share one RGBA8 image.
+    assert!(m.constants.ks.is_some());
+    assert_eq!(m.files.len(), 1);
+    assert_eq!(m.files[0].layout, ["kd.r", "kd.g", "kd.b", "n"]);
+    assert_eq!(m.files[0].colour_space, "srgb");
+    let n = m.n_encoding.expect("n is quantised");
+    assert_eq!(n.bits, 8);
+    assert!(m.bytes.exported < m.bytes.naive / 10, "{:?}", m.bytes);
+    let on_disk: u64 = m.files.iter().map(|f| f.bytes).sum();
+    assert_eq!(
+        on_disk,
+        std::fs::metadata(out.join(&m.files[0].path))
+            .expect("file")
+            .len()
+    );
+
+    // Import: the k_a error is the reported one; export again: the same bytes.
+    let back = set::import(&out.join("material.json")).expect("import");
+    let err = max_rel_ka_error(&doc, &back);
+    assert!(
+        f64::from(err) <= m.ka_error.max * 1.001 + 1e-6,
+        "{err} vs {}",
+        m.ka_error.max
+    );
+    assert!(m.ka_error.max < 0.05, "{:?}", m.ka_error);
+    let again = dir.join("again");
+    let m2 = set::export(&back, &preset::find("compact").expect("preset"), &again).expect("export");
+    for (a, b) in m.files.iter().zip(&m2.files) {
+        assert_eq!(
+            std::fs::read(out.join(&a.path)).expect("read"),
+            std::fs::read(again.join(&b.path)).expect("read"),
+            "{} is stable",
+            a.path
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn every_builtin_preset_exports_and_imports() {
+    let dir = temp("all");
+    let mut doc = painted();
+    // Colour k_s too, so it gets an RGB image.
+    doc.apply(Command::SetChannels(Channels::ALL))
+        .expect("channels");
+    doc.apply(Command::Fill(kapaint::model::FillRegion::Similar {
+        x: 5,
+        y: 5,
+        channel: kapaint::model::Channel::Kd,
+        tolerance: 0.01,
+    }))
+    .expect("fill");
+    for p in preset::builtin() {
+        let out = dir.join(&p.name);
+        let m = set::export(&doc, &p, &out).expect("export");
+        assert!(out.join("material.json").is_file());
+        let back = set::import(&out.join("material.json")).expect("import");
+        let err = max_rel_ka_error(&doc, &back);
+        match p.format {
+            Format::Exr => assert!(err < 1e-4, "{}: {err}", p.name),
+            Format::Png16 => assert!(err < 1e-3, "{}: {err}", p.name),
+            Format::Png8 => assert!(err < 0.05, "{}: {err}", p.name),
+        }
+        assert_eq!(
+            m.files
+                .iter()
+                .any(|f| f.layout.iter().any(|c| c.starts_with("ka"))),
+            p.include_ka,
+            "{}",
+            p.name
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn failures_leave_nothing_behind() {
+    let dir = temp("fail");
+    let doc = painted();
+    let compact = preset::find("compact").expect("preset");
+    // A non-empty target is refused and kept.
+    let busy = dir.join("busy");
+    std::fs::create_dir_all(&busy).expect("dir");
+    std::fs::write(busy.join("keep.txt"), "mine").expect("write");
+    assert!(set::export(&doc, &compact, &busy).is_err());
+    assert_eq!(std::fs::read(busy.join("keep.txt")).expect("kept"), b"mine");
+    // An unwritable place: an error, and no temporary folder left.
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").expect("write");
+    assert!(set::export(&doc, &compact, &file.join("set")).is_err());
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .filter_map(Result::ok)
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // Broken sets are errors naming the file.
+    let out = dir.join("set");
+    set::export(&doc, &compact, &out).expect("export");
+    let manifest = out.join("material.json");
+    let text = std::fs::read_to_string(&manifest).expect("read");
+    std::fs::write(&manifest, &text[..text.len() / 2]).expect("truncate");
+    let err = set::import(&manifest).expect_err("truncated").to_string();
+    assert!(err.contains("material.json"), "{err}");
+    std::fs::write(&manifest, text.replace("kd_n.png", "../../etc/passwd")).expect("write");
+    assert!(set::import(&manifest).is_err());
+    std::fs::write(&manifest, &text).expect("write");
+    std::fs::write(out.join("kd_n.png"), b"not a png").expect("write");
+    let err = set::import(&manifest)
+        .expect_err("corrupt image")
+        .to_string();
+    assert!(err.contains("kd_n.png"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn export_cli_batches_and_reports() {
+    let dir = temp("cli");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let a = dir.join("a.kapaint");
+    let b = dir.join("b.kapaint");
+    for (p, preset) in [(&a, "gold"), (&b, "jade")] {
+        let o = run(&[
+            "new",
+            "--size",
+            "64x32",
+            "--preset",
+            preset,
+            "--out",
+            p.to_str().expect("path"),
+        ]);
+        assert!(o.status.success(), "{o:?}");
+    }
+    let out = dir.join("sets");
+    let o = run(&[
+        "export",
+        a.to_str().expect("path"),
+        b.to_str().expect("path"),
+        "--preset",
+        "compact",
+        "--out",
+        out.to_str().expect("path"),
+        "--report",
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let text = String::from_utf8(o.stdout).expect("utf-8");
+    assert_eq!(text.matches("exported ").count(), 2, "{text}");
+    assert!(text.contains("bytes: set "), "{text}");
+    assert!(out.join("a/material.json").is_file() && out.join("b/material.json").is_file());
+    // A uniform project exports as constants only.
+    let manifest = std::fs::read_to_string(out.join("a/material.json")).expect("read");
+    assert!(manifest.contains("\"files\": []"), "{manifest}");
+    let back = dir.join("back.kapaint");
+    let o = run(&[
+        "import-set",
+        out.join("a/material.json").to_str().expect("path"),
+        "--out",
+        back.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    // Unknown preset: exit 2, one line, nothing written.
+    let none = dir.join("none");
+    let o = run(&[
+        "export",
+        a.to_str().expect("path"),
+        "--preset",
+        "nope",
+        "--out",
+        none.to_str().expect("path"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown export preset"));
+    assert!(!none.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
