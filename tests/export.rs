@@ -103,8 +103,10 @@ fn compact_sets_elide_what_is_constant_and_round_trip() {
     // Import: the k_a error is the reported one; export again: the same bytes.
     let back = set::import(&out.join("material.json")).expect("import");
     let err = max_rel_ka_error(&doc, &back);
+    // The reported error is the set's as a consumer decodes it; importing into a project
+    // rounds once more to the project's own precision (n as a half float: 2^-11 relative).
     assert!(
-        f64::from(err) <= m.ka_error.max * 1.001 + 1e-6,
+        f64::from(err) <= m.ka_error.max + 1e-3,
         "{err} vs {}",
         m.ka_error.max
     );

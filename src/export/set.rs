@@ -207,22 +207,6 @@ impl Comp {
     }
 }
 
-/// What the export stores for one texel component, as a value in `[0, 1]` (PNG) or raw.
-fn component(t: &Texel, ka: Vec3, comp: Comp, n_enc: Option<NEncoding>) -> f32 {
-    match comp {
-        Comp::Kd(c) => decode_unorm(t.kd[c]),
-        Comp::Ks(c) => decode_unorm(t.ks[c.min(2)]),
-        Comp::Ka(c) => ka[c],
-        Comp::N => {
-            let n = decode_n(t.n);
-            match n_enc {
-                Some(e) => f32::from(e.encode(n)) / ((1_u32 << e.bits) - 1) as f32,
-                None => n,
-            }
-        }
-    }
-}
-
 /// Whether a component is a colour (sRGB-encoded in 8-bit files).
 fn is_colour(comp: Comp) -> bool {
     !matches!(comp, Comp::N)
@@ -249,14 +233,36 @@ fn encode_image(
     n_enc: Option<NEncoding>,
 ) -> Result<Vec<u8>, String> {
     let channels = comps.len();
+    // Per stored 16-bit code, what the file holds: colour components sRGB-encoded in 8-bit
+    // files, n through its encoding. Tables keep the per-texel work to lookups.
+    let srgb = format == Format::Png8;
+    let colour_lut: Vec<f32> = (0..=u16::MAX)
+        .map(|q| {
+            let v = decode_unorm(q);
+            if srgb { linear_to_srgb(v) } else { v }
+        })
+        .collect();
+    let n_lut: Vec<f32> = (0..=u16::MAX)
+        .map(|bits| {
+            let n = decode_n(bits);
+            match n_enc {
+                Some(e) => f32::from(e.encode(n)) / ((1_u32 << e.bits) - 1) as f32,
+                None => n,
+            }
+        })
+        .collect();
     let value = |i: usize, k: usize| {
+        let t = &texels[i];
         let comp = comps[k];
-        let v = component(
-            &texels[i],
-            ka.get(i).copied().unwrap_or(Vec3::ZERO),
-            comp,
-            n_enc,
-        );
+        let v = match comp {
+            Comp::Kd(c) => colour_lut[t.kd[c] as usize],
+            Comp::Ks(c) => colour_lut[t.ks[c.min(2)] as usize],
+            Comp::N => n_lut[t.n as usize],
+            Comp::Ka(c) => {
+                let v = ka.get(i).map_or(0.0, |k| k[c]);
+                if srgb { linear_to_srgb(v) } else { v }
+            }
+        };
         (comp, v)
     };
     let mut out = std::io::Cursor::new(Vec::new());
@@ -267,12 +273,7 @@ fn encode_image(
             let data: Vec<u8> = (0..count * channels)
                 .into_par_iter()
                 .map(|j| {
-                    let (comp, v) = value(j / channels, j % channels);
-                    let v = if is_colour(comp) {
-                        linear_to_srgb(v)
-                    } else {
-                        v
-                    };
+                    let (_, v) = value(j / channels, j % channels);
                     (v.clamp(0.0, 1.0) * 255.0).round() as u8
                 })
                 .collect();
@@ -282,7 +283,11 @@ fn encode_image(
                 _ => image::ExtendedColorType::Rgba8,
             };
             image::ImageEncoder::write_image(
-                image::codecs::png::PngEncoder::new(&mut out),
+                image::codecs::png::PngEncoder::new_with_quality(
+                    &mut out,
+                    image::codecs::png::CompressionType::Fast,
+                    image::codecs::png::FilterType::Adaptive,
+                ),
                 &data,
                 width,
                 height,
@@ -304,7 +309,11 @@ fn encode_image(
                 _ => image::ExtendedColorType::Rgba16,
             };
             image::ImageEncoder::write_image(
-                image::codecs::png::PngEncoder::new(&mut out),
+                image::codecs::png::PngEncoder::new_with_quality(
+                    &mut out,
+                    image::codecs::png::CompressionType::Fast,
+                    image::codecs::png::FilterType::Adaptive,
+                ),
                 &data,
                 width,
                 height,
@@ -486,8 +495,7 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
             preset: preset.name.clone(),
         };
         // The k_a error, measured on the set as a consumer decodes it.
-        let decoded = read_maps(&manifest, &tmp)?;
-        manifest.ka_error = ka_error_between(maps, &decoded, model, approx);
+        manifest.ka_error = ka_error_of_set(maps, &manifest, preset.format, model, approx);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
         manifest.bytes.exported =
             manifest.files.iter().map(|f| f.bytes).sum::<u64>() + json.len() as u64;
@@ -514,25 +522,61 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
     }
 }
 
-/// Relative `k_a` error of `b` against `a` (per texel and colour channel).
-fn ka_error_between(
-    a: &MaterialMaps,
-    b: &MaterialMaps,
+/// Relative `k_a` error of the set described by `manifest` against the maps, per texel and
+/// colour channel: every stored value goes through what the files hold (8-bit sRGB or 16-bit
+/// codes, `n` codes) and back as a consumer decodes it, by lookup tables per stored code.
+fn ka_error_of_set(
+    maps: &MaterialMaps,
+    manifest: &Manifest,
+    format: Format,
     model: ShadingModel,
     approx: AmbientApprox,
 ) -> KaError {
-    let w = a.width();
-    let (max, sum, count) = (0..a.height())
+    let chi = crate::model::maps::chi_lut(model, approx);
+    let diffuse = reflectance::diffuse_factor(approx) as f32;
+    // Colour: stored unorm16 code -> file value -> linear.
+    let colour: Vec<f32> = (0..=u16::MAX)
+        .map(|q| {
+            let v = decode_unorm(q);
+            match format {
+                Format::Png8 => srgb_to_linear((linear_to_srgb(v) * 255.0).round() / 255.0),
+                Format::Png16 => (v * 65535.0).round() / 65535.0,
+                Format::Exr => v,
+            }
+        })
+        .collect();
+    // n: stored half-float bits -> code -> chi of the decoded n.
+    let chi_of_set: Vec<f32> = (0..=u16::MAX)
+        .map(|bits| match manifest.n_encoding {
+            Some(e) => reflectance::chi_f32(model, approx, e.decode(e.encode(decode_n(bits)))),
+            None => chi[bits as usize],
+        })
+        .collect();
+    let constant_ks = manifest.constants.ks;
+    let w = maps.width();
+    let (max, sum, count) = (0..maps.height())
         .into_par_iter()
         .map(|y| {
             let (mut max, mut sum) = (0.0_f64, 0.0_f64);
             for x in 0..w {
-                let (p, q) = (a.value(x, y), b.value(x, y));
-                let ka = reflectance::ka(model, approx, p.kd, p.ks, p.n);
-                let kb = reflectance::ka(model, approx, q.kd, q.ks, q.n);
+                let t = maps.texel(x, y);
                 for c in 0..3 {
-                    let err = if ka[c] > 0.0 {
-                        f64::from((kb[c] - ka[c]).abs() / ka[c])
+                    let ka =
+                        diffuse * decode_unorm(t.kd[c]) + decode_unorm(t.ks[c]) * chi[t.n as usize];
+                    // Constants are stored exactly.
+                    let kd = if manifest.constants.kd.is_some() {
+                        decode_unorm(t.kd[c])
+                    } else {
+                        colour[t.kd[c] as usize]
+                    };
+                    let ks = if constant_ks.is_some() {
+                        decode_unorm(t.ks[c])
+                    } else {
+                        colour[t.ks[c] as usize]
+                    };
+                    let kb = diffuse * kd + ks * chi_of_set[t.n as usize];
+                    let err = if ka > 0.0 {
+                        f64::from((kb - ka).abs() / ka)
                     } else {
                         0.0
                     };
@@ -595,6 +639,14 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
         let srgb = file.colour_space == "srgb";
         let exr = file.compression == "exr";
         let n_enc = manifest.n_encoding;
+        let n_codes: Vec<f32> = n_enc.map_or_else(Vec::new, |e| {
+            (0..=((1_u32 << e.bits) - 1) as u16)
+                .map(|q| e.decode(q))
+                .collect()
+        });
+        let srgb8: Vec<f32> = (0..=255_u8)
+            .map(|v| srgb_to_linear(f32::from(v) / 255.0))
+            .collect();
         values
             .par_iter_mut()
             .zip(pixels.par_chunks(4))
@@ -606,7 +658,13 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
                     } else {
                         px[k.min(3)]
                     };
-                    let colour = |x: f32| if srgb { srgb_to_linear(x) } else { x };
+                    let colour = |x: f32| {
+                        if srgb {
+                            srgb8[(x.clamp(0.0, 1.0) * 255.0).round() as usize]
+                        } else {
+                            x
+                        }
+                    };
                     match *comp {
                         Comp::Kd(c) => v.kd[c] = colour(raw),
                         Comp::Ks(3) => v.ks = Vec3::splat(colour(raw)),
@@ -614,7 +672,9 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
                         Comp::N => {
                             v.n = match n_enc {
                                 Some(e) => {
-                                    e.decode((raw * ((1_u32 << e.bits) - 1) as f32).round() as u16)
+                                    let q = (raw.clamp(0.0, 1.0) * ((1_u32 << e.bits) - 1) as f32)
+                                        .round();
+                                    n_codes[q as usize]
                                 }
                                 None => raw,
                             };
