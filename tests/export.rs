@@ -266,3 +266,24 @@ fn export_cli_batches_and_reports() {
     assert!(!none.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn every_set_ships_a_valid_wgsl_decode_snippet() {
+    let dir = temp("snippet");
+    let doc = painted();
+    for p in preset::builtin() {
+        let out = dir.join(&p.name);
+        set::export(&doc, &p, &out).expect("export");
+        let source = std::fs::read_to_string(out.join("material.wgsl")).expect("snippet");
+        assert!(source.contains("fn kapaint_decode_n") && source.contains("fn kapaint_ka"));
+        let module = naga::front::wgsl::parse_str(&source)
+            .unwrap_or_else(|e| panic!("{}: {}", p.name, e.emit_to_string(&source)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{}: {e:?}", p.name));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

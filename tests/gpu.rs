@@ -522,3 +522,73 @@ fn mips_follow_the_dirty_tiles() {
         last[0]
     );
 }
+
+#[test]
+fn the_exported_wgsl_snippet_decodes_like_the_cpu() {
+    use kapaint::export::{preset, set};
+    let Some(gpu) = gpu() else { return };
+    let dir = std::env::temp_dir().join(format!("kapaint-snippet-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    // n spread over 1..5000 so the set stores it on a curve.
+    let mut doc = Document::new(64, 8, DocumentSettings::default()).expect("doc");
+    doc.apply(Command::SetChannels(kapaint::model::Channels {
+        kd: false,
+        ks: false,
+        n: true,
+    }))
+    .expect("channels");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::ONE,
+        Vec3::ONE,
+        1.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::SetSecondary(MaterialValue::new(
+        Vec3::ONE,
+        Vec3::ONE,
+        5000.0,
+    )))
+    .expect("secondary");
+    doc.apply(Command::Gradient {
+        shape: kapaint::model::paint::GradientShape::Linear,
+        start: Vec2::new(0.0, 0.0),
+        end: Vec2::new(64.0, 0.0),
+    })
+    .expect("gradient");
+    let m = set::export(&doc, &preset::find("compact").expect("preset"), &dir).expect("export");
+    let e = m.n_encoding.expect("n on a curve");
+    let snippet = std::fs::read_to_string(dir.join("material.wgsl")).expect("snippet");
+    let kernel = format!(
+        "{snippet}\n@group(0) @binding(0) var<storage, read> codes: array<f32>;\n\
+         @group(0) @binding(1) var<storage, read_write> out: array<f32>;\n\
+         @compute @workgroup_size(64)\nfn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+         let i = id.x;\n    if i < arrayLength(&codes) {{\n\
+         let n = kapaint_decode_n(codes[i] / 255.0);\n\
+         out[2u * i] = n;\n\
+         out[2u * i + 1u] = kapaint_ka(vec3<f32>(0.3), vec3<f32>(0.5), n).x;\n    }}\n}}\n"
+    );
+    let codes: Vec<f32> = (0..=255).map(|c| c as f32).collect();
+    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &codes, 512).expect("kernel");
+    for (c, pair) in got.chunks_exact(2).enumerate() {
+        let n = e.decode(c as u16);
+        assert!(
+            (pair[0] - n).abs() <= 2e-5 * n.max(1.0),
+            "code {c}: {} vs {n}",
+            pair[0]
+        );
+        let ka = reflectance::ka(
+            doc.settings.model,
+            doc.settings.approx,
+            Vec3::splat(0.3),
+            Vec3::splat(0.5),
+            n,
+        )
+        .x;
+        assert!(
+            (pair[1] - ka).abs() <= 1e-5 * ka,
+            "code {c}: k_a {} vs {ka}",
+            pair[1]
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -5,3 +5,4 @@
 pub mod encoding;
 pub mod preset;
 pub mod set;
+pub mod snippet;

@@ -499,6 +499,12 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
         manifest.bytes.exported =
             manifest.files.iter().map(|f| f.bytes).sum::<u64>() + json.len() as u64;
+        // The decode + k_a snippet for engines, beside the images.
+        let snippet = super::snippet::wgsl(&manifest);
+        let snippet_path = tmp.join("material.wgsl");
+        crate::atomic::write_atomic(&snippet_path, snippet.as_bytes())
+            .map_err(|e| io(&snippet_path, e))?;
+        manifest.bytes.exported += snippet.len() as u64;
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
         let path = tmp.join("material.json");
         crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;

@@ -1,5 +1,5 @@
-//! The shader's `chi` evaluated on the GPU (`shaders/chi_check.wgsl`), to check it against
-//! the Rust core.
+//! Small compute kernels on the GPU: the shader's `chi` (`shaders/chi_check.wgsl`) checked
+//! against the Rust core, and any WGSL function over a list of values ([`run_kernel`]).
 
 use crate::reflectance::{AmbientApprox, ShadingModel};
 
@@ -15,17 +15,6 @@ pub fn chi_on_gpu(
     approx: AmbientApprox,
     n: &[f32],
 ) -> Result<Vec<f32>, GpuError> {
-    use wgpu::util::DeviceExt;
-    if n.is_empty() {
-        return Ok(Vec::new());
-    }
-    let device = &gpu.device;
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("chi_check.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(
-            shader_source(include_str!("../../shaders/chi_check.wgsl")).into(),
-        ),
-    });
     let constants = [
         (
             "MODEL",
@@ -43,42 +32,68 @@ pub fn chi_on_gpu(
             },
         ),
     ];
+    let source = shader_source(include_str!("../../shaders/chi_check.wgsl"));
+    run_kernel(gpu, &source, &constants, n, n.len())
+}
+
+/// Runs the compute entry `cs_main` of `source` (binding 0: `array<f32>` input, binding 1:
+/// `array<f32>` output of `out_len` values; workgroups of 64 over the input) and returns
+/// the output.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn run_kernel(
+    gpu: &Gpu,
+    source: &str,
+    constants: &[(&str, f64)],
+    input: &[f32],
+    out_len: usize,
+) -> Result<Vec<f32>, GpuError> {
+    use wgpu::util::DeviceExt;
+    if input.is_empty() || out_len == 0 {
+        return Ok(Vec::new());
+    }
+    let device = &gpu.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("kernel"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("chi check"),
+        label: Some("kernel"),
         layout: None,
         module: &module,
         entry_point: Some("cs_main"),
         compilation_options: wgpu::PipelineCompilationOptions {
-            constants: &constants,
+            constants,
             zero_initialize_workgroup_memory: false,
         },
         cache: None,
     });
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("n"),
-        contents: bytemuck::cast_slice(n),
+    let input_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("input"),
+        contents: bytemuck::cast_slice(input),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let bytes = std::mem::size_of_val(n) as u64;
+    let bytes = (out_len * 4) as u64;
     let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("chi"),
+        label: Some("output"),
         size: bytes,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("chi readback"),
+        label: Some("readback"),
         size: bytes,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("chi check"),
+        label: Some("kernel"),
         layout: &pipeline.get_bind_group_layout(0),
         entries: &[
             wgpu::BindGroupEntry {
                 binding: 0,
-                resource: input.as_entire_binding(),
+                resource: input_buffer.as_entire_binding(),
             },
             wgpu::BindGroupEntry {
                 binding: 1,
@@ -92,7 +107,7 @@ pub fn chi_on_gpu(
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups((n.len() as u32).div_ceil(64), 1, 1);
+        pass.dispatch_workgroups((input.len() as u32).div_ceil(64), 1, 1);
     }
     encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
     gpu.queue.submit([encoder.finish()]);
