@@ -175,53 +175,7 @@ pub enum Command {
         n: Vec<String>,
     },
     /// Render the preview headless (no window, no display) into a PNG or EXR.
-    Render {
-        /// Project whose maps to render.
-        #[arg(long, conflicts_with_all = ["kd", "ks", "n"])]
-        project: Option<PathBuf>,
-        /// Uniform diffuse coefficient `R,G,B` (without --project).
-        #[arg(long)]
-        kd: Option<String>,
-        /// Uniform specular coefficient `S` or `R,G,B` (without --project).
-        #[arg(long)]
-        ks: Option<String>,
-        /// Uniform Phong exponent (without --project).
-        #[arg(long, allow_hyphen_values = true)]
-        n: Option<String>,
-        /// sphere, plane, cube, torus or a mesh file (default: the project's, else sphere).
-        #[arg(long)]
-        mesh: Option<String>,
-        /// phong, blinn, compare-split (Phong left, Blinn-Phong right) or compare-diff.
-        #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-diff"])]
-        model: String,
-        /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
-        #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
-        view: String,
-        /// How k_a's chi is computed.
-        #[arg(long, value_parser = ["fast", "paper", "paper-corrected"], default_value = "fast")]
-        method: String,
-        /// Direction towards the light, `X,Y,Z`.
-        #[arg(long, allow_hyphen_values = true)]
-        light: Option<String>,
-        /// Ambient (sky) intensity I_a.
-        #[arg(long, default_value_t = 0.3)]
-        ia: f32,
-        /// Directional light intensity I_l.
-        #[arg(long, default_value_t = 0.8)]
-        il: f32,
-        /// Image size `WxH` (or `W` for a square).
-        #[arg(long, default_value = "512x512")]
-        size: String,
-        /// Camera angle around the vertical axis, degrees.
-        #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
-        yaw: f32,
-        /// Camera angle above the horizon, degrees.
-        #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
-        pitch: f32,
-        /// Output image: .png or .exr.
-        #[arg(long)]
-        out: PathBuf,
-    },
+    Render(RenderArgs),
     /// Print a mesh's vertices, triangles, UV islands, bounds, and whether normals and UVs were
     /// present (FILE is an .obj file, or sphere, plane, cube, torus).
     MeshInfo {
@@ -475,39 +429,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             }
             Ok(out)
         }
-        Command::Render {
-            project,
-            kd,
-            ks,
-            n,
-            mesh,
-            model,
-            view,
-            method,
-            light,
-            ia,
-            il,
-            size,
-            yaw,
-            pitch,
-            out,
-        } => render_command(RenderArgs {
-            project,
-            kd,
-            ks,
-            n,
-            mesh,
-            model,
-            view,
-            method,
-            light,
-            ia,
-            il,
-            size,
-            yaw,
-            pitch,
-            out,
-        }),
+        Command::Render(args) => render_command(args),
         Command::MeshInfo { file } => {
             let mesh = mesh::open(&file).map_err(|e| CliError::usage(e.to_string()))?;
             Ok(mesh::info_text(&file, &mesh))
@@ -542,6 +464,16 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
     }
 }
 
+/// A project's mesh: a built-in name, or its file (a relative path is tried from the
+/// project's folder when it does not exist from the current one).
+fn project_mesh(settings: &DocumentSettings, project_file: &std::path::Path) -> PathBuf {
+    let own = PathBuf::from(settings.mesh.spec());
+    match project_file.parent() {
+        Some(dir) if own.is_relative() && !own.exists() && dir.join(&own).exists() => dir.join(own),
+        _ => own,
+    }
+}
+
 /// Loads the mesh (`spec`, else the project's own, a relative path taken from the project's
 /// folder), bakes it at the map size and attaches it to `doc`.
 fn attach_surface(
@@ -550,15 +482,7 @@ fn attach_surface(
     spec: Option<&str>,
 ) -> Result<(), CliError> {
     let spec = spec.map_or_else(
-        || {
-            let own = std::path::PathBuf::from(doc.settings.mesh.spec());
-            match project_file.parent() {
-                Some(dir) if own.is_relative() && !own.exists() && dir.join(&own).exists() => {
-                    dir.join(own)
-                }
-                _ => own,
-            }
-        },
+        || project_mesh(&doc.settings, project_file),
         std::path::PathBuf::from,
     );
     let mesh = mesh::open(&spec).map_err(|e| CliError::usage(e.to_string()))?;
@@ -666,21 +590,52 @@ fn export_command(
 }
 
 /// The arguments of `kapaint render`.
-struct RenderArgs {
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// Project whose maps to render.
+    #[arg(long, conflicts_with_all = ["kd", "ks", "n"])]
     project: Option<PathBuf>,
+    /// Uniform diffuse coefficient `R,G,B` (without --project).
+    #[arg(long)]
     kd: Option<String>,
+    /// Uniform specular coefficient `S` or `R,G,B` (without --project).
+    #[arg(long)]
     ks: Option<String>,
+    /// Uniform Phong exponent (without --project).
+    #[arg(long, allow_hyphen_values = true)]
     n: Option<String>,
+    /// sphere, plane, cube, torus or a mesh file (default: the project's, else sphere).
+    #[arg(long)]
     mesh: Option<String>,
+    /// phong, blinn, compare-split (Phong left, Blinn-Phong right) or compare-diff.
+    #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-diff"])]
     model: String,
+    /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
+    #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
     view: String,
+    /// How k_a's chi is computed.
+    #[arg(long, value_parser = ["fast", "paper", "paper-corrected"], default_value = "fast")]
     method: String,
+    /// Direction towards the light, `X,Y,Z`.
+    #[arg(long, allow_hyphen_values = true)]
     light: Option<String>,
+    /// Ambient (sky) intensity I_a.
+    #[arg(long, default_value_t = 0.3)]
     ia: f32,
+    /// Directional light intensity I_l.
+    #[arg(long, default_value_t = 0.8)]
     il: f32,
+    /// Image size `WxH` (or `W` for a square).
+    #[arg(long, default_value = "512x512")]
     size: String,
+    /// Camera angle around the vertical axis, degrees.
+    #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
     yaw: f32,
+    /// Camera angle above the horizon, degrees.
+    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
     pitch: f32,
+    /// Output image: .png or .exr.
+    #[arg(long)]
     out: PathBuf,
 }
 
@@ -688,13 +643,7 @@ struct RenderArgs {
 fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::PathBuf), CliError> {
     if let Some(file) = &a.project {
         let doc = project::load(file).map_err(model_error)?;
-        let spec = std::path::PathBuf::from(doc.settings.mesh.spec());
-        let spec = match file.parent() {
-            Some(dir) if spec.is_relative() && !spec.exists() && dir.join(&spec).exists() => {
-                dir.join(spec)
-            }
-            _ => spec,
-        };
+        let spec = project_mesh(&doc.settings, file);
         return Ok((doc.maps, spec));
     }
     let d = model::MaterialValue::default();

@@ -136,21 +136,6 @@ fn io(path: &Path, e: impl std::fmt::Display) -> SetError {
     }
 }
 
-/// The value every texel of a plane has, if all tiles agree.
-fn constant<T: Copy + PartialEq>(
-    maps: &MaterialMaps,
-    plane: impl Fn(&crate::model::tile::Tile) -> &Plane<T>,
-) -> Option<T> {
-    let mut value = None;
-    for id in 0..maps.tile_count() {
-        let v = plane(maps.tile(id)).uniform()?;
-        if *value.get_or_insert(v) != v {
-            return None;
-        }
-    }
-    value
-}
-
 /// Whether `k_s` is grey everywhere.
 fn ks_monochrome(maps: &MaterialMaps) -> bool {
     (0..maps.tile_count())
@@ -391,10 +376,11 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
     let maps = &doc.maps;
     let (model, approx) = (doc.settings.model, doc.settings.approx);
     let (w, h) = (maps.width(), maps.height());
+    let (kd, ks, n) = maps.uniform_channels();
     let constants = Constants {
-        kd: constant(maps, |t| &t.kd).map(|v| v.map(decode_unorm)),
-        ks: constant(maps, |t| &t.ks).map(|v| v.map(decode_unorm)),
-        n: constant(maps, |t| &t.n).map(decode_n),
+        kd: kd.map(|v| v.map(decode_unorm)),
+        ks: ks.map(|v| v.map(decode_unorm)),
+        n: n.map(decode_n),
     };
     let mono_ks = ks_monochrome(maps);
     let n_enc = match (constants.n, preset.format) {

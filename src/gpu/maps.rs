@@ -25,24 +25,12 @@ pub struct UniformChannels {
 impl UniformChannels {
     /// Scans the tiles' planes (no texel is read unless a plane is full).
     pub fn of(maps: &MaterialMaps) -> Self {
-        fn all_same<T: Copy + PartialEq>(
-            maps: &MaterialMaps,
-            plane: impl Fn(&crate::model::tile::Tile) -> &Plane<T>,
-        ) -> Option<T> {
-            let mut value = None;
-            for id in 0..maps.tile_count() {
-                let v = plane(maps.tile(id)).uniform()?;
-                if *value.get_or_insert(v) != v {
-                    return None;
-                }
-            }
-            value
-        }
+        let (kd, ks, n) = maps.uniform_channels();
         let rgb = |v: [u16; 3]| v.map(crate::model::texel::decode_unorm);
         Self {
-            kd: all_same(maps, |t| &t.kd).map(rgb),
-            ks: all_same(maps, |t| &t.ks).map(rgb),
-            n: all_same(maps, |t| &t.n).map(crate::model::texel::decode_n),
+            kd: kd.map(rgb),
+            ks: ks.map(rgb),
+            n: n.map(crate::model::texel::decode_n),
         }
     }
 }

@@ -13,7 +13,7 @@ use gltf::Semantic;
 use gltf::accessor::{DataType as T, Dimensions as D};
 use gltf::mesh::Mode;
 
-use super::{MAX_FILE_BYTES, MAX_TRIANGLES, Mesh, MeshError};
+use super::{MAX_TRIANGLES, Mesh, MeshError};
 
 /// Deepest node hierarchy followed (deeper means a cycle or an absurd file).
 const MAX_DEPTH: usize = 64;
@@ -24,16 +24,7 @@ pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_path_buf(),
         reason,
     };
-    let meta = std::fs::metadata(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(invalid(format!(
-            "the file is {} bytes, more than the 2 GiB supported",
-            meta.len()
-        )));
-    }
+    super::check_file_size(path)?;
     let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
         source: e,

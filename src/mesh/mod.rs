@@ -208,6 +208,24 @@ pub fn smooth_normals(
         .collect()
 }
 
+/// Fails with a clear error when `path` cannot be read or is larger than supported.
+fn check_file_size(path: &Path) -> Result<(), MeshError> {
+    let meta = std::fs::metadata(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(MeshError::Invalid {
+            path: path.to_path_buf(),
+            reason: format!(
+                "the file is {} bytes, more than the 2 GiB supported",
+                meta.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Names of the built-in meshes.
 pub const BUILTIN_NAMES: [&str; 4] = ["sphere", "plane", "cube", "torus"];
 

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use super::{MAX_FILE_BYTES, Mesh, MeshError, smooth_normals};
+use super::{Mesh, MeshError, smooth_normals};
 
 /// Loads an OBJ file. Vertices are split per distinct (position, UV, normal) index triple;
 /// missing normals are computed smooth per position index.
@@ -15,16 +15,7 @@ pub fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_path_buf(),
         reason,
     };
-    let meta = std::fs::metadata(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(invalid(format!(
-            "the file is {} bytes, more than the 2 GiB supported",
-            meta.len()
-        )));
-    }
+    super::check_file_size(path)?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,

@@ -207,6 +207,30 @@ impl MaterialMaps {
         }
     }
 
+    /// Per channel, the value every texel holds when the channel is one value over the whole
+    /// map (`k_d`, `k_s` as stored unorm16, `n` as stored half bits). Reads only the tiles'
+    /// planes: a full plane makes its channel non-uniform, even if its texels happen to agree.
+    pub fn uniform_channels(&self) -> (Option<[u16; 3]>, Option<[u16; 3]>, Option<u16>) {
+        fn same<T: Copy + PartialEq>(
+            tiles: &[Arc<Tile>],
+            plane: impl Fn(&Tile) -> &super::tile::Plane<T>,
+        ) -> Option<T> {
+            let mut value = None;
+            for tile in tiles {
+                let v = plane(tile).uniform()?;
+                if *value.get_or_insert(v) != v {
+                    return None;
+                }
+            }
+            value
+        }
+        (
+            same(&self.tiles, |t| &t.kd),
+            same(&self.tiles, |t| &t.ks),
+            same(&self.tiles, |t| &t.n),
+        )
+    }
+
     /// Derives `k_a` for the given tiles: per tile, `TILE_TEXELS` values in row-major tile
     /// order (texels beyond the map edge included, they are well defined). Never stored.
     pub fn derive_ka_tiles(
