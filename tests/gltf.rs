@@ -168,12 +168,23 @@ fn node_transforms_apply_and_mirrored_nodes_keep_facing_out() {
 }
 
 #[test]
-fn missing_normals_are_flat_and_strips_unroll() {
+fn missing_normals_are_smooth_over_shared_vertices_and_strips_unroll() {
     let quad = mesh::plane();
     let (json, bin) = mesh_gltf(&quad, false, r#"[{"mesh":0}]"#, 4);
     let m = mesh::load(&temp("flat.glb", &glb(&json, &bin))).expect("loads");
     assert!(!m.had_normals);
     assert!(m.normals.iter().all(|n| (*n - Vec3::Y).length() < 1e-6));
+    // A UV sphere without normals: shared vertices get the smooth (radial) normal.
+    let sphere = mesh::uv_sphere(32, 16);
+    let (json, bin) = mesh_gltf(&sphere, false, r#"[{"mesh":0}]"#, 4);
+    let m = mesh::load(&temp("sphere.glb", &glb(&json, &bin))).expect("loads");
+    let uvs = m.uvs.as_ref().expect("uvs");
+    for (i, (p, n)) in m.positions.iter().zip(&m.normals).enumerate() {
+        let inner = uvs[i].x > 0.0 && uvs[i].x < 1.0 && p.y.abs() < 0.99;
+        if inner {
+            assert!(n.dot(p.normalize()) > 0.99, "vertex {i}: {n} at {p}");
+        }
+    }
     // The same 4 vertices as a strip: indices 0 1 2 3 give two triangles.
     let strip = Mesh {
         triangles: vec![[2, 0, 3], [3, 0, 1]],

@@ -2,8 +2,9 @@
 //!
 //! Every mesh and primitive the scene instantiates, with node transforms applied (normals by
 //! the inverse transpose; mirrored nodes keep their triangles facing out). Triangle strips
-//! and fans are unrolled; points and lines are skipped. Per the glTF specification, a
-//! primitive without normals gets flat normals. Accessors are checked against their buffers
+//! and fans are unrolled; points and lines are skipped. A primitive without normals gets
+//! smooth normals over the vertices it shares, so the vertices the file splits stay hard
+//! edges (a fully split primitive comes out flat, as the glTF specification describes). Accessors are checked against their buffers
 //! before anything is read, so a hostile file is an error, never a panic.
 
 use std::path::Path;
@@ -252,37 +253,27 @@ impl Builder {
         self.any_uv |= uvs.is_some();
         // A missing UV set reads as (0, 0): those triangles have no texels to paint.
         let uv_of = |i: usize| uvs.as_ref().map_or(Vec2::ZERO, |t| t[i]);
-        match &normals {
-            Some(n) => {
-                for i in 0..count {
-                    self.positions.push(world[i]);
-                    self.normals
-                        .push((normal_matrix * n[i]).try_normalize().unwrap_or(Vec3::Y));
-                    self.uvs.push(uv_of(i));
-                }
-                for t in corners {
-                    let [a, b, c] = t.map(|i| base + i);
-                    self.triangles
-                        .push(if flip { [a, c, b] } else { [a, b, c] });
-                }
-            }
-            None => {
-                // Flat normals, as the specification asks: each triangle its own corners.
-                for t in corners {
-                    let t = if flip { [t[0], t[2], t[1]] } else { t };
-                    let [p, q, r] = t.map(|i| world[i as usize]);
-                    let n = (q - p).cross(r - p).try_normalize().unwrap_or(Vec3::Y);
-                    let first =
-                        u32::try_from(self.positions.len()).map_err(|_| "too many vertices")?;
-                    for i in t {
-                        self.positions.push(world[i as usize]);
-                        self.normals.push(n);
-                        self.uvs.push(uv_of(i as usize));
-                    }
-                    self.triangles.push([first, first + 1, first + 2]);
-                }
-            }
+        let triangles: Vec<[u32; 3]> = corners
+            .iter()
+            .map(|&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
+            .collect();
+        let vertex_normals: Vec<Vec3> = if let Some(n) = &normals {
+            n.iter()
+                .map(|&v| (normal_matrix * v).try_normalize().unwrap_or(Vec3::Y))
+                .collect()
+        } else {
+            // Smooth normals over the vertices the file shares; where it splits a vertex
+            // (a hard edge, a UV seam) the copies keep their own side's normal.
+            let identity: Vec<usize> = (0..count).collect();
+            super::smooth_normals(&world, &triangles, &identity, count)
+        };
+        for i in 0..count {
+            self.positions.push(world[i]);
+            self.normals.push(vertex_normals[i]);
+            self.uvs.push(uv_of(i));
         }
+        self.triangles
+            .extend(triangles.iter().map(|t| t.map(|i| base + i)));
         Ok(())
     }
 
