@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
+use image::ExtendedColorType as C;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -236,10 +237,9 @@ fn encode_image(
             }
         })
         .collect();
-    let value = |i: usize, k: usize| {
+    let value = |i: usize, k: usize| -> f32 {
         let t = &texels[i];
-        let comp = comps[k];
-        let v = match comp {
+        match comps[k] {
             Comp::Kd(c) => colour_lut[t.kd[c] as usize],
             Comp::Ks(c) => colour_lut[t.ks[c.min(2)] as usize],
             Comp::N => n_lut[t.n as usize],
@@ -247,78 +247,65 @@ fn encode_image(
                 let v = ka.get(i).map_or(0.0, |k| k[c]);
                 if srgb { linear_to_srgb(v) } else { v }
             }
-        };
-        (comp, v)
+        }
     };
-    let mut out = std::io::Cursor::new(Vec::new());
     let count = texels.len();
     let fail = |e: image::ImageError| e.to_string();
+    // One colour type per component count: grey, RGB, RGBA.
+    let png = |data: &[u8], colors: [image::ExtendedColorType; 3]| {
+        let color = colors[match channels {
+            1 => 0,
+            3 => 1,
+            _ => 2,
+        }];
+        let mut out = std::io::Cursor::new(Vec::new());
+        image::ImageEncoder::write_image(
+            image::codecs::png::PngEncoder::new_with_quality(
+                &mut out,
+                image::codecs::png::CompressionType::Fast,
+                image::codecs::png::FilterType::Adaptive,
+            ),
+            data,
+            width,
+            height,
+            color,
+        )
+        .map_err(fail)?;
+        Ok::<_, String>(out.into_inner())
+    };
     match format {
         Format::Png8 => {
             let data: Vec<u8> = (0..count * channels)
                 .into_par_iter()
-                .map(|j| {
-                    let (_, v) = value(j / channels, j % channels);
-                    (v.clamp(0.0, 1.0) * 255.0).round() as u8
-                })
+                .map(|j| (value(j / channels, j % channels).clamp(0.0, 1.0) * 255.0).round() as u8)
                 .collect();
-            let color = match channels {
-                1 => image::ExtendedColorType::L8,
-                3 => image::ExtendedColorType::Rgb8,
-                _ => image::ExtendedColorType::Rgba8,
-            };
-            image::ImageEncoder::write_image(
-                image::codecs::png::PngEncoder::new_with_quality(
-                    &mut out,
-                    image::codecs::png::CompressionType::Fast,
-                    image::codecs::png::FilterType::Adaptive,
-                ),
-                &data,
-                width,
-                height,
-                color,
-            )
-            .map_err(fail)?;
+            png(&data, [C::L8, C::Rgb8, C::Rgba8])
         }
         Format::Png16 => {
+            // Native-endian 16-bit words, as the encoder expects.
             let data: Vec<u8> = (0..count * channels)
                 .into_par_iter()
                 .flat_map_iter(|j| {
-                    let (_, v) = value(j / channels, j % channels);
+                    let v = value(j / channels, j % channels);
                     ((v.clamp(0.0, 1.0) * 65535.0).round() as u16).to_ne_bytes()
                 })
                 .collect();
-            let color = match channels {
-                1 => image::ExtendedColorType::L16,
-                3 => image::ExtendedColorType::Rgb16,
-                _ => image::ExtendedColorType::Rgba16,
-            };
-            image::ImageEncoder::write_image(
-                image::codecs::png::PngEncoder::new_with_quality(
-                    &mut out,
-                    image::codecs::png::CompressionType::Fast,
-                    image::codecs::png::FilterType::Adaptive,
-                ),
-                &data,
-                width,
-                height,
-                color,
-            )
-            .map_err(fail)?;
+            png(&data, [C::L16, C::Rgb16, C::Rgba16])
         }
         Format::Exr => {
             // RGB floats; a one-component image repeats its value in all three.
             let data: Vec<f32> = (0..count * 3)
                 .into_par_iter()
-                .map(|j| value(j / 3, (j % 3).min(channels - 1)).1)
+                .map(|j| value(j / 3, (j % 3).min(channels - 1)))
                 .collect();
+            let mut out = std::io::Cursor::new(Vec::new());
             image::Rgb32FImage::from_raw(width, height, data)
                 .ok_or("image size")?
                 .write_to(&mut out, image::ImageFormat::OpenExr)
                 .map_err(fail)?;
+            Ok(out.into_inner())
         }
     }
-    Ok(out.into_inner())
 }
 
 /// Which images a set holds, with which components: what is constant is left out, `k_s` is
