@@ -144,7 +144,8 @@ pub enum Command {
         /// Project files (several: one set per project, in OUT/<project name>/).
         #[arg(required = true)]
         files: Vec<PathBuf>,
-        /// Export preset: compact, 16-bit, separate, exr, with-ka, or a user preset.
+        /// Export preset: compact, 16-bit, separate, exr, with-ka, ktx2, ktx2-raw, or a user
+        /// preset.
         #[arg(long, default_value = "compact")]
         preset: String,
         /// Target folder (must not exist, or be empty).
@@ -153,6 +154,10 @@ pub enum Command {
         /// Print the memory report, the n encoding and the k_a error.
         #[arg(long)]
         report: bool,
+        /// Keep texels outside the mesh's UV islands as painted (by default they are filled
+        /// from the nearest island, which needs the project's mesh).
+        #[arg(long)]
+        no_padding: bool,
     },
     /// Rebuild a project from an exported set.
     ImportSet {
@@ -394,7 +399,8 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             preset,
             out,
             report,
-        } => export_command(&files, &preset, &out, report),
+            no_padding,
+        } => export_command(&files, &preset, &out, report, !no_padding),
         Command::ImportSet {
             manifest,
             out,
@@ -492,20 +498,91 @@ fn attach_surface(
         .map_err(model_error)
 }
 
+/// The `--report` lines of one exported set.
+fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
+    let _ = writeln!(text, "  preset: {}", m.preset);
+    if m.dilated {
+        let _ = writeln!(
+            text,
+            "  padding: texels outside the UV islands filled from the nearest island"
+        );
+    }
+    match m.n_encoding {
+        Some(e) => {
+            let _ = writeln!(
+                text,
+                "  n: {:?} over [{}, {}] in {} bits",
+                e.curve, e.lo, e.hi, e.bits
+            );
+        }
+        None => {
+            let _ = writeln!(
+                text,
+                "  n: {}",
+                m.constants
+                    .n
+                    .map_or_else(|| "stored as float".into(), |n| format!("constant {n}"))
+            );
+        }
+    }
+    for f in &m.files {
+        let _ = write!(
+            text,
+            "  {}: {} ({} bit, {}, {}), {} bytes",
+            f.path,
+            f.layout.join(" "),
+            f.bit_depth,
+            f.colour_space,
+            f.compression,
+            f.bytes
+        );
+        if let Some(levels) = f.mip_levels {
+            let _ = write!(text, ", {levels} mip levels");
+        }
+        if let Some(psnr) = &f.psnr {
+            let db: Vec<String> = psnr
+                .iter()
+                .map(|p| p.map_or_else(|| "exact".into(), |p| format!("{p:.1} dB")))
+                .collect();
+            let _ = write!(text, ", PSNR {}", db.join(" / "));
+        }
+        text.push('\n');
+    }
+    let b = m.bytes;
+    let _ = writeln!(
+        text,
+        "  bytes: set {} vs naive k_a+k_d+k_s+n {} ({:.1}x) vs project maps {} ({:.1}x)",
+        b.exported,
+        b.naive,
+        b.naive as f64 / b.exported.max(1) as f64,
+        b.project,
+        b.project as f64 / b.exported.max(1) as f64
+    );
+}
+
 /// `kapaint export`: every project into its set; one line each, plus the report.
 fn export_command(
     files: &[PathBuf],
     preset: &str,
     out: &std::path::Path,
     report: bool,
+    padding: bool,
 ) -> Result<String, CliError> {
     use std::io::IsTerminal as _;
     let preset = crate::export::preset::find(preset).map_err(|e| CliError::usage(e.to_string()))?;
-    // Load (and so validate) every project before writing anything.
+    // Load (and so validate) every project before writing anything; bake the meshes for
+    // padding.
+    let mut text = String::new();
     let docs = files
         .iter()
-        .map(|f| project::load(f).map_err(model_error))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|f| {
+            let mut doc = project::load(f).map_err(model_error)?;
+            if padding && let Err(e) = attach_surface(&mut doc, f, None) {
+                let _ = writeln!(text, "note: {}: no padding ({})", f.display(), e.message);
+            }
+            Ok(doc)
+        })
+        .collect::<Result<Vec<_>, CliError>>()?;
     let targets: Vec<PathBuf> = if files.len() == 1 {
         vec![out.to_path_buf()]
     } else {
@@ -514,22 +591,38 @@ fn export_command(
             .map(|f| out.join(f.file_stem().unwrap_or_default()))
             .collect()
     };
-    let progress = files.len() > 1 && std::io::stderr().is_terminal();
-    let mut text = String::new();
+    let terminal = std::io::stderr().is_terminal();
     for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
-        if progress {
-            let done = i * 30 / files.len();
-            eprint!(
-                "\r[{}{}] {}/{} {}",
-                "#".repeat(done),
-                " ".repeat(30 - done),
-                i + 1,
-                files.len(),
-                file.display()
-            );
-        }
-        let m = crate::export::set::export(doc, &preset, target)
-            .map_err(|e| CliError::usage(e.to_string()))?;
+        let progress = crate::task::Progress::default();
+        // The export runs on a worker; this thread draws the bar while it works.
+        let m = std::thread::scope(|scope| {
+            let worker = std::thread::Builder::new()
+                .name("kapaint-export".into())
+                .spawn_scoped(scope, || {
+                    crate::export::set::export_with(doc, &preset, target, &progress)
+                })
+                .map_err(|e| CliError::usage(format!("cannot start the export: {e}")))?;
+            while terminal && !worker.is_finished() {
+                let done = (progress.fraction() * 30.0) as usize;
+                eprint!(
+                    "\r[{}{}] {}/{} {} {:<8}",
+                    "#".repeat(done),
+                    " ".repeat(30 - done),
+                    i + 1,
+                    files.len(),
+                    file.display(),
+                    progress.stage()
+                );
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            if terminal {
+                eprint!("\r{}\r", " ".repeat(60 + file.display().to_string().len()));
+            }
+            worker
+                .join()
+                .map_err(|_| CliError::usage("the export worker panicked"))?
+                .map_err(|e| CliError::usage(e.to_string()))
+        })?;
         let _ = writeln!(
             text,
             "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
@@ -541,50 +634,8 @@ fn export_command(
             m.ka_error.mean
         );
         if report {
-            let _ = writeln!(text, "  preset: {}", m.preset);
-            match m.n_encoding {
-                Some(e) => {
-                    let _ = writeln!(
-                        text,
-                        "  n: {:?} over [{}, {}] in {} bits",
-                        e.curve, e.lo, e.hi, e.bits
-                    );
-                }
-                None => {
-                    let _ = writeln!(
-                        text,
-                        "  n: {}",
-                        m.constants
-                            .n
-                            .map_or_else(|| "stored as float".into(), |n| format!("constant {n}"))
-                    );
-                }
-            }
-            for f in &m.files {
-                let _ = writeln!(
-                    text,
-                    "  {}: {} ({} bit, {}), {} bytes",
-                    f.path,
-                    f.layout.join(" "),
-                    f.bit_depth,
-                    f.colour_space,
-                    f.bytes
-                );
-            }
-            let b = m.bytes;
-            let _ = writeln!(
-                text,
-                "  bytes: set {} vs naive k_a+k_d+k_s+n {} ({:.1}x) vs project maps {} ({:.1}x)",
-                b.exported,
-                b.naive,
-                b.naive as f64 / b.exported.max(1) as f64,
-                b.project,
-                b.project as f64 / b.exported.max(1) as f64
-            );
+            write_report(&mut text, &m);
         }
-    }
-    if progress {
-        eprintln!();
     }
     Ok(text)
 }

@@ -12,3 +12,4 @@ pub mod model;
 pub mod reflectance;
 pub mod render;
 pub mod report;
+pub mod task;

@@ -3,7 +3,7 @@
 
 #![allow(clippy::expect_used)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 use kapaint::export::preset::{self, Format};
@@ -147,7 +147,22 @@ fn every_builtin_preset_exports_and_imports() {
         match p.format {
             Format::Exr => assert!(err < 1e-4, "{}: {err}", p.name),
             Format::Png16 => assert!(err < 1e-3, "{}: {err}", p.name),
-            Format::Png8 => assert!(err < 0.05, "{}: {err}", p.name),
+            Format::Png8 | Format::Ktx2 => assert!(err < 0.05, "{}: {err}", p.name),
+            Format::Ktx2Bc => {
+                assert!(err < 0.3, "{}: {err}", p.name);
+                let psnr = m.files[0].psnr.as_ref().expect("psnr");
+                assert!(psnr.iter().all(|p| p.is_none_or(|p| p > 30.0)), "{psnr:?}");
+            }
+        }
+        // What import reads is what the report measured (plus the project's own rounding).
+        assert!(
+            f64::from(err) <= m.ka_error.max + 2e-3,
+            "{}: {err} vs {:?}",
+            p.name,
+            m.ka_error
+        );
+        if p.format.is_ktx2() {
+            assert_eq!(m.files[0].mip_levels, Some(8), "{}", p.name);
         }
         assert_eq!(
             m.files
@@ -157,6 +172,71 @@ fn every_builtin_preset_exports_and_imports() {
             "{}",
             p.name
         );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// With k_d constant, grey k_s and n share one two-component image (grey + alpha PNG, BC5 or
+/// RG8 KTX2) and read back as they were written.
+#[test]
+fn two_component_images_pack_ks_with_n() {
+    let dir = temp("ks_n");
+    let mut doc = painted();
+    doc.apply(Command::SetChannels(Channels {
+        kd: false,
+        ks: true,
+        n: true,
+    }))
+    .expect("channels");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::splat(0.5),
+        Vec3::splat(0.8),
+        3.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::Stroke {
+        tool: StrokeTool::Brush,
+        points: vec![
+            StrokePoint {
+                pos: Vec2::new(100.0, 5.0),
+                pressure: 1.0,
+            },
+            StrokePoint {
+                pos: Vec2::new(100.0, 115.0),
+                pressure: 1.0,
+            },
+        ],
+    })
+    .expect("stroke");
+    // Undo the k_d part of the first stroke: paint k_d back to the base everywhere.
+    doc.apply(Command::SetChannels(Channels {
+        kd: true,
+        ks: false,
+        n: false,
+    }))
+    .expect("channels");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.6, 0.5, 0.4),
+        Vec3::splat(0.8),
+        3.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+        .expect("fill");
+    for name in ["compact", "ktx2", "ktx2-raw"] {
+        let out = dir.join(name);
+        let m = set::export(&doc, &preset::find(name).expect("preset"), &out).expect("export");
+        assert!(m.constants.kd.is_some(), "{name}");
+        assert_eq!(m.files.len(), 1, "{name}: {:?}", m.files);
+        assert_eq!(m.files[0].layout, ["ks", "n"], "{name}");
+        let back = set::import(&out.join("material.json")).expect("import");
+        let err = max_rel_ka_error(&doc, &back);
+        assert!(
+            f64::from(err) <= m.ka_error.max + 2e-3,
+            "{name}: {err} vs {:?}",
+            m.ka_error
+        );
+        assert!(err < 0.1, "{name}: {err}");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -285,5 +365,79 @@ fn every_set_ships_a_valid_wgsl_decode_snippet() {
         .validate(&module)
         .unwrap_or_else(|e| panic!("{}: {e:?}", p.name));
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A cancelled export stops with `Cancelled` and leaves nothing at the target or beside it,
+/// whether the cancel comes before the work or during the block encoder.
+#[test]
+fn cancelled_exports_leave_nothing_behind() {
+    let dir = temp("cancel");
+    let doc = painted();
+    let out = dir.join("set");
+    let progress = kapaint::task::Progress::default();
+    progress.cancel();
+    let p = preset::find("ktx2").expect("preset");
+    assert!(matches!(
+        set::export_with(&doc, &p, &out, &progress),
+        Err(set::SetError::Cancelled)
+    ));
+    assert!(!out.exists());
+
+    // A bigger map, cancelled from another thread once encoding has started.
+    let big = kapaint::report::typical::typical_document(512, None, 5).expect("doc");
+    let progress = kapaint::task::Progress::default();
+    let result = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while progress.stage() != "encode" {
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+            progress.cancel();
+        });
+        set::export_with(&big, &p, &out, &progress)
+    });
+    assert!(
+        matches!(result, Err(set::SetError::Cancelled)),
+        "{result:?}"
+    );
+    assert!(!out.exists());
+    let left: Vec<_> = std::fs::read_dir(&dir).expect("dir").collect();
+    assert!(left.is_empty(), "{left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// With the real spot mesh attached, texels outside its UV islands are filled from the
+/// nearest island: every exported texel outside holds a value some island texel holds.
+#[test]
+fn padding_fills_outside_the_islands_from_the_mesh_bake() {
+    let obj =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_triangulated.obj");
+    let mesh = kapaint::mesh::open(&obj).expect("spot");
+    let mut doc = painted();
+    let surface = kapaint::model::surface::Surface::new(mesh, 200, 120).expect("bake");
+    let coverage = surface.bake.coverage.clone();
+    doc.set_surface(Some(std::sync::Arc::new(surface)))
+        .expect("surface");
+    let dir = temp("padding");
+    let out = dir.join("set");
+    let m = set::export(&doc, &preset::find("16-bit").expect("preset"), &out).expect("export");
+    assert!(m.dilated);
+    let image = image::open(out.join(&m.files[0].path))
+        .expect("png")
+        .to_rgba16();
+    let inside: std::collections::HashSet<[u16; 4]> = image
+        .pixels()
+        .zip(&coverage)
+        .filter(|(_, c)| **c == kapaint::mesh::bake::Coverage::Surface)
+        .map(|(p, _)| p.0)
+        .collect();
+    let mut outside = 0;
+    for (p, c) in image.pixels().zip(&coverage) {
+        if *c != kapaint::mesh::bake::Coverage::Surface {
+            outside += 1;
+            assert!(inside.contains(&p.0), "{:?} comes from no island", p.0);
+        }
+    }
+    assert!(outside > 1000, "{outside}");
     let _ = std::fs::remove_dir_all(&dir);
 }

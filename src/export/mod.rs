@@ -3,6 +3,7 @@
 //! `material.json` manifest written atomically and read back ([`set`]).
 
 pub mod encoding;
+pub mod ktx;
 pub mod preset;
 pub mod set;
 pub mod snippet;

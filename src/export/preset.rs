@@ -14,6 +14,48 @@ pub enum Format {
     Png16,
     /// Float OpenEXR (linear; `n` as is).
     Exr,
+    /// KTX2, 8 bits per component, uncompressed, with a full mip chain.
+    Ktx2,
+    /// KTX2 block-compressed with a full mip chain: BC7 for three or four components, BC5
+    /// for two, BC4 for one.
+    Ktx2Bc,
+}
+
+impl Format {
+    /// Whether files hold 8-bit components (PNG8 and both KTX2 kinds).
+    pub fn is_8bit(self) -> bool {
+        matches!(self, Self::Png8 | Self::Ktx2 | Self::Ktx2Bc)
+    }
+
+    /// Whether files are KTX2 containers.
+    pub fn is_ktx2(self) -> bool {
+        matches!(self, Self::Ktx2 | Self::Ktx2Bc)
+    }
+
+    /// The files' extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Png8 | Self::Png16 => "png",
+            Self::Exr => "exr",
+            Self::Ktx2 | Self::Ktx2Bc => "ktx2",
+        }
+    }
+}
+
+/// BC7 encoder effort (BC4 and BC5 have one speed): slower finds better endpoints.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Bc7Quality {
+    /// Fewest partitions and modes tried.
+    UltraFast,
+    /// The default: about 1 dB under `Basic` at a fraction of the time.
+    #[default]
+    VeryFast,
+    /// More modes.
+    Fast,
+    /// The reference encoder's basic profile.
+    Basic,
+    /// Exhaustive.
+    Slow,
 }
 
 /// How channels are packed into files.
@@ -43,6 +85,9 @@ pub struct ExportPreset {
     /// Also write a baked `k_a` map.
     #[serde(default)]
     pub include_ka: bool,
+    /// BC7 effort, for `Ktx2Bc`.
+    #[serde(default)]
+    pub bc7_quality: Bc7Quality,
 }
 
 /// Why a preset could not be used.
@@ -70,6 +115,11 @@ const BUILTIN: &[(&str, &str)] = &[
     ("16-bit", include_str!("../../presets/export/16-bit.ron")),
     ("compact", include_str!("../../presets/export/compact.ron")),
     ("exr", include_str!("../../presets/export/exr.ron")),
+    ("ktx2", include_str!("../../presets/export/ktx2.ron")),
+    (
+        "ktx2-raw",
+        include_str!("../../presets/export/ktx2-raw.ron"),
+    ),
     (
         "separate",
         include_str!("../../presets/export/separate.ron"),
@@ -92,6 +142,12 @@ impl ExportPreset {
             return Err(malformed(format!(
                 "n_bits must be 8 or 16, got {}",
                 preset.n_bits
+            )));
+        }
+        if preset.format.is_8bit() && preset.n_bits != 8 {
+            return Err(malformed(format!(
+                "{:?} stores 8-bit components (n_bits: 8)",
+                preset.format
             )));
         }
         if preset.format == Format::Png16 && preset.n_bits != 16 {
@@ -159,7 +215,9 @@ mod tests {
     #[test]
     fn every_builtin_parses_and_is_found() {
         assert_eq!(builtin().len(), BUILTIN.len());
-        for name in ["compact", "16-bit", "separate", "exr", "with-ka"] {
+        for name in [
+            "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw",
+        ] {
             assert_eq!(find(name).unwrap().name, name);
         }
         assert!(matches!(find("nope"), Err(PresetError::Unknown { .. })));

@@ -12,12 +12,14 @@ use serde::{Deserialize, Serialize};
 
 use super::encoding::{KaError, NEncoding, rank_encodings};
 use super::preset::{ExportPreset, Format, Layout};
+use crate::mesh::bake::Coverage;
 use crate::model::texel::{
     MaterialValue, Texel, decode_n, decode_unorm, linear_to_srgb, srgb_to_linear,
 };
 use crate::model::tile::Plane;
 use crate::model::{Document, DocumentSettings, MaterialMaps};
 use crate::reflectance::{self, AmbientApprox, ShadingModel};
+use crate::task::Progress;
 
 /// Manifest format name and version.
 pub const MANIFEST_FORMAT: &str = "kapaint-material";
@@ -44,6 +46,13 @@ pub struct FileEntry {
     pub height: u32,
     /// File size.
     pub bytes: u64,
+    /// Mip levels (KTX2 files hold a full chain; images have one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mip_levels: Option<u32>,
+    /// For block-compressed files: PSNR (dB) per component of the decoded level 0 against
+    /// the same components uncompressed; `null` where a component is exact.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub psnr: Option<Vec<Option<f64>>>,
 }
 
 /// Channels that are one value everywhere: stored here, not as images.
@@ -103,6 +112,9 @@ pub struct Manifest {
     pub files: Vec<FileEntry>,
     /// Relative `k_a` error of the set (decoded as a consumer would) against the project.
     pub ka_error: KaError,
+    /// Texels outside the mesh's UV islands were filled from the nearest island.
+    #[serde(default)]
+    pub dilated: bool,
     /// Sizes.
     pub bytes: MemoryReport,
     /// The preset used.
@@ -128,6 +140,9 @@ pub enum SetError {
         /// What is wrong.
         reason: String,
     },
+    /// Cancelled through its [`Progress`]; nothing was left at the target.
+    #[error("export cancelled")]
+    Cancelled,
 }
 
 fn io(path: &Path, e: impl std::fmt::Display) -> SetError {
@@ -209,26 +224,43 @@ fn approximation(approx: AmbientApprox, model: ShadingModel) -> Approximation {
     }
 }
 
-/// Encodes one image of `comps` components from the texels.
-fn encode_image(
-    texels: &[Texel],
-    ka: &[Vec3],
-    (width, height): (u32, u32),
-    comps: &[Comp],
-    format: Format,
-    n_enc: Option<NEncoding>,
-) -> Result<Vec<u8>, String> {
-    let channels = comps.len();
-    // Per stored 16-bit code, what the file holds: colour components sRGB-encoded in 8-bit
-    // files, n through its encoding. Tables keep the per-texel work to lookups.
-    let srgb = format == Format::Png8;
-    let colour_lut: Vec<f32> = (0..=u16::MAX)
+/// One encoded image.
+struct EncodedImage {
+    /// The file.
+    bytes: Vec<u8>,
+    /// For 8-bit formats: the components a consumer decodes (level 0), per texel.
+    stored: Option<Vec<u8>>,
+    /// The colour components are sRGB-encoded.
+    srgb: bool,
+    /// KTX2: mip levels, PSNR, compression name.
+    ktx: Option<KtxInfo>,
+}
+
+/// What a KTX2 file reports beyond its bytes.
+struct KtxInfo {
+    levels: u32,
+    psnr: Option<Vec<Option<f64>>>,
+    compression: &'static str,
+}
+
+/// Whether an image's colour components are sRGB-encoded: in 8-bit PNGs always, in KTX2
+/// where the format has an sRGB variant (three or four components).
+fn srgb_image(format: Format, comps: &[Comp]) -> bool {
+    let colour = comps.iter().any(|c| is_colour(*c));
+    colour && (format == Format::Png8 || (format.is_ktx2() && comps.len() >= 3))
+}
+
+/// Per stored 16-bit code, what a file holds: colour components (sRGB-encoded where `srgb`),
+/// and n through its encoding (as a fraction of the code range). Tables keep the per-texel
+/// work to lookups.
+fn file_tables(srgb: bool, n_enc: Option<NEncoding>) -> (Vec<f32>, Vec<f32>) {
+    let colour = (0..=u16::MAX)
         .map(|q| {
             let v = decode_unorm(q);
             if srgb { linear_to_srgb(v) } else { v }
         })
         .collect();
-    let n_lut: Vec<f32> = (0..=u16::MAX)
+    let n = (0..=u16::MAX)
         .map(|bits| {
             let n = decode_n(bits);
             match n_enc {
@@ -237,6 +269,41 @@ fn encode_image(
             }
         })
         .collect();
+    (colour, n)
+}
+
+/// A PNG of `data` (16-bit words native-endian) with `color`.
+fn png_bytes(data: &[u8], (width, height): (u32, u32), color: C) -> Result<Vec<u8>, String> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new_with_quality(
+            &mut out,
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Adaptive,
+        ),
+        data,
+        width,
+        height,
+        color,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
+}
+
+/// Encodes one image of `comps` components from the texels.
+fn encode_image(
+    texels: &[Texel],
+    ka: &[Vec3],
+    (width, height): (u32, u32),
+    comps: &[Comp],
+    preset: &ExportPreset,
+    n_enc: Option<NEncoding>,
+    progress: &Progress,
+) -> Result<EncodedImage, String> {
+    let format = preset.format;
+    let channels = comps.len();
+    let srgb = srgb_image(format, comps);
+    let (colour_lut, n_lut) = file_tables(srgb, n_enc);
     let value = |i: usize, k: usize| -> f32 {
         let t = &texels[i];
         match comps[k] {
@@ -250,28 +317,17 @@ fn encode_image(
         }
     };
     let count = texels.len();
-    let fail = |e: image::ImageError| e.to_string();
-    // One colour type per component count: grey, RGB, RGBA.
-    let png = |data: &[u8], colors: [image::ExtendedColorType; 3]| {
-        let color = colors[match channels {
-            1 => 0,
-            3 => 1,
-            _ => 2,
-        }];
-        let mut out = std::io::Cursor::new(Vec::new());
-        image::ImageEncoder::write_image(
-            image::codecs::png::PngEncoder::new_with_quality(
-                &mut out,
-                image::codecs::png::CompressionType::Fast,
-                image::codecs::png::FilterType::Adaptive,
-            ),
-            data,
-            width,
-            height,
-            color,
-        )
-        .map_err(fail)?;
-        Ok::<_, String>(out.into_inner())
+    let png = |data: &[u8], colors: [C; 4]| {
+        png_bytes(data, (width, height), colors[channels.clamp(1, 4) - 1])
+    };
+    let plain = |bytes| {
+        progress.advance(u64::from(height));
+        EncodedImage {
+            bytes,
+            stored: None,
+            srgb,
+            ktx: None,
+        }
     };
     match format {
         Format::Png8 => {
@@ -279,7 +335,11 @@ fn encode_image(
                 .into_par_iter()
                 .map(|j| (value(j / channels, j % channels).clamp(0.0, 1.0) * 255.0).round() as u8)
                 .collect();
-            png(&data, [C::L8, C::Rgb8, C::Rgba8])
+            let bytes = png(&data, [C::L8, C::La8, C::Rgb8, C::Rgba8])?;
+            Ok(EncodedImage {
+                stored: Some(data),
+                ..plain(bytes)
+            })
         }
         Format::Png16 => {
             // Native-endian 16-bit words, as the encoder expects.
@@ -290,7 +350,7 @@ fn encode_image(
                     ((v.clamp(0.0, 1.0) * 65535.0).round() as u16).to_ne_bytes()
                 })
                 .collect();
-            png(&data, [C::L16, C::Rgb16, C::Rgba16])
+            Ok(plain(png(&data, [C::L16, C::La16, C::Rgb16, C::Rgba16])?))
         }
         Format::Exr => {
             // RGB floats; a one-component image repeats its value in all three.
@@ -302,8 +362,33 @@ fn encode_image(
             image::Rgb32FImage::from_raw(width, height, data)
                 .ok_or("image size")?
                 .write_to(&mut out, image::ImageFormat::OpenExr)
-                .map_err(fail)?;
-            Ok(out.into_inner())
+                .map_err(|e| e.to_string())?;
+            Ok(plain(out.into_inner()))
+        }
+        Format::Ktx2 | Format::Ktx2Bc => {
+            let values: Vec<f32> = (0..count * channels)
+                .into_par_iter()
+                .map(|j| value(j / channels, j % channels))
+                .collect();
+            let source = super::ktx::Source {
+                width,
+                height,
+                channels,
+                values: &values,
+                srgb,
+            };
+            let compressed = (format == Format::Ktx2Bc).then_some(preset.bc7_quality);
+            let written = super::ktx::encode(&source, compressed, progress)?;
+            Ok(EncodedImage {
+                bytes: written.bytes,
+                stored: Some(written.level0),
+                srgb,
+                ktx: Some(KtxInfo {
+                    levels: written.levels,
+                    psnr: written.psnr,
+                    compression: written.compression,
+                }),
+            })
         }
     }
 }
@@ -323,8 +408,16 @@ fn plan_images(
     };
     let (with_kd, with_n) = (constants.kd.is_none(), constants.n.is_none());
     let mut images: Vec<(&'static str, Vec<Comp>)> = Vec::new();
+    let with_ks = constants.ks.is_none();
     if preset.layout == Layout::Packed && with_kd && with_n {
         images.push(("kd_n", [kd, vec![Comp::N]].concat()));
+    } else if preset.layout == Layout::Packed && with_n && with_ks && mono_ks {
+        // k_d constant: grey k_s and n share a two-component image.
+        images.push(("ks_n", vec![Comp::Ks(0), Comp::N]));
+        if preset.include_ka {
+            images.push(("ka", (0..3).map(Comp::Ka).collect()));
+        }
+        return images;
     } else {
         if with_kd {
             images.push(("kd", kd));
@@ -342,15 +435,38 @@ fn plan_images(
     images
 }
 
-/// An encoded image: file name, components, bytes.
-type Encoded = (String, Vec<Comp>, Vec<u8>);
+/// An encoded image with its file name and components.
+type Encoded = (String, Vec<Comp>, EncodedImage);
+
+/// The bytes a consumer decodes from an 8-bit image, `comps.len()` per texel.
+struct StoredImage {
+    comps: Vec<Comp>,
+    data: Vec<u8>,
+    srgb: bool,
+}
 
 /// Exports `doc` with `preset` into the folder `out` (which must not exist or be empty).
 ///
 /// # Errors
 /// An unwritable or non-empty target, or a failed encode or write: nothing is left at `out`.
-#[allow(clippy::too_many_lines)] // One pass: analyse, encode in parallel, measure, commit.
 pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manifest, SetError> {
+    export_with(doc, preset, out, &Progress::default())
+}
+
+/// [`export`], reporting to `progress` (stages `analyse`, `encode`, `measure`) and stopping
+/// with [`SetError::Cancelled`] when it is cancelled.
+///
+/// # Errors
+/// As [`export`], or cancelled.
+#[allow(clippy::too_many_lines)] // One pass: analyse, encode in parallel, measure, commit.
+pub fn export_with(
+    doc: &Document,
+    preset: &ExportPreset,
+    out: &Path,
+    progress: &Progress,
+) -> Result<Manifest, SetError> {
+    let cancelled = |_| SetError::Cancelled;
+    progress.start("analyse", 1);
     if out.exists()
         && (!out.is_dir()
             || std::fs::read_dir(out)
@@ -376,7 +492,24 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
             .first()
             .map(|(e, _)| *e),
     };
-    let texels = rows(maps);
+    let mut texels = rows(maps);
+    // Outside the mesh's UV islands, texels copy the nearest island's, so mips and filtering
+    // do not pull the background into the edges.
+    let dilated = doc.surface().is_some_and(|surface| {
+        let mut filled: Vec<bool> = surface
+            .bake
+            .coverage
+            .iter()
+            .map(|c| *c == Coverage::Surface)
+            .collect();
+        let any = filled.iter().any(|f| *f);
+        if any {
+            crate::mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
+                texels[k] = texels[src];
+            });
+        }
+        any
+    });
     let ka: Vec<Vec3> = if preset.include_ka {
         texels
             .par_iter()
@@ -390,11 +523,9 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
     };
 
     let images = plan_images(preset, &constants, mono_ks);
-    let ext = if preset.format == Format::Exr {
-        "exr"
-    } else {
-        "png"
-    };
+    let ext = preset.format.extension();
+    progress.check().map_err(cancelled)?;
+    progress.start("encode", images.len() as u64 * u64::from(h));
 
     let parent = out
         .parent()
@@ -412,39 +543,63 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
             .par_iter()
             .map(|(stem, comps)| {
                 let file = format!("{stem}.{ext}");
-                encode_image(&texels, &ka, (w, h), comps, preset.format, n_enc)
-                    .map(|bytes| (file.clone(), comps.clone(), bytes))
-                    .map_err(|e| io(&tmp.join(&file), e))
+                if progress.is_cancelled() {
+                    return Err(SetError::Cancelled);
+                }
+                let image = encode_image(&texels, &ka, (w, h), comps, preset, n_enc, progress)
+                    .map_err(|e| {
+                        if progress.is_cancelled() {
+                            SetError::Cancelled
+                        } else {
+                            io(&tmp.join(&file), e)
+                        }
+                    })?;
+                if progress.is_cancelled() {
+                    return Err(SetError::Cancelled);
+                }
+                Ok((file, comps.clone(), image))
             })
             .collect();
+        progress.start("measure", 1);
         let mut files = Vec::new();
+        let mut stored = Vec::new();
         for item in encoded {
-            let (file, comps, bytes) = item?;
+            let (file, comps, image) = item?;
             let path = tmp.join(&file);
-            crate::atomic::write_atomic(&path, &bytes).map_err(|e| io(&path, e))?;
-            let colour_space =
-                if preset.format == Format::Png8 && comps.iter().any(|c| is_colour(*c)) {
-                    "srgb"
-                } else {
-                    "linear"
-                };
+            crate::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
+            let (mip_levels, psnr, kind) = match image.ktx {
+                Some(k) => (Some(k.levels), k.psnr, k.compression),
+                None => (None, None, "none"),
+            };
             files.push(FileEntry {
                 path: file,
                 layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
-                colour_space: colour_space.into(),
+                colour_space: if image.srgb { "srgb" } else { "linear" }.into(),
                 bit_depth: match preset.format {
-                    Format::Png8 => 8,
+                    Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 8,
                     Format::Png16 => 16,
                     Format::Exr => 32,
                 },
-                compression: ext.into(),
+                compression: match preset.format {
+                    Format::Ktx2Bc => format!("ktx2-{kind}"),
+                    _ => ext.into(),
+                },
                 width: w,
                 height: h,
-                bytes: bytes.len() as u64,
+                bytes: image.bytes.len() as u64,
+                mip_levels,
+                psnr,
             });
+            if let Some(data) = image.stored {
+                stored.push(StoredImage {
+                    comps,
+                    data,
+                    srgb: image.srgb,
+                });
+            }
         }
         let depth = match preset.format {
-            Format::Png8 => 1,
+            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 1,
             Format::Png16 => 2,
             Format::Exr => 4,
         };
@@ -460,6 +615,7 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
             n_encoding: n_enc,
             files,
             ka_error: KaError::default(),
+            dilated,
             bytes: MemoryReport {
                 exported: 0,
                 naive: texel_count * 10 * depth,
@@ -468,7 +624,8 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
             preset: preset.name.clone(),
         };
         // The k_a error, measured on the set as a consumer decodes it.
-        manifest.ka_error = ka_error_of_set(maps, &manifest, preset.format, model, approx);
+        manifest.ka_error =
+            ka_error_of_set(&texels, &manifest, &stored, preset.format, model, approx);
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
         manifest.bytes.exported =
             manifest.files.iter().map(|f| f.bytes).sum::<u64>() + json.len() as u64;
@@ -501,59 +658,130 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
     }
 }
 
-/// Relative `k_a` error of the set described by `manifest` against the maps, per texel and
-/// colour channel: every stored value goes through what the files hold (8-bit sRGB or 16-bit
-/// codes, `n` codes) and back as a consumer decodes it, by lookup tables per stored code.
+/// Where a consumer's value of one component comes from.
+#[derive(Clone, Copy)]
+enum Read<'a> {
+    /// Through a table per stored 16-bit code (constants, 16-bit and float files).
+    Table(&'a [f32]),
+    /// A table per byte of an 8-bit file as written (after block compression).
+    Bytes {
+        data: &'a [u8],
+        stride: usize,
+        offset: usize,
+        table: &'a [f32],
+    },
+}
+
+impl Read<'_> {
+    fn get(self, i: usize, code: u16) -> f32 {
+        match self {
+            Self::Table(t) => t[code as usize],
+            Self::Bytes {
+                data,
+                stride,
+                offset,
+                table,
+            } => table[data[i * stride + offset] as usize],
+        }
+    }
+}
+
+/// The first of `want` that an 8-bit image holds, read through `table` (sRGB image) or
+/// `linear`.
+fn in_file<'r>(
+    stored: &'r [StoredImage],
+    want: &[Comp],
+    table: &'r [f32],
+    linear: &'r [f32],
+) -> Option<Read<'r>> {
+    want.iter().find_map(|w| {
+        stored.iter().find_map(|image| {
+            let offset = image.comps.iter().position(|c| c == w)?;
+            Some(Read::Bytes {
+                data: &image.data,
+                stride: image.comps.len(),
+                offset,
+                table: if image.srgb { table } else { linear },
+            })
+        })
+    })
+}
+
+/// Relative `k_a` error of the set described by `manifest` against the texels it was made
+/// from, per texel and colour channel: every value goes through what a consumer reads (the
+/// bytes an 8-bit file holds after compression, or 16-bit and float codes by table) and back.
 fn ka_error_of_set(
-    maps: &MaterialMaps,
+    texels: &[Texel],
     manifest: &Manifest,
+    stored: &[StoredImage],
     format: Format,
     model: ShadingModel,
     approx: AmbientApprox,
 ) -> KaError {
     let chi = crate::model::maps::chi_lut(model, approx);
     let diffuse = reflectance::diffuse_factor(approx) as f32;
-    // Colour: stored unorm16 code -> file value -> linear.
-    let colour: Vec<f32> = (0..=u16::MAX)
-        .map(|q| {
-            let v = decode_unorm(q);
-            match format {
-                Format::Png8 => srgb_to_linear((linear_to_srgb(v) * 255.0).round() / 255.0),
-                Format::Png16 => (v * 65535.0).round() / 65535.0,
-                Format::Exr => v,
-            }
-        })
+    let exact: Vec<f32> = (0..=u16::MAX).map(decode_unorm).collect();
+    let sixteen: Vec<f32> = exact
+        .iter()
+        .map(|v| (v * 65535.0).round() / 65535.0)
         .collect();
-    // n: stored half-float bits -> code -> chi of the decoded n.
+    // n: stored half-float bits -> chi of what the set decodes.
     let chi_of_set: Vec<f32> = (0..=u16::MAX)
         .map(|bits| match manifest.n_encoding {
             Some(e) => reflectance::chi_f32(model, approx, e.decode(e.encode(decode_n(bits)))),
             None => chi[bits as usize],
         })
         .collect();
-    let constant_ks = manifest.constants.ks;
-    let w = maps.width();
-    let (max, sum, count) = (0..maps.height())
-        .into_par_iter()
-        .map(|y| {
+    let srgb8: Vec<f32> = (0..=255_u8)
+        .map(|b| srgb_to_linear(f32::from(b) / 255.0))
+        .collect();
+    let linear8: Vec<f32> = (0..=255_u8).map(|b| f32::from(b) / 255.0).collect();
+    let chi8: Vec<f32> = (0..=255_u16)
+        .map(|q| {
+            manifest.n_encoding.map_or(0.0, |e| {
+                reflectance::chi_f32(model, approx, e.decode(q.min((1 << e.bits) - 1)))
+            })
+        })
+        .collect();
+    // The source of each component: an 8-bit file's bytes, else a table.
+    let colour_table: &[f32] = if format == Format::Png16 {
+        &sixteen
+    } else {
+        &exact
+    };
+    let kd: [Read<'_>; 3] = std::array::from_fn(|c| {
+        if manifest.constants.kd.is_some() {
+            Read::Table(&exact)
+        } else {
+            in_file(stored, &[Comp::Kd(c)], &srgb8, &linear8).unwrap_or(Read::Table(colour_table))
+        }
+    });
+    let ks: [Read<'_>; 3] = std::array::from_fn(|c| {
+        if manifest.constants.ks.is_some() {
+            Read::Table(&exact)
+        } else {
+            in_file(stored, &[Comp::Ks(c), Comp::Ks(0)], &srgb8, &linear8)
+                .unwrap_or(Read::Table(colour_table))
+        }
+    });
+    let n = if manifest.constants.n.is_some() {
+        Read::Table(chi)
+    } else {
+        in_file(stored, &[Comp::N], &chi8, &chi8).unwrap_or(Read::Table(&chi_of_set))
+    };
+    let w = manifest.width as usize;
+    let (max, sum, count) = texels
+        .par_chunks(w)
+        .enumerate()
+        .map(|(y, row)| {
             let (mut max, mut sum) = (0.0_f64, 0.0_f64);
-            for x in 0..w {
-                let t = maps.texel(x, y);
+            for (x, t) in row.iter().enumerate() {
+                let i = y * w + x;
+                let chi_t = chi[t.n as usize];
+                let chi_b = n.get(i, t.n);
                 for c in 0..3 {
-                    let ka =
-                        diffuse * decode_unorm(t.kd[c]) + decode_unorm(t.ks[c]) * chi[t.n as usize];
-                    // Constants are stored exactly.
-                    let kd = if manifest.constants.kd.is_some() {
-                        decode_unorm(t.kd[c])
-                    } else {
-                        colour[t.kd[c] as usize]
-                    };
-                    let ks = if constant_ks.is_some() {
-                        decode_unorm(t.ks[c])
-                    } else {
-                        colour[t.ks[c] as usize]
-                    };
-                    let kb = diffuse * kd + ks * chi_of_set[t.n as usize];
+                    let ka = diffuse * exact[t.kd[c] as usize] + exact[t.ks[c] as usize] * chi_t;
+                    let kb = diffuse * kd[c].get(i, t.kd[c]) + ks[c].get(i, t.ks[c]) * chi_b;
                     let err = if ka > 0.0 {
                         f64::from((kb - ka).abs() / ka)
                     } else {
@@ -563,7 +791,7 @@ fn ka_error_of_set(
                     sum += err;
                 }
             }
-            (max, sum, u64::from(w) * 3)
+            (max, sum, row.len() as u64 * 3)
         })
         .reduce(
             || (0.0, 0.0, 0),
@@ -572,6 +800,37 @@ fn ka_error_of_set(
     KaError {
         max,
         mean: if count > 0 { sum / count as f64 } else { 0.0 },
+    }
+}
+
+/// An image of a set as RGBA floats: whether it is KTX2, its size, the texels.
+type Pixels = (bool, (u32, u32), Vec<f32>);
+
+/// Reads one image of a set.
+fn read_pixels(path: &Path) -> Result<Pixels, SetError> {
+    let invalid = |reason: String| SetError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let ktx = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ktx2"));
+    if ktx {
+        let len = std::fs::metadata(path).map_err(|e| io(path, e))?.len();
+        if len > crate::model::import::MAX_DECODED_BYTES {
+            return Err(invalid(format!("{len} bytes is too large")));
+        }
+        let bytes = std::fs::read(path).map_err(|e| io(path, e))?;
+        let decoded = super::ktx::decode(&bytes).map_err(invalid)?;
+        let pixels = decoded.rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
+        Ok((true, (decoded.width, decoded.height), pixels))
+    } else {
+        let image = crate::model::import::read_image(path).map_err(|e| invalid(e.to_string()))?;
+        Ok((
+            false,
+            (image.width(), image.height()),
+            image.to_rgba32f().into_raw(),
+        ))
     }
 }
 
@@ -595,16 +854,11 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
         if file.path.contains(['/', '\\']) || file.path.starts_with('.') {
             return Err(invalid(&path, "file names must stay inside the set".into()));
         }
-        let image =
-            crate::model::import::read_image(&path).map_err(|e| invalid(&path, e.to_string()))?;
-        if (image.width(), image.height()) != (w, h) {
+        let (ktx, size, pixels) = read_pixels(&path)?;
+        if size != (w, h) {
             return Err(invalid(
                 &path,
-                format!(
-                    "is {}x{}, the manifest says {w}x{h}",
-                    image.width(),
-                    image.height()
-                ),
+                format!("is {}x{}, the manifest says {w}x{h}", size.0, size.1),
             ));
         }
         let comps: Vec<Comp> = file
@@ -614,7 +868,6 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
                 Comp::parse(c).ok_or_else(|| invalid(&path, format!("unknown component {c:?}")))
             })
             .collect::<Result<_, _>>()?;
-        let pixels = image.to_rgba32f();
         let srgb = file.colour_space == "srgb";
         let exr = file.compression == "exr";
         let n_enc = manifest.n_encoding;
@@ -631,11 +884,12 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
             .zip(pixels.par_chunks(4))
             .for_each(|(v, px)| {
                 for (k, comp) in comps.iter().enumerate() {
-                    // EXR one-component images repeat the value; others hold components in order.
-                    let raw = if exr && comps.len() == 1 {
-                        px[0]
-                    } else {
-                        px[k.min(3)]
+                    // EXR one-component images repeat the value, grey + alpha PNGs read as
+                    // (L, L, L, A); others hold components in order.
+                    let raw = match (comps.len(), k) {
+                        (1, _) if exr => px[0],
+                        (2, 1) if !ktx && !exr => px[3],
+                        _ => px[k.min(3)],
                     };
                     let colour = |x: f32| {
                         if srgb {

@@ -201,10 +201,34 @@ pub fn bake(mesh: &Mesh, width: u32, height: u32, padding: u32) -> Result<UvBake
     Ok(out)
 }
 
-/// Grows every island by `rings` texels: each empty texel next to a filled one (8 neighbours,
-/// taken in a fixed order) copies it. Works on the frontier only, so the cost is the islands'
-/// perimeter times `rings`, not the whole map per ring.
+/// Grows every island by `rings` texels (bake padding).
 fn dilate(bake: &mut UvBake, rings: u32) {
+    let mut filled: Vec<bool> = bake
+        .coverage
+        .iter()
+        .map(|c| *c != Coverage::Empty)
+        .collect();
+    dilate_grid(&mut filled, bake.width, bake.height, rings, |k, src| {
+        bake.position[k] = bake.position[src];
+        bake.normal[k] = bake.normal[src];
+        bake.triangle[k] = bake.triangle[src];
+        bake.island[k] = bake.island[src];
+        bake.coverage[k] = Coverage::Padding;
+    });
+}
+
+/// Grows the filled cells of a row-major `width x height` grid by up to `rings` cells: each
+/// empty cell next to a filled one (8 neighbours, taken in a fixed order) gets
+/// `copy(cell, source)` and becomes filled. Sources are chosen against the state before each
+/// ring. Works on the frontier only, so the cost is the islands' perimeter times `rings`, not
+/// the whole grid per ring; `u32::MAX` rings fills every cell reachable from a filled one.
+pub fn dilate_grid(
+    filled: &mut [bool],
+    width: u32,
+    height: u32,
+    rings: u32,
+    mut copy: impl FnMut(usize, usize),
+) {
     const NEIGHBOURS: [(i64, i64); 8] = [
         (-1, 0),
         (1, 0),
@@ -215,7 +239,7 @@ fn dilate(bake: &mut UvBake, rings: u32) {
         (-1, 1),
         (1, 1),
     ];
-    let (w, h) = (i64::from(bake.width), i64::from(bake.height));
+    let (w, h) = (i64::from(width), i64::from(height));
     let neighbours = move |k: usize| {
         let (x, y) = (k as i64 % w, k as i64 / w);
         NEIGHBOURS.iter().filter_map(move |&(dx, dy)| {
@@ -223,42 +247,32 @@ fn dilate(bake: &mut UvBake, rings: u32) {
             (nx >= 0 && ny >= 0 && nx < w && ny < h).then(|| (ny * w + nx) as usize)
         })
     };
-    // Empty texels touching a filled one, found in parallel over rows.
-    let mut frontier: Vec<usize> = bake
-        .coverage
-        .par_iter()
-        .enumerate()
-        .filter(|&(k, c)| {
-            *c == Coverage::Empty && neighbours(k).any(|n| bake.coverage[n] != Coverage::Empty)
-        })
-        .map(|(k, _)| k)
-        .collect();
+    // Empty cells touching a filled one, found in parallel.
+    let mut frontier: Vec<usize> = {
+        let filled = &*filled;
+        (0..filled.len())
+            .into_par_iter()
+            .filter(|&k| !filled[k] && neighbours(k).any(|n| filled[n]))
+            .collect()
+    };
     for _ in 0..rings {
         if frontier.is_empty() {
             break;
         }
-        // Sources are chosen against the state before this ring, then written.
         let fills: Vec<(usize, usize)> = frontier
             .iter()
-            .filter_map(|&k| {
-                neighbours(k)
-                    .find(|&n| bake.coverage[n] != Coverage::Empty)
-                    .map(|s| (k, s))
-            })
+            .filter_map(|&k| neighbours(k).find(|&n| filled[n]).map(|s| (k, s)))
             .collect();
         for &(k, src) in &fills {
-            bake.position[k] = bake.position[src];
-            bake.normal[k] = bake.normal[src];
-            bake.triangle[k] = bake.triangle[src];
-            bake.island[k] = bake.island[src];
+            copy(k, src);
         }
         for &(k, _) in &fills {
-            bake.coverage[k] = Coverage::Padding;
+            filled[k] = true;
         }
         let mut next: Vec<usize> = fills
             .iter()
             .flat_map(|&(k, _)| neighbours(k))
-            .filter(|&n| bake.coverage[n] == Coverage::Empty)
+            .filter(|&n| !filled[n])
             .collect();
         next.sort_unstable();
         next.dedup();
@@ -294,5 +308,19 @@ mod tests {
         let (bary, d2) = nearest_barycentric(Vec2::new(1.0, 1.0), a, b, c);
         assert!((d2 - 0.5).abs() < 1e-6);
         assert!((bary.y - 0.5).abs() < 1e-6 && (bary.z - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn full_dilation_fills_every_cell_from_its_nearest_island() {
+        // Two filled cells at the ends of a 7x1 row: each fills its own half.
+        let mut filled = [true, false, false, false, false, false, true];
+        let mut value = [1, 0, 0, 0, 0, 0, 2];
+        dilate_grid(&mut filled, 7, 1, u32::MAX, |k, s| value[k] = value[s]);
+        assert!(filled.iter().all(|f| *f));
+        assert_eq!(value, [1, 1, 1, 1, 2, 2, 2]);
+        // Nothing filled: nothing to grow from.
+        let mut none = [false; 4];
+        dilate_grid(&mut none, 2, 2, u32::MAX, |_, _| unreachable!());
+        assert!(none.iter().all(|f| !*f));
     }
 }
