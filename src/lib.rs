@@ -13,3 +13,4 @@ pub mod reflectance;
 pub mod render;
 pub mod report;
 pub mod task;
+pub mod ui;

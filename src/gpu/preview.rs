@@ -14,7 +14,8 @@ use crate::reflectance::{AmbientApprox, ShadingModel};
 use crate::render::{FrameSettings, ViewMode};
 
 /// Depth buffer format.
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Depth buffer format of every preview pass.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// The preview's per-frame uniforms, laid out as `Frame` in the shader.
 #[repr(C)]

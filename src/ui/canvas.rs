@@ -1,0 +1,216 @@
+//! The 2D UV canvas: one channel of the maps (or the derived `k_a`) as an egui texture kept
+//! up to date tile by tile, with pan, zoom, a UV wireframe and painting in texel space.
+
+use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
+
+use crate::model::texel::{MaterialValue, linear_to_srgb};
+use crate::model::{Document, MaterialMaps};
+use crate::reflectance;
+use crate::render::n_false_colour;
+
+/// The canvas's accessible name (tests and screen readers find it by this).
+pub const CANVAS_LABEL: &str = "UV canvas painting area";
+
+/// What the canvas shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CanvasChannel {
+    /// Diffuse colour.
+    Kd,
+    /// Specular colour.
+    Ks,
+    /// Exponent, false colour on a log scale.
+    N,
+    /// Derived ambient coefficient.
+    Ka,
+}
+
+impl CanvasChannel {
+    /// Every choice, in menu order.
+    pub const ALL: [Self; 4] = [Self::Kd, Self::Ks, Self::N, Self::Ka];
+
+    /// Label for menus.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Kd => "k_d",
+            Self::Ks => "k_s",
+            Self::N => "n",
+            Self::Ka => "k_a",
+        }
+    }
+}
+
+/// The canvas's state: its texture, which map version it mirrors, and the view.
+pub struct Canvas {
+    /// Channel shown.
+    pub channel: CanvasChannel,
+    /// Texels per screen point.
+    pub zoom: f32,
+    /// Offset of the map's centre from the panel's centre, in points.
+    pub pan: Vec2,
+    /// Draw the UV wireframe.
+    pub wireframe: bool,
+    texture: Option<TextureHandle>,
+    mirrored: Option<(u64, CanvasChannel, (u32, u32), u64)>,
+}
+
+impl Default for Canvas {
+    fn default() -> Self {
+        Self {
+            channel: CanvasChannel::Kd,
+            zoom: 0.0,
+            pan: Vec2::ZERO,
+            wireframe: true,
+            texture: None,
+            mirrored: None,
+        }
+    }
+}
+
+/// Display colour of one texel for `channel`.
+fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
+    let rgb = match channel {
+        CanvasChannel::Kd => v.kd,
+        CanvasChannel::Ks => v.ks,
+        CanvasChannel::N => n_false_colour(v.n),
+        CanvasChannel::Ka => {
+            reflectance::ka(doc.settings.model, doc.settings.approx, v.kd, v.ks, v.n)
+        }
+    };
+    let c = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8;
+    Color32::from_rgb(c(rgb.x), c(rgb.y), c(rgb.z))
+}
+
+/// The pixels of one tile of the maps.
+fn tile_image(
+    doc: &Document,
+    maps: &MaterialMaps,
+    id: usize,
+    channel: CanvasChannel,
+) -> ColorImage {
+    let (x0, y0, x1, y1) = maps.tile_rect(id);
+    let (w, h) = (x1 - x0, y1 - y0);
+    let mut pixels = Vec::with_capacity((w * h) as usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            pixels.push(colour(doc, channel, maps.value(x, y)));
+        }
+    }
+    ColorImage::new([w as usize, h as usize], pixels)
+}
+
+impl Canvas {
+    /// Brings the texture up to date with the maps: changed tiles only, unless the size,
+    /// channel or shading settings changed. Returns the tiles uploaded.
+    pub fn sync(&mut self, ctx: &egui::Context, doc: &Document) -> usize {
+        let maps = &doc.maps;
+        let size = (maps.width(), maps.height());
+        // k_a depends on the model and approximation too.
+        let settings_key = u64::from(doc.settings.model as u8) << 8 | doc.settings.approx as u64;
+        let options = TextureOptions::NEAREST;
+        match (&mut self.texture, self.mirrored) {
+            (Some(tex), Some((version, channel, s, key)))
+                if channel == self.channel && s == size && key == settings_key =>
+            {
+                if version == maps.version() {
+                    return 0;
+                }
+                let dirty = maps.tiles_changed_since(version);
+                for &id in &dirty {
+                    let (x, y, _, _) = maps.tile_rect(id);
+                    tex.set_partial(
+                        [x as usize, y as usize],
+                        tile_image(doc, maps, id, self.channel),
+                        options,
+                    );
+                }
+                self.mirrored = Some((maps.version(), channel, size, key));
+                dirty.len()
+            }
+            _ => {
+                let mut image =
+                    ColorImage::filled([size.0 as usize, size.1 as usize], Color32::BLACK);
+                for id in 0..maps.tile_count() {
+                    let (x0, y0, x1, _) = maps.tile_rect(id);
+                    let w = x1 - x0;
+                    let tile = tile_image(doc, maps, id, self.channel);
+                    for y in 0..tile.size[1] {
+                        let row = (y0 as usize + y) * size.0 as usize + x0 as usize;
+                        image.pixels[row..row + w as usize]
+                            .copy_from_slice(&tile.pixels[y * w as usize..(y + 1) * w as usize]);
+                    }
+                }
+                self.texture = Some(ctx.load_texture("uv-canvas", image, options));
+                self.mirrored = Some((maps.version(), self.channel, size, settings_key));
+                maps.tile_count()
+            }
+        }
+    }
+
+    /// Screen rectangle of the map inside `panel`.
+    pub fn map_rect(&mut self, panel: Rect, size: (u32, u32)) -> Rect {
+        if self.zoom <= 0.0 {
+            // Fit on first show.
+            self.zoom = (panel.width() / size.0 as f32).min(panel.height() / size.1 as f32) * 0.95;
+        }
+        let extent = Vec2::new(size.0 as f32, size.1 as f32) * self.zoom;
+        Rect::from_center_size(panel.center() + self.pan, extent)
+    }
+
+    /// Texel coordinates (continuous) under a screen position.
+    pub fn to_texel(&self, rect: Rect, pos: Pos2, size: (u32, u32)) -> glam::Vec2 {
+        let uv = (pos - rect.min) / rect.size();
+        glam::Vec2::new(uv.x * size.0 as f32, uv.y * size.1 as f32)
+    }
+
+    /// Draws the canvas into `ui`; returns the response (drags paint) and the map's rect.
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        doc: &Document,
+        uv_lines: &[[glam::Vec2; 2]],
+    ) -> (egui::Response, Rect) {
+        self.sync(ui.ctx(), doc);
+        let (panel, response) =
+            ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        response
+            .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Other, true, CANVAS_LABEL));
+        let size = (doc.maps.width(), doc.maps.height());
+        // Zoom about the cursor; pan with the middle button or space + drag.
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0
+                && let Some(cursor) = response.hover_pos()
+            {
+                let factor = (scroll * 0.002).exp();
+                let before = cursor - (panel.center() + self.pan);
+                self.zoom = (self.zoom * factor).clamp(0.01, 64.0);
+                self.pan += before - before * factor;
+            }
+        }
+        let space = ui.input(|i| i.key_down(egui::Key::Space));
+        if response.dragged_by(egui::PointerButton::Middle)
+            || (space && response.dragged_by(egui::PointerButton::Primary))
+        {
+            self.pan += response.drag_delta();
+        }
+        let rect = self.map_rect(panel, size);
+        let painter = ui.painter_at(panel);
+        painter.rect_filled(panel, 0.0, Color32::from_gray(30));
+        if let Some(tex) = &self.texture {
+            painter.image(
+                tex.id(),
+                rect,
+                Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+                Color32::WHITE,
+            );
+        }
+        if self.wireframe {
+            let stroke = egui::Stroke::new(1.0, Color32::from_white_alpha(70));
+            let at = |uv: glam::Vec2| rect.min + Vec2::new(uv.x, uv.y) * rect.size();
+            for [a, b] in uv_lines {
+                painter.line_segment([at(*a), at(*b)], stroke);
+            }
+        }
+        (response, rect)
+    }
+}

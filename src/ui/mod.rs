@@ -1,0 +1,1274 @@
+//! The editor (issue 7): an eframe app around the model. The UI reads the document and
+//! changes it only through [`Command`]s; the GPU side ([`viewport`]) mirrors the maps.
+//!
+//! Layout: menu bar, tool and material panel on the left, view panel on the right, a dock
+//! with the 3D viewport and the UV canvas in the middle, status bar at the bottom. Long work
+//! (open, save, export) runs on named worker threads with a progress bar and cancel.
+
+pub mod canvas;
+pub mod viewport;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use egui::{Key, KeyboardShortcut, Modifiers};
+use egui_dock::{DockArea, DockState, TabViewer};
+use glam::Vec2;
+
+use crate::export::preset::ExportPreset;
+use crate::mesh::Mesh;
+use crate::mesh::pick::Bvh;
+use crate::model::brush::{StrokePoint, SurfacePos};
+use crate::model::surface::Surface;
+use crate::model::texel::MaterialValue;
+use crate::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool, project};
+use crate::reflectance::{self, AmbientApprox, ShadingModel};
+use crate::render::{FrameSettings, Lighting, ViewMode};
+use crate::task::Progress;
+use canvas::{Canvas, CanvasChannel};
+use viewport::{Compare, Viewport, ViewportGpu};
+
+/// Default map size of a new project.
+pub const DEFAULT_SIZE: u32 = 1024;
+
+/// Painting tools.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tool {
+    /// Paint the primary material (B).
+    Brush,
+    /// Paint the base material back (E).
+    Eraser,
+    /// Fill the clicked UV island, or the whole map on the canvas (F in 2D).
+    Fill,
+    /// Pick the material under the cursor (I).
+    Picker,
+}
+
+impl Tool {
+    const ALL: [(Self, &'static str, &'static str); 4] = [
+        (Self::Brush, "Brush", "B"),
+        (Self::Eraser, "Eraser", "E"),
+        (Self::Fill, "Fill", "F (in 2D)"),
+        (Self::Picker, "Picker", "I"),
+    ];
+}
+
+/// Dock tabs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Tab {
+    /// The 3D viewport.
+    Viewport,
+    /// The UV canvas.
+    Canvas,
+}
+
+/// A message for the user, shown for a while.
+#[derive(Clone, Debug)]
+pub struct Notice {
+    /// Text.
+    pub text: String,
+    /// An error (red) rather than information.
+    pub error: bool,
+    at: Instant,
+}
+
+/// What a worker hands back.
+enum JobResult {
+    Opened(PathBuf, Box<Document>),
+    Saved(PathBuf, u64),
+    Exported(PathBuf, Box<crate::export::set::Manifest>),
+    Failed(String),
+}
+
+/// Long work on a worker thread.
+struct Job {
+    label: String,
+    progress: Arc<Progress>,
+    handle: JoinHandle<JobResult>,
+}
+
+/// The export dialog's state.
+struct ExportDialog {
+    presets: Vec<ExportPreset>,
+    chosen: usize,
+    folder: String,
+}
+
+/// The mesh being painted, with what picking and the renderer need.
+struct MeshState {
+    id: u64,
+    mesh: Arc<Mesh>,
+    bvh: Bvh,
+    /// UV edges in map fractions (u, 1 - v), for the canvas wireframe.
+    uv_lines: Vec<[Vec2; 2]>,
+}
+
+impl MeshState {
+    fn new(mesh: Mesh, id: u64) -> Self {
+        let bvh = Bvh::build(&mesh);
+        let mut uv_lines = Vec::new();
+        if let Some(uvs) = &mesh.uvs {
+            for tri in &mesh.triangles {
+                for k in 0..3 {
+                    let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
+                    if a < b || mesh.triangles.len() < 4 {
+                        let at = |i: usize| Vec2::new(uvs[i].x, 1.0 - uvs[i].y);
+                        uv_lines.push([at(a), at(b)]);
+                    }
+                }
+            }
+        }
+        Self {
+            id,
+            mesh: Arc::new(mesh),
+            bvh,
+            uv_lines,
+        }
+    }
+}
+
+/// Everything the panels and tabs read and change (the dock lives beside it).
+pub struct EditorState {
+    /// The document.
+    pub doc: Document,
+    /// Where it is saved.
+    pub path: Option<PathBuf>,
+    saved_version: u64,
+    /// Current tool.
+    pub tool: Tool,
+    /// View mode of the viewport.
+    pub view: ViewMode,
+    /// Lights.
+    pub lighting: Lighting,
+    /// The 3D viewport.
+    pub viewport: Viewport,
+    /// The UV canvas.
+    pub canvas: Canvas,
+    mesh: MeshState,
+    /// Messages.
+    pub notices: Vec<Notice>,
+    job: Option<Job>,
+    export: Option<ExportDialog>,
+    /// The texel under the cursor, in either view.
+    pub hover: Option<(u32, u32)>,
+    /// The tab under the cursor.
+    pub hover_tab: Option<Tab>,
+    /// The tab whose drag is painting a stroke.
+    stroking: Option<Tab>,
+    /// `hover` as of the last frame (the status bar is drawn before the tabs).
+    shown_hover: Option<(u32, u32)>,
+    quit_asked: bool,
+    /// Set when the user confirmed closing with unsaved changes.
+    pub allow_close: bool,
+    autosaver: project::Autosaver,
+}
+
+/// The editor app.
+pub struct Editor {
+    /// Panels' state.
+    pub state: EditorState,
+    dock: DockState<Tab>,
+}
+
+fn new_document(size: u32) -> Result<(Document, MeshState), String> {
+    let mut doc =
+        Document::new(size, size, DocumentSettings::default()).map_err(|e| e.to_string())?;
+    let mesh = crate::mesh::builtin("sphere").ok_or("no built-in sphere")?;
+    attach(&mut doc, &mesh)?;
+    Ok((doc, MeshState::new(mesh, 1)))
+}
+
+/// Bakes `mesh` at the document's size and attaches it.
+fn attach(doc: &mut Document, mesh: &Mesh) -> Result<(), String> {
+    let surface = Surface::new(mesh.clone(), doc.maps.width(), doc.maps.height())?;
+    doc.set_surface(Some(Arc::new(surface)))
+        .map_err(|e| e.to_string())
+}
+
+/// Loads a project and its mesh (falling back to the sphere, with a note, if the mesh file is
+/// gone).
+fn load_project(path: &Path) -> Result<(Document, Mesh, Option<String>), String> {
+    let mut doc = project::load(path).map_err(|e| e.to_string())?;
+    let spec = PathBuf::from(doc.settings.mesh.spec());
+    let spec = match path.parent() {
+        Some(dir) if spec.is_relative() && !spec.exists() && dir.join(&spec).exists() => {
+            dir.join(spec)
+        }
+        _ => spec,
+    };
+    let (mesh, note) = match crate::mesh::open(&spec) {
+        Ok(m) => (m, None),
+        Err(e) => (
+            crate::mesh::builtin("sphere").ok_or("no built-in sphere")?,
+            Some(format!("{e}; showing the sphere instead")),
+        ),
+    };
+    attach(&mut doc, &mesh)?;
+    Ok((doc, mesh, note))
+}
+
+impl Editor {
+    /// The editor on a new default document (sphere, default material), or on `path` when
+    /// given (a missing file becomes a new project saved there).
+    pub fn new(
+        render_state: Option<&eframe::egui_wgpu::RenderState>,
+        path: Option<PathBuf>,
+    ) -> Self {
+        let gpu = render_state.map(ViewportGpu::new);
+        let mut notices = Vec::new();
+        let (doc, mesh) = match path.as_deref().filter(|p| p.exists()).map(load_project) {
+            Some(Ok((doc, mesh, note))) => {
+                if let Some(note) = note {
+                    notices.push(notice(note, true));
+                }
+                (doc, MeshState::new(mesh, 1))
+            }
+            other => {
+                if let Some(Err(e)) = other {
+                    notices.push(notice(e, true));
+                }
+                match new_document(DEFAULT_SIZE) {
+                    Ok(x) => x,
+                    Err(e) => {
+                        notices.push(notice(e, true));
+                        let doc = Document::new(16, 16, DocumentSettings::default())
+                            .unwrap_or_else(|_| unreachable_doc());
+                        (doc, MeshState::new(crate::mesh::plane(), 1))
+                    }
+                }
+            }
+        };
+        let mut viewport = Viewport::new(gpu);
+        viewport.frame(&mesh.mesh);
+        let autosaver = project::Autosaver::new(
+            Duration::from_mins(2),
+            project::recovery_path(path.as_deref()),
+            &doc,
+        );
+        let mut dock = DockState::new(vec![Tab::Viewport]);
+        let surface = dock.main_surface_mut();
+        surface.split_right(egui_dock::NodeIndex::root(), 0.55, vec![Tab::Canvas]);
+        let saved_version = doc.maps.version();
+        Self {
+            state: EditorState {
+                doc,
+                path,
+                saved_version,
+                tool: Tool::Brush,
+                view: ViewMode::Shaded,
+                lighting: Lighting::default(),
+                viewport,
+                canvas: Canvas::default(),
+                mesh,
+                notices,
+                job: None,
+                export: None,
+                hover: None,
+                hover_tab: None,
+                stroking: None,
+                shown_hover: None,
+                quit_asked: false,
+                allow_close: false,
+                autosaver,
+            },
+            dock,
+        }
+    }
+}
+
+/// A 16 x 16 document cannot fail to allocate; this is only for the type checker.
+fn unreachable_doc() -> Document {
+    Document::from_parts(
+        crate::model::MaterialMaps::new(1, 1, MaterialValue::default())
+            .unwrap_or_else(|_| std::process::abort()),
+        DocumentSettings::default(),
+    )
+}
+
+fn notice(text: impl Into<String>, error: bool) -> Notice {
+    Notice {
+        text: text.into(),
+        error,
+        at: Instant::now(),
+    }
+}
+
+/// Hotkeys (shown in tooltips and the README).
+pub mod keys {
+    use super::{Key, KeyboardShortcut, Modifiers};
+    /// Undo.
+    pub const UNDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+    /// Redo.
+    pub const REDO: KeyboardShortcut =
+        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z);
+    /// Redo (alternative).
+    pub const REDO_Y: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+    /// Save.
+    pub const SAVE: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
+    /// Save as.
+    pub const SAVE_AS: KeyboardShortcut =
+        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::S);
+    /// Open.
+    pub const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
+    /// New.
+    pub const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
+    /// Export.
+    pub const EXPORT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::E);
+}
+
+impl EditorState {
+    /// Whether the maps changed since the last save.
+    pub fn dirty(&self) -> bool {
+        self.doc.maps.version() != self.saved_version
+    }
+
+    fn apply(&mut self, command: Command) {
+        if let Err(e) = self.doc.apply(command) {
+            self.notices.push(notice(e.to_string(), true));
+        }
+    }
+
+    fn busy(&self) -> bool {
+        self.job.is_some()
+    }
+
+    fn start_job(
+        &mut self,
+        label: &str,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        if self.busy() {
+            self.notices
+                .push(notice("wait for the current job to finish", true));
+            return;
+        }
+        let progress = Arc::new(Progress::default());
+        let shared = Arc::clone(&progress);
+        match std::thread::Builder::new()
+            .name(format!("kapaint-{}", label.to_lowercase()))
+            .spawn(move || work(&shared))
+        {
+            Ok(handle) => {
+                self.job = Some(Job {
+                    label: label.into(),
+                    progress,
+                    handle,
+                });
+            }
+            Err(e) => self
+                .notices
+                .push(notice(format!("cannot start {label}: {e}"), true)),
+        }
+    }
+
+    fn poll_job(&mut self) {
+        if !self.job.as_ref().is_some_and(|j| j.handle.is_finished()) {
+            return;
+        }
+        let Some(job) = self.job.take() else { return };
+        let result = job
+            .handle
+            .join()
+            .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
+        match result {
+            JobResult::Opened(path, doc) => {
+                let mesh = doc.surface().map(|s| s.mesh.clone());
+                self.doc = *doc;
+                self.saved_version = self.doc.maps.version();
+                if let Some(mesh) = mesh {
+                    self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+                    self.viewport.frame(&self.mesh.mesh);
+                }
+                self.autosaver = project::Autosaver::new(
+                    Duration::from_mins(2),
+                    project::recovery_path(Some(&path)),
+                    &self.doc,
+                );
+                self.notices
+                    .push(notice(format!("opened {}", path.display()), false));
+                self.path = Some(path);
+            }
+            JobResult::Saved(path, version) => {
+                self.saved_version = version;
+                self.notices
+                    .push(notice(format!("saved {}", path.display()), false));
+                self.path = Some(path);
+            }
+            JobResult::Exported(dir, m) => self.notices.push(notice(
+                format!(
+                    "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
+                    dir.display(),
+                    m.files.len(),
+                    m.bytes.exported,
+                    m.ka_error.max * 100.0,
+                    m.ka_error.mean * 100.0
+                ),
+                false,
+            )),
+            JobResult::Failed(e) => self.notices.push(notice(e, true)),
+        }
+    }
+
+    /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
+    pub fn save_to(&mut self, path: PathBuf) {
+        let snapshot = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
+        let version = self.doc.maps.version();
+        self.start_job("Save", move |progress| {
+            progress.start("save", 1);
+            match project::save(&snapshot, &path) {
+                Ok(()) => JobResult::Saved(path, version),
+                Err(e) => JobResult::Failed(format!("could not save: {e}")),
+            }
+        });
+    }
+
+    /// Opens `path` on a worker.
+    pub fn open(&mut self, path: PathBuf) {
+        self.start_job("Open", move |progress| {
+            progress.start("open", 1);
+            match load_project(&path) {
+                Ok((doc, _, _)) => JobResult::Opened(path, Box::new(doc)),
+                Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
+            }
+        });
+    }
+
+    fn save(&mut self) {
+        match self.path.clone() {
+            Some(p) => self.save_to(p),
+            None => self.save_as(),
+        }
+    }
+
+    fn save_as(&mut self) {
+        if let Some(p) = rfd::FileDialog::new()
+            .add_filter("kapaint project", &["kapaint"])
+            .set_file_name("material.kapaint")
+            .save_file()
+        {
+            self.save_to(p);
+        }
+    }
+
+    fn open_dialog(&mut self) {
+        if let Some(p) = rfd::FileDialog::new()
+            .add_filter("kapaint project", &["kapaint"])
+            .pick_file()
+        {
+            self.open(p);
+        }
+    }
+
+    fn new_project(&mut self) {
+        match new_document(DEFAULT_SIZE) {
+            Ok((doc, mesh)) => {
+                self.doc = doc;
+                self.mesh = MeshState::new((*mesh.mesh).clone(), self.mesh.id + 1);
+                self.saved_version = self.doc.maps.version();
+                self.path = None;
+                self.viewport.frame(&self.mesh.mesh);
+            }
+            Err(e) => self.notices.push(notice(e, true)),
+        }
+    }
+
+    fn export_now(&mut self) {
+        let Some(dialog) = &self.export else { return };
+        let Some(preset) = dialog.presets.get(dialog.chosen).cloned() else {
+            return;
+        };
+        let out = PathBuf::from(dialog.folder.trim());
+        let snapshot = {
+            let mut d = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
+            if let Some(s) = self.doc.surface() {
+                let _ = d.set_surface(Some(Arc::clone(s)));
+            }
+            d
+        };
+        self.export = None;
+        self.start_job(
+            "Export",
+            move |progress| match crate::export::set::export_with(
+                &snapshot, &preset, &out, progress,
+            ) {
+                Ok(m) => JobResult::Exported(out, Box::new(m)),
+                Err(e) => JobResult::Failed(format!("export failed: {e}")),
+            },
+        );
+    }
+
+    /// Hotkeys: tools, brush size and hardness, swap, undo/redo, files.
+    fn hotkeys(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let mut commands = Vec::new();
+        ctx.input_mut(|i| {
+            for (shortcut, action) in [
+                (keys::REDO, 1),
+                (keys::REDO_Y, 1),
+                (keys::UNDO, 0),
+                (keys::SAVE_AS, 3),
+                (keys::SAVE, 2),
+                (keys::OPEN, 4),
+                (keys::NEW, 5),
+                (keys::EXPORT, 6),
+            ] {
+                if i.consume_shortcut(&shortcut) {
+                    commands.push(action);
+                }
+            }
+        });
+        for action in commands {
+            match action {
+                0 => self.apply(Command::Undo),
+                1 => self.apply(Command::Redo),
+                2 => self.save(),
+                3 => self.save_as(),
+                4 => self.open_dialog(),
+                5 => self.new_project(),
+                _ => self.open_export(),
+            }
+        }
+        let (shift, pressed) = ctx.input(|i| {
+            let keys = [
+                Key::B,
+                Key::E,
+                Key::I,
+                Key::X,
+                Key::OpenBracket,
+                Key::CloseBracket,
+                Key::F,
+            ];
+            let pressed: Vec<Key> = if i.modifiers.command || i.modifiers.alt {
+                Vec::new()
+            } else {
+                keys.into_iter().filter(|k| i.key_pressed(*k)).collect()
+            };
+            (i.modifiers.shift, pressed)
+        });
+        let mut brush = self.doc.settings.brush.clone();
+        for key in pressed {
+            match key {
+                Key::B => self.tool = Tool::Brush,
+                Key::E => self.tool = Tool::Eraser,
+                Key::I => self.tool = Tool::Picker,
+                Key::X => self.apply(Command::SwapMaterials),
+                Key::OpenBracket if shift => brush.hardness = (brush.hardness - 0.1).max(0.0),
+                Key::CloseBracket if shift => brush.hardness = (brush.hardness + 0.1).min(1.0),
+                Key::OpenBracket => brush.radius_px = (brush.radius_px / 1.25).max(0.5),
+                Key::CloseBracket => brush.radius_px = (brush.radius_px * 1.25).min(2048.0),
+                Key::F => {
+                    // F fills on the canvas, frames the mesh in the viewport.
+                    if self.hover_tab == Some(Tab::Canvas) {
+                        self.tool = Tool::Fill;
+                    } else {
+                        self.viewport.frame(&self.mesh.mesh);
+                    }
+                }
+                _ => {}
+            }
+        }
+        if brush != self.doc.settings.brush {
+            self.apply(Command::SetBrush(brush));
+        }
+    }
+
+    fn open_export(&mut self) {
+        let folder = self.path.as_ref().map_or_else(
+            || "export".to_string(),
+            |p| p.with_extension("").display().to_string() + "-set",
+        );
+        self.export = Some(ExportDialog {
+            presets: crate::export::preset::builtin(),
+            chosen: 0,
+            folder,
+        });
+    }
+}
+
+impl EditorState {
+    /// The texel under a map-space position, if inside.
+    fn texel_at(&self, p: Vec2) -> Option<(u32, u32)> {
+        let (w, h) = (self.doc.maps.width(), self.doc.maps.height());
+        (p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32)
+            .then_some((p.x as u32, p.y as u32))
+    }
+
+    /// The fill region for a click at a texel: its UV island when the mesh covers it, else
+    /// the whole map.
+    fn fill_region(&self, (x, y): (u32, u32)) -> FillRegion {
+        let on_island = self.doc.surface().is_some_and(|s| {
+            let k = (y * s.bake.width + x) as usize;
+            s.bake.island.get(k).is_some_and(|i| *i != u32::MAX)
+        });
+        if on_island {
+            FillRegion::Island { x, y }
+        } else {
+            FillRegion::All
+        }
+    }
+
+    fn stroke_tool(&self) -> Option<StrokeTool> {
+        match self.tool {
+            Tool::Brush => Some(StrokeTool::Brush),
+            Tool::Eraser => Some(StrokeTool::Eraser),
+            Tool::Fill | Tool::Picker => None,
+        }
+    }
+
+    fn end_stroke(&mut self) {
+        if self.stroking.take().is_some() {
+            self.apply(Command::EndStroke);
+        }
+    }
+
+    fn begin_stroke(&mut self, tab: Tab, tool: StrokeTool) {
+        if self.stroking.is_none() {
+            self.stroking = Some(tab);
+            self.apply(Command::BeginStroke(tool));
+        }
+    }
+
+    /// Paints from a canvas response.
+    fn canvas_input(&mut self, response: &egui::Response, rect: egui::Rect) {
+        let size = (self.doc.maps.width(), self.doc.maps.height());
+        let pointer = response.interact_pointer_pos().or(response.hover_pos());
+        let pos = pointer.map(|p| self.canvas.to_texel(rect, p, size));
+        if response.hovered() {
+            self.hover = pos.and_then(|p| self.texel_at(p));
+            self.hover_tab = Some(Tab::Canvas);
+        }
+        let space = response.ctx.input(|i| i.key_down(Key::Space));
+        let primary = response.dragged_by(egui::PointerButton::Primary) && !space;
+        match (self.stroke_tool(), pos) {
+            (Some(tool), Some(p)) if primary || (response.clicked() && !space) => {
+                self.begin_stroke(Tab::Canvas, tool);
+                let pressure = response.ctx.input(|i| {
+                    i.events
+                        .iter()
+                        .find_map(|e| match e {
+                            egui::Event::Touch { force: Some(f), .. } => Some(*f),
+                            _ => None,
+                        })
+                        .unwrap_or(1.0)
+                });
+                self.apply(Command::StrokeTo(StrokePoint {
+                    pos: glam::Vec2::new(p.x, p.y),
+                    pressure,
+                }));
+                if response.clicked() {
+                    self.end_stroke();
+                }
+            }
+            (None, Some(p)) if response.clicked() => {
+                if let Some(t) = self.texel_at(p) {
+                    match self.tool {
+                        Tool::Fill => {
+                            let region = self.fill_region(t);
+                            self.apply(Command::Fill(region));
+                        }
+                        _ => self.apply(Command::Pick { x: t.0, y: t.1 }),
+                    }
+                }
+            }
+            _ => {}
+        }
+        if self.stroking == Some(Tab::Canvas)
+            && (response.drag_stopped() || !response.is_pointer_button_down_on())
+        {
+            self.end_stroke();
+        }
+    }
+
+    /// Paints from a viewport response (left button, not with Alt).
+    fn viewport_input(&mut self, response: &egui::Response, rect: egui::Rect) {
+        let alt = response.ctx.input(|i| i.modifiers.alt);
+        let pointer = response.interact_pointer_pos().or(response.hover_pos());
+        let hit =
+            pointer.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
+        if response.hovered() {
+            self.hover_tab = Some(Tab::Viewport);
+            self.hover = hit.as_ref().and_then(|h| h.uv).and_then(|uv| {
+                self.texel_at(Vec2::new(
+                    uv.x * self.doc.maps.width() as f32,
+                    (1.0 - uv.y) * self.doc.maps.height() as f32,
+                ))
+            });
+        }
+        let primary = response.dragged_by(egui::PointerButton::Primary) && !alt;
+        match (self.stroke_tool(), hit) {
+            (Some(tool), Some(hit)) if primary || (response.clicked() && !alt) => {
+                self.begin_stroke(Tab::Viewport, tool);
+                self.apply(Command::SurfaceStrokeTo(StrokePoint {
+                    pos: SurfacePos {
+                        point: hit.position,
+                        normal: hit.normal,
+                    },
+                    pressure: 1.0,
+                }));
+                if response.clicked() {
+                    self.end_stroke();
+                }
+            }
+            (None, Some(_)) if response.clicked() && !alt => {
+                if let Some(t) = self.hover {
+                    match self.tool {
+                        Tool::Fill => {
+                            let region = self.fill_region(t);
+                            self.apply(Command::Fill(region));
+                        }
+                        _ => self.apply(Command::Pick { x: t.0, y: t.1 }),
+                    }
+                }
+            }
+            _ => {}
+        }
+        if self.stroking == Some(Tab::Viewport)
+            && (response.drag_stopped() || !response.is_pointer_button_down_on())
+        {
+            self.end_stroke();
+        }
+        // The brush circle, sized by the world radius a dab covers here.
+        if let (Some(p), Some(surface)) = (response.hover_pos(), self.doc.surface())
+            && self.stroke_tool().is_some()
+        {
+            let world = self.doc.settings.brush.radius_px * surface.units_per_texel;
+            let cam = &self.viewport.camera;
+            let px = world / (cam.distance * (cam.fov_y / 2.0).tan()) * rect.height() / 2.0;
+            response.ctx.layer_painter(response.layer_id).circle_stroke(
+                p,
+                px.max(2.0),
+                egui::Stroke::new(1.0, egui::Color32::WHITE),
+            );
+        }
+    }
+
+    fn frame_settings(&self) -> FrameSettings {
+        FrameSettings {
+            model: self.doc.settings.model,
+            approx: self.doc.settings.approx,
+            view: self.view,
+            lighting: self.lighting,
+            camera: self.viewport.camera,
+        }
+    }
+
+    /// Left panel: tools, brush, material, channels.
+    fn tools_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Tools");
+        ui.horizontal_wrapped(|ui| {
+            for (tool, label, key) in Tool::ALL {
+                ui.selectable_value(&mut self.tool, tool, label)
+                    .on_hover_text(format!("{label} ({key})"));
+            }
+        });
+        ui.separator();
+        ui.heading("Brush settings");
+        let mut brush = self.doc.settings.brush.clone();
+        ui.add(
+            egui::Slider::new(&mut brush.radius_px, 0.5..=512.0)
+                .logarithmic(true)
+                .text("Radius"),
+        )
+        .on_hover_text("[ and ] change the size");
+        ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
+            .on_hover_text("Shift+[ and Shift+] change the hardness");
+        ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
+        ui.add(egui::Slider::new(&mut brush.flow, 0.0..=1.0).text("Flow"));
+        ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing %"));
+        ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
+        ui.checkbox(&mut brush.pressure_size, "Pressure: size");
+        ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
+        if brush != self.doc.settings.brush {
+            self.apply(Command::SetBrush(brush));
+        }
+        ui.separator();
+        ui.heading("Material");
+        let mut primary = self.doc.settings.primary;
+        ui.horizontal(|ui| {
+            let mut kd = primary.kd.to_array();
+            egui::color_picker::color_edit_button_rgb(ui, &mut kd)
+                .on_hover_text("Diffuse colour k_d (linear)");
+            ui.label("k_d");
+            primary.kd = glam::Vec3::from(kd);
+            let mut ks = primary.ks.to_array();
+            egui::color_picker::color_edit_button_rgb(ui, &mut ks)
+                .on_hover_text("Specular colour k_s (linear)");
+            ui.label("k_s");
+            primary.ks = glam::Vec3::from(ks);
+        });
+        let mut grey = primary.ks.max_element();
+        if ui
+            .add(egui::Slider::new(&mut grey, 0.0..=1.0).text("k_s (grey)"))
+            .changed()
+        {
+            primary.ks = glam::Vec3::splat(grey);
+        }
+        ui.add(
+            egui::Slider::new(&mut primary.n, 0.0..=crate::model::texel::N_MAX)
+                .logarithmic(true)
+                .text("n"),
+        );
+        let other = match self.doc.settings.model {
+            ShadingModel::Phong => ShadingModel::BlinnPhong,
+            ShadingModel::BlinnPhong => ShadingModel::Phong,
+        };
+        let eq = reflectance::equivalent::equivalent_exponent(
+            self.doc.settings.model,
+            f64::from(primary.n),
+        );
+        ui.label(format!("≈ n {eq:.1} in {}", other.name()))
+            .on_hover_text("The exponent of the other model with the closest highlight");
+        if primary != self.doc.settings.primary {
+            self.apply(Command::SetPrimary(primary));
+        }
+        if ui
+            .button("Swap primary / secondary")
+            .on_hover_text("X")
+            .clicked()
+        {
+            self.apply(Command::SwapMaterials);
+        }
+        ui.separator();
+        ui.heading("Channels");
+        let mut ch = self.doc.settings.channels;
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut ch.kd, "k_d");
+            ui.checkbox(&mut ch.ks, "k_s");
+            ui.checkbox(&mut ch.n, "n");
+        });
+        if ch != self.doc.settings.channels {
+            self.apply(Command::SetChannels(ch));
+        }
+    }
+
+    /// Right panel: model, view, compare, light, canvas channel, history.
+    fn view_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Shading");
+        let mut model = self.doc.settings.model;
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut model, ShadingModel::Phong, "Phong (8)");
+            ui.selectable_value(&mut model, ShadingModel::BlinnPhong, "Blinn-Phong (11)");
+        });
+        if model != self.doc.settings.model {
+            self.apply(Command::SetModel(model));
+        }
+        let mut approx = self.doc.settings.approx;
+        egui::ComboBox::from_label("Approximation")
+            .selected_text(approx.name())
+            .show_ui(ui, |ui| {
+                for a in AmbientApprox::ALL {
+                    ui.selectable_value(&mut approx, a, a.name());
+                }
+            });
+        if approx != self.doc.settings.approx {
+            self.apply(Command::SetApprox(approx));
+        }
+        ui.heading("Compare");
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut self.viewport.compare, Compare::Single, "Single");
+            ui.selectable_value(&mut self.viewport.compare, Compare::Split, "Split");
+        });
+        if self.viewport.compare == Compare::Split {
+            ui.add(egui::Slider::new(&mut self.viewport.split_at, 0.0..=1.0).text("Divider"));
+        }
+        ui.heading("View");
+        egui::ComboBox::from_label("View mode")
+            .selected_text(self.view.name())
+            .show_ui(ui, |ui| {
+                for v in ViewMode::ALL {
+                    ui.selectable_value(&mut self.view, v, v.name());
+                }
+            });
+        egui::ComboBox::from_label("Canvas shows")
+            .selected_text(self.canvas.channel.label())
+            .show_ui(ui, |ui| {
+                for c in CanvasChannel::ALL {
+                    ui.selectable_value(&mut self.canvas.channel, c, c.label());
+                }
+            });
+        ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
+        ui.heading("Light");
+        let l = self.lighting.light.normalize_or(glam::Vec3::Z);
+        let (mut yaw, mut pitch) = (l.x.atan2(l.z), l.y.clamp(-1.0, 1.0).asin());
+        let a = ui.add(
+            egui::Slider::new(&mut yaw, -std::f32::consts::PI..=std::f32::consts::PI)
+                .text("Light yaw"),
+        );
+        let b = ui.add(egui::Slider::new(&mut pitch, -1.55..=1.55).text("Light pitch"));
+        if a.changed() || b.changed() {
+            self.lighting.light = glam::Vec3::new(
+                pitch.cos() * yaw.sin(),
+                pitch.sin(),
+                pitch.cos() * yaw.cos(),
+            );
+        }
+        ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
+        ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+        ui.heading("History");
+        ui.label(format!(
+            "{} steps, {:.1} MB",
+            self.doc.history.undo_steps().count(),
+            self.doc.history.bytes() as f64 / 1e6
+        ));
+        egui::ScrollArea::vertical()
+            .max_height(160.0)
+            .show(ui, |ui| {
+                for step in self
+                    .doc
+                    .history
+                    .undo_steps()
+                    .collect::<Vec<_>>()
+                    .iter()
+                    .rev()
+                {
+                    ui.label(format!("{} ({} KB)", step.label, step.bytes() / 1024));
+                }
+            });
+    }
+
+    fn status_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let maps = &self.doc.maps;
+            ui.label(format!("{}x{}", maps.width(), maps.height()));
+            ui.separator();
+            ui.label(format!(
+                "maps {:.0} MB, history {:.0} MB",
+                maps.heap_bytes() as f64 / 1e6,
+                self.doc.history.bytes() as f64 / 1e6
+            ));
+            ui.separator();
+            match &self.viewport.gpu {
+                Some(g) => ui.label(format!(
+                    "frame {:.1} ms, viewport {:.1} ms ({})",
+                    ui.input(|i| i.stable_dt) * 1000.0,
+                    self.viewport.frame_ms,
+                    g.adapter()
+                )),
+                None => ui.label("no GPU"),
+            };
+            if let Some((x, y)) = self.shown_hover {
+                let v = maps.value(x, y);
+                let ka = |m, a| reflectance::ka(m, a, v.kd, v.ks, v.n);
+                let approx = self.doc.settings.approx;
+                let phong = ka(ShadingModel::Phong, approx);
+                let blinn = ka(ShadingModel::BlinnPhong, approx);
+                let exact = |m| {
+                    v.kd * reflectance::diffuse_factor(AmbientApprox::Fast) as f32
+                        + v.ks
+                            * reflectance::exact::chi_exact(m, f64::from(v.n)) as f32
+                };
+                let model = self.doc.settings.model;
+                ui.separator();
+                ui.label(format!(
+                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  exact {:.4}",
+                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x, exact(model).x
+                ))
+                .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), and the exact integral for the current model");
+            }
+            if let Some(job) = &self.job {
+                ui.separator();
+                ui.add(
+                    egui::ProgressBar::new(job.progress.fraction())
+                        .desired_width(160.0)
+                        .text(format!("{} {}", job.label, job.progress.stage())),
+                );
+                if ui.button("Cancel").clicked() {
+                    job.progress.cancel();
+                }
+            }
+        });
+    }
+
+    fn menu(&mut self, ui: &mut egui::Ui) {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                let item = |ui: &mut egui::Ui, label: &str, key: &KeyboardShortcut| {
+                    ui.add(egui::Button::new(label).shortcut_text(ui.ctx().format_shortcut(key)))
+                        .clicked()
+                };
+                if item(ui, "New", &keys::NEW) {
+                    self.new_project();
+                }
+                if item(ui, "Open…", &keys::OPEN) {
+                    self.open_dialog();
+                }
+                if item(ui, "Save", &keys::SAVE) {
+                    self.save();
+                }
+                if item(ui, "Save As…", &keys::SAVE_AS) {
+                    self.save_as();
+                }
+                if item(ui, "Export…", &keys::EXPORT) {
+                    self.open_export();
+                }
+                ui.separator();
+                if ui.button("Quit").clicked() {
+                    self.quit_asked = true;
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui
+                    .add(
+                        egui::Button::new("Undo")
+                            .shortcut_text(ui.ctx().format_shortcut(&keys::UNDO)),
+                    )
+                    .clicked()
+                {
+                    self.apply(Command::Undo);
+                }
+                if ui
+                    .add(
+                        egui::Button::new("Redo")
+                            .shortcut_text(ui.ctx().format_shortcut(&keys::REDO)),
+                    )
+                    .clicked()
+                {
+                    self.apply(Command::Redo);
+                }
+            });
+        });
+    }
+
+    fn export_window(&mut self, ctx: &egui::Context) {
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        let mut open = true;
+        let mut go = false;
+        egui::Window::new("Export")
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::ComboBox::from_label("Preset")
+                    .selected_text(
+                        dialog
+                            .presets
+                            .get(dialog.chosen)
+                            .map_or("", |p| p.name.as_str()),
+                    )
+                    .show_ui(ui, |ui| {
+                        for (i, p) in dialog.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.chosen, i, &p.name)
+                                .on_hover_text(&p.description);
+                        }
+                    });
+                if let Some(p) = dialog.presets.get(dialog.chosen) {
+                    ui.label(&p.description);
+                }
+                ui.horizontal(|ui| {
+                    ui.label("Folder");
+                    ui.text_edit_singleline(&mut dialog.folder);
+                    if ui.button("…").clicked()
+                        && let Some(d) = rfd::FileDialog::new().pick_folder()
+                    {
+                        dialog.folder = d.join("set").display().to_string();
+                    }
+                });
+                go = ui.button("Export").clicked();
+            });
+        if !open {
+            self.export = None;
+        } else if go {
+            self.export_now();
+        }
+    }
+
+    fn close_prompt(&mut self, ctx: &egui::Context) {
+        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit_asked;
+        if close_requested && self.dirty() && !self.allow_close {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.quit_asked = true;
+        } else if self.quit_asked && (self.allow_close || !self.dirty()) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        }
+        if self.quit_asked && self.dirty() && !self.allow_close {
+            egui::Window::new("Unsaved changes")
+                .collapsible(false)
+                .show(ctx, |ui| {
+                    ui.label("The material has unsaved changes.");
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            self.save();
+                            self.quit_asked = false;
+                        }
+                        if ui.button("Discard").clicked() {
+                            self.allow_close = true;
+                        }
+                        if ui.button("Cancel").clicked() {
+                            self.quit_asked = false;
+                        }
+                    });
+                });
+        }
+    }
+
+    fn dropped_files(&mut self, ctx: &egui::Context) {
+        let files: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
+        for path in files {
+            let ext = path
+                .extension()
+                .map(|e| e.to_string_lossy().to_lowercase())
+                .unwrap_or_default();
+            match ext.as_str() {
+                "kapaint" => self.open(path),
+                _ => self.notices.push(notice(
+                    format!("{}: drop a .kapaint project", path.display()),
+                    true,
+                )),
+            }
+        }
+    }
+
+    fn notices(&mut self, ctx: &egui::Context) {
+        self.notices
+            .retain(|n| n.at.elapsed() < Duration::from_secs(if n.error { 12 } else { 5 }));
+        if self.notices.is_empty() {
+            return;
+        }
+        egui::Area::new(egui::Id::new("notices"))
+            .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -36.0))
+            .show(ctx, |ui| {
+                for n in &self.notices {
+                    let colour = if n.error {
+                        egui::Color32::from_rgb(220, 80, 80)
+                    } else {
+                        egui::Color32::from_rgb(120, 200, 120)
+                    };
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        ui.colored_label(colour, &n.text);
+                    });
+                }
+            });
+        ctx.request_repaint_after(Duration::from_millis(500));
+    }
+}
+
+struct Tabs<'a>(&'a mut EditorState);
+
+impl TabViewer for Tabs<'_> {
+    type Tab = Tab;
+
+    fn title(&mut self, tab: &mut Tab) -> egui::WidgetText {
+        match tab {
+            Tab::Viewport => "3D viewport".into(),
+            Tab::Canvas => "UV canvas".into(),
+        }
+    }
+
+    fn id(&mut self, tab: &mut Tab) -> egui::Id {
+        egui::Id::new(*tab)
+    }
+
+    fn closeable(&mut self, _tab: &mut Tab) -> bool {
+        false
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, tab: &mut Tab) {
+        let s = &mut *self.0;
+        match tab {
+            Tab::Viewport => {
+                let settings = s.frame_settings();
+                let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
+                let (response, rect) = s.viewport.show(ui, &s.doc, &mesh, &settings);
+                s.viewport_input(&response, rect);
+            }
+            Tab::Canvas => {
+                let lines = std::mem::take(&mut s.mesh.uv_lines);
+                let (response, rect) = s.canvas.show(ui, &s.doc, &lines);
+                s.mesh.uv_lines = lines;
+                s.canvas_input(&response, rect);
+            }
+        }
+    }
+}
+
+impl Editor {
+    /// One frame of the whole editor.
+    pub fn frame(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let s = &mut self.state;
+        s.poll_job();
+        s.hotkeys(&ctx);
+        s.dropped_files(&ctx);
+        if let Some(Err(e)) = s.autosaver.poll(&s.doc, Instant::now()) {
+            s.notices
+                .push(notice(format!("autosave failed: {e}"), true));
+        }
+        s.shown_hover = s.hover.take();
+        s.hover_tab = None;
+        egui::Panel::top("menu").show(ui, |ui| s.menu(ui));
+        egui::Panel::bottom("status").show(ui, |ui| s.status_bar(ui));
+        egui::Panel::left("tools")
+            .resizable(true)
+            .default_size(250.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| s.tools_panel(ui));
+            });
+        egui::Panel::right("view")
+            .resizable(true)
+            .default_size(240.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| s.view_panel(ui));
+            });
+        egui::CentralPanel::default().show(ui, |ui| {
+            DockArea::new(&mut self.dock)
+                .show_close_buttons(false)
+                .show_leaf_close_all_buttons(false)
+                .show_leaf_collapse_buttons(false)
+                .show_inside(ui, &mut Tabs(s));
+        });
+        s.export_window(&ctx);
+        s.notices(&ctx);
+        s.close_prompt(&ctx);
+        if s.job.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(100));
+        }
+    }
+}
+
+impl eframe::App for Editor {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame(ui);
+    }
+
+    fn on_exit(&mut self) {
+        // A clean exit leaves no recovery file behind.
+        if !self.state.dirty() {
+            let _ = std::fs::remove_file(self.state.autosaver.path());
+        }
+    }
+}
+
+/// Opens the editor window (on `path` when given); returns the process exit code.
+pub fn run(path: Option<PathBuf>) -> i32 {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("kapaint")
+            .with_inner_size([1400.0, 900.0])
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    match eframe::run_native(
+        "kapaint",
+        options,
+        Box::new(move |cc| Ok(Box::new(Editor::new(cc.wgpu_render_state.as_ref(), path)))),
+    ) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("kapaint: cannot open the editor window: {e}");
+            1
+        }
+    }
+}

@@ -1,0 +1,345 @@
+//! The 3D viewport: the wgpu preview renderer drawing into a texture that egui shows, camera
+//! controls, and picking for painting on the mesh. Without a GPU (tests, broken drivers) the
+//! viewport still picks and paints; it only cannot draw.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use eframe::egui_wgpu;
+use egui::{Color32, Pos2, Rect, Sense, TextureId};
+
+use crate::gpu::Gpu;
+use crate::gpu::maps::MapTextures;
+use crate::gpu::preview::{DEPTH_FORMAT, DrawPart, MeshBuffers, PipelineKey, Preview};
+use crate::mesh::Mesh;
+use crate::mesh::pick::{Bvh, Hit};
+use crate::model::Document;
+use crate::reflectance::ShadingModel;
+use crate::render::{Camera, FrameSettings};
+
+/// The viewport's accessible name.
+pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
+
+/// How the two shading models are compared.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    /// The document's model alone.
+    Single,
+    /// Phong left of the divider, Blinn-Phong right.
+    Split,
+}
+
+/// GPU objects of the viewport.
+pub struct ViewportGpu {
+    gpu: Gpu,
+    renderer: egui_wgpu::RenderState,
+    preview: Preview,
+    mesh: Option<(u64, MeshBuffers)>,
+    maps: Option<MapTextures>,
+    target: Option<Target>,
+}
+
+struct Target {
+    size: (u32, u32),
+    color: wgpu::Texture,
+    depth: wgpu::TextureView,
+    id: TextureId,
+}
+
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+impl ViewportGpu {
+    /// The viewport's renderer on eframe's device.
+    pub fn new(render_state: &egui_wgpu::RenderState) -> Self {
+        let device = render_state.device.clone();
+        let unorm16 = device
+            .features()
+            .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM);
+        let gpu = Gpu {
+            device,
+            queue: render_state.queue.clone(),
+            info: render_state.adapter.get_info(),
+            unorm16,
+        };
+        let preview = Preview::new(&gpu);
+        Self {
+            gpu,
+            renderer: render_state.clone(),
+            preview,
+            mesh: None,
+            maps: None,
+            target: None,
+        }
+    }
+
+    /// Adapter name for the status bar.
+    pub fn adapter(&self) -> &str {
+        &self.gpu.info.name
+    }
+
+    /// Renders a frame of `size` pixels; returns the texture egui shows.
+    fn render(
+        &mut self,
+        doc: &Document,
+        mesh: &(u64, Arc<Mesh>),
+        settings: &FrameSettings,
+        compare: Compare,
+        split_at: f32,
+        size: (u32, u32),
+    ) -> TextureId {
+        if self.mesh.as_ref().is_none_or(|(id, _)| *id != mesh.0) {
+            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)));
+        }
+        let maps_size = (doc.maps.width(), doc.maps.height());
+        match &mut self.maps {
+            Some(m) if m.size() == maps_size => {
+                m.sync(&self.gpu, &doc.maps);
+            }
+            _ => self.maps = Some(MapTextures::new(&self.gpu, &doc.maps)),
+        }
+        if self.target.as_ref().is_none_or(|t| t.size != size) {
+            self.target = Some(self.make_target(size));
+        }
+        let (Some((_, mesh)), Some(maps), Some(target)) = (&self.mesh, &self.maps, &self.target)
+        else {
+            return TextureId::default();
+        };
+        let key = PipelineKey::for_frame(settings, &maps.uniform, FORMAT);
+        let (w, h) = size;
+        let parts: Vec<DrawPart> = match compare {
+            Compare::Single => vec![(key, (0, 0, w, h))],
+            Compare::Split => {
+                let at = ((split_at.clamp(0.0, 1.0) * w as f32) as u32).min(w);
+                vec![
+                    (
+                        PipelineKey {
+                            model: ShadingModel::Phong,
+                            ..key
+                        },
+                        (0, 0, at, h),
+                    ),
+                    (
+                        PipelineKey {
+                            model: ShadingModel::BlinnPhong,
+                            ..key
+                        },
+                        (at, 0, w - at, h),
+                    ),
+                ]
+            }
+        };
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("viewport"),
+            });
+        let view = target
+            .color
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        self.preview.draw(
+            &self.gpu,
+            &mut encoder,
+            &view,
+            &target.depth,
+            size,
+            mesh,
+            maps,
+            settings,
+            &parts,
+        );
+        self.gpu.queue.submit([encoder.finish()]);
+        target.id
+    }
+
+    fn make_target(&mut self, size: (u32, u32)) -> Target {
+        let extent = wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        };
+        let texture = |format, usage| {
+            self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("viewport"),
+                size: extent,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color = texture(
+            FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = texture(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT)
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let view = color.create_view(&wgpu::TextureViewDescriptor::default());
+        let mut renderer = self.renderer.renderer.write();
+        let id = match self.target.take() {
+            Some(old) => {
+                renderer.update_egui_texture_from_wgpu_texture(
+                    &self.gpu.device,
+                    &view,
+                    wgpu::FilterMode::Linear,
+                    old.id,
+                );
+                old.id
+            }
+            None => {
+                renderer.register_native_texture(&self.gpu.device, &view, wgpu::FilterMode::Linear)
+            }
+        };
+        Target {
+            size,
+            color,
+            depth,
+            id,
+        }
+    }
+}
+
+/// The viewport's state.
+pub struct Viewport {
+    /// Camera.
+    pub camera: Camera,
+    /// Compare mode.
+    pub compare: Compare,
+    /// Split position, a fraction of the width.
+    pub split_at: f32,
+    /// The renderer, when there is a GPU.
+    pub gpu: Option<ViewportGpu>,
+    /// Milliseconds the last frame took to record and submit.
+    pub frame_ms: f32,
+    /// Why there is no GPU, for the placeholder.
+    pub no_gpu: String,
+    frame_pending: bool,
+}
+
+impl Viewport {
+    /// A viewport; `gpu` from eframe's render state when it has one.
+    pub fn new(gpu: Option<ViewportGpu>) -> Self {
+        Self {
+            camera: Camera::default().orbit(0.5, 0.35),
+            compare: Compare::Single,
+            split_at: 0.5,
+            gpu,
+            frame_ms: 0.0,
+            no_gpu: "The 3D preview needs a GPU (wgpu); painting on the mesh still works.".into(),
+            frame_pending: true,
+        }
+    }
+
+    /// Frames the mesh (F) at the next draw, when the viewport's aspect is known.
+    pub fn frame(&mut self, _mesh: &Mesh) {
+        self.frame_pending = true;
+    }
+
+    /// The surface point under a screen position, if the ray hits the mesh.
+    pub fn pick(&self, rect: Rect, pos: Pos2, mesh: &Mesh, bvh: &Bvh) -> Option<Hit> {
+        let (w, h) = (rect.width().max(1.0), rect.height().max(1.0));
+        let (origin, dir) =
+            self.camera
+                .ray(pos.x - rect.min.x, pos.y - rect.min.y, w as u32, h as u32);
+        bvh.pick(mesh, origin, dir)
+    }
+
+    /// Draws the viewport and handles the camera (right drag or Alt + left: orbit; middle or
+    /// Shift + right: pan; wheel: zoom). Returns the response for painting with the left
+    /// button (not while Alt is held).
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        doc: &Document,
+        mesh: &(u64, Arc<Mesh>),
+        settings: &FrameSettings,
+    ) -> (egui::Response, Rect) {
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        response.widget_info(|| {
+            egui::WidgetInfo::labeled(egui::WidgetType::Other, true, VIEWPORT_LABEL)
+        });
+        if self.frame_pending {
+            // Fit the bounding sphere in the narrower of the two fields of view.
+            self.frame_pending = false;
+            self.camera = self.camera.framing(&mesh.1.positions);
+            let aspect = rect.width() / rect.height().max(1.0);
+            if aspect < 1.0 {
+                self.camera.distance /= aspect.max(0.05);
+            }
+        }
+        let (alt, shift) = ui.input(|i| (i.modifiers.alt, i.modifiers.shift));
+        let delta = response.drag_delta();
+        let right = response.dragged_by(egui::PointerButton::Secondary);
+        let middle = response.dragged_by(egui::PointerButton::Middle);
+        let left = response.dragged_by(egui::PointerButton::Primary);
+        if middle || (right && shift) {
+            self.camera = self
+                .camera
+                .pan(delta.x / rect.height(), delta.y / rect.height());
+        } else if right || (left && alt) {
+            self.camera = self.camera.orbit(-delta.x * 0.01, delta.y * 0.01);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                self.camera = self.camera.zoom((scroll * 0.002).exp());
+            }
+        }
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(40));
+        let ppp = ui.ctx().pixels_per_point();
+        let size = (
+            ((rect.width() * ppp) as u32).max(1),
+            ((rect.height() * ppp) as u32).max(1),
+        );
+        let mut frame = *settings;
+        frame.camera = self.camera;
+        match &mut self.gpu {
+            Some(gpu) => {
+                let start = Instant::now();
+                let id = gpu.render(doc, mesh, &frame, self.compare, self.split_at, size);
+                self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
+                painter.image(
+                    id,
+                    rect,
+                    Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+                    Color32::WHITE,
+                );
+            }
+            None => {
+                painter.text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    &self.no_gpu,
+                    egui::FontId::proportional(14.0),
+                    Color32::GRAY,
+                );
+            }
+        }
+        if self.compare == Compare::Split {
+            let x = rect.min.x + rect.width() * self.split_at;
+            painter.line_segment(
+                [Pos2::new(x, rect.min.y), Pos2::new(x, rect.max.y)],
+                egui::Stroke::new(1.5, Color32::WHITE),
+            );
+            let font = egui::FontId::proportional(13.0);
+            painter.text(
+                rect.min + egui::vec2(8.0, 8.0),
+                egui::Align2::LEFT_TOP,
+                "Phong (eq. 8)",
+                font.clone(),
+                Color32::WHITE,
+            );
+            painter.text(
+                Pos2::new(rect.max.x - 8.0, rect.min.y + 8.0),
+                egui::Align2::RIGHT_TOP,
+                "Blinn-Phong (eq. 11)",
+                font,
+                Color32::WHITE,
+            );
+        }
+        (response, rect)
+    }
+}
