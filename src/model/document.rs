@@ -319,6 +319,16 @@ impl Document {
         Ok(())
     }
 
+    /// Makes `mesh` the project's mesh (saved with it) and attaches its baked surface.
+    ///
+    /// # Errors
+    /// As [`set_surface`](Self::set_surface); nothing changes then.
+    pub fn set_mesh(&mut self, mesh: MeshRef, surface: Arc<Surface>) -> Result<(), ModelError> {
+        self.set_surface(Some(surface))?;
+        self.settings.mesh = mesh;
+        Ok(())
+    }
+
     /// The attached mesh surface.
     pub fn surface(&self) -> Option<&Arc<Surface>> {
         self.surface.as_ref()

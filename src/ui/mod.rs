@@ -21,7 +21,9 @@ use crate::export::preset::ExportPreset;
 use crate::mesh::Mesh;
 use crate::mesh::pick::Bvh;
 use crate::model::brush::{StrokePoint, SurfacePos};
+use crate::model::document::MeshRef;
 use crate::model::surface::Surface;
+use crate::model::texel::Channel;
 use crate::model::texel::MaterialValue;
 use crate::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool, project};
 use crate::reflectance::{self, AmbientApprox, ShadingModel};
@@ -44,13 +46,16 @@ pub enum Tool {
     Fill,
     /// Pick the material under the cursor (I).
     Picker,
+    /// Drag a linear gradient from the primary to the secondary material on the canvas (G).
+    Gradient,
 }
 
 impl Tool {
-    const ALL: [(Self, &'static str, &'static str); 4] = [
+    const ALL: [(Self, &'static str, &'static str); 5] = [
         (Self::Brush, "Brush", "B"),
         (Self::Eraser, "Eraser", "E"),
-        (Self::Fill, "Fill", "F (in 2D)"),
+        (Self::Gradient, "Gradient", "G (on the UV canvas)"),
+        (Self::Fill, "Fill", "F (on the UV canvas)"),
         (Self::Picker, "Picker", "I"),
     ];
 }
@@ -76,9 +81,14 @@ pub struct Notice {
 
 /// What a worker hands back.
 enum JobResult {
-    Opened(PathBuf, Box<Document>),
+    /// A project (to be saved at the path), and whether it came from a recovery copy.
+    Opened(PathBuf, Box<Document>, bool),
     Saved(PathBuf, u64),
     Exported(PathBuf, Box<crate::export::set::Manifest>),
+    /// A mesh loaded and baked at the map size.
+    Mesh(PathBuf, Arc<Surface>),
+    /// An image decoded for a channel.
+    Image(Channel, PathBuf, Box<image::DynamicImage>),
     Failed(String),
 }
 
@@ -157,11 +167,17 @@ pub struct EditorState {
     pub hover_tab: Option<Tab>,
     /// The tab whose drag is painting a stroke.
     stroking: Option<Tab>,
+    /// Where a gradient drag started, in texels.
+    gradient_start: Option<Vec2>,
     /// `hover` as of the last frame (the status bar is drawn before the tabs).
     shown_hover: Option<(u32, u32)>,
     quit_asked: bool,
     /// Set when the user confirmed closing with unsaved changes.
     pub allow_close: bool,
+    /// A recovery copy found at start, newer than the project.
+    pub recovery_offer: Option<PathBuf>,
+    /// Material presets with their thumbnails (rendered a few per frame).
+    presets: Vec<(String, MaterialValue, Option<egui::TextureHandle>)>,
     autosaver: project::Autosaver,
 }
 
@@ -170,6 +186,9 @@ pub struct Editor {
     /// Panels' state.
     pub state: EditorState,
     dock: DockState<Tab>,
+    /// When the process started, until the first frame is drawn (then logged to stderr when
+    /// `KAPAINT_LOG_STARTUP` is set).
+    started: Option<Instant>,
 }
 
 fn new_document(size: u32) -> Result<(Document, MeshState), String> {
@@ -242,14 +261,15 @@ impl Editor {
         };
         let mut viewport = Viewport::new(gpu);
         viewport.frame(&mesh.mesh);
-        let autosaver = project::Autosaver::new(
-            Duration::from_mins(2),
-            project::recovery_path(path.as_deref()),
-            &doc,
-        );
-        let mut dock = DockState::new(vec![Tab::Viewport]);
-        let surface = dock.main_surface_mut();
-        surface.split_right(egui_dock::NodeIndex::root(), 0.55, vec![Tab::Canvas]);
+        let recovery = project::recovery_path(path.as_deref());
+        let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+        let recovery_offer = match (modified(&recovery), path.as_deref().and_then(modified)) {
+            (Some(copy), Some(saved)) if copy > saved => Some(recovery.clone()),
+            (Some(_), None) => Some(recovery.clone()),
+            _ => None,
+        };
+        let autosaver = project::Autosaver::new(Duration::from_mins(2), recovery, &doc);
+        let dock = load_layout().unwrap_or_else(default_layout);
         let saved_version = doc.maps.version();
         Self {
             state: EditorState {
@@ -268,13 +288,54 @@ impl Editor {
                 hover: None,
                 hover_tab: None,
                 stroking: None,
+                gradient_start: None,
                 shown_hover: None,
                 quit_asked: false,
                 allow_close: false,
+                recovery_offer,
+                presets: crate::model::preset::builtin()
+                    .into_iter()
+                    .map(|(name, p)| (name, p.value(), None))
+                    .collect(),
                 autosaver,
             },
             dock,
+            started: None,
         }
+    }
+}
+
+/// The dock's first layout: the viewport left, the UV canvas right.
+pub fn default_layout() -> DockState<Tab> {
+    let mut dock = DockState::new(vec![Tab::Viewport]);
+    dock.main_surface_mut()
+        .split_right(egui_dock::NodeIndex::root(), 0.55, vec![Tab::Canvas]);
+    dock
+}
+
+/// Where the dock layout is kept between runs.
+fn layout_path() -> Option<PathBuf> {
+    std::env::var_os("XDG_CONFIG_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))
+        .map(|d| d.join("kapaint").join("layout.json"))
+}
+
+/// The saved layout, if there is a readable one holding both tabs.
+fn load_layout() -> Option<DockState<Tab>> {
+    let text = std::fs::read(layout_path()?).ok()?;
+    let dock: DockState<Tab> = serde_json::from_slice(&text).ok()?;
+    (dock.find_tab(&Tab::Viewport).is_some() && dock.find_tab(&Tab::Canvas).is_some())
+        .then_some(dock)
+}
+
+/// Saves the layout (atomically; failures only cost the layout).
+fn save_layout(dock: &DockState<Tab>) {
+    if let (Some(path), Ok(json)) = (layout_path(), serde_json::to_vec(dock)) {
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let _ = crate::atomic::write_atomic(&path, &json);
     }
 }
 
@@ -316,6 +377,8 @@ pub mod keys {
     pub const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
     /// Export.
     pub const EXPORT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::E);
+    /// Quit (asks first when there are unsaved changes).
+    pub const QUIT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
 }
 
 impl EditorState {
@@ -373,10 +436,15 @@ impl EditorState {
             .join()
             .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
         match result {
-            JobResult::Opened(path, doc) => {
+            JobResult::Opened(path, doc, recovered) => {
                 let mesh = doc.surface().map(|s| s.mesh.clone());
                 self.doc = *doc;
-                self.saved_version = self.doc.maps.version();
+                // Recovered work is unsaved work.
+                self.saved_version = if recovered {
+                    u64::MAX
+                } else {
+                    self.doc.maps.version()
+                };
                 if let Some(mesh) = mesh {
                     self.mesh = MeshState::new(mesh, self.mesh.id + 1);
                     self.viewport.frame(&self.mesh.mesh);
@@ -407,7 +475,64 @@ impl EditorState {
                 ),
                 false,
             )),
+            JobResult::Mesh(path, surface) => {
+                let mesh = surface.mesh.clone();
+                let spec = MeshRef::from_spec(&path.display().to_string());
+                match self.doc.set_mesh(spec, surface) {
+                    Ok(()) => {
+                        self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+                        self.viewport.frame(&self.mesh.mesh);
+                        self.notices
+                            .push(notice(format!("mesh {}", path.display()), false));
+                    }
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Image(channel, path, image) => {
+                crate::model::import::import_into(&mut self.doc, channel, &image);
+                self.notices.push(notice(
+                    format!("{} imported into {}", path.display(), channel.name()),
+                    false,
+                ));
+            }
             JobResult::Failed(e) => self.notices.push(notice(e, true)),
+        }
+    }
+
+    /// Loads and bakes a mesh on a worker; it becomes the project's mesh.
+    pub fn import_mesh(&mut self, path: PathBuf) {
+        let (w, h) = (self.doc.maps.width(), self.doc.maps.height());
+        self.start_job("Mesh", move |progress| {
+            progress.start("load", 1);
+            let mesh = match crate::mesh::open(&path) {
+                Ok(m) => m,
+                Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
+            };
+            progress.start("bake", 1);
+            match Surface::new(mesh, w, h) {
+                Ok(s) => JobResult::Mesh(path, Arc::new(s)),
+                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Decodes an image on a worker and writes it into `channel` (one undo step).
+    pub fn import_image(&mut self, path: PathBuf, channel: Channel) {
+        self.start_job("Image", move |progress| {
+            progress.start("decode", 1);
+            match crate::model::import::read_image(&path) {
+                Ok(image) => JobResult::Image(channel, path, Box::new(image)),
+                Err(e) => JobResult::Failed(e.to_string()),
+            }
+        });
+    }
+
+    /// The channel the canvas shows (`k_d` for the derived `k_a`): where dropped images go.
+    fn canvas_target(&self) -> Channel {
+        match self.canvas.channel {
+            CanvasChannel::Ks => Channel::Ks,
+            CanvasChannel::N => Channel::N,
+            CanvasChannel::Kd | CanvasChannel::Ka => Channel::Kd,
         }
     }
 
@@ -429,10 +554,51 @@ impl EditorState {
         self.start_job("Open", move |progress| {
             progress.start("open", 1);
             match load_project(&path) {
-                Ok((doc, _, _)) => JobResult::Opened(path, Box::new(doc)),
+                Ok((doc, _, _)) => JobResult::Opened(path, Box::new(doc), false),
                 Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
             }
         });
+    }
+
+    /// Opens the recovery copy `from` as the project at `path` (unsaved).
+    fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
+        self.start_job("Recover", move |progress| {
+            progress.start("open", 1);
+            match load_project(&from) {
+                Ok((doc, _, _)) => {
+                    JobResult::Opened(path.unwrap_or_else(|| from.clone()), Box::new(doc), true)
+                }
+                Err(e) => JobResult::Failed(format!("could not recover {}: {e}", from.display())),
+            }
+        });
+    }
+
+    /// The recovery offer at start: recover the copy, or discard it.
+    fn recovery_window(&mut self, ctx: &egui::Context) {
+        let Some(copy) = self.recovery_offer.clone() else {
+            return;
+        };
+        egui::Window::new("Recover unsaved work?")
+            .collapsible(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "kapaint found a recovery copy of unsaved work:\n{}",
+                    copy.display()
+                ));
+                ui.horizontal(|ui| {
+                    if ui.button("Recover").clicked() {
+                        self.recovery_offer = None;
+                        self.recover(copy.clone(), self.path.clone());
+                    }
+                    if ui.button("Discard").clicked() {
+                        self.recovery_offer = None;
+                        if let Err(e) = std::fs::remove_file(&copy) {
+                            self.notices
+                                .push(notice(format!("{}: {e}", copy.display()), true));
+                        }
+                    }
+                });
+            });
     }
 
     fn save(&mut self) {
@@ -515,6 +681,7 @@ impl EditorState {
                 (keys::OPEN, 4),
                 (keys::NEW, 5),
                 (keys::EXPORT, 6),
+                (keys::QUIT, 7),
             ] {
                 if i.consume_shortcut(&shortcut) {
                     commands.push(action);
@@ -529,13 +696,15 @@ impl EditorState {
                 3 => self.save_as(),
                 4 => self.open_dialog(),
                 5 => self.new_project(),
-                _ => self.open_export(),
+                6 => self.open_export(),
+                _ => self.quit_asked = true,
             }
         }
         let (shift, pressed) = ctx.input(|i| {
             let keys = [
                 Key::B,
                 Key::E,
+                Key::G,
                 Key::I,
                 Key::X,
                 Key::OpenBracket,
@@ -554,6 +723,7 @@ impl EditorState {
             match key {
                 Key::B => self.tool = Tool::Brush,
                 Key::E => self.tool = Tool::Eraser,
+                Key::G => self.tool = Tool::Gradient,
                 Key::I => self.tool = Tool::Picker,
                 Key::X => self.apply(Command::SwapMaterials),
                 Key::OpenBracket if shift => brush.hardness = (brush.hardness - 0.1).max(0.0),
@@ -615,7 +785,7 @@ impl EditorState {
         match self.tool {
             Tool::Brush => Some(StrokeTool::Brush),
             Tool::Eraser => Some(StrokeTool::Eraser),
-            Tool::Fill | Tool::Picker => None,
+            Tool::Fill | Tool::Picker | Tool::Gradient => None,
         }
     }
 
@@ -643,6 +813,10 @@ impl EditorState {
         }
         let space = response.ctx.input(|i| i.key_down(Key::Space));
         let primary = response.dragged_by(egui::PointerButton::Primary) && !space;
+        if self.tool == Tool::Gradient {
+            self.gradient_input(response, pos, rect, primary);
+            return;
+        }
         match (self.stroke_tool(), pos) {
             (Some(tool), Some(p)) if primary || (response.clicked() && !space) => {
                 self.begin_stroke(Tab::Canvas, tool);
@@ -680,6 +854,40 @@ impl EditorState {
             && (response.drag_stopped() || !response.is_pointer_button_down_on())
         {
             self.end_stroke();
+        }
+    }
+
+    /// The gradient tool on the canvas: drag from start to end, applied on release.
+    fn gradient_input(
+        &mut self,
+        response: &egui::Response,
+        pos: Option<Vec2>,
+        rect: egui::Rect,
+        primary: bool,
+    ) {
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            self.gradient_start = pos;
+        }
+        if let (Some(start), Some(end)) = (self.gradient_start, pos) {
+            if primary {
+                let size = (self.doc.maps.width(), self.doc.maps.height());
+                let at = |p: Vec2| {
+                    rect.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * rect.size()
+                };
+                response.ctx.layer_painter(response.layer_id).arrow(
+                    at(start),
+                    at(end) - at(start),
+                    egui::Stroke::new(2.0, egui::Color32::WHITE),
+                );
+            }
+            if response.drag_stopped() {
+                self.gradient_start = None;
+                self.apply(Command::Gradient {
+                    shape: crate::model::paint::GradientShape::Linear,
+                    start,
+                    end,
+                });
+            }
         }
     }
 
@@ -908,6 +1116,9 @@ impl EditorState {
         }
         ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
         ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+        egui::CollapsingHeader::new("Material presets")
+            .default_open(true)
+            .show(ui, |ui| self.presets_panel(ui));
         ui.heading("History");
         ui.label(format!(
             "{} steps, {:.1} MB",
@@ -928,6 +1139,93 @@ impl EditorState {
                     ui.label(format!("{} ({} KB)", step.label, step.bytes() / 1024));
                 }
             });
+    }
+
+    /// Renders a thumbnail: on the GPU with the preview renderer, else with the CPU reference
+    /// renderer (the same shading, ray traced).
+    fn thumbnail(&mut self, value: MaterialValue) -> egui::ColorImage {
+        const SIZE: u32 = 56;
+        let camera = crate::render::Camera::default()
+            .orbit(0.5, 0.35)
+            .framing(&self.mesh.mesh.positions);
+        let settings = FrameSettings {
+            camera,
+            view: ViewMode::Shaded,
+            ..self.frame_settings()
+        };
+        let mesh = (self.mesh.id, Arc::clone(&self.mesh.mesh));
+        if let Some(image) = self
+            .viewport
+            .gpu
+            .as_mut()
+            .and_then(|g| g.thumbnail(&mesh, value, &settings, SIZE))
+        {
+            return image;
+        }
+        let material = crate::render::reference::Material::Uniform(crate::render::Sample {
+            kd: value.kd,
+            ks: value.ks,
+            n: value.n,
+        });
+        let pixels = crate::render::reference::render(
+            &self.mesh.mesh,
+            &self.mesh.bvh,
+            &material,
+            &settings,
+            SIZE,
+            SIZE,
+        );
+        let c = |x: f32| (crate::model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
+        let rgba: Vec<u8> = pixels
+            .iter()
+            .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])
+            .collect();
+        egui::ColorImage::from_rgba_unmultiplied([SIZE as usize; 2], &rgba)
+    }
+
+    /// The preset browser: thumbnails, a click makes the preset the primary material.
+    fn presets_panel(&mut self, ui: &mut egui::Ui) {
+        // A few thumbnails per frame keep the first frames fast.
+        let mut budget = 3;
+        for i in 0..self.presets.len() {
+            if self.presets[i].2.is_none() && budget > 0 {
+                budget -= 1;
+                let image = self.thumbnail(self.presets[i].1);
+                let name = self.presets[i].0.clone();
+                self.presets[i].2 = Some(ui.ctx().load_texture(
+                    name,
+                    image,
+                    egui::TextureOptions::LINEAR,
+                ));
+            }
+        }
+        if budget == 0 {
+            ui.ctx().request_repaint();
+        }
+        let mut chosen = None;
+        ui.horizontal_wrapped(|ui| {
+            for (name, value, texture) in &self.presets {
+                let response = match texture {
+                    Some(t) => ui.add(egui::Button::image(
+                        egui::Image::from_texture(egui::load::SizedTexture::from_handle(t))
+                            .fit_to_exact_size(egui::vec2(40.0, 40.0)),
+                    )),
+                    None => ui.add_sized([48.0, 48.0], egui::Button::new("…")),
+                };
+                if response
+                    .on_hover_text(format!(
+                        "{name}: k_d {:.2} {:.2} {:.2}, k_s {:.2}, n {:.0}",
+                        value.kd.x, value.kd.y, value.kd.z, value.ks.x, value.n
+                    ))
+                    .clicked()
+                {
+                    chosen = Some(*value);
+                }
+            }
+        });
+        if let Some(v) = chosen {
+            self.apply(Command::SetPrimary(v));
+        }
     }
 
     fn status_bar(&mut self, ui: &mut egui::Ui) {
@@ -1006,7 +1304,26 @@ impl EditorState {
                     self.open_export();
                 }
                 ui.separator();
-                if ui.button("Quit").clicked() {
+                if ui.button("Import mesh…").clicked()
+                    && let Some(p) = rfd::FileDialog::new()
+                        .add_filter("mesh", &["obj", "gltf", "glb"])
+                        .pick_file()
+                {
+                    self.import_mesh(p);
+                }
+                for channel in [Channel::Kd, Channel::Ks, Channel::N] {
+                    if ui
+                        .button(format!("Import image into {}…", channel.name()))
+                        .clicked()
+                        && let Some(p) = rfd::FileDialog::new()
+                            .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
+                            .pick_file()
+                    {
+                        self.import_image(p, channel);
+                    }
+                }
+                ui.separator();
+                if item(ui, "Quit", &keys::QUIT) {
                     self.quit_asked = true;
                 }
             });
@@ -1122,8 +1439,16 @@ impl EditorState {
                 .unwrap_or_default();
             match ext.as_str() {
                 "kapaint" => self.open(path),
+                "obj" | "gltf" | "glb" => self.import_mesh(path),
+                "png" | "jpg" | "jpeg" | "tga" | "exr" => {
+                    let channel = self.canvas_target();
+                    self.import_image(path, channel);
+                }
                 _ => self.notices.push(notice(
-                    format!("{}: drop a .kapaint project", path.display()),
+                    format!(
+                        "{}: drop a project (.kapaint), a mesh (.obj, .gltf, .glb) or an image",
+                        path.display()
+                    ),
                     true,
                 )),
             }
@@ -1229,10 +1554,19 @@ impl Editor {
                 .show_inside(ui, &mut Tabs(s));
         });
         s.export_window(&ctx);
+        s.recovery_window(&ctx);
         s.notices(&ctx);
         s.close_prompt(&ctx);
         if s.job.is_some() {
             ctx.request_repaint_after(Duration::from_millis(100));
+        }
+        if let Some(start) = self.started.take()
+            && std::env::var_os("KAPAINT_LOG_STARTUP").is_some()
+        {
+            eprintln!(
+                "kapaint: first frame after {:.0} ms",
+                start.elapsed().as_secs_f64() * 1000.0
+            );
         }
     }
 }
@@ -1243,6 +1577,7 @@ impl eframe::App for Editor {
     }
 
     fn on_exit(&mut self) {
+        save_layout(&self.dock);
         // A clean exit leaves no recovery file behind.
         if !self.state.dirty() {
             let _ = std::fs::remove_file(self.state.autosaver.path());
@@ -1252,6 +1587,7 @@ impl eframe::App for Editor {
 
 /// Opens the editor window (on `path` when given); returns the process exit code.
 pub fn run(path: Option<PathBuf>) -> i32 {
+    let start = Instant::now();
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("kapaint")
@@ -1263,7 +1599,11 @@ pub fn run(path: Option<PathBuf>) -> i32 {
     match eframe::run_native(
         "kapaint",
         options,
-        Box::new(move |cc| Ok(Box::new(Editor::new(cc.wgpu_render_state.as_ref(), path)))),
+        Box::new(move |cc| {
+            let mut editor = Editor::new(cc.wgpu_render_state.as_ref(), path);
+            editor.started = Some(start);
+            Ok(Box::new(editor))
+        }),
     ) {
         Ok(()) => 0,
         Err(e) => {

@@ -10,10 +10,13 @@ use egui::{Color32, Pos2, Rect, Sense, TextureId};
 
 use crate::gpu::Gpu;
 use crate::gpu::maps::MapTextures;
-use crate::gpu::preview::{DEPTH_FORMAT, DrawPart, MeshBuffers, PipelineKey, Preview};
+use crate::gpu::preview::{
+    DEPTH_FORMAT, DrawPart, MeshBuffers, Offscreen, PipelineKey, Preview, RenderedImage,
+};
 use crate::mesh::Mesh;
 use crate::mesh::pick::{Bvh, Hit};
-use crate::model::Document;
+use crate::model::texel::MaterialValue;
+use crate::model::{Document, MaterialMaps};
 use crate::reflectance::ShadingModel;
 use crate::render::{Camera, FrameSettings};
 
@@ -69,6 +72,42 @@ impl ViewportGpu {
             mesh: None,
             maps: None,
             target: None,
+        }
+    }
+
+    /// A `size`-pixel picture of `value` on the mesh, for the preset browser.
+    pub fn thumbnail(
+        &mut self,
+        mesh: &(u64, Arc<Mesh>),
+        value: MaterialValue,
+        settings: &FrameSettings,
+        size: u32,
+    ) -> Option<egui::ColorImage> {
+        if self.mesh.as_ref().is_none_or(|(id, _)| *id != mesh.0) {
+            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)));
+        }
+        let maps = MaterialMaps::new(1, 1, value).ok()?;
+        let textures = MapTextures::new(&self.gpu, &maps);
+        let (_, buffers) = self.mesh.as_ref()?;
+        let offscreen = Offscreen {
+            size: (size, size),
+            linear: false,
+            split: None,
+        };
+        match self
+            .preview
+            .render_offscreen(&self.gpu, buffers, &textures, settings, offscreen)
+            .ok()?
+        {
+            RenderedImage::Srgb8 {
+                width,
+                height,
+                pixels,
+            } => Some(egui::ColorImage::from_rgba_unmultiplied(
+                [width as usize, height as usize],
+                &pixels,
+            )),
+            RenderedImage::Linear { .. } => None,
         }
     }
 
