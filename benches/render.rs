@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use kapaint::gpu::preview::PipelineKey;
+use kapaint::gpu::preview::{DrawPart, Layout, PipelineKey};
 use kapaint::gpu::{Gpu, MapTextures, MeshBuffers, Preview};
 use kapaint::mesh;
 use kapaint::model::brush::{BrushSettings, StrokePoint};
@@ -53,7 +53,7 @@ impl Frame<'_> {
         preview: &mut Preview,
         maps: &MapTextures,
         settings: &FrameSettings,
-        parts: &[kapaint::gpu::preview::DrawPart],
+        parts: &[DrawPart],
     ) {
         let mut encoder = self
             .gpu
@@ -180,22 +180,20 @@ fn frames(c: &mut Criterion) {
             mesh: &buffers,
         };
         group.bench_function(name, |b| {
-            b.iter(|| frame.draw(&mut preview, maps, &s, &[(key, (0, 0, w, h))]));
+            b.iter(|| frame.draw(&mut preview, maps, &s, &[DrawPart::whole(key, (w, h))]));
         });
     }
     // The split compare shades each half once.
     let s = settings(ViewMode::Shaded);
     let key = PipelineKey::for_frame(&s, &painted_maps.uniform, format);
-    let parts = [
-        (
-            PipelineKey {
-                model: ShadingModel::Phong,
-                ..key
-            },
-            (0, 0, w / 2, h),
-        ),
-        (key, (w / 2, 0, w - w / 2, h)),
-    ];
+    let phong = PipelineKey {
+        model: ShadingModel::Phong,
+        ..key
+    };
+    let blinn = PipelineKey {
+        model: ShadingModel::BlinnPhong,
+        ..key
+    };
     let frame = Frame {
         gpu: &gpu,
         color: &color,
@@ -203,8 +201,14 @@ fn frames(c: &mut Criterion) {
         size: (w, h),
         mesh: &buffers,
     };
+    let split = Layout::Split(w / 2).parts(phong, blinn, (w, h));
     group.bench_function("compare_split_painted_maps", |b| {
-        b.iter(|| frame.draw(&mut preview, &painted_maps, &s, &parts));
+        b.iter(|| frame.draw(&mut preview, &painted_maps, &s, &split));
+    });
+    // Side by side: two whole pictures, each half the width.
+    let side = Layout::SideBySide.parts(phong, blinn, (w, h));
+    group.bench_function("compare_side_by_side_painted_maps", |b| {
+        b.iter(|| frame.draw(&mut preview, &painted_maps, &s, &side));
     });
     group.finish();
 }

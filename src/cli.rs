@@ -658,8 +658,9 @@ pub struct RenderArgs {
     /// sphere, plane, cube, torus or a mesh file (default: the project's, else sphere).
     #[arg(long)]
     mesh: Option<String>,
-    /// phong, blinn, compare-split (Phong left, Blinn-Phong right) or compare-diff.
-    #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-diff"])]
+    /// phong, blinn, compare-split (Phong left, Blinn-Phong right), compare-side (the two
+    /// side by side, one camera) or compare-diff (|Phong - Blinn-Phong| heatmap).
+    #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-side", "compare-diff"])]
     model: String,
     /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
     #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
@@ -772,6 +773,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
         "phong" => (ShadingModel::Phong, Compare::Single),
         "blinn" => (ShadingModel::BlinnPhong, Compare::Single),
         "compare-split" => (ShadingModel::Phong, Compare::Split),
+        "compare-side" => (ShadingModel::Phong, Compare::SideBySide),
         _ => (ShadingModel::Phong, Compare::Difference),
     };
     let approx = match a.method.as_str() {

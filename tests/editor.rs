@@ -36,6 +36,7 @@ fn drag(harness: &mut Harness<'_, Editor>, a: Pos2, b: Pos2) {
 }
 
 #[test]
+#[allow(clippy::too_many_lines)] // One scripted session, step by step, as a user works.
 fn a_scripted_editing_session() {
     let mut harness = Harness::builder()
         .with_size(Vec2::new(1400.0, 900.0))
@@ -44,6 +45,32 @@ fn a_scripted_editing_session() {
             Editor::new(None, None),
         );
     harness.run();
+
+    // New project (Ctrl+N): the dialog offers resolution, base preset and mesh.
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
+    harness.run();
+    assert!(
+        harness.state().state.new_dialog.is_some(),
+        "Ctrl+N opens the New dialog"
+    );
+    harness.get_by_label("Resolution");
+    harness.get_by_label("Base preset");
+    harness.get_by_label("Mesh");
+    harness.state_mut().state.new_dialog = Some(kapaint::ui::NewDialog {
+        size: 512,
+        preset: 0,
+        mesh: "sphere".into(),
+    });
+    harness.run();
+    harness
+        .get_by_role_and_label(Role::Button, "Create")
+        .click();
+    harness.run();
+    assert!(
+        harness.state().state.new_dialog.is_none(),
+        "Create closes it"
+    );
+    assert_eq!(harness.state().state.doc.maps.width(), 512);
     let fresh = texels(harness.state());
 
     // Pick the brush as a user would: the button labelled "Brush".
@@ -105,10 +132,46 @@ fn a_scripted_editing_session() {
     harness.run();
     assert_eq!(harness.state().state.tool, kapaint::ui::Tool::Eraser);
 
-    // Compare split.
+    // The recent-files list keeps each project once, newest first, at most RECENT_MAX.
+    let mut recent = Vec::new();
+    for i in 0..12 {
+        kapaint::ui::push_recent(
+            &mut recent,
+            std::path::Path::new(&format!("/nowhere/{i}.kapaint")),
+        );
+    }
+    kapaint::ui::push_recent(&mut recent, std::path::Path::new("/nowhere/5.kapaint"));
+    assert_eq!(recent.len(), kapaint::ui::RECENT_MAX);
+    assert_eq!(recent[0], std::path::PathBuf::from("/nowhere/5.kapaint"));
+    assert_eq!(
+        recent.iter().filter(|p| p.ends_with("5.kapaint")).count(),
+        1
+    );
+
+    // Compare: split, side by side and difference, each side with its own model.
     harness.get_by_label("Split").click();
     harness.run();
-    assert_eq!(harness.state().state.viewport.compare, Compare::Split);
+    assert_eq!(
+        harness.state().state.viewport.comparison.mode,
+        Compare::Split
+    );
+    harness.get_by_label("Side by side").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.viewport.comparison.mode,
+        Compare::SideBySide
+    );
+    harness.get_by_label("Difference").click();
+    harness.run();
+    let c = harness.state().state.viewport.comparison;
+    assert_eq!(c.mode, Compare::Difference);
+    assert_ne!(
+        c.left.model, c.right.model,
+        "Phong against Blinn-Phong by default"
+    );
+    assert!(harness.query_all_by_label("Heat scale").count() > 0);
+    harness.get_by_label("Split").click();
+    harness.run();
 
     // The export dialog opens from its hotkey and offers the presets.
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);

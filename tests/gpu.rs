@@ -8,7 +8,7 @@
 #![allow(clippy::expect_used)]
 
 use glam::{Vec2, Vec3};
-use kapaint::gpu::{Gpu, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
+use kapaint::gpu::{Gpu, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::mesh::{self, pick::Bvh};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb};
 use kapaint::model::{Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool};
@@ -119,7 +119,7 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
                     Offscreen {
                         size: (96, 96),
                         linear: true,
-                        split: None,
+                        layout: Layout::Single,
                     },
                 )
                 .expect("render"),
@@ -140,7 +140,7 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
                     Offscreen {
                         size: (16, 16),
                         linear: true,
-                        split: None,
+                        layout: Layout::Single,
                     },
                 )
                 .expect("render"),
@@ -239,7 +239,7 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
                 Offscreen {
                     size: (w, h),
                     linear: false,
-                    split: None,
+                    layout: Layout::Single,
                 },
             )
             .expect("render")
@@ -305,7 +305,7 @@ fn sync_uploads_only_dirty_tiles_and_the_render_follows() {
 }
 
 #[test]
-fn split_compare_shades_phong_left_and_blinn_right() {
+fn split_and_side_by_side_compare_phong_left_and_blinn_right() {
     let Some(gpu) = gpu() else { return };
     let sphere = mesh::uv_sphere(64, 32);
     let maps = MaterialMaps::new(
@@ -320,7 +320,7 @@ fn split_compare_shades_phong_left_and_blinn_right() {
     );
     let mut preview = Preview::new(&gpu);
     let (w, h) = (96_u32, 64_u32);
-    let mut render = |model, split| {
+    let mut render = |model, size: (u32, u32), layout| {
         let s = settings(model, ViewMode::Shaded, &sphere.positions);
         linear(
             preview
@@ -330,9 +330,9 @@ fn split_compare_shades_phong_left_and_blinn_right() {
                     &textures,
                     &s,
                     Offscreen {
-                        size: (w, h),
+                        size,
                         linear: true,
-                        split,
+                        layout,
                     },
                 )
                 .expect("render"),
@@ -340,9 +340,9 @@ fn split_compare_shades_phong_left_and_blinn_right() {
         .2
     };
     let (phong, blinn, split) = (
-        render(ShadingModel::Phong, None),
-        render(ShadingModel::BlinnPhong, None),
-        render(ShadingModel::Phong, Some(w / 2)),
+        render(ShadingModel::Phong, (w, h), Layout::Single),
+        render(ShadingModel::BlinnPhong, (w, h), Layout::Single),
+        render(ShadingModel::Phong, (w, h), Layout::Split(w / 2)),
     );
     assert_ne!(phong, blinn);
     for y in 0..h {
@@ -350,6 +350,32 @@ fn split_compare_shades_phong_left_and_blinn_right() {
             let i = ((y * w + x) * 4) as usize;
             let want = if x < w / 2 { &phong } else { &blinn };
             assert_eq!(&split[i..i + 4], &want[i..i + 4], "pixel ({x}, {y})");
+        }
+    }
+    // Side by side: each half is the whole picture of its model at half the width, seen by
+    // the same camera (an odd width leaves the middle column empty).
+    let w = 97;
+    let half = w / 2;
+    let side = render(ShadingModel::BlinnPhong, (w, h), Layout::SideBySide);
+    let (left, right) = (
+        render(ShadingModel::Phong, (half, h), Layout::Single),
+        render(ShadingModel::BlinnPhong, (half, h), Layout::Single),
+    );
+    assert_ne!(left, right);
+    for y in 0..h {
+        for x in 0..w {
+            let got = &side[((y * w + x) * 4) as usize..][..4];
+            let want = match x.cmp(&half) {
+                std::cmp::Ordering::Less => &left[((y * half + x) * 4) as usize..][..4],
+                std::cmp::Ordering::Greater => {
+                    &right[((y * half + x - half - 1) * 4) as usize..][..4]
+                }
+                std::cmp::Ordering::Equal => &[0.0; 4][..],
+            };
+            // The viewport's offset moves rasterisation by whole pixels: the same pictures,
+            // up to float rounding in the interpolants.
+            let close = got.iter().zip(want).all(|(a, b)| (a - b).abs() <= 1e-5);
+            assert!(close, "pixel ({x}, {y}): {got:?} vs {want:?}");
         }
     }
 }
@@ -387,7 +413,7 @@ fn extreme_maps_shade_to_finite_colours() {
                             Offscreen {
                                 size: (32, 32),
                                 linear: true,
-                                split: None,
+                                layout: Layout::Single,
                             },
                         )
                         .expect("render"),
@@ -523,13 +549,11 @@ fn mips_follow_the_dirty_tiles() {
     );
 }
 
-#[test]
-fn the_exported_wgsl_snippet_decodes_like_the_cpu() {
+/// A 64 x 8 project whose `n` runs from 1 to 5000, exported as a `compact` set into `dir` so
+/// that the set stores `n` on a curve in 8 bits.
+fn n_gradient_set(dir: &std::path::Path) -> (Document, kapaint::export::set::Manifest) {
     use kapaint::export::{preset, set};
-    let Some(gpu) = gpu() else { return };
-    let dir = std::env::temp_dir().join(format!("kapaint-snippet-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    // n spread over 1..5000 so the set stores it on a curve.
+    let _ = std::fs::remove_dir_all(dir);
     let mut doc = Document::new(64, 8, DocumentSettings::default()).expect("doc");
     doc.apply(Command::SetChannels(kapaint::model::Channels {
         kd: false,
@@ -555,20 +579,16 @@ fn the_exported_wgsl_snippet_decodes_like_the_cpu() {
         end: Vec2::new(64.0, 0.0),
     })
     .expect("gradient");
-    let m = set::export(&doc, &preset::find("compact").expect("preset"), &dir).expect("export");
+    let m = set::export(&doc, &preset::find("compact").expect("preset"), dir).expect("export");
+    (doc, m)
+}
+
+/// Checks a kernel's `(n, k_a)` pairs for the 256 codes of `m`'s `n` against the CPU: the
+/// decoded `n` within 2e-5 relative (absolute below 1), `k_a` with `k_d = 0.3`, `k_s = 0.5`
+/// within 1e-5 relative.
+fn check_decoded_pairs(got: &[f32], doc: &Document, m: &kapaint::export::set::Manifest) {
     let e = m.n_encoding.expect("n on a curve");
-    let snippet = std::fs::read_to_string(dir.join("material.wgsl")).expect("snippet");
-    let kernel = format!(
-        "{snippet}\n@group(0) @binding(0) var<storage, read> codes: array<f32>;\n\
-         @group(0) @binding(1) var<storage, read_write> out: array<f32>;\n\
-         @compute @workgroup_size(64)\nfn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
-         let i = id.x;\n    if i < arrayLength(&codes) {{\n\
-         let n = kapaint_decode_n(codes[i] / 255.0);\n\
-         out[2u * i] = n;\n\
-         out[2u * i + 1u] = kapaint_ka(vec3<f32>(0.3), vec3<f32>(0.5), n).x;\n    }}\n}}\n"
-    );
-    let codes: Vec<f32> = (0..=255).map(|c| c as f32).collect();
-    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &codes, 512).expect("kernel");
+    assert_eq!(got.len(), 512);
     for (c, pair) in got.chunks_exact(2).enumerate() {
         let n = e.decode(c as u16);
         assert!(
@@ -590,5 +610,199 @@ fn the_exported_wgsl_snippet_decodes_like_the_cpu() {
             pair[1]
         );
     }
+}
+
+#[test]
+fn the_exported_wgsl_snippet_decodes_like_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let dir = std::env::temp_dir().join(format!("kapaint-snippet-{}", std::process::id()));
+    let (doc, m) = n_gradient_set(&dir);
+    let snippet = std::fs::read_to_string(dir.join("material.wgsl")).expect("snippet");
+    let kernel = format!(
+        "{snippet}\n@group(0) @binding(0) var<storage, read> codes: array<f32>;\n\
+         @group(0) @binding(1) var<storage, read_write> out: array<f32>;\n\
+         @compute @workgroup_size(64)\nfn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+         let i = id.x;\n    if i < arrayLength(&codes) {{\n\
+         let n = kapaint_decode_n(codes[i] / 255.0);\n\
+         out[2u * i] = n;\n\
+         out[2u * i + 1u] = kapaint_ka(vec3<f32>(0.3), vec3<f32>(0.5), n).x;\n    }}\n}}\n"
+    );
+    let codes: Vec<f32> = (0..=255).map(|c| c as f32).collect();
+    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &codes, 512).expect("kernel");
+    check_decoded_pairs(&got, &doc, &m);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Compiles a GLSL 4.50 compute shader with naga's GLSL frontend and writes it back out as
+/// WGSL (naga's WGSL backend), with its entry point renamed to the `cs_main` that
+/// `run_kernel` calls: wgpu takes WGSL, so this is how the GLSL snippet runs here.
+fn glsl_to_wgsl(source: &str) -> String {
+    let mut module = naga::front::glsl::Frontend::default()
+        .parse(&naga::ShaderStage::Compute.into(), source)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+    assert_eq!(module.entry_points.len(), 1);
+    module.entry_points[0].name = "cs_main".into();
+    let info = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+        .expect("WGSL out")
+}
+
+/// The GLSL snippet, run: it decodes every code like the CPU, and its `ambient_ka` gives the
+/// CPU's `k_a` for every model and approximation, NaN, infinities and negative inputs
+/// included.
+#[test]
+fn the_exported_glsl_snippet_decodes_like_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let dir = std::env::temp_dir().join(format!("kapaint-glsl-snippet-{}", std::process::id()));
+    let (doc, m) = n_gradient_set(&dir);
+    let snippet = std::fs::read_to_string(dir.join("material.glsl")).expect("snippet");
+    let buffers = "layout(local_size_x = 64) in;\n\
+         layout(std430, binding = 0) readonly buffer Values { float values[]; };\n\
+         layout(std430, binding = 1) buffer Results { float results[]; };\n";
+
+    // The 256 codes of the set's n, as an engine would use the snippet.
+    let kernel = glsl_to_wgsl(&format!(
+        "#version 450\n{snippet}\n{buffers}\
+         void main() {{\n    uint i = gl_GlobalInvocationID.x;\n\
+         if (i < uint(values.length())) {{\n\
+         float n = kapaint_decode_n(values[i] / 255.0);\n\
+         results[2u * i] = n;\n\
+         results[2u * i + 1u] = kapaint_ka(vec3(0.3), vec3(0.5), n).x;\n    }}\n}}\n"
+    ));
+    let codes: Vec<f32> = (0..=255).map(|c| c as f32).collect();
+    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &codes, 512).expect("kernel");
+    check_decoded_pairs(&got, &doc, &m);
+
+    // Every model and approximation (slots 3 model + approx), and the sanitizing of k_d and
+    // k_s (slot 6), over awkward values of n.
+    let kernel = glsl_to_wgsl(&format!(
+        "#version 450\n{snippet}\n{buffers}\
+         void main() {{\n    uint i = gl_GlobalInvocationID.x;\n\
+         if (i < uint(values.length())) {{\n\
+         float v = values[i];\n\
+         for (uint model = 0u; model < 2u; model++) {{\n\
+         for (uint approx = 0u; approx < 3u; approx++) {{\n\
+         results[7u * i + 3u * model + approx] = ambient_ka(model, approx, vec3(0.3), vec3(0.5), v).x;\n\
+         }}\n}}\n\
+         results[7u * i + 6u] = kapaint_ka(vec3(v), vec3(1.0 - v), 10.0).x;\n    }}\n}}\n"
+    ));
+    let mut values = vec![
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -0.0,
+        -1.0,
+        0.0,
+        1e-6,
+        0.3,
+        0.5,
+        1.0,
+        2.0,
+        16384.0,
+        32767.0,
+        32768.0,
+        1e5,
+        1e9,
+        f32::MAX,
+    ];
+    values.extend((0..=300).map(|i| (1e6_f32.ln() * i as f32 / 300.0).exp() - 1.0));
+    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &values, 7 * values.len())
+        .expect("kernel");
+    let close = |got: f32, want: f32| (got - want).abs() <= 1e-5 * want.abs();
+    for (&v, row) in values.iter().zip(got.chunks_exact(7)) {
+        for (m, model) in ShadingModel::ALL.into_iter().enumerate() {
+            for (a, approx) in AmbientApprox::ALL.into_iter().enumerate() {
+                let want = reflectance::ka(model, approx, Vec3::splat(0.3), Vec3::splat(0.5), v).x;
+                let g = row[3 * m + a];
+                assert!(
+                    close(g, want),
+                    "{model:?} {approx:?} n = {v}: {g} vs {want}"
+                );
+            }
+        }
+        let want = reflectance::ka(
+            doc.settings.model,
+            doc.settings.approx,
+            Vec3::splat(v),
+            Vec3::splat(1.0 - v),
+            10.0,
+        )
+        .x;
+        assert!(close(row[6], want), "k_d = {v}: {} vs {want}", row[6]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn difference_heatmap_on_the_gpu_matches_the_cpu_ramp() {
+    let Some(gpu) = gpu() else { return };
+    let sphere = mesh::uv_sphere(48, 24);
+    let maps = MaterialMaps::new(
+        16,
+        16,
+        MaterialValue::new(Vec3::new(0.5, 0.3, 0.2), Vec3::splat(0.5), 12.0),
+    )
+    .expect("maps");
+    let (buffers, textures) = (
+        MeshBuffers::new(&gpu, &sphere),
+        MapTextures::new(&gpu, &maps),
+    );
+    let mut preview = Preview::new(&gpu);
+    let (w, h) = (80_u32, 60_u32);
+    let mut render = |model| {
+        let s = settings(model, ViewMode::Shaded, &sphere.positions);
+        preview
+            .render_offscreen(
+                &gpu,
+                &buffers,
+                &textures,
+                &s,
+                Offscreen {
+                    size: (w, h),
+                    linear: true,
+                    layout: Layout::Single,
+                },
+            )
+            .expect("render")
+    };
+    let (phong, blinn) = (
+        render(ShadingModel::Phong),
+        render(ShadingModel::BlinnPhong),
+    );
+    let max = 0.05;
+    let heat = kapaint::gpu::difference::Difference::new(&gpu)
+        .heatmap(&gpu, &phong, &blinn, max)
+        .expect("heatmap");
+    let (RenderedImage::Srgb8 { pixels: got, .. }, (_, _, a), (_, _, b)) =
+        (heat, linear(phong), linear(blinn))
+    else {
+        panic!("an sRGB heatmap");
+    };
+    let mut hot = 0;
+    for (i, (p, q)) in a.chunks_exact(4).zip(b.chunks_exact(4)).enumerate() {
+        let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0_f32, f32::max);
+        hot += usize::from(d > max / 3.0);
+        let c = kapaint::render::heat_ramp(d / max);
+        let byte = |v: f32| (linear_to_srgb(v) * 255.0 + 0.5) as i32;
+        let want = [
+            byte(c.x),
+            byte(c.y),
+            byte(c.z),
+            (p[3].max(q[3]) * 255.0 + 0.5) as i32,
+        ];
+        for k in 0..4 {
+            let g = i32::from(got[i * 4 + k]);
+            assert!(
+                (g - want[k]).abs() <= 1,
+                "pixel {i} component {k}: {g} vs {}",
+                want[k]
+            );
+        }
+    }
+    assert!(hot > 0, "the two models differ somewhere on the sphere");
 }

@@ -626,16 +626,27 @@ pub fn export_with(
         // The k_a error, measured on the set as a consumer decodes it.
         manifest.ka_error =
             ka_error_of_set(&texels, &manifest, &stored, preset.format, model, approx);
-        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
-        manifest.bytes.exported =
-            manifest.files.iter().map(|f| f.bytes).sum::<u64>() + json.len() as u64;
-        // The decode + k_a snippet for engines, beside the images.
-        let snippet = super::snippet::wgsl(&manifest);
-        let snippet_path = tmp.join("material.wgsl");
-        crate::atomic::write_atomic(&snippet_path, snippet.as_bytes())
-            .map_err(|e| io(&snippet_path, e))?;
-        manifest.bytes.exported += snippet.len() as u64;
-        let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
+        // The decode + k_a snippets for engines (WGSL and GLSL), beside the images.
+        let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
+        for (name, snippet) in [
+            ("material.wgsl", super::snippet::wgsl(&manifest)),
+            ("material.glsl", super::snippet::glsl(&manifest)),
+        ] {
+            let snippet_path = tmp.join(name);
+            crate::atomic::write_atomic(&snippet_path, snippet.as_bytes())
+                .map_err(|e| io(&snippet_path, e))?;
+            exported += snippet.len() as u64;
+        }
+        // The manifest counts itself, and its length depends on the count's digits: repeat
+        // until they agree (the count only grows, so this ends, in two or three rounds).
+        let json = loop {
+            let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
+            let total = exported + json.len() as u64;
+            if manifest.bytes.exported == total {
+                break json;
+            }
+            manifest.bytes.exported = total;
+        };
         let path = tmp.join("material.json");
         crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
         Ok(manifest)

@@ -1,15 +1,31 @@
-//! `material.wgsl`, shipped in every set: a self-contained decode of the set's `n` codes and
-//! the `k_a` of eq. (8)/(11) exactly as kapaint computes it (the same generated constants as
-//! `shaders/ambient.wgsl`), so an engine can use the set without kapaint.
+//! `material.wgsl` and `material.glsl`, shipped in every set: a self-contained decode of the
+//! set's `n` codes and the `k_a` of eq. (8)/(11) exactly as kapaint computes it (the same
+//! generated constants as `shaders/ambient.wgsl`), so an engine can use the set without kapaint.
+//!
+//! Both snippets are written by one function per part, told the language; only the code that
+//! comes from `reflectance::wgsl` differs in more than syntax.
 
 use std::fmt::Write as _;
 
 use super::encoding::NCurve;
 use super::set::Manifest;
+use crate::reflectance::wgsl::{ShaderLanguage, ambient_glsl, ambient_wgsl};
 use crate::reflectance::{AmbientApprox, ShadingModel};
 
-/// The WGSL snippet for a set.
+/// The WGSL snippet for a set (`material.wgsl`).
 pub fn wgsl(manifest: &Manifest) -> String {
+    snippet(manifest, ShaderLanguage::Wgsl)
+}
+
+/// The GLSL snippet for a set (`material.glsl`): the same functions as [`wgsl`], for GLSL 4.50
+/// or GLSL ES 3.00 without extensions and without a `#version` line, so it can be pasted into
+/// any stage: `vec3 kapaint_ka(vec3 kd, vec3 ks, float n)` and `float kapaint_decode_n(float
+/// stored)`.
+pub fn glsl(manifest: &Manifest) -> String {
+    snippet(manifest, ShaderLanguage::Glsl)
+}
+
+fn snippet(manifest: &Manifest, lang: ShaderLanguage) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -23,7 +39,10 @@ pub fn wgsl(manifest: &Manifest) -> String {
          // k_a = kapaint_ka(k_d, k_s, n). k_d and k_s are linear after the sampler's sRGB\n\
          // decode (use an sRGB texture format for files whose colour_space is \"srgb\").\n"
     );
-    s += include_str!("../../shaders/ambient.wgsl");
+    match lang {
+        ShaderLanguage::Wgsl => s += &ambient_wgsl(),
+        ShaderLanguage::Glsl => s += &ambient_glsl(),
+    }
     let model = match manifest.model {
         ShadingModel::Phong => "MODEL_PHONG",
         ShadingModel::BlinnPhong => "MODEL_BLINN",
@@ -38,13 +57,34 @@ pub fn wgsl(manifest: &Manifest) -> String {
         AmbientApprox::PaperCorrected => "APPROX_PAPER_CORRECTED",
         AmbientApprox::Fast => "APPROX_FAST",
     };
-    let _ = writeln!(s, "\nconst KAPAINT_MODEL: u32 = {model};");
-    let _ = writeln!(s, "const KAPAINT_APPROX: u32 = {approx};\n");
+    match lang {
+        ShaderLanguage::Wgsl => {
+            let _ = writeln!(s, "\nconst KAPAINT_MODEL: u32 = {model};");
+            let _ = writeln!(s, "const KAPAINT_APPROX: u32 = {approx};\n");
+        }
+        ShaderLanguage::Glsl => {
+            let _ = writeln!(s, "\nconst uint KAPAINT_MODEL = {model};");
+            let _ = writeln!(s, "const uint KAPAINT_APPROX = {approx};\n");
+        }
+    }
+    // `fn name(x: f32) -> f32` or `float name(float x)`, and `let` or `float` for locals.
+    let (float_fn, local): (fn(&str, &str) -> String, &str) = match lang {
+        ShaderLanguage::Wgsl => (
+            |name: &str, arg: &str| format!("fn {name}({arg}: f32) -> f32"),
+            "let",
+        ),
+        ShaderLanguage::Glsl => (
+            |name: &str, arg: &str| format!("float {name}(float {arg})"),
+            "float",
+        ),
+    };
+    let decode = float_fn("kapaint_decode_n", "stored");
     match (manifest.n_encoding, manifest.constants.n) {
         (_, Some(n)) => {
             let _ = writeln!(
                 s,
-                "// n is the same everywhere in this set.\nfn kapaint_decode_n(stored: f32) -> f32 {{\n    return {n:?}f;\n}}"
+                "// n is the same everywhere in this set.\n{decode} {{\n    return {};\n}}",
+                lang.float(n)
             );
         }
         (Some(e), None) => {
@@ -56,20 +96,37 @@ pub fn wgsl(manifest: &Manifest) -> String {
             let _ = writeln!(
                 s,
                 "// n is stored on a {:?} curve over [{:?}, {:?}] in {} bits.\n\
-                 fn kapaint_n_forward(x: f32) -> f32 {{\n    return {forward};\n}}\n\n\
-                 fn kapaint_decode_n(stored: f32) -> f32 {{\n    \
-                 let a = kapaint_n_forward({:?}f);\n    \
-                 let b = kapaint_n_forward({:?}f);\n    \
-                 let v = a + clamp(stored, 0.0, 1.0) * (b - a);\n    \
+                 {} {{\n    return {forward};\n}}\n\n\
+                 {decode} {{\n    \
+                 {local} a = kapaint_n_forward({});\n    \
+                 {local} b = kapaint_n_forward({});\n    \
+                 {local} v = a + clamp(stored, 0.0, 1.0) * (b - a);\n    \
                  return max({inverse}, 0.0);\n}}",
-                e.curve, e.lo, e.hi, e.bits, e.lo, e.hi
+                e.curve,
+                e.lo,
+                e.hi,
+                e.bits,
+                float_fn("kapaint_n_forward", "x"),
+                lang.float(e.lo),
+                lang.float(e.hi)
             );
         }
         (None, None) => {
-            s += "// n is stored as its own value (float).\nfn kapaint_decode_n(stored: f32) -> f32 {\n    return stored;\n}\n";
+            let _ = writeln!(
+                s,
+                "// n is stored as its own value (float).\n{decode} {{\n    return stored;\n}}"
+            );
         }
     }
-    s += "\nfn kapaint_ka(kd: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {\n    \
-          return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n";
+    s += match lang {
+        ShaderLanguage::Wgsl => {
+            "\nfn kapaint_ka(kd: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {\n    \
+             return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n"
+        }
+        ShaderLanguage::Glsl => {
+            "\nvec3 kapaint_ka(vec3 kd, vec3 ks, float n) {\n    \
+             return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n"
+        }
+    };
     s
 }

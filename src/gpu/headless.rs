@@ -4,9 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
-
-use super::{Gpu, GpuError, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
+use super::{Gpu, GpuError, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use crate::mesh::Mesh;
 use crate::model::MaterialMaps;
 use crate::reflectance::ShadingModel;
@@ -19,6 +17,8 @@ pub enum Compare {
     Single,
     /// Phong left of the middle, Blinn-Phong right.
     Split,
+    /// Phong in the left half, Blinn-Phong in the right, each a whole picture.
+    SideBySide,
     /// `|Phong - Blinn-Phong|` as a heatmap (PNG) or raw (EXR).
     Difference,
 }
@@ -75,8 +75,12 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
     let linear = kind == Kind::Exr || req.settings.view.is_data();
     let mut note = String::new();
     let pixels: RenderedImage = match req.compare {
-        Compare::Single | Compare::Split => {
-            let split = (req.compare == Compare::Split).then_some(width / 2);
+        Compare::Single | Compare::Split | Compare::SideBySide => {
+            let layout = match req.compare {
+                Compare::Split => Layout::Split(width / 2),
+                Compare::SideBySide => Layout::SideBySide,
+                _ => Layout::Single,
+            };
             preview.render_offscreen(
                 gpu,
                 &mesh,
@@ -85,7 +89,7 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
                 Offscreen {
                     size: req.size,
                     linear,
-                    split,
+                    layout,
                 },
             )?
         }
@@ -98,7 +102,7 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
                 let offscreen = Offscreen {
                     size: req.size,
                     linear: true,
-                    split: None,
+                    layout: Layout::Single,
                 };
                 preview.render_offscreen(gpu, &mesh, &maps, &settings, offscreen)
             };
@@ -158,6 +162,7 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
         match req.compare {
             Compare::Single => req.settings.model.name(),
             Compare::Split => "phong | blinn",
+            Compare::SideBySide => "phong, blinn side by side",
             Compare::Difference => "|phong - blinn|",
         },
         gpu.info.name,
@@ -195,14 +200,7 @@ fn draw_n_legend(image: &mut RenderedImage) {
 /// A heatmap of `diff` (black, red, yellow, white up to `max`) with a scale bar along the
 /// bottom rows, sRGB bytes.
 fn heatmap(diff: &[f32], width: u32, height: u32, max: f32) -> RenderedImage {
-    let ramp = |t: f32| {
-        let t = t.clamp(0.0, 1.0);
-        Vec3::new(
-            (t * 3.0).min(1.0),
-            (t * 3.0 - 1.0).clamp(0.0, 1.0),
-            (t * 3.0 - 2.0).clamp(0.0, 1.0),
-        )
-    };
+    let ramp = crate::render::heat_ramp;
     let scale = if max > 0.0 { 1.0 / max } else { 0.0 };
     let bar = (height / 24).max(2);
     let mut pixels = Vec::with_capacity((width * height * 4) as usize);

@@ -2,6 +2,7 @@
 //! with `shaders/preview.wgsl`. Works headless on any adapter wgpu finds (lavapipe in CI).
 
 pub mod check;
+pub mod difference;
 pub mod headless;
 pub mod maps;
 pub mod preview;
@@ -9,7 +10,7 @@ pub mod preview;
 use std::fmt;
 
 pub use maps::MapTextures;
-pub use preview::{MeshBuffers, Offscreen, Preview, RenderedImage};
+pub use preview::{Layout, MeshBuffers, Offscreen, Preview, RenderedImage};
 
 /// Why the GPU side could not do something.
 #[derive(Debug)]

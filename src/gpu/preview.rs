@@ -89,11 +89,85 @@ impl MeshBuffers {
     }
 }
 
-/// A scissor rectangle `(x, y, width, height)`.
+/// A pixel rectangle `(x, y, width, height)` of the target.
 pub type Scissor = (u32, u32, u32, u32);
 
-/// One draw of a frame: a pipeline and the part of the target it shades.
-pub type DrawPart = (PipelineKey, Scissor);
+/// One draw of a frame: a pipeline, the pixels it may shade (scissor) and the rectangle its
+/// picture fills (viewport).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawPart {
+    /// The pipeline.
+    pub key: PipelineKey,
+    /// Pixels outside it are not shaded.
+    pub scissor: Scissor,
+    /// Where the camera's picture goes.
+    pub viewport: Scissor,
+}
+
+impl DrawPart {
+    /// One pipeline over the whole `(width, height)` target.
+    pub fn whole(key: PipelineKey, (w, h): (u32, u32)) -> Self {
+        Self {
+            key,
+            scissor: (0, 0, w, h),
+            viewport: (0, 0, w, h),
+        }
+    }
+}
+
+/// How one frame shows the two shading models it compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// One picture, one model (the left key's).
+    Single,
+    /// One picture wiped at column `at`: the left key left of it, the right key right of it;
+    /// the hidden part of each is never shaded.
+    Split(u32),
+    /// Two whole pictures, one per half of the target, seen by the one camera.
+    SideBySide,
+}
+
+impl Layout {
+    /// The parts of a `(width, height)` frame: `left` and `right` are the two sides' pipelines.
+    pub fn parts(self, left: PipelineKey, right: PipelineKey, (w, h): (u32, u32)) -> Vec<DrawPart> {
+        let whole = (0, 0, w, h);
+        match self {
+            Self::Single => vec![DrawPart::whole(left, (w, h))],
+            Self::Split(at) => {
+                let at = at.min(w);
+                vec![
+                    DrawPart {
+                        key: left,
+                        scissor: (0, 0, at, h),
+                        viewport: whole,
+                    },
+                    DrawPart {
+                        key: right,
+                        scissor: (at, 0, w - at, h),
+                        viewport: whole,
+                    },
+                ]
+            }
+            Self::SideBySide => {
+                // Two halves of equal width, so both pictures have one aspect ratio.
+                let half = w / 2;
+                let (a, b) = ((0, 0, half, h), (w - half, 0, half, h));
+                vec![
+                    DrawPart {
+                        key: left,
+                        scissor: a,
+                        viewport: a,
+                    },
+                    DrawPart {
+                        key: right,
+                        scissor: b,
+                        viewport: b,
+                    },
+                ]
+            }
+        }
+    }
+}
 
 /// What an offscreen render produces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,8 +176,9 @@ pub struct Offscreen {
     pub size: (u32, u32),
     /// Linear floats even for shaded views (data views are always linear).
     pub linear: bool,
-    /// Phong left of this column, Blinn-Phong right of it.
-    pub split: Option<u32>,
+    /// Single, or Phong and Blinn-Phong compared (split or side by side); the settings'
+    /// model is ignored when comparing.
+    pub layout: Layout,
 }
 
 /// The overridable constants of one pipeline.
@@ -410,9 +485,9 @@ impl Preview {
         })
     }
 
-    /// Draws one or more parts of a frame into `target`: each part is a pipeline key and a
-    /// scissor rectangle `(x, y, w, h)` (the split compare draws Phong left and Blinn-Phong
-    /// right; the hidden part of each is never shaded). All parts share camera and lights.
+    /// Draws one or more parts of a frame into `target` (see [`Layout::parts`]): each part is a
+    /// pipeline, a scissor rectangle and a viewport. All parts share camera and lights; the
+    /// projection's aspect is the first part's viewport's.
     #[allow(clippy::too_many_arguments)] // One frame's inputs.
     pub fn draw(
         &mut self,
@@ -426,15 +501,11 @@ impl Preview {
         settings: &FrameSettings,
         parts: &[DrawPart],
     ) {
-        self.write_uniforms(
-            gpu,
-            settings,
-            size.0 as f32 / size.1.max(1) as f32,
-            &maps.uniform,
-        );
+        let (_, _, vw, vh) = parts.first().map_or((0, 0, size.0, size.1), |p| p.viewport);
+        self.write_uniforms(gpu, settings, vw as f32 / vh.max(1) as f32, &maps.uniform);
         let bind = self.bind_group(gpu, maps);
-        for (key, _) in parts {
-            self.pipeline(gpu, *key);
+        for part in parts {
+            self.pipeline(gpu, part.key);
         }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("preview"),
@@ -462,19 +533,22 @@ impl Preview {
         pass.set_bind_group(0, &bind, &[]);
         pass.set_vertex_buffer(0, mesh.vertices.slice(..));
         pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for (key, (x, y, w, h)) in parts {
-            if *w == 0 || *h == 0 {
+        for part in parts {
+            let (x, y, w, h) = part.scissor;
+            let (vx, vy, vw, vh) = part.viewport;
+            if w == 0 || h == 0 || vw == 0 || vh == 0 {
                 continue;
             }
-            pass.set_scissor_rect(*x, *y, *w, *h);
-            pass.set_pipeline(&self.pipelines[key]);
+            pass.set_viewport(vx as f32, vy as f32, vw as f32, vh as f32, 0.0, 1.0);
+            pass.set_scissor_rect(x, y, w, h);
+            pass.set_pipeline(&self.pipelines[&part.key]);
             pass.draw_indexed(0..mesh.index_count, 0, 0..1);
         }
     }
 
     /// Renders a frame offscreen and reads it back: sRGB bytes for shaded views unless
-    /// `linear`, linear floats otherwise. `split` draws Phong on the left of column `split`
-    /// and Blinn-Phong on the right (the settings' model is ignored then).
+    /// `linear`, linear floats otherwise. A compare layout draws Phong on the left (of the
+    /// split, or in the left half) and Blinn-Phong on the right.
     ///
     /// # Errors
     /// When the size is zero or above the device's texture limit, or the read-back fails.
@@ -489,7 +563,7 @@ impl Preview {
         let Offscreen {
             size: (width, height),
             linear,
-            split,
+            layout,
         } = offscreen;
         let max = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
@@ -526,27 +600,15 @@ impl Preview {
         );
         let depth = texture(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let key = PipelineKey::for_frame(settings, &maps.uniform, format);
-        let parts: Vec<DrawPart> = match split {
-            None => vec![(key, (0, 0, width, height))],
-            Some(at) => {
-                let at = at.min(width);
-                vec![
-                    (
-                        PipelineKey {
-                            model: ShadingModel::Phong,
-                            ..key
-                        },
-                        (0, 0, at, height),
-                    ),
-                    (
-                        PipelineKey {
-                            model: ShadingModel::BlinnPhong,
-                            ..key
-                        },
-                        (at, 0, width - at, height),
-                    ),
-                ]
-            }
+        let parts = if layout == Layout::Single {
+            layout.parts(key, key, (width, height))
+        } else {
+            let side = |model| PipelineKey { model, ..key };
+            layout.parts(
+                side(ShadingModel::Phong),
+                side(ShadingModel::BlinnPhong),
+                (width, height),
+            )
         };
         let mut encoder = gpu
             .device

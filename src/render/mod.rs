@@ -44,6 +44,17 @@ pub const N_RAMP: [[f32; 3]; 5] = [
     [0.9473, 0.7991, 0.0091],
 ];
 
+/// The difference heatmap's colour for `t` in `[0, 1]` (0 at no difference, 1 at the scale's
+/// top): black, red, yellow, white, linear RGB. `shaders/difference.wgsl` has the same ramp.
+pub fn heat_ramp(t: f32) -> Vec3 {
+    let t = t.clamp(0.0, 1.0);
+    Vec3::new(
+        (t * 3.0).min(1.0),
+        (t * 3.0 - 1.0).clamp(0.0, 1.0),
+        (t * 3.0 - 2.0).clamp(0.0, 1.0),
+    )
+}
+
 /// The false colour of `n` (linear RGB).
 pub fn n_false_colour(n: f32) -> Vec3 {
     let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln() as f32;

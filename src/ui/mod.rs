@@ -100,6 +100,58 @@ struct Job {
 }
 
 /// The export dialog's state.
+/// The New dialog's choices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewDialog {
+    /// Map size (square), texels.
+    pub size: u32,
+    /// Index into the material presets: the base material.
+    pub preset: usize,
+    /// A built-in mesh name, or a mesh file's path.
+    pub mesh: String,
+}
+
+/// Map sizes the New dialog offers.
+pub const NEW_SIZES: [u32; 5] = [512, 1024, 2048, 4096, 8192];
+
+/// Built-in meshes the New dialog offers.
+pub const NEW_MESHES: [&str; 4] = ["sphere", "plane", "cube", "torus"];
+
+/// How many recent files are kept.
+pub const RECENT_MAX: usize = 10;
+
+/// `list` with `path` moved to the front, without duplicates, at most [`RECENT_MAX`] long.
+pub fn push_recent(list: &mut Vec<PathBuf>, path: &Path) {
+    let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    list.retain(|p| *p != path);
+    list.insert(0, path);
+    list.truncate(RECENT_MAX);
+}
+
+fn recent_path() -> Option<PathBuf> {
+    layout_path().map(|p| p.with_file_name("recent.json"))
+}
+
+fn load_recent() -> Vec<PathBuf> {
+    recent_path()
+        .and_then(|p| std::fs::read(p).ok())
+        .and_then(|text| serde_json::from_slice::<Vec<PathBuf>>(&text).ok())
+        .map(|mut list| {
+            list.truncate(RECENT_MAX);
+            list
+        })
+        .unwrap_or_default()
+}
+
+fn save_recent(list: &[PathBuf]) {
+    if let (Some(path), Ok(json)) = (recent_path(), serde_json::to_vec_pretty(list)) {
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let _ = crate::atomic::write_atomic(&path, &json);
+    }
+}
+
 struct ExportDialog {
     presets: Vec<ExportPreset>,
     chosen: usize,
@@ -161,6 +213,10 @@ pub struct EditorState {
     pub notices: Vec<Notice>,
     job: Option<Job>,
     export: Option<ExportDialog>,
+    /// The New dialog, while open.
+    pub new_dialog: Option<NewDialog>,
+    /// Recently opened or saved projects, newest first.
+    pub recent: Vec<PathBuf>,
     /// The texel under the cursor, in either view.
     pub hover: Option<(u32, u32)>,
     /// The tab under the cursor.
@@ -192,9 +248,17 @@ pub struct Editor {
 }
 
 fn new_document(size: u32) -> Result<(Document, MeshState), String> {
-    let mut doc =
-        Document::new(size, size, DocumentSettings::default()).map_err(|e| e.to_string())?;
-    let mesh = crate::mesh::builtin("sphere").ok_or("no built-in sphere")?;
+    new_document_with(size, DocumentSettings::default(), "sphere")
+}
+
+/// A new `size`^2 document with `settings` on the built-in mesh `mesh`.
+fn new_document_with(
+    size: u32,
+    settings: DocumentSettings,
+    mesh: &str,
+) -> Result<(Document, MeshState), String> {
+    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
+    let mesh = crate::mesh::builtin(mesh).ok_or_else(|| format!("no built-in mesh {mesh:?}"))?;
     attach(&mut doc, &mesh)?;
     Ok((doc, MeshState::new(mesh, 1)))
 }
@@ -285,6 +349,8 @@ impl Editor {
                 notices,
                 job: None,
                 export: None,
+                new_dialog: None,
+                recent: load_recent(),
                 hover: None,
                 hover_tab: None,
                 stroking: None,
@@ -456,12 +522,14 @@ impl EditorState {
                 );
                 self.notices
                     .push(notice(format!("opened {}", path.display()), false));
+                self.remember(&path);
                 self.path = Some(path);
             }
             JobResult::Saved(path, version) => {
                 self.saved_version = version;
                 self.notices
                     .push(notice(format!("saved {}", path.display()), false));
+                self.remember(&path);
                 self.path = Some(path);
             }
             JobResult::Exported(dir, m) => self.notices.push(notice(
@@ -627,17 +695,114 @@ impl EditorState {
         }
     }
 
+    /// Opens the New dialog (Ctrl+N), starting from the current document's size.
     fn new_project(&mut self) {
-        match new_document(DEFAULT_SIZE) {
+        let preset = self
+            .presets
+            .iter()
+            .position(|(name, _, _)| Some(name) == self.doc.settings.preset.as_ref())
+            .unwrap_or(0);
+        self.new_dialog = Some(NewDialog {
+            size: self.doc.maps.width(),
+            preset,
+            mesh: "sphere".into(),
+        });
+    }
+
+    /// Replaces the document with a new one as `dialog` says (the old one's unsaved changes
+    /// are in its recovery copy and were asked about before).
+    pub fn create_project(&mut self, dialog: &NewDialog) {
+        let mut settings = DocumentSettings::default();
+        if let Some((name, value, _)) = self.presets.get(dialog.preset) {
+            settings.base = *value;
+            settings.secondary = *value;
+            settings.preset = Some(name.clone());
+        }
+        let builtin = NEW_MESHES.contains(&dialog.mesh.as_str());
+        let mesh_name = if builtin {
+            dialog.mesh.as_str()
+        } else {
+            "sphere"
+        };
+        match new_document_with(dialog.size, settings, mesh_name) {
             Ok((doc, mesh)) => {
                 self.doc = doc;
                 self.mesh = MeshState::new((*mesh.mesh).clone(), self.mesh.id + 1);
                 self.saved_version = self.doc.maps.version();
                 self.path = None;
                 self.viewport.frame(&self.mesh.mesh);
+                if !builtin {
+                    self.import_mesh(PathBuf::from(&dialog.mesh));
+                }
             }
             Err(e) => self.notices.push(notice(e, true)),
         }
+    }
+
+    /// The New dialog: resolution, base preset, mesh.
+    fn new_window(&mut self, ctx: &egui::Context) {
+        let Some(mut dialog) = self.new_dialog.take() else {
+            return;
+        };
+        let (mut open, mut create) = (true, false);
+        egui::Window::new("New project")
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::ComboBox::from_label("Resolution")
+                    .selected_text(format!("{0}x{0}", dialog.size))
+                    .show_ui(ui, |ui| {
+                        for size in NEW_SIZES {
+                            ui.selectable_value(&mut dialog.size, size, format!("{size}x{size}"));
+                        }
+                    });
+                egui::ComboBox::from_label("Base preset")
+                    .selected_text(self.presets.get(dialog.preset).map_or("", |p| p.0.as_str()))
+                    .show_ui(ui, |ui| {
+                        for (i, (name, _, _)) in self.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.preset, i, name);
+                        }
+                    });
+                ui.horizontal(|ui| {
+                    egui::ComboBox::from_label("Mesh")
+                        .selected_text(&dialog.mesh)
+                        .show_ui(ui, |ui| {
+                            for m in NEW_MESHES {
+                                ui.selectable_value(&mut dialog.mesh, m.to_string(), m);
+                            }
+                        });
+                    if ui.button("File…").clicked()
+                        && let Some(p) = rfd::FileDialog::new()
+                            .add_filter("mesh", &["obj", "gltf", "glb"])
+                            .pick_file()
+                    {
+                        dialog.mesh = p.display().to_string();
+                    }
+                });
+                let bytes = u64::from(dialog.size).pow(2) * 14;
+                ui.label(format!("Maps: {:.0} MB", bytes as f64 / 1e6));
+                let label = if self.dirty() {
+                    ui.colored_label(
+                        ui.visuals().warn_fg_color,
+                        "The current project has unsaved changes.",
+                    );
+                    "Discard changes and create"
+                } else {
+                    "Create"
+                };
+                create = ui.button(label).clicked();
+            });
+        if create {
+            self.create_project(&dialog);
+        } else if open {
+            self.new_dialog = Some(dialog);
+        }
+    }
+
+    /// Remembers `path` at the top of the recent files.
+    fn remember(&mut self, path: &Path) {
+        push_recent(&mut self.recent, path);
+        save_recent(&self.recent);
     }
 
     fn export_now(&mut self) {
@@ -1053,6 +1218,55 @@ impl EditorState {
         }
     }
 
+    /// Compare controls: the mode, then each side's model and approximation, the divider or
+    /// the heatmap's scale.
+    fn compare_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Compare");
+        let c = &mut self.viewport.comparison;
+        ui.horizontal_wrapped(|ui| {
+            for (mode, label) in Compare::ALL {
+                ui.selectable_value(&mut c.mode, mode, label);
+            }
+        });
+        if c.mode == Compare::Single {
+            return;
+        }
+        for (name, side) in [("Left", &mut c.left), ("Right", &mut c.right)] {
+            ui.horizontal(|ui| {
+                egui::ComboBox::from_id_salt(("compare model", name))
+                    .selected_text(side.model.name())
+                    .show_ui(ui, |ui| {
+                        for m in ShadingModel::ALL {
+                            ui.selectable_value(&mut side.model, m, m.name());
+                        }
+                    });
+                egui::ComboBox::from_id_salt(("compare approx", name))
+                    .selected_text(side.approx.name())
+                    .show_ui(ui, |ui| {
+                        for a in AmbientApprox::ALL {
+                            ui.selectable_value(&mut side.approx, a, a.name());
+                        }
+                    });
+                ui.label(name);
+            });
+        }
+        match c.mode {
+            Compare::Split => {
+                ui.add(egui::Slider::new(&mut c.split_at, 0.0..=1.0).text("Divider"))
+                    .on_hover_text("Or drag the line in the viewport");
+            }
+            Compare::Difference => {
+                ui.add(
+                    egui::Slider::new(&mut c.diff_max, 1e-4..=1.0)
+                        .logarithmic(true)
+                        .text("Heat scale"),
+                )
+                .on_hover_text("The difference |left - right| shown white");
+            }
+            Compare::Single | Compare::SideBySide => {}
+        }
+    }
+
     /// Right panel: model, view, compare, light, canvas channel, history.
     fn view_panel(&mut self, ui: &mut egui::Ui) {
         ui.heading("Shading");
@@ -1075,14 +1289,7 @@ impl EditorState {
         if approx != self.doc.settings.approx {
             self.apply(Command::SetApprox(approx));
         }
-        ui.heading("Compare");
-        ui.horizontal(|ui| {
-            ui.selectable_value(&mut self.viewport.compare, Compare::Single, "Single");
-            ui.selectable_value(&mut self.viewport.compare, Compare::Split, "Split");
-        });
-        if self.viewport.compare == Compare::Split {
-            ui.add(egui::Slider::new(&mut self.viewport.split_at, 0.0..=1.0).text("Divider"));
-        }
+        self.compare_ui(ui);
         ui.heading("View");
         egui::ComboBox::from_label("View mode")
             .selected_text(self.view.name())
@@ -1294,6 +1501,35 @@ impl EditorState {
                 if item(ui, "Open…", &keys::OPEN) {
                     self.open_dialog();
                 }
+                ui.menu_button("Open Recent", |ui| {
+                    if self.recent.is_empty() {
+                        ui.label("No recent files");
+                    }
+                    let mut chosen = None;
+                    for p in &self.recent {
+                        let name = p.file_name().map_or_else(
+                            || p.display().to_string(),
+                            |n| n.to_string_lossy().into_owned(),
+                        );
+                        if ui
+                            .button(name)
+                            .on_hover_text(p.display().to_string())
+                            .clicked()
+                        {
+                            chosen = Some(p.clone());
+                        }
+                    }
+                    if let Some(p) = chosen {
+                        if self.dirty() {
+                            self.notices.push(notice(
+                                "save or discard the current changes first (Ctrl+S)",
+                                true,
+                            ));
+                        } else {
+                            self.open(p);
+                        }
+                    }
+                });
                 if item(ui, "Save", &keys::SAVE) {
                     self.save();
                 }
@@ -1554,6 +1790,7 @@ impl Editor {
                 .show_inside(ui, &mut Tabs(s));
         });
         s.export_window(&ctx);
+        s.new_window(&ctx);
         s.recovery_window(&ctx);
         s.notices(&ctx);
         s.close_prompt(&ctx);

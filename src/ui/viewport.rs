@@ -9,7 +9,9 @@ use eframe::egui_wgpu;
 use egui::{Color32, Pos2, Rect, Sense, TextureId};
 
 use crate::gpu::Gpu;
+use crate::gpu::difference::{Difference, SIDE_FORMAT};
 use crate::gpu::maps::MapTextures;
+use crate::gpu::preview::Layout;
 use crate::gpu::preview::{
     DEPTH_FORMAT, DrawPart, MeshBuffers, Offscreen, PipelineKey, Preview, RenderedImage,
 };
@@ -17,7 +19,7 @@ use crate::mesh::Mesh;
 use crate::mesh::pick::{Bvh, Hit};
 use crate::model::texel::MaterialValue;
 use crate::model::{Document, MaterialMaps};
-use crate::reflectance::ShadingModel;
+use crate::reflectance::{AmbientApprox, ShadingModel};
 use crate::render::{Camera, FrameSettings};
 
 /// The viewport's accessible name.
@@ -28,8 +30,76 @@ pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
 pub enum Compare {
     /// The document's model alone.
     Single,
-    /// Phong left of the divider, Blinn-Phong right.
+    /// One picture wiped by a draggable divider: the left side's model left of it, the right
+    /// side's right of it.
     Split,
+    /// Two whole pictures side by side, one camera.
+    SideBySide,
+    /// `|left - right|` as a heatmap with a scale bar.
+    Difference,
+}
+
+impl Compare {
+    /// Every mode with its label, in the order the compare controls show them.
+    pub const ALL: [(Self, &'static str); 4] = [
+        (Self::Single, "Single"),
+        (Self::Split, "Split"),
+        (Self::SideBySide, "Side by side"),
+        (Self::Difference, "Difference"),
+    ];
+}
+
+/// One side of a comparison: its shading model and approximation of `chi`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Side {
+    /// Shading model.
+    pub model: ShadingModel,
+    /// Approximation of `chi`.
+    pub approx: AmbientApprox,
+}
+
+impl Side {
+    /// The label drawn over this side of the viewport.
+    pub fn label(self) -> String {
+        let model = match self.model {
+            ShadingModel::Phong => "Phong (eq. 8)",
+            ShadingModel::BlinnPhong => "Blinn-Phong (eq. 11)",
+        };
+        format!("{model}, {}", self.approx.name())
+    }
+}
+
+/// What the viewport compares: the mode, the two sides and where the divider is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Comparison {
+    /// Compare mode.
+    pub mode: Compare,
+    /// The left side (Phong by default).
+    pub left: Side,
+    /// The right side (Blinn-Phong by default).
+    pub right: Side,
+    /// Split position, a fraction of the width.
+    pub split_at: f32,
+    /// The difference shown white in the heatmap (linear radiance).
+    pub diff_max: f32,
+}
+
+impl Default for Comparison {
+    fn default() -> Self {
+        Self {
+            mode: Compare::Single,
+            left: Side {
+                model: ShadingModel::Phong,
+                approx: AmbientApprox::Fast,
+            },
+            right: Side {
+                model: ShadingModel::BlinnPhong,
+                approx: AmbientApprox::Fast,
+            },
+            split_at: 0.5,
+            diff_max: 0.1,
+        }
+    }
 }
 
 /// GPU objects of the viewport.
@@ -40,6 +110,7 @@ pub struct ViewportGpu {
     mesh: Option<(u64, MeshBuffers)>,
     maps: Option<MapTextures>,
     target: Option<Target>,
+    difference: Difference,
 }
 
 struct Target {
@@ -47,6 +118,8 @@ struct Target {
     color: wgpu::Texture,
     depth: wgpu::TextureView,
     id: TextureId,
+    /// The two linear renders the difference mode compares, made when first needed.
+    sides: Option<(wgpu::TextureView, wgpu::TextureView)>,
 }
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -65,6 +138,7 @@ impl ViewportGpu {
             unorm16,
         };
         let preview = Preview::new(&gpu);
+        let difference = Difference::new(&gpu);
         Self {
             gpu,
             renderer: render_state.clone(),
@@ -72,6 +146,7 @@ impl ViewportGpu {
             mesh: None,
             maps: None,
             target: None,
+            difference,
         }
     }
 
@@ -92,7 +167,7 @@ impl ViewportGpu {
         let offscreen = Offscreen {
             size: (size, size),
             linear: false,
-            split: None,
+            layout: Layout::Single,
         };
         match self
             .preview
@@ -122,8 +197,7 @@ impl ViewportGpu {
         doc: &Document,
         mesh: &(u64, Arc<Mesh>),
         settings: &FrameSettings,
-        compare: Compare,
-        split_at: f32,
+        comparison: &Comparison,
         size: (u32, u32),
     ) -> TextureId {
         if self.mesh.as_ref().is_none_or(|(id, _)| *id != mesh.0) {
@@ -139,34 +213,24 @@ impl ViewportGpu {
         if self.target.as_ref().is_none_or(|t| t.size != size) {
             self.target = Some(self.make_target(size));
         }
+        if comparison.mode == Compare::Difference
+            && let Some(target) = &mut self.target
+            && target.sides.is_none()
+        {
+            target.sides = Some((side_texture(&self.gpu, size), side_texture(&self.gpu, size)));
+        }
         let (Some((_, mesh)), Some(maps), Some(target)) = (&self.mesh, &self.maps, &self.target)
         else {
             return TextureId::default();
         };
         let key = PipelineKey::for_frame(settings, &maps.uniform, FORMAT);
-        let (w, h) = size;
-        let parts: Vec<DrawPart> = match compare {
-            Compare::Single => vec![(key, (0, 0, w, h))],
-            Compare::Split => {
-                let at = ((split_at.clamp(0.0, 1.0) * w as f32) as u32).min(w);
-                vec![
-                    (
-                        PipelineKey {
-                            model: ShadingModel::Phong,
-                            ..key
-                        },
-                        (0, 0, at, h),
-                    ),
-                    (
-                        PipelineKey {
-                            model: ShadingModel::BlinnPhong,
-                            ..key
-                        },
-                        (at, 0, w - at, h),
-                    ),
-                ]
-            }
+        let side = |s: Side, format| PipelineKey {
+            model: s.model,
+            approx: s.approx,
+            format,
+            ..key
         };
+        let (w, _) = size;
         let mut encoder = self
             .gpu
             .device
@@ -176,17 +240,62 @@ impl ViewportGpu {
         let view = target
             .color
             .create_view(&wgpu::TextureViewDescriptor::default());
-        self.preview.draw(
-            &self.gpu,
-            &mut encoder,
-            &view,
-            &target.depth,
-            size,
-            mesh,
-            maps,
-            settings,
-            &parts,
-        );
+        let parts = match comparison.mode {
+            Compare::Single => Some(Layout::Single.parts(key, key, size)),
+            Compare::Split => {
+                let at = ((comparison.split_at.clamp(0.0, 1.0) * w as f32) as u32).min(w);
+                Some(Layout::Split(at).parts(
+                    side(comparison.left, FORMAT),
+                    side(comparison.right, FORMAT),
+                    size,
+                ))
+            }
+            Compare::SideBySide => Some(Layout::SideBySide.parts(
+                side(comparison.left, FORMAT),
+                side(comparison.right, FORMAT),
+                size,
+            )),
+            Compare::Difference => None,
+        };
+        match (parts, &target.sides) {
+            (Some(parts), _) => self.preview.draw(
+                &self.gpu,
+                &mut encoder,
+                &view,
+                &target.depth,
+                size,
+                mesh,
+                maps,
+                settings,
+                &parts,
+            ),
+            (None, Some((a, b))) => {
+                for (s, out) in [(comparison.left, a), (comparison.right, b)] {
+                    let part = DrawPart::whole(side(s, SIDE_FORMAT), size);
+                    self.preview.draw(
+                        &self.gpu,
+                        &mut encoder,
+                        out,
+                        &target.depth,
+                        size,
+                        mesh,
+                        maps,
+                        settings,
+                        &[part],
+                    );
+                }
+                self.difference.draw(
+                    &self.gpu,
+                    &mut encoder,
+                    a,
+                    b,
+                    &view,
+                    FORMAT,
+                    comparison.diff_max,
+                );
+            }
+            (None, None) => {}
+        }
         self.gpu.queue.submit([encoder.finish()]);
         target.id
     }
@@ -236,18 +345,37 @@ impl ViewportGpu {
             color,
             depth,
             id,
+            sides: None,
         }
     }
+}
+
+/// A linear float render target for one side of the difference compare.
+fn side_texture(gpu: &Gpu, (width, height): (u32, u32)) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("difference side"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: SIDE_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
 }
 
 /// The viewport's state.
 pub struct Viewport {
     /// Camera.
     pub camera: Camera,
-    /// Compare mode.
-    pub compare: Compare,
-    /// Split position, a fraction of the width.
-    pub split_at: f32,
+    /// What is compared, and how.
+    pub comparison: Comparison,
     /// The renderer, when there is a GPU.
     pub gpu: Option<ViewportGpu>,
     /// Milliseconds the last frame took to record and submit.
@@ -262,8 +390,7 @@ impl Viewport {
     pub fn new(gpu: Option<ViewportGpu>) -> Self {
         Self {
             camera: Camera::default().orbit(0.5, 0.35),
-            compare: Compare::Single,
-            split_at: 0.5,
+            comparison: Comparison::default(),
             gpu,
             frame_ms: 0.0,
             no_gpu: "The 3D preview needs a GPU (wgpu); painting on the mesh still works.".into(),
@@ -276,8 +403,25 @@ impl Viewport {
         self.frame_pending = true;
     }
 
+    /// The picture under `pos`: the whole viewport, or the half it is in when side by side.
+    pub fn picture_at(&self, rect: Rect, pos: Pos2) -> Rect {
+        if self.comparison.mode != Compare::SideBySide {
+            return rect;
+        }
+        let half = rect.width() / 2.0;
+        if pos.x < rect.center().x {
+            Rect::from_min_size(rect.min, egui::vec2(half, rect.height()))
+        } else {
+            Rect::from_min_size(
+                Pos2::new(rect.max.x - half, rect.min.y),
+                egui::vec2(half, rect.height()),
+            )
+        }
+    }
+
     /// The surface point under a screen position, if the ray hits the mesh.
     pub fn pick(&self, rect: Rect, pos: Pos2, mesh: &Mesh, bvh: &Bvh) -> Option<Hit> {
+        let rect = self.picture_at(rect, pos);
         let (w, h) = (rect.width().max(1.0), rect.height().max(1.0));
         let (origin, dir) =
             self.camera
@@ -299,6 +443,9 @@ impl Viewport {
         response.widget_info(|| {
             egui::WidgetInfo::labeled(egui::WidgetType::Other, true, VIEWPORT_LABEL)
         });
+        if self.comparison.mode == Compare::Split {
+            self.divider_ui(ui, rect);
+        }
         if self.frame_pending {
             // Fit the bounding sphere in the narrower of the two fields of view.
             self.frame_pending = false;
@@ -338,7 +485,7 @@ impl Viewport {
         match &mut self.gpu {
             Some(gpu) => {
                 let start = Instant::now();
-                let id = gpu.render(doc, mesh, &frame, self.compare, self.split_at, size);
+                let id = gpu.render(doc, mesh, &frame, &self.comparison, size);
                 self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
                 painter.image(
                     id,
@@ -357,28 +504,105 @@ impl Viewport {
                 );
             }
         }
-        if self.compare == Compare::Split {
-            let x = rect.min.x + rect.width() * self.split_at;
-            painter.line_segment(
-                [Pos2::new(x, rect.min.y), Pos2::new(x, rect.max.y)],
-                egui::Stroke::new(1.5, Color32::WHITE),
-            );
-            let font = egui::FontId::proportional(13.0);
-            painter.text(
-                rect.min + egui::vec2(8.0, 8.0),
-                egui::Align2::LEFT_TOP,
-                "Phong (eq. 8)",
-                font.clone(),
-                Color32::WHITE,
-            );
-            painter.text(
-                Pos2::new(rect.max.x - 8.0, rect.min.y + 8.0),
-                egui::Align2::RIGHT_TOP,
-                "Blinn-Phong (eq. 11)",
-                font,
-                Color32::WHITE,
-            );
-        }
+        self.labels_ui(&painter, rect);
         (response, rect)
     }
+
+    /// The split's divider: a handle over the line that drags it (drawn on top of the
+    /// viewport, so it wins over painting there).
+    fn divider_ui(&mut self, ui: &mut egui::Ui, rect: Rect) {
+        let x = rect.min.x + rect.width() * self.comparison.split_at;
+        let handle = Rect::from_min_max(
+            Pos2::new(x - 5.0, rect.min.y),
+            Pos2::new(x + 5.0, rect.max.y),
+        );
+        let response = ui
+            .interact(handle, ui.id().with("split divider"), Sense::drag())
+            .on_hover_cursor(egui::CursorIcon::ResizeHorizontal);
+        response.widget_info(|| {
+            egui::WidgetInfo::labeled(egui::WidgetType::Other, true, DIVIDER_LABEL)
+        });
+        if response.dragged()
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            self.comparison.split_at = ((p.x - rect.min.x) / rect.width().max(1.0)).clamp(0.0, 1.0);
+        }
+    }
+
+    /// The sides' labels, the divider and the heatmap's scale bar.
+    fn labels_ui(&self, painter: &egui::Painter, rect: Rect) {
+        let c = &self.comparison;
+        let font = egui::FontId::proportional(13.0);
+        let label = |pos: Pos2, align, text: String| {
+            painter.text(pos, align, text, font.clone(), Color32::WHITE);
+        };
+        let top_left = rect.min + egui::vec2(8.0, 8.0);
+        let top_right = Pos2::new(rect.max.x - 8.0, rect.min.y + 8.0);
+        match c.mode {
+            Compare::Single => {}
+            Compare::Split => {
+                let x = rect.min.x + rect.width() * c.split_at;
+                painter.line_segment(
+                    [Pos2::new(x, rect.min.y), Pos2::new(x, rect.max.y)],
+                    egui::Stroke::new(1.5, Color32::WHITE),
+                );
+                label(top_left, egui::Align2::LEFT_TOP, c.left.label());
+                label(top_right, egui::Align2::RIGHT_TOP, c.right.label());
+            }
+            Compare::SideBySide => {
+                label(top_left, egui::Align2::LEFT_TOP, c.left.label());
+                let mid = Pos2::new(rect.center().x + 8.0, rect.min.y + 8.0);
+                label(mid, egui::Align2::LEFT_TOP, c.right.label());
+            }
+            Compare::Difference => {
+                label(
+                    top_left,
+                    egui::Align2::LEFT_TOP,
+                    format!("|{} - {}|", c.left.label(), c.right.label()),
+                );
+                heat_scale_ui(painter, rect, c.diff_max);
+            }
+        }
+    }
+}
+
+/// The divider's accessible name.
+pub const DIVIDER_LABEL: &str = "Split divider";
+
+/// The heatmap's scale bar along the bottom of `rect`: the ramp from 0 to `max`.
+fn heat_scale_ui(painter: &egui::Painter, rect: Rect, max: f32) {
+    let bar = Rect::from_min_size(
+        Pos2::new(rect.min.x + 16.0, rect.max.y - 34.0),
+        egui::vec2((rect.width() - 32.0).clamp(40.0, 320.0), 12.0),
+    );
+    let steps = 64;
+    for i in 0..steps {
+        let t0 = i as f32 / steps as f32;
+        let c = crate::render::heat_ramp(t0 + 0.5 / steps as f32);
+        let srgb = |v: f32| (crate::model::texel::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+        let x0 = bar.min.x + bar.width() * t0;
+        painter.rect_filled(
+            Rect::from_min_max(
+                Pos2::new(x0, bar.min.y),
+                Pos2::new(x0 + bar.width() / steps as f32 + 0.5, bar.max.y),
+            ),
+            0.0,
+            Color32::from_rgb(srgb(c.x), srgb(c.y), srgb(c.z)),
+        );
+    }
+    let font = egui::FontId::proportional(12.0);
+    painter.text(
+        Pos2::new(bar.min.x, bar.max.y + 2.0),
+        egui::Align2::LEFT_TOP,
+        "0",
+        font.clone(),
+        Color32::WHITE,
+    );
+    painter.text(
+        Pos2::new(bar.max.x, bar.max.y + 2.0),
+        egui::Align2::RIGHT_TOP,
+        format!("{max:.3}"),
+        font,
+        Color32::WHITE,
+    );
 }
