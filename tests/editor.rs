@@ -132,6 +132,14 @@ fn a_scripted_editing_session() {
     harness.run();
     assert_eq!(harness.state().state.tool, kapaint::ui::Tool::Eraser);
 
+    // The built-in grain stamp shapes the brush, and Round takes it off again.
+    harness.get_by_label("Grain").click();
+    harness.run();
+    assert!(harness.state().state.doc.settings.brush.stamp.is_some());
+    harness.get_by_label("Round").click();
+    harness.run();
+    assert!(harness.state().state.doc.settings.brush.stamp.is_none());
+
     // The recent-files list keeps each project once, newest first, at most RECENT_MAX.
     let mut recent = Vec::new();
     for i in 0..12 {
@@ -178,4 +186,17 @@ fn a_scripted_editing_session() {
     harness.run();
     harness.get_by_role_and_label(Role::Button, "Export");
     harness.get_by_label("Preset");
+    // Its preview (computed on a worker thread): the packed layout of the painted maps, the
+    // memory report and the estimated k_a error.
+    for _ in 0..200 {
+        harness.run();
+        if harness.query_by_label("Packed layout").is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    harness.get_by_label("Packed layout");
+    harness.get_by_label("kd_n.png");
+    harness.get_by_label_contains("Estimated k_a error");
+    harness.get_by_label_contains("Memory: set");
 }

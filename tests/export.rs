@@ -579,3 +579,36 @@ fn padding_fills_outside_the_islands_from_the_mesh_bake() {
     assert!(outside > 1000, "{outside}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_plan_shows_what_the_export_writes() {
+    let doc = painted();
+    for name in ["compact", "16-bit", "separate", "with-ka", "ktx2-raw"] {
+        let preset = preset::find(name).expect("preset");
+        let plan = kapaint::export::set::plan(&doc, &preset);
+        let dir = temp(&format!("plan-{name}"));
+        let m = set::export(&doc, &preset, &dir).expect("export");
+        let planned: Vec<(&str, &Vec<String>)> = plan
+            .files
+            .iter()
+            .map(|f| (f.path.as_str(), &f.layout))
+            .collect();
+        let written: Vec<(&str, &Vec<String>)> = m
+            .files
+            .iter()
+            .map(|f| (f.path.as_str(), &f.layout))
+            .collect();
+        assert_eq!(planned, written, "{name}");
+        assert_eq!(plan.n_encoding, m.n_encoding, "{name}");
+        assert_eq!(plan.constants, m.constants, "{name}");
+        assert_eq!(
+            (plan.bytes.naive, plan.bytes.project),
+            (m.bytes.naive, m.bytes.project)
+        );
+        // The estimate is n's quantisation alone; the set's measured error adds the other
+        // channels' rounding, so it is at least as large.
+        assert!(plan.ka_error.max > 0.0, "{name}: n is quantised");
+        assert!(m.ka_error.max >= plan.ka_error.max * 0.999, "{name}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

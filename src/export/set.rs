@@ -445,6 +445,95 @@ struct StoredImage {
     srgb: bool,
 }
 
+/// One file a set will hold, as planned before anything is encoded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedFile {
+    /// File name.
+    pub path: String,
+    /// Components in channel order (`kd.r`, `n`, `ks`, ...).
+    pub layout: Vec<String>,
+    /// Bytes of the image uncompressed, at the preset's depth (the file is smaller when the
+    /// format compresses).
+    pub raw_bytes: u64,
+}
+
+/// What exporting a document with a preset will write, and the `k_a` error that `n`'s
+/// quantisation alone will cost: the export dialog's preview, computed without encoding.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SetPlan {
+    /// The images, in the order they are written.
+    pub files: Vec<PlannedFile>,
+    /// Channels that become constants in the manifest instead of images.
+    pub constants: Constants,
+    /// `n`'s curve, range and bits, when `n` is stored in an integer image.
+    pub n_encoding: Option<NEncoding>,
+    /// The relative `k_a` error of that quantisation (block compression adds to it).
+    pub ka_error: KaError,
+    /// Bytes: the images uncompressed, the naive maps, the project's maps.
+    pub bytes: MemoryReport,
+}
+
+/// The plan of exporting `doc` with `preset` (see [`SetPlan`]).
+pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
+    let (plan, _, _) = plan_set(doc, preset);
+    plan
+}
+
+/// [`plan`], with the two facts the writer needs besides: whether `k_s` is grey, and the
+/// planned images' components.
+fn plan_set(
+    doc: &Document,
+    preset: &ExportPreset,
+) -> (SetPlan, bool, Vec<(&'static str, Vec<Comp>)>) {
+    let maps = &doc.maps;
+    let (model, approx) = (doc.settings.model, doc.settings.approx);
+    let (kd, ks, n) = maps.uniform_channels();
+    let constants = Constants {
+        kd: kd.map(|v| v.map(decode_unorm)),
+        ks: ks.map(|v| v.map(decode_unorm)),
+        n: n.map(decode_n),
+    };
+    let mono_ks = ks_monochrome(maps);
+    let (n_encoding, ka_error) = match (constants.n, preset.format) {
+        (Some(_), _) | (None, Format::Exr) => (None, KaError::default()),
+        (None, _) => rank_encodings(maps, model, approx, preset.n_bits)
+            .first()
+            .map_or((None, KaError::default()), |(e, err)| (Some(*e), *err)),
+    };
+    let images = plan_images(preset, &constants, mono_ks);
+    let depth: u64 = match preset.format {
+        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 1,
+        Format::Png16 => 2,
+        Format::Exr => 4,
+    };
+    let texels = u64::from(maps.width()) * u64::from(maps.height());
+    let ext = preset.format.extension();
+    let files: Vec<PlannedFile> = images
+        .iter()
+        .map(|(stem, comps)| PlannedFile {
+            path: format!("{stem}.{ext}"),
+            layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
+            raw_bytes: texels * depth * comps.len() as u64,
+        })
+        .collect();
+    let bytes = MemoryReport {
+        exported: files.iter().map(|f| f.raw_bytes).sum(),
+        naive: texels * 10 * depth,
+        project: texels * 14,
+    };
+    (
+        SetPlan {
+            files,
+            constants,
+            n_encoding,
+            ka_error,
+            bytes,
+        },
+        mono_ks,
+        images,
+    )
+}
+
 /// Exports `doc` with `preset` into the folder `out` (which must not exist or be empty).
 ///
 /// # Errors
@@ -479,19 +568,8 @@ pub fn export_with(
     let maps = &doc.maps;
     let (model, approx) = (doc.settings.model, doc.settings.approx);
     let (w, h) = (maps.width(), maps.height());
-    let (kd, ks, n) = maps.uniform_channels();
-    let constants = Constants {
-        kd: kd.map(|v| v.map(decode_unorm)),
-        ks: ks.map(|v| v.map(decode_unorm)),
-        n: n.map(decode_n),
-    };
-    let mono_ks = ks_monochrome(maps);
-    let n_enc = match (constants.n, preset.format) {
-        (Some(_), _) | (None, Format::Exr) => None,
-        (None, _) => rank_encodings(maps, model, approx, preset.n_bits)
-            .first()
-            .map(|(e, _)| *e),
-    };
+    let (planned, mono_ks, images) = plan_set(doc, preset);
+    let (constants, n_enc) = (planned.constants, planned.n_encoding);
     let mut texels = rows(maps);
     // Outside the mesh's UV islands, texels copy the nearest island's, so mips and filtering
     // do not pull the background into the edges.
@@ -522,7 +600,6 @@ pub fn export_with(
         Vec::new()
     };
 
-    let images = plan_images(preset, &constants, mono_ks);
     let ext = preset.format.extension();
     progress.check().map_err(cancelled)?;
     progress.start("encode", images.len() as u64 * u64::from(h));

@@ -61,6 +61,33 @@ impl Stamp {
         })
     }
 
+    /// A built-in grainy round stamp, `size` pixels square: a soft disc broken by value noise
+    /// from a fixed hash, so it is the same on every machine.
+    pub fn grain(size: u32) -> Self {
+        let size = size.max(2);
+        let hash = |x: u32, y: u32| {
+            let mut h = x.wrapping_mul(0x9E37_79B9) ^ y.wrapping_mul(0x85EB_CA6B);
+            h ^= h >> 15;
+            h = h.wrapping_mul(0x2C1B_3C6D);
+            h ^= h >> 12;
+            (h & 0xffff) as f32 / 65535.0
+        };
+        let alpha = (0..size * size)
+            .map(|i| {
+                let (x, y) = (i % size, i / size);
+                let c = (size as f32 - 1.0) * 0.5;
+                let r = ((x as f32 - c).hypot(y as f32 - c) / (c + 0.5)).min(1.0);
+                let disc = 1.0 - r * r;
+                disc * (0.35 + 0.65 * hash(x, y))
+            })
+            .collect();
+        Self {
+            width: size,
+            height: size,
+            alpha,
+        }
+    }
+
     /// Alpha at dab-local coordinates `u, v` in `[-1, 1]` (0 outside).
     pub fn sample(&self, u: f32, v: f32) -> f32 {
         if !(-1.0..=1.0).contains(&u) || !(-1.0..=1.0).contains(&v) {
@@ -374,6 +401,21 @@ impl<P: StrokePos> Smoother<P> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_grain_stamp_is_a_grainy_disc_the_same_everywhere() {
+        let a = Stamp::grain(64);
+        assert_eq!(a, Stamp::grain(64), "deterministic");
+        assert!(a.alpha.iter().all(|v| (0.0..=1.0).contains(v)));
+        assert_eq!(a.sample(-1.0, -1.0), 0.0, "nothing in the corners");
+        let centre: Vec<f32> = (0..16)
+            .map(|i| a.sample(i as f32 * 0.01 - 0.08, 0.0))
+            .collect();
+        let (lo, hi) = centre
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        assert!(lo > 0.2 && hi - lo > 0.1, "grain near the centre: {lo}..{hi}");
+    }
 
     fn dabs(points: &[(f32, f32)], spacing: f32) -> Vec<DabPoint> {
         let mut r = Resampler::new(spacing);

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use egui::{Key, KeyboardShortcut, Modifiers};
+use egui::{Color32, Key, KeyboardShortcut, Modifiers};
 use egui_dock::{DockArea, DockState, TabViewer};
 use glam::Vec2;
 
@@ -89,6 +89,8 @@ enum JobResult {
     Mesh(PathBuf, Arc<Surface>),
     /// An image decoded for a channel.
     Image(Channel, PathBuf, Box<image::DynamicImage>),
+    /// A brush stamp read from an image.
+    Stamp(PathBuf, crate::model::brush::Stamp),
     Failed(String),
 }
 
@@ -100,6 +102,86 @@ struct Job {
 }
 
 /// The export dialog's state.
+/// The export dialog's preview: the packed layout of each file, the constants, the memory
+/// report and the `k_a` error that `n`'s quantisation costs.
+fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPlan) {
+    let mb = |b: u64| b as f64 / 1e6;
+    ui.label(egui::RichText::new("Packed layout").strong());
+    egui::Grid::new("export layout")
+        .striped(true)
+        .show(ui, |ui| {
+            for f in &plan.files {
+                ui.monospace(&f.path);
+                ui.monospace(f.layout.join(" | "));
+                ui.label(format!("{:.1} MB raw", mb(f.raw_bytes)));
+                ui.end_row();
+            }
+        });
+    let c = &plan.constants;
+    let mut constants = Vec::new();
+    if let Some([r, g, b]) = c.kd {
+        constants.push(format!("k_d = ({r:.3}, {g:.3}, {b:.3})"));
+    }
+    if let Some([r, g, b]) = c.ks {
+        constants.push(format!("k_s = ({r:.3}, {g:.3}, {b:.3})"));
+    }
+    if let Some(n) = c.n {
+        constants.push(format!("n = {n:.2}"));
+    }
+    if plan.files.is_empty() {
+        ui.label("Every channel is constant: the set is a manifest alone.");
+    }
+    if !constants.is_empty() {
+        ui.label(format!(
+            "Constants in the manifest: {}",
+            constants.join(", ")
+        ));
+    }
+    if let Some(e) = plan.n_encoding {
+        ui.label(format!(
+            "n: {:?} curve over [{:.2}, {:.1}], {} bits",
+            e.curve, e.lo, e.hi, e.bits
+        ));
+    }
+    ui.label(format!(
+        "Estimated k_a error (n quantisation): max {:.3} %, mean {:.4} %",
+        plan.ka_error.max * 100.0,
+        plan.ka_error.mean * 100.0
+    ));
+    let b = &plan.bytes;
+    ui.label(format!(
+        "Memory: set {:.1} MB uncompressed (files are smaller), naive k_a + k_d + k_s + n {:.1} MB, project {:.1} MB",
+        mb(b.exported),
+        mb(b.naive),
+        mb(b.project)
+    ));
+}
+
+/// A cheap identity of a stamp for its preview cache: size and a few samples' bits.
+fn stamp_key(stamp: &crate::model::brush::Stamp) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (stamp.width, stamp.height).hash(&mut h);
+    let step = (stamp.alpha.len() / 61).max(1);
+    for v in stamp.alpha.iter().step_by(step) {
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
+}
+
+/// A `size`^2 grey picture of a stamp (white where it paints).
+fn stamp_image(stamp: &crate::model::brush::Stamp, size: usize) -> egui::ColorImage {
+    let mut pixels = Vec::with_capacity(size * size);
+    for y in 0..size {
+        for x in 0..size {
+            let at = |i: usize| (i as f32 + 0.5) / size as f32 * 2.0 - 1.0;
+            let a = stamp.sample(at(x), at(y));
+            pixels.push(Color32::from_gray((a * 255.0 + 0.5) as u8));
+        }
+    }
+    egui::ColorImage::new([size, size], pixels)
+}
+
 /// The New dialog's choices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewDialog {
@@ -156,6 +238,10 @@ struct ExportDialog {
     presets: Vec<ExportPreset>,
     chosen: usize,
     folder: String,
+    /// The preview of the chosen preset: for which preset and maps version, and the plan.
+    plan: Option<(usize, u64, crate::export::set::SetPlan)>,
+    /// A preview being computed on a worker thread.
+    planning: Option<(usize, u64, JoinHandle<crate::export::set::SetPlan>)>,
 }
 
 /// The mesh being painted, with what picking and the renderer need.
@@ -217,6 +303,8 @@ pub struct EditorState {
     pub new_dialog: Option<NewDialog>,
     /// Recently opened or saved projects, newest first.
     pub recent: Vec<PathBuf>,
+    /// The brush stamp's preview texture, and which stamp it shows.
+    stamp_preview: Option<(u64, egui::TextureHandle)>,
     /// The texel under the cursor, in either view.
     pub hover: Option<(u32, u32)>,
     /// The tab under the cursor.
@@ -351,6 +439,7 @@ impl Editor {
                 export: None,
                 new_dialog: None,
                 recent: load_recent(),
+                stamp_preview: None,
                 hover: None,
                 hover_tab: None,
                 stroking: None,
@@ -563,6 +652,13 @@ impl EditorState {
                     false,
                 ));
             }
+            JobResult::Stamp(path, stamp) => {
+                let mut brush = self.doc.settings.brush.clone();
+                brush.stamp = Some(stamp);
+                self.apply(Command::SetBrush(brush));
+                self.notices
+                    .push(notice(format!("stamp {}", path.display()), false));
+            }
             JobResult::Failed(e) => self.notices.push(notice(e, true)),
         }
     }
@@ -580,6 +676,66 @@ impl EditorState {
             match Surface::new(mesh, w, h) {
                 Ok(s) => JobResult::Mesh(path, Arc::new(s)),
                 Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Loads a brush stamp from an image on a worker thread.
+    pub fn load_stamp(&mut self, path: PathBuf) {
+        self.start_job("Stamp", move |progress| {
+            progress.start("decode", 1);
+            match crate::model::import::read_stamp(&path) {
+                Ok(stamp) => JobResult::Stamp(path, stamp),
+                Err(e) => JobResult::Failed(e.to_string()),
+            }
+        });
+    }
+
+    /// The brush's stamp row: a preview of the stamp, the built-in grain, loading one from an
+    /// image, and back to the round dab.
+    fn stamp_ui(&mut self, ui: &mut egui::Ui, brush: &mut crate::model::brush::BrushSettings) {
+        ui.horizontal(|ui| {
+            ui.label("Stamp");
+            match &brush.stamp {
+                None => {
+                    ui.label("round");
+                }
+                Some(stamp) => {
+                    let key = stamp_key(stamp);
+                    if self.stamp_preview.as_ref().is_none_or(|(k, _)| *k != key) {
+                        let image = stamp_image(stamp, 32);
+                        let texture = ui.ctx().load_texture(
+                            "brush stamp",
+                            image,
+                            egui::TextureOptions::LINEAR,
+                        );
+                        self.stamp_preview = Some((key, texture));
+                    }
+                    if let Some((_, texture)) = &self.stamp_preview {
+                        ui.image((texture.id(), egui::vec2(32.0, 32.0)))
+                            .on_hover_text(format!("{}x{} stamp", stamp.width, stamp.height));
+                    }
+                }
+            }
+            if ui
+                .button("Grain")
+                .on_hover_text("A built-in grainy stamp")
+                .clicked()
+            {
+                brush.stamp = Some(crate::model::brush::Stamp::grain(64));
+            }
+            if ui
+                .button("Load…")
+                .on_hover_text("A stamp from an image (luminance times alpha)")
+                .clicked()
+                && let Some(p) = rfd::FileDialog::new()
+                    .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
+                    .pick_file()
+            {
+                self.load_stamp(p);
+            }
+            if brush.stamp.is_some() && ui.button("Round").clicked() {
+                brush.stamp = None;
             }
         });
     }
@@ -811,13 +967,7 @@ impl EditorState {
             return;
         };
         let out = PathBuf::from(dialog.folder.trim());
-        let snapshot = {
-            let mut d = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
-            if let Some(s) = self.doc.surface() {
-                let _ = d.set_surface(Some(Arc::clone(s)));
-            }
-            d
-        };
+        let snapshot = self.snapshot();
         self.export = None;
         self.start_job(
             "Export",
@@ -920,6 +1070,8 @@ impl EditorState {
             presets: crate::export::preset::builtin(),
             chosen: 0,
             folder,
+            plan: None,
+            planning: None,
         });
     }
 }
@@ -1155,6 +1307,7 @@ impl EditorState {
         ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
         ui.checkbox(&mut brush.pressure_size, "Pressure: size");
         ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
+        self.stamp_ui(ui, &mut brush);
         if brush != self.doc.settings.brush {
             self.apply(Command::SetBrush(brush));
         }
@@ -1586,7 +1739,57 @@ impl EditorState {
         });
     }
 
+    /// A copy of the document for a worker thread (the maps' tiles are shared, not copied).
+    fn snapshot(&self) -> Document {
+        let mut d = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
+        if let Some(s) = self.doc.surface() {
+            let _ = d.set_surface(Some(Arc::clone(s)));
+        }
+        d
+    }
+
+    /// Keeps the export dialog's preview current: starts planning on a worker thread when the
+    /// preset or the maps changed, and takes the result when it is done.
+    fn update_export_plan(&mut self, ctx: &egui::Context) {
+        let version = self.doc.maps.version();
+        let snapshot = self.export.as_ref().and_then(|d| {
+            let current = |(p, v): (usize, u64)| p == d.chosen && v == version;
+            let planned = d.plan.as_ref().is_some_and(|(p, v, _)| current((*p, *v)));
+            let pending = d
+                .planning
+                .as_ref()
+                .is_some_and(|(p, v, _)| current((*p, *v)));
+            (!planned && !pending).then(|| self.snapshot())
+        });
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        if let Some(doc) = snapshot
+            && let Some(preset) = dialog.presets.get(dialog.chosen).cloned()
+        {
+            let spawned = std::thread::Builder::new()
+                .name("kapaint export preview".into())
+                .spawn(move || crate::export::set::plan(&doc, &preset));
+            if let Ok(handle) = spawned {
+                dialog.planning = Some((dialog.chosen, version, handle));
+            }
+        }
+        if dialog
+            .planning
+            .as_ref()
+            .is_some_and(|(_, _, h)| h.is_finished())
+            && let Some((p, v, handle)) = dialog.planning.take()
+            && let Ok(plan) = handle.join()
+        {
+            dialog.plan = Some((p, v, plan));
+        }
+        if dialog.planning.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(50));
+        }
+    }
+
     fn export_window(&mut self, ctx: &egui::Context) {
+        self.update_export_plan(ctx);
         let Some(dialog) = &mut self.export else {
             return;
         };
@@ -1612,6 +1815,17 @@ impl EditorState {
                 if let Some(p) = dialog.presets.get(dialog.chosen) {
                     ui.label(&p.description);
                 }
+                ui.separator();
+                match &dialog.plan {
+                    Some((p, _, plan)) if *p == dialog.chosen => export_plan_ui(ui, plan),
+                    _ => {
+                        ui.horizontal(|ui| {
+                            ui.spinner();
+                            ui.label("Measuring the set…");
+                        });
+                    }
+                }
+                ui.separator();
                 ui.horizontal(|ui| {
                     ui.label("Folder");
                     ui.text_edit_singleline(&mut dialog.folder);
