@@ -200,3 +200,34 @@ fn a_scripted_editing_session() {
     harness.get_by_label_contains("Estimated k_a error");
     harness.get_by_label_contains("Memory: set");
 }
+
+#[test]
+fn the_brush_outline_lies_on_the_surface_under_the_cursor() {
+    use kapaint::render::Camera;
+    let camera = Camera::default().orbit(0.4, 0.3);
+    let picture = egui::Rect::from_min_size(Pos2::new(100.0, 50.0), Vec2::new(400.0, 300.0));
+    let facing = (camera.eye() - camera.target).normalize();
+    // Facing the camera, the outline is a circle around the picture's centre.
+    let circle = kapaint::ui::brush_outline(&camera, picture, camera.target, facing, 0.1);
+    assert_eq!(circle.len(), 48);
+    let radii: Vec<f32> = circle
+        .iter()
+        .map(|p| p.distance(picture.center()))
+        .collect();
+    let (lo, hi) = radii
+        .iter()
+        .fold((f32::MAX, 0.0_f32), |(l, h), r| (l.min(*r), h.max(*r)));
+    assert!(lo > 5.0 && hi / lo < 1.02, "a circle: radii {lo}..{hi}");
+    // Seen edge-on (normal across the view), it flattens into a thin ellipse.
+    let across = facing.cross(glam::Vec3::Y).normalize();
+    let edge = kapaint::ui::brush_outline(&camera, picture, camera.target, across, 0.1);
+    let spread = |f: fn(&Pos2) -> f32, pts: &[Pos2]| {
+        let v: Vec<f32> = pts.iter().map(f).collect();
+        v.iter().copied().fold(f32::MIN, f32::max) - v.iter().copied().fold(f32::MAX, f32::min)
+    };
+    let (wide, tall) = (spread(|p| p.x, &edge), spread(|p| p.y, &edge));
+    assert!(
+        wide.min(tall) < 0.2 * wide.max(tall),
+        "edge-on: {wide} x {tall}"
+    );
+}

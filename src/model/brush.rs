@@ -414,7 +414,10 @@ mod tests {
         let (lo, hi) = centre
             .iter()
             .fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-        assert!(lo > 0.2 && hi - lo > 0.1, "grain near the centre: {lo}..{hi}");
+        assert!(
+            lo > 0.2 && hi - lo > 0.1,
+            "grain near the centre: {lo}..{hi}"
+        );
     }
 
     fn dabs(points: &[(f32, f32)], spacing: f32) -> Vec<DabPoint> {

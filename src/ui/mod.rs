@@ -157,6 +157,34 @@ fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPlan) {
     ));
 }
 
+/// Screen points of a circle of `radius` (world units) around `centre` in the plane normal
+/// to `normal`, seen by `camera` in `picture`.
+pub fn brush_outline(
+    camera: &crate::render::Camera,
+    picture: egui::Rect,
+    centre: glam::Vec3,
+    normal: glam::Vec3,
+    radius: f32,
+) -> Vec<egui::Pos2> {
+    let n = normal.normalize_or(glam::Vec3::Z);
+    let (t, b) = n.any_orthonormal_pair();
+    let view_proj = camera.view_proj(picture.width() / picture.height().max(1.0));
+    (0..48)
+        .filter_map(|i| {
+            let a = i as f32 / 48.0 * std::f32::consts::TAU;
+            let world = centre + (t * a.cos() + b * a.sin()) * radius;
+            let clip = view_proj * world.extend(1.0);
+            (clip.w > 1e-6).then(|| {
+                let ndc = clip.truncate() / clip.w;
+                egui::Pos2::new(
+                    picture.min.x + (ndc.x * 0.5 + 0.5) * picture.width(),
+                    picture.min.y + (0.5 - ndc.y * 0.5) * picture.height(),
+                )
+            })
+        })
+        .collect()
+}
+
 /// A cheap identity of a stamp for its preview cache: size and a few samples' bits.
 fn stamp_key(stamp: &crate::model::brush::Stamp) -> u64 {
     use std::hash::{Hash, Hasher};
@@ -1256,18 +1284,28 @@ impl EditorState {
         {
             self.end_stroke();
         }
-        // The brush circle, sized by the world radius a dab covers here.
+        // The brush circle, projected on the surface: a circle of the dab's world radius in
+        // the tangent plane under the cursor, drawn through the camera.
         if let (Some(p), Some(surface)) = (response.hover_pos(), self.doc.surface())
             && self.stroke_tool().is_some()
+            && let Some(hit) = self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh)
         {
             let world = self.doc.settings.brush.radius_px * surface.units_per_texel;
-            let cam = &self.viewport.camera;
-            let px = world / (cam.distance * (cam.fov_y / 2.0).tan()) * rect.height() / 2.0;
-            response.ctx.layer_painter(response.layer_id).circle_stroke(
-                p,
-                px.max(2.0),
-                egui::Stroke::new(1.0, egui::Color32::WHITE),
+            let picture = self.viewport.picture_at(rect, p);
+            let points = brush_outline(
+                &self.viewport.camera,
+                picture,
+                hit.position,
+                hit.normal,
+                world,
             );
+            response
+                .ctx
+                .layer_painter(response.layer_id)
+                .add(egui::Shape::closed_line(
+                    points,
+                    egui::Stroke::new(1.0, egui::Color32::WHITE),
+                ));
         }
     }
 
