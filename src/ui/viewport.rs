@@ -383,6 +383,8 @@ pub struct Viewport {
     /// Why there is no GPU, for the placeholder.
     pub no_gpu: String,
     frame_pending: bool,
+    /// The compare mode the camera was last framed for.
+    framed_for: Compare,
 }
 
 impl Viewport {
@@ -395,6 +397,7 @@ impl Viewport {
             frame_ms: 0.0,
             no_gpu: "The 3D preview needs a GPU (wgpu); painting on the mesh still works.".into(),
             frame_pending: true,
+            framed_for: Compare::Single,
         }
     }
 
@@ -446,11 +449,19 @@ impl Viewport {
         if self.comparison.mode == Compare::Split {
             self.divider_ui(ui, rect);
         }
+        // Side by side halves the pictures' width: frame again when entering or leaving it.
+        if (self.comparison.mode == Compare::SideBySide) != (self.framed_for == Compare::SideBySide)
+        {
+            self.frame_pending = true;
+        }
         if self.frame_pending {
-            // Fit the bounding sphere in the narrower of the two fields of view.
+            // Fit the bounding sphere in the narrower of the two fields of view (of one half
+            // when side by side).
             self.frame_pending = false;
+            self.framed_for = self.comparison.mode;
             self.camera = self.camera.framing(&mesh.1.positions);
-            let aspect = rect.width() / rect.height().max(1.0);
+            let picture = self.picture_at(rect, rect.min);
+            let aspect = picture.width() / picture.height().max(1.0);
             if aspect < 1.0 {
                 self.camera.distance /= aspect.max(0.05);
             }
