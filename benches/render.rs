@@ -267,5 +267,65 @@ fn uploads(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, frames, uploads);
+/// One painting frame as the editor makes it: a 64 px dab on 4096^2 maps, the dirty tiles
+/// synced, and a 1280 x 720 viewport frame of the built-in sphere drawn and waited for.
+fn painting(c: &mut Criterion) {
+    let Ok(gpu) = Gpu::headless() else {
+        eprintln!("SKIPPED: no GPU adapter");
+        return;
+    };
+    let mut group = c.benchmark_group("painting_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(6));
+    let sphere = mesh::builtin("sphere").expect("sphere");
+    let buffers = MeshBuffers::new(&gpu, &sphere);
+    let (mut doc, _) = documents();
+    doc.apply(Command::SetBrush(BrushSettings {
+        radius_px: 64.0,
+        ..BrushSettings::default()
+    }))
+    .expect("brush");
+    let mut maps = MapTextures::new(&gpu, &doc.maps);
+    let mut preview = Preview::new(&gpu);
+    let (w, h) = (1280, 720);
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let color = target(&gpu, w, h, format);
+    let depth = target(&gpu, w, h, wgpu::TextureFormat::Depth32Float);
+    let s = FrameSettings {
+        model: ShadingModel::Phong,
+        approx: AmbientApprox::Fast,
+        view: ViewMode::Shaded,
+        lighting: Lighting::default(),
+        camera: Camera::default().framing(&sphere.positions),
+    };
+    let frame = Frame {
+        gpu: &gpu,
+        color: &color,
+        depth: &depth,
+        size: (w, h),
+        mesh: &buffers,
+    };
+    let mut k = 0_u32;
+    group.bench_function("dab_sync_frame_1280x720", |b| {
+        b.iter(|| {
+            k += 1;
+            let x = f32::from((k % 60) as u16) * 64.0 + 64.0;
+            doc.apply(Command::Stroke {
+                tool: StrokeTool::Brush,
+                points: vec![StrokePoint {
+                    pos: Vec2::new(x, 2048.0 + 512.0 * ((k / 60) % 3) as f32),
+                    pressure: 1.0,
+                }],
+            })
+            .expect("dab");
+            maps.sync(&gpu, &doc.maps);
+            let key = PipelineKey::for_frame(&s, &maps.uniform, format);
+            frame.draw(&mut preview, &maps, &s, &[DrawPart::whole(key, (w, h))]);
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, frames, uploads, painting);
 criterion_main!(benches);

@@ -231,3 +231,53 @@ fn the_brush_outline_lies_on_the_surface_under_the_cursor() {
         "edge-on: {wide} x {tall}"
     );
 }
+
+/// Texels that differ between two snapshots of the maps.
+fn changed(a: &[Texel], b: &[Texel]) -> usize {
+    a.iter().zip(b).filter(|(x, y)| x != y).count()
+}
+
+#[test]
+fn pen_pressure_scales_the_dab() {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, None),
+        );
+    harness.run();
+    assert!(harness.state().state.doc.settings.brush.pressure_size);
+    let fresh = texels(harness.state());
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    let dab = |harness: &mut Harness<'_, Editor>, force: Option<f32>| {
+        harness.hover_at(centre);
+        harness.run();
+        if let Some(force) = force {
+            harness.event(egui::Event::Touch {
+                device_id: egui::TouchDeviceId(1),
+                id: egui::TouchId(1),
+                phase: egui::TouchPhase::Move,
+                pos: centre,
+                force: Some(force),
+            });
+        }
+        harness.drag_at(centre);
+        harness.run();
+        harness.drop_at(centre);
+        harness.run();
+    };
+    // A mouse paints at full pressure.
+    dab(&mut harness, None);
+    let full = changed(&fresh, &texels(harness.state()));
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(texels(harness.state()), fresh, "undone");
+    // A pen pressed lightly paints a smaller dab.
+    dab(&mut harness, Some(0.3));
+    let light = changed(&fresh, &texels(harness.state()));
+    assert!(full > 0 && light > 0, "both dabs paint: {full}, {light}");
+    assert!(
+        light * 3 < full,
+        "pressure 0.3 covers less: {light} of {full} texels"
+    );
+}

@@ -331,6 +331,8 @@ pub struct EditorState {
     pub new_dialog: Option<NewDialog>,
     /// Recently opened or saved projects, newest first.
     pub recent: Vec<PathBuf>,
+    /// The pen's last pressure in the current stroke (1 with a mouse).
+    pressure: f32,
     /// The brush stamp's preview texture, and which stamp it shows.
     stamp_preview: Option<(u64, egui::TextureHandle)>,
     /// The texel under the cursor, in either view.
@@ -468,6 +470,7 @@ impl Editor {
                 new_dialog: None,
                 recent: load_recent(),
                 stamp_preview: None,
+                pressure: 1.0,
                 hover: None,
                 hover_tab: None,
                 stroking: None,
@@ -1134,7 +1137,24 @@ impl EditorState {
         }
     }
 
+    /// Follows the pen's pressure where the platform delivers it (egui reports a tablet pen's
+    /// force with its touch events); kept until the stroke ends, 1 for a mouse.
+    fn track_pressure(&mut self, ctx: &egui::Context) {
+        let force = ctx.input(|i| {
+            i.events.iter().rev().find_map(|e| match e {
+                egui::Event::Touch { force: Some(f), .. } if f.is_finite() => {
+                    Some(f.clamp(0.0, 1.0))
+                }
+                _ => None,
+            })
+        });
+        if let Some(f) = force {
+            self.pressure = f;
+        }
+    }
+
     fn end_stroke(&mut self) {
+        self.pressure = 1.0;
         if self.stroking.take().is_some() {
             self.apply(Command::EndStroke);
         }
@@ -1165,15 +1185,7 @@ impl EditorState {
         match (self.stroke_tool(), pos) {
             (Some(tool), Some(p)) if primary || (response.clicked() && !space) => {
                 self.begin_stroke(Tab::Canvas, tool);
-                let pressure = response.ctx.input(|i| {
-                    i.events
-                        .iter()
-                        .find_map(|e| match e {
-                            egui::Event::Touch { force: Some(f), .. } => Some(*f),
-                            _ => None,
-                        })
-                        .unwrap_or(1.0)
-                });
+                let pressure = self.pressure;
                 self.apply(Command::StrokeTo(StrokePoint {
                     pos: glam::Vec2::new(p.x, p.y),
                     pressure,
@@ -1255,12 +1267,13 @@ impl EditorState {
         match (self.stroke_tool(), hit) {
             (Some(tool), Some(hit)) if primary || (response.clicked() && !alt) => {
                 self.begin_stroke(Tab::Viewport, tool);
+                let pressure = self.pressure;
                 self.apply(Command::SurfaceStrokeTo(StrokePoint {
                     pos: SurfacePos {
                         point: hit.position,
                         normal: hit.normal,
                     },
-                    pressure: 1.0,
+                    pressure,
                 }));
                 if response.clicked() {
                     self.end_stroke();
@@ -2012,6 +2025,7 @@ impl Editor {
         let ctx = ui.ctx().clone();
         let s = &mut self.state;
         s.poll_job();
+        s.track_pressure(&ctx);
         s.hotkeys(&ctx);
         s.dropped_files(&ctx);
         if let Some(Err(e)) = s.autosaver.poll(&s.doc, Instant::now()) {
