@@ -281,3 +281,28 @@ fn pen_pressure_scales_the_dab() {
         "pressure 0.3 covers less: {light} of {full} texels"
     );
 }
+
+#[test]
+fn opening_another_project_never_drops_unsaved_work() {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, None),
+        );
+    harness.run();
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    assert!(harness.state().state.dirty(), "painted");
+    let painted = texels(harness.state());
+    let elsewhere = std::path::PathBuf::from("/nowhere/other.kapaint");
+    harness.state_mut().state.open(elsewhere.clone());
+    harness.run();
+    assert_eq!(harness.state().state.pending_open, Some(elsewhere));
+    harness.get_by_label("Discard and open");
+    harness.get_by_label("Save, then open");
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert_eq!(harness.state().state.pending_open, None);
+    assert_eq!(texels(harness.state()), painted, "the work is still there");
+}

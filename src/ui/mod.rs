@@ -329,6 +329,8 @@ pub struct EditorState {
     export: Option<ExportDialog>,
     /// The New dialog, while open.
     pub new_dialog: Option<NewDialog>,
+    /// A project to open once the user has decided about the unsaved changes.
+    pub pending_open: Option<PathBuf>,
     /// Recently opened or saved projects, newest first.
     pub recent: Vec<PathBuf>,
     /// The pen's last pressure in the current stroke (1 with a mouse).
@@ -468,6 +470,7 @@ impl Editor {
                 job: None,
                 export: None,
                 new_dialog: None,
+                pending_open: None,
                 recent: load_recent(),
                 stamp_preview: None,
                 pressure: 1.0,
@@ -651,6 +654,11 @@ impl EditorState {
                     .push(notice(format!("saved {}", path.display()), false));
                 self.remember(&path);
                 self.path = Some(path);
+                if !self.dirty()
+                    && let Some(next) = self.pending_open.take()
+                {
+                    self.open_now(next);
+                }
             }
             JobResult::Exported(dir, m) => self.notices.push(notice(
                 format!(
@@ -806,6 +814,15 @@ impl EditorState {
 
     /// Opens `path` on a worker.
     pub fn open(&mut self, path: PathBuf) {
+        if self.dirty() {
+            // Unsaved work is never dropped: ask first (see `open_prompt`).
+            self.pending_open = Some(path);
+            return;
+        }
+        self.open_now(path);
+    }
+
+    fn open_now(&mut self, path: PathBuf) {
         self.start_job("Open", move |progress| {
             progress.start("open", 1);
             match load_project(&path) {
@@ -1724,14 +1741,7 @@ impl EditorState {
                         }
                     }
                     if let Some(p) = chosen {
-                        if self.dirty() {
-                            self.notices.push(notice(
-                                "save or discard the current changes first (Ctrl+S)",
-                                true,
-                            ));
-                        } else {
-                            self.open(p);
-                        }
+                        self.open(p);
                     }
                 });
                 if item(ui, "Save", &keys::SAVE) {
@@ -1892,6 +1902,37 @@ impl EditorState {
             self.export = None;
         } else if go {
             self.export_now();
+        }
+    }
+
+    /// Asks what to do with unsaved changes before opening another project: save them first
+    /// (the project opens once saved), discard them, or cancel.
+    fn open_prompt(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.pending_open.clone() else {
+            return;
+        };
+        let (mut save, mut discard, mut cancel) = (false, false, false);
+        egui::Window::new("Open: unsaved changes")
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "The material has unsaved changes. Save them before opening {}?",
+                    path.display()
+                ));
+                ui.horizontal(|ui| {
+                    save = ui.button("Save, then open").clicked();
+                    discard = ui.button("Discard and open").clicked();
+                    cancel = ui.button("Cancel").clicked();
+                });
+            });
+        if discard {
+            self.pending_open = None;
+            self.open_now(path);
+        } else if cancel {
+            self.pending_open = None;
+        } else if save {
+            self.save();
         }
     }
 
@@ -2060,6 +2101,7 @@ impl Editor {
         s.recovery_window(&ctx);
         s.notices(&ctx);
         s.close_prompt(&ctx);
+        s.open_prompt(&ctx);
         if s.job.is_some() {
             ctx.request_repaint_after(Duration::from_millis(100));
         }
