@@ -20,22 +20,13 @@ use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
 
 fn target(gpu: &Gpu, w: u32, h: u32, format: wgpu::TextureFormat) -> wgpu::TextureView {
-    gpu.device
-        .create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        })
-        .create_view(&wgpu::TextureViewDescriptor::default())
+    gpu.texture_2d(
+        "bench",
+        (w, h),
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+    )
+    .create_view(&wgpu::TextureViewDescriptor::default())
 }
 
 /// A target and mesh to draw frames into, waiting for each.

@@ -7,27 +7,17 @@
 
 #![allow(clippy::expect_used)]
 
+mod common;
+
+use common::gpu;
 use glam::{Vec2, Vec3};
-use kapaint::gpu::{Gpu, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
+use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::mesh::{self, pick::Bvh};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb};
 use kapaint::model::{Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool};
 use kapaint::reflectance::{self, AmbientApprox, ShadingModel};
 use kapaint::render::reference::{self, Material};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
-
-fn gpu() -> Option<Gpu> {
-    match Gpu::headless() {
-        Ok(g) => Some(g),
-        Err(e) => {
-            let required = std::env::var_os("KAPAINT_REQUIRE_GPU").is_some()
-                || std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false");
-            assert!(!required, "GPU tests must run here but: {e}");
-            eprintln!("SKIPPED: no GPU adapter ({e})");
-            None
-        }
-    }
-}
 
 fn settings(model: ShadingModel, view: ViewMode, points: &[Vec3]) -> FrameSettings {
     FrameSettings {

@@ -9,30 +9,20 @@
 
 #![allow(clippy::expect_used)]
 
+mod common;
+
+use common::gpu;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use kapaint::gpu::difference::Difference;
-use kapaint::gpu::{Gpu, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
+use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb};
 use kapaint::model::{Channel, Document, DocumentSettings, import};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
 
 const SIZE: (u32, u32) = (192, 144);
-
-fn gpu() -> Option<Gpu> {
-    match Gpu::headless() {
-        Ok(g) => Some(g),
-        Err(e) => {
-            let required = std::env::var_os("KAPAINT_REQUIRE_GPU").is_some()
-                || std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false");
-            assert!(!required, "GPU tests must run here but: {e}");
-            eprintln!("SKIPPED: no GPU adapter ({e})");
-            None
-        }
-    }
-}
 
 fn testdata(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -223,18 +223,7 @@ impl Difference {
             height,
             depth_or_array_layers: 1,
         };
-        let texture = |format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("difference"),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |format, usage| gpu.texture_2d("difference", (width, height), format, usage);
         let side = |pixels: &[f32]| {
             let t = texture(
                 SIDE_FORMAT,

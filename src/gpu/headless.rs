@@ -10,18 +10,7 @@ use crate::model::MaterialMaps;
 use crate::reflectance::ShadingModel;
 use crate::render::{FrameSettings, ViewMode};
 
-/// How the two models are shown.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Compare {
-    /// One model (the settings').
-    Single,
-    /// Phong left of the middle, Blinn-Phong right.
-    Split,
-    /// Phong in the left half, Blinn-Phong in the right, each a whole picture.
-    SideBySide,
-    /// `|Phong - Blinn-Phong|` as a heatmap (PNG) or raw (EXR).
-    Difference,
-}
+pub use crate::render::Compare;
 
 /// One headless render.
 pub struct Request<'a> {

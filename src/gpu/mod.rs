@@ -60,6 +60,30 @@ pub fn shader_source(main: &str) -> String {
 }
 
 impl Gpu {
+    /// A 2D texture of one mip level and one sample, `size` texels.
+    pub fn texture_2d(
+        &self,
+        label: &str,
+        (width, height): (u32, u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> wgpu::Texture {
+        self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    }
+
     /// A device on the first adapter wgpu finds, without any window or display.
     ///
     /// # Errors

@@ -577,23 +577,7 @@ impl Preview {
         } else {
             wgpu::TextureFormat::Rgba8UnormSrgb
         };
-        let extent = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let texture = |format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("offscreen"),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |format, usage| gpu.texture_2d("offscreen", (width, height), format, usage);
         let color = texture(
             format,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,

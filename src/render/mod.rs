@@ -44,6 +44,31 @@ pub const N_RAMP: [[f32; 3]; 5] = [
     [0.9473, 0.7991, 0.0091],
 ];
 
+/// How a frame compares the two shading models (or two sides with their own model and
+/// approximation, in the editor).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    /// One model alone.
+    Single,
+    /// One picture wiped by a divider: the left side's model left of it, the right side's
+    /// right of it.
+    Split,
+    /// Two whole pictures side by side, one camera.
+    SideBySide,
+    /// `|left - right|` as a heatmap with a scale bar.
+    Difference,
+}
+
+impl Compare {
+    /// Every mode with its label, in the order the compare controls show them.
+    pub const ALL: [(Self, &'static str); 4] = [
+        (Self::Single, "Single"),
+        (Self::Split, "Split"),
+        (Self::SideBySide, "Side by side"),
+        (Self::Difference, "Difference"),
+    ];
+}
+
 /// The difference heatmap's colour for `t` in `[0, 1]` (0 at no difference, 1 at the scale's
 /// top): black, red, yellow, white, linear RGB. `shaders/difference.wgsl` has the same ramp.
 pub fn heat_ramp(t: f32) -> Vec3 {

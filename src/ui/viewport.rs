@@ -25,29 +25,7 @@ use crate::render::{Camera, FrameSettings};
 /// The viewport's accessible name.
 pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
 
-/// How the two shading models are compared.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Compare {
-    /// The document's model alone.
-    Single,
-    /// One picture wiped by a draggable divider: the left side's model left of it, the right
-    /// side's right of it.
-    Split,
-    /// Two whole pictures side by side, one camera.
-    SideBySide,
-    /// `|left - right|` as a heatmap with a scale bar.
-    Difference,
-}
-
-impl Compare {
-    /// Every mode with its label, in the order the compare controls show them.
-    pub const ALL: [(Self, &'static str); 4] = [
-        (Self::Single, "Single"),
-        (Self::Split, "Split"),
-        (Self::SideBySide, "Side by side"),
-        (Self::Difference, "Difference"),
-    ];
-}
+pub use crate::render::Compare;
 
 /// One side of a comparison: its shading model and approximation of `chi`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -301,23 +279,7 @@ impl ViewportGpu {
     }
 
     fn make_target(&mut self, size: (u32, u32)) -> Target {
-        let extent = wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        };
-        let texture = |format, usage| {
-            self.gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("viewport"),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |format, usage| self.gpu.texture_2d("viewport", size, format, usage);
         let color = texture(
             FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
@@ -351,23 +313,14 @@ impl ViewportGpu {
 }
 
 /// A linear float render target for one side of the difference compare.
-fn side_texture(gpu: &Gpu, (width, height): (u32, u32)) -> wgpu::TextureView {
-    gpu.device
-        .create_texture(&wgpu::TextureDescriptor {
-            label: Some("difference side"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: SIDE_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        })
-        .create_view(&wgpu::TextureViewDescriptor::default())
+fn side_texture(gpu: &Gpu, size: (u32, u32)) -> wgpu::TextureView {
+    gpu.texture_2d(
+        "difference side",
+        size,
+        SIDE_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
+    .create_view(&wgpu::TextureViewDescriptor::default())
 }
 
 /// The viewport's state.

@@ -1,0 +1,469 @@
+//! The editor's dialogs and prompts: New (resolution, base preset, mesh), the recent files,
+//! the export dialog with its preview of the set, and the prompts that keep unsaved work
+//! (before opening another project, before closing, recovery after a crash).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use super::{EditorState, JobResult, MeshState, layout_path, new_document_with, notice};
+use crate::export::preset::ExportPreset;
+use crate::model::{Document, DocumentSettings};
+
+/// The export dialog's preview: the packed layout of each file, the constants, the memory
+/// report and the `k_a` error that `n`'s quantisation costs.
+pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPlan) {
+    let mb = |b: u64| b as f64 / 1e6;
+    ui.label(egui::RichText::new("Packed layout").strong());
+    egui::Grid::new("export layout")
+        .striped(true)
+        .show(ui, |ui| {
+            for f in &plan.files {
+                ui.monospace(&f.path);
+                ui.monospace(f.layout.join(" | "));
+                ui.label(format!("{:.1} MB raw", mb(f.raw_bytes)));
+                ui.end_row();
+            }
+        });
+    let c = &plan.constants;
+    let mut constants = Vec::new();
+    if let Some([r, g, b]) = c.kd {
+        constants.push(format!("k_d = ({r:.3}, {g:.3}, {b:.3})"));
+    }
+    if let Some([r, g, b]) = c.ks {
+        constants.push(format!("k_s = ({r:.3}, {g:.3}, {b:.3})"));
+    }
+    if let Some(n) = c.n {
+        constants.push(format!("n = {n:.2}"));
+    }
+    if plan.files.is_empty() {
+        ui.label("Every channel is constant: the set is a manifest alone.");
+    }
+    if !constants.is_empty() {
+        ui.label(format!(
+            "Constants in the manifest: {}",
+            constants.join(", ")
+        ));
+    }
+    if let Some(e) = plan.n_encoding {
+        ui.label(format!(
+            "n: {:?} curve over [{:.2}, {:.1}], {} bits",
+            e.curve, e.lo, e.hi, e.bits
+        ));
+    }
+    ui.label(format!(
+        "Estimated k_a error (n quantisation): max {:.3} %, mean {:.4} %",
+        plan.ka_error.max * 100.0,
+        plan.ka_error.mean * 100.0
+    ));
+    let b = &plan.bytes;
+    ui.label(format!(
+        "Memory: set {:.1} MB uncompressed (files are smaller), naive k_a + k_d + k_s + n {:.1} MB, project {:.1} MB",
+        mb(b.exported),
+        mb(b.naive),
+        mb(b.project)
+    ));
+}
+
+/// The New dialog's choices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewDialog {
+    /// Map size (square), texels.
+    pub size: u32,
+    /// Index into the material presets: the base material.
+    pub preset: usize,
+    /// A built-in mesh name, or a mesh file's path.
+    pub mesh: String,
+}
+
+/// Map sizes the New dialog offers.
+pub const NEW_SIZES: [u32; 5] = [512, 1024, 2048, 4096, 8192];
+
+/// Built-in meshes the New dialog offers.
+pub const NEW_MESHES: [&str; 4] = ["sphere", "plane", "cube", "torus"];
+
+/// How many recent files are kept.
+pub const RECENT_MAX: usize = 10;
+
+/// `list` with `path` moved to the front, without duplicates, at most [`RECENT_MAX`] long.
+pub fn push_recent(list: &mut Vec<PathBuf>, path: &Path) {
+    let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    list.retain(|p| *p != path);
+    list.insert(0, path);
+    list.truncate(RECENT_MAX);
+}
+
+pub(super) fn recent_path() -> Option<PathBuf> {
+    layout_path().map(|p| p.with_file_name("recent.json"))
+}
+
+pub(super) fn load_recent() -> Vec<PathBuf> {
+    recent_path()
+        .and_then(|p| std::fs::read(p).ok())
+        .and_then(|text| serde_json::from_slice::<Vec<PathBuf>>(&text).ok())
+        .map(|mut list| {
+            list.truncate(RECENT_MAX);
+            list
+        })
+        .unwrap_or_default()
+}
+
+pub(super) fn save_recent(list: &[PathBuf]) {
+    if let (Some(path), Ok(json)) = (recent_path(), serde_json::to_vec_pretty(list)) {
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let _ = crate::atomic::write_atomic(&path, &json);
+    }
+}
+
+/// The export dialog's state.
+pub(super) struct ExportDialog {
+    presets: Vec<ExportPreset>,
+    chosen: usize,
+    folder: String,
+    /// The preview of the chosen preset: for which preset and maps version, and the plan.
+    plan: Option<(usize, u64, crate::export::set::SetPlan)>,
+    /// A preview being computed on a worker thread.
+    planning: Option<(usize, u64, JoinHandle<crate::export::set::SetPlan>)>,
+}
+
+impl EditorState {
+    /// The recovery offer at start: recover the copy, or discard it.
+    pub(super) fn recovery_window(&mut self, ctx: &egui::Context) {
+        let Some(copy) = self.recovery_offer.clone() else {
+            return;
+        };
+        egui::Window::new("Recover unsaved work?")
+            .collapsible(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "kapaint found a recovery copy of unsaved work:\n{}",
+                    copy.display()
+                ));
+                ui.horizontal(|ui| {
+                    if ui.button("Recover").clicked() {
+                        self.recovery_offer = None;
+                        self.recover(copy.clone(), self.path.clone());
+                    }
+                    if ui.button("Discard").clicked() {
+                        self.recovery_offer = None;
+                        if let Err(e) = std::fs::remove_file(&copy) {
+                            self.notices
+                                .push(notice(format!("{}: {e}", copy.display()), true));
+                        }
+                    }
+                });
+            });
+    }
+
+    /// Opens the New dialog (Ctrl+N), starting from the current document's size.
+    pub(super) fn new_project(&mut self) {
+        let preset = self
+            .presets
+            .iter()
+            .position(|(name, _, _)| Some(name) == self.doc.settings.preset.as_ref())
+            .unwrap_or(0);
+        self.new_dialog = Some(NewDialog {
+            size: self.doc.maps.width(),
+            preset,
+            mesh: "sphere".into(),
+        });
+    }
+
+    /// Replaces the document with a new one as `dialog` says (the old one's unsaved changes
+    /// are in its recovery copy and were asked about before).
+    pub fn create_project(&mut self, dialog: &NewDialog) {
+        let mut settings = DocumentSettings::default();
+        if let Some((name, value, _)) = self.presets.get(dialog.preset) {
+            settings.base = *value;
+            settings.secondary = *value;
+            settings.preset = Some(name.clone());
+        }
+        let builtin = NEW_MESHES.contains(&dialog.mesh.as_str());
+        let mesh_name = if builtin {
+            dialog.mesh.as_str()
+        } else {
+            "sphere"
+        };
+        match new_document_with(dialog.size, settings, mesh_name) {
+            Ok((doc, mesh)) => {
+                self.doc = doc;
+                self.mesh = MeshState::new((*mesh.mesh).clone(), self.mesh.id + 1);
+                self.saved_version = self.doc.maps.version();
+                self.path = None;
+                self.viewport.frame(&self.mesh.mesh);
+                if !builtin {
+                    self.import_mesh(PathBuf::from(&dialog.mesh));
+                }
+            }
+            Err(e) => self.notices.push(notice(e, true)),
+        }
+    }
+
+    /// The New dialog: resolution, base preset, mesh.
+    pub(super) fn new_window(&mut self, ctx: &egui::Context) {
+        let Some(mut dialog) = self.new_dialog.take() else {
+            return;
+        };
+        let (mut open, mut create) = (true, false);
+        egui::Window::new("New project")
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::ComboBox::from_label("Resolution")
+                    .selected_text(format!("{0}x{0}", dialog.size))
+                    .show_ui(ui, |ui| {
+                        for size in NEW_SIZES {
+                            ui.selectable_value(&mut dialog.size, size, format!("{size}x{size}"));
+                        }
+                    });
+                egui::ComboBox::from_label("Base preset")
+                    .selected_text(self.presets.get(dialog.preset).map_or("", |p| p.0.as_str()))
+                    .show_ui(ui, |ui| {
+                        for (i, (name, _, _)) in self.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.preset, i, name);
+                        }
+                    });
+                ui.horizontal(|ui| {
+                    egui::ComboBox::from_label("Mesh")
+                        .selected_text(&dialog.mesh)
+                        .show_ui(ui, |ui| {
+                            for m in NEW_MESHES {
+                                ui.selectable_value(&mut dialog.mesh, m.to_string(), m);
+                            }
+                        });
+                    if ui.button("File…").clicked()
+                        && let Some(p) = rfd::FileDialog::new()
+                            .add_filter("mesh", &["obj", "gltf", "glb"])
+                            .pick_file()
+                    {
+                        dialog.mesh = p.display().to_string();
+                    }
+                });
+                let bytes = u64::from(dialog.size).pow(2) * 14;
+                ui.label(format!("Maps: {:.0} MB", bytes as f64 / 1e6));
+                let label = if self.dirty() {
+                    ui.colored_label(
+                        ui.visuals().warn_fg_color,
+                        "The current project has unsaved changes.",
+                    );
+                    "Discard changes and create"
+                } else {
+                    "Create"
+                };
+                create = ui.button(label).clicked();
+            });
+        if create {
+            self.create_project(&dialog);
+        } else if open {
+            self.new_dialog = Some(dialog);
+        }
+    }
+
+    /// Remembers `path` at the top of the recent files.
+    pub(super) fn remember(&mut self, path: &Path) {
+        push_recent(&mut self.recent, path);
+        save_recent(&self.recent);
+    }
+
+    pub(super) fn export_now(&mut self) {
+        let Some(dialog) = &self.export else { return };
+        let Some(preset) = dialog.presets.get(dialog.chosen).cloned() else {
+            return;
+        };
+        let out = PathBuf::from(dialog.folder.trim());
+        let snapshot = self.snapshot();
+        self.export = None;
+        self.start_job(
+            "Export",
+            move |progress| match crate::export::set::export_with(
+                &snapshot, &preset, &out, progress,
+            ) {
+                Ok(m) => JobResult::Exported(out, Box::new(m)),
+                Err(e) => JobResult::Failed(format!("export failed: {e}")),
+            },
+        );
+    }
+
+    pub(super) fn open_export(&mut self) {
+        let folder = self.path.as_ref().map_or_else(
+            || "export".to_string(),
+            |p| p.with_extension("").display().to_string() + "-set",
+        );
+        self.export = Some(ExportDialog {
+            presets: crate::export::preset::builtin(),
+            chosen: 0,
+            folder,
+            plan: None,
+            planning: None,
+        });
+    }
+
+    /// A copy of the document for a worker thread (the maps' tiles are shared, not copied).
+    pub(super) fn snapshot(&self) -> Document {
+        let mut d = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
+        if let Some(s) = self.doc.surface() {
+            let _ = d.set_surface(Some(Arc::clone(s)));
+        }
+        d
+    }
+
+    /// Keeps the export dialog's preview current: starts planning on a worker thread when the
+    /// preset or the maps changed, and takes the result when it is done.
+    pub(super) fn update_export_plan(&mut self, ctx: &egui::Context) {
+        let version = self.doc.maps.version();
+        let snapshot = self.export.as_ref().and_then(|d| {
+            let current = |(p, v): (usize, u64)| p == d.chosen && v == version;
+            let planned = d.plan.as_ref().is_some_and(|(p, v, _)| current((*p, *v)));
+            let pending = d
+                .planning
+                .as_ref()
+                .is_some_and(|(p, v, _)| current((*p, *v)));
+            (!planned && !pending).then(|| self.snapshot())
+        });
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        if let Some(doc) = snapshot
+            && let Some(preset) = dialog.presets.get(dialog.chosen).cloned()
+        {
+            let spawned = std::thread::Builder::new()
+                .name("kapaint export preview".into())
+                .spawn(move || crate::export::set::plan(&doc, &preset));
+            if let Ok(handle) = spawned {
+                dialog.planning = Some((dialog.chosen, version, handle));
+            }
+        }
+        if dialog
+            .planning
+            .as_ref()
+            .is_some_and(|(_, _, h)| h.is_finished())
+            && let Some((p, v, handle)) = dialog.planning.take()
+            && let Ok(plan) = handle.join()
+        {
+            dialog.plan = Some((p, v, plan));
+        }
+        if dialog.planning.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(50));
+        }
+    }
+
+    pub(super) fn export_window(&mut self, ctx: &egui::Context) {
+        self.update_export_plan(ctx);
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        let mut open = true;
+        let mut go = false;
+        egui::Window::new("Export")
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::ComboBox::from_label("Preset")
+                    .selected_text(
+                        dialog
+                            .presets
+                            .get(dialog.chosen)
+                            .map_or("", |p| p.name.as_str()),
+                    )
+                    .show_ui(ui, |ui| {
+                        for (i, p) in dialog.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.chosen, i, &p.name)
+                                .on_hover_text(&p.description);
+                        }
+                    });
+                if let Some(p) = dialog.presets.get(dialog.chosen) {
+                    ui.label(&p.description);
+                }
+                ui.separator();
+                match &dialog.plan {
+                    Some((p, _, plan)) if *p == dialog.chosen => export_plan_ui(ui, plan),
+                    _ => {
+                        ui.horizontal(|ui| {
+                            ui.spinner();
+                            ui.label("Measuring the set…");
+                        });
+                    }
+                }
+                ui.separator();
+                ui.horizontal(|ui| {
+                    ui.label("Folder");
+                    ui.text_edit_singleline(&mut dialog.folder);
+                    if ui.button("…").clicked()
+                        && let Some(d) = rfd::FileDialog::new().pick_folder()
+                    {
+                        dialog.folder = d.join("set").display().to_string();
+                    }
+                });
+                go = ui.button("Export").clicked();
+            });
+        if !open {
+            self.export = None;
+        } else if go {
+            self.export_now();
+        }
+    }
+
+    /// Asks what to do with unsaved changes before opening another project: save them first
+    /// (the project opens once saved), discard them, or cancel.
+    pub(super) fn open_prompt(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.pending_open.clone() else {
+            return;
+        };
+        let (mut save, mut discard, mut cancel) = (false, false, false);
+        egui::Window::new("Open: unsaved changes")
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "The material has unsaved changes. Save them before opening {}?",
+                    path.display()
+                ));
+                ui.horizontal(|ui| {
+                    save = ui.button("Save, then open").clicked();
+                    discard = ui.button("Discard and open").clicked();
+                    cancel = ui.button("Cancel").clicked();
+                });
+            });
+        if discard {
+            self.pending_open = None;
+            self.open_now(path);
+        } else if cancel {
+            self.pending_open = None;
+        } else if save {
+            self.save();
+        }
+    }
+
+    pub(super) fn close_prompt(&mut self, ctx: &egui::Context) {
+        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit_asked;
+        if close_requested && self.dirty() && !self.allow_close {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.quit_asked = true;
+        } else if self.quit_asked && (self.allow_close || !self.dirty()) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        }
+        if self.quit_asked && self.dirty() && !self.allow_close {
+            egui::Window::new("Unsaved changes")
+                .collapsible(false)
+                .show(ctx, |ui| {
+                    ui.label("The material has unsaved changes.");
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            self.save();
+                            self.quit_asked = false;
+                        }
+                        if ui.button("Discard").clicked() {
+                            self.allow_close = true;
+                        }
+                        if ui.button("Cancel").clicked() {
+                            self.quit_asked = false;
+                        }
+                    });
+                });
+        }
+    }
+}
