@@ -465,6 +465,39 @@ fn render_cli_writes_numerically_checkable_data_views() {
     args.extend(material);
     args.extend(["--out", split.to_str().expect("path")]);
     assert!(run(&args).status.success());
+    // Side by side: each half holds a whole sphere, Phong left and Blinn-Phong right.
+    let side = dir.join("side.png");
+    let mut args = vec![
+        "render",
+        "--model",
+        "compare-side",
+        "--view",
+        "shaded",
+        "--size",
+        "96x48",
+    ];
+    args.extend(material);
+    args.extend(["--out", side.to_str().expect("path")]);
+    let o = run(&args);
+    assert!(o.status.success(), "{o:?}");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("side by side"));
+    let side = image::open(&side).expect("PNG decodes").to_rgba8();
+    let covered = |x0: u32, x1: u32| {
+        (x0..x1)
+            .flat_map(|x| (0..48).map(move |y| (x, y)))
+            .filter(|&(x, y)| side.get_pixel(x, y)[3] > 0)
+            .count()
+    };
+    let (left, right) = (covered(0, 48), covered(48, 96));
+    assert!(
+        left > 300 && right > 300,
+        "a sphere in each half: {left}, {right}"
+    );
+    assert!(
+        left.abs_diff(right) * 20 < left,
+        "the same sphere: {left} vs {right}"
+    );
+    assert_eq!(side.get_pixel(47, 24)[3], 0, "nothing crosses the middle");
     // Errors: one line, exit 2, nothing written.
     let bad = dir.join("x.jpg");
     let mut args = vec!["render", "--model", "phong", "--view", "ka"];
