@@ -59,18 +59,35 @@ fn a_scripted_editing_session() {
     harness.state_mut().state.new_dialog = Some(kapaint::ui::NewDialog {
         size: 512,
         preset: 0,
-        mesh: "sphere".into(),
+        mesh: "torus".into(),
     });
     harness.run();
     harness
         .get_by_role_and_label(Role::Button, "Create")
         .click();
-    harness.run();
+    harness.step();
     assert!(
         harness.state().state.new_dialog.is_none(),
         "Create closes it"
     );
-    assert_eq!(harness.state().state.doc.maps.width(), 512);
+    // The mesh is baked on a worker; the window keeps drawing meanwhile.
+    for _ in 0..500 {
+        if harness.state().state.doc.maps.width() == 512 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        harness.step();
+    }
+    harness.run();
+    let doc = &harness.state().state.doc;
+    assert_eq!(doc.maps.width(), 512);
+    assert_eq!(
+        doc.settings.mesh.spec(),
+        "torus",
+        "the project names its mesh"
+    );
+    assert!(doc.surface().is_some_and(|s| !s.mesh.triangles.is_empty()));
+    assert!(!harness.state().state.dirty(), "nothing to save yet");
     let fresh = texels(harness.state());
 
     // Pick the brush as a user would: the button labelled "Brush".

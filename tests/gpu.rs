@@ -13,7 +13,7 @@ use common::gpu;
 use glam::{Vec2, Vec3};
 use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::mesh::{self, pick::Bvh};
-use kapaint::model::texel::{MaterialValue, linear_to_srgb};
+use kapaint::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8};
 use kapaint::model::{Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool};
 use kapaint::reflectance::{self, AmbientApprox, ShadingModel};
 use kapaint::render::reference::{self, Material};
@@ -572,6 +572,80 @@ fn mips_follow_the_dirty_tiles() {
     );
 }
 
+#[test]
+fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
+    use kapaint::gpu::maps::MapChannel;
+    let Some(gpu) = gpu() else { return };
+    if !gpu.unorm16 {
+        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
+        return;
+    }
+    // Not a multiple of the tile size: edge tiles are partial, levels round down.
+    let (w, h) = (200_usize, 120_usize);
+    let mut doc = Document::new(w as u32, h as u32, DocumentSettings::default()).expect("doc");
+    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.9, 0.2, 0.1),
+        Vec3::splat(0.7),
+        900.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::Stroke {
+        tool: StrokeTool::Brush,
+        points: vec![
+            kapaint::model::brush::StrokePoint {
+                pos: Vec2::new(20.0, 30.0),
+                pressure: 1.0,
+            },
+            kapaint::model::brush::StrokePoint {
+                pos: Vec2::new(190.0, 110.0),
+                pressure: 1.0,
+            },
+        ],
+    })
+    .expect("stroke");
+    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    let texel = |x: usize, y: usize| doc.maps.texel(x as u32, y as u32);
+    for level in 1..textures.kd.mip_level_count() {
+        let span = 1_usize << level;
+        let (lw, lh) = ((w >> level).max(1), (h >> level).max(1));
+        let kd = textures
+            .read_level(&gpu, MapChannel::Kd, level)
+            .expect("read");
+        let n = textures
+            .read_level(&gpu, MapChannel::N, level)
+            .expect("read");
+        assert_eq!((kd.len(), n.len()), (lw * lh * 4, lw * lh), "level {level}");
+        for y in 0..lh {
+            for x in 0..lw {
+                let block: Vec<_> = (y * span..((y + 1) * span).min(h))
+                    .flat_map(|v| (x * span..((x + 1) * span).min(w)).map(move |u| (u, v)))
+                    .map(|(u, v)| texel(u, v))
+                    .collect();
+                let count = block.len() as f64;
+                for c in 0..3 {
+                    let mean = block.iter().map(|t| f64::from(t.kd[c])).sum::<f64>() / count;
+                    let got = f64::from(kd[(y * lw + x) * 4 + c]);
+                    assert!(
+                        (got - mean).abs() <= 2.0,
+                        "level {level} ({x}, {y}): {got} vs {mean}"
+                    );
+                }
+                let mean = block
+                    .iter()
+                    .map(|t| f64::from(kapaint::model::texel::decode_n(t.n)))
+                    .sum::<f64>()
+                    / count;
+                let got = f64::from(half::f16::from_bits(n[y * lw + x]).to_f32());
+                assert!(
+                    (got - mean).abs() <= 1e-3 * mean.max(1.0),
+                    "level {level} ({x}, {y}): n {got} vs {mean}"
+                );
+            }
+        }
+    }
+}
+
 /// A 64 x 8 project whose `n` runs from 1 to 5000, exported as a `compact` set into `dir` so
 /// that the set stores `n` on a curve in 8 bits.
 fn n_gradient_set(dir: &std::path::Path) -> (Document, kapaint::export::set::Manifest) {
@@ -811,7 +885,7 @@ fn difference_heatmap_on_the_gpu_matches_the_cpu_ramp() {
         let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0_f32, f32::max);
         hot += usize::from(d > max / 3.0);
         let c = kapaint::render::heat_ramp(d / max);
-        let byte = |v: f32| (linear_to_srgb(v) * 255.0 + 0.5) as i32;
+        let byte = |v: f32| i32::from(linear_to_srgb8(v));
         let want = [
             byte(c.x),
             byte(c.y),

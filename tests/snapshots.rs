@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use kapaint::gpu::difference::Difference;
 use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
-use kapaint::model::texel::{MaterialValue, linear_to_srgb};
+use kapaint::model::texel::{MaterialValue, linear_to_srgb8};
 use kapaint::model::{Channel, Document, DocumentSettings, import};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
@@ -37,7 +37,7 @@ fn rgba8(image: RenderedImage) -> Vec<u8> {
         RenderedImage::Linear { pixels, .. } => pixels
             .chunks_exact(4)
             .flat_map(|p| {
-                let b = |v: f32| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
+                let b = linear_to_srgb8;
                 [
                     b(p[0]),
                     b(p[1]),

@@ -63,66 +63,58 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
     let maps = MapTextures::new(gpu, req.maps);
     let linear = kind == Kind::Exr || req.settings.view.is_data();
     let mut note = String::new();
-    let pixels: RenderedImage = match req.compare {
-        Compare::Single | Compare::Split | Compare::SideBySide => {
-            let layout = match req.compare {
-                Compare::Split => Layout::Split(width / 2),
-                Compare::SideBySide => Layout::SideBySide,
-                _ => Layout::Single,
+    let pixels: RenderedImage = if let Some(layout) = Layout::of(req.compare, 0.5, width) {
+        preview.render_offscreen(
+            gpu,
+            &mesh,
+            &maps,
+            &req.settings,
+            Offscreen {
+                size: req.size,
+                linear,
+                layout,
+            },
+        )?
+    } else {
+        let mut render = |model| {
+            let settings = FrameSettings {
+                model,
+                ..req.settings
             };
-            preview.render_offscreen(
-                gpu,
-                &mesh,
-                &maps,
-                &req.settings,
-                Offscreen {
-                    size: req.size,
-                    linear,
-                    layout,
-                },
-            )?
-        }
-        Compare::Difference => {
-            let mut render = |model| {
-                let settings = FrameSettings {
-                    model,
-                    ..req.settings
-                };
-                let offscreen = Offscreen {
-                    size: req.size,
-                    linear: true,
-                    layout: Layout::Single,
-                };
-                preview.render_offscreen(gpu, &mesh, &maps, &settings, offscreen)
+            let offscreen = Offscreen {
+                size: req.size,
+                linear: true,
+                layout: Layout::Single,
             };
-            let (a, b) = (
-                render(ShadingModel::Phong)?,
-                render(ShadingModel::BlinnPhong)?,
-            );
-            let (RenderedImage::Linear { pixels: a, .. }, RenderedImage::Linear { pixels: b, .. }) =
-                (a, b)
-            else {
-                return Err(GpuError("difference needs linear renders".into()));
-            };
-            let diff: Vec<f32> = a
-                .chunks_exact(4)
-                .zip(b.chunks_exact(4))
-                .flat_map(|(p, q)| {
-                    let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0_f32, f32::max);
-                    [d, d, d, p[3].max(q[3])]
-                })
-                .collect();
-            let max = diff.chunks_exact(4).map(|p| p[0]).fold(0.0_f32, f32::max);
-            note = format!(", max |phong - blinn| {max:.6}");
-            if kind == Kind::Exr {
-                RenderedImage::Linear {
-                    width,
-                    height,
-                    pixels: diff,
-                }
-            } else {
-                heatmap(&diff, width, height, max)
+            preview.render_offscreen(gpu, &mesh, &maps, &settings, offscreen)
+        };
+        let (a, b) = (
+            render(ShadingModel::Phong)?,
+            render(ShadingModel::BlinnPhong)?,
+        );
+        let (RenderedImage::Linear { pixels: a, .. }, RenderedImage::Linear { pixels: b, .. }) =
+            (a, b)
+        else {
+            return Err(GpuError("difference needs linear renders".into()));
+        };
+        let diff: Vec<f32> = a
+            .chunks_exact(4)
+            .zip(b.chunks_exact(4))
+            .flat_map(|(p, q)| {
+                let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0_f32, f32::max);
+                [d, d, d, p[3].max(q[3])]
+            })
+            .collect();
+        let max = diff.chunks_exact(4).map(|p| p[0]).fold(0.0_f32, f32::max);
+        note = format!(", max |phong - blinn| {max:.6}");
+        if kind == Kind::Exr {
+            RenderedImage::Linear {
+                width,
+                height,
+                pixels: diff,
             }
+        } else {
+            heatmap(&diff, width, height, max)
         }
     };
     let mut pixels = pixels;
@@ -174,8 +166,7 @@ fn draw_n_legend(image: &mut RenderedImage) {
             let i = (y * width + x) as usize * 4;
             match image {
                 RenderedImage::Srgb8 { pixels, .. } => {
-                    let byte =
-                        |v: f32| (crate::model::texel::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+                    let byte = crate::model::texel::linear_to_srgb8;
                     pixels[i..i + 4].copy_from_slice(&[byte(c.x), byte(c.y), byte(c.z), 255]);
                 }
                 RenderedImage::Linear { pixels, .. } => {
@@ -200,7 +191,7 @@ fn heatmap(diff: &[f32], width: u32, height: u32, max: f32) -> RenderedImage {
         } else {
             (ramp(p[0] * scale), p[3])
         };
-        let byte = |v: f32| (crate::model::texel::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+        let byte = crate::model::texel::linear_to_srgb8;
         pixels.extend_from_slice(&[byte(c.x), byte(c.y), byte(c.z), (a * 255.0 + 0.5) as u8]);
     }
     RenderedImage::Srgb8 {

@@ -77,18 +77,18 @@ pub struct MapTextures {
 /// Sums of a mip texel's level-0 texels: `k_d` RGB, `k_s` RGB, `n`, and how many.
 type Sums = [f32; 8];
 
-/// One mip level's texels over one tile: level, origin, size, sums.
-type MipPatch = (u32, (u32, u32), (u32, u32), Vec<Sums>);
-
-/// The mip levels `1..levels` over tile `id` (box sums on the tile-local grid: level 1 summed
-/// straight from the tile's planes, each level above from the one below), and the whole
-/// tile's sums.
-fn tile_mips(
+/// Stages the mip levels `mips` (levels 1, 2, ... in order) over tile `id` into `out`, which
+/// starts at staging offset `base`: box sums on the tile-local grid, level 1 summed straight
+/// from the tile's planes, each level above from the one below, rounded once. Returns the
+/// whole tile's sums.
+fn stage_tile_mips(
     maps: &MaterialMaps,
     id: usize,
-    levels: u32,
-    size: (u32, u32),
-) -> (Sums, Vec<MipPatch>) {
+    unorm16: bool,
+    mips: &[StagedImage],
+    base: u64,
+    out: &mut [u16],
+) -> Sums {
     let rect = maps.tile_rect(id);
     let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
     let tile = maps.tile(id);
@@ -162,27 +162,12 @@ fn tile_mips(
             ];
         }
     }
-    let mut patches = Vec::new();
-    for level in 1..levels {
-        if level > 1 {
-            let (nw, nh) = (gw.div_ceil(2), gh.div_ceil(2));
-            let mut next = vec![[0.0; 8]; nw * nh];
-            for (i, s) in grid.iter().enumerate() {
-                let o = &mut next[(i / gw / 2) * nw + (i % gw) / 2];
-                for (o, s) in o.iter_mut().zip(s) {
-                    *o += s;
-                }
-            }
-            grid = next;
-            (gw, gh) = (nw, nh);
+    for (k, image) in mips.iter().enumerate() {
+        if k > 0 {
+            (grid, gw, gh) = fold(&grid, gw, gh);
         }
-        let r = level_rect(rect, level, size);
-        let (lw, lh) = ((r.2 - r.0) as usize, (r.3 - r.1) as usize);
-        if lw == 0 || lh == 0 {
-            break;
-        }
-        let texels: Vec<Sums> = (0..lw * lh).map(|i| grid[(i / lw) * gw + i % lw]).collect();
-        patches.push((level, (r.0, r.1), (lw as u32, lh as u32), texels));
+        // The grid's origin is the tile's at this level: the image is its top-left part.
+        write_means(&grid, gw, unorm16, image, base, out);
     }
     let mut total = [0.0; 8];
     for s in &grid {
@@ -190,7 +175,21 @@ fn tile_mips(
             *t += s;
         }
     }
-    (total, patches)
+    total
+}
+
+/// The next mip level's sums: each `2 x 2` block of the `w x h` grid added up (the last row
+/// or column alone when odd).
+fn fold(grid: &[Sums], w: usize, h: usize) -> (Vec<Sums>, usize, usize) {
+    let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+    let mut next = vec![[0.0; 8]; nw * nh];
+    for (i, s) in grid.iter().enumerate() {
+        let o = &mut next[(i / w / 2) * nw + (i % w) / 2];
+        for (o, s) in o.iter_mut().zip(s) {
+            *o += s;
+        }
+    }
+    (next, nw, nh)
 }
 
 /// Adds each pair of neighbouring texels of `row` (RGB codes) into `acc` (the last one alone
@@ -370,7 +369,7 @@ impl MapTextures {
         let sums: Vec<(usize, Sums)> = jobs
             .into_par_iter()
             .map(|(id, chunk, images, base)| {
-                (id, stage_tile(maps, id, size, unorm16, images, base, chunk))
+                (id, stage_tile(maps, id, unorm16, images, base, chunk))
             })
             .collect();
         for (id, total) in sums {
@@ -430,30 +429,18 @@ impl MapTextures {
     /// Stages the levels above one texel per tile (`images`, in level order), whole: the first
     /// from the tile sums, each next from the one below.
     fn stage_top_levels(&mut self, maps: &MaterialMaps, images: &[StagedImage]) {
-        let (size, unorm16) = (self.size, self.unorm16);
         let tiles_x = maps.tiles_x() as usize;
         let tiles_y = maps.tile_count() / tiles_x.max(1);
-        let mut grid = self.tile_sums.clone();
-        let (mut gw, mut gh) = (tiles_x, tiles_y);
-        for level_image in images {
-            let level = level_image.level;
-            let (lw, lh) = (
-                (size.0 >> level).max(1) as usize,
-                (size.1 >> level).max(1) as usize,
-            );
-            let (nw, nh) = (gw.div_ceil(2), gh.div_ceil(2));
-            let mut next = vec![[0.0; 8]; nw * nh];
-            for (i, s) in grid.iter().enumerate() {
-                let o = &mut next[(i / gw / 2) * nw + (i % gw) / 2];
-                for k in 0..8 {
-                    o[k] += s[k];
-                }
-            }
-            (grid, gw, gh) = (next, nw, nh);
-            // The texture's level may be smaller than the grid (sizes that are not powers
-            // of two round down): its texels are the grid's top-left ones.
-            let texels: Vec<Sums> = (0..lw * lh).map(|i| grid[(i / lw) * gw + i % lw]).collect();
-            write_means(&texels, unorm16, level_image, 0, &mut self.scratch);
+        let Some((first, rest)) = images.split_first() else {
+            return;
+        };
+        // The texture's levels may be smaller than the grids (sizes that are not powers of
+        // two round down): their texels are the grids' top-left ones.
+        let (mut grid, mut gw, mut gh) = fold(&self.tile_sums, tiles_x, tiles_y);
+        write_means(&grid, gw, self.unorm16, first, 0, &mut self.scratch);
+        for image in rest {
+            (grid, gw, gh) = fold(&grid, gw, gh);
+            write_means(&grid, gw, self.unorm16, image, 0, &mut self.scratch);
         }
     }
 }
@@ -559,7 +546,6 @@ fn rgb_component(unorm16: bool, v: u16) -> u16 {
 fn stage_tile(
     maps: &MaterialMaps,
     id: usize,
-    size: (u32, u32),
     unorm16: bool,
     images: &[StagedImage],
     base: u64,
@@ -609,17 +595,19 @@ fn stage_tile(
             }
         }
     }
-    let levels = mips.last().map_or(1, |i| i.level + 1);
-    let (total, patches) = tile_mips(maps, id, levels, size);
-    for (image, (_, _, _, texels)) in mips.iter().zip(&patches) {
-        write_means(texels, unorm16, image, base, out);
-    }
-    total
+    stage_tile_mips(maps, id, unorm16, mips, base, out)
 }
 
-/// Writes the means of `texels` (sums) as `image`'s three textures into `out`, which starts
-/// at staging offset `base`.
-fn write_means(texels: &[Sums], unorm16: bool, image: &StagedImage, base: u64, out: &mut [u16]) {
+/// Writes the means of the sums in `grid` (rows `stride` apart; the image is its top-left
+/// part) as `image`'s three textures into `out`, which starts at staging offset `base`.
+fn write_means(
+    grid: &[Sums],
+    stride: usize,
+    unorm16: bool,
+    image: &StagedImage,
+    base: u64,
+    out: &mut [u16],
+) {
     let (w, h) = (image.extent.0 as usize, image.extent.1 as usize);
     // Staged offsets and rows are in bytes, even; `out` holds u16 words.
     let word = |offset: u64| ((offset - base) / 2) as usize;
@@ -627,7 +615,10 @@ fn write_means(texels: &[Sums], unorm16: bool, image: &StagedImage, base: u64, o
     let mut n = vec![0_u16; w];
     for y in 0..h {
         for (k, offset) in [(0, image.kd), (3, image.ks)] {
-            for (o, t) in rgba.chunks_exact_mut(4).zip(&texels[y * w..(y + 1) * w]) {
+            for (o, t) in rgba
+                .chunks_exact_mut(4)
+                .zip(&grid[y * stride..y * stride + w])
+            {
                 let inv = 1.0 / t[7].max(1.0);
                 let c = |i: usize| {
                     let v = t[k + i] * inv;
@@ -642,7 +633,7 @@ fn write_means(texels: &[Sums], unorm16: bool, image: &StagedImage, base: u64, o
             let at = word(offset) + y * image.rgba_row as usize / 2;
             out[at..at + rgba.len()].copy_from_slice(&rgba);
         }
-        for (o, t) in n.iter_mut().zip(&texels[y * w..(y + 1) * w]) {
+        for (o, t) in n.iter_mut().zip(&grid[y * stride..y * stride + w]) {
             *o = half::f16::from_f32(t[6] / t[7].max(1.0)).to_bits();
         }
         let at = word(image.n) + y * image.n_row as usize / 2;

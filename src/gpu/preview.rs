@@ -11,7 +11,7 @@ use super::maps::{MapTextures, UniformChannels};
 use super::{Gpu, GpuError, shader_source};
 use crate::mesh::Mesh;
 use crate::reflectance::{AmbientApprox, ShadingModel};
-use crate::render::{FrameSettings, ViewMode};
+use crate::render::{Compare, FrameSettings, ViewMode};
 
 /// Depth buffer format.
 /// Depth buffer format of every preview pass.
@@ -128,6 +128,19 @@ pub enum Layout {
 }
 
 impl Layout {
+    /// How a `width`-pixel frame draws `compare`, the split's divider at `split_at` (a
+    /// fraction of the width); `None` for the difference, which is no one picture.
+    pub fn of(compare: Compare, split_at: f32, width: u32) -> Option<Self> {
+        match compare {
+            Compare::Single => Some(Self::Single),
+            Compare::Split => Some(Self::Split(
+                ((split_at.clamp(0.0, 1.0) * width as f32) as u32).min(width),
+            )),
+            Compare::SideBySide => Some(Self::SideBySide),
+            Compare::Difference => None,
+        }
+    }
+
     /// The parts of a `(width, height)` frame: `left` and `right` are the two sides' pipelines.
     pub fn parts(self, left: PipelineKey, right: PipelineKey, (w, h): (u32, u32)) -> Vec<DrawPart> {
         let whole = (0, 0, w, h);

@@ -252,6 +252,11 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     }
 }
 
+/// Linear component to an 8-bit sRGB code, rounded.
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    (linear_to_srgb(c) * 255.0 + 0.5) as u8
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

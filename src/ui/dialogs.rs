@@ -7,8 +7,9 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use super::{EditorState, JobResult, MeshState, layout_path, new_document_with, notice};
+use super::{EditorState, JobResult, layout_path, new_document_with, notice};
 use crate::export::preset::ExportPreset;
+use crate::model::document::MeshRef;
 use crate::model::{Document, DocumentSettings};
 
 /// The export dialog's preview: the packed layout of each file, the constants, the memory
@@ -79,9 +80,6 @@ pub struct NewDialog {
 
 /// Map sizes the New dialog offers.
 pub const NEW_SIZES: [u32; 5] = [512, 1024, 2048, 4096, 8192];
-
-/// Built-in meshes the New dialog offers.
-pub const NEW_MESHES: [&str; 4] = ["sphere", "plane", "cube", "torus"];
 
 /// How many recent files are kept.
 pub const RECENT_MAX: usize = 10;
@@ -164,6 +162,11 @@ impl EditorState {
             .presets
             .iter()
             .position(|(name, _, _)| Some(name) == self.doc.settings.preset.as_ref())
+            .or_else(|| {
+                self.presets
+                    .iter()
+                    .position(|(name, _, _)| name == "default")
+            })
             .unwrap_or(0);
         self.new_dialog = Some(NewDialog {
             size: self.doc.maps.width(),
@@ -175,31 +178,24 @@ impl EditorState {
     /// Replaces the document with a new one as `dialog` says (the old one's unsaved changes
     /// are in its recovery copy and were asked about before).
     pub fn create_project(&mut self, dialog: &NewDialog) {
-        let mut settings = DocumentSettings::default();
+        let mut settings = DocumentSettings {
+            mesh: MeshRef::from_spec(&dialog.mesh),
+            ..DocumentSettings::default()
+        };
         if let Some((name, value, _)) = self.presets.get(dialog.preset) {
             settings.base = *value;
             settings.secondary = *value;
             settings.preset = Some(name.clone());
         }
-        let builtin = NEW_MESHES.contains(&dialog.mesh.as_str());
-        let mesh_name = if builtin {
-            dialog.mesh.as_str()
-        } else {
-            "sphere"
-        };
-        match new_document_with(dialog.size, settings, mesh_name) {
-            Ok((doc, mesh)) => {
-                self.doc = doc;
-                self.mesh = MeshState::new((*mesh.mesh).clone(), self.mesh.id + 1);
-                self.saved_version = self.doc.maps.version();
-                self.path = None;
-                self.viewport.frame(&self.mesh.mesh);
-                if !builtin {
-                    self.import_mesh(PathBuf::from(&dialog.mesh));
-                }
+        let size = dialog.size;
+        // Loading and baking the mesh at up to 8192^2 takes seconds: a worker does it.
+        self.start_job("New", move |progress| {
+            progress.start("bake", 1);
+            match new_document_with(size, settings) {
+                Ok(doc) => JobResult::Created(Box::new(doc)),
+                Err(e) => JobResult::Failed(format!("new project: {e}")),
             }
-            Err(e) => self.notices.push(notice(e, true)),
-        }
+        });
     }
 
     /// The New dialog: resolution, base preset, mesh.
@@ -230,7 +226,7 @@ impl EditorState {
                     egui::ComboBox::from_label("Mesh")
                         .selected_text(&dialog.mesh)
                         .show_ui(ui, |ui| {
-                            for m in NEW_MESHES {
+                            for m in crate::mesh::BUILTIN_NAMES {
                                 ui.selectable_value(&mut dialog.mesh, m.to_string(), m);
                             }
                         });
@@ -317,11 +313,8 @@ impl EditorState {
         let snapshot = self.export.as_ref().and_then(|d| {
             let current = |(p, v): (usize, u64)| p == d.chosen && v == version;
             let planned = d.plan.as_ref().is_some_and(|(p, v, _)| current((*p, *v)));
-            let pending = d
-                .planning
-                .as_ref()
-                .is_some_and(|(p, v, _)| current((*p, *v)));
-            (!planned && !pending).then(|| self.snapshot())
+            // One plan at a time: a stale one finishes first, then the current one starts.
+            (!planned && d.planning.is_none()).then(|| self.snapshot())
         });
         let Some(dialog) = &mut self.export else {
             return;

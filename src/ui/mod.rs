@@ -10,7 +10,7 @@ mod dialogs;
 pub mod viewport;
 
 use dialogs::{ExportDialog, load_recent};
-pub use dialogs::{NEW_MESHES, NEW_SIZES, NewDialog, RECENT_MAX, push_recent};
+pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, push_recent};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -92,6 +92,8 @@ enum JobResult {
     Mesh(PathBuf, Arc<Surface>),
     /// An image decoded for a channel.
     Image(Channel, PathBuf, Box<image::DynamicImage>),
+    /// A new project (File > New), its mesh baked.
+    Created(Box<Document>),
     /// A brush stamp read from an image.
     Stamp(PathBuf, crate::model::brush::Stamp),
     Failed(String),
@@ -253,21 +255,23 @@ pub struct Editor {
 }
 
 fn new_document(size: u32) -> Result<(Document, MeshState), String> {
-    new_document_with(size, DocumentSettings::default(), "sphere")
-}
-
-/// A new `size`^2 document with `settings` on the built-in mesh `mesh`.
-fn new_document_with(
-    size: u32,
-    settings: DocumentSettings,
-    mesh: &str,
-) -> Result<(Document, MeshState), String> {
-    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
-    let mesh = crate::mesh::builtin(mesh).ok_or_else(|| format!("no built-in mesh {mesh:?}"))?;
-    attach(&mut doc, &mesh)?;
+    let doc = new_document_with(size, DocumentSettings::default())?;
+    let mesh = doc.surface().map(|s| s.mesh.clone()).ok_or("no mesh")?;
     Ok((doc, MeshState::new(mesh, 1)))
 }
 
+/// A new `size`^2 document with `settings`, its mesh (built in or a file, as the settings
+/// name it) attached and baked.
+fn new_document_with(size: u32, settings: DocumentSettings) -> Result<Document, String> {
+    let spec = settings.mesh.spec().to_string();
+    let mesh = match crate::mesh::builtin(&spec) {
+        Some(m) => m,
+        None => crate::mesh::open(Path::new(&spec)).map_err(|e| e.to_string())?,
+    };
+    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
+    attach(&mut doc, &mesh)?;
+    Ok(doc)
+}
 /// Bakes `mesh` at the document's size and attaches it.
 fn attach(doc: &mut Document, mesh: &Mesh) -> Result<(), String> {
     let surface = Surface::new(mesh.clone(), doc.maps.width(), doc.maps.height())?;
@@ -575,6 +579,21 @@ impl EditorState {
                     format!("{} imported into {}", path.display(), channel.name()),
                     false,
                 ));
+            }
+            JobResult::Created(doc) => {
+                let mesh = doc.surface().map(|s| s.mesh.clone());
+                self.doc = *doc;
+                if let Some(mesh) = mesh {
+                    self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+                    self.viewport.frame(&self.mesh.mesh);
+                }
+                self.saved_version = self.doc.maps.version();
+                self.path = None;
+                self.autosaver = project::Autosaver::new(
+                    Duration::from_mins(2),
+                    project::recovery_path(None),
+                    &self.doc,
+                );
             }
             JobResult::Stamp(path, stamp) => {
                 let mut brush = self.doc.settings.brush.clone();

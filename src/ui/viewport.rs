@@ -208,7 +208,6 @@ impl ViewportGpu {
             format,
             ..key
         };
-        let (w, _) = size;
         let mut encoder = self
             .gpu
             .device
@@ -218,23 +217,16 @@ impl ViewportGpu {
         let view = target
             .color
             .create_view(&wgpu::TextureViewDescriptor::default());
-        let parts = match comparison.mode {
-            Compare::Single => Some(Layout::Single.parts(key, key, size)),
-            Compare::Split => {
-                let at = ((comparison.split_at.clamp(0.0, 1.0) * w as f32) as u32).min(w);
-                Some(Layout::Split(at).parts(
-                    side(comparison.left, FORMAT),
-                    side(comparison.right, FORMAT),
-                    size,
-                ))
-            }
-            Compare::SideBySide => Some(Layout::SideBySide.parts(
+        let (left, right) = if comparison.mode == Compare::Single {
+            (key, key)
+        } else {
+            (
                 side(comparison.left, FORMAT),
                 side(comparison.right, FORMAT),
-                size,
-            )),
-            Compare::Difference => None,
+            )
         };
+        let parts = Layout::of(comparison.mode, comparison.split_at, size.0)
+            .map(|layout| layout.parts(left, right, size));
         match (parts, &target.sides) {
             (Some(parts), _) => self.preview.draw(
                 &self.gpu,
@@ -543,7 +535,7 @@ fn heat_scale_ui(painter: &egui::Painter, rect: Rect, max: f32) {
     for i in 0..steps {
         let t0 = i as f32 / steps as f32;
         let c = crate::render::heat_ramp(t0 + 0.5 / steps as f32);
-        let srgb = |v: f32| (crate::model::texel::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+        let srgb = crate::model::texel::linear_to_srgb8;
         let x0 = bar.min.x + bar.width() * t0;
         painter.rect_filled(
             Rect::from_min_max(
