@@ -11,7 +11,7 @@ mod common;
 
 use common::gpu;
 use glam::{Vec2, Vec3};
-use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
+use kapaint::gpu::{Gpu, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::mesh::{self, pick::Bvh};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8};
 use kapaint::model::{Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool};
@@ -574,7 +574,6 @@ fn mips_follow_the_dirty_tiles() {
 
 #[test]
 fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
-    use kapaint::gpu::maps::MapChannel;
     let Some(gpu) = gpu() else { return };
     if !gpu.unorm16 {
         eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
@@ -605,44 +604,109 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     })
     .expect("stroke");
     assert!(textures.sync(&gpu, &doc.maps) > 0);
-    let texel = |x: usize, y: usize| doc.maps.texel(x as u32, y as u32);
     for level in 1..textures.kd.mip_level_count() {
-        let span = 1_usize << level;
-        let (lw, lh) = ((w >> level).max(1), (h >> level).max(1));
-        let kd = textures
-            .read_level(&gpu, MapChannel::Kd, level)
-            .expect("read");
-        let n = textures
-            .read_level(&gpu, MapChannel::N, level)
-            .expect("read");
-        assert_eq!((kd.len(), n.len()), (lw * lh * 4, lw * lh), "level {level}");
-        for y in 0..lh {
-            for x in 0..lw {
-                let block: Vec<_> = (y * span..((y + 1) * span).min(h))
-                    .flat_map(|v| (x * span..((x + 1) * span).min(w)).map(move |u| (u, v)))
-                    .map(|(u, v)| texel(u, v))
-                    .collect();
-                let count = block.len() as f64;
-                for c in 0..3 {
-                    let mean = block.iter().map(|t| f64::from(t.kd[c])).sum::<f64>() / count;
-                    let got = f64::from(kd[(y * lw + x) * 4 + c]);
-                    assert!(
-                        (got - mean).abs() <= 2.0,
-                        "level {level} ({x}, {y}): {got} vs {mean}"
-                    );
-                }
-                let mean = block
-                    .iter()
-                    .map(|t| f64::from(kapaint::model::texel::decode_n(t.n)))
-                    .sum::<f64>()
-                    / count;
-                let got = f64::from(half::f16::from_bits(n[y * lw + x]).to_f32());
-                assert!(
-                    (got - mean).abs() <= 1e-3 * mean.max(1.0),
-                    "level {level} ({x}, {y}): n {got} vs {mean}"
-                );
+        assert_box_means(&gpu, &textures, &doc.maps, level);
+    }
+}
+
+/// Mip `level` of the `k_d` and `n` textures holds the box means of `maps` (2/65535 for
+/// `k_d`, 1e-3 relative for `n`); level 0 holds `k_d`, `k_s` and `n` exactly.
+fn assert_box_means(gpu: &Gpu, textures: &MapTextures, maps: &MaterialMaps, level: u32) {
+    use kapaint::gpu::maps::MapChannel;
+    let (w, h) = (maps.width() as usize, maps.height() as usize);
+    let texel = |x: usize, y: usize| maps.texel(x as u32, y as u32);
+    let span = 1_usize << level;
+    let (lw, lh) = ((w >> level).max(1), (h >> level).max(1));
+    let kd = textures
+        .read_level(gpu, MapChannel::Kd, level)
+        .expect("read");
+    let n = textures
+        .read_level(gpu, MapChannel::N, level)
+        .expect("read");
+    assert_eq!((kd.len(), n.len()), (lw * lh * 4, lw * lh), "level {level}");
+    if level == 0 {
+        let ks = textures.read_level(gpu, MapChannel::Ks, 0).expect("read");
+        for y in 0..h {
+            for x in 0..w {
+                let t = texel(x, y);
+                let i = y * w + x;
+                assert_eq!(kd[i * 4..i * 4 + 3], t.kd, "k_d at ({x}, {y})");
+                assert_eq!(ks[i * 4..i * 4 + 3], t.ks, "k_s at ({x}, {y})");
+                assert_eq!(n[i], t.n, "n at ({x}, {y})");
             }
         }
+        return;
+    }
+    for y in 0..lh {
+        for x in 0..lw {
+            let block: Vec<_> = (y * span..((y + 1) * span).min(h))
+                .flat_map(|v| (x * span..((x + 1) * span).min(w)).map(move |u| (u, v)))
+                .map(|(u, v)| texel(u, v))
+                .collect();
+            let count = block.len() as f64;
+            for c in 0..3 {
+                let mean = block.iter().map(|t| f64::from(t.kd[c])).sum::<f64>() / count;
+                let got = f64::from(kd[(y * lw + x) * 4 + c]);
+                assert!(
+                    (got - mean).abs() <= 2.0,
+                    "level {level} ({x}, {y}): {got} vs {mean}"
+                );
+            }
+            let mean = block
+                .iter()
+                .map(|t| f64::from(kapaint::model::texel::decode_n(t.n)))
+                .sum::<f64>()
+                / count;
+            let got = f64::from(half::f16::from_bits(n[y * lw + x]).to_f32());
+            assert!(
+                (got - mean).abs() <= 1e-3 * mean.max(1.0),
+                "level {level} ({x}, {y}): n {got} vs {mean}"
+            );
+        }
+    }
+}
+
+#[test]
+fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
+    let Some(gpu) = gpu() else { return };
+    if !gpu.unorm16 {
+        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
+        return;
+    }
+    // 2048 x 1536 with mips stages about 75 MB: the first upload takes two batches.
+    let mut doc = Document::new(2048, 1536, DocumentSettings::default()).expect("doc");
+    let stroke = |doc: &mut Document, value: MaterialValue, from: Vec2, to: Vec2| {
+        doc.apply(Command::SetPrimary(value)).expect("primary");
+        doc.apply(Command::Stroke {
+            tool: StrokeTool::Brush,
+            points: [from, to]
+                .map(|pos| kapaint::model::brush::StrokePoint { pos, pressure: 1.0 })
+                .to_vec(),
+        })
+        .expect("stroke");
+    };
+    let red = MaterialValue::new(Vec3::new(0.9, 0.2, 0.1), Vec3::splat(0.3), 40.0);
+    stroke(
+        &mut doc,
+        red,
+        Vec2::new(10.0, 10.0),
+        Vec2::new(2040.0, 1500.0),
+    );
+    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    for level in [0, 3, 9] {
+        assert_box_means(&gpu, &textures, &doc.maps, level);
+    }
+    // A stroke the other way: its tiles make many small rectangles, not one.
+    let blue = MaterialValue::new(Vec3::new(0.1, 0.3, 0.8), Vec3::splat(0.05), 2000.0);
+    stroke(
+        &mut doc,
+        blue,
+        Vec2::new(2000.0, 30.0),
+        Vec2::new(30.0, 1400.0),
+    );
+    assert!(textures.sync(&gpu, &doc.maps) > 50);
+    for level in [0, 1, 6, 7, 10] {
+        assert_box_means(&gpu, &textures, &doc.maps, level);
     }
 }
 

@@ -6,6 +6,7 @@ pub mod difference;
 pub mod headless;
 pub mod maps;
 pub mod preview;
+mod upload;
 
 use std::fmt;
 
