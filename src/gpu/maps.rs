@@ -61,9 +61,6 @@ pub struct MapTextures {
     /// Per tile, the sums of its texels (what the mip levels above one texel per tile are
     /// built from).
     tile_sums: Vec<MapSums>,
-    /// The staged words of the last batch (little-endian `u16`s as the GPU reads them), kept
-    /// to reuse the allocation.
-    scratch: Vec<u16>,
     /// Staging buffers, kept and mapped again between syncs.
     staging: StagingPool,
 }
@@ -114,7 +111,6 @@ impl MapTextures {
             size: (maps.width(), maps.height()),
             unorm16: gpu.unorm16,
             tile_sums: vec![MapSums::default(); maps.tile_count()],
-            scratch: Vec::new(),
             staging: StagingPool::default(),
         };
         let all: Vec<usize> = (0..maps.tile_count()).collect();
@@ -180,19 +176,16 @@ impl MapTextures {
         let rects = upload::tile_rects(tiles, tiles_x);
         let batches = upload::batches(&rects, self.size, self.kd.mip_level_count());
         for batch in &batches {
-            // Every staged word is written (row padding may keep stale words: never read).
-            self.scratch.resize((batch.len / 2) as usize, 0);
-            let (sums, rest) = upload::fill_rects(maps, self.unorm16, batch, &mut self.scratch);
+            // Every staged byte is written (row padding may keep stale bytes: never read).
+            let buffer = self.staging.take(gpu, batch.len);
+            let sums = upload::fill_rects(maps, self.unorm16, batch, &buffer)?;
             for (id, total) in sums {
                 self.tile_sums[id] = total;
             }
             let top = batch.top_levels();
             if !top.is_empty() {
-                upload::fill_top_levels(&self.tile_sums, tiles_x, self.unorm16, top, rest);
+                upload::fill_top_levels(&self.tile_sums, tiles_x, self.unorm16, top, &buffer)?;
             }
-            let (buffer, mut view) = self.staging.take(gpu, batch.len)?;
-            view.copy_from_slice(bytemuck::cast_slice(&self.scratch));
-            drop(view);
             buffer.unmap();
             let mut encoder = gpu
                 .device

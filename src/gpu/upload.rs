@@ -1,14 +1,11 @@
 //! Staging a sync's dirty tiles for the map textures: the tiles grouped into rectangles (one
 //! image per rectangle and mip level, so a 256 x 256 region is 7 images, not 16 x 7), each
-//! level's texels written one band of tile rows per parallel job, and the levels above one
-//! texel per tile rebuilt from per-tile sums. (The jobs fill a kept scratch buffer that is
-//! then copied into the mapped staging buffer once: wgpu 30's `WriteOnly` slices of a mapping
-//! cannot be sent to other threads.)
+//! level's texels written straight into the mapped staging buffer, one band of tile rows per
+//! parallel job (each band its own mapped views), and the levels above one texel per tile
+//! rebuilt from per-tile sums.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-
-use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 use crate::model::MaterialMaps;
 use crate::model::texel::{N_MAX, clamp_nan_low, decode_n, decode_unorm};
@@ -296,23 +293,50 @@ pub(super) fn batches(rects: &[TileRect], size: (u32, u32), levels: u32) -> Vec<
     out
 }
 
-/// A run of rows of one staged image (all three textures): `u16` words as the GPU reads
-/// them, rows `rgba_row` and `n_row` words apart.
-struct Band<'a> {
+/// A run of rows of one staged image (all three textures), each mapped for writing.
+struct Band {
     level: u32,
     /// The band's first texel, in texels of its level.
     origin: (u32, u32),
-    rgba_row: usize,
-    n_row: usize,
-    kd: &'a mut [u16],
-    ks: &'a mut [u16],
-    n: &'a mut [u16],
+    kd: Rows,
+    ks: Rows,
+    n: Rows,
 }
 
-/// Writes `row` at row `y`, word `x` of a band whose rows are `pitch` words apart.
-fn put_row(band: &mut [u16], pitch: usize, (x, y): (usize, usize), row: &[u16]) {
-    let at = y * pitch + x;
-    band[at..at + row.len()].copy_from_slice(row);
+/// Rows of one texture in the mapped staging buffer, `pitch` bytes apart (no view when there
+/// are no rows).
+struct Rows {
+    view: Option<wgpu::BufferViewMut>,
+    pitch: usize,
+}
+
+impl Rows {
+    /// Maps `rows` rows of `pitch` bytes at `offset` of `buffer`.
+    fn map(buffer: &wgpu::Buffer, offset: u64, rows: u32, pitch: u32) -> Result<Self, GpuError> {
+        let len = u64::from(rows) * u64::from(pitch);
+        let view = if len == 0 {
+            None
+        } else {
+            Some(
+                buffer
+                    .get_mapped_range_mut(offset..offset + len)
+                    .map_err(|e| GpuError(format!("cannot write the staging buffer: {e}")))?,
+            )
+        };
+        Ok(Self {
+            view,
+            pitch: pitch as usize,
+        })
+    }
+
+    /// Writes `row` (`u16` words, little-endian as the GPU reads them) at row `y`, word `x`.
+    fn put(&mut self, (x, y): (usize, usize), row: &[u16]) {
+        if let Some(view) = &mut self.view {
+            let bytes: &[u8] = bytemuck::cast_slice(row);
+            let at = y * self.pitch + 2 * x;
+            view.slice(at..at + bytes.len()).copy_from_slice(bytes);
+        }
+    }
 }
 
 /// The alpha written beside `k_d` and `k_s` (1 in either format).
@@ -330,24 +354,22 @@ fn rgb_component(unorm16: bool, v: u16) -> u16 {
 }
 
 /// One parallel job: one row of a rectangle's tiles and, per level, its band of rows.
-struct Job<'a> {
+struct Job {
     tiles: Vec<usize>,
-    bands: Vec<Band<'a>>,
+    bands: Vec<Band>,
 }
 
-/// Fills `out` (the staged words of `batch`, little-endian `u16`s) with its rectangles and
-/// returns the sums of every tile staged. The levels above one texel per tile are left to
-/// [`fill_top_levels`]; the rest of `out` after the rectangles is returned for them.
-pub(super) fn fill_rects<'a>(
+/// Stages the rectangles of `batch` into `buffer` (mapped) and returns the sums of every
+/// tile staged. The levels above one texel per tile are left to [`fill_top_levels`].
+pub(super) fn fill_rects(
     maps: &MaterialMaps,
     unorm16: bool,
     batch: &Batch,
-    out: &'a mut [u16],
-) -> (Vec<(usize, MapSums)>, &'a mut [u16]) {
+    buffer: &wgpu::Buffer,
+) -> Result<Vec<(usize, MapSums)>, GpuError> {
     let size = (maps.width(), maps.height());
     let tiles_x = maps.tiles_x() as usize;
-    let mut rest = out;
-    let mut jobs: Vec<Job<'a>> = Vec::new();
+    let mut jobs: Vec<Job> = Vec::new();
     let mut images = batch.images.iter();
     for &(rect, count) in &batch.rects {
         let first_job = jobs.len();
@@ -359,66 +381,66 @@ pub(super) fn fill_rects<'a>(
         }
         for image in images.by_ref().take(count) {
             let level = image.level;
-            // Each tile row's rows at this level (empty where the level rounds down).
-            let spans: Vec<(u32, u32)> = (rect.y0..rect.y1)
-                .map(|ty| {
-                    let row = TileRect {
-                        y0: ty,
-                        y1: ty + 1,
-                        ..rect
-                    };
-                    let r = level_rect(rect_texels(row, size), level, size);
-                    (r.1, r.3.max(r.1))
-                })
-                .collect();
-            let (kd, tail) = take_rows(rest, &spans, image.rgba_row);
-            let (ks, tail) = take_rows(tail, &spans, image.rgba_row);
-            let (n, tail) = take_rows(tail, &spans, image.n_row);
-            rest = tail;
-            let rows = kd.into_iter().zip(ks).zip(n);
-            for ((job, &(y0, _)), ((kd, ks), n)) in
-                jobs[first_job..].iter_mut().zip(&spans).zip(rows)
-            {
+            for (job, ty) in jobs[first_job..].iter_mut().zip(rect.y0..rect.y1) {
+                // This tile row's rows at this level (none where the level rounds down).
+                let row = TileRect {
+                    y0: ty,
+                    y1: ty + 1,
+                    ..rect
+                };
+                let r = level_rect(rect_texels(row, size), level, size);
+                let (skip, rows) = (u64::from(r.1 - image.origin.1), r.3.saturating_sub(r.1));
+                let rgba_skip = skip * u64::from(image.rgba_row);
                 job.bands.push(Band {
                     level,
-                    origin: (image.origin.0, y0),
-                    rgba_row: image.rgba_row as usize / 2,
-                    n_row: image.n_row as usize / 2,
-                    kd,
-                    ks,
-                    n,
+                    origin: (image.origin.0, r.1),
+                    kd: Rows::map(buffer, image.kd + rgba_skip, rows, image.rgba_row)?,
+                    ks: Rows::map(buffer, image.ks + rgba_skip, rows, image.rgba_row)?,
+                    n: Rows::map(
+                        buffer,
+                        image.n + skip * u64::from(image.n_row),
+                        rows,
+                        image.n_row,
+                    )?,
                 });
             }
         }
     }
-    let sums = jobs
-        .into_par_iter()
-        .flat_map_iter(|mut job| {
-            let bands = &mut job.bands;
-            job.tiles
-                .iter()
-                .map(|&id| (id, stage_tile(maps, id, unorm16, bands).into()))
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    (sums, rest)
+    Ok(run_jobs(jobs, |job| {
+        let bands = &mut job.bands;
+        job.tiles
+            .iter()
+            .map(|&id| (id, stage_tile(maps, id, unorm16, bands).into()))
+            .collect()
+    }))
 }
 
-/// Splits the rows of each span (`(first, end)` rows, `pitch` bytes apart) off the front of
-/// `words`, in order; returns them and the words after.
-fn take_rows<'a>(
-    words: &'a mut [u16],
-    spans: &[(u32, u32)],
-    pitch: u32,
-) -> (Vec<&'a mut [u16]>, &'a mut [u16]) {
-    let mut rest = words;
-    let mut out = Vec::with_capacity(spans.len());
-    for &(y0, y1) in spans {
-        let (rows, tail) = rest.split_at_mut((y1 - y0) as usize * pitch as usize / 2);
-        out.push(rows);
-        rest = tail;
-    }
-    (out, rest)
+/// Runs `work` on every job and gathers what it returns. The calling thread works too, taking
+/// jobs in turn with the pool's threads: no job waits for a sleeping thread to wake, and a
+/// single job never leaves the calling thread.
+fn run_jobs<J: Send, R: Send>(jobs: Vec<J>, work: impl Fn(&mut J) -> Vec<R> + Sync) -> Vec<R> {
+    let helpers = rayon::current_num_threads().min(jobs.len().saturating_sub(1));
+    let jobs: Vec<Mutex<J>> = jobs.into_iter().map(Mutex::new).collect();
+    let next = AtomicUsize::new(0);
+    let results = Mutex::new(Vec::new());
+    let take_turns = || {
+        let mut done = Vec::new();
+        while let Some(job) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
+            let mut job = job.lock().unwrap_or_else(PoisonError::into_inner);
+            done.extend(work(&mut job));
+        }
+        results
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .append(&mut done);
+    };
+    rayon::in_place_scope(|scope| {
+        for _ in 0..helpers {
+            scope.spawn(|_| take_turns());
+        }
+        take_turns();
+    });
+    results.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// Writes the whole levels above one texel per tile (`images`, in level order) into `out`,
@@ -428,30 +450,22 @@ pub(super) fn fill_top_levels(
     tiles_x: usize,
     unorm16: bool,
     images: &[StagedImage],
-    out: &mut [u16],
-) {
+    buffer: &wgpu::Buffer,
+) -> Result<(), GpuError> {
     let tiles_y = tile_sums.len() / tiles_x.max(1);
-    let mut rest = out;
     let mut below: Option<(Vec<MapSums>, usize, usize)> = None;
     for image in images {
         let (grid, gw, gh) = match &below {
             None => fold(tile_sums, tiles_x, tiles_y),
             Some((grid, gw, gh)) => fold(grid, *gw, *gh),
         };
-        let (rgba_row, n_row) = (image.rgba_row as usize / 2, image.n_row as usize / 2);
-        let rows = image.extent.1 as usize;
-        let (kd, tail) = rest.split_at_mut(rgba_row * rows);
-        let (ks, tail) = tail.split_at_mut(rgba_row * rows);
-        let (n, tail) = tail.split_at_mut(n_row * rows);
-        rest = tail;
+        let rows = image.extent.1;
         let mut band = Band {
             level: image.level,
             origin: (0, 0),
-            rgba_row,
-            n_row,
-            kd,
-            ks,
-            n,
+            kd: Rows::map(buffer, image.kd, rows, image.rgba_row)?,
+            ks: Rows::map(buffer, image.ks, rows, image.rgba_row)?,
+            n: Rows::map(buffer, image.n, rows, image.n_row)?,
         };
         // The texture's levels may be smaller than the grids (sizes that are not powers of
         // two round down): their texels are the grids' top-left ones.
@@ -459,12 +473,13 @@ pub(super) fn fill_top_levels(
         write_means(&grid, gw, unorm16, extent, &mut band, (0, 0));
         below = Some((grid, gw, gh));
     }
+    Ok(())
 }
 
 /// Stages tile `id` into `bands` (levels 0, 1, ... in order): level 0 copied from its planes,
 /// the levels above from box sums (each from the one below, rounded once). Returns the
 /// whole tile's sums.
-fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band<'_>]) -> TileSums {
+fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band]) -> TileSums {
     let tile = maps.tile(id);
     let rect = maps.tile_rect(id);
     let Some((first, mips)) = bands.split_first_mut() else {
@@ -479,18 +494,19 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band<'
         let [r, g, b] = v.map(|c| u64::from(rgb_component(unorm16, c)));
         bytemuck::cast((r | g << 16 | b << 32 | u64::from(a) << 48).to_le())
     };
-    for (plane, band) in [(&tile.kd, &mut first.kd), (&tile.ks, &mut first.ks)] {
+    let mut row = [[0_u16; 4]; TILE_SIZE];
+    let row = &mut row[..w];
+    for (plane, out) in [(&tile.kd, &mut first.kd), (&tile.ks, &mut first.ks)] {
+        if let Plane::Uniform(v) = plane {
+            row.fill(texel(v));
+        }
         for y in 0..h {
-            let at = (y0 + y) * first.rgba_row + x * 4;
-            let (out, _) = band[at..at + w * 4].as_chunks_mut::<4>();
-            match plane {
-                Plane::Uniform(v) => out.fill(texel(v)),
-                Plane::Data(d) => {
-                    for (o, v) in out.iter_mut().zip(&d[y * TILE_SIZE..y * TILE_SIZE + w]) {
-                        *o = texel(v);
-                    }
+            if let Plane::Data(d) = plane {
+                for (o, v) in row.iter_mut().zip(&d[y * TILE_SIZE..y * TILE_SIZE + w]) {
+                    *o = texel(v);
                 }
             }
+            out.put((x * 4, y0 + y), row.as_flattened());
         }
     }
     let uniform_n = [tile.n.uniform().unwrap_or(0); TILE_SIZE];
@@ -499,7 +515,7 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band<'
             Plane::Uniform(_) => &uniform_n[..w],
             Plane::Data(d) => &d[y * TILE_SIZE..y * TILE_SIZE + w],
         };
-        put_row(first.n, first.n_row, (x, y0 + y), row);
+        first.n.put((x, y0 + y), row);
     }
     stage_tile_mips(maps, id, unorm16, mips)
 }
@@ -507,12 +523,7 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band<'
 /// Stages the mip levels over tile `id` into `bands` (levels 1, 2, ... in order): box sums
 /// on the tile-local grid, level 1 summed straight from the tile's planes, each level above
 /// from the one below, rounded once. Returns the whole tile's sums.
-fn stage_tile_mips(
-    maps: &MaterialMaps,
-    id: usize,
-    unorm16: bool,
-    bands: &mut [Band<'_>],
-) -> TileSums {
+fn stage_tile_mips(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band]) -> TileSums {
     let rect = maps.tile_rect(id);
     let size = (maps.width(), maps.height());
     let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
@@ -629,27 +640,29 @@ fn write_means<S: MipSums>(
     stride: usize,
     unorm16: bool,
     (w, h): (usize, usize),
-    band: &mut Band<'_>,
+    band: &mut Band,
     (x, y): (usize, usize),
 ) {
     let a = alpha(unorm16);
+    let mut rgba = vec![[0_u16; 4]; w];
     let mut n = vec![0.0_f32; w];
+    let mut n_bits = vec![half::f16::ZERO; w];
     for row in 0..h {
         let sums = &grid[row * stride..row * stride + w];
-        for (first, out) in [(0, &mut *band.kd), (3, &mut *band.ks)] {
-            let at = (y + row) * band.rgba_row + x * 4;
-            let (out, _) = out[at..at + w * 4].as_chunks_mut::<4>();
-            for (o, s) in out.iter_mut().zip(sums) {
+        for (first, out) in [(0, &mut band.kd), (3, &mut band.ks)] {
+            for (o, s) in rgba.iter_mut().zip(sums) {
                 *o = s.rgba(first, unorm16, a);
             }
+            out.put((x * 4, y + row), rgba.as_flattened());
         }
         for (o, s) in n.iter_mut().zip(sums) {
             *o = s.n();
         }
-        let at = (y + row) * band.n_row + x;
-        let out: &mut [half::f16] =
-            half::slice::HalfBitsSliceExt::reinterpret_cast_mut(&mut band.n[at..at + w]);
-        half::slice::HalfFloatSliceExt::convert_from_f32_slice(out, &n);
+        half::slice::HalfFloatSliceExt::convert_from_f32_slice(&mut n_bits[..], &n);
+        band.n.put(
+            (x, y + row),
+            bytemuck::cast_slice::<half::f16, u16>(&n_bits),
+        );
     }
 }
 
@@ -662,36 +675,25 @@ pub(super) struct StagingPool {
 }
 
 impl StagingPool {
-    /// A buffer of at least `len` bytes and its first `len` bytes mapped for writing: a kept
-    /// one that is ready, else a new one while fewer than [`KEPT_BUFFERS`] are in flight, else
-    /// a kept one once the GPU is done with it.
-    pub fn take(
-        &mut self,
-        gpu: &Gpu,
-        len: u64,
-    ) -> Result<(wgpu::Buffer, wgpu::BufferViewMut), GpuError> {
+    /// A buffer of at least `len` bytes, mapped for writing: a kept one that is ready, else a
+    /// new one while fewer than [`KEPT_BUFFERS`] are in flight, else a kept one once the GPU
+    /// is done with it.
+    pub fn take(&mut self, gpu: &Gpu, len: u64) -> wgpu::Buffer {
         let ready =
             |(b, m): &(wgpu::Buffer, Arc<AtomicBool>)| b.size() >= len && m.load(Ordering::Acquire);
         if !self.kept.iter().any(ready) && self.kept.len() >= KEPT_BUFFERS {
             gpu.wait();
         }
         if let Some(i) = self.kept.iter().position(ready) {
-            let (buffer, _) = self.kept.swap_remove(i);
-            if let Ok(view) = buffer.get_mapped_range_mut(..len) {
-                return Ok((buffer, view));
-            }
+            return self.kept.swap_remove(i).0;
         }
         // Room to grow: a little more than asked, in whole MiB.
-        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("map tiles"),
             size: (len + 1).next_multiple_of(1 << 20),
             usage: wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: true,
-        });
-        let view = buffer
-            .get_mapped_range_mut(..len)
-            .map_err(|e| GpuError(format!("cannot map a staging buffer of {len} bytes: {e}")))?;
-        Ok((buffer, view))
+        })
     }
 
     /// Keeps `buffer` (submitted for copying) and maps it again; the smallest goes when more
