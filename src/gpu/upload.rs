@@ -489,10 +489,13 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
     let x = (rect.0 - first.origin.0) as usize;
     let y0 = (rect.1 - first.origin.1) as usize;
     let a = alpha(unorm16);
-    // One 8-byte store per texel (components and alpha packed in a register).
-    let texel = |v: &[u16; 3]| -> [u16; 4] {
-        let [r, g, b] = v.map(|c| u64::from(rgb_component(unorm16, c)));
-        bytemuck::cast((r | g << 16 | b << 32 | u64::from(a) << 48).to_le())
+    let texel = |v: &[u16; 3]| {
+        [
+            rgb_component(unorm16, v[0]),
+            rgb_component(unorm16, v[1]),
+            rgb_component(unorm16, v[2]),
+            a,
+        ]
     };
     let mut row = [[0_u16; 4]; TILE_SIZE];
     let row = &mut row[..w];
@@ -502,8 +505,13 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
         }
         for y in 0..h {
             if let Plane::Data(d) = plane {
-                for (o, v) in row.iter_mut().zip(&d[y * TILE_SIZE..y * TILE_SIZE + w]) {
-                    *o = texel(v);
+                let src = &d[y * TILE_SIZE..y * TILE_SIZE + w];
+                if unorm16 {
+                    rgb_to_rgba(src, row, a);
+                } else {
+                    for (o, v) in row.iter_mut().zip(src) {
+                        *o = texel(v);
+                    }
                 }
             }
             out.put((x * 4, y0 + y), row.as_flattened());
@@ -518,6 +526,29 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
         first.n.put((x, y0 + y), row);
     }
     stage_tile_mips(maps, id, unorm16, mips)
+}
+
+/// Copies RGB texels into RGBA ones with alpha `a`, four at a time: three 8-byte loads and
+/// four 8-byte stores (the components move as whole words, never one at a time).
+fn rgb_to_rgba(src: &[[u16; 3]], out: &mut [[u16; 4]], a: u16) {
+    let alpha = u64::from(a) << 48;
+    let low48 = (1_u64 << 48) - 1;
+    let (groups, rest) = src.as_chunks::<4>();
+    let (out_groups, out_rest) = out.as_chunks_mut::<4>();
+    for (o, g) in out_groups.iter_mut().zip(groups) {
+        // Four texels are 24 bytes: three little-endian words, each texel 48 bits of them.
+        let [w0, w1, w2] = bytemuck::cast::<[[u16; 3]; 4], [u64; 3]>(*g).map(u64::from_le);
+        let texels = [
+            w0 & low48,
+            (w0 >> 48 | w1 << 16) & low48,
+            (w1 >> 32 | w2 << 32) & low48,
+            w2 >> 16,
+        ];
+        *o = bytemuck::cast(texels.map(|t| (t | alpha).to_le()));
+    }
+    for (o, v) in out_rest.iter_mut().zip(rest) {
+        *o = [v[0], v[1], v[2], a];
+    }
 }
 
 /// Stages the mip levels over tile `id` into `bands` (levels 1, 2, ... in order): box sums
@@ -727,6 +758,20 @@ mod tests {
             .collect();
         out.sort_unstable();
         out
+    }
+
+    #[test]
+    fn rgb_texels_become_rgba_with_alpha_at_any_length() {
+        for len in [0_usize, 1, 3, 4, 5, 8, 63, 64] {
+            let src: Vec<[u16; 3]> = (0..len as u16)
+                .map(|i| [i * 3, i * 3 + 1, 0xfff0 - i].map(|c| c ^ 0x5a5a))
+                .collect();
+            let mut out = vec![[0_u16; 4]; len];
+            rgb_to_rgba(&src, &mut out, 0xabcd);
+            for (o, v) in out.iter().zip(&src) {
+                assert_eq!(*o, [v[0], v[1], v[2], 0xabcd], "length {len}");
+            }
+        }
     }
 
     #[test]
