@@ -1,6 +1,7 @@
 //! Profiling aid: repeats a hard 128 px dab inside one 256x256 square of 4096^2 maps and
 //! syncs the dirty tiles to the GPU each time (`perf record` this). Prints the mean sync
-//! time, with and without waiting for the queue.
+//! time, with and without waiting for the queue. `cargo run --release --example
+//! upload_profile [ROUNDS]`.
 
 use std::time::{Duration, Instant};
 
@@ -26,7 +27,11 @@ fn main() -> Result<(), String> {
     )
     .map_err(|e| e.to_string())?;
     let mut maps = MapTextures::new(&gpu, &doc.maps);
-    let rounds = 2000_u32;
+    // Rounds from the first argument (default 2000).
+    let rounds: u32 = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(2000);
     let (mut cpu, mut whole) = (Duration::ZERO, Duration::ZERO);
     for k in 0..rounds {
         let x0 = f32::from((k % 15) as u16) * 256.0;
