@@ -15,7 +15,7 @@ use kapaint::gpu::{Gpu, MapTextures, MeshBuffers, Preview};
 use kapaint::mesh;
 use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::MaterialValue;
-use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{Channels, Command, Document, DocumentSettings, StrokeTool};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
 
@@ -226,7 +226,8 @@ fn uploads(c: &mut Criterion) {
         ..BrushSettings::default()
     }))
     .expect("brush");
-    let mut bench = |b: &mut criterion::Bencher<'_>, wait: bool| {
+    let mut bench = |b: &mut criterion::Bencher<'_>, wait: bool, channels: Channels| {
+        doc.apply(Command::SetChannels(channels)).expect("channels");
         b.iter_custom(|iters| {
             let mut total = Duration::ZERO;
             for _ in 0..iters {
@@ -254,8 +255,19 @@ fn uploads(c: &mut Criterion) {
     };
     // The whole upload, until the GPU has the texels; and the part the UI thread waits for
     // (staging, encoding, submitting: the copies themselves run on the GPU's queue).
-    group.bench_function("dirty_256x256_region", |b| bench(b, true));
-    group.bench_function("dirty_256x256_region_cpu_side", |b| bench(b, false));
+    group.bench_function("dirty_256x256_region", |b| bench(b, true, Channels::ALL));
+    group.bench_function("dirty_256x256_region_cpu_side", |b| {
+        bench(b, false, Channels::ALL);
+    });
+    // A stroke on k_d alone stages k_d alone (8 of the 18 bytes a texel).
+    let kd = Channels {
+        kd: true,
+        ks: false,
+        n: false,
+    };
+    group.bench_function("dirty_256x256_region_kd_only_cpu_side", |b| {
+        bench(b, false, kd);
+    });
     group.finish();
 }
 

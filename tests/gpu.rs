@@ -710,6 +710,71 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
     }
 }
 
+#[test]
+fn a_stroke_on_some_channels_stages_only_those() {
+    use kapaint::model::Channels;
+    let Some(gpu) = gpu() else { return };
+    if !gpu.unorm16 {
+        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
+        return;
+    }
+    let mut doc = Document::new(512, 384, DocumentSettings::default()).expect("doc");
+    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    let mut dab = |doc: &mut Document, channels: Channels, value: MaterialValue| {
+        doc.apply(Command::SetChannels(channels)).expect("channels");
+        doc.apply(Command::SetPrimary(value)).expect("primary");
+        doc.apply(Command::Stroke {
+            tool: StrokeTool::Brush,
+            points: vec![kapaint::model::brush::StrokePoint {
+                pos: Vec2::new(200.0, 150.0),
+                pressure: 1.0,
+            }],
+        })
+        .expect("dab");
+        assert!(textures.sync(&gpu, &doc.maps) > 0);
+        for level in [0, 1, 3, 7] {
+            assert_box_means(&gpu, &textures, &doc.maps, level);
+        }
+        textures.staged_bytes()
+    };
+    let value = |k: f32| {
+        MaterialValue::new(
+            Vec3::new(k, 0.5, 1.0 - k),
+            Vec3::splat(k * 0.5),
+            10.0 + 900.0 * k,
+        )
+    };
+    let all = dab(&mut doc, Channels::ALL, value(0.2));
+    let kd = dab(
+        &mut doc,
+        Channels {
+            kd: true,
+            ks: false,
+            n: false,
+        },
+        value(0.9),
+    );
+    let n = dab(
+        &mut doc,
+        Channels {
+            kd: false,
+            ks: false,
+            n: true,
+        },
+        value(0.5),
+    );
+    // k_d is 8 of the 18 bytes a texel, n 2 of them (plus the small whole top levels).
+    assert!(kd * 10 < all * 5, "k_d only staged {kd} of {all} bytes");
+    assert!(n * 10 < all * 2, "n only staged {n} of {all} bytes");
+    // Undo puts back whole tiles: every channel again, and still mirrored.
+    doc.apply(Command::Undo).expect("undo");
+    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    assert_eq!(textures.staged_bytes(), all);
+    for level in [0, 2, 8] {
+        assert_box_means(&gpu, &textures, &doc.maps, level);
+    }
+}
+
 /// A 64 x 8 project whose `n` runs from 1 to 5000, exported as a `compact` set into `dir` so
 /// that the set stores `n` on a curve in 8 bits.
 fn n_gradient_set(dir: &std::path::Path) -> (Document, kapaint::export::set::Manifest) {

@@ -5,7 +5,7 @@
 //! CPU from the tile, rounded once per level): staged by [`super::upload`] straight into a
 //! mapped buffer and copied by one command buffer of sub-rectangle copies.
 
-use crate::model::MaterialMaps;
+use crate::model::{Channels, MaterialMaps};
 
 use super::upload::{self, MapSums, StagingPool};
 use super::{Gpu, GpuError};
@@ -63,6 +63,8 @@ pub struct MapTextures {
     tile_sums: Vec<MapSums>,
     /// Staging buffers, kept and mapped again between syncs.
     staging: StagingPool,
+    /// Bytes staged by the last sync.
+    staged_bytes: u64,
 }
 
 impl std::fmt::Debug for MapTextures {
@@ -112,13 +114,19 @@ impl MapTextures {
             unorm16: gpu.unorm16,
             tile_sums: vec![MapSums::default(); maps.tile_count()],
             staging: StagingPool::default(),
+            staged_bytes: 0,
         };
         let all: Vec<usize> = (0..maps.tile_count()).collect();
         // A failed upload leaves the version at 0: the next sync tries every tile again.
-        if out.upload(gpu, maps, &all).is_ok() {
+        if out.upload(gpu, maps, &all, 0).is_ok() {
             out.version = maps.version();
         }
         out
+    }
+
+    /// Bytes the last sync staged (and copied into the textures), for tests and diagnostics.
+    pub fn staged_bytes(&self) -> u64 {
+        self.staged_bytes
     }
 
     /// Map size mirrored.
@@ -134,7 +142,7 @@ impl MapTextures {
             return 0;
         }
         let dirty = maps.tiles_changed_since(self.version);
-        if self.upload(gpu, maps, &dirty).is_err() {
+        if self.upload(gpu, maps, &dirty, self.version).is_err() {
             return 0;
         }
         self.uniform = UniformChannels::of(maps);
@@ -168,13 +176,35 @@ impl MapTextures {
     /// Uploads `tiles` and the mip levels over them: the tiles grouped into rectangles, each
     /// batch of them staged in one mapped buffer (filled in parallel) and copied by one
     /// command buffer, one copy per rectangle, level and texture.
-    fn upload(&mut self, gpu: &Gpu, maps: &MaterialMaps, tiles: &[usize]) -> Result<(), GpuError> {
+    fn upload(
+        &mut self,
+        gpu: &Gpu,
+        maps: &MaterialMaps,
+        tiles: &[usize],
+        since: u64,
+    ) -> Result<(), GpuError> {
         if tiles.is_empty() {
             return Ok(());
         }
         let tiles_x = maps.tiles_x() as usize;
-        let rects = upload::tile_rects(tiles, tiles_x);
+        // Each rectangle stages the channels any of its tiles changed since `since`.
+        let rects: Vec<(upload::TileRect, Channels)> = upload::tile_rects(tiles, tiles_x)
+            .into_iter()
+            .map(|r| {
+                let ids = (r.y0..r.y1).flat_map(|y| (r.x0..r.x1).map(move |x| y * tiles_x + x));
+                let changed = ids.fold(Channels::NONE, |c, id| {
+                    let t = maps.channels_changed_since(id, since);
+                    Channels {
+                        kd: c.kd || t.kd,
+                        ks: c.ks || t.ks,
+                        n: c.n || t.n,
+                    }
+                });
+                (r, changed)
+            })
+            .collect();
         let batches = upload::batches(&rects, self.size, self.kd.mip_level_count());
+        self.staged_bytes = batches.iter().map(|b| b.len).sum();
         for batch in &batches {
             // Every staged byte is written (row padding may keep stale bytes: never read).
             let buffer = self.staging.take(gpu, batch.len);
@@ -193,11 +223,14 @@ impl MapTextures {
                     label: Some("map upload"),
                 });
             for i in &batch.images {
-                for (texture, offset, bytes_per_row) in [
-                    (&self.kd, i.kd, i.rgba_row),
-                    (&self.ks, i.ks, i.rgba_row),
-                    (&self.n, i.n, i.n_row),
-                ] {
+                for (texture, offset, bytes_per_row, _) in [
+                    (&self.kd, i.kd, i.rgba_row, i.channels.kd),
+                    (&self.ks, i.ks, i.rgba_row, i.channels.ks),
+                    (&self.n, i.n, i.n_row, i.channels.n),
+                ]
+                .into_iter()
+                .filter(|c| c.3)
+                {
                     encoder.copy_buffer_to_texture(
                         wgpu::TexelCopyBufferInfo {
                             buffer: &buffer,

@@ -7,9 +7,9 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
-use crate::model::MaterialMaps;
 use crate::model::texel::{N_MAX, clamp_nan_low, decode_n, decode_unorm};
 use crate::model::tile::{Plane, TILE_SIZE};
+use crate::model::{Channels, MaterialMaps};
 
 use super::{Gpu, GpuError};
 
@@ -205,6 +205,8 @@ pub(super) struct StagedImage {
     pub level: u32,
     pub origin: (u32, u32),
     pub extent: (u32, u32),
+    /// The textures staged (the others keep what they hold: no bytes, no copy).
+    pub channels: Channels,
     pub kd: u64,
     pub ks: u64,
     pub n: u64,
@@ -229,25 +231,39 @@ impl Batch {
         &self.images[rect_images..]
     }
 
-    /// Reserves room for one rectangle of `level` in the three textures.
-    fn push_level(&mut self, level: u32, origin: (u32, u32), extent: (u32, u32)) {
+    /// Reserves room for one rectangle of `level` in the textures of `channels`.
+    fn push_level(
+        &mut self,
+        level: u32,
+        origin: (u32, u32),
+        extent: (u32, u32),
+        channels: Channels,
+    ) {
         let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let rgba_row = (extent.0 * 8).next_multiple_of(align);
         let n_row = (extent.0 * 2).next_multiple_of(align);
-        let rgba_bytes = u64::from(rgba_row) * u64::from(extent.1);
-        let n_bytes = u64::from(n_row) * u64::from(extent.1);
+        let bytes = |on: bool, row: u32| {
+            if on {
+                u64::from(row) * u64::from(extent.1)
+            } else {
+                0
+            }
+        };
         let kd = self.len;
+        let ks = kd + bytes(channels.kd, rgba_row);
+        let n = ks + bytes(channels.ks, rgba_row);
         self.images.push(StagedImage {
             level,
             origin,
             extent,
+            channels,
             kd,
-            ks: kd + rgba_bytes,
-            n: kd + 2 * rgba_bytes,
+            ks,
+            n,
             rgba_row,
             n_row,
         });
-        self.len = kd + 2 * rgba_bytes + n_bytes;
+        self.len = n + bytes(channels.n, n_row);
     }
 }
 
@@ -265,10 +281,10 @@ fn rect_texels(rect: TileRect, size: (u32, u32)) -> (u32, u32, u32, u32) {
 
 /// The batches that stage `rects` of maps of `size` with `levels` mip levels: each
 /// rectangle's levels up to one texel per tile, then the levels above, whole, in the last.
-pub(super) fn batches(rects: &[TileRect], size: (u32, u32), levels: u32) -> Vec<Batch> {
+pub(super) fn batches(rects: &[(TileRect, Channels)], size: (u32, u32), levels: u32) -> Vec<Batch> {
     let mut out = Vec::new();
     let mut batch = Batch::default();
-    for &rect in rects {
+    for &(rect, channels) in rects {
         if batch.len >= BATCH_BYTES {
             out.push(std::mem::take(&mut batch));
         }
@@ -277,17 +293,15 @@ pub(super) fn batches(rects: &[TileRect], size: (u32, u32), levels: u32) -> Vec<
         for level in 0..levels.min(TILE_LEVEL + 1) {
             let r = level_rect(texels, level, size);
             if r.2 > r.0 && r.3 > r.1 {
-                batch.push_level(level, (r.0, r.1), (r.2 - r.0, r.3 - r.1));
+                batch.push_level(level, (r.0, r.1), (r.2 - r.0, r.3 - r.1), channels);
             }
         }
         batch.rects.push((rect, batch.images.len() - before));
     }
+    // The whole levels above: every channel (the means of all the tiles, tiny).
     for level in TILE_LEVEL + 1..levels {
-        batch.push_level(
-            level,
-            (0, 0),
-            ((size.0 >> level).max(1), (size.1 >> level).max(1)),
-        );
+        let extent = ((size.0 >> level).max(1), (size.1 >> level).max(1));
+        batch.push_level(level, (0, 0), extent, Channels::ALL);
     }
     out.push(batch);
     out
@@ -327,6 +341,11 @@ impl Rows {
             view,
             pitch: pitch as usize,
         })
+    }
+
+    /// Whether these rows are staged (else the texture keeps what it holds).
+    fn staged(&self) -> bool {
+        self.view.is_some()
     }
 
     /// Writes `row` (`u16` words, little-endian as the GPU reads them) at row `y`, word `x`.
@@ -391,15 +410,17 @@ pub(super) fn fill_rects(
                 let r = level_rect(rect_texels(row, size), level, size);
                 let (skip, rows) = (u64::from(r.1 - image.origin.1), r.3.saturating_sub(r.1));
                 let rgba_skip = skip * u64::from(image.rgba_row);
+                let on = image.channels;
+                let staged = |on: bool| if on { rows } else { 0 };
                 job.bands.push(Band {
                     level,
                     origin: (image.origin.0, r.1),
-                    kd: Rows::map(buffer, image.kd + rgba_skip, rows, image.rgba_row)?,
-                    ks: Rows::map(buffer, image.ks + rgba_skip, rows, image.rgba_row)?,
+                    kd: Rows::map(buffer, image.kd + rgba_skip, staged(on.kd), image.rgba_row)?,
+                    ks: Rows::map(buffer, image.ks + rgba_skip, staged(on.ks), image.rgba_row)?,
                     n: Rows::map(
                         buffer,
                         image.n + skip * u64::from(image.n_row),
-                        rows,
+                        staged(on.n),
                         image.n_row,
                     )?,
                 });
@@ -500,6 +521,9 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
     let mut row = [[0_u16; 4]; TILE_SIZE];
     let row = &mut row[..w];
     for (plane, out) in [(&tile.kd, &mut first.kd), (&tile.ks, &mut first.ks)] {
+        if !out.staged() {
+            continue;
+        }
         if let Plane::Uniform(v) = plane {
             row.fill(texel(v));
         }
@@ -518,7 +542,8 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
         }
     }
     let uniform_n = [tile.n.uniform().unwrap_or(0); TILE_SIZE];
-    for y in 0..h {
+    let n_rows = if first.n.staged() { h } else { 0 };
+    for y in 0..n_rows {
         let row = match &tile.n {
             Plane::Uniform(_) => &uniform_n[..w],
             Plane::Data(d) => &d[y * TILE_SIZE..y * TILE_SIZE + w],
@@ -681,10 +706,16 @@ fn write_means<S: MipSums>(
     for row in 0..h {
         let sums = &grid[row * stride..row * stride + w];
         for (first, out) in [(0, &mut band.kd), (3, &mut band.ks)] {
+            if !out.staged() {
+                continue;
+            }
             for (o, s) in rgba.iter_mut().zip(sums) {
                 *o = s.rgba(first, unorm16, a);
             }
             out.put((x * 4, y + row), rgba.as_flattened());
+        }
+        if !band.n.staged() {
+            continue;
         }
         for (o, s) in n.iter_mut().zip(sums) {
             *o = s.n();
@@ -813,6 +844,7 @@ mod tests {
     #[test]
     fn large_syncs_are_split_into_batches_of_bounded_size() {
         let rects = tile_rects(&(0..128 * 128).collect::<Vec<_>>(), 128);
+        let rects: Vec<_> = rects.into_iter().map(|r| (r, Channels::ALL)).collect();
         let batches = batches(&rects, (8192, 8192), 14);
         assert!(batches.len() > 1);
         // One rectangle past the limit at most: 512^2 texels of 18 bytes with mips.

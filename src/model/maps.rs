@@ -6,7 +6,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::ModelError;
-use super::texel::{MaterialValue, Texel, decode_n, decode_rgb};
+use super::texel::{Channels, MaterialValue, Texel, decode_n, decode_rgb};
 use super::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile};
 use crate::reflectance::{self, AmbientApprox, PAPER_TWO_OVER_PI, ShadingModel, TWO_OVER_PI};
 
@@ -19,8 +19,9 @@ pub type TileId = usize;
 /// The maps of one material: any size up to `MAX_SIDE` square, stored as 64 x 64 tiles.
 ///
 /// Tiles are shared (`Arc`) so that history can keep old versions without copying: writing
-/// to a tile clones it only if history still holds it. Every write bumps the tile's version,
-/// so consumers (the GPU mirror, k_a caches) can ask what changed since they last looked.
+/// to a tile clones it only if history still holds it. Every write bumps the versions of the
+/// tile's channels it may change, so consumers (the GPU mirror, k_a caches) can ask what
+/// changed since they last looked, tile by tile and channel by channel.
 #[derive(Clone, Debug)]
 pub struct MaterialMaps {
     width: u32,
@@ -28,7 +29,8 @@ pub struct MaterialMaps {
     tiles_x: u32,
     tiles_y: u32,
     tiles: Vec<Arc<Tile>>,
-    versions: Vec<u64>,
+    /// Per tile, the versions of its `k_d`, `k_s` and `n` planes.
+    versions: Vec<[u64; 3]>,
     clock: u64,
 }
 
@@ -48,7 +50,7 @@ impl MaterialMaps {
             tiles_x,
             tiles_y,
             tiles: vec![tile; count],
-            versions: vec![1; count],
+            versions: vec![[1; 3]; count],
             clock: 1,
         })
     }
@@ -127,17 +129,21 @@ impl MaterialMaps {
 
     /// A tile for writing: cloned first if anything else (history) holds it. Bumps its version.
     pub fn tile_mut(&mut self, id: TileId) -> &mut Tile {
-        self.clock += 1;
-        self.versions[id] = self.clock;
+        self.touch(id, Channels::ALL);
         Arc::make_mut(&mut self.tiles[id])
     }
 
     /// Several tiles for writing at once (each cloned first if shared), for parallel work on
     /// disjoint tiles. `ids` must be sorted ascending without duplicates; bumps versions.
     pub fn tiles_mut_many(&mut self, ids: &[TileId]) -> Vec<&mut Tile> {
+        self.tiles_mut_many_in(ids, Channels::ALL)
+    }
+
+    /// [`MaterialMaps::tiles_mut_many`] for a writer that changes only `channels` (the other
+    /// planes may be rewritten, but with the values they hold): only their versions move.
+    pub fn tiles_mut_many_in(&mut self, ids: &[TileId], channels: Channels) -> Vec<&mut Tile> {
         for &id in ids {
-            self.clock += 1;
-            self.versions[id] = self.clock;
+            self.touch(id, channels);
         }
         super::tile::select_mut(&mut self.tiles, ids)
             .into_iter()
@@ -147,9 +153,19 @@ impl MaterialMaps {
 
     /// Puts `tile` in place of tile `id` and returns the previous one (undo and redo).
     pub fn replace_tile(&mut self, id: TileId, tile: Arc<Tile>) -> Arc<Tile> {
-        self.clock += 1;
-        self.versions[id] = self.clock;
+        self.touch(id, Channels::ALL);
         std::mem::replace(&mut self.tiles[id], tile)
+    }
+
+    /// Advances the clock and stamps `channels` of tile `id` with it.
+    fn touch(&mut self, id: TileId, channels: Channels) {
+        self.clock += 1;
+        let on = [channels.kd, channels.ks, channels.n];
+        for (version, on) in self.versions[id].iter_mut().zip(on) {
+            if on {
+                *version = self.clock;
+            }
+        }
     }
 
     /// The current version: it grows with every write.
@@ -157,15 +173,21 @@ impl MaterialMaps {
         self.clock
     }
 
-    /// The version of one tile.
+    /// The version of one tile (its latest channel).
     pub fn tile_version(&self, id: TileId) -> u64 {
-        self.versions[id]
+        self.versions[id].into_iter().max().unwrap_or(0)
+    }
+
+    /// The channels of tile `id` written after `version`.
+    pub fn channels_changed_since(&self, id: TileId, version: u64) -> Channels {
+        let [kd, ks, n] = self.versions[id].map(|v| v > version);
+        Channels { kd, ks, n }
     }
 
     /// Tiles written after `version` (pass 0 for all), ascending.
     pub fn tiles_changed_since(&self, version: u64) -> Vec<TileId> {
         (0..self.tiles.len())
-            .filter(|&id| self.versions[id] > version)
+            .filter(|&id| self.versions[id].iter().any(|&v| v > version))
             .collect()
     }
 
@@ -380,6 +402,32 @@ mod tests {
             Some(Texel::encode(MaterialValue::default()).n)
         );
         assert_eq!(maps.tile(1).n.get(0), 7);
+        assert_eq!(maps.channels_changed_since(1, v0), Channels::ALL);
+    }
+
+    #[test]
+    fn versions_follow_the_channels_written() {
+        let mut maps = MaterialMaps::new(128, 128, MaterialValue::default()).unwrap();
+        let v0 = maps.version();
+        let only_n = Channels {
+            kd: false,
+            ks: false,
+            n: true,
+        };
+        maps.tiles_mut_many_in(&[0, 3], only_n)[1].n.data_mut()[5] = 9;
+        assert_eq!(maps.tiles_changed_since(v0), vec![0, 3]);
+        assert_eq!(maps.channels_changed_since(3, v0), only_n);
+        assert!(maps.tile_version(3) > v0);
+        let v1 = maps.version();
+        assert!(maps.tiles_changed_since(v1).is_empty());
+        maps.tile_mut(2);
+        assert_eq!(maps.channels_changed_since(2, v1), Channels::ALL);
+        let none = Channels {
+            kd: false,
+            ks: false,
+            n: false,
+        };
+        assert_eq!(maps.channels_changed_since(3, v1), none);
     }
 
     #[test]

@@ -324,7 +324,9 @@ pub fn paint_dab(
     let pres: Vec<Arc<Tile>> = ids.iter().map(|&id| pre_tile(history, maps, id)).collect();
     history.save_before_write(maps, &ids);
     let covs = coverage.tiles_mut(maps.tile_count(), &ids);
-    let tiles = maps.tiles_mut_many(&ids);
+    // Only the enabled channels change (the energy guard too adjusts only the enabled one;
+    // the others are rewritten with the values they hold).
+    let tiles = maps.tiles_mut_many_in(&ids, target.channels);
     let tables = n_tables();
     let work: Vec<_> = tiles
         .into_iter()
@@ -833,6 +835,14 @@ mod tests {
         let out = target.blend(pre, 1.0).decode();
         assert!((out.kd.x + out.ks.x) <= 1.0 + 1e-4);
         assert!((out.ks.x - 0.8).abs() < 1e-4, "k_s untouched");
+        // Untouched to the bit, every code, so a dab may mark only the enabled channels as
+        // changed.
+        for q in 0..=u16::MAX {
+            let mut pre = Texel::encode(MaterialValue::new(Vec3::splat(0.3), Vec3::ZERO, 10.0));
+            pre.ks = [q, q / 2, u16::MAX - q];
+            let out = target.blend(pre, 0.7);
+            assert_eq!((out.ks, out.n), (pre.ks, pre.n), "code {q}");
+        }
     }
 
     #[test]
