@@ -7,7 +7,7 @@
 
 use crate::model::{Channels, MaterialMaps};
 
-use super::upload::{self, MapSums, StagingPool};
+use super::upload::{self, StagingPool, Sums};
 use super::{Gpu, GpuError};
 
 /// Which channels are one value over the whole map (the preview then skips their fetch).
@@ -60,7 +60,7 @@ pub struct MapTextures {
     unorm16: bool,
     /// Per tile, the sums of its texels (what the mip levels above one texel per tile are
     /// built from).
-    tile_sums: Vec<MapSums>,
+    tile_sums: Vec<Sums>,
     /// Staging buffers, kept and mapped again between syncs.
     staging: StagingPool,
     /// Bytes staged by the last sync.
@@ -112,7 +112,7 @@ impl MapTextures {
             version: 0,
             size: (maps.width(), maps.height()),
             unorm16: gpu.unorm16,
-            tile_sums: vec![MapSums::default(); maps.tile_count()],
+            tile_sums: vec![Sums::default(); maps.tile_count()],
             staging: StagingPool::default(),
             staged_bytes: 0,
         };
@@ -193,12 +193,7 @@ impl MapTextures {
             .map(|r| {
                 let ids = (r.y0..r.y1).flat_map(|y| (r.x0..r.x1).map(move |x| y * tiles_x + x));
                 let changed = ids.fold(Channels::NONE, |c, id| {
-                    let t = maps.channels_changed_since(id, since);
-                    Channels {
-                        kd: c.kd || t.kd,
-                        ks: c.ks || t.ks,
-                        n: c.n || t.n,
-                    }
+                    c.union(maps.channels_changed_since(id, since))
                 });
                 (r, changed)
             })
@@ -223,14 +218,14 @@ impl MapTextures {
                     label: Some("map upload"),
                 });
             for i in &batch.images {
-                for (texture, offset, bytes_per_row, _) in [
-                    (&self.kd, i.kd, i.rgba_row, i.channels.kd),
-                    (&self.ks, i.ks, i.rgba_row, i.channels.ks),
-                    (&self.n, i.n, i.n_row, i.channels.n),
-                ]
-                .into_iter()
-                .filter(|c| c.3)
-                {
+                for (staged, texture, offset, bytes_per_row) in [
+                    (i.channels.kd, &self.kd, i.kd, i.rgba_row),
+                    (i.channels.ks, &self.ks, i.ks, i.rgba_row),
+                    (i.channels.n, &self.n, i.n, i.n_row),
+                ] {
+                    if !staged {
+                        continue;
+                    }
                     encoder.copy_buffer_to_texture(
                         wgpu::TexelCopyBufferInfo {
                             buffer: &buffer,

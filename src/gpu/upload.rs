@@ -8,38 +8,22 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use crate::model::texel::{N_MAX, clamp_nan_low, decode_n, decode_unorm};
-use crate::model::tile::{Plane, TILE_SIZE};
+use crate::model::tile::{Plane, TILE_SIZE, Tile};
 use crate::model::{Channels, MaterialMaps};
 
 use super::{Gpu, GpuError};
 
-/// Sums of the level-0 texels under one texel of a mip level, what its mean is rounded from.
-pub(super) trait MipSums: Copy + Default + std::ops::AddAssign + Send {
-    /// The mean `k_d` (`first == 0`) or `k_s` (`first == 3`) as the texture stores it, with
-    /// alpha `a`.
-    fn rgba(&self, first: usize, unorm16: bool, a: u16) -> [u16; 4];
-    /// The mean `n`.
-    fn n(&self) -> f32;
-}
-
-/// Within a tile (at most 4096 texels): `k_d` and `k_s` as sums of unorm16 codes (exact),
-/// `n` in single precision, and how many texels.
+/// Sums of the level-0 texels under one texel of a mip level, what its mean is rounded from:
+/// `k_d` and `k_s` as sums of unorm16 codes (exact), `n`, and how many texels. Wide enough
+/// for a whole 8192^2 map.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) struct TileSums {
-    codes: [u32; 6],
-    n: f32,
-    count: u32,
-}
-
-/// Over many tiles (up to a whole 8192^2 map): the same in 64 bits.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) struct MapSums {
+pub(super) struct Sums {
     codes: [u64; 6],
     n: f64,
     count: u64,
 }
 
-impl std::ops::AddAssign for TileSums {
+impl std::ops::AddAssign for Sums {
     fn add_assign(&mut self, o: Self) {
         for (c, o) in self.codes.iter_mut().zip(o.codes) {
             *c += o;
@@ -49,63 +33,30 @@ impl std::ops::AddAssign for TileSums {
     }
 }
 
-impl std::ops::AddAssign for MapSums {
-    fn add_assign(&mut self, o: Self) {
-        for (c, o) in self.codes.iter_mut().zip(o.codes) {
-            *c += o;
-        }
-        self.n += o.n;
-        self.count += o.count;
-    }
-}
-
-impl From<TileSums> for MapSums {
-    fn from(t: TileSums) -> Self {
-        Self {
-            codes: t.codes.map(u64::from),
-            n: f64::from(t.n),
-            count: u64::from(t.count),
-        }
-    }
-}
-
-/// A mean code (`sum / count`, rounded) as the texture stores it.
-fn mean_component(mean: f32, unorm16: bool) -> u16 {
-    if unorm16 {
-        // In range by construction (a mean of codes); `as` saturates anyway.
-        (mean + 0.5) as u16
-    } else {
-        half::f16::from_f32(mean * (1.0 / 65535.0)).to_bits()
-    }
-}
-
-impl MipSums for TileSums {
+impl Sums {
+    /// The mean `k_d` (`first == 0`) or `k_s` (`first == 3`) as the texture stores it, with
+    /// alpha `a`.
     fn rgba(&self, first: usize, unorm16: bool, a: u16) -> [u16; 4] {
         if unorm16 && self.count.is_power_of_two() {
-            // Away from the map's edges: an exact integer mean, rounded half up.
+            // Whole blocks (away from the map's edges): an integer mean, rounded half up.
             let (shift, half) = (self.count.trailing_zeros(), self.count >> 1);
             let c = |i: usize| ((self.codes[first + i] + half) >> shift) as u16;
             return [c(0), c(1), c(2), a];
         }
-        // Sums past 2^24 lose low bits in f32, but then the count is at least 256: under
-        // 0.005 of a code in the mean.
-        let inv = 1.0 / self.count.max(1) as f32;
-        let c = |i: usize| mean_component(self.codes[first + i] as f32 * inv, unorm16);
-        [c(0), c(1), c(2), a]
-    }
-
-    fn n(&self) -> f32 {
-        self.n / self.count.max(1) as f32
-    }
-}
-
-impl MipSums for MapSums {
-    fn rgba(&self, first: usize, unorm16: bool, a: u16) -> [u16; 4] {
         let inv = 1.0 / self.count.max(1) as f64;
-        let c = |i: usize| mean_component((self.codes[first + i] as f64 * inv) as f32, unorm16);
+        let c = |i: usize| {
+            let mean = self.codes[first + i] as f64 * inv;
+            if unorm16 {
+                // In range by construction (a mean of codes); `as` saturates anyway.
+                (mean + 0.5) as u16
+            } else {
+                half::f16::from_f64(mean / 65535.0).to_bits()
+            }
+        };
         [c(0), c(1), c(2), a]
     }
 
+    /// The mean `n`.
     fn n(&self) -> f32 {
         (self.n / self.count.max(1) as f64) as f32
     }
@@ -385,7 +336,7 @@ pub(super) fn fill_rects(
     unorm16: bool,
     batch: &Batch,
     buffer: &wgpu::Buffer,
-) -> Result<Vec<(usize, MapSums)>, GpuError> {
+) -> Result<Vec<(usize, Sums)>, GpuError> {
     let size = (maps.width(), maps.height());
     let tiles_x = maps.tiles_x() as usize;
     let mut jobs: Vec<Job> = Vec::new();
@@ -431,7 +382,7 @@ pub(super) fn fill_rects(
         let bands = &mut job.bands;
         job.tiles
             .iter()
-            .map(|&id| (id, stage_tile(maps, id, unorm16, bands).into()))
+            .map(|&id| (id, stage_tile(maps, id, unorm16, bands)))
             .collect()
     }))
 }
@@ -467,14 +418,14 @@ fn run_jobs<J: Send, R: Send>(jobs: Vec<J>, work: impl Fn(&mut J) -> Vec<R> + Sy
 /// Writes the whole levels above one texel per tile (`images`, in level order) into `out`,
 /// the first from the per-tile sums (`tiles_x` to a row), each next from the one below.
 pub(super) fn fill_top_levels(
-    tile_sums: &[MapSums],
+    tile_sums: &[Sums],
     tiles_x: usize,
     unorm16: bool,
     images: &[StagedImage],
     buffer: &wgpu::Buffer,
 ) -> Result<(), GpuError> {
     let tiles_y = tile_sums.len() / tiles_x.max(1);
-    let mut below: Option<(Vec<MapSums>, usize, usize)> = None;
+    let mut below: Option<(Vec<Sums>, usize, usize)> = None;
     for image in images {
         let (grid, gw, gh) = match &below {
             None => fold(tile_sums, tiles_x, tiles_y),
@@ -500,11 +451,11 @@ pub(super) fn fill_top_levels(
 /// Stages tile `id` into `bands` (levels 0, 1, ... in order): level 0 copied from its planes,
 /// the levels above from box sums (each from the one below, rounded once). Returns the
 /// whole tile's sums.
-fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band]) -> TileSums {
+fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band]) -> Sums {
     let tile = maps.tile(id);
     let rect = maps.tile_rect(id);
     let Some((first, mips)) = bands.split_first_mut() else {
-        return TileSums::default();
+        return Sums::default();
     };
     let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
     let x = (rect.0 - first.origin.0) as usize;
@@ -550,7 +501,7 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
         };
         first.n.put((x, y0 + y), row);
     }
-    stage_tile_mips(maps, id, unorm16, mips)
+    stage_tile_mips(tile, rect, (maps.width(), maps.height()), unorm16, mips)
 }
 
 /// Copies RGB texels into RGBA ones with alpha `a`, four at a time: three 8-byte loads and
@@ -576,16 +527,20 @@ fn rgb_to_rgba(src: &[[u16; 3]], out: &mut [[u16; 4]], a: u16) {
     }
 }
 
-/// Stages the mip levels over tile `id` into `bands` (levels 1, 2, ... in order): box sums
-/// on the tile-local grid, level 1 summed straight from the tile's planes, each level above
-/// from the one below, rounded once. Returns the whole tile's sums.
-fn stage_tile_mips(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band]) -> TileSums {
-    let rect = maps.tile_rect(id);
-    let size = (maps.width(), maps.height());
+/// Stages the mip levels over `tile` (texels `rect` of maps of `size`) into `bands` (levels
+/// 1, 2, ... in order): box sums on the tile-local grid, level 1 summed straight from the
+/// tile's planes, each level above from the one below, rounded once. Returns the whole
+/// tile's sums.
+fn stage_tile_mips(
+    tile: &Tile,
+    rect: (u32, u32, u32, u32),
+    size: (u32, u32),
+    unorm16: bool,
+    bands: &mut [Band],
+) -> Sums {
     let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
-    let tile = maps.tile(id);
     let (mut gw, mut gh) = (w.div_ceil(2), h.div_ceil(2));
-    let mut grid = vec![TileSums::default(); gw * gh];
+    let mut grid = vec![Sums::default(); gw * gh];
     // Level 1 from pairs of rows: each pair added down the columns first (codes as `u32`,
     // `n` decoded), then across.
     let mut columns = [[0_u32; 3 * TILE_SIZE]; 2];
@@ -645,10 +600,10 @@ fn stage_tile_mips(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [B
                 }
             }
             let right = if pair == 2 { n_columns[x + 1] } else { 0.0 };
-            *o = TileSums {
-                codes,
-                n: n_columns[x] + right,
-                count: pair as u32 * row_count,
+            *o = Sums {
+                codes: codes.map(u64::from),
+                n: f64::from(n_columns[x] + right),
+                count: (pair as u32 * row_count).into(),
             };
         }
     }
@@ -668,7 +623,7 @@ fn stage_tile_mips(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [B
             write_means(&grid, gw, unorm16, extent, band, at);
         }
     }
-    let mut total = TileSums::default();
+    let mut total = Sums::default();
     for s in grid {
         total += s;
     }
@@ -677,9 +632,9 @@ fn stage_tile_mips(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [B
 
 /// The next mip level's sums: each `2 x 2` block of the `w x h` grid added up (the last row
 /// or column alone when odd).
-pub(super) fn fold<S: MipSums>(grid: &[S], w: usize, h: usize) -> (Vec<S>, usize, usize) {
+pub(super) fn fold(grid: &[Sums], w: usize, h: usize) -> (Vec<Sums>, usize, usize) {
     let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
-    let mut next = vec![S::default(); nw * nh];
+    let mut next = vec![Sums::default(); nw * nh];
     for (y, row) in grid.chunks(w).enumerate() {
         let out = &mut next[(y / 2) * nw..(y / 2 + 1) * nw];
         for (x, s) in row.iter().enumerate() {
@@ -691,8 +646,8 @@ pub(super) fn fold<S: MipSums>(grid: &[S], w: usize, h: usize) -> (Vec<S>, usize
 
 /// Writes the means of the top-left `w x h` sums of `grid` (rows `stride` apart) into the
 /// three textures of `band`, at texel `(x, y)` of the band.
-fn write_means<S: MipSums>(
-    grid: &[S],
+fn write_means(
+    grid: &[Sums],
     stride: usize,
     unorm16: bool,
     (w, h): (usize, usize),
@@ -744,7 +699,10 @@ impl StagingPool {
         let ready =
             |(b, m): &(wgpu::Buffer, Arc<AtomicBool>)| b.size() >= len && m.load(Ordering::Acquire);
         if !self.kept.iter().any(ready) && self.kept.len() >= KEPT_BUFFERS {
+            // Every kept buffer is still being copied from: wait for the GPU. One still
+            // unmapped after that failed to map, and goes.
             gpu.wait();
+            self.kept.retain(|(_, m)| m.load(Ordering::Acquire));
         }
         if let Some(i) = self.kept.iter().position(ready) {
             return self.kept.swap_remove(i).0;

@@ -422,12 +422,7 @@ mod tests {
         assert!(maps.tiles_changed_since(v1).is_empty());
         maps.tile_mut(2);
         assert_eq!(maps.channels_changed_since(2, v1), Channels::ALL);
-        let none = Channels {
-            kd: false,
-            ks: false,
-            n: false,
-        };
-        assert_eq!(maps.channels_changed_since(3, v1), none);
+        assert_eq!(maps.channels_changed_since(3, v1), Channels::NONE);
     }
 
     #[test]

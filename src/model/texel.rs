@@ -101,6 +101,16 @@ impl Channels {
     pub fn is_empty(self) -> bool {
         !(self.kd || self.ks || self.n)
     }
+
+    /// The channels enabled in either.
+    #[must_use]
+    pub fn union(self, other: Self) -> Self {
+        Self {
+            kd: self.kd || other.kd,
+            ks: self.ks || other.ks,
+            n: self.n || other.n,
+        }
+    }
 }
 
 impl Default for Channels {
