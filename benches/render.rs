@@ -67,6 +67,19 @@ impl Frame<'_> {
 }
 
 /// A 4096^2 document with strokes in every channel, and one whose k_s is zero everywhere.
+/// Paints one brush stroke through `points` at full pressure.
+fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
+    let points = points
+        .iter()
+        .map(|&pos| StrokePoint { pos, pressure: 1.0 })
+        .collect();
+    doc.apply(Command::Stroke {
+        tool: StrokeTool::Brush,
+        points,
+    })
+    .expect("stroke");
+}
+
 fn documents() -> (Document, Document) {
     let mut painted = Document::new(
         4096,
@@ -82,21 +95,10 @@ fn documents() -> (Document, Document) {
     .expect("doc");
     for k in 0..8 {
         let y = 300.0 + 480.0 * k as f32;
-        painted
-            .apply(Command::Stroke {
-                tool: StrokeTool::Brush,
-                points: vec![
-                    StrokePoint {
-                        pos: Vec2::new(100.0, y),
-                        pressure: 1.0,
-                    },
-                    StrokePoint {
-                        pos: Vec2::new(4000.0, y + 200.0),
-                        pressure: 1.0,
-                    },
-                ],
-            })
-            .expect("stroke");
+        brush_stroke(
+            &mut painted,
+            &[Vec2::new(100.0, y), Vec2::new(4000.0, y + 200.0)],
+        );
     }
     let matte = Document::new(
         4096,
@@ -233,14 +235,8 @@ fn uploads(c: &mut Criterion) {
             for _ in 0..iters {
                 k += 1;
                 let x0 = f32::from((k % 15) as u16) * 256.0;
-                doc.apply(Command::Stroke {
-                    tool: StrokeTool::Brush,
-                    points: vec![StrokePoint {
-                        pos: Vec2::new(x0 + 128.0, 128.0 + 256.0 * (k % 7) as f32),
-                        pressure: 1.0,
-                    }],
-                })
-                .expect("dab");
+                let y = 128.0 + 256.0 * (k % 7) as f32;
+                brush_stroke(&mut doc, &[Vec2::new(x0 + 128.0, y)]);
                 let start = std::time::Instant::now();
                 let n = maps.sync(&gpu, &doc.maps);
                 if wait {
@@ -315,14 +311,8 @@ fn painting(c: &mut Criterion) {
         b.iter(|| {
             k += 1;
             let x = f32::from((k % 60) as u16) * 64.0 + 64.0;
-            doc.apply(Command::Stroke {
-                tool: StrokeTool::Brush,
-                points: vec![StrokePoint {
-                    pos: Vec2::new(x, 2048.0 + 512.0 * ((k / 60) % 3) as f32),
-                    pressure: 1.0,
-                }],
-            })
-            .expect("dab");
+            let y = 2048.0 + 512.0 * ((k / 60) % 3) as f32;
+            brush_stroke(&mut doc, &[Vec2::new(x, y)]);
             maps.sync(&gpu, &doc.maps);
             let key = PipelineKey::for_frame(&s, &maps.uniform, format);
             frame.draw(&mut preview, &maps, &s, &[DrawPart::whole(key, (w, h))]);

@@ -180,20 +180,7 @@ fn painted_maps() -> MaterialMaps {
             continue;
         }
         let y = 60.0 + 80.0 * i as f32;
-        doc.apply(Command::Stroke {
-            tool: StrokeTool::Brush,
-            points: vec![
-                kapaint::model::brush::StrokePoint {
-                    pos: Vec2::new(10.0, y),
-                    pressure: 1.0,
-                },
-                kapaint::model::brush::StrokePoint {
-                    pos: Vec2::new(246.0, y + 20.0),
-                    pressure: 1.0,
-                },
-            ],
-        })
-        .expect("stroke");
+        brush_stroke(&mut doc, &[Vec2::new(10.0, y), Vec2::new(246.0, y + 20.0)]);
     }
     doc.maps
 }
@@ -280,14 +267,7 @@ fn sync_uploads_only_dirty_tiles_and_the_render_follows() {
     let mut doc = Document::new(512, 512, DocumentSettings::default()).expect("doc");
     let mut textures = MapTextures::new(&gpu, &doc.maps);
     assert_eq!(textures.sync(&gpu, &doc.maps), 0, "nothing changed");
-    doc.apply(Command::Stroke {
-        tool: StrokeTool::Brush,
-        points: vec![kapaint::model::brush::StrokePoint {
-            pos: Vec2::new(100.0, 100.0),
-            pressure: 1.0,
-        }],
-    })
-    .expect("dab");
+    brush_stroke(&mut doc, &[Vec2::new(100.0, 100.0)]);
     // A 32 px dab at (100, 100) touches the 4 tiles around (64..192)^2 at most.
     let uploaded = textures.sync(&gpu, &doc.maps);
     assert!((1..=4).contains(&uploaded), "{uploaded} tiles");
@@ -514,62 +494,18 @@ fn render_cli_writes_numerically_checkable_data_views() {
 
 #[test]
 fn mips_follow_the_dirty_tiles() {
-    use kapaint::gpu::maps::MapChannel;
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 512, DocumentSettings::default()).expect("doc");
     let mut textures = MapTextures::new(&gpu, &doc.maps);
-    doc.apply(Command::Stroke {
-        tool: StrokeTool::Brush,
-        points: vec![
-            kapaint::model::brush::StrokePoint {
-                pos: Vec2::new(90.0, 100.0),
-                pressure: 1.0,
-            },
-            kapaint::model::brush::StrokePoint {
-                pos: Vec2::new(300.0, 140.0),
-                pressure: 1.0,
-            },
-        ],
-    })
-    .expect("stroke");
+    brush_stroke(&mut doc, &[Vec2::new(90.0, 100.0), Vec2::new(300.0, 140.0)]);
     assert!(textures.sync(&gpu, &doc.maps) > 0);
     if !gpu.unorm16 {
         eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
         return;
     }
-    // Level 2 texel = mean of the 4 x 4 level-0 block, up to one rounding per level.
-    let kd: Vec<[u16; 3]> = (0..512 * 512)
-        .map(|i| doc.maps.texel(i % 512, i / 512).kd)
-        .collect();
-    let level2 = textures.read_level(&gpu, MapChannel::Kd, 2).expect("read");
-    assert_eq!(level2.len(), 128 * 128 * 4);
-    let mut worst = 0.0_f64;
-    for y in 0..128 {
-        for x in 0..128 {
-            for c in 0..3 {
-                let mut sum = 0.0;
-                for dy in 0..4 {
-                    for dx in 0..4 {
-                        sum += f64::from(kd[(4 * y + dy) * 512 + 4 * x + dx][c]);
-                    }
-                }
-                let got = f64::from(level2[(y * 128 + x) * 4 + c]);
-                worst = worst.max((got - sum / 16.0).abs());
-            }
-        }
-    }
-    assert!(
-        worst <= 2.0,
-        "level 2 differs from the box mean by {worst} / 65535"
-    );
-    // The 1 x 1 level is the mean of the whole map.
-    let last = textures.read_level(&gpu, MapChannel::Kd, 9).expect("read");
-    let mean = kd.iter().map(|v| f64::from(v[0])).sum::<f64>() / kd.len() as f64;
-    assert!(
-        (f64::from(last[0]) - mean).abs() <= 10.0,
-        "{} vs {mean}",
-        last[0]
-    );
+    // Level 2 holds the 4 x 4 box means; the 1 x 1 level the mean of the whole map.
+    assert_box_means(&gpu, &textures, &doc.maps, 2);
+    assert_box_means(&gpu, &textures, &doc.maps, 9);
 }
 
 #[test]
@@ -589,24 +525,24 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
         900.0,
     )))
     .expect("primary");
-    doc.apply(Command::Stroke {
-        tool: StrokeTool::Brush,
-        points: vec![
-            kapaint::model::brush::StrokePoint {
-                pos: Vec2::new(20.0, 30.0),
-                pressure: 1.0,
-            },
-            kapaint::model::brush::StrokePoint {
-                pos: Vec2::new(190.0, 110.0),
-                pressure: 1.0,
-            },
-        ],
-    })
-    .expect("stroke");
+    brush_stroke(&mut doc, &[Vec2::new(20.0, 30.0), Vec2::new(190.0, 110.0)]);
     assert!(textures.sync(&gpu, &doc.maps) > 0);
     for level in 1..textures.kd.mip_level_count() {
         assert_box_means(&gpu, &textures, &doc.maps, level);
     }
+}
+
+/// Paints one brush stroke through `points` at full pressure.
+fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
+    let points = points
+        .iter()
+        .map(|&pos| kapaint::model::brush::StrokePoint { pos, pressure: 1.0 })
+        .collect();
+    doc.apply(Command::Stroke {
+        tool: StrokeTool::Brush,
+        points,
+    })
+    .expect("stroke");
 }
 
 /// Mip `level` of the `k_d` and `n` textures holds the box means of `maps` (2/65535 for
@@ -677,13 +613,7 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
     let mut doc = Document::new(2048, 1536, DocumentSettings::default()).expect("doc");
     let stroke = |doc: &mut Document, value: MaterialValue, from: Vec2, to: Vec2| {
         doc.apply(Command::SetPrimary(value)).expect("primary");
-        doc.apply(Command::Stroke {
-            tool: StrokeTool::Brush,
-            points: [from, to]
-                .map(|pos| kapaint::model::brush::StrokePoint { pos, pressure: 1.0 })
-                .to_vec(),
-        })
-        .expect("stroke");
+        brush_stroke(doc, &[from, to]);
     };
     let red = MaterialValue::new(Vec3::new(0.9, 0.2, 0.1), Vec3::splat(0.3), 40.0);
     stroke(
@@ -723,14 +653,7 @@ fn a_stroke_on_some_channels_stages_only_those() {
     let mut dab = |doc: &mut Document, channels: Channels, value: MaterialValue| {
         doc.apply(Command::SetChannels(channels)).expect("channels");
         doc.apply(Command::SetPrimary(value)).expect("primary");
-        doc.apply(Command::Stroke {
-            tool: StrokeTool::Brush,
-            points: vec![kapaint::model::brush::StrokePoint {
-                pos: Vec2::new(200.0, 150.0),
-                pressure: 1.0,
-            }],
-        })
-        .expect("dab");
+        brush_stroke(doc, &[Vec2::new(200.0, 150.0)]);
         assert!(textures.sync(&gpu, &doc.maps) > 0);
         for level in [0, 1, 3, 7] {
             assert_box_means(&gpu, &textures, &doc.maps, level);
