@@ -532,6 +532,33 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     }
 }
 
+#[test]
+fn without_16_bit_norm_textures_the_maps_upload_as_half_floats() {
+    let Some(mut gpu) = gpu() else { return };
+    // As on an adapter without 16-bit normalised textures.
+    gpu.unorm16 = false;
+    let (w, h) = (200_u32, 120_u32);
+    let mut doc = Document::new(w, h, DocumentSettings::default()).expect("doc");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.9, 0.2, 0.001),
+        Vec3::splat(0.7),
+        900.0,
+    )))
+    .expect("primary");
+    brush_stroke(&mut doc, &[Vec2::new(20.0, 30.0), Vec2::new(190.0, 110.0)]);
+    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    assert_eq!(textures.kd.format(), wgpu::TextureFormat::Rgba16Float);
+    for level in 0..textures.kd.mip_level_count() {
+        assert_box_means(&gpu, &textures, &doc.maps, level);
+    }
+    // A later stroke updates its tiles and the levels over them.
+    brush_stroke(&mut doc, &[Vec2::new(150.0, 10.0), Vec2::new(10.0, 100.0)]);
+    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    for level in 0..textures.kd.mip_level_count() {
+        assert_box_means(&gpu, &textures, &doc.maps, level);
+    }
+}
+
 /// Paints one brush stroke through `points` at full pressure.
 fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
     let points = points
@@ -546,7 +573,8 @@ fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
 }
 
 /// Mip `level` of the `k_d` and `n` textures holds the box means of `maps` (2/65535 for
-/// `k_d`, 1e-3 relative for `n`); level 0 holds `k_d`, `k_s` and `n` exactly.
+/// `k_d` in unorm16, or to half-float precision; 1e-3 relative for `n`); level 0 holds `k_d`,
+/// `k_s` and `n` exactly (as the texture's format stores them).
 fn assert_box_means(gpu: &Gpu, textures: &MapTextures, maps: &MaterialMaps, level: u32) {
     use kapaint::gpu::maps::MapChannel;
     let (w, h) = (maps.width() as usize, maps.height() as usize);
@@ -560,14 +588,29 @@ fn assert_box_means(gpu: &Gpu, textures: &MapTextures, maps: &MaterialMaps, leve
         .read_level(gpu, MapChannel::N, level)
         .expect("read");
     assert_eq!((kd.len(), n.len()), (lw * lh * 4, lw * lh), "level {level}");
+    // The texture's code for a unorm16 code, and back to unorm16 steps.
+    let stored = |c: u16| {
+        if gpu.unorm16 {
+            c
+        } else {
+            half::f16::from_f32(kapaint::model::texel::decode_unorm(c)).to_bits()
+        }
+    };
+    let steps = |c: u16| {
+        if gpu.unorm16 {
+            f64::from(c)
+        } else {
+            f64::from(half::f16::from_bits(c).to_f32()) * 65535.0
+        }
+    };
     if level == 0 {
         let ks = textures.read_level(gpu, MapChannel::Ks, 0).expect("read");
         for y in 0..h {
             for x in 0..w {
                 let t = texel(x, y);
                 let i = y * w + x;
-                assert_eq!(kd[i * 4..i * 4 + 3], t.kd, "k_d at ({x}, {y})");
-                assert_eq!(ks[i * 4..i * 4 + 3], t.ks, "k_s at ({x}, {y})");
+                assert_eq!(kd[i * 4..i * 4 + 3], t.kd.map(stored), "k_d at ({x}, {y})");
+                assert_eq!(ks[i * 4..i * 4 + 3], t.ks.map(stored), "k_s at ({x}, {y})");
                 assert_eq!(n[i], t.n, "n at ({x}, {y})");
             }
         }
@@ -582,9 +625,11 @@ fn assert_box_means(gpu: &Gpu, textures: &MapTextures, maps: &MaterialMaps, leve
             let count = block.len() as f64;
             for c in 0..3 {
                 let mean = block.iter().map(|t| f64::from(t.kd[c])).sum::<f64>() / count;
-                let got = f64::from(kd[(y * lw + x) * 4 + c]);
+                let got = steps(kd[(y * lw + x) * 4 + c]);
+                // Half floats keep 11 significant bits.
+                let tolerance = if gpu.unorm16 { 2.0 } else { 2.0 + mean / 1024.0 };
                 assert!(
-                    (got - mean).abs() <= 2.0,
+                    (got - mean).abs() <= tolerance,
                     "level {level} ({x}, {y}): {got} vs {mean}"
                 );
             }
@@ -686,7 +731,7 @@ fn a_stroke_on_some_channels_stages_only_those() {
         },
         value(0.5),
     );
-    // k_d is 8 of the 18 bytes a texel, n 2 of them (plus the small whole top levels).
+    // k_d is 8 of the 18 bytes a texel, n 2 of them (and the same for the levels above).
     assert!(kd * 10 < all * 5, "k_d only staged {kd} of {all} bytes");
     assert!(n * 10 < all * 2, "n only staged {n} of {all} bytes");
     // Undo puts back whole tiles: every channel again, and still mirrored.

@@ -7,7 +7,7 @@
 
 use crate::model::{Channels, MaterialMaps};
 
-use super::upload::{self, StagingPool, Sums};
+use super::upload::{self, StagingPool, TopSums};
 use super::{Gpu, GpuError};
 
 /// Which channels are one value over the whole map (the preview then skips their fetch).
@@ -58,9 +58,9 @@ pub struct MapTextures {
     version: u64,
     size: (u32, u32),
     unorm16: bool,
-    /// Per tile, the sums of its texels (what the mip levels above one texel per tile are
-    /// built from).
-    tile_sums: Vec<Sums>,
+    /// Sums per tile and per block of tiles (what the mip levels above one texel per tile
+    /// are built from).
+    top_sums: TopSums,
     /// Staging buffers, kept and mapped again between syncs.
     staging: StagingPool,
     /// Bytes staged by the last sync.
@@ -112,7 +112,7 @@ impl MapTextures {
             version: 0,
             size: (maps.width(), maps.height()),
             unorm16: gpu.unorm16,
-            tile_sums: vec![Sums::default(); maps.tile_count()],
+            top_sums: TopSums::new(maps.tiles_x() as usize, maps.tiles_y() as usize),
             staging: StagingPool::default(),
             staged_bytes: 0,
         };
@@ -204,12 +204,10 @@ impl MapTextures {
             // Every staged byte is written (row padding may keep stale bytes: never read).
             let buffer = self.staging.take(gpu, batch.len);
             let sums = upload::fill_rects(maps, self.unorm16, batch, &buffer)?;
-            for (id, total) in sums {
-                self.tile_sums[id] = total;
-            }
+            self.top_sums.set(&sums);
             let top = batch.top_levels();
             if !top.is_empty() {
-                upload::fill_top_levels(&self.tile_sums, tiles_x, self.unorm16, top, &buffer)?;
+                self.top_sums.fill(self.unorm16, top, &buffer)?;
             }
             buffer.unmap();
             let mut encoder = gpu

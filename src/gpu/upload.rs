@@ -37,28 +37,29 @@ impl Sums {
     /// The mean `k_d` (`first == 0`) or `k_s` (`first == 3`) as the texture stores it, with
     /// alpha `a`.
     fn rgba(&self, first: usize, unorm16: bool, a: u16) -> [u16; 4] {
-        if unorm16 && self.count.is_power_of_two() {
-            // Whole blocks (away from the map's edges): an integer mean, rounded half up.
-            let (shift, half) = (self.count.trailing_zeros(), self.count >> 1);
-            let c = |i: usize| ((self.codes[first + i] + half) >> shift) as u16;
-            return [c(0), c(1), c(2), a];
-        }
-        let inv = 1.0 / self.count.max(1) as f64;
-        let c = |i: usize| {
-            let mean = self.codes[first + i] as f64 * inv;
-            if unorm16 {
-                // In range by construction (a mean of codes); `as` saturates anyway.
-                (mean + 0.5) as u16
-            } else {
-                half::f16::from_f64(mean / 65535.0).to_bits()
-            }
-        };
+        let c = |i: usize| mean_code(self.codes[first + i], self.count.max(1), unorm16);
         [c(0), c(1), c(2), a]
     }
 
     /// The mean `n`.
     fn n(&self) -> f32 {
         (self.n / self.count.max(1) as f64) as f32
+    }
+}
+
+/// The mean of `count` unorm16 codes summing to `sum`, as a texture of `k_d` or `k_s` stores
+/// it: rounded half up as unorm16, or as half float.
+fn mean_code(sum: u64, count: u64, unorm16: bool) -> u16 {
+    if unorm16 && count.is_power_of_two() {
+        // Whole blocks (away from the map's edges): an integer mean.
+        return ((sum + (count >> 1)) >> count.trailing_zeros()) as u16;
+    }
+    let mean = sum as f64 / count as f64;
+    if unorm16 {
+        // In range by construction (a mean of codes); `as` saturates anyway.
+        (mean + 0.5) as u16
+    } else {
+        half::f16::from_f64(mean / 65535.0).to_bits()
     }
 }
 
@@ -166,7 +167,8 @@ pub(super) struct StagedImage {
 }
 
 /// One batch of copies: its images in staging order (each rectangle's levels, then, in the
-/// last batch, the whole levels above one texel per tile) and the staging bytes they take.
+/// last batch, the parts of the levels above one texel per tile over them all) and the staging
+/// bytes they take.
 #[derive(Debug, Default)]
 pub(super) struct Batch {
     pub images: Vec<StagedImage>,
@@ -176,7 +178,7 @@ pub(super) struct Batch {
 }
 
 impl Batch {
-    /// The whole levels above one texel per tile (in the last batch only).
+    /// The parts of the levels above one texel per tile (in the last batch only).
     pub fn top_levels(&self) -> &[StagedImage] {
         let rect_images = self.rects.iter().map(|&(_, count)| count).sum();
         &self.images[rect_images..]
@@ -231,7 +233,8 @@ fn rect_texels(rect: TileRect, size: (u32, u32)) -> (u32, u32, u32, u32) {
 }
 
 /// The batches that stage `rects` of maps of `size` with `levels` mip levels: each
-/// rectangle's levels up to one texel per tile, then the levels above, whole, in the last.
+/// rectangle's levels up to one texel per tile, then, in the last, the texels of the levels
+/// above over all the rectangles.
 pub(super) fn batches(rects: &[(TileRect, Channels)], size: (u32, u32), levels: u32) -> Vec<Batch> {
     let mut out = Vec::new();
     let mut batch = Batch::default();
@@ -249,10 +252,21 @@ pub(super) fn batches(rects: &[(TileRect, Channels)], size: (u32, u32), levels: 
         }
         batch.rects.push((rect, batch.images.len() - before));
     }
-    // The whole levels above: every channel (the means of all the tiles, tiny).
-    for level in TILE_LEVEL + 1..levels {
-        let extent = ((size.0 >> level).max(1), (size.1 >> level).max(1));
-        batch.push_level(level, (0, 0), extent, Channels::ALL);
+    // The levels above: the texels over all the rectangles (their bounding box), in the
+    // channels any of them staged.
+    let bounds = rects.iter().map(|&(r, _)| r).reduce(|a, b| TileRect {
+        x0: a.x0.min(b.x0),
+        y0: a.y0.min(b.y0),
+        x1: a.x1.max(b.x1),
+        y1: a.y1.max(b.y1),
+    });
+    let channels = rects.iter().fold(Channels::NONE, |c, &(_, r)| c.union(r));
+    if let Some(bounds) = bounds {
+        let texels = rect_texels(bounds, size);
+        for level in TILE_LEVEL + 1..levels {
+            let r = level_rect(texels, level, size);
+            batch.push_level(level, (r.0, r.1), (r.2 - r.0, r.3 - r.1), channels);
+        }
     }
     out.push(batch);
     out
@@ -300,12 +314,17 @@ impl Rows {
     }
 
     /// Writes `row` (`u16` words, little-endian as the GPU reads them) at row `y`, word `x`.
-    fn put(&mut self, (x, y): (usize, usize), row: &[u16]) {
-        if let Some(view) = &mut self.view {
-            let bytes: &[u8] = bytemuck::cast_slice(row);
-            let at = y * self.pitch + 2 * x;
-            view.slice(at..at + bytes.len()).copy_from_slice(bytes);
+    fn put(&mut self, at: (usize, usize), row: &[u16]) {
+        let bytes: &[u8] = bytemuck::cast_slice(row);
+        if let Some(mut out) = self.bytes(at, bytes.len()) {
+            out.copy_from_slice(bytes);
         }
+    }
+
+    /// The `len` bytes from row `y`, word `x`, to write (none where not staged).
+    fn bytes(&mut self, (x, y): (usize, usize), len: usize) -> Option<wgpu::WriteOnly<'_, [u8]>> {
+        let at = y * self.pitch + 2 * x;
+        self.view.as_mut().map(|view| view.slice(at..at + len))
     }
 }
 
@@ -330,7 +349,7 @@ struct Job {
 }
 
 /// Stages the rectangles of `batch` into `buffer` (mapped) and returns the sums of every
-/// tile staged. The levels above one texel per tile are left to [`fill_top_levels`].
+/// tile staged. The levels above one texel per tile are left to [`TopSums::fill`].
 pub(super) fn fill_rects(
     maps: &MaterialMaps,
     unorm16: bool,
@@ -380,9 +399,11 @@ pub(super) fn fill_rects(
     }
     Ok(run_jobs(jobs, |job| {
         let bands = &mut job.bands;
+        // One scratch pyramid per job, reused for each of its tiles.
+        let mut sums = TileSums::new();
         job.tiles
             .iter()
-            .map(|&id| (id, stage_tile(maps, id, unorm16, bands)))
+            .map(|&id| (id, stage_tile(maps, id, unorm16, bands, &mut sums)))
             .collect()
     }))
 }
@@ -415,43 +436,102 @@ fn run_jobs<J: Send, R: Send>(jobs: Vec<J>, work: impl Fn(&mut J) -> Vec<R> + Sy
     results.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Writes the whole levels above one texel per tile (`images`, in level order) into `out`,
-/// the first from the per-tile sums (`tiles_x` to a row), each next from the one below.
-pub(super) fn fill_top_levels(
-    tile_sums: &[Sums],
-    tiles_x: usize,
-    unorm16: bool,
-    images: &[StagedImage],
-    buffer: &wgpu::Buffer,
-) -> Result<(), GpuError> {
-    let tiles_y = tile_sums.len() / tiles_x.max(1);
-    let mut below: Option<(Vec<Sums>, usize, usize)> = None;
-    for image in images {
-        let (grid, gw, gh) = match &below {
-            None => fold(tile_sums, tiles_x, tiles_y),
-            Some((grid, gw, gh)) => fold(grid, *gw, *gh),
-        };
-        let rows = image.extent.1;
-        let mut band = Band {
-            level: image.level,
-            origin: (0, 0),
-            kd: Rows::map(buffer, image.kd, rows, image.rgba_row)?,
-            ks: Rows::map(buffer, image.ks, rows, image.rgba_row)?,
-            n: Rows::map(buffer, image.n, rows, image.n_row)?,
-        };
-        // The texture's levels may be smaller than the grids (sizes that are not powers of
-        // two round down): their texels are the grids' top-left ones.
-        let extent = (image.extent.0 as usize, image.extent.1 as usize);
-        write_means(&grid, gw, unorm16, extent, &mut band, (0, 0));
-        below = Some((grid, gw, gh));
+/// Sums over every tile and over each block of tiles under a texel of the levels above one
+/// texel per tile: grid 0 has one cell per tile, each next grid one per `2 x 2` block of the
+/// one below (the last row or column alone when odd), down to one cell. Kept between syncs:
+/// a sync re-adds only the blocks over the tiles it staged.
+#[derive(Debug)]
+pub(super) struct TopSums {
+    /// Each grid's cells (rows `w` apart), `w` and `h`.
+    grids: Vec<(Vec<Sums>, usize, usize)>,
+}
+
+impl TopSums {
+    /// Empty sums for `tiles_x x tiles_y` tiles.
+    pub fn new(tiles_x: usize, tiles_y: usize) -> Self {
+        let (mut w, mut h) = (tiles_x.max(1), tiles_y.max(1));
+        let mut grids = vec![(vec![Sums::default(); w * h], w, h)];
+        while w > 1 || h > 1 {
+            (w, h) = (w.div_ceil(2), h.div_ceil(2));
+            grids.push((vec![Sums::default(); w * h], w, h));
+        }
+        Self { grids }
     }
-    Ok(())
+
+    /// Sets the sums of some tiles and re-adds the blocks over them, level by level.
+    pub fn set(&mut self, tiles: &[(usize, Sums)]) {
+        let Some((first, _, _)) = self.grids.first_mut() else {
+            return;
+        };
+        let mut changed: Vec<usize> = Vec::with_capacity(tiles.len());
+        for &(id, sums) in tiles {
+            if let Some(cell) = first.get_mut(id) {
+                *cell = sums;
+                changed.push(id);
+            }
+        }
+        for k in 1..self.grids.len() {
+            let (below, above) = self.grids.split_at_mut(k);
+            let ((cells, w, h), (next, nw, _)) = (&below[k - 1], &mut above[0]);
+            let mut parents: Vec<usize> = changed
+                .iter()
+                .map(|&i| (i / w / 2) * *nw + (i % w) / 2)
+                .collect();
+            parents.sort_unstable();
+            parents.dedup();
+            for &p in &parents {
+                let (x, y) = (2 * (p % *nw), 2 * (p / *nw));
+                // Added in row order, as a whole fold of the grid would.
+                let mut sum = Sums::default();
+                for (cx, cy) in [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)] {
+                    if cx < *w && cy < *h {
+                        sum += cells[cy * w + cx];
+                    }
+                }
+                next[p] = sum;
+            }
+            changed = parents;
+        }
+    }
+
+    /// Writes the parts of the levels above one texel per tile that `images` hold (in level
+    /// order, the first from grid 1) into `buffer` (mapped).
+    pub fn fill(
+        &self,
+        unorm16: bool,
+        images: &[StagedImage],
+        buffer: &wgpu::Buffer,
+    ) -> Result<(), GpuError> {
+        for (image, (grid, gw, _)) in images.iter().zip(self.grids.iter().skip(1)) {
+            let (rows, on) = (image.extent.1, image.channels);
+            let staged = |on: bool| if on { rows } else { 0 };
+            let mut band = Band {
+                level: image.level,
+                origin: image.origin,
+                kd: Rows::map(buffer, image.kd, staged(on.kd), image.rgba_row)?,
+                ks: Rows::map(buffer, image.ks, staged(on.ks), image.rgba_row)?,
+                n: Rows::map(buffer, image.n, staged(on.n), image.n_row)?,
+            };
+            // The grid's cells are the level's texels (where sizes that are not powers of two
+            // round down, the level has fewer: the grid's top-left ones).
+            let (x, y) = (image.origin.0 as usize, image.origin.1 as usize);
+            let extent = (image.extent.0 as usize, image.extent.1 as usize);
+            write_means(&grid[y * gw + x..], *gw, unorm16, extent, &mut band, (0, 0));
+        }
+        Ok(())
+    }
 }
 
 /// Stages tile `id` into `bands` (levels 0, 1, ... in order): level 0 copied from its planes,
 /// the levels above from box sums (each from the one below, rounded once). Returns the
 /// whole tile's sums.
-fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band]) -> Sums {
+fn stage_tile(
+    maps: &MaterialMaps,
+    id: usize,
+    unorm16: bool,
+    bands: &mut [Band],
+    sums: &mut TileSums,
+) -> Sums {
     let tile = maps.tile(id);
     let rect = maps.tile_rect(id);
     let Some((first, mips)) = bands.split_first_mut() else {
@@ -479,17 +559,21 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
             row.fill(texel(v));
         }
         for y in 0..h {
+            let at = (x * 4, y0 + y);
             if let Plane::Data(d) = plane {
                 let src = &d[y * TILE_SIZE..y * TILE_SIZE + w];
                 if unorm16 {
-                    rgb_to_rgba(src, row, a);
-                } else {
-                    for (o, v) in row.iter_mut().zip(src) {
-                        *o = texel(v);
+                    // Straight into the staging buffer.
+                    if let Some(bytes) = out.bytes(at, 8 * w) {
+                        rgb_to_rgba(src, bytes, a);
                     }
+                    continue;
+                }
+                for (o, v) in row.iter_mut().zip(src) {
+                    *o = texel(v);
                 }
             }
-            out.put((x * 4, y0 + y), row.as_flattened());
+            out.put(at, row.as_flattened());
         }
     }
     let uniform_n = [tile.n.uniform().unwrap_or(0); TILE_SIZE];
@@ -501,17 +585,25 @@ fn stage_tile(maps: &MaterialMaps, id: usize, unorm16: bool, bands: &mut [Band])
         };
         first.n.put((x, y0 + y), row);
     }
-    stage_tile_mips(tile, rect, (maps.width(), maps.height()), unorm16, mips)
+    stage_tile_mips(
+        tile,
+        rect,
+        (maps.width(), maps.height()),
+        unorm16,
+        mips,
+        sums,
+    )
 }
 
-/// Copies RGB texels into RGBA ones with alpha `a`, four at a time: three 8-byte loads and
-/// four 8-byte stores (the components move as whole words, never one at a time).
-fn rgb_to_rgba(src: &[[u16; 3]], out: &mut [[u16; 4]], a: u16) {
+/// Writes RGB texels as RGBA ones with alpha `a` into `out` (8 bytes a texel, little-endian),
+/// four at a time: three 8-byte loads and four 8-byte stores (the components move as whole
+/// words, never one at a time).
+fn rgb_to_rgba(src: &[[u16; 3]], out: wgpu::WriteOnly<'_, [u8]>, a: u16) {
     let alpha = u64::from(a) << 48;
     let low48 = (1_u64 << 48) - 1;
     let (groups, rest) = src.as_chunks::<4>();
-    let (out_groups, out_rest) = out.as_chunks_mut::<4>();
-    for (o, g) in out_groups.iter_mut().zip(groups) {
+    let (out_groups, out_rest) = out.into_chunks::<32>();
+    out_groups.write_iter(groups.iter().map(|g| {
         // Four texels are 24 bytes: three little-endian words, each texel 48 bits of them.
         let [w0, w1, w2] = bytemuck::cast::<[[u16; 3]; 4], [u64; 3]>(*g).map(u64::from_le);
         let texels = [
@@ -520,96 +612,245 @@ fn rgb_to_rgba(src: &[[u16; 3]], out: &mut [[u16; 4]], a: u16) {
             (w1 >> 32 | w2 << 32) & low48,
             w2 >> 16,
         ];
-        *o = bytemuck::cast(texels.map(|t| (t | alpha).to_le()));
+        bytemuck::cast::<[u64; 4], [u8; 32]>(texels.map(|t| (t | alpha).to_le()))
+    }));
+    let (out_rest, _) = out_rest.into_chunks::<8>();
+    out_rest.write_iter(
+        rest.iter()
+            .map(|v| bytemuck::cast::<[u16; 4], [u8; 8]>([v[0], v[1], v[2], a].map(u16::to_le))),
+    );
+}
+
+/// Cells on a side of a tile's level 1, the largest grid of in-tile sums.
+const HALF_TILE: usize = TILE_SIZE / 2;
+
+/// Box sums over one tile's texels at one mip level (1 and up), on the tile-local grid, kept
+/// compact and folded in place: `k_d` and `k_s` as sums of unorm16 codes in `u32` (a whole
+/// tile's fit), `n` in `f32`. A cell's texel count follows from its place (cells at the map's
+/// right and bottom edges may be partial).
+struct TileSums {
+    codes: Vec<[u32; 6]>,
+    n: Vec<f32>,
+    /// Cells across and down (rows `w` apart).
+    w: usize,
+    h: usize,
+    level: u32,
+    /// The tile's texels across and down.
+    texels: (usize, usize),
+}
+
+impl TileSums {
+    /// Room for a whole tile's level 1 (28 KiB).
+    fn new() -> Self {
+        Self {
+            codes: vec![[0; 6]; HALF_TILE * HALF_TILE],
+            n: vec![0.0; HALF_TILE * HALF_TILE],
+            w: 0,
+            h: 0,
+            level: 1,
+            texels: (0, 0),
+        }
     }
-    for (o, v) in out_rest.iter_mut().zip(rest) {
-        *o = [v[0], v[1], v[2], a];
+
+    /// Level 1 of `tile` (`w x h` texels): pairs of rows added down the columns first (codes
+    /// as `u32`, `n` decoded and clamped), then pairs of columns.
+    fn level_one(&mut self, tile: &Tile, (w, h): (usize, usize)) {
+        (self.w, self.h, self.level, self.texels) = (w.div_ceil(2), h.div_ceil(2), 1, (w, h));
+        let mut columns = [[0_u32; 3 * TILE_SIZE]; 2];
+        let mut n_columns = [0.0_f32; TILE_SIZE];
+        let mut n_row = [0.0_f32; TILE_SIZE];
+        for gy in 0..self.h {
+            let rows = 2 * gy..(2 * gy + 2).min(h);
+            let row_count = rows.len() as u32;
+            for (col, plane) in columns.iter_mut().zip([&tile.kd, &tile.ks]) {
+                let col = &mut col[..3 * w];
+                match plane {
+                    Plane::Uniform(v) => {
+                        for (c, k) in col.iter_mut().zip(v.iter().cycle()) {
+                            *c = u32::from(*k) * row_count;
+                        }
+                    }
+                    Plane::Data(d) => {
+                        let row = |y: usize| d[y * TILE_SIZE..y * TILE_SIZE + w].as_flattened();
+                        if row_count == 2 {
+                            for ((c, a), b) in
+                                col.iter_mut().zip(row(rows.start)).zip(row(rows.start + 1))
+                            {
+                                *c = u32::from(*a) + u32::from(*b);
+                            }
+                        } else {
+                            for (c, a) in col.iter_mut().zip(row(rows.start)) {
+                                *c = u32::from(*a);
+                            }
+                        }
+                    }
+                }
+            }
+            let n_columns = &mut n_columns[..w];
+            match &tile.n {
+                Plane::Uniform(v) => n_columns.fill(decode_n(*v) * row_count as f32),
+                Plane::Data(d) => {
+                    n_columns.fill(0.0);
+                    for y in rows {
+                        let bits: &[half::f16] = half::slice::HalfBitsSliceExt::reinterpret_cast(
+                            &d[y * TILE_SIZE..y * TILE_SIZE + w],
+                        );
+                        half::slice::HalfFloatSliceExt::convert_to_f32_slice(bits, &mut n_row[..w]);
+                        for (c, v) in n_columns.iter_mut().zip(&n_row[..w]) {
+                            *c += clamp_nan_low(*v, 0.0, N_MAX);
+                        }
+                    }
+                }
+            }
+            let cells = gy * self.w..(gy + 1) * self.w;
+            let (kd, ks) = (&columns[0], &columns[1]);
+            for (gx, (codes, n)) in self.codes[cells.clone()]
+                .iter_mut()
+                .zip(&mut self.n[cells])
+                .enumerate()
+            {
+                let x = 2 * gx;
+                let pair = x + 1 < w;
+                let sum = |col: &[u32; 3 * TILE_SIZE], c: usize| {
+                    col[3 * x + c] + if pair { col[3 * x + 3 + c] } else { 0 }
+                };
+                *codes = [
+                    sum(kd, 0),
+                    sum(kd, 1),
+                    sum(kd, 2),
+                    sum(ks, 0),
+                    sum(ks, 1),
+                    sum(ks, 2),
+                ];
+                *n = n_columns[x] + if pair { n_columns[x + 1] } else { 0.0 };
+            }
+        }
+    }
+
+    /// Texels under cell `g` along an axis with `texels` texels.
+    fn cell_texels(&self, g: usize, texels: usize) -> u32 {
+        let side = 1_usize << self.level;
+        side.min(texels - g * side) as u32
+    }
+
+    /// The next level: each `2 x 2` block of cells added up (the last row or column alone
+    /// when odd), written over the cells it came from.
+    fn fold(&mut self) {
+        let (w, h) = (self.w, self.h);
+        let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+        // Cell `ny * nw + nx` reads cells at `2 ny * w + 2 nx` and after, which no earlier
+        // cell of the next level has overwritten.
+        for ny in 0..nh {
+            for nx in 0..nw {
+                let (x, y) = (2 * nx, 2 * ny);
+                let block = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
+                let mut codes = [0_u32; 6];
+                let mut n = [0.0_f32; 4];
+                for (k, (cx, cy)) in block.into_iter().enumerate() {
+                    // Cells past the grid's edge add nothing.
+                    if cx < w && cy < h {
+                        let c = cy * w + cx;
+                        for (o, v) in codes.iter_mut().zip(self.codes[c]) {
+                            *o += v;
+                        }
+                        n[k] = self.n[c];
+                    }
+                }
+                self.codes[ny * nw + nx] = codes;
+                self.n[ny * nw + nx] = (n[0] + n[1]) + (n[2] + n[3]);
+            }
+        }
+        (self.w, self.h, self.level) = (nw, nh, self.level + 1);
+    }
+
+    /// Writes the means of the top-left `ew x eh` cells into the textures of `band`, at
+    /// texel `(x, y)` of the band.
+    fn write(
+        &self,
+        unorm16: bool,
+        (ew, eh): (usize, usize),
+        band: &mut Band,
+        (x, y): (usize, usize),
+    ) {
+        let a = alpha(unorm16);
+        let mut rgba = [[0_u16; 4]; HALF_TILE];
+        let mut n = [0.0_f32; HALF_TILE];
+        let mut n_bits = [half::f16::ZERO; HALF_TILE];
+        let (rgba, n, n_bits) = (&mut rgba[..ew], &mut n[..ew], &mut n_bits[..ew]);
+        // Whole cells (`4^level` texels, all but those at a partial tile's edges) take the
+        // fast path: an integer mean by shifting (unorm16), `n` scaled by an exact power of
+        // two.
+        let shift = 2 * self.level;
+        let (half_count, inv_count) = (1_u32 << (shift - 1), 1.0 / (1_u32 << shift) as f32);
+        let whole_columns = (self.texels.0 >> self.level).min(ew);
+        for gy in 0..eh {
+            let rows = self.cell_texels(gy, self.texels.1);
+            let whole = if rows == 1 << self.level && unorm16 {
+                whole_columns
+            } else {
+                0
+            };
+            let cells = gy * self.w..gy * self.w + ew;
+            let count = |gx: usize| u64::from(self.cell_texels(gx, self.texels.0) * rows);
+            for (first, out) in [(0, &mut band.kd), (3, &mut band.ks)] {
+                if !out.staged() {
+                    continue;
+                }
+                let codes = &self.codes[cells.clone()];
+                for (o, c) in rgba[..whole].iter_mut().zip(codes) {
+                    let mean = |i: usize| ((c[first + i] + half_count) >> shift) as u16;
+                    *o = [mean(0), mean(1), mean(2), a];
+                }
+                for (gx, (o, c)) in rgba.iter_mut().zip(codes).enumerate().skip(whole) {
+                    let mean = |i: usize| mean_code(u64::from(c[first + i]), count(gx), unorm16);
+                    *o = [mean(0), mean(1), mean(2), a];
+                }
+                out.put((x * 4, y + gy), rgba.as_flattened());
+            }
+            if band.n.staged() {
+                let sums = &self.n[cells];
+                for (o, s) in n[..whole].iter_mut().zip(sums) {
+                    *o = *s * inv_count;
+                }
+                for (gx, (o, s)) in n.iter_mut().zip(sums).enumerate().skip(whole) {
+                    *o = *s / count(gx) as f32;
+                }
+                half::slice::HalfFloatSliceExt::convert_from_f32_slice(&mut *n_bits, n);
+                band.n
+                    .put((x, y + gy), bytemuck::cast_slice::<half::f16, u16>(n_bits));
+            }
+        }
+    }
+
+    /// The whole tile's sums (folding what is left to one cell).
+    fn total(&mut self) -> Sums {
+        while self.w > 1 || self.h > 1 {
+            self.fold();
+        }
+        Sums {
+            codes: self.codes[0].map(u64::from),
+            n: f64::from(self.n[0]),
+            count: (self.texels.0 * self.texels.1) as u64,
+        }
     }
 }
 
 /// Stages the mip levels over `tile` (texels `rect` of maps of `size`) into `bands` (levels
-/// 1, 2, ... in order): box sums on the tile-local grid, level 1 summed straight from the
-/// tile's planes, each level above from the one below, rounded once. Returns the whole
-/// tile's sums.
+/// 1, 2, ... in order), each level folded from the one below, rounded once. Returns the
+/// whole tile's sums.
 fn stage_tile_mips(
     tile: &Tile,
     rect: (u32, u32, u32, u32),
     size: (u32, u32),
     unorm16: bool,
     bands: &mut [Band],
+    sums: &mut TileSums,
 ) -> Sums {
-    let (w, h) = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
-    let (mut gw, mut gh) = (w.div_ceil(2), h.div_ceil(2));
-    let mut grid = vec![Sums::default(); gw * gh];
-    // Level 1 from pairs of rows: each pair added down the columns first (codes as `u32`,
-    // `n` decoded), then across.
-    let mut columns = [[0_u32; 3 * TILE_SIZE]; 2];
-    let mut n_columns = [0.0_f32; TILE_SIZE];
-    let mut n_row = [0.0_f32; TILE_SIZE];
-    for gy in 0..gh {
-        let rows = 2 * gy..(2 * gy + 2).min(h);
-        let row_count = rows.len() as u32;
-        for (col, plane) in columns.iter_mut().zip([&tile.kd, &tile.ks]) {
-            let col = &mut col[..3 * w];
-            match plane {
-                Plane::Uniform(v) => {
-                    for (c, k) in col.iter_mut().zip(v.iter().cycle()) {
-                        *c = u32::from(*k) * row_count;
-                    }
-                }
-                Plane::Data(d) => {
-                    let row = |y: usize| d[y * TILE_SIZE..y * TILE_SIZE + w].as_flattened();
-                    if row_count == 2 {
-                        for ((c, a), b) in
-                            col.iter_mut().zip(row(rows.start)).zip(row(rows.start + 1))
-                        {
-                            *c = u32::from(*a) + u32::from(*b);
-                        }
-                    } else {
-                        for (c, a) in col.iter_mut().zip(row(rows.start)) {
-                            *c = u32::from(*a);
-                        }
-                    }
-                }
-            }
-        }
-        let n_columns = &mut n_columns[..w];
-        match &tile.n {
-            Plane::Uniform(v) => n_columns.fill(decode_n(*v) * row_count as f32),
-            Plane::Data(d) => {
-                n_columns.fill(0.0);
-                for y in rows {
-                    let bits: &[half::f16] = half::slice::HalfBitsSliceExt::reinterpret_cast(
-                        &d[y * TILE_SIZE..y * TILE_SIZE + w],
-                    );
-                    half::slice::HalfFloatSliceExt::convert_to_f32_slice(bits, &mut n_row[..w]);
-                    for (c, v) in n_columns.iter_mut().zip(&n_row[..w]) {
-                        *c += clamp_nan_low(*v, 0.0, N_MAX);
-                    }
-                }
-            }
-        }
-        for (gx, o) in grid[gy * gw..(gy + 1) * gw].iter_mut().enumerate() {
-            let x = 2 * gx;
-            let pair = (w - x).min(2);
-            let mut codes = [0_u32; 6];
-            for (k, col) in columns.iter().enumerate() {
-                for c in 0..3 {
-                    let right = if pair == 2 { col[3 * x + 3 + c] } else { 0 };
-                    codes[3 * k + c] = col[3 * x + c] + right;
-                }
-            }
-            let right = if pair == 2 { n_columns[x + 1] } else { 0.0 };
-            *o = Sums {
-                codes: codes.map(u64::from),
-                n: f64::from(n_columns[x] + right),
-                count: (pair as u32 * row_count).into(),
-            };
-        }
-    }
+    let texels = ((rect.2 - rect.0) as usize, (rect.3 - rect.1) as usize);
+    sums.level_one(tile, texels);
     for (k, band) in bands.iter_mut().enumerate() {
         if k > 0 {
-            (grid, gw, gh) = fold(&grid, gw, gh);
+            sums.fold();
         }
         // The grid's origin is the tile's at this level; the texture's part of it is its
         // top-left (the level may round down at the map's edges).
@@ -620,28 +861,10 @@ fn stage_tile_mips(
                 (r.1 - band.origin.1) as usize,
             );
             let extent = ((r.2 - r.0) as usize, (r.3 - r.1) as usize);
-            write_means(&grid, gw, unorm16, extent, band, at);
+            sums.write(unorm16, extent, band, at);
         }
     }
-    let mut total = Sums::default();
-    for s in grid {
-        total += s;
-    }
-    total
-}
-
-/// The next mip level's sums: each `2 x 2` block of the `w x h` grid added up (the last row
-/// or column alone when odd).
-pub(super) fn fold(grid: &[Sums], w: usize, h: usize) -> (Vec<Sums>, usize, usize) {
-    let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
-    let mut next = vec![Sums::default(); nw * nh];
-    for (y, row) in grid.chunks(w).enumerate() {
-        let out = &mut next[(y / 2) * nw..(y / 2 + 1) * nw];
-        for (x, s) in row.iter().enumerate() {
-            out[x / 2] += *s;
-        }
-    }
-    (next, nw, nh)
+    sums.total()
 }
 
 /// Writes the means of the top-left `w x h` sums of `grid` (rows `stride` apart) into the
@@ -755,12 +978,52 @@ mod tests {
             let src: Vec<[u16; 3]> = (0..len as u16)
                 .map(|i| [i * 3, i * 3 + 1, 0xfff0 - i].map(|c| c ^ 0x5a5a))
                 .collect();
-            let mut out = vec![[0_u16; 4]; len];
-            rgb_to_rgba(&src, &mut out, 0xabcd);
+            let mut bytes = vec![0_u8; 8 * len];
+            rgb_to_rgba(&src, wgpu::WriteOnly::from_mut(&mut bytes[..]), 0xabcd);
+            let out: Vec<[u16; 4]> = bytes
+                .as_chunks::<8>()
+                .0
+                .iter()
+                .map(|b| bytemuck::cast::<[u8; 8], [u16; 4]>(*b).map(u16::from_le))
+                .collect();
             for (o, v) in out.iter().zip(&src) {
                 assert_eq!(*o, [v[0], v[1], v[2], 0xabcd], "length {len}");
             }
         }
+    }
+
+    #[test]
+    fn top_sums_re_added_over_a_few_tiles_equal_sums_built_whole() {
+        // 13 x 9 tiles: odd sides, so blocks at the right and bottom edges are partial.
+        let (tx, ty) = (13, 9);
+        let sums = |id: usize, k: u64| Sums {
+            codes: [1, 2, 3, 4, 5, 6].map(|c| c * 1000 + (id as u64 * 7 + k) % 997),
+            n: (id as f64 * 0.37 + k as f64).sin().abs() * 4096.0,
+            count: 4096,
+        };
+        let all = |k: u64| (0..tx * ty).map(|id| (id, sums(id, k))).collect::<Vec<_>>();
+        let mut kept = TopSums::new(tx, ty);
+        kept.set(&all(0));
+        // Some tiles change: the corner, an edge and a scattered few.
+        let changed = [0, 12, 50, 51, 64, 116];
+        let mut now = all(0);
+        for &id in &changed {
+            now[id] = (id, sums(id, 5));
+        }
+        kept.set(&changed.map(|id| now[id]));
+        let mut whole = TopSums::new(tx, ty);
+        whole.set(&now);
+        assert_eq!(kept.grids.len(), 5, "13 x 9, 7 x 5, 4 x 3, 2 x 2, 1 x 1");
+        for (k, (a, b)) in kept.grids.iter().zip(&whole.grids).enumerate() {
+            assert_eq!(a, b, "grid {k}");
+        }
+        // The last cell is the sum of every tile.
+        let mut total = Sums::default();
+        for (_, s) in &now {
+            total += *s;
+        }
+        assert_eq!(kept.grids[4].0[0].codes, total.codes);
+        assert_eq!(kept.grids[4].0[0].count, total.count);
     }
 
     #[test]
