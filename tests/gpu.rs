@@ -627,7 +627,11 @@ fn assert_box_means(gpu: &Gpu, textures: &MapTextures, maps: &MaterialMaps, leve
                 let mean = block.iter().map(|t| f64::from(t.kd[c])).sum::<f64>() / count;
                 let got = steps(kd[(y * lw + x) * 4 + c]);
                 // Half floats keep 11 significant bits.
-                let tolerance = if gpu.unorm16 { 2.0 } else { 2.0 + mean / 1024.0 };
+                let tolerance = if gpu.unorm16 {
+                    2.0
+                } else {
+                    2.0 + mean / 1024.0
+                };
                 assert!(
                     (got - mean).abs() <= tolerance,
                     "level {level} ({x}, {y}): {got} vs {mean}"
