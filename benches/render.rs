@@ -66,7 +66,6 @@ impl Frame<'_> {
     }
 }
 
-/// A 4096^2 document with strokes in every channel, and one whose k_s is zero everywhere.
 /// Paints one brush stroke through `points` at full pressure.
 fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
     let points = points
@@ -80,6 +79,7 @@ fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
     .expect("stroke");
 }
 
+/// A 4096^2 document with strokes in every channel, and one whose k_s is zero everywhere.
 fn documents() -> (Document, Document) {
     let mut painted = Document::new(
         4096,

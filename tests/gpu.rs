@@ -499,10 +499,6 @@ fn mips_follow_the_dirty_tiles() {
     let mut textures = MapTextures::new(&gpu, &doc.maps);
     brush_stroke(&mut doc, &[Vec2::new(90.0, 100.0), Vec2::new(300.0, 140.0)]);
     assert!(textures.sync(&gpu, &doc.maps) > 0);
-    if !gpu.unorm16 {
-        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
-        return;
-    }
     // Level 2 holds the 4 x 4 box means; the 1 x 1 level the mean of the whole map.
     assert_box_means(&gpu, &textures, &doc.maps, 2);
     assert_box_means(&gpu, &textures, &doc.maps, 9);
@@ -511,10 +507,6 @@ fn mips_follow_the_dirty_tiles() {
 #[test]
 fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     let Some(gpu) = gpu() else { return };
-    if !gpu.unorm16 {
-        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
-        return;
-    }
     // Not a multiple of the tile size: edge tiles are partial, levels round down.
     let (w, h) = (200_usize, 120_usize);
     let mut doc = Document::new(w as u32, h as u32, DocumentSettings::default()).expect("doc");
@@ -654,10 +646,6 @@ fn assert_box_means(gpu: &Gpu, textures: &MapTextures, maps: &MaterialMaps, leve
 #[test]
 fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
     let Some(gpu) = gpu() else { return };
-    if !gpu.unorm16 {
-        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
-        return;
-    }
     // 2048 x 1536 with mips stages about 75 MB: the first upload takes two batches.
     let mut doc = Document::new(2048, 1536, DocumentSettings::default()).expect("doc");
     let stroke = |doc: &mut Document, value: MaterialValue, from: Vec2, to: Vec2| {
@@ -693,10 +681,6 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
 fn a_stroke_on_some_channels_stages_only_those() {
     use kapaint::model::Channels;
     let Some(gpu) = gpu() else { return };
-    if !gpu.unorm16 {
-        eprintln!("SKIPPED mip values: no 16-bit norm textures on this adapter");
-        return;
-    }
     let mut doc = Document::new(512, 384, DocumentSettings::default()).expect("doc");
     let mut textures = MapTextures::new(&gpu, &doc.maps);
     let mut dab = |doc: &mut Document, channels: Channels, value: MaterialValue| {

@@ -1,8 +1,9 @@
 //! Staging a sync's dirty tiles for the map textures: the tiles grouped into rectangles (one
 //! image per rectangle and mip level, so a 256 x 256 region is 7 images, not 16 x 7), each
 //! level's texels written straight into the mapped staging buffer, one band of tile rows per
-//! parallel job (each band its own mapped views), and the levels above one texel per tile
-//! rebuilt from per-tile sums.
+//! parallel job (each band its own mapped views). Inside a tile the mips come from a compact
+//! pyramid of sums; above one texel per tile, from sums per tile and per block kept between
+//! syncs and re-added over the dirty tiles only.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -282,6 +283,37 @@ struct Band {
     n: Rows,
 }
 
+impl Band {
+    /// Maps `rows` rows of `image` from its row `first_row` (in texels of its level), in the
+    /// textures it stages.
+    fn map(
+        buffer: &wgpu::Buffer,
+        image: &StagedImage,
+        first_row: u32,
+        rows: u32,
+    ) -> Result<Self, GpuError> {
+        let skip = u64::from(first_row - image.origin.1);
+        let on = image.channels;
+        let staged = |on: bool| if on { rows } else { 0 };
+        let rgba = |offset: u64, on: bool| {
+            let at = offset + skip * u64::from(image.rgba_row);
+            Rows::map(buffer, at, staged(on), image.rgba_row)
+        };
+        Ok(Self {
+            level: image.level,
+            origin: (image.origin.0, first_row),
+            kd: rgba(image.kd, on.kd)?,
+            ks: rgba(image.ks, on.ks)?,
+            n: Rows::map(
+                buffer,
+                image.n + skip * u64::from(image.n_row),
+                staged(on.n),
+                image.n_row,
+            )?,
+        })
+    }
+}
+
 /// Rows of one texture in the mapped staging buffer, `pitch` bytes apart (no view when there
 /// are no rows).
 struct Rows {
@@ -378,22 +410,8 @@ pub(super) fn fill_rects(
                     ..rect
                 };
                 let r = level_rect(rect_texels(row, size), level, size);
-                let (skip, rows) = (u64::from(r.1 - image.origin.1), r.3.saturating_sub(r.1));
-                let rgba_skip = skip * u64::from(image.rgba_row);
-                let on = image.channels;
-                let staged = |on: bool| if on { rows } else { 0 };
-                job.bands.push(Band {
-                    level,
-                    origin: (image.origin.0, r.1),
-                    kd: Rows::map(buffer, image.kd + rgba_skip, staged(on.kd), image.rgba_row)?,
-                    ks: Rows::map(buffer, image.ks + rgba_skip, staged(on.ks), image.rgba_row)?,
-                    n: Rows::map(
-                        buffer,
-                        image.n + skip * u64::from(image.n_row),
-                        staged(on.n),
-                        image.n_row,
-                    )?,
-                });
+                job.bands
+                    .push(Band::map(buffer, image, r.1, r.3.saturating_sub(r.1))?);
             }
         }
     }
@@ -503,20 +521,12 @@ impl TopSums {
         buffer: &wgpu::Buffer,
     ) -> Result<(), GpuError> {
         for (image, (grid, gw, _)) in images.iter().zip(self.grids.iter().skip(1)) {
-            let (rows, on) = (image.extent.1, image.channels);
-            let staged = |on: bool| if on { rows } else { 0 };
-            let mut band = Band {
-                level: image.level,
-                origin: image.origin,
-                kd: Rows::map(buffer, image.kd, staged(on.kd), image.rgba_row)?,
-                ks: Rows::map(buffer, image.ks, staged(on.ks), image.rgba_row)?,
-                n: Rows::map(buffer, image.n, staged(on.n), image.n_row)?,
-            };
+            let mut band = Band::map(buffer, image, image.origin.1, image.extent.1)?;
             // The grid's cells are the level's texels (where sizes that are not powers of two
             // round down, the level has fewer: the grid's top-left ones).
             let (x, y) = (image.origin.0 as usize, image.origin.1 as usize);
             let extent = (image.extent.0 as usize, image.extent.1 as usize);
-            write_means(&grid[y * gw + x..], *gw, unorm16, extent, &mut band, (0, 0));
+            write_means(&grid[y * gw + x..], *gw, unorm16, extent, &mut band);
         }
         Ok(())
     }
@@ -868,14 +878,13 @@ fn stage_tile_mips(
 }
 
 /// Writes the means of the top-left `w x h` sums of `grid` (rows `stride` apart) into the
-/// three textures of `band`, at texel `(x, y)` of the band.
+/// textures of `band`, from its first texel.
 fn write_means(
     grid: &[Sums],
     stride: usize,
     unorm16: bool,
     (w, h): (usize, usize),
     band: &mut Band,
-    (x, y): (usize, usize),
 ) {
     let a = alpha(unorm16);
     let mut rgba = vec![[0_u16; 4]; w];
@@ -890,7 +899,7 @@ fn write_means(
             for (o, s) in rgba.iter_mut().zip(sums) {
                 *o = s.rgba(first, unorm16, a);
             }
-            out.put((x * 4, y + row), rgba.as_flattened());
+            out.put((0, row), rgba.as_flattened());
         }
         if !band.n.staged() {
             continue;
@@ -899,10 +908,8 @@ fn write_means(
             *o = s.n();
         }
         half::slice::HalfFloatSliceExt::convert_from_f32_slice(&mut n_bits[..], &n);
-        band.n.put(
-            (x, y + row),
-            bytemuck::cast_slice::<half::f16, u16>(&n_bits),
-        );
+        band.n
+            .put((0, row), bytemuck::cast_slice::<half::f16, u16>(&n_bits));
     }
 }
 

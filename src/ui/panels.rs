@@ -378,12 +378,13 @@ impl EditorState {
     }
 
     pub(super) fn menu_ui(&mut self, ui: &mut egui::Ui) {
+        // A menu entry showing its shortcut; whether it was clicked.
+        let item = |ui: &mut egui::Ui, label: &str, key: &KeyboardShortcut| {
+            ui.add(egui::Button::new(label).shortcut_text(ui.ctx().format_shortcut(key)))
+                .clicked()
+        };
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                let item = |ui: &mut egui::Ui, label: &str, key: &KeyboardShortcut| {
-                    ui.add(egui::Button::new(label).shortcut_text(ui.ctx().format_shortcut(key)))
-                        .clicked()
-                };
                 if item(ui, "New", &keys::NEW) {
                     self.new_project();
                 }
@@ -446,22 +447,10 @@ impl EditorState {
                 }
             });
             ui.menu_button("Edit", |ui| {
-                if ui
-                    .add(
-                        egui::Button::new("Undo")
-                            .shortcut_text(ui.ctx().format_shortcut(&keys::UNDO)),
-                    )
-                    .clicked()
-                {
+                if item(ui, "Undo", &keys::UNDO) {
                     self.apply(Command::Undo);
                 }
-                if ui
-                    .add(
-                        egui::Button::new("Redo")
-                            .shortcut_text(ui.ctx().format_shortcut(&keys::REDO)),
-                    )
-                    .clicked()
-                {
+                if item(ui, "Redo", &keys::REDO) {
                     self.apply(Command::Redo);
                 }
             });
