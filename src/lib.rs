@@ -5,8 +5,11 @@
 
 pub mod atomic;
 pub mod cli;
+pub mod crash;
 pub mod export;
+pub mod file_check;
 pub mod gpu;
+pub mod memory;
 pub mod mesh;
 pub mod model;
 pub mod reflectance;

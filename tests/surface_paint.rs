@@ -260,7 +260,7 @@ fn a_stroke_across_a_seam_of_spot_paints_both_sides_as_one() {
     let mut resampler = Resampler::<SurfacePos>::new(brush.spacing_px() * surface.units_per_texel);
     let mut dabs = Vec::new();
     for p in &input {
-        resampler.push(*p, &mut dabs);
+        resampler.push(*p, &mut dabs).expect("within the dab limit");
     }
     let s = &doc.settings;
     let target = PaintTarget::new(s.primary, s.channels, s.brush.blend, false);

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::MaterialMaps;
 use crate::model::maps::chi_lut;
-use crate::model::texel::decode_n;
+use crate::model::texel::{N_MAX, decode_n};
 use crate::model::tile::TILE_TEXELS;
 use crate::reflectance::{AmbientApprox, ShadingModel, diffuse_factor};
 
@@ -50,7 +50,11 @@ impl NCurve {
 
 /// A complete encoding of `n`: curve, range and bit depth. A consumer decodes a stored code
 /// `q` as `inverse(f(lo) + q / (2^bits - 1) * (f(hi) - f(lo)))`.
+///
+/// Read from a manifest only through its checks: bits 8 or 16 (what kapaint writes), and
+/// `0 <= lo <= hi <= N_MAX`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "NEncodingFile")]
 pub struct NEncoding {
     /// The curve.
     pub curve: NCurve,
@@ -60,6 +64,38 @@ pub struct NEncoding {
     pub hi: f32,
     /// Bits per code (8 or 16).
     pub bits: u8,
+}
+
+/// An encoding as a manifest spells it, before it is checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NEncodingFile {
+    curve: NCurve,
+    lo: f32,
+    hi: f32,
+    bits: u8,
+}
+
+impl TryFrom<NEncodingFile> for NEncoding {
+    type Error = String;
+
+    fn try_from(f: NEncodingFile) -> Result<Self, String> {
+        use crate::model::check::in_range;
+        if !matches!(f.bits, 8 | 16) {
+            return Err(format!(
+                "n_encoding.bits must be 8 or 16 (what kapaint writes), got {}",
+                f.bits
+            ));
+        }
+        let lo = in_range("n_encoding.lo", f.lo, 0.0, N_MAX)?;
+        let hi = in_range("n_encoding.hi", f.hi, lo, N_MAX)?;
+        Ok(Self {
+            curve: f.curve,
+            lo,
+            hi,
+            bits: f.bits,
+        })
+    }
 }
 
 impl NEncoding {

@@ -27,7 +27,12 @@ pub const MANIFEST_FORMAT: &str = "kapaint-material";
 pub const MANIFEST_VERSION: u32 = 1;
 
 /// One image of a set.
+///
+/// Read from a manifest only through its checks ([`FileEntryFile`]): a plain file name in
+/// the set's folder whose extension matches the compression, one to four known components,
+/// a known colour space, and a bit depth the format has.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "FileEntryFile")]
 pub struct FileEntry {
     /// File name inside the set's folder.
     pub path: String,
@@ -55,8 +60,106 @@ pub struct FileEntry {
     pub psnr: Option<Vec<Option<f64>>>,
 }
 
+/// A file entry as a manifest spells it, before it is checked.
+#[derive(Deserialize)]
+struct FileEntryFile {
+    path: String,
+    layout: Vec<String>,
+    colour_space: String,
+    bit_depth: u32,
+    compression: String,
+    width: u32,
+    height: u32,
+    bytes: u64,
+    #[serde(default)]
+    mip_levels: Option<u32>,
+    #[serde(default)]
+    psnr: Option<Vec<Option<f64>>>,
+}
+
+/// The compressions a set's files can have, with their extension and bit depths.
+const COMPRESSIONS: [(&str, &str, &[u32]); 6] = [
+    ("png", "png", &[8, 16]),
+    ("exr", "exr", &[32]),
+    ("ktx2", "ktx2", &[8]),
+    ("ktx2-bc4", "ktx2", &[8]),
+    ("ktx2-bc5", "ktx2", &[8]),
+    ("ktx2-bc7", "ktx2", &[8]),
+];
+
+impl TryFrom<FileEntryFile> for FileEntry {
+    type Error = String;
+
+    fn try_from(f: FileEntryFile) -> Result<Self, String> {
+        let name = &f.path;
+        crate::model::check::bounded_text("a file name", name, 255)?;
+        if name.is_empty() || name.contains(['/', '\\', ':']) || name.starts_with('.') {
+            return Err(format!(
+                "file name {name:?} must be a plain name inside the set's folder"
+            ));
+        }
+        let (_, ext, depths) = COMPRESSIONS
+            .iter()
+            .find(|(c, _, _)| *c == f.compression)
+            .ok_or_else(|| {
+                format!(
+                    "{name}: unknown compression {:?} (known: png, exr, ktx2, ktx2-bc4, ktx2-bc5, ktx2-bc7)",
+                    f.compression
+                )
+            })?;
+        if !Path::new(name)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+        {
+            return Err(format!(
+                "{name}: a {} file must end in .{ext}",
+                f.compression
+            ));
+        }
+        if !depths.contains(&f.bit_depth) {
+            return Err(format!(
+                "{name}: bit_depth {} is not one a {} file has ({depths:?})",
+                f.bit_depth, f.compression
+            ));
+        }
+        if !matches!(f.colour_space.as_str(), "srgb" | "linear") {
+            return Err(format!(
+                "{name}: colour_space must be srgb or linear, got {:?}",
+                f.colour_space
+            ));
+        }
+        if f.layout.is_empty() || f.layout.len() > 4 {
+            return Err(format!(
+                "{name}: layout must list 1 to 4 components, got {}",
+                f.layout.len()
+            ));
+        }
+        let mut seen = Vec::new();
+        for c in &f.layout {
+            let comp = Comp::parse(c).ok_or_else(|| format!("{name}: unknown component {c:?}"))?;
+            if seen.contains(&comp) {
+                return Err(format!("{name}: component {c:?} is listed twice"));
+            }
+            seen.push(comp);
+        }
+        Ok(Self {
+            path: f.path,
+            layout: f.layout,
+            colour_space: f.colour_space,
+            bit_depth: f.bit_depth,
+            compression: f.compression,
+            width: f.width,
+            height: f.height,
+            bytes: f.bytes,
+            mip_levels: f.mip_levels,
+            psnr: f.psnr,
+        })
+    }
+}
+
 /// Channels that are one value everywhere: stored here, not as images.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ConstantsFile")]
 pub struct Constants {
     /// `k_d` (linear), if constant.
     pub kd: Option<[f32; 3]>,
@@ -66,8 +169,39 @@ pub struct Constants {
     pub n: Option<f32>,
 }
 
+/// Constants as a manifest spells them, before their ranges are checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConstantsFile {
+    kd: Option<[f32; 3]>,
+    ks: Option<[f32; 3]>,
+    n: Option<f32>,
+}
+
+impl TryFrom<ConstantsFile> for Constants {
+    type Error = String;
+
+    fn try_from(f: ConstantsFile) -> Result<Self, String> {
+        use crate::model::check::{all_in_range, in_range};
+        Ok(Self {
+            kd: f
+                .kd
+                .map(|v| all_in_range("constants.kd", v, 0.0, 1.0))
+                .transpose()?,
+            ks: f
+                .ks
+                .map(|v| all_in_range("constants.ks", v, 0.0, 1.0))
+                .transpose()?,
+            n: f.n
+                .map(|v| in_range("constants.n", v, 0.0, crate::model::texel::N_MAX))
+                .transpose()?,
+        })
+    }
+}
+
 /// How to recompute `k_a` as kapaint does.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ApproximationFile")]
 pub struct Approximation {
     /// `fast`, `paper` or `paper-corrected`.
     pub name: String,
@@ -75,6 +209,45 @@ pub struct Approximation {
     pub diffuse_factor: f64,
     /// For the paper's forms: `chi(n) = a (n + b)^c`.
     pub paper_constants: Option<[f64; 3]>,
+}
+
+/// An approximation as a manifest spells it, before its name is checked.
+#[derive(Deserialize)]
+struct ApproximationFile {
+    name: String,
+    diffuse_factor: f64,
+    paper_constants: Option<[f64; 3]>,
+}
+
+impl TryFrom<ApproximationFile> for Approximation {
+    type Error = String;
+
+    fn try_from(f: ApproximationFile) -> Result<Self, String> {
+        Approximation::of_name(&f.name)?;
+        Ok(Self {
+            name: f.name,
+            diffuse_factor: f.diffuse_factor,
+            paper_constants: f.paper_constants,
+        })
+    }
+}
+
+impl Approximation {
+    /// The approximation this entry names.
+    ///
+    /// # Errors
+    /// A name kapaint does not know.
+    pub fn of_name(name: &str) -> Result<AmbientApprox, String> {
+        AmbientApprox::ALL
+            .into_iter()
+            .find(|a| a.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "approximation {name:?} is not one kapaint knows (known: {})",
+                    AmbientApprox::ALL.map(AmbientApprox::name).join(", ")
+                )
+            })
+    }
 }
 
 /// Bytes of the set against the alternatives.
@@ -90,7 +263,11 @@ pub struct MemoryReport {
 }
 
 /// `material.json`.
+///
+/// Read only through its checks ([`ManifestFile`]): a known format and version, a size in
+/// range, files of that size, and every channel either a constant or in a file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ManifestFile")]
 pub struct Manifest {
     /// Always [`MANIFEST_FORMAT`].
     pub format: String,
@@ -121,6 +298,104 @@ pub struct Manifest {
     pub preset: String,
 }
 
+/// A manifest as a file spells it, before the checks that span its fields.
+#[derive(Deserialize)]
+struct ManifestFile {
+    format: String,
+    version: u32,
+    width: u32,
+    height: u32,
+    model: ShadingModel,
+    approximation: Approximation,
+    constants: Constants,
+    n_encoding: Option<NEncoding>,
+    files: Vec<FileEntry>,
+    ka_error: KaError,
+    #[serde(default)]
+    dilated: bool,
+    bytes: MemoryReport,
+    preset: String,
+}
+
+impl TryFrom<ManifestFile> for Manifest {
+    type Error = String;
+
+    fn try_from(f: ManifestFile) -> Result<Self, String> {
+        if f.format != MANIFEST_FORMAT || f.version != MANIFEST_VERSION {
+            return Err(format!(
+                "format {:?} version {} is not one this kapaint reads ({MANIFEST_FORMAT:?} version {MANIFEST_VERSION})",
+                f.format, f.version
+            ));
+        }
+        let (w, h) = (f.width, f.height);
+        let max = crate::model::maps::MAX_SIDE;
+        if w == 0 || h == 0 || w > max || h > max {
+            return Err(format!("size {w}x{h} is outside 1..={max}"));
+        }
+        crate::model::check::bounded_text(
+            "preset",
+            &f.preset,
+            crate::model::check::MAX_NAME_BYTES,
+        )?;
+        let mut names: Vec<&str> = Vec::new();
+        let mut comps: Vec<Comp> = Vec::new();
+        for file in &f.files {
+            if (file.width, file.height) != (w, h) {
+                return Err(format!(
+                    "{} is listed as {}x{}, the set is {w}x{h}",
+                    file.path, file.width, file.height
+                ));
+            }
+            if names.iter().any(|n| n.eq_ignore_ascii_case(&file.path)) {
+                return Err(format!("{} is listed twice", file.path));
+            }
+            names.push(&file.path);
+            for c in file.layout.iter().filter_map(|c| Comp::parse(c)) {
+                if c == Comp::N
+                    && file.compression != "exr"
+                    && f.n_encoding
+                        .is_none_or(|e| u32::from(e.bits) > file.bit_depth)
+                {
+                    return Err(format!(
+                        "{} holds n in {}-bit codes, but n_encoding does not say how to decode them",
+                        file.path, file.bit_depth
+                    ));
+                }
+                comps.push(c);
+            }
+        }
+        let has = |c: Comp| comps.contains(&c);
+        let kd = (0..3).all(|c| has(Comp::Kd(c)));
+        let ks = has(Comp::Ks(3)) || (0..3).all(|c| has(Comp::Ks(c)));
+        for (name, constant, stored) in [
+            ("k_d", f.constants.kd.is_some(), kd),
+            ("k_s", f.constants.ks.is_some(), ks),
+            ("n", f.constants.n.is_some(), has(Comp::N)),
+        ] {
+            if !constant && !stored {
+                return Err(format!(
+                    "{name} is neither a constant nor stored in any file"
+                ));
+            }
+        }
+        Ok(Self {
+            format: f.format,
+            version: f.version,
+            width: w,
+            height: h,
+            model: f.model,
+            approximation: f.approximation,
+            constants: f.constants,
+            n_encoding: f.n_encoding,
+            files: f.files,
+            ka_error: f.ka_error,
+            dilated: f.dilated,
+            bytes: f.bytes,
+            preset: f.preset,
+        })
+    }
+}
+
 /// Why an export or import failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SetError {
@@ -136,6 +411,14 @@ pub enum SetError {
     #[error("{path}: {reason}")]
     Invalid {
         /// The manifest or image.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The target cannot take a set (a file, or a folder that is not empty).
+    #[error("{path}: {reason}")]
+    Target {
+        /// The target.
         path: PathBuf,
         /// What is wrong.
         reason: String,
@@ -563,7 +846,10 @@ pub fn export_with(
                 .next()
                 .is_some())
     {
-        return Err(io(out, "exists and is not an empty folder"));
+        return Err(SetError::Target {
+            path: out.to_path_buf(),
+            reason: "exists and is not an empty folder".into(),
+        });
     }
     let maps = &doc.maps;
     let (model, approx) = (doc.settings.model, doc.settings.approx);
@@ -1023,43 +1309,40 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
 /// # Errors
 /// A missing, malformed or inconsistent manifest or image.
 pub fn import(manifest_path: &Path) -> Result<Document, SetError> {
-    let text = std::fs::read(manifest_path).map_err(|e| io(manifest_path, e))?;
+    let text = read_manifest_bytes(manifest_path)?;
     let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| SetError::Invalid {
         path: manifest_path.to_path_buf(),
-        reason: format!("not a kapaint material manifest: {e}"),
+        reason: format!("not a valid kapaint material manifest: {e}"),
     })?;
-    if manifest.format != MANIFEST_FORMAT || manifest.version > MANIFEST_VERSION {
-        return Err(SetError::Invalid {
-            path: manifest_path.to_path_buf(),
-            reason: format!(
-                "format {:?} version {} is not one this kapaint reads",
-                manifest.format, manifest.version
-            ),
-        });
-    }
-    if manifest.width == 0
-        || manifest.height == 0
-        || manifest.width > crate::model::maps::MAX_SIDE
-        || manifest.height > crate::model::maps::MAX_SIDE
-    {
-        return Err(SetError::Invalid {
-            path: manifest_path.to_path_buf(),
-            reason: format!(
-                "size {}x{} is outside 1..=8192",
-                manifest.width, manifest.height
-            ),
-        });
-    }
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
     let maps = read_maps(&manifest, dir)?;
-    let approx = AmbientApprox::ALL
-        .into_iter()
-        .find(|a| a.name() == manifest.approximation.name)
-        .unwrap_or(AmbientApprox::Fast);
+    let approx = Approximation::of_name(&manifest.approximation.name).map_err(|reason| {
+        SetError::Invalid {
+            path: manifest_path.to_path_buf(),
+            reason,
+        }
+    })?;
     let settings = DocumentSettings {
         model: manifest.model,
         approx,
         ..DocumentSettings::default()
     };
     Ok(Document::from_parts(maps, settings))
+}
+
+/// Largest manifest read (bytes).
+const MAX_MANIFEST_BYTES: u64 = 4 << 20;
+
+/// The manifest's bytes: a regular file of at most [`MAX_MANIFEST_BYTES`].
+fn read_manifest_bytes(path: &Path) -> Result<Vec<u8>, SetError> {
+    crate::file_check::read_limited(path, MAX_MANIFEST_BYTES).map_err(|e| {
+        if e.is_io() {
+            io(path, e)
+        } else {
+            SetError::Invalid {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            }
+        }
+    })
 }

@@ -45,6 +45,9 @@ pub struct UvBake {
     pub island: Vec<u32>,
     /// Coverage.
     pub coverage: Vec<Coverage>,
+    /// Texel-triangle pairs the bake tested: its work, which overlapping UVs must not
+    /// multiply (each covered texel is settled once).
+    pub touch_tests: u64,
 }
 
 /// Per-triangle UV island indices (union of triangles sharing UV points).
@@ -121,7 +124,117 @@ fn touches(a: Vec2, b: Vec2, c: Vec2, center: Vec2, h: f32) -> bool {
     true
 }
 
+/// Most texel rows all triangles together may span: a bound on the bake's work that no real
+/// UV layout comes near (a mesh filling an 8192^2 map ten times over spans about 10^7), but
+/// that a hostile file of millions of large overlapping triangles would pass.
+pub const MAX_BAKE_ROWS: u64 = 1 << 30;
+
+/// How far beyond a triangle's exact extent in a row texels are still tested (texels), so
+/// that rounding never drops a texel the touch test would take.
+const SPAN_MARGIN: f32 = 0.01;
+
+/// The x extent of triangle `(a, b, c)` within the horizontal slab `y0 <= y <= y1`: the
+/// extent of the polygon the slab cuts out of it (its corners inside the slab and its edges'
+/// crossings of the slab's lines), or `None` when the slab misses it.
+fn slab_span(a: Vec2, b: Vec2, c: Vec2, y0: f32, y1: f32) -> Option<(f32, f32)> {
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for p in [a, b, c] {
+        if p.y >= y0 && p.y <= y1 {
+            lo = lo.min(p.x);
+            hi = hi.max(p.x);
+        }
+    }
+    for (p, q) in [(a, b), (b, c), (c, a)] {
+        for line in [y0, y1] {
+            if (p.y - line) * (q.y - line) < 0.0 {
+                let x = p.x + (q.x - p.x) * ((line - p.y) / (q.y - p.y));
+                lo = lo.min(x);
+                hi = hi.max(x);
+            }
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// Which texels of a band can still change: a texel whose centre lies inside a triangle is
+/// final (no later triangle can beat distance 0), so overlapping UVs cost only the texels
+/// still open. Bits are set for open texels, one row of words per texel row, with a summary
+/// bit per word that has any.
+struct OpenTexels {
+    words_per_row: usize,
+    summaries_per_row: usize,
+    bits: Vec<u64>,
+    summary: Vec<u64>,
+}
+
+impl OpenTexels {
+    fn new(width: usize, rows: usize) -> Self {
+        let words_per_row = width.div_ceil(64);
+        let summaries_per_row = words_per_row.div_ceil(64);
+        let mut bits = vec![u64::MAX; words_per_row * rows];
+        let mut summary = vec![0_u64; summaries_per_row * rows];
+        for r in 0..rows {
+            if !width.is_multiple_of(64) {
+                bits[r * words_per_row + words_per_row - 1] = (1_u64 << (width % 64)) - 1;
+            }
+            for w in 0..words_per_row {
+                summary[r * summaries_per_row + w / 64] |= 1 << (w % 64);
+            }
+        }
+        Self {
+            words_per_row,
+            summaries_per_row,
+            bits,
+            summary,
+        }
+    }
+
+    /// The open texels of row `r` in `x0..=x1`, in order.
+    fn open_in(&self, r: usize, x0: usize, x1: usize, out: &mut Vec<usize>) {
+        out.clear();
+        let (w0, w1) = (x0 / 64, x1 / 64);
+        let mut w = w0;
+        while w <= w1 {
+            let s = self.summary[r * self.summaries_per_row + w / 64] >> (w % 64);
+            if s == 0 {
+                w = (w / 64 + 1) * 64; // no open word in the rest of this summary word
+                continue;
+            }
+            w += s.trailing_zeros() as usize;
+            if w > w1 {
+                break;
+            }
+            let mut word = self.bits[r * self.words_per_row + w];
+            if w == w0 {
+                word &= u64::MAX << (x0 % 64);
+            }
+            if w == w1 && x1 % 64 != 63 {
+                word &= (1_u64 << (x1 % 64 + 1)) - 1;
+            }
+            while word != 0 {
+                out.push(w * 64 + word.trailing_zeros() as usize);
+                word &= word - 1;
+            }
+            w += 1;
+        }
+    }
+
+    /// Marks texel `x` of row `r` final.
+    fn close(&mut self, r: usize, x: usize) {
+        let w = x / 64;
+        let word = &mut self.bits[r * self.words_per_row + w];
+        *word &= !(1_u64 << (x % 64));
+        if *word == 0 {
+            self.summary[r * self.summaries_per_row + w / 64] &= !(1_u64 << (w % 64));
+        }
+    }
+}
+
 /// Bakes `mesh` (which must have UVs) at `width x height` with `padding` texels of dilation.
+///
+/// # Errors
+/// A mesh without UVs, or one whose triangles together span more than [`MAX_BAKE_ROWS`]
+/// texel rows.
 pub fn bake(mesh: &Mesh, width: u32, height: u32, padding: u32) -> Result<UvBake, String> {
     mesh.paintable()?;
     let uvs = mesh.uvs.as_ref().ok_or("no UVs")?;
@@ -131,15 +244,24 @@ pub fn bake(mesh: &Mesh, width: u32, height: u32, padding: u32) -> Result<UvBake
     let to_texel = |t: Vec2| Vec2::new(t.x * width as f32, (1.0 - t.y) * height as f32);
     let bands = h.div_ceil(BAND_ROWS);
     let mut binned: Vec<Vec<u32>> = vec![Vec::new(); bands];
+    let mut rows_spanned: u64 = 0;
     for (i, t) in mesh.triangles.iter().enumerate() {
         let [a, b, c] = t.map(|v| to_texel(uvs[v as usize]));
         let (lo, hi) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
         if !(lo.is_finite() && hi.is_finite()) || hi < 0.0 || lo > height as f32 {
             continue;
         }
-        let first = (lo.floor().max(0.0) as usize / BAND_ROWS).min(bands - 1);
-        let last = (hi.floor().max(0.0) as usize / BAND_ROWS).min(bands - 1);
-        for band in &mut binned[first..=last] {
+        let (top, bottom) = (
+            (lo.floor().max(0.0) as usize).min(h - 1),
+            (hi.floor().max(0.0) as usize).min(h - 1),
+        );
+        rows_spanned += (bottom - top + 1) as u64;
+        if rows_spanned > MAX_BAKE_ROWS {
+            return Err(format!(
+                "the UV layout is too costly to bake at {width}x{height}: its triangles span more than {MAX_BAKE_ROWS} texel rows in all (millions of large overlapping UV triangles?)"
+            ));
+        }
+        for band in &mut binned[top / BAND_ROWS..=bottom / BAND_ROWS] {
             band.push(i as u32);
         }
     }
@@ -151,54 +273,121 @@ pub fn bake(mesh: &Mesh, width: u32, height: u32, padding: u32) -> Result<UvBake
         triangle: vec![u32::MAX; w * h],
         island: vec![u32::MAX; w * h],
         coverage: vec![Coverage::Empty; w * h],
+        touch_tests: 0,
     };
     let band_len = w * BAND_ROWS;
-    out.position
+    out.touch_tests = out
+        .position
         .par_chunks_mut(band_len)
         .zip(out.normal.par_chunks_mut(band_len))
         .zip(out.triangle.par_chunks_mut(band_len))
         .zip(out.island.par_chunks_mut(band_len))
         .zip(out.coverage.par_chunks_mut(band_len))
         .enumerate()
-        .for_each(|(band, ((((pos, nrm), tri), isl), cov))| {
-            let y0 = band * BAND_ROWS;
-            let rows = pos.len() / w;
-            let mut best = vec![f32::INFINITY; pos.len()];
-            for &ti in &binned[band] {
-                let t = mesh.triangles[ti as usize];
-                let [a, b, c] = t.map(|v| to_texel(uvs[v as usize]));
-                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-                let xs = (lo.x.floor().max(0.0) as usize).min(w - 1);
-                let xe = (hi.x.floor().max(0.0) as usize).min(w - 1);
-                let ys = (lo.y.floor().max(y0 as f32) as usize).clamp(y0, y0 + rows - 1);
-                let ye = (hi.y.floor().max(0.0) as usize).clamp(y0, y0 + rows - 1);
-                for y in ys..=ye {
-                    for x in xs..=xe {
-                        let center = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                        if !touches(a, b, c, center, 0.5) {
-                            continue;
-                        }
-                        let (bary, d2) = nearest_barycentric(center, a, b, c);
-                        let k = (y - y0) * w + x;
-                        if d2 >= best[k] {
-                            continue;
-                        }
-                        best[k] = d2;
-                        let [pa, pb, pc] = t.map(|v| mesh.positions[v as usize]);
-                        let [na, nb, nc] = t.map(|v| mesh.normals[v as usize]);
-                        pos[k] = pa * bary.x + pb * bary.y + pc * bary.z;
-                        nrm[k] = (na * bary.x + nb * bary.y + nc * bary.z)
-                            .try_normalize()
-                            .unwrap_or(na);
-                        tri[k] = ti;
-                        isl[k] = islands[ti as usize];
-                        cov[k] = Coverage::Surface;
-                    }
-                }
-            }
-        });
+        .map(|(band, ((((pos, nrm), tri), isl), cov))| {
+            let slices = BandSlices {
+                pos,
+                nrm,
+                tri,
+                isl,
+                cov,
+            };
+            rasterize_band(
+                mesh,
+                uvs,
+                &islands,
+                (width, height),
+                &binned[band],
+                band * BAND_ROWS,
+                slices,
+            )
+        })
+        .sum();
     dilate(&mut out, padding);
     Ok(out)
+}
+
+/// The bake's outputs over one band of rows.
+struct BandSlices<'a> {
+    pos: &'a mut [Vec3],
+    nrm: &'a mut [Vec3],
+    tri: &'a mut [u32],
+    isl: &'a mut [u32],
+    cov: &'a mut [Coverage],
+}
+
+/// Rasterises `triangles` (indices into the mesh) into the band of rows starting at `y0`;
+/// returns the texel tests made.
+fn rasterize_band(
+    mesh: &Mesh,
+    uvs: &[Vec2],
+    islands: &[u32],
+    (width, height): (u32, u32),
+    triangles: &[u32],
+    y0: usize,
+    out: BandSlices<'_>,
+) -> u64 {
+    let BandSlices {
+        pos,
+        nrm,
+        tri,
+        isl,
+        cov,
+    } = out;
+    let w = width as usize;
+    let to_texel = |t: Vec2| Vec2::new(t.x * width as f32, (1.0 - t.y) * height as f32);
+    let rows = pos.len() / w;
+    let mut best = vec![f32::INFINITY; pos.len()];
+    let mut open = OpenTexels::new(w, rows);
+    let mut candidates = Vec::new();
+    let mut tests = 0_u64;
+    for &ti in triangles {
+        let t = mesh.triangles[ti as usize];
+        let [a, b, c] = t.map(|v| to_texel(uvs[v as usize]));
+        let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+        let xs = (lo.x.floor().max(0.0) as usize).min(w - 1);
+        let xe = (hi.x.floor().max(0.0) as usize).min(w - 1);
+        let ys = (lo.y.floor().max(y0 as f32) as usize).clamp(y0, y0 + rows - 1);
+        let ye = (hi.y.floor().max(0.0) as usize).clamp(y0, y0 + rows - 1);
+        for y in ys..=ye {
+            let Some((left, right)) = slab_span(a, b, c, y as f32, y as f32 + 1.0) else {
+                continue;
+            };
+            // Texel x touches [left, right] when x + 1 >= left and x <= right.
+            let x0 = ((left - SPAN_MARGIN).ceil() - 1.0).max(xs as f32) as usize;
+            let x1 = ((right + SPAN_MARGIN).floor().min(xe as f32)).max(0.0) as usize;
+            if x0 > x1 {
+                continue;
+            }
+            open.open_in(y - y0, x0, x1, &mut candidates);
+            tests += candidates.len() as u64;
+            for &x in &candidates {
+                let center = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                if !touches(a, b, c, center, 0.5) {
+                    continue;
+                }
+                let (bary, d2) = nearest_barycentric(center, a, b, c);
+                let k = (y - y0) * w + x;
+                if d2 >= best[k] {
+                    continue;
+                }
+                best[k] = d2;
+                if d2 == 0.0 {
+                    open.close(y - y0, x);
+                }
+                let [pa, pb, pc] = t.map(|v| mesh.positions[v as usize]);
+                let [na, nb, nc] = t.map(|v| mesh.normals[v as usize]);
+                pos[k] = pa * bary.x + pb * bary.y + pc * bary.z;
+                nrm[k] = (na * bary.x + nb * bary.y + nc * bary.z)
+                    .try_normalize()
+                    .unwrap_or(na);
+                tri[k] = ti;
+                isl[k] = islands[ti as usize];
+                cov[k] = Coverage::Surface;
+            }
+        }
+    }
+    tests
 }
 
 /// Grows every island by `rings` texels (bake padding).
@@ -297,6 +486,77 @@ mod tests {
         // [1.5, 2.5]^2 touches it at the corner (1.5, 2.5)... 1.5 + 2.5 = 4: touching counts.
         assert!(touches(a, b, c, Vec2::new(2.0, 2.0), 0.5));
         assert!(!touches(a, b, c, Vec2::new(-1.0, 2.0), 0.4));
+    }
+
+    #[test]
+    fn slab_spans_are_the_triangles_extent_in_each_row() {
+        let (a, b, c) = (
+            Vec2::new(0.0, 0.0),
+            Vec2::new(4.0, 0.0),
+            Vec2::new(0.0, 4.0),
+        );
+        assert_eq!(slab_span(a, b, c, 0.0, 1.0), Some((0.0, 4.0)));
+        assert_eq!(slab_span(a, b, c, 2.0, 3.0), Some((0.0, 2.0)));
+        assert_eq!(slab_span(a, b, c, 3.5, 4.5), Some((0.0, 0.5)));
+        assert_eq!(slab_span(a, b, c, 5.0, 6.0), None);
+        // A sliver on one row.
+        let flat = slab_span(
+            Vec2::new(1.0, 2.5),
+            Vec2::new(7.0, 2.5),
+            Vec2::new(3.0, 2.5),
+            2.0,
+            3.0,
+        );
+        assert_eq!(flat, Some((1.0, 7.0)));
+    }
+
+    #[test]
+    fn overlapping_uvs_cost_what_the_covered_texels_cost() {
+        // 10,000 copies of one triangle over half the UV square: each covered texel is
+        // settled by the first copy, so the others only retest its edge.
+        let copies = 10_000_u32;
+        let mesh = Mesh {
+            name: "stack".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            normals: vec![Vec3::Z; 3],
+            uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y]),
+            triangles: vec![[0, 1, 2]; copies as usize],
+            had_normals: true,
+        };
+        let side = 1024;
+        let b = bake(&mesh, side, side, 0).unwrap();
+        let covered = b
+            .coverage
+            .iter()
+            .filter(|c| **c == Coverage::Surface)
+            .count() as u64;
+        assert!(covered > u64::from(side * side) / 2);
+        // The edge: at most a few texels per row per copy beyond the covered area.
+        let bound = covered + u64::from(copies) * u64::from(side) * 4;
+        assert!(
+            b.touch_tests < bound,
+            "{} texel tests, more than {bound} (covered {covered})",
+            b.touch_tests
+        );
+    }
+
+    #[test]
+    fn open_texels_list_what_is_left_in_order() {
+        let mut open = OpenTexels::new(200, 2);
+        let mut out = Vec::new();
+        open.open_in(1, 60, 70, &mut out);
+        assert_eq!(out, (60..=70).collect::<Vec<_>>());
+        for x in 0..200 {
+            if x != 3 && x != 130 && x != 199 {
+                open.close(1, x);
+            }
+        }
+        open.open_in(1, 0, 199, &mut out);
+        assert_eq!(out, vec![3, 130, 199]);
+        open.open_in(1, 4, 198, &mut out);
+        assert_eq!(out, vec![130]);
+        open.open_in(0, 190, 199, &mut out);
+        assert_eq!(out.len(), 10, "other rows untouched");
     }
 
     #[test]

@@ -25,11 +25,7 @@ pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_path_buf(),
         reason,
     };
-    super::check_file_size(path)?;
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
+    let bytes = super::read_mesh_file(path)?;
     let not_gltf = |e: gltf::Error| invalid(format!("not a valid glTF file: {e}"));
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(not_gltf)?;
@@ -37,17 +33,35 @@ pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
     // attribute unchecked (and panics on a dangling one): check references first.
     check_references(document.as_json()).map_err(&invalid)?;
     let document = gltf::Document::from_json(document.into_json()).map_err(not_gltf)?;
-    let buffers = gltf::import_buffers(&document, path.parent(), blob)
-        .map_err(|e| invalid(format!("cannot read the glTF buffers: {e}")))?;
-    let buffers: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let buffers = load_buffers(&document, dir, blob).map_err(&invalid)?;
+    let buffers: Vec<&[u8]> = buffers.iter().map(Vec::as_slice).collect();
 
-    // The default scene (else the first; else every mesh once, untransformed).
+    // The default scene (else the first; else every mesh once, untransformed). A node graph
+    // can reuse a node many times (2^40 instances from 40 nodes), so what the scene would
+    // instantiate is counted before anything is expanded.
     let mut instances: Vec<(gltf::Mesh<'_>, Mat4)> = Vec::new();
     match document
         .default_scene()
         .or_else(|| document.scenes().next())
     {
         Some(scene) => {
+            let mut counts = vec![None; document.nodes().len()];
+            let total = scene
+                .nodes()
+                .try_fold(Count::default(), |sum, node| {
+                    Ok::<_, String>(sum.add(count(&node, 0, &mut counts)?))
+                })
+                .map_err(&invalid)?;
+            if total.triangles > MAX_TRIANGLES as u64 || total.instances > MAX_INSTANCES {
+                return Err(invalid(format!(
+                    "the scene instantiates {} meshes with {} triangles (nodes are reused), more than the {MAX_INSTANCES} instances and {MAX_TRIANGLES} triangles supported",
+                    total.instances, total.triangles
+                )));
+            }
             for node in scene.nodes() {
                 collect(&node, Mat4::IDENTITY, 0, &mut instances).map_err(&invalid)?;
             }
@@ -88,6 +102,154 @@ fn check_references(root: &gltf::json::Root) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Most mesh instances a scene may create.
+const MAX_INSTANCES: u64 = 1_000_000;
+
+/// What a node and its subtree instantiate (saturating: a hostile graph overflows `u64`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Count {
+    instances: u64,
+    triangles: u64,
+}
+
+impl Count {
+    fn add(self, other: Self) -> Self {
+        Self {
+            instances: self.instances.saturating_add(other.instances),
+            triangles: self.triangles.saturating_add(other.triangles),
+        }
+    }
+}
+
+/// Triangles one instance of `mesh` adds, from its accessors' counts (nothing is read).
+fn mesh_triangles(mesh: &gltf::Mesh<'_>) -> u64 {
+    mesh.primitives()
+        .map(|p| {
+            let corners = p
+                .indices()
+                .map(|a| a.count())
+                .or_else(|| p.get(&Semantic::Positions).map(|a| a.count()))
+                .unwrap_or(0) as u64;
+            match p.mode() {
+                Mode::Triangles => corners / 3,
+                Mode::TriangleStrip | Mode::TriangleFan => corners.saturating_sub(2),
+                _ => 0,
+            }
+        })
+        .fold(0, u64::saturating_add)
+}
+
+/// What `node` instantiates, memoised per node (so a node reused a billion times is counted
+/// once); the depth bound catches cycles.
+fn count(node: &gltf::Node<'_>, depth: usize, memo: &mut [Option<Count>]) -> Result<Count, String> {
+    if depth > MAX_DEPTH {
+        return Err(format!(
+            "the node hierarchy is deeper than {MAX_DEPTH} (a cycle?)"
+        ));
+    }
+    if let Some(Some(c)) = memo.get(node.index()) {
+        return Ok(*c);
+    }
+    let own = node.mesh().map_or(Count::default(), |m| Count {
+        instances: 1,
+        triangles: mesh_triangles(&m),
+    });
+    let total = node.children().try_fold(own, |sum, child| {
+        Ok::<_, String>(sum.add(count(&child, depth + 1, memo)?))
+    })?;
+    if let Some(slot) = memo.get_mut(node.index()) {
+        *slot = Some(total);
+    }
+    Ok(total)
+}
+
+/// Reads every buffer: the GLB's binary chunk, `data:` URIs, and files beside the glTF. A file
+/// must be a regular file inside the glTF's folder (no absolute paths, no `..`, no other URI
+/// schemes), and at least as long as the buffer's declared `byteLength`, of which no more is
+/// read.
+fn load_buffers(
+    document: &gltf::Document,
+    dir: &Path,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>, String> {
+    use gltf::buffer::{Data, Source};
+    let mut total: u64 = 0;
+    let mut out = Vec::new();
+    for buffer in document.buffers() {
+        let declared = buffer.length() as u64;
+        total = total.saturating_add(declared);
+        if total > super::MAX_FILE_BYTES {
+            return Err(format!(
+                "the buffers declare more than the {} bytes supported",
+                super::MAX_FILE_BYTES
+            ));
+        }
+        let what = format!("buffer {}", buffer.index());
+        let data = match buffer.source() {
+            Source::Uri(uri) if !uri.starts_with("data:") => {
+                read_buffer_file(dir, uri, declared).map_err(|e| format!("{what}: {e}"))?
+            }
+            source => {
+                Data::from_source_and_blob(source, None, &mut blob)
+                    .map_err(|e| format!("{what}: {e}"))?
+                    .0
+            }
+        };
+        if (data.len() as u64) < declared {
+            return Err(format!(
+                "{what} holds {} bytes but its byteLength is {declared} (truncated?)",
+                data.len()
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// A buffer file named by a relative `uri`, confined to `dir`; at most `declared` bytes.
+fn read_buffer_file(dir: &Path, uri: &str, declared: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read as _;
+    use std::path::Component;
+    if uri.contains(':') {
+        return Err(format!(
+            "{uri:?}: only files beside the glTF are read (no URI schemes)"
+        ));
+    }
+    let decoded = urlencoding::decode(uri).map_err(|_| format!("{uri:?} is not a valid URI"))?;
+    let relative = Path::new(decoded.as_ref());
+    if relative
+        .components()
+        .any(|c| !matches!(c, Component::Normal(_) | Component::CurDir))
+    {
+        return Err(format!(
+            "{uri:?} leaves the glTF's folder (absolute paths and .. are not followed)"
+        ));
+    }
+    let file = dir.join(relative);
+    let inside = match (file.canonicalize(), dir.canonicalize()) {
+        (Ok(f), Ok(d)) => f.starts_with(d),
+        (Err(e), _) | (_, Err(e)) => return Err(format!("{}: {e}", file.display())),
+    };
+    if !inside {
+        return Err(format!(
+            "{uri:?} links outside the glTF's folder, which is not followed"
+        ));
+    }
+    let len = crate::file_check::regular_file(&file, super::MAX_FILE_BYTES)
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    if len < declared {
+        return Err(format!(
+            "{} holds {len} bytes but the buffer's byteLength is {declared} (truncated?)",
+            file.display()
+        ));
+    }
+    let mut data = Vec::with_capacity(declared as usize);
+    std::fs::File::open(&file)
+        .and_then(|f| f.take(declared).read_to_end(&mut data))
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    Ok(data)
 }
 
 /// Walks the node tree, accumulating transforms.

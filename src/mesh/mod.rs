@@ -208,22 +208,19 @@ pub fn smooth_normals(
         .collect()
 }
 
-/// Fails with a clear error when `path` cannot be read or is larger than supported.
-fn check_file_size(path: &Path) -> Result<(), MeshError> {
-    let meta = std::fs::metadata(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(MeshError::Invalid {
+/// Reads a whole mesh file: a regular file (not a FIFO, a device or a link to one) of at most
+/// [`MAX_FILE_BYTES`].
+fn read_mesh_file(path: &Path) -> Result<Vec<u8>, MeshError> {
+    crate::file_check::read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
+        crate::file_check::FileCheck::Io(source) => MeshError::Io {
             path: path.to_path_buf(),
-            reason: format!(
-                "the file is {} bytes, more than the 2 GiB supported",
-                meta.len()
-            ),
-        });
-    }
-    Ok(())
+            source,
+        },
+        other => MeshError::Invalid {
+            path: path.to_path_buf(),
+            reason: format!("the file {other}"),
+        },
+    })
 }
 
 /// Names of the built-in meshes.

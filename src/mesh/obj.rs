@@ -15,14 +15,19 @@ pub fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_path_buf(),
         reason,
     };
-    super::check_file_size(path)?;
+    let bytes = super::read_mesh_file(path)?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj(path, &options)
+    // Materials are not used, so `mtllib` is never followed (it could name /dev/zero or a
+    // FIFO).
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |_| {
+            Ok((Vec::new(), std::collections::HashMap::new()))
+        })
         .map_err(|e| invalid(format!("not a valid OBJ file: {e}")))?;
 
     let mut positions = Vec::new();

@@ -6,7 +6,9 @@
 //! the path.
 
 use glam::{Vec2, Vec3};
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
+
+use super::check;
 
 /// How a stroke's target combines with what is under it. Every channel blends in `[0, 1]`
 /// space: `k_d`, `k_s` as they are, `n` in log space ([`super::texel::n_to_blend`]).
@@ -40,25 +42,85 @@ impl BlendMode {
     }
 }
 
+/// Largest stamp side in pixels.
+pub const MAX_STAMP_SIDE: u32 = 1024;
+
 /// A grayscale alpha stamp that shapes each dab (sampled bilinearly over the dab's square).
+///
+/// Built only through [`Stamp::new`] (files included), so its size always matches its values
+/// and every value is in `[0, 1]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "StampFile")]
 pub struct Stamp {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Alpha per pixel in `[0, 1]`, row-major.
-    pub alpha: Vec<f32>,
+    width: u32,
+    height: u32,
+    alpha: Vec<f32>,
+}
+
+/// A stamp as a file spells it, before [`Stamp::new`] checks it.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StampFile {
+    width: u32,
+    height: u32,
+    alpha: Vec<f32>,
+}
+
+impl TryFrom<StampFile> for Stamp {
+    type Error = String;
+
+    fn try_from(file: StampFile) -> Result<Self, String> {
+        Self::new(file.width, file.height, file.alpha)
+    }
 }
 
 impl Stamp {
-    /// Builds a stamp, validating the size and clamping the values.
-    pub fn new(width: u32, height: u32, alpha: Vec<f32>) -> Option<Self> {
-        (width > 0 && height > 0 && alpha.len() == (width * height) as usize).then(|| Self {
+    /// A stamp of `width x height` pixels (each side 1 to [`MAX_STAMP_SIDE`]) with one alpha
+    /// per pixel, row-major, each finite and in `[0, 1]`.
+    ///
+    /// # Errors
+    /// A side out of range, a value count that is not `width * height`, or a value that is
+    /// not a number in `[0, 1]`; the message says which.
+    pub fn new(width: u32, height: u32, alpha: Vec<f32>) -> Result<Self, String> {
+        for (side, v) in [("width", width), ("height", height)] {
+            super::check::int_in_range(&format!("stamp {side}"), v, 1, MAX_STAMP_SIDE)?;
+        }
+        let expected = u64::from(width) * u64::from(height);
+        if alpha.len() as u64 != expected {
+            return Err(format!(
+                "a {width}x{height} stamp needs {expected} alpha values, got {}",
+                alpha.len()
+            ));
+        }
+        if let Some((i, v)) = alpha
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && (0.0..=1.0).contains(*v)))
+        {
+            return Err(format!(
+                "stamp alpha {i} must be a number in [0, 1], got {v}"
+            ));
+        }
+        Ok(Self {
             width,
             height,
-            alpha: alpha.into_iter().map(super::texel::unit).collect(),
+            alpha,
         })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Alpha per pixel in `[0, 1]`, row-major.
+    pub fn alpha(&self) -> &[f32] {
+        &self.alpha
     }
 
     /// A built-in grainy round stamp, `size` pixels square: a soft disc broken by value noise
@@ -111,23 +173,30 @@ impl Stamp {
 #[serde(default)]
 #[allow(clippy::struct_excessive_bools)] // Independent switches, as a brush panel shows them.
 pub struct BrushSettings {
-    /// Radius in texels (2D) at full pressure.
+    /// Radius in texels (2D) at full pressure, `[0.5, 4096]`.
+    #[serde(deserialize_with = "check::radius_px")]
     pub radius_px: f32,
     /// Fraction of the radius painted at full strength before the soft falloff, `[0, 1]`.
+    #[serde(deserialize_with = "check::hardness")]
     pub hardness: f32,
     /// The most a single stroke can cover, `[0, 1]`.
+    #[serde(deserialize_with = "check::opacity")]
     pub opacity: f32,
     /// How much each dab adds towards `opacity`, `[0, 1]`.
+    #[serde(deserialize_with = "check::flow")]
     pub flow: f32,
     /// Distance between dabs as a percentage of the radius, `[1, 1000]`.
+    #[serde(deserialize_with = "check::spacing_percent")]
     pub spacing_percent: f32,
     /// Pressure scales the radius.
     pub pressure_size: bool,
     /// Pressure scales the flow.
     pub pressure_opacity: bool,
     /// Random offset of each dab as a fraction of the radius, `[0, 1]`.
+    #[serde(deserialize_with = "check::jitter")]
     pub jitter: f32,
     /// Lazy-mouse radius in texels: the brush trails the pointer by this much (0: off).
+    #[serde(deserialize_with = "check::smoothing_px")]
     pub smoothing_px: f32,
     /// How the target blends.
     pub blend: BlendMode,
@@ -148,7 +217,8 @@ pub struct BrushSettings {
     pub front_faces_only: bool,
     /// Optional alpha stamp.
     pub stamp: Option<Stamp>,
-    /// Kernel radius of the blur tool in texels.
+    /// Kernel radius of the blur tool in texels, `[1, 16]`.
+    #[serde(deserialize_with = "check::blur_radius_px")]
     pub blur_radius_px: u32,
 }
 
@@ -225,9 +295,10 @@ impl BrushSettings {
 /// A position strokes move through: texel coordinates ([`Vec2`]) on the UV canvas, or a
 /// point on a mesh with its normal ([`SurfacePos`]).
 pub trait StrokePos: Copy {
-    /// The point a fraction `t` of the way to `other`.
+    /// The point a fraction `t` of the way to `other` (computed in `f64`, so a point far
+    /// along a long segment is exact).
     #[must_use]
-    fn lerp_to(self, other: Self, t: f32) -> Self;
+    fn lerp_to(self, other: Self, t: f64) -> Self;
     /// Distance to `other` (texels, or object units on a mesh).
     fn distance_to(self, other: Self) -> f32;
     /// Whether every coordinate is finite.
@@ -237,8 +308,9 @@ pub trait StrokePos: Copy {
 }
 
 impl StrokePos for Vec2 {
-    fn lerp_to(self, other: Self, t: f32) -> Self {
-        self + (other - self) * t
+    fn lerp_to(self, other: Self, t: f64) -> Self {
+        let a = self.as_dvec2();
+        (a + (other.as_dvec2() - a) * t).as_vec2()
     }
     fn distance_to(self, other: Self) -> f32 {
         self.distance(other)
@@ -255,17 +327,19 @@ impl StrokePos for Vec2 {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SurfacePos {
     /// Object-space point (on or very near the surface).
+    #[serde(deserialize_with = "check::finite_vec3")]
     pub point: Vec3,
     /// Surface normal there; zero (the default) means "take it from the mesh".
-    #[serde(default)]
+    #[serde(default, deserialize_with = "check::finite_vec3")]
     pub normal: Vec3,
 }
 
 impl StrokePos for SurfacePos {
-    fn lerp_to(self, other: Self, t: f32) -> Self {
-        let normal = self.normal.lerp(other.normal, t);
+    fn lerp_to(self, other: Self, t: f64) -> Self {
+        let normal = self.normal.lerp(other.normal, t as f32);
+        let a = self.point.as_dvec3();
         Self {
-            point: self.point + (other.point - self.point) * t,
+            point: (a + (other.point.as_dvec3() - a) * t).as_vec3(),
             normal: normal.try_normalize().unwrap_or(self.normal),
         }
     }
@@ -285,12 +359,31 @@ impl StrokePos for SurfacePos {
 
 /// One input sample of a stroke.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(bound(deserialize = "P: StrokePos + Deserialize<'de>"))]
 pub struct StrokePoint<P = Vec2> {
     /// Position: in texel units on the canvas (texel `(i, j)` has its centre at
     /// `(i + 0.5, j + 0.5)`), or a [`SurfacePos`] on a mesh.
+    #[serde(deserialize_with = "finite_pos")]
     pub pos: P,
     /// Pen pressure in `[0, 1]` (1 for a mouse).
+    #[serde(deserialize_with = "check::pressure")]
     pub pressure: f32,
+}
+
+/// A stroke position from a file: every coordinate finite.
+fn finite_pos<'de, D, P>(d: D) -> Result<P, D::Error>
+where
+    D: Deserializer<'de>,
+    P: StrokePos + Deserialize<'de>,
+{
+    let pos = P::deserialize(d)?;
+    if pos.finite() {
+        Ok(pos)
+    } else {
+        Err(serde::de::Error::custom(
+            "a stroke point must have finite coordinates",
+        ))
+    }
 }
 
 /// An input sample on a mesh surface.
@@ -305,27 +398,59 @@ pub struct DabPoint<P = Vec2> {
     pub pressure: f32,
 }
 
+/// Most dabs one stroke places: far more than a day's longest stroke (a 1-texel brush at
+/// its closest spacing crosses an 8192^2 map 180 times), and a bound on a scripted stroke
+/// to a point a billion texels away.
+pub const MAX_STROKE_DABS: u64 = 1 << 22;
+
+/// A stroke reached [`MAX_STROKE_DABS`]; the dabs up to the limit were placed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the stroke reached the limit of {MAX_STROKE_DABS} dabs; the rest of it was not painted")]
+pub struct DabLimit;
+
 /// Places dabs every `spacing` along the polyline of input points.
+///
+/// Positions along a segment are counted in whole steps from its first dab and computed in
+/// `f64`, so a long segment neither drifts nor stalls (an `f32` position stepped by a small
+/// spacing stops moving past 2^24 steps).
 #[derive(Clone, Debug)]
 pub struct Resampler<P = Vec2> {
-    spacing: f32,
+    spacing: f64,
     last: Option<StrokePoint<P>>,
     /// Arc length since the last dab.
-    travelled: f32,
+    travelled: f64,
+    /// Dabs placed so far.
+    dabs: u64,
 }
 
 impl<P: StrokePos> Resampler<P> {
     /// A resampler for dabs `spacing` apart (texels, or object units on a mesh).
     pub fn new(spacing: f32) -> Self {
         Self {
-            spacing: if spacing > 0.0 { spacing } else { 1e-6 },
+            spacing: if spacing > 0.0 && spacing.is_finite() {
+                f64::from(spacing)
+            } else {
+                1e-6
+            },
             last: None,
             travelled: 0.0,
+            dabs: 0,
         }
     }
 
     /// Adds an input point and appends the dabs it completes.
-    pub fn push(&mut self, point: StrokePoint<P>, out: &mut Vec<DabPoint<P>>) {
+    ///
+    /// # Errors
+    /// [`DabLimit`] when the stroke reaches [`MAX_STROKE_DABS`]: the dabs up to the limit are
+    /// appended, and every later point adds none.
+    pub fn push(
+        &mut self,
+        point: StrokePoint<P>,
+        out: &mut Vec<DabPoint<P>>,
+    ) -> Result<(), DabLimit> {
+        if self.dabs >= MAX_STROKE_DABS {
+            return Err(DabLimit);
+        }
         let point = StrokePoint {
             pos: if point.pos.finite() {
                 point.pos
@@ -343,25 +468,38 @@ impl<P: StrokePos> Resampler<P> {
                 pos: point.pos,
                 pressure: point.pressure,
             });
+            self.dabs += 1;
             self.last = Some(point);
-            return;
+            return Ok(());
         };
-        let length = last.pos.distance_to(point.pos);
+        let length = f64::from(last.pos.distance_to(point.pos));
         if length <= 0.0 || !length.is_finite() {
-            return;
+            return Ok(());
         }
-        // Distance along this segment to the next dab.
-        let mut at = self.spacing - self.travelled;
-        while at <= length {
-            let t = at / length;
+        // Distance along this segment to its first dab, then one dab per whole step.
+        let first = self.spacing - self.travelled;
+        self.last = Some(point);
+        if first > length {
+            self.travelled += length;
+            return Ok(());
+        }
+        let steps = ((length - first) / self.spacing).floor() as u64 + 1;
+        let placed = steps.min(MAX_STROKE_DABS - self.dabs);
+        out.reserve(placed as usize);
+        for k in 0..placed {
+            let t = (first + k as f64 * self.spacing) / length;
             out.push(DabPoint {
                 pos: last.pos.lerp_to(point.pos, t),
-                pressure: last.pressure + (point.pressure - last.pressure) * t,
+                pressure: last.pressure + (point.pressure - last.pressure) * t as f32,
             });
-            at += self.spacing;
         }
-        self.travelled = length - (at - self.spacing);
-        self.last = Some(point);
+        self.dabs += placed;
+        self.travelled = length - (first + (steps - 1) as f64 * self.spacing);
+        if placed < steps {
+            Err(DabLimit)
+        } else {
+            Ok(())
+        }
     }
 }
 
@@ -392,7 +530,7 @@ impl<P: StrokePos> Smoother<P> {
         if distance <= self.radius {
             return (self.radius == 0.0 && distance > 0.0).then_some(pointer);
         }
-        let moved = brush.lerp_to(pointer, 1.0 - self.radius / distance);
+        let moved = brush.lerp_to(pointer, 1.0 - f64::from(self.radius / distance));
         self.brush = Some(moved);
         Some(moved)
     }
@@ -430,7 +568,8 @@ mod tests {
                     pressure: 1.0,
                 },
                 &mut out,
-            );
+            )
+            .unwrap();
         }
         out
     }
@@ -448,6 +587,27 @@ mod tests {
     }
 
     #[test]
+    fn a_segment_a_billion_texels_long_places_every_dab_and_then_stops() {
+        // Past 2^24 spacings an f32 position stepped by the spacing stops moving; counted
+        // steps in f64 do not, and the dab limit ends the stroke.
+        let mut r = Resampler::new(8.0);
+        let mut out = Vec::new();
+        let at = |x: f32| StrokePoint {
+            pos: Vec2::new(x, 0.0),
+            pressure: 1.0,
+        };
+        r.push(at(0.0), &mut out).unwrap();
+        r.push(at(1000.0), &mut out).unwrap();
+        assert_eq!(out.len(), 126); // 0, 8, ..., 1000
+        assert_eq!(r.push(at(1e9), &mut out), Err(DabLimit));
+        assert_eq!(out.len() as u64, MAX_STROKE_DABS);
+        let steps: Vec<f32> = out.windows(2).map(|w| w[1].pos.x - w[0].pos.x).collect();
+        assert!(steps.iter().all(|d| (d - 8.0).abs() < 0.01), "even spacing");
+        assert_eq!(r.push(at(2e9), &mut out), Err(DabLimit));
+        assert_eq!(out.len() as u64, MAX_STROKE_DABS, "nothing after the limit");
+    }
+
+    #[test]
     fn pressure_is_interpolated() {
         let mut r = Resampler::new(5.0);
         let mut out = Vec::new();
@@ -457,14 +617,16 @@ mod tests {
                 pressure: 0.0,
             },
             &mut out,
-        );
+        )
+        .unwrap();
         r.push(
             StrokePoint {
                 pos: Vec2::new(10.0, 0.0),
                 pressure: 1.0,
             },
             &mut out,
-        );
+        )
+        .unwrap();
         let p: Vec<f32> = out.iter().map(|d| d.pressure).collect();
         assert_eq!(p, vec![0.0, 0.5, 1.0]);
     }

@@ -22,6 +22,7 @@ use crate::reflectance::{AmbientApprox, ShadingModel};
 
 /// The mesh a document is painted on.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(try_from = "MeshRefFile")]
 pub enum MeshRef {
     /// The built-in UV sphere.
     #[default]
@@ -30,6 +31,39 @@ pub enum MeshRef {
     File(String),
     /// Another built-in mesh (plane, cube, torus), by name.
     Builtin(String),
+}
+
+/// A mesh reference as a file spells it, before it is checked.
+#[derive(Deserialize)]
+enum MeshRefFile {
+    Sphere,
+    File(String),
+    Builtin(String),
+}
+
+impl TryFrom<MeshRefFile> for MeshRef {
+    type Error = String;
+
+    fn try_from(f: MeshRefFile) -> Result<Self, String> {
+        use super::check::{MAX_PATH_BYTES, bounded_text};
+        match f {
+            MeshRefFile::Sphere => Ok(Self::Sphere),
+            MeshRefFile::File(path) => {
+                if path.is_empty() {
+                    return Err("the mesh path is empty".into());
+                }
+                bounded_text("the mesh path", &path, MAX_PATH_BYTES)?;
+                Ok(Self::File(path))
+            }
+            MeshRefFile::Builtin(name) if crate::mesh::BUILTIN_NAMES.contains(&name.as_str()) => {
+                Ok(Self::Builtin(name))
+            }
+            MeshRefFile::Builtin(name) => Err(format!(
+                "no built-in mesh is named {name:?} (known: {})",
+                crate::mesh::BUILTIN_NAMES.join(", ")
+            )),
+        }
+    }
 }
 
 impl MeshRef {
@@ -72,6 +106,7 @@ pub struct DocumentSettings {
     /// Mesh the material is painted on.
     pub mesh: MeshRef,
     /// The material preset the document was made from, if any.
+    #[serde(deserialize_with = "super::check::optional_name")]
     pub preset: Option<String>,
 }
 
@@ -121,6 +156,7 @@ pub enum FillRegion {
         /// Channel compared.
         channel: Channel,
         /// Largest difference still filled, in `[0, 1]`.
+        #[serde(deserialize_with = "super::check::tolerance")]
         tolerance: f32,
     },
     /// The UV island under a texel (needs the document's mesh surface).
@@ -187,8 +223,10 @@ pub enum Command {
         /// Linear or radial.
         shape: GradientShape,
         /// Start point in texel units.
+        #[serde(deserialize_with = "super::check::finite_vec2")]
         start: Vec2,
         /// End point in texel units.
+        #[serde(deserialize_with = "super::check::finite_vec2")]
         end: Vec2,
     },
     /// Reads every channel at a texel into the primary material.
@@ -364,27 +402,27 @@ impl Document {
             Command::SetModel(m) => self.settings.model = m,
             Command::SetApprox(a) => self.settings.approx = a,
             Command::BeginStroke(tool) => self.begin_stroke(tool),
-            Command::StrokeTo(p) => self.stroke_to(p),
+            Command::StrokeTo(p) => self.stroke_to(p)?,
             Command::EndStroke => self.end_stroke(),
             Command::AbortStroke => self.abort_stroke(),
             Command::Stroke { tool, points } => {
                 self.begin_stroke(tool);
-                for p in points {
-                    self.stroke_to(p);
-                }
+                let result = points.into_iter().try_for_each(|p| self.stroke_to(p));
                 self.end_stroke();
+                result?;
             }
             Command::SurfaceStrokeTo(p) => {
                 let surface = self.require_surface("a stroke on the mesh")?;
-                self.surface_stroke_to(&surface, p);
+                self.surface_stroke_to(&surface, p)?;
             }
             Command::SurfaceStroke { tool, points } => {
                 let surface = self.require_surface("a stroke on the mesh")?;
                 self.begin_stroke(tool);
-                for p in points {
-                    self.surface_stroke_to(&surface, p);
-                }
+                let result = points
+                    .into_iter()
+                    .try_for_each(|p| self.surface_stroke_to(&surface, p));
                 self.end_stroke();
+                result?;
             }
             Command::Fill(region) => self.fill(region)?,
             Command::Gradient { shape, start, end } => self.gradient(shape, start, end),
@@ -444,15 +482,17 @@ impl Document {
         });
     }
 
-    fn stroke_to(&mut self, point: StrokePoint) {
+    /// Moves the stroke; the dabs of a stroke past [`super::brush::MAX_STROKE_DABS`] are not
+    /// painted, and the error says so (what was painted stays, as one undo step).
+    fn stroke_to(&mut self, point: StrokePoint) -> Result<(), ModelError> {
         let Some(stroke) = &mut self.stroke else {
-            return;
+            return Ok(());
         };
         let Some(pos) = stroke.smoother.follow(point.pos) else {
-            return;
+            return Ok(());
         };
         let mut dabs = Vec::new();
-        stroke.resampler.push(
+        let placed = stroke.resampler.push(
             StrokePoint {
                 pos,
                 pressure: point.pressure,
@@ -462,17 +502,23 @@ impl Document {
         for dab in &dabs {
             self.apply_dab(dab.pos, dab.pressure);
         }
+        placed.map_err(|e| ModelError::Command(e.to_string()))
     }
 
-    fn surface_stroke_to(&mut self, surface: &Surface, point: SurfacePoint) {
+    /// [`Self::stroke_to`] on the mesh.
+    fn surface_stroke_to(
+        &mut self,
+        surface: &Surface,
+        point: SurfacePoint,
+    ) -> Result<(), ModelError> {
         let Some(stroke) = &mut self.stroke else {
-            return;
+            return Ok(());
         };
         let Some(pos) = stroke.surface_smoother.follow(point.pos) else {
-            return;
+            return Ok(());
         };
         let mut dabs = Vec::new();
-        stroke.surface_resampler.push(
+        let placed = stroke.surface_resampler.push(
             StrokePoint {
                 pos,
                 pressure: point.pressure,
@@ -482,6 +528,7 @@ impl Document {
         for dab in dabs {
             self.apply_surface_dab(surface, dab);
         }
+        placed.map_err(|e| ModelError::Command(e.to_string()))
     }
 
     /// Radius and alpha of a dab at `pressure`, in texels.

@@ -107,14 +107,15 @@ pub fn read_stamp(path: &Path) -> Result<super::brush::Stamp, ModelError> {
         });
     }
     let rgba = image.to_rgba32f();
+    // Float images can hold values outside [0, 1] (or NaN): the stamp takes them clamped.
     let alpha = rgba
         .pixels()
-        .map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) * p[3])
+        .map(|p| super::texel::unit((0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) * p[3]))
         .collect();
-    super::brush::Stamp::new(image.width(), image.height(), alpha).ok_or_else(|| {
+    super::brush::Stamp::new(image.width(), image.height(), alpha).map_err(|reason| {
         ModelError::Image {
             path: path.to_path_buf(),
-            reason: "the stamp image is empty".into(),
+            reason,
         }
     })
 }

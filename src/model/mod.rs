@@ -4,6 +4,7 @@
 //! [`document::Command`]s; the GPU mirrors the maps' dirty tiles.
 
 pub mod brush;
+pub mod check;
 pub mod document;
 mod error;
 pub mod history;

@@ -203,6 +203,14 @@ pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
         n: entry(&rasters[2]),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
+    // Never write what the loader would refuse: the manifest goes through the loader's own
+    // checks, and every stored exponent through its test, before a byte is written.
+    parse_manifest(&json).map_err(|e| format!("the project would not load back ({e})"))?;
+    if let Some(bits) = invalid_n_in(maps) {
+        return Err(format!(
+            "the project would not load back (n holds half-float bits {bits:#06x})"
+        ));
+    }
     let mut zip = zip::ZipWriter::new(out);
     let deflated = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated);
@@ -246,7 +254,7 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
 /// Loads and validates a project from any seekable reader; the error is a reason text.
 pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
     let mut zip = zip::ZipArchive::new(reader).map_err(|e| format!("not a zip archive ({e})"))?;
-    let manifest: Manifest = {
+    let manifest = {
         let entry = zip
             .by_name("manifest.json")
             .map_err(|e| format!("manifest.json: {e}"))?;
@@ -261,8 +269,37 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             .take(MAX_MANIFEST_BYTES)
             .read_to_end(&mut text)
             .map_err(|e| format!("manifest.json: {e}"))?;
-        serde_json::from_slice(&text).map_err(|e| format!("manifest.json: {e}"))?
+        parse_manifest(&text)?
     };
+    let (w, h) = (manifest.width, manifest.height);
+    let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
+    let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
+    let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
+    let n_samples = match &n {
+        Raster::Uniform(v) | Raster::Gray(v) | Raster::Rgb(v) => v,
+    };
+    if let Some(bad) = n_samples.par_iter().find_any(|&&bits| !valid_n_bits(bits)) {
+        return Err(format!(
+            "n holds an invalid exponent (half-float bits {bad:#06x})"
+        ));
+    }
+    let settings = manifest.settings;
+    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
+    fill_maps(&mut maps, &kd, &ks, &n);
+    Ok(Document::from_parts(maps, settings))
+}
+
+/// Whether half-float bits hold a storable exponent: finite, not negative, at most `N_MAX`.
+fn valid_n_bits(bits: u16) -> bool {
+    let v = half::f16::from_bits(bits).to_f32();
+    v.is_finite() && (0.0..=N_MAX).contains(&v) && bits & 0x8000 == 0
+}
+
+/// Parses `manifest.json` and checks what it says about the project as a whole (format,
+/// version, size); every field was checked as it was read.
+fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
+    let manifest: Manifest =
+        serde_json::from_slice(json).map_err(|e| format!("manifest.json: {e}"))?;
     if manifest.format != FORMAT {
         return Err(format!(
             "manifest format is {:?}, expected {FORMAT:?}",
@@ -279,35 +316,18 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(format!("map size {w}x{h} is out of range"));
     }
-    let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
-    let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
-    let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
-    let n_samples = match &n {
-        Raster::Uniform(v) | Raster::Gray(v) | Raster::Rgb(v) => v,
-    };
-    if let Some(bad) = n_samples.par_iter().find_any(|&&bits| !valid_n_bits(bits)) {
-        return Err(format!(
-            "n holds an invalid exponent (half-float bits {bad:#06x})"
-        ));
-    }
-    let settings = sanitize_settings(manifest.settings);
-    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
-    fill_maps(&mut maps, &kd, &ks, &n);
-    Ok(Document::from_parts(maps, settings))
+    Ok(manifest)
 }
 
-/// Whether half-float bits hold a storable exponent: finite, not negative, at most `N_MAX`.
-fn valid_n_bits(bits: u16) -> bool {
-    let v = half::f16::from_bits(bits).to_f32();
-    v.is_finite() && (0.0..=N_MAX).contains(&v) && bits & 0x8000 == 0
-}
-
-fn sanitize_settings(mut s: DocumentSettings) -> DocumentSettings {
-    s.base = s.base.sanitized();
-    s.primary = s.primary.sanitized();
-    s.secondary = s.secondary.sanitized();
-    s.brush = s.brush.sanitized();
-    s
+/// The first stored exponent the loader would refuse, if any (none ever should be: every
+/// writer encodes through [`super::texel::encode_n`]).
+fn invalid_n_in(maps: &MaterialMaps) -> Option<u16> {
+    (0..maps.tile_count())
+        .into_par_iter()
+        .find_map_any(|id| match &maps.tile(id).n {
+            Plane::Uniform(bits) => (!valid_n_bits(*bits)).then_some(*bits),
+            Plane::Data(d) => d.iter().copied().find(|&bits| !valid_n_bits(bits)),
+        })
 }
 
 fn read_channel<R: Read + Seek>(
@@ -449,11 +469,18 @@ pub fn recovery_path(project: Option<&Path>) -> PathBuf {
             .unwrap_or_default();
         return dir.join(format!(".{name}-recovery"));
     }
-    let state = std::env::var_os("XDG_STATE_HOME")
+    state_dir().join("untitled.kapaint-recovery")
+}
+
+/// kapaint's state folder: `$XDG_STATE_HOME/kapaint`, else `~/.local/state/kapaint` (else
+/// the temporary folder). It may not exist yet: writers create it.
+pub fn state_dir() -> PathBuf {
+    std::env::var_os("XDG_STATE_HOME")
+        .filter(|v| !v.is_empty())
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".local/state")))
-        .unwrap_or_else(std::env::temp_dir);
-    state.join("kapaint").join("untitled.kapaint-recovery")
+        .unwrap_or_else(std::env::temp_dir)
+        .join("kapaint")
 }
 
 /// Autosave timing: a recovery copy is due when the document changed since the last one and

@@ -27,7 +27,11 @@ pub fn unit(v: f32) -> f32 {
 pub const N_MAX: f32 = 16384.0;
 
 /// A material at one texel, linear values.
+///
+/// From a file, every field is checked ([`MaterialValueFile`]): a value out of range is an
+/// error, never a clamped surprise.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "MaterialValueFile")]
 pub struct MaterialValue {
     /// Diffuse coefficient, linear RGB in `[0, 1]`.
     pub kd: Vec3,
@@ -35,6 +39,27 @@ pub struct MaterialValue {
     pub ks: Vec3,
     /// Phong exponent in `[0, N_MAX]`.
     pub n: f32,
+}
+
+/// A material value as a file spells it, before its ranges are checked.
+#[derive(Deserialize)]
+pub struct MaterialValueFile {
+    kd: [f32; 3],
+    ks: [f32; 3],
+    n: f32,
+}
+
+impl TryFrom<MaterialValueFile> for MaterialValue {
+    type Error = String;
+
+    fn try_from(f: MaterialValueFile) -> Result<Self, String> {
+        use super::check::{all_in_range, in_range};
+        Ok(Self {
+            kd: Vec3::from(all_in_range("kd", f.kd, 0.0, 1.0)?),
+            ks: Vec3::from(all_in_range("ks", f.ks, 0.0, 1.0)?),
+            n: in_range("n", f.n, 0.0, N_MAX)?,
+        })
+    }
 }
 
 impl MaterialValue {

@@ -98,6 +98,16 @@ pub fn copy_baseline(bytes: usize, repeats: usize) -> (f64, f64) {
     (one, all)
 }
 
+/// Bytes the bench allocates per texel: the three input maps, the output and the two buffers
+/// of the copy baseline.
+pub const BYTES_PER_TEXEL: u64 =
+    BenchMaps::BYTES_PER_TEXEL_READ as u64 + 12 + 2 * BenchMaps::BYTES_PER_TEXEL_READ as u64;
+
+/// Bytes [`run`] allocates on `size x size` maps.
+pub fn bytes_needed(size: usize) -> u64 {
+    (size as u64).pow(2) * BYTES_PER_TEXEL
+}
+
 /// Runs the whole bench on `size x size` maps.
 pub fn run(size: usize, repeats: usize, error_points: usize) -> Vec<BenchRow> {
     let texels = size * size;

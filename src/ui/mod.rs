@@ -138,9 +138,9 @@ pub fn brush_outline(
 fn stamp_key(stamp: &crate::model::brush::Stamp) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (stamp.width, stamp.height).hash(&mut h);
-    let step = (stamp.alpha.len() / 61).max(1);
-    for v in stamp.alpha.iter().step_by(step) {
+    (stamp.width(), stamp.height()).hash(&mut h);
+    let step = (stamp.alpha().len() / 61).max(1);
+    for v in stamp.alpha().iter().step_by(step) {
         v.to_bits().hash(&mut h);
     }
     h.finish()

@@ -533,7 +533,7 @@ impl EditorState {
                     }
                     if let Some((_, texture)) = &self.stamp_preview {
                         ui.image((texture.id(), egui::vec2(32.0, 32.0)))
-                            .on_hover_text(format!("{}x{} stamp", stamp.width, stamp.height));
+                            .on_hover_text(format!("{}x{} stamp", stamp.width(), stamp.height()));
                     }
                 }
             }

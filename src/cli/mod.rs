@@ -1,7 +1,10 @@
 //! The `kapaint` command line. Output formats here are a contract for scripts.
 //!
-//! Every bad argument ends the program with one line on stderr and exit code 2, before any
-//! output is written, so a script never sees a partial table.
+//! Every failure ends the program with one line on stderr, before any output is written, so
+//! a script never sees a partial table. Exit codes: 0 done; [`EXIT_IO`] (1) a file could not
+//! be read or written for a reason other than its content (a full disk, no permission, a
+//! read-only folder); [`EXIT_USAGE`] (2) bad arguments or bad input (a missing or malformed
+//! file, a value out of range); [`crate::crash::EXIT_INTERNAL`] (70) an internal error.
 
 use std::fmt::Write as _;
 use std::io::{BufRead, Write};
@@ -12,14 +15,25 @@ use glam::DVec3;
 
 use crate::mesh;
 use crate::model::{self, Channel, Document, DocumentSettings, ModelError, import, project};
-use crate::reflectance::{
-    self, AmbientApprox, ShadingModel, TWO_OVER_PI,
-    exact::{EXACT_N_MAX, chi_exact},
-};
+use crate::reflectance::{self, AmbientApprox, ShadingModel, TWO_OVER_PI, exact::chi_exact};
 use crate::report::{accuracy, bench};
+
+mod args;
+mod export;
+mod render;
+
+use args::{parse_n, parse_rgb, parse_size, read_stdin_values};
+pub use render::RenderArgs;
+
+/// Exit code for a failed read or write that is not the input's fault.
+pub const EXIT_IO: i32 = 1;
 
 /// Exit code for bad arguments or input.
 pub const EXIT_USAGE: i32 = 2;
+
+/// Most sample points `kapaint accuracy` takes per range (each costs an exact integral per
+/// model: 256 points take about a minute on 2 cores).
+pub const MAX_ACCURACY_POINTS: usize = 256;
 
 /// A failure to report: one line of text and an exit code.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -31,13 +45,35 @@ pub struct CliError {
 }
 
 impl CliError {
-    /// A bad-argument error (exit code 2).
+    /// A bad-argument or bad-input error (exit code 2).
     pub fn usage(message: impl Into<String>) -> Self {
         Self {
             message: message.into(),
             code: EXIT_USAGE,
         }
     }
+
+    /// A failed read or write that is not the input's fault (exit code 1).
+    pub fn io(message: impl Into<String>) -> Self {
+        Self {
+            message: message.into(),
+            code: EXIT_IO,
+        }
+    }
+
+    /// An I/O error on a file: a missing file is bad input, anything else the system's.
+    pub fn of_io(message: impl Into<String>, e: &std::io::Error) -> Self {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            Self::usage(message)
+        } else {
+            Self::io(message)
+        }
+    }
+}
+
+/// `text` as one line: every run of whitespace, line breaks included, becomes one space.
+pub fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Paint per-texel Phong reflectance and preview it with a derived ambient term.
@@ -84,7 +120,7 @@ pub enum Command {
     },
     /// Print the error of every approximation against the exact integrator (markdown).
     Accuracy {
-        /// Sample points per n range (spaced evenly in ln(n + 1)).
+        /// Sample points per n range (2 to 256, spaced evenly in ln(n + 1)).
         #[arg(long, default_value_t = 96)]
         points: usize,
     },
@@ -187,6 +223,14 @@ pub enum Command {
         /// Mesh file or built-in name.
         file: PathBuf,
     },
+    /// Panics on purpose, to check what a crash looks like (one line, a report file, exit
+    /// code 70).
+    #[command(hide = true)]
+    DebugPanic {
+        /// Panic in every worker thread at once instead of the main thread.
+        #[arg(long)]
+        workers: bool,
+    },
     /// Time the k_a derive of a full map per method against its error and a memory copy.
     Bench {
         /// Map side in texels.
@@ -253,10 +297,7 @@ pub fn main() -> i32 {
                 let _ = e.print();
                 return 0;
             }
-            // Clap's message is several lines; its first line says what is wrong.
-            let rendered = e.render().to_string();
-            let first = rendered.lines().next().unwrap_or("error: bad arguments");
-            eprintln!("kapaint: {}", first.trim_start_matches("error: "));
+            eprintln!("kapaint: {}", clap_message(&e.render().to_string()));
             return EXIT_USAGE;
         }
     };
@@ -274,9 +315,25 @@ pub fn main() -> i32 {
             0
         }
         Err(e) => {
-            eprintln!("kapaint: {}", e.message);
+            eprintln!("kapaint: {}", one_line(&e.message));
             e.code
         }
+    }
+}
+
+/// Clap's error as one line: its first paragraph (what is wrong, and the arguments it names
+/// on the lines below), without the usage and help lines.
+pub fn clap_message(rendered: &str) -> String {
+    let first: Vec<&str> = rendered
+        .lines()
+        .take_while(|l| !l.trim().is_empty() && !l.starts_with("Usage:"))
+        .collect();
+    let text = one_line(&first.join(" "));
+    let text = text.trim_start_matches("error: ").trim_end_matches(':');
+    if text.is_empty() {
+        "bad arguments (see kapaint --help)".into()
+    } else {
+        text.to_string()
     }
 }
 
@@ -286,7 +343,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
     match command {
         Command::Chi { model, method, n } => {
             let values = if n.len() == 1 && n[0] == "-" {
-                read_stdin_values(stdin)?
+                read_stdin_values(stdin, method)?
             } else {
                 n.iter()
                     .map(|s| parse_n(s, method))
@@ -308,8 +365,10 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             Ok(format!("{},{},{}\n", fmt17(ka.x), fmt17(ka.y), fmt17(ka.z)))
         }
         Command::Accuracy { points } => {
-            if points < 2 {
-                return Err(CliError::usage("--points must be at least 2"));
+            if !(2..=MAX_ACCURACY_POINTS).contains(&points) {
+                return Err(CliError::usage(format!(
+                    "--points must be 2 to {MAX_ACCURACY_POINTS}, got {points}"
+                )));
             }
             Ok(accuracy::accuracy_report(&accuracy::Grid::standard(points)).markdown())
         }
@@ -322,7 +381,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
         } => {
             let (w, h) = parse_size(&size)?;
             // A mesh file must exist and load now, not at the first stroke on it.
-            mesh::open(std::path::Path::new(&mesh)).map_err(|e| CliError::usage(e.to_string()))?;
+            mesh::open(std::path::Path::new(&mesh)).map_err(mesh_error)?;
             if out.exists() && !force {
                 return Err(CliError::usage(format!(
                     "{} exists; pass --force to overwrite it",
@@ -400,7 +459,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             out,
             report,
             no_padding,
-        } => export_command(&files, &preset, &out, report, !no_padding),
+        } => export::export_command(&files, &preset, &out, report, !no_padding),
         Command::ImportSet {
             manifest,
             out,
@@ -412,8 +471,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                     out.display()
                 )));
             }
-            let doc = crate::export::set::import(&manifest)
-                .map_err(|e| CliError::usage(e.to_string()))?;
+            let doc = crate::export::set::import(&manifest).map_err(set_error)?;
             project::save(&doc, &out).map_err(model_error)?;
             Ok(format!(
                 "imported {} into {} ({}x{})\n",
@@ -435,15 +493,27 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             }
             Ok(out)
         }
-        Command::Render(args) => render_command(args),
+        Command::Render(args) => render::render_command(args),
         Command::MeshInfo { file } => {
-            let mesh = mesh::open(&file).map_err(|e| CliError::usage(e.to_string()))?;
+            let mesh = mesh::open(&file).map_err(mesh_error)?;
             Ok(mesh::info_text(&file, &mesh))
+        }
+        Command::DebugPanic { workers } => {
+            if workers {
+                use rayon::prelude::*;
+                (0..64_u32).into_par_iter().for_each(|i| {
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                    panic!("deliberate panic in worker task {i}");
+                });
+            }
+            panic!("deliberate panic on the main thread");
         }
         Command::Bench { size, out, repeats } => {
             if !(16..=16384).contains(&size) {
                 return Err(CliError::usage("--size must be in [16, 16384]"));
             }
+            crate::memory::check_fits(&format!("--size {size}"), bench::bytes_needed(size))
+                .map_err(|e| CliError::usage(format!("{e}: use a smaller --size")))?;
             if let Some(dir) = &out {
                 std::fs::create_dir_all(dir).map_err(|e| {
                     CliError::usage(format!("cannot create {}: {e}", dir.display()))
@@ -472,7 +542,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
 
 /// A project's mesh: a built-in name, or its file (a relative path is tried from the
 /// project's folder when it does not exist from the current one).
-fn project_mesh(settings: &DocumentSettings, project_file: &std::path::Path) -> PathBuf {
+pub(super) fn project_mesh(settings: &DocumentSettings, project_file: &std::path::Path) -> PathBuf {
     let own = PathBuf::from(settings.mesh.spec());
     match project_file.parent() {
         Some(dir) if own.is_relative() && !own.exists() && dir.join(&own).exists() => dir.join(own),
@@ -482,7 +552,7 @@ fn project_mesh(settings: &DocumentSettings, project_file: &std::path::Path) -> 
 
 /// Loads the mesh (`spec`, else the project's own, a relative path taken from the project's
 /// folder), bakes it at the map size and attaches it to `doc`.
-fn attach_surface(
+pub(super) fn attach_surface(
     doc: &mut Document,
     project_file: &std::path::Path,
     spec: Option<&str>,
@@ -491,355 +561,52 @@ fn attach_surface(
         || project_mesh(&doc.settings, project_file),
         std::path::PathBuf::from,
     );
-    let mesh = mesh::open(&spec).map_err(|e| CliError::usage(e.to_string()))?;
+    let mesh = mesh::open(&spec).map_err(mesh_error)?;
     let surface = model::surface::Surface::new(mesh, doc.maps.width(), doc.maps.height())
         .map_err(|e| CliError::usage(format!("{}: {e}", spec.display())))?;
     doc.set_surface(Some(std::sync::Arc::new(surface)))
         .map_err(model_error)
 }
 
-/// The `--report` lines of one exported set.
-fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
-    let _ = writeln!(text, "  preset: {}", m.preset);
-    if m.dilated {
-        let _ = writeln!(
-            text,
-            "  padding: texels outside the UV islands filled from the nearest island"
-        );
-    }
-    match m.n_encoding {
-        Some(e) => {
-            let _ = writeln!(
-                text,
-                "  n: {:?} over [{}, {}] in {} bits",
-                e.curve, e.lo, e.hi, e.bits
-            );
-        }
-        None => {
-            let _ = writeln!(
-                text,
-                "  n: {}",
-                m.constants
-                    .n
-                    .map_or_else(|| "stored as float".into(), |n| format!("constant {n}"))
-            );
-        }
-    }
-    for f in &m.files {
-        let _ = write!(
-            text,
-            "  {}: {} ({} bit, {}, {}), {} bytes",
-            f.path,
-            f.layout.join(" "),
-            f.bit_depth,
-            f.colour_space,
-            f.compression,
-            f.bytes
-        );
-        if let Some(levels) = f.mip_levels {
-            let _ = write!(text, ", {levels} mip levels");
-        }
-        if let Some(psnr) = &f.psnr {
-            let db: Vec<String> = psnr
-                .iter()
-                .map(|p| p.map_or_else(|| "exact".into(), |p| format!("{p:.1} dB")))
-                .collect();
-            let _ = write!(text, ", PSNR {}", db.join(" / "));
-        }
-        text.push('\n');
-    }
-    let b = m.bytes;
-    let _ = writeln!(
-        text,
-        "  bytes: set {} vs naive k_a+k_d+k_s+n {} ({:.1}x) vs project maps {} ({:.1}x)",
-        b.exported,
-        b.naive,
-        b.naive as f64 / b.exported.max(1) as f64,
-        b.project,
-        b.project as f64 / b.exported.max(1) as f64
-    );
-}
-
-/// `kapaint export`: every project into its set; one line each, plus the report.
-fn export_command(
-    files: &[PathBuf],
-    preset: &str,
-    out: &std::path::Path,
-    report: bool,
-    padding: bool,
-) -> Result<String, CliError> {
-    use std::io::IsTerminal as _;
-    let preset = crate::export::preset::find(preset).map_err(|e| CliError::usage(e.to_string()))?;
-    // Load (and so validate) every project before writing anything; bake the meshes for
-    // padding.
-    let mut text = String::new();
-    let docs = files
-        .iter()
-        .map(|f| {
-            let mut doc = project::load(f).map_err(model_error)?;
-            if padding && let Err(e) = attach_surface(&mut doc, f, None) {
-                let _ = writeln!(text, "note: {}: no padding ({})", f.display(), e.message);
-            }
-            Ok(doc)
-        })
-        .collect::<Result<Vec<_>, CliError>>()?;
-    let targets: Vec<PathBuf> = if files.len() == 1 {
-        vec![out.to_path_buf()]
-    } else {
-        files
-            .iter()
-            .map(|f| out.join(f.file_stem().unwrap_or_default()))
-            .collect()
-    };
-    let terminal = std::io::stderr().is_terminal();
-    for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
-        let progress = crate::task::Progress::default();
-        // The export runs on a worker; this thread draws the bar while it works.
-        let m = std::thread::scope(|scope| {
-            let worker = std::thread::Builder::new()
-                .name("kapaint-export".into())
-                .spawn_scoped(scope, || {
-                    crate::export::set::export_with(doc, &preset, target, &progress)
-                })
-                .map_err(|e| CliError::usage(format!("cannot start the export: {e}")))?;
-            while terminal && !worker.is_finished() {
-                let done = (progress.fraction() * 30.0) as usize;
-                eprint!(
-                    "\r[{}{}] {}/{} {} {:<8}",
-                    "#".repeat(done),
-                    " ".repeat(30 - done),
-                    i + 1,
-                    files.len(),
-                    file.display(),
-                    progress.stage()
-                );
-                std::thread::sleep(std::time::Duration::from_millis(100));
-            }
-            if terminal {
-                eprint!("\r{}\r", " ".repeat(60 + file.display().to_string().len()));
-            }
-            worker
-                .join()
-                .map_err(|_| CliError::usage("the export worker panicked"))?
-                .map_err(|e| CliError::usage(e.to_string()))
-        })?;
-        let _ = writeln!(
-            text,
-            "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
-            file.display(),
-            target.display(),
-            m.files.len(),
-            m.bytes.exported,
-            m.ka_error.max,
-            m.ka_error.mean
-        );
-        if report {
-            write_report(&mut text, &m);
-        }
-    }
-    Ok(text)
-}
-
-/// The arguments of `kapaint render`.
-#[derive(Debug, clap::Args)]
-pub struct RenderArgs {
-    /// Project whose maps to render.
-    #[arg(long, conflicts_with_all = ["kd", "ks", "n"])]
-    project: Option<PathBuf>,
-    /// Uniform diffuse coefficient `R,G,B` (without --project).
-    #[arg(long)]
-    kd: Option<String>,
-    /// Uniform specular coefficient `S` or `R,G,B` (without --project).
-    #[arg(long)]
-    ks: Option<String>,
-    /// Uniform Phong exponent (without --project).
-    #[arg(long, allow_hyphen_values = true)]
-    n: Option<String>,
-    /// sphere, plane, cube, torus or a mesh file (default: the project's, else sphere).
-    #[arg(long)]
-    mesh: Option<String>,
-    /// phong, blinn, compare-split (Phong left, Blinn-Phong right), compare-side (the two
-    /// side by side, one camera) or compare-diff (|Phong - Blinn-Phong| heatmap).
-    #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-side", "compare-diff"])]
-    model: String,
-    /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
-    #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
-    view: String,
-    /// How k_a's chi is computed.
-    #[arg(long, value_parser = ["fast", "paper", "paper-corrected"], default_value = "fast")]
-    method: String,
-    /// Direction towards the light, `X,Y,Z`.
-    #[arg(long, allow_hyphen_values = true)]
-    light: Option<String>,
-    /// Ambient (sky) intensity I_a.
-    #[arg(long, default_value_t = 0.3)]
-    ia: f32,
-    /// Directional light intensity I_l.
-    #[arg(long, default_value_t = 0.8)]
-    il: f32,
-    /// Image size `WxH` (or `W` for a square).
-    #[arg(long, default_value = "512x512")]
-    size: String,
-    /// Camera angle around the vertical axis, degrees.
-    #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
-    yaw: f32,
-    /// Camera angle above the horizon, degrees.
-    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
-    pitch: f32,
-    /// Output image: .png or .exr.
-    #[arg(long)]
-    out: PathBuf,
-}
-
-/// The maps to render (a project's, or one uniform material) and the mesh they come with.
-fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::PathBuf), CliError> {
-    if let Some(file) = &a.project {
-        let doc = project::load(file).map_err(model_error)?;
-        let spec = project_mesh(&doc.settings, file);
-        return Ok((doc.maps, spec));
-    }
-    let d = model::MaterialValue::default();
-    let kd =
-        a.kd.as_deref()
-            .map(|t| parse_rgb("--kd", t, false))
-            .transpose()?;
-    let ks =
-        a.ks.as_deref()
-            .map(|t| parse_rgb("--ks", t, true))
-            .transpose()?;
-    let n =
-        a.n.as_deref()
-            .map(|t| parse_n(t, MethodArg::Fast))
-            .transpose()?;
-    let value = model::MaterialValue::new(
-        kd.map_or(d.kd, DVec3::as_vec3),
-        ks.map_or(d.ks, DVec3::as_vec3),
-        n.map_or(d.n, |v| v as f32),
-    );
-    let maps = model::MaterialMaps::new(16, 16, value).map_err(model_error)?;
-    Ok((maps, std::path::PathBuf::from("sphere")))
-}
-
-/// Parses `--light X,Y,Z` (not all zero).
-fn parse_light(text: &str) -> Result<glam::Vec3, CliError> {
-    let bad = || CliError::usage(format!("--light must be a non-zero X,Y,Z, got {text:?}"));
-    let v: Vec<f32> = text
-        .split(',')
-        .map(|p| p.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| bad())?;
-    match v.as_slice() {
-        [x, y, z] => {
-            let l = glam::Vec3::new(*x, *y, *z);
-            (l.is_finite() && l.length() > 0.0)
-                .then_some(l)
-                .ok_or_else(bad)
-        }
-        _ => Err(bad()),
+/// A model-layer error in one line: exit code 1 for a failed read or write that is not the
+/// input's fault, 2 for everything else.
+#[expect(
+    clippy::needless_pass_by_value,
+    reason = "used as `map_err(model_error)`"
+)]
+pub(super) fn model_error(e: ModelError) -> CliError {
+    match &e {
+        ModelError::Io { source, .. } => CliError::of_io(e.to_string(), source),
+        _ => CliError::usage(e.to_string()),
     }
 }
 
-fn render_command(a: RenderArgs) -> Result<String, CliError> {
-    use crate::gpu::headless::{self, Compare};
-    use crate::render::{Camera, FrameSettings, Lighting, ViewMode};
-    let (width, height) = parse_size(&a.size)?;
-    let ext = a
-        .out
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(ext.as_deref(), Some("png" | "exr")) {
-        return Err(CliError::usage(format!(
-            "{}: --out must end in .png or .exr",
-            a.out.display()
-        )));
+/// A mesh error in one line (exit codes as [`model_error`]).
+#[expect(
+    clippy::needless_pass_by_value,
+    reason = "used as `map_err(mesh_error)`"
+)]
+pub(super) fn mesh_error(e: mesh::MeshError) -> CliError {
+    match &e {
+        mesh::MeshError::Io { source, .. } => CliError::of_io(e.to_string(), source),
+        mesh::MeshError::Invalid { .. } => CliError::usage(e.to_string()),
     }
-    let (maps, own_mesh) = render_material(&a)?;
-    let mesh_spec = a.mesh.map_or(own_mesh, std::path::PathBuf::from);
-    let mesh = mesh::open(&mesh_spec).map_err(|e| CliError::usage(e.to_string()))?;
-    let light = match &a.light {
-        Some(text) => parse_light(text)?,
-        None => Lighting::default().light,
-    };
-    for (flag, v) in [("--ia", a.ia), ("--il", a.il)] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(CliError::usage(format!("{flag} must be >= 0, got {v}")));
+}
+
+/// An export or set-import error in one line: 1 when writing or reading failed, 2 for a bad
+/// set or target.
+#[expect(
+    clippy::needless_pass_by_value,
+    reason = "used as `map_err(set_error)`"
+)]
+pub(super) fn set_error(e: crate::export::set::SetError) -> CliError {
+    use crate::export::set::SetError;
+    match &e {
+        SetError::Io { .. } => CliError::io(e.to_string()),
+        SetError::Invalid { .. } | SetError::Target { .. } | SetError::Cancelled => {
+            CliError::usage(e.to_string())
         }
     }
-    if !(a.yaw.is_finite() && a.pitch.is_finite()) {
-        return Err(CliError::usage("--yaw and --pitch must be finite"));
-    }
-    let (model, compare) = match a.model.as_str() {
-        "phong" => (ShadingModel::Phong, Compare::Single),
-        "blinn" => (ShadingModel::BlinnPhong, Compare::Single),
-        "compare-split" => (ShadingModel::Phong, Compare::Split),
-        "compare-side" => (ShadingModel::Phong, Compare::SideBySide),
-        _ => (ShadingModel::Phong, Compare::Difference),
-    };
-    let approx = match a.method.as_str() {
-        "paper" => AmbientApprox::PaperPrinted,
-        "paper-corrected" => AmbientApprox::PaperCorrected,
-        _ => AmbientApprox::Fast,
-    };
-    let view = ViewMode::from_name(&a.view)
-        .ok_or_else(|| CliError::usage(format!("unknown view {:?}", a.view)))?;
-    let camera = Camera {
-        yaw: a.yaw.to_radians(),
-        pitch: a.pitch.to_radians().clamp(-1.55, 1.55),
-        ..Camera::default()
-    }
-    .framing(&mesh.positions);
-    let settings = FrameSettings {
-        model,
-        approx,
-        view,
-        lighting: Lighting {
-            light,
-            ia: a.ia,
-            il: a.il,
-        },
-        camera,
-    };
-    let gpu = crate::gpu::Gpu::headless().map_err(|e| CliError {
-        message: e.to_string(),
-        code: 1,
-    })?;
-    headless::run(
-        &gpu,
-        &headless::Request {
-            mesh: &mesh,
-            maps: &maps,
-            settings,
-            compare,
-            size: (width, height),
-            out: a.out,
-        },
-    )
-    .map_err(|e| CliError::usage(e.to_string()))
-}
-
-/// Every model-layer error is reported in one line with exit code 2.
-#[allow(clippy::needless_pass_by_value)] // Used as `map_err(model_error)`.
-fn model_error(e: ModelError) -> CliError {
-    CliError::usage(e.to_string())
-}
-
-/// Parses `W` or `WxH`.
-fn parse_size(text: &str) -> Result<(u32, u32), CliError> {
-    let bad = || {
-        CliError::usage(format!(
-            "--size must be W or WxH with sides 1 to 8192, got {text:?}"
-        ))
-    };
-    let (w, h) = text.split_once(['x', 'X']).unwrap_or((text, text));
-    let (w, h): (u32, u32) = (
-        w.trim().parse().map_err(|_| bad())?,
-        h.trim().parse().map_err(|_| bad())?,
-    );
-    if w == 0 || h == 0 || w > model::maps::MAX_SIDE || h > model::maps::MAX_SIDE {
-        return Err(bad());
-    }
-    Ok((w, h))
 }
 
 /// A paint script: `(commands: [ ... ])` in RON.
@@ -931,69 +698,5 @@ fn ka_value(model: ShadingModel, method: MethodArg, kd: DVec3, ks: DVec3, n: f64
         Some(approx) => {
             reflectance::ka(model, approx, kd.as_vec3(), ks.as_vec3(), n as f32).as_dvec3()
         }
-    }
-}
-
-fn parse_n(text: &str, method: MethodArg) -> Result<f64, CliError> {
-    let n: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| CliError::usage(format!("n must be a number, got {text:?}")))?;
-    if !n.is_finite() {
-        return Err(CliError::usage(format!("n must be finite, got {text:?}")));
-    }
-    if n < 0.0 {
-        return Err(CliError::usage(format!("n must be >= 0, got {text}")));
-    }
-    if matches!(method, MethodArg::Exact) && n > EXACT_N_MAX {
-        return Err(CliError::usage(format!(
-            "n = {text} is above the exact integrator's limit {EXACT_N_MAX:e}"
-        )));
-    }
-    if n > f64::from(f32::MAX) {
-        return Err(CliError::usage(format!("n = {text} does not fit in f32")));
-    }
-    Ok(n)
-}
-
-fn read_stdin_values(stdin: &mut dyn BufRead) -> Result<Vec<f64>, CliError> {
-    let mut values = Vec::new();
-    for (i, line) in stdin.lines().enumerate() {
-        let line = line.map_err(|e| CliError::usage(format!("cannot read stdin: {e}")))?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let n = parse_n(&line, MethodArg::Fast)
-            .map_err(|e| CliError::usage(format!("stdin line {}: {}", i + 1, e.message)))?;
-        values.push(n);
-    }
-    if values.is_empty() {
-        return Err(CliError::usage("no values on stdin"));
-    }
-    Ok(values)
-}
-
-/// Parses `R,G,B` (or a single value when `allow_scalar`), each finite and in `[0, 1]`.
-fn parse_rgb(flag: &str, text: &str, allow_scalar: bool) -> Result<DVec3, CliError> {
-    let parts: Vec<&str> = text.split(',').collect();
-    let values = parts
-        .iter()
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<Vec<f64>, _>>()
-        .map_err(|_| CliError::usage(format!("{flag} must be numbers, got {text:?}")))?;
-    if let Some(bad) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
-        return Err(CliError::usage(format!(
-            "{flag} components must be in [0, 1], got {bad}"
-        )));
-    }
-    match values.as_slice() {
-        [v] if allow_scalar => Ok(DVec3::splat(*v)),
-        [r, g, b] => Ok(DVec3::new(*r, *g, *b)),
-        _ if allow_scalar => Err(CliError::usage(format!(
-            "{flag} must be S or R,G,B, got {text:?}"
-        ))),
-        _ => Err(CliError::usage(format!(
-            "{flag} must be R,G,B, got {text:?}"
-        ))),
     }
 }

@@ -1,0 +1,152 @@
+//! `kapaint export`: projects into texture sets, with a progress bar and the report.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use super::{CliError, attach_surface, model_error};
+use crate::model::project;
+
+/// The `--report` lines of one exported set.
+fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
+    let _ = writeln!(text, "  preset: {}", m.preset);
+    if m.dilated {
+        let _ = writeln!(
+            text,
+            "  padding: texels outside the UV islands filled from the nearest island"
+        );
+    }
+    match m.n_encoding {
+        Some(e) => {
+            let _ = writeln!(
+                text,
+                "  n: {:?} over [{}, {}] in {} bits",
+                e.curve, e.lo, e.hi, e.bits
+            );
+        }
+        None => {
+            let _ = writeln!(
+                text,
+                "  n: {}",
+                m.constants
+                    .n
+                    .map_or_else(|| "stored as float".into(), |n| format!("constant {n}"))
+            );
+        }
+    }
+    for f in &m.files {
+        let _ = write!(
+            text,
+            "  {}: {} ({} bit, {}, {}), {} bytes",
+            f.path,
+            f.layout.join(" "),
+            f.bit_depth,
+            f.colour_space,
+            f.compression,
+            f.bytes
+        );
+        if let Some(levels) = f.mip_levels {
+            let _ = write!(text, ", {levels} mip levels");
+        }
+        if let Some(psnr) = &f.psnr {
+            let db: Vec<String> = psnr
+                .iter()
+                .map(|p| p.map_or_else(|| "exact".into(), |p| format!("{p:.1} dB")))
+                .collect();
+            let _ = write!(text, ", PSNR {}", db.join(" / "));
+        }
+        text.push('\n');
+    }
+    let b = m.bytes;
+    let _ = writeln!(
+        text,
+        "  bytes: set {} vs naive k_a+k_d+k_s+n {} ({:.1}x) vs project maps {} ({:.1}x)",
+        b.exported,
+        b.naive,
+        b.naive as f64 / b.exported.max(1) as f64,
+        b.project,
+        b.project as f64 / b.exported.max(1) as f64
+    );
+}
+
+/// `kapaint export`: every project into its set; one line each, plus the report.
+pub(super) fn export_command(
+    files: &[PathBuf],
+    preset: &str,
+    out: &std::path::Path,
+    report: bool,
+    padding: bool,
+) -> Result<String, CliError> {
+    use std::io::IsTerminal as _;
+    let preset = crate::export::preset::find(preset).map_err(|e| CliError::usage(e.to_string()))?;
+    // Load (and so validate) every project before writing anything; bake the meshes for
+    // padding.
+    let mut text = String::new();
+    let docs = files
+        .iter()
+        .map(|f| {
+            let mut doc = project::load(f).map_err(model_error)?;
+            if padding && let Err(e) = attach_surface(&mut doc, f, None) {
+                let _ = writeln!(text, "note: {}: no padding ({})", f.display(), e.message);
+            }
+            Ok(doc)
+        })
+        .collect::<Result<Vec<_>, CliError>>()?;
+    let targets: Vec<PathBuf> = if files.len() == 1 {
+        vec![out.to_path_buf()]
+    } else {
+        files
+            .iter()
+            .map(|f| out.join(f.file_stem().unwrap_or_default()))
+            .collect()
+    };
+    let terminal = std::io::stderr().is_terminal();
+    for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
+        let progress = crate::task::Progress::default();
+        // The export runs on a worker; this thread draws the bar while it works.
+        let m = std::thread::scope(|scope| {
+            let worker = std::thread::Builder::new()
+                .name("kapaint-export".into())
+                .spawn_scoped(scope, || {
+                    crate::export::set::export_with(doc, &preset, target, &progress)
+                })
+                .map_err(|e| CliError::io(format!("cannot start the export: {e}")))?;
+            while terminal && !worker.is_finished() {
+                let done = (progress.fraction() * 30.0) as usize;
+                eprint!(
+                    "\r[{}{}] {}/{} {} {:<8}",
+                    "#".repeat(done),
+                    " ".repeat(30 - done),
+                    i + 1,
+                    files.len(),
+                    file.display(),
+                    progress.stage()
+                );
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            if terminal {
+                eprint!("\r{}\r", " ".repeat(60 + file.display().to_string().len()));
+            }
+            worker
+                .join()
+                .map_err(|_| CliError {
+                    message: "the export worker stopped unexpectedly".into(),
+                    code: crate::crash::EXIT_INTERNAL,
+                })?
+                .map_err(super::set_error)
+        })?;
+        let _ = writeln!(
+            text,
+            "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
+            file.display(),
+            target.display(),
+            m.files.len(),
+            m.bytes.exported,
+            m.ka_error.max,
+            m.ka_error.mean
+        );
+        if report {
+            write_report(&mut text, &m);
+        }
+    }
+    Ok(text)
+}

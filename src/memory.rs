@@ -1,0 +1,52 @@
+//! How much memory the machine can give: big allocations (a benchmark's maps, a decoded
+//! image) are checked against it first, so they fail with a clear error instead of an
+//! out-of-memory kill.
+
+/// Bytes the system says can still be allocated without swapping (`MemAvailable` of
+/// `/proc/meminfo`), or `None` where that is not known (other systems).
+pub fn available_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// `Ok` when `bytes` fit in the memory available now (always, where that is not known).
+///
+/// # Errors
+/// A sentence saying what needs how much, and how much there is.
+pub fn check_fits(what: &str, bytes: u64) -> Result<(), String> {
+    match available_bytes() {
+        Some(available) if bytes > available => Err(format!(
+            "{what} needs about {} of memory, and {} is available",
+            human(bytes),
+            human(available)
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Bytes as GB or MB with one decimal.
+pub fn human(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else {
+        format!("{:.1} MB", b / 1e6)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_absurd_request_does_not_fit() {
+        if available_bytes().is_some() {
+            let err = check_fits("the test", u64::MAX).unwrap_err();
+            assert!(err.starts_with("the test needs about"), "{err}");
+            assert!(check_fits("a byte", 1).is_ok());
+        }
+        assert_eq!(human(25_800_000_000), "25.8 GB");
+    }
+}
