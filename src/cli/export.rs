@@ -99,6 +99,7 @@ pub(super) fn export_command(
             .map(|f| out.join(f.file_stem().unwrap_or_default()))
             .collect()
     };
+    check_targets(files, &targets)?;
     let terminal = std::io::stderr().is_terminal();
     for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
         let progress = crate::task::Progress::default();
@@ -149,4 +150,29 @@ pub(super) fn export_command(
         }
     }
     Ok(text)
+}
+
+/// Every target is free (absent, or an empty folder) and no two projects share one, before
+/// anything is written: a failed batch leaves nothing behind.
+fn check_targets(files: &[PathBuf], targets: &[PathBuf]) -> Result<(), CliError> {
+    for (k, target) in targets.iter().enumerate() {
+        if let Some(j) = targets[..k].iter().position(|t| t == target) {
+            return Err(CliError::usage(format!(
+                "{} and {} would both export to {}; give the projects different names",
+                files[j].display(),
+                files[k].display(),
+                target.display()
+            )));
+        }
+        let busy = target.exists()
+            && (!target.is_dir()
+                || std::fs::read_dir(target).map_or(true, |mut d| d.next().is_some()));
+        if busy {
+            return Err(CliError::usage(format!(
+                "{}: exists and is not an empty folder",
+                target.display()
+            )));
+        }
+    }
+    Ok(())
 }

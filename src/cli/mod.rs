@@ -61,12 +61,15 @@ impl CliError {
         }
     }
 
-    /// An I/O error on a file: a missing file is bad input, anything else the system's.
+    /// An I/O error on a file: a path that names nothing, or the wrong kind of thing, is bad
+    /// input; anything else (no space, no permission, a read-only disk) the system's.
     pub fn of_io(message: impl Into<String>, e: &std::io::Error) -> Self {
-        if e.kind() == std::io::ErrorKind::NotFound {
-            Self::usage(message)
-        } else {
-            Self::io(message)
+        use std::io::ErrorKind as K;
+        match e.kind() {
+            K::NotFound | K::NotADirectory | K::IsADirectory | K::InvalidInput => {
+                Self::usage(message)
+            }
+            _ => Self::io(message),
         }
     }
 }
@@ -609,6 +612,9 @@ pub(super) fn set_error(e: crate::export::set::SetError) -> CliError {
     }
 }
 
+/// Largest paint script read (bytes).
+const MAX_SCRIPT_BYTES: u64 = 256 << 20;
+
 /// A paint script: `(commands: [ ... ])` in RON.
 #[derive(Debug, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -618,7 +624,19 @@ pub struct PaintScript {
 }
 
 fn read_script(path: &std::path::Path) -> Result<Vec<model::Command>, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| model_error(ModelError::io(path, e)))?;
+    let bytes = crate::file_check::read_limited(path, MAX_SCRIPT_BYTES).map_err(|e| {
+        if e.is_io() {
+            CliError::io(format!("{}: {e}", path.display()))
+        } else {
+            CliError::usage(format!("{}: {e}", path.display()))
+        }
+    })?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        model_error(ModelError::Script {
+            path: path.to_path_buf(),
+            reason: "not UTF-8 text".into(),
+        })
+    })?;
     let script: PaintScript = ron::from_str(&text).map_err(|e| {
         model_error(ModelError::Script {
             path: path.to_path_buf(),

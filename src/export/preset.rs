@@ -68,8 +68,11 @@ pub enum Layout {
 }
 
 /// An export preset.
+///
+/// Read only through its checks ([`ExportPresetFile`]): a name, and `n_bits` that the
+/// format can store.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "ExportPresetFile")]
 pub struct ExportPreset {
     /// Name (what `--preset` takes, with the file stem).
     pub name: String,
@@ -88,6 +91,53 @@ pub struct ExportPreset {
     /// BC7 effort, for `Ktx2Bc`.
     #[serde(default)]
     pub bc7_quality: Bc7Quality,
+}
+
+/// An export preset as its file spells it, before it is checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExportPresetFile {
+    name: String,
+    #[serde(default)]
+    description: String,
+    format: Format,
+    layout: Layout,
+    n_bits: u8,
+    #[serde(default)]
+    include_ka: bool,
+    #[serde(default)]
+    bc7_quality: Bc7Quality,
+}
+
+impl TryFrom<ExportPresetFile> for ExportPreset {
+    type Error = String;
+
+    fn try_from(f: ExportPresetFile) -> Result<Self, String> {
+        use crate::model::check::{MAX_PATH_BYTES, bounded_text, name};
+        name("name", &f.name)?;
+        bounded_text("description", &f.description, MAX_PATH_BYTES)?;
+        if !matches!(f.n_bits, 8 | 16) {
+            return Err(format!("n_bits must be 8 or 16, got {}", f.n_bits));
+        }
+        if f.format.is_8bit() && f.n_bits != 8 {
+            return Err(format!(
+                "{:?} stores 8-bit components (n_bits: 8)",
+                f.format
+            ));
+        }
+        if f.format == Format::Png16 && f.n_bits != 16 {
+            return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
+        }
+        Ok(Self {
+            name: f.name,
+            description: f.description,
+            format: f.format,
+            layout: f.layout,
+            n_bits: f.n_bits,
+            include_ka: f.include_ka,
+            bc7_quality: f.bc7_quality,
+        })
+    }
 }
 
 /// Why a preset could not be used.
@@ -133,32 +183,10 @@ impl ExportPreset {
     /// # Errors
     /// Malformed RON, unknown fields, or values out of range.
     pub fn parse(path: &Path, text: &str) -> Result<Self, PresetError> {
-        let malformed = |reason: String| PresetError::Malformed {
+        ron::from_str(text).map_err(|e| PresetError::Malformed {
             path: path.to_path_buf(),
-            reason,
-        };
-        let preset: Self = ron::from_str(text).map_err(|e| malformed(e.to_string()))?;
-        if !matches!(preset.n_bits, 8 | 16) {
-            return Err(malformed(format!(
-                "n_bits must be 8 or 16, got {}",
-                preset.n_bits
-            )));
-        }
-        if preset.format.is_8bit() && preset.n_bits != 8 {
-            return Err(malformed(format!(
-                "{:?} stores 8-bit components (n_bits: 8)",
-                preset.format
-            )));
-        }
-        if preset.format == Format::Png16 && preset.n_bits != 16 {
-            return Err(malformed(
-                "16-bit PNGs store n in 16 bits (n_bits: 16)".into(),
-            ));
-        }
-        if preset.name.trim().is_empty() {
-            return Err(malformed("name is empty".into()));
-        }
-        Ok(preset)
+            reason: e.to_string(),
+        })
     }
 }
 
@@ -180,11 +208,14 @@ pub fn builtin() -> Vec<ExportPreset> {
 pub fn find(name: &str) -> Result<ExportPreset, PresetError> {
     if let Some(dir) = std::env::var_os("KAPAINT_EXPORT_PRESET_DIR").map(PathBuf::from) {
         let path = dir.join(format!("{name}.ron"));
-        if path.is_file() {
-            let text = std::fs::read_to_string(&path).map_err(|e| PresetError::Malformed {
+        if path.exists() {
+            let malformed = |reason: String| PresetError::Malformed {
                 path: path.clone(),
-                reason: e.to_string(),
-            })?;
+                reason,
+            };
+            let bytes = crate::file_check::read_limited(&path, 1 << 20)
+                .map_err(|e| malformed(format!("the file {e}")))?;
+            let text = String::from_utf8(bytes).map_err(|_| malformed("not UTF-8 text".into()))?;
             return ExportPreset::parse(&path, &text);
         }
     }

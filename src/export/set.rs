@@ -898,9 +898,12 @@ pub fn export_with(
     let name = out
         .file_name()
         .map_or_else(|| "set".into(), |n| n.to_string_lossy().into_owned());
+    remove_stale_sets(parent, &name);
     let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir(&tmp).map_err(|e| io(&tmp, e))?;
+    // Removed on every way out but the last rename.
+    let guard = crate::atomic::TempPath::new(tmp.clone());
     let result = (|| {
         let encoded: Vec<Result<Encoded, SetError>> = images
             .par_iter()
@@ -1014,20 +1017,32 @@ pub fn export_with(
         crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
         Ok(manifest)
     })();
-    match result {
-        Ok(manifest) => {
-            if out.exists() {
-                std::fs::remove_dir(out).map_err(|e| io(out, e))?;
-            }
-            std::fs::rename(&tmp, out).map_err(|e| {
-                let _ = std::fs::remove_dir_all(&tmp);
-                io(out, e)
-            })?;
-            Ok(manifest)
-        }
-        Err(e) => {
-            let _ = std::fs::remove_dir_all(&tmp);
-            Err(e)
+    let manifest = result?;
+    if out.exists() {
+        std::fs::remove_dir(out).map_err(|e| io(out, e))?;
+    }
+    std::fs::rename(&tmp, out).map_err(|e| io(out, e))?;
+    guard.keep();
+    Ok(manifest)
+}
+
+/// Removes the temporary folders of earlier exports to `name` in `dir` whose process is gone.
+fn remove_stale_sets(dir: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.tmp-");
+    for entry in entries.filter_map(Result::ok) {
+        let Some(pid) = entry
+            .file_name()
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && crate::atomic::process_gone(pid) == Some(true) {
+            let _ = std::fs::remove_dir_all(entry.path());
         }
     }
 }
@@ -1190,11 +1205,14 @@ fn read_pixels(path: &Path) -> Result<Pixels, SetError> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("ktx2"));
     if ktx {
-        let len = std::fs::metadata(path).map_err(|e| io(path, e))?.len();
-        if len > crate::model::import::MAX_DECODED_BYTES {
-            return Err(invalid(format!("{len} bytes is too large")));
-        }
-        let bytes = std::fs::read(path).map_err(|e| io(path, e))?;
+        let bytes = crate::file_check::read_limited(path, crate::model::import::MAX_DECODED_BYTES)
+            .map_err(|e| {
+                if e.is_io() {
+                    io(path, e)
+                } else {
+                    invalid(format!("the file {e}"))
+                }
+            })?;
         let decoded = super::ktx::decode(&bytes).map_err(invalid)?;
         let pixels = decoded.rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
         Ok((true, (decoded.width, decoded.height), pixels))

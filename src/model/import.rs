@@ -1,22 +1,27 @@
 //! Importing an image into one channel of the maps.
 //!
 //! PNG, JPEG, TGA and EXR are read with decoder limits (at most 16384 x 16384 pixels and
-//! 2 GiB decoded), so a decompression bomb is a clear error rather than an out-of-memory
-//! crash. The image is resampled to the map size. 8- and 16-bit images are sRGB-encoded and
+//! 2 GiB decoded, checked against the memory available before anything is allocated), so a
+//! decompression bomb is a clear error rather than an out-of-memory kill. A JPEG without its
+//! end-of-image marker is truncated and refused. The image is resampled to the map size by a
+//! triangle filter, streamed over bands of rows: peak memory is the decoded image plus a few
+//! rows, never a float copy of the whole image. 8- and 16-bit images are sRGB-encoded and
 //! converted to linear for `k_d`/`k_s`; float images (EXR) are taken as linear. For `n`, a
 //! gray level `v` of an integer image maps through the perceptual scale
-//! (`n = (1 + N_MAX)^v - 1`, the same scale as the brush's log blending); a float image holds
-//! `n` itself.
+//! (`n = (1 + N_MAX)^v - 1`, the same scale as the brush's log blending); a float image
+//! holds `n` itself (never clamped to `[0, 1]` by the resampling).
 
+use std::io::{Read as _, Seek as _};
 use std::path::Path;
 
 use glam::Vec3;
-use image::{DynamicImage, imageops::FilterType};
+use image::DynamicImage;
+use rayon::prelude::*;
 
 use super::ModelError;
 use super::document::Document;
 use super::texel::{Channel, encode_n, encode_rgb, n_from_blend, srgb_to_linear};
-use super::tile::TILE_SIZE;
+use super::tile::{Plane, TILE_SIZE};
 
 /// Largest image side accepted.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
@@ -24,30 +29,93 @@ pub const MAX_IMAGE_SIDE: u32 = 16384;
 /// Largest decoded size accepted, in bytes.
 pub const MAX_DECODED_BYTES: u64 = 2 << 30;
 
+/// Largest image file accepted, in bytes (an incompressible image at the decoded limit).
+pub const MAX_FILE_BYTES: u64 = MAX_DECODED_BYTES + (64 << 20);
+
+/// How far from its end a JPEG must hold its end-of-image marker (bytes): anything after it
+/// is trailing data some cameras append.
+const JPEG_TAIL_BYTES: u64 = 64 << 10;
+
 /// Decodes an image file with the import limits.
 pub fn read_image(path: &Path) -> Result<DynamicImage, ModelError> {
     let fail = |reason: String| ModelError::Image {
         path: path.to_path_buf(),
         reason,
     };
-    let mut reader = image::ImageReader::open(path)
-        .map_err(|e| ModelError::io(path, e))?
+    crate::file_check::regular_file(path, MAX_FILE_BYTES).map_err(|e| match e {
+        crate::file_check::FileCheck::Io(source) => ModelError::io(path, source),
+        other => fail(format!("the file {other}")),
+    })?;
+    let mut file = std::fs::File::open(path).map_err(|e| ModelError::io(path, e))?;
+    let reader = image::ImageReader::new(std::io::BufReader::new(&mut file))
         .with_guessed_format()
         .map_err(|e| ModelError::io(path, e))?;
-    if reader.format().is_none() {
+    let Some(format) = reader.format() else {
         return Err(fail("not a supported image (PNG, JPEG, TGA or EXR)".into()));
-    }
+    };
+    let too_large = |what: String| {
+        fail(format!(
+            "image is too large to import (limits: {MAX_IMAGE_SIDE}x{MAX_IMAGE_SIDE} pixels, 2 GiB decoded): {what}"
+        ))
+    };
+    let mut reader = reader;
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(MAX_IMAGE_SIDE);
     limits.max_image_height = Some(MAX_IMAGE_SIDE);
     limits.max_alloc = Some(MAX_DECODED_BYTES);
     reader.limits(limits);
-    reader.decode().map_err(|e| match e {
-        image::ImageError::Limits(l) => fail(format!(
-            "image is too large to import (limits: {MAX_IMAGE_SIDE}x{MAX_IMAGE_SIDE} pixels, 2 GiB decoded): {l}"
-        )),
-        other => fail(other.to_string()),
-    })
+    let decoder = reader.into_decoder().map_err(|e| match e {
+        image::ImageError::Limits(l) => too_large(l.to_string()),
+        other => fail(decode_error(&other)),
+    })?;
+    let bytes = image::ImageDecoder::total_bytes(&decoder);
+    if bytes > MAX_DECODED_BYTES {
+        return Err(too_large(format!("it decodes to {bytes} bytes")));
+    }
+    crate::memory::check_fits("decoding it", bytes).map_err(fail)?;
+    let image = DynamicImage::from_decoder(decoder).map_err(|e| match e {
+        image::ImageError::Limits(l) => too_large(l.to_string()),
+        other => fail(decode_error(&other)),
+    })?;
+    if format == image::ImageFormat::Jpeg
+        && !jpeg_ends(&mut file).map_err(|e| ModelError::io(path, e))?
+    {
+        return Err(fail(
+            "the JPEG is truncated (it has no end-of-image marker)".into(),
+        ));
+    }
+    Ok(image)
+}
+
+/// Whether a JPEG file holds its end-of-image marker (`FF D9`) near its end. Inside the
+/// compressed data every `FF` is followed by `00` or a restart marker, so the marker cannot
+/// appear by chance: a file cut anywhere before its end lacks it.
+fn jpeg_ends(file: &mut std::fs::File) -> std::io::Result<bool> {
+    let len = file.metadata()?.len();
+    let start = len.saturating_sub(JPEG_TAIL_BYTES);
+    file.seek(std::io::SeekFrom::Start(start))?;
+    let mut tail = Vec::new();
+    file.take(JPEG_TAIL_BYTES).read_to_end(&mut tail)?;
+    Ok(tail.windows(2).any(|w| w == [0xFF, 0xD9]))
+}
+
+/// A decoder's error as one line, saying "truncated" where the file ends too early.
+fn decode_error(e: &image::ImageError) -> String {
+    let text = one_line(&e.to_string());
+    let lower = text.to_lowercase();
+    let early_end = matches!(e, image::ImageError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof)
+        || lower.contains("end of file")
+        || lower.contains("eof");
+    if early_end && !lower.contains("truncated") {
+        format!("the image is truncated ({text})")
+    } else {
+        text
+    }
+}
+
+/// A decoder's message as one line (some end in a blank line).
+fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Whether the decoded image holds linear floats (EXR) rather than sRGB-encoded integers.
@@ -58,38 +126,229 @@ fn is_float(image: &DynamicImage) -> bool {
     )
 }
 
-/// Writes `image` into `channel` of the document as one undo step.
-pub fn import_into(doc: &mut Document, channel: Channel, image: &DynamicImage) {
-    let (w, h) = (doc.maps.width(), doc.maps.height());
+/// Row `y` of `image` as RGB floats: integer samples scaled to `[0, 1]`, float samples as they
+/// are, gray repeated, alpha dropped.
+fn source_row(image: &DynamicImage, y: u32, out: &mut [[f32; 3]]) {
+    fn fill<T: Copy>(raw: &[T], stride: usize, out: &mut [[f32; 3]], f: impl Fn(T) -> f32) {
+        for (px, o) in raw.chunks_exact(stride).zip(out.iter_mut()) {
+            *o = if stride < 3 {
+                [f(px[0]); 3]
+            } else {
+                [f(px[0]), f(px[1]), f(px[2])]
+            };
+        }
+    }
+    let w = image.width() as usize;
+    let row = |stride: usize| (y as usize * w * stride)..((y as usize + 1) * w * stride);
+    let u8f = |v: u8| f32::from(v) / 255.0;
+    let u16f = |v: u16| f32::from(v) / 65535.0;
+    match image {
+        DynamicImage::ImageLuma8(b) => fill(&b.as_raw()[row(1)], 1, out, u8f),
+        DynamicImage::ImageLumaA8(b) => fill(&b.as_raw()[row(2)], 2, out, u8f),
+        DynamicImage::ImageRgb8(b) => fill(&b.as_raw()[row(3)], 3, out, u8f),
+        DynamicImage::ImageRgba8(b) => fill(&b.as_raw()[row(4)], 4, out, u8f),
+        DynamicImage::ImageLuma16(b) => fill(&b.as_raw()[row(1)], 1, out, u16f),
+        DynamicImage::ImageLumaA16(b) => fill(&b.as_raw()[row(2)], 2, out, u16f),
+        DynamicImage::ImageRgb16(b) => fill(&b.as_raw()[row(3)], 3, out, u16f),
+        DynamicImage::ImageRgba16(b) => fill(&b.as_raw()[row(4)], 4, out, u16f),
+        DynamicImage::ImageRgb32F(b) => fill(&b.as_raw()[row(3)], 3, out, |v| v),
+        DynamicImage::ImageRgba32F(b) => fill(&b.as_raw()[row(4)], 4, out, |v| v),
+        other => {
+            let line = other.crop_imm(0, y, other.width(), 1).to_rgb32f();
+            fill(line.as_raw(), 3, out, |v| v);
+        }
+    }
+}
+
+/// The taps of a triangle filter from `src` samples to `dst`: per output sample, its first
+/// source sample and the normalised weights from there (the filter widens by `src / dst`
+/// when shrinking, as `image::imageops::resize` does).
+fn triangle_taps(src: u32, dst: u32) -> Vec<(u32, Vec<f32>)> {
+    let ratio = src as f32 / dst as f32;
+    let scale = ratio.max(1.0);
+    (0..dst)
+        .map(|o| {
+            let centre = (o as f32 + 0.5) * ratio;
+            let left = ((centre - scale).floor().max(0.0) as u32).min(src - 1);
+            let right = ((centre + scale).ceil() as u32).clamp(left + 1, src);
+            let weights: Vec<f32> = (left..right)
+                .map(|i| (1.0 - ((i as f32 - (centre - 0.5)) / scale).abs()).max(0.0))
+                .collect();
+            let sum: f32 = weights.iter().sum();
+            let weights = if sum > 0.0 {
+                weights.iter().map(|w| w / sum).collect()
+            } else {
+                vec![1.0 / weights.len() as f32; weights.len()]
+            };
+            (left, weights)
+        })
+        .collect()
+}
+
+/// One channel resampled to a map size and encoded, a plane per tile (row-major tiles):
+/// the heavy part of an import, done off the UI thread, installed by [`install`].
+pub enum ChannelPlanes {
+    /// `k_d` or `k_s`.
+    Rgb(Channel, Vec<Plane<[u16; 3]>>),
+    /// `n`.
+    N(Vec<Plane<u16>>),
+}
+
+impl ChannelPlanes {
+    /// The channel the planes belong to.
+    pub fn channel(&self) -> Channel {
+        match self {
+            Self::Rgb(c, _) => *c,
+            Self::N(_) => Channel::N,
+        }
+    }
+}
+
+/// Resamples `image` to `width x height` and encodes it into `channel`'s planes, a band of
+/// tile rows at a time (in parallel): each band streams its source rows through the
+/// horizontal filter into the few output rows they feed.
+pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32) -> ChannelPlanes {
     let linear = is_float(image);
-    let resized = image::imageops::resize(&image.to_rgb32f(), w, h, FilterType::Triangle);
+    // A decoder never hands over an empty image; if one came, it would read as black.
+    let (sw, sh) = (image.width().max(1), image.height().max(1));
+    let xs = triangle_taps(sw, width);
+    let ys = triangle_taps(sh, height);
+    let tiles_x = (width as usize).div_ceil(TILE_SIZE);
+    let tiles_y = (height as usize).div_ceil(TILE_SIZE);
+    let w = width as usize;
+    let bands: Vec<Vec<[f32; 3]>> = (0..tiles_y)
+        .into_par_iter()
+        .map(|ty| {
+            let y0 = ty * TILE_SIZE;
+            let y1 = (y0 + TILE_SIZE).min(height as usize);
+            let mut acc = vec![[0.0_f32; 3]; (y1 - y0) * w];
+            let mut source = vec![[0.0_f32; 3]; sw as usize];
+            if image.width() == 0 {
+                return acc;
+            }
+            let mut filtered = vec![[0.0_f32; 3]; w];
+            let first = ys[y0].0;
+            let last = ys[y1 - 1].0 + ys[y1 - 1].1.len() as u32;
+            for sy in first..last.min(image.height()) {
+                source_row(image, sy, &mut source);
+                for (x, (left, weights)) in xs.iter().enumerate() {
+                    let mut sum = [0.0_f32; 3];
+                    for (k, wgt) in weights.iter().enumerate() {
+                        let p = source[*left as usize + k];
+                        for c in 0..3 {
+                            sum[c] += p[c] * wgt;
+                        }
+                    }
+                    filtered[x] = sum;
+                }
+                for y in y0..y1 {
+                    let (top, weights) = &ys[y];
+                    let Some(wgt) = sy.checked_sub(*top).and_then(|k| weights.get(k as usize))
+                    else {
+                        continue;
+                    };
+                    let row = &mut acc[(y - y0) * w..(y - y0 + 1) * w];
+                    for (a, f) in row.iter_mut().zip(&filtered) {
+                        for c in 0..3 {
+                            a[c] += f[c] * wgt;
+                        }
+                    }
+                }
+            }
+            acc
+        })
+        .collect();
     let convert = |c: f32| if linear { c } else { srgb_to_linear(c) };
-    doc.history
-        .begin(format!("Import image into {}", channel.name()));
-    for id in 0..doc.maps.tile_count() {
-        let (x0, y0, x1, y1) = doc.maps.tile_rect(id);
-        let tile = doc.history.tile_for_write(&mut doc.maps, id);
-        for y in y0..y1 {
-            for x in x0..x1 {
-                let p = resized.get_pixel(x, y).0;
-                let i = (y - y0) as usize * TILE_SIZE + (x - x0) as usize;
-                match channel {
-                    Channel::Kd => tile.kd.data_mut()[i] = encode_rgb(Vec3::from(p).map(convert)),
-                    Channel::Ks => tile.ks.data_mut()[i] = encode_rgb(Vec3::from(p).map(convert)),
-                    Channel::N => {
+    let tile_texels = |tx: usize, ty: usize| {
+        let band = &bands[ty];
+        let x0 = tx * TILE_SIZE;
+        let cols = TILE_SIZE.min(w - x0);
+        let rows = band.len() / w;
+        (0..rows)
+            .flat_map(move |r| (0..cols).map(move |c| (r * TILE_SIZE + c, band[r * w + x0 + c])))
+    };
+    match channel {
+        Channel::Kd | Channel::Ks => {
+            let planes = (0..tiles_x * tiles_y)
+                .into_par_iter()
+                .map(|id| {
+                    let mut plane = Plane::Uniform([0; 3]);
+                    let data = plane.data_mut();
+                    for (i, p) in tile_texels(id % tiles_x, id / tiles_x) {
+                        data[i] = encode_rgb(Vec3::from(p).map(convert));
+                    }
+                    plane.compact();
+                    plane
+                })
+                .collect();
+            ChannelPlanes::Rgb(channel, planes)
+        }
+        Channel::N => {
+            let planes = (0..tiles_x * tiles_y)
+                .into_par_iter()
+                .map(|id| {
+                    let mut plane = Plane::Uniform(0);
+                    let data = plane.data_mut();
+                    for (i, p) in tile_texels(id % tiles_x, id / tiles_x) {
                         let v = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-                        tile.n.data_mut()[i] = if linear {
+                        data[i] = if linear {
                             encode_n(v)
                         } else {
                             encode_n(n_from_blend(v))
                         };
                     }
+                    plane.compact();
+                    plane
+                })
+                .collect();
+            ChannelPlanes::N(planes)
+        }
+    }
+}
+
+/// Writes resampled planes into the document as one undo step.
+///
+/// # Errors
+/// Planes made for another map size.
+pub fn install(doc: &mut Document, planes: ChannelPlanes) -> Result<(), ModelError> {
+    let count = match &planes {
+        ChannelPlanes::Rgb(_, p) => p.len(),
+        ChannelPlanes::N(p) => p.len(),
+    };
+    if count != doc.maps.tile_count() {
+        return Err(ModelError::Command(format!(
+            "the image was resampled for {count} tiles, but the maps have {}",
+            doc.maps.tile_count()
+        )));
+    }
+    doc.history
+        .begin(format!("Import image into {}", planes.channel().name()));
+    match planes {
+        ChannelPlanes::Rgb(channel, planes) => {
+            for (id, plane) in planes.into_iter().enumerate() {
+                let tile = doc.history.tile_for_write(&mut doc.maps, id);
+                if channel == Channel::Kd {
+                    tile.kd = plane;
+                } else {
+                    tile.ks = plane;
                 }
             }
         }
-        tile.compact();
+        ChannelPlanes::N(planes) => {
+            for (id, plane) in planes.into_iter().enumerate() {
+                doc.history.tile_for_write(&mut doc.maps, id).n = plane;
+            }
+        }
     }
     doc.history.end();
+    Ok(())
+}
+
+/// Writes `image` into `channel` of the document as one undo step.
+pub fn import_into(doc: &mut Document, channel: Channel, image: &DynamicImage) {
+    let planes = resample(image, channel, doc.maps.width(), doc.maps.height());
+    // The planes are made for these maps, so the sizes agree.
+    let _ = install(doc, planes);
 }
 
 /// Reads a grayscale brush stamp from an image file (luminance of the decoded image; an
@@ -125,4 +384,35 @@ pub fn import_file(doc: &mut Document, channel: Channel, path: &Path) -> Result<
     let image = read_image(path)?;
     import_into(doc, channel, &image);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn taps_are_the_identity_at_the_same_size_and_average_when_shrinking() {
+        for (left, weights) in triangle_taps(7, 7) {
+            let at: Vec<f32> = weights.iter().copied().filter(|w| *w > 0.0).collect();
+            assert_eq!(at, vec![1.0], "left {left}");
+        }
+        let half = triangle_taps(8, 4);
+        for (o, (left, weights)) in half.iter().enumerate() {
+            let sum: f32 = weights.iter().sum();
+            assert!((sum - 1.0).abs() < 1e-6);
+            let centre: f32 = weights
+                .iter()
+                .enumerate()
+                .map(|(k, w)| (*left as f32 + k as f32 + 0.5) * w)
+                .sum();
+            // Inside, the weights centre on the output sample; at the edges the filter is
+            // cut by the image's border (as `image::imageops::resize` does).
+            if (1..3).contains(&o) {
+                assert!(
+                    (centre - (o as f32 * 2.0 + 1.0)).abs() < 1e-4,
+                    "{o}: {centre}"
+                );
+            }
+        }
+    }
 }

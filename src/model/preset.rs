@@ -9,8 +9,10 @@ use super::ModelError;
 use super::texel::{MaterialValue, N_MAX};
 
 /// A material preset as written in a `.ron` file.
+///
+/// Read only through its checks ([`MaterialPresetFile`]): values in range, a name.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "MaterialPresetFile")]
 pub struct MaterialPreset {
     /// Display name.
     pub name: String,
@@ -23,44 +25,69 @@ pub struct MaterialPreset {
     /// Phong exponent in `[0, 16384]`.
     pub n: f32,
     /// The ambient a published table gives (compared against the derived one in docs).
-    #[serde(default)]
     pub table_ambient: Option<[f32; 3]>,
 }
+
+/// A preset as its file spells it, before it is checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialPresetFile {
+    name: String,
+    source: String,
+    kd: [f32; 3],
+    ks: [f32; 3],
+    n: f32,
+    #[serde(default)]
+    table_ambient: Option<[f32; 3]>,
+}
+
+impl TryFrom<MaterialPresetFile> for MaterialPreset {
+    type Error = String;
+
+    fn try_from(f: MaterialPresetFile) -> Result<Self, String> {
+        use super::check::{MAX_PATH_BYTES, all_in_range, bounded_text, in_range, name};
+        name("name", &f.name)?;
+        bounded_text("source", &f.source, MAX_PATH_BYTES)?;
+        Ok(Self {
+            kd: all_in_range("kd", f.kd, 0.0, 1.0)?,
+            ks: all_in_range("ks", f.ks, 0.0, 1.0)?,
+            n: in_range("n", f.n, 0.0, N_MAX)?,
+            table_ambient: f
+                .table_ambient
+                .map(|a| all_in_range("table_ambient", a, 0.0, 1.0))
+                .transpose()?,
+            name: f.name,
+            source: f.source,
+        })
+    }
+}
+
+/// Largest preset file read (bytes).
+const MAX_PRESET_BYTES: u64 = 1 << 20;
 
 impl MaterialPreset {
     /// Parses and validates preset text; errors name `path`.
     pub fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
-        let fail = |reason: String| ModelError::Preset {
+        ron::from_str(text).map_err(|e| ModelError::Preset {
             path: path.to_path_buf(),
-            reason,
-        };
-        let preset: Self = ron::from_str(text).map_err(|e| fail(e.to_string()))?;
-        let unit = |label: &str, v: [f32; 3]| -> Result<(), ModelError> {
-            if v.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c)) {
-                Ok(())
-            } else {
-                Err(fail(format!(
-                    "{label} components must be in [0, 1], got {v:?}"
-                )))
-            }
-        };
-        unit("kd", preset.kd)?;
-        unit("ks", preset.ks)?;
-        if let Some(a) = preset.table_ambient {
-            unit("table_ambient", a)?;
-        }
-        if !(preset.n.is_finite() && (0.0..=N_MAX).contains(&preset.n)) {
-            return Err(fail(format!("n must be in [0, {N_MAX}], got {}", preset.n)));
-        }
-        if preset.name.trim().is_empty() {
-            return Err(fail("name is empty".into()));
-        }
-        Ok(preset)
+            reason: e.to_string(),
+        })
     }
 
-    /// Reads and parses a preset file.
+    /// Reads and parses a preset file (a regular file of at most 1 MiB).
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::io(path, e))?;
+        let bytes =
+            crate::file_check::read_limited(path, MAX_PRESET_BYTES).map_err(|e| match e {
+                crate::file_check::FileCheck::Io(source) => ModelError::io(path, source),
+                other => ModelError::Preset {
+                    path: path.to_path_buf(),
+                    reason: format!("the file {other}"),
+                },
+            })?;
+        let text = String::from_utf8(bytes).map_err(|_| ModelError::Preset {
+            path: path.to_path_buf(),
+            reason: "not UTF-8 text".into(),
+        })?;
         Self::parse(path, &text)
     }
 

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::ModelError;
-use super::document::{Document, DocumentSettings};
+use super::document::{Document, DocumentSettings, MeshRef};
 use super::maps::{MAX_SIDE, MaterialMaps};
 use super::texel::{MaterialValue, N_MAX};
 use super::tile::{Plane, TILE_SIZE, Tile};
@@ -150,8 +150,94 @@ pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
     Ok(cursor.into_inner())
 }
 
-/// Serialises a document as a project into `out`.
+/// Serialises a document as a project into `out` (its mesh path as the document holds it).
 pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
+    write_project(doc, doc.settings.clone(), out)
+}
+
+/// The settings as a project at `project` stores them: a mesh file's path relative to the
+/// project's folder (so a project and its mesh can move together, and commands run from any
+/// folder find it), or absolute where no relative path exists.
+fn settings_for_file(settings: &DocumentSettings, project: &Path) -> DocumentSettings {
+    let mut stored = settings.clone();
+    if let MeshRef::File(mesh) = &settings.mesh
+        && let (Ok(mesh_abs), Ok(dir_abs)) = (
+            std::path::absolute(mesh),
+            std::path::absolute(project_dir(project)),
+        )
+    {
+        let relative = relative_path(&dir_abs, &mesh_abs).unwrap_or(mesh_abs);
+        stored.mesh = MeshRef::File(relative.to_string_lossy().into_owned());
+    }
+    stored
+}
+
+/// The settings as loaded from a project at `project`: a relative mesh path is taken from the
+/// project's folder (projects written before paths were stored that way held paths relative
+/// to the folder they were made in: those are tried there too), and held absolute.
+fn settings_from_file(mut settings: DocumentSettings, project: &Path) -> DocumentSettings {
+    if let MeshRef::File(mesh) = &settings.mesh {
+        let mesh = Path::new(mesh);
+        if mesh.is_relative() {
+            let beside = project_dir(project).join(mesh);
+            let found = if beside.exists() || !mesh.exists() {
+                beside
+            } else {
+                mesh.to_path_buf()
+            };
+            let found = std::path::absolute(&found).unwrap_or(found);
+            settings.mesh = MeshRef::File(found.to_string_lossy().into_owned());
+        }
+    }
+    settings
+}
+
+/// The folder a project is in (`.` for a bare file name).
+fn project_dir(project: &Path) -> &Path {
+    project
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+/// `target` relative to the folder `base` (both absolute), by their components: `None` when
+/// they share no root (another drive).
+fn relative_path(base: &Path, target: &Path) -> Option<PathBuf> {
+    use std::path::Component;
+    fn normal(p: &Path) -> Vec<Component<'_>> {
+        let mut out: Vec<Component<'_>> = Vec::new();
+        for c in p.components() {
+            match c {
+                Component::CurDir => {}
+                Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                    out.pop();
+                }
+                other => out.push(other),
+            }
+        }
+        out
+    }
+    let (base, target) = (normal(base), normal(target));
+    if base.first() != target.first() {
+        return None;
+    }
+    let common = base.iter().zip(&target).take_while(|(a, b)| a == b).count();
+    let mut out = PathBuf::new();
+    for _ in common..base.len() {
+        out.push("..");
+    }
+    for c in &target[common..] {
+        out.push(c.as_os_str());
+    }
+    Some(out)
+}
+
+/// Serialises a document with `settings` into `out`.
+fn write_project(
+    doc: &Document,
+    settings: DocumentSettings,
+    out: impl Write + Seek,
+) -> Result<(), String> {
     let maps = &doc.maps;
     let (w, h) = (maps.width(), maps.height());
     let rasters: Vec<(&str, Raster)> = vec![
@@ -197,7 +283,7 @@ pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
         version: VERSION,
         width: w,
         height: h,
-        settings: doc.settings.clone(),
+        settings,
         kd: entry(&rasters[0]),
         ks: entry(&rasters[1]),
         n: entry(&rasters[2]),
@@ -237,18 +323,38 @@ pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
     // A serialisation failure (e.g. the disk filling up inside the zip writer) is reported as
     // an I/O error on the file, like any other write failure.
     crate::atomic::write_atomic_with(path, |file| {
-        write_to(doc, file).map_err(std::io::Error::other)
+        // The first write error (a full disk) is the one reported; the zip writer then
+        // finishes quietly instead of printing its own failure.
+        let mut out = crate::atomic::FirstError::new(file);
+        let written = write_project(doc, settings_for_file(&doc.settings, path), &mut out);
+        if let Some(e) = out.take_error() {
+            return Err(e);
+        }
+        written.map_err(std::io::Error::other)
     })
     .map_err(|e| ModelError::io(path, e))
 }
 
-/// Loads and validates a project file.
+/// Largest project file read (bytes): an 8192^2 project of noise is about 1 GB.
+pub const MAX_PROJECT_BYTES: u64 = 4 << 30;
+
+/// Loads and validates a project file (a regular file: a FIFO or a device is refused before
+/// it is opened).
 pub fn load(path: &Path) -> Result<Document, ModelError> {
+    crate::file_check::regular_file(path, MAX_PROJECT_BYTES).map_err(|e| match e {
+        crate::file_check::FileCheck::Io(source) => ModelError::io(path, source),
+        other => ModelError::Project {
+            path: path.to_path_buf(),
+            reason: format!("the file {other}"),
+        },
+    })?;
     let file = File::open(path).map_err(|e| ModelError::io(path, e))?;
-    from_reader(file).map_err(|reason| ModelError::Project {
+    let mut doc = from_reader(file).map_err(|reason| ModelError::Project {
         path: path.to_path_buf(),
         reason,
-    })
+    })?;
+    doc.settings = settings_from_file(std::mem::take(&mut doc.settings), path);
+    Ok(doc)
 }
 
 /// Loads and validates a project from any seekable reader; the error is a reason text.
@@ -627,6 +733,21 @@ mod tests {
         assert!(autosave.due(t0 + Duration::from_secs(61), 6));
         autosave.saved(t0 + Duration::from_secs(61), 6);
         assert!(!autosave.due(t0 + Duration::from_secs(100), 6));
+    }
+
+    #[test]
+    fn mesh_paths_are_stored_relative_to_the_project() {
+        let rel = |a: &str, b: &str| relative_path(Path::new(a), Path::new(b));
+        assert_eq!(
+            rel("/w/sub", "/w/barrel.glb"),
+            Some(PathBuf::from("../barrel.glb"))
+        );
+        assert_eq!(rel("/w", "/w/m/x.obj"), Some(PathBuf::from("m/x.obj")));
+        assert_eq!(
+            rel("/w/a/b", "/w/a/../m.obj"),
+            Some(PathBuf::from("../../m.obj"))
+        );
+        assert_eq!(rel("/w", "/w/./x.obj"), Some(PathBuf::from("x.obj")));
     }
 
     #[test]

@@ -38,9 +38,11 @@ pub const PAPER_TWO_OVER_PI: f64 = 0.637;
 pub enum ShadingModel {
     /// Original Phong, `rho_s = max(0, R.V)^n` (eq. 4); its ambient is eq. (8).
     #[default]
+    #[serde(alias = "Phong")]
     Phong,
     /// Modified (Blinn-)Phong, `rho_s = max(0, N.H)^n` (eq. 9); its ambient is eq. (11).
-    #[serde(rename = "blinn")]
+    /// Files say `blinn`; scripts may say `BlinnPhong` as the type does.
+    #[serde(rename = "blinn", alias = "BlinnPhong", alias = "blinn-phong")]
     BlinnPhong,
 }
 
@@ -63,16 +65,16 @@ impl ShadingModel {
 )]
 pub enum AmbientApprox {
     /// Eq. (8) and (11) exactly as printed, `0.637 k_d + a k_s (n + b)^c`.
-    #[serde(rename = "paper")]
+    #[serde(rename = "paper", alias = "PaperPrinted")]
     PaperPrinted,
     /// The printed constants with the Blinn-Phong exponent corrected (`-0.875` is a misprint;
     /// our integrator puts the minimax exponent at [`PAPER_BLINN_CORRECTED_EXPONENT`]).
-    #[serde(rename = "paper-corrected")]
+    #[serde(rename = "paper-corrected", alias = "PaperCorrected")]
     PaperCorrected,
     /// kapaint's own approximation: per-octave polynomials, max relative error <= 1e-4 on
     /// `n in [0, 16384]` for both models (see [`fast`]).
     #[default]
-    #[serde(rename = "fast")]
+    #[serde(rename = "fast", alias = "Fast")]
     Fast,
 }
 

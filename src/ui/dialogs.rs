@@ -98,7 +98,7 @@ pub(super) fn recent_path() -> Option<PathBuf> {
 
 pub(super) fn load_recent() -> Vec<PathBuf> {
     recent_path()
-        .and_then(|p| std::fs::read(p).ok())
+        .and_then(|p| crate::file_check::read_limited(&p, 1 << 20).ok())
         .and_then(|text| serde_json::from_slice::<Vec<PathBuf>>(&text).ok())
         .map(|mut list| {
             list.truncate(RECENT_MAX);

@@ -90,8 +90,8 @@ enum JobResult {
     Exported(PathBuf, Box<crate::export::set::Manifest>),
     /// A mesh loaded and baked at the map size.
     Mesh(PathBuf, Arc<Surface>),
-    /// An image decoded for a channel.
-    Image(Channel, PathBuf, Box<image::DynamicImage>),
+    /// An image decoded and resampled into a channel's planes.
+    Image(PathBuf, Box<crate::model::import::ChannelPlanes>),
     /// A new project (File > New), its mesh baked.
     Created(Box<Document>),
     /// A brush stamp read from an image.
@@ -401,7 +401,7 @@ fn layout_path() -> Option<PathBuf> {
 
 /// The saved layout, if there is a readable one holding both tabs.
 fn load_layout() -> Option<DockState<Tab>> {
-    let text = std::fs::read(layout_path()?).ok()?;
+    let text = crate::file_check::read_limited(&layout_path()?, 1 << 20).ok()?;
     let dock: DockState<Tab> = serde_json::from_slice(&text).ok()?;
     (dock.find_tab(&Tab::Viewport).is_some() && dock.find_tab(&Tab::Canvas).is_some())
         .then_some(dock)
@@ -515,18 +515,13 @@ impl EditorState {
             .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
         match result {
             JobResult::Opened(path, doc, recovered) => {
-                let mesh = doc.surface().map(|s| s.mesh.clone());
-                self.doc = *doc;
+                self.replace_document(*doc);
                 // Recovered work is unsaved work.
                 self.saved_version = if recovered {
                     u64::MAX
                 } else {
                     self.doc.maps.version()
                 };
-                if let Some(mesh) = mesh {
-                    self.mesh = MeshState::new(mesh, self.mesh.id + 1);
-                    self.viewport.frame(&self.mesh.mesh);
-                }
                 self.autosaver = project::Autosaver::new(
                     Duration::from_mins(2),
                     project::recovery_path(Some(&path)),
@@ -573,20 +568,18 @@ impl EditorState {
                     Err(e) => self.notices.push(notice(e.to_string(), true)),
                 }
             }
-            JobResult::Image(channel, path, image) => {
-                crate::model::import::import_into(&mut self.doc, channel, &image);
-                self.notices.push(notice(
-                    format!("{} imported into {}", path.display(), channel.name()),
-                    false,
-                ));
+            JobResult::Image(path, planes) => {
+                let channel = planes.channel();
+                match crate::model::import::install(&mut self.doc, *planes) {
+                    Ok(()) => self.notices.push(notice(
+                        format!("{} imported into {}", path.display(), channel.name()),
+                        false,
+                    )),
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
             }
             JobResult::Created(doc) => {
-                let mesh = doc.surface().map(|s| s.mesh.clone());
-                self.doc = *doc;
-                if let Some(mesh) = mesh {
-                    self.mesh = MeshState::new(mesh, self.mesh.id + 1);
-                    self.viewport.frame(&self.mesh.mesh);
-                }
+                self.replace_document(*doc);
                 self.saved_version = self.doc.maps.version();
                 self.path = None;
                 self.autosaver = project::Autosaver::new(
@@ -603,6 +596,16 @@ impl EditorState {
                     .push(notice(format!("stamp {}", path.display()), false));
             }
             JobResult::Failed(e) => self.notices.push(notice(e, true)),
+        }
+    }
+
+    /// Makes `doc` the document, with its mesh shown and framed.
+    fn replace_document(&mut self, doc: Document) {
+        let mesh = doc.surface().map(|s| s.mesh.clone());
+        self.doc = doc;
+        if let Some(mesh) = mesh {
+            self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+            self.viewport.frame(&self.mesh.mesh);
         }
     }
 
@@ -634,12 +637,18 @@ impl EditorState {
         });
     }
 
-    /// Decodes an image on a worker and writes it into `channel` (one undo step).
+    /// Decodes and resamples an image on a worker; it is written into `channel` (one undo
+    /// step) when it arrives.
     pub fn import_image(&mut self, path: PathBuf, channel: Channel) {
+        let (w, h) = (self.doc.maps.width(), self.doc.maps.height());
         self.start_job("Image", move |progress| {
             progress.start("decode", 1);
             match crate::model::import::read_image(&path) {
-                Ok(image) => JobResult::Image(channel, path, Box::new(image)),
+                Ok(image) => {
+                    progress.start("resample", 1);
+                    let planes = crate::model::import::resample(&image, channel, w, h);
+                    JobResult::Image(path, Box::new(planes))
+                }
                 Err(e) => JobResult::Failed(e.to_string()),
             }
         });
