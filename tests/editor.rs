@@ -198,15 +198,18 @@ fn a_scripted_editing_session() {
     harness.get_by_label("Split").click();
     harness.run();
 
-    // The export dialog opens from its hotkey and offers the presets.
+    // The export dialog opens from its hotkey and offers the presets. (Its preview is
+    // planned on a worker thread and the dialog repaints until it arrives, so frames are
+    // stepped, not run until idle: on a loaded machine that takes more than a few frames.)
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
-    harness.run();
+    harness.step();
+    harness.step();
     harness.get_by_role_and_label(Role::Button, "Export");
     harness.get_by_label("Preset");
     // Its preview (computed on a worker thread): the packed layout of the painted maps, the
     // memory report and the estimated k_a error.
     for _ in 0..200 {
-        harness.run();
+        harness.step();
         if harness.query_by_label("Packed layout").is_some() {
             break;
         }
@@ -322,4 +325,33 @@ fn opening_another_project_never_drops_unsaved_work() {
     harness.run();
     assert_eq!(harness.state().state.pending_open, None);
     assert_eq!(texels(harness.state()), painted, "the work is still there");
+}
+
+#[test]
+fn a_settings_change_is_unsaved_work() {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, None),
+        );
+    harness.run();
+    assert!(!harness.state().state.dirty(), "a fresh document");
+    // Switch the shading model: no texel changes, but the project stores the model.
+    harness.get_by_label("Blinn-Phong (11)").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.doc.settings.model,
+        kapaint::reflectance::ShadingModel::BlinnPhong
+    );
+    assert!(
+        harness.state().state.dirty(),
+        "a changed setting must count as unsaved"
+    );
+    // So opening another project asks first.
+    let elsewhere = std::path::PathBuf::from("/nowhere/other.kapaint");
+    harness.state_mut().state.open(elsewhere.clone());
+    harness.run();
+    assert_eq!(harness.state().state.pending_open, Some(elsewhere));
+    harness.get_by_label("Discard and open");
 }

@@ -3,6 +3,9 @@
 
 #![allow(clippy::expect_used)]
 
+#[path = "common/faults.rs"]
+mod faults;
+
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
@@ -251,6 +254,16 @@ fn two_component_images_pack_ks_with_n() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Temporary export folders left in `dir`.
+fn temporaries(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    std::fs::read_dir(dir)
+        .expect("dir")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.to_string_lossy().contains(".tmp-"))
+        .collect()
+}
+
 #[test]
 fn failures_leave_nothing_behind() {
     let dir = temp("fail");
@@ -262,16 +275,23 @@ fn failures_leave_nothing_behind() {
     std::fs::write(busy.join("keep.txt"), "mine").expect("write");
     assert!(set::export(&doc, &compact, &busy).is_err());
     assert_eq!(std::fs::read(busy.join("keep.txt")).expect("kept"), b"mine");
-    // An unwritable place: an error, and no temporary folder left.
+    // A file where the target's folder should be: an error before anything is made.
     let file = dir.join("a-file");
     std::fs::write(&file, "x").expect("write");
     assert!(set::export(&doc, &compact, &file.join("set")).is_err());
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
-        .expect("dir")
-        .filter_map(Result::ok)
-        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
-        .collect();
-    assert!(leftovers.is_empty(), "{leftovers:?}");
+    assert!(temporaries(&dir).is_empty());
+    // The last step fails: the target is an (empty) mount point, which the finished set
+    // cannot replace. Every file is written by then, in the temporary folder beside it,
+    // which must go too.
+    let target = dir.join("mounted");
+    if let Some(mount) = faults::tmpfs(&target, "size=64k") {
+        let progress = kapaint::task::Progress::default();
+        let err = set::export_with(&doc, &compact, &target, &progress)
+            .expect_err("a mount point cannot be replaced");
+        assert_eq!(progress.stage(), "measure", "it failed at the end: {err}");
+        assert!(temporaries(&dir).is_empty(), "{:?}", temporaries(&dir));
+        drop(mount);
+    }
     // Broken sets are errors naming the file.
     let out = dir.join("set");
     set::export(&doc, &compact, &out).expect("export");

@@ -7,6 +7,10 @@ use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+#[path = "common/faults.rs"]
+mod faults;
+use faults::tmpfs;
+
 fn temp(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("kapaint-hostile-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -894,36 +898,6 @@ fn a_killed_saves_temporary_file_is_removed_by_the_next_save() {
     ));
     assert!(!stale.exists());
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// A tmpfs mounted for a test, unmounted when dropped.
-struct Mount(PathBuf);
-
-impl Drop for Mount {
-    fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
-    }
-}
-
-/// Mounts a tmpfs with `options` at `at` (needs root); `None`, reported, where mounting is
-/// not allowed, unless `KAPAINT_REQUIRE_FAULTS` says these tests must run (CI).
-fn tmpfs(at: &Path, options: &str) -> Option<Mount> {
-    std::fs::create_dir_all(at).expect("mount point");
-    let mounted = Command::new("mount")
-        .args(["-t", "tmpfs", "-o", options, "tmpfs"])
-        .arg(at)
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if mounted {
-        return Some(Mount(at.to_path_buf()));
-    }
-    assert!(
-        std::env::var_os("KAPAINT_REQUIRE_FAULTS").is_none(),
-        "fault tests must run here, but a tmpfs cannot be mounted"
-    );
-    eprintln!("SKIPPED: cannot mount a tmpfs (not root?)");
-    None
 }
 
 /// A project of noise in k_d and n at 512^2 (about 2 MB, none of it compressible).

@@ -171,13 +171,13 @@ fn a_stroke_across_the_sphere_seam_matches_the_same_stroke_away_from_it() {
             }
         }
     }
-    // Both sides of the seam are painted, and nothing differs from the seamless stroke by
-    // more than float noise in the baked positions (unorm16 steps).
+    // Both sides of the seam are painted, and every texel equals the seamless stroke's to
+    // one unorm16 step (float rounding of the baked positions).
     assert!(
         painted_left > 50 && painted_right > 50,
         "{painted_left} {painted_right}"
     );
-    assert!(worst <= 64, "largest difference {worst} / 65535");
+    assert!(worst <= 1, "largest difference {worst} / 65535");
 }
 
 /// A position's bits, to find vertices at the same place.
@@ -310,10 +310,18 @@ fn spacing_on_the_surface_does_not_depend_on_input_sampling() {
         flow: 0.3,
         ..BrushSettings::default()
     };
+    // Points along a curve on the sphere (an arc of its equator, winding up and down).
     let line = |n: usize| {
-        let (a, b) = (Vec3::new(0.6, 0.0, 0.8), Vec3::new(0.8, 0.0, 0.6));
         (0..=n)
-            .map(|k| at(a.lerp(b, k as f32 / n as f32)))
+            .map(|k| {
+                let t = k as f32 / n as f32;
+                let (lon, lat) = (0.64 + 0.5 * t, 0.15 * (6.0 * t).sin());
+                at(Vec3::new(
+                    lon.sin() * lat.cos(),
+                    lat.sin(),
+                    lon.cos() * lat.cos(),
+                ))
+            })
             .collect::<Vec<_>>()
     };
     let paint = |points| {
@@ -325,13 +333,15 @@ fn spacing_on_the_surface_does_not_depend_on_input_sampling() {
         .expect("stroke");
         kd_map(&doc)
     };
-    let (coarse, fine) = (paint(line(1)), paint(line(97)));
+    let (coarse, fine) = (paint(line(60)), paint(line(600)));
     let worst = coarse
         .iter()
         .zip(&fine)
         .flat_map(|(a, b)| (0..3).map(|c| (i32::from(a[c]) - i32::from(b[c])).abs()))
         .max();
-    assert!(worst.is_some_and(|d| d <= 2), "{worst:?}");
+    // The dabs drift by what the coarse chords cut off the curve's length (measured:
+    // 114 / 65535, 0.2 %, as on the UV canvas).
+    assert!(worst.is_some_and(|d| d <= 160), "{worst:?}");
 }
 
 #[test]

@@ -299,6 +299,8 @@ pub struct Document {
     pub settings: DocumentSettings,
     surface: Option<Arc<Surface>>,
     stroke: Option<ActiveStroke>,
+    /// Bumped by every command that changes the settings (which are saved too).
+    settings_version: u64,
 }
 
 impl std::fmt::Debug for Document {
@@ -321,6 +323,7 @@ impl Document {
             settings,
             surface: None,
             stroke: None,
+            settings_version: 0,
         })
     }
 
@@ -332,6 +335,7 @@ impl Document {
             settings,
             surface: None,
             stroke: None,
+            settings_version: 0,
         }
     }
 
@@ -363,8 +367,18 @@ impl Document {
     /// As [`set_surface`](Self::set_surface); nothing changes then.
     pub fn set_mesh(&mut self, mesh: MeshRef, surface: Arc<Surface>) -> Result<(), ModelError> {
         self.set_surface(Some(surface))?;
-        self.settings.mesh = mesh;
+        if self.settings.mesh != mesh {
+            self.settings.mesh = mesh;
+            self.settings_version += 1;
+        }
         Ok(())
+    }
+
+    /// A number that changes whenever anything a project file stores changes (the maps, or
+    /// a setting through a command): what "unsaved changes" and autosave compare.
+    pub fn version(&self) -> u64 {
+        // Both parts only grow, so their sum changes whenever either does.
+        self.maps.version().wrapping_add(self.settings_version)
     }
 
     /// The attached mesh surface.
@@ -391,16 +405,26 @@ impl Document {
     /// When the command cannot apply (outside the map, a mesh command with no mesh): the
     /// document is unchanged.
     pub fn apply(&mut self, command: Command) -> Result<(), ModelError> {
-        match command {
-            Command::SetBrush(b) => self.settings.brush = b.sanitized(),
-            Command::SetPrimary(v) => self.settings.primary = v.sanitized(),
-            Command::SetSecondary(v) => self.settings.secondary = v.sanitized(),
-            Command::SwapMaterials => {
-                std::mem::swap(&mut self.settings.primary, &mut self.settings.secondary);
+        /// Sets a setting, counting a change.
+        fn set<T: PartialEq>(field: &mut T, value: T, version: &mut u64) {
+            if *field != value {
+                *field = value;
+                *version += 1;
             }
-            Command::SetChannels(c) => self.settings.channels = c,
-            Command::SetModel(m) => self.settings.model = m,
-            Command::SetApprox(a) => self.settings.approx = a,
+        }
+        let v = &mut self.settings_version;
+        match command {
+            Command::SetBrush(b) => set(&mut self.settings.brush, b.sanitized(), v),
+            Command::SetPrimary(p) => set(&mut self.settings.primary, p.sanitized(), v),
+            Command::SetSecondary(p) => set(&mut self.settings.secondary, p.sanitized(), v),
+            Command::SwapMaterials => {
+                let primary = self.settings.primary;
+                let secondary = std::mem::replace(&mut self.settings.secondary, primary);
+                set(&mut self.settings.primary, secondary, v);
+            }
+            Command::SetChannels(c) => set(&mut self.settings.channels, c, v),
+            Command::SetModel(m) => set(&mut self.settings.model, m, v),
+            Command::SetApprox(a) => set(&mut self.settings.approx, a, v),
             Command::BeginStroke(tool) => self.begin_stroke(tool),
             Command::StrokeTo(p) => self.stroke_to(p)?,
             Command::EndStroke => self.end_stroke(),
@@ -434,7 +458,12 @@ impl Document {
                         self.maps.height()
                     )));
                 }
-                self.settings.primary = self.maps.value(x, y);
+                let picked = self.maps.value(x, y);
+                set(
+                    &mut self.settings.primary,
+                    picked,
+                    &mut self.settings_version,
+                );
             }
             Command::Undo => {
                 self.end_stroke();

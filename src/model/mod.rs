@@ -13,6 +13,7 @@ pub mod maps;
 pub mod paint;
 pub mod preset;
 pub mod project;
+pub mod recovery;
 pub mod stats;
 pub mod surface;
 pub mod texel;

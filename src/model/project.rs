@@ -13,7 +13,6 @@
 use std::fs::File;
 use std::io::{Read, Seek, Write};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
 
 use image::{ImageBuffer, Luma, Rgb};
 use rayon::prelude::*;
@@ -175,7 +174,10 @@ fn settings_for_file(settings: &DocumentSettings, project: &Path) -> DocumentSet
 /// The settings as loaded from a project at `project`: a relative mesh path is taken from the
 /// project's folder (projects written before paths were stored that way held paths relative
 /// to the folder they were made in: those are tried there too), and held absolute.
-fn settings_from_file(mut settings: DocumentSettings, project: &Path) -> DocumentSettings {
+pub(super) fn settings_from_file(
+    mut settings: DocumentSettings,
+    project: &Path,
+) -> DocumentSettings {
     if let MeshRef::File(mesh) = &settings.mesh {
         let mesh = Path::new(mesh);
         if mesh.is_relative() {
@@ -396,7 +398,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
 }
 
 /// Whether half-float bits hold a storable exponent: finite, not negative, at most `N_MAX`.
-fn valid_n_bits(bits: u16) -> bool {
+pub(super) fn valid_n_bits(bits: u16) -> bool {
     let v = half::f16::from_bits(bits).to_f32();
     v.is_finite() && (0.0..=N_MAX).contains(&v) && bits & 0x8000 == 0
 }
@@ -564,20 +566,6 @@ fn fill_maps(maps: &mut MaterialMaps, kd: &Raster, ks: &Raster, n: &Raster) {
     }
 }
 
-/// Where the recovery copy of a project lives: beside it as `.NAME.kapaint-recovery`, or for
-/// an unsaved document in `$XDG_STATE_HOME/kapaint` (or `~/.local/state/kapaint`).
-pub fn recovery_path(project: Option<&Path>) -> PathBuf {
-    if let Some(p) = project {
-        let dir = p.parent().unwrap_or(Path::new("."));
-        let name = p
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        return dir.join(format!(".{name}-recovery"));
-    }
-    state_dir().join("untitled.kapaint-recovery")
-}
-
 /// kapaint's state folder: `$XDG_STATE_HOME/kapaint`, else `~/.local/state/kapaint` (else
 /// the temporary folder). It may not exist yet: writers create it.
 pub fn state_dir() -> PathBuf {
@@ -589,151 +577,9 @@ pub fn state_dir() -> PathBuf {
         .join("kapaint")
 }
 
-/// Autosave timing: a recovery copy is due when the document changed since the last one and
-/// the interval has passed. The caller saves (on a worker thread in the editor) and reports.
-#[derive(Clone, Debug)]
-pub struct Autosave {
-    /// Time between recovery copies.
-    pub interval: Duration,
-    last_time: Instant,
-    last_version: u64,
-}
-
-impl Autosave {
-    /// Autosave every `interval`, counting from `now`, with `version` already safe.
-    pub fn new(interval: Duration, now: Instant, version: u64) -> Self {
-        Self {
-            interval,
-            last_time: now,
-            last_version: version,
-        }
-    }
-
-    /// Whether a recovery copy should be written now.
-    pub fn due(&self, now: Instant, version: u64) -> bool {
-        version != self.last_version && now.duration_since(self.last_time) >= self.interval
-    }
-
-    /// Records that `version` was saved at `now`.
-    pub fn saved(&mut self, now: Instant, version: u64) {
-        self.last_time = now;
-        self.last_version = version;
-    }
-}
-
-/// Autosave on a timer: [`Autosaver::poll`] (each frame, or from any loop) snapshots the
-/// document when a recovery copy is due and writes it atomically on a named background
-/// thread, so painting never waits on the disk. A snapshot costs no copy of the maps: tiles
-/// are shared copy-on-write.
-#[derive(Debug)]
-pub struct Autosaver {
-    timing: Autosave,
-    path: PathBuf,
-    job: Option<(u64, std::thread::JoinHandle<Result<(), ModelError>>)>,
-}
-
-impl Autosaver {
-    /// Writes recovery copies to `path` every `interval` while the document changes; the
-    /// document's current state (`doc.maps.version()`) counts as saved.
-    pub fn new(interval: Duration, path: PathBuf, doc: &Document) -> Self {
-        Self {
-            timing: Autosave::new(interval, Instant::now(), doc.maps.version()),
-            path,
-            job: None,
-        }
-    }
-
-    /// Where recovery copies go.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    /// Reports a finished recovery save (its result), and starts a new one if one is due.
-    pub fn poll(&mut self, doc: &Document, now: Instant) -> Option<Result<PathBuf, ModelError>> {
-        let finished = if self.job.as_ref().is_some_and(|(_, h)| h.is_finished()) {
-            self.finish()
-        } else {
-            None
-        };
-        let version = doc.maps.version();
-        if self.job.is_none() && self.timing.due(now, version) {
-            let snapshot = Document::from_parts(doc.maps.clone(), doc.settings.clone());
-            let path = self.path.clone();
-            let spawned = std::thread::Builder::new()
-                .name("kapaint-autosave".into())
-                .spawn(move || save(&snapshot, &path));
-            match spawned {
-                Ok(handle) => self.job = Some((version, handle)),
-                Err(e) => return Some(Err(ModelError::io(&self.path, e))),
-            }
-            // Counted from the start, so a failing disk is retried one interval later.
-            self.timing.saved(now, version);
-        }
-        finished
-    }
-
-    /// Waits for a save in flight, if any, and reports it.
-    pub fn wait(&mut self) -> Option<Result<PathBuf, ModelError>> {
-        self.finish()
-    }
-
-    fn finish(&mut self) -> Option<Result<PathBuf, ModelError>> {
-        let (_, handle) = self.job.take()?;
-        Some(match handle.join() {
-            Ok(result) => result.map(|()| self.path.clone()),
-            Err(_) => Err(ModelError::io(
-                &self.path,
-                std::io::Error::other("the autosave thread stopped unexpectedly"),
-            )),
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn autosaver_writes_a_loadable_recovery_copy_in_the_background() {
-        let dir = std::env::temp_dir().join(format!("kapaint-autosave-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(".a.kapaint-recovery");
-        let mut doc = Document::new(96, 64, crate::model::DocumentSettings::default()).unwrap();
-        let mut saver = Autosaver::new(Duration::from_mins(1), path.clone(), &doc);
-        let t0 = Instant::now();
-        assert!(saver.poll(&doc, t0 + Duration::from_mins(2)).is_none());
-        assert!(saver.wait().is_none(), "nothing changed, nothing written");
-        assert!(!path.exists());
-        doc.apply(crate::model::Command::Fill(crate::model::FillRegion::All))
-            .unwrap();
-        assert!(saver.poll(&doc, t0 + Duration::from_secs(121)).is_none());
-        assert_eq!(saver.wait().unwrap().unwrap(), path);
-        let back = load(&path).unwrap();
-        assert_eq!(back.maps.texel(5, 5), doc.maps.texel(5, 5));
-        assert!(saver.poll(&doc, t0 + Duration::from_secs(500)).is_none());
-        assert!(saver.wait().is_none(), "saved state is not saved again");
-
-        // A folder that does not exist: an error to show, never a panic.
-        let mut bad = Autosaver::new(Duration::ZERO, dir.join("no/such/dir/x"), &doc);
-        doc.apply(crate::model::Command::Undo).unwrap();
-        assert!(bad.poll(&doc, Instant::now()).is_none());
-        assert!(bad.wait().unwrap().is_err());
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    #[test]
-    fn autosave_is_due_only_after_a_change_and_the_interval() {
-        let t0 = Instant::now();
-        let mut autosave = Autosave::new(Duration::from_mins(1), t0, 5);
-        assert!(
-            !autosave.due(t0 + Duration::from_mins(2), 5),
-            "nothing changed"
-        );
-        assert!(!autosave.due(t0 + Duration::from_secs(30), 6), "too soon");
-        assert!(autosave.due(t0 + Duration::from_secs(61), 6));
-        autosave.saved(t0 + Duration::from_secs(61), 6);
-        assert!(!autosave.due(t0 + Duration::from_secs(100), 6));
-    }
 
     #[test]
     fn mesh_paths_are_stored_relative_to_the_project() {
@@ -748,12 +594,5 @@ mod tests {
             Some(PathBuf::from("../../m.obj"))
         );
         assert_eq!(rel("/w", "/w/./x.obj"), Some(PathBuf::from("x.obj")));
-    }
-
-    #[test]
-    fn recovery_files_sit_beside_the_project() {
-        let p = recovery_path(Some(Path::new("/work/art/cow.kapaint")));
-        assert_eq!(p, Path::new("/work/art/.cow.kapaint-recovery"));
-        assert!(recovery_path(None).ends_with("kapaint/untitled.kapaint-recovery"));
     }
 }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use super::{EditorState, JobResult, layout_path, new_document_with, notice};
+use super::{EditorState, JobResult, layout_path, new_document_with};
 use crate::export::preset::ExportPreset;
 use crate::model::document::MeshRef;
 use crate::model::{Document, DocumentSettings};
@@ -141,16 +141,15 @@ impl EditorState {
                     copy.display()
                 ));
                 ui.horizontal(|ui| {
-                    if ui.button("Recover").clicked() {
+                    // Recover is the default: Enter takes it.
+                    let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    if ui.button("Recover").clicked() || enter {
                         self.recovery_offer = None;
                         self.recover(copy.clone(), self.path.clone());
                     }
                     if ui.button("Discard").clicked() {
                         self.recovery_offer = None;
-                        if let Err(e) = std::fs::remove_file(&copy) {
-                            self.notices
-                                .push(notice(format!("{}: {e}", copy.display()), true));
-                        }
+                        crate::model::recovery::remove(&copy);
                     }
                 });
             });

@@ -29,7 +29,7 @@ use crate::model::document::MeshRef;
 use crate::model::surface::Surface;
 use crate::model::texel::Channel;
 use crate::model::texel::MaterialValue;
-use crate::model::{Command, Document, DocumentSettings, project};
+use crate::model::{Command, Document, DocumentSettings, project, recovery};
 use crate::render::{Lighting, ViewMode};
 use crate::task::Progress;
 use canvas::{Canvas, CanvasChannel};
@@ -241,7 +241,7 @@ pub struct EditorState {
     pub recovery_offer: Option<PathBuf>,
     /// Material presets with their thumbnails (rendered a few per frame).
     presets: Vec<(String, MaterialValue, Option<egui::TextureHandle>)>,
-    autosaver: project::Autosaver,
+    autosaver: recovery::Autosaver,
 }
 
 /// The editor app.
@@ -282,14 +282,23 @@ fn attach(doc: &mut Document, mesh: &Mesh) -> Result<(), String> {
 /// Loads a project and its mesh (falling back to the sphere, with a note, if the mesh file is
 /// gone).
 fn load_project(path: &Path) -> Result<(Document, Mesh, Option<String>), String> {
-    let mut doc = project::load(path).map_err(|e| e.to_string())?;
+    with_mesh(project::load(path).map_err(|e| e.to_string())?)
+}
+
+/// How often the editor autosaves: [`recovery::AUTOSAVE_INTERVAL`], or
+/// `KAPAINT_AUTOSAVE_SECONDS` (the crash test uses a short one).
+fn autosave_interval() -> Duration {
+    std::env::var("KAPAINT_AUTOSAVE_SECONDS")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .map_or(recovery::AUTOSAVE_INTERVAL, Duration::from_secs_f64)
+}
+
+/// A loaded document with its mesh attached (the sphere, with a note, if the mesh file is
+/// gone; a project holds its mesh's path absolute once loaded).
+fn with_mesh(mut doc: Document) -> Result<(Document, Mesh, Option<String>), String> {
     let spec = PathBuf::from(doc.settings.mesh.spec());
-    let spec = match path.parent() {
-        Some(dir) if spec.is_relative() && !spec.exists() && dir.join(&spec).exists() => {
-            dir.join(spec)
-        }
-        _ => spec,
-    };
     let (mesh, note) = match crate::mesh::open(&spec) {
         Ok(m) => (m, None),
         Err(e) => (
@@ -334,16 +343,19 @@ impl Editor {
         };
         let mut viewport = Viewport::new(gpu);
         viewport.frame(&mesh.mesh);
-        let recovery = project::recovery_path(path.as_deref());
+        let recovery = recovery::recovery_path(path.as_deref());
         let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
-        let recovery_offer = match (modified(&recovery), path.as_deref().and_then(modified)) {
+        let recovery_offer = match (
+            recovery::modified(&recovery),
+            path.as_deref().and_then(modified),
+        ) {
             (Some(copy), Some(saved)) if copy > saved => Some(recovery.clone()),
             (Some(_), None) => Some(recovery.clone()),
             _ => None,
         };
-        let autosaver = project::Autosaver::new(Duration::from_mins(2), recovery, &doc);
+        let autosaver = recovery::Autosaver::new(autosave_interval(), recovery, &doc);
         let dock = load_layout().unwrap_or_else(default_layout);
-        let saved_version = doc.maps.version();
+        let saved_version = doc.version();
         Self {
             state: EditorState {
                 doc,
@@ -460,9 +472,10 @@ pub mod keys {
 }
 
 impl EditorState {
-    /// Whether the maps changed since the last save.
+    /// Whether anything the project file stores (maps or settings) changed since the last
+    /// save.
     pub fn dirty(&self) -> bool {
-        self.doc.maps.version() != self.saved_version
+        self.doc.version() != self.saved_version
     }
 
     fn apply(&mut self, command: Command) {
@@ -520,11 +533,11 @@ impl EditorState {
                 self.saved_version = if recovered {
                     u64::MAX
                 } else {
-                    self.doc.maps.version()
+                    self.doc.version()
                 };
-                self.autosaver = project::Autosaver::new(
-                    Duration::from_mins(2),
-                    project::recovery_path(Some(&path)),
+                self.autosaver = recovery::Autosaver::new(
+                    autosave_interval(),
+                    recovery::recovery_path(Some(&path)),
                     &self.doc,
                 );
                 self.notices
@@ -580,11 +593,11 @@ impl EditorState {
             }
             JobResult::Created(doc) => {
                 self.replace_document(*doc);
-                self.saved_version = self.doc.maps.version();
+                self.saved_version = self.doc.version();
                 self.path = None;
-                self.autosaver = project::Autosaver::new(
-                    Duration::from_mins(2),
-                    project::recovery_path(None),
+                self.autosaver = recovery::Autosaver::new(
+                    autosave_interval(),
+                    recovery::recovery_path(None),
                     &self.doc,
                 );
             }
@@ -666,7 +679,7 @@ impl EditorState {
     /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
     pub fn save_to(&mut self, path: PathBuf) {
         let snapshot = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
-        let version = self.doc.maps.version();
+        let version = self.doc.version();
         self.start_job("Save", move |progress| {
             progress.start("save", 1);
             match project::save(&snapshot, &path) {
@@ -700,7 +713,10 @@ impl EditorState {
     fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
         self.start_job("Recover", move |progress| {
             progress.start("open", 1);
-            match load_project(&from) {
+            match recovery::load(&from)
+                .map_err(|e| e.to_string())
+                .and_then(with_mesh)
+            {
                 Ok((doc, _, _)) => {
                     JobResult::Opened(path.unwrap_or_else(|| from.clone()), Box::new(doc), true)
                 }
@@ -921,7 +937,7 @@ impl eframe::App for Editor {
         save_layout(&self.dock);
         // A clean exit leaves no recovery file behind.
         if !self.state.dirty() {
-            let _ = std::fs::remove_file(self.state.autosaver.path());
+            recovery::remove(self.state.autosaver.path());
         }
     }
 }
