@@ -80,7 +80,7 @@ fn linear(image: RenderedImage) -> (u32, u32, Vec<f32>) {
 fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
     let Some(gpu) = gpu() else { return };
     let sphere = mesh::uv_sphere(64, 32);
-    let buffers = MeshBuffers::new(&gpu, &sphere);
+    let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
     let mut preview = Preview::new(&gpu);
     for (value, model) in [
         (
@@ -97,7 +97,7 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
         ),
     ] {
         let maps = MaterialMaps::new(32, 32, value).expect("maps");
-        let textures = MapTextures::new(&gpu, &maps);
+        let textures = MapTextures::new(&gpu, &maps).expect("map textures");
         let s = settings(model, ViewMode::Ka, &sphere.positions);
         let (_, _, pixels) = linear(
             preview
@@ -191,8 +191,8 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
     let sphere = mesh::uv_sphere(64, 32);
     let bvh = Bvh::build(&sphere);
     let maps = painted_maps();
-    let buffers = MeshBuffers::new(&gpu, &sphere);
-    let textures = MapTextures::new(&gpu, &maps);
+    let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
+    let textures = MapTextures::new(&gpu, &maps).expect("map textures");
     let mut preview = Preview::new(&gpu);
     let (w, h) = (192, 192);
     for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
@@ -265,11 +265,15 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
 fn sync_uploads_only_dirty_tiles_and_the_render_follows() {
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 512, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps);
-    assert_eq!(textures.sync(&gpu, &doc.maps), 0, "nothing changed");
+    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    assert_eq!(
+        textures.sync(&gpu, &doc.maps).expect("sync"),
+        0,
+        "nothing changed"
+    );
     brush_stroke(&mut doc, &[Vec2::new(100.0, 100.0)]);
     // A 32 px dab at (100, 100) touches the 4 tiles around (64..192)^2 at most.
-    let uploaded = textures.sync(&gpu, &doc.maps);
+    let uploaded = textures.sync(&gpu, &doc.maps).expect("sync");
     assert!((1..=4).contains(&uploaded), "{uploaded} tiles");
     assert!(textures.uniform.kd.is_none(), "k_d is no longer uniform");
 }
@@ -285,8 +289,8 @@ fn split_and_side_by_side_compare_phong_left_and_blinn_right() {
     )
     .expect("maps");
     let (buffers, textures) = (
-        MeshBuffers::new(&gpu, &sphere),
-        MapTextures::new(&gpu, &maps),
+        MeshBuffers::new(&gpu, &sphere).expect("mesh buffers"),
+        MapTextures::new(&gpu, &maps).expect("map textures"),
     );
     let mut preview = Preview::new(&gpu);
     let (w, h) = (96_u32, 64_u32);
@@ -354,7 +358,7 @@ fn split_and_side_by_side_compare_phong_left_and_blinn_right() {
 fn extreme_maps_shade_to_finite_colours() {
     let Some(gpu) = gpu() else { return };
     let sphere = mesh::uv_sphere(32, 16);
-    let buffers = MeshBuffers::new(&gpu, &sphere);
+    let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
     let mut preview = Preview::new(&gpu);
     for value in [
         MaterialValue::new(Vec3::ONE, Vec3::ONE, 0.0),
@@ -362,7 +366,7 @@ fn extreme_maps_shade_to_finite_colours() {
         MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 1e-3),
     ] {
         let maps = MaterialMaps::new(8, 8, value).expect("maps");
-        let textures = MapTextures::new(&gpu, &maps);
+        let textures = MapTextures::new(&gpu, &maps).expect("map textures");
         for view in ViewMode::ALL {
             for approx in [
                 AmbientApprox::Fast,
@@ -496,9 +500,9 @@ fn render_cli_writes_numerically_checkable_data_views() {
 fn mips_follow_the_dirty_tiles() {
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 512, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
     brush_stroke(&mut doc, &[Vec2::new(90.0, 100.0), Vec2::new(300.0, 140.0)]);
-    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
     // Level 2 holds the 4 x 4 box means; the 1 x 1 level the mean of the whole map.
     assert_box_means(&gpu, &textures, &doc.maps, 2);
     assert_box_means(&gpu, &textures, &doc.maps, 9);
@@ -510,7 +514,7 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     // Not a multiple of the tile size: edge tiles are partial, levels round down.
     let (w, h) = (200_usize, 120_usize);
     let mut doc = Document::new(w as u32, h as u32, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
     doc.apply(Command::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.2, 0.1),
         Vec3::splat(0.7),
@@ -518,7 +522,7 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     )))
     .expect("primary");
     brush_stroke(&mut doc, &[Vec2::new(20.0, 30.0), Vec2::new(190.0, 110.0)]);
-    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
     for level in 1..textures.kd.mip_level_count() {
         assert_box_means(&gpu, &textures, &doc.maps, level);
     }
@@ -538,14 +542,14 @@ fn without_16_bit_norm_textures_the_maps_upload_as_half_floats() {
     )))
     .expect("primary");
     brush_stroke(&mut doc, &[Vec2::new(20.0, 30.0), Vec2::new(190.0, 110.0)]);
-    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
     assert_eq!(textures.kd.format(), wgpu::TextureFormat::Rgba16Float);
     for level in 0..textures.kd.mip_level_count() {
         assert_box_means(&gpu, &textures, &doc.maps, level);
     }
     // A later stroke updates its tiles and the levels over them.
     brush_stroke(&mut doc, &[Vec2::new(150.0, 10.0), Vec2::new(10.0, 100.0)]);
-    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
     for level in 0..textures.kd.mip_level_count() {
         assert_box_means(&gpu, &textures, &doc.maps, level);
     }
@@ -659,7 +663,7 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
         Vec2::new(10.0, 10.0),
         Vec2::new(2040.0, 1500.0),
     );
-    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
     for level in [0, 3, 9] {
         assert_box_means(&gpu, &textures, &doc.maps, level);
     }
@@ -671,7 +675,7 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
         Vec2::new(2000.0, 30.0),
         Vec2::new(30.0, 1400.0),
     );
-    assert!(textures.sync(&gpu, &doc.maps) > 50);
+    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 50);
     for level in [0, 1, 6, 7, 10] {
         assert_box_means(&gpu, &textures, &doc.maps, level);
     }
@@ -682,12 +686,12 @@ fn a_stroke_on_some_channels_stages_only_those() {
     use kapaint::model::Channels;
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 384, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps);
+    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
     let mut dab = |doc: &mut Document, channels: Channels, value: MaterialValue| {
         doc.apply(Command::SetChannels(channels)).expect("channels");
         doc.apply(Command::SetPrimary(value)).expect("primary");
         brush_stroke(doc, &[Vec2::new(200.0, 150.0)]);
-        assert!(textures.sync(&gpu, &doc.maps) > 0);
+        assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
         for level in [0, 1, 3, 7] {
             assert_box_means(&gpu, &textures, &doc.maps, level);
         }
@@ -724,7 +728,7 @@ fn a_stroke_on_some_channels_stages_only_those() {
     assert!(n * 10 < all * 2, "n only staged {n} of {all} bytes");
     // Undo puts back whole tiles: every channel again, and still mirrored.
     doc.apply(Command::Undo).expect("undo");
-    assert!(textures.sync(&gpu, &doc.maps) > 0);
+    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
     assert_eq!(textures.staged_bytes(), all);
     for level in [0, 2, 8] {
         assert_box_means(&gpu, &textures, &doc.maps, level);
@@ -931,8 +935,8 @@ fn difference_heatmap_on_the_gpu_matches_the_cpu_ramp() {
     )
     .expect("maps");
     let (buffers, textures) = (
-        MeshBuffers::new(&gpu, &sphere),
-        MapTextures::new(&gpu, &maps),
+        MeshBuffers::new(&gpu, &sphere).expect("mesh buffers"),
+        MapTextures::new(&gpu, &maps).expect("map textures"),
     );
     let mut preview = Preview::new(&gpu);
     let (w, h) = (80_u32, 60_u32);
@@ -987,4 +991,86 @@ fn difference_heatmap_on_the_gpu_matches_the_cpu_ramp() {
         }
     }
     assert!(hot > 0, "the two models differ somewhere on the sphere");
+}
+
+/// A device like a smaller GPU's: textures up to 1024 texels a side, buffers up to 8 MiB.
+fn small_gpu() -> Option<Gpu> {
+    gpu()?;
+    let adapter = Gpu::adapter().expect("adapter");
+    let limits = wgpu::Limits {
+        max_texture_dimension_2d: 1024,
+        max_buffer_size: 8 << 20,
+        ..adapter.limits()
+    };
+    Some(Gpu::from_adapter_with_limits(&adapter, limits).expect("device"))
+}
+
+#[test]
+fn what_does_not_fit_the_gpu_is_an_error_not_a_panic() {
+    let Some(gpu) = small_gpu() else { return };
+    let sphere = mesh::uv_sphere(32, 16);
+    let buffers = MeshBuffers::new(&gpu, &sphere).expect("a small mesh fits");
+    // Maps beyond the largest texture.
+    let big = MaterialMaps::new(2048, 2048, MaterialValue::default()).expect("maps");
+    let err = MapTextures::new(&gpu, &big).expect_err("2048^2 does not fit");
+    assert!(err.to_string().contains("does not fit this GPU"), "{err}");
+    // A read-back beyond the largest buffer: 1024^2 linear RGBA floats are 16 MiB, caught by
+    // the error scope around the render.
+    let small = MaterialMaps::new(64, 64, MaterialValue::default()).expect("maps");
+    let textures = MapTextures::new(&gpu, &small).expect("64^2 fits");
+    let settings = settings(ShadingModel::Phong, ViewMode::Ka, &sphere.positions);
+    let mut preview = Preview::new(&gpu);
+    let offscreen = |size| Offscreen {
+        size,
+        linear: true,
+        layout: Layout::Single,
+    };
+    let rendered = preview.render_offscreen(
+        &gpu,
+        &buffers,
+        &textures,
+        &settings,
+        offscreen((1024, 1024)),
+    );
+    let Err(err) = rendered else {
+        panic!("a read-back larger than the largest buffer rendered");
+    };
+    assert!(
+        err.to_string().starts_with("rendering the preview"),
+        "{err}"
+    );
+    assert!(!err.to_string().contains('\n'), "one line: {err}");
+    // The device still works after both.
+    let image = preview
+        .render_offscreen(&gpu, &buffers, &textures, &settings, offscreen((64, 64)))
+        .expect("a small render");
+    assert!(matches!(image, RenderedImage::Linear { .. }));
+}
+
+#[test]
+fn a_lost_device_is_an_error_not_a_panic() {
+    let Some(gpu) = gpu() else { return };
+    let sphere = mesh::uv_sphere(32, 16);
+    let maps = MaterialMaps::new(64, 64, MaterialValue::default()).expect("maps");
+    let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh");
+    let mut textures = MapTextures::new(&gpu, &maps).expect("maps");
+    let mut preview = Preview::new(&gpu);
+    gpu.device.destroy();
+    gpu.wait();
+    let settings = settings(ShadingModel::Phong, ViewMode::Shaded, &sphere.positions);
+    let offscreen = Offscreen {
+        size: (32, 32),
+        linear: false,
+        layout: Layout::Single,
+    };
+    assert!(MapTextures::new(&gpu, &maps).is_err());
+    assert!(MeshBuffers::new(&gpu, &sphere).is_err());
+    assert!(
+        preview
+            .render_offscreen(&gpu, &buffers, &textures, &settings, offscreen)
+            .is_err()
+    );
+    let mut doc = Document::new(64, 64, DocumentSettings::default()).expect("doc");
+    doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+    assert!(textures.sync(&gpu, &doc.maps).is_err());
 }

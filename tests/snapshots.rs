@@ -133,8 +133,8 @@ fn the_main_views_match_their_snapshots() {
     let texture = testdata("spot_texture.png");
     import::import_file(&mut doc, Channel::Kd, &texture).expect("k_d");
     import::import_file(&mut doc, Channel::N, &texture).expect("n");
-    let buffers = MeshBuffers::new(&gpu, &mesh);
-    let maps = MapTextures::new(&gpu, &doc.maps);
+    let buffers = MeshBuffers::new(&gpu, &mesh).expect("mesh buffers");
+    let maps = MapTextures::new(&gpu, &doc.maps).expect("map textures");
     let mut preview = Preview::new(&gpu);
     let settings = |model, view| FrameSettings {
         model,

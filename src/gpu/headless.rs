@@ -59,8 +59,8 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
     let kind = kind_of(&req.out)?;
     let (width, height) = req.size;
     let mut preview = Preview::new(gpu);
-    let mesh = MeshBuffers::new(gpu, req.mesh);
-    let maps = MapTextures::new(gpu, req.maps);
+    let mesh = MeshBuffers::new(gpu, req.mesh)?;
+    let maps = MapTextures::new(gpu, req.maps)?;
     let linear = kind == Kind::Exr || req.settings.view.is_data();
     let mut note = String::new();
     let pixels: RenderedImage = if let Some(layout) = Layout::of(req.compare, 0.5, width) {

@@ -78,7 +78,26 @@ impl std::fmt::Debug for MapTextures {
 
 impl MapTextures {
     /// Creates the textures for `maps` and uploads every tile.
-    pub fn new(gpu: &Gpu, maps: &MaterialMaps) -> Self {
+    ///
+    /// # Errors
+    /// Maps larger than the device's largest texture, or a device that is out of memory or
+    /// lost: an error to show, never a panic.
+    pub fn new(gpu: &Gpu, maps: &MaterialMaps) -> Result<Self, super::GpuError> {
+        gpu.check_texture_size("a map", (maps.width(), maps.height()))?;
+        let mut out = gpu.checked("making the map textures", || Self::textures(gpu, maps))?;
+        let all: Vec<usize> = (0..maps.tile_count()).collect();
+        // A failed upload leaves the version at 0: the next sync tries every tile again.
+        if gpu
+            .checked("uploading the maps", || out.upload(gpu, maps, &all, 0))?
+            .is_ok()
+        {
+            out.version = maps.version();
+        }
+        Ok(out)
+    }
+
+    /// The textures for `maps`, nothing uploaded yet.
+    fn textures(gpu: &Gpu, maps: &MaterialMaps) -> Self {
         let size = wgpu::Extent3d {
             width: maps.width(),
             height: maps.height(),
@@ -104,7 +123,7 @@ impl MapTextures {
         } else {
             wgpu::TextureFormat::Rgba16Float
         };
-        let mut out = Self {
+        Self {
             kd: texture("k_d", rgb_format),
             ks: texture("k_s", rgb_format),
             n: texture("n", wgpu::TextureFormat::R16Float),
@@ -115,13 +134,7 @@ impl MapTextures {
             top_sums: TopSums::new(maps.tiles_x() as usize, maps.tiles_y() as usize),
             staging: StagingPool::default(),
             staged_bytes: 0,
-        };
-        let all: Vec<usize> = (0..maps.tile_count()).collect();
-        // A failed upload leaves the version at 0: the next sync tries every tile again.
-        if out.upload(gpu, maps, &all, 0).is_ok() {
-            out.version = maps.version();
         }
-        out
     }
 
     /// Bytes the last sync staged (and copied into the textures), for tests and diagnostics.
@@ -137,17 +150,26 @@ impl MapTextures {
     /// Uploads the tiles changed since the last sync; returns how many. Maps of another size
     /// need new textures ([`MapTextures::new`]). If staging fails (the device is out of
     /// memory), nothing is marked synced and the next sync tries the same tiles again.
-    pub fn sync(&mut self, gpu: &Gpu, maps: &MaterialMaps) -> usize {
+    ///
+    /// # Errors
+    /// The device was lost or broke down during the upload.
+    pub fn sync(&mut self, gpu: &Gpu, maps: &MaterialMaps) -> Result<usize, super::GpuError> {
         if maps.version() == self.version {
-            return 0;
+            return Ok(0);
         }
         let dirty = maps.tiles_changed_since(self.version);
-        if self.upload(gpu, maps, &dirty, self.version).is_err() {
-            return 0;
+        let from = self.version;
+        if gpu
+            .checked("uploading the maps", || {
+                self.upload(gpu, maps, &dirty, from)
+            })?
+            .is_err()
+        {
+            return Ok(0);
         }
         self.uniform = UniformChannels::of(maps);
         self.version = maps.version();
-        dirty.len()
+        Ok(dirty.len())
     }
 
     /// Reads mip `level` of one texture back (RGBA u16 per texel for `k_d`/`k_s`, u16 for `n`;

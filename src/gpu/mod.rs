@@ -9,6 +9,7 @@ pub mod preview;
 mod upload;
 
 use std::fmt;
+use std::sync::{Arc, Mutex};
 
 pub use maps::MapTextures;
 pub use preview::{Layout, MeshBuffers, Offscreen, Preview, RenderedImage};
@@ -35,12 +36,72 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// Whether 16-bit normalised textures are available (else `k_d`/`k_s` use half floats).
     pub unorm16: bool,
+    /// Errors no scope caught, and the loss of the device: kept here for the next
+    /// [`Gpu::checked`] call to report, instead of wgpu's default panic.
+    faults: Arc<DeviceFaults>,
+}
+
+/// What went wrong on a device outside the error scopes of [`Gpu::checked`].
+#[derive(Debug, Default)]
+struct DeviceFaults {
+    lost: Mutex<Option<String>>,
+    uncaptured: Mutex<Option<String>>,
+}
+
+/// Open out-of-memory and validation error scopes on a device (see [`Gpu::scope`]).
+#[derive(Debug)]
+pub struct ErrorScope {
+    memory: wgpu::ErrorScopeGuard,
+    validation: wgpu::ErrorScopeGuard,
+    faults: Arc<DeviceFaults>,
+}
+
+impl ErrorScope {
+    /// Closes the scopes: an error naming `what` if the work in them failed.
+    ///
+    /// # Errors
+    /// The device ran out of memory, the work broke a rule of the device, or the device was
+    /// lost meanwhile.
+    pub fn finish(self, what: &str) -> Result<(), GpuError> {
+        let invalid = pollster::block_on(self.validation.pop());
+        let out_of_memory = pollster::block_on(self.memory.pop());
+        if let Some(e) = out_of_memory {
+            return Err(GpuError(format!(
+                "{what}: the GPU is out of memory ({})",
+                one_line(&e.to_string())
+            )));
+        }
+        if let Some(e) = invalid {
+            return Err(GpuError(format!("{what}: {}", one_line(&e.to_string()))));
+        }
+        self.faults.check()
+    }
+}
+
+impl DeviceFaults {
+    /// An error once the device was lost, or once an error escaped every scope (reported
+    /// once).
+    fn check(&self) -> Result<(), GpuError> {
+        if let Some(reason) = self.lost.lock().ok().and_then(|l| l.clone()) {
+            return Err(GpuError(format!("the GPU device was lost ({reason})")));
+        }
+        if let Some(e) = self.uncaptured.lock().ok().and_then(|mut u| u.take()) {
+            return Err(GpuError(format!("GPU error: {e}")));
+        }
+        Ok(())
+    }
+}
+
+/// `text` on one line.
+fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 impl fmt::Debug for Gpu {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Gpu")
             .field("adapter", &self.info.name)
+            .field("faults", &self.faults)
             .field("backend", &self.info.backend)
             .field("unorm16", &self.unorm16)
             .finish_non_exhaustive()
@@ -61,6 +122,90 @@ pub fn shader_source(main: &str) -> String {
 }
 
 impl Gpu {
+    /// Wraps a device (opened here or by eframe): its uncaptured errors and its loss are
+    /// recorded for [`Gpu::checked`] to report, never a panic.
+    pub fn on_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        let unorm16 = device
+            .features()
+            .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM);
+        let faults = Arc::new(DeviceFaults::default());
+        let seen = Arc::clone(&faults);
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut slot) = seen.uncaptured.lock() {
+                slot.get_or_insert_with(|| one_line(&e.to_string()));
+            }
+        }));
+        let seen = Arc::clone(&faults);
+        device.set_device_lost_callback(move |reason, message| {
+            if let Ok(mut slot) = seen.lost.lock() {
+                slot.get_or_insert_with(|| one_line(&format!("{reason:?}: {message}")));
+            }
+        });
+        Self {
+            device,
+            queue,
+            info,
+            unorm16,
+            faults,
+        }
+    }
+
+    /// `Ok` while the device works: an error once it was lost, or once an error escaped
+    /// every scope (reported once).
+    ///
+    /// # Errors
+    /// The device was lost, or an uncaptured error happened.
+    pub fn healthy(&self) -> Result<(), GpuError> {
+        self.faults.check()
+    }
+
+    /// Runs `work` (allocations, uploads, a frame, a read-back) inside out-of-memory and
+    /// validation error scopes: what fails in it is an error naming `what`, never a panic.
+    ///
+    /// # Errors
+    /// The device is lost or out of memory, or `work` broke a rule of the device (a texture
+    /// or buffer beyond its limits).
+    pub fn checked<T>(&self, what: &str, work: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let scope = self.scope()?;
+        let value = work();
+        scope.finish(what)?;
+        Ok(value)
+    }
+
+    /// Opens the error scopes of [`Gpu::checked`] for work that needs the `Gpu`'s owner
+    /// mutably; [`ErrorScope::finish`] closes them.
+    ///
+    /// # Errors
+    /// The device is already lost or broken.
+    pub fn scope(&self) -> Result<ErrorScope, GpuError> {
+        self.healthy()?;
+        let memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        Ok(ErrorScope {
+            memory,
+            validation,
+            faults: Arc::clone(&self.faults),
+        })
+    }
+
+    /// `Ok` when a 2D texture of `size` texels fits the device's limits.
+    ///
+    /// # Errors
+    /// A side of zero or beyond the device's largest texture.
+    pub fn check_texture_size(
+        &self,
+        what: &str,
+        (width, height): (u32, u32),
+    ) -> Result<(), GpuError> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(GpuError(format!(
+                "{what} of {width}x{height} texels does not fit this GPU (its largest texture is {max}x{max})"
+            )));
+        }
+        Ok(())
+    }
+
     /// A 2D texture of one mip level and one sample, `size` texels.
     pub fn texture_2d(
         &self,
@@ -90,20 +235,7 @@ impl Gpu {
     /// # Errors
     /// When no adapter is found or the device cannot be created.
     pub fn headless() -> Result<Self, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| {
-            GpuError(format!(
-                "no GPU adapter found ({e}); install a Vulkan driver (e.g. Mesa's lavapipe, package mesa-vulkan-drivers)"
-            ))
-        })?;
-        Self::from_adapter(&adapter)
+        Self::from_adapter(&Self::adapter()?)
     }
 
     /// A device on `adapter`, with the features and limits the preview uses when offered.
@@ -111,6 +243,18 @@ impl Gpu {
     /// # Errors
     /// When the device cannot be created.
     pub fn from_adapter(adapter: &wgpu::Adapter) -> Result<Self, GpuError> {
+        Self::from_adapter_with_limits(adapter, adapter.limits())
+    }
+
+    /// A device on `adapter` with `limits` (at most the adapter's): a smaller GPU, for
+    /// tests of what does not fit.
+    ///
+    /// # Errors
+    /// When the device cannot be created.
+    pub fn from_adapter_with_limits(
+        adapter: &wgpu::Adapter,
+        limits: wgpu::Limits,
+    ) -> Result<Self, GpuError> {
         let unorm16 = adapter
             .features()
             .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM);
@@ -123,15 +267,30 @@ impl Gpu {
             label: Some("kapaint"),
             required_features,
             // The adapter's own limits: 8192^2 maps need more than the portable defaults.
-            required_limits: adapter.limits(),
+            required_limits: limits,
             ..Default::default()
         }))
         .map_err(|e| GpuError(format!("cannot open the GPU device: {e}")))?;
-        Ok(Self {
-            device,
-            queue,
-            info: adapter.get_info(),
-            unorm16,
+        Ok(Self::on_device(device, queue, adapter.get_info()))
+    }
+
+    /// The first adapter wgpu finds without a display.
+    ///
+    /// # Errors
+    /// When there is none.
+    pub fn adapter() -> Result<wgpu::Adapter, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| {
+            GpuError(format!(
+                "no GPU adapter found ({e}); install a Vulkan driver (e.g. Mesa's lavapipe, package mesa-vulkan-drivers)"
+            ))
         })
     }
 

@@ -58,7 +58,22 @@ impl std::fmt::Debug for MeshBuffers {
 
 impl MeshBuffers {
     /// Uploads `mesh` (a mesh without UVs gets UV (0, 0): it previews, it cannot be painted).
-    pub fn new(gpu: &Gpu, mesh: &Mesh) -> Self {
+    ///
+    /// # Errors
+    /// Buffers beyond the device's limits, or a device out of memory or lost.
+    pub fn new(gpu: &Gpu, mesh: &Mesh) -> Result<Self, GpuError> {
+        let max = gpu.device.limits().max_buffer_size;
+        let bytes = (mesh.positions.len() * std::mem::size_of::<Vertex>()) as u64;
+        if bytes > max {
+            return Err(GpuError(format!(
+                "the mesh's {} vertices need {bytes} bytes, more than this GPU's largest buffer ({max})",
+                mesh.positions.len()
+            )));
+        }
+        gpu.checked("uploading the mesh", || Self::upload(gpu, mesh))
+    }
+
+    fn upload(gpu: &Gpu, mesh: &Mesh) -> Self {
         use wgpu::util::DeviceExt;
         let vertices: Vec<Vertex> = (0..mesh.positions.len())
             .map(|i| Vertex {
@@ -566,6 +581,21 @@ impl Preview {
     /// # Errors
     /// When the size is zero or above the device's texture limit, or the read-back fails.
     pub fn render_offscreen(
+        &mut self,
+        gpu: &Gpu,
+        mesh: &MeshBuffers,
+        maps: &MapTextures,
+        settings: &FrameSettings,
+        offscreen: Offscreen,
+    ) -> Result<RenderedImage, GpuError> {
+        let scope = gpu.scope()?;
+        let image = self.render_offscreen_in_scope(gpu, mesh, maps, settings, offscreen);
+        scope.finish("rendering the preview")?;
+        image
+    }
+
+    /// [`Preview::render_offscreen`], inside its error scope.
+    fn render_offscreen_in_scope(
         &mut self,
         gpu: &Gpu,
         mesh: &MeshBuffers,

@@ -8,13 +8,13 @@ use std::time::Instant;
 use eframe::egui_wgpu;
 use egui::{Color32, Pos2, Rect, Sense, TextureId};
 
-use crate::gpu::Gpu;
 use crate::gpu::difference::{Difference, SIDE_FORMAT};
 use crate::gpu::maps::MapTextures;
 use crate::gpu::preview::Layout;
 use crate::gpu::preview::{
     DEPTH_FORMAT, DrawPart, MeshBuffers, Offscreen, PipelineKey, Preview, RenderedImage,
 };
+use crate::gpu::{Gpu, GpuError};
 use crate::mesh::Mesh;
 use crate::mesh::pick::{Bvh, Hit};
 use crate::model::texel::MaterialValue;
@@ -105,16 +105,11 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 impl ViewportGpu {
     /// The viewport's renderer on eframe's device.
     pub fn new(render_state: &egui_wgpu::RenderState) -> Self {
-        let device = render_state.device.clone();
-        let unorm16 = device
-            .features()
-            .contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM);
-        let gpu = Gpu {
-            device,
-            queue: render_state.queue.clone(),
-            info: render_state.adapter.get_info(),
-            unorm16,
-        };
+        let gpu = Gpu::on_device(
+            render_state.device.clone(),
+            render_state.queue.clone(),
+            render_state.adapter.get_info(),
+        );
         let preview = Preview::new(&gpu);
         let difference = Difference::new(&gpu);
         Self {
@@ -137,10 +132,10 @@ impl ViewportGpu {
         size: u32,
     ) -> Option<egui::ColorImage> {
         if self.mesh.as_ref().is_none_or(|(id, _)| *id != mesh.0) {
-            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)));
+            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1).ok()?));
         }
         let maps = MaterialMaps::new(1, 1, value).ok()?;
-        let textures = MapTextures::new(&self.gpu, &maps);
+        let textures = MapTextures::new(&self.gpu, &maps).ok()?;
         let (_, buffers) = self.mesh.as_ref()?;
         let offscreen = Offscreen {
             size: (size, size),
@@ -170,6 +165,10 @@ impl ViewportGpu {
     }
 
     /// Renders a frame of `size` pixels; returns the texture egui shows.
+    ///
+    /// # Errors
+    /// A mesh, maps or picture beyond the device's limits, or a device out of memory or
+    /// lost: the viewport says so, and painting goes on.
     fn render(
         &mut self,
         doc: &Document,
@@ -177,26 +176,50 @@ impl ViewportGpu {
         settings: &FrameSettings,
         comparison: &Comparison,
         size: (u32, u32),
-    ) -> TextureId {
+    ) -> Result<TextureId, GpuError> {
         if self.mesh.as_ref().is_none_or(|(id, _)| *id != mesh.0) {
-            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)));
+            self.mesh = None;
+            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)?));
         }
         let maps_size = (doc.maps.width(), doc.maps.height());
         match &mut self.maps {
             Some(m) if m.size() == maps_size => {
-                m.sync(&self.gpu, &doc.maps);
+                m.sync(&self.gpu, &doc.maps)?;
             }
-            _ => self.maps = Some(MapTextures::new(&self.gpu, &doc.maps)),
+            _ => {
+                self.maps = None;
+                self.maps = Some(MapTextures::new(&self.gpu, &doc.maps)?);
+            }
         }
         if self.target.as_ref().is_none_or(|t| t.size != size) {
-            self.target = Some(self.make_target(size));
+            self.gpu.check_texture_size("the viewport", size)?;
+            let scope = self.gpu.scope()?;
+            let target = self.make_target(size);
+            scope.finish("making the viewport")?;
+            self.target = Some(target);
         }
         if comparison.mode == Compare::Difference
             && let Some(target) = &mut self.target
             && target.sides.is_none()
         {
-            target.sides = Some((side_texture(&self.gpu, size), side_texture(&self.gpu, size)));
+            let gpu = &self.gpu;
+            target.sides = Some(gpu.checked("making the difference view", || {
+                (side_texture(gpu, size), side_texture(gpu, size))
+            })?);
         }
+        let scope = self.gpu.scope()?;
+        let id = self.draw(settings, comparison, size);
+        scope.finish("drawing the viewport")?;
+        Ok(id)
+    }
+
+    /// Records and submits the frame into the current target.
+    fn draw(
+        &mut self,
+        settings: &FrameSettings,
+        comparison: &Comparison,
+        size: (u32, u32),
+    ) -> TextureId {
         let (Some((_, mesh)), Some(maps), Some(target)) = (&self.mesh, &self.maps, &self.target)
         else {
             return TextureId::default();
@@ -327,6 +350,8 @@ pub struct Viewport {
     pub frame_ms: f32,
     /// Why there is no GPU, for the placeholder.
     pub no_gpu: String,
+    /// Why the last frame could not be drawn (a map beyond the GPU's limits, a lost device).
+    pub gpu_error: Option<String>,
     frame_pending: bool,
     /// The compare mode the camera was last framed for.
     framed_for: Compare,
@@ -341,6 +366,7 @@ impl Viewport {
             gpu,
             frame_ms: 0.0,
             no_gpu: "The 3D preview needs a GPU (wgpu); painting on the mesh still works.".into(),
+            gpu_error: None,
             frame_pending: true,
             framed_for: Compare::Single,
         }
@@ -441,14 +467,30 @@ impl Viewport {
         match &mut self.gpu {
             Some(gpu) => {
                 let start = Instant::now();
-                let id = gpu.render(doc, mesh, &frame, &self.comparison, size);
-                self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
-                painter.image(
-                    id,
-                    rect,
-                    Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
-                    Color32::WHITE,
-                );
+                match gpu.render(doc, mesh, &frame, &self.comparison, size) {
+                    Ok(id) => {
+                        self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
+                        self.gpu_error = None;
+                        painter.image(
+                            id,
+                            rect,
+                            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+                            Color32::WHITE,
+                        );
+                    }
+                    Err(e) => {
+                        painter.text(
+                            rect.center(),
+                            egui::Align2::CENTER_CENTER,
+                            format!(
+                                "The 3D preview cannot draw: {e}\nPainting on the UV canvas and saving still work."
+                            ),
+                            egui::FontId::proportional(14.0),
+                            Color32::from_rgb(230, 120, 110),
+                        );
+                        self.gpu_error = Some(e.to_string());
+                    }
+                }
             }
             None => {
                 painter.text(
