@@ -99,12 +99,26 @@ pub(super) fn recent_path() -> Option<PathBuf> {
 pub(super) fn load_recent() -> Vec<PathBuf> {
     recent_path()
         .and_then(|p| crate::file_check::read_limited(&p, 1 << 20).ok())
-        .and_then(|text| serde_json::from_slice::<Vec<PathBuf>>(&text).ok())
-        .map(|mut list| {
-            list.truncate(RECENT_MAX);
-            list
-        })
+        .map(|text| parse_recent(&text))
         .unwrap_or_default()
+}
+
+/// The recent-files list from its JSON: at most [`RECENT_MAX`] entries, each a path of at
+/// most 4096 bytes without control characters (anything else is dropped, a list that does
+/// not parse is empty).
+pub fn parse_recent(json: &[u8]) -> Vec<PathBuf> {
+    let Ok(list) = serde_json::from_slice::<Vec<String>>(json) else {
+        return Vec::new();
+    };
+    list.into_iter()
+        .filter(|p| {
+            !p.is_empty()
+                && crate::model::check::bounded_text("path", p, crate::model::check::MAX_PATH_BYTES)
+                    .is_ok()
+        })
+        .take(RECENT_MAX)
+        .map(PathBuf::from)
+        .collect()
 }
 
 pub(super) fn save_recent(list: &[PathBuf]) {

@@ -12,7 +12,7 @@ mod panels;
 pub mod viewport;
 
 use dialogs::{ExportDialog, load_recent};
-pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, push_recent};
+pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, parse_recent, push_recent};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -413,19 +413,54 @@ fn layout_path() -> Option<PathBuf> {
 
 /// The saved layout, if there is a readable one holding both tabs.
 fn load_layout() -> Option<DockState<Tab>> {
-    let text = crate::file_check::read_limited(&layout_path()?, 1 << 20).ok()?;
-    let dock: DockState<Tab> = serde_json::from_slice(&text).ok()?;
+    parse_layout(&crate::file_check::read_limited(&layout_path()?, 1 << 20).ok()?)
+}
+
+/// A dock layout from its JSON, if it parses and holds both tabs (the `null` coordinates
+/// earlier versions wrote read as 0).
+pub fn parse_layout(json: &[u8]) -> Option<DockState<Tab>> {
+    let mut value: serde_json::Value = serde_json::from_slice(json).ok()?;
+    finite_points(&mut value);
+    let dock: DockState<Tab> = serde_json::from_value(value).ok()?;
     (dock.find_tab(&Tab::Viewport).is_some() && dock.find_tab(&Tab::Canvas).is_some())
         .then_some(dock)
 }
 
 /// Saves the layout (atomically; failures only cost the layout).
 fn save_layout(dock: &DockState<Tab>) {
-    if let (Some(path), Ok(json)) = (layout_path(), serde_json::to_vec(dock)) {
+    if let (Some(path), Some(json)) = (layout_path(), layout_json(dock)) {
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
         let _ = crate::atomic::write_atomic(&path, &json);
+    }
+}
+
+/// The layout as JSON that [`parse_layout`] reads back, or `None` if it would not (nothing
+/// unreadable is ever written).
+pub fn layout_json(dock: &DockState<Tab>) -> Option<Vec<u8>> {
+    let mut value = serde_json::to_value(dock).ok()?;
+    finite_points(&mut value);
+    let json = serde_json::to_vec(&value).ok()?;
+    parse_layout(&json).is_some().then_some(json)
+}
+
+/// egui_dock keeps each node's last on-screen rectangle, which is infinite before the first
+/// frame: JSON writes those coordinates as `null`, which no number reads back. They are
+/// recomputed every frame, so 0 stands in for them.
+fn finite_points(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Object(map) => {
+            for (key, v) in map.iter_mut() {
+                if v.is_null() && (key == "x" || key == "y") {
+                    *v = serde_json::Value::from(0.0);
+                } else {
+                    finite_points(v);
+                }
+            }
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(finite_points),
+        _ => {}
     }
 }
 
@@ -873,6 +908,11 @@ impl TabViewer for Tabs<'_> {
 }
 
 impl Editor {
+    /// Replaces the dock layout (as a saved one is restored at start).
+    pub fn set_layout(&mut self, dock: DockState<Tab>) {
+        self.dock = dock;
+    }
+
     /// One frame of the whole editor.
     pub fn frame(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
