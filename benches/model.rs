@@ -225,5 +225,76 @@ fn project_io(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, dabs, fills_and_derive, project_io);
+/// Autosave on a 4096^2 painted document after a 256 px stroke: what the UI thread pays to
+/// start a recovery record (a snapshot of the changed tiles and a thread), and the whole
+/// record written and flushed to disk on its thread.
+fn autosave(c: &mut Criterion) {
+    use kapaint::model::recovery::Autosaver;
+    use std::time::Instant;
+    let mut group = c.benchmark_group("autosave_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(10));
+    let mut doc = painted_document(SIDE);
+    doc.apply(Command::SetBrush(BrushSettings {
+        radius_px: 128.0,
+        ..BrushSettings::default()
+    }))
+    .expect("brush");
+    let dir = std::env::temp_dir().join(format!("kapaint-bench-autosave-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut saver = Autosaver::new(Duration::ZERO, dir.join(".p.kapaint-recovery"), &doc);
+    let mut y = 200.0_f32;
+    let mut stroke = |doc: &mut Document| {
+        y = if y > 3800.0 { 200.0 } else { y + 300.0 };
+        doc.apply(Command::Stroke {
+            tool: StrokeTool::Brush,
+            points: vec![
+                StrokePoint {
+                    pos: Vec2::new(1000.0, y),
+                    pressure: 1.0,
+                },
+                StrokePoint {
+                    pos: Vec2::new(1128.0, y),
+                    pressure: 1.0,
+                },
+            ],
+        })
+        .expect("stroke");
+    };
+    // The first recovery copy is the whole project; the ones measured append to it.
+    stroke(&mut doc);
+    saver.poll(&doc, Instant::now());
+    saver.wait().expect("a save").expect("saved");
+    group.bench_function("ui_thread_starts_a_record_after_a_256px_stroke", |b| {
+        b.iter_custom(|rounds| {
+            let mut spent = Duration::ZERO;
+            for _ in 0..rounds {
+                stroke(&mut doc);
+                let start = Instant::now();
+                black_box(saver.poll(&doc, Instant::now()));
+                spent += start.elapsed();
+                saver.wait().expect("a save").expect("saved");
+            }
+            spent
+        });
+    });
+    group.bench_function("record_after_a_256px_stroke_written_and_flushed", |b| {
+        b.iter_custom(|rounds| {
+            let mut spent = Duration::ZERO;
+            for _ in 0..rounds {
+                stroke(&mut doc);
+                let start = Instant::now();
+                saver.poll(&doc, Instant::now());
+                saver.wait().expect("a save").expect("saved");
+                spent += start.elapsed();
+            }
+            spent
+        });
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    group.finish();
+}
+
+criterion_group!(benches, dabs, fills_and_derive, project_io, autosave);
 criterion_main!(benches);

@@ -458,7 +458,7 @@ fn equivalent_n_maps_between_the_models() {
         })
         .collect();
     assert_eq!(rows[0], (0.0, 0.0));
-    // The README's figure: n = 1 matches Blinn-Phong's 5.44.
+    // The documented figure (docs/renderer.md): n = 1 matches Blinn-Phong's 5.44.
     assert!((rows[1].1 - 5.44).abs() < 0.005, "{rows:?}");
     assert!((rows[2].1 / 10000.0 - 4.0).abs() < 0.01, "{rows:?}");
     assert_usage_error(

@@ -21,6 +21,18 @@ fn texels(editor: &Editor) -> Vec<Texel> {
     out
 }
 
+/// The editor on a new default document in a 1400 x 900 window, its first frame drawn.
+fn editor() -> Harness<'static, Editor> {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, None),
+        );
+    harness.run();
+    harness
+}
+
 /// Drags the primary button from `a` to `b` in steps, a frame per step.
 fn drag(harness: &mut Harness<'_, Editor>, a: Pos2, b: Pos2) {
     harness.hover_at(a);
@@ -38,13 +50,7 @@ fn drag(harness: &mut Harness<'_, Editor>, a: Pos2, b: Pos2) {
 #[test]
 #[allow(clippy::too_many_lines)] // One scripted session, step by step, as a user works.
 fn a_scripted_editing_session() {
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, None),
-        );
-    harness.run();
+    let mut harness = editor();
 
     // New project (Ctrl+N): the dialog offers resolution, base preset and mesh.
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
@@ -259,13 +265,7 @@ fn changed(a: &[Texel], b: &[Texel]) -> usize {
 
 #[test]
 fn pen_pressure_scales_the_dab() {
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, None),
-        );
-    harness.run();
+    let mut harness = editor();
     assert!(harness.state().state.doc.settings.brush.pressure_size);
     let fresh = texels(harness.state());
     let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
@@ -304,13 +304,7 @@ fn pen_pressure_scales_the_dab() {
 
 #[test]
 fn opening_another_project_never_drops_unsaved_work() {
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, None),
-        );
-    harness.run();
+    let mut harness = editor();
     let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
     drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
     assert!(harness.state().state.dirty(), "painted");
@@ -329,13 +323,7 @@ fn opening_another_project_never_drops_unsaved_work() {
 
 #[test]
 fn a_settings_change_is_unsaved_work() {
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, None),
-        );
-    harness.run();
+    let mut harness = editor();
     assert!(!harness.state().state.dirty(), "a fresh document");
     // Switch the shading model: no texel changes, but the project stores the model.
     harness.get_by_label("Blinn-Phong (11)").click();

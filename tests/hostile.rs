@@ -7,6 +7,8 @@ use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
+#[path = "common/encode.rs"]
+mod encode;
 #[path = "common/faults.rs"]
 mod faults;
 use faults::tmpfs;
@@ -41,7 +43,7 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A failure as the README promises: exit `code`, exactly one line on stderr that mentions
+/// A failure as docs/cli.md promises: exit `code`, exactly one line on stderr that mentions
 /// `mentions`, nothing on stdout.
 fn assert_fails(o: &Output, code: i32, mentions: &str) {
     let err = stderr(o);
@@ -59,6 +61,16 @@ fn assert_fails(o: &Output, code: i32, mentions: &str) {
     );
 }
 
+/// A failed command left the file as it was.
+fn assert_unchanged(path: &Path, before: &[u8]) {
+    assert_eq!(
+        std::fs::read(path).expect("the file is still there"),
+        before,
+        "{} changed",
+        path.display()
+    );
+}
+
 fn assert_ok(o: &Output) {
     assert!(o.status.success(), "failed: {}", stderr(o));
 }
@@ -71,6 +83,9 @@ fn new_project(dir: &Path, name: &str) -> PathBuf {
     ));
     dir.join(name)
 }
+
+/// One triangle with UVs, as an OBJ file.
+const TRIANGLE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
 
 /// Rewrites `manifest.json` inside a project (a zip) through `edit`.
 fn edit_project_manifest(path: &Path, mut edit: impl FnMut(&mut serde_json::Value)) {
@@ -377,15 +392,15 @@ fn argument_errors_are_one_line_naming_what_is_missing() {
 }
 
 #[test]
-fn the_readme_script_and_its_command_names_run() {
-    let dir = temp("readme-script");
-    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
-        .expect("README");
-    let script = readme
+fn the_documented_script_and_its_command_names_run() {
+    let dir = temp("documented-script");
+    let docs = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/cli.md"))
+        .expect("docs/cli.md");
+    let script = docs
         .split("```ron\n")
         .nth(1)
         .and_then(|rest| rest.split("```").next())
-        .expect("the README has a RON script");
+        .expect("docs/cli.md has a RON script");
     std::fs::write(dir.join("readme.ron"), script).expect("script");
     assert_ok(&kapaint_in(
         &dir,
@@ -466,20 +481,10 @@ fn gltf_text(uri: &str, nodes: &str, scene_nodes: &str) -> String {
 fn triangle_uri() -> String {
     let floats: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
     let bytes: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
-    let alphabet = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut text = String::new();
-    for chunk in bytes.chunks(3) {
-        let n = (u32::from(chunk[0]) << 16)
-            | (u32::from(*chunk.get(1).unwrap_or(&0)) << 8)
-            | u32::from(*chunk.get(2).unwrap_or(&0));
-        for k in 0..=chunk.len() {
-            text.push(char::from(alphabet[(n >> (18 - 6 * k)) as usize & 63]));
-        }
-    }
-    while !text.len().is_multiple_of(4) {
-        text.push('=');
-    }
-    format!("data:application/octet-stream;base64,{text}")
+    format!(
+        "data:application/octet-stream;base64,{}",
+        encode::base64(&bytes)
+    )
 }
 
 #[test]
@@ -558,7 +563,7 @@ fn gltf_buffers_stay_in_their_folder_and_within_their_length() {
 #[test]
 fn meshes_never_read_materials_devices_or_fifos() {
     let dir = temp("obj-mtl");
-    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+    let obj = TRIANGLE_OBJ;
     let fifo = dir.join("pipe");
     assert!(
         Command::new("mkfifo")
@@ -649,10 +654,7 @@ fn strokes_a_billion_texels_long_end_with_an_error_not_a_hang() {
         std::fs::write(dir.join("s.ron"), script).expect("script");
         let o = kapaint_within(&dir, &["paint", "p.kapaint", "--script", "s.ron"], 60);
         assert_fails(&o, 2, "limit of");
-        assert_eq!(
-            std::fs::read(dir.join("p.kapaint")).expect("project"),
-            before
-        );
+        assert_unchanged(&dir.join("p.kapaint"), &before);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -760,10 +762,7 @@ fn truncated_jpegs_are_refused() {
             ],
         );
         assert_fails(&o, 2, "truncated");
-        assert_eq!(
-            std::fs::read(dir.join("p.kapaint")).expect("project"),
-            before
-        );
+        assert_unchanged(&dir.join("p.kapaint"), &before);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -772,7 +771,7 @@ fn truncated_jpegs_are_refused() {
 fn a_projects_mesh_is_found_from_any_folder() {
     let dir = temp("mesh-path");
     std::fs::create_dir_all(dir.join("sub")).expect("sub");
-    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+    let obj = TRIANGLE_OBJ;
     std::fs::write(dir.join("m.obj"), obj).expect("obj");
     assert_ok(&kapaint_in(
         &dir,
@@ -1006,36 +1005,138 @@ fn a_read_only_folder_and_a_file_in_the_way_are_clear_errors() {
     new_project(&dir, "p.kapaint");
     std::fs::write(dir.join("s.ron"), "(commands: [ Fill(All) ])").expect("script");
     std::fs::write(dir.join("a-file"), "x").expect("file");
-    let o = kapaint_in(
-        &dir,
-        &[
-            "paint",
-            "p.kapaint",
-            "--script",
-            "s.ron",
-            "--out",
-            "a-file/p.kapaint",
-        ],
-    );
-    assert_fails(&o, 2, "a-file/p.kapaint");
+    let paint_to = |out: &str| {
+        kapaint_in(
+            &dir,
+            &["paint", "p.kapaint", "--script", "s.ron", "--out", out],
+        )
+    };
+    assert_fails(&paint_to("a-file/p.kapaint"), 2, "a-file/p.kapaint");
     let o = kapaint_in(&dir, &["export", "p.kapaint", "--out", "a-file"]);
     assert_fails(&o, 2, "not an empty folder");
     assert_eq!(std::fs::read(dir.join("a-file")).expect("file"), b"x");
     if let Some(_mount) = tmpfs(&dir.join("ro"), "size=1m,ro") {
-        let o = kapaint_in(
-            &dir,
-            &[
-                "paint",
-                "p.kapaint",
-                "--script",
-                "s.ron",
-                "--out",
-                "ro/p.kapaint",
-            ],
-        );
-        assert_fails(&o, 1, "read-only");
+        assert_fails(&paint_to("ro/p.kapaint"), 1, "read-only");
         let o = kapaint_in(&dir, &["export", "p.kapaint", "--out", "ro/set"]);
         assert_fails(&o, 1, "read-only");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Bits packed as deflate packs them: fields from their low bit, Huffman codes from their
+/// high bit.
+struct Bits {
+    bytes: Vec<u8>,
+    used: u32,
+}
+
+impl Bits {
+    fn field(&mut self, value: u32, len: u32) {
+        for k in 0..len {
+            if self.used == 0 {
+                self.bytes.push(0);
+            }
+            if (value >> k) & 1 == 1 {
+                *self.bytes.last_mut().expect("a byte") |= 1 << self.used;
+            }
+            self.used = (self.used + 1) % 8;
+        }
+    }
+
+    fn code(&mut self, code: u32, len: u32) {
+        for k in (0..len).rev() {
+            self.field((code >> k) & 1, 1);
+        }
+    }
+}
+
+/// A PNG of `width x height` black pixels (every sample zero), deflated by hand with the
+/// fixed Huffman codes: one zero, then copies of the 258 bytes before, so 2 GB of pixels
+/// fit in a 14 MB file, as a decompression bomb would.
+fn black_png(width: u32, height: u32, colour_type: u8, bytes_per_pixel: u64) -> Vec<u8> {
+    let raw = u64::from(height) * (1 + u64::from(width) * bytes_per_pixel);
+    let mut bits = Bits {
+        bytes: vec![0x78, 0x01],
+        used: 0,
+    };
+    bits.field(1, 1); // the last block
+    bits.field(1, 2); // fixed codes
+    bits.code(0x30, 8); // literal 0
+    let runs = (raw - 1) / 258;
+    for _ in 0..runs {
+        bits.code(0xC5, 8); // length 258
+        bits.code(0, 5); // distance 1
+    }
+    for _ in 0..(raw - 1 - runs * 258) {
+        bits.code(0x30, 8);
+    }
+    bits.code(0, 7); // end of block
+    let adler = (((raw % 65521) as u32) << 16) | 1;
+    let mut idat = bits.bytes;
+    idat.extend_from_slice(&adler.to_be_bytes());
+    let chunk = |kind: &[u8], data: &[u8]| {
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+        out.extend_from_slice(&crc32fast::hash(&[kind, data].concat()).to_be_bytes());
+        out
+    };
+    let mut header = width.to_be_bytes().to_vec();
+    header.extend_from_slice(&height.to_be_bytes());
+    let depth = if bytes_per_pixel == 8 { 16 } else { 8 };
+    header.extend_from_slice(&[depth, colour_type, 0, 0, 0]);
+    [
+        b"\x89PNG\r\n\x1a\n".to_vec(),
+        chunk(b"IHDR", &header),
+        chunk(b"IDAT", &idat),
+        chunk(b"IEND", &[]),
+    ]
+    .concat()
+}
+
+#[test]
+fn importing_a_huge_image_costs_its_decoded_size_not_four_times_it() {
+    if !Command::new("prlimit")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+    {
+        assert!(
+            std::env::var_os("KAPAINT_REQUIRE_FAULTS").is_none(),
+            "prlimit is needed here"
+        );
+        eprintln!("SKIPPED: no prlimit");
+        return;
+    }
+    let dir = temp("huge-image");
+    new_project(&dir, "p.kapaint");
+    // 16384 x 16383 RGBA16 decodes to 2.0 GiB (was 5.3 GB peak), 16384^2 RGB8 to 0.75 GiB
+    // (was 4.0 GB): each must import with its decoded size plus 0.9 GB of address space for
+    // everything else.
+    for (name, width, height, colour_type, bytes_per_pixel) in [
+        ("rgba16.png", 16384, 16383, 6, 8),
+        ("rgb8.png", 16384, 16384, 2, 3),
+    ] {
+        std::fs::write(
+            dir.join(name),
+            black_png(width, height, colour_type, bytes_per_pixel),
+        )
+        .expect("png");
+        let limit = u64::from(width) * u64::from(height) * bytes_per_pixel + (900 << 20);
+        let o = Command::new("prlimit")
+            .arg(format!("--data={limit}"))
+            .arg("--")
+            .arg(bin())
+            .args(["import", "p.kapaint", "--channel", "kd", "--image", name])
+            .current_dir(&dir)
+            .output()
+            .expect("prlimit runs");
+        assert_ok(&o);
+        assert_eq!(
+            info_stat(&dir, "p.kapaint", "kd.r"),
+            [0.0, 0.0, 0.0],
+            "{name}"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

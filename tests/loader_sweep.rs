@@ -6,6 +6,9 @@
 
 #![allow(clippy::expect_used)]
 
+#[path = "common/encode.rs"]
+mod encode;
+
 use std::io::Write as _;
 use std::panic::AssertUnwindSafe;
 use std::path::{Path, PathBuf};
@@ -369,7 +372,7 @@ fn meshes() {
     bin.extend([0_u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()));
     let gltf = format!(
         r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"translation":[0,1,0]}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"mode":4}}]}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},{{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}],"bufferViews":[{{"buffer":0,"byteLength":36,"byteOffset":0}},{{"buffer":0,"byteLength":6,"byteOffset":36}}],"buffers":[{{"uri":"data:application/octet-stream;base64,{}","byteLength":44}}]}}"#,
-        base64(&bin)
+        encode::base64(&bin)
     );
     cases.extend(
         text_cases(&gltf, 62, true)
@@ -385,23 +388,6 @@ fn meshes() {
         }
     });
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-fn base64(bytes: &[u8]) -> String {
-    let alphabet = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut text = String::new();
-    for chunk in bytes.chunks(3) {
-        let n = (u32::from(chunk[0]) << 16)
-            | (u32::from(*chunk.get(1).unwrap_or(&0)) << 8)
-            | u32::from(*chunk.get(2).unwrap_or(&0));
-        for k in 0..=chunk.len() {
-            text.push(char::from(alphabet[(n >> (18 - 6 * k)) as usize & 63]));
-        }
-    }
-    while !text.len().is_multiple_of(4) {
-        text.push('=');
-    }
-    text
 }
 
 #[test]

@@ -168,7 +168,7 @@ pub enum Command {
     Paint {
         /// Project file (rewritten atomically unless --out is given).
         file: PathBuf,
-        /// Script of commands (see README).
+        /// Script of commands (see docs/cli.md).
         #[arg(long)]
         script: PathBuf,
         /// Mesh for strokes on the surface and island/part fills (default: the project's).
