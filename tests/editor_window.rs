@@ -119,11 +119,12 @@ fn the_real_window_paints_saves_and_quits() {
 
 #[test]
 fn work_survives_kill_9_through_the_autosave() {
+    // The stroke ends before the 4-second autosave falls due and no input follows it: the
+    // idle window must wake up by itself to save it.
     let script = r#"
 start
 stroke
-# Two autosave intervals, then the process dies without a chance to save anything.
-sleep 5
+sleep 7
 kill -9 $pid; wait $pid 2>/dev/null
 [ -f "$project" ] && { echo "the project was saved before the kill"; exit 6; }
 start
@@ -132,7 +133,7 @@ xdotool key --clearmodifiers Return
 sleep 2
 save_and_quit
 "#;
-    if let Some(project) = run_in_window("crash", script, &[("KAPAINT_AUTOSAVE_SECONDS", "2")]) {
+    if let Some(project) = run_in_window("crash", script, &[("KAPAINT_AUTOSAVE_SECONDS", "4")]) {
         assert_painted(
             &project,
             "the stroke painted before kill -9 was not recovered",

@@ -378,6 +378,20 @@ impl Autosaver {
         self.job.is_none() && self.saved_version == doc.version()
     }
 
+    /// How long until [`Autosaver::poll`] has something to do: the rest of the interval while
+    /// the document differs from its recovery copy, a moment while a save runs, `None` when
+    /// the copy is current. An idle window must wake up then, or a stroke followed by nothing
+    /// would never be saved.
+    pub fn next_poll(&self, doc: &Document, now: Instant) -> Option<Duration> {
+        if self.job.is_some() {
+            return Some(Duration::from_millis(100));
+        }
+        (doc.version() != self.saved_version).then(|| {
+            self.interval
+                .saturating_sub(now.duration_since(self.last_time))
+        })
+    }
+
     /// Reports a finished autosave (its result), and starts the next one if one is due.
     pub fn poll(&mut self, doc: &Document, now: Instant) -> Option<Result<PathBuf, ModelError>> {
         let finished = if self.job.as_ref().is_some_and(|j| j.handle.is_finished()) {
@@ -640,6 +654,32 @@ mod tests {
         saver.wait().unwrap().unwrap();
         assert!(saver.is_current(&doc));
         assert!(same_maps(&load(&path).unwrap(), &doc));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn the_next_poll_is_when_the_copy_falls_due() {
+        let dir = temp("next");
+        let mut doc = Document::new(64, 64, DocumentSettings::default()).unwrap();
+        let mut saver = Autosaver::new(Duration::from_secs(20), dir.join("r"), &doc);
+        let t = saver.last_time;
+        assert_eq!(saver.next_poll(&doc, t), None, "nothing to save");
+        doc.apply(Command::Fill(FillRegion::All)).unwrap();
+        assert_eq!(
+            saver.next_poll(&doc, t + Duration::from_secs(5)),
+            Some(Duration::from_secs(15))
+        );
+        assert_eq!(
+            saver.next_poll(&doc, t + Duration::from_secs(25)),
+            Some(Duration::ZERO)
+        );
+        saver.poll(&doc, t + Duration::from_secs(25));
+        assert!(
+            saver.next_poll(&doc, t).is_some(),
+            "a save runs: look again soon"
+        );
+        saver.wait().unwrap().unwrap();
+        assert_eq!(saver.next_poll(&doc, t + Duration::from_secs(26)), None);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

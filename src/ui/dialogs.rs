@@ -149,6 +149,8 @@ impl EditorState {
         };
         egui::Window::new("Recover unsaved work?")
             .collapsible(false)
+            .resizable(false)
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
             .show(ctx, |ui| {
                 ui.label(format!(
                     "kapaint found a recovery copy of unsaved work:\n{}",
@@ -157,7 +159,8 @@ impl EditorState {
                 ui.horizontal(|ui| {
                     // Recover is the default: Enter takes it.
                     let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
-                    if ui.button("Recover").clicked() || enter {
+                    let recover = ui.button("Recover").on_hover_text("Enter");
+                    if recover.clicked() || enter {
                         self.recovery_offer = None;
                         self.recover(copy.clone(), self.path.clone());
                     }

@@ -84,8 +84,9 @@ pub struct Notice {
 
 /// What a worker hands back.
 enum JobResult {
-    /// A project (to be saved at the path), and whether it came from a recovery copy.
-    Opened(PathBuf, Box<Document>, bool),
+    /// A project (to be saved at the path; `None` for recovered untitled work), and whether it
+    /// came from a recovery copy.
+    Opened(Option<PathBuf>, Box<Document>, bool),
     Saved(PathBuf, u64),
     Exported(PathBuf, Box<crate::export::set::Manifest>),
     /// A mesh loaded and baked at the map size.
@@ -572,13 +573,22 @@ impl EditorState {
                 };
                 self.autosaver = recovery::Autosaver::new(
                     autosave_interval(),
-                    recovery::recovery_path(Some(&path)),
+                    recovery::recovery_path(path.as_deref()),
                     &self.doc,
                 );
-                self.notices
-                    .push(notice(format!("opened {}", path.display()), false));
-                self.remember(&path);
-                self.path = Some(path);
+                let name = path
+                    .as_deref()
+                    .map_or_else(|| "an untitled project".into(), |p| p.display().to_string());
+                let text = if recovered {
+                    format!("recovered the unsaved work of {name}: save to keep it")
+                } else {
+                    format!("opened {name}")
+                };
+                self.notices.push(notice(text, false));
+                if let Some(p) = &path {
+                    self.remember(p);
+                }
+                self.path = path;
             }
             JobResult::Saved(path, version) => {
                 self.saved_version = version;
@@ -738,7 +748,7 @@ impl EditorState {
         self.start_job("Open", move |progress| {
             progress.start("open", 1);
             match load_project(&path) {
-                Ok((doc, _, _)) => JobResult::Opened(path, Box::new(doc), false),
+                Ok((doc, _, _)) => JobResult::Opened(Some(path), Box::new(doc), false),
                 Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
             }
         });
@@ -752,9 +762,7 @@ impl EditorState {
                 .map_err(|e| e.to_string())
                 .and_then(with_mesh)
             {
-                Ok((doc, _, _)) => {
-                    JobResult::Opened(path.unwrap_or_else(|| from.clone()), Box::new(doc), true)
-                }
+                Ok((doc, _, _)) => JobResult::Opened(path, Box::new(doc), true),
                 Err(e) => JobResult::Failed(format!("could not recover {}: {e}", from.display())),
             }
         });
@@ -921,9 +929,14 @@ impl Editor {
         s.track_pressure(&ctx);
         s.hotkeys(&ctx);
         s.dropped_files(&ctx);
-        if let Some(Err(e)) = s.autosaver.poll(&s.doc, Instant::now()) {
+        let now = Instant::now();
+        if let Some(Err(e)) = s.autosaver.poll(&s.doc, now) {
             s.notices
                 .push(notice(format!("autosave failed: {e}"), true));
+        }
+        // An idle window draws no frames: wake up when the recovery copy falls due.
+        if let Some(wait) = s.autosaver.next_poll(&s.doc, now) {
+            ctx.request_repaint_after(wait);
         }
         s.shown_hover = s.hover.take();
         s.hover_tab = None;
