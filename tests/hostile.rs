@@ -1140,3 +1140,48 @@ fn importing_a_huge_image_costs_its_decoded_size_not_four_times_it() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn autosave_on_a_full_disk_is_an_error_that_leaves_nothing_half_written() {
+    use kapaint::model::recovery::{self, Autosaver};
+    use kapaint::model::{Document, DocumentSettings};
+    use std::time::{Duration, Instant};
+    let dir = temp("autosave-full");
+    let Some(mount) = tmpfs(&dir.join("full"), "size=256k") else {
+        return;
+    };
+    let path = dir.join("full/.p.kapaint-recovery");
+    // Noise in every channel: a project far larger than the disk.
+    let mut doc = Document::new(256, 256, DocumentSettings::default()).expect("doc");
+    let noise = dir.join("noise.png");
+    let mut state = 0x9E37_79B9_u32;
+    image::RgbImage::from_fn(256, 256, |_, _| {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        image::Rgb(state.to_le_bytes()[..3].try_into().expect("three bytes"))
+    })
+    .save(&noise)
+    .expect("noise");
+    let mut saver = Autosaver::new(Duration::ZERO, path.clone(), &doc);
+    kapaint::model::import::import_file(&mut doc, kapaint::model::Channel::Kd, &noise)
+        .expect("import");
+    saver.poll(&doc, Instant::now());
+    let err = saver
+        .wait()
+        .expect("an autosave ran")
+        .expect_err("the disk is full");
+    assert!(
+        err.to_string().to_lowercase().contains("no space left"),
+        "{err}"
+    );
+    assert!(!err.to_string().contains('\n'));
+    // Nothing half-written: no base, and nothing a recovery could mistake for one.
+    let left: Vec<_> = std::fs::read_dir(&path)
+        .map(|d| d.filter_map(Result::ok).map(|e| e.file_name()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "{left:?}");
+    assert!(recovery::load(&path).is_err());
+    drop(mount);
+    let _ = std::fs::remove_dir_all(&dir);
+}
