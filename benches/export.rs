@@ -3,8 +3,10 @@
 //! KTX2 with mips, uncompressed and BC7/BC4 at the default effort, measured),
 //! and the choice of n's encoding alone.
 
-#![allow(missing_docs)] // criterion_main! generates an undocumented main.
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::time::Duration;
 

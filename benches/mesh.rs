@@ -2,8 +2,10 @@
 //! mesh (target <= 1 s) and of the spot mesh; BVH build and pick on 1M triangles; the
 //! object-space index and a 128 px-equivalent dab on 4096^2 maps (target <= 1 ms).
 
-#![allow(missing_docs)] // criterion_main! generates an undocumented main.
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::time::Duration;
 

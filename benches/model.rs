@@ -2,8 +2,10 @@
 //! channels: a 128 px dab, a 100-dab stroke, a whole-map fill and its undo, the full k_a
 //! derive against a copy of the same bytes, and project save/load.
 
-#![allow(missing_docs)] // criterion_main! generates an undocumented main.
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::hint::black_box;
 use std::time::Duration;

@@ -1,4 +1,3 @@
-#![allow(missing_docs)] // criterion_main! generates an undocumented main.
 //! Criterion benches for the reflectance kernels: `chi` per method, and the k_a derive of a
 //! map on one thread and on all threads against a plain copy of the same input bytes.
 

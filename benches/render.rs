@@ -3,8 +3,10 @@
 //! a 1920x1080 frame of a 1M-triangle mesh with 4096^2 maps, the skip variants against the
 //! full shader, and a 256x256 dirty-region upload.
 
-#![allow(missing_docs)] // criterion_main! generates an undocumented main.
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::time::Duration;
 

@@ -1,5 +1,8 @@
 //! The command line as scripts see it: formats, ordering, exit codes, no partial output.
-#![allow(clippy::expect_used)] // Test helpers: a failed expectation is a failed test.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::io::Write;
 use std::process::{Command, Output, Stdio};

@@ -3,8 +3,6 @@
 //! compare split and the export dialog. No GPU is needed: the viewport picks and paints on
 //! the CPU and shows a placeholder where the preview would be.
 
-#![allow(clippy::expect_used)]
-
 use egui::accesskit::Role;
 use egui::{Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;
@@ -48,7 +46,10 @@ fn drag(harness: &mut Harness<'_, Editor>, a: Pos2, b: Pos2) {
 }
 
 #[test]
-#[allow(clippy::too_many_lines)] // One scripted session, step by step, as a user works.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one scripted session, step by step, as a user works"
+)]
 fn a_scripted_editing_session() {
     let mut harness = editor();
 

@@ -4,7 +4,10 @@
 //! recovery. Skipped where Xvfb or xdotool are missing, unless `CI` or `KAPAINT_REQUIRE_GPU`
 //! is set (CI installs them).
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -1,7 +1,10 @@
 //! Exported texture sets: layouts, elided channels, the manifest, round trips, k_a error, and
 //! failures that leave nothing behind.
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 #[path = "common/faults.rs"]
 mod faults;

@@ -1,7 +1,10 @@
 //! glTF 2.0 import: files built here (GLB, .gltf with a .bin, data: URIs), the spot mesh
 //! converted to GLB, and corrupted copies of them.
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::path::{Path, PathBuf};
 

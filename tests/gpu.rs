@@ -5,7 +5,10 @@
 //! In CI (`CI` or `KAPAINT_REQUIRE_GPU` set) a missing adapter fails the tests; elsewhere
 //! they say clearly that they were skipped.
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 mod common;
 

@@ -1,7 +1,10 @@
 //! Bad input, faults and hostile files as a user or an attacker would bring them: every one
 //! gets one line of error and a documented exit code, never a panic, a hang or a changed
 //! input file.
-#![allow(clippy::expect_used)] // Test helpers: a failed expectation is a failed test.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};

@@ -4,7 +4,10 @@
 //! valid value (a project that loads must save and load again); a panic anywhere fails the
 //! sweep. The counts are printed per loader (with or without `--nocapture`).
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 #[path = "common/encode.rs"]
 mod encode;

@@ -1,6 +1,9 @@
 //! Mesh import against the real spot files of `../shared/testdata`, and corrupted copies.
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::path::{Path, PathBuf};
 

@@ -1,6 +1,9 @@
 //! The material model driven through commands, as the editor and scripts drive it.
 
-#![allow(clippy::expect_used)] // Test helpers: a failed expectation is a failed test.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BlendMode, BrushSettings, StrokePoint};

@@ -1,8 +1,6 @@
 //! Property tests: random command sequences keep every texel valid, and undoing all of them
 //! restores the starting maps bit-exactly.
 
-#![allow(clippy::expect_used)]
-
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BlendMode, BrushSettings, StrokePoint};
 use kapaint::model::paint::GradientShape;

@@ -8,7 +8,10 @@
 //! `KAPAINT_UPDATE_SNAPSHOTS=1 cargo test --release --test snapshots` rewrites the pictures;
 //! a failing view writes what it rendered to `target/snapshots/` beside the expected one.
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 mod common;
 

@@ -2,7 +2,10 @@
 //! the UV seams of the sphere and of the real spot mesh, mirroring, facing, and island and
 //! part fills.
 
-#![allow(clippy::expect_used)]
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use std::path::Path;
 use std::sync::Arc;

@@ -180,7 +180,7 @@ pub enum Command {
     },
     /// Export projects as compact texture sets (images + material.json).
     Export {
-        /// Project files (several: one set per project, in OUT/<project name>/).
+        /// Project files (several: one set per project, in `OUT/<project name>/`).
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// Export preset: compact, 16-bit, separate, exr, with-ka, ktx2, ktx2-raw, or a user
@@ -341,7 +341,7 @@ pub fn clap_message(rendered: &str) -> String {
 }
 
 /// Runs a parsed command and returns everything it prints, or the error to report.
-#[allow(clippy::too_many_lines)] // One arm per subcommand, each short.
+#[expect(clippy::too_many_lines, reason = "one arm per subcommand, each short")]
 pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError> {
     match command {
         Command::Chi { model, method, n } => {

@@ -69,7 +69,7 @@ pub enum Layout {
 
 /// An export preset.
 ///
-/// Read only through its checks ([`ExportPresetFile`]): a name, and `n_bits` that the
+/// Read only through its checks (`ExportPresetFile`): a name, and `n_bits` that the
 /// format can store.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "ExportPresetFile")]

@@ -28,7 +28,7 @@ pub const MANIFEST_VERSION: u32 = 1;
 
 /// One image of a set.
 ///
-/// Read from a manifest only through its checks ([`FileEntryFile`]): a plain file name in
+/// Read from a manifest only through its checks (`FileEntryFile`): a plain file name in
 /// the set's folder whose extension matches the compression, one to four known components,
 /// a known colour space, and a bit depth the format has.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -264,7 +264,7 @@ pub struct MemoryReport {
 
 /// `material.json`.
 ///
-/// Read only through its checks ([`ManifestFile`]): a known format and version, a size in
+/// Read only through its checks (`ManifestFile`): a known format and version, a size in
 /// range, files of that size, and every channel either a constant or in a file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "ManifestFile")]
@@ -830,7 +830,10 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
 ///
 /// # Errors
 /// As [`export`], or cancelled.
-#[allow(clippy::too_many_lines)] // One pass: analyse, encode in parallel, measure, commit.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one pass: analyse, encode in parallel, measure, commit"
+)]
 pub fn export_with(
     doc: &Document,
     preset: &ExportPreset,

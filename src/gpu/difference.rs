@@ -123,7 +123,7 @@ impl Difference {
 
     /// Records the heatmap of `|left - right|` into `target` (of `format`, the size of the
     /// two sides): white at `max` and above, black at 0.
-    #[allow(clippy::too_many_arguments)] // One pass's inputs.
+    #[expect(clippy::too_many_arguments, reason = "one pass's inputs")]
     pub fn draw(
         &mut self,
         gpu: &Gpu,

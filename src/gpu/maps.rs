@@ -2,7 +2,7 @@
 //! floats where the adapter lacks 16-bit norm formats) and `n` as R16 float (the model's own
 //! bits), each with a full mip chain. Each sync uploads only the tiles changed since the last
 //! one and rebuilds only those tiles' footprint in every mip level (box means computed on the
-//! CPU from the tile, rounded once per level): staged by [`super::upload`] straight into a
+//! CPU from the tile, rounded once per level): staged by `gpu::upload` straight into a
 //! mapped buffer and copied by one command buffer of sub-rectangle copies.
 
 use crate::model::{Channels, MaterialMaps};

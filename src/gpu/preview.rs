@@ -211,7 +211,10 @@ pub struct Offscreen {
 
 /// The overridable constants of one pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[allow(clippy::struct_excessive_bools)] // One bool per overridable constant of the shader.
+#[expect(
+    clippy::struct_excessive_bools,
+    reason = "one bool per overridable constant of the shader"
+)]
 pub struct PipelineKey {
     /// Shading model.
     pub model: ShadingModel,
@@ -516,7 +519,7 @@ impl Preview {
     /// Draws one or more parts of a frame into `target` (see [`Layout::parts`]): each part is a
     /// pipeline, a scissor rectangle and a viewport. All parts share camera and lights; the
     /// projection's aspect is the first part's viewport's.
-    #[allow(clippy::too_many_arguments)] // One frame's inputs.
+    #[expect(clippy::too_many_arguments, reason = "one frame's inputs")]
     pub fn draw(
         &mut self,
         gpu: &Gpu,

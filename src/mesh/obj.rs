@@ -9,7 +9,10 @@ use super::{Mesh, MeshError, smooth_normals};
 
 /// Loads an OBJ file. Vertices are split per distinct (position, UV, normal) index triple;
 /// missing normals are computed smooth per position index.
-#[allow(clippy::too_many_lines)] // One pass over the file's objects; splitting it hides the flow.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one pass over the file's objects; splitting it hides the flow"
+)]
 pub fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
     let invalid = |reason: String| MeshError::Invalid {
         path: path.to_path_buf(),

@@ -171,7 +171,10 @@ impl Stamp {
 /// Everything that shapes a dab and a stroke.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
-#[allow(clippy::struct_excessive_bools)] // Independent switches, as a brush panel shows them.
+#[expect(
+    clippy::struct_excessive_bools,
+    reason = "independent switches, as a brush panel shows them"
+)]
 pub struct BrushSettings {
     /// Radius in texels (2D) at full pressure, `[0.5, 4096]`.
     #[serde(deserialize_with = "check::radius_px")]

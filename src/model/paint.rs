@@ -351,7 +351,10 @@ pub fn paint_dab(
 }
 
 /// Paints one tile: coverage update and blend of the enabled channels, run by run.
-#[allow(clippy::too_many_arguments)] // The hot loop's inputs, passed once per tile.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the hot loop's inputs, passed once per tile"
+)]
 fn paint_tile(
     tile: &mut Tile,
     cov: &mut [f32],
@@ -441,7 +444,10 @@ fn paint_tile(
 
 /// The pre-stroke RGB values of a tile as flat components, a uniform plane expanded once
 /// per tile so runs can read it like data.
-#[allow(clippy::large_enum_variant)] // Lives on the stack, once per painted tile.
+#[expect(
+    clippy::large_enum_variant,
+    reason = "lives on the stack, once per painted tile"
+)]
 enum PreRgb<'a> {
     Uniform([u16; 3 * TILE_SIZE]),
     Data(&'a [[u16; 3]]),
@@ -738,7 +744,10 @@ pub enum GradientShape {
 
 /// Writes a gradient from `from` (at `start`) to `to` (at `end`) over the whole map, blended
 /// at `opacity` with the targets' mode and channels.
-#[allow(clippy::too_many_arguments)] // One call site per tool; a struct would only rename them.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "one call site per tool; a struct would only rename them"
+)]
 pub fn gradient(
     maps: &mut MaterialMaps,
     history: &mut History,

@@ -10,7 +10,7 @@ use super::texel::{MaterialValue, N_MAX};
 
 /// A material preset as written in a `.ron` file.
 ///
-/// Read only through its checks ([`MaterialPresetFile`]): values in range, a name.
+/// Read only through its checks (`MaterialPresetFile`): values in range, a name.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(try_from = "MaterialPresetFile")]
 pub struct MaterialPreset {

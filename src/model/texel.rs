@@ -12,7 +12,6 @@ use serde::{Deserialize, Serialize};
 
 /// Clamps into `[lo, hi]`, mapping NaN to `lo` (`f32::clamp` would keep NaN).
 #[inline]
-#[allow(clippy::manual_clamp)] // Deliberate: `max` drops NaN, `clamp` keeps it.
 pub fn clamp_nan_low(v: f32, lo: f32, hi: f32) -> f32 {
     v.max(lo).min(hi)
 }
@@ -98,7 +97,6 @@ impl Default for MaterialValue {
 
 /// Which channels an operation writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[allow(clippy::struct_excessive_bools)] // Three independent switches, as the UI shows them.
 pub struct Channels {
     /// Write `k_d`.
     pub kd: bool,

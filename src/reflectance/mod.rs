@@ -124,7 +124,10 @@ pub fn diffuse_factor(approx: AmbientApprox) -> f64 {
 
 /// Maps any `f32` exponent onto the supported domain `[0, f32::MAX]` (see module docs).
 #[inline]
-#[allow(clippy::manual_clamp)] // `clamp` would keep NaN; max/min map it to the lower end.
+#[expect(
+    clippy::manual_clamp,
+    reason = "`clamp` would keep NaN; max/min map it to the lower end"
+)]
 pub fn sanitize_n_f32(n: f32) -> f32 {
     // `max` returns the non-NaN operand, so NaN becomes 0 here.
     n.max(0.0).min(f32::MAX)
@@ -132,14 +135,20 @@ pub fn sanitize_n_f32(n: f32) -> f32 {
 
 /// Maps any `f64` exponent onto the supported domain `[0, f64::MAX]` (see module docs).
 #[inline]
-#[allow(clippy::manual_clamp)] // `clamp` would keep NaN; max/min map it to the lower end.
+#[expect(
+    clippy::manual_clamp,
+    reason = "`clamp` would keep NaN; max/min map it to the lower end"
+)]
 pub fn sanitize_n_f64(n: f64) -> f64 {
     n.max(0.0).min(f64::MAX)
 }
 
 /// Maps a reflectance coefficient into `[0, 1]`, NaN to 0.
 #[inline]
-#[allow(clippy::manual_clamp)] // `clamp` would keep NaN; max/min map it to the lower end.
+#[expect(
+    clippy::manual_clamp,
+    reason = "`clamp` would keep NaN; max/min map it to the lower end"
+)]
 pub fn sanitize_coefficient(k: f32) -> f32 {
     k.max(0.0).min(1.0)
 }

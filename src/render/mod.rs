@@ -1,6 +1,6 @@
 //! What a preview shows, independent of the GPU: the camera, the view modes, the lighting, and
 //! the shading equation itself ([`shade`]), which the WGSL preview shader evaluates per
-//! fragment and the CPU reference renderer ([`reference`]) per pixel.
+//! fragment and the CPU reference renderer ([`self::reference`]) per pixel.
 
 pub mod reference;
 
