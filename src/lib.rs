@@ -16,4 +16,5 @@ pub mod reflectance;
 pub mod render;
 pub mod report;
 pub mod task;
+pub mod tools;
 pub mod ui;

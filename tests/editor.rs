@@ -154,7 +154,10 @@ fn a_scripted_editing_session() {
     assert!(harness.state().state.doc.settings.brush.radius_px < radius);
     harness.key_press(egui::Key::E);
     harness.run();
-    assert_eq!(harness.state().state.tool, kapaint::ui::Tool::Eraser);
+    assert_eq!(
+        harness.state().state.tools.active(),
+        kapaint::tools::ToolKind::Eraser
+    );
 
     // The built-in grain stamp shapes the brush, and Round takes it off again.
     harness.get_by_label("Grain").click();
@@ -343,4 +346,72 @@ fn a_settings_change_is_unsaved_work() {
     harness.run();
     assert_eq!(harness.state().state.pending_open, Some(elsewhere));
     harness.get_by_label("Discard and open");
+}
+
+#[test]
+fn escape_abandons_a_stroke_under_way() {
+    let mut harness = editor();
+    let before = texels(harness.state());
+    let a = harness.get_by_label(CANVAS_LABEL).rect().center();
+    let b = a + Vec2::new(60.0, 20.0);
+    harness.hover_at(a);
+    harness.run();
+    harness.drag_at(a);
+    harness.run();
+    for i in 1..=6 {
+        harness.hover_at(a + (b - a) * (i as f32 / 6.0));
+        harness.run();
+    }
+    assert_ne!(texels(harness.state()), before, "painting");
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert_eq!(texels(harness.state()), before, "Escape undid the stroke");
+    harness.drop_at(b);
+    harness.run();
+    assert_eq!(
+        texels(harness.state()),
+        before,
+        "and the release adds nothing"
+    );
+    assert_eq!(harness.state().state.doc.history.undo_steps().count(), 0);
+}
+
+#[test]
+fn a_gradient_dragged_in_the_viewport_lays_a_gradient() {
+    let mut harness = editor();
+    let primary = harness.state().state.doc.settings.primary;
+    let before = texels(harness.state());
+    harness.get_by_label("Gradient").click();
+    harness.run();
+    // Its options: linear or radial.
+    harness.get_by_label("Radial");
+    let viewport = harness.get_by_label(VIEWPORT_LABEL).rect();
+    drag(
+        &mut harness,
+        viewport.center() - Vec2::new(40.0, 0.0),
+        viewport.center() + Vec2::new(40.0, 10.0),
+    );
+    assert_ne!(texels(harness.state()), before, "a gradient was laid");
+    assert_eq!(
+        harness.state().state.doc.settings.primary,
+        primary,
+        "not a pick"
+    );
+}
+
+#[test]
+fn every_tool_and_its_options_are_in_the_panel() {
+    let mut harness = editor();
+    for kind in kapaint::tools::ToolKind::ALL {
+        harness.get_by_label(kind.label()).click();
+        harness.run();
+        assert_eq!(harness.state().state.tools.active(), kind);
+    }
+    harness.get_by_label("Blur").click();
+    harness.run();
+    assert!(harness.query_all_by_label("Blur radius").count() > 0);
+    harness.get_by_label("Fill").click();
+    harness.run();
+    // The tool's button and its mode's combo box.
+    assert_eq!(harness.query_all_by_label("Fill").count(), 2);
 }

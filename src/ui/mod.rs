@@ -32,36 +32,12 @@ use crate::model::texel::MaterialValue;
 use crate::model::{Command, Document, DocumentSettings, project, recovery};
 use crate::render::{Lighting, ViewMode};
 use crate::task::Progress;
+use crate::tools::{ToolKind, Tools};
 use canvas::{Canvas, CanvasChannel};
 use viewport::{Viewport, ViewportGpu};
 
 /// Default map size of a new project.
 pub const DEFAULT_SIZE: u32 = 1024;
-
-/// Painting tools.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Tool {
-    /// Paint the primary material (B).
-    Brush,
-    /// Paint the base material back (E).
-    Eraser,
-    /// Fill the clicked UV island, or the whole map on the canvas (F in 2D).
-    Fill,
-    /// Pick the material under the cursor (I).
-    Picker,
-    /// Drag a linear gradient from the primary to the secondary material on the canvas (G).
-    Gradient,
-}
-
-impl Tool {
-    const ALL: [(Self, &'static str, &'static str); 5] = [
-        (Self::Brush, "Brush", "B"),
-        (Self::Eraser, "Eraser", "E"),
-        (Self::Gradient, "Gradient", "G (on the UV canvas)"),
-        (Self::Fill, "Fill", "F (on the UV canvas)"),
-        (Self::Picker, "Picker", "I"),
-    ];
-}
 
 /// Dock tabs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -200,8 +176,8 @@ pub struct EditorState {
     /// Where it is saved.
     pub path: Option<PathBuf>,
     saved_version: u64,
-    /// Current tool.
-    pub tool: Tool,
+    /// The tools and which one is active.
+    pub tools: Tools,
     /// View mode of the viewport.
     pub view: ViewMode,
     /// Lights.
@@ -223,16 +199,14 @@ pub struct EditorState {
     pub recent: Vec<PathBuf>,
     /// The pen's last pressure in the current stroke (1 with a mouse).
     pressure: f32,
+    /// The view the primary button went down on, until it goes up.
+    held: Option<Tab>,
     /// The brush stamp's preview texture, and which stamp it shows.
     stamp_preview: Option<(u64, egui::TextureHandle)>,
     /// The texel under the cursor, in either view.
     pub hover: Option<(u32, u32)>,
     /// The tab under the cursor.
     pub hover_tab: Option<Tab>,
-    /// The tab whose drag is painting a stroke.
-    stroking: Option<Tab>,
-    /// Where a gradient drag started, in texels.
-    gradient_start: Option<Vec2>,
     /// `hover` as of the last frame (the status bar is drawn before the tabs).
     shown_hover: Option<(u32, u32)>,
     quit_asked: bool,
@@ -362,7 +336,7 @@ impl Editor {
                 doc,
                 path,
                 saved_version,
-                tool: Tool::Brush,
+                tools: Tools::default(),
                 view: ViewMode::Shaded,
                 lighting: Lighting::default(),
                 viewport,
@@ -376,10 +350,9 @@ impl Editor {
                 recent: load_recent(),
                 stamp_preview: None,
                 pressure: 1.0,
+                held: None,
                 hover: None,
                 hover_tab: None,
-                stroking: None,
-                gradient_start: None,
                 shown_hover: None,
                 quit_asked: false,
                 allow_close: false,
@@ -833,8 +806,10 @@ impl EditorState {
             let keys = [
                 Key::B,
                 Key::E,
+                Key::R,
                 Key::G,
                 Key::I,
+                Key::Escape,
                 Key::X,
                 Key::OpenBracket,
                 Key::CloseBracket,
@@ -850,10 +825,12 @@ impl EditorState {
         let mut brush = self.doc.settings.brush.clone();
         for key in pressed {
             match key {
-                Key::B => self.tool = Tool::Brush,
-                Key::E => self.tool = Tool::Eraser,
-                Key::G => self.tool = Tool::Gradient,
-                Key::I => self.tool = Tool::Picker,
+                Key::B => self.select_tool(ToolKind::Brush),
+                Key::E => self.select_tool(ToolKind::Eraser),
+                Key::R => self.select_tool(ToolKind::Blur),
+                Key::G => self.select_tool(ToolKind::Gradient),
+                Key::I => self.select_tool(ToolKind::Picker),
+                Key::Escape => self.tool_event(crate::tools::ToolEvent::Escape),
                 Key::X => self.apply(Command::SwapMaterials),
                 Key::OpenBracket if shift => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Key::CloseBracket if shift => brush.hardness = (brush.hardness + 0.1).min(1.0),
@@ -862,7 +839,7 @@ impl EditorState {
                 Key::F => {
                     // F fills on the canvas, frames the mesh in the viewport.
                     if self.hover_tab == Some(Tab::Canvas) {
-                        self.tool = Tool::Fill;
+                        self.select_tool(ToolKind::Fill);
                     } else {
                         self.viewport.frame(&self.mesh.mesh);
                     }

@@ -10,22 +10,100 @@ use egui::KeyboardShortcut;
 
 use super::canvas::CanvasChannel;
 use super::viewport::Compare;
-use super::{EditorState, Tool, keys, notice, stamp_image, stamp_key};
+use super::{EditorState, keys, notice, stamp_image, stamp_key};
 use crate::model::Command;
+use crate::model::paint::GradientShape;
 use crate::model::texel::{Channel, MaterialValue};
 use crate::reflectance::{self, AmbientApprox, ShadingModel};
 use crate::render::{FrameSettings, ViewMode};
+use crate::tools::{FillMode, ToolKind};
+
+/// The key that selects a tool.
+fn tool_key(kind: ToolKind) -> &'static str {
+    match kind {
+        ToolKind::Brush => "B",
+        ToolKind::Eraser => "E",
+        ToolKind::Blur => "R",
+        ToolKind::Fill => "F on the UV canvas",
+        ToolKind::Gradient => "G",
+        ToolKind::Picker => "I",
+    }
+}
 
 impl EditorState {
+    /// The active tool's options: the fill's mode, the gradient's shape.
+    fn tool_options_ui(&mut self, ui: &mut egui::Ui) {
+        match self.tools.active() {
+            ToolKind::Fill => {
+                let mode = &mut self.tools.fill.mode;
+                let name = match mode {
+                    FillMode::Island => "UV island (or all)",
+                    FillMode::Similar { .. } => "Similar texels",
+                    FillMode::All => "Whole map",
+                };
+                egui::ComboBox::from_label("Fill")
+                    .selected_text(name)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(mode, FillMode::Island, "UV island (or all)");
+                        if ui
+                            .selectable_label(
+                                matches!(mode, FillMode::Similar { .. }),
+                                "Similar texels",
+                            )
+                            .clicked()
+                        {
+                            *mode = FillMode::Similar {
+                                channel: Channel::Kd,
+                                tolerance: 0.05,
+                            };
+                        }
+                        ui.selectable_value(mode, FillMode::All, "Whole map");
+                    });
+                if let FillMode::Similar { channel, tolerance } = mode {
+                    egui::ComboBox::from_label("Compared channel")
+                        .selected_text(channel.name())
+                        .show_ui(ui, |ui| {
+                            for c in Channel::ALL {
+                                ui.selectable_value(channel, c, c.name());
+                            }
+                        });
+                    ui.add(egui::Slider::new(tolerance, 0.0..=1.0).text("Tolerance"))
+                        .on_hover_text("The largest difference still filled, in blend space");
+                }
+            }
+            ToolKind::Gradient => {
+                let shape = &mut self.tools.gradient.shape;
+                ui.horizontal(|ui| {
+                    ui.selectable_value(shape, GradientShape::Linear, "Linear");
+                    ui.selectable_value(shape, GradientShape::Radial, "Radial");
+                });
+            }
+            ToolKind::Blur => {
+                let mut brush = self.doc.settings.brush.clone();
+                ui.add(egui::Slider::new(&mut brush.blur_radius_px, 1..=16).text("Blur radius"))
+                    .on_hover_text("Kernel radius in texels");
+                if brush != self.doc.settings.brush {
+                    self.apply(Command::SetBrush(brush));
+                }
+            }
+            ToolKind::Brush | ToolKind::Eraser | ToolKind::Picker => {}
+        }
+    }
+
     /// Left panel: tools, brush, material, channels.
     pub(super) fn tools_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Tools");
+        let mut chosen = self.tools.active();
         ui.horizontal_wrapped(|ui| {
-            for (tool, label, key) in Tool::ALL {
-                ui.selectable_value(&mut self.tool, tool, label)
-                    .on_hover_text(format!("{label} ({key})"));
+            for kind in ToolKind::ALL {
+                ui.selectable_value(&mut chosen, kind, kind.label())
+                    .on_hover_text(format!("{} ({})", kind.label(), tool_key(kind)));
             }
         });
+        if chosen != self.tools.active() {
+            self.select_tool(chosen);
+        }
+        self.tool_options_ui(ui);
         ui.separator();
         ui.heading("Brush settings");
         let mut brush = self.doc.settings.brush.clone();
