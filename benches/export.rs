@@ -39,7 +39,9 @@ fn exports(c: &mut Criterion) {
         });
     }
     group.bench_function("rank_n_encodings_8_bit", |b| {
-        b.iter(|| encoding::rank_encodings(&doc.maps, doc.settings.model, doc.settings.approx, 8));
+        b.iter(|| {
+            encoding::rank_encodings(doc.maps(), doc.settings().model, doc.settings().approx, 8)
+        });
     });
     group.finish();
     let _ = std::fs::remove_dir_all(&dir);

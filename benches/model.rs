@@ -27,10 +27,10 @@ const SIDE: u32 = 4096;
 
 /// A document whose every tile holds varied data (nothing uniform).
 fn painted_document(side: u32) -> Document {
-    let mut doc = Document::new(side, side, DocumentSettings::default()).expect("size");
-    let count = doc.maps.tile_count();
+    let mut maps = MaterialMaps::new(side, side, MaterialValue::default()).expect("size");
+    let count = maps.tile_count();
     for id in 0..count {
-        let tile = doc.maps.tile_mut(id);
+        let tile = maps.tile_mut(id);
         for i in 0..TILE_TEXELS {
             let h = (id * TILE_TEXELS + i) as u32;
             let f =
@@ -45,7 +45,7 @@ fn painted_document(side: u32) -> Document {
             );
         }
     }
-    doc
+    Document::from_parts(maps, DocumentSettings::default())
 }
 
 fn brush128() -> BrushSettings {
@@ -129,7 +129,7 @@ fn dabs(c: &mut Criterion) {
     ];
     group.bench_function("stroke_100_dabs_128px", |b| {
         b.iter_batched(
-            || Document::from_parts(base.maps.clone(), base.settings.clone()),
+            || Document::from_parts(base.maps().clone(), base.settings().clone()),
             |mut doc| {
                 doc.apply(Command::Stroke {
                     tool: StrokeTool::Brush,
@@ -152,7 +152,7 @@ fn fills_and_derive(c: &mut Criterion) {
     let painted = painted_document(SIDE);
     group.bench_function("fill_whole_map", |b| {
         b.iter_batched(
-            || Document::from_parts(painted.maps.clone(), painted.settings.clone()),
+            || Document::from_parts(painted.maps().clone(), painted.settings().clone()),
             |mut doc| {
                 doc.apply(Command::Fill(FillRegion::All)).expect("fill");
                 doc
@@ -163,7 +163,8 @@ fn fills_and_derive(c: &mut Criterion) {
     group.bench_function("undo_whole_map_fill", |b| {
         b.iter_batched(
             || {
-                let mut doc = Document::from_parts(painted.maps.clone(), painted.settings.clone());
+                let mut doc =
+                    Document::from_parts(painted.maps().clone(), painted.settings().clone());
                 doc.apply(Command::Fill(FillRegion::All)).expect("fill");
                 doc
             },
@@ -180,7 +181,7 @@ fn fills_and_derive(c: &mut Criterion) {
     group.bench_function("derive_ka_full_map", |b| {
         b.iter(|| {
             painted
-                .maps
+                .maps()
                 .derive_ka_into(ShadingModel::Phong, AmbientApprox::Fast, &mut out);
         });
     });

@@ -127,8 +127,8 @@ fn frames(c: &mut Criterion) {
     let sphere = mesh::uv_sphere(1000, 500);
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
     let (painted, matte) = documents();
-    let painted_maps = MapTextures::new(&gpu, &painted.maps).expect("map textures");
-    let matte_maps = MapTextures::new(&gpu, &matte.maps).expect("map textures");
+    let painted_maps = MapTextures::new(&gpu, painted.maps()).expect("map textures");
+    let matte_maps = MapTextures::new(&gpu, matte.maps()).expect("map textures");
     let mut preview = Preview::new(&gpu);
     let (w, h) = (1920, 1080);
     let color = target(&gpu, w, h, wgpu::TextureFormat::Rgba8UnormSrgb);
@@ -220,7 +220,7 @@ fn uploads(c: &mut Criterion) {
         .sample_size(40)
         .measurement_time(Duration::from_secs(10));
     let mut doc = painted;
-    let mut maps = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut maps = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     let mut k = 0_u32;
     // Each iteration paints a hard 128 px dab inside one 256x256 square (16 tiles), then the
     // timed part: sync (upload the dirty tiles) and wait for the queue.
@@ -240,7 +240,7 @@ fn uploads(c: &mut Criterion) {
                 let y = 128.0 + 256.0 * (k % 7) as f32;
                 brush_stroke(&mut doc, &[Vec2::new(x0 + 128.0, y)]);
                 let start = std::time::Instant::now();
-                let n = maps.sync(&gpu, &doc.maps).expect("sync");
+                let n = maps.sync(&gpu, doc.maps()).expect("sync");
                 if wait {
                     gpu.wait();
                 }
@@ -288,7 +288,7 @@ fn painting(c: &mut Criterion) {
         ..BrushSettings::default()
     }))
     .expect("brush");
-    let mut maps = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut maps = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     let mut preview = Preview::new(&gpu);
     let (w, h) = (1280, 720);
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -315,7 +315,7 @@ fn painting(c: &mut Criterion) {
             let x = f32::from((k % 60) as u16) * 64.0 + 64.0;
             let y = 2048.0 + 512.0 * ((k / 60) % 3) as f32;
             brush_stroke(&mut doc, &[Vec2::new(x, y)]);
-            maps.sync(&gpu, &doc.maps).expect("sync");
+            maps.sync(&gpu, doc.maps()).expect("sync");
             let key = PipelineKey::for_frame(&s, &maps.uniform, format);
             frame.draw(&mut preview, &maps, &s, &[DrawPart::whole(key, (w, h))]);
         });

@@ -14,13 +14,13 @@ fn main() -> Result<(), String> {
         texture.exists().then_some(texture.as_path()),
         50,
     )?;
-    let (lo, hi) = kapaint::export::encoding::n_range(&doc.maps);
+    let (lo, hi) = kapaint::export::encoding::n_range(doc.maps());
     println!("n in [{lo}, {hi}]\n");
     println!("| model | bits | curve | max rel k_a error | mean rel k_a error |");
     println!("|---|---|---|---|---|");
     for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
         for bits in [8, 16] {
-            for (e, err) in rank_encodings(&doc.maps, model, AmbientApprox::Fast, bits) {
+            for (e, err) in rank_encodings(doc.maps(), model, AmbientApprox::Fast, bits) {
                 println!(
                     "| {} | {bits} | {:?} | {:.3e} | {:.3e} |",
                     model.name(),

@@ -38,14 +38,14 @@ fn main() -> Result<(), String> {
         "built {side}x{side} typical document in {:.2} s",
         start.elapsed().as_secs_f64()
     );
-    println!("undo steps: {}", doc.history.undo_steps().count());
+    println!("undo steps: {}", doc.history().undo_steps().count());
     println!(
         "maps heap: {:.1} MiB",
-        doc.maps.heap_bytes() as f64 / 1_048_576.0
+        doc.maps().heap_bytes() as f64 / 1_048_576.0
     );
     println!(
         "history: {:.1} MiB",
-        doc.history.bytes() as f64 / 1_048_576.0
+        doc.history().bytes() as f64 / 1_048_576.0
     );
     println!("resident: {:.1} MiB", resident_bytes() as f64 / 1_048_576.0);
     let path = std::env::temp_dir().join("kapaint-scale.kapaint");

@@ -26,7 +26,7 @@ fn main() -> Result<(), String> {
         },
     )
     .map_err(|e| e.to_string())?;
-    let mut maps = MapTextures::new(&gpu, &doc.maps).map_err(|e| e.to_string())?;
+    let mut maps = MapTextures::new(&gpu, doc.maps()).map_err(|e| e.to_string())?;
     // Rounds from the first argument (default 2000).
     let rounds: u32 = std::env::args()
         .nth(1)
@@ -44,7 +44,7 @@ fn main() -> Result<(), String> {
         })
         .map_err(|e| e.to_string())?;
         let start = Instant::now();
-        maps.sync(&gpu, &doc.maps).map_err(|e| e.to_string())?;
+        maps.sync(&gpu, doc.maps()).map_err(|e| e.to_string())?;
         cpu += start.elapsed();
         gpu.wait();
         whole += start.elapsed();

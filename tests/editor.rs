@@ -13,7 +13,7 @@ use kapaint::ui::canvas::CANVAS_LABEL;
 use kapaint::ui::viewport::{Compare, VIEWPORT_LABEL};
 
 fn texels(editor: &Editor) -> Vec<Texel> {
-    let maps = &editor.state.doc.maps;
+    let maps = editor.state.doc.maps();
     let mut out = Vec::with_capacity(maps.texel_count());
     maps.for_each_texel(|_, _, t| out.push(t));
     out
@@ -79,7 +79,7 @@ fn a_scripted_editing_session() {
     );
     // The mesh is baked on a worker; the window keeps drawing meanwhile.
     for _ in 0..500 {
-        if harness.state().state.doc.maps.width() == 512 {
+        if harness.state().state.doc.maps().width() == 512 {
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(10));
@@ -87,9 +87,9 @@ fn a_scripted_editing_session() {
     }
     harness.run();
     let doc = &harness.state().state.doc;
-    assert_eq!(doc.maps.width(), 512);
+    assert_eq!(doc.maps().width(), 512);
     assert_eq!(
-        doc.settings.mesh.spec(),
+        doc.settings().mesh.spec(),
         "torus",
         "the project names its mesh"
     );
@@ -111,7 +111,7 @@ fn a_scripted_editing_session() {
     let painted = texels(harness.state());
     assert_ne!(painted, fresh, "the canvas stroke changed nothing");
     assert_eq!(
-        harness.state().state.doc.history.undo_steps().count(),
+        harness.state().state.doc.history().undo_steps().count(),
         1,
         "one stroke, one step"
     );
@@ -148,10 +148,10 @@ fn a_scripted_editing_session() {
     );
 
     // Hotkeys: [ shrinks the brush, E picks the eraser.
-    let radius = harness.state().state.doc.settings.brush.radius_px;
+    let radius = harness.state().state.doc.settings().brush.radius_px;
     harness.key_press(egui::Key::OpenBracket);
     harness.run();
-    assert!(harness.state().state.doc.settings.brush.radius_px < radius);
+    assert!(harness.state().state.doc.settings().brush.radius_px < radius);
     harness.key_press(egui::Key::E);
     harness.run();
     assert_eq!(
@@ -162,10 +162,10 @@ fn a_scripted_editing_session() {
     // The built-in grain stamp shapes the brush, and Round takes it off again.
     harness.get_by_label("Grain").click();
     harness.run();
-    assert!(harness.state().state.doc.settings.brush.stamp.is_some());
+    assert!(harness.state().state.doc.settings().brush.stamp.is_some());
     harness.get_by_label("Round").click();
     harness.run();
-    assert!(harness.state().state.doc.settings.brush.stamp.is_none());
+    assert!(harness.state().state.doc.settings().brush.stamp.is_none());
 
     // The recent-files list keeps each project once, newest first, at most RECENT_MAX.
     let mut recent = Vec::new();
@@ -270,7 +270,7 @@ fn changed(a: &[Texel], b: &[Texel]) -> usize {
 #[test]
 fn pen_pressure_scales_the_dab() {
     let mut harness = editor();
-    assert!(harness.state().state.doc.settings.brush.pressure_size);
+    assert!(harness.state().state.doc.settings().brush.pressure_size);
     let fresh = texels(harness.state());
     let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
     let dab = |harness: &mut Harness<'_, Editor>, force: Option<f32>| {
@@ -333,7 +333,7 @@ fn a_settings_change_is_unsaved_work() {
     harness.get_by_label("Blinn-Phong (11)").click();
     harness.run();
     assert_eq!(
-        harness.state().state.doc.settings.model,
+        harness.state().state.doc.settings().model,
         kapaint::reflectance::ShadingModel::BlinnPhong
     );
     assert!(
@@ -373,13 +373,13 @@ fn escape_abandons_a_stroke_under_way() {
         before,
         "and the release adds nothing"
     );
-    assert_eq!(harness.state().state.doc.history.undo_steps().count(), 0);
+    assert_eq!(harness.state().state.doc.history().undo_steps().count(), 0);
 }
 
 #[test]
 fn a_gradient_dragged_in_the_viewport_lays_a_gradient() {
     let mut harness = editor();
-    let primary = harness.state().state.doc.settings.primary;
+    let primary = harness.state().state.doc.settings().primary;
     let before = texels(harness.state());
     harness.get_by_label("Gradient").click();
     harness.run();
@@ -393,7 +393,7 @@ fn a_gradient_dragged_in_the_viewport_lays_a_gradient() {
     );
     assert_ne!(texels(harness.state()), before, "a gradient was laid");
     assert_eq!(
-        harness.state().state.doc.settings.primary,
+        harness.state().state.doc.settings().primary,
         primary,
         "not a pick"
     );

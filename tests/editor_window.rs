@@ -106,7 +106,7 @@ fn run_in_window(tag: &str, script: &str, env: &[(&str, &str)]) -> Option<PathBu
 /// Asserts the saved project holds a stroke, then removes the test's folder.
 fn assert_painted(project: &Path, what: &str) {
     let doc = kapaint::model::project::load(project).expect("saved project loads");
-    assert!(doc.maps.uniform_texel().is_none(), "{what}");
+    assert!(doc.maps().uniform_texel().is_none(), "{what}");
     if let Some(dir) = project.parent() {
         let _ = std::fs::remove_dir_all(dir);
     }

@@ -67,11 +67,11 @@ fn painted() -> Document {
 }
 
 fn max_rel_ka_error(a: &Document, b: &Document) -> f32 {
-    let (m, x) = (a.settings.model, a.settings.approx);
+    let (m, x) = (a.settings().model, a.settings().approx);
     let mut worst = 0.0_f32;
-    for y in 0..a.maps.height() {
-        for xx in 0..a.maps.width() {
-            let (p, q) = (a.maps.value(xx, y), b.maps.value(xx, y));
+    for y in 0..a.maps().height() {
+        for xx in 0..a.maps().width() {
+            let (p, q) = (a.maps().value(xx, y), b.maps().value(xx, y));
             let (ka, kb) = (
                 reflectance::ka(m, x, p.kd, p.ks, p.n),
                 reflectance::ka(m, x, q.kd, q.ks, q.n),

@@ -185,7 +185,7 @@ fn painted_maps() -> MaterialMaps {
         let y = 60.0 + 80.0 * i as f32;
         brush_stroke(&mut doc, &[Vec2::new(10.0, y), Vec2::new(246.0, y + 20.0)]);
     }
-    doc.maps
+    doc.into_parts().0
 }
 
 #[test]
@@ -268,15 +268,15 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
 fn sync_uploads_only_dirty_tiles_and_the_render_follows() {
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 512, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     assert_eq!(
-        textures.sync(&gpu, &doc.maps).expect("sync"),
+        textures.sync(&gpu, doc.maps()).expect("sync"),
         0,
         "nothing changed"
     );
     brush_stroke(&mut doc, &[Vec2::new(100.0, 100.0)]);
     // A 32 px dab at (100, 100) touches the 4 tiles around (64..192)^2 at most.
-    let uploaded = textures.sync(&gpu, &doc.maps).expect("sync");
+    let uploaded = textures.sync(&gpu, doc.maps()).expect("sync");
     assert!((1..=4).contains(&uploaded), "{uploaded} tiles");
     assert!(textures.uniform.kd.is_none(), "k_d is no longer uniform");
 }
@@ -503,12 +503,12 @@ fn render_cli_writes_numerically_checkable_data_views() {
 fn mips_follow_the_dirty_tiles() {
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 512, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     brush_stroke(&mut doc, &[Vec2::new(90.0, 100.0), Vec2::new(300.0, 140.0)]);
-    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
+    assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
     // Level 2 holds the 4 x 4 box means; the 1 x 1 level the mean of the whole map.
-    assert_box_means(&gpu, &textures, &doc.maps, 2);
-    assert_box_means(&gpu, &textures, &doc.maps, 9);
+    assert_box_means(&gpu, &textures, doc.maps(), 2);
+    assert_box_means(&gpu, &textures, doc.maps(), 9);
 }
 
 #[test]
@@ -517,7 +517,7 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     // Not a multiple of the tile size: edge tiles are partial, levels round down.
     let (w, h) = (200_usize, 120_usize);
     let mut doc = Document::new(w as u32, h as u32, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     doc.apply(Command::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.2, 0.1),
         Vec3::splat(0.7),
@@ -525,9 +525,9 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     )))
     .expect("primary");
     brush_stroke(&mut doc, &[Vec2::new(20.0, 30.0), Vec2::new(190.0, 110.0)]);
-    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
+    assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
     for level in 1..textures.kd.mip_level_count() {
-        assert_box_means(&gpu, &textures, &doc.maps, level);
+        assert_box_means(&gpu, &textures, doc.maps(), level);
     }
 }
 
@@ -545,16 +545,16 @@ fn without_16_bit_norm_textures_the_maps_upload_as_half_floats() {
     )))
     .expect("primary");
     brush_stroke(&mut doc, &[Vec2::new(20.0, 30.0), Vec2::new(190.0, 110.0)]);
-    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     assert_eq!(textures.kd.format(), wgpu::TextureFormat::Rgba16Float);
     for level in 0..textures.kd.mip_level_count() {
-        assert_box_means(&gpu, &textures, &doc.maps, level);
+        assert_box_means(&gpu, &textures, doc.maps(), level);
     }
     // A later stroke updates its tiles and the levels over them.
     brush_stroke(&mut doc, &[Vec2::new(150.0, 10.0), Vec2::new(10.0, 100.0)]);
-    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
+    assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
     for level in 0..textures.kd.mip_level_count() {
-        assert_box_means(&gpu, &textures, &doc.maps, level);
+        assert_box_means(&gpu, &textures, doc.maps(), level);
     }
 }
 
@@ -666,9 +666,9 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
         Vec2::new(10.0, 10.0),
         Vec2::new(2040.0, 1500.0),
     );
-    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     for level in [0, 3, 9] {
-        assert_box_means(&gpu, &textures, &doc.maps, level);
+        assert_box_means(&gpu, &textures, doc.maps(), level);
     }
     // A stroke the other way: its tiles make many small rectangles, not one.
     let blue = MaterialValue::new(Vec3::new(0.1, 0.3, 0.8), Vec3::splat(0.05), 2000.0);
@@ -678,9 +678,9 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
         Vec2::new(2000.0, 30.0),
         Vec2::new(30.0, 1400.0),
     );
-    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 50);
+    assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 50);
     for level in [0, 1, 6, 7, 10] {
-        assert_box_means(&gpu, &textures, &doc.maps, level);
+        assert_box_means(&gpu, &textures, doc.maps(), level);
     }
 }
 
@@ -689,14 +689,14 @@ fn a_stroke_on_some_channels_stages_only_those() {
     use kapaint::model::Channels;
     let Some(gpu) = gpu() else { return };
     let mut doc = Document::new(512, 384, DocumentSettings::default()).expect("doc");
-    let mut textures = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     let mut dab = |doc: &mut Document, channels: Channels, value: MaterialValue| {
         doc.apply(Command::SetChannels(channels)).expect("channels");
         doc.apply(Command::SetPrimary(value)).expect("primary");
         brush_stroke(doc, &[Vec2::new(200.0, 150.0)]);
-        assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
+        assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
         for level in [0, 1, 3, 7] {
-            assert_box_means(&gpu, &textures, &doc.maps, level);
+            assert_box_means(&gpu, &textures, doc.maps(), level);
         }
         textures.staged_bytes()
     };
@@ -731,10 +731,10 @@ fn a_stroke_on_some_channels_stages_only_those() {
     assert!(n * 10 < all * 2, "n only staged {n} of {all} bytes");
     // Undo puts back whole tiles: every channel again, and still mirrored.
     doc.apply(Command::Undo).expect("undo");
-    assert!(textures.sync(&gpu, &doc.maps).expect("sync") > 0);
+    assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
     assert_eq!(textures.staged_bytes(), all);
     for level in [0, 2, 8] {
-        assert_box_means(&gpu, &textures, &doc.maps, level);
+        assert_box_means(&gpu, &textures, doc.maps(), level);
     }
 }
 
@@ -786,8 +786,8 @@ fn check_decoded_pairs(got: &[f32], doc: &Document, m: &kapaint::export::set::Ma
             pair[0]
         );
         let ka = reflectance::ka(
-            doc.settings.model,
-            doc.settings.approx,
+            doc.settings().model,
+            doc.settings().approx,
             Vec3::splat(0.3),
             Vec3::splat(0.5),
             n,
@@ -915,8 +915,8 @@ fn the_exported_glsl_snippet_decodes_like_the_cpu() {
             }
         }
         let want = reflectance::ka(
-            doc.settings.model,
-            doc.settings.approx,
+            doc.settings().model,
+            doc.settings().approx,
             Vec3::splat(v),
             Vec3::splat(1.0 - v),
             10.0,
@@ -1075,5 +1075,5 @@ fn a_lost_device_is_an_error_not_a_panic() {
     );
     let mut doc = Document::new(64, 64, DocumentSettings::default()).expect("doc");
     doc.apply(Command::Fill(FillRegion::All)).expect("fill");
-    assert!(textures.sync(&gpu, &doc.maps).is_err());
+    assert!(textures.sync(&gpu, doc.maps()).is_err());
 }

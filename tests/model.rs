@@ -52,7 +52,7 @@ fn red() -> MaterialValue {
 #[test]
 fn every_command_keeps_the_maps_valid_and_undo_restores_bit_exactly() {
     let mut d = doc(300, 200);
-    let initial = snapshot(&d.maps);
+    let initial = snapshot(d.maps());
     let commands = vec![
         Command::SetPrimary(red()),
         Command::SetBrush(BrushSettings {
@@ -107,11 +107,11 @@ fn every_command_keeps_the_maps_valid_and_undo_restores_bit_exactly() {
     let mut snapshots = vec![initial.clone()];
     for command in commands {
         d.apply(command).expect("command applies");
-        assert_valid(&d.maps);
-        snapshots.push(snapshot(&d.maps));
+        assert_valid(d.maps());
+        snapshots.push(snapshot(d.maps()));
     }
     // Undo walks back through every snapshot bit-exactly, redo forward again.
-    let steps = d.history.undo_steps().count();
+    let steps = d.history().undo_steps().count();
     assert_eq!(steps, 7);
     let changed: Vec<&Vec<Texel>> = {
         let mut v = vec![&snapshots[0]];
@@ -125,12 +125,12 @@ fn every_command_keeps_the_maps_valid_and_undo_restores_bit_exactly() {
     assert_eq!(changed.len(), steps + 1);
     for want in changed.iter().rev().skip(1) {
         d.apply(Command::Undo).expect("undo");
-        assert!(snapshot(&d.maps) == **want, "undo is not bit-exact");
+        assert!(snapshot(d.maps()) == **want, "undo is not bit-exact");
     }
-    assert_eq!(snapshot(&d.maps), initial);
+    assert_eq!(snapshot(d.maps()), initial);
     for want in changed.iter().skip(1) {
         d.apply(Command::Redo).expect("redo");
-        assert!(snapshot(&d.maps) == **want, "redo is not bit-exact");
+        assert!(snapshot(d.maps()) == **want, "redo is not bit-exact");
     }
 }
 
@@ -150,7 +150,7 @@ fn stroke_result_does_not_depend_on_input_sampling() {
             points,
         })
         .expect("stroke");
-        snapshot(&d.maps)
+        snapshot(d.maps())
     };
     let worst = |a: &[Texel], b: &[Texel]| {
         a.iter()
@@ -216,7 +216,7 @@ fn opacity_caps_a_stroke_however_many_dabs_overlap() {
         ..BrushSettings::default()
     }))
     .expect("set");
-    let base = d.maps.value(64, 64).kd.x;
+    let base = d.maps().value(64, 64).kd.x;
     let points = (0..40)
         .map(|i| point(60.0 + (i % 2) as f32 * 8.0, 64.0))
         .collect();
@@ -225,7 +225,7 @@ fn opacity_caps_a_stroke_however_many_dabs_overlap() {
         points,
     })
     .expect("stroke");
-    let v = d.maps.value(64, 64).kd.x;
+    let v = d.maps().value(64, 64).kd.x;
     let half_way = base + (1.0 - base) * 0.5;
     assert!((v - half_way).abs() < 1e-3, "{v} vs {half_way}");
 }
@@ -248,14 +248,14 @@ fn mirror_eraser_and_picker() {
     for y in 0..100 {
         for x in 0..100 {
             assert_eq!(
-                d.maps.texel(x, y),
-                d.maps.texel(199 - x, y),
+                d.maps().texel(x, y),
+                d.maps().texel(199 - x, y),
                 "mirror at ({x}, {y})"
             );
         }
     }
     d.apply(Command::Pick { x: 30, y: 50 }).expect("pick");
-    assert_eq!(d.settings.primary, red().quantized());
+    assert_eq!(d.settings().primary, red().quantized());
     assert!(d.apply(Command::Pick { x: 200, y: 0 }).is_err());
     // The eraser paints the base material back.
     d.apply(Command::SetBrush(BrushSettings {
@@ -269,7 +269,7 @@ fn mirror_eraser_and_picker() {
         points: vec![point(30.0, 0.0), point(30.0, 100.0)],
     })
     .expect("erase");
-    assert_eq!(d.maps.value(30, 50), d.settings.base.quantized());
+    assert_eq!(d.maps().value(30, 50), d.settings().base.quantized());
 }
 
 #[test]
@@ -293,9 +293,9 @@ fn gradient_and_fill_write_what_they_say() {
         end: Vec2::new(256.0, 0.0),
     })
     .expect("gradient");
-    let left = d.maps.value(0, 10);
-    let mid = d.maps.value(128, 10);
-    let right = d.maps.value(255, 10);
+    let left = d.maps().value(0, 10);
+    let mid = d.maps().value(128, 10);
+    let right = d.maps().value(255, 10);
     assert!(left.kd.x < 0.01 && right.kd.x > 0.99);
     assert!((mid.kd.x - 0.5).abs() < 0.01);
     // n is blended in log space: the midpoint is sqrt(1 + N_MAX) - 1, not N_MAX / 2.
@@ -307,8 +307,8 @@ fn gradient_and_fill_write_what_they_say() {
     );
     // A full-opacity fill makes every tile uniform again: no memory.
     d.apply(Command::Fill(FillRegion::All)).expect("fill");
-    assert_eq!(d.maps.heap_bytes(), 0);
-    assert_eq!(d.maps.value(200, 50), d.settings.primary.quantized());
+    assert_eq!(d.maps().heap_bytes(), 0);
+    assert_eq!(d.maps().value(200, 50), d.settings().primary.quantized());
 }
 
 #[test]
@@ -340,9 +340,9 @@ fn flood_fill_stops_at_the_tolerance() {
         tolerance: 0.01,
     }))
     .expect("fill");
-    assert_eq!(d.maps.value(20, 90).kd, Vec3::new(0.0, 0.0, 1.0));
-    assert_ne!(d.maps.value(90, 90).kd, Vec3::new(0.0, 0.0, 1.0));
-    assert_eq!(d.maps.value(50, 50).kd, Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(d.maps().value(20, 90).kd, Vec3::new(0.0, 0.0, 1.0));
+    assert_ne!(d.maps().value(90, 90).kd, Vec3::new(0.0, 0.0, 1.0));
+    assert_eq!(d.maps().value(50, 50).kd, Vec3::new(1.0, 0.0, 0.0));
 }
 
 fn small_project() -> Document {
@@ -365,8 +365,8 @@ fn project_round_trip_is_lossless() {
     let d = small_project();
     let bytes = project::to_bytes(&d).expect("saves");
     let back = project::from_reader(std::io::Cursor::new(bytes)).expect("loads");
-    assert_eq!(snapshot(&back.maps), snapshot(&d.maps));
-    assert_eq!(back.settings, d.settings);
+    assert_eq!(snapshot(back.maps()), snapshot(d.maps()));
+    assert_eq!(back.settings(), d.settings());
 }
 
 #[test]
@@ -392,7 +392,7 @@ fn random_byte_flips_never_panic_and_never_load_invalid_maps() {
         let at = (state >> 33) as usize % corrupt.len();
         corrupt[at] ^= 1 << ((state >> 20) % 8);
         match project::from_reader(std::io::Cursor::new(corrupt)) {
-            Ok(d) => assert_valid(&d.maps),
+            Ok(d) => assert_valid(d.maps()),
             Err(_) => errors += 1,
         }
     }
@@ -435,7 +435,7 @@ fn importing_the_spot_texture_converts_srgb_to_linear() {
         let p = png.get_pixel(x, y).0;
         let want = Vec3::new(f32::from(p[0]), f32::from(p[1]), f32::from(p[2]))
             .map(|c| srgb_to_linear(c / 255.0));
-        let got = d.maps.value(x, y).kd;
+        let got = d.maps().value(x, y).kd;
         assert!(
             (got - want).abs().max_element() < 2e-3,
             "({x}, {y}): {got} vs {want}"
@@ -443,7 +443,7 @@ fn importing_the_spot_texture_converts_srgb_to_linear() {
     }
     // One undo step restores the base.
     d.apply(Command::Undo).expect("undo");
-    assert_eq!(d.maps.value(512, 300), d.settings.base.quantized());
+    assert_eq!(d.maps().value(512, 300), d.settings().base.quantized());
 }
 
 #[test]
@@ -456,8 +456,8 @@ fn importing_into_n_uses_the_log_scale() {
         .expect("write");
     let mut d = doc(64, 64);
     import::import_file(&mut d, Channel::N, &gray).expect("import");
-    assert_eq!(d.maps.value(0, 0).n, 0.0);
-    assert_eq!(d.maps.value(63, 0).n, N_MAX);
+    assert_eq!(d.maps().value(0, 0).n, 0.0);
+    assert_eq!(d.maps().value(63, 0).n, N_MAX);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -480,7 +480,7 @@ fn bad_images_are_clear_errors() {
     let bomb_path = dir.join("bomb.png");
     std::fs::write(&bomb_path, &bomb).expect("write");
     let mut d = doc(32, 32);
-    let before = snapshot(&d.maps);
+    let before = snapshot(d.maps());
     for (path, needle) in [
         (&truncated, "truncated"),
         (&not_image, "png"),
@@ -495,7 +495,11 @@ fn bad_images_are_clear_errors() {
         );
         assert!(err.to_lowercase().contains(needle), "{err}");
     }
-    assert_eq!(snapshot(&d.maps), before, "a failed import changes nothing");
+    assert_eq!(
+        snapshot(d.maps()),
+        before,
+        "a failed import changes nothing"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -101,7 +101,7 @@ fn any_command() -> impl Strategy<Value = Command> {
 
 fn snapshot(doc: &Document) -> Vec<Texel> {
     let mut out = Vec::new();
-    doc.maps.for_each_texel(|_, _, t| out.push(t));
+    doc.maps().for_each_texel(|_, _, t| out.push(t));
     out
 }
 
@@ -115,15 +115,15 @@ proptest! {
         for command in commands {
             doc.apply(command).expect("every generated command is valid");
             let mut ok = true;
-            doc.maps.for_each_texel(|_, _, t| {
+            doc.maps().for_each_texel(|_, _, t| {
                 let n = half::f16::from_bits(t.n).to_f32();
                 ok &= n.is_finite() && (0.0..=N_MAX).contains(&n);
             });
             prop_assert!(ok, "an invalid n was stored");
-            let s = &doc.settings;
+            let s = doc.settings();
             prop_assert!(s.primary.kd.is_finite() && s.primary.n.is_finite());
         }
-        while doc.history.undo_steps().next().is_some() {
+        while doc.history().undo_steps().next().is_some() {
             doc.apply(Command::Undo).expect("undo");
         }
         prop_assert!(snapshot(&doc) == start, "undoing everything did not restore the start");

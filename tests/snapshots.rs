@@ -137,7 +137,7 @@ fn the_main_views_match_their_snapshots() {
     import::import_file(&mut doc, Channel::Kd, &texture).expect("k_d");
     import::import_file(&mut doc, Channel::N, &texture).expect("n");
     let buffers = MeshBuffers::new(&gpu, &mesh).expect("mesh buffers");
-    let maps = MapTextures::new(&gpu, &doc.maps).expect("map textures");
+    let maps = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     let mut preview = Preview::new(&gpu);
     let settings = |model, view| FrameSettings {
         model,

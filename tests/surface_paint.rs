@@ -52,10 +52,10 @@ fn at(pos: Vec3) -> SurfacePoint {
 
 /// Every texel's stored k_d, row-major.
 fn kd_map(doc: &Document) -> Vec<[u16; 3]> {
-    let (w, h) = (doc.maps.width(), doc.maps.height());
+    let (w, h) = (doc.maps().width(), doc.maps().height());
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| doc.maps.texel(x, y).kd)
+        .map(|(x, y)| doc.maps().texel(x, y).kd)
         .collect()
 }
 
@@ -265,7 +265,7 @@ fn a_stroke_across_a_seam_of_spot_paints_both_sides_as_one() {
     for p in &input {
         resampler.push(*p, &mut dabs).expect("within the dab limit");
     }
-    let s = &doc.settings;
+    let s = doc.settings();
     let target = PaintTarget::new(s.primary, s.channels, s.brush.blend, false);
     let base = Texel::encode(s.base);
     let r2 = radius * radius;
@@ -415,7 +415,7 @@ fn front_faces_only_keeps_a_big_brush_on_the_near_side() {
                 .min_by(|a, b| a.1.distance(pos).total_cmp(&b.1.distance(pos)))
                 .expect("texel");
             let (x, y) = ((i % 128) as u32, (i / 128) as u32);
-            doc.maps.value(x, y).kd.x > 0.5
+            doc.maps().value(x, y).kd.x > 0.5
         };
         assert!(painted(Vec3::new(0.0, 0.9, 0.4)));
         assert_eq!(
@@ -438,7 +438,7 @@ fn fills_by_island_and_by_part() {
     doc.apply(Command::Fill(FillRegion::Island { x, y }))
         .expect("fill island");
     let kd = kd_map(&doc);
-    let painted = Texel::encode(doc.settings.primary).kd;
+    let painted = Texel::encode(doc.settings().primary).kd;
     for (i, v) in kd.iter().enumerate() {
         let inside = surface.bake.island[i] == island;
         assert_eq!(*v == painted, inside, "texel {i}");

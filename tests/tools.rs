@@ -29,7 +29,7 @@ fn document() -> Document {
 
 fn texels(doc: &Document) -> Vec<Texel> {
     let mut out = Vec::new();
-    doc.maps.for_each_texel(|_, _, t| out.push(t));
+    doc.maps().for_each_texel(|_, _, t| out.push(t));
     out
 }
 
@@ -86,7 +86,7 @@ fn on_surface(doc: &Document, point: Vec3) -> Place {
 
 fn with_sphere(mut doc: Document) -> Document {
     let surface =
-        Surface::new(uv_sphere(32, 16), doc.maps.width(), doc.maps.height()).expect("bake");
+        Surface::new(uv_sphere(32, 16), doc.maps().width(), doc.maps().height()).expect("bake");
     doc.set_surface(Some(Arc::new(surface))).expect("surface");
     doc
 }
@@ -110,7 +110,7 @@ fn a_brush_stroke_is_one_undo_step_from_press_to_release() {
     run(&mut tools, &mut doc, &[ToolEvent::Release]);
     assert!(!tools.busy() && !doc.stroking());
     assert_ne!(texels(&doc), before, "painted");
-    assert_eq!(doc.history.undo_steps().count(), 1, "one step");
+    assert_eq!(doc.history().undo_steps().count(), 1, "one step");
     doc.apply(Command::Undo).expect("undo");
     assert_eq!(texels(&doc), before, "undone bit-exactly");
 }
@@ -134,7 +134,7 @@ fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
                 &[press(60.0, 30.0), ToolEvent::Release],
             );
             let before = texels(&doc);
-            let steps = doc.history.undo_steps().count();
+            let steps = doc.history().undo_steps().count();
             let mut tools = Tools::default();
             tools.select(kind, &doc);
             let (a, b) = if on_mesh {
@@ -171,7 +171,7 @@ fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
                 before,
                 "{kind:?} (mesh: {on_mesh}) left its stroke"
             );
-            assert_eq!(doc.history.undo_steps().count(), steps, "no undo step");
+            assert_eq!(doc.history().undo_steps().count(), steps, "no undo step");
             assert!(!tools.busy());
             assert!(
                 run(&mut tools, &mut doc, &[ToolEvent::Release]).is_empty(),
@@ -185,7 +185,7 @@ fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
 fn a_gradient_dragged_on_the_mesh_lays_a_gradient_not_a_pick() {
     let mut doc = with_sphere(document());
     let before = texels(&doc);
-    let primary = doc.settings.primary;
+    let primary = doc.settings().primary;
     let mut tools = Tools::default();
     tools.select(ToolKind::Gradient, &doc);
     let (a, b) = (
@@ -214,7 +214,7 @@ fn a_gradient_dragged_on_the_mesh_lays_a_gradient_not_a_pick() {
     assert_eq!(shape, GradientShape::Linear);
     assert_eq!((Some(start), Some(end)), (a.texel(), b.texel()));
     assert_ne!(texels(&doc), before);
-    assert_eq!(doc.settings.primary, primary, "nothing was picked");
+    assert_eq!(doc.settings().primary, primary, "nothing was picked");
 }
 
 #[test]
@@ -249,7 +249,7 @@ fn a_gradient_can_be_radial_and_escape_drops_it() {
         }]
     ));
     // Radial: equal values at equal distances from the start.
-    let (l, r) = (doc.maps.value(43, 32), doc.maps.value(84, 32)); // centres 20.5 away
+    let (l, r) = (doc.maps().value(43, 32), doc.maps().value(84, 32)); // centres 20.5 away
     assert!((l.kd - r.kd).abs().max_element() < 1e-3, "{l:?} {r:?}");
 }
 
@@ -289,8 +289,14 @@ fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
             ..
         })]
     ));
-    assert!(doc.maps.value(10, 10).kd.y > 0.7, "the left half is filled");
-    assert!(doc.maps.value(120, 10).kd.y < 0.7, "the right half is not");
+    assert!(
+        doc.maps().value(10, 10).kd.y > 0.7,
+        "the left half is filled"
+    );
+    assert!(
+        doc.maps().value(120, 10).kd.y < 0.7,
+        "the right half is not"
+    );
     tools.fill.mode = FillMode::All;
     let commands = run(&mut tools, &mut doc, &[press(10.0, 10.0)]);
     assert_eq!(commands, vec![Command::Fill(FillRegion::All)]);
@@ -332,7 +338,7 @@ fn the_picker_reads_the_texel_under_the_pointer_in_either_view() {
         }],
     );
     assert_eq!(commands, vec![Command::Pick { x, y }]);
-    assert_eq!(doc.settings.primary, doc.maps.value(x, y));
+    assert_eq!(doc.settings().primary, doc.maps().value(x, y));
 }
 
 #[test]
@@ -343,14 +349,14 @@ fn switching_tools_mid_stroke_keeps_the_stroke_and_drops_a_gradient() {
     let ended = tools.select(ToolKind::Picker, &doc);
     assert_eq!(ended, vec![Command::EndStroke]);
     doc.apply(Command::EndStroke).expect("end");
-    assert_eq!(doc.history.undo_steps().count(), 1, "the stroke is kept");
+    assert_eq!(doc.history().undo_steps().count(), 1, "the stroke is kept");
     tools.select(ToolKind::Gradient, &doc);
     run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
     assert!(
         tools.select(ToolKind::Brush, &doc).is_empty(),
         "no gradient laid"
     );
-    assert_eq!(doc.history.undo_steps().count(), 1);
+    assert_eq!(doc.history().undo_steps().count(), 1);
 }
 
 #[test]

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use super::{CliError, attach_surface, model_error};
+use super::{CliError, model_error};
 use crate::model::project;
 
 /// The `--report` lines of one exported set.
@@ -84,9 +84,12 @@ pub(super) fn export_command(
     let docs = files
         .iter()
         .map(|f| {
-            let mut doc = project::load(f).map_err(model_error)?;
-            if padding && let Err(e) = attach_surface(&mut doc, f, None) {
-                let _ = writeln!(text, "note: {}: no padding ({})", f.display(), e.message);
+            if !padding {
+                return project::load(f).map_err(model_error);
+            }
+            let (doc, failed) = project::open_with_mesh(f, None).map_err(model_error)?;
+            if let Some(e) = failed {
+                let _ = writeln!(text, "note: {}: no padding ({e})", f.display());
             }
             Ok(doc)
         })

@@ -440,7 +440,8 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             let commands = read_script(&script)?;
             let mut doc = project::load(&file).map_err(model_error)?;
             if commands.iter().any(model::Command::needs_surface) {
-                attach_surface(&mut doc, &file, mesh.as_deref())?;
+                let spec = mesh.unwrap_or_else(|| doc.settings().mesh.spec().to_string());
+                project::attach_mesh(&mut doc, std::path::Path::new(&spec)).map_err(model_error)?;
             }
             let count = commands.len();
             for (i, command) in commands.into_iter().enumerate() {
@@ -480,8 +481,8 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
                 "imported {} into {} ({}x{})\n",
                 manifest.display(),
                 out.display(),
-                doc.maps.width(),
-                doc.maps.height()
+                doc.maps().width(),
+                doc.maps().height()
             ))
         }
         Command::EquivalentN { from, n } => {
@@ -541,34 +542,6 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
             Ok(table)
         }
     }
-}
-
-/// A project's mesh: a built-in name, or its file (a relative path is tried from the
-/// project's folder when it does not exist from the current one).
-pub(super) fn project_mesh(settings: &DocumentSettings, project_file: &std::path::Path) -> PathBuf {
-    let own = PathBuf::from(settings.mesh.spec());
-    match project_file.parent() {
-        Some(dir) if own.is_relative() && !own.exists() && dir.join(&own).exists() => dir.join(own),
-        _ => own,
-    }
-}
-
-/// Loads the mesh (`spec`, else the project's own, a relative path taken from the project's
-/// folder), bakes it at the map size and attaches it to `doc`.
-pub(super) fn attach_surface(
-    doc: &mut Document,
-    project_file: &std::path::Path,
-    spec: Option<&str>,
-) -> Result<(), CliError> {
-    let spec = spec.map_or_else(
-        || project_mesh(&doc.settings, project_file),
-        std::path::PathBuf::from,
-    );
-    let mesh = mesh::open(&spec).map_err(mesh_error)?;
-    let surface = model::surface::Surface::new(mesh, doc.maps.width(), doc.maps.height())
-        .map_err(|e| CliError::usage(format!("{}: {e}", spec.display())))?;
-    doc.set_surface(Some(std::sync::Arc::new(surface)))
-        .map_err(model_error)
 }
 
 /// A model-layer error in one line: exit code 1 for a failed read or write that is not the
@@ -648,8 +621,8 @@ fn read_script(path: &std::path::Path) -> Result<Vec<model::Command>, CliError> 
 
 /// `kapaint info` output: `key: value` lines, then one line per channel component.
 pub fn info_text(path: &std::path::Path, doc: &Document, file_bytes: u64) -> String {
-    let maps = &doc.maps;
-    let s = &doc.settings;
+    let maps = doc.maps();
+    let s = doc.settings();
     let mut out = String::new();
     let _ = writeln!(out, "file: {}", path.display());
     let _ = writeln!(out, "size: {}x{}", maps.width(), maps.height());

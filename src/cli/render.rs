@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use glam::DVec3;
 
 use super::args::{parse_light, parse_n, parse_rgb, parse_size};
-use super::{CliError, MethodArg, model_error, project_mesh};
+use super::{CliError, MethodArg, model_error};
 use crate::mesh;
 use crate::model::{self, project};
 use crate::reflectance::{AmbientApprox, ShadingModel};
@@ -65,8 +65,8 @@ pub struct RenderArgs {
 fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::PathBuf), CliError> {
     if let Some(file) = &a.project {
         let doc = project::load(file).map_err(model_error)?;
-        let spec = project_mesh(&doc.settings, file);
-        return Ok((doc.maps, spec));
+        let spec = PathBuf::from(doc.settings().mesh.spec());
+        return Ok((doc.into_parts().0, spec));
     }
     let d = model::MaterialValue::default();
     let kd =

@@ -768,8 +768,8 @@ fn plan_set(
     doc: &Document,
     preset: &ExportPreset,
 ) -> (SetPlan, bool, Vec<(&'static str, Vec<Comp>)>) {
-    let maps = &doc.maps;
-    let (model, approx) = (doc.settings.model, doc.settings.approx);
+    let maps = doc.maps();
+    let (model, approx) = (doc.settings().model, doc.settings().approx);
     let (kd, ks, n) = maps.uniform_channels();
     let constants = Constants {
         kd: kd.map(|v| v.map(decode_unorm)),
@@ -854,8 +854,8 @@ pub fn export_with(
             reason: "exists and is not an empty folder".into(),
         });
     }
-    let maps = &doc.maps;
-    let (model, approx) = (doc.settings.model, doc.settings.approx);
+    let maps = doc.maps();
+    let (model, approx) = (doc.settings().model, doc.settings().approx);
     let (w, h) = (maps.width(), maps.height());
     let (planned, mono_ks, images) = plan_set(doc, preset);
     let (constants, n_enc) = (planned.constants, planned.n_encoding);

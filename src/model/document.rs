@@ -236,11 +236,20 @@ pub enum Command {
         /// Texel row.
         y: u32,
     },
+    /// Replaces a channel with an image already resampled to the map size (one undo step;
+    /// see [`super::import`]). Not for scripts: its planes come from a decoder.
+    #[serde(skip)]
+    ImportChannel(ImportedChannel),
     /// Undoes the last step.
     Undo,
     /// Redoes the last undone step.
     Redo,
 }
+
+/// A channel's planes made by [`super::import::resample`], shared so that the command clones
+/// cheaply.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportedChannel(pub Arc<super::import::ChannelPlanes>);
 
 impl Command {
     /// Whether the command paints on the mesh (and so needs [`Document::set_surface`]).
@@ -291,12 +300,9 @@ impl ActiveStroke {
 
 /// A material being painted.
 pub struct Document {
-    /// The maps (read freely; change them only through commands).
-    pub maps: MaterialMaps,
-    /// Undo and redo.
-    pub history: History,
-    /// Settings saved with the project.
-    pub settings: DocumentSettings,
+    maps: MaterialMaps,
+    history: History,
+    settings: DocumentSettings,
     surface: Option<Arc<Surface>>,
     stroke: Option<ActiveStroke>,
     /// Bumped by every command that changes the settings (which are saved too).
@@ -337,6 +343,27 @@ impl Document {
             stroke: None,
             settings_version: 0,
         }
+    }
+
+    /// The maps: read them freely; they change only through [`Document::apply`].
+    pub fn maps(&self) -> &MaterialMaps {
+        &self.maps
+    }
+
+    /// Undo and redo.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// The settings saved with the project (changed through the `Set*` commands).
+    pub fn settings(&self) -> &DocumentSettings {
+        &self.settings
+    }
+
+    /// The maps and settings, for a caller that builds another document from them (the
+    /// history and the attached mesh are dropped).
+    pub fn into_parts(self) -> (MaterialMaps, DocumentSettings) {
+        (self.maps, self.settings)
     }
 
     /// Attaches the mesh surface that object-space strokes and island/part fills paint on
@@ -464,6 +491,10 @@ impl Document {
                     picked,
                     &mut self.settings_version,
                 );
+            }
+            Command::ImportChannel(imported) => {
+                self.end_stroke();
+                super::import::install(&mut self.maps, &mut self.history, &imported.0)?;
             }
             Command::Undo => {
                 self.end_stroke();

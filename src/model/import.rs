@@ -19,7 +19,9 @@ use image::DynamicImage;
 use rayon::prelude::*;
 
 use super::ModelError;
-use super::document::Document;
+use super::document::{Document, ImportedChannel};
+use super::history::History;
+use super::maps::MaterialMaps;
 use super::texel::{Channel, encode_n, encode_rgb, n_from_blend, srgb_to_linear};
 use super::tile::{Plane, TILE_SIZE};
 
@@ -186,7 +188,9 @@ fn triangle_taps(src: u32, dst: u32) -> Vec<(u32, Vec<f32>)> {
 }
 
 /// One channel resampled to a map size and encoded, a plane per tile (row-major tiles):
-/// the heavy part of an import, done off the UI thread, installed by [`install`].
+/// the heavy part of an import, done off the UI thread, installed by
+/// [`super::Command::ImportChannel`].
+#[derive(Clone, Debug, PartialEq)]
 pub enum ChannelPlanes {
     /// `k_d` or `k_s`.
     Rgb(Channel, Vec<Plane<[u16; 3]>>),
@@ -306,49 +310,56 @@ pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32)
     }
 }
 
-/// Writes resampled planes into the document as one undo step.
+/// Writes resampled planes into the maps as one undo step (what
+/// [`super::Command::ImportChannel`] does).
 ///
 /// # Errors
 /// Planes made for another map size.
-pub fn install(doc: &mut Document, planes: ChannelPlanes) -> Result<(), ModelError> {
-    let count = match &planes {
+pub(super) fn install(
+    maps: &mut MaterialMaps,
+    history: &mut History,
+    planes: &ChannelPlanes,
+) -> Result<(), ModelError> {
+    let count = match planes {
         ChannelPlanes::Rgb(_, p) => p.len(),
         ChannelPlanes::N(p) => p.len(),
     };
-    if count != doc.maps.tile_count() {
+    if count != maps.tile_count() {
         return Err(ModelError::Command(format!(
             "the image was resampled for {count} tiles, but the maps have {}",
-            doc.maps.tile_count()
+            maps.tile_count()
         )));
     }
-    doc.history
-        .begin(format!("Import image into {}", planes.channel().name()));
+    history.begin(format!("Import image into {}", planes.channel().name()));
     match planes {
         ChannelPlanes::Rgb(channel, planes) => {
-            for (id, plane) in planes.into_iter().enumerate() {
-                let tile = doc.history.tile_for_write(&mut doc.maps, id);
-                if channel == Channel::Kd {
-                    tile.kd = plane;
+            for (id, plane) in planes.iter().enumerate() {
+                let tile = history.tile_for_write(maps, id);
+                if *channel == Channel::Kd {
+                    tile.kd = plane.clone();
                 } else {
-                    tile.ks = plane;
+                    tile.ks = plane.clone();
                 }
             }
         }
         ChannelPlanes::N(planes) => {
-            for (id, plane) in planes.into_iter().enumerate() {
-                doc.history.tile_for_write(&mut doc.maps, id).n = plane;
+            for (id, plane) in planes.iter().enumerate() {
+                history.tile_for_write(maps, id).n = plane.clone();
             }
         }
     }
-    doc.history.end();
+    history.end();
     Ok(())
 }
 
 /// Writes `image` into `channel` of the document as one undo step.
 pub fn import_into(doc: &mut Document, channel: Channel, image: &DynamicImage) {
-    let planes = resample(image, channel, doc.maps.width(), doc.maps.height());
+    let (w, h) = (doc.maps().width(), doc.maps().height());
+    let planes = resample(image, channel, w, h);
     // The planes are made for these maps, so the sizes agree.
-    let _ = install(doc, planes);
+    let _ = doc.apply(super::Command::ImportChannel(ImportedChannel(
+        std::sync::Arc::new(planes),
+    )));
 }
 
 /// Reads a grayscale brush stamp from an image file (luminance of the decoded image; an

@@ -151,7 +151,7 @@ pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
 
 /// Serialises a document as a project into `out` (its mesh path as the document holds it).
 pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
-    write_project(doc, doc.settings.clone(), out)
+    write_project(doc, doc.settings().clone(), out)
 }
 
 /// The settings as a project at `project` stores them: a mesh file's path relative to the
@@ -240,7 +240,7 @@ fn write_project(
     settings: DocumentSettings,
     out: impl Write + Seek,
 ) -> Result<(), String> {
-    let maps = &doc.maps;
+    let maps = doc.maps();
     let (w, h) = (maps.width(), maps.height());
     let rasters: Vec<(&str, Raster)> = vec![
         (
@@ -328,13 +328,47 @@ pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
         // The first write error (a full disk) is the one reported; the zip writer then
         // finishes quietly instead of printing its own failure.
         let mut out = crate::atomic::FirstError::new(file);
-        let written = write_project(doc, settings_for_file(&doc.settings, path), &mut out);
+        let written = write_project(doc, settings_for_file(doc.settings(), path), &mut out);
         if let Some(e) = out.take_error() {
             return Err(e);
         }
         written.map_err(std::io::Error::other)
     })
     .map_err(|e| ModelError::io(path, e))
+}
+
+/// Loads `mesh` (a built-in name or a mesh file), bakes it at the document's size and
+/// attaches it: what strokes on the mesh and island fills paint on.
+///
+/// # Errors
+/// A mesh that does not load (an I/O error as [`ModelError::Io`]), has no UVs, or does not
+/// bake; the document is unchanged.
+pub fn attach_mesh(doc: &mut Document, mesh: &Path) -> Result<(), ModelError> {
+    use crate::mesh::MeshError;
+    let loaded = crate::mesh::open(mesh).map_err(|e| match e {
+        MeshError::Io { path, source } => ModelError::Io { path, source },
+        invalid @ MeshError::Invalid { .. } => ModelError::Command(invalid.to_string()),
+    })?;
+    let surface = super::surface::Surface::new(loaded, doc.maps().width(), doc.maps().height())
+        .map_err(|e| ModelError::Command(format!("{}: {e}", mesh.display())))?;
+    doc.set_surface(Some(std::sync::Arc::new(surface)))
+}
+
+/// Opens a project with its mesh attached (`mesh` instead of the project's own, when given):
+/// the document, and why the mesh could not be attached when it could not (the document
+/// then has no surface, and the caller decides: the editor shows the sphere, `export` skips
+/// padding, `paint` refuses strokes on the mesh).
+///
+/// # Errors
+/// A project that does not load.
+pub fn open_with_mesh(
+    path: &Path,
+    mesh: Option<&Path>,
+) -> Result<(Document, Option<ModelError>), ModelError> {
+    let mut doc = load(path)?;
+    let own = PathBuf::from(doc.settings().mesh.spec());
+    let failed = attach_mesh(&mut doc, mesh.unwrap_or(&own)).err();
+    Ok((doc, failed))
 }
 
 /// Largest project file read (bytes): an 8192^2 project of noise is about 1 GB.
@@ -351,12 +385,15 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
         },
     })?;
     let file = File::open(path).map_err(|e| ModelError::io(path, e))?;
-    let mut doc = from_reader(file).map_err(|reason| ModelError::Project {
+    let doc = from_reader(file).map_err(|reason| ModelError::Project {
         path: path.to_path_buf(),
         reason,
     })?;
-    doc.settings = settings_from_file(std::mem::take(&mut doc.settings), path);
-    Ok(doc)
+    let (maps, settings) = doc.into_parts();
+    Ok(Document::from_parts(
+        maps,
+        settings_from_file(settings, path),
+    ))
 }
 
 /// Loads and validates a project from any seekable reader; the error is a reason text.

@@ -113,13 +113,12 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
     let mut last_error = None;
     for stamp in generations(path) {
         match project::load(&base_file(path, stamp)) {
-            Ok(mut doc) => {
-                replay(
-                    &mut doc,
+            Ok(doc) => {
+                return Ok(replay(
+                    doc,
                     &journal_file(path, stamp),
                     &base_file(path, stamp),
-                );
-                return Ok(doc);
+                ));
             }
             Err(e) => last_error = Some(e),
         }
@@ -130,24 +129,25 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
     }))
 }
 
-/// Replays every whole, valid record of `journal` on `doc`; stops at the first that is not.
-fn replay(doc: &mut Document, journal: &Path, base: &Path) {
-    let Ok(mut file) = std::fs::File::open(journal) else {
-        return;
-    };
-    let mut magic = [0_u8; 8];
-    if file.read_exact(&mut magic).is_err() || &magic != JOURNAL_MAGIC {
-        return;
-    }
-    while let Some(record) = read_record(&mut file) {
-        let Ok(change) = decode_record(&record, &doc.maps) else {
-            break;
-        };
-        for (id, tile) in change.tiles {
-            doc.maps.replace_tile(id, Arc::new(tile));
+/// `doc` with every whole, valid record of `journal` replayed on it (up to the first that
+/// is not).
+fn replay(doc: Document, journal: &Path, base: &Path) -> Document {
+    let (mut maps, mut settings) = doc.into_parts();
+    if let Ok(mut file) = std::fs::File::open(journal) {
+        let mut magic = [0_u8; 8];
+        if file.read_exact(&mut magic).is_ok() && &magic == JOURNAL_MAGIC {
+            while let Some(record) = read_record(&mut file) {
+                let Ok(change) = decode_record(&record, &maps) else {
+                    break;
+                };
+                for (id, tile) in change.tiles {
+                    maps.replace_tile(id, Arc::new(tile));
+                }
+                settings = project::settings_from_file(change.settings, base);
+            }
         }
-        doc.settings = project::settings_from_file(change.settings, base);
     }
+    Document::from_parts(maps, settings)
 }
 
 /// The next record's payload, if the file holds a whole one whose checksum matches.
@@ -362,7 +362,7 @@ impl Autosaver {
             path,
             last_time: Instant::now(),
             saved_version: doc.version(),
-            maps_version: doc.maps.version(),
+            maps_version: doc.maps().version(),
             generation: None,
             job: None,
         }
@@ -414,24 +414,24 @@ impl Autosaver {
 
     /// Starts an autosave now (a new generation, or a record appended to this one).
     fn start(&mut self, doc: &Document) -> Result<(), ModelError> {
-        let size = (doc.maps.width(), doc.maps.height());
+        let size = (doc.maps().width(), doc.maps().height());
         let version = doc.version();
-        let maps_version = doc.maps.version();
+        let maps_version = doc.maps().version();
         let append = self
             .generation
             .filter(|g| g.size == size && g.journal_bytes <= g.base_bytes.max(64 << 20));
         let dir = self.path.clone();
         let work: Box<dyn FnOnce() -> Outcome + Send> = if let Some(generation) = append {
             let tiles: Vec<(usize, Arc<Tile>)> = doc
-                .maps
+                .maps()
                 .tiles_changed_since(self.maps_version)
                 .into_iter()
-                .map(|id| (id, Arc::clone(doc.maps.tile(id))))
+                .map(|id| (id, Arc::clone(doc.maps().tile(id))))
                 .collect();
-            let settings = doc.settings.clone();
+            let settings = doc.settings().clone();
             Box::new(move || append_record(&dir, generation, size, &settings, &tiles))
         } else {
-            let snapshot = Document::from_parts(doc.maps.clone(), doc.settings.clone());
+            let snapshot = Document::from_parts(doc.maps().clone(), doc.settings().clone());
             Box::new(move || write_generation(&dir, &snapshot))
         };
         let handle = std::thread::Builder::new()
@@ -499,7 +499,7 @@ fn write_generation(dir: &Path, doc: &Document) -> Outcome {
         stamp,
         base_bytes,
         journal_bytes: JOURNAL_MAGIC.len() as u64,
-        size: (doc.maps.width(), doc.maps.height()),
+        size: (doc.maps().width(), doc.maps().height()),
     })
 }
 
@@ -566,8 +566,8 @@ mod tests {
     /// Texel for texel over the map (a loaded plane may be uniform where the painted one is
     /// full, and what lies past a partial tile's edge is not stored).
     fn same_maps(a: &Document, b: &Document) -> bool {
-        let (w, h) = (a.maps.width(), a.maps.height());
-        (0..h).all(|y| (0..w).all(|x| a.maps.texel(x, y) == b.maps.texel(x, y)))
+        let (w, h) = (a.maps().width(), a.maps().height());
+        (0..h).all(|y| (0..w).all(|x| a.maps().texel(x, y) == b.maps().texel(x, y)))
     }
 
     #[test]
@@ -597,7 +597,7 @@ mod tests {
             saver.wait().unwrap().unwrap();
             let back = load(&path).unwrap();
             assert!(same_maps(&back, &doc));
-            assert_eq!(back.settings, doc.settings);
+            assert_eq!(back.settings(), doc.settings());
         }
         let g = saver.generation.unwrap();
         assert_eq!(g.base_bytes, base_bytes);

@@ -66,7 +66,7 @@ impl Fill {
 
 impl Tool for Fill {
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
-        let size = (doc.maps.width(), doc.maps.height());
+        let size = (doc.maps().width(), doc.maps().height());
         match event {
             ToolEvent::Press { at, .. } => at
                 .texel_index(size)

@@ -11,7 +11,7 @@ pub struct Picker;
 
 impl Tool for Picker {
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
-        let size = (doc.maps.width(), doc.maps.height());
+        let size = (doc.maps().width(), doc.maps().height());
         match event {
             ToolEvent::Press { at, .. } | ToolEvent::Drag { at, .. } => at
                 .texel_index(size)

@@ -73,7 +73,7 @@ fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
         CanvasChannel::Ks => v.ks,
         CanvasChannel::N => n_false_colour(v.n),
         CanvasChannel::Ka => {
-            reflectance::ka(doc.settings.model, doc.settings.approx, v.kd, v.ks, v.n)
+            reflectance::ka(doc.settings().model, doc.settings().approx, v.kd, v.ks, v.n)
         }
     };
     let c = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8;
@@ -102,10 +102,11 @@ impl Canvas {
     /// Brings the texture up to date with the maps: changed tiles only, unless the size,
     /// channel or shading settings changed. Returns the tiles uploaded.
     pub fn sync(&mut self, ctx: &egui::Context, doc: &Document) -> usize {
-        let maps = &doc.maps;
+        let maps = doc.maps();
         let size = (maps.width(), maps.height());
         // k_a depends on the model and approximation too.
-        let settings_key = u64::from(doc.settings.model as u8) << 8 | doc.settings.approx as u64;
+        let settings_key =
+            u64::from(doc.settings().model as u8) << 8 | doc.settings().approx as u64;
         let options = TextureOptions::NEAREST;
         match (&mut self.texture, self.mirrored) {
             (Some(tex), Some((version, channel, s, key)))
@@ -174,7 +175,7 @@ impl Canvas {
             ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Other, true, CANVAS_LABEL));
-        let size = (doc.maps.width(), doc.maps.height());
+        let size = (doc.maps().width(), doc.maps().height());
         // Zoom about the cursor; pan with the middle button or space + drag.
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);

@@ -7,7 +7,9 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use super::{EditorState, JobResult, layout_path, new_document_with};
+use super::jobs::new_document_with;
+use super::layout::layout_path;
+use super::{EditorState, JobResult};
 use crate::export::preset::ExportPreset;
 use crate::model::document::MeshRef;
 use crate::model::{Document, DocumentSettings};
@@ -177,7 +179,7 @@ impl EditorState {
         let preset = self
             .presets
             .iter()
-            .position(|(name, _, _)| Some(name) == self.doc.settings.preset.as_ref())
+            .position(|(name, _, _)| Some(name) == self.doc.settings().preset.as_ref())
             .or_else(|| {
                 self.presets
                     .iter()
@@ -185,7 +187,7 @@ impl EditorState {
             })
             .unwrap_or(0);
         self.new_dialog = Some(NewDialog {
-            size: self.doc.maps.width(),
+            size: self.doc.maps().width(),
             preset,
             mesh: "sphere".into(),
         });
@@ -315,7 +317,7 @@ impl EditorState {
 
     /// A copy of the document for a worker thread (the maps' tiles are shared, not copied).
     pub(super) fn snapshot(&self) -> Document {
-        let mut d = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
+        let mut d = Document::from_parts(self.doc.maps().clone(), self.doc.settings().clone());
         if let Some(s) = self.doc.surface() {
             let _ = d.set_surface(Some(Arc::clone(s)));
         }
@@ -325,7 +327,7 @@ impl EditorState {
     /// Keeps the export dialog's preview current: starts planning on a worker thread when the
     /// preset or the maps changed, and takes the result when it is done.
     pub(super) fn update_export_plan(&mut self, ctx: &egui::Context) {
-        let version = self.doc.maps.version();
+        let version = self.doc.maps().version();
         let snapshot = self.export.as_ref().and_then(|d| {
             let current = |(p, v): (usize, u64)| p == d.chosen && v == version;
             let planned = d.plan.as_ref().is_some_and(|(p, v, _)| current((*p, *v)));

@@ -14,7 +14,7 @@ use crate::tools::{Place, ToolEvent, ToolKind};
 impl EditorState {
     /// The texel under a map-space position, if inside.
     fn texel_at(&self, p: Vec2) -> Option<(u32, u32)> {
-        Place::Canvas(p).texel_index((self.doc.maps.width(), self.doc.maps.height()))
+        Place::Canvas(p).texel_index((self.doc.maps().width(), self.doc.maps().height()))
     }
 
     /// Follows the pen's pressure where the platform delivers it (egui reports a tablet pen's
@@ -81,7 +81,7 @@ impl EditorState {
 
     /// The canvas: hover readout, tool events, the gradient being dragged.
     pub(super) fn canvas_input(&mut self, response: &egui::Response, rect: egui::Rect) {
-        let size = (self.doc.maps.width(), self.doc.maps.height());
+        let size = (self.doc.maps().width(), self.doc.maps().height());
         let pointer = response.interact_pointer_pos().or(response.hover_pos());
         let pos = pointer.map(|p| self.canvas.to_texel(rect, p, size));
         if response.hovered() {
@@ -111,7 +111,10 @@ impl EditorState {
         let pointer = response.interact_pointer_pos().or(response.hover_pos());
         let hit =
             pointer.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
-        let (w, h) = (self.doc.maps.width() as f32, self.doc.maps.height() as f32);
+        let (w, h) = (
+            self.doc.maps().width() as f32,
+            self.doc.maps().height() as f32,
+        );
         let place = hit.as_ref().map(|hit| Place::Surface {
             pos: SurfacePos {
                 point: hit.position,
@@ -130,7 +133,7 @@ impl EditorState {
             && self.tools.active().strokes()
             && let Some(hit) = self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh)
         {
-            let world = self.doc.settings.brush.radius_px * surface.units_per_texel;
+            let world = self.doc.settings().brush.radius_px * surface.units_per_texel;
             let picture = self.viewport.picture_at(rect, p);
             let points = brush_outline(
                 &self.viewport.camera,
@@ -151,8 +154,8 @@ impl EditorState {
 
     pub(super) fn frame_settings(&self) -> FrameSettings {
         FrameSettings {
-            model: self.doc.settings.model,
-            approx: self.doc.settings.approx,
+            model: self.doc.settings().model,
+            approx: self.doc.settings().approx,
             view: self.view,
             lighting: self.lighting,
             camera: self.viewport.camera,

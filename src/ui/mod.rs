@@ -8,15 +8,19 @@
 pub mod canvas;
 mod dialogs;
 mod input;
+mod jobs;
+mod layout;
 mod panels;
 pub mod viewport;
 
 use dialogs::{ExportDialog, load_recent};
 pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, parse_recent, push_recent};
+use jobs::{Job, JobResult, load_project, new_document};
+pub use layout::{default_layout, layout_json, parse_layout};
+use layout::{load_layout, save_layout};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use egui::{Color32, Key, KeyboardShortcut, Modifiers};
@@ -25,13 +29,10 @@ use glam::Vec2;
 
 use crate::mesh::Mesh;
 use crate::mesh::pick::Bvh;
-use crate::model::document::MeshRef;
-use crate::model::surface::Surface;
 use crate::model::texel::Channel;
 use crate::model::texel::MaterialValue;
-use crate::model::{Command, Document, DocumentSettings, project, recovery};
+use crate::model::{Command, Document, DocumentSettings, recovery};
 use crate::render::{Lighting, ViewMode};
-use crate::task::Progress;
 use crate::tools::{ToolKind, Tools};
 use canvas::{Canvas, CanvasChannel};
 use viewport::{Viewport, ViewportGpu};
@@ -56,31 +57,6 @@ pub struct Notice {
     /// An error (red) rather than information.
     pub error: bool,
     at: Instant,
-}
-
-/// What a worker hands back.
-enum JobResult {
-    /// A project (to be saved at the path; `None` for recovered untitled work), and whether it
-    /// came from a recovery copy.
-    Opened(Option<PathBuf>, Box<Document>, bool),
-    Saved(PathBuf, u64),
-    Exported(PathBuf, Box<crate::export::set::Manifest>),
-    /// A mesh loaded and baked at the map size.
-    Mesh(PathBuf, Arc<Surface>),
-    /// An image decoded and resampled into a channel's planes.
-    Image(PathBuf, Box<crate::model::import::ChannelPlanes>),
-    /// A new project (File > New), its mesh baked.
-    Created(Box<Document>),
-    /// A brush stamp read from an image.
-    Stamp(PathBuf, crate::model::brush::Stamp),
-    Failed(String),
-}
-
-/// Long work on a worker thread.
-struct Job {
-    label: String,
-    progress: Arc<Progress>,
-    handle: JoinHandle<JobResult>,
 }
 
 /// Screen points of a circle of `radius` (world units) around `centre` in the plane normal
@@ -229,62 +205,6 @@ pub struct Editor {
     started: Option<Instant>,
 }
 
-fn new_document(size: u32) -> Result<(Document, MeshState), String> {
-    let doc = new_document_with(size, DocumentSettings::default())?;
-    let mesh = doc.surface().map(|s| s.mesh.clone()).ok_or("no mesh")?;
-    Ok((doc, MeshState::new(mesh, 1)))
-}
-
-/// A new `size`^2 document with `settings`, its mesh (built in or a file, as the settings
-/// name it) attached and baked.
-fn new_document_with(size: u32, settings: DocumentSettings) -> Result<Document, String> {
-    let spec = settings.mesh.spec().to_string();
-    let mesh = match crate::mesh::builtin(&spec) {
-        Some(m) => m,
-        None => crate::mesh::open(Path::new(&spec)).map_err(|e| e.to_string())?,
-    };
-    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
-    attach(&mut doc, &mesh)?;
-    Ok(doc)
-}
-/// Bakes `mesh` at the document's size and attaches it.
-fn attach(doc: &mut Document, mesh: &Mesh) -> Result<(), String> {
-    let surface = Surface::new(mesh.clone(), doc.maps.width(), doc.maps.height())?;
-    doc.set_surface(Some(Arc::new(surface)))
-        .map_err(|e| e.to_string())
-}
-
-/// Loads a project and its mesh (falling back to the sphere, with a note, if the mesh file is
-/// gone).
-fn load_project(path: &Path) -> Result<(Document, Mesh, Option<String>), String> {
-    with_mesh(project::load(path).map_err(|e| e.to_string())?)
-}
-
-/// How often the editor autosaves: [`recovery::AUTOSAVE_INTERVAL`], or
-/// `KAPAINT_AUTOSAVE_SECONDS` (the crash test uses a short one).
-fn autosave_interval() -> Duration {
-    std::env::var("KAPAINT_AUTOSAVE_SECONDS")
-        .ok()
-        .and_then(|s| s.parse::<f64>().ok())
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .map_or(recovery::AUTOSAVE_INTERVAL, Duration::from_secs_f64)
-}
-
-/// A loaded document with its mesh attached (the sphere, with a note, if the mesh file is
-/// gone; a project holds its mesh's path absolute once loaded).
-fn with_mesh(mut doc: Document) -> Result<(Document, Mesh, Option<String>), String> {
-    let spec = PathBuf::from(doc.settings.mesh.spec());
-    let (mesh, note) = match crate::mesh::open(&spec) {
-        Ok(m) => (m, None),
-        Err(e) => (
-            crate::mesh::builtin("sphere").ok_or("no built-in sphere")?,
-            Some(format!("{e}; showing the sphere instead")),
-        ),
-    };
-    attach(&mut doc, &mesh)?;
-    Ok((doc, mesh, note))
-}
-
 impl Editor {
     /// The editor on a new default document (sphere, default material), or on `path` when
     /// given (a missing file becomes a new project saved there).
@@ -295,10 +215,13 @@ impl Editor {
         let gpu = render_state.map(ViewportGpu::new);
         let mut notices = Vec::new();
         let (doc, mesh) = match path.as_deref().filter(|p| p.exists()).map(load_project) {
-            Some(Ok((doc, mesh, note))) => {
+            Some(Ok((doc, note))) => {
                 if let Some(note) = note {
                     notices.push(notice(note, true));
                 }
+                let mesh = doc
+                    .surface()
+                    .map_or_else(crate::mesh::plane, |s| s.mesh.clone());
                 (doc, MeshState::new(mesh, 1))
             }
             other => {
@@ -369,73 +292,14 @@ impl Editor {
     }
 }
 
-/// The dock's first layout: the viewport left, the UV canvas right.
-pub fn default_layout() -> DockState<Tab> {
-    let mut dock = DockState::new(vec![Tab::Viewport]);
-    dock.main_surface_mut()
-        .split_right(egui_dock::NodeIndex::root(), 0.55, vec![Tab::Canvas]);
-    dock
-}
-
-/// Where the dock layout is kept between runs.
-fn layout_path() -> Option<PathBuf> {
-    std::env::var_os("XDG_CONFIG_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))
-        .map(|d| d.join("kapaint").join("layout.json"))
-}
-
-/// The saved layout, if there is a readable one holding both tabs.
-fn load_layout() -> Option<DockState<Tab>> {
-    parse_layout(&crate::file_check::read_limited(&layout_path()?, 1 << 20).ok()?)
-}
-
-/// A dock layout from its JSON, if it parses and holds both tabs (the `null` coordinates
-/// earlier versions wrote read as 0).
-pub fn parse_layout(json: &[u8]) -> Option<DockState<Tab>> {
-    let mut value: serde_json::Value = serde_json::from_slice(json).ok()?;
-    finite_points(&mut value);
-    let dock: DockState<Tab> = serde_json::from_value(value).ok()?;
-    (dock.find_tab(&Tab::Viewport).is_some() && dock.find_tab(&Tab::Canvas).is_some())
-        .then_some(dock)
-}
-
-/// Saves the layout (atomically; failures only cost the layout).
-fn save_layout(dock: &DockState<Tab>) {
-    if let (Some(path), Some(json)) = (layout_path(), layout_json(dock)) {
-        if let Some(dir) = path.parent() {
-            let _ = std::fs::create_dir_all(dir);
-        }
-        let _ = crate::atomic::write_atomic(&path, &json);
-    }
-}
-
-/// The layout as JSON that [`parse_layout`] reads back, or `None` if it would not (nothing
-/// unreadable is ever written).
-pub fn layout_json(dock: &DockState<Tab>) -> Option<Vec<u8>> {
-    let mut value = serde_json::to_value(dock).ok()?;
-    finite_points(&mut value);
-    let json = serde_json::to_vec(&value).ok()?;
-    parse_layout(&json).is_some().then_some(json)
-}
-
-/// egui_dock keeps each node's last on-screen rectangle, which is infinite before the first
-/// frame: JSON writes those coordinates as `null`, which no number reads back. They are
-/// recomputed every frame, so 0 stands in for them.
-fn finite_points(value: &mut serde_json::Value) {
-    match value {
-        serde_json::Value::Object(map) => {
-            for (key, v) in map.iter_mut() {
-                if v.is_null() && (key == "x" || key == "y") {
-                    *v = serde_json::Value::from(0.0);
-                } else {
-                    finite_points(v);
-                }
-            }
-        }
-        serde_json::Value::Array(items) => items.iter_mut().for_each(finite_points),
-        _ => {}
-    }
+/// How often the editor autosaves: [`recovery::AUTOSAVE_INTERVAL`], or
+/// `KAPAINT_AUTOSAVE_SECONDS` (the crash test uses a short one).
+fn autosave_interval() -> Duration {
+    std::env::var("KAPAINT_AUTOSAVE_SECONDS")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .map_or(recovery::AUTOSAVE_INTERVAL, Duration::from_secs_f64)
 }
 
 /// A 16 x 16 document cannot fail to allocate; this is only for the type checker.
@@ -493,198 +357,6 @@ impl EditorState {
         }
     }
 
-    fn busy(&self) -> bool {
-        self.job.is_some()
-    }
-
-    fn start_job(
-        &mut self,
-        label: &str,
-        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
-    ) {
-        if self.busy() {
-            self.notices
-                .push(notice("wait for the current job to finish", true));
-            return;
-        }
-        let progress = Arc::new(Progress::default());
-        let shared = Arc::clone(&progress);
-        match std::thread::Builder::new()
-            .name(format!("kapaint-{}", label.to_lowercase()))
-            .spawn(move || work(&shared))
-        {
-            Ok(handle) => {
-                self.job = Some(Job {
-                    label: label.into(),
-                    progress,
-                    handle,
-                });
-            }
-            Err(e) => self
-                .notices
-                .push(notice(format!("cannot start {label}: {e}"), true)),
-        }
-    }
-
-    fn poll_job(&mut self) {
-        if !self.job.as_ref().is_some_and(|j| j.handle.is_finished()) {
-            return;
-        }
-        let Some(job) = self.job.take() else { return };
-        let result = job
-            .handle
-            .join()
-            .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
-        match result {
-            JobResult::Opened(path, doc, recovered) => {
-                self.replace_document(*doc);
-                // Recovered work is unsaved work.
-                self.saved_version = if recovered {
-                    u64::MAX
-                } else {
-                    self.doc.version()
-                };
-                self.autosaver = recovery::Autosaver::new(
-                    autosave_interval(),
-                    recovery::recovery_path(path.as_deref()),
-                    &self.doc,
-                );
-                let name = path
-                    .as_deref()
-                    .map_or_else(|| "an untitled project".into(), |p| p.display().to_string());
-                let text = if recovered {
-                    format!("recovered the unsaved work of {name}: save to keep it")
-                } else {
-                    format!("opened {name}")
-                };
-                self.notices.push(notice(text, false));
-                if let Some(p) = &path {
-                    self.remember(p);
-                }
-                self.path = path;
-            }
-            JobResult::Saved(path, version) => {
-                self.saved_version = version;
-                self.notices
-                    .push(notice(format!("saved {}", path.display()), false));
-                self.remember(&path);
-                self.path = Some(path);
-                if !self.dirty()
-                    && let Some(next) = self.pending_open.take()
-                {
-                    self.open_now(next);
-                }
-            }
-            JobResult::Exported(dir, m) => self.notices.push(notice(
-                format!(
-                    "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
-                    dir.display(),
-                    m.files.len(),
-                    m.bytes.exported,
-                    m.ka_error.max * 100.0,
-                    m.ka_error.mean * 100.0
-                ),
-                false,
-            )),
-            JobResult::Mesh(path, surface) => {
-                let mesh = surface.mesh.clone();
-                let spec = MeshRef::from_spec(&path.display().to_string());
-                match self.doc.set_mesh(spec, surface) {
-                    Ok(()) => {
-                        self.mesh = MeshState::new(mesh, self.mesh.id + 1);
-                        self.viewport.frame(&self.mesh.mesh);
-                        self.notices
-                            .push(notice(format!("mesh {}", path.display()), false));
-                    }
-                    Err(e) => self.notices.push(notice(e.to_string(), true)),
-                }
-            }
-            JobResult::Image(path, planes) => {
-                let channel = planes.channel();
-                match crate::model::import::install(&mut self.doc, *planes) {
-                    Ok(()) => self.notices.push(notice(
-                        format!("{} imported into {}", path.display(), channel.name()),
-                        false,
-                    )),
-                    Err(e) => self.notices.push(notice(e.to_string(), true)),
-                }
-            }
-            JobResult::Created(doc) => {
-                self.replace_document(*doc);
-                self.saved_version = self.doc.version();
-                self.path = None;
-                self.autosaver = recovery::Autosaver::new(
-                    autosave_interval(),
-                    recovery::recovery_path(None),
-                    &self.doc,
-                );
-            }
-            JobResult::Stamp(path, stamp) => {
-                let mut brush = self.doc.settings.brush.clone();
-                brush.stamp = Some(stamp);
-                self.apply(Command::SetBrush(brush));
-                self.notices
-                    .push(notice(format!("stamp {}", path.display()), false));
-            }
-            JobResult::Failed(e) => self.notices.push(notice(e, true)),
-        }
-    }
-
-    /// Makes `doc` the document, with its mesh shown and framed.
-    fn replace_document(&mut self, doc: Document) {
-        let mesh = doc.surface().map(|s| s.mesh.clone());
-        self.doc = doc;
-        if let Some(mesh) = mesh {
-            self.mesh = MeshState::new(mesh, self.mesh.id + 1);
-            self.viewport.frame(&self.mesh.mesh);
-        }
-    }
-
-    /// Loads and bakes a mesh on a worker; it becomes the project's mesh.
-    pub fn import_mesh(&mut self, path: PathBuf) {
-        let (w, h) = (self.doc.maps.width(), self.doc.maps.height());
-        self.start_job("Mesh", move |progress| {
-            progress.start("load", 1);
-            let mesh = match crate::mesh::open(&path) {
-                Ok(m) => m,
-                Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
-            };
-            progress.start("bake", 1);
-            match Surface::new(mesh, w, h) {
-                Ok(s) => JobResult::Mesh(path, Arc::new(s)),
-                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
-            }
-        });
-    }
-
-    /// Loads a brush stamp from an image on a worker thread.
-    pub fn load_stamp(&mut self, path: PathBuf) {
-        self.start_job("Stamp", move |progress| {
-            progress.start("decode", 1);
-            match crate::model::import::read_stamp(&path) {
-                Ok(stamp) => JobResult::Stamp(path, stamp),
-                Err(e) => JobResult::Failed(e.to_string()),
-            }
-        });
-    }
-
-    /// Decodes and resamples an image on a worker; it is written into `channel` (one undo
-    /// step) when it arrives.
-    pub fn import_image(&mut self, path: PathBuf, channel: Channel) {
-        let (w, h) = (self.doc.maps.width(), self.doc.maps.height());
-        self.start_job("Image", move |progress| {
-            progress.start("decode", 1);
-            match crate::model::import::read_image(&path) {
-                Ok(image) => {
-                    progress.start("resample", 1);
-                    let planes = crate::model::import::resample(&image, channel, w, h);
-                    JobResult::Image(path, Box::new(planes))
-                }
-                Err(e) => JobResult::Failed(e.to_string()),
-            }
-        });
-    }
-
     /// The channel the canvas shows (`k_d` for the derived `k_a`): where dropped images go.
     fn canvas_target(&self) -> Channel {
         match self.canvas.channel {
@@ -694,77 +366,8 @@ impl EditorState {
         }
     }
 
-    /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
-    pub fn save_to(&mut self, path: PathBuf) {
-        let snapshot = Document::from_parts(self.doc.maps.clone(), self.doc.settings.clone());
-        let version = self.doc.version();
-        self.start_job("Save", move |progress| {
-            progress.start("save", 1);
-            match project::save(&snapshot, &path) {
-                Ok(()) => JobResult::Saved(path, version),
-                Err(e) => JobResult::Failed(format!("could not save: {e}")),
-            }
-        });
-    }
-
-    /// Opens `path` on a worker.
-    pub fn open(&mut self, path: PathBuf) {
-        if self.dirty() {
-            // Unsaved work is never dropped: ask first (see `open_prompt`).
-            self.pending_open = Some(path);
-            return;
-        }
-        self.open_now(path);
-    }
-
-    fn open_now(&mut self, path: PathBuf) {
-        self.start_job("Open", move |progress| {
-            progress.start("open", 1);
-            match load_project(&path) {
-                Ok((doc, _, _)) => JobResult::Opened(Some(path), Box::new(doc), false),
-                Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
-            }
-        });
-    }
-
-    /// Opens the recovery copy `from` as the project at `path` (unsaved).
-    fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
-        self.start_job("Recover", move |progress| {
-            progress.start("open", 1);
-            match recovery::load(&from)
-                .map_err(|e| e.to_string())
-                .and_then(with_mesh)
-            {
-                Ok((doc, _, _)) => JobResult::Opened(path, Box::new(doc), true),
-                Err(e) => JobResult::Failed(format!("could not recover {}: {e}", from.display())),
-            }
-        });
-    }
-
-    fn save(&mut self) {
-        match self.path.clone() {
-            Some(p) => self.save_to(p),
-            None => self.save_as(),
-        }
-    }
-
-    fn save_as(&mut self) {
-        if let Some(p) = rfd::FileDialog::new()
-            .add_filter("kapaint project", &["kapaint"])
-            .set_file_name("material.kapaint")
-            .save_file()
-        {
-            self.save_to(p);
-        }
-    }
-
-    fn open_dialog(&mut self) {
-        if let Some(p) = rfd::FileDialog::new()
-            .add_filter("kapaint project", &["kapaint"])
-            .pick_file()
-        {
-            self.open(p);
-        }
+    fn busy(&self) -> bool {
+        self.job.is_some()
     }
 
     /// Hotkeys: tools, brush size and hardness, swap, undo/redo, files.
@@ -822,7 +425,7 @@ impl EditorState {
             };
             (i.modifiers.shift, pressed)
         });
-        let mut brush = self.doc.settings.brush.clone();
+        let mut brush = self.doc.settings().brush.clone();
         for key in pressed {
             match key {
                 Key::B => self.select_tool(ToolKind::Brush),
@@ -847,7 +450,7 @@ impl EditorState {
                 _ => {}
             }
         }
-        if brush != self.doc.settings.brush {
+        if brush != self.doc.settings().brush {
             self.apply(Command::SetBrush(brush));
         }
     }

@@ -79,10 +79,10 @@ impl EditorState {
                 });
             }
             ToolKind::Blur => {
-                let mut brush = self.doc.settings.brush.clone();
+                let mut brush = self.doc.settings().brush.clone();
                 ui.add(egui::Slider::new(&mut brush.blur_radius_px, 1..=16).text("Blur radius"))
                     .on_hover_text("Kernel radius in texels");
-                if brush != self.doc.settings.brush {
+                if brush != self.doc.settings().brush {
                     self.apply(Command::SetBrush(brush));
                 }
             }
@@ -106,7 +106,7 @@ impl EditorState {
         self.tool_options_ui(ui);
         ui.separator();
         ui.heading("Brush settings");
-        let mut brush = self.doc.settings.brush.clone();
+        let mut brush = self.doc.settings().brush.clone();
         ui.add(
             egui::Slider::new(&mut brush.radius_px, 0.5..=512.0)
                 .logarithmic(true)
@@ -122,12 +122,12 @@ impl EditorState {
         ui.checkbox(&mut brush.pressure_size, "Pressure: size");
         ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
         self.stamp_ui(ui, &mut brush);
-        if brush != self.doc.settings.brush {
+        if brush != self.doc.settings().brush {
             self.apply(Command::SetBrush(brush));
         }
         ui.separator();
         ui.heading("Material");
-        let mut primary = self.doc.settings.primary;
+        let mut primary = self.doc.settings().primary;
         ui.horizontal(|ui| {
             let mut kd = primary.kd.to_array();
             egui::color_picker::color_edit_button_rgb(ui, &mut kd)
@@ -152,17 +152,17 @@ impl EditorState {
                 .logarithmic(true)
                 .text("n"),
         );
-        let other = match self.doc.settings.model {
+        let other = match self.doc.settings().model {
             ShadingModel::Phong => ShadingModel::BlinnPhong,
             ShadingModel::BlinnPhong => ShadingModel::Phong,
         };
         let eq = reflectance::equivalent::equivalent_exponent(
-            self.doc.settings.model,
+            self.doc.settings().model,
             f64::from(primary.n),
         );
         ui.label(format!("≈ n {eq:.1} in {}", other.name()))
             .on_hover_text("The exponent of the other model with the closest highlight");
-        if primary != self.doc.settings.primary {
+        if primary != self.doc.settings().primary {
             self.apply(Command::SetPrimary(primary));
         }
         if ui
@@ -174,13 +174,13 @@ impl EditorState {
         }
         ui.separator();
         ui.heading("Channels");
-        let mut ch = self.doc.settings.channels;
+        let mut ch = self.doc.settings().channels;
         ui.horizontal(|ui| {
             ui.checkbox(&mut ch.kd, "k_d");
             ui.checkbox(&mut ch.ks, "k_s");
             ui.checkbox(&mut ch.n, "n");
         });
-        if ch != self.doc.settings.channels {
+        if ch != self.doc.settings().channels {
             self.apply(Command::SetChannels(ch));
         }
     }
@@ -237,15 +237,15 @@ impl EditorState {
     /// Right panel: model, view, compare, light, canvas channel, history.
     pub(super) fn view_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Shading");
-        let mut model = self.doc.settings.model;
+        let mut model = self.doc.settings().model;
         ui.horizontal(|ui| {
             ui.selectable_value(&mut model, ShadingModel::Phong, "Phong (8)");
             ui.selectable_value(&mut model, ShadingModel::BlinnPhong, "Blinn-Phong (11)");
         });
-        if model != self.doc.settings.model {
+        if model != self.doc.settings().model {
             self.apply(Command::SetModel(model));
         }
-        let mut approx = self.doc.settings.approx;
+        let mut approx = self.doc.settings().approx;
         egui::ComboBox::from_label("Approximation")
             .selected_text(approx.name())
             .show_ui(ui, |ui| {
@@ -253,7 +253,7 @@ impl EditorState {
                     ui.selectable_value(&mut approx, a, a.name());
                 }
             });
-        if approx != self.doc.settings.approx {
+        if approx != self.doc.settings().approx {
             self.apply(Command::SetApprox(approx));
         }
         self.compare_ui(ui);
@@ -296,15 +296,15 @@ impl EditorState {
         ui.heading("History");
         ui.label(format!(
             "{} steps, {:.1} MB",
-            self.doc.history.undo_steps().count(),
-            self.doc.history.bytes() as f64 / 1e6
+            self.doc.history().undo_steps().count(),
+            self.doc.history().bytes() as f64 / 1e6
         ));
         egui::ScrollArea::vertical()
             .max_height(160.0)
             .show(ui, |ui| {
                 for step in self
                     .doc
-                    .history
+                    .history()
                     .undo_steps()
                     .collect::<Vec<_>>()
                     .iter()
@@ -404,13 +404,13 @@ impl EditorState {
 
     pub(super) fn status_bar_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            let maps = &self.doc.maps;
+            let maps = self.doc.maps();
             ui.label(format!("{}x{}", maps.width(), maps.height()));
             ui.separator();
             ui.label(format!(
                 "maps {:.0} MB, history {:.0} MB",
                 maps.heap_bytes() as f64 / 1e6,
-                self.doc.history.bytes() as f64 / 1e6
+                self.doc.history().bytes() as f64 / 1e6
             ));
             ui.separator();
             match &self.viewport.gpu {
@@ -425,7 +425,7 @@ impl EditorState {
             if let Some((x, y)) = self.shown_hover {
                 let v = maps.value(x, y);
                 let ka = |m, a| reflectance::ka(m, a, v.kd, v.ks, v.n);
-                let approx = self.doc.settings.approx;
+                let approx = self.doc.settings().approx;
                 let phong = ka(ShadingModel::Phong, approx);
                 let blinn = ka(ShadingModel::BlinnPhong, approx);
                 let exact = |m| {
@@ -433,7 +433,7 @@ impl EditorState {
                         + v.ks
                             * reflectance::exact::chi_exact(m, f64::from(v.n)) as f32
                 };
-                let model = self.doc.settings.model;
+                let model = self.doc.settings().model;
                 ui.separator();
                 ui.label(format!(
                     "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  exact {:.4}",

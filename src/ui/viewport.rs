@@ -181,14 +181,14 @@ impl ViewportGpu {
             self.mesh = None;
             self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)?));
         }
-        let maps_size = (doc.maps.width(), doc.maps.height());
+        let maps_size = (doc.maps().width(), doc.maps().height());
         match &mut self.maps {
             Some(m) if m.size() == maps_size => {
-                m.sync(&self.gpu, &doc.maps)?;
+                m.sync(&self.gpu, doc.maps())?;
             }
             _ => {
                 self.maps = None;
-                self.maps = Some(MapTextures::new(&self.gpu, &doc.maps)?);
+                self.maps = Some(MapTextures::new(&self.gpu, doc.maps())?);
             }
         }
         if self.target.as_ref().is_none_or(|t| t.size != size) {

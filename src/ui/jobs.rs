@@ -1,0 +1,345 @@
+//! Long work on named worker threads (open, save, recover, export, mesh and image import,
+//! stamps), each reporting through a [`Progress`], polled every frame; and the documents
+//! they make, with their meshes attached.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+
+use super::{EditorState, MeshState, autosave_interval, notice};
+use crate::model::document::MeshRef;
+use crate::model::surface::Surface;
+use crate::model::texel::Channel;
+use crate::model::{Command, Document, DocumentSettings, ModelError, project, recovery};
+use crate::task::Progress;
+
+/// What a worker hands back.
+pub(super) enum JobResult {
+    /// A project (to be saved at the path; `None` for recovered untitled work), and whether it
+    /// came from a recovery copy.
+    Opened(Option<PathBuf>, Box<Document>, bool),
+    Saved(PathBuf, u64),
+    Exported(PathBuf, Box<crate::export::set::Manifest>),
+    /// A mesh loaded and baked at the map size.
+    Mesh(PathBuf, Arc<Surface>),
+    /// An image decoded and resampled into a channel's planes.
+    Image(PathBuf, Box<crate::model::import::ChannelPlanes>),
+    /// A new project (File > New), its mesh baked.
+    Created(Box<Document>),
+    /// A brush stamp read from an image.
+    Stamp(PathBuf, crate::model::brush::Stamp),
+    Failed(String),
+}
+
+/// Long work on a worker thread.
+pub(super) struct Job {
+    pub(super) label: String,
+    pub(super) progress: Arc<Progress>,
+    pub(super) handle: JoinHandle<JobResult>,
+}
+
+/// A new `size`^2 document on the default settings, with its mesh.
+pub(super) fn new_document(size: u32) -> Result<(Document, MeshState), String> {
+    let doc = new_document_with(size, DocumentSettings::default())?;
+    let mesh = doc.surface().map(|s| s.mesh.clone()).ok_or("no mesh")?;
+    Ok((doc, MeshState::new(mesh, 1)))
+}
+
+/// A new `size`^2 document with `settings`, its mesh (built in or a file, as the settings
+/// name it) attached and baked.
+pub(super) fn new_document_with(size: u32, settings: DocumentSettings) -> Result<Document, String> {
+    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
+    let spec = PathBuf::from(doc.settings().mesh.spec());
+    project::attach_mesh(&mut doc, &spec).map_err(|e| e.to_string())?;
+    Ok(doc)
+}
+
+/// Loads a project with its mesh (the sphere, and a note saying why, where the mesh cannot
+/// be attached).
+pub(super) fn load_project(path: &Path) -> Result<(Document, Option<String>), String> {
+    let (doc, failed) = project::open_with_mesh(path, None).map_err(|e| e.to_string())?;
+    with_fallback(doc, failed)
+}
+
+/// `doc` as it is, or, when its mesh `failed`, with the built-in sphere and a note.
+fn with_fallback(
+    mut doc: Document,
+    failed: Option<ModelError>,
+) -> Result<(Document, Option<String>), String> {
+    let Some(e) = failed else {
+        return Ok((doc, None));
+    };
+    project::attach_mesh(&mut doc, Path::new("sphere")).map_err(|e| e.to_string())?;
+    Ok((doc, Some(format!("{e}; showing the sphere instead"))))
+}
+
+impl EditorState {
+    pub(super) fn start_job(
+        &mut self,
+        label: &str,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        if self.busy() {
+            self.notices
+                .push(notice("wait for the current job to finish", true));
+            return;
+        }
+        let progress = Arc::new(Progress::default());
+        let shared = Arc::clone(&progress);
+        match std::thread::Builder::new()
+            .name(format!("kapaint-{}", label.to_lowercase()))
+            .spawn(move || work(&shared))
+        {
+            Ok(handle) => {
+                self.job = Some(Job {
+                    label: label.into(),
+                    progress,
+                    handle,
+                });
+            }
+            Err(e) => self
+                .notices
+                .push(notice(format!("cannot start {label}: {e}"), true)),
+        }
+    }
+
+    pub(super) fn poll_job(&mut self) {
+        if !self.job.as_ref().is_some_and(|j| j.handle.is_finished()) {
+            return;
+        }
+        let Some(job) = self.job.take() else { return };
+        let result = job
+            .handle
+            .join()
+            .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
+        match result {
+            JobResult::Opened(path, doc, recovered) => self.opened(path, *doc, recovered),
+            JobResult::Saved(path, version) => {
+                self.saved_version = version;
+                self.notices
+                    .push(notice(format!("saved {}", path.display()), false));
+                self.remember(&path);
+                self.path = Some(path);
+                if !self.dirty()
+                    && let Some(next) = self.pending_open.take()
+                {
+                    self.open_now(next);
+                }
+            }
+            JobResult::Exported(dir, m) => self.notices.push(notice(
+                format!(
+                    "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
+                    dir.display(),
+                    m.files.len(),
+                    m.bytes.exported,
+                    m.ka_error.max * 100.0,
+                    m.ka_error.mean * 100.0
+                ),
+                false,
+            )),
+            JobResult::Mesh(path, surface) => {
+                let mesh = surface.mesh.clone();
+                let spec = MeshRef::from_spec(&path.display().to_string());
+                match self.doc.set_mesh(spec, surface) {
+                    Ok(()) => {
+                        self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+                        self.viewport.frame(&self.mesh.mesh);
+                        self.notices
+                            .push(notice(format!("mesh {}", path.display()), false));
+                    }
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Image(path, planes) => {
+                let channel = planes.channel();
+                let imported = crate::model::document::ImportedChannel(Arc::new(*planes));
+                match self.doc.apply(Command::ImportChannel(imported)) {
+                    Ok(()) => self.notices.push(notice(
+                        format!("{} imported into {}", path.display(), channel.name()),
+                        false,
+                    )),
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Created(doc) => {
+                self.replace_document(*doc);
+                self.saved_version = self.doc.version();
+                self.path = None;
+                self.autosaver = recovery::Autosaver::new(
+                    autosave_interval(),
+                    recovery::recovery_path(None),
+                    &self.doc,
+                );
+            }
+            JobResult::Stamp(path, stamp) => {
+                let mut brush = self.doc.settings().brush.clone();
+                brush.stamp = Some(stamp);
+                self.apply(Command::SetBrush(brush));
+                self.notices
+                    .push(notice(format!("stamp {}", path.display()), false));
+            }
+            JobResult::Failed(e) => self.notices.push(notice(e, true)),
+        }
+    }
+
+    /// Makes `doc` the document, with its mesh shown and framed.
+    /// Takes an opened (or recovered) project as the document.
+    fn opened(&mut self, path: Option<PathBuf>, doc: Document, recovered: bool) {
+        self.replace_document(doc);
+        // Recovered work is unsaved work.
+        self.saved_version = if recovered {
+            u64::MAX
+        } else {
+            self.doc.version()
+        };
+        self.autosaver = recovery::Autosaver::new(
+            autosave_interval(),
+            recovery::recovery_path(path.as_deref()),
+            &self.doc,
+        );
+        let name = path
+            .as_deref()
+            .map_or_else(|| "an untitled project".into(), |p| p.display().to_string());
+        let text = if recovered {
+            format!("recovered the unsaved work of {name}: save to keep it")
+        } else {
+            format!("opened {name}")
+        };
+        self.notices.push(notice(text, false));
+        if let Some(p) = &path {
+            self.remember(p);
+        }
+        self.path = path;
+    }
+
+    pub(super) fn replace_document(&mut self, doc: Document) {
+        let mesh = doc.surface().map(|s| s.mesh.clone());
+        self.doc = doc;
+        if let Some(mesh) = mesh {
+            self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+            self.viewport.frame(&self.mesh.mesh);
+        }
+    }
+
+    /// Loads and bakes a mesh on a worker; it becomes the project's mesh.
+    pub fn import_mesh(&mut self, path: PathBuf) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Mesh", move |progress| {
+            progress.start("load", 1);
+            let mesh = match crate::mesh::open(&path) {
+                Ok(m) => m,
+                Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
+            };
+            progress.start("bake", 1);
+            match Surface::new(mesh, w, h) {
+                Ok(s) => JobResult::Mesh(path, Arc::new(s)),
+                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Loads a brush stamp from an image on a worker thread.
+    pub fn load_stamp(&mut self, path: PathBuf) {
+        self.start_job("Stamp", move |progress| {
+            progress.start("decode", 1);
+            match crate::model::import::read_stamp(&path) {
+                Ok(stamp) => JobResult::Stamp(path, stamp),
+                Err(e) => JobResult::Failed(e.to_string()),
+            }
+        });
+    }
+
+    /// Decodes and resamples an image on a worker; it is written into `channel` (one undo
+    /// step) when it arrives.
+    pub fn import_image(&mut self, path: PathBuf, channel: Channel) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Image", move |progress| {
+            progress.start("decode", 1);
+            match crate::model::import::read_image(&path) {
+                Ok(image) => {
+                    progress.start("resample", 1);
+                    let planes = crate::model::import::resample(&image, channel, w, h);
+                    JobResult::Image(path, Box::new(planes))
+                }
+                Err(e) => JobResult::Failed(e.to_string()),
+            }
+        });
+    }
+
+    /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
+    pub fn save_to(&mut self, path: PathBuf) {
+        let snapshot = Document::from_parts(self.doc.maps().clone(), self.doc.settings().clone());
+        let version = self.doc.version();
+        self.start_job("Save", move |progress| {
+            progress.start("save", 1);
+            match project::save(&snapshot, &path) {
+                Ok(()) => JobResult::Saved(path, version),
+                Err(e) => JobResult::Failed(format!("could not save: {e}")),
+            }
+        });
+    }
+
+    /// Opens `path` on a worker.
+    pub fn open(&mut self, path: PathBuf) {
+        if self.dirty() {
+            // Unsaved work is never dropped: ask first (see `open_prompt`).
+            self.pending_open = Some(path);
+            return;
+        }
+        self.open_now(path);
+    }
+
+    pub(super) fn open_now(&mut self, path: PathBuf) {
+        self.start_job("Open", move |progress| {
+            progress.start("open", 1);
+            match load_project(&path) {
+                Ok((doc, _)) => JobResult::Opened(Some(path), Box::new(doc), false),
+                Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Opens the recovery copy `from` as the project at `path` (unsaved).
+    pub(super) fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
+        self.start_job("Recover", move |progress| {
+            progress.start("open", 1);
+            let recovered = recovery::load(&from)
+                .map_err(|e| e.to_string())
+                .and_then(|mut doc| {
+                    let own = PathBuf::from(doc.settings().mesh.spec());
+                    let failed = project::attach_mesh(&mut doc, &own).err();
+                    with_fallback(doc, failed)
+                });
+            match recovered {
+                Ok((doc, _)) => JobResult::Opened(path, Box::new(doc), true),
+                Err(e) => JobResult::Failed(format!("could not recover {}: {e}", from.display())),
+            }
+        });
+    }
+
+    pub(super) fn save(&mut self) {
+        match self.path.clone() {
+            Some(p) => self.save_to(p),
+            None => self.save_as(),
+        }
+    }
+
+    pub(super) fn save_as(&mut self) {
+        if let Some(p) = rfd::FileDialog::new()
+            .add_filter("kapaint project", &["kapaint"])
+            .set_file_name("material.kapaint")
+            .save_file()
+        {
+            self.save_to(p);
+        }
+    }
+
+    pub(super) fn open_dialog(&mut self) {
+        if let Some(p) = rfd::FileDialog::new()
+            .add_filter("kapaint project", &["kapaint"])
+            .pick_file()
+        {
+            self.open(p);
+        }
+    }
+}
