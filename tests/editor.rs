@@ -415,3 +415,26 @@ fn every_tool_and_its_options_are_in_the_panel() {
     // The tool's button and its mode's combo box.
     assert_eq!(harness.query_all_by_label("Fill").count(), 2);
 }
+
+#[test]
+fn the_shortcut_sheet_shows_the_keymap_the_keys_run() {
+    let mut harness = editor();
+    harness.get_by_label("Help").click();
+    harness.run();
+    harness.get_by_label("Keyboard shortcuts").click();
+    harness.run();
+    for binding in kapaint::ui::keys::KEYMAP {
+        assert!(
+            harness.query_all_by_label(binding.description).count() > 0,
+            "the sheet lacks {}",
+            binding.description
+        );
+    }
+    // And the keys do what the sheet says: R makes the blur tool active.
+    harness.key_press(egui::Key::R);
+    harness.run();
+    assert_eq!(
+        harness.state().state.tools.active(),
+        kapaint::tools::ToolKind::Blur
+    );
+}

@@ -9,6 +9,7 @@ pub mod canvas;
 mod dialogs;
 mod input;
 mod jobs;
+pub mod keys;
 mod layout;
 mod panels;
 pub mod viewport;
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use egui::{Color32, Key, KeyboardShortcut, Modifiers};
+use egui::Color32;
 use egui_dock::{DockArea, DockState, TabViewer};
 use glam::Vec2;
 
@@ -33,7 +34,7 @@ use crate::model::texel::Channel;
 use crate::model::texel::MaterialValue;
 use crate::model::{Command, Document, DocumentSettings, recovery};
 use crate::render::{Lighting, ViewMode};
-use crate::tools::{ToolKind, Tools};
+use crate::tools::Tools;
 use canvas::{Canvas, CanvasChannel};
 use viewport::{Viewport, ViewportGpu};
 
@@ -186,6 +187,8 @@ pub struct EditorState {
     /// `hover` as of the last frame (the status bar is drawn before the tabs).
     shown_hover: Option<(u32, u32)>,
     quit_asked: bool,
+    /// Whether Help > Keyboard shortcuts is open.
+    shortcuts_open: bool,
     /// Set when the user confirmed closing with unsaved changes.
     pub allow_close: bool,
     /// A recovery copy found at start, newer than the project.
@@ -278,6 +281,7 @@ impl Editor {
                 hover_tab: None,
                 shown_hover: None,
                 quit_asked: false,
+                shortcuts_open: false,
                 allow_close: false,
                 recovery_offer,
                 presets: crate::model::preset::builtin()
@@ -319,31 +323,6 @@ fn notice(text: impl Into<String>, error: bool) -> Notice {
     }
 }
 
-/// Hotkeys (shown in tooltips and the README).
-pub mod keys {
-    use super::{Key, KeyboardShortcut, Modifiers};
-    /// Undo.
-    pub const UNDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
-    /// Redo.
-    pub const REDO: KeyboardShortcut =
-        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z);
-    /// Redo (alternative).
-    pub const REDO_Y: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
-    /// Save.
-    pub const SAVE: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
-    /// Save as.
-    pub const SAVE_AS: KeyboardShortcut =
-        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::S);
-    /// Open.
-    pub const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
-    /// New.
-    pub const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
-    /// Export.
-    pub const EXPORT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::E);
-    /// Quit (asks first when there are unsaved changes).
-    pub const QUIT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
-}
-
 impl EditorState {
     /// Whether anything the project file stores (maps or settings) changed since the last
     /// save.
@@ -368,91 +347,6 @@ impl EditorState {
 
     fn busy(&self) -> bool {
         self.job.is_some()
-    }
-
-    /// Hotkeys: tools, brush size and hardness, swap, undo/redo, files.
-    fn hotkeys(&mut self, ctx: &egui::Context) {
-        if ctx.egui_wants_keyboard_input() {
-            return;
-        }
-        let mut commands = Vec::new();
-        ctx.input_mut(|i| {
-            for (shortcut, action) in [
-                (keys::REDO, 1),
-                (keys::REDO_Y, 1),
-                (keys::UNDO, 0),
-                (keys::SAVE_AS, 3),
-                (keys::SAVE, 2),
-                (keys::OPEN, 4),
-                (keys::NEW, 5),
-                (keys::EXPORT, 6),
-                (keys::QUIT, 7),
-            ] {
-                if i.consume_shortcut(&shortcut) {
-                    commands.push(action);
-                }
-            }
-        });
-        for action in commands {
-            match action {
-                0 => self.apply(Command::Undo),
-                1 => self.apply(Command::Redo),
-                2 => self.save(),
-                3 => self.save_as(),
-                4 => self.open_dialog(),
-                5 => self.new_project(),
-                6 => self.open_export(),
-                _ => self.quit_asked = true,
-            }
-        }
-        let (shift, pressed) = ctx.input(|i| {
-            let keys = [
-                Key::B,
-                Key::E,
-                Key::R,
-                Key::G,
-                Key::I,
-                Key::Escape,
-                Key::X,
-                Key::OpenBracket,
-                Key::CloseBracket,
-                Key::F,
-            ];
-            let pressed: Vec<Key> = if i.modifiers.command || i.modifiers.alt {
-                Vec::new()
-            } else {
-                keys.into_iter().filter(|k| i.key_pressed(*k)).collect()
-            };
-            (i.modifiers.shift, pressed)
-        });
-        let mut brush = self.doc.settings().brush.clone();
-        for key in pressed {
-            match key {
-                Key::B => self.select_tool(ToolKind::Brush),
-                Key::E => self.select_tool(ToolKind::Eraser),
-                Key::R => self.select_tool(ToolKind::Blur),
-                Key::G => self.select_tool(ToolKind::Gradient),
-                Key::I => self.select_tool(ToolKind::Picker),
-                Key::Escape => self.tool_event(crate::tools::ToolEvent::Escape),
-                Key::X => self.apply(Command::SwapMaterials),
-                Key::OpenBracket if shift => brush.hardness = (brush.hardness - 0.1).max(0.0),
-                Key::CloseBracket if shift => brush.hardness = (brush.hardness + 0.1).min(1.0),
-                Key::OpenBracket => brush.radius_px = (brush.radius_px / 1.25).max(0.5),
-                Key::CloseBracket => brush.radius_px = (brush.radius_px * 1.25).min(2048.0),
-                Key::F => {
-                    // F fills on the canvas, frames the mesh in the viewport.
-                    if self.hover_tab == Some(Tab::Canvas) {
-                        self.select_tool(ToolKind::Fill);
-                    } else {
-                        self.viewport.frame(&self.mesh.mesh);
-                    }
-                }
-                _ => {}
-            }
-        }
-        if brush != self.doc.settings().brush {
-            self.apply(Command::SetBrush(brush));
-        }
     }
 }
 
@@ -544,6 +438,7 @@ impl Editor {
         s.export_window(&ctx);
         s.new_window(&ctx);
         s.recovery_window(&ctx);
+        s.shortcuts_window(&ctx);
         s.notices(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);

@@ -6,11 +6,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
 
-use egui::KeyboardShortcut;
-
 use super::canvas::CanvasChannel;
+use super::keys::{self, Action};
 use super::viewport::Compare;
-use super::{EditorState, keys, notice, stamp_image, stamp_key};
+use super::{EditorState, notice, stamp_image, stamp_key};
 use crate::model::Command;
 use crate::model::paint::GradientShape;
 use crate::model::texel::{Channel, MaterialValue};
@@ -457,16 +456,18 @@ impl EditorState {
 
     pub(super) fn menu_ui(&mut self, ui: &mut egui::Ui) {
         // A menu entry showing its shortcut; whether it was clicked.
-        let item = |ui: &mut egui::Ui, label: &str, key: &KeyboardShortcut| {
-            ui.add(egui::Button::new(label).shortcut_text(ui.ctx().format_shortcut(key)))
+        let item = |ui: &mut egui::Ui, label: &str, action: Action| {
+            let text =
+                keys::shortcut(action).map_or_else(String::new, |k| ui.ctx().format_shortcut(&k));
+            ui.add(egui::Button::new(label).shortcut_text(text))
                 .clicked()
         };
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if item(ui, "New", &keys::NEW) {
+                if item(ui, "New", Action::New) {
                     self.new_project();
                 }
-                if item(ui, "Open…", &keys::OPEN) {
+                if item(ui, "Open…", Action::Open) {
                     self.open_dialog();
                 }
                 ui.menu_button("Open Recent", |ui| {
@@ -491,13 +492,13 @@ impl EditorState {
                         self.open(p);
                     }
                 });
-                if item(ui, "Save", &keys::SAVE) {
+                if item(ui, "Save", Action::Save) {
                     self.save();
                 }
-                if item(ui, "Save As…", &keys::SAVE_AS) {
+                if item(ui, "Save As…", Action::SaveAs) {
                     self.save_as();
                 }
-                if item(ui, "Export…", &keys::EXPORT) {
+                if item(ui, "Export…", Action::Export) {
                     self.open_export();
                 }
                 ui.separator();
@@ -520,16 +521,21 @@ impl EditorState {
                     }
                 }
                 ui.separator();
-                if item(ui, "Quit", &keys::QUIT) {
+                if item(ui, "Quit", Action::Quit) {
                     self.quit_asked = true;
                 }
             });
             ui.menu_button("Edit", |ui| {
-                if item(ui, "Undo", &keys::UNDO) {
+                if item(ui, "Undo", Action::Undo) {
                     self.apply(Command::Undo);
                 }
-                if item(ui, "Redo", &keys::REDO) {
+                if item(ui, "Redo", Action::Redo) {
                     self.apply(Command::Redo);
+                }
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.button("Keyboard shortcuts").clicked() {
+                    self.shortcuts_open = true;
                 }
             });
         });
