@@ -13,7 +13,7 @@ use kapaint::ui::canvas::CANVAS_LABEL;
 use kapaint::ui::viewport::{Compare, VIEWPORT_LABEL};
 
 fn texels(editor: &Editor) -> Vec<Texel> {
-    let maps = editor.state.doc.maps();
+    let maps = editor.state.doc().maps();
     let mut out = Vec::with_capacity(maps.texel_count());
     maps.for_each_texel(|_, _, t| out.push(t));
     out
@@ -57,36 +57,39 @@ fn a_scripted_editing_session() {
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
     harness.run();
     assert!(
-        harness.state().state.new_dialog.is_some(),
+        harness.state().state.new_dialog().is_some(),
         "Ctrl+N opens the New dialog"
     );
     harness.get_by_label("Resolution");
     harness.get_by_label("Base preset");
     harness.get_by_label("Mesh");
-    harness.state_mut().state.new_dialog = Some(kapaint::ui::NewDialog {
-        size: 512,
-        preset: 0,
-        mesh: "torus".into(),
-    });
+    harness
+        .state_mut()
+        .state
+        .set_new_dialog(kapaint::ui::NewDialog {
+            size: 512,
+            preset: 0,
+            mesh: "torus".into(),
+        });
     harness.run();
     harness
         .get_by_role_and_label(Role::Button, "Create")
         .click();
     harness.step();
     assert!(
-        harness.state().state.new_dialog.is_none(),
+        harness.state().state.new_dialog().is_none(),
         "Create closes it"
     );
     // The mesh is baked on a worker; the window keeps drawing meanwhile.
     for _ in 0..500 {
-        if harness.state().state.doc.maps().width() == 512 {
+        if harness.state().state.doc().maps().width() == 512 {
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(10));
         harness.step();
     }
     harness.run();
-    let doc = &harness.state().state.doc;
+    let doc = &harness.state().state.doc();
     assert_eq!(doc.maps().width(), 512);
     assert_eq!(
         doc.settings().mesh.spec(),
@@ -111,7 +114,7 @@ fn a_scripted_editing_session() {
     let painted = texels(harness.state());
     assert_ne!(painted, fresh, "the canvas stroke changed nothing");
     assert_eq!(
-        harness.state().state.doc.history().undo_steps().count(),
+        harness.state().state.doc().history().undo_steps().count(),
         1,
         "one stroke, one step"
     );
@@ -148,24 +151,24 @@ fn a_scripted_editing_session() {
     );
 
     // Hotkeys: [ shrinks the brush, E picks the eraser.
-    let radius = harness.state().state.doc.settings().brush.radius_px;
+    let radius = harness.state().state.doc().settings().brush.radius_px;
     harness.key_press(egui::Key::OpenBracket);
     harness.run();
-    assert!(harness.state().state.doc.settings().brush.radius_px < radius);
+    assert!(harness.state().state.doc().settings().brush.radius_px < radius);
     harness.key_press(egui::Key::E);
     harness.run();
     assert_eq!(
-        harness.state().state.tools.active(),
+        harness.state().state.tools().active(),
         kapaint::tools::ToolKind::Eraser
     );
 
     // The built-in grain stamp shapes the brush, and Round takes it off again.
     harness.get_by_label("Grain").click();
     harness.run();
-    assert!(harness.state().state.doc.settings().brush.stamp.is_some());
+    assert!(harness.state().state.doc().settings().brush.stamp.is_some());
     harness.get_by_label("Round").click();
     harness.run();
-    assert!(harness.state().state.doc.settings().brush.stamp.is_none());
+    assert!(harness.state().state.doc().settings().brush.stamp.is_none());
 
     // The recent-files list keeps each project once, newest first, at most RECENT_MAX.
     let mut recent = Vec::new();
@@ -186,19 +189,13 @@ fn a_scripted_editing_session() {
     // Compare: split, side by side and difference, each side with its own model.
     harness.get_by_label("Split").click();
     harness.run();
-    assert_eq!(
-        harness.state().state.viewport.comparison.mode,
-        Compare::Split
-    );
+    assert_eq!(harness.state().state.comparison().mode, Compare::Split);
     harness.get_by_label("Side by side").click();
     harness.run();
-    assert_eq!(
-        harness.state().state.viewport.comparison.mode,
-        Compare::SideBySide
-    );
+    assert_eq!(harness.state().state.comparison().mode, Compare::SideBySide);
     harness.get_by_label("Difference").click();
     harness.run();
-    let c = harness.state().state.viewport.comparison;
+    let c = harness.state().state.comparison();
     assert_eq!(c.mode, Compare::Difference);
     assert_ne!(
         c.left.model, c.right.model,
@@ -270,7 +267,7 @@ fn changed(a: &[Texel], b: &[Texel]) -> usize {
 #[test]
 fn pen_pressure_scales_the_dab() {
     let mut harness = editor();
-    assert!(harness.state().state.doc.settings().brush.pressure_size);
+    assert!(harness.state().state.doc().settings().brush.pressure_size);
     let fresh = texels(harness.state());
     let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
     let dab = |harness: &mut Harness<'_, Editor>, force: Option<f32>| {
@@ -316,12 +313,15 @@ fn opening_another_project_never_drops_unsaved_work() {
     let elsewhere = std::path::PathBuf::from("/nowhere/other.kapaint");
     harness.state_mut().state.open(elsewhere.clone());
     harness.run();
-    assert_eq!(harness.state().state.pending_open, Some(elsewhere));
+    assert_eq!(
+        harness.state().state.pending_open(),
+        Some(elsewhere.as_path())
+    );
     harness.get_by_label("Discard and open");
     harness.get_by_label("Save, then open");
     harness.get_by_label("Cancel").click();
     harness.run();
-    assert_eq!(harness.state().state.pending_open, None);
+    assert_eq!(harness.state().state.pending_open(), None);
     assert_eq!(texels(harness.state()), painted, "the work is still there");
 }
 
@@ -333,7 +333,7 @@ fn a_settings_change_is_unsaved_work() {
     harness.get_by_label("Blinn-Phong (11)").click();
     harness.run();
     assert_eq!(
-        harness.state().state.doc.settings().model,
+        harness.state().state.doc().settings().model,
         kapaint::reflectance::ShadingModel::BlinnPhong
     );
     assert!(
@@ -344,7 +344,10 @@ fn a_settings_change_is_unsaved_work() {
     let elsewhere = std::path::PathBuf::from("/nowhere/other.kapaint");
     harness.state_mut().state.open(elsewhere.clone());
     harness.run();
-    assert_eq!(harness.state().state.pending_open, Some(elsewhere));
+    assert_eq!(
+        harness.state().state.pending_open(),
+        Some(elsewhere.as_path())
+    );
     harness.get_by_label("Discard and open");
 }
 
@@ -373,13 +376,16 @@ fn escape_abandons_a_stroke_under_way() {
         before,
         "and the release adds nothing"
     );
-    assert_eq!(harness.state().state.doc.history().undo_steps().count(), 0);
+    assert_eq!(
+        harness.state().state.doc().history().undo_steps().count(),
+        0
+    );
 }
 
 #[test]
 fn a_gradient_dragged_in_the_viewport_lays_a_gradient() {
     let mut harness = editor();
-    let primary = harness.state().state.doc.settings().primary;
+    let primary = harness.state().state.doc().settings().primary;
     let before = texels(harness.state());
     harness.get_by_label("Gradient").click();
     harness.run();
@@ -393,7 +399,7 @@ fn a_gradient_dragged_in_the_viewport_lays_a_gradient() {
     );
     assert_ne!(texels(harness.state()), before, "a gradient was laid");
     assert_eq!(
-        harness.state().state.doc.settings().primary,
+        harness.state().state.doc().settings().primary,
         primary,
         "not a pick"
     );
@@ -405,7 +411,7 @@ fn every_tool_and_its_options_are_in_the_panel() {
     for kind in kapaint::tools::ToolKind::ALL {
         harness.get_by_label(kind.label()).click();
         harness.run();
-        assert_eq!(harness.state().state.tools.active(), kind);
+        assert_eq!(harness.state().state.tools().active(), kind);
     }
     harness.get_by_label("Blur").click();
     harness.run();
@@ -434,7 +440,7 @@ fn the_shortcut_sheet_shows_the_keymap_the_keys_run() {
     harness.key_press(egui::Key::R);
     harness.run();
     assert_eq!(
-        harness.state().state.tools.active(),
+        harness.state().state.tools().active(),
         kapaint::tools::ToolKind::Blur
     );
 }

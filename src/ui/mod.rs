@@ -149,31 +149,31 @@ impl MeshState {
 /// Everything the panels and tabs read and change (the dock lives beside it).
 pub struct EditorState {
     /// The document.
-    pub doc: Document,
+    doc: Document,
     /// Where it is saved.
-    pub path: Option<PathBuf>,
+    path: Option<PathBuf>,
     saved_version: u64,
     /// The tools and which one is active.
-    pub tools: Tools,
+    tools: Tools,
     /// View mode of the viewport.
-    pub view: ViewMode,
+    view: ViewMode,
     /// Lights.
-    pub lighting: Lighting,
+    lighting: Lighting,
     /// The 3D viewport.
-    pub viewport: Viewport,
+    viewport: Viewport,
     /// The UV canvas.
-    pub canvas: Canvas,
+    canvas: Canvas,
     mesh: MeshState,
     /// Messages.
-    pub notices: Vec<Notice>,
+    notices: Vec<Notice>,
     job: Option<Job>,
     export: Option<ExportDialog>,
     /// The New dialog, while open.
-    pub new_dialog: Option<NewDialog>,
+    new_dialog: Option<NewDialog>,
     /// A project to open once the user has decided about the unsaved changes.
-    pub pending_open: Option<PathBuf>,
+    pending_open: Option<PathBuf>,
     /// Recently opened or saved projects, newest first.
-    pub recent: Vec<PathBuf>,
+    recent: Vec<PathBuf>,
     /// The pen's last pressure in the current stroke (1 with a mouse).
     pressure: f32,
     /// The view the primary button went down on, until it goes up.
@@ -181,18 +181,18 @@ pub struct EditorState {
     /// The brush stamp's preview texture, and which stamp it shows.
     stamp_preview: Option<(u64, egui::TextureHandle)>,
     /// The texel under the cursor, in either view.
-    pub hover: Option<(u32, u32)>,
+    hover: Option<(u32, u32)>,
     /// The tab under the cursor.
-    pub hover_tab: Option<Tab>,
+    hover_tab: Option<Tab>,
     /// `hover` as of the last frame (the status bar is drawn before the tabs).
     shown_hover: Option<(u32, u32)>,
     quit_asked: bool,
     /// Whether Help > Keyboard shortcuts is open.
     shortcuts_open: bool,
     /// Set when the user confirmed closing with unsaved changes.
-    pub allow_close: bool,
+    allow_close: bool,
     /// A recovery copy found at start, newer than the project.
-    pub recovery_offer: Option<PathBuf>,
+    recovery_offer: Option<PathBuf>,
     /// Material presets with their thumbnails (rendered a few per frame).
     presets: Vec<(String, MaterialValue, Option<egui::TextureHandle>)>,
     autosaver: recovery::Autosaver,
@@ -324,6 +324,46 @@ fn notice(text: impl Into<String>, error: bool) -> Notice {
 }
 
 impl EditorState {
+    /// The document.
+    pub fn doc(&self) -> &Document {
+        &self.doc
+    }
+
+    /// Where the document is saved, if anywhere yet.
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    /// The tools and which one is active.
+    pub fn tools(&self) -> &Tools {
+        &self.tools
+    }
+
+    /// What the 3D viewport compares, and how.
+    pub fn comparison(&self) -> viewport::Comparison {
+        self.viewport.comparison
+    }
+
+    /// The New dialog's choices, while it is open.
+    pub fn new_dialog(&self) -> Option<&NewDialog> {
+        self.new_dialog.as_ref()
+    }
+
+    /// Sets the New dialog's choices (opening it).
+    pub fn set_new_dialog(&mut self, dialog: NewDialog) {
+        self.new_dialog = Some(dialog);
+    }
+
+    /// A project waiting to be opened until the user decides about unsaved changes.
+    pub fn pending_open(&self) -> Option<&Path> {
+        self.pending_open.as_deref()
+    }
+
+    /// The messages shown in the corner.
+    pub fn notices(&self) -> &[Notice] {
+        &self.notices
+    }
+
     /// Whether anything the project file stores (maps or settings) changed since the last
     /// save.
     pub fn dirty(&self) -> bool {
@@ -439,7 +479,7 @@ impl Editor {
         s.new_window(&ctx);
         s.recovery_window(&ctx);
         s.shortcuts_window(&ctx);
-        s.notices(&ctx);
+        s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
         if s.job.is_some() {

@@ -572,7 +572,7 @@ impl EditorState {
         }
     }
 
-    pub(super) fn notices(&mut self, ctx: &egui::Context) {
+    pub(super) fn notices_ui(&mut self, ctx: &egui::Context) {
         self.notices
             .retain(|n| n.at.elapsed() < Duration::from_secs(if n.error { 12 } else { 5 }));
         if self.notices.is_empty() {
