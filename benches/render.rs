@@ -12,7 +12,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use kapaint::gpu::preview::{DrawPart, Layout, PipelineKey};
+use kapaint::gpu::preview::{DrawPart, Layout, PipelineKey, PreviewDrawData, begin_pass};
 use kapaint::gpu::{Gpu, MapTextures, MeshBuffers, Preview};
 use kapaint::mesh;
 use kapaint::model::brush::{BrushSettings, StrokePoint};
@@ -36,14 +36,13 @@ struct Frame<'a> {
     gpu: &'a Gpu,
     color: &'a wgpu::TextureView,
     depth: &'a wgpu::TextureView,
-    size: (u32, u32),
     mesh: &'a MeshBuffers,
 }
 
 impl Frame<'_> {
     fn draw(
         &self,
-        preview: &mut Preview,
+        preview: &Preview,
         maps: &MapTextures,
         settings: &FrameSettings,
         parts: &[DrawPart],
@@ -52,17 +51,11 @@ impl Frame<'_> {
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        preview.draw(
-            self.gpu,
-            &mut encoder,
-            self.color,
-            self.depth,
-            self.size,
-            self.mesh,
-            maps,
-            settings,
-            parts,
-        );
+        let data = PreviewDrawData::new(preview, self.gpu, self.mesh, maps, settings, parts);
+        {
+            let mut pass = begin_pass(&mut encoder, self.color, self.depth);
+            preview.draw(&mut pass, &data);
+        }
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait();
     }
@@ -129,7 +122,7 @@ fn frames(c: &mut Criterion) {
     let (painted, matte) = documents();
     let painted_maps = MapTextures::new(&gpu, painted.maps()).expect("map textures");
     let matte_maps = MapTextures::new(&gpu, matte.maps()).expect("map textures");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let (w, h) = (1920, 1080);
     let color = target(&gpu, w, h, wgpu::TextureFormat::Rgba8UnormSrgb);
     let depth = target(&gpu, w, h, wgpu::TextureFormat::Depth32Float);
@@ -171,11 +164,10 @@ fn frames(c: &mut Criterion) {
             gpu: &gpu,
             color: &color,
             depth: &depth,
-            size: (w, h),
             mesh: &buffers,
         };
         group.bench_function(name, |b| {
-            b.iter(|| frame.draw(&mut preview, maps, &s, &[DrawPart::whole(key, (w, h))]));
+            b.iter(|| frame.draw(&preview, maps, &s, &[DrawPart::whole(key, (w, h))]));
         });
     }
     // The split compare shades each half once.
@@ -193,17 +185,16 @@ fn frames(c: &mut Criterion) {
         gpu: &gpu,
         color: &color,
         depth: &depth,
-        size: (w, h),
         mesh: &buffers,
     };
     let split = Layout::Split(w / 2).parts(phong, blinn, (w, h));
     group.bench_function("compare_split_painted_maps", |b| {
-        b.iter(|| frame.draw(&mut preview, &painted_maps, &s, &split));
+        b.iter(|| frame.draw(&preview, &painted_maps, &s, &split));
     });
     // Side by side: two whole pictures, each half the width.
     let side = Layout::SideBySide.parts(phong, blinn, (w, h));
     group.bench_function("compare_side_by_side_painted_maps", |b| {
-        b.iter(|| frame.draw(&mut preview, &painted_maps, &s, &side));
+        b.iter(|| frame.draw(&preview, &painted_maps, &s, &side));
     });
     group.finish();
 }
@@ -289,7 +280,7 @@ fn painting(c: &mut Criterion) {
     }))
     .expect("brush");
     let mut maps = MapTextures::new(&gpu, doc.maps()).expect("map textures");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let (w, h) = (1280, 720);
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let color = target(&gpu, w, h, format);
@@ -305,7 +296,6 @@ fn painting(c: &mut Criterion) {
         gpu: &gpu,
         color: &color,
         depth: &depth,
-        size: (w, h),
         mesh: &buffers,
     };
     let mut k = 0_u32;
@@ -317,7 +307,7 @@ fn painting(c: &mut Criterion) {
             brush_stroke(&mut doc, &[Vec2::new(x, y)]);
             maps.sync(&gpu, doc.maps()).expect("sync");
             let key = PipelineKey::for_frame(&s, &maps.uniform, format);
-            frame.draw(&mut preview, &maps, &s, &[DrawPart::whole(key, (w, h))]);
+            frame.draw(&preview, &maps, &s, &[DrawPart::whole(key, (w, h))]);
         });
     });
     group.finish();

@@ -4,11 +4,7 @@
 // k_a = (2/pi) k_d + k_s chi(n): eq. (6) of the paper, with chi by eq. (8)/(11) as
 // printed, with the corrected Blinn exponent, or by kapaint's Fast approximation.
 
-const MODEL_PHONG: u32 = 0u;
-const MODEL_BLINN: u32 = 1u;
-const APPROX_PAPER_PRINTED: u32 = 0u;
-const APPROX_PAPER_CORRECTED: u32 = 1u;
-const APPROX_FAST: u32 = 2u;
+#include "ids.wgsl"
 
 const TWO_OVER_PI: f32 = 6.3661975e-1f;
 const PAPER_TWO_OVER_PI: f32 = 6.37e-1f;

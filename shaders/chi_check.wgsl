@@ -1,6 +1,6 @@
-// requires: ambient.wgsl
-//
 // Compute check of the shader's chi against the Rust core: out[i] = chi(MODEL, APPROX, n[i]).
+
+#include "ambient.wgsl"
 
 override MODEL: u32 = 0u;
 override APPROX: u32 = 2u;

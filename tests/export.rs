@@ -94,7 +94,10 @@ fn compact_sets_elide_what_is_constant_and_round_trip() {
     assert!(m.constants.ks.is_some());
     assert_eq!(m.files.len(), 1);
     assert_eq!(m.files[0].layout, ["kd.r", "kd.g", "kd.b", "n"]);
-    assert_eq!(m.files[0].colour_space, "srgb");
+    assert_eq!(
+        m.files[0].colour_space,
+        kapaint::export::set::ColourSpace::Srgb
+    );
     let n = m.n_encoding.expect("n is quantised");
     assert_eq!(n.bits, 8);
     // The two shader snippets are a fixed 16 KB or so whatever the map size; on this small

@@ -84,7 +84,7 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
     let Some(gpu) = gpu() else { return };
     let sphere = mesh::uv_sphere(64, 32);
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     for (value, model) in [
         (
             MaterialValue::new(Vec3::new(0.8, 0.3, 0.1), Vec3::splat(0.5), 40.0),
@@ -196,7 +196,7 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
     let maps = painted_maps();
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
     let textures = MapTextures::new(&gpu, &maps).expect("map textures");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let (w, h) = (192, 192);
     for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
         let s = settings(model, ViewMode::Shaded, &sphere.positions);
@@ -295,9 +295,9 @@ fn split_and_side_by_side_compare_phong_left_and_blinn_right() {
         MeshBuffers::new(&gpu, &sphere).expect("mesh buffers"),
         MapTextures::new(&gpu, &maps).expect("map textures"),
     );
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let (w, h) = (96_u32, 64_u32);
-    let mut render = |model, size: (u32, u32), layout| {
+    let render = |model, size: (u32, u32), layout| {
         let s = settings(model, ViewMode::Shaded, &sphere.positions);
         linear(
             preview
@@ -362,7 +362,7 @@ fn extreme_maps_shade_to_finite_colours() {
     let Some(gpu) = gpu() else { return };
     let sphere = mesh::uv_sphere(32, 16);
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     for value in [
         MaterialValue::new(Vec3::ONE, Vec3::ONE, 0.0),
         MaterialValue::new(Vec3::ONE, Vec3::ONE, 16384.0),
@@ -941,9 +941,9 @@ fn difference_heatmap_on_the_gpu_matches_the_cpu_ramp() {
         MeshBuffers::new(&gpu, &sphere).expect("mesh buffers"),
         MapTextures::new(&gpu, &maps).expect("map textures"),
     );
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let (w, h) = (80_u32, 60_u32);
-    let mut render = |model| {
+    let render = |model| {
         let s = settings(model, ViewMode::Shaded, &sphere.positions);
         preview
             .render_offscreen(
@@ -1022,7 +1022,7 @@ fn what_does_not_fit_the_gpu_is_an_error_not_a_panic() {
     let small = MaterialMaps::new(64, 64, MaterialValue::default()).expect("maps");
     let textures = MapTextures::new(&gpu, &small).expect("64^2 fits");
     let settings = settings(ShadingModel::Phong, ViewMode::Ka, &sphere.positions);
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let offscreen = |size| Offscreen {
         size,
         linear: true,
@@ -1057,7 +1057,7 @@ fn a_lost_device_is_an_error_not_a_panic() {
     let maps = MaterialMaps::new(64, 64, MaterialValue::default()).expect("maps");
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh");
     let mut textures = MapTextures::new(&gpu, &maps).expect("maps");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     gpu.device.destroy();
     gpu.wait();
     let settings = settings(ShadingModel::Phong, ViewMode::Shaded, &sphere.positions);

@@ -138,7 +138,7 @@ fn the_main_views_match_their_snapshots() {
     import::import_file(&mut doc, Channel::N, &texture).expect("n");
     let buffers = MeshBuffers::new(&gpu, &mesh).expect("mesh buffers");
     let maps = MapTextures::new(&gpu, doc.maps()).expect("map textures");
-    let mut preview = Preview::new(&gpu);
+    let preview = Preview::new(&gpu);
     let settings = |model, view| FrameSettings {
         model,
         approx: AmbientApprox::Fast,
@@ -151,7 +151,7 @@ fn the_main_views_match_their_snapshots() {
         }
         .framing(&mesh.positions),
     };
-    let mut render = |model, view, layout, linear| {
+    let render = |model, view, layout, linear| {
         preview
             .render_offscreen(
                 &gpu,

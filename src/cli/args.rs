@@ -4,9 +4,60 @@ use std::io::BufRead;
 
 use glam::DVec3;
 
-use super::{CliError, MethodArg};
+use clap::ValueEnum;
+
+use super::CliError;
 use crate::model;
 use crate::reflectance::exact::EXACT_N_MAX;
+use crate::reflectance::{AmbientApprox, ShadingModel};
+
+/// `--model` values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum ModelArg {
+    /// Original Phong, eq. (8).
+    Phong,
+    /// Blinn-Phong, eq. (11).
+    Blinn,
+}
+
+impl From<ModelArg> for ShadingModel {
+    fn from(m: ModelArg) -> Self {
+        match m {
+            ModelArg::Phong => Self::Phong,
+            ModelArg::Blinn => Self::BlinnPhong,
+        }
+    }
+}
+
+/// `--method` values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum MethodArg {
+    /// The exact integral of eq. (6).
+    Exact,
+    /// Eq. (8) / (11) as printed.
+    Paper,
+    /// Eq. (8) / (11) with the Blinn exponent corrected.
+    PaperCorrected,
+    /// kapaint's fast approximation.
+    Fast,
+}
+
+impl MethodArg {
+    /// The approximation, or `None` for the exact integral.
+    pub fn approx(self) -> Option<AmbientApprox> {
+        match self {
+            Self::Exact => None,
+            Self::Paper => Some(AmbientApprox::PaperPrinted),
+            Self::PaperCorrected => Some(AmbientApprox::PaperCorrected),
+            Self::Fast => Some(AmbientApprox::Fast),
+        }
+    }
+}
+
+/// A value with 17 significant digits, enough to round-trip an `f64`.
+pub fn fmt17(x: f64) -> String {
+    format!("{x:.16e}")
+}
 
 /// Parses `W` or `WxH`.
 pub(super) fn parse_size(text: &str) -> Result<(u32, u32), CliError> {

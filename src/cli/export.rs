@@ -68,8 +68,46 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
     );
 }
 
+/// Export projects as compact texture sets (images + material.json).
+#[derive(Debug, clap::Args)]
+pub struct ExportArgs {
+    /// Project files (several: one set per project, in `OUT/<project name>/`).
+    #[arg(required = true)]
+    files: Vec<PathBuf>,
+    /// Export preset: compact, 16-bit, separate, exr, with-ka, ktx2, ktx2-raw, or a user
+    /// preset.
+    #[arg(long, default_value = "compact")]
+    preset: String,
+    /// Target folder (must not exist, or be empty).
+    #[arg(long)]
+    out: PathBuf,
+    /// Print the memory report, the n encoding and the k_a error.
+    #[arg(long)]
+    report: bool,
+    /// Keep texels outside the mesh's UV islands as painted (by default they are filled
+    /// from the nearest island, which needs the project's mesh).
+    #[arg(long)]
+    no_padding: bool,
+}
+
+impl ExportArgs {
+    /// Runs the command; returns what it prints.
+    ///
+    /// # Errors
+    /// A project or preset that does not load, a busy target, a failed export.
+    pub fn run(self) -> Result<String, CliError> {
+        export_command(
+            &self.files,
+            &self.preset,
+            &self.out,
+            self.report,
+            !self.no_padding,
+        )
+    }
+}
+
 /// `kapaint export`: every project into its set; one line each, plus the report.
-pub(super) fn export_command(
+fn export_command(
     files: &[PathBuf],
     preset: &str,
     out: &std::path::Path,

@@ -6,34 +6,40 @@
 //! read-only folder); [`EXIT_USAGE`] (2) bad arguments or bad input (a missing or malformed
 //! file, a value out of range); [`crate::crash::EXIT_INTERNAL`] (70) an internal error.
 
-use std::fmt::Write as _;
 use std::io::{BufRead, Write};
-use std::path::PathBuf;
 
-use clap::{Parser, Subcommand, ValueEnum};
-use glam::DVec3;
+use clap::{Parser, Subcommand};
 
 use crate::mesh;
-use crate::model::{self, Channel, Document, DocumentSettings, ModelError, import, project};
-use crate::reflectance::{self, AmbientApprox, ShadingModel, TWO_OVER_PI, exact::chi_exact};
-use crate::report::{accuracy, bench};
+use crate::model::ModelError;
 
+mod accuracy;
 mod args;
+mod bench;
+mod chi;
+mod debug_panic;
+mod equivalent_n;
 mod export;
+mod import;
+mod import_set;
+mod info;
+mod ka;
+mod mesh_info;
+mod new;
+mod paint;
 mod render;
 
-use args::{parse_n, parse_rgb, parse_size, read_stdin_values};
-pub use render::RenderArgs;
+pub use accuracy::MAX_ACCURACY_POINTS;
+pub use args::{MethodArg, ModelArg, fmt17};
+pub use chi::chi_value;
+pub use info::info_text;
+pub use paint::PaintScript;
 
 /// Exit code for a failed read or write that is not the input's fault.
 pub const EXIT_IO: i32 = 1;
 
 /// Exit code for bad arguments or input.
 pub const EXIT_USAGE: i32 = 2;
-
-/// Most sample points `kapaint accuracy` takes per range (each costs an exact integral per
-/// model: 256 points take about a minute on 2 cores).
-pub const MAX_ACCURACY_POINTS: usize = 256;
 
 /// A failure to report: one line of text and an exit code.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -92,202 +98,36 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Print chi(n), the specular part of k_a per unit k_s, as CSV `n,chi`.
-    Chi {
-        /// Specular lobe.
-        #[arg(long, value_enum)]
-        model: ModelArg,
-        /// How chi is computed.
-        #[arg(long, value_enum)]
-        method: MethodArg,
-        /// Exponents (n >= 0); a single `-` reads one value per line from stdin.
-        #[arg(required = true, allow_hyphen_values = true)]
-        n: Vec<String>,
-    },
+    Chi(chi::ChiArgs),
     /// Print k_a = (2/pi) k_d + k_s chi(n) of one texel as `r,g,b`.
-    Ka {
-        /// Specular lobe.
-        #[arg(long, value_enum)]
-        model: ModelArg,
-        /// How chi is computed.
-        #[arg(long, value_enum)]
-        method: MethodArg,
-        /// Diffuse coefficient `R,G,B`, each in [0, 1].
-        #[arg(long)]
-        kd: String,
-        /// Specular coefficient `S` or `R,G,B`, each in [0, 1].
-        #[arg(long)]
-        ks: String,
-        /// Phong exponent (n >= 0).
-        #[arg(long, allow_hyphen_values = true)]
-        n: String,
-    },
+    Ka(ka::KaArgs),
     /// Print the error of every approximation against the exact integrator (markdown).
-    Accuracy {
-        /// Sample points per n range (2 to 256, spaced evenly in ln(n + 1)).
-        #[arg(long, default_value_t = 96)]
-        points: usize,
-    },
+    Accuracy(accuracy::AccuracyArgs),
     /// Create a project of one material everywhere.
-    New {
-        /// Map size, `W` or `WxH` (each 1 to 8192).
-        #[arg(long)]
-        size: String,
-        /// Material preset (file stem or name), e.g. `brass`.
-        #[arg(long, default_value = "default")]
-        preset: String,
-        /// Project file to write.
-        #[arg(long)]
-        out: PathBuf,
-        /// Mesh the material is painted on: sphere, plane, cube, torus or a mesh file.
-        #[arg(long, default_value = "sphere")]
-        mesh: String,
-        /// Overwrite an existing file.
-        #[arg(long)]
-        force: bool,
-    },
+    New(new::NewArgs),
     /// Print a project's resolution, per-channel min/mean/max and memory.
-    Info {
-        /// Project file.
-        file: PathBuf,
-    },
+    Info(info::InfoArgs),
     /// Import an image (PNG, JPEG, TGA, EXR) into one channel of a project.
-    Import {
-        /// Project file (rewritten atomically unless --out is given).
-        file: PathBuf,
-        /// Channel to replace.
-        #[arg(long, value_parser = ["kd", "ks", "n"])]
-        channel: String,
-        /// Image file.
-        #[arg(long)]
-        image: PathBuf,
-        /// Write the result here instead of over FILE.
-        #[arg(long)]
-        out: Option<PathBuf>,
-    },
+    Import(import::ImportArgs),
     /// Replay a paint script (RON list of commands) on a project and save it.
-    Paint {
-        /// Project file (rewritten atomically unless --out is given).
-        file: PathBuf,
-        /// Script of commands (see docs/cli.md).
-        #[arg(long)]
-        script: PathBuf,
-        /// Mesh for strokes on the surface and island/part fills (default: the project's).
-        #[arg(long)]
-        mesh: Option<String>,
-        /// Write the result here instead of over FILE.
-        #[arg(long)]
-        out: Option<PathBuf>,
-    },
+    Paint(paint::PaintArgs),
     /// Export projects as compact texture sets (images + material.json).
-    Export {
-        /// Project files (several: one set per project, in `OUT/<project name>/`).
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Export preset: compact, 16-bit, separate, exr, with-ka, ktx2, ktx2-raw, or a user
-        /// preset.
-        #[arg(long, default_value = "compact")]
-        preset: String,
-        /// Target folder (must not exist, or be empty).
-        #[arg(long)]
-        out: PathBuf,
-        /// Print the memory report, the n encoding and the k_a error.
-        #[arg(long)]
-        report: bool,
-        /// Keep texels outside the mesh's UV islands as painted (by default they are filled
-        /// from the nearest island, which needs the project's mesh).
-        #[arg(long)]
-        no_padding: bool,
-    },
+    Export(export::ExportArgs),
     /// Rebuild a project from an exported set.
-    ImportSet {
-        /// The set's material.json.
-        manifest: PathBuf,
-        /// Project file to write.
-        #[arg(long)]
-        out: PathBuf,
-        /// Overwrite an existing file.
-        #[arg(long)]
-        force: bool,
-    },
+    ImportSet(import_set::ImportSetArgs),
     /// The exponent of the other model whose highlight matches (CSV "n,equivalent").
-    EquivalentN {
-        /// The model the given exponents belong to.
-        #[arg(long, value_enum)]
-        from: ModelArg,
-        /// Exponents (n >= 0).
-        #[arg(required = true, allow_hyphen_values = true)]
-        n: Vec<String>,
-    },
+    EquivalentN(equivalent_n::EquivalentNArgs),
     /// Render the preview headless (no window, no display) into a PNG or EXR.
-    Render(RenderArgs),
-    /// Print a mesh's vertices, triangles, UV islands, bounds, and whether normals and UVs were
-    /// present (FILE is an .obj file, or sphere, plane, cube, torus).
-    MeshInfo {
-        /// Mesh file or built-in name.
-        file: PathBuf,
-    },
+    Render(render::RenderArgs),
+    /// Print a mesh's vertices, triangles, UV islands, bounds, and whether normals and UVs
+    /// were present (FILE is an .obj, .gltf or .glb file, or sphere, plane, cube, torus).
+    MeshInfo(mesh_info::MeshInfoArgs),
     /// Panics on purpose, to check what a crash looks like (one line, a report file, exit
     /// code 70).
     #[command(hide = true)]
-    DebugPanic {
-        /// Panic in every worker thread at once instead of the main thread.
-        #[arg(long)]
-        workers: bool,
-    },
+    DebugPanic(debug_panic::DebugPanicArgs),
     /// Time the k_a derive of a full map per method against its error and a memory copy.
-    Bench {
-        /// Map side in texels.
-        #[arg(long, default_value_t = 4096)]
-        size: usize,
-        /// Directory for bench.csv and bench.png.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Timing repetitions (the best is kept).
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-    },
-}
-
-/// `--model` values.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum ModelArg {
-    /// Original Phong, eq. (8).
-    Phong,
-    /// Blinn-Phong, eq. (11).
-    Blinn,
-}
-
-impl From<ModelArg> for ShadingModel {
-    fn from(m: ModelArg) -> Self {
-        match m {
-            ModelArg::Phong => Self::Phong,
-            ModelArg::Blinn => Self::BlinnPhong,
-        }
-    }
-}
-
-/// `--method` values.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum MethodArg {
-    /// The exact integral of eq. (6).
-    Exact,
-    /// Eq. (8) / (11) as printed.
-    Paper,
-    /// Eq. (8) / (11) with the Blinn exponent corrected.
-    PaperCorrected,
-    /// kapaint's fast approximation.
-    Fast,
-}
-
-impl MethodArg {
-    fn approx(self) -> Option<AmbientApprox> {
-        match self {
-            Self::Exact => None,
-            Self::Paper => Some(AmbientApprox::PaperPrinted),
-            Self::PaperCorrected => Some(AmbientApprox::PaperCorrected),
-            Self::Fast => Some(AmbientApprox::Fast),
-        }
-    }
+    Bench(bench::BenchArgs),
 }
 
 /// Parses arguments, runs, prints errors; returns the process exit code.
@@ -341,211 +181,30 @@ pub fn clap_message(rendered: &str) -> String {
 }
 
 /// Runs a parsed command and returns everything it prints, or the error to report.
-#[expect(clippy::too_many_lines, reason = "one arm per subcommand, each short")]
+///
+/// # Errors
+/// What the command reports: one line and an exit code.
 pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError> {
     match command {
-        Command::Chi { model, method, n } => {
-            let values = if n.len() == 1 && n[0] == "-" {
-                read_stdin_values(stdin, method)?
-            } else {
-                n.iter()
-                    .map(|s| parse_n(s, method))
-                    .collect::<Result<Vec<_>, _>>()?
-            };
-            Ok(chi_csv(model.into(), method, &values))
-        }
-        Command::Ka {
-            model,
-            method,
-            kd,
-            ks,
-            n,
-        } => {
-            let kd = parse_rgb("--kd", &kd, false)?;
-            let ks = parse_rgb("--ks", &ks, true)?;
-            let n = parse_n(&n, method)?;
-            let ka = ka_value(model.into(), method, kd, ks, n);
-            Ok(format!("{},{},{}\n", fmt17(ka.x), fmt17(ka.y), fmt17(ka.z)))
-        }
-        Command::Accuracy { points } => {
-            if !(2..=MAX_ACCURACY_POINTS).contains(&points) {
-                return Err(CliError::usage(format!(
-                    "--points must be 2 to {MAX_ACCURACY_POINTS}, got {points}"
-                )));
-            }
-            Ok(accuracy::accuracy_report(&accuracy::Grid::standard(points)).markdown())
-        }
-        Command::New {
-            size,
-            preset,
-            out,
-            mesh,
-            force,
-        } => {
-            let (w, h) = parse_size(&size)?;
-            // A mesh file must exist and load now, not at the first stroke on it.
-            mesh::open(std::path::Path::new(&mesh)).map_err(mesh_error)?;
-            if out.exists() && !force {
-                return Err(CliError::usage(format!(
-                    "{} exists; pass --force to overwrite it",
-                    out.display()
-                )));
-            }
-            let preset = model::preset::find(&preset).map_err(model_error)?;
-            let settings = DocumentSettings {
-                base: preset.value(),
-                secondary: preset.value(),
-                preset: Some(preset.name.clone()),
-                mesh: model::document::MeshRef::from_spec(&mesh),
-                ..DocumentSettings::default()
-            };
-            let doc = Document::new(w, h, settings).map_err(model_error)?;
-            project::save(&doc, &out).map_err(model_error)?;
-            Ok(format!(
-                "created {} ({w}x{h}, {})\n",
-                out.display(),
-                preset.name
-            ))
-        }
-        Command::Info { file } => {
-            let doc = project::load(&file).map_err(model_error)?;
-            let bytes = std::fs::metadata(&file).map_or(0, |m| m.len());
-            Ok(info_text(&file, &doc, bytes))
-        }
-        Command::Import {
-            file,
-            channel,
-            image,
-            out,
-        } => {
-            let channel = Channel::from_name(&channel)
-                .ok_or_else(|| CliError::usage(format!("unknown channel {channel:?}")))?;
-            let mut doc = project::load(&file).map_err(model_error)?;
-            import::import_file(&mut doc, channel, &image).map_err(model_error)?;
-            let target = out.unwrap_or(file);
-            project::save(&doc, &target).map_err(model_error)?;
-            Ok(format!(
-                "imported {} into {} of {}\n",
-                image.display(),
-                channel.name(),
-                target.display()
-            ))
-        }
-        Command::Paint {
-            file,
-            script,
-            mesh,
-            out,
-        } => {
-            let commands = read_script(&script)?;
-            let mut doc = project::load(&file).map_err(model_error)?;
-            if commands.iter().any(model::Command::needs_surface) {
-                let spec = mesh.unwrap_or_else(|| doc.settings().mesh.spec().to_string());
-                project::attach_mesh(&mut doc, std::path::Path::new(&spec)).map_err(model_error)?;
-            }
-            let count = commands.len();
-            for (i, command) in commands.into_iter().enumerate() {
-                doc.apply(command).map_err(|e| {
-                    CliError::usage(format!("{}: command {}: {e}", script.display(), i + 1))
-                })?;
-            }
-            doc.apply(model::Command::EndStroke).map_err(model_error)?;
-            let target = out.unwrap_or(file);
-            project::save(&doc, &target).map_err(model_error)?;
-            Ok(format!(
-                "applied {count} commands, saved {}\n",
-                target.display()
-            ))
-        }
-        Command::Export {
-            files,
-            preset,
-            out,
-            report,
-            no_padding,
-        } => export::export_command(&files, &preset, &out, report, !no_padding),
-        Command::ImportSet {
-            manifest,
-            out,
-            force,
-        } => {
-            if out.exists() && !force {
-                return Err(CliError::usage(format!(
-                    "{} exists; pass --force to overwrite it",
-                    out.display()
-                )));
-            }
-            let doc = crate::export::set::import(&manifest).map_err(set_error)?;
-            project::save(&doc, &out).map_err(model_error)?;
-            Ok(format!(
-                "imported {} into {} ({}x{})\n",
-                manifest.display(),
-                out.display(),
-                doc.maps().width(),
-                doc.maps().height()
-            ))
-        }
-        Command::EquivalentN { from, n } => {
-            let values = n
-                .iter()
-                .map(|t| parse_n(t, MethodArg::Fast))
-                .collect::<Result<Vec<f64>, _>>()?;
-            let mut out = String::from("n,equivalent\n");
-            for v in values {
-                let m = crate::reflectance::equivalent::equivalent_exponent(from.into(), v);
-                let _ = writeln!(out, "{v},{m:.6}");
-            }
-            Ok(out)
-        }
-        Command::Render(args) => render::render_command(args),
-        Command::MeshInfo { file } => {
-            let mesh = mesh::open(&file).map_err(mesh_error)?;
-            Ok(mesh::info_text(&file, &mesh))
-        }
-        Command::DebugPanic { workers } => {
-            if workers {
-                use rayon::prelude::*;
-                (0..64_u32).into_par_iter().for_each(|i| {
-                    std::thread::sleep(std::time::Duration::from_millis(5));
-                    panic!("deliberate panic in worker task {i}");
-                });
-            }
-            panic!("deliberate panic on the main thread");
-        }
-        Command::Bench { size, out, repeats } => {
-            if !(16..=16384).contains(&size) {
-                return Err(CliError::usage("--size must be in [16, 16384]"));
-            }
-            crate::memory::check_fits(&format!("--size {size}"), bench::bytes_needed(size))
-                .map_err(|e| CliError::usage(format!("{e}: use a smaller --size")))?;
-            if let Some(dir) = &out {
-                std::fs::create_dir_all(dir).map_err(|e| {
-                    CliError::usage(format!("cannot create {}: {e}", dir.display()))
-                })?;
-            }
-            let rows = bench::run(size, repeats, 48);
-            let table = bench::markdown(&rows, size);
-            if let Some(dir) = out {
-                let csv = dir.join("bench.csv");
-                crate::atomic::write_atomic(&csv, bench::csv(&rows).as_bytes()).map_err(|e| {
-                    CliError {
-                        message: format!("cannot write {}: {e}", csv.display()),
-                        code: 1,
-                    }
-                })?;
-                let png = dir.join("bench.png");
-                bench::plot(&rows, &png).map_err(|e| CliError {
-                    message: e,
-                    code: 1,
-                })?;
-            }
-            Ok(table)
-        }
+        Command::Chi(a) => a.run(stdin),
+        Command::Ka(a) => a.run(),
+        Command::Accuracy(a) => a.run(),
+        Command::New(a) => a.run(),
+        Command::Info(a) => a.run(),
+        Command::Import(a) => a.run(),
+        Command::Paint(a) => a.run(),
+        Command::Export(a) => a.run(),
+        Command::ImportSet(a) => a.run(),
+        Command::EquivalentN(a) => a.run(),
+        Command::Render(a) => a.run(),
+        Command::MeshInfo(a) => a.run(),
+        Command::DebugPanic(a) => a.run(),
+        Command::Bench(a) => a.run(),
     }
 }
 
 /// A model-layer error in one line: exit code 1 for a failed read or write that is not the
-/// input's fault, 2 for everything else.
+/// input's fault, 70 for a broken invariant inside kapaint, 2 for bad input.
 #[expect(
     clippy::needless_pass_by_value,
     reason = "used as `map_err(model_error)`"
@@ -553,7 +212,17 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
 pub(super) fn model_error(e: ModelError) -> CliError {
     match &e {
         ModelError::Io { source, .. } => CliError::of_io(e.to_string(), source),
-        _ => CliError::usage(e.to_string()),
+        ModelError::Internal(_) => CliError {
+            message: e.to_string(),
+            code: crate::crash::EXIT_INTERNAL,
+        },
+        ModelError::InvalidSize { .. }
+        | ModelError::Project { .. }
+        | ModelError::Preset { .. }
+        | ModelError::UnknownPreset { .. }
+        | ModelError::Image { .. }
+        | ModelError::Script { .. }
+        | ModelError::Command(_) => CliError::usage(e.to_string()),
     }
 }
 
@@ -585,109 +254,26 @@ pub(super) fn set_error(e: crate::export::set::SetError) -> CliError {
     }
 }
 
-/// Largest paint script read (bytes).
-const MAX_SCRIPT_BYTES: u64 = 256 << 20;
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// A paint script: `(commands: [ ... ])` in RON.
-#[derive(Debug, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PaintScript {
-    /// Commands applied in order.
-    pub commands: Vec<model::Command>,
-}
-
-fn read_script(path: &std::path::Path) -> Result<Vec<model::Command>, CliError> {
-    let bytes = crate::file_check::read_limited(path, MAX_SCRIPT_BYTES).map_err(|e| {
-        if e.is_io() {
-            CliError::io(format!("{}: {e}", path.display()))
-        } else {
-            CliError::usage(format!("{}: {e}", path.display()))
-        }
-    })?;
-    let text = String::from_utf8(bytes).map_err(|_| {
-        model_error(ModelError::Script {
-            path: path.to_path_buf(),
-            reason: "not UTF-8 text".into(),
-        })
-    })?;
-    let script: PaintScript = ron::from_str(&text).map_err(|e| {
-        model_error(ModelError::Script {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })
-    })?;
-    Ok(script.commands)
-}
-
-/// `kapaint info` output: `key: value` lines, then one line per channel component.
-pub fn info_text(path: &std::path::Path, doc: &Document, file_bytes: u64) -> String {
-    let maps = doc.maps();
-    let s = doc.settings();
-    let mut out = String::new();
-    let _ = writeln!(out, "file: {}", path.display());
-    let _ = writeln!(out, "size: {}x{}", maps.width(), maps.height());
-    let _ = writeln!(
-        out,
-        "tiles: {} ({}x{} of 64x64)",
-        maps.tile_count(),
-        maps.tiles_x(),
-        maps.tiles_y()
-    );
-    let _ = writeln!(out, "model: {}", s.model.name());
-    let _ = writeln!(out, "method: {}", s.approx.name());
-    let _ = writeln!(out, "mesh: {}", s.mesh.spec());
-    let _ = writeln!(out, "preset: {}", s.preset.as_deref().unwrap_or("-"));
-    let expanded = maps.tile_count() * model::tile::TILE_TEXELS * 14;
-    let _ = writeln!(
-        out,
-        "memory: {} bytes in maps ({} bytes if every tile were expanded)",
-        maps.heap_bytes(),
-        expanded
-    );
-    let _ = writeln!(out, "file bytes: {file_bytes}");
-    let _ = writeln!(out, "channel min mean max");
-    for stat in model::stats::channel_stats(maps) {
-        let _ = writeln!(
-            out,
-            "{} {:.6} {:.6} {:.6}",
-            stat.label, stat.min, stat.mean, stat.max
+    /// A mesh baked at another size than the maps is kapaint's fault, not the input's: it
+    /// exits 70, not 2 (bad input).
+    #[test]
+    fn a_broken_invariant_in_the_model_is_an_internal_error() {
+        use crate::model::{Document, DocumentSettings, surface::Surface};
+        let mut doc = Document::new(8, 8, DocumentSettings::default()).expect("document");
+        let sphere = mesh::builtin("sphere").expect("sphere");
+        let surface = Surface::new(sphere, 16, 16).expect("bake");
+        let e = doc
+            .set_surface(Some(std::sync::Arc::new(surface)))
+            .expect_err("sizes differ");
+        let e = model_error(e);
+        assert_eq!(e.code, crate::crash::EXIT_INTERNAL, "{}", e.message);
+        assert_eq!(
+            model_error(ModelError::Command("pick outside".into())).code,
+            EXIT_USAGE
         );
-    }
-    out
-}
-
-/// `chi` with 17 significant digits, enough to round-trip an `f64`.
-pub fn fmt17(x: f64) -> String {
-    format!("{x:.16e}")
-}
-
-fn chi_csv(model: ShadingModel, method: MethodArg, values: &[f64]) -> String {
-    use rayon::prelude::*;
-    let chis: Vec<f64> = values
-        .par_iter()
-        .map(|&n| chi_value(model, method, n))
-        .collect();
-    let mut out = String::from("n,chi\n");
-    for (n, chi) in values.iter().zip(chis) {
-        let _ = writeln!(out, "{n},{}", fmt17(chi));
-    }
-    out
-}
-
-/// `chi(n)` by the chosen method: the exact integral in `f64`, approximations in `f32` as a
-/// renderer evaluates them.
-pub fn chi_value(model: ShadingModel, method: MethodArg, n: f64) -> f64 {
-    match method.approx() {
-        None => chi_exact(model, n),
-        Some(approx) => f64::from(reflectance::chi_f32(model, approx, n as f32)),
-    }
-}
-
-fn ka_value(model: ShadingModel, method: MethodArg, kd: DVec3, ks: DVec3, n: f64) -> DVec3 {
-    match method.approx() {
-        None => TWO_OVER_PI * kd + ks * chi_exact(model, n),
-        Some(approx) => {
-            reflectance::ka(model, approx, kd.as_vec3(), ks.as_vec3(), n as f32).as_dvec3()
-        }
     }
 }

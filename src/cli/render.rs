@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::args::{parse_light, parse_n, parse_rgb, parse_size};
-use super::{CliError, MethodArg, model_error};
+use super::args::{MethodArg, parse_light, parse_n, parse_rgb, parse_size};
+use super::{CliError, model_error};
 use crate::mesh;
 use crate::model::{self, project};
 use crate::reflectance::{AmbientApprox, ShadingModel};
@@ -90,7 +90,17 @@ fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::Pa
     Ok((maps, std::path::PathBuf::from("sphere")))
 }
 
-pub(super) fn render_command(a: RenderArgs) -> Result<String, CliError> {
+impl RenderArgs {
+    /// Runs the command; returns what it prints.
+    ///
+    /// # Errors
+    /// Bad arguments, a project or mesh that does not load, a GPU that fails, a failed write.
+    pub fn run(self) -> Result<String, CliError> {
+        render_command(self)
+    }
+}
+
+fn render_command(a: RenderArgs) -> Result<String, CliError> {
     use crate::gpu::headless::{self, Compare};
     use crate::render::{Camera, FrameSettings, Lighting, ViewMode};
     let (width, height) = parse_size(&a.size)?;

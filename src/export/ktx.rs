@@ -12,6 +12,7 @@ use ktx2::{Format as KtxFormat, Header, Index, LevelIndex, dfd};
 use rayon::prelude::*;
 
 use super::preset::Bc7Quality;
+use super::set::Compression;
 use crate::model::texel::{linear_to_srgb, srgb_to_linear};
 use crate::task::Progress;
 
@@ -44,8 +45,8 @@ pub struct Written {
     pub psnr: Option<Vec<Option<f64>>>,
     /// Mip levels in the file.
     pub levels: u32,
-    /// `bc7`, `bc5`, `bc4` or `none`.
-    pub compression: &'static str,
+    /// The file's compression: plain KTX2, or BC4, BC5 or BC7 blocks.
+    pub compression: Compression,
 }
 
 /// Level 0 of a KTX2 file as decoded texels.
@@ -217,19 +218,19 @@ pub fn encode(
         chain.push((((size.0 / 2).max(1), (size.1 / 2).max(1)), next));
     }
     let (format, variant, compression) = match (compressed, ch) {
-        (None, 1) => (KtxFormat::R8_UNORM, None, "none"),
-        (None, 2) => (KtxFormat::R8G8_UNORM, None, "none"),
-        (None, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, None, "none"),
-        (None, _) => (KtxFormat::R8G8B8A8_UNORM, None, "none"),
+        (None, 1) => (KtxFormat::R8_UNORM, None, Compression::Ktx2),
+        (None, 2) => (KtxFormat::R8G8_UNORM, None, Compression::Ktx2),
+        (None, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, None, Compression::Ktx2),
+        (None, _) => (KtxFormat::R8G8B8A8_UNORM, None, Compression::Ktx2),
         (Some(_), 1) => (
             KtxFormat::BC4_UNORM_BLOCK,
             Some(CompressionVariant::BC4),
-            "bc4",
+            Compression::Ktx2Bc4,
         ),
         (Some(_), 2) => (
             KtxFormat::BC5_UNORM_BLOCK,
             Some(CompressionVariant::BC5),
-            "bc5",
+            Compression::Ktx2Bc5,
         ),
         (Some(q), _) => (
             if srgb {
@@ -238,7 +239,7 @@ pub fn encode(
                 KtxFormat::BC7_UNORM_BLOCK
             },
             Some(CompressionVariant::BC7(bc7_settings(q, ch == 4))),
-            "bc7",
+            Compression::Ktx2Bc7,
         ),
     };
     let stored_channels = if variant.is_none() && ch == 3 { 4 } else { ch };

@@ -9,8 +9,10 @@ use std::fmt::Write as _;
 
 use super::encoding::NCurve;
 use super::set::Manifest;
-use crate::reflectance::wgsl::{ShaderLanguage, ambient_glsl, ambient_wgsl};
-use crate::reflectance::{AmbientApprox, ShadingModel};
+use crate::reflectance::AmbientApprox;
+use crate::reflectance::wgsl::{
+    ShaderLanguage, ambient_glsl, ambient_wgsl_standalone, approx_constant, model_constant,
+};
 
 /// The WGSL snippet for a set (`material.wgsl`).
 pub fn wgsl(manifest: &Manifest) -> String {
@@ -40,23 +42,16 @@ fn snippet(manifest: &Manifest, lang: ShaderLanguage) -> String {
          // decode (use an sRGB texture format for files whose colour_space is \"srgb\").\n"
     );
     match lang {
-        ShaderLanguage::Wgsl => s += &ambient_wgsl(),
+        ShaderLanguage::Wgsl => s += &ambient_wgsl_standalone(),
         ShaderLanguage::Glsl => s += &ambient_glsl(),
     }
-    let model = match manifest.model {
-        ShadingModel::Phong => "MODEL_PHONG",
-        ShadingModel::BlinnPhong => "MODEL_BLINN",
-    };
+    let model = model_constant(manifest.model);
     let approx = match manifest.approximation.name.as_str() {
         "paper" => AmbientApprox::PaperPrinted,
         "paper-corrected" => AmbientApprox::PaperCorrected,
         _ => AmbientApprox::Fast,
     };
-    let approx = match approx {
-        AmbientApprox::PaperPrinted => "APPROX_PAPER_PRINTED",
-        AmbientApprox::PaperCorrected => "APPROX_PAPER_CORRECTED",
-        AmbientApprox::Fast => "APPROX_FAST",
-    };
+    let approx = approx_constant(approx);
     match lang {
         ShaderLanguage::Wgsl => {
             let _ = writeln!(s, "\nconst KAPAINT_MODEL: u32 = {model};");

@@ -1,6 +1,7 @@
 //! Small compute kernels on the GPU: the shader's `chi` (`shaders/chi_check.wgsl`) checked
 //! against the Rust core, and any WGSL function over a list of values ([`run_kernel`]).
 
+use crate::reflectance::wgsl::shader_id;
 use crate::reflectance::{AmbientApprox, ShadingModel};
 
 use super::{Gpu, GpuError, shader_source};
@@ -16,23 +17,10 @@ pub fn chi_on_gpu(
     n: &[f32],
 ) -> Result<Vec<f32>, GpuError> {
     let constants = [
-        (
-            "MODEL",
-            match model {
-                ShadingModel::Phong => 0.0,
-                ShadingModel::BlinnPhong => 1.0,
-            },
-        ),
-        (
-            "APPROX",
-            match approx {
-                AmbientApprox::PaperPrinted => 0.0,
-                AmbientApprox::PaperCorrected => 1.0,
-                AmbientApprox::Fast => 2.0,
-            },
-        ),
+        ("MODEL", f64::from(shader_id(&ShadingModel::ALL, &model))),
+        ("APPROX", f64::from(shader_id(&AmbientApprox::ALL, &approx))),
     ];
-    let source = shader_source(include_str!("../../shaders/chi_check.wgsl"));
+    let source = shader_source("chi_check.wgsl");
     run_kernel(gpu, &source, &constants, n, n.len())
 }
 

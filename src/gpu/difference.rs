@@ -4,44 +4,61 @@
 //! same picture on the CPU from read-backs ([`crate::render::heat_ramp`] is the one ramp).
 
 use std::collections::HashMap;
+use std::sync::{Mutex, PoisonError};
 
 use super::{Gpu, GpuError, RenderedImage};
 
 /// The format of the two renders the pass reads (linear floats, so small differences survive).
 pub const SIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
+/// The pass's uniforms, laid out as `Heat` in `shaders/difference.wgsl` (a test checks the
+/// sizes and offsets against naga's layouter).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct HeatUniforms {
-    inv_max: f32,
-    pad: [f32; 3],
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct HeatUniforms {
+    /// `1 / max` (0 when `max` is 0 or not finite): the difference shown white.
+    pub inv_max: f32,
+    /// Padding to 16 bytes.
+    pub pad0: f32,
+    /// Padding to 16 bytes.
+    pub pad1: f32,
+    /// Padding to 16 bytes.
+    pub pad2: f32,
 }
 
-/// The heatmap pass: one pipeline per target format, cached.
+/// The heatmap pass: immutable once made, with one pipeline per target format, cached.
 pub struct Difference {
     module: wgpu::ShaderModule,
     bind_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
-    uniforms: wgpu::Buffer,
-    pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    pipelines: Mutex<HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>>,
 }
 
 impl std::fmt::Debug for Difference {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let count = self
+            .pipelines
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .len();
         f.debug_struct("Difference")
-            .field("pipelines", &self.pipelines.len())
+            .field("pipelines", &count)
             .finish_non_exhaustive()
     }
+}
+
+/// One heatmap's draw data: its bind group (the two sides and the uniforms) and pipeline.
+#[derive(Debug)]
+pub struct DifferenceDrawData {
+    bind_group: wgpu::BindGroup,
+    pipeline: wgpu::RenderPipeline,
 }
 
 impl Difference {
     /// Compiles the pass.
     pub fn new(gpu: &Gpu) -> Self {
         let device = &gpu.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("difference.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/difference.wgsl").into()),
-        });
+        let module = super::shader_module(device, "difference.wgsl");
         let texture = |binding| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::FRAGMENT,
@@ -74,24 +91,22 @@ impl Difference {
             bind_group_layouts: &[Some(&bind_layout)],
             immediate_size: 0,
         });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("difference"),
-            size: std::mem::size_of::<HeatUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         Self {
             module,
             bind_layout,
             layout,
-            uniforms,
-            pipelines: HashMap::new(),
+            pipelines: Mutex::default(),
         }
     }
 
-    fn pipeline(&mut self, gpu: &Gpu, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
+    /// The pipeline for a target of `format`, compiled on first use.
+    fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
         let (module, layout) = (&self.module, &self.layout);
-        self.pipelines.entry(format).or_insert_with(|| {
+        let mut pipelines = self
+            .pipelines
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        let pipeline = pipelines.entry(format).or_insert_with(|| {
             gpu.device
                 .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some("difference"),
@@ -118,37 +133,37 @@ impl Difference {
                     multiview_mask: None,
                     cache: None,
                 })
-        })
+        });
+        pipeline.clone()
     }
 
-    /// Records the heatmap of `|left - right|` into `target` (of `format`, the size of the
-    /// two sides): white at `max` and above, black at 0.
-    #[expect(clippy::too_many_arguments, reason = "one pass's inputs")]
-    pub fn draw(
-        &mut self,
+    /// The draw data of the heatmap of `|left - right|` (two linear renders of one size) into
+    /// a target of `format`: white at `max` and above, black at 0.
+    pub fn draw_data(
+        &self,
         gpu: &Gpu,
-        encoder: &mut wgpu::CommandEncoder,
         left: &wgpu::TextureView,
         right: &wgpu::TextureView,
-        target: &wgpu::TextureView,
         format: wgpu::TextureFormat,
         max: f32,
-    ) {
+    ) -> DifferenceDrawData {
+        use wgpu::util::DeviceExt;
         let inv_max = if max.is_finite() && max > 0.0 {
             1.0 / max
         } else {
             0.0
         };
-        gpu.queue.write_buffer(
-            &self.uniforms,
-            0,
-            bytemuck::bytes_of(&HeatUniforms {
-                inv_max,
-                pad: [0.0; 3],
-            }),
-        );
-        self.pipeline(gpu, format);
-        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let uniforms = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("difference"),
+                contents: bytemuck::bytes_of(&HeatUniforms {
+                    inv_max,
+                    ..HeatUniforms::default()
+                }),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("difference"),
             layout: &self.bind_layout,
             entries: &[
@@ -162,11 +177,29 @@ impl Difference {
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,
-                    resource: self.uniforms.as_entire_binding(),
+                    resource: uniforms.as_entire_binding(),
                 },
             ],
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        DifferenceDrawData {
+            bind_group,
+            pipeline: self.pipeline(gpu, format),
+        }
+    }
+
+    /// Records `data` into `pass` (one triangle over the target).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, data: &DifferenceDrawData) {
+        pass.set_pipeline(&data.pipeline);
+        pass.set_bind_group(0, &data.bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// A render pass over `target`, cleared: what the heatmap is drawn in.
+    pub fn begin_pass<'e>(
+        encoder: &'e mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+    ) -> wgpu::RenderPass<'e> {
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("difference"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: target,
@@ -181,10 +214,7 @@ impl Difference {
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipelines[&format]);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.draw(0..3, 0..1);
+        })
     }
 
     /// The heatmap of two linear images read back from the GPU (tests and diagnostics):
@@ -193,7 +223,7 @@ impl Difference {
     /// # Errors
     /// When the images are not linear, differ in size, or the read-back fails.
     pub fn heatmap(
-        &mut self,
+        &self,
         gpu: &Gpu,
         left: &RenderedImage,
         right: &RenderedImage,
@@ -250,20 +280,36 @@ impl Difference {
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        self.draw(
-            gpu,
-            &mut encoder,
-            &a,
-            &b,
-            &out.create_view(&wgpu::TextureViewDescriptor::default()),
-            format,
-            max,
-        );
+        let data = self.draw_data(gpu, &a, &b, format, max);
+        {
+            let target = out.create_view(&wgpu::TextureViewDescriptor::default());
+            let mut pass = Self::begin_pass(&mut encoder, &target);
+            self.draw(&mut pass, &data);
+        }
         let pixels = super::preview::read_texture(gpu, encoder, &out, 4, 0)?;
         Ok(RenderedImage::Srgb8 {
             width,
             height,
             pixels,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn heat_uniforms_match_the_shader_struct() {
+        let (size, offsets) = crate::gpu::shader::struct_layout("difference.wgsl", "Heat");
+        assert_eq!(size as usize, std::mem::size_of::<HeatUniforms>());
+        let rust = [
+            ("inv_max", std::mem::offset_of!(HeatUniforms, inv_max)),
+            ("pad0", std::mem::offset_of!(HeatUniforms, pad0)),
+            ("pad1", std::mem::offset_of!(HeatUniforms, pad1)),
+            ("pad2", std::mem::offset_of!(HeatUniforms, pad2)),
+        ]
+        .map(|(n, o)| (n.to_string(), o as u32));
+        assert_eq!(offsets, rust);
     }
 }

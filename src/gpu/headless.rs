@@ -58,7 +58,7 @@ fn kind_of(path: &Path) -> Result<Kind, GpuError> {
 pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
     let kind = kind_of(&req.out)?;
     let (width, height) = req.size;
-    let mut preview = Preview::new(gpu);
+    let preview = Preview::new(gpu);
     let mesh = MeshBuffers::new(gpu, req.mesh)?;
     let maps = MapTextures::new(gpu, req.maps)?;
     let linear = kind == Kind::Exr || req.settings.view.is_data();
@@ -76,7 +76,7 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
             },
         )?
     } else {
-        let mut render = |model| {
+        let render = |model| {
             let settings = FrameSettings {
                 model,
                 ..req.settings

@@ -7,8 +7,9 @@
 
 use crate::model::{Channels, MaterialMaps};
 
-use super::upload::{self, StagingPool, TopSums};
+use super::upload::{self, StagingPool};
 use super::{Gpu, GpuError};
+use crate::model::mips::TopSums;
 
 /// Which channels are one value over the whole map (the preview then skips their fetch).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -229,7 +230,7 @@ impl MapTextures {
             self.top_sums.set(&sums);
             let top = batch.top_levels();
             if !top.is_empty() {
-                self.top_sums.fill(self.unorm16, top, &buffer)?;
+                upload::fill_top(&self.top_sums, self.unorm16, top, &buffer)?;
             }
             buffer.unmap();
             let mut encoder = gpu

@@ -6,13 +6,14 @@ pub mod difference;
 pub mod headless;
 pub mod maps;
 pub mod preview;
+pub mod shader;
 mod upload;
 
 use std::fmt;
 use std::sync::{Arc, Mutex};
 
 pub use maps::MapTextures;
-pub use preview::{Layout, MeshBuffers, Offscreen, Preview, RenderedImage};
+pub use preview::{Layout, MeshBuffers, Offscreen, Preview, PreviewDrawData, RenderedImage};
 
 /// Why the GPU side could not do something.
 #[derive(Debug)]
@@ -108,17 +109,20 @@ impl fmt::Debug for Gpu {
     }
 }
 
-/// WGSL of a shader in `shaders/` with the files its `// requires:` line names prepended.
-pub fn shader_source(main: &str) -> String {
-    let ambient = include_str!("../../shaders/ambient.wgsl");
-    match main
-        .lines()
-        .next()
-        .and_then(|l| l.strip_prefix("// requires:"))
-    {
-        Some(list) if list.trim() == "ambient.wgsl" => format!("{ambient}\n{main}"),
-        _ => main.to_string(),
-    }
+/// The WGSL of a file of `shaders/` with its includes resolved ([`shader::resolve`]). The
+/// files are embedded and a test resolves each, so this cannot fail in a build that passed
+/// its tests; if it did, the source holds the reason, and the device reports it as a shader
+/// error on first use instead of a panic.
+pub fn shader_source(name: &str) -> String {
+    shader::resolve(name).unwrap_or_else(|e| format!("// {e}\nerror"))
+}
+
+/// A shader module of a file of `shaders/`, its includes resolved.
+pub fn shader_module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(shader_source(name).into()),
+    })
 }
 
 impl Gpu {

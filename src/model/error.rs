@@ -64,6 +64,10 @@ pub enum ModelError {
     /// A command that cannot run in the document's state (e.g. a pick outside the map).
     #[error("{0}")]
     Command(String),
+    /// A broken invariant inside kapaint (parts of a document that do not fit together): not
+    /// the input's fault.
+    #[error("internal error: {0}")]
+    Internal(String),
 }
 
 impl ModelError {

@@ -325,7 +325,7 @@ pub(super) fn install(
         ChannelPlanes::N(p) => p.len(),
     };
     if count != maps.tile_count() {
-        return Err(ModelError::Command(format!(
+        return Err(ModelError::Internal(format!(
             "the image was resampled for {count} tiles, but the maps have {}",
             maps.tile_count()
         )));

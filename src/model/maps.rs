@@ -16,6 +16,54 @@ pub const MAX_SIDE: u32 = 8192;
 /// Index of a tile in row-major tile order.
 pub type TileId = usize;
 
+/// A rectangle of texels: columns `x0..x1`, rows `y0..y1` (exclusive ends).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TexelRect {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl TexelRect {
+    /// Columns covered.
+    pub fn width(self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    /// Rows covered.
+    pub fn height(self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+
+    /// Whether it covers no texel.
+    pub fn is_empty(self) -> bool {
+        self.x1 <= self.x0 || self.y1 <= self.y0
+    }
+
+    /// This rectangle of level 0 at mip `level` of maps of `size`, in texels of that level:
+    /// every texel of the level that a texel of the rectangle falls in, clipped to the
+    /// level's size (sizes that are not powers of two round down).
+    #[must_use]
+    pub fn at_level(self, level: u32, size: (u32, u32)) -> Self {
+        let (lw, lh) = ((size.0 >> level).max(1), (size.1 >> level).max(1));
+        Self {
+            x0: (self.x0 >> level).min(lw),
+            y0: (self.y0 >> level).min(lh),
+            x1: (self.x1.saturating_sub(1) >> level)
+                .saturating_add(1)
+                .min(lw),
+            y1: (self.y1.saturating_sub(1) >> level)
+                .saturating_add(1)
+                .min(lh),
+        }
+    }
+}
+
 /// The maps of one material: any size up to `MAX_SIDE` square, stored as 64 x 64 tiles.
 ///
 /// Tiles are shared (`Arc`) so that history can keep old versions without copying: writing
@@ -91,6 +139,12 @@ impl MaterialMaps {
         let (tx, ty) = (x as usize / TILE_SIZE, y as usize / TILE_SIZE);
         let (ix, iy) = (x as usize % TILE_SIZE, y as usize % TILE_SIZE);
         (ty * self.tiles_x as usize + tx, iy * TILE_SIZE + ix)
+    }
+
+    /// The texels a tile covers in the maps.
+    pub fn tile_texels(&self, id: TileId) -> TexelRect {
+        let (x0, y0, x1, y1) = self.tile_rect(id);
+        TexelRect { x0, y0, x1, y1 }
     }
 
     /// The texel rectangle `(x0, y0, x1, y1)` (exclusive ends) a tile covers in the maps.

@@ -10,6 +10,7 @@ mod error;
 pub mod history;
 pub mod import;
 pub mod maps;
+pub mod mips;
 pub mod paint;
 pub mod preset;
 pub mod project;

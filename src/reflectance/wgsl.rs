@@ -119,17 +119,75 @@ fn fast_table(
     );
 }
 
+/// The file of shader ids (`MODEL_*`, `APPROX_*`, `VIEW_*`) that shaders include; it is
+/// generated from the Rust enums, never written by hand.
+pub const IDS_FILE: &str = "ids.wgsl";
+
+/// `NameLikeThis` as `NAME_LIKE_THIS`.
+pub fn screaming_snake(name: &str) -> String {
+    let mut out = String::with_capacity(name.len() + 4);
+    for (i, c) in name.chars().enumerate() {
+        if c.is_ascii_uppercase() && i > 0 {
+            out.push('_');
+        }
+        out.push(c.to_ascii_uppercase());
+    }
+    out.replace('-', "_")
+}
+
+/// A value's shader id: its index in `all`, the enum's list in a fixed order.
+pub fn shader_id<T: PartialEq>(all: &[T], value: &T) -> u32 {
+    all.iter().position(|v| v == value).unwrap_or(0) as u32
+}
+
+/// The shader constant that names a shading model: `MODEL_` and its file name.
+pub fn model_constant(model: ShadingModel) -> String {
+    format!("MODEL_{}", screaming_snake(model.name()))
+}
+
+/// The shader constant that names an approximation: `APPROX_` and its variant name.
+pub fn approx_constant(approx: AmbientApprox) -> String {
+    format!("APPROX_{}", screaming_snake(&format!("{approx:?}")))
+}
+
+/// Every model's and approximation's shader constant with its id, from the enums.
+pub fn model_and_approx_ids() -> Vec<(String, u32)> {
+    let models = ShadingModel::ALL
+        .iter()
+        .map(|m| (model_constant(*m), shader_id(&ShadingModel::ALL, m)));
+    let approxes = AmbientApprox::ALL
+        .iter()
+        .map(|a| (approx_constant(*a), shader_id(&AmbientApprox::ALL, a)));
+    models.chain(approxes).collect()
+}
+
+/// [`ambient_wgsl`] with the ids written out instead of included: WGSL that stands alone,
+/// for the exported `material.wgsl`.
+pub fn ambient_wgsl_standalone() -> String {
+    let mut ids = String::new();
+    for (name, value) in model_and_approx_ids() {
+        let _ = writeln!(
+            ids,
+            "{}",
+            ShaderLanguage::Wgsl.constant(&name, ConstType::U32, &format!("{value}u"))
+        );
+    }
+    ambient_wgsl().replace(&format!("#include \"{IDS_FILE}\"\n"), &ids)
+}
+
 /// The constants and `Fast` tables both languages start with.
 fn constants(out: &mut String, lang: ShaderLanguage) {
     use ConstType::{F32, U32};
-    for (name, value) in [
-        ("MODEL_PHONG", 0),
-        ("MODEL_BLINN", 1),
-        ("APPROX_PAPER_PRINTED", 0),
-        ("APPROX_PAPER_CORRECTED", 1),
-        ("APPROX_FAST", 2),
-    ] {
-        let _ = writeln!(out, "{}", lang.constant(name, U32, &format!("{value}u")));
+    match lang {
+        // WGSL shares one generated file of ids with the renderer's shaders.
+        ShaderLanguage::Wgsl => {
+            let _ = writeln!(out, "#include \"{IDS_FILE}\"");
+        }
+        ShaderLanguage::Glsl => {
+            for (name, value) in model_and_approx_ids() {
+                let _ = writeln!(out, "{}", lang.constant(&name, U32, &format!("{value}u")));
+            }
+        }
     }
     out.push('\n');
     // f32::MAX as the shaders have always spelt it (nine digits; it rounds to the same bits).
@@ -420,7 +478,7 @@ mod tests {
 
     #[test]
     fn glsl_twin_validates_and_declares_what_the_wgsl_does() {
-        let wgsl = naga::front::wgsl::parse_str(&ambient_wgsl()).expect("WGSL parses");
+        let wgsl = naga::front::wgsl::parse_str(&ambient_wgsl_standalone()).expect("WGSL parses");
         // GLSL needs an entry point: an empty compute one.
         let source = format!(
             "#version 450\n{}\nlayout(local_size_x = 1) in;\nvoid main() {{}}\n",

@@ -89,7 +89,7 @@ pub fn n_false_colour(n: f32) -> Vec3 {
 }
 
 impl ViewMode {
-    /// Every view, in the order the shader numbers them.
+    /// Every view, in the order the shader numbers them (`gpu::shader::view_id`).
     pub const ALL: [Self; 10] = [
         Self::Shaded,
         Self::Ka,
@@ -102,11 +102,6 @@ impl ViewMode {
         Self::Checker,
         Self::NFalseColour,
     ];
-
-    /// The shader's `VIEW` constant.
-    pub fn index(self) -> u32 {
-        Self::ALL.iter().position(|&v| v == self).unwrap_or(0) as u32
-    }
 
     /// The CLI name.
     pub fn name(self) -> &'static str {
@@ -434,10 +429,13 @@ mod tests {
 
     #[test]
     fn the_shader_holds_the_same_false_colour_scale() {
-        let wgsl = include_str!("../../shaders/preview.wgsl");
+        let wgsl = include_str!("../../shaders/preview_functions.wgsl");
         for c in N_RAMP {
             let text = format!("vec3<f32>({:?}, {:?}, {:?})", c[0], c[1], c[2]);
-            assert!(wgsl.contains(&text), "{text} missing from preview.wgsl");
+            assert!(
+                wgsl.contains(&text),
+                "{text} missing from preview_functions.wgsl"
+            );
         }
         let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln();
         assert!(

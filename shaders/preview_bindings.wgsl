@@ -1,0 +1,10 @@
+// The preview's bind group: the frame's uniforms, the three maps and their sampler
+// (src/gpu/preview/mod.rs lays out the same bindings).
+
+#include "preview_types.wgsl"
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var kd_map: texture_2d<f32>;
+@group(0) @binding(2) var ks_map: texture_2d<f32>;
+@group(0) @binding(3) var n_map: texture_2d<f32>;
+@group(0) @binding(4) var map_sampler: sampler;

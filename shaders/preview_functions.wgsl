@@ -1,0 +1,33 @@
+// The preview's functions that need no bindings: the false-colour scale of n, the specular
+// power and the guard against non-finite results.
+
+// n's false-colour scale: ln(1 + n) / ln(1 + 16384) through five colours (dark blue, blue,
+// teal, green, yellow; linear RGB), as `render::N_RAMP`.
+const N_LOG_SPAN: f32 = 9.704121561132915f;
+const N_RAMP = array<vec3<f32>, 5>(
+    vec3<f32>(0.0331, 0.0006, 0.0622),
+    vec3<f32>(0.0482, 0.0785, 0.3712),
+    vec3<f32>(0.0123, 0.3016, 0.2756),
+    vec3<f32>(0.1946, 0.6172, 0.0284),
+    vec3<f32>(0.9473, 0.7991, 0.0091),
+);
+
+fn n_false_colour(n: f32) -> vec3<f32> {
+    let t = clamp(log(1.0 + n) / N_LOG_SPAN, 0.0, 1.0) * 4.0;
+    let i = min(u32(t), 3u);
+    return mix(N_RAMP[i], N_RAMP[i + 1u], t - f32(i));
+}
+
+// x^n for x in [0, 1] without pow's undefined cases: 0 for x <= 0, 1 for n == 0.
+fn spec_pow(x: f32, n: f32) -> f32 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    return exp2(n * log2(min(x, 1.0)));
+}
+
+// Replaces a non-finite result by 0 (on the bits: compilers may assume finite floats).
+fn finite_or_zero(c: vec3<f32>) -> vec3<f32> {
+    let bits = bitcast<vec3<u32>>(c) & vec3<u32>(0x7fffffffu);
+    return select(vec3<f32>(0.0), c, bits < vec3<u32>(0x7f800000u));
+}

@@ -1,0 +1,43 @@
+//! `kapaint import`: an image (PNG, JPEG, TGA, EXR) into one channel of a project.
+
+use std::path::PathBuf;
+
+use super::{CliError, model_error};
+use crate::model::{Channel, import, project};
+
+/// Import an image (PNG, JPEG, TGA, EXR) into one channel of a project.
+#[derive(Debug, clap::Args)]
+pub struct ImportArgs {
+    /// Project file (rewritten atomically unless --out is given).
+    file: PathBuf,
+    /// Channel to replace.
+    #[arg(long, value_parser = ["kd", "ks", "n"])]
+    channel: String,
+    /// Image file.
+    #[arg(long)]
+    image: PathBuf,
+    /// Write the result here instead of over FILE.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+impl ImportArgs {
+    /// Runs the command; returns what it prints.
+    ///
+    /// # Errors
+    /// A project or image that does not load, or a failed write.
+    pub fn run(self) -> Result<String, CliError> {
+        let channel = Channel::from_name(&self.channel)
+            .ok_or_else(|| CliError::usage(format!("unknown channel {:?}", self.channel)))?;
+        let mut doc = project::load(&self.file).map_err(model_error)?;
+        import::import_file(&mut doc, channel, &self.image).map_err(model_error)?;
+        let target = self.out.unwrap_or(self.file);
+        project::save(&doc, &target).map_err(model_error)?;
+        Ok(format!(
+            "imported {} into {} of {}\n",
+            self.image.display(),
+            channel.name(),
+            target.display()
+        ))
+    }
+}

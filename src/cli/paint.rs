@@ -1,0 +1,83 @@
+//! `kapaint paint`: a paint script (a RON list of commands) replayed on a project.
+
+use std::path::{Path, PathBuf};
+
+use super::{CliError, model_error};
+use crate::model::{self, ModelError, project};
+
+/// Largest paint script read (bytes).
+const MAX_SCRIPT_BYTES: u64 = 256 << 20;
+
+/// Replay a paint script (RON list of commands) on a project and save it.
+#[derive(Debug, clap::Args)]
+pub struct PaintArgs {
+    /// Project file (rewritten atomically unless --out is given).
+    file: PathBuf,
+    /// Script of commands (see docs/cli.md).
+    #[arg(long)]
+    script: PathBuf,
+    /// Mesh for strokes on the surface and island/part fills (default: the project's).
+    #[arg(long)]
+    mesh: Option<String>,
+    /// Write the result here instead of over FILE.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+impl PaintArgs {
+    /// Runs the command; returns what it prints.
+    ///
+    /// # Errors
+    /// A project, script or mesh that does not load, a command that cannot apply, or a
+    /// failed write; the project is untouched then.
+    pub fn run(self) -> Result<String, CliError> {
+        let commands = read_script(&self.script)?;
+        let mut doc = project::load(&self.file).map_err(model_error)?;
+        if commands.iter().any(model::Command::needs_surface) {
+            let spec = self
+                .mesh
+                .unwrap_or_else(|| doc.settings().mesh.spec().to_string());
+            project::attach_mesh(&mut doc, Path::new(&spec)).map_err(model_error)?;
+        }
+        let count = commands.len();
+        for (i, command) in commands.into_iter().enumerate() {
+            doc.apply(command).map_err(|e| {
+                CliError::usage(format!("{}: command {}: {e}", self.script.display(), i + 1))
+            })?;
+        }
+        doc.apply(model::Command::EndStroke).map_err(model_error)?;
+        let target = self.out.unwrap_or(self.file);
+        project::save(&doc, &target).map_err(model_error)?;
+        Ok(format!(
+            "applied {count} commands, saved {}\n",
+            target.display()
+        ))
+    }
+}
+
+/// A paint script: `(commands: [ ... ])` in RON.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PaintScript {
+    /// Commands applied in order.
+    pub commands: Vec<model::Command>,
+}
+
+fn read_script(path: &Path) -> Result<Vec<model::Command>, CliError> {
+    let bytes = crate::file_check::read_limited(path, MAX_SCRIPT_BYTES).map_err(|e| {
+        if e.is_io() {
+            CliError::io(format!("{}: {e}", path.display()))
+        } else {
+            CliError::usage(format!("{}: {e}", path.display()))
+        }
+    })?;
+    let script_error = |reason: String| {
+        model_error(ModelError::Script {
+            path: path.to_path_buf(),
+            reason,
+        })
+    };
+    let text = String::from_utf8(bytes).map_err(|_| script_error("not UTF-8 text".into()))?;
+    let script: PaintScript = ron::from_str(&text).map_err(|e| script_error(e.to_string()))?;
+    Ok(script.commands)
+}

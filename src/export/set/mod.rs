@@ -1,0 +1,305 @@
+//! Writing and reading texture sets: images plus `material.json`.
+//!
+//! A set is written into a temporary folder beside the target and renamed into place at the
+//! end, so a half-written set is never left where the target should be.
+
+mod encode;
+mod import;
+mod manifest;
+mod measure;
+mod plan;
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use self::encode::{Encoded, StoredImage, encode_image, rows};
+pub use self::import::import;
+use self::manifest::approximation;
+pub use self::manifest::{
+    Approximation, ColourSpace, Compression, Constants, FileEntry, MANIFEST_FORMAT,
+    MANIFEST_VERSION, Manifest, MemoryReport,
+};
+use self::measure::ka_error_of_set;
+use self::plan::plan_set;
+pub use self::plan::{PlannedFile, SetPlan, plan};
+use super::encoding::KaError;
+use super::preset::{ExportPreset, Format};
+use crate::mesh::bake::Coverage;
+use crate::model::Document;
+use crate::reflectance;
+use crate::task::Progress;
+/// Why an export or import failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SetError {
+    /// A file could not be written or read.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The set is malformed.
+    #[error("{path}: {reason}")]
+    Invalid {
+        /// The manifest or image.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The target cannot take a set (a file, or a folder that is not empty).
+    #[error("{path}: {reason}")]
+    Target {
+        /// The target.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Cancelled through its [`Progress`]; nothing was left at the target.
+    #[error("export cancelled")]
+    Cancelled,
+}
+
+fn io(path: &Path, e: impl std::fmt::Display) -> SetError {
+    SetError::Io {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    }
+}
+
+/// Exports `doc` with `preset` into the folder `out` (which must not exist or be empty).
+///
+/// # Errors
+/// An unwritable or non-empty target, or a failed encode or write: nothing is left at `out`.
+pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manifest, SetError> {
+    export_with(doc, preset, out, &Progress::default())
+}
+
+/// [`export`], reporting to `progress` (stages `analyse`, `encode`, `measure`) and stopping
+/// with [`SetError::Cancelled`] when it is cancelled.
+///
+/// # Errors
+/// As [`export`], or cancelled.
+#[expect(
+    clippy::too_many_lines,
+    reason = "one pass: analyse, encode in parallel, measure, commit"
+)]
+pub fn export_with(
+    doc: &Document,
+    preset: &ExportPreset,
+    out: &Path,
+    progress: &Progress,
+) -> Result<Manifest, SetError> {
+    let cancelled = |_| SetError::Cancelled;
+    progress.start("analyse", 1);
+    if out.exists()
+        && (!out.is_dir()
+            || std::fs::read_dir(out)
+                .map_err(|e| io(out, e))?
+                .next()
+                .is_some())
+    {
+        return Err(SetError::Target {
+            path: out.to_path_buf(),
+            reason: "exists and is not an empty folder".into(),
+        });
+    }
+    let maps = doc.maps();
+    let (model, approx) = (doc.settings().model, doc.settings().approx);
+    let (w, h) = (maps.width(), maps.height());
+    let (planned, mono_ks, images) = plan_set(doc, preset);
+    let (constants, n_enc) = (planned.constants, planned.n_encoding);
+    let mut texels = rows(maps);
+    // Outside the mesh's UV islands, texels copy the nearest island's, so mips and filtering
+    // do not pull the background into the edges.
+    let dilated = doc.surface().is_some_and(|surface| {
+        let mut filled: Vec<bool> = surface
+            .bake
+            .coverage
+            .iter()
+            .map(|c| *c == Coverage::Surface)
+            .collect();
+        let any = filled.iter().any(|f| *f);
+        if any {
+            crate::mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
+                texels[k] = texels[src];
+            });
+        }
+        any
+    });
+    let ka: Vec<Vec3> = if preset.include_ka {
+        texels
+            .par_iter()
+            .map(|t| {
+                let v = t.decode();
+                reflectance::ka(model, approx, v.kd, v.ks, v.n)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+
+    let ext = preset.format.extension();
+    progress.check().map_err(cancelled)?;
+    progress.start("encode", images.len() as u64 * u64::from(h));
+
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
+    let name = out
+        .file_name()
+        .map_or_else(|| "set".into(), |n| n.to_string_lossy().into_owned());
+    remove_stale_sets(parent, &name);
+    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir(&tmp).map_err(|e| io(&tmp, e))?;
+    // Removed on every way out but the last rename.
+    let guard = crate::atomic::TempPath::new(tmp.clone());
+    let result = (|| {
+        let encoded: Vec<Result<Encoded, SetError>> = images
+            .par_iter()
+            .map(|(stem, comps)| {
+                let file = format!("{stem}.{ext}");
+                if progress.is_cancelled() {
+                    return Err(SetError::Cancelled);
+                }
+                let image = encode_image(&texels, &ka, (w, h), comps, preset, n_enc, progress)
+                    .map_err(|e| {
+                        if progress.is_cancelled() {
+                            SetError::Cancelled
+                        } else {
+                            io(&tmp.join(&file), e)
+                        }
+                    })?;
+                if progress.is_cancelled() {
+                    return Err(SetError::Cancelled);
+                }
+                Ok((file, comps.clone(), image))
+            })
+            .collect();
+        progress.start("measure", 1);
+        let mut files = Vec::new();
+        let mut stored = Vec::new();
+        for item in encoded {
+            let (file, comps, image) = item?;
+            let path = tmp.join(&file);
+            crate::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
+            let (mip_levels, psnr, compression) = match image.ktx {
+                Some(k) => (Some(k.levels), k.psnr, k.compression),
+                None if preset.format == Format::Exr => (None, None, Compression::Exr),
+                None => (None, None, Compression::Png),
+            };
+            files.push(FileEntry {
+                path: file,
+                layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
+                colour_space: if image.srgb {
+                    ColourSpace::Srgb
+                } else {
+                    ColourSpace::Linear
+                },
+                bit_depth: match preset.format {
+                    Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 8,
+                    Format::Png16 => 16,
+                    Format::Exr => 32,
+                },
+                compression,
+                width: w,
+                height: h,
+                bytes: image.bytes.len() as u64,
+                mip_levels,
+                psnr,
+            });
+            if let Some(data) = image.stored {
+                stored.push(StoredImage {
+                    comps,
+                    data,
+                    srgb: image.srgb,
+                });
+            }
+        }
+        let depth = match preset.format {
+            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 1,
+            Format::Png16 => 2,
+            Format::Exr => 4,
+        };
+        let texel_count = u64::from(w) * u64::from(h);
+        let mut manifest = Manifest {
+            format: MANIFEST_FORMAT.into(),
+            version: MANIFEST_VERSION,
+            width: w,
+            height: h,
+            model,
+            approximation: approximation(approx, model),
+            constants,
+            n_encoding: n_enc,
+            files,
+            ka_error: KaError::default(),
+            dilated,
+            bytes: MemoryReport {
+                exported: 0,
+                naive: texel_count * 10 * depth,
+                project: texel_count * 14,
+            },
+            preset: preset.name.clone(),
+        };
+        // The k_a error, measured on the set as a consumer decodes it.
+        manifest.ka_error =
+            ka_error_of_set(&texels, &manifest, &stored, preset.format, model, approx);
+        // The decode + k_a snippets for engines (WGSL and GLSL), beside the images.
+        let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
+        for (name, snippet) in [
+            ("material.wgsl", crate::export::snippet::wgsl(&manifest)),
+            ("material.glsl", crate::export::snippet::glsl(&manifest)),
+        ] {
+            let snippet_path = tmp.join(name);
+            crate::atomic::write_atomic(&snippet_path, snippet.as_bytes())
+                .map_err(|e| io(&snippet_path, e))?;
+            exported += snippet.len() as u64;
+        }
+        // The manifest counts itself, and its length depends on the count's digits: repeat
+        // until they agree (the count only grows, so this ends, in two or three rounds).
+        let json = loop {
+            let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
+            let total = exported + json.len() as u64;
+            if manifest.bytes.exported == total {
+                break json;
+            }
+            manifest.bytes.exported = total;
+        };
+        let path = tmp.join("material.json");
+        crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
+        Ok(manifest)
+    })();
+    let manifest = result?;
+    if out.exists() {
+        std::fs::remove_dir(out).map_err(|e| io(out, e))?;
+    }
+    std::fs::rename(&tmp, out).map_err(|e| io(out, e))?;
+    guard.keep();
+    Ok(manifest)
+}
+
+/// Removes the temporary folders of earlier exports to `name` in `dir` whose process is gone.
+fn remove_stale_sets(dir: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.tmp-");
+    for entry in entries.filter_map(Result::ok) {
+        let Some(pid) = entry
+            .file_name()
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|pid| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && crate::atomic::process_gone(pid) == Some(true) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}

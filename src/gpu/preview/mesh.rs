@@ -1,0 +1,80 @@
+//! A mesh on the GPU: interleaved vertices and a triangle list.
+
+use glam::Vec3;
+
+use crate::gpu::{Gpu, GpuError};
+use crate::mesh::Mesh;
+
+/// Interleaved vertex: position, normal, UV.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct Vertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+    uv: [f32; 2],
+}
+
+/// A mesh on the GPU.
+pub struct MeshBuffers {
+    pub(super) vertices: wgpu::Buffer,
+    pub(super) indices: wgpu::Buffer,
+    pub(super) index_count: u32,
+    /// Object-space bounds, for framing.
+    pub bounds: (Vec3, Vec3),
+}
+
+impl std::fmt::Debug for MeshBuffers {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MeshBuffers")
+            .field("triangles", &(self.index_count / 3))
+            .finish_non_exhaustive()
+    }
+}
+
+impl MeshBuffers {
+    /// Uploads `mesh` (a mesh without UVs gets UV (0, 0): it previews, it cannot be painted).
+    ///
+    /// # Errors
+    /// Buffers beyond the device's limits, or a device out of memory or lost.
+    pub fn new(gpu: &Gpu, mesh: &Mesh) -> Result<Self, GpuError> {
+        let max = gpu.device.limits().max_buffer_size;
+        let bytes = (mesh.positions.len() * std::mem::size_of::<Vertex>()) as u64;
+        if bytes > max {
+            return Err(GpuError(format!(
+                "the mesh's {} vertices need {bytes} bytes, more than this GPU's largest buffer ({max})",
+                mesh.positions.len()
+            )));
+        }
+        gpu.checked("uploading the mesh", || Self::upload(gpu, mesh))
+    }
+
+    fn upload(gpu: &Gpu, mesh: &Mesh) -> Self {
+        use wgpu::util::DeviceExt;
+        let vertices: Vec<Vertex> = (0..mesh.positions.len())
+            .map(|i| Vertex {
+                position: mesh.positions[i].to_array(),
+                normal: mesh.normals[i].to_array(),
+                uv: mesh.uvs.as_ref().map_or([0.0; 2], |u| u[i].to_array()),
+            })
+            .collect();
+        let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        Self {
+            vertices: gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mesh vertices"),
+                    contents: bytemuck::cast_slice(&vertices),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+            indices: gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mesh indices"),
+                    contents: bytemuck::cast_slice(&indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                }),
+            index_count: indices.len() as u32,
+            bounds: mesh.bounds(),
+        }
+    }
+}

@@ -1,0 +1,160 @@
+//! The preview renderer, split the way re_renderer splits its renderers:
+//! - [`Preview`] is immutable once made: the shader (`shaders/preview.wgsl` and what it
+//!   includes), the bind group layout, the sampler and a cache of pipelines, one per
+//!   combination of overridable constants a frame uses ([`PipelineKey`]: model,
+//!   approximation, view, which maps are uniform, whether there is any specular);
+//! - [`PreviewDrawData`] is one frame's data: its uniforms, its bind group, its parts (a
+//!   pipeline, a scissor and a viewport each) and the mesh to draw;
+//! - [`Preview::draw`] records a frame's data into a render pass and changes nothing.
+//!
+//! It draws into any colour target, and headless into an offscreen image that is read back
+//! ([`Preview::render_offscreen`]).
+
+mod draw_data;
+mod layout;
+mod mesh;
+mod offscreen;
+mod pipeline;
+
+pub use draw_data::{FrameUniforms, PreviewDrawData};
+pub use layout::{DrawPart, Layout, Scissor};
+pub use mesh::MeshBuffers;
+pub use offscreen::{Offscreen, RenderedImage, read_buffer, read_texture};
+pub use pipeline::PipelineKey;
+
+use super::Gpu;
+use pipeline::PipelineCache;
+
+/// Depth buffer format of every preview pass.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// The preview renderer (see the module's doc).
+pub struct Preview {
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    bind_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    pipelines: PipelineCache,
+}
+
+impl std::fmt::Debug for Preview {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Preview")
+            .field("pipelines", &self.pipelines.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Preview {
+    /// Compiles the preview shader and makes the layouts every pipeline shares.
+    pub fn new(gpu: &Gpu) -> Self {
+        let device = &gpu.device;
+        let module = super::shader_module(device, "preview.wgsl");
+        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        // The bindings of shaders/preview_bindings.wgsl.
+        let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("preview"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<FrameUniforms>() as u64,
+                        ),
+                    },
+                    count: None,
+                },
+                texture_entry(1),
+                texture_entry(2),
+                texture_entry(3),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("preview"),
+            bind_group_layouts: &[Some(&bind_layout)],
+            immediate_size: 0,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("maps"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            module,
+            layout,
+            bind_layout,
+            sampler,
+            pipelines: PipelineCache::default(),
+        }
+    }
+
+    /// Number of pipelines compiled so far.
+    pub fn pipeline_count(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    /// The pipeline for `key`, compiled on first use.
+    pub fn pipeline(&self, gpu: &Gpu, key: PipelineKey) -> wgpu::RenderPipeline {
+        self.pipelines
+            .get_or_compile(&gpu.device, &self.module, &self.layout, key)
+    }
+
+    /// Records `data` into `pass`: each part with its pipeline, scissor and viewport. All
+    /// parts share the frame's camera, lights and maps.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, data: &PreviewDrawData) {
+        data.record(pass);
+    }
+}
+
+/// A render pass over `target` and `depth`, both cleared: what a preview frame is drawn in.
+pub fn begin_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    target: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("preview"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

@@ -1,0 +1,144 @@
+//! The commands that change a document, and the stroke tools and fill regions they name.
+
+use std::sync::Arc;
+
+use glam::Vec2;
+use serde::{Deserialize, Serialize};
+
+use crate::model::brush::{BrushSettings, StrokePoint, SurfacePoint};
+use crate::model::paint::GradientShape;
+use crate::model::texel::{Channel, Channels, MaterialValue};
+use crate::reflectance::{AmbientApprox, ShadingModel};
+
+/// Tools that work as strokes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StrokeTool {
+    /// Paints the primary material.
+    Brush,
+    /// Paints the base material back.
+    Eraser,
+    /// Smooths the enabled channels.
+    Blur,
+}
+
+/// Which texels a fill writes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum FillRegion {
+    /// The whole map.
+    All,
+    /// The connected region around a texel whose channel is within `tolerance` (blend space).
+    Similar {
+        /// Seed texel column.
+        x: u32,
+        /// Seed texel row.
+        y: u32,
+        /// Channel compared.
+        channel: Channel,
+        /// Largest difference still filled, in `[0, 1]`.
+        #[serde(deserialize_with = "crate::model::check::tolerance")]
+        tolerance: f32,
+    },
+    /// The UV island under a texel (needs the document's mesh surface).
+    Island {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+    /// The mesh part (connected piece of surface, across UV seams) under a texel.
+    Part {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+}
+
+/// Everything that changes a document.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Command {
+    /// Replaces the brush settings (sanitised).
+    SetBrush(BrushSettings),
+    /// Sets the primary material.
+    SetPrimary(MaterialValue),
+    /// Sets the secondary material.
+    SetSecondary(MaterialValue),
+    /// Swaps primary and secondary.
+    SwapMaterials,
+    /// Sets the channels tools write.
+    SetChannels(Channels),
+    /// Sets the shading model.
+    SetModel(ShadingModel),
+    /// Sets the approximation of `chi`.
+    SetApprox(AmbientApprox),
+    /// Starts a stroke (one undo step).
+    BeginStroke(StrokeTool),
+    /// Moves the stroke to a new input point.
+    StrokeTo(StrokePoint),
+    /// Ends the stroke.
+    EndStroke,
+    /// Abandons the stroke, restoring the maps.
+    AbortStroke,
+    /// A whole stroke at once (scripts): begin, every point, end.
+    Stroke {
+        /// The tool.
+        tool: StrokeTool,
+        /// Input points in texel units.
+        points: Vec<StrokePoint>,
+    },
+    /// Moves the stroke to a new point on the mesh (object-space brush; needs a surface).
+    SurfaceStrokeTo(SurfacePoint),
+    /// A whole stroke on the mesh at once (scripts).
+    SurfaceStroke {
+        /// The tool.
+        tool: StrokeTool,
+        /// Input points in object space.
+        points: Vec<SurfacePoint>,
+    },
+    /// Fills with the primary material.
+    Fill(FillRegion),
+    /// A gradient from the primary (at `start`) to the secondary material (at `end`).
+    Gradient {
+        /// Linear or radial.
+        shape: GradientShape,
+        /// Start point in texel units.
+        #[serde(deserialize_with = "crate::model::check::finite_vec2")]
+        start: Vec2,
+        /// End point in texel units.
+        #[serde(deserialize_with = "crate::model::check::finite_vec2")]
+        end: Vec2,
+    },
+    /// Reads every channel at a texel into the primary material.
+    Pick {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+    /// Replaces a channel with an image already resampled to the map size (one undo step;
+    /// see [`crate::model::import`]). Not for scripts: its planes come from a decoder.
+    #[serde(skip)]
+    ImportChannel(ImportedChannel),
+    /// Undoes the last step.
+    Undo,
+    /// Redoes the last undone step.
+    Redo,
+}
+
+/// A channel's planes made by [`crate::model::import::resample`], shared so that the command
+/// clones cheaply.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportedChannel(pub Arc<crate::model::import::ChannelPlanes>);
+
+impl Command {
+    /// Whether the command paints on the mesh (and so needs
+    /// [`Document::set_surface`](super::Document::set_surface)).
+    pub fn needs_surface(&self) -> bool {
+        matches!(
+            self,
+            Self::SurfaceStrokeTo(_)
+                | Self::SurfaceStroke { .. }
+                | Self::Fill(FillRegion::Island { .. } | FillRegion::Part { .. })
+        )
+    }
+}

@@ -1,0 +1,186 @@
+//! Dabs and fills: where they land ([`Footprint`]) and what they write ([`PaintTarget`]).
+//!
+//! A stroke keeps a coverage value per texel, the alpha it has reached so far. Each dab raises
+//! coverage towards the brush opacity by its flow; the texel is then the blend of its value
+//! *before the stroke* (kept by the open history transaction) with the target at that
+//! coverage. Overlapping dabs (or mirrored copies of one) therefore never exceed the opacity,
+//! and a stroke's result does not depend on dab order.
+
+mod blur;
+mod dab;
+mod fill;
+mod footprint;
+mod gradient;
+#[cfg(test)]
+mod tests;
+
+pub use blur::blur_dab;
+pub use dab::paint_dab;
+pub use fill::{fill_all, fill_mask, flood_region};
+pub use footprint::{DiscFootprint, Footprint, TileRect};
+pub use gradient::{GradientShape, gradient};
+
+use std::sync::{Arc, OnceLock};
+
+use glam::Vec3;
+
+use super::brush::BlendMode;
+use super::history::History;
+use super::maps::{MaterialMaps, TileId};
+use super::texel::{
+    MaterialValue, Texel, decode_n, decode_unorm, encode_unorm, n_from_blend, n_to_blend,
+};
+use super::tile::{TILE_TEXELS, Tile};
+
+/// Lookup tables between stored `n` bits and the perceptual blend space.
+struct NTables {
+    to_blend: Vec<f32>,
+    from_blend: Vec<u16>,
+}
+
+/// Resolution of the blend-space to bits table: finer than a half float's step everywhere.
+const FROM_BLEND_STEPS: usize = 1 << 18;
+
+fn n_tables() -> &'static NTables {
+    static TABLES: OnceLock<NTables> = OnceLock::new();
+    TABLES.get_or_init(|| NTables {
+        to_blend: (0..=u16::MAX).map(|b| n_to_blend(decode_n(b))).collect(),
+        from_blend: (0..=FROM_BLEND_STEPS)
+            .map(|i| super::texel::encode_n(n_from_blend(i as f32 / FROM_BLEND_STEPS as f32)))
+            .collect(),
+    })
+}
+
+#[inline]
+fn n_bits_to_blend(bits: u16) -> f32 {
+    n_tables().to_blend[bits as usize]
+}
+
+#[inline]
+fn n_bits_from_blend(u: f32) -> u16 {
+    let i = (super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as usize;
+    n_tables().from_blend[i.min(FROM_BLEND_STEPS)]
+}
+
+/// What a paint operation writes: per-channel targets in blend space, which channels, how.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaintTarget {
+    /// Target `k_d`.
+    pub kd: Vec3,
+    /// Target `k_s`.
+    pub ks: Vec3,
+    /// Target `n` in blend space.
+    pub n_blend: f32,
+    /// Channels written.
+    pub channels: super::texel::Channels,
+    /// Blend mode.
+    pub mode: BlendMode,
+    /// Keep `k_d + k_s <= 1` per colour channel.
+    pub energy_guard: bool,
+}
+
+impl PaintTarget {
+    /// A target from a material value.
+    pub fn new(
+        value: MaterialValue,
+        channels: super::texel::Channels,
+        mode: BlendMode,
+        energy_guard: bool,
+    ) -> Self {
+        let v = value.sanitized();
+        Self {
+            kd: v.kd,
+            ks: v.ks,
+            n_blend: n_to_blend(v.n),
+            channels,
+            mode,
+            energy_guard,
+        }
+    }
+
+    /// The texel `pre` blended towards the target at alpha `a`.
+    #[inline]
+    pub fn blend(&self, pre: Texel, a: f32) -> Texel {
+        let mut out = pre;
+        let mode = self.mode;
+        let mut kd = [0.0; 3];
+        let mut ks = [0.0; 3];
+        for c in 0..3 {
+            kd[c] = decode_unorm(pre.kd[c]);
+            ks[c] = decode_unorm(pre.ks[c]);
+            if self.channels.kd {
+                kd[c] = mode.apply(kd[c], self.kd[c], a);
+            }
+            if self.channels.ks {
+                ks[c] = mode.apply(ks[c], self.ks[c], a);
+            }
+        }
+        if self.energy_guard && (self.channels.kd || self.channels.ks) {
+            guard_energy(&mut kd, &mut ks, self.channels.kd, self.channels.ks);
+        }
+        for c in 0..3 {
+            out.kd[c] = encode_unorm(kd[c]);
+            out.ks[c] = encode_unorm(ks[c]);
+        }
+        if self.channels.n {
+            out.n = n_bits_from_blend(mode.apply(n_bits_to_blend(pre.n), self.n_blend, a));
+        }
+        out
+    }
+}
+
+/// Keeps `k_d + k_s <= 1` per colour channel: the channel being painted gives way to the
+/// other; when both are painted, both scale down together.
+fn guard_energy(kd: &mut [f32; 3], ks: &mut [f32; 3], painting_kd: bool, painting_ks: bool) {
+    for c in 0..3 {
+        let sum = kd[c] + ks[c];
+        if sum <= 1.0 {
+            continue;
+        }
+        match (painting_kd, painting_ks) {
+            (true, false) => kd[c] = 1.0 - ks[c],
+            (false, true) => ks[c] = 1.0 - kd[c],
+            _ => {
+                kd[c] /= sum;
+                ks[c] /= sum;
+            }
+        }
+    }
+}
+
+/// Per-texel stroke coverage for the tiles a stroke touched, indexed by tile.
+#[derive(Default, Debug)]
+pub struct Coverage {
+    tiles: Vec<Option<Box<[f32]>>>,
+}
+
+impl Coverage {
+    /// Resets every texel to zero, keeping the allocations (a new stroke on the same tiles).
+    pub fn clear(&mut self) {
+        for tile in self.tiles.iter_mut().flatten() {
+            tile.fill(0.0);
+        }
+    }
+
+    /// Coverage slices for several tiles (sorted, unique ids), created at zero on first use.
+    fn tiles_mut(&mut self, tile_count: usize, ids: &[TileId]) -> Vec<&mut [f32]> {
+        if self.tiles.len() < tile_count {
+            self.tiles.resize_with(tile_count, || None);
+        }
+        for &id in ids {
+            self.tiles[id].get_or_insert_with(|| vec![0.0; TILE_TEXELS].into_boxed_slice());
+        }
+        super::tile::select_mut(&mut self.tiles, ids)
+            .into_iter()
+            .filter_map(|slot| slot.as_deref_mut())
+            .collect()
+    }
+}
+
+/// The pre-operation version of a tile: the one the open transaction saved, else the current.
+fn pre_tile(history: &History, maps: &MaterialMaps, id: TileId) -> Arc<Tile> {
+    history
+        .saved_tile(id)
+        .cloned()
+        .unwrap_or_else(|| Arc::clone(maps.tile(id)))
+}

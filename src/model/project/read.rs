@@ -1,0 +1,180 @@
+//! Reading a project: the zip, the manifest, each channel's PNG or constant, into tiles.
+
+use std::io::{Read, Seek};
+
+use rayon::prelude::*;
+
+use super::{
+    ChannelEntry, MAX_MANIFEST_BYTES, N_ENCODING, RGB_ENCODING, Raster, parse_manifest,
+    valid_n_bits,
+};
+use crate::model::document::Document;
+use crate::model::maps::MaterialMaps;
+use crate::model::texel::MaterialValue;
+use crate::model::tile::{Plane, TILE_SIZE, Tile};
+
+/// Loads and validates a project from any seekable reader; the error is a reason text.
+pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
+    let mut zip = zip::ZipArchive::new(reader).map_err(|e| format!("not a zip archive ({e})"))?;
+    let manifest = {
+        let entry = zip
+            .by_name("manifest.json")
+            .map_err(|e| format!("manifest.json: {e}"))?;
+        if entry.size() > MAX_MANIFEST_BYTES {
+            return Err(format!(
+                "manifest.json is {} bytes, more than the limit",
+                entry.size()
+            ));
+        }
+        let mut text = Vec::new();
+        entry
+            .take(MAX_MANIFEST_BYTES)
+            .read_to_end(&mut text)
+            .map_err(|e| format!("manifest.json: {e}"))?;
+        parse_manifest(&text)?
+    };
+    let (w, h) = (manifest.width, manifest.height);
+    let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
+    let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
+    let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
+    let n_samples = match &n {
+        Raster::Uniform(v) | Raster::Gray(v) | Raster::Rgb(v) => v,
+    };
+    if let Some(bad) = n_samples.par_iter().find_any(|&&bits| !valid_n_bits(bits)) {
+        return Err(format!(
+            "n holds an invalid exponent (half-float bits {bad:#06x})"
+        ));
+    }
+    let settings = manifest.settings;
+    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
+    fill_maps(&mut maps, &kd, &ks, &n);
+    Ok(Document::from_parts(maps, settings))
+}
+
+fn read_channel<R: Read + Seek>(
+    zip: &mut zip::ZipArchive<R>,
+    entry: &ChannelEntry,
+    name: &str,
+    w: u32,
+    h: u32,
+    components: usize,
+) -> Result<Raster, String> {
+    match entry {
+        ChannelEntry::Uniform { value } => {
+            if value.len() != components {
+                return Err(format!(
+                    "{name}: uniform value has {} components, expected {components}",
+                    value.len()
+                ));
+            }
+            Ok(Raster::Uniform(value.clone()))
+        }
+        ChannelEntry::Image { file, encoding } => {
+            let expected = if components == 3 {
+                RGB_ENCODING
+            } else {
+                N_ENCODING
+            };
+            if encoding != expected {
+                return Err(format!(
+                    "{file}: encoding {encoding:?} is not supported for {name}"
+                ));
+            }
+            let mut entry = zip.by_name(file).map_err(|e| format!("{file}: {e}"))?;
+            // A 16-bit PNG of this size can never need more than this.
+            let limit = u64::from(w) * u64::from(h) * components as u64 * 2 * 2 + (1 << 20);
+            if entry.size() > limit {
+                return Err(format!(
+                    "{file} claims {} bytes, more than a {w}x{h} map can need",
+                    entry.size()
+                ));
+            }
+            let mut bytes = Vec::with_capacity(entry.size() as usize);
+            (&mut entry)
+                .take(limit)
+                .read_to_end(&mut bytes)
+                .map_err(|e| format!("{file}: {e}"))?;
+            let mut reader = image::ImageReader::with_format(
+                std::io::Cursor::new(bytes),
+                image::ImageFormat::Png,
+            );
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(w);
+            limits.max_image_height = Some(h);
+            limits.max_alloc = Some(limit);
+            reader.limits(limits);
+            let image = reader.decode().map_err(|e| format!("{file}: {e}"))?;
+            if (image.width(), image.height()) != (w, h) {
+                return Err(format!(
+                    "{file} is {}x{}, the manifest says {w}x{h}",
+                    image.width(),
+                    image.height()
+                ));
+            }
+            match (components, image) {
+                (3, image::DynamicImage::ImageRgb16(img)) => Ok(Raster::Rgb(img.into_raw())),
+                (1, image::DynamicImage::ImageLuma16(img)) => Ok(Raster::Gray(img.into_raw())),
+                (_, other) => Err(format!(
+                    "{file} has colour type {:?}, expected 16-bit {}",
+                    other.color(),
+                    if components == 3 { "RGB" } else { "gray" }
+                )),
+            }
+        }
+    }
+}
+
+fn fill_maps(maps: &mut MaterialMaps, kd: &Raster, ks: &Raster, n: &Raster) {
+    let w = maps.width() as usize;
+    let rgb_plane =
+        |r: &Raster, x0: usize, y0: usize, cols: usize, rows: usize| -> Plane<[u16; 3]> {
+            match r {
+                Raster::Uniform(v) => Plane::Uniform([v[0], v[1], v[2]]),
+                Raster::Rgb(d) | Raster::Gray(d) => {
+                    let mut p = Plane::Uniform([0; 3]);
+                    let data = p.data_mut();
+                    for y in 0..rows {
+                        for x in 0..cols {
+                            let at = ((y0 + y) * w + x0 + x) * 3;
+                            data[y * TILE_SIZE + x] = [d[at], d[at + 1], d[at + 2]];
+                        }
+                    }
+                    p.compact();
+                    p
+                }
+            }
+        };
+    let tiles: Vec<Tile> = (0..maps.tile_count())
+        .into_par_iter()
+        .map(|id| {
+            let (x0, y0, x1, y1) = maps.tile_rect(id);
+            let (x0, y0, cols, rows) = (
+                x0 as usize,
+                y0 as usize,
+                (x1 - x0) as usize,
+                (y1 - y0) as usize,
+            );
+            let n_plane = match n {
+                Raster::Uniform(v) => Plane::Uniform(v[0]),
+                Raster::Gray(d) | Raster::Rgb(d) => {
+                    let mut p = Plane::Uniform(0);
+                    let data = p.data_mut();
+                    for y in 0..rows {
+                        data[y * TILE_SIZE..y * TILE_SIZE + cols]
+                            .copy_from_slice(&d[(y0 + y) * w + x0..(y0 + y) * w + x0 + cols]);
+                    }
+                    p.compact();
+                    p
+                }
+            };
+            Tile {
+                kd: rgb_plane(kd, x0, y0, cols, rows),
+                ks: rgb_plane(ks, x0, y0, cols, rows),
+                n: n_plane,
+            }
+        })
+        .collect();
+    for (id, tile) in tiles.into_iter().enumerate() {
+        *maps.tile_mut(id) = tile;
+    }
+}

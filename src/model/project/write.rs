@@ -1,0 +1,183 @@
+//! Writing a project: channels to rasters and PNGs, the manifest, and the zip around them.
+
+use std::io::{Seek, Write};
+
+use image::{ImageBuffer, Luma, Rgb};
+use rayon::prelude::*;
+
+use super::{
+    ChannelEntry, FORMAT, Manifest, N_ENCODING, RGB_ENCODING, Raster, VERSION, parse_manifest,
+    valid_n_bits,
+};
+use crate::model::document::{Document, DocumentSettings};
+use crate::model::maps::MaterialMaps;
+use crate::model::tile::{Plane, TILE_SIZE, Tile};
+
+fn channel_uniform<T: Copy + PartialEq>(
+    maps: &MaterialMaps,
+    plane: impl Fn(&Tile) -> &Plane<T>,
+) -> Option<T> {
+    let first = plane(maps.tile(0)).uniform()?;
+    (0..maps.tile_count())
+        .all(|id| plane(maps.tile(id)).uniform() == Some(first))
+        .then_some(first)
+}
+
+/// Copies a channel of every tile into a row-major raster of `C` samples per texel.
+fn rasterize<const C: usize, T: Copy + PartialEq + Send + Sync>(
+    maps: &MaterialMaps,
+    plane: impl Fn(&Tile) -> &Plane<T> + Sync,
+    samples: impl Fn(T) -> [u16; C] + Sync,
+) -> Vec<u16> {
+    let (w, h) = (maps.width() as usize, maps.height() as usize);
+    let mut out = vec![0u16; w * h * C];
+    out.par_chunks_mut(w * C * TILE_SIZE)
+        .enumerate()
+        .for_each(|(ty, band)| {
+            let rows = band.len() / (w * C);
+            for tx in 0..maps.tiles_x() as usize {
+                let tile = maps.tile(ty * maps.tiles_x() as usize + tx);
+                let p = plane(tile);
+                let x0 = tx * TILE_SIZE;
+                let cols = TILE_SIZE.min(w - x0);
+                for r in 0..rows {
+                    for c in 0..cols {
+                        let s = samples(p.get(r * TILE_SIZE + c));
+                        let at = (r * w + x0 + c) * C;
+                        band[at..at + C].copy_from_slice(&s);
+                    }
+                }
+            }
+        });
+    out
+}
+
+fn encode_png(raster: &Raster, width: u32, height: u32) -> Result<Vec<u8>, String> {
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let mut bytes = Vec::new();
+    let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Up);
+    let result = match raster {
+        Raster::Rgb(data) => {
+            ImageBuffer::<Rgb<u16>, &[u16]>::from_raw(width, height, data.as_slice())
+                .ok_or("raster size mismatch")?
+                .write_with_encoder(encoder)
+        }
+        Raster::Gray(data) => {
+            ImageBuffer::<Luma<u16>, &[u16]>::from_raw(width, height, data.as_slice())
+                .ok_or("raster size mismatch")?
+                .write_with_encoder(encoder)
+        }
+        Raster::Uniform(_) => return Ok(Vec::new()),
+    };
+    result.map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// Serialises a document into project bytes (what [`save`](super::save) writes).
+pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    write_to(doc, &mut cursor)?;
+    Ok(cursor.into_inner())
+}
+
+/// Serialises a document as a project into `out` (its mesh path as the document holds it).
+pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
+    write_project(doc, doc.settings().clone(), out)
+}
+
+/// Serialises a document with `settings` into `out`.
+pub(super) fn write_project(
+    doc: &Document,
+    settings: DocumentSettings,
+    out: impl Write + Seek,
+) -> Result<(), String> {
+    let maps = doc.maps();
+    let (w, h) = (maps.width(), maps.height());
+    let rasters: Vec<(&str, Raster)> = vec![
+        (
+            "kd",
+            channel_uniform(maps, |t| &t.kd).map_or_else(
+                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.kd, |v| v)),
+                |v| Raster::Uniform(v.to_vec()),
+            ),
+        ),
+        (
+            "ks",
+            channel_uniform(maps, |t| &t.ks).map_or_else(
+                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.ks, |v| v)),
+                |v| Raster::Uniform(v.to_vec()),
+            ),
+        ),
+        (
+            "n",
+            channel_uniform(maps, |t| &t.n).map_or_else(
+                || Raster::Gray(rasterize::<1, _>(maps, |t| &t.n, |v| [v])),
+                |v| Raster::Uniform(vec![v]),
+            ),
+        ),
+    ];
+    let pngs: Vec<Result<Vec<u8>, String>> = rasters
+        .par_iter()
+        .map(|(_, r)| encode_png(r, w, h))
+        .collect();
+    let entry = |(name, raster): &(&str, Raster)| match raster {
+        Raster::Uniform(v) => ChannelEntry::Uniform { value: v.clone() },
+        Raster::Rgb(_) => ChannelEntry::Image {
+            file: format!("{name}.png"),
+            encoding: RGB_ENCODING.into(),
+        },
+        Raster::Gray(_) => ChannelEntry::Image {
+            file: format!("{name}.png"),
+            encoding: N_ENCODING.into(),
+        },
+    };
+    let manifest = Manifest {
+        format: FORMAT.into(),
+        version: VERSION,
+        width: w,
+        height: h,
+        settings,
+        kd: entry(&rasters[0]),
+        ks: entry(&rasters[1]),
+        n: entry(&rasters[2]),
+    };
+    let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
+    // Never write what the loader would refuse: the manifest goes through the loader's own
+    // checks, and every stored exponent through its test, before a byte is written.
+    parse_manifest(&json).map_err(|e| format!("the project would not load back ({e})"))?;
+    if let Some(bits) = invalid_n_in(maps) {
+        return Err(format!(
+            "the project would not load back (n holds half-float bits {bits:#06x})"
+        ));
+    }
+    let mut zip = zip::ZipWriter::new(out);
+    let deflated = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let stored = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Stored)
+        .large_file(true);
+    zip.start_file("manifest.json", deflated)
+        .map_err(|e| e.to_string())?;
+    zip.write_all(&json).map_err(|e| e.to_string())?;
+    for ((name, raster), png) in rasters.iter().zip(pngs) {
+        let png = png?;
+        if !matches!(raster, Raster::Uniform(_)) {
+            zip.start_file(format!("{name}.png"), stored)
+                .map_err(|e| e.to_string())?;
+            zip.write_all(&png).map_err(|e| e.to_string())?;
+        }
+    }
+    zip.finish().map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// The first stored exponent the loader would refuse, if any (none ever should be: every
+/// writer encodes through [`crate::model::texel::encode_n`]).
+fn invalid_n_in(maps: &MaterialMaps) -> Option<u16> {
+    (0..maps.tile_count())
+        .into_par_iter()
+        .find_map_any(|id| match &maps.tile(id).n {
+            Plane::Uniform(bits) => (!valid_n_bits(*bits)).then_some(*bits),
+            Plane::Data(d) => d.iter().copied().find(|&bits| !valid_n_bits(bits)),
+        })
+}

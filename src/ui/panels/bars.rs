@@ -1,0 +1,206 @@
+//! The menu bar, the status bar, dropped files and notices.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use crate::model::Command;
+use crate::model::texel::Channel;
+use crate::reflectance::{self, AmbientApprox, ShadingModel};
+use crate::ui::keys::{self, Action};
+use crate::ui::{EditorState, notice};
+
+impl EditorState {
+    pub(in crate::ui) fn status_bar_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let maps = self.doc.maps();
+            ui.label(format!("{}x{}", maps.width(), maps.height()));
+            ui.separator();
+            ui.label(format!(
+                "maps {:.0} MB, history {:.0} MB",
+                maps.heap_bytes() as f64 / 1e6,
+                self.doc.history().bytes() as f64 / 1e6
+            ));
+            ui.separator();
+            match &self.viewport.gpu {
+                Some(g) => ui.label(format!(
+                    "frame {:.1} ms, viewport {:.1} ms ({})",
+                    ui.input(|i| i.stable_dt) * 1000.0,
+                    self.viewport.frame_ms,
+                    g.adapter()
+                )),
+                None => ui.label("no GPU"),
+            };
+            if let Some((x, y)) = self.shown_hover {
+                let v = maps.value(x, y);
+                let ka = |m, a| reflectance::ka(m, a, v.kd, v.ks, v.n);
+                let approx = self.doc.settings().approx;
+                let phong = ka(ShadingModel::Phong, approx);
+                let blinn = ka(ShadingModel::BlinnPhong, approx);
+                let exact = |m| {
+                    v.kd * reflectance::diffuse_factor(AmbientApprox::Fast) as f32
+                        + v.ks
+                            * reflectance::exact::chi_exact(m, f64::from(v.n)) as f32
+                };
+                let model = self.doc.settings().model;
+                ui.separator();
+                ui.label(format!(
+                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  exact {:.4}",
+                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x, exact(model).x
+                ))
+                .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), and the exact integral for the current model");
+            }
+            if let Some(job) = &self.job {
+                ui.separator();
+                ui.add(
+                    egui::ProgressBar::new(job.progress.fraction())
+                        .desired_width(160.0)
+                        .text(format!("{} {}", job.label, job.progress.stage())),
+                );
+                if ui.button("Cancel").clicked() {
+                    job.progress.cancel();
+                }
+            }
+        });
+    }
+
+    pub(in crate::ui) fn menu_ui(&mut self, ui: &mut egui::Ui) {
+        // A menu entry showing its shortcut; whether it was clicked.
+        let item = |ui: &mut egui::Ui, label: &str, action: Action| {
+            let text =
+                keys::shortcut(action).map_or_else(String::new, |k| ui.ctx().format_shortcut(&k));
+            ui.add(egui::Button::new(label).shortcut_text(text))
+                .clicked()
+        };
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if item(ui, "New", Action::New) {
+                    self.new_project();
+                }
+                if item(ui, "Open…", Action::Open) {
+                    self.open_dialog();
+                }
+                ui.menu_button("Open Recent", |ui| {
+                    if self.recent.is_empty() {
+                        ui.label("No recent files");
+                    }
+                    let mut chosen = None;
+                    for p in &self.recent {
+                        let name = p.file_name().map_or_else(
+                            || p.display().to_string(),
+                            |n| n.to_string_lossy().into_owned(),
+                        );
+                        if ui
+                            .button(name)
+                            .on_hover_text(p.display().to_string())
+                            .clicked()
+                        {
+                            chosen = Some(p.clone());
+                        }
+                    }
+                    if let Some(p) = chosen {
+                        self.open(p);
+                    }
+                });
+                if item(ui, "Save", Action::Save) {
+                    self.save();
+                }
+                if item(ui, "Save As…", Action::SaveAs) {
+                    self.save_as();
+                }
+                if item(ui, "Export…", Action::Export) {
+                    self.open_export();
+                }
+                ui.separator();
+                if ui.button("Import mesh…").clicked()
+                    && let Some(p) = rfd::FileDialog::new()
+                        .add_filter("mesh", &["obj", "gltf", "glb"])
+                        .pick_file()
+                {
+                    self.import_mesh(p);
+                }
+                for channel in [Channel::Kd, Channel::Ks, Channel::N] {
+                    if ui
+                        .button(format!("Import image into {}…", channel.name()))
+                        .clicked()
+                        && let Some(p) = rfd::FileDialog::new()
+                            .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
+                            .pick_file()
+                    {
+                        self.import_image(p, channel);
+                    }
+                }
+                ui.separator();
+                if item(ui, "Quit", Action::Quit) {
+                    self.quit_asked = true;
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if item(ui, "Undo", Action::Undo) {
+                    self.apply(Command::Undo);
+                }
+                if item(ui, "Redo", Action::Redo) {
+                    self.apply(Command::Redo);
+                }
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.button("Keyboard shortcuts").clicked() {
+                    self.shortcuts_open = true;
+                }
+            });
+        });
+    }
+
+    pub(in crate::ui) fn dropped_files(&mut self, ctx: &egui::Context) {
+        let files: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
+        for path in files {
+            let ext = path
+                .extension()
+                .map(|e| e.to_string_lossy().to_lowercase())
+                .unwrap_or_default();
+            match ext.as_str() {
+                "kapaint" => self.open(path),
+                "obj" | "gltf" | "glb" => self.import_mesh(path),
+                "png" | "jpg" | "jpeg" | "tga" | "exr" => {
+                    let channel = self.canvas_target();
+                    self.import_image(path, channel);
+                }
+                _ => self.notices.push(notice(
+                    format!(
+                        "{}: drop a project (.kapaint), a mesh (.obj, .gltf, .glb) or an image",
+                        path.display()
+                    ),
+                    true,
+                )),
+            }
+        }
+    }
+
+    pub(in crate::ui) fn notices_ui(&mut self, ctx: &egui::Context) {
+        self.notices
+            .retain(|n| n.at.elapsed() < Duration::from_secs(if n.error { 12 } else { 5 }));
+        if self.notices.is_empty() {
+            return;
+        }
+        egui::Area::new(egui::Id::new("notices"))
+            .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -36.0))
+            .show(ctx, |ui| {
+                for n in &self.notices {
+                    let colour = if n.error {
+                        egui::Color32::from_rgb(220, 80, 80)
+                    } else {
+                        egui::Color32::from_rgb(120, 200, 120)
+                    };
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        ui.colored_label(colour, &n.text);
+                    });
+                }
+            });
+        ctx.request_repaint_after(Duration::from_millis(500));
+    }
+}

@@ -1,0 +1,7 @@
+//! The editor's panels: tools, brush and material on the left; shading, compare, view, light
+//! and presets on the right; the menu bar, the status bar, dropped files and notices. Each
+//! reads the state and issues [`Command`](crate::model::Command)s.
+
+mod bars;
+mod tool_panel;
+mod view_panel;

@@ -1,0 +1,225 @@
+//! The left panel: tools and their options, brush settings and stamp, material, channels.
+
+use crate::model::Command;
+use crate::model::paint::GradientShape;
+use crate::model::texel::Channel;
+use crate::reflectance::{self, ShadingModel};
+use crate::tools::{FillMode, ToolKind};
+use crate::ui::{EditorState, stamp_image, stamp_key};
+
+/// The key that selects a tool.
+fn tool_key(kind: ToolKind) -> &'static str {
+    match kind {
+        ToolKind::Brush => "B",
+        ToolKind::Eraser => "E",
+        ToolKind::Blur => "R",
+        ToolKind::Fill => "F on the UV canvas",
+        ToolKind::Gradient => "G",
+        ToolKind::Picker => "I",
+    }
+}
+
+impl EditorState {
+    /// The active tool's options: the fill's mode, the gradient's shape.
+    fn tool_options_ui(&mut self, ui: &mut egui::Ui) {
+        match self.tools.active() {
+            ToolKind::Fill => {
+                let mode = &mut self.tools.fill.mode;
+                let name = match mode {
+                    FillMode::Island => "UV island (or all)",
+                    FillMode::Similar { .. } => "Similar texels",
+                    FillMode::All => "Whole map",
+                };
+                egui::ComboBox::from_label("Fill")
+                    .selected_text(name)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(mode, FillMode::Island, "UV island (or all)");
+                        if ui
+                            .selectable_label(
+                                matches!(mode, FillMode::Similar { .. }),
+                                "Similar texels",
+                            )
+                            .clicked()
+                        {
+                            *mode = FillMode::Similar {
+                                channel: Channel::Kd,
+                                tolerance: 0.05,
+                            };
+                        }
+                        ui.selectable_value(mode, FillMode::All, "Whole map");
+                    });
+                if let FillMode::Similar { channel, tolerance } = mode {
+                    egui::ComboBox::from_label("Compared channel")
+                        .selected_text(channel.name())
+                        .show_ui(ui, |ui| {
+                            for c in Channel::ALL {
+                                ui.selectable_value(channel, c, c.name());
+                            }
+                        });
+                    ui.add(egui::Slider::new(tolerance, 0.0..=1.0).text("Tolerance"))
+                        .on_hover_text("The largest difference still filled, in blend space");
+                }
+            }
+            ToolKind::Gradient => {
+                let shape = &mut self.tools.gradient.shape;
+                ui.horizontal(|ui| {
+                    ui.selectable_value(shape, GradientShape::Linear, "Linear");
+                    ui.selectable_value(shape, GradientShape::Radial, "Radial");
+                });
+            }
+            ToolKind::Blur => {
+                let mut brush = self.doc.settings().brush.clone();
+                ui.add(egui::Slider::new(&mut brush.blur_radius_px, 1..=16).text("Blur radius"))
+                    .on_hover_text("Kernel radius in texels");
+                if brush != self.doc.settings().brush {
+                    self.apply(Command::SetBrush(brush));
+                }
+            }
+            ToolKind::Brush | ToolKind::Eraser | ToolKind::Picker => {}
+        }
+    }
+
+    /// Left panel: tools, brush, material, channels.
+    pub(in crate::ui) fn tools_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Tools");
+        let mut chosen = self.tools.active();
+        ui.horizontal_wrapped(|ui| {
+            for kind in ToolKind::ALL {
+                ui.selectable_value(&mut chosen, kind, kind.label())
+                    .on_hover_text(format!("{} ({})", kind.label(), tool_key(kind)));
+            }
+        });
+        if chosen != self.tools.active() {
+            self.select_tool(chosen);
+        }
+        self.tool_options_ui(ui);
+        ui.separator();
+        ui.heading("Brush settings");
+        let mut brush = self.doc.settings().brush.clone();
+        ui.add(
+            egui::Slider::new(&mut brush.radius_px, 0.5..=512.0)
+                .logarithmic(true)
+                .text("Radius"),
+        )
+        .on_hover_text("[ and ] change the size");
+        ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
+            .on_hover_text("Shift+[ and Shift+] change the hardness");
+        ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
+        ui.add(egui::Slider::new(&mut brush.flow, 0.0..=1.0).text("Flow"));
+        ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing %"));
+        ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
+        ui.checkbox(&mut brush.pressure_size, "Pressure: size");
+        ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
+        self.stamp_ui(ui, &mut brush);
+        if brush != self.doc.settings().brush {
+            self.apply(Command::SetBrush(brush));
+        }
+        ui.separator();
+        ui.heading("Material");
+        let mut primary = self.doc.settings().primary;
+        ui.horizontal(|ui| {
+            let mut kd = primary.kd.to_array();
+            egui::color_picker::color_edit_button_rgb(ui, &mut kd)
+                .on_hover_text("Diffuse colour k_d (linear)");
+            ui.label("k_d");
+            primary.kd = glam::Vec3::from(kd);
+            let mut ks = primary.ks.to_array();
+            egui::color_picker::color_edit_button_rgb(ui, &mut ks)
+                .on_hover_text("Specular colour k_s (linear)");
+            ui.label("k_s");
+            primary.ks = glam::Vec3::from(ks);
+        });
+        let mut grey = primary.ks.max_element();
+        if ui
+            .add(egui::Slider::new(&mut grey, 0.0..=1.0).text("k_s (grey)"))
+            .changed()
+        {
+            primary.ks = glam::Vec3::splat(grey);
+        }
+        ui.add(
+            egui::Slider::new(&mut primary.n, 0.0..=crate::model::texel::N_MAX)
+                .logarithmic(true)
+                .text("n"),
+        );
+        let other = match self.doc.settings().model {
+            ShadingModel::Phong => ShadingModel::BlinnPhong,
+            ShadingModel::BlinnPhong => ShadingModel::Phong,
+        };
+        let eq = reflectance::equivalent::equivalent_exponent(
+            self.doc.settings().model,
+            f64::from(primary.n),
+        );
+        ui.label(format!("≈ n {eq:.1} in {}", other.name()))
+            .on_hover_text("The exponent of the other model with the closest highlight");
+        if primary != self.doc.settings().primary {
+            self.apply(Command::SetPrimary(primary));
+        }
+        if ui
+            .button("Swap primary / secondary")
+            .on_hover_text("X")
+            .clicked()
+        {
+            self.apply(Command::SwapMaterials);
+        }
+        ui.separator();
+        ui.heading("Channels");
+        let mut ch = self.doc.settings().channels;
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut ch.kd, "k_d");
+            ui.checkbox(&mut ch.ks, "k_s");
+            ui.checkbox(&mut ch.n, "n");
+        });
+        if ch != self.doc.settings().channels {
+            self.apply(Command::SetChannels(ch));
+        }
+    }
+
+    /// The brush's stamp row: a preview of the stamp, the built-in grain, loading one from an
+    /// image, and back to the round dab.
+    fn stamp_ui(&mut self, ui: &mut egui::Ui, brush: &mut crate::model::brush::BrushSettings) {
+        ui.horizontal(|ui| {
+            ui.label("Stamp");
+            match &brush.stamp {
+                None => {
+                    ui.label("round");
+                }
+                Some(stamp) => {
+                    let key = stamp_key(stamp);
+                    if self.stamp_preview.as_ref().is_none_or(|(k, _)| *k != key) {
+                        let image = stamp_image(stamp, 32);
+                        let texture = ui.ctx().load_texture(
+                            "brush stamp",
+                            image,
+                            egui::TextureOptions::LINEAR,
+                        );
+                        self.stamp_preview = Some((key, texture));
+                    }
+                    if let Some((_, texture)) = &self.stamp_preview {
+                        ui.image((texture.id(), egui::vec2(32.0, 32.0)))
+                            .on_hover_text(format!("{}x{} stamp", stamp.width(), stamp.height()));
+                    }
+                }
+            }
+            if ui
+                .button("Grain")
+                .on_hover_text("A built-in grainy stamp")
+                .clicked()
+            {
+                brush.stamp = Some(crate::model::brush::Stamp::grain(64));
+            }
+            if ui
+                .button("Load…")
+                .on_hover_text("A stamp from an image (luminance times alpha)")
+                .clicked()
+                && let Some(p) = rfd::FileDialog::new()
+                    .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
+                    .pick_file()
+            {
+                self.load_stamp(p);
+            }
+            if brush.stamp.is_some() && ui.button("Round").clicked() {
+                brush.stamp = None;
+            }
+        });
+    }
+}

@@ -1,0 +1,230 @@
+//! The right panel: shading, compare, view, light, material presets and history.
+
+use std::sync::Arc;
+
+use crate::model::Command;
+use crate::model::texel::MaterialValue;
+use crate::reflectance::{AmbientApprox, ShadingModel};
+use crate::render::{FrameSettings, ViewMode};
+use crate::ui::EditorState;
+use crate::ui::canvas::CanvasChannel;
+use crate::ui::viewport::Compare;
+
+impl EditorState {
+    /// Compare controls: the mode, then each side's model and approximation, the divider or
+    /// the heatmap's scale.
+    fn compare_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Compare");
+        let c = &mut self.viewport.comparison;
+        ui.horizontal_wrapped(|ui| {
+            for (mode, label) in Compare::ALL {
+                ui.selectable_value(&mut c.mode, mode, label);
+            }
+        });
+        if c.mode == Compare::Single {
+            return;
+        }
+        for (name, side) in [("Left", &mut c.left), ("Right", &mut c.right)] {
+            ui.horizontal(|ui| {
+                egui::ComboBox::from_id_salt(("compare model", name))
+                    .selected_text(side.model.name())
+                    .show_ui(ui, |ui| {
+                        for m in ShadingModel::ALL {
+                            ui.selectable_value(&mut side.model, m, m.name());
+                        }
+                    });
+                egui::ComboBox::from_id_salt(("compare approx", name))
+                    .selected_text(side.approx.name())
+                    .show_ui(ui, |ui| {
+                        for a in AmbientApprox::ALL {
+                            ui.selectable_value(&mut side.approx, a, a.name());
+                        }
+                    });
+                ui.label(name);
+            });
+        }
+        match c.mode {
+            Compare::Split => {
+                ui.add(egui::Slider::new(&mut c.split_at, 0.0..=1.0).text("Divider"))
+                    .on_hover_text("Or drag the line in the viewport");
+            }
+            Compare::Difference => {
+                ui.add(
+                    egui::Slider::new(&mut c.diff_max, 1e-4..=1.0)
+                        .logarithmic(true)
+                        .text("Heat scale"),
+                )
+                .on_hover_text("The difference |left - right| shown white");
+            }
+            Compare::Single | Compare::SideBySide => {}
+        }
+    }
+
+    /// Right panel: model, view, compare, light, canvas channel, history.
+    pub(in crate::ui) fn view_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Shading");
+        let mut model = self.doc.settings().model;
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut model, ShadingModel::Phong, "Phong (8)");
+            ui.selectable_value(&mut model, ShadingModel::BlinnPhong, "Blinn-Phong (11)");
+        });
+        if model != self.doc.settings().model {
+            self.apply(Command::SetModel(model));
+        }
+        let mut approx = self.doc.settings().approx;
+        egui::ComboBox::from_label("Approximation")
+            .selected_text(approx.name())
+            .show_ui(ui, |ui| {
+                for a in AmbientApprox::ALL {
+                    ui.selectable_value(&mut approx, a, a.name());
+                }
+            });
+        if approx != self.doc.settings().approx {
+            self.apply(Command::SetApprox(approx));
+        }
+        self.compare_ui(ui);
+        ui.heading("View");
+        egui::ComboBox::from_label("View mode")
+            .selected_text(self.view.name())
+            .show_ui(ui, |ui| {
+                for v in ViewMode::ALL {
+                    ui.selectable_value(&mut self.view, v, v.name());
+                }
+            });
+        egui::ComboBox::from_label("Canvas shows")
+            .selected_text(self.canvas.channel.label())
+            .show_ui(ui, |ui| {
+                for c in CanvasChannel::ALL {
+                    ui.selectable_value(&mut self.canvas.channel, c, c.label());
+                }
+            });
+        ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
+        ui.heading("Light");
+        let l = self.lighting.light.normalize_or(glam::Vec3::Z);
+        let (mut yaw, mut pitch) = (l.x.atan2(l.z), l.y.clamp(-1.0, 1.0).asin());
+        let a = ui.add(
+            egui::Slider::new(&mut yaw, -std::f32::consts::PI..=std::f32::consts::PI)
+                .text("Light yaw"),
+        );
+        let b = ui.add(egui::Slider::new(&mut pitch, -1.55..=1.55).text("Light pitch"));
+        if a.changed() || b.changed() {
+            self.lighting.light = glam::Vec3::new(
+                pitch.cos() * yaw.sin(),
+                pitch.sin(),
+                pitch.cos() * yaw.cos(),
+            );
+        }
+        ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
+        ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+        egui::CollapsingHeader::new("Material presets")
+            .default_open(true)
+            .show(ui, |ui| self.presets_ui(ui));
+        ui.heading("History");
+        ui.label(format!(
+            "{} steps, {:.1} MB",
+            self.doc.history().undo_steps().count(),
+            self.doc.history().bytes() as f64 / 1e6
+        ));
+        egui::ScrollArea::vertical()
+            .max_height(160.0)
+            .show(ui, |ui| {
+                for step in self
+                    .doc
+                    .history()
+                    .undo_steps()
+                    .collect::<Vec<_>>()
+                    .iter()
+                    .rev()
+                {
+                    ui.label(format!("{} ({} KB)", step.label, step.bytes() / 1024));
+                }
+            });
+    }
+
+    /// Renders a thumbnail: on the GPU with the preview renderer, else with the CPU reference
+    /// renderer (the same shading, ray traced).
+    fn thumbnail(&mut self, value: MaterialValue) -> egui::ColorImage {
+        const SIZE: u32 = 56;
+        let camera = crate::render::Camera::default()
+            .orbit(0.5, 0.35)
+            .framing(&self.mesh.mesh.positions);
+        let settings = FrameSettings {
+            camera,
+            view: ViewMode::Shaded,
+            ..self.frame_settings()
+        };
+        let mesh = (self.mesh.id, Arc::clone(&self.mesh.mesh));
+        if let Some(image) = self
+            .viewport
+            .gpu
+            .as_mut()
+            .and_then(|g| g.thumbnail(&mesh, value, &settings, SIZE))
+        {
+            return image;
+        }
+        let material = crate::render::reference::Material::Uniform(crate::render::Sample {
+            kd: value.kd,
+            ks: value.ks,
+            n: value.n,
+        });
+        let pixels = crate::render::reference::render(
+            &self.mesh.mesh,
+            &self.mesh.bvh,
+            &material,
+            &settings,
+            SIZE,
+            SIZE,
+        );
+        let c = |x: f32| (crate::model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
+        let rgba: Vec<u8> = pixels
+            .iter()
+            .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])
+            .collect();
+        egui::ColorImage::from_rgba_unmultiplied([SIZE as usize; 2], &rgba)
+    }
+
+    /// The preset browser: thumbnails, a click makes the preset the primary material.
+    fn presets_ui(&mut self, ui: &mut egui::Ui) {
+        // A few thumbnails per frame keep the first frames fast.
+        let mut budget = 3;
+        for i in 0..self.presets.len() {
+            if self.presets[i].2.is_none() && budget > 0 {
+                budget -= 1;
+                let image = self.thumbnail(self.presets[i].1);
+                let name = self.presets[i].0.clone();
+                self.presets[i].2 = Some(ui.ctx().load_texture(
+                    name,
+                    image,
+                    egui::TextureOptions::LINEAR,
+                ));
+            }
+        }
+        if budget == 0 {
+            ui.ctx().request_repaint();
+        }
+        let mut chosen = None;
+        ui.horizontal_wrapped(|ui| {
+            for (name, value, texture) in &self.presets {
+                let response = match texture {
+                    Some(t) => ui.add(egui::Button::image(
+                        egui::Image::from_texture(egui::load::SizedTexture::from_handle(t))
+                            .fit_to_exact_size(egui::vec2(40.0, 40.0)),
+                    )),
+                    None => ui.add_sized([48.0, 48.0], egui::Button::new("…")),
+                };
+                if response
+                    .on_hover_text(format!(
+                        "{name}: k_d {:.2} {:.2} {:.2}, k_s {:.2}, n {:.0}",
+                        value.kd.x, value.kd.y, value.kd.z, value.ks.x, value.n
+                    ))
+                    .clicked()
+                {
+                    chosen = Some(*value);
+                }
+            }
+        });
+        if let Some(v) = chosen {
+            self.apply(Command::SetPrimary(v));
+        }
+    }
+}
