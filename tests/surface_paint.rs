@@ -87,8 +87,8 @@ fn ball_footprint_visits_exactly_the_texels_within_the_ball() {
         for id in fp.tiles(&maps) {
             let rect = maps.tile_rect(id);
             fp.visit_tile(id, rect, |i, w| {
-                let x = rect.0 as usize + i % TILE_SIZE;
-                let y = rect.1 as usize + i / TILE_SIZE;
+                let x = rect.x0 as usize + i % TILE_SIZE;
+                let y = rect.y0 as usize + i / TILE_SIZE;
                 got[y * 256 + x] = w;
             });
         }

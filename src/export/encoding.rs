@@ -181,7 +181,7 @@ pub fn ka_error(
     let (max, sum, count) = (0..maps.tile_count())
         .into_par_iter()
         .map(|id| {
-            let (x0, y0, x1, y1) = maps.tile_rect(id);
+            let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
             let tile = maps.tile(id);
             let (mut max, mut sum, mut count) = (0.0_f64, 0.0_f64, 0_u64);
             for i in 0..TILE_TEXELS {

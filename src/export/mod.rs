@@ -1,4 +1,4 @@
-//! Exporting compact texture sets (issue 6): presets ([`preset`]), the choice of `n`'s
+//! Exporting compact texture sets: presets ([`preset`]), the choice of `n`'s
 //! encoding by the `k_a` error it causes ([`encoding`]), and sets of images with a
 //! `material.json` manifest written atomically and read back ([`set`]).
 

@@ -59,16 +59,7 @@ impl Difference {
     pub fn new(gpu: &Gpu) -> Self {
         let device = &gpu.device;
         let module = super::shader_module(device, "difference.wgsl");
-        let texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let texture = |binding| super::texture_entry(binding, false);
         let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("difference"),
             entries: &[

@@ -117,6 +117,20 @@ pub fn shader_source(name: &str) -> String {
     shader::resolve(name).unwrap_or_else(|e| format!("// {e}\nerror"))
 }
 
+/// A layout entry for a 2D float texture read by the fragment stage at `binding`.
+pub fn texture_entry(binding: u32, filterable: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 /// A shader module of a file of `shaders/`, its includes resolved.
 pub fn shader_module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -142,22 +142,16 @@ impl MaterialMaps {
     }
 
     /// The texels a tile covers in the maps.
-    pub fn tile_texels(&self, id: TileId) -> TexelRect {
-        let (x0, y0, x1, y1) = self.tile_rect(id);
-        TexelRect { x0, y0, x1, y1 }
-    }
-
-    /// The texel rectangle `(x0, y0, x1, y1)` (exclusive ends) a tile covers in the maps.
-    pub fn tile_rect(&self, id: TileId) -> (u32, u32, u32, u32) {
+    pub fn tile_rect(&self, id: TileId) -> TexelRect {
         let tx = (id % self.tiles_x as usize) as u32;
         let ty = (id / self.tiles_x as usize) as u32;
         let (x0, y0) = (tx * TILE_SIZE as u32, ty * TILE_SIZE as u32);
-        (
+        TexelRect {
             x0,
             y0,
-            (x0 + TILE_SIZE as u32).min(self.width),
-            (y0 + TILE_SIZE as u32).min(self.height),
-        )
+            x1: (x0 + TILE_SIZE as u32).min(self.width),
+            y1: (y0 + TILE_SIZE as u32).min(self.height),
+        }
     }
 
     /// The stored texel at `(x, y)`; panics outside the maps.
@@ -272,7 +266,7 @@ impl MaterialMaps {
     /// Visits every texel row by row in tile order: `f(x, y, texel)`.
     pub fn for_each_texel(&self, mut f: impl FnMut(u32, u32, Texel)) {
         for id in 0..self.tiles.len() {
-            let (x0, y0, x1, y1) = self.tile_rect(id);
+            let TexelRect { x0, y0, x1, y1 } = self.tile_rect(id);
             let tile = &self.tiles[id];
             for y in y0..y1 {
                 for x in x0..x1 {
@@ -439,7 +433,15 @@ mod tests {
         assert!(MaterialMaps::new(8193, 10, base).is_err());
         let maps = MaterialMaps::new(100, 70, base).unwrap();
         assert_eq!((maps.tiles_x(), maps.tiles_y()), (2, 2));
-        assert_eq!(maps.tile_rect(3), (64, 64, 100, 70));
+        assert_eq!(
+            maps.tile_rect(3),
+            TexelRect {
+                x0: 64,
+                y0: 64,
+                x1: 100,
+                y1: 70
+            }
+        );
         assert_eq!(maps.heap_bytes(), 0);
         assert_eq!(maps.value(99, 69), base.quantized());
     }

@@ -77,7 +77,7 @@ pub fn channel_stats(maps: &MaterialMaps) -> Vec<ChannelStat> {
     let acc = (0..maps.tile_count())
         .into_par_iter()
         .map(|id| {
-            let (x0, y0, x1, y1) = maps.tile_rect(id);
+            let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
             let (cols, rows) = ((x1 - x0) as usize, (y1 - y0) as usize);
             let tile = maps.tile(id);
             let mut acc = Acc::empty();

@@ -10,8 +10,9 @@
 use glam::Vec3;
 
 use super::brush::BrushSettings;
+use super::maps::TexelRect;
 use super::maps::{MaterialMaps, TileId};
-use super::paint::{Footprint, TileRect};
+use super::paint::Footprint;
 use super::tile::TILE_SIZE;
 use crate::mesh::Mesh;
 use crate::mesh::bake::{self, Coverage, UvBake};
@@ -270,9 +271,9 @@ impl Footprint for BallFootprint<'_> {
             .collect()
     }
 
-    fn visit_runs(&self, id: TileId, rect: TileRect, mut f: impl FnMut(usize, &[f32])) {
+    fn visit_runs(&self, id: TileId, rect: TexelRect, mut f: impl FnMut(usize, &[f32])) {
         let s = self.surface;
-        let (x0, y0, x1, y1) = rect;
+        let TexelRect { x0, y0, x1, y1 } = rect;
         let r2 = self.radius * self.radius;
         let w = s.bake.width as usize;
         let blocks = &s.block_boxes[id];

@@ -87,7 +87,7 @@ fn tile_image(
     id: usize,
     channel: CanvasChannel,
 ) -> ColorImage {
-    let (x0, y0, x1, y1) = maps.tile_rect(id);
+    let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
     let (w, h) = (x1 - x0, y1 - y0);
     let mut pixels = Vec::with_capacity((w * h) as usize);
     for y in y0..y1 {
@@ -117,7 +117,7 @@ impl Canvas {
                 }
                 let dirty = maps.tiles_changed_since(version);
                 for &id in &dirty {
-                    let (x, y, _, _) = maps.tile_rect(id);
+                    let crate::model::maps::TexelRect { x0: x, y0: y, .. } = maps.tile_rect(id);
                     tex.set_partial(
                         [x as usize, y as usize],
                         tile_image(doc, maps, id, self.channel),
@@ -131,7 +131,7 @@ impl Canvas {
                 let mut image =
                     ColorImage::filled([size.0 as usize, size.1 as usize], Color32::BLACK);
                 for id in 0..maps.tile_count() {
-                    let (x0, y0, x1, _) = maps.tile_rect(id);
+                    let crate::model::maps::TexelRect { x0, y0, x1, .. } = maps.tile_rect(id);
                     let w = x1 - x0;
                     let tile = tile_image(doc, maps, id, self.channel);
                     for y in 0..tile.size[1] {

@@ -1,4 +1,4 @@
-//! The editor (issue 7): an eframe app around the model. The UI reads the document and
+//! The editor: an eframe app around the model. The UI reads the document and
 //! changes it only through [`Command`]s; the GPU side ([`viewport`]) mirrors the maps.
 //!
 //! Layout: menu bar, tool and material panel on the left, view panel on the right, a dock

@@ -50,16 +50,7 @@ impl Preview {
     pub fn new(gpu: &Gpu) -> Self {
         let device = &gpu.device;
         let module = super::shader_module(device, "preview.wgsl");
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let texture_entry = |binding| super::texture_entry(binding, true);
         // The bindings of shaders/preview_bindings.wgsl.
         let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview"),

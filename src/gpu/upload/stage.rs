@@ -198,7 +198,7 @@ fn stage_tile(
     sums: &mut TileSums,
 ) -> Sums {
     let tile = maps.tile(id);
-    let rect = maps.tile_texels(id);
+    let rect = maps.tile_rect(id);
     let Some((first, mips)) = bands.split_first_mut() else {
         return Sums::default();
     };

@@ -29,8 +29,8 @@ pub fn blur_dab(
     for id in fp.tiles(maps) {
         let rect = maps.tile_rect(id);
         fp.visit_tile(id, rect, |i, weight| {
-            let x = i64::from(rect.0) + (i % TILE_SIZE) as i64;
-            let y = i64::from(rect.1) + (i / TILE_SIZE) as i64;
+            let x = i64::from(rect.x0) + (i % TILE_SIZE) as i64;
+            let y = i64::from(rect.y0) + (i / TILE_SIZE) as i64;
             let mut sum = [0.0_f32; 7];
             let mut count = 0.0;
             for yy in (y - k).max(0)..=(y + k).min(h - 1) {

@@ -4,12 +4,10 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::{
-    Coverage, FROM_BLEND_STEPS, Footprint, NTables, PaintTarget, TileRect, n_tables, pre_tile,
-};
+use super::{Coverage, FROM_BLEND_STEPS, Footprint, NTables, PaintTarget, n_tables, pre_tile};
 use crate::model::brush::BlendMode;
 use crate::model::history::History;
-use crate::model::maps::{MaterialMaps, TileId};
+use crate::model::maps::{MaterialMaps, TexelRect, TileId};
 use crate::model::texel::{decode_unorm, encode_unorm};
 use crate::model::tile::{TILE_SIZE, Tile};
 
@@ -36,7 +34,7 @@ pub fn paint_dab(
     if ids.is_empty() {
         return;
     }
-    let rects: Vec<TileRect> = ids.iter().map(|&id| maps.tile_rect(id)).collect();
+    let rects: Vec<TexelRect> = ids.iter().map(|&id| maps.tile_rect(id)).collect();
     let pres: Vec<Arc<Tile>> = ids.iter().map(|&id| pre_tile(history, maps, id)).collect();
     history.save_before_write(maps, &ids);
     let covs = coverage.tiles_mut(maps.tile_count(), &ids);
@@ -79,7 +77,7 @@ fn paint_tile(
     opacity: f32,
     alpha: f32,
     tables: &NTables,
-    (fp, id, rect): (&impl Footprint, TileId, TileRect),
+    (fp, id, rect): (&impl Footprint, TileId, TexelRect),
 ) {
     if target.energy_guard {
         // The guard couples k_d and k_s: take the general per-texel path.

@@ -123,7 +123,7 @@ pub fn fill_mask(
 ) {
     let w = maps.width() as usize;
     for id in 0..maps.tile_count() {
-        let (x0, y0, x1, y1) = maps.tile_rect(id);
+        let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
         let any = (y0..y1).any(|y| {
             mask[y as usize * w + x0 as usize..y as usize * w + x1 as usize].contains(&true)
         });

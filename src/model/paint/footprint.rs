@@ -3,11 +3,8 @@
 use glam::Vec2;
 
 use crate::model::brush::BrushSettings;
-use crate::model::maps::{MaterialMaps, TileId};
+use crate::model::maps::{MaterialMaps, TexelRect, TileId};
 use crate::model::tile::TILE_SIZE;
-
-/// A tile's texel rectangle `(x0, y0, x1, y1)`, exclusive ends.
-pub type TileRect = (u32, u32, u32, u32);
 
 /// The texels a dab touches, grouped by tile, each with a weight in `(0, 1]`.
 ///
@@ -19,10 +16,10 @@ pub trait Footprint: Sync {
     fn tiles(&self, maps: &MaterialMaps) -> Vec<TileId>;
     /// Calls `f(start, weights)` for runs of consecutive texels of tile `id`: texel indices
     /// `start..start + weights.len()` (row-major in the tile) with those weights (zero allowed).
-    fn visit_runs(&self, id: TileId, rect: TileRect, f: impl FnMut(usize, &[f32]));
+    fn visit_runs(&self, id: TileId, rect: TexelRect, f: impl FnMut(usize, &[f32]));
 
     /// Calls `f(index_in_tile, weight)` for every texel of tile `id` with a positive weight.
-    fn visit_tile(&self, id: TileId, rect: TileRect, mut f: impl FnMut(usize, f32)) {
+    fn visit_tile(&self, id: TileId, rect: TexelRect, mut f: impl FnMut(usize, f32)) {
         self.visit_runs(id, rect, |start, weights| {
             for (k, &w) in weights.iter().enumerate() {
                 if w > 0.0 {
@@ -44,7 +41,7 @@ pub struct DiscFootprint<'a> {
 }
 
 impl DiscFootprint<'_> {
-    fn bounds(&self, maps: &MaterialMaps) -> Option<(u32, u32, u32, u32)> {
+    fn bounds(&self, maps: &MaterialMaps) -> Option<TexelRect> {
         let lo = (self.center - self.radius).floor().max(Vec2::ZERO);
         let hi = (self.center + self.radius).ceil();
         let (w, h) = (maps.width() as f32, maps.height() as f32);
@@ -56,18 +53,18 @@ impl DiscFootprint<'_> {
         {
             return None;
         }
-        Some((
-            lo.x as u32,
-            lo.y as u32,
-            hi.x.min(w) as u32,
-            hi.y.min(h) as u32,
-        ))
+        Some(TexelRect {
+            x0: lo.x as u32,
+            y0: lo.y as u32,
+            x1: hi.x.min(w) as u32,
+            y1: hi.y.min(h) as u32,
+        })
     }
 }
 
 impl Footprint for DiscFootprint<'_> {
     fn tiles(&self, maps: &MaterialMaps) -> Vec<TileId> {
-        let Some((x0, y0, x1, y1)) = self.bounds(maps) else {
+        let Some(TexelRect { x0, y0, x1, y1 }) = self.bounds(maps) else {
             return Vec::new();
         };
         let t = TILE_SIZE as u32;
@@ -80,8 +77,8 @@ impl Footprint for DiscFootprint<'_> {
         ids
     }
 
-    fn visit_runs(&self, _id: TileId, rect: TileRect, mut f: impl FnMut(usize, &[f32])) {
-        let (x0, y0, x1, y1) = rect;
+    fn visit_runs(&self, _id: TileId, rect: TexelRect, mut f: impl FnMut(usize, &[f32])) {
+        let TexelRect { x0, y0, x1, y1 } = rect;
         let r = self.radius;
         let r2 = r * r;
         let inv_r = 1.0 / r;

@@ -35,7 +35,7 @@ pub fn gradient(
     let axis = end - start;
     let len2 = axis.length_squared().max(1e-12);
     for id in 0..maps.tile_count() {
-        let (x0, y0, x1, y1) = maps.tile_rect(id);
+        let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
         let pre = pre_tile(history, maps, id);
         let tile = history.tile_for_write(maps, id);
         for y in y0..y1 {

@@ -17,7 +17,7 @@ mod tests;
 pub use blur::blur_dab;
 pub use dab::paint_dab;
 pub use fill::{fill_all, fill_mask, flood_region};
-pub use footprint::{DiscFootprint, Footprint, TileRect};
+pub use footprint::{DiscFootprint, Footprint};
 pub use gradient::{GradientShape, gradient};
 
 use std::sync::{Arc, OnceLock};

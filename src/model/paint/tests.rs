@@ -25,8 +25,8 @@ fn disc_footprint_covers_the_disc_exactly() {
         let rect = maps.tile_rect(id);
         fp.visit_tile(id, rect, |i, _| {
             hits.insert((
-                rect.0 + (i % TILE_SIZE) as u32,
-                rect.1 + (i / TILE_SIZE) as u32,
+                rect.x0 + (i % TILE_SIZE) as u32,
+                rect.y0 + (i / TILE_SIZE) as u32,
             ));
         });
     }

@@ -147,7 +147,7 @@ fn fill_maps(maps: &mut MaterialMaps, kd: &Raster, ks: &Raster, n: &Raster) {
     let tiles: Vec<Tile> = (0..maps.tile_count())
         .into_par_iter()
         .map(|id| {
-            let (x0, y0, x1, y1) = maps.tile_rect(id);
+            let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
             let (x0, y0, cols, rows) = (
                 x0 as usize,
                 y0 as usize,
