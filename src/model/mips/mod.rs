@@ -452,40 +452,4 @@ fn write_means<R: MipRows>(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn top_sums_re_added_over_a_few_tiles_equal_sums_built_whole() {
-        // 13 x 9 tiles: odd sides, so blocks at the right and bottom edges are partial.
-        let (tx, ty) = (13, 9);
-        let sums = |id: usize, k: u64| Sums {
-            codes: [1, 2, 3, 4, 5, 6].map(|c| c * 1000 + (id as u64 * 7 + k) % 997),
-            n: (id as f64 * 0.37 + k as f64).sin().abs() * 4096.0,
-            count: 4096,
-        };
-        let all = |k: u64| (0..tx * ty).map(|id| (id, sums(id, k))).collect::<Vec<_>>();
-        let mut kept = TopSums::new(tx, ty);
-        kept.set(&all(0));
-        // Some tiles change: the corner, an edge and a scattered few.
-        let changed = [0, 12, 50, 51, 64, 116];
-        let mut now = all(0);
-        for &id in &changed {
-            now[id] = (id, sums(id, 5));
-        }
-        kept.set(&changed.map(|id| now[id]));
-        let mut whole = TopSums::new(tx, ty);
-        whole.set(&now);
-        assert_eq!(kept.grids.len(), 5, "13 x 9, 7 x 5, 4 x 3, 2 x 2, 1 x 1");
-        for (k, (a, b)) in kept.grids.iter().zip(&whole.grids).enumerate() {
-            assert_eq!(a, b, "grid {k}");
-        }
-        // The last cell is the sum of every tile.
-        let mut total = Sums::default();
-        for (_, s) in &now {
-            total += *s;
-        }
-        assert_eq!(kept.grids[4].0[0].codes, total.codes);
-        assert_eq!(kept.grids[4].0[0].count, total.count);
-    }
-}
+mod tests;
