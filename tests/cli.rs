@@ -469,3 +469,39 @@ fn equivalent_n_maps_between_the_models() {
         "n must be >= 0",
     );
 }
+
+/// `kapaint edit` is a subcommand like the others: `--help` lists it, `help edit` and
+/// `edit --help` print its usage and open no window (no display here: a window would fail).
+#[test]
+fn edit_is_listed_and_its_help_opens_no_window() {
+    let headless = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .expect("kapaint runs")
+    };
+    let help = headless(&["--help"]);
+    assert!(help.status.success());
+    assert!(
+        stdout(&help)
+            .lines()
+            .any(|l| l.trim_start().starts_with("edit ")),
+        "{}",
+        stdout(&help)
+    );
+    for args in [&["help", "edit"][..], &["edit", "--help"]] {
+        let o = headless(args);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            stdout(&o).contains("Usage: kapaint edit [FILE]"),
+            "{args:?}: {}",
+            stdout(&o)
+        );
+    }
+}

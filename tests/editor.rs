@@ -118,6 +118,9 @@ fn a_scripted_editing_session() {
         1,
         "one stroke, one step"
     );
+    // The history panel counts it in English: "1 step", not "1 steps".
+    harness.get_by_label_contains("1 step, ");
+    assert!(harness.query_by_label_contains("1 steps").is_none());
 
     // Undo restores the maps bit-exactly.
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
@@ -155,6 +158,16 @@ fn a_scripted_editing_session() {
     harness.key_press(egui::Key::OpenBracket);
     harness.run();
     assert!(harness.state().state.doc().settings().brush.radius_px < radius);
+    // Shift+[ and Shift+] arrive as `{` and `}` with Shift held, as egui reports them.
+    let hardness = harness.state().state.doc().settings().brush.hardness;
+    harness.key_press_modifiers(Modifiers::SHIFT, egui::Key::OpenCurlyBracket);
+    harness.run();
+    let softer = harness.state().state.doc().settings().brush.hardness;
+    assert!(softer < hardness, "Shift+[ softens: {hardness} -> {softer}");
+    harness.key_press_modifiers(Modifiers::SHIFT, egui::Key::CloseCurlyBracket);
+    harness.run();
+    let harder = harness.state().state.doc().settings().brush.hardness;
+    assert!(harder > softer, "Shift+] hardens: {softer} -> {harder}");
     harness.key_press(egui::Key::E);
     harness.run();
     assert_eq!(
@@ -442,5 +455,63 @@ fn the_shortcut_sheet_shows_the_keymap_the_keys_run() {
     assert_eq!(
         harness.state().state.tools().active(),
         kapaint::tools::ToolKind::Blur
+    );
+}
+
+/// With the cursor over the canvas the status bar shows `k_a` by the exact integral, but the
+/// UI thread (here, the test's) never runs the integrator (45 to 320 ms a value): a worker
+/// does, and the value shows when it arrives.
+#[test]
+fn the_exact_readout_never_integrates_on_the_ui_thread() {
+    let mut harness = editor();
+    let before = kapaint::reflectance::exact::calls_on_this_thread();
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    for k in 0..6 {
+        harness.hover_at(canvas.center() + Vec2::new(k as f32 * 7.0, 3.0));
+        harness.run();
+    }
+    assert_eq!(
+        kapaint::reflectance::exact::calls_on_this_thread(),
+        before,
+        "a frame ran the exact integrator on the UI thread"
+    );
+    // The worker's value arrives within seconds and is shown.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness.query_by_label_contains("exact 0.").is_none() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the exact value never arrived"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.run();
+    }
+    assert_eq!(kapaint::reflectance::exact::calls_on_this_thread(), before);
+}
+
+/// The window title names the project and marks unsaved work.
+#[test]
+fn the_title_names_the_project_and_marks_unsaved_work() {
+    let mut harness = editor();
+    assert_eq!(harness.state().state.window_title(), "untitled - kapaint");
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    drag(
+        &mut harness,
+        canvas.center() - Vec2::new(40.0, 0.0),
+        canvas.center() + Vec2::new(40.0, 5.0),
+    );
+    assert_eq!(harness.state().state.window_title(), "untitled* - kapaint");
+}
+
+/// Dialogs open in the middle of the window, not at the top left over the tools.
+#[test]
+fn dialogs_open_centred() {
+    let mut harness = editor();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
+    harness.run();
+    harness.run();
+    let title = harness.get_by_label("New project").rect();
+    assert!(
+        (title.center().x - 700.0).abs() < 120.0 && title.top() > 150.0,
+        "the New dialog's title is at {title:?} in a 1400 x 900 window"
     );
 }

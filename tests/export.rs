@@ -161,6 +161,9 @@ fn every_builtin_preset_exports_and_imports() {
         let out = dir.join(&p.name);
         let m = set::export(&doc, &p, &out).expect("export");
         assert!(out.join("material.json").is_file());
+        // What the editor's notice counts is what the folder holds.
+        let written = std::fs::read_dir(&out).expect("set folder").count();
+        assert_eq!(m.file_count(), written, "{}", p.name);
         let back = set::import(&out.join("material.json")).expect("import");
         let err = max_rel_ka_error(&doc, &back);
         match p.format {

@@ -18,6 +18,7 @@ mod args;
 mod bench;
 mod chi;
 mod debug_panic;
+mod edit;
 mod equivalent_n;
 mod export;
 mod import;
@@ -97,6 +98,8 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Open the editor, on the project FILE if one is given (`kapaint` alone opens it too).
+    Edit(edit::EditArgs),
     /// Print chi(n), the specular part of k_a per unit k_s, as CSV `n,chi`.
     Chi(chi::ChiArgs),
     /// Print k_a = (2/pi) k_d + k_s chi(n) of one texel as `r,g,b`.
@@ -144,8 +147,13 @@ pub fn main() -> i32 {
             return EXIT_USAGE;
         }
     };
+    let command = match cli.command {
+        Command::Edit(editor) => return editor.run(),
+        command => command,
+    };
+    crate::crash::install(crate::crash::OnPanic::Exit);
     let stdin = std::io::stdin();
-    match run(cli.command, &mut stdin.lock()) {
+    match run(command, &mut stdin.lock()) {
         Ok(text) => {
             let mut stdout = std::io::stdout().lock();
             if stdout
@@ -186,6 +194,9 @@ pub fn clap_message(rendered: &str) -> String {
 /// What the command reports: one line and an exit code.
 pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError> {
     match command {
+        Command::Edit(_) => Err(CliError::usage(
+            "`kapaint edit` opens the editor's window: run it from a terminal",
+        )),
         Command::Chi(a) => a.run(stdin),
         Command::Ka(a) => a.run(),
         Command::Accuracy(a) => a.run(),

@@ -48,6 +48,16 @@ pub const EXACT_N_MAX: f64 = 1.0e6;
 /// The tanh-sinh level used by [`chi_exact`]; the tests compare it with the next level.
 pub const DEFAULT_LEVEL: u32 = 7;
 
+thread_local! {
+    static CALLS_ON_THIS_THREAD: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// How many exact integrals the calling thread has run: the editor's tests check that its
+/// UI thread never runs one (each takes 45 to 320 ms).
+pub fn calls_on_this_thread() -> u64 {
+    CALLS_ON_THIS_THREAD.with(std::cell::Cell::get)
+}
+
 /// `chi(n)`, the specular average of eq. (6), for `model` at the default quadrature level.
 ///
 /// `n` is clamped into `[0, EXACT_N_MAX]`; NaN is treated as 0. At `n = 0` the value is the
@@ -59,6 +69,7 @@ pub fn chi_exact(model: ShadingModel, n: f64) -> f64 {
 /// [`chi_exact`] with an explicit tanh-sinh level (step `2^(-level/2)`), for convergence
 /// studies: `level + 2` doubles the nodes of every rule.
 pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
+    CALLS_ON_THIS_THREAD.with(|c| c.set(c.get() + 1));
     let n = if n.is_nan() {
         0.0
     } else {

@@ -103,6 +103,23 @@ impl ViewMode {
         Self::NFalseColour,
     ];
 
+    /// The name the editor shows: the CLI's, with `k_a`, `k_d`, `k_s` spelt as everywhere
+    /// else in the UI.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Shaded => "shaded",
+            Self::Ka => "k_a",
+            Self::Kd => "k_d",
+            Self::Ks => "k_s",
+            Self::N => "n",
+            Self::Diffuse => "diffuse",
+            Self::Specular => "specular",
+            Self::Ambient => "ambient",
+            Self::Checker => "checker",
+            Self::NFalseColour => "n false colour",
+        }
+    }
+
     /// The CLI name.
     pub fn name(self) -> &'static str {
         match self {

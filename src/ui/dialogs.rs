@@ -222,7 +222,7 @@ impl EditorState {
             return;
         };
         let (mut open, mut create) = (true, false);
-        egui::Window::new("New project")
+        centred(egui::Window::new("New project"), ctx)
             .open(&mut open)
             .collapsible(false)
             .show(ctx, |ui| {
@@ -368,7 +368,7 @@ impl EditorState {
         };
         let mut open = true;
         let mut go = false;
-        egui::Window::new("Export")
+        centred(egui::Window::new("Export"), ctx)
             .open(&mut open)
             .collapsible(false)
             .show(ctx, |ui| {
@@ -425,6 +425,7 @@ impl EditorState {
         };
         let (mut save, mut discard, mut cancel) = (false, false, false);
         egui::Window::new("Open: unsaved changes")
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
             .collapsible(false)
             .resizable(false)
             .show(ctx, |ui| {
@@ -459,6 +460,7 @@ impl EditorState {
         }
         if self.quit_asked && self.dirty() && !self.allow_close {
             egui::Window::new("Unsaved changes")
+                .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
                 .collapsible(false)
                 .show(ctx, |ui| {
                     ui.label("The material has unsaved changes.");
@@ -477,4 +479,12 @@ impl EditorState {
                 });
         }
     }
+}
+
+/// A window that opens in the middle of the editor (not at the top left, over the tools);
+/// it can still be moved.
+pub(super) fn centred<'a>(window: egui::Window<'a>, ctx: &egui::Context) -> egui::Window<'a> {
+    window
+        .pivot(egui::Align2::CENTER_CENTER)
+        .default_pos(ctx.content_rect().center())
 }

@@ -130,7 +130,7 @@ impl EditorState {
                 format!(
                     "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
                     dir.display(),
-                    m.files.len(),
+                    m.file_count(),
                     m.bytes.exported,
                     m.ka_error.max * 100.0,
                     m.ka_error.mean * 100.0
@@ -155,7 +155,11 @@ impl EditorState {
                 let imported = crate::model::document::ImportedChannel(Arc::new(*planes));
                 match self.doc.apply(Command::ImportChannel(imported)) {
                     Ok(()) => self.notices.push(notice(
-                        format!("{} imported into {}", path.display(), channel.name()),
+                        format!(
+                            "{} imported into {}",
+                            path.display(),
+                            crate::ui::panels::channel_label(channel)
+                        ),
                         false,
                     )),
                     Err(e) => self.notices.push(notice(e.to_string(), true)),

@@ -142,6 +142,20 @@ pub fn shortcut(action: Action) -> Option<KeyboardShortcut> {
         .map(|b| b.shortcut)
 }
 
+/// What a shifted symbol key arrives as: with Shift held, egui reports the symbol the layout
+/// makes (`{` for Shift+`[` on US and most layouts), not the key.
+fn shifted(shortcut: KeyboardShortcut) -> Option<KeyboardShortcut> {
+    let key = match shortcut.logical_key {
+        Key::OpenBracket => Key::OpenCurlyBracket,
+        Key::CloseBracket => Key::CloseCurlyBracket,
+        _ => return None,
+    };
+    shortcut
+        .modifiers
+        .shift
+        .then(|| KeyboardShortcut::new(shortcut.modifiers, key))
+}
+
 /// A binding as people write it (`Ctrl+Shift+Z`, `Shift+[`, `B`), independent of the platform
 /// (the README and the tests use it; the editor shows egui's own formatting).
 pub fn written(shortcut: &KeyboardShortcut) -> String {
@@ -170,7 +184,10 @@ impl EditorState {
         let actions: Vec<Action> = ctx.input_mut(|i| {
             KEYMAP
                 .iter()
-                .filter(|b| i.consume_shortcut(&b.shortcut))
+                .filter(|b| {
+                    i.consume_shortcut(&b.shortcut)
+                        || shifted(b.shortcut).is_some_and(|s| i.consume_shortcut(&s))
+                })
                 .map(|b| b.action)
                 .collect()
         });
@@ -209,7 +226,7 @@ impl EditorState {
     /// Help > Keyboard shortcuts: the keymap, as the input code reads it.
     pub(super) fn shortcuts_window(&mut self, ctx: &egui::Context) {
         let mut open = self.shortcuts_open;
-        egui::Window::new("Keyboard shortcuts")
+        super::dialogs::centred(egui::Window::new("Keyboard shortcuts"), ctx)
             .open(&mut open)
             .collapsible(false)
             .show(ctx, |ui| {

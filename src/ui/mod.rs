@@ -12,6 +12,7 @@ mod jobs;
 pub mod keys;
 mod layout;
 mod panels;
+mod readout;
 pub mod viewport;
 
 use dialogs::{ExportDialog, load_recent};
@@ -186,6 +187,8 @@ pub struct EditorState {
     hover_tab: Option<Tab>,
     /// `hover` as of the last frame (the status bar is drawn before the tabs).
     shown_hover: Option<(u32, u32)>,
+    /// Exact `chi` values for the status bar, integrated on a worker.
+    exact_chi: readout::ExactChi,
     quit_asked: bool,
     /// Whether Help > Keyboard shortcuts is open.
     shortcuts_open: bool,
@@ -206,6 +209,8 @@ pub struct Editor {
     /// When the process started, until the first frame is drawn (then logged to stderr when
     /// `KAPAINT_LOG_STARTUP` is set).
     started: Option<Instant>,
+    /// The window title last sent.
+    title: String,
 }
 
 impl Editor {
@@ -280,6 +285,7 @@ impl Editor {
                 hover: None,
                 hover_tab: None,
                 shown_hover: None,
+                exact_chi: readout::ExactChi::new(),
                 quit_asked: false,
                 shortcuts_open: false,
                 allow_close: false,
@@ -292,6 +298,7 @@ impl Editor {
             },
             dock,
             started: None,
+            title: String::new(),
         }
     }
 }
@@ -368,6 +375,18 @@ impl EditorState {
     /// save.
     pub fn dirty(&self) -> bool {
         self.doc.version() != self.saved_version
+    }
+
+    /// The window's title: the project's file name (or "untitled"), a `*` while it has
+    /// unsaved changes, then the program's name.
+    pub fn window_title(&self) -> String {
+        let name = self
+            .path
+            .as_deref()
+            .and_then(Path::file_name)
+            .map_or_else(|| "untitled".into(), |n| n.to_string_lossy().into_owned());
+        let marker = if self.dirty() { "*" } else { "" };
+        format!("{name}{marker} - kapaint")
     }
 
     fn apply(&mut self, command: Command) {
@@ -484,6 +503,11 @@ impl Editor {
         s.open_prompt(&ctx);
         if s.job.is_some() {
             ctx.request_repaint_after(Duration::from_millis(100));
+        }
+        let title = s.window_title();
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
         }
         if let Some(start) = self.started.take()
             && std::env::var_os("KAPAINT_LOG_STARTUP").is_some()

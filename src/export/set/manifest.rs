@@ -380,6 +380,14 @@ pub struct Manifest {
     pub preset: String,
 }
 
+impl Manifest {
+    /// Every file the set's folder holds: the images, `material.json`, `material.wgsl` and
+    /// `material.glsl`.
+    pub fn file_count(&self) -> usize {
+        self.files.len() + 3
+    }
+}
+
 /// A manifest as a file spells it, before the checks that span its fields.
 #[derive(Deserialize)]
 struct ManifestFile {

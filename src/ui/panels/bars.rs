@@ -16,9 +16,9 @@ impl EditorState {
             ui.label(format!("{}x{}", maps.width(), maps.height()));
             ui.separator();
             ui.label(format!(
-                "maps {:.0} MB, history {:.0} MB",
-                maps.heap_bytes() as f64 / 1e6,
-                self.doc.history().bytes() as f64 / 1e6
+                "maps {}, history {}",
+                super::view_panel::megabytes(maps.heap_bytes()),
+                super::view_panel::megabytes(self.doc.history().bytes())
             ));
             ui.separator();
             match &self.viewport.gpu {
@@ -36,16 +36,23 @@ impl EditorState {
                 let approx = self.doc.settings().approx;
                 let phong = ka(ShadingModel::Phong, approx);
                 let blinn = ka(ShadingModel::BlinnPhong, approx);
-                let exact = |m| {
-                    v.kd * reflectance::diffuse_factor(AmbientApprox::Fast) as f32
-                        + v.ks
-                            * reflectance::exact::chi_exact(m, f64::from(v.n)) as f32
-                };
                 let model = self.doc.settings().model;
+                // Integrated on a worker, shown when it arrives: never on this thread.
+                let n_bits = maps.texel(x, y).n;
+                let exact = self
+                    .exact_chi
+                    .get(ui.ctx(), model, n_bits)
+                    .map_or_else(
+                        || "...".to_string(),
+                        |chi| {
+                            let diffuse = reflectance::diffuse_factor(AmbientApprox::Fast) as f32;
+                            format!("{:.4}", diffuse * v.kd.x + v.ks.x * chi as f32)
+                        },
+                    );
                 ui.separator();
                 ui.label(format!(
-                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  exact {:.4}",
-                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x, exact(model).x
+                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  exact {exact}",
+                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x
                 ))
                 .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), and the exact integral for the current model");
             }
@@ -120,7 +127,7 @@ impl EditorState {
                 }
                 for channel in [Channel::Kd, Channel::Ks, Channel::N] {
                     if ui
-                        .button(format!("Import image into {}…", channel.name()))
+                        .button(format!("Import image into {}…", channel_label(channel)))
                         .clicked()
                         && let Some(p) = rfd::FileDialog::new()
                             .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
@@ -202,5 +209,14 @@ impl EditorState {
                 }
             });
         ctx.request_repaint_after(Duration::from_millis(500));
+    }
+}
+
+/// A channel as the editor names it everywhere: `k_d`, `k_s`, `n`.
+pub(in crate::ui) fn channel_label(channel: Channel) -> &'static str {
+    match channel {
+        Channel::Kd => "k_d",
+        Channel::Ks => "k_s",
+        Channel::N => "n",
     }
 }

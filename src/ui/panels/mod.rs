@@ -5,3 +5,5 @@
 mod bars;
 mod tool_panel;
 mod view_panel;
+
+pub(super) use bars::channel_label;

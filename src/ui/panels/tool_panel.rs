@@ -50,10 +50,10 @@ impl EditorState {
                     });
                 if let FillMode::Similar { channel, tolerance } = mode {
                     egui::ComboBox::from_label("Compared channel")
-                        .selected_text(channel.name())
+                        .selected_text(super::bars::channel_label(*channel))
                         .show_ui(ui, |ui| {
                             for c in Channel::ALL {
-                                ui.selectable_value(channel, c, c.name());
+                                ui.selectable_value(channel, c, super::bars::channel_label(c));
                             }
                         });
                     ui.add(egui::Slider::new(tolerance, 0.0..=1.0).text("Tolerance"))
@@ -149,8 +149,11 @@ impl EditorState {
             self.doc.settings().model,
             f64::from(primary.n),
         );
-        ui.label(format!("≈ n {eq:.1} in {}", other.name()))
-            .on_hover_text("The exponent of the other model with the closest highlight");
+        ui.label(format!(
+            "≈ n {eq:.1} in {}",
+            super::view_panel::model_label(other)
+        ))
+        .on_hover_text("The exponent of the other model with the closest highlight");
         if primary != self.doc.settings().primary {
             self.apply(Command::SetPrimary(primary));
         }

@@ -27,10 +27,11 @@ impl EditorState {
         for (name, side) in [("Left", &mut c.left), ("Right", &mut c.right)] {
             ui.horizontal(|ui| {
                 egui::ComboBox::from_id_salt(("compare model", name))
-                    .selected_text(side.model.name())
+                    .selected_text(model_label(side.model))
+                    .width(COMBO_WIDTH)
                     .show_ui(ui, |ui| {
                         for m in ShadingModel::ALL {
-                            ui.selectable_value(&mut side.model, m, m.name());
+                            ui.selectable_value(&mut side.model, m, model_label(m));
                         }
                     });
                 egui::ComboBox::from_id_salt(("compare approx", name))
@@ -65,8 +66,9 @@ impl EditorState {
         ui.heading("Shading");
         let mut model = self.doc.settings().model;
         ui.horizontal(|ui| {
-            ui.selectable_value(&mut model, ShadingModel::Phong, "Phong (8)");
-            ui.selectable_value(&mut model, ShadingModel::BlinnPhong, "Blinn-Phong (11)");
+            for m in ShadingModel::ALL {
+                ui.selectable_value(&mut model, m, model_label(m));
+            }
         });
         if model != self.doc.settings().model {
             self.apply(Command::SetModel(model));
@@ -85,10 +87,11 @@ impl EditorState {
         self.compare_ui(ui);
         ui.heading("View");
         egui::ComboBox::from_label("View mode")
-            .selected_text(self.view.name())
+            .selected_text(self.view.label())
+            .width(COMBO_WIDTH)
             .show_ui(ui, |ui| {
                 for v in ViewMode::ALL {
-                    ui.selectable_value(&mut self.view, v, v.name());
+                    ui.selectable_value(&mut self.view, v, v.label());
                 }
             });
         egui::ComboBox::from_label("Canvas shows")
@@ -120,10 +123,9 @@ impl EditorState {
             .default_open(true)
             .show(ui, |ui| self.presets_ui(ui));
         ui.heading("History");
-        ui.label(format!(
-            "{} steps, {:.1} MB",
+        ui.label(history_summary(
             self.doc.history().undo_steps().count(),
-            self.doc.history().bytes() as f64 / 1e6
+            self.doc.history().bytes(),
         ));
         egui::ScrollArea::vertical()
             .max_height(160.0)
@@ -227,4 +229,28 @@ impl EditorState {
             self.apply(Command::SetPrimary(v));
         }
     }
+}
+
+/// The width of the right panel's drop-down menus: wide enough for the longest entry
+/// ("n false colour", "Blinn-Phong (11)").
+const COMBO_WIDTH: f32 = 130.0;
+
+/// A shading model as the editor names it: with the paper's equation of its `k_a`.
+pub(in crate::ui) fn model_label(model: ShadingModel) -> &'static str {
+    match model {
+        ShadingModel::Phong => "Phong (8)",
+        ShadingModel::BlinnPhong => "Blinn-Phong (11)",
+    }
+}
+
+/// The history's size: "1 step, 0.2 MB", "3 steps, 1.5 MB" (the status bar shows the same
+/// memory figure).
+pub(in crate::ui) fn history_summary(steps: usize, bytes: usize) -> String {
+    let noun = if steps == 1 { "step" } else { "steps" };
+    format!("{steps} {noun}, {}", megabytes(bytes))
+}
+
+/// Bytes as megabytes with one decimal, as the panel and the status bar both show them.
+pub(in crate::ui) fn megabytes(bytes: usize) -> String {
+    format!("{:.1} MB", bytes as f64 / 1e6)
 }
