@@ -21,8 +21,11 @@ fn texels(editor: &Editor) -> Vec<Texel> {
 
 /// The editor on a new default document in a 1400 x 900 window, its first frame drawn.
 fn editor() -> Harness<'static, Editor> {
+    // The status bar's exact value arrives from a worker whenever it is done and asks for a
+    // frame then: a few more steps than a UI that only reacts to input.
     let mut harness = Harness::builder()
         .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(16)
         .build_ui_state(
             |ui, editor: &mut Editor| editor.frame(ui),
             Editor::new(None, None),
@@ -513,5 +516,65 @@ fn dialogs_open_centred() {
     assert!(
         (title.center().x - 700.0).abs() < 120.0 && title.top() > 150.0,
         "the New dialog's title is at {title:?} in a 1400 x 900 window"
+    );
+}
+
+/// Every pointer event of a frame is painted: a quick curved stroke whose events all arrive
+/// in one frame paints the same texels as the same events spread over a frame each (egui
+/// delivers several moves a frame when painting is slower than the mouse), the tail up to
+/// the release point included.
+#[test]
+fn a_stroke_of_many_events_in_one_frame_paints_as_if_spread_over_many() {
+    let path = |canvas: egui::Rect| -> Vec<Pos2> {
+        // A half circle: one pointer position per frame would cut it to a straight line.
+        (0..=36)
+            .map(|k| {
+                let t = std::f32::consts::PI * k as f32 / 36.0;
+                canvas.center() + Vec2::new(-80.0 * t.cos(), -60.0 * t.sin())
+            })
+            .collect()
+    };
+    let paint = |one_frame: bool| {
+        let mut harness = editor();
+        let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+        let points = path(canvas);
+        harness.hover_at(points[0]);
+        harness.run();
+        let events = std::iter::once(egui::Event::PointerButton {
+            pos: points[0],
+            button: egui::PointerButton::Primary,
+            pressed: true,
+            modifiers: Modifiers::NONE,
+        })
+        .chain(points[1..].iter().map(|p| egui::Event::PointerMoved(*p)))
+        .chain(std::iter::once(egui::Event::PointerButton {
+            pos: points[36],
+            button: egui::PointerButton::Primary,
+            pressed: false,
+            modifiers: Modifiers::NONE,
+        }));
+        for event in events {
+            harness.input_mut().events.push(event);
+            if !one_frame {
+                harness.step();
+            }
+        }
+        harness.run();
+        assert_eq!(
+            harness.state().state.doc().history().undo_steps().count(),
+            1,
+            "one stroke, one step"
+        );
+        texels(harness.state())
+    };
+    let spread = paint(false);
+    let at_once = paint(true);
+    assert!(
+        spread != texels(&Editor::new(None, None)),
+        "nothing painted"
+    );
+    assert!(
+        at_once == spread,
+        "one frame of events painted other texels"
     );
 }

@@ -31,7 +31,8 @@ start() {
   for _ in $(seq 1 600); do grep -q "first frame" "$log" && break; sleep 0.1; done
   grep -q "first frame" "$log" || { echo "no first frame"; cat "$log"; kill $pid; exit 3; }
   sleep 1
-  win=$(xdotool search --sync --name '^kapaint$' | head -1)
+  # The title names the project: "stroke.kapaint - kapaint".
+  win=$(xdotool search --sync --name ' - kapaint$' | head -1)
   xdotool windowfocus --sync "$win" 2>/dev/null || true
 }
 stroke() {
@@ -114,7 +115,19 @@ fn assert_painted(project: &Path, what: &str) {
 
 #[test]
 fn the_real_window_paints_saves_and_quits() {
-    let script = "start\nstroke\nsave_and_quit\n";
+    // The title marks the unsaved stroke, and the mark goes with the save.
+    let script = r#"
+start
+stroke
+title=$(xdotool getwindowname "$win")
+[ "$title" = "stroke.kapaint* - kapaint" ] || { echo "title after the stroke: $title"; exit 7; }
+xdotool key --clearmodifiers ctrl+s
+for _ in $(seq 1 300); do [ -f "$project" ] && break; sleep 0.1; done
+sleep 1
+title=$(xdotool getwindowname "$win")
+[ "$title" = "stroke.kapaint - kapaint" ] || { echo "title after saving: $title"; exit 8; }
+save_and_quit
+"#;
     if let Some(project) = run_in_window("save", script, &[]) {
         assert_painted(&project, "the saved project does not hold the stroke");
     }

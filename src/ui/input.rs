@@ -1,7 +1,9 @@
-//! Pointer input on the UV canvas and the 3D viewport: each frame's primary-button press,
-//! drag and release become [`ToolEvent`]s for the active tool, whose commands are applied to
-//! the document; the camera and the light drag stay here. Space (canvas) and Alt (viewport)
-//! keep the primary button for panning and orbiting.
+//! Pointer input on the UV canvas and the 3D viewport: every pointer event egui delivers in a
+//! frame (press, each move, release, in order, with their positions) becomes a [`ToolEvent`]
+//! for the active tool, whose commands are applied to the document, so a quick stroke keeps
+//! its shape and its tail up to the release point however few frames it spans. The camera
+//! and the light drag stay here. Space (canvas) and Alt (viewport) keep the primary button
+//! for panning and orbiting.
 
 use egui::Key;
 use glam::Vec2;
@@ -47,36 +49,54 @@ impl EditorState {
         }
     }
 
-    /// The tool events of one view this frame: a press where the primary button went down
-    /// on it (not while `reserved`, the modifier that gives the button to the camera), drags
-    /// while it is held, a release where it came up. A press off the map or the mesh still
-    /// holds the button, so a drag that reaches them starts there.
+    /// The tool events of one view this frame, from `samples` (this frame's primary-button
+    /// events, in order, each with the place under it): a press on the view (not while
+    /// `reserved`, the modifier that gives the button to the camera, nor under a window over
+    /// it), a drag for every move while it is held, a drag to where it came up and the
+    /// release. A press off the map or the mesh still holds the button, so a drag that reaches
+    /// them starts there.
     fn pointer_input(
         &mut self,
         tab: Tab,
         response: &egui::Response,
-        at: Option<Place>,
+        samples: Vec<(Sample, Option<Place>)>,
         reserved: bool,
     ) {
-        let primary = response.ctx.input(|i| i.pointer.primary_down());
-        let down = primary && response.is_pointer_button_down_on();
         let pressure = self.pressure;
-        if self.held.is_none() && (down || response.clicked()) && !reserved {
-            self.held = Some(tab);
-            if let Some(at) = at {
-                self.tool_event(ToolEvent::Press { at, pressure });
+        for (sample, at) in samples {
+            match sample {
+                Sample::Down(p) => {
+                    let on_view = response.interact_rect.contains(p)
+                        && response.ctx.layer_id_at(p) == Some(response.layer_id);
+                    if self.held.is_none() && on_view && !reserved {
+                        self.held = Some(tab);
+                        if let Some(at) = at {
+                            self.tool_event(ToolEvent::Press { at, pressure });
+                        }
+                    }
+                }
+                Sample::Move(_) | Sample::Up(_) if self.held == Some(tab) => {
+                    if let Some(at) = at {
+                        self.tool_event(ToolEvent::Drag { at, pressure });
+                    }
+                    if matches!(sample, Sample::Up(_)) {
+                        self.release();
+                    }
+                }
+                Sample::Move(_) | Sample::Up(_) => {}
             }
-        } else if self.held == Some(tab)
-            && down
-            && let Some(at) = at
-        {
-            self.tool_event(ToolEvent::Drag { at, pressure });
         }
-        if self.held == Some(tab) && (!down || response.drag_stopped()) {
-            self.held = None;
-            self.pressure = 1.0;
-            self.tool_event(ToolEvent::Release);
+        // A release egui never reported (the pointer left the window): end the stroke.
+        if self.held == Some(tab) && !response.ctx.input(|i| i.pointer.primary_down()) {
+            self.release();
         }
+    }
+
+    /// Ends the stroke under way.
+    fn release(&mut self) {
+        self.held = None;
+        self.pressure = 1.0;
+        self.tool_event(ToolEvent::Release);
     }
 
     /// The canvas: hover readout, tool events, the gradient being dragged.
@@ -89,7 +109,14 @@ impl EditorState {
             self.hover_tab = Some(Tab::Canvas);
         }
         let space = response.ctx.input(|i| i.key_down(Key::Space));
-        self.pointer_input(Tab::Canvas, response, pos.map(Place::Canvas), space);
+        let samples = pointer_samples(&response.ctx)
+            .into_iter()
+            .map(|s| {
+                let at = Place::Canvas(self.canvas.to_texel(rect, s.pos(), size));
+                (s, Some(at))
+            })
+            .collect();
+        self.pointer_input(Tab::Canvas, response, samples, space);
         if self.tools.active() == ToolKind::Gradient
             && let Some((start, end)) = self.tools.gradient.drag()
         {
@@ -115,18 +142,30 @@ impl EditorState {
             self.doc.maps().width() as f32,
             self.doc.maps().height() as f32,
         );
-        let place = hit.as_ref().map(|hit| Place::Surface {
+        let place_of = |hit: &crate::mesh::pick::Hit| Place::Surface {
             pos: SurfacePos {
                 point: hit.position,
                 normal: hit.normal,
             },
             texel: hit.uv.map(|uv| Vec2::new(uv.x * w, (1.0 - uv.y) * h)),
-        });
+        };
+        let place = hit.as_ref().map(place_of);
         if response.hovered() {
             self.hover_tab = Some(Tab::Viewport);
             self.hover = place.and_then(Place::texel).and_then(|p| self.texel_at(p));
         }
-        self.pointer_input(Tab::Viewport, response, place, alt);
+        // Picking every sample costs a ray each; only while a stroke may start or is held.
+        let samples = pointer_samples(&response.ctx)
+            .into_iter()
+            .filter(|_| self.held.is_none() || self.held == Some(Tab::Viewport))
+            .map(|s| {
+                let hit = self
+                    .viewport
+                    .pick(rect, s.pos(), &self.mesh.mesh, &self.mesh.bvh);
+                (s, hit.as_ref().map(place_of))
+            })
+            .collect();
+        self.pointer_input(Tab::Viewport, response, samples, alt);
         // The brush circle, projected on the surface: a circle of the dab's world radius in
         // the tangent plane under the cursor, drawn through the camera.
         if let (Some(p), Some(surface)) = (response.hover_pos(), self.doc.surface())
@@ -161,4 +200,47 @@ impl EditorState {
             camera: self.viewport.camera,
         }
     }
+}
+
+/// One primary-button pointer event of a frame, with its position in points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Sample {
+    /// The button went down.
+    Down(egui::Pos2),
+    /// The pointer moved.
+    Move(egui::Pos2),
+    /// The button came up.
+    Up(egui::Pos2),
+}
+
+impl Sample {
+    fn pos(self) -> egui::Pos2 {
+        match self {
+            Self::Down(p) | Self::Move(p) | Self::Up(p) => p,
+        }
+    }
+}
+
+/// This frame's pointer events, in the order egui delivered them: presses and releases of
+/// the primary button and every move.
+fn pointer_samples(ctx: &egui::Context) -> Vec<Sample> {
+    ctx.input(|i| {
+        i.events
+            .iter()
+            .filter_map(|e| match e {
+                egui::Event::PointerMoved(p) => Some(Sample::Move(*p)),
+                egui::Event::PointerButton {
+                    pos,
+                    button: egui::PointerButton::Primary,
+                    pressed,
+                    ..
+                } => Some(if *pressed {
+                    Sample::Down(*pos)
+                } else {
+                    Sample::Up(*pos)
+                }),
+                _ => None,
+            })
+            .collect()
+    })
 }

@@ -215,7 +215,13 @@ impl EditorState {
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
                 Action::SmallerBrush => brush.radius_px = (brush.radius_px / 1.25).max(0.5),
                 Action::LargerBrush => brush.radius_px = (brush.radius_px * 1.25).min(2048.0),
-                Action::Abort => self.tool_event(ToolEvent::Escape),
+                Action::Abort => {
+                    self.tool_event(ToolEvent::Escape);
+                    // The button stays with nobody until it is released and pressed again:
+                    // the rest of the drag and its release paint nothing.
+                    self.held = None;
+                    self.pressure = 1.0;
+                }
             }
         }
         if brush != self.doc.settings().brush {
