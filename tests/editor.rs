@@ -578,3 +578,59 @@ fn a_stroke_of_many_events_in_one_frame_paints_as_if_spread_over_many() {
         "one frame of events painted other texels"
     );
 }
+
+/// The light's yaw and pitch are shown and edited in degrees.
+#[test]
+fn light_angles_are_in_degrees() {
+    let harness = editor();
+    let l = kapaint::render::Lighting::default().light.normalize();
+    let (yaw, pitch) = (
+        f64::from(l.x.atan2(l.z).to_degrees()),
+        f64::from(l.y.asin().to_degrees()),
+    );
+    assert!(yaw.abs() > 5.0 && pitch.abs() > 5.0, "{yaw} {pitch}");
+    let values: Vec<f64> = harness
+        .get_all_by_role(Role::Slider)
+        .filter_map(|n| egui_kittest::kittest::NodeT::accesskit_node(&n).numeric_value())
+        .collect();
+    for angle in [yaw, pitch] {
+        assert!(
+            values.iter().any(|v| (v - angle).abs() < 0.05),
+            "no slider shows {angle} degrees: {values:?}"
+        );
+    }
+}
+
+/// Home fits the map in the UV canvas again after zooming (F stays the fill tool).
+#[test]
+fn home_fits_the_canvas() {
+    let mut harness = editor();
+    let fitted = harness.state().state.canvas_zoom();
+    assert!(fitted > 0.0);
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    harness.hover_at(canvas.center() + Vec2::new(30.0, 20.0));
+    harness.run();
+    for _ in 0..10 {
+        harness.input_mut().events.push(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: Vec2::new(0.0, 120.0),
+            phase: egui::TouchPhase::Move,
+            modifiers: Modifiers::NONE,
+        });
+        harness.step();
+    }
+    harness.run();
+    let zoomed = harness.state().state.canvas_zoom();
+    assert!(
+        zoomed > fitted * 1.5,
+        "the wheel zoomed: {fitted} -> {zoomed}"
+    );
+    harness.key_press(egui::Key::Home);
+    harness.run();
+    let back = harness.state().state.canvas_zoom();
+    // The panel is the same but for a pixel or two of layout since the first frame.
+    assert!(
+        (back - fitted).abs() < fitted * 0.02,
+        "Home fits again: {back} vs {fitted}"
+    );
+}

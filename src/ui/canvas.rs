@@ -147,6 +147,12 @@ impl Canvas {
         }
     }
 
+    /// Fits the whole map in the panel at the next frame, centred.
+    pub fn fit(&mut self) {
+        self.zoom = 0.0;
+        self.pan = Vec2::ZERO;
+    }
+
     /// Screen rectangle of the map inside `panel`.
     pub fn map_rect(&mut self, panel: Rect, size: (u32, u32)) -> Rect {
         if self.zoom <= 0.0 {

@@ -218,6 +218,14 @@ impl EditorState {
 
     pub(super) fn replace_document(&mut self, doc: Document) {
         let mesh = doc.surface().map(|s| s.mesh.clone());
+        let size = |d: &Document| (d.maps().width(), d.maps().height());
+        if size(&doc) != size(&self.doc) {
+            // A map of another size: fit it anew (the old zoom would show a 4096^2 map 4x).
+            self.canvas.fit();
+        }
+        // The texel under the cursor was found on the old maps.
+        self.hover = None;
+        self.shown_hover = None;
         self.doc = doc;
         if let Some(mesh) = mesh {
             self.mesh = MeshState::new(mesh, self.mesh.id + 1);

@@ -31,6 +31,8 @@ pub enum Action {
     Tool(ToolKind),
     /// The fill tool over the UV canvas; frame the mesh over the 3D viewport.
     FillOrFrame,
+    /// Fit the whole map in the UV canvas.
+    FitCanvas,
     /// Swap the primary and secondary materials.
     SwapMaterials,
     /// A smaller brush.
@@ -100,6 +102,12 @@ pub const KEYMAP: &[Binding] = &[
         Key::F,
         Action::FillOrFrame,
         "fill (UV canvas) / frame mesh (viewport)",
+    ),
+    bind(
+        NONE,
+        Key::Home,
+        Action::FitCanvas,
+        "fit the map in the UV canvas",
     ),
     bind(
         NONE,
@@ -210,6 +218,7 @@ impl EditorState {
                         self.viewport.frame(&self.mesh.mesh);
                     }
                 }
+                Action::FitCanvas => self.canvas.fit(),
                 Action::SwapMaterials => self.apply(Command::SwapMaterials),
                 Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
@@ -278,6 +287,7 @@ mod tests {
             Action::Export,
             Action::Quit,
             Action::FillOrFrame,
+            Action::FitCanvas,
             Action::SwapMaterials,
             Action::SmallerBrush,
             Action::LargerBrush,

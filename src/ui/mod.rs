@@ -377,6 +377,12 @@ impl EditorState {
         self.doc.version() != self.saved_version
     }
 
+    /// The UV canvas's zoom, in screen points per texel (0 until it is fitted to its
+    /// panel).
+    pub fn canvas_zoom(&self) -> f32 {
+        self.canvas.zoom
+    }
+
     /// The window's title: the project's file name (or "untitled"), a `*` while it has
     /// unsaved changes, then the program's name.
     pub fn window_title(&self) -> String {

@@ -30,7 +30,10 @@ impl EditorState {
                 )),
                 None => ui.label("no GPU"),
             };
-            if let Some((x, y)) = self.shown_hover {
+            if let Some((x, y)) = self
+                .shown_hover
+                .filter(|&(x, y)| x < maps.width() && y < maps.height())
+            {
                 let v = maps.value(x, y);
                 let ka = |m, a| reflectance::ka(m, a, v.kd, v.ks, v.n);
                 let approx = self.doc.settings().approx;

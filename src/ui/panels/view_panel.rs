@@ -103,14 +103,26 @@ impl EditorState {
             });
         ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
         ui.heading("Light");
+        // Shown and edited in degrees, as artists think of angles; kept as a direction.
         let l = self.lighting.light.normalize_or(glam::Vec3::Z);
-        let (mut yaw, mut pitch) = (l.x.atan2(l.z), l.y.clamp(-1.0, 1.0).asin());
+        let (mut yaw, mut pitch) = (
+            l.x.atan2(l.z).to_degrees(),
+            l.y.clamp(-1.0, 1.0).asin().to_degrees(),
+        );
         let a = ui.add(
-            egui::Slider::new(&mut yaw, -std::f32::consts::PI..=std::f32::consts::PI)
+            egui::Slider::new(&mut yaw, -180.0..=180.0)
+                .suffix("°")
+                .fixed_decimals(1)
                 .text("Light yaw"),
         );
-        let b = ui.add(egui::Slider::new(&mut pitch, -1.55..=1.55).text("Light pitch"));
+        let b = ui.add(
+            egui::Slider::new(&mut pitch, -89.0..=89.0)
+                .suffix("°")
+                .fixed_decimals(1)
+                .text("Light pitch"),
+        );
         if a.changed() || b.changed() {
+            let (yaw, pitch) = (yaw.to_radians(), pitch.to_radians());
             self.lighting.light = glam::Vec3::new(
                 pitch.cos() * yaw.sin(),
                 pitch.sin(),
