@@ -634,3 +634,16 @@ fn home_fits_the_canvas() {
         "Home fits again: {back} vs {fitted}"
     );
 }
+
+/// The n false-colour view shows its scale in the viewport, as `kapaint render` does.
+#[test]
+fn the_n_false_colour_view_has_a_legend() {
+    use kapaint::ui::viewport::N_LEGEND_LABEL;
+    let mut harness = editor();
+    assert!(harness.query_by_label(N_LEGEND_LABEL).is_none());
+    harness.get_by_label("View mode").click();
+    harness.run();
+    harness.get_by_label("n false colour").click();
+    harness.run();
+    harness.get_by_label(N_LEGEND_LABEL);
+}

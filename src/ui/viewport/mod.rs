@@ -5,7 +5,7 @@
 mod overlay;
 mod renderer;
 
-pub use overlay::DIVIDER_LABEL;
+pub use overlay::{DIVIDER_LABEL, N_LEGEND_LABEL};
 pub use renderer::ViewportGpu;
 
 use std::sync::Arc;
@@ -242,6 +242,11 @@ impl Viewport {
             }
         }
         self.labels_ui(&painter, rect);
+        if settings.view == crate::render::ViewMode::NFalseColour
+            && self.comparison.mode != Compare::Difference
+        {
+            overlay::n_legend_ui(ui, &painter, rect);
+        }
         (response, rect)
     }
 }

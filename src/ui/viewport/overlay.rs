@@ -1,4 +1,5 @@
-//! What is drawn over the viewport: the split divider, the sides' labels, the heat scale.
+//! What is drawn over the viewport: the split divider, the sides' labels, the heat scale and
+//! the legend of the `n` false-colour view.
 
 use egui::{Color32, Pos2, Rect, Sense};
 
@@ -68,15 +69,46 @@ pub const DIVIDER_LABEL: &str = "Split divider";
 
 /// The heatmap's scale bar along the bottom of `rect`: the ramp from 0 to `max`.
 fn heat_scale_ui(painter: &egui::Painter, rect: Rect, max: f32) {
-    let bar = Rect::from_min_size(
+    let bar = scale_bar(rect);
+    ramp_ui(painter, bar, crate::render::heat_ramp);
+    tick(painter, bar, 0.0, "0");
+    tick(painter, bar, 1.0, &format!("{max:.3}"));
+}
+
+/// The accessible name of the `n` false-colour legend.
+pub const N_LEGEND_LABEL: &str = "n false-colour scale, 0 to 16384, logarithmic";
+
+/// The `n` false-colour view's legend along the bottom of `rect`: the ramp over
+/// `ln(1 + n) / ln(1 + 16384)`, with ticks at 0, 10, 100, 1000 and 16384.
+pub(super) fn n_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect: Rect) {
+    let bar = scale_bar(rect);
+    ramp_ui(painter, bar, |t| {
+        let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln() as f32;
+        crate::render::n_false_colour((t * span).exp() - 1.0)
+    });
+    let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln() as f32;
+    for n in [0.0_f32, 10.0, 100.0, 1000.0, 16384.0] {
+        tick(painter, bar, (1.0 + n).ln() / span, &format!("{n}"));
+    }
+    ui.interact(bar, ui.id().with("n legend"), Sense::hover())
+        .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Other, true, N_LEGEND_LABEL));
+}
+
+/// Where a scale bar goes: along the bottom of `rect`.
+fn scale_bar(rect: Rect) -> Rect {
+    Rect::from_min_size(
         Pos2::new(rect.min.x + 16.0, rect.max.y - 34.0),
         egui::vec2((rect.width() - 32.0).clamp(40.0, 320.0), 12.0),
-    );
+    )
+}
+
+/// Fills `bar` with `ramp(t)` (linear RGB) for `t` from 0 at the left to 1 at the right.
+fn ramp_ui(painter: &egui::Painter, bar: Rect, ramp: impl Fn(f32) -> glam::Vec3) {
     let steps = 64;
+    let srgb = crate::model::texel::linear_to_srgb8;
     for i in 0..steps {
         let t0 = i as f32 / steps as f32;
-        let c = crate::render::heat_ramp(t0 + 0.5 / steps as f32);
-        let srgb = crate::model::texel::linear_to_srgb8;
+        let c = ramp(t0 + 0.5 / steps as f32);
         let x0 = bar.min.x + bar.width() * t0;
         painter.rect_filled(
             Rect::from_min_max(
@@ -87,19 +119,22 @@ fn heat_scale_ui(painter: &egui::Painter, rect: Rect, max: f32) {
             Color32::from_rgb(srgb(c.x), srgb(c.y), srgb(c.z)),
         );
     }
-    let font = egui::FontId::proportional(12.0);
+}
+
+/// A label under `bar` at `t` (0 left, 1 right), kept inside the bar's ends.
+fn tick(painter: &egui::Painter, bar: Rect, t: f32, text: &str) {
+    let align = if t <= 0.0 {
+        egui::Align2::LEFT_TOP
+    } else if t >= 1.0 {
+        egui::Align2::RIGHT_TOP
+    } else {
+        egui::Align2::CENTER_TOP
+    };
     painter.text(
-        Pos2::new(bar.min.x, bar.max.y + 2.0),
-        egui::Align2::LEFT_TOP,
-        "0",
-        font.clone(),
-        Color32::WHITE,
-    );
-    painter.text(
-        Pos2::new(bar.max.x, bar.max.y + 2.0),
-        egui::Align2::RIGHT_TOP,
-        format!("{max:.3}"),
-        font,
+        Pos2::new(bar.min.x + bar.width() * t.clamp(0.0, 1.0), bar.max.y + 2.0),
+        align,
+        text,
+        egui::FontId::proportional(12.0),
         Color32::WHITE,
     );
 }
