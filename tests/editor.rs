@@ -647,3 +647,95 @@ fn the_n_false_colour_view_has_a_legend() {
     harness.run();
     harness.get_by_label(N_LEGEND_LABEL);
 }
+
+/// Exporting into a folder that holds a set asks to replace it (the dialog stays, with its
+/// choices), replaces it on Replace, and the next export offers the same folder again.
+#[test]
+fn exporting_over_a_set_asks_then_replaces_and_keeps_the_choices() {
+    let dir = std::env::temp_dir().join(format!("kapaint-replace-ui-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("set");
+    let small = kapaint::model::Document::new(8, 8, kapaint::model::DocumentSettings::default())
+        .expect("document");
+    let separate = kapaint::export::preset::find("separate").expect("preset");
+    kapaint::export::set::export(&small, &separate, &out).expect("a set is there");
+    let folder = out.display().to_string();
+    let folder_field = |harness: &Harness<'_, Editor>| {
+        harness
+            .get_all_by_role(Role::TextInput)
+            .filter_map(|n| n.value())
+            .collect::<Vec<_>>()
+    };
+
+    let mut harness = editor();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.step();
+    harness.step();
+    let field = harness
+        .get_all_by_role(Role::TextInput)
+        .find(|n| n.value().as_deref() == Some("export"))
+        .expect("the folder field");
+    field.focus();
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.step();
+    harness
+        .get_all_by_role(Role::TextInput)
+        .find(|n| n.value().as_deref() == Some("export"))
+        .expect("the folder field")
+        .type_text(&folder);
+    harness.step();
+    assert!(
+        folder_field(&harness).contains(&folder),
+        "{:?}",
+        folder_field(&harness)
+    );
+    harness
+        .get_by_role_and_label(Role::Button, "Export")
+        .click();
+    harness.step();
+    harness.step();
+    // Asked, not refused: the dialog is still there.
+    harness.get_by_label_contains("holds an exported set already");
+    harness
+        .get_by_role_and_label(Role::Button, "Replace")
+        .click();
+    harness.step();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while !harness
+        .state()
+        .state
+        .notices()
+        .iter()
+        .any(|n| n.text.starts_with("exported"))
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no export: {:?}",
+            harness
+                .state()
+                .state
+                .notices()
+                .iter()
+                .map(|n| n.text.clone())
+                .collect::<Vec<_>>()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+    let manifest = std::fs::read_to_string(out.join("material.json")).expect("manifest");
+    assert!(
+        manifest.contains("\"width\": 1024"),
+        "the new set replaced the old"
+    );
+    // The next export offers the same folder.
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.step();
+    harness.step();
+    assert!(
+        folder_field(&harness).contains(&folder),
+        "{:?}",
+        folder_field(&harness)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -641,3 +641,77 @@ fn the_plan_shows_what_the_export_writes() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+/// Exporting to a folder that holds a set asks for replacing: plain export refuses it,
+/// `export_replacing` swaps the new set in (nothing of the old one, nothing beside it), and a
+/// folder that holds anything else is never replaced.
+#[test]
+fn a_set_is_replaced_only_when_asked_and_only_a_set() {
+    let dir = temp("replace");
+    let doc = painted();
+    let compact = preset::find("compact").expect("preset");
+    let separate = preset::find("separate").expect("preset");
+    let out = dir.join("set");
+    set::export(&doc, &separate, &out).expect("first export");
+    assert_eq!(set::target(&out).expect("target"), set::Target::Set);
+    let e = set::export(&doc, &compact, &out).expect_err("a set is there");
+    assert!(e.to_string().contains("holds an exported set"), "{e}");
+    let progress = kapaint::task::Progress::default();
+    let m = set::export_replacing(&doc, &compact, &out, &progress).expect("replace");
+    assert_eq!(m.preset, "compact");
+    let names = |d: &Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .expect("dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(names(&out).len(), m.file_count(), "{:?}", names(&out));
+    assert_eq!(names(&dir), ["set"], "nothing left beside the set");
+    // A folder of other things is refused, replacing or not, and left as it was.
+    let other = dir.join("photos");
+    std::fs::create_dir_all(&other).expect("dir");
+    std::fs::write(other.join("holiday.jpg"), b"not a set").expect("write");
+    assert_eq!(set::target(&other).expect("target"), set::Target::Taken);
+    assert!(set::export_replacing(&doc, &compact, &other, &progress).is_err());
+    assert_eq!(names(&other), ["holiday.jpg"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `kapaint export` to a folder that holds a set says to pass `--replace`, and replaces it
+/// with it.
+#[test]
+fn export_cli_replaces_a_set_with_replace() {
+    let dir = temp("cli-replace");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let project = dir.join("p.kapaint");
+    let project = project.to_str().expect("path");
+    let out = dir.join("set");
+    let out = out.to_str().expect("path");
+    assert!(
+        run(&["new", "--size", "32", "--out", project])
+            .status
+            .success()
+    );
+    let export = |extra: &[&str]| {
+        let mut args = vec!["export", project, "--out", out, "--no-padding"];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    assert!(export(&[]).status.success());
+    let again = export(&[]);
+    assert_eq!(again.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert!(stderr.contains("--replace"), "{stderr}");
+    let replaced = export(&["--replace", "--preset", "separate"]);
+    assert!(replaced.status.success(), "{replaced:?}");
+    let manifest = std::fs::read_to_string(dir.join("set/material.json")).expect("manifest");
+    assert!(manifest.contains("\"preset\": \"separate\""), "{manifest}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -78,9 +78,13 @@ pub struct ExportArgs {
     /// preset.
     #[arg(long, default_value = "compact")]
     preset: String,
-    /// Target folder (must not exist, or be empty).
+    /// Target folder (must not exist, or be empty, or with --replace hold an exported set).
     #[arg(long)]
     out: PathBuf,
+    /// Replace a set already in the target folder (written beside it, then swapped in); a
+    /// folder that holds anything else is never replaced.
+    #[arg(long)]
+    replace: bool,
     /// Print the memory report, the n encoding and the k_a error.
     #[arg(long)]
     report: bool,
@@ -102,6 +106,7 @@ impl ExportArgs {
             &self.out,
             self.report,
             !self.no_padding,
+            self.replace,
         )
     }
 }
@@ -113,6 +118,7 @@ fn export_command(
     out: &std::path::Path,
     report: bool,
     padding: bool,
+    replace: bool,
 ) -> Result<String, CliError> {
     use std::io::IsTerminal as _;
     let preset = crate::export::preset::find(preset).map_err(|e| CliError::usage(e.to_string()))?;
@@ -140,7 +146,7 @@ fn export_command(
             .map(|f| out.join(f.file_stem().unwrap_or_default()))
             .collect()
     };
-    check_targets(files, &targets)?;
+    check_targets(files, &targets, replace)?;
     let terminal = std::io::stderr().is_terminal();
     for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
         let progress = crate::task::Progress::default();
@@ -149,7 +155,11 @@ fn export_command(
             let worker = std::thread::Builder::new()
                 .name("kapaint-export".into())
                 .spawn_scoped(scope, || {
-                    crate::export::set::export_with(doc, &preset, target, &progress)
+                    if replace {
+                        crate::export::set::export_replacing(doc, &preset, target, &progress)
+                    } else {
+                        crate::export::set::export_with(doc, &preset, target, &progress)
+                    }
                 })
                 .map_err(|e| CliError::io(format!("cannot start the export: {e}")))?;
             while terminal && !worker.is_finished() {
@@ -195,7 +205,8 @@ fn export_command(
 
 /// Every target is free (absent, or an empty folder) and no two projects share one, before
 /// anything is written: a failed batch leaves nothing behind.
-fn check_targets(files: &[PathBuf], targets: &[PathBuf]) -> Result<(), CliError> {
+fn check_targets(files: &[PathBuf], targets: &[PathBuf], replace: bool) -> Result<(), CliError> {
+    use crate::export::set::{Target, target as target_of};
     for (k, target) in targets.iter().enumerate() {
         if let Some(j) = targets[..k].iter().position(|t| t == target) {
             return Err(CliError::usage(format!(
@@ -205,14 +216,21 @@ fn check_targets(files: &[PathBuf], targets: &[PathBuf]) -> Result<(), CliError>
                 target.display()
             )));
         }
-        let busy = target.exists()
-            && (!target.is_dir()
-                || std::fs::read_dir(target).map_or(true, |mut d| d.next().is_some()));
-        if busy {
-            return Err(CliError::usage(format!(
-                "{}: exists and is not an empty folder",
-                target.display()
-            )));
+        match target_of(target).map_err(super::set_error)? {
+            Target::Free => {}
+            Target::Set if replace => {}
+            Target::Set => {
+                return Err(CliError::usage(format!(
+                    "{}: holds an exported set already; pass --replace to replace it",
+                    target.display()
+                )));
+            }
+            Target::Taken => {
+                return Err(CliError::usage(format!(
+                    "{}: exists and is not an empty folder",
+                    target.display()
+                )));
+            }
         }
     }
     Ok(())

@@ -137,6 +137,10 @@ pub(super) struct ExportDialog {
     presets: Vec<ExportPreset>,
     chosen: usize,
     folder: String,
+    /// The folder holds a set: asking whether to replace it.
+    confirm_replace: bool,
+    /// Why the folder cannot take the set, shown in the dialog.
+    problem: Option<String>,
     /// The preview of the chosen preset: for which preset and maps version, and the plan.
     plan: Option<(usize, u64, crate::export::set::SetPlan)>,
     /// A preview being computed on a worker thread.
@@ -282,34 +286,52 @@ impl EditorState {
         save_recent(&self.recent);
     }
 
-    pub(super) fn export_now(&mut self) {
+    /// Starts the export on a worker (replacing the set at the folder where `replace`); the
+    /// dialog's choices are kept for the next export.
+    pub(super) fn export_now(&mut self, replace: bool) {
         let Some(dialog) = &self.export else { return };
         let Some(preset) = dialog.presets.get(dialog.chosen).cloned() else {
             return;
         };
         let out = PathBuf::from(dialog.folder.trim());
+        self.export_choice = Some((preset.name.clone(), dialog.folder.clone()));
         let snapshot = self.snapshot();
         self.export = None;
-        self.start_job(
-            "Export",
-            move |progress| match crate::export::set::export_with(
-                &snapshot, &preset, &out, progress,
-            ) {
+        self.start_job("Export", move |progress| {
+            let export = if replace {
+                crate::export::set::export_replacing
+            } else {
+                crate::export::set::export_with
+            };
+            match export(&snapshot, &preset, &out, progress) {
                 Ok(m) => JobResult::Exported(out, Box::new(m)),
                 Err(e) => JobResult::Failed(format!("export failed: {e}")),
-            },
-        );
+            }
+        });
     }
 
     pub(super) fn open_export(&mut self) {
-        let folder = self.path.as_ref().map_or_else(
-            || "export".to_string(),
-            |p| p.with_extension("").display().to_string() + "-set",
-        );
+        let presets = crate::export::preset::builtin();
+        // The last export's choices, else the project's name and the first preset.
+        let (chosen, folder) = match &self.export_choice {
+            Some((name, folder)) => (
+                presets.iter().position(|p| &p.name == name).unwrap_or(0),
+                folder.clone(),
+            ),
+            None => (
+                0,
+                self.path.as_ref().map_or_else(
+                    || "export".to_string(),
+                    |p| p.with_extension("").display().to_string() + "-set",
+                ),
+            ),
+        };
         self.export = Some(ExportDialog {
-            presets: crate::export::preset::builtin(),
-            chosen: 0,
+            presets,
+            chosen,
             folder,
+            confirm_replace: false,
+            problem: None,
             plan: None,
             planning: None,
         });
@@ -367,7 +389,7 @@ impl EditorState {
             return;
         };
         let mut open = true;
-        let mut go = false;
+        let (mut go, mut replace) = (false, false);
         centred(egui::Window::new("Export"), ctx)
             .open(&mut open)
             .collapsible(false)
@@ -401,19 +423,60 @@ impl EditorState {
                 ui.separator();
                 ui.horizontal(|ui| {
                     ui.label("Folder");
-                    ui.text_edit_singleline(&mut dialog.folder);
+                    if ui.text_edit_singleline(&mut dialog.folder).changed() {
+                        (dialog.confirm_replace, dialog.problem) = (false, None);
+                    }
                     if ui.button("…").clicked()
                         && let Some(d) = rfd::FileDialog::new().pick_folder()
                     {
                         dialog.folder = d.join("set").display().to_string();
+                        (dialog.confirm_replace, dialog.problem) = (false, None);
                     }
                 });
-                go = ui.button("Export").clicked();
+                if let Some(problem) = &dialog.problem {
+                    ui.colored_label(ui.visuals().error_fg_color, problem);
+                }
+                if dialog.confirm_replace {
+                    ui.label(format!(
+                        "{} holds an exported set already. Replace it?",
+                        dialog.folder.trim()
+                    ));
+                    ui.horizontal(|ui| {
+                        replace = ui.button("Replace").clicked();
+                        if ui.button("Cancel").clicked() {
+                            dialog.confirm_replace = false;
+                        }
+                    });
+                } else {
+                    go = ui.button("Export").clicked();
+                }
             });
         if !open {
             self.export = None;
+        } else if replace {
+            self.export_now(true);
         } else if go {
-            self.export_now();
+            self.ask_or_export();
+        }
+    }
+
+    /// Exports into a free folder; asks first where a set is there already; says why where
+    /// something else is. The dialog and its choices stay until the export starts.
+    fn ask_or_export(&mut self) {
+        use crate::export::set::{Target, target};
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        match target(Path::new(dialog.folder.trim())) {
+            Ok(Target::Free) => self.export_now(false),
+            Ok(Target::Set) => dialog.confirm_replace = true,
+            Ok(Target::Taken) => {
+                dialog.problem = Some(format!(
+                    "{} is not empty and holds no exported set: choose another folder",
+                    dialog.folder.trim()
+                ));
+            }
+            Err(e) => dialog.problem = Some(e.to_string()),
         }
     }
 
@@ -481,10 +544,10 @@ impl EditorState {
     }
 }
 
-/// A window that opens in the middle of the editor (not at the top left, over the tools);
-/// it can still be moved.
+/// A window that opens about the middle of the editor (not at the top left, over the tools);
+/// it can still be moved. Its top left is placed once, half a typical dialog's size from the
+/// centre, so it stays put when its content grows (a centred pivot would move its buttons
+/// from under the pointer).
 pub(super) fn centred<'a>(window: egui::Window<'a>, ctx: &egui::Context) -> egui::Window<'a> {
-    window
-        .pivot(egui::Align2::CENTER_CENTER)
-        .default_pos(ctx.content_rect().center())
+    window.default_pos(ctx.content_rect().center() - egui::vec2(200.0, 150.0))
 }

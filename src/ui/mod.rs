@@ -169,6 +169,8 @@ pub struct EditorState {
     notices: Vec<Notice>,
     job: Option<Job>,
     export: Option<ExportDialog>,
+    /// The last export's preset and folder, offered again by the next.
+    export_choice: Option<(String, String)>,
     /// The New dialog, while open.
     new_dialog: Option<NewDialog>,
     /// A project to open once the user has decided about the unsaved changes.
@@ -276,6 +278,7 @@ impl Editor {
                 notices,
                 job: None,
                 export: None,
+                export_choice: None,
                 new_dialog: None,
                 pending_open: None,
                 recent: load_recent(),

@@ -77,33 +77,93 @@ pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manif
     export_with(doc, preset, out, &Progress::default())
 }
 
+/// What is at an export's target folder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// Nothing, or an empty folder: the set goes there.
+    Free,
+    /// A set kapaint wrote (a folder with a `material.json`): it can be replaced.
+    Set,
+    /// Something else (a file, a folder of other things): never replaced.
+    Taken,
+}
+
+/// What is at `out`.
+///
+/// # Errors
+/// A folder that cannot be read.
+pub fn target(out: &Path) -> Result<Target, SetError> {
+    if !out.exists() {
+        return Ok(Target::Free);
+    }
+    if !out.is_dir() {
+        return Ok(Target::Taken);
+    }
+    if std::fs::read_dir(out)
+        .map_err(|e| io(out, e))?
+        .next()
+        .is_none()
+    {
+        return Ok(Target::Free);
+    }
+    Ok(if out.join("material.json").is_file() {
+        Target::Set
+    } else {
+        Target::Taken
+    })
+}
+
 /// [`export`], reporting to `progress` (stages `analyse`, `encode`, `measure`) and stopping
 /// with [`SetError::Cancelled`] when it is cancelled.
 ///
 /// # Errors
 /// As [`export`], or cancelled.
-#[expect(
-    clippy::too_many_lines,
-    reason = "one pass: analyse, encode in parallel, measure, commit"
-)]
 pub fn export_with(
     doc: &Document,
     preset: &ExportPreset,
     out: &Path,
     progress: &Progress,
 ) -> Result<Manifest, SetError> {
+    export_into(doc, preset, out, progress, false)
+}
+
+/// [`export_with`] that may also replace a set already at `out` ([`Target::Set`]): the new
+/// set is written beside it, swapped in, and the old one removed, so `out` always holds a
+/// whole set. A target that is not a set is never replaced.
+///
+/// # Errors
+/// As [`export_with`]; a target that is neither free nor a set.
+pub fn export_replacing(
+    doc: &Document,
+    preset: &ExportPreset,
+    out: &Path,
+    progress: &Progress,
+) -> Result<Manifest, SetError> {
+    export_into(doc, preset, out, progress, true)
+}
+
+#[expect(
+    clippy::too_many_lines,
+    reason = "one pass: analyse, encode in parallel, measure, commit"
+)]
+fn export_into(
+    doc: &Document,
+    preset: &ExportPreset,
+    out: &Path,
+    progress: &Progress,
+    replace: bool,
+) -> Result<Manifest, SetError> {
     let cancelled = |_| SetError::Cancelled;
     progress.start("analyse", 1);
-    if out.exists()
-        && (!out.is_dir()
-            || std::fs::read_dir(out)
-                .map_err(|e| io(out, e))?
-                .next()
-                .is_some())
-    {
+    let found = target(out)?;
+    if found == Target::Taken || (found == Target::Set && !replace) {
         return Err(SetError::Target {
             path: out.to_path_buf(),
-            reason: "exists and is not an empty folder".into(),
+            reason: if found == Target::Set {
+                "holds an exported set already: replace it, or choose another folder".into()
+            } else {
+                "exists and is not an empty folder".into()
+            },
         });
     }
     let maps = doc.maps();
@@ -275,6 +335,20 @@ pub fn export_with(
         Ok(manifest)
     })();
     let manifest = result?;
+    if found == Target::Set {
+        // Swap: the old set moves aside, the new one takes its name, the old one goes. Should
+        // the second rename fail, the old set is put back.
+        let old = parent.join(format!(".{name}.old-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&old);
+        std::fs::rename(out, &old).map_err(|e| io(out, e))?;
+        if let Err(e) = std::fs::rename(&tmp, out) {
+            let _ = std::fs::rename(&old, out);
+            return Err(io(out, e));
+        }
+        guard.keep();
+        let _ = std::fs::remove_dir_all(&old);
+        return Ok(manifest);
+    }
     if out.exists() {
         std::fs::remove_dir(out).map_err(|e| io(out, e))?;
     }
