@@ -739,3 +739,44 @@ fn exporting_over_a_set_asks_then_replaces_and_keeps_the_choices() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The preset thumbnails follow the mesh: after opening a project on another mesh they are
+/// drawn again on it (they kept the old mesh).
+#[test]
+fn preset_thumbnails_follow_the_mesh() {
+    let dir = std::env::temp_dir().join(format!("kapaint-thumbs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("cube.kapaint");
+    let settings = kapaint::model::DocumentSettings {
+        mesh: kapaint::model::document::MeshRef::from_spec("cube"),
+        ..kapaint::model::DocumentSettings::default()
+    };
+    let doc = kapaint::model::Document::new(64, 64, settings).expect("document");
+    kapaint::model::project::save(&doc, &path).expect("save");
+
+    let mut harness = editor();
+    let current = |h: &Harness<'_, Editor>| {
+        let (shown, mesh) = h.state().state.thumbnail_meshes();
+        shown.iter().all(|s| *s == Some(mesh))
+    };
+    for _ in 0..40 {
+        if current(&harness) {
+            break;
+        }
+        harness.step();
+    }
+    assert!(current(&harness), "every thumbnail drawn");
+    let (_, before) = harness.state().state.thumbnail_meshes();
+    harness.state_mut().state.open(path);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness.state().state.thumbnail_meshes().1 == before || !current(&harness) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the cube never arrived"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        harness.step();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -198,8 +198,9 @@ pub struct EditorState {
     allow_close: bool,
     /// A recovery copy found at start, newer than the project.
     recovery_offer: Option<PathBuf>,
-    /// Material presets with their thumbnails (rendered a few per frame).
-    presets: Vec<(String, MaterialValue, Option<egui::TextureHandle>)>,
+    /// Material presets with their thumbnails (rendered a few per frame) and the mesh each
+    /// thumbnail shows.
+    presets: Vec<(String, MaterialValue, Option<Thumbnail>)>,
     autosaver: recovery::Autosaver,
 }
 
@@ -306,6 +307,9 @@ impl Editor {
     }
 }
 
+/// A preset's thumbnail: the id of the mesh it shows, and its texture.
+type Thumbnail = (u64, egui::TextureHandle);
+
 /// How often the editor autosaves: [`recovery::AUTOSAVE_INTERVAL`], or
 /// `KAPAINT_AUTOSAVE_SECONDS` (the crash test uses a short one).
 fn autosave_interval() -> Duration {
@@ -384,6 +388,17 @@ impl EditorState {
     /// panel).
     pub fn canvas_zoom(&self) -> f32 {
         self.canvas.zoom
+    }
+
+    /// The mesh each preset thumbnail shows (`None` until it is drawn) and the mesh the
+    /// document is on now: thumbnails follow the mesh after New, Open or an import.
+    pub fn thumbnail_meshes(&self) -> (Vec<Option<u64>>, u64) {
+        let shown = self
+            .presets
+            .iter()
+            .map(|(_, _, t)| t.as_ref().map(|(id, _)| *id))
+            .collect();
+        (shown, self.mesh.id)
     }
 
     /// The window's title: the project's file name (or "untitled"), a `*` while it has

@@ -200,16 +200,19 @@ impl EditorState {
     /// The preset browser: thumbnails, a click makes the preset the primary material.
     fn presets_ui(&mut self, ui: &mut egui::Ui) {
         // A few thumbnails per frame keep the first frames fast.
+        // A thumbnail of another mesh (before New, Open or a mesh import) is drawn again.
         let mut budget = 3;
+        let mesh = self.mesh.id;
         for i in 0..self.presets.len() {
-            if self.presets[i].2.is_none() && budget > 0 {
+            let stale = self.presets[i].2.as_ref().is_none_or(|(id, _)| *id != mesh);
+            if stale && budget > 0 {
                 budget -= 1;
                 let image = self.thumbnail(self.presets[i].1);
                 let name = self.presets[i].0.clone();
-                self.presets[i].2 = Some(ui.ctx().load_texture(
-                    name,
-                    image,
-                    egui::TextureOptions::LINEAR,
+                self.presets[i].2 = Some((
+                    mesh,
+                    ui.ctx()
+                        .load_texture(name, image, egui::TextureOptions::LINEAR),
                 ));
             }
         }
@@ -220,7 +223,7 @@ impl EditorState {
         ui.horizontal_wrapped(|ui| {
             for (name, value, texture) in &self.presets {
                 let response = match texture {
-                    Some(t) => ui.add(egui::Button::image(
+                    Some((_, t)) => ui.add(egui::Button::image(
                         egui::Image::from_texture(egui::load::SizedTexture::from_handle(t))
                             .fit_to_exact_size(egui::vec2(40.0, 40.0)),
                     )),
