@@ -3,10 +3,7 @@
 //! `|left - right|`, for the editor's viewport. `kapaint render --model compare-diff` makes the
 //! same picture on the CPU from read-backs ([`crate::render::heat_ramp`] is the one ramp).
 
-use std::collections::HashMap;
-use std::sync::{Mutex, PoisonError};
-
-use super::{Gpu, GpuError, RenderedImage};
+use super::{Gpu, GpuError, PipelineCache, RenderedImage};
 
 /// The format of the two renders the pass reads (linear floats, so small differences survive).
 pub const SIDE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -31,18 +28,13 @@ pub struct Difference {
     module: wgpu::ShaderModule,
     bind_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>>,
+    pipelines: PipelineCache<wgpu::TextureFormat>,
 }
 
 impl std::fmt::Debug for Difference {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let count = self
-            .pipelines
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .len();
         f.debug_struct("Difference")
-            .field("pipelines", &count)
+            .field("pipelines", &self.pipelines.len())
             .finish_non_exhaustive()
     }
 }
@@ -86,18 +78,14 @@ impl Difference {
             module,
             bind_layout,
             layout,
-            pipelines: Mutex::default(),
+            pipelines: PipelineCache::default(),
         }
     }
 
     /// The pipeline for a target of `format`, compiled on first use.
     fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
         let (module, layout) = (&self.module, &self.layout);
-        let mut pipelines = self
-            .pipelines
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner);
-        let pipeline = pipelines.entry(format).or_insert_with(|| {
+        self.pipelines.get_or_compile(format, || {
             gpu.device
                 .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some("difference"),
@@ -124,8 +112,7 @@ impl Difference {
                     multiview_mask: None,
                     cache: None,
                 })
-        });
-        pipeline.clone()
+        })
     }
 
     /// The draw data of the heatmap of `|left - right|` (two linear renders of one size) into
@@ -190,22 +177,7 @@ impl Difference {
         encoder: &'e mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
     ) -> wgpu::RenderPass<'e> {
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("difference"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        })
+        super::cleared_pass(encoder, "difference", target, None)
     }
 
     /// The heatmap of two linear images read back from the GPU (tests and diagnostics):

@@ -9,6 +9,7 @@ pub mod preview;
 pub mod shader;
 mod upload;
 
+use std::collections::HashMap;
 use std::fmt;
 use std::sync::{Arc, Mutex};
 
@@ -115,6 +116,79 @@ impl fmt::Debug for Gpu {
 /// error on first use instead of a panic.
 pub fn shader_source(name: &str) -> String {
     shader::resolve(name).unwrap_or_else(|e| format!("// {e}\nerror"))
+}
+
+/// Compiled render pipelines by key, behind a lock so that the renderer that owns them stays
+/// immutable: a draw only reads them, a frame's draw data compiles what it is missing.
+pub struct PipelineCache<K> {
+    pipelines: Mutex<HashMap<K, wgpu::RenderPipeline>>,
+}
+
+impl<K> Default for PipelineCache<K> {
+    fn default() -> Self {
+        Self {
+            pipelines: Mutex::new(HashMap::new()),
+        }
+    }
+}
+
+impl<K: std::hash::Hash + Eq> PipelineCache<K> {
+    /// How many pipelines are compiled.
+    pub fn len(&self) -> usize {
+        self.lock().len()
+    }
+
+    /// Whether none is compiled yet.
+    pub fn is_empty(&self) -> bool {
+        self.lock().is_empty()
+    }
+
+    /// The pipeline for `key`, made by `compile` on first use.
+    pub fn get_or_compile(
+        &self,
+        key: K,
+        compile: impl FnOnce() -> wgpu::RenderPipeline,
+    ) -> wgpu::RenderPipeline {
+        self.lock().entry(key).or_insert_with(compile).clone()
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<K, wgpu::RenderPipeline>> {
+        self.pipelines
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
+
+/// A render pass over `target` (and `depth`, where given), both cleared.
+pub fn cleared_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    depth: Option<&wgpu::TextureView>,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
 }
 
 /// A layout entry for a 2D float texture read by the fragment stage at `binding`.

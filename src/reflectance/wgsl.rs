@@ -164,29 +164,19 @@ pub fn model_and_approx_ids() -> Vec<(String, u32)> {
 /// [`ambient_wgsl`] with the ids written out instead of included: WGSL that stands alone,
 /// for the exported `material.wgsl`.
 pub fn ambient_wgsl_standalone() -> String {
-    let mut ids = String::new();
-    for (name, value) in model_and_approx_ids() {
-        let _ = writeln!(
-            ids,
-            "{}",
-            ShaderLanguage::Wgsl.constant(&name, ConstType::U32, &format!("{value}u"))
-        );
-    }
-    ambient_wgsl().replace(&format!("#include \"{IDS_FILE}\"\n"), &ids)
+    ambient_wgsl_with(false)
 }
 
-/// The constants and `Fast` tables both languages start with.
-fn constants(out: &mut String, lang: ShaderLanguage) {
+/// The constants and `Fast` tables both languages start with; the model and approximation
+/// ids written out, or (`include_ids`, WGSL for the renderer) included from [`IDS_FILE`],
+/// which the renderer's shaders share.
+fn constants(out: &mut String, lang: ShaderLanguage, include_ids: bool) {
     use ConstType::{F32, U32};
-    match lang {
-        // WGSL shares one generated file of ids with the renderer's shaders.
-        ShaderLanguage::Wgsl => {
-            let _ = writeln!(out, "#include \"{IDS_FILE}\"");
-        }
-        ShaderLanguage::Glsl => {
-            for (name, value) in model_and_approx_ids() {
-                let _ = writeln!(out, "{}", lang.constant(&name, U32, &format!("{value}u")));
-            }
+    if include_ids {
+        let _ = writeln!(out, "#include \"{IDS_FILE}\"");
+    } else {
+        for (name, value) in model_and_approx_ids() {
+            let _ = writeln!(out, "{}", lang.constant(&name, U32, &format!("{value}u")));
         }
     }
     out.push('\n');
@@ -225,6 +215,11 @@ fn constants(out: &mut String, lang: ShaderLanguage) {
 
 /// The WGSL source of `shaders/ambient.wgsl`.
 pub fn ambient_wgsl() -> String {
+    ambient_wgsl_with(true)
+}
+
+/// The WGSL of `k_a`, its ids included from [`IDS_FILE`] or written out.
+fn ambient_wgsl_with(include_ids: bool) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -234,7 +229,7 @@ pub fn ambient_wgsl() -> String {
          // k_a = (2/pi) k_d + k_s chi(n): eq. (6) of the paper, with chi by eq. (8)/(11) as\n\
          // printed, with the corrected Blinn exponent, or by kapaint's Fast approximation.\n"
     );
-    constants(&mut out, ShaderLanguage::Wgsl);
+    constants(&mut out, ShaderLanguage::Wgsl, include_ids);
     out.push_str(BODY_WGSL);
     out
 }
@@ -254,7 +249,7 @@ pub fn ambient_glsl() -> String {
          // The bit tricks and the tables need 32-bit floats and ints (a no-op on desktop GL).\n\
          precision highp float;\nprecision highp int;\n"
     );
-    constants(&mut out, ShaderLanguage::Glsl);
+    constants(&mut out, ShaderLanguage::Glsl, false);
     out.push_str(BODY_GLSL);
     out
 }

@@ -22,8 +22,7 @@ pub use mesh::MeshBuffers;
 pub use offscreen::{Offscreen, RenderedImage, read_buffer, read_texture};
 pub use pipeline::PipelineKey;
 
-use super::Gpu;
-use pipeline::PipelineCache;
+use super::{Gpu, PipelineCache};
 
 /// Depth buffer format of every preview pass.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -34,7 +33,7 @@ pub struct Preview {
     layout: wgpu::PipelineLayout,
     bind_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
-    pipelines: PipelineCache,
+    pipelines: PipelineCache<PipelineKey>,
 }
 
 impl std::fmt::Debug for Preview {
@@ -108,8 +107,9 @@ impl Preview {
 
     /// The pipeline for `key`, compiled on first use.
     pub fn pipeline(&self, gpu: &Gpu, key: PipelineKey) -> wgpu::RenderPipeline {
-        self.pipelines
-            .get_or_compile(&gpu.device, &self.module, &self.layout, key)
+        self.pipelines.get_or_compile(key, || {
+            pipeline::compile(&gpu.device, &self.module, &self.layout, key)
+        })
     }
 
     /// Records `data` into `pass`: each part with its pipeline, scissor and viewport. All
@@ -125,27 +125,5 @@ pub fn begin_pass<'e>(
     target: &wgpu::TextureView,
     depth: &wgpu::TextureView,
 ) -> wgpu::RenderPass<'e> {
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("preview"),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: depth,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
-                store: wgpu::StoreOp::Discard,
-            }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    })
+    super::cleared_pass(encoder, "preview", target, Some(depth))
 }

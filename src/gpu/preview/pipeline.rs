@@ -1,8 +1,5 @@
 //! Pipelines: one per combination of the shader's overridable constants a frame uses, keyed
-//! by [`PipelineKey`] and compiled on first use into a cache that draws only read.
-
-use std::collections::HashMap;
-use std::sync::{Mutex, PoisonError};
+//! by [`PipelineKey`] and compiled on first use into the renderer's cache.
 
 use super::DEPTH_FORMAT;
 use super::mesh::Vertex;
@@ -89,43 +86,8 @@ impl PipelineKey {
     }
 }
 
-/// Compiled pipelines by key. Behind a lock so that the renderer that owns it stays
-/// immutable: a draw only reads it, a frame's draw data compiles what it is missing.
-#[derive(Default)]
-pub(super) struct PipelineCache {
-    pipelines: Mutex<HashMap<PipelineKey, wgpu::RenderPipeline>>,
-}
-
-impl PipelineCache {
-    /// How many pipelines are compiled.
-    pub fn len(&self) -> usize {
-        self.pipelines
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .len()
-    }
-
-    /// The pipeline for `key`, compiled from `module` with `layout` on first use.
-    pub fn get_or_compile(
-        &self,
-        device: &wgpu::Device,
-        module: &wgpu::ShaderModule,
-        layout: &wgpu::PipelineLayout,
-        key: PipelineKey,
-    ) -> wgpu::RenderPipeline {
-        let mut pipelines = self
-            .pipelines
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner);
-        pipelines
-            .entry(key)
-            .or_insert_with(|| compile(device, module, layout, key))
-            .clone()
-    }
-}
-
 /// Compiles the preview pipeline for `key`.
-fn compile(
+pub(super) fn compile(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
     layout: &wgpu::PipelineLayout,
