@@ -10,6 +10,7 @@ use egui_kittest::kittest::Queryable;
 use kapaint::model::texel::Texel;
 use kapaint::ui::Editor;
 use kapaint::ui::canvas::CANVAS_LABEL;
+use kapaint::ui::files::{FileDialogBackend, FilePurpose, FileRequest};
 use kapaint::ui::viewport::{Compare, VIEWPORT_LABEL};
 
 fn texels(editor: &Editor) -> Vec<Texel> {
@@ -779,4 +780,184 @@ fn preset_thumbnails_follow_the_mesh() {
         harness.step();
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Steps the harness until `done` holds (a worker's job), for at most a minute.
+fn wait_until(harness: &mut Harness<'_, Editor>, what: &str, done: impl Fn(&Editor) -> bool) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while !done(harness.state()) {
+        let notices: Vec<String> = harness
+            .state()
+            .state
+            .notices()
+            .iter()
+            .map(|n| n.text.clone())
+            .collect();
+        assert!(std::time::Instant::now() < deadline, "{what}: {notices:?}");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+}
+
+/// A fresh folder for a test.
+#[expect(clippy::expect_used, reason = "a test helper: no folder, no test")]
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+/// The editor with kapaint's own file dialog (as where no desktop portal runs), starting in
+/// `dir`.
+fn editor_without_portal(dir: &std::path::Path) -> Harness<'static, Editor> {
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::Builtin);
+    files.set_last_dir(dir.to_path_buf());
+    harness
+}
+
+#[test]
+fn untitled_work_is_saved_through_the_in_app_file_dialog() {
+    let dir = scratch("save-dialog");
+    let mut harness = editor_without_portal(&dir);
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    assert_eq!(
+        harness.state().state.file_dialog_open_for(),
+        Some(FilePurpose::SaveProject),
+        "Ctrl+S on an untitled project asks where"
+    );
+    harness.get_by_label_contains("Save project");
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run();
+    let saved = dir.join("material.kapaint");
+    wait_until(&mut harness, "saved", |e| !e.state.dirty());
+    assert_eq!(harness.state().state.path(), Some(saved.as_path()));
+    assert_eq!(
+        harness.state().state.window_title(),
+        "material.kapaint - kapaint"
+    );
+    let doc = kapaint::model::project::load(&saved).expect("the saved project loads");
+    assert_eq!(
+        doc.maps().uniform_texel(),
+        None,
+        "the stroke is in the saved file"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_quit_prompt_saves_untitled_work_then_closes() {
+    let dir = scratch("quit-dialog");
+    let mut harness = editor_without_portal(&dir);
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    harness.get_by_label("The material has unsaved changes.");
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run_steps(2);
+    assert!(!harness.state().state.closing(), "not before it is saved");
+    harness.get_by_label_contains("Save project");
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.step();
+    wait_until(&mut harness, "saved, then closing", |e| e.state.closing());
+    assert!(dir.join("material.kapaint").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_project_opens_through_the_in_app_file_dialog() {
+    let dir = scratch("open-dialog");
+    let project = dir.join("other.kapaint");
+    let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+        .expect("document");
+    kapaint::model::project::save(&doc, &project).expect("saved");
+    let mut harness = editor_without_portal(&dir);
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::O);
+    harness.run();
+    harness.get_by_label_contains("Open project");
+    harness.get_by_label_contains("other.kapaint").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "Open").click();
+    harness.run();
+    wait_until(&mut harness, "opened", |e| {
+        e.state.path() == Some(project.as_path())
+    });
+    assert_eq!(harness.state().state.doc().maps().width(), 64);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every place that asks for a file gets its answer: Import mesh, Import image, the brush
+/// stamp's Load, New > File and the export folder (answered here by a stand-in for the
+/// system dialog).
+#[test]
+fn every_file_request_reaches_its_command() {
+    fn answer(request: &FileRequest) -> Option<std::path::PathBuf> {
+        let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot");
+        Some(match request.purpose {
+            FilePurpose::ImportMesh | FilePurpose::NewMesh => spot.join("spot_triangulated.obj"),
+            FilePurpose::ImportImage(_) | FilePurpose::StampImage => spot.join("spot_texture.png"),
+            FilePurpose::ExportFolder => std::env::temp_dir().join("kapaint-export-choice"),
+            FilePurpose::OpenProject | FilePurpose::SaveProject => return None,
+        })
+    }
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer);
+    let notice = |text: &'static str| {
+        move |e: &Editor| e.state.notices().iter().any(|n| n.text.contains(text))
+    };
+
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Import mesh…").click();
+    harness.run_steps(2);
+    wait_until(
+        &mut harness,
+        "mesh imported",
+        notice("spot_triangulated.obj"),
+    );
+
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness
+        .get_by_label_contains("Import image into k_s")
+        .click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "image imported", notice("imported into k_s"));
+
+    harness.key_press(egui::Key::B);
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "Load…").click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "stamp loaded", notice("stamp "));
+
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "File…").click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "mesh chosen for New", |e| {
+        e.state
+            .new_dialog()
+            .is_some_and(|d| d.mesh.ends_with("spot_triangulated.obj"))
+    });
+
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "…").click();
+    harness.run_steps(2);
+    let chosen = std::env::temp_dir()
+        .join("kapaint-export-choice")
+        .join("set")
+        .display()
+        .to_string();
+    wait_until(&mut harness, "export folder chosen", |e| {
+        e.state.export_folder() == Some(chosen.as_str())
+    });
 }

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use super::files::FilePurpose;
 use super::jobs::new_document_with;
 use super::layout::layout_path;
 use super::{EditorState, JobResult};
@@ -147,6 +148,19 @@ pub(super) struct ExportDialog {
     planning: Option<(usize, u64, JoinHandle<crate::export::set::SetPlan>)>,
 }
 
+impl ExportDialog {
+    /// The folder the set goes to, as typed or chosen.
+    pub(super) fn folder(&self) -> &str {
+        &self.folder
+    }
+
+    /// Exports into a new `set` folder inside the chosen `dir`.
+    pub(super) fn choose_folder(&mut self, dir: &Path) {
+        self.folder = dir.join("set").display().to_string();
+        (self.confirm_replace, self.problem) = (false, None);
+    }
+}
+
 impl EditorState {
     /// The recovery offer at start: recover the copy, or discard it.
     pub(super) fn recovery_window(&mut self, ctx: &egui::Context) {
@@ -225,7 +239,7 @@ impl EditorState {
         let Some(mut dialog) = self.new_dialog.take() else {
             return;
         };
-        let (mut open, mut create) = (true, false);
+        let (mut open, mut create, mut choose) = (true, false, false);
         centred(egui::Window::new("New project"), ctx)
             .open(&mut open)
             .collapsible(false)
@@ -252,12 +266,8 @@ impl EditorState {
                                 ui.selectable_value(&mut dialog.mesh, m.to_string(), m);
                             }
                         });
-                    if ui.button("File…").clicked()
-                        && let Some(p) = rfd::FileDialog::new()
-                            .add_filter("mesh", &["obj", "gltf", "glb"])
-                            .pick_file()
-                    {
-                        dialog.mesh = p.display().to_string();
+                    if ui.button("File…").clicked() {
+                        choose = true;
                     }
                 });
                 let bytes = u64::from(dialog.size).pow(2) * 14;
@@ -277,6 +287,9 @@ impl EditorState {
             self.create_project(&dialog);
         } else if open {
             self.new_dialog = Some(dialog);
+            if choose {
+                self.choose_file(FilePurpose::NewMesh);
+            }
         }
     }
 
@@ -389,7 +402,7 @@ impl EditorState {
             return;
         };
         let mut open = true;
-        let (mut go, mut replace) = (false, false);
+        let (mut go, mut replace, mut choose) = (false, false, false);
         centred(egui::Window::new("Export"), ctx)
             .open(&mut open)
             .collapsible(false)
@@ -426,11 +439,8 @@ impl EditorState {
                     if ui.text_edit_singleline(&mut dialog.folder).changed() {
                         (dialog.confirm_replace, dialog.problem) = (false, None);
                     }
-                    if ui.button("…").clicked()
-                        && let Some(d) = rfd::FileDialog::new().pick_folder()
-                    {
-                        dialog.folder = d.join("set").display().to_string();
-                        (dialog.confirm_replace, dialog.problem) = (false, None);
+                    if ui.button("…").clicked() {
+                        choose = true;
                     }
                 });
                 if let Some(problem) = &dialog.problem {
@@ -453,6 +463,8 @@ impl EditorState {
             });
         if !open {
             self.export = None;
+        } else if choose {
+            self.choose_file(FilePurpose::ExportFolder);
         } else if replace {
             self.export_now(true);
         } else if go {
@@ -513,15 +525,15 @@ impl EditorState {
     }
 
     pub(super) fn close_prompt(&mut self, ctx: &egui::Context) {
-        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit_asked;
-        if close_requested && self.dirty() && !self.allow_close {
+        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit.asked;
+        if close_requested && self.dirty() && !self.quit.allowed {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.quit_asked = true;
-        } else if self.quit_asked && (self.allow_close || !self.dirty()) {
+            self.quit.asked = true;
+        } else if self.quit.asked && (self.quit.allowed || !self.dirty()) {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             return;
         }
-        if self.quit_asked && self.dirty() && !self.allow_close {
+        if self.quit.asked && self.dirty() && !self.quit.allowed {
             egui::Window::new("Unsaved changes")
                 .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
                 .collapsible(false)
@@ -529,14 +541,16 @@ impl EditorState {
                     ui.label("The material has unsaved changes.");
                     ui.horizontal(|ui| {
                         if ui.button("Save").clicked() {
+                            // Untitled work asks where first; the window closes once saved.
+                            self.quit.after_save = true;
                             self.save();
-                            self.quit_asked = false;
+                            self.quit.asked = false;
                         }
                         if ui.button("Discard").clicked() {
-                            self.allow_close = true;
+                            self.quit.allowed = true;
                         }
                         if ui.button("Cancel").clicked() {
-                            self.quit_asked = false;
+                            self.quit.asked = false;
                         }
                     });
                 });

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
+use super::files::FilePurpose;
 use super::{EditorState, MeshState, autosave_interval, notice};
 use crate::model::document::MeshRef;
 use crate::model::surface::Surface;
@@ -120,6 +121,11 @@ impl EditorState {
                     .push(notice(format!("saved {}", path.display()), false));
                 self.remember(&path);
                 self.path = Some(path);
+                if std::mem::take(&mut self.quit.after_save) && !self.dirty() {
+                    // The quit prompt's Save: the work is safe, so the window closes.
+                    self.quit.allowed = true;
+                    self.quit.asked = true;
+                }
                 if !self.dirty()
                     && let Some(next) = self.pending_open.take()
                 {
@@ -182,7 +188,10 @@ impl EditorState {
                 self.notices
                     .push(notice(format!("stamp {}", path.display()), false));
             }
-            JobResult::Failed(e) => self.notices.push(notice(e, true)),
+            JobResult::Failed(e) => {
+                self.quit.after_save = false;
+                self.notices.push(notice(e, true));
+            }
         }
     }
 
@@ -337,21 +346,10 @@ impl EditorState {
     }
 
     pub(super) fn save_as(&mut self) {
-        if let Some(p) = rfd::FileDialog::new()
-            .add_filter("kapaint project", &["kapaint"])
-            .set_file_name("material.kapaint")
-            .save_file()
-        {
-            self.save_to(p);
-        }
+        self.choose_file(FilePurpose::SaveProject);
     }
 
     pub(super) fn open_dialog(&mut self) {
-        if let Some(p) = rfd::FileDialog::new()
-            .add_filter("kapaint project", &["kapaint"])
-            .pick_file()
-        {
-            self.open(p);
-        }
+        self.choose_file(FilePurpose::OpenProject);
     }
 }

@@ -186,7 +186,8 @@ impl EditorState {
     /// Runs the actions of the keys pressed this frame (none while a text field has the
     /// keyboard).
     pub(super) fn hotkeys(&mut self, ctx: &egui::Context) {
-        if ctx.egui_wants_keyboard_input() {
+        // Nor while a file dialog is open: its keys are its own.
+        if ctx.egui_wants_keyboard_input() || self.files.open_for().is_some() {
             return;
         }
         let actions: Vec<Action> = ctx.input_mut(|i| {
@@ -209,7 +210,7 @@ impl EditorState {
                 Action::Open => self.open_dialog(),
                 Action::New => self.new_project(),
                 Action::Export => self.open_export(),
-                Action::Quit => self.quit_asked = true,
+                Action::Quit => self.quit.asked = true,
                 Action::Tool(kind) => self.select_tool(kind),
                 Action::FillOrFrame => {
                     if self.hover_tab == Some(Tab::Canvas) {

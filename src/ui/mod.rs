@@ -7,6 +7,7 @@
 
 pub mod canvas;
 mod dialogs;
+pub mod files;
 mod input;
 mod jobs;
 pub mod keys;
@@ -191,17 +192,29 @@ pub struct EditorState {
     shown_hover: Option<(u32, u32)>,
     /// Exact `chi` values for the status bar, integrated on a worker.
     exact_chi: readout::ExactChi,
-    quit_asked: bool,
+    /// Quitting: asked, waiting for a save, or allowed.
+    quit: Quit,
+    /// The file chooser: the system's, or kapaint's own without a desktop portal.
+    files: files::FileChooser,
     /// Whether Help > Keyboard shortcuts is open.
     shortcuts_open: bool,
-    /// Set when the user confirmed closing with unsaved changes.
-    allow_close: bool,
     /// A recovery copy found at start, newer than the project.
     recovery_offer: Option<PathBuf>,
     /// Material presets with their thumbnails (rendered a few per frame) and the mesh each
     /// thumbnail shows.
     presets: Vec<(String, MaterialValue, Option<Thumbnail>)>,
     autosaver: recovery::Autosaver,
+}
+
+/// Where quitting stands.
+#[derive(Default)]
+struct Quit {
+    /// Quit was asked (menu, key or the window's close button).
+    asked: bool,
+    /// Quit once the save under way is done (the quit prompt's Save).
+    after_save: bool,
+    /// The user confirmed closing with unsaved changes.
+    allowed: bool,
 }
 
 /// The editor app.
@@ -290,9 +303,9 @@ impl Editor {
                 hover_tab: None,
                 shown_hover: None,
                 exact_chi: readout::ExactChi::new(),
-                quit_asked: false,
+                quit: Quit::default(),
+                files: files::FileChooser::new(),
                 shortcuts_open: false,
-                allow_close: false,
                 recovery_offer,
                 presets: crate::model::preset::builtin()
                     .into_iter()
@@ -366,6 +379,21 @@ impl EditorState {
     /// Sets the New dialog's choices (opening it).
     pub fn set_new_dialog(&mut self, dialog: NewDialog) {
         self.new_dialog = Some(dialog);
+    }
+
+    /// What the open file dialog is for, if one is open.
+    pub fn file_dialog_open_for(&self) -> Option<files::FilePurpose> {
+        self.files.open_for()
+    }
+
+    /// Whether the window is closing (quit asked, and nothing unsaved, or discarded).
+    pub fn closing(&self) -> bool {
+        self.quit.asked && (self.quit.allowed || !self.dirty())
+    }
+
+    /// The export dialog's folder, while it is open.
+    pub fn export_folder(&self) -> Option<&str> {
+        self.export.as_ref().map(dialogs::ExportDialog::folder)
     }
 
     /// A project waiting to be opened until the user decides about unsaved changes.
@@ -525,6 +553,7 @@ impl Editor {
         s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
+        s.files_ui(&ctx);
         if s.job.is_some() {
             ctx.request_repaint_after(Duration::from_millis(100));
         }

@@ -6,6 +6,7 @@ use std::time::Duration;
 use crate::model::Command;
 use crate::model::texel::Channel;
 use crate::reflectance::{self, AmbientApprox, ShadingModel};
+use crate::ui::files::FilePurpose;
 use crate::ui::keys::{self, Action};
 use crate::ui::{EditorState, notice};
 
@@ -121,27 +122,20 @@ impl EditorState {
                     self.open_export();
                 }
                 ui.separator();
-                if ui.button("Import mesh…").clicked()
-                    && let Some(p) = rfd::FileDialog::new()
-                        .add_filter("mesh", &["obj", "gltf", "glb"])
-                        .pick_file()
-                {
-                    self.import_mesh(p);
+                if ui.button("Import mesh…").clicked() {
+                    self.choose_file(FilePurpose::ImportMesh);
                 }
                 for channel in [Channel::Kd, Channel::Ks, Channel::N] {
                     if ui
                         .button(format!("Import image into {}…", channel_label(channel)))
                         .clicked()
-                        && let Some(p) = rfd::FileDialog::new()
-                            .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
-                            .pick_file()
                     {
-                        self.import_image(p, channel);
+                        self.choose_file(FilePurpose::ImportImage(channel));
                     }
                 }
                 ui.separator();
                 if item(ui, "Quit", Action::Quit) {
-                    self.quit_asked = true;
+                    self.quit.asked = true;
                 }
             });
             ui.menu_button("Edit", |ui| {

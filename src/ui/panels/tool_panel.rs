@@ -5,6 +5,7 @@ use crate::model::paint::GradientShape;
 use crate::model::texel::Channel;
 use crate::reflectance::{self, ShadingModel};
 use crate::tools::{FillMode, ToolKind};
+use crate::ui::files::FilePurpose;
 use crate::ui::{EditorState, stamp_image, stamp_key};
 
 /// The key that selects a tool.
@@ -214,11 +215,8 @@ impl EditorState {
                 .button("Load…")
                 .on_hover_text("A stamp from an image (luminance times alpha)")
                 .clicked()
-                && let Some(p) = rfd::FileDialog::new()
-                    .add_filter("image", &["png", "jpg", "jpeg", "tga", "exr"])
-                    .pick_file()
             {
-                self.load_stamp(p);
+                self.choose_file(FilePurpose::StampImage);
             }
             if brush.stamp.is_some() && ui.button("Round").clicked() {
                 brush.stamp = None;
