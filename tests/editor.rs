@@ -961,3 +961,79 @@ fn every_file_request_reaches_its_command() {
         e.state.export_folder() == Some(chosen.as_str())
     });
 }
+
+/// A 2048^2 project of noise (every tile stored, so opening it takes a while).
+#[expect(clippy::expect_used, reason = "a test helper: no project, no test")]
+fn noisy_project(path: &std::path::Path) -> kapaint::model::Document {
+    use kapaint::model::texel::MaterialValue;
+    let mut maps =
+        kapaint::model::MaterialMaps::new(2048, 2048, MaterialValue::default()).expect("maps");
+    let mut seed = 0x2545_f491_u32;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    for id in 0..maps.tile_count() {
+        let tile = maps.tile_mut(id);
+        for i in 0..64 * 64 {
+            let r = next();
+            let half = |v: u32| u16::try_from(v & 0x7fff).unwrap_or(0);
+            let n = half::f16::from_f32((r >> 20) as f32).to_bits();
+            tile.set_texel(
+                i,
+                Texel {
+                    kd: [half(r), half(r >> 3), half(r >> 7)],
+                    ks: [half(r >> 11); 3],
+                    n,
+                },
+            );
+        }
+    }
+    let doc =
+        kapaint::model::Document::from_parts(maps, kapaint::model::DocumentSettings::default());
+    kapaint::model::project::save(&doc, path).expect("saved");
+    doc
+}
+
+#[test]
+fn a_project_named_at_start_opens_on_a_worker_and_takes_no_strokes_meanwhile() {
+    let dir = scratch("open-at-start");
+    let project = dir.join("big.kapaint");
+    let saved = noisy_project(&project);
+    // The editor is there at once, on an untitled placeholder (nothing can be saved over the
+    // file), with the project opening on a worker.
+    let editor = Editor::new(None, Some(project.clone()));
+    assert_eq!(editor.state.opening(), Some(project.as_path()));
+    assert_eq!(editor.state.path(), None);
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(1)
+        .build_ui_state(|ui, editor: &mut Editor| editor.frame(ui), editor);
+    if harness.state().state.opening().is_some() {
+        harness.get_by_label("Opening big.kapaint…");
+        // A stroke on the document about to be replaced is refused, not painted and lost.
+        let before = harness.state().state.doc().version();
+        let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+        harness.drag_at(centre);
+        harness.step();
+        harness.hover_at(centre + Vec2::new(60.0, 20.0));
+        harness.step();
+        harness.drop_at(centre + Vec2::new(60.0, 20.0));
+        harness.step();
+        if harness.state().state.opening().is_some() {
+            assert_eq!(harness.state().state.doc().version(), before);
+        }
+    } else {
+        eprintln!("the project opened within a frame: the refusal was not exercised");
+    }
+    wait_until(&mut harness, "opened", |e| {
+        e.state.path() == Some(project.as_path())
+    });
+    assert!(!harness.state().state.dirty());
+    let mut want = Vec::new();
+    saved.maps().for_each_texel(|_, _, t| want.push(t));
+    assert!(texels(harness.state()) == want, "the project as saved");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -182,11 +182,16 @@ impl EditorState {
                     let recover = ui.button("Recover").on_hover_text("Enter");
                     if recover.clicked() || enter {
                         self.recovery_offer = None;
-                        self.recover(copy.clone(), self.path.clone());
+                        let path = self.starting.take().or_else(|| self.path.clone());
+                        self.recover(copy.clone(), path);
                     }
                     if ui.button("Discard").clicked() {
                         self.recovery_offer = None;
                         crate::model::recovery::remove(&copy);
+                        // The project named at start opens as saved.
+                        if let Some(p) = self.starting.take() {
+                            self.open_now(p);
+                        }
                     }
                 });
             });

@@ -16,9 +16,9 @@ use crate::task::Progress;
 
 /// What a worker hands back.
 pub(super) enum JobResult {
-    /// A project (to be saved at the path; `None` for recovered untitled work), and whether it
-    /// came from a recovery copy.
-    Opened(Option<PathBuf>, Box<Document>, bool),
+    /// A project (to be saved at the path; `None` for recovered untitled work), whether it
+    /// came from a recovery copy, and a note for the user (its mesh could not be loaded).
+    Opened(Option<PathBuf>, Box<Document>, bool, Option<String>),
     Saved(PathBuf, u64),
     Exported(PathBuf, Box<crate::export::set::Manifest>),
     /// A mesh loaded and baked at the map size.
@@ -35,6 +35,8 @@ pub(super) enum JobResult {
 /// Long work on a worker thread.
 pub(super) struct Job {
     pub(super) label: String,
+    /// The project it opens (or the recovery copy it recovers), replacing the document.
+    pub(super) opens: Option<PathBuf>,
     pub(super) progress: Arc<Progress>,
     pub(super) handle: JoinHandle<JobResult>,
 }
@@ -80,6 +82,17 @@ impl EditorState {
         label: &str,
         work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
     ) {
+        self.start_job_opening(label, None, work);
+    }
+
+    /// Starts a job; one that `opens` a project replaces the document when done, and the
+    /// editor takes no input until then.
+    fn start_job_opening(
+        &mut self,
+        label: &str,
+        opens: Option<PathBuf>,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
         if self.busy() {
             self.notices
                 .push(notice("wait for the current job to finish", true));
@@ -94,6 +107,7 @@ impl EditorState {
             Ok(handle) => {
                 self.job = Some(Job {
                     label: label.into(),
+                    opens,
                     progress,
                     handle,
                 });
@@ -114,7 +128,12 @@ impl EditorState {
             .join()
             .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
         match result {
-            JobResult::Opened(path, doc, recovered) => self.opened(path, *doc, recovered),
+            JobResult::Opened(path, doc, recovered, note) => {
+                self.opened(path, *doc, recovered);
+                if let Some(note) = note {
+                    self.notices.push(notice(note, true));
+                }
+            }
             JobResult::Saved(path, version) => {
                 self.saved_version = version;
                 self.notices
@@ -311,10 +330,10 @@ impl EditorState {
     }
 
     pub(super) fn open_now(&mut self, path: PathBuf) {
-        self.start_job("Open", move |progress| {
+        self.start_job_opening("Open", Some(path.clone()), move |progress| {
             progress.start("open", 1);
             match load_project(&path) {
-                Ok((doc, _)) => JobResult::Opened(Some(path), Box::new(doc), false),
+                Ok((doc, note)) => JobResult::Opened(Some(path), Box::new(doc), false, note),
                 Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
             }
         });
@@ -322,7 +341,8 @@ impl EditorState {
 
     /// Opens the recovery copy `from` as the project at `path` (unsaved).
     pub(super) fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
-        self.start_job("Recover", move |progress| {
+        let opens = path.clone().unwrap_or_else(|| from.clone());
+        self.start_job_opening("Recover", Some(opens), move |progress| {
             progress.start("open", 1);
             let recovered = recovery::load(&from)
                 .map_err(|e| e.to_string())
@@ -332,7 +352,7 @@ impl EditorState {
                     with_fallback(doc, failed)
                 });
             match recovered {
-                Ok((doc, _)) => JobResult::Opened(path, Box::new(doc), true),
+                Ok((doc, note)) => JobResult::Opened(path, Box::new(doc), true, note),
                 Err(e) => JobResult::Failed(format!("could not recover {}: {e}", from.display())),
             }
         });
@@ -351,5 +371,21 @@ impl EditorState {
 
     pub(super) fn open_dialog(&mut self) {
         self.choose_file(FilePurpose::OpenProject);
+    }
+
+    /// While a project opens: a window over the editor saying which, that takes the pointer
+    /// (a stroke on the document about to be replaced would be lost).
+    pub(super) fn opening_ui(&self, ctx: &egui::Context) {
+        let Some(path) = self.opening() else { return };
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        egui::Modal::new(egui::Id::new("kapaint-opening")).show(ctx, |ui| {
+            ui.horizontal(|ui| {
+                ui.spinner();
+                ui.label(format!("Opening {name}…"));
+            });
+        });
     }
 }

@@ -187,7 +187,10 @@ impl EditorState {
     /// keyboard).
     pub(super) fn hotkeys(&mut self, ctx: &egui::Context) {
         // Nor while a file dialog is open: its keys are its own.
-        if ctx.egui_wants_keyboard_input() || self.files.open_for().is_some() {
+        if ctx.egui_wants_keyboard_input()
+            || self.files.open_for().is_some()
+            || self.opening().is_some()
+        {
             return;
         }
         let actions: Vec<Action> = ctx.input_mut(|i| {

@@ -18,7 +18,7 @@ pub mod viewport;
 
 use dialogs::{ExportDialog, load_recent};
 pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, parse_recent, push_recent};
-use jobs::{Job, JobResult, load_project, new_document};
+use jobs::{Job, JobResult, new_document};
 pub use layout::{default_layout, layout_json, parse_layout};
 use layout::{load_layout, save_layout};
 
@@ -154,6 +154,8 @@ pub struct EditorState {
     doc: Document,
     /// Where it is saved.
     path: Option<PathBuf>,
+    /// The project named at start, while the recovery offer decides how it opens.
+    starting: Option<PathBuf>,
     saved_version: u64,
     /// The tools and which one is active.
     tools: Tools,
@@ -231,57 +233,52 @@ pub struct Editor {
 
 impl Editor {
     /// The editor on a new default document (sphere, default material), or on `path` when
-    /// given (a missing file becomes a new project saved there).
+    /// given: a project there opens on a worker once the window is up (the window shows at
+    /// once, with the opening in progress over it); a missing file becomes a new project
+    /// saved there.
     pub fn new(
         render_state: Option<&eframe::egui_wgpu::RenderState>,
         path: Option<PathBuf>,
     ) -> Self {
         let gpu = render_state.map(ViewportGpu::new);
         let mut notices = Vec::new();
-        let (doc, mesh) = match path.as_deref().filter(|p| p.exists()).map(load_project) {
-            Some(Ok((doc, note))) => {
-                if let Some(note) = note {
-                    notices.push(notice(note, true));
-                }
-                let mesh = doc
-                    .surface()
-                    .map_or_else(crate::mesh::plane, |s| s.mesh.clone());
-                (doc, MeshState::new(mesh, 1))
-            }
-            other => {
-                if let Some(Err(e)) = other {
-                    notices.push(notice(e, true));
-                }
-                match new_document(DEFAULT_SIZE) {
-                    Ok(x) => x,
-                    Err(e) => {
-                        notices.push(notice(e, true));
-                        let doc = Document::new(16, 16, DocumentSettings::default())
-                            .unwrap_or_else(|_| unreachable_doc());
-                        (doc, MeshState::new(crate::mesh::plane(), 1))
-                    }
-                }
+        let (doc, mesh) = match new_document(DEFAULT_SIZE) {
+            Ok(x) => x,
+            Err(e) => {
+                notices.push(notice(e, true));
+                let doc = Document::new(16, 16, DocumentSettings::default())
+                    .unwrap_or_else(|_| unreachable_doc());
+                (doc, MeshState::new(crate::mesh::plane(), 1))
             }
         };
+        // A project that is there opens on a worker; until then the document is untitled,
+        // so nothing can be saved over the file.
+        let (existing, untitled_until_open) = match path {
+            Some(p) if p.exists() => (Some(p), None),
+            other => (None, other),
+        };
+        let path = existing.as_deref().or(untitled_until_open.as_deref());
         let mut viewport = Viewport::new(gpu);
         viewport.frame(&mesh.mesh);
-        let recovery = recovery::recovery_path(path.as_deref());
+        let recovery = recovery::recovery_path(path);
         let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
-        let recovery_offer = match (
-            recovery::modified(&recovery),
-            path.as_deref().and_then(modified),
-        ) {
+        let recovery_offer = match (recovery::modified(&recovery), path.and_then(modified)) {
             (Some(copy), Some(saved)) if copy > saved => Some(recovery.clone()),
             (Some(_), None) => Some(recovery.clone()),
             _ => None,
         };
-        let autosaver = recovery::Autosaver::new(autosave_interval(), recovery, &doc);
+        let autosaver = recovery::Autosaver::new(
+            autosave_interval(),
+            recovery::recovery_path(untitled_until_open.as_deref()),
+            &doc,
+        );
         let dock = load_layout().unwrap_or_else(default_layout);
         let saved_version = doc.version();
-        Self {
+        let mut editor = Self {
             state: EditorState {
                 doc,
-                path,
+                path: untitled_until_open,
+                starting: None,
                 saved_version,
                 tools: Tools::default(),
                 view: ViewMode::Shaded,
@@ -316,7 +313,17 @@ impl Editor {
             dock,
             started: None,
             title: String::new(),
+        };
+        if let Some(p) = existing {
+            let s = &mut editor.state;
+            if s.recovery_offer.is_some() {
+                // Recover or Discard decides what opens.
+                s.starting = Some(p);
+            } else {
+                s.open_now(p);
+            }
         }
+        editor
     }
 }
 
@@ -459,6 +466,12 @@ impl EditorState {
     fn busy(&self) -> bool {
         self.job.is_some()
     }
+
+    /// The project being opened (or recovered) on a worker, if one is: the document is about
+    /// to be replaced, so it takes no input meanwhile.
+    pub fn opening(&self) -> Option<&Path> {
+        self.job.as_ref().and_then(|j| j.opens.as_deref())
+    }
 }
 
 struct Tabs<'a>(&'a mut EditorState);
@@ -553,6 +566,7 @@ impl Editor {
         s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
+        s.opening_ui(&ctx);
         s.files_ui(&ctx);
         if s.job.is_some() {
             ctx.request_repaint_after(Duration::from_millis(100));

@@ -65,7 +65,7 @@ impl EditorState {
                 ui.add(
                     egui::ProgressBar::new(job.progress.fraction())
                         .desired_width(160.0)
-                        .text(format!("{} {}", job.label, job.progress.stage())),
+                        .text(job_text(&job.label, &job.progress.stage())),
                 );
                 if ui.button("Cancel").clicked() {
                     job.progress.cancel();
@@ -215,5 +215,24 @@ pub(in crate::ui) fn channel_label(channel: Channel) -> &'static str {
         Channel::Kd => "k_d",
         Channel::Ks => "k_s",
         Channel::N => "n",
+    }
+}
+
+/// A job's progress text: "Export: encode", or only "Open" where the stage repeats the label.
+fn job_text(label: &str, stage: &str) -> String {
+    if stage.is_empty() || stage.eq_ignore_ascii_case(label) {
+        label.to_string()
+    } else {
+        format!("{label}: {stage}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_stage_that_repeats_the_label_is_said_once() {
+        assert_eq!(super::job_text("Open", "open"), "Open");
+        assert_eq!(super::job_text("Export", "encode"), "Export: encode");
+        assert_eq!(super::job_text("Save", ""), "Save");
     }
 }
