@@ -437,6 +437,44 @@ fn every_tool_and_its_options_are_in_the_panel() {
     harness.run();
     // The tool's button and its mode's combo box.
     assert_eq!(harness.query_all_by_label("Fill").count(), 2);
+    // The stroke's options, each changing the brush it names.
+    harness.get_by_label("Brush").click();
+    harness.run();
+    let brush = |h: &Harness<'_, Editor>| h.state().state.doc().settings().brush.clone();
+    for (label, on) in [
+        (
+            "U",
+            (|b| b.mirror_u) as fn(&kapaint::model::brush::BrushSettings) -> bool,
+        ),
+        ("V", |b| b.mirror_v),
+        ("X", |b| b.mirror_x),
+        ("Y", |b| b.mirror_y),
+        ("Z", |b| b.mirror_z),
+        ("Front faces only", |b| b.front_faces_only),
+    ] {
+        let before = on(&brush(&harness));
+        harness.get_by_role_and_label(Role::CheckBox, label).click();
+        harness.run();
+        assert_ne!(on(&brush(&harness)), before, "{label}");
+    }
+    assert!(harness.query_all_by_label("Lazy mouse").count() > 0);
+    harness.get_by_label("Blend").click();
+    harness.run();
+    harness.get_by_label("Multiply").click();
+    harness.run();
+    assert_eq!(
+        brush(&harness).blend,
+        kapaint::model::brush::BlendMode::Multiply
+    );
+}
+
+#[test]
+fn f1_opens_the_shortcut_sheet() {
+    let mut harness = editor();
+    harness.key_press(egui::Key::F1);
+    harness.run();
+    harness.get_by_label("Keyboard shortcuts");
+    harness.get_by_label("keyboard shortcuts (this sheet)");
 }
 
 #[test]

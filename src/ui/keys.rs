@@ -45,6 +45,8 @@ pub enum Action {
     HarderBrush,
     /// Abandon the stroke or gradient under way.
     Abort,
+    /// Show the keyboard shortcuts.
+    Shortcuts,
 }
 
 /// One key binding.
@@ -136,6 +138,12 @@ pub const KEYMAP: &[Binding] = &[
     bind(NONE, Key::CloseBracket, Action::LargerBrush, "larger brush"),
     bind(
         NONE,
+        Key::F1,
+        Action::Shortcuts,
+        "keyboard shortcuts (this sheet)",
+    ),
+    bind(
+        NONE,
         Key::Escape,
         Action::Abort,
         "abandon the stroke or gradient under way",
@@ -223,6 +231,7 @@ impl EditorState {
                     }
                 }
                 Action::FitCanvas => self.canvas.fit(),
+                Action::Shortcuts => self.shortcuts_open = !self.shortcuts_open,
                 Action::SwapMaterials => self.apply(Command::SwapMaterials),
                 Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),

@@ -112,6 +112,7 @@ impl EditorState {
         ui.checkbox(&mut brush.pressure_size, "Pressure: size");
         ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
         self.stamp_ui(ui, &mut brush);
+        stroke_options_ui(ui, &mut brush);
         if brush != self.doc.settings().brush {
             self.apply(Command::SetBrush(brush));
         }
@@ -222,5 +223,53 @@ impl EditorState {
                 brush.stamp = None;
             }
         });
+    }
+}
+
+/// The stroke's options: blend mode, lazy mouse, mirrors, front faces only, energy guard.
+fn stroke_options_ui(ui: &mut egui::Ui, brush: &mut crate::model::brush::BrushSettings) {
+    use crate::model::brush::BlendMode;
+    egui::ComboBox::from_label("Blend")
+        .selected_text(blend_label(brush.blend))
+        .show_ui(ui, |ui| {
+            for mode in BlendMode::ALL {
+                ui.selectable_value(&mut brush.blend, mode, blend_label(mode));
+            }
+        })
+        .response
+        .on_hover_text("How the material is laid over the map (n blends in log space)");
+    ui.add(
+        egui::Slider::new(&mut brush.smoothing_px, 0.0..=64.0)
+            .text("Lazy mouse")
+            .suffix(" px"),
+    )
+    .on_hover_text("The brush trails the pointer by this many texels: steadier lines (0: off)");
+    ui.horizontal(|ui| {
+        ui.label("Mirror");
+        ui.checkbox(&mut brush.mirror_u, "U")
+            .on_hover_text("Across the UV map's vertical centre line");
+        ui.checkbox(&mut brush.mirror_v, "V")
+            .on_hover_text("Across the UV map's horizontal centre line");
+        ui.checkbox(&mut brush.mirror_x, "X")
+            .on_hover_text("On the mesh, across its X = 0 plane");
+        ui.checkbox(&mut brush.mirror_y, "Y")
+            .on_hover_text("On the mesh, across its Y = 0 plane");
+        ui.checkbox(&mut brush.mirror_z, "Z")
+            .on_hover_text("On the mesh, across its Z = 0 plane");
+    });
+    ui.checkbox(&mut brush.front_faces_only, "Front faces only")
+        .on_hover_text("On the mesh: paint only where the surface faces you, not through it");
+    ui.checkbox(&mut brush.energy_guard, "Energy guard")
+        .on_hover_text("Keep k_d + k_s at most 1 per colour channel while painting");
+}
+
+/// A blend mode's name in the panel.
+fn blend_label(mode: crate::model::brush::BlendMode) -> &'static str {
+    use crate::model::brush::BlendMode;
+    match mode {
+        BlendMode::Normal => "Normal",
+        BlendMode::Add => "Add",
+        BlendMode::Subtract => "Subtract",
+        BlendMode::Multiply => "Multiply",
     }
 }
