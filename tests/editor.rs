@@ -1075,3 +1075,82 @@ fn a_project_named_at_start_opens_on_a_worker_and_takes_no_strokes_meanwhile() {
     assert!(texels(harness.state()) == want, "the project as saved");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A right-button drag across the viewport, with `modifiers` held, over a few frames.
+fn right_drag(harness: &mut Harness<'_, Editor>, modifiers: Modifiers, by: Vec2) {
+    let a = harness.get_by_label(VIEWPORT_LABEL).rect().center();
+    let button = |pos, pressed| egui::Event::PointerButton {
+        pos,
+        button: egui::PointerButton::Secondary,
+        pressed,
+        modifiers,
+    };
+    harness.event(egui::Event::ModifiersChanged(modifiers));
+    harness.event(egui::Event::PointerMoved(a));
+    harness.step();
+    harness.event(button(a, true));
+    harness.step();
+    for i in 1..=6 {
+        harness.event(egui::Event::PointerMoved(a + by * (i as f32 / 6.0)));
+        harness.step();
+    }
+    harness.event(button(a + by, false));
+    harness.event(egui::Event::ModifiersChanged(Modifiers::default()));
+    harness.step();
+    harness.step();
+}
+
+#[test]
+fn shift_right_drag_turns_the_light_not_the_camera() {
+    let mut harness = editor();
+    let before = harness.state().state.frame_settings();
+    right_drag(&mut harness, Modifiers::SHIFT, Vec2::new(80.0, -40.0));
+    let after = harness.state().state.frame_settings();
+    assert_eq!(after.camera, before.camera, "the camera stays");
+    let (l0, l1) = (before.lighting.direction(), after.lighting.direction());
+    assert!(l0.angle_between(l1) > 0.5, "the light turned: {l0} -> {l1}");
+    assert!(l1.y > l0.y, "dragging up raises it: {l0} -> {l1}");
+    // Without Shift the right button still orbits.
+    right_drag(&mut harness, Modifiers::default(), Vec2::new(80.0, 0.0));
+    assert_ne!(harness.state().state.frame_settings().camera, after.camera);
+}
+
+#[test]
+fn the_light_can_follow_the_camera() {
+    let mut harness = editor();
+    let settings = |h: &Harness<'_, Editor>| h.state().state.frame_settings();
+    // By default the light stays put in the world while the camera orbits.
+    let before = settings(&harness);
+    right_drag(&mut harness, Modifiers::default(), Vec2::new(120.0, 0.0));
+    let orbited = settings(&harness);
+    assert_ne!(orbited.camera, before.camera);
+    assert!(
+        orbited
+            .lighting
+            .direction()
+            .distance(before.lighting.direction())
+            < 1e-5
+    );
+    // Following: switched on without a jump, then it turns with the camera.
+    harness.get_by_label("Light follows camera").click();
+    harness.run();
+    let on = settings(&harness);
+    assert!(
+        on.lighting
+            .direction()
+            .distance(orbited.lighting.direction())
+            < 1e-4
+    );
+    right_drag(&mut harness, Modifiers::default(), Vec2::new(-200.0, 30.0));
+    let turned = settings(&harness);
+    let relative =
+        |s: &kapaint::render::FrameSettings| s.camera.rotation().inverse() * s.lighting.direction();
+    assert!(
+        turned
+            .lighting
+            .direction()
+            .angle_between(on.lighting.direction())
+            > 0.5
+    );
+    assert!(relative(&turned).distance(relative(&on)) < 1e-4);
+}

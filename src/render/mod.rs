@@ -263,6 +263,13 @@ impl Camera {
     }
 
     /// The eye position.
+    /// The rotation from the default view (from +Z, looking down -Z) to this one: a
+    /// direction given relative to the camera, turned into the world.
+    pub fn rotation(&self) -> glam::Quat {
+        glam::Quat::from_rotation_y(self.yaw) * glam::Quat::from_rotation_x(-self.pitch)
+    }
+
+    /// The eye position.
     pub fn eye(&self) -> Vec3 {
         let dir = Vec3::new(
             self.pitch.cos() * self.yaw.sin(),

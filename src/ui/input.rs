@@ -166,6 +166,13 @@ impl EditorState {
             })
             .collect();
         self.pointer_input(Tab::Viewport, response, samples, alt);
+        // Shift + right drag turns the light: across for its yaw, up and down for its height.
+        if response.dragged_by(egui::PointerButton::Secondary)
+            && response.ctx.input(|i| i.modifiers.shift)
+        {
+            let d = response.drag_delta();
+            self.turn_light(d.x * 0.01, -d.y * 0.01);
+        }
         // The brush circle, projected on the surface: a circle of the dab's world radius in
         // the tangent plane under the cursor, drawn through the camera.
         if let (Some(p), Some(surface)) = (response.hover_pos(), self.doc.surface())
@@ -191,14 +198,46 @@ impl EditorState {
         }
     }
 
-    pub(super) fn frame_settings(&self) -> FrameSettings {
+    /// What the viewport draws this frame: the light in the world (turned with the camera
+    /// when it follows the camera).
+    pub fn frame_settings(&self) -> FrameSettings {
+        let mut lighting = self.lighting;
+        if self.light_follows_camera {
+            lighting.light = self.viewport.camera.rotation() * lighting.direction();
+        }
         FrameSettings {
             model: self.doc.settings().model,
             approx: self.doc.settings().approx,
             view: self.view,
-            lighting: self.lighting,
+            lighting,
             camera: self.viewport.camera,
         }
+    }
+
+    /// Turns the light by `yaw` about the vertical and raises it by `pitch` (radians; its
+    /// height stays within 89 degrees of the horizon).
+    pub(super) fn turn_light(&mut self, yaw: f32, pitch: f32) {
+        let l = self.lighting.direction();
+        let limit = 89f32.to_radians();
+        let height = (l.y.clamp(-1.0, 1.0).asin() + pitch).clamp(-limit, limit);
+        let around = l.x.atan2(l.z) + yaw;
+        self.lighting.light = glam::Vec3::new(
+            height.cos() * around.sin(),
+            height.sin(),
+            height.cos() * around.cos(),
+        );
+    }
+
+    /// Makes the light follow the camera (kept relative to the view, so turning the model
+    /// never leaves it dark) or stay put in the world; it does not jump either way.
+    pub fn set_light_follows_camera(&mut self, follow: bool) {
+        if follow == self.light_follows_camera {
+            return;
+        }
+        let turn = self.viewport.camera.rotation();
+        let l = self.lighting.direction();
+        self.lighting.light = if follow { turn.inverse() * l } else { turn * l };
+        self.light_follows_camera = follow;
     }
 }
 

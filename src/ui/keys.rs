@@ -279,7 +279,8 @@ impl EditorState {
 pub const MOUSE: &[(&str, &str)] = &[
     ("Left drag", "paint with the active tool"),
     ("Right drag, Alt + left drag", "orbit (viewport)"),
-    ("Middle drag, Shift + right drag", "pan (viewport)"),
+    ("Middle drag", "pan (viewport)"),
+    ("Shift + right drag", "turn the light (viewport)"),
     ("Space + drag", "pan the UV canvas"),
     ("Wheel", "zoom"),
 ];

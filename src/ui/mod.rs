@@ -161,8 +161,10 @@ pub struct EditorState {
     tools: Tools,
     /// View mode of the viewport.
     view: ViewMode,
-    /// Lights.
+    /// Lights (relative to the camera while `light_follows_camera`).
     lighting: Lighting,
+    /// The light turns with the camera.
+    light_follows_camera: bool,
     /// The 3D viewport.
     viewport: Viewport,
     /// The UV canvas.
@@ -283,6 +285,7 @@ impl Editor {
                 tools: Tools::default(),
                 view: ViewMode::Shaded,
                 lighting: Lighting::default(),
+                light_follows_camera: false,
                 viewport,
                 canvas: Canvas::default(),
                 mesh,

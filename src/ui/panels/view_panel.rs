@@ -61,6 +61,56 @@ impl EditorState {
         }
     }
 
+    /// The light: yaw and pitch in degrees, following the camera, intensities.
+    fn light_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Light");
+        // Shown and edited in degrees, as artists think of angles; kept as a direction.
+        let l = self.lighting.light.normalize_or(glam::Vec3::Z);
+        let (mut yaw, mut pitch) = (
+            l.x.atan2(l.z).to_degrees(),
+            l.y.clamp(-1.0, 1.0).asin().to_degrees(),
+        );
+        let a = ui.add(
+            egui::Slider::new(&mut yaw, -180.0..=180.0)
+                .suffix("°")
+                // Shown to 0.1 degree but not rounded: a rounding slider would snap the
+                // light every frame it is drawn.
+                .custom_formatter(|v, _| format!("{v:.1}"))
+                .clamping(egui::SliderClamping::Never)
+                .text("Light yaw"),
+        );
+        let b = ui.add(
+            egui::Slider::new(&mut pitch, -89.0..=89.0)
+                .suffix("°")
+                // Shown to 0.1 degree but not rounded: a rounding slider would snap the
+                // light every frame it is drawn.
+                .custom_formatter(|v, _| format!("{v:.1}"))
+                .clamping(egui::SliderClamping::Never)
+                .text("Light pitch"),
+        );
+        if a.changed() || b.changed() {
+            let (yaw, pitch) = (yaw.to_radians(), pitch.to_radians());
+            self.lighting.light = glam::Vec3::new(
+                pitch.cos() * yaw.sin(),
+                pitch.sin(),
+                pitch.cos() * yaw.cos(),
+            );
+        }
+        let mut follow = self.light_follows_camera;
+        if ui
+            .checkbox(&mut follow, "Light follows camera")
+            .on_hover_text(
+                "Keep the light where it is relative to the view while orbiting \
+                 (yaw and pitch are then relative to the camera); Shift + right drag turns it",
+            )
+            .changed()
+        {
+            self.set_light_follows_camera(follow);
+        }
+        ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
+        ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+    }
+
     /// Right panel: model, view, compare, light, canvas channel, history.
     pub(in crate::ui) fn view_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Shading");
@@ -102,35 +152,7 @@ impl EditorState {
                 }
             });
         ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
-        ui.heading("Light");
-        // Shown and edited in degrees, as artists think of angles; kept as a direction.
-        let l = self.lighting.light.normalize_or(glam::Vec3::Z);
-        let (mut yaw, mut pitch) = (
-            l.x.atan2(l.z).to_degrees(),
-            l.y.clamp(-1.0, 1.0).asin().to_degrees(),
-        );
-        let a = ui.add(
-            egui::Slider::new(&mut yaw, -180.0..=180.0)
-                .suffix("°")
-                .fixed_decimals(1)
-                .text("Light yaw"),
-        );
-        let b = ui.add(
-            egui::Slider::new(&mut pitch, -89.0..=89.0)
-                .suffix("°")
-                .fixed_decimals(1)
-                .text("Light pitch"),
-        );
-        if a.changed() || b.changed() {
-            let (yaw, pitch) = (yaw.to_radians(), pitch.to_radians());
-            self.lighting.light = glam::Vec3::new(
-                pitch.cos() * yaw.sin(),
-                pitch.sin(),
-                pitch.cos() * yaw.cos(),
-            );
-        }
-        ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
-        ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+        self.light_ui(ui);
         egui::CollapsingHeader::new("Material presets")
             .default_open(true)
             .show(ui, |ui| self.presets_ui(ui));

@@ -181,11 +181,12 @@ impl Viewport {
         let right = response.dragged_by(egui::PointerButton::Secondary);
         let middle = response.dragged_by(egui::PointerButton::Middle);
         let left = response.dragged_by(egui::PointerButton::Primary);
-        if middle || (right && shift) {
+        // Shift + right drag turns the light (the editor reads it from the response).
+        if middle {
             self.camera = self
                 .camera
                 .pan(delta.x / rect.height(), delta.y / rect.height());
-        } else if right || (left && alt) {
+        } else if (right && !shift) || (left && alt) {
             self.camera = self.camera.orbit(-delta.x * 0.01, delta.y * 0.01);
         }
         if response.hovered() {
