@@ -1154,3 +1154,53 @@ fn the_light_can_follow_the_camera() {
     );
     assert!(relative(&turned).distance(relative(&on)) < 1e-4);
 }
+
+#[test]
+fn the_right_panel_keeps_its_width_in_every_compare_mode() {
+    let mut harness = editor();
+    let width = |h: &Harness<'_, Editor>| {
+        egui::containers::panel::PanelState::load(&h.ctx, egui::Id::new("view"))
+            .map(|s| s.size().x)
+            .expect("the right panel")
+    };
+    let single = width(&harness);
+    for (mode, label) in Compare::ALL {
+        harness.get_by_label(label).click();
+        harness.run();
+        harness.run();
+        assert!(
+            (width(&harness) - single).abs() < 0.5,
+            "{mode:?}: {} against {single}",
+            width(&harness)
+        );
+    }
+}
+
+#[test]
+fn the_canvas_shows_the_brush_outline_at_its_zoom() {
+    let mut harness = editor();
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    harness.hover_at(canvas.center());
+    harness.run();
+    let (centre, radius) = harness
+        .state()
+        .state
+        .canvas_outline()
+        .expect("a brush outline over the canvas");
+    assert!(centre.distance(canvas.center()) < 0.5);
+    let state = &harness.state().state;
+    let want = state.doc().settings().brush.radius_px * state.canvas_zoom();
+    assert!(
+        (radius - want).abs() < 0.01 * want,
+        "{radius} against {want}"
+    );
+    // A larger brush (] is 1.25 times), a larger circle.
+    harness.key_press(egui::Key::CloseBracket);
+    harness.run();
+    let (_, larger) = harness.state().state.canvas_outline().expect("outline");
+    assert!((larger / radius - 1.25).abs() < 0.01, "{larger} / {radius}");
+    // None with the picker, nor off the canvas.
+    harness.key_press(egui::Key::I);
+    harness.run();
+    assert!(harness.state().state.canvas_outline().is_none());
+}

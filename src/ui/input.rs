@@ -117,6 +117,23 @@ impl EditorState {
             })
             .collect();
         self.pointer_input(Tab::Canvas, response, samples, space);
+        // The brush circle: the dab's radius in texels, at the canvas's zoom.
+        self.canvas_outline = None;
+        if let Some(p) = response.hover_pos()
+            && self.tools.active().strokes()
+            && !space
+        {
+            let radius = self.doc.settings().brush.radius_px * rect.width() / size.0 as f32;
+            let painter = response.ctx.layer_painter(response.layer_id);
+            // Dark under light, so it shows on any material.
+            painter.circle_stroke(
+                p,
+                radius + 1.0,
+                egui::Stroke::new(1.0, egui::Color32::BLACK),
+            );
+            painter.circle_stroke(p, radius, egui::Stroke::new(1.0, egui::Color32::WHITE));
+            self.canvas_outline = Some((p, radius));
+        }
         if self.tools.active() == ToolKind::Gradient
             && let Some((start, end)) = self.tools.gradient.drag()
         {

@@ -192,6 +192,8 @@ pub struct EditorState {
     hover: Option<(u32, u32)>,
     /// The tab under the cursor.
     hover_tab: Option<Tab>,
+    /// The brush circle drawn on the UV canvas this frame: centre and radius in points.
+    canvas_outline: Option<(egui::Pos2, f32)>,
     /// `hover` as of the last frame (the status bar is drawn before the tabs).
     shown_hover: Option<(u32, u32)>,
     /// Exact `chi` values for the status bar, integrated on a worker.
@@ -301,6 +303,7 @@ impl Editor {
                 held: None,
                 hover: None,
                 hover_tab: None,
+                canvas_outline: None,
                 shown_hover: None,
                 exact_chi: readout::ExactChi::new(),
                 quit: Quit::default(),
@@ -389,6 +392,12 @@ impl EditorState {
     /// Sets the New dialog's choices (opening it).
     pub fn set_new_dialog(&mut self, dialog: NewDialog) {
         self.new_dialog = Some(dialog);
+    }
+
+    /// The brush circle on the UV canvas (centre and radius in points), while the cursor is
+    /// over it with a painting tool.
+    pub fn canvas_outline(&self) -> Option<(egui::Pos2, f32)> {
+        self.canvas_outline
     }
 
     /// What the open file dialog is for, if one is open.

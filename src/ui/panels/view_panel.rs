@@ -24,8 +24,11 @@ impl EditorState {
         if c.mode == Compare::Single {
             return;
         }
-        for (name, side) in [("Left", &mut c.left), ("Right", &mut c.right)] {
-            ui.horizontal(|ui| {
+        // One combo box a row, within the panel's width whatever the mode (the panel would
+        // grow to fit a wider row, and the layout jump as the mode changes).
+        egui::Grid::new("compare sides").show(ui, |ui| {
+            for (name, side) in [("Left", &mut c.left), ("Right", &mut c.right)] {
+                ui.label(name);
                 egui::ComboBox::from_id_salt(("compare model", name))
                     .selected_text(model_label(side.model))
                     .width(COMBO_WIDTH)
@@ -34,16 +37,19 @@ impl EditorState {
                             ui.selectable_value(&mut side.model, m, model_label(m));
                         }
                     });
+                ui.end_row();
+                ui.label("");
                 egui::ComboBox::from_id_salt(("compare approx", name))
                     .selected_text(side.approx.name())
+                    .width(COMBO_WIDTH)
                     .show_ui(ui, |ui| {
                         for a in AmbientApprox::ALL {
                             ui.selectable_value(&mut side.approx, a, a.name());
                         }
                     });
-                ui.label(name);
-            });
-        }
+                ui.end_row();
+            }
+        });
         match c.mode {
             Compare::Split => {
                 ui.add(egui::Slider::new(&mut c.split_at, 0.0..=1.0).text("Divider"))
