@@ -176,6 +176,22 @@ impl Lighting {
             .filter(|d| d.is_finite())
             .unwrap_or(Vec3::Y)
     }
+
+    /// The light's yaw (about +Y, from +Z towards +X) and pitch (above the horizon), in
+    /// radians.
+    pub fn angles(&self) -> (f32, f32) {
+        let l = self.direction();
+        (l.x.atan2(l.z), l.y.clamp(-1.0, 1.0).asin())
+    }
+
+    /// Points the light at `yaw` and `pitch` (radians, as [`Lighting::angles`] gives them).
+    pub fn set_angles(&mut self, yaw: f32, pitch: f32) {
+        self.light = Vec3::new(
+            pitch.cos() * yaw.sin(),
+            pitch.sin(),
+            pitch.cos() * yaw.cos(),
+        );
+    }
 }
 
 /// An orbit camera around a target, Y up.

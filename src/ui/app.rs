@@ -21,6 +21,9 @@ use crate::model::{Document, DocumentSettings, recovery};
 use crate::render::{Lighting, ViewMode};
 use crate::tools::Tools;
 
+/// The map size of the document shown while a project named at start opens.
+const PLACEHOLDER_SIZE: u32 = 16;
+
 /// The editor app.
 pub struct Editor {
     /// Panels' state.
@@ -44,7 +47,19 @@ impl Editor {
     ) -> Self {
         let gpu = render_state.map(ViewportGpu::new);
         let mut notices = Vec::new();
-        let (doc, mesh) = match new_document(DEFAULT_SIZE) {
+        // A project that is there opens on a worker; until then the document is untitled,
+        // so nothing can be saved over the file.
+        let (existing, untitled_until_open) = match path {
+            Some(p) if p.exists() => (Some(p), None),
+            other => (None, other),
+        };
+        // Under a project being opened, a placeholder costs next to nothing to make.
+        let size = if existing.is_some() {
+            PLACEHOLDER_SIZE
+        } else {
+            DEFAULT_SIZE
+        };
+        let (doc, mesh) = match new_document(size) {
             Ok(x) => x,
             Err(e) => {
                 notices.push(notice(e, true));
@@ -52,12 +67,6 @@ impl Editor {
                     .unwrap_or_else(|_| unreachable_doc());
                 (doc, MeshState::new(crate::mesh::plane(), 1))
             }
-        };
-        // A project that is there opens on a worker; until then the document is untitled,
-        // so nothing can be saved over the file.
-        let (existing, untitled_until_open) = match path {
-            Some(p) if p.exists() => (Some(p), None),
-            other => (None, other),
         };
         let path = existing.as_deref().or(untitled_until_open.as_deref());
         let mut viewport = Viewport::new(gpu);

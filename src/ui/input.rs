@@ -234,15 +234,10 @@ impl EditorState {
     /// Turns the light by `yaw` about the vertical and raises it by `pitch` (radians; its
     /// height stays within 89 degrees of the horizon).
     pub(super) fn turn_light(&mut self, yaw: f32, pitch: f32) {
-        let l = self.lighting.direction();
+        let (around, height) = self.lighting.angles();
         let limit = 89f32.to_radians();
-        let height = (l.y.clamp(-1.0, 1.0).asin() + pitch).clamp(-limit, limit);
-        let around = l.x.atan2(l.z) + yaw;
-        self.lighting.light = glam::Vec3::new(
-            height.cos() * around.sin(),
-            height.sin(),
-            height.cos() * around.cos(),
-        );
+        self.lighting
+            .set_angles(around + yaw, (height + pitch).clamp(-limit, limit));
     }
 
     /// Makes the light follow the camera (kept relative to the view, so turning the model

@@ -160,14 +160,7 @@ impl Document {
     /// A document of `width x height` texels, every texel the settings' base material.
     pub fn new(width: u32, height: u32, settings: DocumentSettings) -> Result<Self, ModelError> {
         let maps = MaterialMaps::new(width, height, settings.base)?;
-        Ok(Self {
-            maps,
-            history: History::default(),
-            settings,
-            surface: None,
-            stroke: None,
-            settings_version: 0,
-        })
+        Ok(Self::from_parts(maps, settings))
     }
 
     /// A document around existing maps (loading), with empty history.

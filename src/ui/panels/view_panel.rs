@@ -71,36 +71,13 @@ impl EditorState {
     fn light_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Light");
         // Shown and edited in degrees, as artists think of angles; kept as a direction.
-        let l = self.lighting.light.normalize_or(glam::Vec3::Z);
-        let (mut yaw, mut pitch) = (
-            l.x.atan2(l.z).to_degrees(),
-            l.y.clamp(-1.0, 1.0).asin().to_degrees(),
-        );
-        let a = ui.add(
-            egui::Slider::new(&mut yaw, -180.0..=180.0)
-                .suffix("°")
-                // Shown to 0.1 degree but not rounded: a rounding slider would snap the
-                // light every frame it is drawn.
-                .custom_formatter(|v, _| format!("{v:.1}"))
-                .clamping(egui::SliderClamping::Never)
-                .text("Light yaw"),
-        );
-        let b = ui.add(
-            egui::Slider::new(&mut pitch, -89.0..=89.0)
-                .suffix("°")
-                // Shown to 0.1 degree but not rounded: a rounding slider would snap the
-                // light every frame it is drawn.
-                .custom_formatter(|v, _| format!("{v:.1}"))
-                .clamping(egui::SliderClamping::Never)
-                .text("Light pitch"),
-        );
+        let (yaw, pitch) = self.lighting.angles();
+        let (mut yaw, mut pitch) = (yaw.to_degrees(), pitch.to_degrees());
+        let a = ui.add(degrees(&mut yaw, 180.0, "Light yaw"));
+        let b = ui.add(degrees(&mut pitch, 89.0, "Light pitch"));
         if a.changed() || b.changed() {
-            let (yaw, pitch) = (yaw.to_radians(), pitch.to_radians());
-            self.lighting.light = glam::Vec3::new(
-                pitch.cos() * yaw.sin(),
-                pitch.sin(),
-                pitch.cos() * yaw.cos(),
-            );
+            self.lighting
+                .set_angles(yaw.to_radians(), pitch.to_radians());
         }
         let mut follow = self.light_follows_camera;
         if ui
@@ -296,4 +273,14 @@ pub(in crate::ui) fn history_summary(steps: usize, bytes: usize) -> String {
 /// Bytes as megabytes with one decimal, as the panel and the status bar both show them.
 pub(in crate::ui) fn megabytes(bytes: usize) -> String {
     format!("{:.1} MB", bytes as f64 / 1e6)
+}
+
+/// A slider of an angle in degrees within `±limit`, shown to 0.1 degree but not rounded (a
+/// rounding slider would change the value every frame it is drawn).
+fn degrees<'a>(value: &'a mut f32, limit: f32, text: &str) -> egui::Slider<'a> {
+    egui::Slider::new(value, -limit..=limit)
+        .suffix("°")
+        .custom_formatter(|v, _| format!("{v:.1}"))
+        .clamping(egui::SliderClamping::Never)
+        .text(text)
 }
