@@ -111,6 +111,8 @@ impl Editor {
                 hover: None,
                 hover_tab: None,
                 canvas_outline: None,
+                brush_size: super::screen_brush::BrushSize::default(),
+                texels_per_point: None,
                 shown_hover: None,
                 exact_chi: readout::ExactChi::new(),
                 quit: Quit::default(),

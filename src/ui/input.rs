@@ -8,6 +8,7 @@
 use egui::Key;
 use glam::Vec2;
 
+use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
 use crate::model::brush::SurfacePos;
 use crate::render::FrameSettings;
@@ -70,6 +71,9 @@ impl EditorState {
                         && response.ctx.layer_id_at(p) == Some(response.layer_id);
                     if self.held.is_none() && on_view && !reserved {
                         self.held = Some(tab);
+                        if self.tools.active().strokes() {
+                            self.fit_brush_to_screen();
+                        }
                         if let Some(at) = at {
                             self.tool_event(ToolEvent::Press { at, pressure });
                         }
@@ -108,6 +112,9 @@ impl EditorState {
             self.hover = pos.and_then(|p| self.texel_at(p));
             self.hover_tab = Some(Tab::Canvas);
         }
+        if pointer.is_some() && (response.hovered() || self.held == Some(Tab::Canvas)) {
+            self.texels_per_point = Some(size.0 as f32 / rect.width().max(1e-3));
+        }
         let space = response.ctx.input(|i| i.key_down(Key::Space));
         let samples = pointer_samples(&response.ctx)
             .into_iter()
@@ -123,7 +130,11 @@ impl EditorState {
             && self.tools.active().strokes()
             && !space
         {
-            let radius = self.doc.settings().brush.radius_px * rect.width() / size.0 as f32;
+            let radius = if self.brush_size.on_screen {
+                self.brush_size.screen_radius
+            } else {
+                self.doc.settings().brush.radius_px * rect.width() / size.0 as f32
+            };
             let painter = response.ctx.layer_painter(response.layer_id);
             // Dark under light, so it shows on any material.
             painter.circle_stroke(
@@ -171,6 +182,14 @@ impl EditorState {
             self.hover_tab = Some(Tab::Viewport);
             self.hover = place.and_then(Place::texel).and_then(|p| self.texel_at(p));
         }
+        // A screen point's size on the surface under the cursor, in texels.
+        if let (Some(p), Some(hit), Some(surface)) = (pointer, &hit, self.doc.surface())
+            && (response.hovered() || self.held == Some(Tab::Viewport))
+        {
+            let picture = self.viewport.picture_at(rect, p);
+            self.texels_per_point = points_per_world(&self.viewport.camera, picture, hit.position)
+                .map(|ppw| 1.0 / (ppw * surface.units_per_texel));
+        }
         // Picking every sample costs a ray each; only while a stroke may start or is held.
         let samples = pointer_samples(&response.ctx)
             .into_iter()
@@ -196,8 +215,13 @@ impl EditorState {
             && self.tools.active().strokes()
             && let Some(hit) = self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh)
         {
-            let world = self.doc.settings().brush.radius_px * surface.units_per_texel;
             let picture = self.viewport.picture_at(rect, p);
+            let world = if self.brush_size.on_screen {
+                points_per_world(&self.viewport.camera, picture, hit.position)
+                    .map_or(0.0, |ppw| self.brush_size.screen_radius / ppw)
+            } else {
+                self.doc.settings().brush.radius_px * surface.units_per_texel
+            };
             let points = brush_outline(
                 &self.viewport.camera,
                 picture,

@@ -235,8 +235,8 @@ impl EditorState {
                 Action::SwapMaterials => self.apply(Command::SwapMaterials),
                 Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
-                Action::SmallerBrush => brush.radius_px = (brush.radius_px / 1.25).max(0.5),
-                Action::LargerBrush => brush.radius_px = (brush.radius_px * 1.25).min(2048.0),
+                Action::SmallerBrush => self.scale_brush(&mut brush, 1.0 / 1.25),
+                Action::LargerBrush => self.scale_brush(&mut brush, 1.25),
                 Action::Abort => {
                     self.tool_event(ToolEvent::Escape);
                     // The button stays with nobody until it is released and pressed again:

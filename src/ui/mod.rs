@@ -15,6 +15,7 @@ pub mod keys;
 mod layout;
 mod panels;
 mod readout;
+pub mod screen_brush;
 pub mod viewport;
 
 pub use app::{Editor, run};
@@ -62,6 +63,22 @@ pub struct Notice {
     at: Instant,
 }
 
+/// Where `world` falls in `picture` through `view_proj`, if in front of the camera.
+pub(super) fn project(
+    view_proj: glam::Mat4,
+    picture: egui::Rect,
+    world: glam::Vec3,
+) -> Option<egui::Pos2> {
+    let clip = view_proj * world.extend(1.0);
+    (clip.w > 1e-6).then(|| {
+        let ndc = clip.truncate() / clip.w;
+        egui::Pos2::new(
+            picture.min.x + (ndc.x * 0.5 + 0.5) * picture.width(),
+            picture.min.y + (0.5 - ndc.y * 0.5) * picture.height(),
+        )
+    })
+}
+
 /// Screen points of a circle of `radius` (world units) around `centre` in the plane normal
 /// to `normal`, seen by `camera` in `picture`.
 pub fn brush_outline(
@@ -77,15 +94,11 @@ pub fn brush_outline(
     (0..48)
         .filter_map(|i| {
             let a = i as f32 / 48.0 * std::f32::consts::TAU;
-            let world = centre + (t * a.cos() + b * a.sin()) * radius;
-            let clip = view_proj * world.extend(1.0);
-            (clip.w > 1e-6).then(|| {
-                let ndc = clip.truncate() / clip.w;
-                egui::Pos2::new(
-                    picture.min.x + (ndc.x * 0.5 + 0.5) * picture.width(),
-                    picture.min.y + (0.5 - ndc.y * 0.5) * picture.height(),
-                )
-            })
+            project(
+                view_proj,
+                picture,
+                centre + (t * a.cos() + b * a.sin()) * radius,
+            )
         })
         .collect()
 }
@@ -192,6 +205,10 @@ pub struct EditorState {
     hover: Option<(u32, u32)>,
     /// The tab under the cursor.
     hover_tab: Option<Tab>,
+    /// How the brush's size is given: in texels, or on screen.
+    brush_size: screen_brush::BrushSize,
+    /// Texels per screen point under the cursor (canvas zoom, or the surface's scale).
+    texels_per_point: Option<f32>,
     /// The brush circle drawn on the UV canvas this frame: centre and radius in points.
     canvas_outline: Option<(egui::Pos2, f32)>,
     /// `hover` as of the last frame (the status bar is drawn before the tabs).

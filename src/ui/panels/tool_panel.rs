@@ -97,12 +97,7 @@ impl EditorState {
         ui.separator();
         ui.heading("Brush settings");
         let mut brush = self.doc.settings().brush.clone();
-        ui.add(
-            egui::Slider::new(&mut brush.radius_px, 0.5..=512.0)
-                .logarithmic(true)
-                .text("Radius"),
-        )
-        .on_hover_text("[ and ] change the size");
+        self.brush_radius_ui(ui, &mut brush);
         ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
             .on_hover_text("Shift+[ and Shift+] change the hardness");
         ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));

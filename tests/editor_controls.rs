@@ -1,0 +1,286 @@
+//! The editor's everyday controls, driven through egui_kittest: the light, the panels, the
+//! canvas's fit, outline and legend, the brush's size on screen, colours, presets, history
+//! and resizing the maps.
+
+use egui::accesskit::Role;
+use egui::{Modifiers, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use kapaint::ui::Editor;
+use kapaint::ui::canvas::CANVAS_LABEL;
+use kapaint::ui::viewport::{Compare, VIEWPORT_LABEL};
+
+#[expect(dead_code, reason = "each editor test file uses some of the helpers")]
+mod kit;
+use kit::*;
+
+/// The light's yaw and pitch are shown and edited in degrees.
+#[test]
+fn light_angles_are_in_degrees() {
+    let harness = editor();
+    let l = kapaint::render::Lighting::default().light.normalize();
+    let (yaw, pitch) = (
+        f64::from(l.x.atan2(l.z).to_degrees()),
+        f64::from(l.y.asin().to_degrees()),
+    );
+    assert!(yaw.abs() > 5.0 && pitch.abs() > 5.0, "{yaw} {pitch}");
+    let values: Vec<f64> = harness
+        .get_all_by_role(Role::Slider)
+        .filter_map(|n| egui_kittest::kittest::NodeT::accesskit_node(&n).numeric_value())
+        .collect();
+    for angle in [yaw, pitch] {
+        assert!(
+            values.iter().any(|v| (v - angle).abs() < 0.05),
+            "no slider shows {angle} degrees: {values:?}"
+        );
+    }
+}
+
+/// Home fits the map in the UV canvas again after zooming (F stays the fill tool).
+#[test]
+fn home_fits_the_canvas() {
+    let mut harness = editor();
+    let fitted = harness.state().state.canvas_zoom();
+    assert!(fitted > 0.0);
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    harness.hover_at(canvas.center() + Vec2::new(30.0, 20.0));
+    harness.run();
+    for _ in 0..10 {
+        harness.input_mut().events.push(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: Vec2::new(0.0, 120.0),
+            phase: egui::TouchPhase::Move,
+            modifiers: Modifiers::NONE,
+        });
+        harness.step();
+    }
+    harness.run();
+    let zoomed = harness.state().state.canvas_zoom();
+    assert!(
+        zoomed > fitted * 1.5,
+        "the wheel zoomed: {fitted} -> {zoomed}"
+    );
+    harness.key_press(egui::Key::Home);
+    harness.run();
+    let back = harness.state().state.canvas_zoom();
+    // The panel is the same but for a pixel or two of layout since the first frame.
+    assert!(
+        (back - fitted).abs() < fitted * 0.02,
+        "Home fits again: {back} vs {fitted}"
+    );
+}
+
+/// The n false-colour view shows its scale in the viewport, as `kapaint render` does.
+#[test]
+fn the_n_false_colour_view_has_a_legend() {
+    use kapaint::ui::viewport::N_LEGEND_LABEL;
+    let mut harness = editor();
+    assert!(harness.query_by_label(N_LEGEND_LABEL).is_none());
+    harness.get_by_label("View mode").click();
+    harness.run();
+    harness.get_by_label("n false colour").click();
+    harness.run();
+    harness.get_by_label(N_LEGEND_LABEL);
+}
+
+#[test]
+fn shift_right_drag_turns_the_light_not_the_camera() {
+    let mut harness = editor();
+    let before = harness.state().state.frame_settings();
+    right_drag(&mut harness, Modifiers::SHIFT, Vec2::new(80.0, -40.0));
+    let after = harness.state().state.frame_settings();
+    assert_eq!(after.camera, before.camera, "the camera stays");
+    let (l0, l1) = (before.lighting.direction(), after.lighting.direction());
+    assert!(l0.angle_between(l1) > 0.5, "the light turned: {l0} -> {l1}");
+    assert!(l1.y > l0.y, "dragging up raises it: {l0} -> {l1}");
+    // Without Shift the right button still orbits.
+    right_drag(&mut harness, Modifiers::default(), Vec2::new(80.0, 0.0));
+    assert_ne!(harness.state().state.frame_settings().camera, after.camera);
+}
+
+#[test]
+fn the_light_can_follow_the_camera() {
+    let mut harness = editor();
+    let settings = |h: &Harness<'_, Editor>| h.state().state.frame_settings();
+    // By default the light stays put in the world while the camera orbits.
+    let before = settings(&harness);
+    right_drag(&mut harness, Modifiers::default(), Vec2::new(120.0, 0.0));
+    let orbited = settings(&harness);
+    assert_ne!(orbited.camera, before.camera);
+    assert!(
+        orbited
+            .lighting
+            .direction()
+            .distance(before.lighting.direction())
+            < 1e-5
+    );
+    // Following: switched on without a jump, then it turns with the camera.
+    harness.get_by_label("Light follows camera").click();
+    harness.run();
+    let on = settings(&harness);
+    assert!(
+        on.lighting
+            .direction()
+            .distance(orbited.lighting.direction())
+            < 1e-4
+    );
+    right_drag(&mut harness, Modifiers::default(), Vec2::new(-200.0, 30.0));
+    let turned = settings(&harness);
+    let relative =
+        |s: &kapaint::render::FrameSettings| s.camera.rotation().inverse() * s.lighting.direction();
+    assert!(
+        turned
+            .lighting
+            .direction()
+            .angle_between(on.lighting.direction())
+            > 0.5
+    );
+    assert!(relative(&turned).distance(relative(&on)) < 1e-4);
+}
+
+#[test]
+fn the_right_panel_keeps_its_width_in_every_compare_mode() {
+    let mut harness = editor();
+    let width = |h: &Harness<'_, Editor>| {
+        egui::containers::panel::PanelState::load(&h.ctx, egui::Id::new("view"))
+            .map(|s| s.size().x)
+            .expect("the right panel")
+    };
+    let single = width(&harness);
+    for (mode, label) in Compare::ALL {
+        harness.get_by_label(label).click();
+        harness.run();
+        harness.run();
+        assert!(
+            (width(&harness) - single).abs() < 0.5,
+            "{mode:?}: {} against {single}",
+            width(&harness)
+        );
+    }
+}
+
+#[test]
+fn the_canvas_shows_the_brush_outline_at_its_zoom() {
+    let mut harness = editor();
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    harness.hover_at(canvas.center());
+    harness.run();
+    let (centre, radius) = harness
+        .state()
+        .state
+        .canvas_outline()
+        .expect("a brush outline over the canvas");
+    assert!(centre.distance(canvas.center()) < 0.5);
+    let state = &harness.state().state;
+    let want = state.doc().settings().brush.radius_px * state.canvas_zoom();
+    assert!(
+        (radius - want).abs() < 0.01 * want,
+        "{radius} against {want}"
+    );
+    // A larger brush (] is 1.25 times), a larger circle.
+    harness.key_press(egui::Key::CloseBracket);
+    harness.run();
+    let (_, larger) = harness.state().state.canvas_outline().expect("outline");
+    assert!((larger / radius - 1.25).abs() < 0.01, "{larger} / {radius}");
+    // None with the picker, nor off the canvas.
+    harness.key_press(egui::Key::I);
+    harness.run();
+    assert!(harness.state().state.canvas_outline().is_none());
+}
+
+/// Wheel turns over `at`, a frame each, until the smooth scroll has settled.
+fn wheel(harness: &mut Harness<'_, Editor>, at: Pos2, dy: f32) {
+    harness.hover_at(at);
+    harness.run();
+    for _ in 0..4 {
+        harness.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: Vec2::new(0.0, dy),
+            phase: egui::TouchPhase::Move,
+            modifiers: Modifiers::default(),
+        });
+        harness.run();
+    }
+    for _ in 0..30 {
+        harness.step();
+    }
+}
+
+#[test]
+fn a_brush_sized_on_screen_keeps_its_size_at_any_zoom() {
+    use kapaint::ui::screen_brush::BrushSize;
+    let mut harness = editor();
+    harness.state_mut().state.set_brush_size(BrushSize {
+        on_screen: true,
+        screen_radius: 20.0,
+    });
+    harness.run();
+    assert!(harness.query_all_by_label("Radius on screen").count() > 0);
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    let centre = canvas.center();
+    let radius_px = |h: &Harness<'_, Editor>| h.state().state.doc().settings().brush.radius_px;
+    // On the canvas: the circle is 20 points whatever the zoom, and a stroke takes
+    // 20 points' worth of texels.
+    drag(&mut harness, centre, centre + Vec2::new(30.0, 0.0));
+    let zoom = harness.state().state.canvas_zoom();
+    let before = radius_px(&harness);
+    assert!(
+        (before - 20.0 / zoom).abs() < 1e-3 * before,
+        "{before} at zoom {zoom}"
+    );
+    wheel(&mut harness, centre, 300.0);
+    let zoomed = harness.state().state.canvas_zoom();
+    assert!(zoomed > 1.3 * zoom, "zoomed in: {zoom} -> {zoomed}");
+    harness.hover_at(centre);
+    harness.run();
+    let (_, circle) = harness.state().state.canvas_outline().expect("outline");
+    assert!(
+        (circle - 20.0).abs() < 0.01,
+        "the circle stays 20 points: {circle}"
+    );
+    drag(&mut harness, centre, centre + Vec2::new(30.0, 0.0));
+    let after = radius_px(&harness);
+    assert!(
+        (after - 20.0 / zoomed).abs() < 1e-3 * after,
+        "{after} at zoom {zoomed}"
+    );
+    // ] grows the size on screen, not the texels.
+    harness.key_press(egui::Key::CloseBracket);
+    harness.run();
+    assert_eq!(harness.state().state.brush_size().screen_radius, 25.0);
+    assert_eq!(
+        radius_px(&harness),
+        after,
+        "texels follow at the next stroke"
+    );
+
+    // In the viewport: closer, fewer texels under the same circle.
+    let viewport = harness.get_by_label(VIEWPORT_LABEL).rect();
+    let mid = viewport.center();
+    drag(&mut harness, mid, mid + Vec2::new(10.0, 0.0));
+    let far = radius_px(&harness);
+    let per_point = harness
+        .state()
+        .state
+        .texels_per_point()
+        .expect("over the sphere");
+    assert!(
+        (far - 25.0 * per_point).abs() < 1e-3 * far,
+        "{far} vs {per_point}"
+    );
+    wheel(&mut harness, mid, 300.0);
+    drag(&mut harness, mid, mid + Vec2::new(10.0, 0.0));
+    let near = radius_px(&harness);
+    assert!(
+        near < 0.8 * far,
+        "closer, smaller in texels: {far} -> {near}"
+    );
+    // Off, the brush keeps its texels at any zoom.
+    harness
+        .state_mut()
+        .state
+        .set_brush_size(BrushSize::default());
+    wheel(&mut harness, mid, -300.0);
+    drag(&mut harness, mid, mid + Vec2::new(10.0, 0.0));
+    assert_eq!(radius_px(&harness), near);
+}

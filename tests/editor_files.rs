@@ -1,0 +1,200 @@
+//! The editor's files, driven through egui_kittest: saving and opening through kapaint's own
+//! file dialog where no desktop portal runs, every file request reaching its command, and a
+//! project named at start opening on a worker.
+
+use egui::accesskit::Role;
+use egui::{Modifiers, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use kapaint::ui::Editor;
+use kapaint::ui::canvas::CANVAS_LABEL;
+use kapaint::ui::files::{FileDialogBackend, FilePurpose, FileRequest};
+
+#[expect(dead_code, reason = "each editor test file uses some of the helpers")]
+mod kit;
+use kit::*;
+
+#[test]
+fn untitled_work_is_saved_through_the_in_app_file_dialog() {
+    let dir = scratch("save-dialog");
+    let mut harness = editor_without_portal(&dir);
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    assert_eq!(
+        harness.state().state.file_dialog_open_for(),
+        Some(FilePurpose::SaveProject),
+        "Ctrl+S on an untitled project asks where"
+    );
+    harness.get_by_label_contains("Save project");
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run();
+    let saved = dir.join("material.kapaint");
+    wait_until(&mut harness, "saved", |e| !e.state.dirty());
+    assert_eq!(harness.state().state.path(), Some(saved.as_path()));
+    assert_eq!(
+        harness.state().state.window_title(),
+        "material.kapaint - kapaint"
+    );
+    let doc = kapaint::model::project::load(&saved).expect("the saved project loads");
+    assert_eq!(
+        doc.maps().uniform_texel(),
+        None,
+        "the stroke is in the saved file"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_quit_prompt_saves_untitled_work_then_closes() {
+    let dir = scratch("quit-dialog");
+    let mut harness = editor_without_portal(&dir);
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Q);
+    harness.run_steps(2);
+    harness.get_by_label("The material has unsaved changes.");
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run_steps(2);
+    assert!(!harness.state().state.closing(), "not before it is saved");
+    harness.get_by_label_contains("Save project");
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.step();
+    wait_until(&mut harness, "saved, then closing", |e| e.state.closing());
+    assert!(dir.join("material.kapaint").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_project_opens_through_the_in_app_file_dialog() {
+    let dir = scratch("open-dialog");
+    let project = dir.join("other.kapaint");
+    let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+        .expect("document");
+    kapaint::model::project::save(&doc, &project).expect("saved");
+    let mut harness = editor_without_portal(&dir);
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::O);
+    harness.run();
+    harness.get_by_label_contains("Open project");
+    harness.get_by_label_contains("other.kapaint").click();
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "Open").click();
+    harness.run();
+    wait_until(&mut harness, "opened", |e| {
+        e.state.path() == Some(project.as_path())
+    });
+    assert_eq!(harness.state().state.doc().maps().width(), 64);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every place that asks for a file gets its answer: Import mesh, Import image, the brush
+/// stamp's Load, New > File and the export folder (answered here by a stand-in for the
+/// system dialog).
+#[test]
+fn every_file_request_reaches_its_command() {
+    fn answer(request: &FileRequest) -> Option<std::path::PathBuf> {
+        let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot");
+        Some(match request.purpose {
+            FilePurpose::ImportMesh | FilePurpose::NewMesh => spot.join("spot_triangulated.obj"),
+            FilePurpose::ImportImage(_) | FilePurpose::StampImage => spot.join("spot_texture.png"),
+            FilePurpose::ExportFolder => std::env::temp_dir().join("kapaint-export-choice"),
+            FilePurpose::OpenProject | FilePurpose::SaveProject => return None,
+        })
+    }
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer);
+    let notice = |text: &'static str| {
+        move |e: &Editor| e.state.notices().iter().any(|n| n.text.contains(text))
+    };
+
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Import mesh…").click();
+    harness.run_steps(2);
+    wait_until(
+        &mut harness,
+        "mesh imported",
+        notice("spot_triangulated.obj"),
+    );
+
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness
+        .get_by_label_contains("Import image into k_s")
+        .click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "image imported", notice("imported into k_s"));
+
+    harness.key_press(egui::Key::B);
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "Load…").click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "stamp loaded", notice("stamp "));
+
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "File…").click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "mesh chosen for New", |e| {
+        e.state
+            .new_dialog()
+            .is_some_and(|d| d.mesh.ends_with("spot_triangulated.obj"))
+    });
+
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "…").click();
+    harness.run_steps(2);
+    let chosen = std::env::temp_dir()
+        .join("kapaint-export-choice")
+        .join("set")
+        .display()
+        .to_string();
+    wait_until(&mut harness, "export folder chosen", |e| {
+        e.state.export_folder() == Some(chosen.as_str())
+    });
+}
+
+#[test]
+fn a_project_named_at_start_opens_on_a_worker_and_takes_no_strokes_meanwhile() {
+    let dir = scratch("open-at-start");
+    let project = dir.join("big.kapaint");
+    let saved = noisy_project(&project);
+    // The editor is there at once, on an untitled placeholder (nothing can be saved over the
+    // file), with the project opening on a worker.
+    let editor = Editor::new(None, Some(project.clone()));
+    assert_eq!(editor.state.opening(), Some(project.as_path()));
+    assert_eq!(editor.state.path(), None);
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(1)
+        .build_ui_state(|ui, editor: &mut Editor| editor.frame(ui), editor);
+    if harness.state().state.opening().is_some() {
+        harness.get_by_label("Opening big.kapaint…");
+        // A stroke on the document about to be replaced is refused, not painted and lost.
+        let before = harness.state().state.doc().version();
+        let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+        harness.drag_at(centre);
+        harness.step();
+        harness.hover_at(centre + Vec2::new(60.0, 20.0));
+        harness.step();
+        harness.drop_at(centre + Vec2::new(60.0, 20.0));
+        harness.step();
+        if harness.state().state.opening().is_some() {
+            assert_eq!(harness.state().state.doc().version(), before);
+        }
+    } else {
+        eprintln!("the project opened within a frame: the refusal was not exercised");
+    }
+    wait_until(&mut harness, "opened", |e| {
+        e.state.path() == Some(project.as_path())
+    });
+    assert!(!harness.state().state.dirty());
+    let mut want = Vec::new();
+    saved.maps().for_each_texel(|_, _, t| want.push(t));
+    assert!(texels(harness.state()) == want, "the project as saved");
+    let _ = std::fs::remove_dir_all(&dir);
+}
