@@ -284,3 +284,54 @@ fn a_brush_sized_on_screen_keeps_its_size_at_any_zoom() {
     drag(&mut harness, mid, mid + Vec2::new(10.0, 0.0));
     assert_eq!(radius_px(&harness), near);
 }
+
+#[test]
+fn the_primary_colour_is_typed_in_srgb_and_recent_materials_come_back() {
+    use kapaint::model::texel::srgb_to_linear;
+    let mut harness = editor();
+    let kd = |h: &Harness<'_, Editor>| h.state().state.doc().settings().primary.kd;
+    // Hex, in sRGB: #ff8000 is linear (1, 0.216, 0).
+    let hex = harness.get_by_role(Role::TextInput);
+    hex.focus();
+    harness.run();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_role(Role::TextInput).type_text("#ff8000");
+    harness.run();
+    let orange = kd(&harness);
+    let want = glam::Vec3::new(1.0, srgb_to_linear(128.0 / 255.0), 0.0);
+    assert!(
+        (orange - want).abs().max_element() < 1e-6,
+        "{orange} against {want}"
+    );
+    // The RGB and HSV fields show the same colour in sRGB.
+    let field = |h: &Harness<'_, Editor>, name: &str| {
+        use egui_kittest::kittest::NodeT as _;
+        h.get_by_label(name).accesskit_node().value()
+    };
+    for (name, want) in [
+        ("R", "255"),
+        ("G", "128"),
+        ("B", "0"),
+        ("H", "30°"),
+        ("S", "100%"),
+    ] {
+        assert_eq!(field(&harness, name).as_deref(), Some(want), "{name}");
+    }
+    // A stroke lays it and it joins the recent materials; so does the next one.
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    let centre = canvas.center();
+    drag(&mut harness, centre, centre + Vec2::new(30.0, 0.0));
+    // The secondary swatch swaps the materials.
+    let secondary = harness.state().state.doc().settings().secondary;
+    harness.get_by_label("Secondary").click();
+    harness.run();
+    assert_eq!(harness.state().state.doc().settings().primary, secondary);
+    drag(&mut harness, centre, centre + Vec2::new(0.0, 30.0));
+    let recent = harness.state().state.recent_materials().to_vec();
+    assert_eq!(recent.len(), 2, "{recent:?}");
+    assert_eq!((recent[0], recent[1].kd), (secondary, orange));
+    // A click on a recent swatch makes it the primary again.
+    harness.get_by_label("Recent material 2").click();
+    harness.run();
+    assert_eq!(kd(&harness), orange);
+}

@@ -113,6 +113,8 @@ impl Editor {
                 canvas_outline: None,
                 brush_size: super::screen_brush::BrushSize::default(),
                 texels_per_point: None,
+                hex_text: None,
+                recent_materials: Vec::new(),
                 shown_hover: None,
                 exact_chi: readout::ExactChi::new(),
                 quit: Quit::default(),

@@ -11,6 +11,7 @@ use glam::Vec2;
 use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
 use crate::model::brush::SurfacePos;
+use crate::model::{Command, StrokeTool};
 use crate::render::FrameSettings;
 use crate::tools::{Place, ToolEvent, ToolKind};
 
@@ -46,7 +47,16 @@ impl EditorState {
     /// Hands an event to the active tool and applies its commands.
     pub(super) fn tool_event(&mut self, event: ToolEvent) {
         for command in self.tools.handle(event, &self.doc) {
+            let lays = matches!(
+                command,
+                Command::BeginStroke(StrokeTool::Brush)
+                    | Command::Fill(_)
+                    | Command::Gradient { .. }
+            );
             self.apply(command);
+            if lays {
+                self.remember_material();
+            }
         }
     }
 

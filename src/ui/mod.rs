@@ -207,6 +207,10 @@ pub struct EditorState {
     hover_tab: Option<Tab>,
     /// How the brush's size is given: in texels, or on screen.
     brush_size: screen_brush::BrushSize,
+    /// The hex field's text while it is typed in (`None`: it shows the primary's `k_d`).
+    hex_text: Option<String>,
+    /// Materials laid last by a stroke, fill or gradient, newest first.
+    recent_materials: Vec<MaterialValue>,
     /// Texels per screen point under the cursor (canvas zoom, or the surface's scale).
     texels_per_point: Option<f32>,
     /// The brush circle drawn on the UV canvas this frame: centre and radius in points.

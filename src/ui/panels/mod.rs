@@ -3,6 +3,7 @@
 //! reads the state and issues [`Command`](crate::model::Command)s.
 
 mod bars;
+pub mod colour;
 mod tool_panel;
 mod view_panel;
 

@@ -114,6 +114,7 @@ impl EditorState {
         ui.separator();
         ui.heading("Material");
         let mut primary = self.doc.settings().primary;
+        self.colour_ui(ui, &mut primary);
         ui.horizontal(|ui| {
             let mut kd = primary.kd.to_array();
             egui::color_picker::color_edit_button_rgb(ui, &mut kd)
@@ -161,6 +162,7 @@ impl EditorState {
         {
             self.apply(Command::SwapMaterials);
         }
+        self.recent_materials_ui(ui);
         ui.separator();
         ui.heading("Channels");
         let mut ch = self.doc.settings().channels;
