@@ -335,3 +335,73 @@ fn the_primary_colour_is_typed_in_srgb_and_recent_materials_come_back() {
     harness.run();
     assert_eq!(kd(&harness), orange);
 }
+
+#[test]
+fn the_primary_material_and_the_brush_are_saved_as_presets_of_ones_own() {
+    let dir = scratch("own-presets");
+    let mut harness = editor();
+    harness.state_mut().state.set_preset_dir(dir.clone());
+    harness.run();
+    // Names show under the thumbnails, not only in tooltips.
+    harness.get_by_label("Brass");
+    harness.get_by_label("Red Plastic");
+    // The primary material, as a preset.
+    let primary = harness.state().state.doc().settings().primary;
+    harness.get_by_label("Save primary as preset…").click();
+    harness.run();
+    harness.get_by_label("Preset name").type_text("Wet clay");
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run();
+    let file = dir.join("wet-clay.ron");
+    let saved = kapaint::model::preset::MaterialPreset::load(&file).expect("saved preset");
+    assert_eq!((saved.name.as_str(), saved.value()), ("Wet clay", primary));
+    assert!(harness.state().state.preset_names().contains(&"Wet clay"));
+    harness.get_by_label("Wet clay");
+    // The brush, as a named brush preset that a choice brings back.
+    let mut brush = harness.state().state.doc().settings().brush.clone();
+    brush.radius_px = 7.5;
+    brush.jitter = 0.3;
+    harness
+        .state_mut()
+        .state
+        .apply_command(kapaint::model::Command::SetBrush(brush.clone()));
+    harness.run();
+    harness.get_by_label("Save brush…").click();
+    harness.run();
+    harness.get_by_label("Preset name").type_text("Speckle");
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run();
+    let back = kapaint::model::brush::preset::BrushPreset::load(&dir.join("brushes/speckle.ron"))
+        .expect("saved brush");
+    assert_eq!(back.brush, brush);
+    harness.get_by_label("Brush preset").click();
+    harness.run();
+    harness.get_by_label("Soft round").click();
+    harness.run();
+    assert_eq!(harness.state().state.doc().settings().brush.hardness, 0.0);
+    harness.get_by_label("Brush preset").click();
+    harness.run();
+    harness.get_by_label("Speckle").click();
+    harness.run();
+    assert_eq!(harness.state().state.doc().settings().brush, brush);
+    // Read again, the user's presets are listed with the shipped ones; a malformed file is
+    // named in a notice and skipped.
+    std::fs::write(dir.join("broken.ron"), "(name: \"Broken\", kd: (2, 0, 0))").expect("write");
+    harness.state_mut().state.reload_presets();
+    harness.run();
+    let state = &harness.state().state;
+    assert!(state.preset_names().contains(&"Wet clay"));
+    assert!(!state.preset_names().contains(&"Broken"));
+    assert!(state.brush_preset_names().contains(&"Speckle"));
+    assert!(
+        state
+            .notices()
+            .iter()
+            .any(|n| n.error && n.text.contains("broken.ron")),
+        "{:?}",
+        state.notices().iter().map(|n| &n.text).collect::<Vec<_>>()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -149,9 +149,68 @@ pub fn builtin() -> Vec<(String, MaterialPreset)> {
         .collect()
 }
 
-/// The user's preset directory: `$KAPAINT_PRESET_DIR`, if set.
+/// The user's preset folder: `$KAPAINT_PRESET_DIR`, else `$XDG_CONFIG_HOME/kapaint/presets`,
+/// else `~/.config/kapaint/presets`. Material presets are its `.ron` files; brush presets
+/// live in its `brushes` folder. It may not exist yet: saving a preset creates it.
 pub fn user_dir() -> Option<PathBuf> {
-    std::env::var_os("KAPAINT_PRESET_DIR").map(PathBuf::from)
+    std::env::var_os("KAPAINT_PRESET_DIR")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("XDG_CONFIG_HOME")
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+                .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))
+                .map(|d| d.join("kapaint").join("presets"))
+        })
+}
+
+/// A file stem for a preset named `name`: lower case letters, digits and dashes (at most
+/// 64 characters; "preset" if nothing is left).
+pub fn file_stem_for(name: &str) -> String {
+    let mut stem = String::new();
+    for c in name.trim().chars() {
+        if c.is_ascii_alphanumeric() {
+            stem.push(c.to_ascii_lowercase());
+        } else if !stem.ends_with('-') && !stem.is_empty() {
+            stem.push('-');
+        }
+    }
+    let stem: String = stem.trim_end_matches('-').chars().take(64).collect();
+    if stem.is_empty() {
+        "preset".into()
+    } else {
+        stem
+    }
+}
+
+/// Saves `value` as the material preset `name` in `dir` (created if missing), atomically, as
+/// `STEM.ron`; returns its file stem and path. A preset of the same file name is replaced.
+///
+/// # Errors
+/// An empty or over-long name, or a failure to write.
+pub fn save_user(
+    dir: &Path,
+    name: &str,
+    value: MaterialValue,
+) -> Result<(String, PathBuf), ModelError> {
+    let name = name.trim();
+    let stem = file_stem_for(name);
+    let path = dir.join(format!("{stem}.ron"));
+    super::check::name("the preset's name", name).map_err(|reason| ModelError::Preset {
+        path: path.clone(),
+        reason,
+    })?;
+    let v = value.sanitized();
+    let text = format!(
+        "(\n    name: {name:?},\n    source: \"saved in kapaint\",\n    kd: ({}, {}, {}),\n    ks: ({}, {}, {}),\n    n: {},\n)\n",
+        v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.ks.y, v.ks.z, v.n
+    );
+    // The text must read back as the preset it describes.
+    MaterialPreset::parse(&path, &text)?;
+    std::fs::create_dir_all(dir).map_err(|e| ModelError::io(dir, e))?;
+    crate::atomic::write_atomic(&path, text.as_bytes()).map_err(|e| ModelError::io(&path, e))?;
+    Ok((stem, path))
 }
 
 /// Every `.ron` file in `dir`, sorted by name, each parsed or with its error.
@@ -234,6 +293,24 @@ mod tests {
             assert_eq!((a, pa), (b, pb));
         }
         assert!(built_in.iter().all(|(_, p)| !p.source.is_empty()));
+    }
+
+    #[test]
+    fn a_saved_preset_reads_back_exactly() {
+        let dir = std::env::temp_dir().join(format!("kapaint-preset-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let value = MaterialValue::new(Vec3::new(0.8, 0.1, 0.05), Vec3::splat(0.3), 250.0);
+        let (stem, path) = save_user(&dir, "  Rusty Red #2 ", value).unwrap();
+        assert_eq!(stem, "rusty-red-2");
+        assert_eq!(path, dir.join("rusty-red-2.ron"));
+        let back = MaterialPreset::load(&path).unwrap();
+        assert_eq!(back.name, "Rusty Red #2");
+        assert_eq!(back.value(), value);
+        let listed = load_dir(&dir);
+        assert_eq!(listed.len(), 1);
+        assert!(save_user(&dir, "   ", value).is_err());
+        assert_eq!(file_stem_for("!!!"), "preset");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

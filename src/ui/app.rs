@@ -83,6 +83,11 @@ impl Editor {
             recovery::recovery_path(untitled_until_open.as_deref()),
             &doc,
         );
+        let preset_dir = crate::model::preset::user_dir();
+        let presets =
+            super::panels::presets::load_material_presets(preset_dir.as_deref(), &mut notices);
+        let brush_presets =
+            super::panels::presets::load_brush_presets(preset_dir.as_deref(), &mut notices);
         let dock = load_layout().unwrap_or_else(default_layout);
         let saved_version = doc.version();
         let mut editor = Self {
@@ -121,10 +126,10 @@ impl Editor {
                 files: files::FileChooser::new(),
                 shortcuts_open: false,
                 recovery_offer,
-                presets: crate::model::preset::builtin()
-                    .into_iter()
-                    .map(|(name, p)| (name, p.value(), None))
-                    .collect(),
+                presets,
+                brush_presets,
+                naming: None,
+                preset_dir,
                 autosaver,
             },
             dock,

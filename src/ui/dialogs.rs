@@ -202,12 +202,8 @@ impl EditorState {
         let preset = self
             .presets
             .iter()
-            .position(|(name, _, _)| Some(name) == self.doc.settings().preset.as_ref())
-            .or_else(|| {
-                self.presets
-                    .iter()
-                    .position(|(name, _, _)| name == "default")
-            })
+            .position(|p| Some(&p.stem) == self.doc.settings().preset.as_ref())
+            .or_else(|| self.presets.iter().position(|p| p.stem == "default"))
             .unwrap_or(0);
         self.new_dialog = Some(NewDialog {
             size: self.doc.maps().width(),
@@ -223,10 +219,10 @@ impl EditorState {
             mesh: MeshRef::from_spec(&dialog.mesh),
             ..DocumentSettings::default()
         };
-        if let Some((name, value, _)) = self.presets.get(dialog.preset) {
-            settings.base = *value;
-            settings.secondary = *value;
-            settings.preset = Some(name.clone());
+        if let Some(p) = self.presets.get(dialog.preset) {
+            settings.base = p.value;
+            settings.secondary = p.value;
+            settings.preset = Some(p.stem.clone());
         }
         let size = dialog.size;
         // Loading and baking the mesh at up to 8192^2 takes seconds: a worker does it.
@@ -257,10 +253,14 @@ impl EditorState {
                         }
                     });
                 egui::ComboBox::from_label("Base preset")
-                    .selected_text(self.presets.get(dialog.preset).map_or("", |p| p.0.as_str()))
+                    .selected_text(
+                        self.presets
+                            .get(dialog.preset)
+                            .map_or("", |p| p.name.as_str()),
+                    )
                     .show_ui(ui, |ui| {
-                        for (i, (name, _, _)) in self.presets.iter().enumerate() {
-                            ui.selectable_value(&mut dialog.preset, i, name);
+                        for (i, p) in self.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.preset, i, &p.name);
                         }
                     });
                 ui.horizontal(|ui| {

@@ -229,7 +229,13 @@ pub struct EditorState {
     recovery_offer: Option<PathBuf>,
     /// Material presets with their thumbnails (rendered a few per frame) and the mesh each
     /// thumbnail shows.
-    presets: Vec<(String, MaterialValue, Option<Thumbnail>)>,
+    presets: Vec<panels::presets::PresetEntry>,
+    /// Brush presets, shipped and the user's.
+    brush_presets: Vec<crate::model::brush::preset::BrushPreset>,
+    /// The user preset folder presets are saved to.
+    preset_dir: Option<PathBuf>,
+    /// A preset's name being typed, what it names, and whether its field opened this frame.
+    naming: Option<(panels::presets::Naming, String, bool)>,
     autosaver: recovery::Autosaver,
 }
 
@@ -345,7 +351,7 @@ impl EditorState {
         let shown = self
             .presets
             .iter()
-            .map(|(_, _, t)| t.as_ref().map(|(id, _)| *id))
+            .map(|p| p.thumbnail.as_ref().map(|(id, _)| *id))
             .collect();
         (shown, self.mesh.id)
     }
@@ -360,6 +366,11 @@ impl EditorState {
             .map_or_else(|| "untitled".into(), |n| n.to_string_lossy().into_owned());
         let marker = if self.dirty() { "*" } else { "" };
         format!("{name}{marker} - kapaint")
+    }
+
+    /// Applies a command as the panels do (an error becomes a notice).
+    pub fn apply_command(&mut self, command: Command) {
+        self.apply(command);
     }
 
     fn apply(&mut self, command: Command) {

@@ -19,10 +19,11 @@ pub fn texels(editor: &Editor) -> Vec<Texel> {
 /// The editor on a new default document in a 1400 x 900 window, its first frame drawn.
 pub fn editor() -> Harness<'static, Editor> {
     // The status bar's exact value arrives from a worker whenever it is done and asks for a
-    // frame then: a few more steps than a UI that only reacts to input.
+    // frame then, and preset thumbnails are drawn a few a frame (again after the mesh
+    // changes): more steps than a UI that only reacts to input.
     let mut harness = Harness::builder()
         .with_size(Vec2::new(1400.0, 900.0))
-        .with_max_steps(16)
+        .with_max_steps(40)
         .build_ui_state(
             |ui, editor: &mut Editor| editor.frame(ui),
             Editor::new(None, None),

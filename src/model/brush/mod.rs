@@ -6,6 +6,7 @@
 //! the path.
 
 mod placement;
+pub mod preset;
 mod stamp;
 #[cfg(test)]
 mod tests;

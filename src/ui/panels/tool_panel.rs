@@ -96,6 +96,7 @@ impl EditorState {
         self.tool_options_ui(ui);
         ui.separator();
         ui.heading("Brush settings");
+        self.brush_presets_ui(ui);
         let mut brush = self.doc.settings().brush.clone();
         self.brush_radius_ui(ui, &mut brush);
         ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))

@@ -162,7 +162,7 @@ impl EditorState {
 
     /// Renders a thumbnail: on the GPU with the preview renderer, else with the CPU reference
     /// renderer (the same shading, ray traced).
-    fn thumbnail(&mut self, value: MaterialValue) -> egui::ColorImage {
+    pub(super) fn thumbnail(&mut self, value: MaterialValue) -> egui::ColorImage {
         const SIZE: u32 = 56;
         let camera = crate::render::Camera::default()
             .orbit(0.5, 0.35)
@@ -200,54 +200,6 @@ impl EditorState {
             .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])
             .collect();
         egui::ColorImage::from_rgba_unmultiplied([SIZE as usize; 2], &rgba)
-    }
-
-    /// The preset browser: thumbnails, a click makes the preset the primary material.
-    fn presets_ui(&mut self, ui: &mut egui::Ui) {
-        // A few thumbnails per frame keep the first frames fast.
-        // A thumbnail of another mesh (before New, Open or a mesh import) is drawn again.
-        let mut budget = 3;
-        let mesh = self.mesh.id;
-        for i in 0..self.presets.len() {
-            let stale = self.presets[i].2.as_ref().is_none_or(|(id, _)| *id != mesh);
-            if stale && budget > 0 {
-                budget -= 1;
-                let image = self.thumbnail(self.presets[i].1);
-                let name = self.presets[i].0.clone();
-                self.presets[i].2 = Some((
-                    mesh,
-                    ui.ctx()
-                        .load_texture(name, image, egui::TextureOptions::LINEAR),
-                ));
-            }
-        }
-        if budget == 0 {
-            ui.ctx().request_repaint();
-        }
-        let mut chosen = None;
-        ui.horizontal_wrapped(|ui| {
-            for (name, value, texture) in &self.presets {
-                let response = match texture {
-                    Some((_, t)) => ui.add(egui::Button::image(
-                        egui::Image::from_texture(egui::load::SizedTexture::from_handle(t))
-                            .fit_to_exact_size(egui::vec2(40.0, 40.0)),
-                    )),
-                    None => ui.add_sized([48.0, 48.0], egui::Button::new("…")),
-                };
-                if response
-                    .on_hover_text(format!(
-                        "{name}: k_d {:.2} {:.2} {:.2}, k_s {:.2}, n {:.0}",
-                        value.kd.x, value.kd.y, value.kd.z, value.ks.x, value.n
-                    ))
-                    .clicked()
-                {
-                    chosen = Some(*value);
-                }
-            }
-        });
-        if let Some(v) = chosen {
-            self.apply(Command::SetPrimary(v));
-        }
     }
 }
 
