@@ -405,3 +405,38 @@ fn the_primary_material_and_the_brush_are_saved_as_presets_of_ones_own() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_click_on_a_history_step_jumps_to_it_and_undone_steps_stay_listed() {
+    let mut harness = editor();
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    let mut states = vec![texels(harness.state())];
+    for i in 0..3 {
+        let a = centre + Vec2::new(0.0, 25.0 * i as f32);
+        drag(&mut harness, a, a + Vec2::new(40.0, 0.0));
+        states.push(texels(harness.state()));
+    }
+    let steps = |h: &Harness<'_, Editor>| {
+        let history = h.state().state.doc().history();
+        (history.undo_steps().count(), history.redo_steps().count())
+    };
+    assert_eq!(steps(&harness), (3, 0));
+    // Back to the first stroke: two steps undone, still listed.
+    harness.get_by_label_contains("1. ").click();
+    harness.run();
+    assert_eq!(steps(&harness), (1, 2));
+    assert_eq!(texels(harness.state()), states[1]);
+    harness.get_by_label_contains("3. ");
+    // Forward to the last, through the greyed step.
+    harness.get_by_label_contains("3. ").click();
+    harness.run();
+    assert_eq!(texels(harness.state()), states[3]);
+    // To the original, then a new edit drops the undone steps.
+    harness.get_by_label("Original").click();
+    harness.run();
+    assert_eq!(texels(harness.state()), states[0]);
+    assert_eq!(steps(&harness), (0, 3));
+    drag(&mut harness, centre, centre + Vec2::new(0.0, 40.0));
+    assert_eq!(steps(&harness), (1, 0));
+    assert!(harness.query_by_label_contains("2. ").is_none());
+}

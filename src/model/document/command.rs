@@ -123,6 +123,9 @@ pub enum Command {
     Undo,
     /// Redoes the last undone step.
     Redo,
+    /// Undoes or redoes until this many steps are applied (0: the state before the oldest
+    /// step kept; the history panel's click on a step).
+    HistoryJump(usize),
 }
 
 /// A channel's planes made by [`crate::model::import::resample`], shared so that the command

@@ -334,6 +334,15 @@ impl Document {
                 self.end_stroke();
                 self.history.redo(&mut self.maps);
             }
+            Command::HistoryJump(applied) => {
+                self.end_stroke();
+                while self.history.undo_steps().count() > applied {
+                    self.history.undo(&mut self.maps);
+                }
+                while self.history.undo_steps().count() < applied
+                    && self.history.redo(&mut self.maps)
+                {}
+            }
         }
         Ok(())
     }

@@ -144,20 +144,53 @@ impl EditorState {
             self.doc.history().undo_steps().count(),
             self.doc.history().bytes(),
         ));
+        self.history_list_ui(ui);
+    }
+
+    /// The steps, oldest first: a click jumps to the state after a step (undone steps stay
+    /// listed, greyed, until a new edit drops them); "Original" is the state before them.
+    fn history_list_ui(&mut self, ui: &mut egui::Ui) {
+        let history = self.doc.history();
+        let applied = history.undo_steps().count();
+        let steps: Vec<(String, usize)> = history
+            .undo_steps()
+            .chain(history.redo_steps())
+            .map(|s| (s.label.clone(), s.bytes()))
+            .collect();
+        let mut jump = None;
         egui::ScrollArea::vertical()
+            .id_salt("history")
             .max_height(160.0)
+            .stick_to_bottom(true)
             .show(ui, |ui| {
-                for step in self
-                    .doc
-                    .history()
-                    .undo_steps()
-                    .collect::<Vec<_>>()
-                    .iter()
-                    .rev()
+                if ui
+                    .selectable_label(applied == 0, "Original")
+                    .on_hover_text("Before the oldest step kept")
+                    .clicked()
                 {
-                    ui.label(format!("{} ({} KB)", step.label, step.bytes() / 1024));
+                    jump = Some(0);
+                }
+                for (i, (label, bytes)) in steps.iter().enumerate() {
+                    let text = format!("{}. {label} · {} KB", i + 1, bytes / 1024);
+                    let text = if i < applied {
+                        egui::RichText::new(text)
+                    } else {
+                        egui::RichText::new(text).weak().italics()
+                    };
+                    let response = ui.selectable_label(i + 1 == applied, text);
+                    let response = if i < applied {
+                        response
+                    } else {
+                        response.on_hover_text("Undone: a click redoes up to here")
+                    };
+                    if response.clicked() {
+                        jump = Some(i + 1);
+                    }
                 }
             });
+        if let Some(n) = jump {
+            self.apply(Command::HistoryJump(n));
+        }
     }
 
     /// Renders a thumbnail: on the GPU with the preview renderer, else with the CPU reference
