@@ -440,3 +440,50 @@ fn a_click_on_a_history_step_jumps_to_it_and_undone_steps_stay_listed() {
     assert_eq!(steps(&harness), (1, 0));
     assert!(harness.query_by_label_contains("2. ").is_none());
 }
+
+#[test]
+fn image_resize_shows_its_memory_first_and_is_one_undo_step() {
+    let mut harness = editor();
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect();
+    let centre = canvas.center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 0.0));
+    let painted = texels(harness.state());
+    let zoom = harness.state().state.canvas_zoom();
+    harness.get_by_label("Image").click();
+    harness.run();
+    harness.get_by_label("Resize…").click();
+    harness.run();
+    harness.get_by_label_contains("Now 1024x1024");
+    harness.get_by_label_contains("Undo keeps the old maps");
+    harness.get_by_label_contains("Peak while resampling");
+    harness
+        .state_mut()
+        .state
+        .set_resize_dialog(kapaint::ui::resize::ResizeDialog {
+            width: 512,
+            height: 512,
+        });
+    harness.run();
+    harness.get_by_label_contains("up to 3.7 MB after");
+    harness
+        .get_by_role_and_label(Role::Button, "Resize")
+        .click();
+    harness.run();
+    wait_until(&mut harness, "resized", |e| {
+        e.state.doc().maps().width() == 512
+    });
+    harness.run();
+    let state = &harness.state().state;
+    assert_eq!(state.doc().maps().height(), 512);
+    assert_eq!(state.doc().surface().map(|s| s.width()), Some(512));
+    assert!(state.dirty());
+    // The map keeps its place on screen: twice the points per texel.
+    let ratio = state.canvas_zoom() / zoom;
+    assert!((ratio - 2.0).abs() < 1e-3, "{ratio}");
+    harness.get_by_label_contains("Resize 1024x1024 to 512x512");
+    // One undo step brings the 1024^2 maps back, bit-exactly.
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(texels(harness.state()), painted);
+    assert!((harness.state().state.canvas_zoom() / zoom - 1.0).abs() < 1e-3);
+}

@@ -472,3 +472,64 @@ fn mesh_commands_without_a_mesh_are_clear_errors() {
     let other = sphere_surface(32);
     assert!(doc.set_surface(Some(other)).is_err(), "size mismatch");
 }
+
+#[test]
+fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
+    use kapaint::model::resize::{ResizedMaps, resized};
+    let surface = sphere_surface(128);
+    let mut doc = document(&surface, BrushSettings::default());
+    let on_sphere = |doc: &mut Document| {
+        let pos = SurfacePos {
+            point: Vec3::new(0.0, 0.0, 1.0),
+            normal: Vec3::Z,
+        };
+        doc.apply(Command::SurfaceStroke {
+            tool: StrokeTool::Brush,
+            points: vec![SurfacePoint { pos, pressure: 1.0 }],
+        })
+        .expect("stroke");
+    };
+    on_sphere(&mut doc);
+    let before: Vec<Texel> = texels(&doc);
+    let version = doc.version();
+    let small = resized(doc.maps(), 64, 64).expect("resized");
+    let baked = Arc::new(Surface::new(surface.mesh.clone(), 64, 64).expect("bake"));
+    doc.apply(Command::Resize(ResizedMaps(Arc::new((small, Some(baked))))))
+        .expect("resize");
+    assert_eq!(
+        (doc.maps().width(), doc.surface().map(|s| s.width())),
+        (64, Some(64))
+    );
+    assert!(doc.version() > version, "a resize is a change");
+    let after = texels(&doc);
+    // Painting on the mesh at the new size works (the surface follows the maps).
+    on_sphere(&mut doc);
+    // Two steps back: the stroke, then the resize; the maps and the surface return exactly.
+    doc.apply(Command::Undo).expect("undo");
+    assert_eq!(texels(&doc), after);
+    doc.apply(Command::Undo).expect("undo");
+    assert_eq!(texels(&doc), before);
+    assert!(Arc::ptr_eq(doc.surface().expect("surface"), &surface));
+    assert!(
+        doc.version() > version,
+        "undone is still a change since the save"
+    );
+    // Redo brings the resized maps back, bit-exactly.
+    doc.apply(Command::Redo).expect("redo");
+    assert_eq!(texels(&doc), after);
+    assert_eq!(doc.surface().map(|s| s.width()), Some(64));
+    // A baked surface of another size is refused, and nothing changes.
+    let wrong = Arc::new(Surface::new(surface.mesh.clone(), 32, 32).expect("bake"));
+    let big = resized(doc.maps(), 128, 128).expect("resized");
+    assert!(
+        doc.apply(Command::Resize(ResizedMaps(Arc::new((big, Some(wrong))))))
+            .is_err()
+    );
+    assert_eq!(texels(&doc), after);
+}
+
+fn texels(doc: &Document) -> Vec<Texel> {
+    let mut out = Vec::new();
+    doc.maps().for_each_texel(|_, _, t| out.push(t));
+    out
+}

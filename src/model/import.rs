@@ -208,19 +208,17 @@ impl ChannelPlanes {
     }
 }
 
-/// Resamples `image` to `width x height` and encodes it into `channel`'s planes, a band of
-/// tile rows at a time (in parallel): each band streams its source rows through the
-/// horizontal filter into the few output rows they feed.
-pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32) -> ChannelPlanes {
-    let linear = is_float(image);
+/// The image filtered to `width x height`, a band of tile rows at a time (in parallel): each
+/// band streams its source rows through the horizontal filter into the few output rows they
+/// feed. Row-major RGB per band.
+fn filtered_bands(image: &DynamicImage, width: u32, height: u32) -> Vec<Vec<[f32; 3]>> {
     // A decoder never hands over an empty image; if one came, it would read as black.
     let (sw, sh) = (image.width().max(1), image.height().max(1));
     let xs = triangle_taps(sw, width);
     let ys = triangle_taps(sh, height);
-    let tiles_x = (width as usize).div_ceil(TILE_SIZE);
     let tiles_y = (height as usize).div_ceil(TILE_SIZE);
     let w = width as usize;
-    let bands: Vec<Vec<[f32; 3]>> = (0..tiles_y)
+    (0..tiles_y)
         .into_par_iter()
         .map(|ty| {
             let y0 = ty * TILE_SIZE;
@@ -261,7 +259,30 @@ pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32)
             }
             acc
         })
-        .collect();
+        .collect()
+}
+
+/// Resamples `image` to `width x height` and encodes it into `channel`'s planes, a band of
+/// tile rows at a time (in parallel): each band streams its source rows through the
+/// horizontal filter into the few output rows they feed.
+pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32) -> ChannelPlanes {
+    resample_as(image, channel, width, height, false)
+}
+
+/// As [`resample`]; with `n_as_blend`, a float image holds `n`'s blend value (log space)
+/// rather than `n` itself (a map being resized).
+pub(super) fn resample_as(
+    image: &DynamicImage,
+    channel: Channel,
+    width: u32,
+    height: u32,
+    n_as_blend: bool,
+) -> ChannelPlanes {
+    let linear = is_float(image);
+    let tiles_x = (width as usize).div_ceil(TILE_SIZE);
+    let tiles_y = (height as usize).div_ceil(TILE_SIZE);
+    let w = width as usize;
+    let bands = filtered_bands(image, width, height);
     let convert = |c: f32| if linear { c } else { srgb_to_linear(c) };
     let tile_texels = |tx: usize, ty: usize| {
         let band = &bands[ty];
@@ -270,6 +291,13 @@ pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32)
         let rows = band.len() / w;
         (0..rows)
             .flat_map(move |r| (0..cols).map(move |c| (r * TILE_SIZE + c, band[r * w + x0 + c])))
+    };
+    // The texels of a tile inside the map: columns and rows.
+    let extent = |tx: usize, ty: usize| {
+        (
+            TILE_SIZE.min(w - tx * TILE_SIZE),
+            TILE_SIZE.min(height as usize - ty * TILE_SIZE),
+        )
     };
     match channel {
         Channel::Kd | Channel::Ks => {
@@ -281,6 +309,7 @@ pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32)
                     for (i, p) in tile_texels(id % tiles_x, id / tiles_x) {
                         data[i] = encode_rgb(Vec3::from(p).map(convert));
                     }
+                    fill_outside(data, extent(id % tiles_x, id / tiles_x));
                     plane.compact();
                     plane
                 })
@@ -295,17 +324,53 @@ pub fn resample(image: &DynamicImage, channel: Channel, width: u32, height: u32)
                     let data = plane.data_mut();
                     for (i, p) in tile_texels(id % tiles_x, id / tiles_x) {
                         let v = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-                        data[i] = if linear {
+                        data[i] = if linear && !n_as_blend {
                             encode_n(v)
                         } else {
                             encode_n(n_from_blend(v))
                         };
                     }
+                    fill_outside(data, extent(id % tiles_x, id / tiles_x));
                     plane.compact();
                     plane
                 })
                 .collect();
             ChannelPlanes::N(planes)
+        }
+    }
+}
+
+/// Gives the texels of a tile outside the map (past `cols` columns or `rows` rows) the value
+/// of its first texel, so that a tile of one value inside the map is stored as one value.
+fn fill_outside<T: Copy>(data: &mut [T], (cols, rows): (usize, usize)) {
+    if cols == TILE_SIZE && rows == TILE_SIZE {
+        return;
+    }
+    let first = data[0];
+    for (i, v) in data.iter_mut().enumerate() {
+        if i % TILE_SIZE >= cols || i / TILE_SIZE >= rows {
+            *v = first;
+        }
+    }
+}
+
+/// Puts resampled planes into maps made for them (not undoable: maps being built).
+pub(super) fn write_planes(maps: &mut MaterialMaps, planes: &ChannelPlanes) {
+    match planes {
+        ChannelPlanes::Rgb(channel, planes) => {
+            for (id, plane) in planes.iter().enumerate() {
+                let tile = maps.tile_mut(id);
+                if *channel == Channel::Kd {
+                    tile.kd = plane.clone();
+                } else {
+                    tile.ks = plane.clone();
+                }
+            }
+        }
+        ChannelPlanes::N(planes) => {
+            for (id, plane) in planes.iter().enumerate() {
+                maps.tile_mut(id).n = plane.clone();
+            }
         }
     }
 }

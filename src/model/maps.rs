@@ -216,6 +216,14 @@ impl MaterialMaps {
         }
     }
 
+    /// Stamps every tile and channel past `version` (maps swapped in whole, by a resize or
+    /// its undo: the document's version keeps growing, and mirrors see every tile changed).
+    pub fn stamp_after(&mut self, version: u64) {
+        self.clock = self.clock.max(version) + 1;
+        let clock = self.clock;
+        self.versions.iter_mut().for_each(|v| *v = [clock; 3]);
+    }
+
     /// The current version: it grows with every write.
     pub fn version(&self) -> u64 {
         self.clock

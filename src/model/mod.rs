@@ -15,6 +15,7 @@ pub mod paint;
 pub mod preset;
 pub mod project;
 pub mod recovery;
+pub mod resize;
 pub mod stats;
 pub mod surface;
 pub mod texel;

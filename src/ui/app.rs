@@ -108,6 +108,7 @@ impl Editor {
                 export: None,
                 export_choice: None,
                 new_dialog: None,
+                resize_dialog: None,
                 pending_open: None,
                 recent: load_recent(),
                 stamp_preview: None,
@@ -245,6 +246,7 @@ impl Editor {
         });
         s.export_window(&ctx);
         s.new_window(&ctx);
+        s.resize_window(&ctx);
         s.recovery_window(&ctx);
         s.shortcuts_window(&ctx);
         s.notices_ui(&ctx);

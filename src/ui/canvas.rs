@@ -128,6 +128,13 @@ impl Canvas {
                 dirty.len()
             }
             _ => {
+                // Maps of another size (a resize, or its undo): the same extent on screen.
+                if let Some((.., old, _)) = self.mirrored
+                    && old != size
+                    && self.zoom > 0.0
+                {
+                    self.zoom *= old.0 as f32 / size.0 as f32;
+                }
                 let mut image =
                     ColorImage::filled([size.0 as usize, size.1 as usize], Color32::BLACK);
                 for id in 0..maps.tile_count() {

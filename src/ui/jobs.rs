@@ -25,6 +25,8 @@ pub(super) enum JobResult {
     Mesh(PathBuf, Arc<Surface>),
     /// An image decoded and resampled into a channel's planes.
     Image(PathBuf, Box<crate::model::import::ChannelPlanes>),
+    /// The maps resized, with the mesh baked at their size.
+    Resized(crate::model::resize::ResizedMaps),
     /// A new project (File > New), its mesh baked.
     Created(Box<Document>),
     /// A brush stamp read from an image.
@@ -37,6 +39,9 @@ pub(super) struct Job {
     pub(super) label: String,
     /// The project it opens (or the recovery copy it recovers), replacing the document.
     pub(super) opens: Option<PathBuf>,
+    /// What a window over the editor says while the job runs: the editor takes no input
+    /// until it is done (the document is about to be replaced or resized).
+    pub(super) modal: Option<String>,
     pub(super) progress: Arc<Progress>,
     pub(super) handle: JoinHandle<JobResult>,
 }
@@ -93,6 +98,33 @@ impl EditorState {
         opens: Option<PathBuf>,
         work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
     ) {
+        let modal = opens.as_ref().map(|path| {
+            let name = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            format!("Opening {name}…")
+        });
+        self.start_job_with(label, opens, modal, work);
+    }
+
+    /// Starts a job that the editor waits for behind a window saying `modal`.
+    pub(super) fn start_job_modal(
+        &mut self,
+        label: &str,
+        modal: String,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        self.start_job_with(label, None, Some(modal), work);
+    }
+
+    fn start_job_with(
+        &mut self,
+        label: &str,
+        opens: Option<PathBuf>,
+        modal: Option<String>,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
         if self.busy() {
             self.notices
                 .push(notice("wait for the current job to finish", true));
@@ -108,6 +140,7 @@ impl EditorState {
                 self.job = Some(Job {
                     label: label.into(),
                     opens,
+                    modal,
                     progress,
                     handle,
                 });
@@ -189,6 +222,12 @@ impl EditorState {
                     )),
                     Err(e) => self.notices.push(notice(e.to_string(), true)),
                 }
+            }
+            JobResult::Resized(resized) => {
+                let (w, h) = (resized.0.0.width(), resized.0.0.height());
+                self.apply(Command::Resize(resized));
+                self.notices
+                    .push(notice(format!("Resized the maps to {w}x{h}"), false));
             }
             JobResult::Created(doc) => {
                 self.replace_document(*doc);
@@ -376,15 +415,13 @@ impl EditorState {
     /// While a project opens: a window over the editor saying which, that takes the pointer
     /// (a stroke on the document about to be replaced would be lost).
     pub(super) fn opening_ui(&self, ctx: &egui::Context) {
-        let Some(path) = self.opening() else { return };
-        let name = path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
+        let Some(text) = self.job.as_ref().and_then(|j| j.modal.as_deref()) else {
+            return;
+        };
         egui::Modal::new(egui::Id::new("kapaint-opening")).show(ctx, |ui| {
             ui.horizontal(|ui| {
                 ui.spinner();
-                ui.label(format!("Opening {name}…"));
+                ui.label(text);
             });
         });
     }

@@ -15,6 +15,7 @@ pub mod keys;
 mod layout;
 mod panels;
 mod readout;
+pub mod resize;
 pub mod screen_brush;
 pub mod viewport;
 
@@ -189,6 +190,8 @@ pub struct EditorState {
     export: Option<ExportDialog>,
     /// The last export's preset and folder, offered again by the next.
     export_choice: Option<(String, String)>,
+    /// The Resize dialog, while open.
+    resize_dialog: Option<resize::ResizeDialog>,
     /// The New dialog, while open.
     new_dialog: Option<NewDialog>,
     /// A project to open once the user has decided about the unsaved changes.

@@ -119,6 +119,11 @@ pub enum Command {
     /// see [`crate::model::import`]). Not for scripts: its planes come from a decoder.
     #[serde(skip)]
     ImportChannel(ImportedChannel),
+    /// Installs maps resized on a worker ([`crate::model::resize::resized`]) with the mesh
+    /// surface baked at their size, as one undo step. Not for scripts: its maps come from a
+    /// worker.
+    #[serde(skip)]
+    Resize(crate::model::resize::ResizedMaps),
     /// Undoes the last step.
     Undo,
     /// Redoes the last undone step.

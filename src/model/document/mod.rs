@@ -328,22 +328,57 @@ impl Document {
             }
             Command::Undo => {
                 self.end_stroke();
-                self.history.undo(&mut self.maps);
+                self.history.undo(&mut self.maps, &mut self.surface);
             }
             Command::Redo => {
                 self.end_stroke();
-                self.history.redo(&mut self.maps);
+                self.history.redo(&mut self.maps, &mut self.surface);
             }
+            Command::Resize(resized) => self.install_resized(&resized)?,
             Command::HistoryJump(applied) => {
                 self.end_stroke();
                 while self.history.undo_steps().count() > applied {
-                    self.history.undo(&mut self.maps);
+                    self.history.undo(&mut self.maps, &mut self.surface);
                 }
                 while self.history.undo_steps().count() < applied
-                    && self.history.redo(&mut self.maps)
+                    && self.history.redo(&mut self.maps, &mut self.surface)
                 {}
             }
         }
+        Ok(())
+    }
+
+    /// Puts resized maps and their surface in place, keeping the old ones as one undo step.
+    fn install_resized(
+        &mut self,
+        resized: &crate::model::resize::ResizedMaps,
+    ) -> Result<(), ModelError> {
+        let (maps, surface) = &*resized.0;
+        let size = (maps.width(), maps.height());
+        if let Some(s) = surface
+            && (s.width(), s.height()) != size
+        {
+            return Err(ModelError::Internal(format!(
+                "the mesh is baked at {}x{} but the resized maps are {}x{}",
+                s.width(),
+                s.height(),
+                size.0,
+                size.1
+            )));
+        }
+        self.end_stroke();
+        let mut maps = maps.clone();
+        maps.stamp_after(self.maps.version());
+        let old = std::mem::replace(&mut self.maps, maps);
+        let old_surface = std::mem::replace(&mut self.surface, surface.clone());
+        let label = format!(
+            "Resize {}x{} to {}x{}",
+            old.width(),
+            old.height(),
+            size.0,
+            size.1
+        );
+        self.history.push_whole(label, old, old_surface);
         Ok(())
     }
 

@@ -146,6 +146,15 @@ impl EditorState {
                     self.apply(Command::Redo);
                 }
             });
+            ui.menu_button("Image", |ui| {
+                if ui
+                    .button("Resize…")
+                    .on_hover_text("Resample the maps to another size (one undo step)")
+                    .clicked()
+                {
+                    self.open_resize();
+                }
+            });
             ui.menu_button("Help", |ui| {
                 if ui.button("Keyboard shortcuts").clicked() {
                     self.shortcuts_open = true;

@@ -9,3 +9,4 @@ mod tool_panel;
 mod view_panel;
 
 pub(super) use bars::channel_label;
+pub(super) use view_panel::megabytes;

@@ -1,0 +1,118 @@
+//! Resizing the maps of a project (Image > Resize): every channel resampled by the triangle
+//! filter image import uses (a tent widened by the ratio when shrinking), `k_d` and `k_s` as
+//! linear values and `n` in the log space the brushes blend it in, so a resized map keeps its
+//! highlights' look rather than averaging exponents. The document installs the result as one
+//! undo step that swaps the whole maps (and the mesh surface baked for them) back.
+
+use std::sync::Arc;
+
+use image::{DynamicImage, ImageBuffer, Rgb};
+
+use super::ModelError;
+use super::maps::MaterialMaps;
+use super::surface::Surface;
+use super::texel::{Channel, MaterialValue, decode_n, decode_rgb, n_to_blend};
+
+/// Maps resampled to a new size with the mesh surface baked at that size: made on a worker,
+/// installed by [`super::Command::Resize`].
+#[derive(Clone, Debug)]
+pub struct ResizedMaps(pub Arc<(MaterialMaps, Option<Arc<Surface>>)>);
+
+impl PartialEq for ResizedMaps {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// Bytes a `width x height` resize holds at its peak beyond the maps it starts from: the new
+/// maps stored in full (14 bytes a texel) and one channel as floats at the larger of the two
+/// sizes (12 bytes a texel).
+pub fn peak_bytes(from: (u32, u32), width: u32, height: u32) -> u64 {
+    let texels = u64::from(width) * u64::from(height);
+    let larger = texels.max(u64::from(from.0) * u64::from(from.1));
+    texels * 14 + larger * 12
+}
+
+/// `maps` resampled to `width x height`.
+///
+/// # Errors
+/// A size out of range, or the same size as now.
+pub fn resized(maps: &MaterialMaps, width: u32, height: u32) -> Result<MaterialMaps, ModelError> {
+    if (width, height) == (maps.width(), maps.height()) {
+        return Err(ModelError::Command(format!(
+            "the maps are already {width}x{height}"
+        )));
+    }
+    let mut out = MaterialMaps::new(width, height, MaterialValue::default())?;
+    for channel in Channel::ALL {
+        let image = channel_image(maps, channel);
+        let planes = super::import::resample_as(&image, channel, width, height, true);
+        drop(image);
+        super::import::write_planes(&mut out, &planes);
+    }
+    Ok(out)
+}
+
+/// One channel as a linear float image: `k_d` and `k_s` as they are, `n` as its blend value
+/// in all three components.
+fn channel_image(maps: &MaterialMaps, channel: Channel) -> DynamicImage {
+    let (w, h) = (maps.width(), maps.height());
+    let mut image: ImageBuffer<Rgb<f32>, Vec<f32>> = ImageBuffer::new(w, h);
+    maps.for_each_texel(|x, y, t| {
+        let v = match channel {
+            Channel::Kd => decode_rgb(t.kd).to_array(),
+            Channel::Ks => decode_rgb(t.ks).to_array(),
+            Channel::N => [n_to_blend(decode_n(t.n)); 3],
+        };
+        image.put_pixel(x, y, Rgb(v));
+    });
+    DynamicImage::ImageRgb32F(image)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn a_uniform_map_stays_uniform_and_n_resamples_in_log_space() {
+        let base = MaterialValue::new(Vec3::new(0.6, 0.2, 0.1), Vec3::splat(0.3), 90.0);
+        let maps = MaterialMaps::new(128, 128, base).unwrap();
+        let half = resized(&maps, 64, 96).unwrap();
+        assert_eq!((half.width(), half.height()), (64, 96));
+        assert_eq!(half.uniform_texel(), maps.uniform_texel());
+        assert_eq!(half.heap_bytes(), 0, "uniform planes cost nothing");
+        // Two columns of n = 10 and n = 1000 shrink to about their geometric middle.
+        let mut maps = MaterialMaps::new(2, 1, base).unwrap();
+        let tile = maps.tile_mut(0);
+        let lo = crate::model::texel::Texel::encode(MaterialValue { n: 10.0, ..base });
+        let hi = crate::model::texel::Texel::encode(MaterialValue { n: 1000.0, ..base });
+        tile.set_texel(0, lo);
+        tile.set_texel(1, hi);
+        let one = resized(&maps, 1, 1).unwrap();
+        let n = one.value(0, 0).n;
+        assert!(
+            (90.0..=112.0).contains(&n),
+            "log-space mean of 10 and 1000: {n}"
+        );
+        assert!(resized(&one, 1, 1).is_err(), "same size");
+        assert!(resized(&one, 0, 4).is_err());
+    }
+
+    #[test]
+    fn doubling_then_halving_comes_back_close() {
+        let mut maps = MaterialMaps::new(64, 64, MaterialValue::default()).unwrap();
+        let tile = maps.tile_mut(0);
+        for i in 0..64 * 64 {
+            let (x, y) = ((i % 64) as f32 / 63.0, (i / 64) as f32 / 63.0);
+            let v = MaterialValue::new(Vec3::new(x, y, 0.5), Vec3::splat(0.2), 1.0 + 500.0 * x);
+            tile.set_texel(i, crate::model::texel::Texel::encode(v));
+        }
+        let back = resized(&resized(&maps, 128, 128).unwrap(), 64, 64).unwrap();
+        for (x, y) in [(10, 10), (30, 40), (50, 20)] {
+            let (a, b) = (maps.value(x, y), back.value(x, y));
+            assert!((a.kd - b.kd).abs().max_element() < 0.01, "{a:?} {b:?}");
+            assert!((a.n / b.n - 1.0).abs() < 0.05, "{a:?} {b:?}");
+        }
+    }
+}
