@@ -299,5 +299,29 @@ fn autosave(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, dabs, fills_and_derive, project_io, autosave);
+/// Image > Resize of painted maps (every tile varied): the resampling a worker does.
+fn resize(c: &mut Criterion) {
+    let mut group = c.benchmark_group("resize");
+    group.sample_size(10);
+    let big = painted_document(SIDE);
+    let small = painted_document(SIDE / 2);
+    group.bench_function("4096_to_2048", |b| {
+        b.iter(|| {
+            kapaint::model::resize::resized(big.maps(), SIDE / 2, SIDE / 2).expect("resized")
+        });
+    });
+    group.bench_function("2048_to_4096", |b| {
+        b.iter(|| kapaint::model::resize::resized(small.maps(), SIDE, SIDE).expect("resized"));
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    dabs,
+    fills_and_derive,
+    project_io,
+    autosave,
+    resize
+);
 criterion_main!(benches);

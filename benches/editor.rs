@@ -1,0 +1,114 @@
+//! Criterion bench of the editor's CPU side, one frame at a time (egui_kittest, no window, no
+//! GPU): the UI and the status bar's readout on a 4096^2 project (every tile painted), with the
+//! cursor moving a point a frame over the side panel, the UV canvas or the viewport. Issue 17
+//! asks that a frame over the canvas cost no more than one over the panel.
+
+#![expect(
+    clippy::expect_used,
+    reason = "bench set-up: a failed expectation is a failed bench"
+)]
+
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use egui::{Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use kapaint::model::texel::{MaterialValue, Texel};
+use kapaint::model::tile::TILE_TEXELS;
+use kapaint::model::{Document, DocumentSettings, MaterialMaps, project};
+use kapaint::ui::Editor;
+use kapaint::ui::canvas::CANVAS_LABEL;
+use kapaint::ui::viewport::VIEWPORT_LABEL;
+
+const SIDE: u32 = 4096;
+
+/// A 4096^2 project whose every texel differs from its neighbours (n across its range), saved
+/// to a temporary file.
+fn project_file() -> std::path::PathBuf {
+    let mut maps = MaterialMaps::new(SIDE, SIDE, MaterialValue::default()).expect("size");
+    for id in 0..maps.tile_count() {
+        let tile = maps.tile_mut(id);
+        for i in 0..TILE_TEXELS {
+            let h = (id * TILE_TEXELS + i) as u32;
+            let f = |k: u32| (h.wrapping_mul(2_654_435_761).rotate_left(k) % 1000) as f32 / 1000.0;
+            tile.set_texel(
+                i,
+                Texel::encode(MaterialValue::new(
+                    glam::Vec3::new(f(0), f(5), f(9)),
+                    glam::Vec3::splat(f(13) * 0.5),
+                    (f(17) * 9.0).exp2() * 8.0,
+                )),
+            );
+        }
+    }
+    let doc = Document::from_parts(maps, DocumentSettings::default());
+    let path = std::env::temp_dir().join(format!(
+        "kapaint-bench-editor-{}.kapaint",
+        std::process::id()
+    ));
+    project::save(&doc, &path).expect("saved");
+    path
+}
+
+/// The editor on the project, opened, in a 1400 x 900 window.
+fn editor(path: &std::path::Path) -> Harness<'static, Editor> {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(200)
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, Some(path.to_path_buf())),
+        );
+    let deadline = std::time::Instant::now() + Duration::from_mins(2);
+    while harness.state().state.opening().is_some()
+        || harness.state().state.doc().maps().width() != SIDE
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the project did not open"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        harness.step();
+    }
+    // Let the thumbnails and the first readouts settle.
+    for _ in 0..60 {
+        harness.step();
+    }
+    harness
+}
+
+fn frames(c: &mut Criterion) {
+    let path = project_file();
+    let mut harness = editor(&path);
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect().center();
+    let viewport = harness.get_by_label(VIEWPORT_LABEL).rect().center();
+    // The right panel, beside its widgets' labels (empty panel area).
+    let panel = Pos2::new(1400.0 - 20.0, 880.0);
+    let mut group = c.benchmark_group("editor_frame_4096");
+    group
+        .sample_size(40)
+        .measurement_time(Duration::from_secs(6))
+        .warm_up_time(Duration::from_secs(2));
+    for (name, at) in [
+        ("cursor_over_side_panel", panel),
+        ("cursor_over_canvas", canvas),
+        ("cursor_over_viewport", viewport),
+    ] {
+        let mut k = 0u32;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                // A point a frame, back and forth: a new texel under the cursor most frames.
+                k = k.wrapping_add(1);
+                let dx = (k % 16) as f32 - 8.0;
+                harness.hover_at(at + Vec2::new(dx, 0.0));
+                harness.step();
+            });
+        });
+    }
+    group.finish();
+    let _ = std::fs::remove_file(&path);
+}
+
+criterion_group!(benches, frames);
+criterion_main!(benches);
