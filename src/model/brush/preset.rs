@@ -24,6 +24,10 @@ const MAX_BRUSH_PRESET_BYTES: u64 = 8 << 20;
 /// The shipped brush presets, by file stem.
 const BUILTIN: &[(&str, &str)] = &[
     (
+        "default",
+        include_str!("../../../presets/brushes/default.ron"),
+    ),
+    (
         "hard-round",
         include_str!("../../../presets/brushes/hard-round.ron"),
     ),
@@ -129,7 +133,7 @@ mod tests {
         assert!(on_disk.iter().all(Result::is_ok), "{on_disk:?}");
         let on_disk: Vec<_> = on_disk.into_iter().flatten().collect();
         assert_eq!(builtin(), on_disk, "add new brush preset files to BUILTIN");
-        assert!(on_disk.len() >= 3);
+        assert!(on_disk.len() >= 4);
     }
 
     #[test]
