@@ -198,3 +198,61 @@ fn a_project_named_at_start_opens_on_a_worker_and_takes_no_strokes_meanwhile() {
     assert!(texels(harness.state()) == want, "the project as saved");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
+    use kapaint::model::recovery::{Autosaver, recovery_path};
+    let dir = scratch("recovery-modal");
+    let project = dir.join("work.kapaint");
+    let mut doc =
+        kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+            .expect("document");
+    kapaint::model::project::save(&doc, &project).expect("saved");
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    // Unsaved work since: a fill, in a recovery copy newer than the project.
+    let mut autosaver = Autosaver::new(
+        std::time::Duration::ZERO,
+        recovery_path(Some(&project)),
+        &doc,
+    );
+    doc.apply(kapaint::model::Command::Fill(
+        kapaint::model::FillRegion::All,
+    ))
+    .expect("fill");
+    let _ = autosaver.poll(&doc, std::time::Instant::now());
+    autosaver.wait().expect("autosaved").expect("written");
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(40)
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, Some(project.clone())),
+        );
+    harness.run();
+    harness.get_by_label_contains("found a recovery copy");
+    let version = harness.state().state.doc().version();
+    // A stroke on the canvas and Ctrl+S while the offer is up change nothing.
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    assert_eq!(
+        harness.state().state.doc().version(),
+        version,
+        "the placeholder took input"
+    );
+    assert_eq!(harness.state().state.file_dialog_open_for(), None);
+    // Recover: the project comes back with the fill.
+    harness
+        .get_by_role_and_label(Role::Button, "Recover")
+        .click();
+    harness.run();
+    wait_until(&mut harness, "recovered", |e| {
+        e.state.opening().is_none() && e.state.doc().maps().width() == 64
+    });
+    assert_eq!(
+        harness.state().state.doc().maps().value(3, 3),
+        doc.maps().value(3, 3)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

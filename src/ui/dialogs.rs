@@ -162,39 +162,38 @@ impl ExportDialog {
 }
 
 impl EditorState {
-    /// The recovery offer at start: recover the copy, or discard it.
+    /// The recovery offer at start: recover the copy, or discard it. Modal: until it is
+    /// answered the document is a placeholder, and a stroke on it would be autosaved over the
+    /// untitled recovery copy.
     pub(super) fn recovery_window(&mut self, ctx: &egui::Context) {
         let Some(copy) = self.recovery_offer.clone() else {
             return;
         };
-        egui::Window::new("Recover unsaved work?")
-            .collapsible(false)
-            .resizable(false)
-            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
-            .show(ctx, |ui| {
-                ui.label(format!(
-                    "kapaint found a recovery copy of unsaved work:\n{}",
-                    copy.display()
-                ));
-                ui.horizontal(|ui| {
-                    // Recover is the default: Enter takes it.
-                    let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
-                    let recover = ui.button("Recover").on_hover_text("Enter");
-                    if recover.clicked() || enter {
-                        self.recovery_offer = None;
-                        let path = self.starting.take().or_else(|| self.path.clone());
-                        self.recover(copy.clone(), path);
+        egui::Modal::new(egui::Id::new("kapaint-recovery-offer")).show(ctx, |ui| {
+            ui.heading("Recover unsaved work?");
+            ui.label(format!(
+                "kapaint found a recovery copy of unsaved work:\n{}",
+                copy.display()
+            ));
+            ui.horizontal(|ui| {
+                // Recover is the default: Enter takes it.
+                let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+                let recover = ui.button("Recover").on_hover_text("Enter");
+                if recover.clicked() || enter {
+                    self.recovery_offer = None;
+                    let path = self.starting.take().or_else(|| self.path.clone());
+                    self.recover(copy.clone(), path);
+                }
+                if ui.button("Discard").clicked() {
+                    self.recovery_offer = None;
+                    crate::model::recovery::remove(&copy);
+                    // The project named at start opens as saved.
+                    if let Some(p) = self.starting.take() {
+                        self.open_now(p);
                     }
-                    if ui.button("Discard").clicked() {
-                        self.recovery_offer = None;
-                        crate::model::recovery::remove(&copy);
-                        // The project named at start opens as saved.
-                        if let Some(p) = self.starting.take() {
-                            self.open_now(p);
-                        }
-                    }
-                });
+                }
             });
+        });
     }
 
     /// Opens the New dialog (Ctrl+N), starting from the current document's size.

@@ -198,6 +198,7 @@ impl EditorState {
         if ctx.egui_wants_keyboard_input()
             || self.files.open_for().is_some()
             || self.job.as_ref().is_some_and(|j| j.modal.is_some())
+            || self.recovery_offer.is_some()
         {
             return;
         }
