@@ -148,9 +148,9 @@ fn every_file_request_reaches_its_command() {
     harness.run_steps(2);
     harness.get_by_role_and_label(Role::Button, "…").click();
     harness.run_steps(2);
+    // A folder that is not there yet: the set goes into it.
     let chosen = std::env::temp_dir()
         .join("kapaint-export-choice")
-        .join("set")
         .display()
         .to_string();
     wait_until(&mut harness, "export folder chosen", |e| {
@@ -253,6 +253,28 @@ fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
     assert_eq!(
         harness.state().state.doc().maps().value(3, 3),
         doc.maps().value(3, 3)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_export_goes_into_the_folder_chosen_unless_it_holds_other_things() {
+    use kapaint::ui::export_folder_in;
+    let dir = scratch("export-folder-choice");
+    assert_eq!(export_folder_in(&dir), dir, "an empty folder takes the set");
+    std::fs::write(dir.join("notes.txt"), "mine").expect("write");
+    assert_eq!(
+        export_folder_in(&dir),
+        dir.join("set"),
+        "never over other files"
+    );
+    let set = dir.join("old-set");
+    std::fs::create_dir(&set).expect("folder");
+    std::fs::write(set.join("material.json"), "{}").expect("write");
+    assert_eq!(
+        export_folder_in(&set),
+        set,
+        "a set is replaced after the prompt"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

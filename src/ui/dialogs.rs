@@ -154,9 +154,10 @@ impl ExportDialog {
         &self.folder
     }
 
-    /// Exports into a new `set` folder inside the chosen `dir`.
+    /// Exports into the chosen `dir` where it is empty or a set already (replaced after a
+    /// prompt), else into a new `set` folder inside it.
     pub(super) fn choose_folder(&mut self, dir: &Path) {
-        self.folder = dir.join("set").display().to_string();
+        self.folder = export_folder_in(dir).display().to_string();
         (self.confirm_replace, self.problem) = (false, None);
     }
 }
@@ -559,6 +560,17 @@ impl EditorState {
                     });
                 });
         }
+    }
+}
+
+/// Where an export into the folder `dir` the user chose goes: `dir` itself when it is free (or
+/// empty) or holds a set, else a `set` folder inside it (a folder of other things is never
+/// replaced).
+pub fn export_folder_in(dir: &Path) -> PathBuf {
+    use crate::export::set::{Target, target};
+    match target(dir) {
+        Ok(Target::Free | Target::Set) => dir.to_path_buf(),
+        _ => dir.join("set"),
     }
 }
 

@@ -21,7 +21,7 @@ pub mod viewport;
 
 pub use app::{Editor, run};
 use dialogs::ExportDialog;
-pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, parse_recent, push_recent};
+pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, export_folder_in, parse_recent, push_recent};
 use jobs::{Job, JobResult};
 pub use layout::{default_layout, layout_json, parse_layout};
 
