@@ -9,6 +9,7 @@ pub mod document;
 mod error;
 pub mod history;
 pub mod import;
+pub mod layers;
 pub mod maps;
 pub mod mips;
 pub mod paint;
