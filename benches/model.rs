@@ -316,12 +316,70 @@ fn resize(c: &mut Criterion) {
     group.finish();
 }
 
+/// A 16-layer 4096^2 stack, each paint layer painted over about 10 % of the map (a band of
+/// tiles) with a mask painted there too.
+fn layered_stack() -> kapaint::model::layers::LayerStack {
+    use kapaint::model::layers::{Layer, LayerStack, Mask, PaintTile, Stamped};
+    use std::sync::Arc;
+    let mut stack = LayerStack::new(SIDE, SIDE, MaterialValue::default());
+    stack.layers.clear();
+    let tiles = stack.tile_count();
+    for l in 0..16 {
+        let mut layer = Layer::paint(format!("Layer {}", l + 1), tiles);
+        let mut mask = Mask::white(tiles);
+        let value = MaterialValue::new(
+            Vec3::new(0.1 + 0.05 * l as f32, 0.5, 0.3),
+            Vec3::splat(0.2),
+            (l as f32).exp2(),
+        );
+        for id in (0..tiles).filter(|id| (id / 7 + l) % 10 == 0) {
+            let tile = layer.paint_tile_mut(id).expect("paint layer");
+            *tile = PaintTile::filled(value, [true, true, true]);
+            for (i, a) in tile.alpha[0].data_mut().iter_mut().enumerate() {
+                *a = ((i * 37) % 65_536) as u16;
+            }
+            let mut plane = kapaint::model::tile::Plane::Uniform(u16::MAX);
+            for (i, m) in plane.data_mut().iter_mut().enumerate() {
+                *m = ((i * 11) % 65_536) as u16;
+            }
+            mask.tiles[id] = Arc::new(Stamped::new(plane));
+        }
+        layer.mask = Some(mask);
+        stack.layers.push(layer);
+    }
+    stack
+}
+
+/// Layers: toggling a painted layer's visibility recomposites every tile it touches (the
+/// compositor finds them; issue 18 asks <= 60 ms on 2 cores), and the first full composite.
+fn layers(c: &mut Criterion) {
+    use kapaint::model::layers::Compositor;
+    let mut group = c.benchmark_group("layers_4096");
+    group.sample_size(10);
+    let mut stack = layered_stack();
+    let mut maps = MaterialMaps::new(SIDE, SIDE, MaterialValue::default()).expect("size");
+    let mut compositor = Compositor::new();
+    compositor.update(&stack, &mut maps);
+    eprintln!("16 layers: {} MB of tiles", stack.heap_bytes() / 1_000_000);
+    group.bench_function("toggle_visibility_16_layers", |b| {
+        b.iter(|| {
+            stack.layers[8].props.visible = !stack.layers[8].props.visible;
+            compositor.update(&stack, &mut maps)
+        });
+    });
+    group.bench_function("full_composite_16_layers", |b| {
+        b.iter(|| Compositor::new().update(&stack, &mut maps.clone()));
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
     dabs,
     fills_and_derive,
     project_io,
     autosave,
-    resize
+    resize,
+    layers
 );
 criterion_main!(benches);

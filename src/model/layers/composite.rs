@@ -6,9 +6,11 @@
 //! the brushes use. A group composites its children onto nothing first, then lays the result
 //! over what is below like one layer. The result is encoded as the maps store it.
 //!
-//! [`Compositor`] keeps, per tile, a signature of everything that tile's composite depends on
-//! (the stack's settings and the stamps of every layer's and mask's tile there) and
-//! recomposites only the tiles whose signature changed. A tile is computed by the same
+//! Only the layers that take part at a tile are visited there: visible, not masked out, and
+//! with something at that tile (a paint layer's untouched tile is nothing). [`Compositor`]
+//! keeps, per tile, a signature of everything that tile's composite depends on (those layers'
+//! settings and the stamps of their tiles and mask tiles there) and recomposites only the
+//! tiles whose signature changed: hiding a layer recomposites only where it has paint. A tile is computed by the same
 //! function either way, so the incremental result is bit-identical to flattening the whole
 //! stack from scratch; a recomposited tile that comes out the same is not written, so the
 //! maps' dirty tiles (and the GPU upload) stay the ones that really changed.
@@ -18,7 +20,7 @@ use std::hash::{Hash, Hasher};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{Covered, Layer, LayerContent, LayerStack};
+use super::{Covered, Layer, LayerContent, LayerStack, PaintTile};
 use crate::model::maps::MaterialMaps;
 use crate::model::texel::{
     Texel, decode_n, decode_rgb, decode_unorm, encode_n, encode_rgb, n_from_blend, n_to_blend,
@@ -46,6 +48,51 @@ fn values(t: Texel) -> [f32; 7] {
     ]
 }
 
+/// A layer as it takes part at one tile: only visible layers that cover something there
+/// (a paint layer's tile, a fill, a group with such children), each with what it needs.
+enum Active<'a> {
+    /// A paint layer's tile.
+    Paint(&'a Layer, &'a PaintTile),
+    /// A fill layer, its value as compositing values.
+    Fill(&'a Layer, [f32; 7]),
+    /// A group and its active children.
+    Group(&'a Layer, Vec<Active<'a>>),
+}
+
+impl Active<'_> {
+    fn layer(&self) -> &Layer {
+        match self {
+            Self::Paint(l, _) | Self::Fill(l, _) | Self::Group(l, _) => l,
+        }
+    }
+}
+
+/// The layers of `layers` that take part at tile `id`, bottom first.
+fn active(layers: &[Layer], id: usize) -> Vec<Active<'_>> {
+    layers
+        .iter()
+        .filter(|l| {
+            let p = &l.props;
+            let hidden_by_mask = l.mask.as_ref().is_some_and(|m| {
+                m.enabled
+                    && m.tiles[id]
+                        .get()
+                        .uniform()
+                        .is_some_and(|v| if m.inverted { v == u16::MAX } else { v == 0 })
+            });
+            p.visible && p.opacity > 0.0 && p.channels.iter().any(|c| c.enabled) && !hidden_by_mask
+        })
+        .filter_map(|l| match &l.content {
+            LayerContent::Paint(tiles) => tiles[id].as_ref().map(|t| Active::Paint(l, t.get())),
+            LayerContent::Fill(v) => Some(Active::Fill(l, values(Texel::encode(*v)))),
+            LayerContent::Group(children) => {
+                let inner = active(children, id);
+                (!inner.is_empty()).then_some(Active::Group(l, inner))
+            }
+        })
+        .collect()
+}
+
 /// How much of `layer` its mask shows at texel `i` of tile `id` (1 without a mask).
 fn masked(layer: &Layer, id: usize, i: usize) -> f32 {
     match &layer.mask {
@@ -57,23 +104,42 @@ fn masked(layer: &Layer, id: usize, i: usize) -> f32 {
     }
 }
 
-/// Lays `layers` (bottom first) over `state` at texel `i` of tile `id`.
-fn apply(state: &mut State, layers: &[Layer], id: usize, i: usize) {
-    for layer in layers.iter().filter(|l| l.props.visible) {
+/// Lays the source `v` at per-channel coverage `alpha` over `state` with `layer`'s modes.
+fn lay(state: &mut State, layer: &Layer, v: &[f32; 7], alpha: [f32; 3]) {
+    for (c, part) in PARTS.iter().enumerate() {
+        let blend = layer.props.channels[c];
+        if blend.enabled && alpha[c] > 0.0 {
+            for k in part.clone() {
+                let source = Covered {
+                    value: v[k],
+                    alpha: alpha[c],
+                };
+                state[k] = state[k].under(source, blend.mode);
+            }
+        }
+    }
+}
+
+/// Lays the active layers (bottom first) over `state` at texel `i` of tile `id`.
+fn apply(state: &mut State, layers: &[Active<'_>], id: usize, i: usize) {
+    for a in layers {
+        let layer = a.layer();
         let cover = layer.props.opacity.clamp(0.0, 1.0) * masked(layer, id, i);
         if cover <= 0.0 {
             continue;
         }
-        // The layer's values and, per channel, its coverage here.
-        let (v, alpha) = match &layer.content {
-            LayerContent::Paint(tiles) => {
-                let Some(tile) = &tiles[id] else { continue };
-                let tile = tile.get();
-                let a = |c: usize| decode_unorm(tile.alpha[c].get(i)) * cover;
-                (values(tile.value.texel(i)), [a(0), a(1), a(2)])
+        match a {
+            Active::Paint(_, tile) => {
+                let alpha = |c: usize| decode_unorm(tile.alpha[c].get(i)) * cover;
+                lay(
+                    state,
+                    layer,
+                    &values(tile.value.texel(i)),
+                    [alpha(0), alpha(1), alpha(2)],
+                );
             }
-            LayerContent::Fill(value) => (values(Texel::encode(*value)), [cover; 3]),
-            LayerContent::Group(children) => {
+            Active::Fill(_, v) => lay(state, layer, v, [cover; 3]),
+            Active::Group(_, children) => {
                 let mut inner = [Covered::CLEAR; 7];
                 apply(&mut inner, children, id, i);
                 for (c, part) in PARTS.iter().enumerate() {
@@ -88,51 +154,37 @@ fn apply(state: &mut State, layers: &[Layer], id: usize, i: usize) {
                         }
                     }
                 }
-                continue;
-            }
-        };
-        for (c, part) in PARTS.iter().enumerate() {
-            let blend = layer.props.channels[c];
-            if blend.enabled && alpha[c] > 0.0 {
-                for k in part.clone() {
-                    let source = Covered {
-                        value: v[k],
-                        alpha: alpha[c],
-                    };
-                    state[k] = state[k].under(source, blend.mode);
-                }
             }
         }
     }
 }
 
-/// Whether every input of tile `id` is one value over the tile (then one texel stands for
-/// all).
-fn uniform_inputs(layers: &[Layer], id: usize) -> bool {
-    layers.iter().filter(|l| l.props.visible).all(|layer| {
-        let mask = layer
+/// Whether every input of the active layers at tile `id` is one value over the tile (then
+/// one texel stands for all).
+fn uniform_inputs(layers: &[Active<'_>], id: usize) -> bool {
+    layers.iter().all(|a| {
+        let mask = a
+            .layer()
             .mask
             .as_ref()
             .is_none_or(|m| !m.enabled || m.tiles[id].get().uniform().is_some());
-        let content = match &layer.content {
-            LayerContent::Paint(tiles) => tiles[id].as_ref().is_none_or(|t| {
-                let t = t.get();
+        mask && match a {
+            Active::Paint(_, t) => {
                 t.value.kd.uniform().is_some()
                     && t.value.ks.uniform().is_some()
                     && t.value.n.uniform().is_some()
                     && t.alpha.iter().all(|a| a.uniform().is_some())
-            }),
-            LayerContent::Fill(_) => true,
-            LayerContent::Group(children) => uniform_inputs(children, id),
-        };
-        mask && content
+            }
+            Active::Fill(..) => true,
+            Active::Group(_, children) => uniform_inputs(children, id),
+        }
     })
 }
 
 /// The composite of texel `i` of tile `id`, as stored.
-fn texel(stack: &LayerStack, base: &[f32; 7], id: usize, i: usize) -> Texel {
+fn texel(layers: &[Active<'_>], base: &[f32; 7], id: usize, i: usize) -> Texel {
     let mut state: State = base.map(Covered::opaque);
-    apply(&mut state, &stack.layers, id, i);
+    apply(&mut state, layers, id, i);
     let v = state.map(|c| c.value);
     Texel {
         kd: encode_rgb(Vec3::new(v[0], v[1], v[2])),
@@ -143,50 +195,46 @@ fn texel(stack: &LayerStack, base: &[f32; 7], id: usize, i: usize) -> Texel {
 
 /// The composite of tile `id`, compacted (a tile of one value is stored as one value).
 pub fn composite_tile(stack: &LayerStack, id: usize) -> Tile {
+    composite_active(stack, &active(&stack.layers, id), id)
+}
+
+fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Tile {
     let base = values(Texel::encode(stack.base));
-    if uniform_inputs(&stack.layers, id) {
-        return Tile::uniform(texel(stack, &base, id, 0));
+    if uniform_inputs(layers, id) {
+        return Tile::uniform(texel(layers, &base, id, 0));
     }
     let mut tile = Tile::uniform(Texel::default());
     for i in 0..TILE_TEXELS {
-        tile.set_texel(i, texel(stack, &base, id, i));
+        tile.set_texel(i, texel(layers, &base, id, i));
     }
     tile.compact();
     tile
 }
 
-/// Hashes everything about the stack but its tiles: sizes, base, and per layer its settings,
-/// kind, fill value and mask switches, in order.
-fn hash_settings(layers: &[Layer], h: &mut impl Hasher) {
+/// Hashes what the composite of tile `id` depends on: per active layer, in order, its
+/// settings, its fill value or its tile's stamp, its mask's switches and tile stamp, and its
+/// active children.
+fn hash_active(layers: &[Active<'_>], id: usize, h: &mut impl Hasher) {
     layers.len().hash(h);
-    for layer in layers {
-        let p = &layer.props;
-        (p.visible, p.opacity.to_bits(), p.channels).hash(h);
-        layer.mask.as_ref().map(|m| (m.enabled, m.inverted)).hash(h);
-        match &layer.content {
-            LayerContent::Paint(_) => 0u8.hash(h),
-            LayerContent::Fill(v) => {
-                1u8.hash(h);
-                Texel::encode(*v).hash(h);
+    for a in layers {
+        let l = a.layer();
+        (l.props.opacity.to_bits(), l.props.channels).hash(h);
+        l.mask
+            .as_ref()
+            .map(|m| (m.enabled, m.inverted, m.tiles[id].stamp()))
+            .hash(h);
+        match a {
+            Active::Paint(_, _) => {
+                let LayerContent::Paint(tiles) = &l.content else {
+                    continue;
+                };
+                (0u8, tiles[id].as_ref().map_or(0, |t| t.stamp())).hash(h);
             }
-            LayerContent::Group(children) => {
+            Active::Fill(_, v) => (1u8, v.map(f32::to_bits)).hash(h),
+            Active::Group(_, children) => {
                 2u8.hash(h);
-                hash_settings(children, h);
+                hash_active(children, id, h);
             }
-        }
-    }
-}
-
-/// Hashes the stamps of every layer's and mask's tile `id`, in order.
-fn hash_tiles(layers: &[Layer], id: usize, h: &mut impl Hasher) {
-    for layer in layers {
-        if let Some(m) = &layer.mask {
-            m.tiles[id].stamp().hash(h);
-        }
-        match &layer.content {
-            LayerContent::Paint(tiles) => tiles[id].as_ref().map_or(0, |t| t.stamp()).hash(h),
-            LayerContent::Fill(_) => {}
-            LayerContent::Group(children) => hash_tiles(children, id, h),
         }
     }
 }
@@ -218,16 +266,11 @@ impl Compositor {
         if self.signatures.len() != count {
             self.signatures = vec![0; count];
         }
-        let settings = {
-            let mut h = std::hash::DefaultHasher::new();
-            (stack.width, stack.height, Texel::encode(stack.base)).hash(&mut h);
-            hash_settings(&stack.layers, &mut h);
-            h.finish()
-        };
+        let base = Texel::encode(stack.base);
         let signature = |id: usize| {
             let mut h = std::hash::DefaultHasher::new();
-            settings.hash(&mut h);
-            hash_tiles(&stack.layers, id, &mut h);
+            (stack.width, stack.height, base).hash(&mut h);
+            hash_active(&active(&stack.layers, id), id, &mut h);
             h.finish().max(1)
         };
         let stale: Vec<(usize, u64)> = (0..count)
