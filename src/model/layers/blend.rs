@@ -124,11 +124,18 @@ impl Covered {
     #[inline]
     #[must_use]
     pub fn under(self, source: Self, mode: LayerBlend) -> Self {
+        self.under_with(source, |b, l| mode.mix(b, l))
+    }
+
+    /// [`Self::under`] with the blend given as a function `B(below, layer)`.
+    #[inline]
+    #[must_use]
+    pub fn under_with(self, source: Self, mix: impl Fn(f32, f32) -> f32) -> Self {
         let (ab, as_) = (self.alpha, source.alpha);
         if as_ <= 0.0 {
             return self;
         }
-        let blended = (1.0 - ab) * source.value + ab * mode.mix(self.value, source.value);
+        let blended = (1.0 - ab) * source.value + ab * mix(self.value, source.value);
         let alpha = as_ + ab * (1.0 - as_);
         let premultiplied = as_ * blended + (1.0 - as_) * ab * self.value;
         Self {

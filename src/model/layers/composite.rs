@@ -22,13 +22,8 @@ use rayon::prelude::*;
 
 use super::{Covered, Layer, LayerContent, LayerStack, PaintTile};
 use crate::model::maps::MaterialMaps;
-use crate::model::texel::{
-    Texel, decode_n, decode_rgb, decode_unorm, encode_n, encode_rgb, n_from_blend, n_to_blend,
-};
+use crate::model::texel::{Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, n_to_blend};
 use crate::model::tile::{TILE_TEXELS, Tile};
-
-/// One texel being composited: `k_d` RGB, `k_s` RGB, `n` (log space).
-type State = [Covered; 7];
 
 /// The components of `k_d`, `k_s` and `n` in a [`State`].
 const PARTS: [std::ops::Range<usize>; 3] = [0..3, 3..6, 6..7];
@@ -93,69 +88,158 @@ fn active(layers: &[Layer], id: usize) -> Vec<Active<'_>> {
         .collect()
 }
 
-/// How much of `layer` its mask shows at texel `i` of tile `id` (1 without a mask).
-fn masked(layer: &Layer, id: usize, i: usize) -> f32 {
+/// A tile (or one texel of it) being composited, a plane per component (`k_d` RGB, `k_s` RGB,
+/// `n` in log space): values (not premultiplied) and coverage.
+struct Planes {
+    value: [Vec<f32>; 7],
+    alpha: [Vec<f32>; 7],
+}
+
+impl Planes {
+    /// `len` texels of nothing (the start of a group).
+    fn clear(len: usize) -> Self {
+        Self {
+            value: std::array::from_fn(|_| vec![0.0; len]),
+            alpha: std::array::from_fn(|_| vec![0.0; len]),
+        }
+    }
+
+    /// `len` texels of `base`, opaque.
+    fn opaque(base: &[f32; 7], len: usize) -> Self {
+        Self {
+            value: std::array::from_fn(|k| vec![base[k]; len]),
+            alpha: std::array::from_fn(|_| vec![1.0; len]),
+        }
+    }
+}
+
+/// Lays `src` (values at coverage `cover`) over component `dst` with `mode`, texel by texel:
+/// [`Covered::under`], with the mode chosen once for the whole run.
+fn lay_plane(
+    (dst_v, dst_a): (&mut [f32], &mut [f32]),
+    src: &[f32],
+    cover: &[f32],
+    mode: super::LayerBlend,
+) {
+    use super::LayerBlend as B;
+    #[inline]
+    fn run(
+        mix: impl Fn(f32, f32) -> f32 + Copy,
+        dst_v: &mut [f32],
+        dst_a: &mut [f32],
+        src: &[f32],
+        cover: &[f32],
+    ) {
+        for (((v, a), &s), &c) in dst_v.iter_mut().zip(dst_a.iter_mut()).zip(src).zip(cover) {
+            let below = Covered {
+                value: *v,
+                alpha: *a,
+            };
+            let out = below.under_with(Covered { value: s, alpha: c }, mix);
+            (*v, *a) = (out.value, out.alpha);
+        }
+    }
+    // One loop per mode, each with its blend inlined.
+    match mode {
+        B::Normal => run(|b, l| B::Normal.mix(b, l), dst_v, dst_a, src, cover),
+        B::Multiply => run(|b, l| B::Multiply.mix(b, l), dst_v, dst_a, src, cover),
+        B::Screen => run(|b, l| B::Screen.mix(b, l), dst_v, dst_a, src, cover),
+        B::Overlay => run(|b, l| B::Overlay.mix(b, l), dst_v, dst_a, src, cover),
+        B::Add => run(|b, l| B::Add.mix(b, l), dst_v, dst_a, src, cover),
+        B::Subtract => run(|b, l| B::Subtract.mix(b, l), dst_v, dst_a, src, cover),
+        B::Darken => run(|b, l| B::Darken.mix(b, l), dst_v, dst_a, src, cover),
+        B::Lighten => run(|b, l| B::Lighten.mix(b, l), dst_v, dst_a, src, cover),
+    }
+}
+
+/// What `len` texels of a mask show of its layer (opacity included): `out[i]` for texel `i`
+/// (or texel 0 alone when `len` is 1).
+fn cover_of(layer: &Layer, id: usize, out: &mut [f32]) {
+    let opacity = layer.props.opacity.clamp(0.0, 1.0);
     match &layer.mask {
         Some(mask) if mask.enabled => {
-            let m = decode_unorm(mask.tiles[id].get().get(i));
-            if mask.inverted { 1.0 - m } else { m }
-        }
-        _ => 1.0,
-    }
-}
-
-/// Lays the source `v` at per-channel coverage `alpha` over `state` with `layer`'s modes.
-fn lay(state: &mut State, layer: &Layer, v: &[f32; 7], alpha: [f32; 3]) {
-    for (c, part) in PARTS.iter().enumerate() {
-        let blend = layer.props.channels[c];
-        if blend.enabled && alpha[c] > 0.0 {
-            for k in part.clone() {
-                let source = Covered {
-                    value: v[k],
-                    alpha: alpha[c],
-                };
-                state[k] = state[k].under(source, blend.mode);
+            let plane = mask.tiles[id].get();
+            for (i, c) in out.iter_mut().enumerate() {
+                let m = decode_unorm(plane.get(i));
+                *c = opacity * if mask.inverted { 1.0 - m } else { m };
             }
         }
+        _ => out.fill(opacity),
     }
 }
 
-/// Lays the active layers (bottom first) over `state` at texel `i` of tile `id`.
-fn apply(state: &mut State, layers: &[Active<'_>], id: usize, i: usize) {
+/// Lays the active layers (bottom first) over `state` (the first `len` texels of tile `id`).
+fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
+    let len = state.value[0].len();
+    let mut cover = vec![0.0; len];
+    let mut alpha = vec![0.0; len];
+    let mut src = vec![0.0; len];
     for a in layers {
         let layer = a.layer();
-        let cover = layer.props.opacity.clamp(0.0, 1.0) * masked(layer, id, i);
-        if cover <= 0.0 {
-            continue;
-        }
-        match a {
-            Active::Paint(_, tile) => {
-                let alpha = |c: usize| decode_unorm(tile.alpha[c].get(i)) * cover;
-                lay(
-                    state,
-                    layer,
-                    &values(tile.value.texel(i)),
-                    [alpha(0), alpha(1), alpha(2)],
-                );
-            }
-            Active::Fill(_, v) => lay(state, layer, v, [cover; 3]),
+        cover_of(layer, id, &mut cover);
+        let inner = match a {
             Active::Group(_, children) => {
-                let mut inner = [Covered::CLEAR; 7];
-                apply(&mut inner, children, id, i);
-                for (c, part) in PARTS.iter().enumerate() {
-                    let blend = layer.props.channels[c];
-                    if blend.enabled {
-                        for k in part.clone() {
-                            let source = Covered {
-                                value: inner[k].value,
-                                alpha: inner[k].alpha * cover,
-                            };
-                            state[k] = state[k].under(source, blend.mode);
+                let mut inner = Planes::clear(len);
+                apply(&mut inner, children, id);
+                Some(inner)
+            }
+            _ => None,
+        };
+        for (c, part) in PARTS.iter().enumerate() {
+            let blend = layer.props.channels[c];
+            if !blend.enabled {
+                continue;
+            }
+            // The channel's coverage here (a paint layer's and a fill's are one for the
+            // channel; a group's is per component).
+            match a {
+                Active::Paint(_, tile) => match tile.alpha[c].uniform() {
+                    Some(u) => {
+                        let u = decode_unorm(u);
+                        alpha
+                            .iter_mut()
+                            .zip(&cover)
+                            .for_each(|(al, cv)| *al = u * cv);
+                    }
+                    None => {
+                        for (i, (al, cv)) in alpha.iter_mut().zip(&cover).enumerate() {
+                            *al = decode_unorm(tile.alpha[c].get(i)) * cv;
+                        }
+                    }
+                },
+                Active::Fill(..) => alpha.copy_from_slice(&cover),
+                Active::Group(..) => {}
+            }
+            for k in part.clone() {
+                match a {
+                    Active::Paint(_, tile) => {
+                        for (i, s) in src.iter_mut().enumerate() {
+                            *s = component(tile, k, i);
+                        }
+                    }
+                    Active::Fill(_, v) => src.fill(v[k]),
+                    Active::Group(..) => {
+                        let inner = inner.as_ref().unwrap_or_else(|| unreachable!());
+                        src.copy_from_slice(&inner.value[k]);
+                        for ((al, ia), cv) in alpha.iter_mut().zip(&inner.alpha[k]).zip(&cover) {
+                            *al = ia * cv;
                         }
                     }
                 }
+                let (v, al) = (&mut state.value[k], &mut state.alpha[k]);
+                lay_plane((v, al), &src, &alpha, blend.mode);
             }
         }
+    }
+}
+
+/// Component `k` of texel `i` of a paint tile, as a compositing value.
+#[inline]
+fn component(tile: &PaintTile, k: usize, i: usize) -> f32 {
+    match k {
+        0..3 => decode_unorm(tile.value.kd.get(i)[k]),
+        3..6 => decode_unorm(tile.value.ks.get(i)[k - 3]),
+        _ => crate::model::paint::n_bits_to_blend(tile.value.n.get(i)),
     }
 }
 
@@ -181,18 +265,6 @@ fn uniform_inputs(layers: &[Active<'_>], id: usize) -> bool {
     })
 }
 
-/// The composite of texel `i` of tile `id`, as stored.
-fn texel(layers: &[Active<'_>], base: &[f32; 7], id: usize, i: usize) -> Texel {
-    let mut state: State = base.map(Covered::opaque);
-    apply(&mut state, layers, id, i);
-    let v = state.map(|c| c.value);
-    Texel {
-        kd: encode_rgb(Vec3::new(v[0], v[1], v[2])),
-        ks: encode_rgb(Vec3::new(v[3], v[4], v[5])),
-        n: encode_n(n_from_blend(v[6])),
-    }
-}
-
 /// The composite of tile `id`, compacted (a tile of one value is stored as one value).
 pub fn composite_tile(stack: &LayerStack, id: usize) -> Tile {
     composite_active(stack, &active(&stack.layers, id), id)
@@ -200,12 +272,28 @@ pub fn composite_tile(stack: &LayerStack, id: usize) -> Tile {
 
 fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Tile {
     let base = values(Texel::encode(stack.base));
-    if uniform_inputs(layers, id) {
-        return Tile::uniform(texel(layers, &base, id, 0));
+    // Inputs of one value over the tile: one texel stands for all.
+    let len = if uniform_inputs(layers, id) {
+        1
+    } else {
+        TILE_TEXELS
+    };
+    let mut state = Planes::opaque(&base, len);
+    apply(&mut state, layers, id);
+    let v = &state.value;
+    let at = |i: usize| Texel {
+        kd: encode_rgb(Vec3::new(v[0][i], v[1][i], v[2][i])),
+        ks: encode_rgb(Vec3::new(v[3][i], v[4][i], v[5][i])),
+        // The brushes' table from log space to half floats (exact to well within a half
+        // float's step).
+        n: crate::model::paint::n_bits_from_blend(v[6][i]),
+    };
+    if len == 1 {
+        return Tile::uniform(at(0));
     }
     let mut tile = Tile::uniform(Texel::default());
     for i in 0..TILE_TEXELS {
-        tile.set_texel(i, texel(layers, &base, id, i));
+        tile.set_texel(i, at(i));
     }
     tile.compact();
     tile

@@ -52,12 +52,12 @@ fn n_tables() -> &'static NTables {
 }
 
 #[inline]
-fn n_bits_to_blend(bits: u16) -> f32 {
+pub(crate) fn n_bits_to_blend(bits: u16) -> f32 {
     n_tables().to_blend[bits as usize]
 }
 
 #[inline]
-fn n_bits_from_blend(u: f32) -> u16 {
+pub(crate) fn n_bits_from_blend(u: f32) -> u16 {
     let i = (super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as usize;
     n_tables().from_blend[i.min(FROM_BLEND_STEPS)]
 }
