@@ -354,7 +354,8 @@ fn fill_outside<T: Copy>(data: &mut [T], (cols, rows): (usize, usize)) {
     }
 }
 
-/// Puts resampled planes into maps made for them (not undoable: maps being built).
+/// Puts resampled planes into maps made for them (not undoable by itself: [`install`] saves
+/// the tiles to history first).
 pub(super) fn write_planes(maps: &mut MaterialMaps, planes: &ChannelPlanes) {
     match planes {
         ChannelPlanes::Rgb(channel, planes) => {
@@ -396,23 +397,8 @@ pub(super) fn install(
         )));
     }
     history.begin(format!("Import image into {}", planes.channel().name()));
-    match planes {
-        ChannelPlanes::Rgb(channel, planes) => {
-            for (id, plane) in planes.iter().enumerate() {
-                let tile = history.tile_for_write(maps, id);
-                if *channel == Channel::Kd {
-                    tile.kd = plane.clone();
-                } else {
-                    tile.ks = plane.clone();
-                }
-            }
-        }
-        ChannelPlanes::N(planes) => {
-            for (id, plane) in planes.iter().enumerate() {
-                history.tile_for_write(maps, id).n = plane.clone();
-            }
-        }
-    }
+    history.save_before_write(maps, &(0..count).collect::<Vec<_>>());
+    write_planes(maps, planes);
     history.end();
     Ok(())
 }

@@ -76,25 +76,28 @@ impl MaterialPreset {
 
     /// Reads and parses a preset file (a regular file of at most 1 MiB).
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let bytes =
-            crate::file_check::read_limited(path, MAX_PRESET_BYTES).map_err(|e| match e {
-                crate::file_check::FileCheck::Io(source) => ModelError::io(path, source),
-                other => ModelError::Preset {
-                    path: path.to_path_buf(),
-                    reason: format!("the file {other}"),
-                },
-            })?;
-        let text = String::from_utf8(bytes).map_err(|_| ModelError::Preset {
-            path: path.to_path_buf(),
-            reason: "not UTF-8 text".into(),
-        })?;
-        Self::parse(path, &text)
+        Self::parse(path, &read_text(path, MAX_PRESET_BYTES)?)
     }
 
     /// The preset's material value.
     pub fn value(&self) -> MaterialValue {
         MaterialValue::new(Vec3::from(self.kd), Vec3::from(self.ks), self.n)
     }
+}
+
+/// The text of a preset file: a regular file of at most `max_bytes`, UTF-8; errors name it.
+pub(super) fn read_text(path: &Path, max_bytes: u64) -> Result<String, ModelError> {
+    let bytes = crate::file_check::read_limited(path, max_bytes).map_err(|e| match e {
+        crate::file_check::FileCheck::Io(source) => ModelError::io(path, source),
+        other => ModelError::Preset {
+            path: path.to_path_buf(),
+            reason: format!("the file {other}"),
+        },
+    })?;
+    String::from_utf8(bytes).map_err(|_| ModelError::Preset {
+        path: path.to_path_buf(),
+        reason: "not UTF-8 text".into(),
+    })
 }
 
 macro_rules! builtin {
@@ -213,8 +216,8 @@ pub fn save_user(
     Ok((stem, path))
 }
 
-/// Every `.ron` file in `dir`, sorted by name, each parsed or with its error.
-pub fn load_dir(dir: &Path) -> Vec<Result<(String, MaterialPreset), ModelError>> {
+/// The `.ron` files in `dir`, sorted by name (none where it cannot be read).
+pub(super) fn ron_files(dir: &Path) -> Vec<PathBuf> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Vec::new();
     };
@@ -225,6 +228,11 @@ pub fn load_dir(dir: &Path) -> Vec<Result<(String, MaterialPreset), ModelError>>
         .collect();
     paths.sort();
     paths
+}
+
+/// Every `.ron` file in `dir`, sorted by name, each parsed or with its error.
+pub fn load_dir(dir: &Path) -> Vec<Result<(String, MaterialPreset), ModelError>> {
+    ron_files(dir)
         .into_iter()
         .map(|p| {
             let stem = p

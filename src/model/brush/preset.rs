@@ -57,19 +57,10 @@ impl BrushPreset {
 
     /// Reads a preset file (a regular file of at most 8 MiB).
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let bytes =
-            crate::file_check::read_limited(path, MAX_BRUSH_PRESET_BYTES).map_err(|e| match e {
-                crate::file_check::FileCheck::Io(source) => ModelError::io(path, source),
-                other => ModelError::Preset {
-                    path: path.to_path_buf(),
-                    reason: format!("the file {other}"),
-                },
-            })?;
-        let text = String::from_utf8(bytes).map_err(|_| ModelError::Preset {
-            path: path.to_path_buf(),
-            reason: "not UTF-8 text".into(),
-        })?;
-        Self::parse(path, &text)
+        Self::parse(
+            path,
+            &crate::model::preset::read_text(path, MAX_BRUSH_PRESET_BYTES)?,
+        )
     }
 
     /// Saves the preset into `dir` (created if missing) as `STEM.ron`, atomically, replacing
@@ -110,16 +101,10 @@ pub fn builtin() -> Vec<BrushPreset> {
 
 /// Every `.ron` file in `dir`, sorted by name, each read or with its error.
 pub fn load_dir(dir: &Path) -> Vec<Result<BrushPreset, ModelError>> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Vec::new();
-    };
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .collect();
-    paths.sort();
-    paths.iter().map(|p| BrushPreset::load(p)).collect()
+    crate::model::preset::ron_files(dir)
+        .iter()
+        .map(|p| BrushPreset::load(p))
+        .collect()
 }
 
 #[cfg(test)]
