@@ -14,9 +14,11 @@
 
 mod blend;
 pub mod composite;
+pub mod paint;
 
 pub use blend::{Covered, LayerBlend};
 pub use composite::{Compositor, composite_tile};
+pub use paint::{LayerStroke, LayerValue};
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
