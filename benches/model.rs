@@ -367,6 +367,25 @@ fn layers(c: &mut Criterion) {
             compositor.update(&stack, &mut maps)
         });
     });
+    // The 5 x 5 tiles a 128 px-radius dab covers, near the map's centre, on layer 8: a write
+    // there (new stamps), then those tiles recomposited.
+    let tiles_x = stack.tiles_x();
+    let dab: Vec<usize> = (30..35)
+        .flat_map(|ty| (30..35).map(move |tx| ty * tiles_x + tx))
+        .collect();
+    let mut k = 0u16;
+    stack.layers[8].props.visible = true;
+    compositor.update(&stack, &mut maps);
+    group.bench_function("recomposite_25_tiles_after_a_dab_on_layer_8", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            for &id in &dab {
+                let tile = stack.layers[8].paint_tile_mut(id).expect("paint layer");
+                tile.alpha[0].data_mut()[usize::from(k) % 4096] = k;
+            }
+            compositor.update_tiles(&stack, &mut maps, &dab)
+        });
+    });
     group.bench_function("full_composite_16_layers", |b| {
         b.iter(|| Compositor::new().update(&stack, &mut maps.clone()));
     });

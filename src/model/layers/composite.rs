@@ -327,6 +327,14 @@ fn hash_active(layers: &[Active<'_>], id: usize, h: &mut impl Hasher) {
     }
 }
 
+/// The signature of tile `id`'s inputs (never 0).
+fn signature(stack: &LayerStack, id: usize) -> u64 {
+    let mut h = std::hash::DefaultHasher::new();
+    (stack.width, stack.height, Texel::encode(stack.base)).hash(&mut h);
+    hash_active(&active(&stack.layers, id), id, &mut h);
+    h.finish().max(1)
+}
+
 /// Keeps [`MaterialMaps`] the composite of a [`LayerStack`], recompositing only the tiles
 /// whose inputs changed.
 #[derive(Clone, Debug, Default)]
@@ -354,18 +362,41 @@ impl Compositor {
         if self.signatures.len() != count {
             self.signatures = vec![0; count];
         }
-        let base = Texel::encode(stack.base);
-        let signature = |id: usize| {
-            let mut h = std::hash::DefaultHasher::new();
-            (stack.width, stack.height, base).hash(&mut h);
-            hash_active(&active(&stack.layers, id), id, &mut h);
-            h.finish().max(1)
-        };
         let stale: Vec<(usize, u64)> = (0..count)
             .into_par_iter()
-            .map(|id| (id, signature(id)))
+            .map(|id| (id, signature(stack, id)))
             .filter(|&(id, s)| self.signatures[id] != s)
             .collect();
+        self.write(stack, maps, stale)
+    }
+
+    /// As [`Self::update`], looking only at `ids` (the tiles a stroke touched: no other
+    /// tile's inputs changed).
+    pub fn update_tiles(
+        &mut self,
+        stack: &LayerStack,
+        maps: &mut MaterialMaps,
+        ids: &[usize],
+    ) -> Vec<usize> {
+        let count = stack.tile_count();
+        if self.signatures.len() != count {
+            self.signatures = vec![0; count];
+        }
+        let stale: Vec<(usize, u64)> = ids
+            .par_iter()
+            .map(|&id| (id, signature(stack, id)))
+            .filter(|&(id, s)| self.signatures[id] != s)
+            .collect();
+        self.write(stack, maps, stale)
+    }
+
+    /// Composites the `stale` tiles (with their new signatures) and writes those that changed.
+    fn write(
+        &mut self,
+        stack: &LayerStack,
+        maps: &mut MaterialMaps,
+        stale: Vec<(usize, u64)>,
+    ) -> Vec<usize> {
         let tiles: Vec<(usize, u64, Tile)> = stale
             .into_par_iter()
             .map(|(id, s)| (id, s, composite_tile(stack, id)))

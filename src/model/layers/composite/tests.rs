@@ -205,6 +205,8 @@ proptest! {
                     prop_assert_eq!(maps.tile_version(id), *version, "tile {} rewritten", id);
                 }
             }
+            // Looking at every tile again finds nothing (a stroke's tiles alone would do).
+            prop_assert!(compositor.update_tiles(&stack, &mut maps, &(0..tiles).collect::<Vec<_>>()).is_empty());
             // Nothing changed, nothing written.
             prop_assert!(compositor.update(&stack, &mut maps).is_empty());
         }
@@ -268,4 +270,20 @@ fn a_channel_disabled_or_a_hidden_layer_leaves_the_maps_as_below() {
     );
     stack.layers[0].props.visible = false;
     assert_eq!(flattened(&stack).uniform_texel(), Some(Texel::encode(base)));
+}
+
+#[test]
+fn a_stroke_recomposites_the_tiles_it_names() {
+    let mut stack = LayerStack::new(128, 128, MaterialValue::default());
+    let mut maps = MaterialMaps::new(128, 128, MaterialValue::default()).expect("size");
+    let mut compositor = Compositor::new();
+    compositor.update(&stack, &mut maps);
+    let red = MaterialValue::new(Vec3::new(1.0, 0.0, 0.0), Vec3::splat(0.2), 50.0);
+    *stack.layers[0].paint_tile_mut(3).expect("paint layer") = PaintTile::filled(red, [true; 3]);
+    assert_eq!(compositor.update_tiles(&stack, &mut maps, &[3]), vec![3]);
+    assert!(same(&maps, &flattened(&stack)));
+    assert!(
+        compositor.update(&stack, &mut maps).is_empty(),
+        "nothing left"
+    );
 }
