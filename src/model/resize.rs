@@ -11,7 +11,7 @@ use image::{DynamicImage, ImageBuffer, Rgb};
 use super::ModelError;
 use super::maps::MaterialMaps;
 use super::surface::Surface;
-use super::texel::{Channel, MaterialValue, decode_n, decode_rgb, n_to_blend};
+use super::texel::{Channel, MaterialValue, decode_rgb};
 
 /// Maps resampled to a new size with the mesh surface baked at that size: made on a worker,
 /// installed by [`super::Command::Resize`].
@@ -62,7 +62,7 @@ fn channel_image(maps: &MaterialMaps, channel: Channel) -> DynamicImage {
         let v = match channel {
             Channel::Kd => decode_rgb(t.kd).to_array(),
             Channel::Ks => decode_rgb(t.ks).to_array(),
-            Channel::N => [n_to_blend(decode_n(t.n)); 3],
+            Channel::N => [super::paint::n_bits_to_blend(t.n); 3],
         };
         image.put_pixel(x, y, Rgb(v));
     });

@@ -252,7 +252,7 @@ impl Editor {
         s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
-        s.opening_ui(&ctx);
+        s.modal_job_ui(&ctx);
         s.files_ui(&ctx);
         if s.job.is_some() {
             ctx.request_repaint_after(Duration::from_millis(100));

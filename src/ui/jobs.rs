@@ -412,10 +412,16 @@ impl EditorState {
         self.choose_file(FilePurpose::OpenProject);
     }
 
-    /// While a project opens: a window over the editor saying which, that takes the pointer
-    /// (a stroke on the document about to be replaced would be lost).
-    pub(super) fn opening_ui(&self, ctx: &egui::Context) {
-        let Some(text) = self.job.as_ref().and_then(|j| j.modal.as_deref()) else {
+    /// What the window over the editor says while a job it waits for runs (a project
+    /// opening, the maps being resized), if one does.
+    pub(super) fn modal_job(&self) -> Option<&str> {
+        self.job.as_ref().and_then(|j| j.modal.as_deref())
+    }
+
+    /// While a project opens or the maps are resized: a window over the editor saying so,
+    /// that takes the pointer (a stroke on the document about to be replaced would be lost).
+    pub(super) fn modal_job_ui(&self, ctx: &egui::Context) {
+        let Some(text) = self.modal_job() else {
             return;
         };
         egui::Modal::new(egui::Id::new("kapaint-opening")).show(ctx, |ui| {

@@ -197,7 +197,7 @@ impl EditorState {
         // Nor while a file dialog is open: its keys are its own.
         if ctx.egui_wants_keyboard_input()
             || self.files.open_for().is_some()
-            || self.job.as_ref().is_some_and(|j| j.modal.is_some())
+            || self.modal_job().is_some()
             || self.recovery_offer.is_some()
         {
             return;

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use super::EditorState;
 use super::dialogs::{NEW_SIZES, centred};
 use super::jobs::JobResult;
-use super::panels::megabytes;
+use crate::memory::human;
 use crate::model::resize::{ResizedMaps, peak_bytes, resized};
 use crate::model::surface::Surface;
 
@@ -95,21 +95,16 @@ impl EditorState {
                             }
                         });
                 }
-                let texels = |w: u32, h: u32| u64::from(w) * u64::from(h);
-                let maps_now = self.doc.maps().heap_bytes();
-                let full_after = texels(dialog.width, dialog.height) * 14;
+                let maps_now = human(self.doc.maps().heap_bytes() as u64);
+                let full_after = u64::from(dialog.width) * u64::from(dialog.height) * 14;
                 ui.label(format!(
-                    "Maps: {} now, up to {} after",
-                    megabytes(maps_now),
-                    megabytes(usize::try_from(full_after).unwrap_or(usize::MAX)),
+                    "Maps: {maps_now} now, up to {} after",
+                    human(full_after)
                 ));
-                ui.label(format!("Undo keeps the old maps: {}", megabytes(maps_now)));
+                ui.label(format!("Undo keeps the old maps: {maps_now}"));
                 let peak = peak_bytes(now, dialog.width, dialog.height);
                 let available = crate::memory::available_bytes();
-                let text = format!(
-                    "Peak while resampling: {}",
-                    megabytes(usize::try_from(peak).unwrap_or(usize::MAX))
-                );
+                let text = format!("Peak while resampling: {}", human(peak));
                 let fits = available.is_none_or(|a| peak < a);
                 if fits {
                     ui.label(text);

@@ -337,12 +337,15 @@ impl Document {
             Command::Resize(resized) => self.install_resized(&resized)?,
             Command::HistoryJump(applied) => {
                 self.end_stroke();
-                while self.history.undo_steps().count() > applied {
+                let now = self.history.undo_steps().count();
+                for _ in applied..now {
                     self.history.undo(&mut self.maps, &mut self.surface);
                 }
-                while self.history.undo_steps().count() < applied
-                    && self.history.redo(&mut self.maps, &mut self.surface)
-                {}
+                for _ in now..applied {
+                    if !self.history.redo(&mut self.maps, &mut self.surface) {
+                        break;
+                    }
+                }
             }
         }
         Ok(())

@@ -20,7 +20,7 @@ use std::hash::{Hash, Hasher};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{Covered, Layer, LayerContent, LayerStack, PaintTile};
+use super::{Covered, Layer, LayerContent, LayerStack, PaintTile, SharedPaintTile};
 use crate::model::maps::MaterialMaps;
 use crate::model::texel::{Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, n_to_blend};
 use crate::model::tile::{TILE_TEXELS, Tile};
@@ -47,7 +47,7 @@ fn values(t: Texel) -> [f32; 7] {
 /// (a paint layer's tile, a fill, a group with such children), each with what it needs.
 enum Active<'a> {
     /// A paint layer's tile.
-    Paint(&'a Layer, &'a PaintTile),
+    Paint(&'a Layer, &'a SharedPaintTile),
     /// A fill layer, its value as compositing values.
     Fill(&'a Layer, [f32; 7]),
     /// A group and its active children.
@@ -78,7 +78,7 @@ fn active(layers: &[Layer], id: usize) -> Vec<Active<'_>> {
             p.visible && p.opacity > 0.0 && p.channels.iter().any(|c| c.enabled) && !hidden_by_mask
         })
         .filter_map(|l| match &l.content {
-            LayerContent::Paint(tiles) => tiles[id].as_ref().map(|t| Active::Paint(l, t.get())),
+            LayerContent::Paint(tiles) => tiles[id].as_ref().map(|t| Active::Paint(l, t)),
             LayerContent::Fill(v) => Some(Active::Fill(l, values(Texel::encode(*v)))),
             LayerContent::Group(children) => {
                 let inner = active(children, id);
@@ -193,7 +193,7 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
             // The channel's coverage here (a paint layer's and a fill's are one for the
             // channel; a group's is per component).
             match a {
-                Active::Paint(_, tile) => match tile.alpha[c].uniform() {
+                Active::Paint(_, tile) => match tile.get().alpha[c].uniform() {
                     Some(u) => {
                         let u = decode_unorm(u);
                         alpha
@@ -203,7 +203,7 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
                     }
                     None => {
                         for (i, (al, cv)) in alpha.iter_mut().zip(&cover).enumerate() {
-                            *al = decode_unorm(tile.alpha[c].get(i)) * cv;
+                            *al = decode_unorm(tile.get().alpha[c].get(i)) * cv;
                         }
                     }
                 },
@@ -214,7 +214,7 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
                 match a {
                     Active::Paint(_, tile) => {
                         for (i, s) in src.iter_mut().enumerate() {
-                            *s = component(tile, k, i);
+                            *s = component(tile.get(), k, i);
                         }
                     }
                     Active::Fill(_, v) => src.fill(v[k]),
@@ -254,6 +254,7 @@ fn uniform_inputs(layers: &[Active<'_>], id: usize) -> bool {
             .is_none_or(|m| !m.enabled || m.tiles[id].get().uniform().is_some());
         mask && match a {
             Active::Paint(_, t) => {
+                let t = t.get();
                 t.value.kd.uniform().is_some()
                     && t.value.ks.uniform().is_some()
                     && t.value.n.uniform().is_some()
@@ -312,12 +313,7 @@ fn hash_active(layers: &[Active<'_>], id: usize, h: &mut impl Hasher) {
             .map(|m| (m.enabled, m.inverted, m.tiles[id].stamp()))
             .hash(h);
         match a {
-            Active::Paint(_, _) => {
-                let LayerContent::Paint(tiles) = &l.content else {
-                    continue;
-                };
-                (0u8, tiles[id].as_ref().map_or(0, |t| t.stamp())).hash(h);
-            }
+            Active::Paint(_, tile) => (0u8, tile.stamp()).hash(h),
             Active::Fill(_, v) => (1u8, v.map(f32::to_bits)).hash(h),
             Active::Group(_, children) => {
                 2u8.hash(h);

@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use crate::model::Command;
-use crate::model::texel::{MaterialValue, linear_to_srgb, srgb_to_linear};
+use crate::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8, srgb_to_linear};
 use crate::ui::EditorState;
 
 /// How many recent materials the panel keeps.
@@ -32,9 +32,7 @@ pub fn parse_hex(text: &str) -> Option<Vec3> {
 
 /// A linear colour's sRGB bytes.
 fn srgb8(linear: Vec3) -> [u8; 3] {
-    linear
-        .to_array()
-        .map(|c| (linear_to_srgb(c) * 255.0).round() as u8)
+    linear.to_array().map(linear_to_srgb8)
 }
 
 /// Hue in degrees `[0, 360)`, saturation and value in `[0, 1]` of an sRGB-encoded colour.

@@ -9,4 +9,3 @@ mod tool_panel;
 mod view_panel;
 
 pub(super) use bars::channel_label;
-pub(super) use view_panel::megabytes;

@@ -152,11 +152,6 @@ impl EditorState {
     fn history_list_ui(&mut self, ui: &mut egui::Ui) {
         let history = self.doc.history();
         let applied = history.undo_steps().count();
-        let steps: Vec<(String, usize)> = history
-            .undo_steps()
-            .chain(history.redo_steps())
-            .map(|s| (s.label.clone(), s.bytes()))
-            .collect();
         let mut jump = None;
         egui::ScrollArea::vertical()
             .id_salt("history")
@@ -170,8 +165,8 @@ impl EditorState {
                 {
                     jump = Some(0);
                 }
-                for (i, (label, bytes)) in steps.iter().enumerate() {
-                    let text = format!("{}. {label} · {} KB", i + 1, bytes / 1024);
+                for (i, step) in history.undo_steps().chain(history.redo_steps()).enumerate() {
+                    let text = format!("{}. {} · {} KB", i + 1, step.label, step.bytes() / 1024);
                     let text = if i < applied {
                         egui::RichText::new(text)
                     } else {
