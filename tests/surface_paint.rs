@@ -475,7 +475,7 @@ fn mesh_commands_without_a_mesh_are_clear_errors() {
 
 #[test]
 fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
-    use kapaint::model::resize::{ResizedMaps, resized};
+    use kapaint::model::resize::{ResizedMaps, resized_stack};
     let surface = sphere_surface(128);
     let mut doc = document(&surface, BrushSettings::default());
     let on_sphere = |doc: &mut Document| {
@@ -492,7 +492,7 @@ fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
     on_sphere(&mut doc);
     let before: Vec<Texel> = texels(&doc);
     let version = doc.version();
-    let small = resized(doc.maps(), 64, 64).expect("resized");
+    let small = resized_stack(doc.stack(), 64, 64).expect("resized");
     let baked = Arc::new(Surface::new(surface.mesh.clone(), 64, 64).expect("bake"));
     doc.apply(Command::Resize(ResizedMaps(Arc::new((small, Some(baked))))))
         .expect("resize");
@@ -520,7 +520,7 @@ fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
     assert_eq!(doc.surface().map(|s| s.width()), Some(64));
     // A baked surface of another size is refused, and nothing changes.
     let wrong = Arc::new(Surface::new(surface.mesh.clone(), 32, 32).expect("bake"));
-    let big = resized(doc.maps(), 128, 128).expect("resized");
+    let big = resized_stack(doc.stack(), 128, 128).expect("resized");
     assert!(
         doc.apply(Command::Resize(ResizedMaps(Arc::new((big, Some(wrong))))))
             .is_err()

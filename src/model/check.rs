@@ -164,6 +164,30 @@ pub fn finite_vec3<'de, D: Deserializer<'de>>(d: D) -> Result<glam::Vec3, D::Err
     }
 }
 
+ranged_f32!(
+    /// A layer's opacity, `[0, 1]`.
+    layer_opacity, "opacity", 0.0, 1.0
+);
+
+/// A finite number.
+pub fn finite_f32<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(D::Error::custom(format!(
+            "expected a finite number, got {v}"
+        )))
+    }
+}
+
+/// A layer's name ([`name`]).
+pub fn layer_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let v = String::deserialize(d)?;
+    name("the layer name", &v).map_err(D::Error::custom)?;
+    Ok(v)
+}
+
 /// An optional name ([`name`]).
 pub fn optional_name<'de, D: Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     let v = Option::<String>::deserialize(d)?;

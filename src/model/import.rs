@@ -20,7 +20,6 @@ use rayon::prelude::*;
 
 use super::ModelError;
 use super::document::{Document, ImportedChannel};
-use super::history::History;
 use super::maps::MaterialMaps;
 use super::texel::{Channel, encode_n, encode_rgb, n_from_blend, srgb_to_linear};
 use super::tile::{Plane, TILE_SIZE};
@@ -374,33 +373,6 @@ pub(super) fn write_planes(maps: &mut MaterialMaps, planes: &ChannelPlanes) {
             }
         }
     }
-}
-
-/// Writes resampled planes into the maps as one undo step (what
-/// [`super::Command::ImportChannel`] does).
-///
-/// # Errors
-/// Planes made for another map size.
-pub(super) fn install(
-    maps: &mut MaterialMaps,
-    history: &mut History,
-    planes: &ChannelPlanes,
-) -> Result<(), ModelError> {
-    let count = match planes {
-        ChannelPlanes::Rgb(_, p) => p.len(),
-        ChannelPlanes::N(p) => p.len(),
-    };
-    if count != maps.tile_count() {
-        return Err(ModelError::Internal(format!(
-            "the image was resampled for {count} tiles, but the maps have {}",
-            maps.tile_count()
-        )));
-    }
-    history.begin(format!("Import image into {}", planes.channel().name()));
-    history.save_before_write(maps, &(0..count).collect::<Vec<_>>());
-    write_planes(maps, planes);
-    history.end();
-    Ok(())
 }
 
 /// Writes `image` into `channel` of the document as one undo step.

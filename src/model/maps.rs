@@ -205,6 +205,13 @@ impl MaterialMaps {
         std::mem::replace(&mut self.tiles[id], tile)
     }
 
+    /// Puts `tile` in place of tile `id`, whose planes differ only in `channels` (the
+    /// compositor's write): only their versions move.
+    pub fn replace_tile_in(&mut self, id: TileId, tile: Arc<Tile>, channels: Channels) {
+        self.touch(id, channels);
+        self.tiles[id] = tile;
+    }
+
     /// Advances the clock and stamps `channels` of tile `id` with it.
     fn touch(&mut self, id: TileId, channels: Channels) {
         self.clock += 1;

@@ -9,14 +9,15 @@ use std::sync::Arc;
 use image::{DynamicImage, ImageBuffer, Rgb};
 
 use super::ModelError;
+use super::layers::{Layer, LayerContent, LayerStack, PaintTile, Stamped};
 use super::maps::MaterialMaps;
 use super::surface::Surface;
 use super::texel::{Channel, MaterialValue, decode_rgb};
 
-/// Maps resampled to a new size with the mesh surface baked at that size: made on a worker,
-/// installed by [`super::Command::Resize`].
+/// A layer stack resampled to a new size with the mesh surface baked at that size: made on a
+/// worker, installed by [`super::Command::Resize`].
 #[derive(Clone, Debug)]
-pub struct ResizedMaps(pub Arc<(MaterialMaps, Option<Arc<Surface>>)>);
+pub struct ResizedMaps(pub Arc<(LayerStack, Option<Arc<Surface>>)>);
 
 impl PartialEq for ResizedMaps {
     fn eq(&self, other: &Self) -> bool {
@@ -51,6 +52,112 @@ pub fn resized(maps: &MaterialMaps, width: u32, height: u32) -> Result<MaterialM
         super::import::write_planes(&mut out, &planes);
     }
     Ok(out)
+}
+
+/// Every layer of `stack` resampled to `width x height`: a paint layer's values and coverages
+/// and a mask's gray by the same filter as the maps (coverages and grays linearly).
+///
+/// # Errors
+/// As [`resized`].
+pub fn resized_stack(
+    stack: &LayerStack,
+    width: u32,
+    height: u32,
+) -> Result<LayerStack, ModelError> {
+    let mut out = stack.clone();
+    out.width = width;
+    out.height = height;
+    let count = out.tile_count();
+    resize_layers(
+        &mut out.layers,
+        (stack.width, stack.height),
+        (width, height),
+        count,
+    )?;
+    Ok(out)
+}
+
+fn resize_layers(
+    layers: &mut [Layer],
+    from: (u32, u32),
+    to: (u32, u32),
+    count: usize,
+) -> Result<(), ModelError> {
+    use super::tile::{Plane, Tile};
+    let gray_maps =
+        |planes: &mut dyn Iterator<Item = [Plane<u16>; 3]>| -> Result<MaterialMaps, ModelError> {
+            let mut maps = MaterialMaps::new(from.0, from.1, MaterialValue::default())?;
+            for (id, p) in planes.enumerate() {
+                let mut tile = Tile::uniform(super::texel::Texel::default());
+                let [a, b, c] = p;
+                tile.kd = Plane::Data(
+                    (0..super::tile::TILE_TEXELS)
+                        .map(|i| [a.get(i), b.get(i), c.get(i)])
+                        .collect(),
+                );
+                tile.kd.compact();
+                maps.replace_tile(id, Arc::new(tile));
+            }
+            Ok(maps)
+        };
+    for layer in layers {
+        if let Some(mask) = &mut layer.mask {
+            let mut planes = mask.tiles.iter().map(|t| {
+                let g = t.get().clone();
+                [g.clone(), g.clone(), g]
+            });
+            let big = resized(&gray_maps(&mut planes)?, to.0, to.1)?;
+            mask.tiles = (0..count)
+                .map(|id| {
+                    let mut g = Plane::Data(
+                        (0..super::tile::TILE_TEXELS)
+                            .map(|i| big.tile(id).kd.get(i)[0])
+                            .collect(),
+                    );
+                    g.compact();
+                    Arc::new(Stamped::new(g))
+                })
+                .collect();
+        }
+        match &mut layer.content {
+            LayerContent::Paint(tiles) => {
+                if tiles.iter().all(Option::is_none) {
+                    *tiles = vec![None; count];
+                    continue;
+                }
+                let empty = PaintTile::filled(MaterialValue::default(), [false; 3]);
+                let mut values = MaterialMaps::new(from.0, from.1, MaterialValue::default())?;
+                for (id, t) in tiles.iter().enumerate() {
+                    let t = t.as_ref().map_or(&empty, |t| t.get());
+                    values.replace_tile(id, Arc::new(t.value.clone()));
+                }
+                let mut alphas = tiles
+                    .iter()
+                    .map(|t| t.as_ref().map_or(&empty, |t| t.get()).alpha.clone());
+                let alpha = resized(&gray_maps(&mut alphas)?, to.0, to.1)?;
+                let values = resized(&values, to.0, to.1)?;
+                *tiles = (0..count)
+                    .map(|id| {
+                        let a = &alpha.tile(id).kd;
+                        let mut tile = PaintTile {
+                            value: (**values.tile(id)).clone(),
+                            alpha: std::array::from_fn(|c| {
+                                Plane::Data(
+                                    (0..super::tile::TILE_TEXELS).map(|i| a.get(i)[c]).collect(),
+                                )
+                            }),
+                        };
+                        tile.alpha.iter_mut().for_each(Plane::compact);
+                        let empty = tile.alpha.iter().all(|p| p.uniform() == Some(0));
+                        (!empty).then(|| Arc::new(Stamped::new(tile)))
+                    })
+                    .collect();
+            }
+            LayerContent::Fill(_) => {}
+            LayerContent::Group(children) => resize_layers(children, from, to, count)?,
+        }
+    }
+    Ok(())
 }
 
 /// One channel as a linear float image: `k_d` and `k_s` as they are, `n` as its blend value

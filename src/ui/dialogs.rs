@@ -357,7 +357,7 @@ impl EditorState {
 
     /// A copy of the document for a worker thread (the maps' tiles are shared, not copied).
     pub(super) fn snapshot(&self) -> Document {
-        let mut d = Document::from_parts(self.doc.maps().clone(), self.doc.settings().clone());
+        let mut d = self.doc.snapshot();
         if let Some(s) = self.doc.surface() {
             let _ = d.set_surface(Some(Arc::clone(s)));
         }

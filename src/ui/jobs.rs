@@ -224,7 +224,7 @@ impl EditorState {
                 }
             }
             JobResult::Resized(resized) => {
-                let (w, h) = (resized.0.0.width(), resized.0.0.height());
+                let (w, h) = (resized.0.0.width, resized.0.0.height);
                 self.apply(Command::Resize(resized));
                 self.notices
                     .push(notice(format!("Resized the maps to {w}x{h}"), false));
@@ -347,7 +347,7 @@ impl EditorState {
 
     /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
     pub fn save_to(&mut self, path: PathBuf) {
-        let snapshot = Document::from_parts(self.doc.maps().clone(), self.doc.settings().clone());
+        let snapshot = self.doc.snapshot();
         let version = self.doc.version();
         self.start_job("Save", move |progress| {
             progress.start("save", 1);

@@ -7,7 +7,7 @@ use super::EditorState;
 use super::dialogs::{NEW_SIZES, centred};
 use super::jobs::JobResult;
 use crate::memory::human;
-use crate::model::resize::{ResizedMaps, peak_bytes, resized};
+use crate::model::resize::{ResizedMaps, peak_bytes, resized_stack};
 use crate::model::surface::Surface;
 
 /// The Resize dialog's choices.
@@ -51,14 +51,14 @@ impl EditorState {
     /// Resamples the maps to `width x height` on a worker (the mesh baked again at that
     /// size); the editor waits behind a window, then installs them as one undo step.
     pub fn resize_maps(&mut self, width: u32, height: u32) {
-        let maps = self.doc.maps().clone();
+        let stack = self.doc.stack().clone();
         let mesh = self.doc.surface().map(|s| s.mesh.clone());
         self.start_job_modal(
             "Resize",
             format!("Resizing the maps to {width}x{height}…"),
             move |progress| {
                 progress.start("resample", 1);
-                let maps = match resized(&maps, width, height) {
+                let stack = match resized_stack(&stack, width, height) {
                     Ok(m) => m,
                     Err(e) => return JobResult::Failed(format!("resize: {e}")),
                 };
@@ -67,7 +67,7 @@ impl EditorState {
                     Ok(s) => s.map(Arc::new),
                     Err(e) => return JobResult::Failed(format!("resize: the mesh: {e}")),
                 };
-                JobResult::Resized(ResizedMaps(Arc::new((maps, surface))))
+                JobResult::Resized(ResizedMaps(Arc::new((stack, surface))))
             },
         );
     }

@@ -131,6 +131,113 @@ pub enum Command {
     /// Undoes or redoes until this many steps are applied (0: the state before the oldest
     /// step kept; the history panel's click on a step).
     HistoryJump(usize),
+    /// Adds a layer above the selected one (in its group) and selects it.
+    AddLayer {
+        /// Paint, fill (the primary material) or group.
+        kind: LayerKind,
+        /// Its name.
+        #[serde(deserialize_with = "crate::model::check::layer_name")]
+        name: String,
+    },
+    /// Selects a layer by index (0: the bottom of the top level) or name (the topmost of
+    /// that name, at any depth); tools then paint its content.
+    SelectLayer(LayerRef),
+    /// Selects the layer at a path of indices into groups (the Layers panel).
+    SelectPath(Vec<usize>),
+    /// Sets the selected layer's opacity (clamped to `[0, 1]`).
+    SetLayerOpacity(#[serde(deserialize_with = "crate::model::check::layer_opacity")] f32),
+    /// Shows or hides the selected layer.
+    SetLayerVisible(bool),
+    /// Locks or unlocks the selected layer against painting.
+    SetLayerLocked(bool),
+    /// Renames the selected layer.
+    RenameLayer(#[serde(deserialize_with = "crate::model::check::layer_name")] String),
+    /// Sets the blend mode of one of the selected layer's channels.
+    SetLayerBlend {
+        /// The channel.
+        channel: Channel,
+        /// Its mode (for `n`: Normal, Multiply, Add, Min, Max).
+        mode: crate::model::layers::LayerBlend,
+    },
+    /// Which of its channels the selected layer lays over the layers below.
+    SetLayerChannels(Channels),
+    /// Sets a fill layer's material.
+    SetLayerFill(MaterialValue),
+    /// Moves the selected layer.
+    MoveLayer(LayerMove),
+    /// Deletes the selected layer.
+    DeleteLayer,
+    /// Duplicates the selected layer above itself and selects the copy.
+    DuplicateLayer,
+    /// Merges the selected layer into the one below it (a paint layer of what both showed).
+    MergeDown,
+    /// Flattens every layer into one paint layer of the composite.
+    Flatten,
+    /// Adds a white mask to the selected layer.
+    AddMask,
+    /// Deletes the selected layer's mask.
+    DeleteMask,
+    /// Bakes the selected layer's mask into it (a paint layer) and deletes the mask.
+    ApplyMask,
+    /// Tools paint the selected layer's mask.
+    SelectMask,
+    /// Tools paint the selected layer's content.
+    SelectContent,
+    /// Inverts the selected layer's mask.
+    InvertMask,
+    /// Enables or disables the selected layer's mask.
+    SetMaskEnabled(bool),
+    /// Makes the selected layer's mask white where a channel of the composite is above a
+    /// threshold (`k_d`, `k_s`: their mean; `n`: the exponent), black elsewhere.
+    MaskFromChannel {
+        /// The channel read.
+        channel: Channel,
+        /// The threshold.
+        #[serde(deserialize_with = "crate::model::check::finite_f32")]
+        threshold: f32,
+    },
+    /// Puts the selected layer into a new group in its place.
+    Group,
+    /// Replaces the selected group by its layers.
+    Ungroup,
+}
+
+/// A layer's kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerKind {
+    /// Painted planes.
+    Paint,
+    /// One material over the whole map, shaped by its mask.
+    Fill,
+    /// A folder of layers.
+    Group,
+}
+
+/// A layer named in a script: its index in the top-level list or its name.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum LayerRef {
+    /// Index from the bottom of the top-level list.
+    Index(usize),
+    /// Name (the topmost layer of that name, at any depth).
+    Name(String),
+}
+
+/// Where [`Command::MoveLayer`] moves a layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerMove {
+    /// One place up in its list.
+    Up,
+    /// One place down in its list.
+    Down,
+    /// The top of its list.
+    Top,
+    /// The bottom of its list.
+    Bottom,
+    /// Into the group just above it, at that group's bottom.
+    IntoGroup,
+    /// Out of its group, just above it.
+    OutOfGroup,
 }
 
 /// A channel's planes made by [`crate::model::import::resample`], shared so that the command

@@ -1,36 +1,35 @@
-//! Fills and gradients: the commands that write a whole region in one undo step.
+//! Fills and gradients: the commands that write a whole region of the selected layer or mask
+//! in one undo step.
 
 use glam::Vec2;
 
 use super::{Document, FillRegion};
 use crate::model::ModelError;
+use crate::model::layers::LayerStroke;
+use crate::model::layers::edit::{self, LayerEdit, tile_texels};
 use crate::model::paint::{self, GradientShape};
 
 impl Document {
     pub(super) fn fill(&mut self, region: FillRegion) -> Result<(), ModelError> {
         self.end_stroke();
-        let target = self.target_for(self.settings.primary);
-        let opacity = self.settings.brush.opacity;
-        match region {
-            FillRegion::All => {
-                self.history.begin("Fill");
-                paint::fill_all(&mut self.maps, &mut self.history, &target, opacity);
-            }
+        self.check_paintable()?;
+        let (w, h) = (self.maps.width(), self.maps.height());
+        let (mask, label) = match region {
+            FillRegion::All => (None, "Fill"),
             FillRegion::Similar {
                 x,
                 y,
                 channel,
                 tolerance,
             } => {
-                if x >= self.maps.width() || y >= self.maps.height() {
+                if x >= w || y >= h {
                     return Err(ModelError::Command(format!(
                         "fill seed ({x}, {y}) is outside the map"
                     )));
                 }
                 let mask =
                     paint::flood_region(&self.maps, x, y, channel, tolerance.clamp(0.0, 1.0));
-                self.history.begin("Fill similar");
-                paint::fill_mask(&mut self.maps, &mut self.history, &target, opacity, &mask);
+                (Some(mask), "Fill similar")
             }
             FillRegion::Island { x, y } | FillRegion::Part { x, y } => {
                 let surface = self.require_surface("filling a UV island or mesh part")?;
@@ -42,32 +41,72 @@ impl Document {
                 let mask = mask.ok_or_else(|| {
                     ModelError::Command(format!("no part of the mesh is at texel ({x}, {y})"))
                 })?;
-                self.history.begin(label);
-                paint::fill_mask(&mut self.maps, &mut self.history, &target, opacity, &mask);
+                (Some(mask), label)
             }
-        }
-        self.history.end();
-        Ok(())
+        };
+        let stroke = LayerStroke::Brush(self.settings.brush.blend);
+        let target = self.layer_edit(self.settings.primary, self.settings.primary, stroke);
+        let opacity = self.settings.brush.opacity;
+        self.edit_planes(label, |mut planes, pre, count| {
+            if mask.is_none() && edit::fill_uniform(planes.reborrow(), &target, opacity, count) {
+                return;
+            }
+            let mask = mask.as_deref();
+            edit::edit_tiles(
+                planes,
+                pre,
+                &target,
+                edit::all_tiles(count),
+                |id, (), write| {
+                    for (i, x, y) in tile_texels(w, h, id) {
+                        if mask.is_none_or(|m| m[y as usize * w as usize + x as usize]) {
+                            write(i, opacity, 0.0);
+                        }
+                    }
+                },
+            );
+        })
     }
 
-    pub(super) fn gradient(&mut self, shape: GradientShape, start: Vec2, end: Vec2) {
+    pub(super) fn gradient(
+        &mut self,
+        shape: GradientShape,
+        start: Vec2,
+        end: Vec2,
+    ) -> Result<(), ModelError> {
         self.end_stroke();
         if !(start.is_finite() && end.is_finite()) {
-            return;
+            return Ok(());
         }
-        let from = self.target_for(self.settings.primary);
-        let to = self.target_for(self.settings.secondary);
-        self.history.begin("Gradient");
-        paint::gradient(
-            &mut self.maps,
-            &mut self.history,
-            &from,
-            &to,
-            shape,
-            start,
-            end,
-            self.settings.brush.opacity,
-        );
-        self.history.end();
+        self.check_paintable()?;
+        let stroke = LayerStroke::Brush(self.settings.brush.blend);
+        let mut target: LayerEdit =
+            self.layer_edit(self.settings.primary, self.settings.secondary, stroke);
+        // On a mask, white to black.
+        target.gray = [1.0, 0.0];
+        let opacity = self.settings.brush.opacity;
+        let (w, h) = (self.maps.width(), self.maps.height());
+        let axis = end - start;
+        let len2 = axis.length_squared().max(1e-12);
+        self.edit_planes("Gradient", |planes, pre, count| {
+            edit::edit_tiles(
+                planes,
+                pre,
+                &target,
+                edit::all_tiles(count),
+                |id, (), write| {
+                    for (i, x, y) in tile_texels(w, h, id) {
+                        let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - start;
+                        let t = match shape {
+                            GradientShape::Linear => p.dot(axis) / len2,
+                            GradientShape::Radial => (p.length_squared() / len2).sqrt(),
+                        }
+                        .clamp(0.0, 1.0);
+                        // `t = 0` means "the start material" to the kernel; keep it exact there.
+                        write(i, opacity, t);
+                    }
+                },
+            );
+        })
     }
 }

@@ -6,9 +6,12 @@
 
 mod command;
 mod fill;
+mod layers;
 mod stroke;
 
-pub use command::{Command, FillRegion, ImportedChannel, StrokeTool};
+pub use command::{
+    Command, FillRegion, ImportedChannel, LayerKind, LayerMove, LayerRef, StrokeTool,
+};
 
 use std::sync::Arc;
 
@@ -16,9 +19,8 @@ use serde::{Deserialize, Serialize};
 
 use super::ModelError;
 use super::brush::BrushSettings;
-use super::history::History;
+use super::layers::{Compositor, LayerStack, Selection, StackHistory, State};
 use super::maps::MaterialMaps;
-use super::paint::PaintTarget;
 use super::surface::Surface;
 use super::texel::{Channels, MaterialValue};
 use crate::reflectance::{AmbientApprox, ShadingModel};
@@ -135,15 +137,20 @@ impl Default for DocumentSettings {
     }
 }
 
-/// A material being painted.
+/// A material being painted: a layer stack over a base material, and its composite.
 pub struct Document {
+    /// The composite of the stack: what the renderer, `k_a` and export read.
     maps: MaterialMaps,
-    history: History,
+    /// The stack, the selected layer and the mesh surface.
+    state: State,
+    compositor: Compositor,
+    history: StackHistory,
     settings: DocumentSettings,
-    surface: Option<Arc<Surface>>,
     stroke: Option<ActiveStroke>,
     /// Bumped by every command that changes the settings (which are saved too).
     settings_version: u64,
+    /// Bumped by every change to the stack (which may leave the composite as it was).
+    layers_version: u64,
 }
 
 impl std::fmt::Debug for Document {
@@ -157,22 +164,74 @@ impl std::fmt::Debug for Document {
 }
 
 impl Document {
-    /// A document of `width x height` texels, every texel the settings' base material.
+    /// A document of `width x height` texels: the settings' base material and one empty
+    /// paint layer, "Layer 1", selected.
     pub fn new(width: u32, height: u32, settings: DocumentSettings) -> Result<Self, ModelError> {
         let maps = MaterialMaps::new(width, height, settings.base)?;
-        Ok(Self::from_parts(maps, settings))
+        let stack = LayerStack::new(width, height, settings.base);
+        Ok(Self::assemble(maps, stack, settings))
     }
 
-    /// A document around existing maps (loading), with empty history.
+    /// A document around existing maps (a version 1 project, an imported set): the maps become
+    /// one opaque paint layer, "Layer 1", over the settings' base. Empty history.
     pub fn from_parts(maps: MaterialMaps, settings: DocumentSettings) -> Self {
+        let stack = LayerStack::from_maps(&maps, settings.base, "Layer 1");
+        Self::assemble(maps, stack, settings)
+    }
+
+    /// A document around a layer stack (a version 2 project), its topmost layer selected.
+    ///
+    /// # Errors
+    /// A stack of a size the maps cannot have.
+    pub fn from_stack(stack: LayerStack, settings: DocumentSettings) -> Result<Self, ModelError> {
+        let maps = MaterialMaps::new(stack.width, stack.height, stack.base)?;
+        Ok(Self::assemble(maps, stack, settings))
+    }
+
+    /// A copy of the stack and settings without history or mesh (autosave, background saves).
+    #[must_use]
+    pub fn snapshot(&self) -> Self {
+        let mut doc = Self::assemble(
+            self.maps.clone(),
+            self.state.stack.clone(),
+            self.settings.clone(),
+        );
+        doc.state.selection = self.state.selection.clone();
+        doc
+    }
+
+    fn assemble(mut maps: MaterialMaps, stack: LayerStack, settings: DocumentSettings) -> Self {
+        let mut compositor = Compositor::new();
+        compositor.update(&stack, &mut maps);
+        let path = stack
+            .layers
+            .len()
+            .checked_sub(1)
+            .map_or_else(Vec::new, |i| vec![i]);
         Self {
             maps,
-            history: History::default(),
+            state: State {
+                stack,
+                selection: Selection { path, mask: false },
+                surface: None,
+            },
+            compositor,
+            history: StackHistory::default(),
             settings,
-            surface: None,
             stroke: None,
             settings_version: 0,
+            layers_version: 0,
         }
+    }
+
+    /// The layer stack: read it freely; it changes only through [`Document::apply`].
+    pub fn stack(&self) -> &LayerStack {
+        &self.state.stack
+    }
+
+    /// The selected layer and whether tools paint its mask.
+    pub fn selection(&self) -> &Selection {
+        &self.state.selection
     }
 
     /// The maps: read them freely; they change only through [`Document::apply`].
@@ -181,7 +240,7 @@ impl Document {
     }
 
     /// Undo and redo.
-    pub fn history(&self) -> &History {
+    pub fn history(&self) -> &StackHistory {
         &self.history
     }
 
@@ -190,8 +249,8 @@ impl Document {
         &self.settings
     }
 
-    /// The maps and settings, for a caller that builds another document from them (the
-    /// history and the attached mesh are dropped).
+    /// The composite maps and the settings, for a caller that builds another document or
+    /// renders them (the layers, history and attached mesh are dropped).
     pub fn into_parts(self) -> (MaterialMaps, DocumentSettings) {
         (self.maps, self.settings)
     }
@@ -214,7 +273,7 @@ impl Document {
             )));
         }
         self.end_stroke();
-        self.surface = surface;
+        self.state.surface = surface;
         Ok(())
     }
 
@@ -234,17 +293,20 @@ impl Document {
     /// A number that changes whenever anything a project file stores changes (the maps, or
     /// a setting through a command): what "unsaved changes" and autosave compare.
     pub fn version(&self) -> u64 {
-        // Both parts only grow, so their sum changes whenever either does.
-        self.maps.version().wrapping_add(self.settings_version)
+        // Every part only grows, so their sum changes whenever any does.
+        self.maps
+            .version()
+            .wrapping_add(self.settings_version)
+            .wrapping_add(self.layers_version)
     }
 
     /// The attached mesh surface.
     pub fn surface(&self) -> Option<&Arc<Surface>> {
-        self.surface.as_ref()
+        self.state.surface.as_ref()
     }
 
     fn require_surface(&self, what: &str) -> Result<Arc<Surface>, ModelError> {
-        self.surface.clone().ok_or_else(|| {
+        self.state.surface.clone().ok_or_else(|| {
             ModelError::Command(format!(
                 "{what} needs a mesh to paint on, and this document has none attached"
             ))
@@ -282,12 +344,12 @@ impl Document {
             Command::SetChannels(c) => set(&mut self.settings.channels, c, v),
             Command::SetModel(m) => set(&mut self.settings.model, m, v),
             Command::SetApprox(a) => set(&mut self.settings.approx, a, v),
-            Command::BeginStroke(tool) => self.begin_stroke(tool),
+            Command::BeginStroke(tool) => self.begin_stroke(tool)?,
             Command::StrokeTo(p) => self.stroke_to(p)?,
             Command::EndStroke => self.end_stroke(),
             Command::AbortStroke => self.abort_stroke(),
             Command::Stroke { tool, points } => {
-                self.begin_stroke(tool);
+                self.begin_stroke(tool)?;
                 let result = points.into_iter().try_for_each(|p| self.stroke_to(p));
                 self.end_stroke();
                 result?;
@@ -298,7 +360,7 @@ impl Document {
             }
             Command::SurfaceStroke { tool, points } => {
                 let surface = self.require_surface("a stroke on the mesh")?;
-                self.begin_stroke(tool);
+                self.begin_stroke(tool)?;
                 let result = points
                     .into_iter()
                     .try_for_each(|p| self.surface_stroke_to(&surface, p));
@@ -306,7 +368,7 @@ impl Document {
                 result?;
             }
             Command::Fill(region) => self.fill(region)?,
-            Command::Gradient { shape, start, end } => self.gradient(shape, start, end),
+            Command::Gradient { shape, start, end } => self.gradient(shape, start, end)?,
             Command::Pick { x, y } => {
                 if x >= self.maps.width() || y >= self.maps.height() {
                     return Err(ModelError::Command(format!(
@@ -322,42 +384,65 @@ impl Document {
                     &mut self.settings_version,
                 );
             }
-            Command::ImportChannel(imported) => {
-                self.end_stroke();
-                super::import::install(&mut self.maps, &mut self.history, &imported.0)?;
-            }
+            Command::ImportChannel(imported) => self.import_channel(&imported.0)?,
             Command::Undo => {
                 self.end_stroke();
-                self.history.undo(&mut self.maps, &mut self.surface);
+                if self.history.undo(&mut self.state) {
+                    self.after_history();
+                }
             }
             Command::Redo => {
                 self.end_stroke();
-                self.history.redo(&mut self.maps, &mut self.surface);
+                if self.history.redo(&mut self.state) {
+                    self.after_history();
+                }
             }
             Command::Resize(resized) => self.install_resized(&resized)?,
             Command::HistoryJump(applied) => {
                 self.end_stroke();
                 let now = self.history.undo_steps().count();
+                let mut moved = false;
                 for _ in applied..now {
-                    self.history.undo(&mut self.maps, &mut self.surface);
+                    moved |= self.history.undo(&mut self.state);
                 }
                 for _ in now..applied {
-                    if !self.history.redo(&mut self.maps, &mut self.surface) {
+                    if !self.history.redo(&mut self.state) {
                         break;
                     }
+                    moved = true;
+                }
+                if moved {
+                    self.after_history();
                 }
             }
+            other => self.layer_command(other)?,
         }
         Ok(())
     }
 
-    /// Puts resized maps and their surface in place, keeping the old ones as one undo step.
+    /// After undo or redo swapped the state: the composite follows it, and the maps take
+    /// the new size where a step resized them.
+    fn after_history(&mut self) {
+        let stack = &self.state.stack;
+        if (stack.width, stack.height) != (self.maps.width(), self.maps.height()) {
+            let version = self.maps.version();
+            if let Ok(mut maps) = MaterialMaps::new(stack.width, stack.height, stack.base) {
+                maps.stamp_after(version);
+                self.maps = maps;
+                self.compositor = Compositor::new();
+            }
+        }
+        self.compositor.update(&self.state.stack, &mut self.maps);
+        self.layers_version += 1;
+    }
+
+    /// Puts a resized stack and its surface in place, keeping the old ones as one undo step.
     fn install_resized(
         &mut self,
         resized: &crate::model::resize::ResizedMaps,
     ) -> Result<(), ModelError> {
-        let (maps, surface) = &*resized.0;
-        let size = (maps.width(), maps.height());
+        let (stack, surface) = &*resized.0;
+        let size = (stack.width, stack.height);
         if let Some(s) = surface
             && (s.width(), s.height()) != size
         {
@@ -370,23 +455,18 @@ impl Document {
             )));
         }
         self.end_stroke();
-        let mut maps = maps.clone();
-        maps.stamp_after(self.maps.version());
-        let old = std::mem::replace(&mut self.maps, maps);
-        let old_surface = std::mem::replace(&mut self.surface, surface.clone());
         let label = format!(
             "Resize {}x{} to {}x{}",
-            old.width(),
-            old.height(),
+            self.maps.width(),
+            self.maps.height(),
             size.0,
             size.1
         );
-        self.history.push_whole(label, old, old_surface);
+        let before = self.state.clone();
+        self.state.stack = stack.clone();
+        self.state.surface.clone_from(surface);
+        self.history.push(label, before, &self.state);
+        self.after_history();
         Ok(())
-    }
-
-    fn target_for(&self, value: MaterialValue) -> PaintTarget {
-        let s = &self.settings;
-        PaintTarget::new(value, s.channels, s.brush.blend, s.brush.energy_guard)
     }
 }

@@ -7,16 +7,22 @@ use crate::model::ModelError;
 use crate::model::brush::{
     BrushSettings, DabPoint, Resampler, Smoother, StrokePoint, SurfacePoint, SurfacePos,
 };
-use crate::model::history::History;
+use crate::model::layers::edit::{self, LayerEdit, Planes, PrePlanes};
+use crate::model::layers::{Compositor, LayerStroke, State};
 use crate::model::maps::MaterialMaps;
-use crate::model::paint::{self, Coverage, DiscFootprint, Footprint, PaintTarget};
+use crate::model::paint::{Coverage, DiscFootprint, Footprint};
 use crate::model::surface::{BallFootprint, Surface};
 use crate::model::texel::Channels;
 
 /// A stroke in progress.
 pub(super) struct ActiveStroke {
     tool: StrokeTool,
-    target: PaintTarget,
+    target: LayerEdit,
+    /// The state before the stroke: each dab blends from its planes, and undo restores it.
+    before: State,
+    label: &'static str,
+    /// Whether a dab wrote anything.
+    touched: bool,
     brush: BrushSettings,
     channels: Channels,
     resampler: Resampler,
@@ -30,10 +36,12 @@ pub(super) struct ActiveStroke {
 /// The parts of a stroke a dab reads, borrowed apart so a footprint can hold the brush.
 struct StrokeParts<'a> {
     tool: StrokeTool,
-    target: &'a PaintTarget,
+    target: &'a LayerEdit,
+    before: &'a State,
     brush: &'a BrushSettings,
     channels: Channels,
     coverage: &'a mut Coverage,
+    touched: &'a mut bool,
 }
 
 impl ActiveStroke {
@@ -41,32 +49,50 @@ impl ActiveStroke {
         StrokeParts {
             tool: self.tool,
             target: &self.target,
+            before: &self.before,
             brush: &self.brush,
             channels: self.channels,
             coverage: &mut self.coverage,
+            touched: &mut self.touched,
         }
     }
 }
 
+/// What a dab writes into: the document's state and its composite, borrowed apart from the
+/// stroke.
+struct DabTarget<'a> {
+    maps: &'a mut MaterialMaps,
+    state: &'a mut State,
+    compositor: &'a mut Compositor,
+}
+
 impl Document {
-    pub(super) fn begin_stroke(&mut self, tool: StrokeTool) {
+    /// Starts a stroke on the selected layer's content or mask.
+    ///
+    /// # Errors
+    /// When the selection cannot be painted (locked, a fill layer's content, no layer).
+    pub(super) fn begin_stroke(&mut self, tool: StrokeTool) -> Result<(), ModelError> {
         self.end_stroke();
+        self.check_paintable()?;
         let brush = self.settings.brush.clone().sanitized();
-        let (value, label) = match tool {
-            StrokeTool::Brush => (self.settings.primary, "Brush stroke"),
-            StrokeTool::Eraser => (self.settings.base, "Eraser stroke"),
-            StrokeTool::Blur => (self.settings.primary, "Blur stroke"),
+        let (stroke, label) = match tool {
+            StrokeTool::Brush => (LayerStroke::Brush(brush.blend), "Brush stroke"),
+            StrokeTool::Eraser => (LayerStroke::Erase, "Eraser stroke"),
+            StrokeTool::Blur => (LayerStroke::Brush(brush.blend), "Blur stroke"),
         };
-        let mut target = self.target_for(value);
-        if tool == StrokeTool::Eraser {
-            target.mode = crate::model::brush::BlendMode::Normal;
-        }
-        self.history.begin(label);
+        let target = self.layer_edit(self.settings.primary, self.settings.primary, stroke);
         // On a mesh, sizes in texels become object units at the mesh's texel density.
-        let units = self.surface.as_ref().map_or(1.0, |s| s.units_per_texel);
+        let units = self
+            .state
+            .surface
+            .as_ref()
+            .map_or(1.0, |s| s.units_per_texel);
         self.stroke = Some(ActiveStroke {
             tool,
             target,
+            before: self.state.clone(),
+            label,
+            touched: false,
             channels: self.settings.channels,
             resampler: Resampler::new(brush.spacing_px()),
             smoother: Smoother::new(brush.smoothing_px),
@@ -76,6 +102,7 @@ impl Document {
             rng: 0x5EED_0F4A_9A1E_5700,
             brush,
         });
+        Ok(())
     }
 
     /// Moves the stroke; the dabs of a stroke past [`crate::model::brush::MAX_STROKE_DABS`] are
@@ -187,38 +214,93 @@ impl Document {
                 normal: if front { normal } else { Vec3::ZERO },
                 brush,
             };
-            Self::dab_with(&mut self.maps, &mut self.history, parts, alpha, &fp);
+            let mut to = DabTarget {
+                maps: &mut self.maps,
+                state: &mut self.state,
+                compositor: &mut self.compositor,
+            };
+            Self::dab_with(&mut to, parts, alpha, &fp);
         }
     }
 
-    /// Applies the stroke's tool through footprint `fp` (which may borrow `stroke.brush`).
-    fn dab_with(
-        maps: &mut MaterialMaps,
-        history: &mut History,
-        stroke: StrokeParts<'_>,
-        alpha: f32,
-        fp: &impl Footprint,
-    ) {
+    /// Applies the stroke's tool through footprint `fp` (which may borrow `stroke.brush`) to
+    /// the selected planes, and recomposites the tiles it touched.
+    fn dab_with(to: &mut DabTarget<'_>, stroke: StrokeParts<'_>, alpha: f32, fp: &impl Footprint) {
         let StrokeParts {
             tool,
             target,
+            before,
             brush,
             channels,
             coverage,
+            touched,
         } = stroke;
+        let mut ids = fp.tiles(to.maps);
+        ids.sort_unstable();
+        ids.dedup();
+        if ids.is_empty() || alpha <= 0.0 || brush.opacity <= 0.0 {
+            return;
+        }
+        let selection = &to.state.selection;
+        let Some(layer) = to.state.stack.layer_mut(&selection.path) else {
+            return;
+        };
+        let Some(planes) = layer.planes_mut(selection.mask) else {
+            return;
+        };
+        let maps: &MaterialMaps = to.maps;
+        *touched = true;
         match tool {
             StrokeTool::Brush | StrokeTool::Eraser => {
-                paint::paint_dab(maps, history, coverage, target, brush.opacity, alpha, fp);
+                let Some(pre) = before
+                    .stack
+                    .layer(&selection.path)
+                    .and_then(|l| l.planes(selection.mask))
+                else {
+                    return;
+                };
+                let opacity = brush.opacity;
+                let covs = coverage.tiles_mut(maps.tile_count(), &ids);
+                let work: Vec<_> = ids.iter().copied().zip(covs).collect();
+                edit::edit_tiles(planes, pre, target, work, |id, cov, write| {
+                    fp.visit_tile(id, maps.tile_rect(id), |i, w| {
+                        let c = cov[i];
+                        let next = c + (opacity - c) * (w * alpha).min(1.0);
+                        cov[i] = c.max(next);
+                        write(i, cov[i], 0.0);
+                    });
+                });
             }
-            StrokeTool::Blur => paint::blur_dab(
-                maps,
-                history,
-                channels,
-                brush.blur_radius_px,
-                alpha * brush.opacity,
-                fp,
-            ),
+            StrokeTool::Blur => {
+                let strength = alpha * brush.opacity;
+                let weights: Vec<_> = ids
+                    .iter()
+                    .map(|&id| {
+                        let mut texels = Vec::new();
+                        fp.visit_tile(id, maps.tile_rect(id), |i, w| {
+                            texels.push((i, (w * strength).min(1.0)));
+                        });
+                        (id, texels)
+                    })
+                    .collect();
+                let ch = [channels.kd, channels.ks, channels.n];
+                let size = (maps.width(), maps.height());
+                let radius = brush.blur_radius_px;
+                match planes {
+                    Planes::Paint(tiles) => {
+                        let pre = tiles.to_vec();
+                        let pre = PrePlanes::Paint(&pre);
+                        edit::blur(Planes::Paint(tiles), pre, size, ch, radius, weights);
+                    }
+                    Planes::Mask(tiles) => {
+                        let pre = tiles.to_vec();
+                        let pre = PrePlanes::Mask(&pre);
+                        edit::blur(Planes::Mask(tiles), pre, size, ch, radius, weights);
+                    }
+                }
+            }
         }
+        to.compositor.update_tiles(&to.state.stack, to.maps, &ids);
     }
 
     /// One dab and its mirrored copies.
@@ -252,19 +334,30 @@ impl Document {
                 radius,
                 brush,
             };
-            Self::dab_with(&mut self.maps, &mut self.history, parts, alpha, &fp);
+            let mut to = DabTarget {
+                maps: &mut self.maps,
+                state: &mut self.state,
+                compositor: &mut self.compositor,
+            };
+            Self::dab_with(&mut to, parts, alpha, &fp);
         }
     }
 
+    /// Ends the stroke: one undo step if it changed anything.
     pub(super) fn end_stroke(&mut self) {
-        if self.stroke.take().is_some() {
-            self.history.end();
+        if let Some(stroke) = self.stroke.take()
+            && stroke.touched
+        {
+            self.history.push(stroke.label, stroke.before, &self.state);
+            self.layers_version += 1;
         }
     }
 
+    /// Abandons the stroke, restoring the state before it.
     pub(super) fn abort_stroke(&mut self) {
-        if self.stroke.take().is_some() {
-            self.history.abort(&mut self.maps);
+        if let Some(stroke) = self.stroke.take() {
+            self.state = stroke.before;
+            self.compositor.update(&self.state.stack, &mut self.maps);
         }
     }
 }

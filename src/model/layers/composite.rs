@@ -300,6 +300,45 @@ fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Til
     tile
 }
 
+/// `layers` composited onto nothing at tile `id`, as a paint tile (`None` where none of them
+/// covers anything): what merging them into one paint layer keeps.
+pub fn merge_tile(layers: &[Layer], id: usize) -> Option<PaintTile> {
+    use crate::model::tile::Plane;
+    let act = active(layers, id);
+    if act.is_empty() {
+        return None;
+    }
+    let len = if uniform_inputs(&act, id) {
+        1
+    } else {
+        TILE_TEXELS
+    };
+    let mut state = Planes::clear(len);
+    apply(&mut state, &act, id);
+    let v = &state.value;
+    let mut tile = PaintTile::filled(crate::model::texel::MaterialValue::default(), [false; 3]);
+    let alpha = |k: usize, i: usize| crate::model::texel::encode_unorm(state.alpha[k][i]);
+    let texel = |i: usize| Texel {
+        kd: encode_rgb(Vec3::new(v[0][i], v[1][i], v[2][i])),
+        ks: encode_rgb(Vec3::new(v[3][i], v[4][i], v[5][i])),
+        n: crate::model::paint::n_bits_from_blend(v[6][i]),
+    };
+    if len == 1 {
+        tile.value = Tile::uniform(texel(0));
+        tile.alpha = [0, 3, 6].map(|k| Plane::Uniform(alpha(k, 0)));
+        return Some(tile);
+    }
+    for i in 0..TILE_TEXELS {
+        tile.value.set_texel(i, texel(i));
+        for (c, k) in [0, 3, 6].into_iter().enumerate() {
+            tile.alpha[c].data_mut()[i] = alpha(k, i);
+        }
+    }
+    tile.value.compact();
+    tile.alpha.iter_mut().for_each(Plane::compact);
+    Some(tile)
+}
+
 /// Hashes what the composite of tile `id` depends on: per active layer, in order, its
 /// settings, its fill value or its tile's stamp, its mask's switches and tile stamp, and its
 /// active children.
@@ -400,8 +439,15 @@ impl Compositor {
         let mut written = Vec::new();
         for (id, s, tile) in tiles {
             self.signatures[id] = s;
-            if **maps.tile(id) != tile {
-                maps.replace_tile(id, std::sync::Arc::new(tile));
+            let old = maps.tile(id);
+            let changed = crate::model::texel::Channels {
+                kd: old.kd != tile.kd,
+                ks: old.ks != tile.ks,
+                n: old.n != tile.n,
+            };
+            if !changed.is_empty() {
+                // Only the planes that changed are marked: the upload stays per channel.
+                maps.replace_tile_in(id, std::sync::Arc::new(tile), changed);
                 written.push(id);
             }
         }

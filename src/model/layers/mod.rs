@@ -14,10 +14,14 @@
 
 mod blend;
 pub mod composite;
+pub mod edit;
+pub mod history;
+pub mod ops;
 pub mod paint;
 
 pub use blend::{Covered, LayerBlend};
-pub use composite::{Compositor, composite_tile};
+pub use composite::{Compositor, composite_tile, merge_tile};
+pub use history::{Selection, StackHistory, State};
 pub use paint::{LayerStroke, LayerValue};
 
 use std::sync::Arc;
@@ -306,5 +310,120 @@ impl LayerStack {
     /// Heap bytes of every layer's tiles and masks.
     pub fn heap_bytes(&self) -> usize {
         self.layers.iter().map(Layer::heap_bytes).sum()
+    }
+}
+
+impl LayerStack {
+    /// The layer at `path` (indices from the top-level list down into groups).
+    pub fn layer(&self, path: &[usize]) -> Option<&Layer> {
+        let (&last, parents) = path.split_last()?;
+        self.list(parents)?.get(last)
+    }
+
+    /// The layer at `path`, to change.
+    pub fn layer_mut(&mut self, path: &[usize]) -> Option<&mut Layer> {
+        let (&last, parents) = path.split_last()?;
+        self.list_mut(parents)?.get_mut(last)
+    }
+
+    /// The list of layers inside the group at `path` (the top level for an empty path).
+    pub fn list(&self, path: &[usize]) -> Option<&Vec<Layer>> {
+        let mut list = &self.layers;
+        for &i in path {
+            match &list.get(i)?.content {
+                LayerContent::Group(children) => list = children,
+                _ => return None,
+            }
+        }
+        Some(list)
+    }
+
+    /// The list of layers inside the group at `path`, to change.
+    pub fn list_mut(&mut self, path: &[usize]) -> Option<&mut Vec<Layer>> {
+        let mut list = &mut self.layers;
+        for &i in path {
+            match &mut list.get_mut(i)?.content {
+                LayerContent::Group(children) => list = children,
+                _ => return None,
+            }
+        }
+        Some(list)
+    }
+
+    /// Every layer, depth first, bottom first within each list, with its path.
+    pub fn walk(&self) -> Vec<(Vec<usize>, &Layer)> {
+        fn go<'a>(
+            list: &'a [Layer],
+            prefix: &mut Vec<usize>,
+            out: &mut Vec<(Vec<usize>, &'a Layer)>,
+        ) {
+            for (i, layer) in list.iter().enumerate() {
+                prefix.push(i);
+                out.push((prefix.clone(), layer));
+                if let LayerContent::Group(children) = &layer.content {
+                    go(children, prefix, out);
+                }
+                prefix.pop();
+            }
+        }
+        let mut out = Vec::new();
+        go(&self.layers, &mut Vec::new(), &mut out);
+        out
+    }
+
+    /// A stack of one opaque paint layer holding `maps` (how a version 1 project opens, and
+    /// what flattening leaves).
+    pub fn from_maps(maps: &super::maps::MaterialMaps, base: MaterialValue, name: &str) -> Self {
+        let tiles = (0..maps.tile_count())
+            .map(|id| {
+                Some(Arc::new(Stamped::new(PaintTile {
+                    value: (**maps.tile(id)).clone(),
+                    alpha: std::array::from_fn(|_| Plane::Uniform(u16::MAX)),
+                })))
+            })
+            .collect();
+        Self {
+            width: maps.width(),
+            height: maps.height(),
+            base: base.sanitized(),
+            layers: vec![Layer {
+                props: LayerProps::named(name),
+                content: LayerContent::Paint(tiles),
+                mask: None,
+            }],
+        }
+    }
+}
+
+impl Layer {
+    /// The planes tools write: the mask's when `mask` is set, else a paint layer's tiles.
+    pub fn planes_mut(&mut self, mask: bool) -> Option<edit::Planes<'_>> {
+        if mask {
+            return self.mask.as_mut().map(|m| edit::Planes::Mask(&mut m.tiles));
+        }
+        match &mut self.content {
+            LayerContent::Paint(tiles) => Some(edit::Planes::Paint(tiles)),
+            _ => None,
+        }
+    }
+
+    /// The same planes, to read.
+    pub fn planes(&self, mask: bool) -> Option<edit::PrePlanes<'_>> {
+        if mask {
+            return self.mask.as_ref().map(|m| edit::PrePlanes::Mask(&m.tiles));
+        }
+        match &self.content {
+            LayerContent::Paint(tiles) => Some(edit::PrePlanes::Paint(tiles)),
+            _ => None,
+        }
+    }
+
+    /// The layer's kind as the CLI and scripts name it.
+    pub fn kind_name(&self) -> &'static str {
+        match self.content {
+            LayerContent::Paint(_) => "paint",
+            LayerContent::Fill(_) => "fill",
+            LayerContent::Group(_) => "group",
+        }
     }
 }

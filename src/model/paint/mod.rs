@@ -163,7 +163,7 @@ impl Coverage {
     }
 
     /// Coverage slices for several tiles (sorted, unique ids), created at zero on first use.
-    fn tiles_mut(&mut self, tile_count: usize, ids: &[TileId]) -> Vec<&mut [f32]> {
+    pub(crate) fn tiles_mut(&mut self, tile_count: usize, ids: &[TileId]) -> Vec<&mut [f32]> {
         if self.tiles.len() < tile_count {
             self.tiles.resize_with(tile_count, || None);
         }

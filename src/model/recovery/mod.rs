@@ -155,7 +155,7 @@ impl Autosaver {
             let settings = doc.settings().clone();
             Box::new(move || append_record(&dir, generation, size, &settings, &tiles))
         } else {
-            let snapshot = Document::from_parts(doc.maps().clone(), doc.settings().clone());
+            let snapshot = doc.snapshot();
             Box::new(move || write_generation(&dir, &snapshot))
         };
         let handle = std::thread::Builder::new()

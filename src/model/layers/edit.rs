@@ -1,0 +1,446 @@
+//! Tools on a layer: what a dab, fill, gradient or blur writes into a paint layer's planes or a
+//! mask.
+//!
+//! Every write is relative to the texel as it was before the operation (`pre`), at the
+//! operation's coverage `a` there, as on the flat maps: a paint layer's texel becomes
+//! [`LayerStroke::apply`] of its pre-operation value and coverage, a mask's gray moves from its
+//! pre-operation value towards the target gray by `a`.
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile, Stamped};
+use crate::model::paint::{n_bits_from_blend, n_bits_to_blend};
+use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
+use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, select_mut};
+
+/// A material as the layer kernels blend it: `k_d`, `k_s` linear, `n` in blend space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EditValue {
+    /// Seven components: `k_d` RGB, `k_s` RGB, `n` in blend space.
+    pub c: [f32; 7],
+}
+
+impl EditValue {
+    /// From a material value (sanitised first).
+    pub fn of(value: MaterialValue) -> Self {
+        let v = value.sanitized();
+        Self {
+            c: [
+                v.kd.x,
+                v.kd.y,
+                v.kd.z,
+                v.ks.x,
+                v.ks.y,
+                v.ks.z,
+                n_to_blend(v.n),
+            ],
+        }
+    }
+
+    fn lerp(&self, other: &Self, t: f32) -> Self {
+        Self {
+            c: std::array::from_fn(|k| self.c[k] + (other.c[k] - self.c[k]) * t),
+        }
+    }
+}
+
+/// What an edit writes: a material (from, and to for gradients) into the enabled channels of a
+/// paint layer, or a gray (from, to) into a mask.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LayerEdit {
+    /// The material at `t = 0`.
+    pub from: EditValue,
+    /// The material at `t = 1` (gradients; the same as `from` otherwise).
+    pub to: EditValue,
+    /// Channels written on a paint layer (`k_d`, `k_s`, `n`).
+    pub channels: [bool; 3],
+    /// How a paint layer's texel takes the material.
+    pub stroke: LayerStroke,
+    /// The mask's gray at `t = 0` and `t = 1`.
+    pub gray: [f32; 2],
+}
+
+/// The planes an edit writes into.
+pub enum Planes<'a> {
+    /// A paint layer's tiles.
+    Paint(&'a mut [Option<SharedPaintTile>]),
+    /// A mask's tiles.
+    Mask(&'a mut [SharedMaskTile]),
+}
+
+impl Planes<'_> {
+    /// The same planes, borrowed again for a call that consumes them.
+    pub fn reborrow(&mut self) -> Planes<'_> {
+        match self {
+            Self::Paint(t) => Planes::Paint(t),
+            Self::Mask(t) => Planes::Mask(t),
+        }
+    }
+}
+
+/// The same planes as they were before the operation.
+#[derive(Clone, Copy)]
+pub enum PrePlanes<'a> {
+    /// A paint layer's tiles.
+    Paint(&'a [Option<SharedPaintTile>]),
+    /// A mask's tiles.
+    Mask(&'a [SharedMaskTile]),
+}
+
+/// A tile being written, created or copied on the first texel written.
+enum Slot<'a> {
+    Paint(
+        &'a mut Option<SharedPaintTile>,
+        Option<&'a SharedPaintTile>,
+        bool,
+    ),
+    Mask(&'a mut SharedMaskTile, &'a SharedMaskTile, bool),
+}
+
+/// The data of a shared tile to write: copied (if shared) and stamped on the first write of an
+/// operation, then written in place.
+fn writable<'t, T: Clone>(tile: &'t mut Arc<Stamped<T>>, written: &mut bool) -> &'t mut T {
+    if *written {
+        // Unique since the first write: no copy, and the stamp stays.
+        return &mut Arc::make_mut(tile).data;
+    }
+    *written = true;
+    Stamped::write(tile)
+}
+
+fn empty_paint_tile() -> SharedPaintTile {
+    Arc::new(Stamped::new(PaintTile::filled(
+        MaterialValue::default(),
+        [false; 3],
+    )))
+}
+
+/// Component ranges of the three channels in an [`EditValue`].
+const RANGES: [std::ops::Range<usize>; 3] = [0..3, 3..6, 6..7];
+
+fn decode(channel: usize, bits: u16) -> f32 {
+    if channel == 2 {
+        n_bits_to_blend(bits)
+    } else {
+        decode_unorm(bits)
+    }
+}
+
+fn encode(channel: usize, value: f32) -> u16 {
+    if channel == 2 {
+        n_bits_from_blend(value)
+    } else {
+        encode_unorm(value)
+    }
+}
+
+/// The stored bits of component `k` of a tile's texel `i`.
+fn component(tile: &crate::model::tile::Tile, k: usize, i: usize) -> u16 {
+    match k {
+        0..3 => tile.kd.get(i)[k],
+        3..6 => tile.ks.get(i)[k - 3],
+        _ => tile.n.get(i),
+    }
+}
+
+impl Slot<'_> {
+    /// Writes texel `i` at coverage `a`, with the material or gray at gradient position `t`.
+    fn write(&mut self, edit: &LayerEdit, i: usize, a: f32, t: f32) {
+        match self {
+            Self::Paint(slot, pre, written) => {
+                let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
+                let target = if t == 0.0 {
+                    edit.from
+                } else {
+                    edit.from.lerp(&edit.to, t)
+                };
+                for (ch, range) in RANGES.iter().enumerate() {
+                    if !edit.channels[ch] {
+                        continue;
+                    }
+                    let pre_alpha = pre.map_or(0.0, |p| decode_unorm(p.get().alpha[ch].get(i)));
+                    let mut alpha = pre_alpha;
+                    let mut values = [0_u16; 3];
+                    for (slot, k) in range.clone().enumerate() {
+                        let pre_value =
+                            pre.map_or(0.0, |p| decode(ch, component(&p.get().value, k, i)));
+                        let out = edit.stroke.apply(
+                            LayerValue {
+                                value: pre_value,
+                                alpha: pre_alpha,
+                            },
+                            target.c[k],
+                            a,
+                        );
+                        alpha = out.alpha;
+                        values[slot] = encode(ch, out.value);
+                    }
+                    tile.alpha[ch].data_mut()[i] = encode_unorm(alpha);
+                    match ch {
+                        0 => tile.value.kd.data_mut()[i] = values,
+                        1 => tile.value.ks.data_mut()[i] = values,
+                        _ => tile.value.n.data_mut()[i] = values[0],
+                    }
+                }
+            }
+            Self::Mask(slot, pre, written) => {
+                let g = edit.gray[0] + (edit.gray[1] - edit.gray[0]) * t;
+                let g = if edit.stroke == LayerStroke::Erase {
+                    0.0
+                } else {
+                    g
+                };
+                let p = decode_unorm(pre.get().get(i));
+                let a = a.clamp(0.0, 1.0);
+                writable(slot, written).data_mut()[i] = encode_unorm(p + (g - p) * a);
+            }
+        }
+    }
+
+    /// Stores uniform planes compactly after the writes.
+    fn compact(&mut self) {
+        match self {
+            Self::Paint(Some(tile), _, written) if *written => {
+                let t = writable(tile, written);
+                t.value.compact();
+                t.alpha.iter_mut().for_each(Plane::compact);
+            }
+            Self::Mask(tile, _, written) if *written => writable(tile, written).compact(),
+            _ => {}
+        }
+    }
+}
+
+/// Writes tiles `work` (each an id and the data its visitor needs) in parallel. For each
+/// tile, `visit` calls its argument with `(texel index in the tile, coverage, t)` for every
+/// texel to write.
+pub fn edit_tiles<X: Send>(
+    planes: Planes<'_>,
+    pre: PrePlanes<'_>,
+    edit: &LayerEdit,
+    work: Vec<(usize, X)>,
+    visit: impl Fn(usize, X, &mut dyn FnMut(usize, f32, f32)) + Sync,
+) {
+    let ids: Vec<usize> = work.iter().map(|(id, _)| *id).collect();
+    let slots: Vec<Slot<'_>> = match (planes, pre) {
+        (Planes::Paint(tiles), PrePlanes::Paint(pre)) => select_mut(tiles, &ids)
+            .into_iter()
+            .zip(&ids)
+            .map(|(t, &id)| Slot::Paint(t, pre[id].as_ref(), false))
+            .collect(),
+        (Planes::Mask(tiles), PrePlanes::Mask(pre)) => select_mut(tiles, &ids)
+            .into_iter()
+            .zip(&ids)
+            .map(|(t, &id)| Slot::Mask(t, &pre[id], false))
+            .collect(),
+        _ => return,
+    };
+    slots
+        .into_par_iter()
+        .zip(work)
+        .for_each(|(mut slot, (id, data))| {
+            visit(id, data, &mut |i, a, t| slot.write(edit, i, a, t));
+            slot.compact();
+        });
+}
+
+/// Texel indices inside tile `id` of a `width x height` map, with their map coordinates.
+pub fn tile_texels(width: u32, height: u32, id: usize) -> impl Iterator<Item = (usize, u32, u32)> {
+    let tiles_x = (width as usize).div_ceil(TILE_SIZE);
+    let (x0, y0) = ((id % tiles_x) * TILE_SIZE, (id / tiles_x) * TILE_SIZE);
+    let (x1, y1) = (
+        (x0 + TILE_SIZE).min(width as usize),
+        (y0 + TILE_SIZE).min(height as usize),
+    );
+    (y0..y1).flat_map(move |y| {
+        (x0..x1).map(move |x| ((y - y0) * TILE_SIZE + (x - x0), x as u32, y as u32))
+    })
+}
+
+/// A blur of one dab: each texel moves towards the box average (premultiplied by coverage on a
+/// paint layer) of the planes around it by its weight. `weights` lists, per tile, the texels
+/// and weights the dab covers; `pre` is the planes before the dab.
+pub fn blur(
+    planes: Planes<'_>,
+    pre: PrePlanes<'_>,
+    (width, height): (u32, u32),
+    channels: [bool; 3],
+    kernel_px: u32,
+    weights: Vec<(usize, Vec<(usize, f32)>)>,
+) {
+    let tiles_x = (width as usize).div_ceil(TILE_SIZE);
+    let k = i64::from(kernel_px.max(1));
+    let locate = |x: i64, y: i64| {
+        let (x, y) = (x as usize, y as usize);
+        (
+            (y / TILE_SIZE) * tiles_x + x / TILE_SIZE,
+            (y % TILE_SIZE) * TILE_SIZE + x % TILE_SIZE,
+        )
+    };
+    // Eight sums: seven premultiplied components and, per channel, its coverage.
+    let average = |x: i64, y: i64| -> ([f32; 7], [f32; 3]) {
+        let mut sum = [0.0_f32; 7];
+        let mut cover = [0.0_f32; 3];
+        let mut count = 0.0;
+        for yy in (y - k).max(0)..=(y + k).min(i64::from(height) - 1) {
+            for xx in (x - k).max(0)..=(x + k).min(i64::from(width) - 1) {
+                let (id, i) = locate(xx, yy);
+                count += 1.0;
+                match pre {
+                    PrePlanes::Paint(tiles) => {
+                        let Some(t) = &tiles[id] else { continue };
+                        for (ch, range) in RANGES.iter().enumerate() {
+                            let a = decode_unorm(t.get().alpha[ch].get(i));
+                            cover[ch] += a;
+                            for kk in range.clone() {
+                                sum[kk] += a * decode(ch, component(&t.get().value, kk, i));
+                            }
+                        }
+                    }
+                    PrePlanes::Mask(tiles) => sum[0] += decode_unorm(tiles[id].get().get(i)),
+                }
+            }
+        }
+        (sum.map(|s| s / count), cover.map(|c| c / count))
+    };
+    let edit = LayerEdit {
+        from: EditValue { c: [0.0; 7] },
+        to: EditValue { c: [0.0; 7] },
+        channels,
+        stroke: LayerStroke::Brush(crate::model::brush::BlendMode::Normal),
+        gray: [0.0; 2],
+    };
+    // Blurred texels are computed from `pre`, then written by direct assignment.
+    let results: Blurred = weights
+        .into_par_iter()
+        .map(|(id, texels)| {
+            let x0 = ((id % tiles_x) * TILE_SIZE) as i64;
+            let y0 = ((id / tiles_x) * TILE_SIZE) as i64;
+            let out = texels
+                .into_iter()
+                .map(|(i, w)| {
+                    let (avg, cover) =
+                        average(x0 + (i % TILE_SIZE) as i64, y0 + (i / TILE_SIZE) as i64);
+                    (i, avg, cover, w.clamp(0.0, 1.0))
+                })
+                .collect();
+            (id, out)
+        })
+        .collect();
+    edit_blurred(planes, pre, &edit, results);
+}
+
+/// Per tile, its blurred texels: index, premultiplied averages, coverage averages, weight.
+type Blurred = Vec<(usize, Vec<(usize, [f32; 7], [f32; 3], f32)>)>;
+
+/// Writes blurred texels: premultiplied values and coverages move towards their averages.
+fn edit_blurred(planes: Planes<'_>, pre: PrePlanes<'_>, edit: &LayerEdit, work: Blurred) {
+    match (planes, pre) {
+        (Planes::Paint(tiles), PrePlanes::Paint(pre)) => {
+            for (id, texels) in work {
+                let slot = &mut tiles[id];
+                let pre_tile = pre[id].as_ref();
+                let tile = Stamped::write(slot.get_or_insert_with(empty_paint_tile));
+                for (i, avg, cover, w) in texels {
+                    for (ch, range) in RANGES.iter().enumerate() {
+                        if !edit.channels[ch] {
+                            continue;
+                        }
+                        let a0 = pre_tile.map_or(0.0, |p| decode_unorm(p.get().alpha[ch].get(i)));
+                        let a1 = a0 + (cover[ch] - a0) * w;
+                        tile.alpha[ch].data_mut()[i] = encode_unorm(a1);
+                        for kk in range.clone() {
+                            let v0 = pre_tile
+                                .map_or(0.0, |p| decode(ch, component(&p.get().value, kk, i)));
+                            let pm = a0 * v0 + (avg[kk] - a0 * v0) * w;
+                            let v = if a1 > 0.0 {
+                                (pm / a1).clamp(0.0, 1.0)
+                            } else {
+                                v0
+                            };
+                            let bits = encode(ch, v);
+                            match kk {
+                                0..3 => tile.value.kd.data_mut()[i][kk] = bits,
+                                3..6 => tile.value.ks.data_mut()[i][kk - 3] = bits,
+                                _ => tile.value.n.data_mut()[i] = bits,
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        (Planes::Mask(tiles), PrePlanes::Mask(pre)) => {
+            for (id, texels) in work {
+                let plane = Stamped::write(&mut tiles[id]);
+                for (i, avg, _, w) in texels {
+                    let p = decode_unorm(pre[id].get().get(i));
+                    plane.data_mut()[i] = encode_unorm(p + (avg[0] - p) * w);
+                }
+            }
+        }
+        _ => {}
+    }
+}
+
+/// A whole-map fill at full coverage in the normal mode as uniform tiles: no per-texel work
+/// and no memory. Returns false when the fill needs the per-texel path.
+pub fn fill_uniform(planes: Planes<'_>, edit: &LayerEdit, opacity: f32, tile_count: usize) -> bool {
+    let normal = edit.stroke == LayerStroke::Brush(crate::model::brush::BlendMode::Normal);
+    if opacity < 1.0 || !normal || edit.from != edit.to {
+        return false;
+    }
+    match planes {
+        Planes::Paint(tiles) => {
+            let v = &edit.from.c;
+            let value = MaterialValue::new(
+                glam::Vec3::new(v[0], v[1], v[2]),
+                glam::Vec3::new(v[3], v[4], v[5]),
+                crate::model::texel::n_from_blend(v[6]),
+            );
+            for slot in tiles.iter_mut().take(tile_count) {
+                let mut fresh = PaintTile::filled(value, edit.channels);
+                // Keep what the other channels held.
+                if let Some(old) = slot.as_ref() {
+                    let old = old.get();
+                    for ch in 0..3 {
+                        if !edit.channels[ch] {
+                            fresh.alpha[ch] = old.alpha[ch].clone();
+                            match ch {
+                                0 => fresh.value.kd = old.value.kd.clone(),
+                                1 => fresh.value.ks = old.value.ks.clone(),
+                                _ => fresh.value.n = old.value.n.clone(),
+                            }
+                        }
+                    }
+                }
+                // The fill's n is stored through the blend-space table, as brushes store it.
+                if edit.channels[2] {
+                    fresh.value.n = Plane::Uniform(n_bits_from_blend(v[6]));
+                }
+                *slot = Some(Arc::new(Stamped::new(fresh)));
+            }
+        }
+        Planes::Mask(tiles) => {
+            let g = encode_unorm(edit.gray[0]);
+            let g = if edit.stroke == LayerStroke::Erase {
+                0
+            } else {
+                g
+            };
+            for slot in tiles.iter_mut() {
+                *slot = Arc::new(Stamped::new(Plane::Uniform(g)));
+            }
+        }
+    }
+    true
+}
+
+/// Every texel of every tile, for fills and gradients: `(tile id, ())` work items.
+pub fn all_tiles(tile_count: usize) -> Vec<(usize, ())> {
+    (0..tile_count).map(|id| (id, ())).collect()
+}
+
+/// Number of texels in a tile (for per-texel fills of whole tiles).
+pub const TEXELS: usize = TILE_TEXELS;

@@ -1,0 +1,47 @@
+//! Whole-stack operations the layer commands build on: merging layers into one paint
+//! layer's tiles, and a mask from a channel's values.
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use super::{Layer, SharedMaskTile, SharedPaintTile, Stamped, merge_tile};
+use crate::model::maps::MaterialMaps;
+use crate::model::texel::{Channel, decode_n, decode_rgb};
+use crate::model::tile::{Plane, TILE_TEXELS};
+
+/// `layers` merged tile by tile into one paint layer's tiles.
+pub fn merged(layers: &[Layer], tile_count: usize) -> Vec<Option<SharedPaintTile>> {
+    (0..tile_count)
+        .into_par_iter()
+        .map(|id| merge_tile(layers, id).map(|t| Arc::new(Stamped::new(t))))
+        .collect()
+}
+
+/// A mask white where `channel` of the composite is above `threshold`.
+pub fn mask_from_channel(
+    maps: &MaterialMaps,
+    channel: Channel,
+    threshold: f32,
+) -> Vec<SharedMaskTile> {
+    (0..maps.tile_count())
+        .into_par_iter()
+        .map(|id| {
+            let tile = maps.tile(id);
+            let mut plane = Plane::Data(
+                (0..TILE_TEXELS)
+                    .map(|i| {
+                        let v = match channel {
+                            Channel::Kd => decode_rgb(tile.kd.get(i)).element_sum() / 3.0,
+                            Channel::Ks => decode_rgb(tile.ks.get(i)).element_sum() / 3.0,
+                            Channel::N => decode_n(tile.n.get(i)),
+                        };
+                        if v > threshold { u16::MAX } else { 0 }
+                    })
+                    .collect(),
+            );
+            plane.compact();
+            Arc::new(Stamped::new(plane))
+        })
+        .collect()
+}
