@@ -22,7 +22,9 @@ pub mod surface;
 pub mod texel;
 pub mod tile;
 
-pub use document::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
+pub use document::{
+    Command, Document, DocumentSettings, FillRegion, LayerKind, LayerMove, LayerRef, StrokeTool,
+};
 pub use error::ModelError;
 pub use maps::MaterialMaps;
 pub use texel::{Channel, Channels, MaterialValue};

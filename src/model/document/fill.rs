@@ -82,8 +82,8 @@ impl Document {
         let stroke = LayerStroke::Brush(self.settings.brush.blend);
         let mut target: LayerEdit =
             self.layer_edit(self.settings.primary, self.settings.secondary, stroke);
-        // On a mask, white to black.
-        target.gray = [1.0, 0.0];
+        // On a mask, white to black (as shown).
+        target.gray = [self.stored_gray(1.0), self.stored_gray(0.0)];
         let opacity = self.settings.brush.opacity;
         let (w, h) = (self.maps.width(), self.maps.height());
         let axis = end - start;

@@ -56,13 +56,31 @@ impl Document {
         stroke: LayerStroke,
     ) -> LayerEdit {
         let c = self.settings.channels;
+        // On a mask, tools reveal (white) and the eraser hides (black), as seen through the
+        // mask's inversion.
+        let shown = if stroke == LayerStroke::Erase {
+            0.0
+        } else {
+            1.0
+        };
         LayerEdit {
             from: EditValue::of(from),
             to: EditValue::of(to),
             channels: [c.kd, c.ks, c.n],
             stroke,
-            gray: [1.0, 1.0],
+            gray: [self.stored_gray(shown); 2],
         }
+    }
+
+    /// The stored gray of the selected mask that shows as `shown`.
+    pub(super) fn stored_gray(&self, shown: f32) -> f32 {
+        let inverted = self
+            .state
+            .stack
+            .layer(&self.state.selection.path)
+            .and_then(|l| l.mask.as_ref())
+            .is_some_and(|m| m.inverted);
+        if inverted { 1.0 - shown } else { shown }
     }
 
     /// One undo step that writes the selected planes: `f` gets them, the same planes as they

@@ -58,7 +58,8 @@ pub struct LayerEdit {
     pub channels: [bool; 3],
     /// How a paint layer's texel takes the material.
     pub stroke: LayerStroke,
-    /// The mask's gray at `t = 0` and `t = 1`.
+    /// The mask's stored gray at `t = 0` and `t = 1` (the caller maps white and black through
+    /// the mask's inversion).
     pub gray: [f32; 2],
 }
 
@@ -187,11 +188,6 @@ impl Slot<'_> {
             }
             Self::Mask(slot, pre, written) => {
                 let g = edit.gray[0] + (edit.gray[1] - edit.gray[0]) * t;
-                let g = if edit.stroke == LayerStroke::Erase {
-                    0.0
-                } else {
-                    g
-                };
                 let p = decode_unorm(pre.get().get(i));
                 let a = a.clamp(0.0, 1.0);
                 writable(slot, written).data_mut()[i] = encode_unorm(p + (g - p) * a);
@@ -424,11 +420,6 @@ pub fn fill_uniform(planes: Planes<'_>, edit: &LayerEdit, opacity: f32, tile_cou
         }
         Planes::Mask(tiles) => {
             let g = encode_unorm(edit.gray[0]);
-            let g = if edit.stroke == LayerStroke::Erase {
-                0
-            } else {
-                g
-            };
             for slot in tiles.iter_mut() {
                 *slot = Arc::new(Stamped::new(Plane::Uniform(g)));
             }

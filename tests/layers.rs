@@ -1,0 +1,355 @@
+//! Layers through the document, as scripts and the editor drive them: the issue's contract,
+//! painting on a layer and on its mask, hiding a layer, and undo and redo of every kind of
+//! layer operation, bit-exact.
+
+use glam::{Vec2, Vec3};
+use kapaint::model::brush::StrokePoint;
+use kapaint::model::layers::LayerContent;
+use kapaint::model::texel::{Channel, Channels, Texel};
+use kapaint::model::{Command, Document, DocumentSettings, MaterialValue};
+
+fn document() -> Document {
+    let settings = DocumentSettings {
+        base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.04), 10.0),
+        ..DocumentSettings::default()
+    };
+    Document::new(192, 128, settings).expect("document")
+}
+
+fn texels(doc: &Document) -> Vec<Texel> {
+    let m = doc.maps();
+    (0..m.height())
+        .flat_map(|y| (0..m.width()).map(move |x| (x, y)))
+        .map(|(x, y)| m.texel(x, y))
+        .collect()
+}
+
+fn run(doc: &mut Document, script: &str) {
+    #[derive(serde::Deserialize)]
+    struct Script {
+        commands: Vec<Command>,
+    }
+    let script: Script = ron::from_str(script).expect("script parses");
+    for c in script.commands {
+        let what = format!("{c:?}");
+        doc.apply(c)
+            .unwrap_or_else(|e| panic!("{}: {e}", &what[..what.len().min(80)]));
+    }
+}
+
+fn stroke(doc: &mut Document, from: Vec2, to: Vec2) {
+    let points = (0..=8)
+        .map(|k| StrokePoint {
+            pos: from.lerp(to, k as f32 / 8.0),
+            pressure: 1.0,
+        })
+        .collect();
+    doc.apply(Command::Stroke {
+        tool: kapaint::model::StrokeTool::Brush,
+        points,
+    })
+    .expect("stroke");
+}
+
+#[test]
+fn a_new_document_is_its_base_and_one_empty_paint_layer_selected() {
+    let doc = document();
+    let stack = doc.stack();
+    assert_eq!(stack.layers.len(), 1);
+    assert_eq!(stack.layers[0].props.name, "Layer 1");
+    assert!(
+        matches!(&stack.layers[0].content, LayerContent::Paint(t) if t.iter().all(Option::is_none))
+    );
+    assert_eq!(doc.selection().path, vec![0]);
+    assert!(!doc.selection().mask);
+    // An empty layer costs no tile memory, and the composite is the base.
+    assert_eq!(stack.heap_bytes(), 0);
+    assert_eq!(doc.maps().uniform_texel(), Some(Texel::encode(stack.base)));
+}
+
+#[test]
+fn hiding_a_painted_layer_returns_the_maps_to_the_state_below_bit_exactly() {
+    let mut doc = document();
+    stroke(&mut doc, Vec2::new(20.0, 20.0), Vec2::new(150.0, 90.0));
+    let below = texels(&doc);
+    run(
+        &mut doc,
+        r#"(commands: [AddLayer(kind: Paint, name: "Rust"), SetPrimary((kd: (0.4, 0.15, 0.05), ks: (0.02, 0.02, 0.02), n: 3.0))])"#,
+    );
+    stroke(&mut doc, Vec2::new(10.0, 100.0), Vec2::new(180.0, 10.0));
+    let painted = texels(&doc);
+    assert_ne!(painted, below);
+    let version = doc.version();
+    doc.apply(Command::SetLayerVisible(false)).expect("hide");
+    assert_eq!(texels(&doc), below, "hidden: the layers below, exactly");
+    assert!(doc.version() > version, "hiding is a change to save");
+    doc.apply(Command::SetLayerVisible(true)).expect("show");
+    assert_eq!(texels(&doc), painted);
+    // Undo of the show and the hide.
+    doc.apply(Command::Undo).expect("undo");
+    assert_eq!(texels(&doc), below);
+    doc.apply(Command::Undo).expect("undo");
+    assert_eq!(texels(&doc), painted);
+}
+
+#[test]
+fn the_contract_script_builds_a_base_a_masked_rust_layer_and_a_gloss_layer() {
+    let mut doc = document();
+    // The script of docs/layers.md (strokes shortened).
+    run(
+        &mut doc,
+        r#"(commands: [
+            SetPrimary((kd: (0.6, 0.6, 0.62), ks: (0.3, 0.3, 0.3), n: 200.0)),
+            Fill(All),
+            AddLayer(kind: Paint, name: "Rust"),
+            SetPrimary((kd: (0.35, 0.12, 0.04), ks: (0.02, 0.02, 0.02), n: 4.0)),
+            Fill(All),
+            AddMask,
+            InvertMask,
+            SelectMask,
+            Stroke(tool: Brush, points: [(pos: (40.0, 64.0), pressure: 1.0), (pos: (150.0, 64.0), pressure: 1.0)]),
+            SelectContent,
+            AddLayer(kind: Paint, name: "Gloss"),
+            SetLayerChannels((kd: false, ks: false, n: true)),
+            SetLayerOpacity(0.5),
+            SetLayerBlend(channel: N, mode: Normal),
+            SetPrimary((kd: (0.0, 0.0, 0.0), ks: (0.0, 0.0, 0.0), n: 1000.0)),
+            Fill(All),
+            SelectLayer("Rust"),
+            SetLayerBlend(channel: Kd, mode: Multiply),
+            SetLayerBlend(channel: Kd, mode: Normal),
+        ])"#,
+    );
+    let names: Vec<_> = doc
+        .stack()
+        .layers
+        .iter()
+        .map(|l| l.props.name.clone())
+        .collect();
+    assert_eq!(names, ["Layer 1", "Rust", "Gloss"]);
+    let m = doc.maps();
+    // Outside the mask stroke: the base fill's k_d; inside it: rust.
+    let outside = m.value(5, 5);
+    let inside = m.value(95, 64);
+    assert!((outside.kd.x - 0.6).abs() < 1e-3, "{outside:?}");
+    assert!((inside.kd.x - 0.35).abs() < 1e-3, "{inside:?}");
+    // The gloss layer changes only n: half of 1000 over 200 in log space, not the mean.
+    let expected = {
+        let u = |n: f32| (1.0 + n).ln();
+        ((u(200.0) + u(1000.0)) / 2.0).exp() - 1.0
+    };
+    assert!(
+        (outside.n - expected).abs() / expected < 0.01,
+        "{} vs {expected}",
+        outside.n
+    );
+    assert!(outside.n < 500.0, "a linear mean would give 600");
+    // Selecting by name selects; the mask commands acted on Rust's mask.
+    assert_eq!(doc.selection().path, vec![1]);
+    let rust = &doc.stack().layers[1];
+    let mask = rust.mask.as_ref().expect("mask");
+    assert!(mask.inverted && mask.enabled);
+}
+
+#[test]
+fn a_paint_layer_fill_is_opaque_in_the_enabled_channels_only() {
+    let mut doc = document();
+    doc.apply(Command::SetChannels(Channels {
+        kd: false,
+        ks: false,
+        n: true,
+    }))
+    .expect("channels");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::splat(0.9),
+        Vec3::splat(0.9),
+        500.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+        .expect("fill");
+    let v = doc.maps().value(3, 3);
+    assert!((v.kd.x - 0.5).abs() < 1e-3, "k_d stays the base's: {v:?}");
+    assert!((v.n - 500.0).abs() < 1.0, "{v:?}");
+    // Uniform fills cost no per-texel memory.
+    assert_eq!(doc.stack().heap_bytes(), 0);
+}
+
+/// Applies `command` after a setup, checks undo gives back the state before it and redo the
+/// state after it, both bit-exact (maps and stack settings).
+fn check_undo(doc: &mut Document, command: Command) {
+    let label = format!("{command:?}");
+    let before = (
+        texels(doc),
+        doc.stack().walk().len(),
+        doc.selection().clone(),
+    );
+    let steps = doc.history().undo_steps().count();
+    doc.apply(command)
+        .unwrap_or_else(|e| panic!("{label}: {e}"));
+    assert_eq!(
+        doc.history().undo_steps().count(),
+        steps + 1,
+        "{label}: one step"
+    );
+    let after = (
+        texels(doc),
+        doc.stack().walk().len(),
+        doc.selection().clone(),
+    );
+    let after_stack = doc.stack().clone();
+    doc.apply(Command::Undo).expect("undo");
+    assert_eq!(
+        (
+            texels(doc),
+            doc.stack().walk().len(),
+            doc.selection().clone()
+        ),
+        before,
+        "{label}: undo"
+    );
+    doc.apply(Command::Redo).expect("redo");
+    assert_eq!(
+        (
+            texels(doc),
+            doc.stack().walk().len(),
+            doc.selection().clone()
+        ),
+        after,
+        "{label}: redo"
+    );
+    assert!(*doc.stack() == after_stack, "{label}: the stack after redo");
+}
+
+#[test]
+fn every_layer_operation_is_one_undo_step_and_undo_and_redo_are_bit_exact() {
+    use kapaint::model::layers::LayerBlend;
+    use kapaint::model::{LayerKind, LayerMove, LayerRef};
+    let mut doc = document();
+    stroke(&mut doc, Vec2::new(10.0, 10.0), Vec2::new(120.0, 100.0));
+    let add = |kind, name: &str| Command::AddLayer {
+        kind,
+        name: name.into(),
+    };
+    check_undo(&mut doc, add(LayerKind::Paint, "Two"));
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.1, 0.7, 0.2),
+        Vec3::splat(0.2),
+        900.0,
+    )))
+    .expect("primary");
+    stroke(&mut doc, Vec2::new(100.0, 10.0), Vec2::new(20.0, 110.0));
+    for c in [
+        Command::SetLayerOpacity(0.4),
+        Command::SetLayerBlend {
+            channel: Channel::Kd,
+            mode: LayerBlend::Screen,
+        },
+        Command::SetLayerBlend {
+            channel: Channel::N,
+            mode: LayerBlend::Add,
+        },
+        Command::SetLayerChannels(Channels {
+            kd: true,
+            ks: false,
+            n: true,
+        }),
+        Command::RenameLayer("Renamed".into()),
+        Command::SetLayerLocked(true),
+        Command::SetLayerLocked(false),
+        Command::AddMask,
+        Command::InvertMask,
+        Command::MaskFromChannel {
+            channel: Channel::N,
+            threshold: 100.0,
+        },
+        Command::SetMaskEnabled(false),
+        Command::SetMaskEnabled(true),
+        Command::DuplicateLayer,
+        Command::MoveLayer(LayerMove::Down),
+        Command::MoveLayer(LayerMove::Top),
+        Command::ApplyMask,
+        Command::Group,
+        Command::Ungroup,
+        add(LayerKind::Fill, "Fill"),
+        Command::SetLayerFill(MaterialValue::new(Vec3::splat(0.2), Vec3::ZERO, 2.0)),
+        Command::AddMask,
+        Command::DeleteMask,
+        add(LayerKind::Group, "Folder"),
+    ] {
+        check_undo(&mut doc, c);
+    }
+    // Selecting is not a step.
+    doc.apply(Command::SelectLayer(LayerRef::Name("Renamed".into())))
+        .expect("select");
+    assert_eq!(doc.selection().path, vec![1]);
+    for c in [
+        Command::SetLayerVisible(false),
+        Command::SetLayerVisible(true),
+        Command::MergeDown,
+        Command::DeleteLayer,
+        Command::Flatten,
+    ] {
+        check_undo(&mut doc, c);
+    }
+    // A stroke on a mask is one step too.
+    doc.apply(Command::AddMask).expect("mask");
+    doc.apply(Command::SelectMask).expect("select mask");
+    let steps = doc.history().undo_steps().count();
+    stroke(&mut doc, Vec2::new(10.0, 60.0), Vec2::new(180.0, 60.0));
+    assert_eq!(doc.history().undo_steps().count(), steps + 1);
+}
+
+#[test]
+fn the_n_blend_refuses_modes_n_has_not_and_a_locked_layer_refuses_paint() {
+    use kapaint::model::layers::LayerBlend;
+    let mut doc = document();
+    let err = doc
+        .apply(Command::SetLayerBlend {
+            channel: Channel::N,
+            mode: LayerBlend::Screen,
+        })
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("Normal, Multiply, Add, Min, Max"), "{err}");
+    doc.apply(Command::SetLayerLocked(true)).expect("lock");
+    let before = texels(&doc);
+    let err = doc
+        .apply(Command::Fill(kapaint::model::FillRegion::All))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("locked"), "{err}");
+    assert_eq!(texels(&doc), before);
+    // A fill layer's content has no pixels to paint.
+    doc.apply(Command::AddLayer {
+        kind: kapaint::model::LayerKind::Fill,
+        name: "F".into(),
+    })
+    .expect("fill layer");
+    let err = doc
+        .apply(Command::BeginStroke(kapaint::model::StrokeTool::Brush))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("no pixels to paint"), "{err}");
+}
+
+#[test]
+fn the_eraser_on_a_layer_uncovers_the_layers_below() {
+    let mut doc = document();
+    let base = texels(&doc);
+    stroke(&mut doc, Vec2::new(20.0, 64.0), Vec2::new(170.0, 64.0));
+    assert_ne!(texels(&doc), base);
+    doc.apply(Command::Stroke {
+        tool: kapaint::model::StrokeTool::Eraser,
+        points: (0..=16)
+            .map(|k| StrokePoint {
+                pos: Vec2::new(20.0 + 150.0 * k as f32 / 16.0, 64.0),
+                pressure: 1.0,
+            })
+            .collect(),
+    })
+    .expect("erase");
+    // Where the eraser passed at full strength, the base shows again exactly.
+    let m = doc.maps();
+    assert_eq!(m.texel(95, 64), Texel::encode(doc.stack().base));
+}
