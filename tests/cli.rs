@@ -505,3 +505,57 @@ fn edit_is_listed_and_its_help_opens_no_window() {
         );
     }
 }
+
+#[test]
+fn a_paint_script_builds_layers_and_kapaint_layers_lists_them() {
+    let dir = std::env::temp_dir().join(format!("kapaint-layers-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let project = dir.join("p.kapaint");
+    let path = project.to_str().expect("path");
+    let o = kapaint(&["new", "--size", "128", "--out", path]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let script = dir.join("layers.ron");
+    std::fs::write(
+        &script,
+        r#"(commands: [
+            AddLayer(kind: Paint, name: "Rust, old"),
+            SetPrimary((kd: (0.35, 0.12, 0.04), ks: (0.02, 0.02, 0.02), n: 4.0)),
+            Stroke(tool: Brush, points: [(pos: (10.0, 64.0), pressure: 1.0), (pos: (120.0, 64.0), pressure: 1.0)]),
+            AddMask,
+            InvertMask,
+            AddLayer(kind: Fill, name: "Gloss"),
+            SetLayerChannels((kd: false, ks: false, n: true)),
+            SetLayerOpacity(0.5),
+            SetLayerBlend(channel: N, mode: Max),
+            SetLayerVisible(false),
+        ])"#,
+    )
+    .expect("script");
+    let o = kapaint(&["paint", path, "--script", script.to_str().expect("path")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = kapaint(&["layers", path]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).expect("utf-8");
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[0],
+        "index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes"
+    );
+    assert!(
+        lines[1].starts_with("0,paint,Layer 1,true,1,normal,normal,normal,none,0"),
+        "{text}"
+    );
+    assert!(
+        lines[2].starts_with("1,paint,\"Rust, old\",true,1,normal,normal,normal,inverted,"),
+        "{text}"
+    );
+    let bytes: u64 = lines[2]
+        .rsplit(',')
+        .next()
+        .and_then(|b| b.parse().ok())
+        .expect("bytes");
+    assert!(bytes > 0, "a painted layer holds tiles: {text}");
+    assert_eq!(lines[3], "2,fill,Gloss,false,0.5,off,off,max,none,0");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,6 +1,10 @@
 //! Layers through the document, as scripts and the editor drive them: the issue's contract,
 //! painting on a layer and on its mask, hiding a layer, and undo and redo of every kind of
 //! layer operation, bit-exact.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::StrokePoint;
@@ -136,7 +140,7 @@ fn the_contract_script_builds_a_base_a_masked_rust_layer_and_a_gloss_layer() {
     // The gloss layer changes only n: half of 1000 over 200 in log space, not the mean.
     let expected = {
         let u = |n: f32| (1.0 + n).ln();
-        ((u(200.0) + u(1000.0)) / 2.0).exp() - 1.0
+        f32::midpoint(u(200.0), u(1000.0)).exp() - 1.0
     };
     assert!(
         (outside.n - expected).abs() / expected < 0.01,
@@ -352,4 +356,114 @@ fn the_eraser_on_a_layer_uncovers_the_layers_below() {
     // Where the eraser passed at full strength, the base shows again exactly.
     let m = doc.maps();
     assert_eq!(m.texel(95, 64), Texel::encode(doc.stack().base));
+}
+
+fn layered() -> Document {
+    let mut doc = document();
+    stroke(&mut doc, Vec2::new(20.0, 20.0), Vec2::new(150.0, 90.0));
+    run(
+        &mut doc,
+        r#"(commands: [
+            AddLayer(kind: Paint, name: "Rust"),
+            SetPrimary((kd: (0.35, 0.12, 0.04), ks: (0.02, 0.02, 0.02), n: 4.0)),
+            Stroke(tool: Brush, points: [(pos: (10.0, 100.0), pressure: 1.0), (pos: (180.0, 10.0), pressure: 1.0)]),
+            AddMask,
+            SelectMask,
+            Stroke(tool: Eraser, points: [(pos: (60.0, 10.0), pressure: 1.0), (pos: (60.0, 120.0), pressure: 1.0)]),
+            SelectContent,
+            SetLayerOpacity(0.75),
+            SetLayerBlend(channel: N, mode: Max),
+            Group,
+            AddLayer(kind: Fill, name: "Gloss"),
+            SetLayerChannels((kd: false, ks: false, n: true)),
+            SetLayerOpacity(0.3),
+        ])"#,
+    );
+    doc
+}
+
+#[test]
+fn a_version_2_project_keeps_the_stack_and_its_composite() {
+    let doc = layered();
+    let bytes = kapaint::model::project::to_bytes(&doc).expect("save");
+    let back = kapaint::model::project::from_reader(std::io::Cursor::new(bytes)).expect("load");
+    assert_eq!(texels(&back), texels(&doc), "the composite");
+    let props = |d: &Document| {
+        d.stack()
+            .walk()
+            .into_iter()
+            .map(|(p, l)| {
+                (
+                    p,
+                    l.props.clone(),
+                    l.mask.as_ref().map(|m| (m.enabled, m.inverted)),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(props(&back), props(&doc));
+    assert_eq!(back.stack().base, doc.stack().base);
+    // The layers themselves came back: hiding the group shows the same thing in both.
+    let mut a = doc;
+    let mut b = back;
+    for d in [&mut a, &mut b] {
+        d.apply(Command::SelectPath(vec![1])).expect("select group");
+        d.apply(Command::SetLayerVisible(false)).expect("hide");
+    }
+    assert_eq!(texels(&a), texels(&b));
+}
+
+#[test]
+fn malformed_layer_data_is_one_clear_error() {
+    use std::io::Write;
+    let doc = layered();
+    let bytes = kapaint::model::project::to_bytes(&doc).expect("save");
+    // Rewrites manifest.json with `edit` applied, keeping every other entry.
+    let rewrite = |edit: &dyn Fn(&mut serde_json::Value)| -> String {
+        let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes.clone())).expect("zip");
+        let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        for i in 0..zip.len() {
+            let mut f = zip.by_index(i).expect("entry");
+            let name = f.name().expect("name").to_string();
+            let mut data = Vec::new();
+            std::io::Read::read_to_end(&mut f, &mut data).expect("read");
+            if name == "manifest.json" {
+                let mut v: serde_json::Value = serde_json::from_slice(&data).expect("json");
+                edit(&mut v);
+                data = serde_json::to_vec(&v).expect("json");
+            }
+            out.start_file(name, zip::write::SimpleFileOptions::default())
+                .expect("start");
+            out.write_all(&data).expect("write");
+        }
+        let bytes = out.finish().expect("finish").into_inner();
+        match kapaint::model::project::from_reader(std::io::Cursor::new(bytes)) {
+            Ok(_) => "loaded".into(),
+            Err(e) => e,
+        }
+    };
+    let unknown = rewrite(&|v| v["layers"][0]["kind"] = "sticker".into());
+    assert!(unknown.contains("sticker"), "{unknown}");
+    let many = rewrite(&|v| {
+        let one = v["layers"][0].clone();
+        v["layers"] = serde_json::Value::Array(vec![one; 5000]);
+    });
+    assert!(many.contains("more than 256 layers"), "{many}");
+    let mask_file = rewrite(&|v| {
+        v["layers"][1]["children"][0]["mask"]["gray"] = serde_json::json!({"kind": "image", "file": "kd.png", "encoding": "png-rgb16-unorm-linear"});
+        v["width"] = 96.into();
+    });
+    // Images larger than the manifest's size are refused by the decoder's limits.
+    assert!(
+        mask_file.contains(".png") && mask_file.contains("exceeds limit"),
+        "{mask_file}"
+    );
+    let fill_with_planes =
+        rewrite(&|v| v["layers"][2]["planes"] = v["layers"][0]["planes"].clone());
+    assert!(
+        fill_with_planes.contains("not a paint layer"),
+        "{fill_with_planes}"
+    );
+    let v1_with_layers = rewrite(&|v| v["version"] = 1.into());
+    assert!(v1_with_layers.contains("version 1"), "{v1_with_layers}");
 }

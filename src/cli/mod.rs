@@ -25,6 +25,7 @@ mod import;
 mod import_set;
 mod info;
 mod ka;
+mod layers;
 mod mesh_info;
 mod new;
 mod paint;
@@ -110,6 +111,8 @@ pub enum Command {
     New(new::NewArgs),
     /// Print a project's resolution, per-channel min/mean/max and memory.
     Info(info::InfoArgs),
+    /// List a project's layers as CSV.
+    Layers(layers::LayersArgs),
     /// Import an image (PNG, JPEG, TGA, EXR) into one channel of a project.
     Import(import::ImportArgs),
     /// Replay a paint script (RON list of commands) on a project and save it.
@@ -202,6 +205,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
         Command::Accuracy(a) => a.run(),
         Command::New(a) => a.run(),
         Command::Info(a) => a.run(),
+        Command::Layers(a) => a.run(),
         Command::Import(a) => a.run(),
         Command::Paint(a) => a.run(),
         Command::Export(a) => a.run(),

@@ -7,6 +7,7 @@
 mod command;
 mod fill;
 mod layers;
+pub use layers::MAX_LAYERS;
 mod stroke;
 
 pub use command::{
@@ -222,6 +223,11 @@ impl Document {
             settings_version: 0,
             layers_version: 0,
         }
+    }
+
+    /// Replaces the settings wholesale (a loader adjusting paths), without an undo step.
+    pub fn replace_settings(&mut self, settings: DocumentSettings) {
+        self.settings = settings;
     }
 
     /// The layer stack: read it freely; it changes only through [`Document::apply`].

@@ -314,6 +314,24 @@ impl LayerStack {
 }
 
 impl LayerStack {
+    /// Whether the stack is one plain paint layer (visible, opaque, every channel in the
+    /// normal mode, no mask): then its composite says everything about it.
+    pub fn is_flat(&self) -> bool {
+        match self.layers.as_slice() {
+            [l] => {
+                matches!(l.content, LayerContent::Paint(_))
+                    && l.mask.is_none()
+                    && l.props.visible
+                    && l.props.opacity >= 1.0
+                    && l.props
+                        .channels
+                        .iter()
+                        .all(|c| c.enabled && c.mode == LayerBlend::Normal)
+            }
+            _ => false,
+        }
+    }
+
     /// The layer at `path` (indices from the top-level list down into groups).
     pub fn layer(&self, path: &[usize]) -> Option<&Layer> {
         let (&last, parents) = path.split_last()?;

@@ -10,6 +10,7 @@
 //! everything (zip and PNG checksums, sizes, colour types, every stored value) and reports
 //! the first problem as one error; it never panics on any input.
 
+pub mod layers;
 mod read;
 mod write;
 
@@ -30,8 +31,8 @@ use write::write_project;
 /// The format name in the manifest.
 pub const FORMAT: &str = "kapaint-project";
 
-/// The manifest version this build writes and reads.
-pub const VERSION: u32 = 1;
+/// The manifest version this build writes (it reads 1 and 2).
+pub const VERSION: u32 = 2;
 
 /// Largest manifest accepted (bytes).
 const MAX_MANIFEST_BYTES: u64 = 4 << 20;
@@ -73,6 +74,13 @@ pub struct Manifest {
     pub ks: ChannelEntry,
     /// `n` storage.
     pub n: ChannelEntry,
+    /// The base material under the layers (version 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<super::texel::MaterialValue>,
+    /// The layer stack, bottom first (version 2); `kd`, `ks` and `n` then hold its composite
+    /// for readers that do not composite.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layers: Option<Vec<layers::LayerEntry>>,
 }
 
 const RGB_ENCODING: &str = "png-rgb16-unorm-linear";
@@ -234,11 +242,10 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
         path: path.to_path_buf(),
         reason,
     })?;
-    let (maps, settings) = doc.into_parts();
-    Ok(Document::from_parts(
-        maps,
-        settings_from_file(settings, path),
-    ))
+    let mut doc = doc;
+    let settings = settings_from_file(doc.settings().clone(), path);
+    doc.replace_settings(settings);
+    Ok(doc)
 }
 
 /// Whether half-float bits hold a storable exponent: finite, not negative, at most `N_MAX`.
@@ -258,11 +265,25 @@ fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
             manifest.format
         ));
     }
-    if manifest.version != VERSION {
-        return Err(format!(
-            "project version {} is not supported (this build reads version {VERSION})",
-            manifest.version
-        ));
+    match (manifest.version, &manifest.layers) {
+        (1, None) => {}
+        (2, Some(entries)) => layers::check_shape(entries, 0, &mut 0)?,
+        (1 | 2, _) => {
+            return Err(format!(
+                "a version {} project {} layers",
+                manifest.version,
+                if manifest.version == 1 {
+                    "holds no"
+                } else {
+                    "must list its"
+                }
+            ));
+        }
+        (v, _) => {
+            return Err(format!(
+                "project version {v} is not supported (this build reads versions 1 and {VERSION})"
+            ));
+        }
     }
     let (w, h) = (manifest.width, manifest.height);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {

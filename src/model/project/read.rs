@@ -34,10 +34,73 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         parse_manifest(&text)?
     };
     let (w, h) = (manifest.width, manifest.height);
+    if let Some(entries) = &manifest.layers {
+        let tile_count = MaterialMaps::new(w, h, MaterialValue::default())
+            .map_err(|e| e.to_string())?
+            .tile_count();
+        let mut read = |k: usize, e: &super::layers::LayerEntry| read_layer(&mut zip, k, e, w, h);
+        let layers = super::layers::build(entries, &mut 0, tile_count, &mut read)?;
+        let stack = crate::model::layers::LayerStack {
+            width: w,
+            height: h,
+            base: manifest.base.unwrap_or(manifest.settings.base).sanitized(),
+            layers,
+        };
+        return Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string());
+    }
     let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
     let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
     let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
-    let n_samples = match &n {
+    check_n(&n)?;
+    let settings = manifest.settings;
+    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
+    fill_maps(&mut maps, &kd, &ks, &n);
+    Ok(Document::from_parts(maps, settings))
+}
+
+/// Reads the maps of layer `k`: values and coverage for a painted paint layer, and its mask.
+fn read_layer<R: Read + Seek>(
+    zip: &mut zip::ZipArchive<R>,
+    k: usize,
+    e: &super::layers::LayerEntry,
+    w: u32,
+    h: u32,
+) -> Result<super::layers::LayerMaps, String> {
+    let name = |part: &str| format!("layer {k} ({:?}) {part}", e.name);
+    let zero3 = Raster::Uniform(vec![0; 3]);
+    let zero1 = Raster::Uniform(vec![0]);
+    let mut out = super::layers::LayerMaps {
+        stem: format!("layer{k}"),
+        values: None,
+        alpha: None,
+        mask: None,
+    };
+    let new_maps = || MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string());
+    if let Some(p) = &e.planes {
+        let kd = read_channel(zip, &p.kd, &name("kd"), w, h, 3)?;
+        let ks = read_channel(zip, &p.ks, &name("ks"), w, h, 3)?;
+        let n = read_channel(zip, &p.n, &name("n"), w, h, 1)?;
+        check_n(&n)?;
+        let alpha = read_channel(zip, &p.alpha, &name("coverage"), w, h, 3)?;
+        let mut values = new_maps()?;
+        fill_maps(&mut values, &kd, &ks, &n);
+        let mut cover = new_maps()?;
+        fill_maps(&mut cover, &alpha, &zero3, &zero1);
+        out.values = Some(values);
+        out.alpha = Some(cover);
+    }
+    if let Some(m) = &e.mask {
+        let gray = read_channel(zip, &m.gray, &name("mask"), w, h, 3)?;
+        let mut mask = new_maps()?;
+        fill_maps(&mut mask, &gray, &zero3, &zero1);
+        out.mask = Some(mask);
+    }
+    Ok(out)
+}
+
+/// Refuses stored exponents that are not valid half floats in range.
+fn check_n(n: &Raster) -> Result<(), String> {
+    let n_samples = match n {
         Raster::Uniform(v) | Raster::Gray(v) | Raster::Rgb(v) => v,
     };
     if let Some(bad) = n_samples.par_iter().find_any(|&&bits| !valid_n_bits(bits)) {
@@ -45,10 +108,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             "n holds an invalid exponent (half-float bits {bad:#06x})"
         ));
     }
-    let settings = manifest.settings;
-    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
-    fill_maps(&mut maps, &kd, &ks, &n);
-    Ok(Document::from_parts(maps, settings))
+    Ok(())
 }
 
 fn read_channel<R: Read + Seek>(

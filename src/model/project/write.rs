@@ -73,6 +73,49 @@ fn encode_png(raster: &Raster, width: u32, height: u32) -> Result<Vec<u8>, Strin
     Ok(bytes)
 }
 
+/// The three channels of `maps` as rasters (a constant where uniform), named `{prefix}kd`,
+/// `{prefix}ks` and `{prefix}n`.
+fn channel_rasters(maps: &MaterialMaps, prefix: &str) -> [(String, Raster); 3] {
+    [
+        (
+            format!("{prefix}kd"),
+            channel_uniform(maps, |t| &t.kd).map_or_else(
+                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.kd, |v| v)),
+                |v| Raster::Uniform(v.to_vec()),
+            ),
+        ),
+        (
+            format!("{prefix}ks"),
+            channel_uniform(maps, |t| &t.ks).map_or_else(
+                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.ks, |v| v)),
+                |v| Raster::Uniform(v.to_vec()),
+            ),
+        ),
+        (
+            format!("{prefix}n"),
+            channel_uniform(maps, |t| &t.n).map_or_else(
+                || Raster::Gray(rasterize::<1, _>(maps, |t| &t.n, |v| [v])),
+                |v| Raster::Uniform(vec![v]),
+            ),
+        ),
+    ]
+}
+
+/// How the manifest names a raster.
+fn entry((name, raster): &(String, Raster)) -> ChannelEntry {
+    match raster {
+        Raster::Uniform(v) => ChannelEntry::Uniform { value: v.clone() },
+        Raster::Rgb(_) => ChannelEntry::Image {
+            file: format!("{name}.png"),
+            encoding: RGB_ENCODING.into(),
+        },
+        Raster::Gray(_) => ChannelEntry::Image {
+            file: format!("{name}.png"),
+            encoding: N_ENCODING.into(),
+        },
+    }
+}
+
 /// Serialises a document into project bytes (what [`save`](super::save) writes).
 pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
     let mut cursor = std::io::Cursor::new(Vec::new());
@@ -93,44 +136,36 @@ pub(super) fn write_project(
 ) -> Result<(), String> {
     let maps = doc.maps();
     let (w, h) = (maps.width(), maps.height());
-    let rasters: Vec<(&str, Raster)> = vec![
-        (
-            "kd",
-            channel_uniform(maps, |t| &t.kd).map_or_else(
-                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.kd, |v| v)),
-                |v| Raster::Uniform(v.to_vec()),
-            ),
-        ),
-        (
-            "ks",
-            channel_uniform(maps, |t| &t.ks).map_or_else(
-                || Raster::Rgb(rasterize::<3, _>(maps, |t| &t.ks, |v| v)),
-                |v| Raster::Uniform(v.to_vec()),
-            ),
-        ),
-        (
-            "n",
-            channel_uniform(maps, |t| &t.n).map_or_else(
-                || Raster::Gray(rasterize::<1, _>(maps, |t| &t.n, |v| [v])),
-                |v| Raster::Uniform(vec![v]),
-            ),
-        ),
-    ];
+    let mut rasters: Vec<(String, Raster)> = channel_rasters(maps, "").into();
+    let layer_maps = super::layers::layer_maps(doc.stack())?;
+    let mut stored = Vec::new();
+    for l in &layer_maps {
+        let mut planes = None;
+        if let (Some(v), Some(a)) = (&l.values, &l.alpha) {
+            let at = rasters.len();
+            rasters.extend(channel_rasters(v, &format!("{}_", l.stem)));
+            let [alpha, _, _] = channel_rasters(a, &format!("{}_alpha_", l.stem));
+            rasters.push(alpha);
+            planes = Some(super::layers::PlanesEntry {
+                kd: entry(&rasters[at]),
+                ks: entry(&rasters[at + 1]),
+                n: entry(&rasters[at + 2]),
+                alpha: entry(&rasters[at + 3]),
+            });
+        }
+        let mask = l.mask.as_ref().map(|m| {
+            let [gray, _, _] = channel_rasters(m, &format!("{}_mask_", l.stem));
+            let e = entry(&gray);
+            rasters.push(gray);
+            e
+        });
+        stored.push((planes, mask));
+    }
     let pngs: Vec<Result<Vec<u8>, String>> = rasters
         .par_iter()
         .map(|(_, r)| encode_png(r, w, h))
         .collect();
-    let entry = |(name, raster): &(&str, Raster)| match raster {
-        Raster::Uniform(v) => ChannelEntry::Uniform { value: v.clone() },
-        Raster::Rgb(_) => ChannelEntry::Image {
-            file: format!("{name}.png"),
-            encoding: RGB_ENCODING.into(),
-        },
-        Raster::Gray(_) => ChannelEntry::Image {
-            file: format!("{name}.png"),
-            encoding: N_ENCODING.into(),
-        },
-    };
+    let layers = super::layers::entries(&doc.stack().layers, &mut 0, &|k| stored[k].clone());
     let manifest = Manifest {
         format: FORMAT.into(),
         version: VERSION,
@@ -140,12 +175,16 @@ pub(super) fn write_project(
         kd: entry(&rasters[0]),
         ks: entry(&rasters[1]),
         n: entry(&rasters[2]),
+        base: Some(doc.stack().base),
+        layers: Some(layers),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
     // Never write what the loader would refuse: the manifest goes through the loader's own
     // checks, and every stored exponent through its test, before a byte is written.
     parse_manifest(&json).map_err(|e| format!("the project would not load back ({e})"))?;
-    if let Some(bits) = invalid_n_in(maps) {
+    let mut all_maps = vec![maps];
+    all_maps.extend(layer_maps.iter().filter_map(|l| l.values.as_ref()));
+    if let Some(bits) = all_maps.into_iter().find_map(invalid_n_in) {
         return Err(format!(
             "the project would not load back (n holds half-float bits {bits:#06x})"
         ));
@@ -153,7 +192,7 @@ pub(super) fn write_project(
     let mut zip = zip::ZipWriter::new(out);
     let deflated = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated);
-    let stored = zip::write::SimpleFileOptions::default()
+    let stored_file = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Stored)
         .large_file(true);
     zip.start_file("manifest.json", deflated)
@@ -162,7 +201,7 @@ pub(super) fn write_project(
     for ((name, raster), png) in rasters.iter().zip(pngs) {
         let png = png?;
         if !matches!(raster, Raster::Uniform(_)) {
-            zip.start_file(format!("{name}.png"), stored)
+            zip.start_file(format!("{name}.png"), stored_file)
                 .map_err(|e| e.to_string())?;
             zip.write_all(&png).map_err(|e| e.to_string())?;
         }

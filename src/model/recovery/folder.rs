@@ -107,6 +107,10 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
 /// `doc` with every whole, valid record of `journal` replayed on it (up to the first that
 /// is not).
 fn replay(doc: Document, journal: &Path, base: &Path) -> Document {
+    if !std::fs::metadata(journal).is_ok_and(|m| m.len() > JOURNAL_MAGIC.len() as u64) {
+        // No record: the generation as written, layers and all.
+        return doc;
+    }
     let (mut maps, mut settings) = doc.into_parts();
     if let Ok(mut file) = std::fs::File::open(journal) {
         let mut magic = [0_u8; 8];

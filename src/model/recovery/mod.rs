@@ -143,7 +143,9 @@ impl Autosaver {
         let maps_version = doc.maps().version();
         let append = self
             .generation
-            .filter(|g| g.size == size && g.journal_bytes <= g.base_bytes.max(64 << 20));
+            .filter(|g| g.size == size && g.journal_bytes <= g.base_bytes.max(64 << 20))
+            // The journal holds composite tiles: only a stack of one plain layer is that.
+            .filter(|_| doc.stack().is_flat());
         let dir = self.path.clone();
         let work: Box<dyn FnOnce() -> Outcome + Send> = if let Some(generation) = append {
             let tiles: Vec<(usize, Arc<Tile>)> = doc
