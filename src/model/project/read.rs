@@ -46,7 +46,30 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             base: manifest.base.unwrap_or(manifest.settings.base).sanitized(),
             layers,
         };
-        return Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string());
+        let doc = Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string())?;
+        // The stored composite is read too: every entry's checksum is checked, and it must
+        // be what the layers composite to.
+        let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
+        let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
+        let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
+        check_n(&n)?;
+        let mut stored =
+            MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
+        fill_maps(&mut stored, &kd, &ks, &n);
+        let differs = |id: usize| {
+            let (a, b) = (stored.tile(id), doc.maps().tile(id));
+            let r = stored.tile_rect(id);
+            (r.y0..r.y1).any(|y| {
+                (r.x0..r.x1).any(|x| {
+                    let i = (y - r.y0) as usize * TILE_SIZE + (x - r.x0) as usize;
+                    a.texel(i) != b.texel(i)
+                })
+            })
+        };
+        if (0..stored.tile_count()).into_par_iter().any(differs) {
+            return Err("the stored composite differs from what the layers composite to".into());
+        }
+        return Ok(doc);
     }
     let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
     let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
