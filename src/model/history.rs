@@ -4,33 +4,26 @@
 //! no copy). Ending it stores those tiles as one step. Undo swaps them back into the maps and
 //! keeps the swapped-out tiles for redo, so both directions are bit-exact and cost only the
 //! tiles the step touched. A memory cap drops the oldest steps.
+//!
+//! The document keeps layer-stack snapshots instead ([`super::layers::StackHistory`]); this
+//! transaction recorder serves the flat-maps paint engine ([`super::paint`]).
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 
 use super::maps::{MaterialMaps, TileId};
-use super::surface::Surface;
 use super::tile::Tile;
 
 /// Default cap on the memory history may hold: 1 GiB.
 pub const DEFAULT_UNDO_CAP_BYTES: usize = 1 << 30;
 
-/// One undoable step: the tiles it replaced, or the whole maps (and the surface baked for
-/// them) it replaced with maps of another size.
+/// One undoable step: the tiles it replaced.
 #[derive(Clone, Debug)]
 pub struct Step {
     /// What the step did, for the history panel.
     pub label: String,
     tiles: Vec<(TileId, Arc<Tile>)>,
-    whole: Option<Box<Whole>>,
     bytes: usize,
-}
-
-/// Maps swapped in whole, with their surface.
-#[derive(Clone, Debug)]
-struct Whole {
-    maps: MaterialMaps,
-    surface: Option<Arc<Surface>>,
 }
 
 impl Step {
@@ -50,33 +43,12 @@ impl Step {
         Self {
             label,
             tiles,
-            whole: None,
             bytes,
         }
     }
 
-    fn new_whole(label: String, maps: MaterialMaps, surface: Option<Arc<Surface>>) -> Self {
-        Self {
-            label,
-            tiles: Vec::new(),
-            bytes: maps.heap_bytes(),
-            whole: Some(Box::new(Whole { maps, surface })),
-        }
-    }
-
-    /// Swaps the step's tiles (or whole maps and surface) with the document's and returns the
-    /// step that reverses it.
-    fn apply(self, maps: &mut MaterialMaps, surface: &mut Option<Arc<Surface>>) -> Self {
-        if let Some(whole) = self.whole {
-            let Whole {
-                maps: mut incoming,
-                surface: incoming_surface,
-            } = *whole;
-            incoming.stamp_after(maps.version());
-            let old = std::mem::replace(maps, incoming);
-            let old_surface = std::mem::replace(surface, incoming_surface);
-            return Self::new_whole(self.label, old, old_surface);
-        }
+    /// Swaps the step's tiles with the maps' and returns the step that reverses it.
+    fn apply(self, maps: &mut MaterialMaps) -> Self {
         let tiles = self
             .tiles
             .into_iter()
@@ -195,39 +167,23 @@ impl History {
         }
     }
 
-    /// Records maps replaced whole (by maps of another size) as one step: `old` and the
-    /// surface baked for them come back on undo. An open transaction is ended first.
-    pub fn push_whole(
-        &mut self,
-        label: impl Into<String>,
-        old: MaterialMaps,
-        old_surface: Option<Arc<Surface>>,
-    ) {
-        self.end();
-        self.redo.clear();
-        self.undo
-            .push_back(Step::new_whole(label.into(), old, old_surface));
-        self.enforce_cap();
-    }
-
-    /// Undoes the last step; false if there is none. `surface` is swapped too where the
-    /// step replaced the maps whole.
-    pub fn undo(&mut self, maps: &mut MaterialMaps, surface: &mut Option<Arc<Surface>>) -> bool {
+    /// Undoes the last step; false if there is none.
+    pub fn undo(&mut self, maps: &mut MaterialMaps) -> bool {
         self.end();
         let Some(step) = self.undo.pop_back() else {
             return false;
         };
-        self.redo.push(step.apply(maps, surface));
+        self.redo.push(step.apply(maps));
         true
     }
 
     /// Redoes the last undone step; false if there is none.
-    pub fn redo(&mut self, maps: &mut MaterialMaps, surface: &mut Option<Arc<Surface>>) -> bool {
+    pub fn redo(&mut self, maps: &mut MaterialMaps) -> bool {
         self.end();
         let Some(step) = self.redo.pop() else {
             return false;
         };
-        self.undo.push_back(step.apply(maps, surface));
+        self.undo.push_back(step.apply(maps));
         self.enforce_cap();
         true
     }
@@ -300,15 +256,15 @@ mod tests {
         history.end();
         let after = maps.clone();
         assert_eq!(history.undo_steps().next().map(Step::tile_count), Some(2));
-        assert!(history.undo(&mut maps, &mut None));
+        assert!(history.undo(&mut maps));
         for id in 0..maps.tile_count() {
             assert_eq!(**maps.tile(id), **before.tile(id));
         }
-        assert!(history.redo(&mut maps, &mut None));
+        assert!(history.redo(&mut maps));
         for id in 0..maps.tile_count() {
             assert_eq!(**maps.tile(id), **after.tile(id));
         }
-        assert!(!history.redo(&mut maps, &mut None));
+        assert!(!history.redo(&mut maps));
     }
 
     #[test]
@@ -320,7 +276,7 @@ mod tests {
         write(&mut history, &mut maps, 0, 99);
         history.abort(&mut maps);
         assert_eq!(**maps.tile(0), *before);
-        assert!(!history.undo(&mut maps, &mut None));
+        assert!(!history.undo(&mut maps));
     }
 
     #[test]

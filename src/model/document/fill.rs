@@ -6,7 +6,7 @@ use glam::Vec2;
 use super::{Document, FillRegion};
 use crate::model::ModelError;
 use crate::model::layers::LayerStroke;
-use crate::model::layers::edit::{self, LayerEdit, tile_texels};
+use crate::model::layers::edit::{self, LayerEdit};
 use crate::model::paint::{self, GradientShape};
 
 impl Document {
@@ -52,19 +52,10 @@ impl Document {
                 return;
             }
             let mask = mask.as_deref();
-            edit::edit_tiles(
-                planes,
-                pre,
-                &target,
-                edit::all_tiles(count),
-                |id, (), write| {
-                    for (i, x, y) in tile_texels(w, h, id) {
-                        if mask.is_none_or(|m| m[y as usize * w as usize + x as usize]) {
-                            write(i, opacity, 0.0);
-                        }
-                    }
-                },
-            );
+            edit::edit_texels(planes, pre, &target, (w, h), |x, y| {
+                mask.is_none_or(|m| m[y as usize * w as usize + x as usize])
+                    .then_some((opacity, 0.0))
+            });
         })
     }
 
@@ -88,25 +79,15 @@ impl Document {
         let (w, h) = (self.maps.width(), self.maps.height());
         let axis = end - start;
         let len2 = axis.length_squared().max(1e-12);
-        self.edit_planes("Gradient", |planes, pre, count| {
-            edit::edit_tiles(
-                planes,
-                pre,
-                &target,
-                edit::all_tiles(count),
-                |id, (), write| {
-                    for (i, x, y) in tile_texels(w, h, id) {
-                        let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - start;
-                        let t = match shape {
-                            GradientShape::Linear => p.dot(axis) / len2,
-                            GradientShape::Radial => (p.length_squared() / len2).sqrt(),
-                        }
-                        .clamp(0.0, 1.0);
-                        // `t = 0` means "the start material" to the kernel; keep it exact there.
-                        write(i, opacity, t);
-                    }
-                },
-            );
+        self.edit_planes("Gradient", |planes, pre, _| {
+            edit::edit_texels(planes, pre, &target, (w, h), |x, y| {
+                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - start;
+                let t = match shape {
+                    GradientShape::Linear => p.dot(axis) / len2,
+                    GradientShape::Radial => (p.length_squared() / len2).sqrt(),
+                };
+                Some((opacity, t.clamp(0.0, 1.0)))
+            });
         })
     }
 }

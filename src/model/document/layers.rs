@@ -1,14 +1,12 @@
 //! The layer commands, and the editing of the selected layer's planes by fills, gradients and
 //! imports. Each command that changes the stack is one undo step.
 
-use std::sync::Arc;
-
 use super::{Command, Document, LayerKind, LayerMove, LayerRef};
 use crate::model::ModelError;
 use crate::model::import::ChannelPlanes;
 use crate::model::layers::edit::{EditValue, LayerEdit, Planes, PrePlanes};
 use crate::model::layers::{
-    Layer, LayerContent, LayerStack, LayerStroke, Mask, PaintTile, Stamped, State, channel_index,
+    Layer, LayerContent, LayerStack, LayerStroke, Mask, Stamped, State, channel_index,
 };
 use crate::model::texel::{Channel, MaterialValue};
 use crate::model::tile::Plane;
@@ -160,7 +158,9 @@ impl Document {
         self.edit_planes(&label, |planes, _, _| {
             let Planes::Paint(tiles) = planes else { return };
             for (id, slot) in tiles.iter_mut().enumerate() {
-                let tile = Stamped::write(slot.get_or_insert_with(empty_paint_tile));
+                let tile = Stamped::write(
+                    slot.get_or_insert_with(crate::model::layers::edit::empty_paint_tile),
+                );
                 match imported {
                     ChannelPlanes::Rgb(Channel::Ks, p) => {
                         tile.value.ks = p[id].clone();
@@ -486,13 +486,6 @@ impl Document {
 
 fn no_layer() -> ModelError {
     command_error("no layer is selected")
-}
-
-fn empty_paint_tile() -> crate::model::layers::SharedPaintTile {
-    Arc::new(Stamped::new(PaintTile::filled(
-        MaterialValue::default(),
-        [false; 3],
-    )))
 }
 
 fn selected_mut(st: &mut State) -> Result<&mut Layer, ModelError> {

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile, Stamped};
 use crate::model::paint::{n_bits_from_blend, n_bits_to_blend};
 use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
-use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, select_mut};
+use crate::model::tile::{Plane, TILE_SIZE, select_mut};
 
 /// A material as the layer kernels blend it: `k_d`, `k_s` linear, `n` in blend space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,7 +111,8 @@ fn writable<'t, T: Clone>(tile: &'t mut Arc<Stamped<T>>, written: &mut bool) -> 
     Stamped::write(tile)
 }
 
-fn empty_paint_tile() -> SharedPaintTile {
+/// A paint tile nobody painted yet (transparent), to write into.
+pub(crate) fn empty_paint_tile() -> SharedPaintTile {
     Arc::new(Stamped::new(PaintTile::filled(
         MaterialValue::default(),
         [false; 3],
@@ -301,13 +302,6 @@ pub fn blur(
         }
         (sum.map(|s| s / count), cover.map(|c| c / count))
     };
-    let edit = LayerEdit {
-        from: EditValue { c: [0.0; 7] },
-        to: EditValue { c: [0.0; 7] },
-        channels,
-        stroke: LayerStroke::Brush(crate::model::brush::BlendMode::Normal),
-        gray: [0.0; 2],
-    };
     // Blurred texels are computed from `pre`, then written by direct assignment.
     let results: Blurred = weights
         .into_par_iter()
@@ -325,14 +319,14 @@ pub fn blur(
             (id, out)
         })
         .collect();
-    edit_blurred(planes, pre, &edit, results);
+    edit_blurred(planes, pre, channels, results);
 }
 
 /// Per tile, its blurred texels: index, premultiplied averages, coverage averages, weight.
 type Blurred = Vec<(usize, Vec<(usize, [f32; 7], [f32; 3], f32)>)>;
 
 /// Writes blurred texels: premultiplied values and coverages move towards their averages.
-fn edit_blurred(planes: Planes<'_>, pre: PrePlanes<'_>, edit: &LayerEdit, work: Blurred) {
+fn edit_blurred(planes: Planes<'_>, pre: PrePlanes<'_>, channels: [bool; 3], work: Blurred) {
     match (planes, pre) {
         (Planes::Paint(tiles), PrePlanes::Paint(pre)) => {
             for (id, texels) in work {
@@ -341,7 +335,7 @@ fn edit_blurred(planes: Planes<'_>, pre: PrePlanes<'_>, edit: &LayerEdit, work: 
                 let tile = Stamped::write(slot.get_or_insert_with(empty_paint_tile));
                 for (i, avg, cover, w) in texels {
                     for (ch, range) in RANGES.iter().enumerate() {
-                        if !edit.channels[ch] {
+                        if !channels[ch] {
                             continue;
                         }
                         let a0 = pre_tile.map_or(0.0, |p| decode_unorm(p.get().alpha[ch].get(i)));
@@ -428,10 +422,22 @@ pub fn fill_uniform(planes: Planes<'_>, edit: &LayerEdit, opacity: f32, tile_cou
     true
 }
 
-/// Every texel of every tile, for fills and gradients: `(tile id, ())` work items.
-pub fn all_tiles(tile_count: usize) -> Vec<(usize, ())> {
-    (0..tile_count).map(|id| (id, ())).collect()
+/// Writes every texel of a `width x height` map that `at(x, y)` gives a coverage and gradient
+/// position for (fills and gradients).
+pub fn edit_texels(
+    planes: Planes<'_>,
+    pre: PrePlanes<'_>,
+    edit: &LayerEdit,
+    (width, height): (u32, u32),
+    at: impl Fn(u32, u32) -> Option<(f32, f32)> + Sync,
+) {
+    let tiles = (width as usize).div_ceil(TILE_SIZE) * (height as usize).div_ceil(TILE_SIZE);
+    let work = (0..tiles).map(|id| (id, ())).collect();
+    edit_tiles(planes, pre, edit, work, |id, (), write| {
+        for (i, x, y) in tile_texels(width, height, id) {
+            if let Some((a, t)) = at(x, y) {
+                write(i, a, t);
+            }
+        }
+    });
 }
-
-/// Number of texels in a tile (for per-texel fills of whole tiles).
-pub const TEXELS: usize = TILE_TEXELS;

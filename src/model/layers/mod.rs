@@ -247,12 +247,7 @@ impl Layer {
             return None;
         };
         let slot = tiles.get_mut(id)?;
-        let tile = slot.get_or_insert_with(|| {
-            Arc::new(Stamped::new(PaintTile::filled(
-                MaterialValue::default(),
-                [false; 3],
-            )))
-        });
+        let tile = slot.get_or_insert_with(edit::empty_paint_tile);
         Some(Stamped::write(tile))
     }
 
