@@ -191,7 +191,7 @@ fn a_scripted_editing_session() {
     // The export dialog opens from its hotkey and offers the presets. (Its preview is
     // planned on a worker thread and the dialog repaints until it arrives, so frames are
     // stepped, not run until idle: on a loaded machine that takes more than a few frames.)
-    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
     harness.step();
     harness.step();
     harness.get_by_role_and_label(Role::Button, "Export");
@@ -599,7 +599,7 @@ fn exporting_over_a_set_asks_then_replaces_and_keeps_the_choices() {
     };
 
     let mut harness = editor();
-    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
     harness.step();
     harness.step();
     let field = harness
@@ -660,7 +660,7 @@ fn exporting_over_a_set_asks_then_replaces_and_keeps_the_choices() {
         "the new set replaced the old"
     );
     // The next export offers the same folder.
-    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
     harness.step();
     harness.step();
     assert!(

@@ -144,7 +144,7 @@ fn every_file_request_reaches_its_command() {
             .is_some_and(|d| d.mesh.ends_with("spot_triangulated.obj"))
     });
 
-    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::E);
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
     harness.run_steps(2);
     harness.get_by_role_and_label(Role::Button, "…").click();
     harness.run_steps(2);

@@ -23,7 +23,8 @@ pub mod texel;
 pub mod tile;
 
 pub use document::{
-    Command, Document, DocumentSettings, FillRegion, LayerKind, LayerMove, LayerRef, StrokeTool,
+    Command, Document, DocumentSettings, FillRegion, LayerKind, LayerMove, LayerPlace, LayerRef,
+    StrokeTool,
 };
 pub use error::ModelError;
 pub use maps::MaterialMaps;

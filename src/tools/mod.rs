@@ -151,7 +151,8 @@ pub struct Tools {
     pub fill: Fill,
     /// The gradient tool and its options.
     pub gradient: Gradient,
-    picker: Picker,
+    /// The picker and its option.
+    pub picker: Picker,
 }
 
 impl Tools {

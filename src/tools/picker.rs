@@ -1,5 +1,5 @@
 //! The picker: a press reads every channel under the pointer into the primary material, on
-//! the UV canvas or on the mesh.
+//! the UV canvas or on the mesh: of the composite, or (an option) of the selected layer.
 
 use crate::model::{Command, Document};
 
@@ -7,7 +7,10 @@ use super::{Tool, ToolEvent};
 
 /// The picker tool.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Picker;
+pub struct Picker {
+    /// Read the selected layer (its covered channels) rather than the composite.
+    pub from_layer: bool,
+}
 
 impl Tool for Picker {
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
@@ -15,7 +18,13 @@ impl Tool for Picker {
         match event {
             ToolEvent::Press { at, .. } | ToolEvent::Drag { at, .. } => at
                 .texel_index(size)
-                .map(|(x, y)| Command::Pick { x, y })
+                .map(|(x, y)| {
+                    if self.from_layer {
+                        Command::PickLayer { x, y }
+                    } else {
+                        Command::Pick { x, y }
+                    }
+                })
                 .into_iter()
                 .collect(),
             ToolEvent::Release | ToolEvent::Escape => Vec::new(),

@@ -8,9 +8,11 @@ use std::time::{Duration, Instant};
 use egui_dock::{DockArea, DockState, TabViewer};
 
 use super::canvas::Canvas;
+use super::canvas::CanvasChannel;
 use super::dialogs::load_recent;
 use super::jobs::new_document;
 use super::layout::{load_layout, save_layout};
+use super::panels::layers::LayerView;
 use super::viewport::{Viewport, ViewportGpu};
 use super::{
     DEFAULT_SIZE, EditorState, MeshState, Quit, Tab, autosave_interval, default_layout, files,
@@ -132,6 +134,8 @@ impl Editor {
                 naming: None,
                 preset_dir,
                 autosaver,
+                layers_panel: super::panels::layers::PanelState::default(),
+                layer_view: LayerView::Composite,
             },
             dock,
             started: None,
@@ -168,6 +172,7 @@ impl TabViewer for Tabs<'_> {
         match tab {
             Tab::Viewport => "3D viewport".into(),
             Tab::Canvas => "UV canvas".into(),
+            Tab::Layers => "Layers".into(),
         }
     }
 
@@ -183,16 +188,33 @@ impl TabViewer for Tabs<'_> {
         let s = &mut *self.0;
         match tab {
             Tab::Viewport => {
-                let settings = s.frame_settings();
+                let mut settings = s.frame_settings();
+                if s.layer_view == LayerView::Mask {
+                    settings.view = ViewMode::Kd;
+                }
                 let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
-                let (response, rect) = s.viewport.show(ui, &s.doc, &mesh, &settings);
+                let maps = s.layers_panel.view_maps.get(&s.doc, s.layer_view);
+                let (response, rect) = s.viewport.show(ui, maps, &mesh, &settings);
+                s.painting_label(ui, rect);
                 s.viewport_input(&response, rect);
             }
             Tab::Canvas => {
                 let lines = std::mem::take(&mut s.mesh.uv_lines);
-                let (response, rect) = s.canvas.show(ui, &s.doc, &lines);
+                let channel = s.canvas.channel;
+                if s.layer_view == LayerView::Mask {
+                    s.canvas.channel = CanvasChannel::Kd;
+                }
+                let maps = s.layers_panel.view_maps.get(&s.doc, s.layer_view);
+                let (response, rect) = s.canvas.show(ui, &s.doc, maps, &lines);
+                s.canvas.channel = channel;
                 s.mesh.uv_lines = lines;
+                s.painting_label(ui, rect);
                 s.canvas_input(&response, rect);
+            }
+            Tab::Layers => {
+                egui::ScrollArea::vertical()
+                    .id_salt("layers tab")
+                    .show(ui, |ui| s.layers_ui(ui));
             }
         }
     }

@@ -99,14 +99,21 @@ fn tile_image(
 }
 
 impl Canvas {
-    /// Brings the texture up to date with the maps: changed tiles only, unless the size,
-    /// channel or shading settings changed. Returns the tiles uploaded.
-    pub fn sync(&mut self, ctx: &egui::Context, doc: &Document) -> usize {
-        let maps = doc.maps();
+    /// Brings the texture up to date with `maps` (the document's composite, or a layer view's
+    /// maps, `source` telling them apart): changed tiles only, unless the size, channel,
+    /// source or shading settings changed. Returns the tiles uploaded.
+    pub fn sync(
+        &mut self,
+        ctx: &egui::Context,
+        doc: &Document,
+        maps: &MaterialMaps,
+        source: u64,
+    ) -> usize {
         let size = (maps.width(), maps.height());
         // k_a depends on the model and approximation too.
-        let settings_key =
-            u64::from(doc.settings().model as u8) << 8 | doc.settings().approx as u64;
+        let settings_key = source << 16
+            | u64::from(doc.settings().model as u8) << 8
+            | doc.settings().approx as u64;
         let options = TextureOptions::NEAREST;
         match (&mut self.texture, self.mirrored) {
             (Some(tex), Some((version, channel, s, key)))
@@ -181,14 +188,15 @@ impl Canvas {
         &mut self,
         ui: &mut egui::Ui,
         doc: &Document,
+        (maps, source): (&MaterialMaps, u64),
         uv_lines: &[[glam::Vec2; 2]],
     ) -> (egui::Response, Rect) {
-        self.sync(ui.ctx(), doc);
+        self.sync(ui.ctx(), doc, maps, source);
         let (panel, response) =
             ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Other, true, CANVAS_LABEL));
-        let size = (doc.maps().width(), doc.maps().height());
+        let size = (maps.width(), maps.height());
         // Zoom about the cursor; pan with the middle button or space + drag.
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);

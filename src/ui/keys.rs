@@ -47,6 +47,12 @@ pub enum Action {
     Abort,
     /// Show the keyboard shortcuts.
     Shortcuts,
+    /// A new paint layer above the selected one.
+    NewLayer,
+    /// Duplicate the selected layer.
+    DuplicateLayer,
+    /// Merge the selected layer down.
+    MergeDown,
 }
 
 /// One key binding.
@@ -86,8 +92,11 @@ pub const KEYMAP: &[Binding] = &[
     bind(CTRL_SHIFT, Key::S, Action::SaveAs, "save as"),
     bind(CTRL, Key::S, Action::Save, "save"),
     bind(CTRL, Key::O, Action::Open, "open"),
+    bind(CTRL_SHIFT, Key::N, Action::NewLayer, "new layer"),
     bind(CTRL, Key::N, Action::New, "new"),
-    bind(CTRL, Key::E, Action::Export, "export"),
+    bind(CTRL_SHIFT, Key::E, Action::Export, "export"),
+    bind(CTRL, Key::E, Action::MergeDown, "merge layer down"),
+    bind(CTRL, Key::J, Action::DuplicateLayer, "duplicate layer"),
     bind(CTRL, Key::Q, Action::Quit, "quit"),
     bind(NONE, Key::B, Action::Tool(ToolKind::Brush), "brush"),
     bind(NONE, Key::E, Action::Tool(ToolKind::Eraser), "eraser"),
@@ -222,6 +231,9 @@ impl EditorState {
                 Action::Open => self.open_dialog(),
                 Action::New => self.new_project(),
                 Action::Export => self.open_export(),
+                Action::NewLayer => self.new_layer(crate::model::LayerKind::Paint),
+                Action::DuplicateLayer => self.apply(Command::DuplicateLayer),
+                Action::MergeDown => self.apply(Command::MergeDown),
                 Action::Quit => self.quit.asked = true,
                 Action::Tool(kind) => self.select_tool(kind),
                 Action::FillOrFrame => {
@@ -309,6 +321,9 @@ mod tests {
             Action::SofterBrush,
             Action::HarderBrush,
             Action::Abort,
+            Action::NewLayer,
+            Action::DuplicateLayer,
+            Action::MergeDown,
         ];
         for action in actions {
             assert!(shortcut(action).is_some(), "{action:?} has no key");

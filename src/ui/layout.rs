@@ -6,11 +6,27 @@ use egui_dock::DockState;
 
 use super::Tab;
 
-/// The dock's first layout: the viewport left, the UV canvas right.
+/// The dock's first layout: the viewport left, the UV canvas right, the layers under it.
 pub fn default_layout() -> DockState<Tab> {
     let mut dock = DockState::new(vec![Tab::Viewport]);
+    let [_, canvas] =
+        dock.main_surface_mut()
+            .split_right(egui_dock::NodeIndex::root(), 0.55, vec![Tab::Canvas]);
     dock.main_surface_mut()
-        .split_right(egui_dock::NodeIndex::root(), 0.55, vec![Tab::Canvas]);
+        .split_below(canvas, 0.5, vec![Tab::Layers]);
+    dock
+}
+
+/// A layout saved before the Layers tab existed gains it, under the UV canvas.
+fn with_layers(mut dock: DockState<Tab>) -> DockState<Tab> {
+    if dock.find_tab(&Tab::Layers).is_none()
+        && let Some(at) = dock.find_tab(&Tab::Canvas)
+        && let Some(tree) = dock
+            .get_surface_mut(at.surface)
+            .and_then(|s| s.node_tree_mut())
+    {
+        tree.split_below(at.node, 0.5, vec![Tab::Layers]);
+    }
     dock
 }
 
@@ -34,7 +50,7 @@ pub fn parse_layout(json: &[u8]) -> Option<DockState<Tab>> {
     finite_points(&mut value);
     let dock: DockState<Tab> = serde_json::from_value(value).ok()?;
     (dock.find_tab(&Tab::Viewport).is_some() && dock.find_tab(&Tab::Canvas).is_some())
-        .then_some(dock)
+        .then(|| with_layers(dock))
 }
 
 /// Saves the layout (atomically; failures only cost the layout).

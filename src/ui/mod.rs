@@ -12,8 +12,10 @@ pub mod files;
 mod input;
 mod jobs;
 pub mod keys;
+mod layer_view;
 mod layout;
 mod panels;
+pub use panels::layers::LayerView;
 mod readout;
 pub mod resize;
 pub mod screen_brush;
@@ -52,6 +54,8 @@ pub enum Tab {
     Viewport,
     /// The UV canvas.
     Canvas,
+    /// The layer stack.
+    Layers,
 }
 
 /// A message for the user, shown for a while.
@@ -240,6 +244,10 @@ pub struct EditorState {
     /// A preset's name being typed, what it names, and whether its field opened this frame.
     naming: Option<(panels::presets::Naming, String, bool)>,
     autosaver: recovery::Autosaver,
+    /// The Layers tab's thumbnails and the name being typed.
+    layers_panel: panels::layers::PanelState,
+    /// What the viewport and canvas show of the layers.
+    pub layer_view: panels::layers::LayerView,
 }
 
 /// Where quitting stands.

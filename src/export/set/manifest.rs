@@ -378,6 +378,10 @@ pub struct Manifest {
     pub bytes: MemoryReport,
     /// The preset used.
     pub preset: String,
+    /// How many layers (groups and their children included) the project had, flattened into
+    /// the set (0 in sets from before layers).
+    #[serde(default)]
+    pub layers: u32,
 }
 
 impl Manifest {
@@ -405,6 +409,8 @@ struct ManifestFile {
     dilated: bool,
     bytes: MemoryReport,
     preset: String,
+    #[serde(default)]
+    layers: u32,
 }
 
 impl TryFrom<ManifestFile> for Manifest {
@@ -482,6 +488,7 @@ impl TryFrom<ManifestFile> for Manifest {
             dilated: f.dilated,
             bytes: f.bytes,
             preset: f.preset,
+            layers: f.layers,
         })
     }
 }

@@ -305,6 +305,7 @@ fn export_into(
                 project: texel_count * 14,
             },
             preset: preset.name.clone(),
+            layers: u32::try_from(doc.stack().walk().len()).unwrap_or(u32::MAX),
         };
         // The k_a error, measured on the set as a consumer decodes it.
         manifest.ka_error =

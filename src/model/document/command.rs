@@ -115,6 +115,15 @@ pub enum Command {
         /// Texel row.
         y: u32,
     },
+    /// Reads the selected layer at a texel into the primary material: the channels it covers
+    /// there (a paint layer), its material (a fill layer) or what its children merge to (a
+    /// group); the other channels stay as they were.
+    PickLayer {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
     /// Replaces a channel with an image already resampled to the map size (one undo step;
     /// see [`crate::model::import`]). Not for scripts: its planes come from a decoder.
     #[serde(skip)]
@@ -165,6 +174,13 @@ pub enum Command {
     SetLayerFill(MaterialValue),
     /// Moves the selected layer.
     MoveLayer(LayerMove),
+    /// Moves the selected layer next to or into another (the Layers panel's drag and drop).
+    MoveLayerTo {
+        /// The path of the layer it lands by (as the stack is before the move).
+        target: Vec<usize>,
+        /// Above or below that layer in its list, or at the top of that group.
+        place: LayerPlace,
+    },
     /// Deletes the selected layer.
     DeleteLayer,
     /// Duplicates the selected layer above itself and selects the copy.
@@ -238,6 +254,17 @@ pub enum LayerMove {
     IntoGroup,
     /// Out of its group, just above it.
     OutOfGroup,
+}
+
+/// Where [`Command::MoveLayerTo`] puts a layer, relative to its target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerPlace {
+    /// Just above the target, in the target's list.
+    Above,
+    /// Just below the target, in the target's list.
+    Below,
+    /// At the top of the target group's children.
+    Into,
 }
 
 /// A channel's planes made by [`crate::model::import::resample`], shared so that the command

@@ -1,7 +1,7 @@
 //! The layer commands, and the editing of the selected layer's planes by fills, gradients and
 //! imports. Each command that changes the stack is one undo step.
 
-use super::{Command, Document, LayerKind, LayerMove, LayerRef};
+use super::{Command, Document, LayerKind, LayerRef, moves};
 use crate::model::ModelError;
 use crate::model::import::ChannelPlanes;
 use crate::model::layers::edit::{EditValue, LayerEdit, Planes, PrePlanes};
@@ -14,7 +14,7 @@ use crate::model::tile::Plane;
 /// The most layers (groups and their children included) a document holds.
 pub const MAX_LAYERS: usize = 256;
 
-fn command_error(text: impl Into<String>) -> ModelError {
+pub(super) fn command_error(text: impl Into<String>) -> ModelError {
     ModelError::Command(text.into())
 }
 
@@ -67,6 +67,34 @@ impl Document {
             channels: [c.kd, c.ks, c.n],
             stroke,
             gray: [self.stored_gray(shown); 2],
+        }
+    }
+
+    /// The selected layer's value at texel `(x, y)` over `under`: the channels a paint layer
+    /// (or a group's merge) covers there, or a fill layer's material.
+    pub(super) fn layer_value(&self, x: u32, y: u32, under: MaterialValue) -> MaterialValue {
+        let Some(layer) = self.state.stack.layer(&self.state.selection.path) else {
+            return under;
+        };
+        let (id, i) = self.maps.locate(x, y);
+        let merged;
+        let tile = match &layer.content {
+            LayerContent::Fill(value) => return *value,
+            LayerContent::Paint(tiles) => tiles.get(id).and_then(Option::as_ref).map(|t| t.get()),
+            LayerContent::Group(children) => {
+                merged = crate::model::layers::merge_tile(children, id);
+                merged.as_ref()
+            }
+        };
+        let Some(tile) = tile else {
+            return under;
+        };
+        let v = tile.value.texel(i).decode();
+        let [kd, ks, n] = tile.alpha.each_ref().map(|a| a.get(i) > 0);
+        MaterialValue {
+            kd: if kd { v.kd } else { under.kd },
+            ks: if ks { v.ks } else { under.ks },
+            n: if n { v.n } else { under.n },
         }
     }
 
@@ -210,10 +238,6 @@ impl Document {
                 self.select(self.state.selection.path.clone(), false);
                 Ok(())
             }
-            Command::SetLayerOpacity(v) => self.props("Layer opacity", |l| {
-                l.props.opacity = v.clamp(0.0, 1.0);
-                Ok(())
-            }),
             Command::SetLayerVisible(v) => {
                 self.props(if v { "Show layer" } else { "Hide layer" }, |l| {
                     l.props.visible = v;
@@ -345,7 +369,10 @@ impl Document {
                 st.selection.mask = false;
                 Ok(())
             }),
-            Command::MoveLayer(m) => self.change("Move layer", |st, _| move_layer(st, m)),
+            Command::MoveLayer(m) => self.change("Move layer", |st, _| moves::move_layer(st, m)),
+            Command::MoveLayerTo { target, place } => self.change("Move layer", |st, _| {
+                moves::move_layer_to(st, &target, place)
+            }),
             other => self.group_command(other),
         }
     }
@@ -359,7 +386,7 @@ impl Document {
                 let layer = list.remove(i);
                 list.insert(i, Layer::group("Group", vec![layer]));
                 st.selection.mask = false;
-                Ok(())
+                moves::check_depth(&st.stack)
             }),
             Command::Ungroup => self.change("Ungroup", |st, _| {
                 let (parent, i) = split(&st.selection.path)?;
@@ -448,6 +475,31 @@ impl Document {
         }
     }
 
+    /// Sets the selected layer's opacity as one undo step, or, right after another change of
+    /// the same layer's opacity (`run`), as part of that step.
+    pub(super) fn set_opacity(
+        &mut self,
+        opacity: f32,
+        run: Option<&[usize]>,
+    ) -> Result<(), ModelError> {
+        const LABEL: &str = "Layer opacity";
+        let path = self.state.selection.path.clone();
+        let opacity = opacity.clamp(0.0, 1.0);
+        let joined = run == Some(path.as_slice()) && !self.stroking();
+        match self.history.take_last(LABEL).filter(|_| joined) {
+            Some(before) => {
+                selected_mut(&mut self.state)?.props.opacity = opacity;
+                self.commit(LABEL, before);
+            }
+            None => self.props(LABEL, |l| {
+                l.props.opacity = opacity;
+                Ok(())
+            })?,
+        }
+        self.opacity_run = Some(path);
+        Ok(())
+    }
+
     fn select(&mut self, path: Vec<usize>, mask: bool) {
         self.end_stroke();
         self.state.selection = crate::model::layers::Selection { path, mask };
@@ -484,7 +536,7 @@ impl Document {
     }
 }
 
-fn no_layer() -> ModelError {
+pub(super) fn no_layer() -> ModelError {
     command_error("no layer is selected")
 }
 
@@ -493,7 +545,7 @@ fn selected_mut(st: &mut State) -> Result<&mut Layer, ModelError> {
 }
 
 /// The parent path and index of a layer's path.
-fn split(path: &[usize]) -> Result<(Vec<usize>, usize), ModelError> {
+pub(super) fn split(path: &[usize]) -> Result<(Vec<usize>, usize), ModelError> {
     path.split_last()
         .map(|(&i, parent)| (parent.to_vec(), i))
         .ok_or_else(no_layer)
@@ -528,43 +580,6 @@ fn resolve(stack: &LayerStack, r: &LayerRef) -> Result<Vec<usize>, ModelError> {
             .map(|(p, _)| p)
             .ok_or_else(|| command_error(format!("no layer is named \"{name}\""))),
     }
-}
-
-/// Moves the selected layer within its list, or into or out of a group.
-fn move_layer(st: &mut State, m: LayerMove) -> Result<(), ModelError> {
-    let (parent, i) = split(&st.selection.path)?;
-    let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-    let last = list.len() - 1;
-    let to = match m {
-        LayerMove::Up => (i + 1).min(last),
-        LayerMove::Down => i.saturating_sub(1),
-        LayerMove::Top => last,
-        LayerMove::Bottom => 0,
-        LayerMove::IntoGroup => {
-            let Some(LayerContent::Group(_)) = list.get(i + 1).map(|l| &l.content) else {
-                return Err(command_error("no group is just above the selected layer"));
-            };
-            let layer = list.remove(i);
-            if let LayerContent::Group(children) = &mut list[i].content {
-                children.insert(0, layer);
-            }
-            st.selection.path = [parent, vec![i, 0]].concat();
-            return Ok(());
-        }
-        LayerMove::OutOfGroup => {
-            let (grand, g) = split(&parent)
-                .map_err(|_| command_error("the selected layer is not in a group"))?;
-            let layer = list.remove(i);
-            let outer = st.stack.list_mut(&grand).ok_or_else(no_layer)?;
-            outer.insert(g + 1, layer);
-            st.selection.path = [grand, vec![g + 1]].concat();
-            return Ok(());
-        }
-    };
-    let layer = list.remove(i);
-    list.insert(to, layer);
-    st.selection.path = [parent, vec![to]].concat();
-    Ok(())
 }
 
 /// What a layer command reads besides the state.

@@ -7,11 +7,12 @@
 mod command;
 mod fill;
 mod layers;
+mod moves;
 pub use layers::MAX_LAYERS;
 mod stroke;
 
 pub use command::{
-    Command, FillRegion, ImportedChannel, LayerKind, LayerMove, LayerRef, StrokeTool,
+    Command, FillRegion, ImportedChannel, LayerKind, LayerMove, LayerPlace, LayerRef, StrokeTool,
 };
 
 use std::sync::Arc;
@@ -152,6 +153,9 @@ pub struct Document {
     settings_version: u64,
     /// Bumped by every change to the stack (which may leave the composite as it was).
     layers_version: u64,
+    /// The layer whose opacity the last command set: the next opacity change of that layer
+    /// joins its undo step (a slider's drag is one step).
+    opacity_run: Option<Vec<usize>>,
 }
 
 impl std::fmt::Debug for Document {
@@ -222,6 +226,7 @@ impl Document {
             stroke: None,
             settings_version: 0,
             layers_version: 0,
+            opacity_run: None,
         }
     }
 
@@ -337,6 +342,10 @@ impl Document {
                 *version += 1;
             }
         }
+        let opacity_run = self.opacity_run.take();
+        if let Command::SetLayerOpacity(opacity) = command {
+            return self.set_opacity(opacity, opacity_run.as_deref());
+        }
         let v = &mut self.settings_version;
         match command {
             Command::SetBrush(b) => set(&mut self.settings.brush, b.sanitized(), v),
@@ -376,14 +385,17 @@ impl Document {
             Command::Fill(region) => self.fill(region)?,
             Command::Gradient { shape, start, end } => self.gradient(shape, start, end)?,
             Command::Pick { x, y } => {
-                if x >= self.maps.width() || y >= self.maps.height() {
-                    return Err(ModelError::Command(format!(
-                        "pick at ({x}, {y}) is outside the {}x{} map",
-                        self.maps.width(),
-                        self.maps.height()
-                    )));
-                }
+                self.check_texel(x, y, "pick")?;
                 let picked = self.maps.value(x, y);
+                set(
+                    &mut self.settings.primary,
+                    picked,
+                    &mut self.settings_version,
+                );
+            }
+            Command::PickLayer { x, y } => {
+                self.check_texel(x, y, "pick")?;
+                let picked = self.layer_value(x, y, self.settings.primary);
                 set(
                     &mut self.settings.primary,
                     picked,
@@ -422,6 +434,18 @@ impl Document {
                 }
             }
             other => self.layer_command(other)?,
+        }
+        Ok(())
+    }
+
+    /// An error when `(x, y)` is outside the map.
+    fn check_texel(&self, x: u32, y: u32, what: &str) -> Result<(), ModelError> {
+        if x >= self.maps.width() || y >= self.maps.height() {
+            return Err(ModelError::Command(format!(
+                "{what} at ({x}, {y}) is outside the {}x{} map",
+                self.maps.width(),
+                self.maps.height()
+            )));
         }
         Ok(())
     }

@@ -121,6 +121,15 @@ impl StackHistory {
         self.enforce_cap();
     }
 
+    /// Takes the last step's state before it off the history, if that step is labelled
+    /// `label` and nothing is undone: what a change joining that step records again.
+    pub fn take_last(&mut self, label: &str) -> Option<State> {
+        if !self.redo.is_empty() || self.undo.back().is_none_or(|s| s.label != label) {
+            return None;
+        }
+        self.undo.pop_back().map(|s| s.state)
+    }
+
     /// Undoes the last step into `now`; false if there is none.
     pub fn undo(&mut self, now: &mut State) -> bool {
         let Some(step) = self.undo.pop_back() else {

@@ -18,6 +18,7 @@ pub mod edit;
 pub mod history;
 pub mod ops;
 pub mod paint;
+pub mod thumbnail;
 
 pub use blend::{Covered, LayerBlend};
 pub use composite::{Compositor, composite_tile, merge_tile};
@@ -290,6 +291,17 @@ impl LayerStack {
             .layers
             .push(Layer::paint("Layer 1", stack.tile_count()));
         stack
+    }
+
+    /// The same size and base with no layers.
+    #[must_use]
+    pub fn without_layers(&self) -> Self {
+        Self {
+            width: self.width,
+            height: self.height,
+            base: self.base,
+            layers: Vec::new(),
+        }
     }
 
     /// Tiles across.

@@ -5,9 +5,11 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::{Layer, SharedMaskTile, SharedPaintTile, Stamped, merge_tile};
+use glam::Vec3;
+
+use super::{Layer, LayerStack, Mask, SharedMaskTile, SharedPaintTile, Stamped, merge_tile};
 use crate::model::maps::MaterialMaps;
-use crate::model::texel::{Channel, decode_n, decode_rgb};
+use crate::model::texel::{Channel, MaterialValue, N_MAX, decode_n, decode_rgb};
 use crate::model::tile::{Plane, TILE_TEXELS};
 
 /// `layers` merged tile by tile into one paint layer's tiles.
@@ -44,4 +46,32 @@ pub fn mask_from_channel(
             Arc::new(Stamped::new(plane))
         })
         .collect()
+}
+
+/// What the "selected layer only" view shows: the base and the layer at `path` alone, shown
+/// (its group's settings left out). `None` if no layer is there.
+pub fn layer_alone(stack: &LayerStack, path: &[usize]) -> Option<LayerStack> {
+    let mut layer = stack.layer(path)?.clone();
+    layer.props.visible = true;
+    Some(LayerStack {
+        layers: vec![layer],
+        ..stack.without_layers()
+    })
+}
+
+/// What the "mask" view shows: the mask of the layer at `path` as it applies (inversion
+/// included, even when disabled) in `k_d`, `k_s` and `n`, white showing the layer. `None` if
+/// that layer has no mask.
+pub fn mask_alone(stack: &LayerStack, path: &[usize]) -> Option<LayerStack> {
+    let mask = stack.layer(path)?.mask.clone()?;
+    let mut white = Layer::fill("mask", MaterialValue::new(Vec3::ONE, Vec3::ONE, N_MAX));
+    white.mask = Some(Mask {
+        enabled: true,
+        ..mask
+    });
+    Some(LayerStack {
+        base: MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 0.0),
+        layers: vec![white],
+        ..stack.without_layers()
+    })
 }

@@ -4,6 +4,7 @@
 
 mod bars;
 pub mod colour;
+pub mod layers;
 pub(super) mod presets;
 mod tool_panel;
 mod view_panel;

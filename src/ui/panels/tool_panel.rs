@@ -76,7 +76,16 @@ impl EditorState {
                     self.apply(Command::SetBrush(brush));
                 }
             }
-            ToolKind::Brush | ToolKind::Eraser | ToolKind::Picker => {}
+            ToolKind::Picker => {
+                let from = &mut self.tools.picker.from_layer;
+                ui.horizontal(|ui| {
+                    ui.selectable_value(from, false, "All layers");
+                    ui.selectable_value(from, true, "Selected layer");
+                })
+                .response
+                .on_hover_text("Read the composite, or what the selected layer holds");
+            }
+            ToolKind::Brush | ToolKind::Eraser => {}
         }
     }
 

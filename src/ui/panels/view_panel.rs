@@ -8,6 +8,7 @@ use crate::reflectance::{AmbientApprox, ShadingModel};
 use crate::render::{FrameSettings, ViewMode};
 use crate::ui::EditorState;
 use crate::ui::canvas::CanvasChannel;
+use crate::ui::panels::layers::LayerView;
 use crate::ui::viewport::Compare;
 
 impl EditorState {
@@ -127,6 +128,16 @@ impl EditorState {
                     ui.selectable_value(&mut self.view, v, v.label());
                 }
             });
+        egui::ComboBox::from_label("Layers shown")
+            .selected_text(self.layer_view.label())
+            .width(COMBO_WIDTH)
+            .show_ui(ui, |ui| {
+                for v in LayerView::ALL {
+                    ui.selectable_value(&mut self.layer_view, v, v.label());
+                }
+            })
+            .response
+            .on_hover_text("The selected layer alone over the base, or its mask in grey");
         egui::ComboBox::from_label("Canvas shows")
             .selected_text(self.canvas.channel.label())
             .show_ui(ui, |ui| {

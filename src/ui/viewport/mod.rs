@@ -15,7 +15,7 @@ use egui::{Color32, Pos2, Rect, Sense};
 
 use crate::mesh::Mesh;
 use crate::mesh::pick::{Bvh, Hit};
-use crate::model::Document;
+use crate::model::MaterialMaps;
 use crate::reflectance::{AmbientApprox, ShadingModel};
 use crate::render::{Camera, FrameSettings};
 
@@ -148,7 +148,7 @@ impl Viewport {
     pub fn show(
         &mut self,
         ui: &mut egui::Ui,
-        doc: &Document,
+        maps: (&MaterialMaps, u64),
         mesh: &(u64, Arc<Mesh>),
         settings: &FrameSettings,
     ) -> (egui::Response, Rect) {
@@ -207,7 +207,7 @@ impl Viewport {
         match &mut self.gpu {
             Some(gpu) => {
                 let start = Instant::now();
-                match gpu.render(doc, mesh, &frame, &self.comparison, size) {
+                match gpu.render(maps, mesh, &frame, &self.comparison, size) {
                     Ok(id) => {
                         self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
                         self.gpu_error = None;

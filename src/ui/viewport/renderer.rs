@@ -17,8 +17,8 @@ use crate::gpu::preview::{
 };
 use crate::gpu::{Gpu, GpuError};
 use crate::mesh::Mesh;
+use crate::model::MaterialMaps;
 use crate::model::texel::MaterialValue;
-use crate::model::{Document, MaterialMaps};
 use crate::render::FrameSettings;
 
 /// GPU objects of the viewport.
@@ -27,6 +27,8 @@ pub struct ViewportGpu {
     renderer: egui_wgpu::RenderState,
     mesh: Option<(u64, MeshBuffers)>,
     maps: Option<MapTextures>,
+    /// Which maps `maps` mirrors (the composite, or a layer view's).
+    maps_source: u64,
     target: Option<Target>,
 }
 
@@ -70,6 +72,7 @@ impl ViewportGpu {
             renderer: render_state.clone(),
             mesh: None,
             maps: None,
+            maps_source: 0,
             target: None,
         }
     }
@@ -123,7 +126,7 @@ impl ViewportGpu {
     /// lost: the viewport says so, and painting goes on.
     pub(super) fn render(
         &mut self,
-        doc: &Document,
+        (maps, source): (&MaterialMaps, u64),
         mesh: &(u64, Arc<Mesh>),
         settings: &FrameSettings,
         comparison: &Comparison,
@@ -133,14 +136,15 @@ impl ViewportGpu {
             self.mesh = None;
             self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)?));
         }
-        let maps_size = (doc.maps().width(), doc.maps().height());
+        let maps_size = (maps.width(), maps.height());
         match &mut self.maps {
-            Some(m) if m.size() == maps_size => {
-                m.sync(&self.gpu, doc.maps())?;
+            Some(m) if m.size() == maps_size && self.maps_source == source => {
+                m.sync(&self.gpu, maps)?;
             }
             _ => {
                 self.maps = None;
-                self.maps = Some(MapTextures::new(&self.gpu, doc.maps())?);
+                self.maps = Some(MapTextures::new(&self.gpu, maps)?);
+                self.maps_source = source;
             }
         }
         if self.target.as_ref().is_none_or(|t| t.size != size) {

@@ -1,0 +1,54 @@
+//! The maps the viewport and canvas show: the composite, or for the "selected layer only" and
+//! "mask" views, maps composited from a stack of that layer (or mask) alone, kept up to date
+//! tile by tile as it is painted.
+
+use crate::model::layers::{Compositor, ops};
+use crate::model::{Document, MaterialMaps};
+use crate::ui::panels::layers::LayerView;
+
+/// The maps of the view being shown, when it is not the composite.
+#[derive(Default)]
+pub struct ViewMaps {
+    /// The view and layer path they are of.
+    key: Option<(LayerView, Vec<usize>)>,
+    compositor: Compositor,
+    maps: Option<MaterialMaps>,
+    /// Changes whenever the maps shown become other maps (mirrors upload them whole).
+    source: u64,
+}
+
+impl ViewMaps {
+    /// The maps `view` shows of `doc`, and a number that changes whenever they become other
+    /// maps (0: the composite). A view of a layer without a mask shows the composite.
+    pub fn get<'a>(&'a mut self, doc: &'a Document, view: LayerView) -> (&'a MaterialMaps, u64) {
+        let path = &doc.selection().path;
+        let stack = match view {
+            LayerView::Composite => None,
+            LayerView::Selected => ops::layer_alone(doc.stack(), path),
+            LayerView::Mask => ops::mask_alone(doc.stack(), path),
+        };
+        let Some(stack) = stack else {
+            self.key = None;
+            self.maps = None;
+            return (doc.maps(), 0);
+        };
+        let key = Some((view, path.clone()));
+        let fits = self
+            .maps
+            .as_ref()
+            .is_some_and(|m| (m.width(), m.height()) == (stack.width, stack.height));
+        if self.key != key || !fits {
+            self.key = key;
+            self.compositor = Compositor::new();
+            self.maps = MaterialMaps::new(stack.width, stack.height, stack.base).ok();
+            self.source += 1;
+        }
+        match &mut self.maps {
+            Some(maps) => {
+                self.compositor.update(&stack, maps);
+                (maps, self.source)
+            }
+            None => (doc.maps(), 0),
+        }
+    }
+}
