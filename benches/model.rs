@@ -390,6 +390,52 @@ fn layers(c: &mut Criterion) {
         b.iter(|| Compositor::new().update(&stack, &mut maps.clone()));
     });
     group.finish();
+    layer_dabs(c);
+}
+
+/// One 128 px dab through the document, as a stroke lays it (paint the selected layer, then
+/// recomposite the tiles it touched and derive `k_a` there): on layer 8 of 16 painted, masked
+/// layers, and on a one-layer document, in the same run (issue 18: <= 1 ms, <= 2x).
+fn layer_dabs(c: &mut Criterion) {
+    let mut group = c.benchmark_group("layers_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(4));
+    let settings = DocumentSettings {
+        brush: brush128(),
+        primary: MaterialValue::new(Vec3::new(0.8, 0.3, 0.1), Vec3::splat(0.3), 60.0),
+        ..DocumentSettings::default()
+    };
+    let layered = Document::from_stack(layered_stack(), settings.clone()).expect("size");
+    let single = Document::new(SIDE, SIDE, settings).expect("size");
+    for (name, mut doc, layer) in [
+        ("dab_128px_on_layer_8_of_16", layered, 8),
+        ("dab_128px_on_1_layer", single, 0),
+    ] {
+        doc.apply(Command::SelectPath(vec![layer])).expect("select");
+        doc.apply(Command::BeginStroke(StrokeTool::Brush))
+            .expect("begin");
+        // Back and forth by the spacing (25 % of 128 px): one dab a point.
+        let mut k = 0u32;
+        let mut version = doc.maps().version();
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                k += 1;
+                let x = 2000.5 + if k.is_multiple_of(2) { 0.0 } else { 32.0 };
+                doc.apply(Command::StrokeTo(StrokePoint {
+                    pos: Vec2::new(x, 1500.5),
+                    pressure: 1.0,
+                }))
+                .expect("dab");
+                let dirty = doc.maps().tiles_changed_since(version);
+                version = doc.maps().version();
+                doc.maps()
+                    .derive_ka_tiles(ShadingModel::Phong, AmbientApprox::Fast, &dirty)
+                    .len()
+            });
+        });
+    }
+    group.finish();
 }
 
 criterion_group!(

@@ -36,9 +36,9 @@ start() {
   xdotool windowfocus --sync "$win" 2>/dev/null || true
 }
 stroke() {
-  # The UV canvas sits right of centre in the 1400x900 window.
-  xdotool mousemove 890 430 sleep 0.3 mousedown 1 sleep 0.3
-  for x in 900 920 940 960 980 1000 1020; do xdotool mousemove $x 460 sleep 0.1; done
+  # The UV canvas sits right of centre in the 1400x900 window, above the Layers tab.
+  xdotool mousemove 890 270 sleep 0.3 mousedown 1 sleep 0.3
+  for x in 900 920 940 960 980 1000 1020; do xdotool mousemove $x 300 sleep 0.1; done
   xdotool sleep 0.3 mouseup 1 sleep 0.5
 }
 save_and_quit() {
@@ -187,5 +187,26 @@ save_and_quit
     if let Some(project) = run_in_window("untitled", script, &[]) {
         let saved = project.with_file_name("material.kapaint");
         assert_painted(&saved, "the untitled stroke was not saved");
+    }
+}
+
+#[test]
+fn the_real_window_paints_on_a_second_layer() {
+    // Ctrl+Shift+N adds "Layer 2" and selects it; the stroke lands there, not on "Layer 1".
+    let script = r#"
+start
+xdotool key --clearmodifiers ctrl+shift+n
+sleep 0.5
+stroke
+save_and_quit
+"#;
+    if let Some(project) = run_in_window("layer", script, &[]) {
+        let doc = kapaint::model::project::load(&project).expect("saved project loads");
+        let layers = &doc.stack().layers;
+        let names: Vec<&str> = layers.iter().map(|l| l.props.name.as_str()).collect();
+        assert_eq!(names, ["Layer 1", "Layer 2"]);
+        assert_eq!(layers[0].heap_bytes(), 0, "Layer 1 stays empty");
+        assert!(layers[1].heap_bytes() > 0, "the stroke is on Layer 2");
+        assert_painted(&project, "the composite shows the stroke");
     }
 }
