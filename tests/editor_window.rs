@@ -193,13 +193,13 @@ save_and_quit
 #[test]
 fn the_real_window_paints_on_a_second_layer() {
     // Ctrl+Shift+N adds "Layer 2" and selects it; the stroke lands there, not on "Layer 1".
-    let script = r#"
+    let script = r"
 start
 xdotool key --clearmodifiers ctrl+shift+n
 sleep 0.5
 stroke
 save_and_quit
-"#;
+";
     if let Some(project) = run_in_window("layer", script, &[]) {
         let doc = kapaint::model::project::load(&project).expect("saved project loads");
         let layers = &doc.stack().layers;
