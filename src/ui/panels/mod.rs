@@ -4,6 +4,7 @@
 
 mod bars;
 pub mod colour;
+mod layer_settings;
 pub mod layers;
 pub(super) mod presets;
 mod tool_panel;
