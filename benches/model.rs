@@ -316,47 +316,13 @@ fn resize(c: &mut Criterion) {
     group.finish();
 }
 
-/// A 16-layer 4096^2 stack, each paint layer painted over about 10 % of the map (a band of
-/// tiles) with a mask painted there too.
-fn layered_stack() -> kapaint::model::layers::LayerStack {
-    use kapaint::model::layers::{Layer, LayerStack, Mask, PaintTile, Stamped};
-    use std::sync::Arc;
-    let mut stack = LayerStack::new(SIDE, SIDE, MaterialValue::default());
-    stack.layers.clear();
-    let tiles = stack.tile_count();
-    for l in 0..16 {
-        let mut layer = Layer::paint(format!("Layer {}", l + 1), tiles);
-        let mut mask = Mask::white(tiles);
-        let value = MaterialValue::new(
-            Vec3::new(0.1 + 0.05 * l as f32, 0.5, 0.3),
-            Vec3::splat(0.2),
-            (l as f32).exp2(),
-        );
-        for id in (0..tiles).filter(|id| (id / 7 + l) % 10 == 0) {
-            let tile = layer.paint_tile_mut(id).expect("paint layer");
-            *tile = PaintTile::filled(value, [true, true, true]);
-            for (i, a) in tile.alpha[0].data_mut().iter_mut().enumerate() {
-                *a = ((i * 37) % 65_536) as u16;
-            }
-            let mut plane = kapaint::model::tile::Plane::Uniform(u16::MAX);
-            for (i, m) in plane.data_mut().iter_mut().enumerate() {
-                *m = ((i * 11) % 65_536) as u16;
-            }
-            mask.tiles[id] = Arc::new(Stamped::new(plane));
-        }
-        layer.mask = Some(mask);
-        stack.layers.push(layer);
-    }
-    stack
-}
-
 /// Layers: toggling a painted layer's visibility recomposites every tile it touches (the
 /// compositor finds them; issue 18 asks <= 60 ms on 2 cores), and the first full composite.
 fn layers(c: &mut Criterion) {
     use kapaint::model::layers::Compositor;
     let mut group = c.benchmark_group("layers_4096");
     group.sample_size(10);
-    let mut stack = layered_stack();
+    let mut stack = kapaint::report::typical::layered_stack(SIDE, 16);
     let mut maps = MaterialMaps::new(SIDE, SIDE, MaterialValue::default()).expect("size");
     let mut compositor = Compositor::new();
     compositor.update(&stack, &mut maps);
@@ -406,7 +372,11 @@ fn layer_dabs(c: &mut Criterion) {
         primary: MaterialValue::new(Vec3::new(0.8, 0.3, 0.1), Vec3::splat(0.3), 60.0),
         ..DocumentSettings::default()
     };
-    let layered = Document::from_stack(layered_stack(), settings.clone()).expect("size");
+    let layered = Document::from_stack(
+        kapaint::report::typical::layered_stack(SIDE, 16),
+        settings.clone(),
+    )
+    .expect("size");
     let single = Document::new(SIDE, SIDE, settings).expect("size");
     for (name, mut doc, layer) in [
         ("dab_128px_on_layer_8_of_16", layered, 8),
@@ -438,6 +408,35 @@ fn layer_dabs(c: &mut Criterion) {
     group.finish();
 }
 
+/// Saving and opening a 16-layer 4096^2 project (the stack of [`layered_stack`]: every
+/// layer painted over 10 % of the map, with masks); issue 18 asks <= 3 s each.
+fn layered_project_io(c: &mut Criterion) {
+    let mut group = c.benchmark_group("layers_4096");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
+    let doc = Document::from_stack(
+        kapaint::report::typical::layered_stack(SIDE, 16),
+        DocumentSettings::default(),
+    )
+    .expect("size");
+    let dir = std::env::temp_dir().join(format!("kapaint-bench-layers-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("layers.kapaint");
+    group.bench_function("save_16_layers", |b| {
+        b.iter(|| project::save(&doc, &path).expect("save"));
+    });
+    eprintln!(
+        "16-layer project: {} MB",
+        std::fs::metadata(&path).map_or(0, |m| m.len() / 1_000_000)
+    );
+    group.bench_function("open_16_layers", |b| {
+        b.iter(|| black_box(project::load(&path).expect("load")));
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    group.finish();
+}
+
 criterion_group!(
     benches,
     dabs,
@@ -445,6 +444,7 @@ criterion_group!(
     project_io,
     autosave,
     resize,
-    layers
+    layers,
+    layered_project_io
 );
 criterion_main!(benches);

@@ -1,69 +1,60 @@
-//! Profiling aid: repeats 128 px dabs on a 4096^2 map (`perf record` this).
+//! Profiling aid: repeats the dab of the `layers_4096` benchmark (a 128 px-radius brush, back
+//! and forth by its spacing through the document, then `k_a` derived on the tiles it
+//! changed) on a 4096^2 document: on layer 8 of the 16-layer benchmark stack, or with
+//! `single` on a one-layer document. `perf record` this.
+//!
+//! Usage: `cargo run --release --example dab_profile [layers|single] [ROUNDS]`
 
 use glam::{Vec2, Vec3};
-use kapaint::model::brush::BrushSettings;
-use kapaint::model::history::History;
-use kapaint::model::paint::{Coverage, DiscFootprint, PaintTarget, paint_dab};
+use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::MaterialValue;
-use kapaint::model::{Channels, MaterialMaps};
+use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+use kapaint::reflectance::{AmbientApprox, ShadingModel};
 
 fn main() -> Result<(), String> {
-    let brush = BrushSettings {
-        radius_px: 128.0,
-        hardness: 0.5,
-        flow: 0.5,
-        ..BrushSettings::default()
-    };
-    let channels = match std::env::args().nth(1).as_deref() {
-        Some("kd") => Channels {
-            kd: true,
-            ks: false,
-            n: false,
+    let mut args = std::env::args().skip(1);
+    let single = args.next().as_deref() == Some("single");
+    let rounds: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2000);
+    let settings = DocumentSettings {
+        brush: BrushSettings {
+            radius_px: 128.0,
+            hardness: 0.5,
+            flow: 0.5,
+            ..BrushSettings::default()
         },
-        Some("n") => Channels {
-            kd: false,
-            ks: false,
-            n: true,
-        },
-        Some("none") => Channels {
-            kd: false,
-            ks: false,
-            n: false,
-        },
-        _ => Channels::ALL,
+        primary: MaterialValue::new(Vec3::new(0.8, 0.3, 0.1), Vec3::splat(0.3), 60.0),
+        ..DocumentSettings::default()
     };
-    let target = PaintTarget::new(
-        MaterialValue::new(Vec3::new(1.0, 0.2, 0.1), Vec3::splat(0.6), 300.0),
-        channels,
-        brush.blend,
-        false,
-    );
-    let mut maps =
-        MaterialMaps::new(4096, 4096, MaterialValue::default()).map_err(|e| e.to_string())?;
-    let mut history = History::default();
-    history.begin("profile");
-    let fp = DiscFootprint {
-        center: Vec2::new(2000.5, 1500.5),
-        radius: 128.0,
-        brush: &brush,
+    let (mut doc, layer) = if single {
+        (Document::new(4096, 4096, settings), 0)
+    } else {
+        let stack = kapaint::report::typical::layered_stack(4096, 16);
+        (Document::from_stack(stack, settings), 8)
     };
+    let doc = doc.as_mut().map_err(|e| e.to_string())?;
+    let run = |doc: &mut Document, c| doc.apply(c).map_err(|e| e.to_string());
+    run(doc, Command::SelectPath(vec![layer]))?;
+    run(doc, Command::BeginStroke(StrokeTool::Brush))?;
+    let mut version = doc.maps().version();
     let start = std::time::Instant::now();
-    let rounds = 2000;
-    for _ in 0..rounds {
-        let mut coverage = Coverage::default();
-        paint_dab(
-            &mut maps,
-            &mut history,
-            &mut coverage,
-            &target,
-            1.0,
-            0.5,
-            &fp,
-        );
+    let mut derived = 0;
+    for k in 0..rounds {
+        let x = 2000.5 + if k % 2 == 0 { 0.0 } else { 32.0 };
+        run(
+            doc,
+            Command::StrokeTo(StrokePoint {
+                pos: Vec2::new(x, 1500.5),
+                pressure: 1.0,
+            }),
+        )?;
+        let dirty = doc.maps().tiles_changed_since(version);
+        version = doc.maps().version();
+        derived += doc
+            .maps()
+            .derive_ka_tiles(ShadingModel::Phong, AmbientApprox::Fast, &dirty)
+            .len();
     }
-    println!(
-        "{:.3} ms per dab",
-        start.elapsed().as_secs_f64() * 1e3 / f64::from(rounds)
-    );
+    let per = start.elapsed().as_secs_f64() / f64::from(rounds);
+    println!("{:.3} ms a dab ({derived} tiles derived)", per * 1e3);
     Ok(())
 }

@@ -467,3 +467,39 @@ fn malformed_layer_data_is_one_clear_error() {
     let v1_with_layers = rewrite(&|v| v["version"] = 1.into());
     assert!(v1_with_layers.contains("version 1"), "{v1_with_layers}");
 }
+
+/// Strokes recomposite only the texels their dabs reach, in place: after brush strokes in
+/// every blend mode, the eraser and blur, on layers, masks and inside a group, the maps are
+/// bit for bit the stack flattened from scratch.
+#[test]
+fn strokes_recomposite_in_place_exactly_as_a_full_flatten() {
+    use kapaint::model::layers::Compositor;
+    let mut doc = layered();
+    run(
+        &mut doc,
+        r#"(commands: [
+            SetBrush((radius_px: 23.0, hardness: 0.3, flow: 0.6, spacing_percent: 10.0)),
+            SelectLayer("Rust"),
+            SetBrush((radius_px: 23.0, hardness: 0.3, flow: 0.6, spacing_percent: 10.0, blend: Multiply)),
+            Stroke(tool: Brush, points: [(pos: (5.0, 5.0), pressure: 1.0), (pos: (120.0, 70.0), pressure: 0.6)]),
+            SetBrush((radius_px: 17.0, blend: Add)),
+            Stroke(tool: Brush, points: [(pos: (100.0, 5.0), pressure: 1.0), (pos: (30.0, 120.0), pressure: 1.0)]),
+            SetBrush((radius_px: 31.0, blend: Normal, blur_radius_px: 3)),
+            Stroke(tool: Blur, points: [(pos: (60.0, 60.0), pressure: 1.0), (pos: (140.0, 60.0), pressure: 1.0)]),
+            SelectMask,
+            Stroke(tool: Brush, points: [(pos: (150.0, 20.0), pressure: 1.0), (pos: (150.0, 110.0), pressure: 1.0)]),
+            SelectContent,
+            Stroke(tool: Eraser, points: [(pos: (0.0, 64.0), pressure: 1.0), (pos: (191.0, 64.0), pressure: 1.0)]),
+            AddLayer(kind: Paint, name: "Top"),
+            SetLayerBlend(channel: Kd, mode: Overlay),
+            Stroke(tool: Brush, points: [(pos: (90.0, 0.0), pressure: 1.0), (pos: (91.0, 127.0), pressure: 1.0)]),
+        ])"#,
+    );
+    let mut flat =
+        kapaint::model::MaterialMaps::new(192, 128, MaterialValue::default()).expect("maps");
+    Compositor::new().update(doc.stack(), &mut flat);
+    let differing = (0..flat.tile_count())
+        .filter(|&id| **flat.tile(id) != **doc.maps().tile(id))
+        .count();
+    assert_eq!(differing, 0, "tiles differing from a full flatten");
+}

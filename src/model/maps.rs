@@ -181,6 +181,13 @@ impl MaterialMaps {
         Arc::make_mut(&mut self.tiles[id])
     }
 
+    /// A tile for writing by a writer that changes only `channels` (see
+    /// [`MaterialMaps::tiles_mut_many_in`]): cloned first if shared; only their versions move.
+    pub fn tile_mut_in(&mut self, id: TileId, channels: Channels) -> &mut Tile {
+        self.touch(id, channels);
+        Arc::make_mut(&mut self.tiles[id])
+    }
+
     /// Several tiles for writing at once (each cloned first if shared), for parallel work on
     /// disjoint tiles. `ids` must be sorted ascending without duplicates; bumps versions.
     pub fn tiles_mut_many(&mut self, ids: &[TileId]) -> Vec<&mut Tile> {

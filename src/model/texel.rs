@@ -215,7 +215,9 @@ impl Texel {
 /// `[0, 1]` (NaN -> 0) to unorm16, rounding to nearest.
 #[inline]
 pub fn encode_unorm(v: f32) -> u16 {
-    (unit(v) * 65535.0 + 0.5) as u16
+    // Through i32, which converts four at a time where a loop vectorises; in range, the same
+    // as converting to u16 directly.
+    (unit(v) * 65535.0 + 0.5) as i32 as u16
 }
 
 /// unorm16 to `[0, 1]`.

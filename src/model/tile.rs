@@ -30,6 +30,67 @@ pub fn select_mut<'a, T>(items: &'a mut [T], ids: &[usize]) -> Vec<&'a mut T> {
         .collect()
 }
 
+/// A rectangle of texels inside one tile, in tile coordinates (ends exclusive): the part of a
+/// tile an edit wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileRect {
+    /// First column.
+    pub x0: usize,
+    /// First row.
+    pub y0: usize,
+    /// One past the last column.
+    pub x1: usize,
+    /// One past the last row.
+    pub y1: usize,
+}
+
+impl TileRect {
+    /// The whole tile.
+    pub const FULL: Self = Self {
+        x0: 0,
+        y0: 0,
+        x1: TILE_SIZE,
+        y1: TILE_SIZE,
+    };
+
+    /// The texel at index `i` (row-major in the tile) alone.
+    #[inline]
+    pub fn texel(i: usize) -> Self {
+        let (x, y) = (i % TILE_SIZE, i / TILE_SIZE);
+        Self {
+            x0: x,
+            y0: y,
+            x1: x + 1,
+            y1: y + 1,
+        }
+    }
+
+    /// Grows `rect` (none: empty) to hold texel `i`.
+    #[inline]
+    pub fn include(rect: &mut Option<Self>, i: usize) {
+        let t = Self::texel(i);
+        *rect = Some(match *rect {
+            None => t,
+            Some(r) => Self {
+                x0: r.x0.min(t.x0),
+                y0: r.y0.min(t.y0),
+                x1: r.x1.max(t.x1),
+                y1: r.y1.max(t.y1),
+            },
+        });
+    }
+
+    /// Whether it is the whole tile.
+    pub fn is_full(self) -> bool {
+        self == Self::FULL
+    }
+
+    /// The texel indices (row-major in the tile) inside, row by row.
+    pub fn indices(self) -> impl Iterator<Item = usize> {
+        (self.y0..self.y1).flat_map(move |y| (self.x0..self.x1).map(move |x| y * TILE_SIZE + x))
+    }
+}
+
 /// One channel of a tile: a single value for every texel, or one value per texel.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Plane<T: Copy> {
@@ -142,6 +203,19 @@ impl Tile {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tile_rect_grows_to_hold_its_texels() {
+        let mut rect = None;
+        TileRect::include(&mut rect, 5 * TILE_SIZE + 9);
+        TileRect::include(&mut rect, 2 * TILE_SIZE + 30);
+        let r = rect.expect("two texels");
+        assert_eq!((r.x0, r.y0, r.x1, r.y1), (9, 2, 31, 6));
+        assert_eq!(r.indices().count(), 22 * 4);
+        assert_eq!(r.indices().next(), Some(2 * TILE_SIZE + 9));
+        assert!(!r.is_full());
+        assert_eq!(TileRect::FULL.indices().count(), TILE_TEXELS);
+    }
 
     #[test]
     fn uniform_planes_materialise_on_write_and_compact_back() {

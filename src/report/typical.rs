@@ -92,3 +92,42 @@ pub fn typical_document(
     }
     Ok(doc)
 }
+
+/// A `side x side` stack of `layers` paint layers over the default base, each painted over
+/// about 10 % of the map (every tenth band of tiles, a different band per layer: a uniform
+/// material at varied coverage) with a varied mask there: the layered document of the layer
+/// benchmarks.
+pub fn layered_stack(side: u32, layers: usize) -> crate::model::layers::LayerStack {
+    use crate::model::layers::{Layer, LayerStack, Mask, PaintTile, Stamped};
+    use crate::model::tile::Plane;
+    use std::sync::Arc;
+    let mut stack = LayerStack::new(side, side, MaterialValue::default());
+    stack.layers.clear();
+    let tiles = stack.tile_count();
+    for l in 0..layers {
+        let mut layer = Layer::paint(format!("Layer {}", l + 1), tiles);
+        let mut mask = Mask::white(tiles);
+        let value = MaterialValue::new(
+            Vec3::new(0.1 + 0.05 * l as f32, 0.5, 0.3),
+            Vec3::splat(0.2),
+            (l as f32).exp2(),
+        );
+        for id in (0..tiles).filter(|id| (id / 7 + l) % 10 == 0) {
+            let Some(tile) = layer.paint_tile_mut(id) else {
+                continue;
+            };
+            *tile = PaintTile::filled(value, [true, true, true]);
+            for (i, a) in tile.alpha[0].data_mut().iter_mut().enumerate() {
+                *a = ((i * 37) % 65_536) as u16;
+            }
+            let mut plane = Plane::Uniform(u16::MAX);
+            for (i, m) in plane.data_mut().iter_mut().enumerate() {
+                *m = ((i * 11) % 65_536) as u16;
+            }
+            mask.tiles[id] = Arc::new(Stamped::new(plane));
+        }
+        layer.mask = Some(mask);
+        stack.layers.push(layer);
+    }
+    stack
+}

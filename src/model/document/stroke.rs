@@ -1,6 +1,7 @@
 //! Strokes: smoothing and resampling input into dabs, jitter, mirroring, and each dab's tool.
 
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use super::{Document, StrokeTool};
 use crate::model::ModelError;
@@ -13,6 +14,7 @@ use crate::model::maps::MaterialMaps;
 use crate::model::paint::{Coverage, DiscFootprint, Footprint};
 use crate::model::surface::{BallFootprint, Surface};
 use crate::model::texel::Channels;
+use crate::model::tile::TileRect;
 
 /// A stroke in progress.
 pub(super) struct ActiveStroke {
@@ -241,6 +243,8 @@ impl Document {
         if ids.is_empty() || alpha <= 0.0 || brush.opacity <= 0.0 {
             return;
         }
+        // Tiles composited up to date before the dab need recompositing only where it writes.
+        let current = to.compositor.current(&to.state.stack, &ids);
         let selection = &to.state.selection;
         let Some(layer) = to.state.stack.layer_mut(&selection.path) else {
             return;
@@ -250,7 +254,7 @@ impl Document {
         };
         let maps: &MaterialMaps = to.maps;
         *touched = true;
-        match tool {
+        let written = match tool {
             StrokeTool::Brush | StrokeTool::Eraser => {
                 let Some(pre) = before
                     .stack
@@ -259,48 +263,35 @@ impl Document {
                 else {
                     return;
                 };
-                let opacity = brush.opacity;
-                let covs = coverage.tiles_mut(maps.tile_count(), &ids);
-                let work: Vec<_> = ids.iter().copied().zip(covs).collect();
-                edit::edit_tiles(planes, pre, target, work, |id, cov, write| {
-                    fp.visit_tile(id, maps.tile_rect(id), |i, w| {
-                        let c = cov[i];
-                        let next = c + (opacity - c) * (w * alpha).min(1.0);
-                        cov[i] = c.max(next);
-                        write(i, cov[i], 0.0);
-                    });
-                });
+                let dab = (alpha, brush.opacity);
+                cover_dab((planes, pre), target, coverage, (maps, &ids), fp, dab)
             }
             StrokeTool::Blur => {
-                let strength = alpha * brush.opacity;
-                let weights: Vec<_> = ids
-                    .iter()
-                    .map(|&id| {
-                        let mut texels = Vec::new();
-                        fp.visit_tile(id, maps.tile_rect(id), |i, w| {
-                            texels.push((i, (w * strength).min(1.0)));
-                        });
-                        (id, texels)
-                    })
-                    .collect();
                 let ch = [channels.kd, channels.ks, channels.n];
-                let size = (maps.width(), maps.height());
-                let radius = brush.blur_radius_px;
-                match planes {
-                    Planes::Paint(tiles) => {
-                        let pre = tiles.to_vec();
-                        let pre = PrePlanes::Paint(&pre);
-                        edit::blur(Planes::Paint(tiles), pre, size, ch, radius, weights);
-                    }
-                    Planes::Mask(tiles) => {
-                        let pre = tiles.to_vec();
-                        let pre = PrePlanes::Mask(&pre);
-                        edit::blur(Planes::Mask(tiles), pre, size, ch, radius, weights);
-                    }
-                }
+                let strength = alpha * brush.opacity;
+                blur_dab(
+                    planes,
+                    (maps, &ids),
+                    fp,
+                    strength,
+                    (ch, brush.blur_radius_px),
+                )
             }
-        }
-        to.compositor.update_tiles(&to.state.stack, to.maps, &ids);
+        };
+        let regions: Vec<_> = ids
+            .iter()
+            .zip(written)
+            .zip(current)
+            .filter_map(|((&id, rect), current)| {
+                if current {
+                    rect.map(|r| (id, r))
+                } else {
+                    Some((id, TileRect::FULL))
+                }
+            })
+            .collect();
+        to.compositor
+            .update_regions(&to.state.stack, to.maps, &regions);
     }
 
     /// One dab and its mirrored copies.
@@ -360,6 +351,93 @@ impl Document {
             self.compositor.update(&self.state.stack, &mut self.maps);
         }
     }
+}
+
+/// A brush or eraser dab through `fp` at `(alpha, opacity)`: the stroke's coverage rises
+/// where the dab reaches, then every texel it reached takes its pre-stroke value at that
+/// coverage. Returns, per tile of `ids`, the texels reached.
+fn cover_dab(
+    (planes, pre): (Planes<'_>, PrePlanes<'_>),
+    target: &LayerEdit,
+    coverage: &mut Coverage,
+    (maps, ids): (&MaterialMaps, &[usize]),
+    fp: &impl Footprint,
+    (alpha, opacity): (f32, f32),
+) -> Vec<Option<TileRect>> {
+    let covs = coverage.tiles_mut(maps.tile_count(), ids);
+    let reached: Vec<(Option<TileRect>, &[f32])> = covs
+        .into_par_iter()
+        .zip(ids)
+        .map(|(cov, &id)| {
+            let mut rect = None;
+            fp.visit_tile(id, maps.tile_rect(id), |i, w| {
+                let c = cov[i];
+                let next = c + (opacity - c) * (w * alpha).min(1.0);
+                cov[i] = c.max(next);
+                TileRect::include(&mut rect, i);
+            });
+            let cov: &[f32] = cov;
+            (rect, cov)
+        })
+        .collect();
+    let work = ids
+        .iter()
+        .zip(&reached)
+        .filter_map(|(&id, &(rect, cover))| {
+            Some(edit::CoverWrite {
+                id,
+                rect: rect?,
+                cover,
+            })
+        })
+        .collect();
+    edit::edit_cover(planes, pre, target, work);
+    reached.iter().map(|r| r.0).collect()
+}
+
+/// A blur dab through `fp` at `strength` over `channels` with a kernel of `radius` texels.
+/// Returns, per tile of `ids`, the texels written.
+fn blur_dab(
+    planes: Planes<'_>,
+    (maps, ids): (&MaterialMaps, &[usize]),
+    fp: &impl Footprint,
+    strength: f32,
+    (channels, radius): ([bool; 3], u32),
+) -> Vec<Option<TileRect>> {
+    let weights: Vec<_> = ids
+        .iter()
+        .map(|&id| {
+            let mut texels = Vec::new();
+            fp.visit_tile(id, maps.tile_rect(id), |i, w| {
+                texels.push((i, (w * strength).min(1.0)));
+            });
+            (id, texels)
+        })
+        .collect();
+    let rects = weights
+        .iter()
+        .map(|(_, texels)| {
+            let mut rect = None;
+            for &(i, _) in texels {
+                TileRect::include(&mut rect, i);
+            }
+            rect
+        })
+        .collect();
+    let size = (maps.width(), maps.height());
+    match planes {
+        Planes::Paint(tiles) => {
+            let pre = tiles.to_vec();
+            let pre = PrePlanes::Paint(&pre);
+            edit::blur(Planes::Paint(tiles), pre, size, channels, radius, weights);
+        }
+        Planes::Mask(tiles) => {
+            let pre = tiles.to_vec();
+            let pre = PrePlanes::Mask(&pre);
+            edit::blur(Planes::Mask(tiles), pre, size, channels, radius, weights);
+        }
+    }
+    rects
 }
 
 /// A deterministic number in `[-1, 1)` (SplitMix64), for jitter that replays identically.

@@ -132,16 +132,16 @@ impl Covered {
     #[must_use]
     pub fn under_with(self, source: Self, mix: impl Fn(f32, f32) -> f32) -> Self {
         let (ab, as_) = (self.alpha, source.alpha);
-        if as_ <= 0.0 {
-            return self;
-        }
         let blended = (1.0 - ab) * source.value + ab * mix(self.value, source.value);
         let alpha = as_ + ab * (1.0 - as_);
         let premultiplied = as_ * blended + (1.0 - as_) * ab * self.value;
-        Self {
+        let over = Self {
             value: (premultiplied / alpha).clamp(0.0, 1.0),
             alpha: alpha.min(1.0),
-        }
+        };
+        // Nothing laid on leaves what is below as it is. Both sides are computed and one
+        // chosen, without a branch, so loops over texels vectorise.
+        if as_ > 0.0 { over } else { self }
     }
 }
 

@@ -22,8 +22,9 @@ use rayon::prelude::*;
 
 use super::{Covered, Layer, LayerContent, LayerStack, PaintTile, SharedPaintTile};
 use crate::model::maps::MaterialMaps;
+use crate::model::texel::Channels;
 use crate::model::texel::{Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, n_to_blend};
-use crate::model::tile::{TILE_TEXELS, Tile};
+use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileRect};
 
 /// The components of `k_d`, `k_s` and `n` in a [`State`].
 const PARTS: [std::ops::Range<usize>; 3] = [0..3, 3..6, 6..7];
@@ -111,6 +112,62 @@ impl Planes {
             alpha: std::array::from_fn(|_| vec![1.0; len]),
         }
     }
+
+    /// Every entry encoded as the maps store it (as [`Self::texel`], a component at a time).
+    fn encode(&self) -> Vec<Texel> {
+        let len = self.value[0].len();
+        let mut out = vec![
+            Texel {
+                kd: [0; 3],
+                ks: [0; 3],
+                n: 0,
+            };
+            len
+        ];
+        let mut bits = vec![0_u16; len];
+        for (k, plane) in self.value.iter().enumerate() {
+            if k == 6 {
+                for (b, &v) in bits.iter_mut().zip(plane) {
+                    *b = crate::model::paint::n_bits_from_blend(v);
+                }
+            } else {
+                for (b, &v) in bits.iter_mut().zip(plane) {
+                    *b = crate::model::texel::encode_unorm(v);
+                }
+            }
+            for (t, &b) in out.iter_mut().zip(&bits) {
+                match k {
+                    0..3 => t.kd[k] = b,
+                    3..6 => t.ks[k - 3] = b,
+                    _ => t.n = b,
+                }
+            }
+        }
+        out
+    }
+
+    /// Entry `j` encoded as the maps store it.
+    #[inline]
+    fn texel(&self, j: usize) -> Texel {
+        let v = &self.value;
+        Texel {
+            kd: encode_rgb(Vec3::new(v[0][j], v[1][j], v[2][j])),
+            ks: encode_rgb(Vec3::new(v[3][j], v[4][j], v[5][j])),
+            // The brushes' table from log space to half floats (exact to well within a half
+            // float's step).
+            n: crate::model::paint::n_bits_from_blend(v[6][j]),
+        }
+    }
+}
+
+/// The texels `len` entries of planes stand for: the whole tile, or (1) its first texel for
+/// all.
+fn span(len: usize) -> TileRect {
+    if len == 1 {
+        TileRect::texel(0)
+    } else {
+        TileRect::FULL
+    }
 }
 
 /// Lays `src` (values at coverage `cover`) over component `dst` with `mode`, texel by texel:
@@ -152,35 +209,87 @@ fn lay_plane(
     }
 }
 
-/// What `len` texels of a mask show of its layer (opacity included): `out[i]` for texel `i`
-/// (or texel 0 alone when `len` is 1).
-fn cover_of(layer: &Layer, id: usize, out: &mut [f32]) {
+/// The texels a [`Planes`] holds: rows of a rectangle of the tile, each a contiguous run
+/// `(first texel in the tile, first entry in the planes, length)`; a rectangle as wide as the
+/// tile is one run.
+fn runs(rect: TileRect) -> Vec<(usize, usize, usize)> {
+    let width = rect.x1 - rect.x0;
+    if width == TILE_SIZE {
+        return vec![(rect.y0 * TILE_SIZE, 0, (rect.y1 - rect.y0) * TILE_SIZE)];
+    }
+    (rect.y0..rect.y1)
+        .enumerate()
+        .map(|(row, y)| (y * TILE_SIZE + rect.x0, row * width, width))
+        .collect()
+}
+
+/// Decodes `plane` at the texels of `runs` into `out` through `f` (one entry a texel), a run
+/// at a time.
+#[inline]
+fn decode_runs<T: Copy + PartialEq>(
+    plane: &Plane<T>,
+    runs: &[(usize, usize, usize)],
+    out: &mut [f32],
+    f: impl Fn(T) -> f32,
+) {
+    match plane {
+        Plane::Uniform(v) => out.fill(f(*v)),
+        Plane::Data(d) => {
+            for &(start, at, len) in runs {
+                for (o, &v) in out[at..at + len].iter_mut().zip(&d[start..start + len]) {
+                    *o = f(v);
+                }
+            }
+        }
+    }
+}
+
+/// What the texels of `runs` of a mask show of its layer (opacity included), into `out`.
+fn cover_of(layer: &Layer, id: usize, runs: &[(usize, usize, usize)], out: &mut [f32]) {
     let opacity = layer.props.opacity.clamp(0.0, 1.0);
     match &layer.mask {
         Some(mask) if mask.enabled => {
             let plane = mask.tiles[id].get();
-            for (i, c) in out.iter_mut().enumerate() {
-                let m = decode_unorm(plane.get(i));
-                *c = opacity * if mask.inverted { 1.0 - m } else { m };
+            if mask.inverted {
+                decode_runs(plane, runs, out, |m| opacity * (1.0 - decode_unorm(m)));
+            } else {
+                decode_runs(plane, runs, out, |m| opacity * decode_unorm(m));
             }
         }
         _ => out.fill(opacity),
     }
 }
 
-/// Lays the active layers (bottom first) over `state` (the first `len` texels of tile `id`).
-fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
+/// Component `k` of a paint tile at the texels of `runs`, as compositing values, into `out`.
+fn component(tile: &PaintTile, k: usize, runs: &[(usize, usize, usize)], out: &mut [f32]) {
+    match k {
+        0..3 => decode_runs(&tile.value.kd, runs, out, |v| decode_unorm(v[k])),
+        3..6 => decode_runs(&tile.value.ks, runs, out, |v| decode_unorm(v[k - 3])),
+        _ => {
+            let table = crate::model::paint::n_blend_table();
+            decode_runs(&tile.value.n, runs, out, |bits| table[bits as usize]);
+        }
+    }
+}
+
+/// Lays the active layers (bottom first) over `state`: the texels of `runs` of tile `id`.
+fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize, runs: &[(usize, usize, usize)]) {
     let len = state.value[0].len();
+    debug_assert_eq!(
+        len,
+        runs.iter().map(|r| r.2).sum::<usize>(),
+        "one plane entry per texel"
+    );
     let mut cover = vec![0.0; len];
     let mut alpha = vec![0.0; len];
     let mut src = vec![0.0; len];
     for a in layers {
         let layer = a.layer();
-        cover_of(layer, id, &mut cover);
+        cover_of(layer, id, runs, &mut cover);
         let inner = match a {
             Active::Group(_, children) => {
                 let mut inner = Planes::clear(len);
-                apply(&mut inner, children, id);
+                apply(&mut inner, children, id, runs);
                 Some(inner)
             }
             _ => None,
@@ -193,30 +302,16 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
             // The channel's coverage here (a paint layer's and a fill's are one for the
             // channel; a group's is per component).
             match a {
-                Active::Paint(_, tile) => match tile.get().alpha[c].uniform() {
-                    Some(u) => {
-                        let u = decode_unorm(u);
-                        alpha
-                            .iter_mut()
-                            .zip(&cover)
-                            .for_each(|(al, cv)| *al = u * cv);
-                    }
-                    None => {
-                        for (i, (al, cv)) in alpha.iter_mut().zip(&cover).enumerate() {
-                            *al = decode_unorm(tile.get().alpha[c].get(i)) * cv;
-                        }
-                    }
-                },
+                Active::Paint(_, tile) => {
+                    decode_runs(&tile.get().alpha[c], runs, &mut alpha, decode_unorm);
+                    alpha.iter_mut().zip(&cover).for_each(|(al, cv)| *al *= cv);
+                }
                 Active::Fill(..) => alpha.copy_from_slice(&cover),
                 Active::Group(..) => {}
             }
             for k in part.clone() {
                 match a {
-                    Active::Paint(_, tile) => {
-                        for (i, s) in src.iter_mut().enumerate() {
-                            *s = component(tile.get(), k, i);
-                        }
-                    }
+                    Active::Paint(_, tile) => component(tile.get(), k, runs, &mut src),
                     Active::Fill(_, v) => src.fill(v[k]),
                     Active::Group(..) => {
                         let inner = inner.as_ref().unwrap_or_else(|| unreachable!());
@@ -230,16 +325,6 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize) {
                 lay_plane((v, al), &src, &alpha, blend.mode);
             }
         }
-    }
-}
-
-/// Component `k` of texel `i` of a paint tile, as a compositing value.
-#[inline]
-fn component(tile: &PaintTile, k: usize, i: usize) -> f32 {
-    match k {
-        0..3 => decode_unorm(tile.value.kd.get(i)[k]),
-        3..6 => decode_unorm(tile.value.ks.get(i)[k - 3]),
-        _ => crate::model::paint::n_bits_to_blend(tile.value.n.get(i)),
     }
 }
 
@@ -280,15 +365,8 @@ fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Til
         TILE_TEXELS
     };
     let mut state = Planes::opaque(&base, len);
-    apply(&mut state, layers, id);
-    let v = &state.value;
-    let at = |i: usize| Texel {
-        kd: encode_rgb(Vec3::new(v[0][i], v[1][i], v[2][i])),
-        ks: encode_rgb(Vec3::new(v[3][i], v[4][i], v[5][i])),
-        // The brushes' table from log space to half floats (exact to well within a half
-        // float's step).
-        n: crate::model::paint::n_bits_from_blend(v[6][i]),
-    };
+    apply(&mut state, layers, id, &runs(span(len)));
+    let at = |i: usize| state.texel(i);
     if len == 1 {
         return Tile::uniform(at(0));
     }
@@ -300,10 +378,24 @@ fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Til
     tile
 }
 
+/// Texels `rect` of tile `id`'s composite, row by row.
+fn composite_rect(stack: &LayerStack, id: usize, rect: TileRect) -> Vec<Texel> {
+    let layers = active(&stack.layers, id);
+    let base = values(Texel::encode(stack.base));
+    let count = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
+    if uniform_inputs(&layers, id) {
+        let mut state = Planes::opaque(&base, 1);
+        apply(&mut state, &layers, id, &runs(span(1)));
+        return vec![state.texel(0); count];
+    }
+    let mut state = Planes::opaque(&base, count);
+    apply(&mut state, &layers, id, &runs(rect));
+    state.encode()
+}
+
 /// `layers` composited onto nothing at tile `id`, as a paint tile (`None` where none of them
 /// covers anything): what merging them into one paint layer keeps.
 pub fn merge_tile(layers: &[Layer], id: usize) -> Option<PaintTile> {
-    use crate::model::tile::Plane;
     let act = active(layers, id);
     if act.is_empty() {
         return None;
@@ -314,15 +406,10 @@ pub fn merge_tile(layers: &[Layer], id: usize) -> Option<PaintTile> {
         TILE_TEXELS
     };
     let mut state = Planes::clear(len);
-    apply(&mut state, &act, id);
-    let v = &state.value;
+    apply(&mut state, &act, id, &runs(span(len)));
     let mut tile = PaintTile::filled(crate::model::texel::MaterialValue::default(), [false; 3]);
     let alpha = |k: usize, i: usize| crate::model::texel::encode_unorm(state.alpha[k][i]);
-    let texel = |i: usize| Texel {
-        kd: encode_rgb(Vec3::new(v[0][i], v[1][i], v[2][i])),
-        ks: encode_rgb(Vec3::new(v[3][i], v[4][i], v[5][i])),
-        n: crate::model::paint::n_bits_from_blend(v[6][i]),
-    };
+    let texel = |i: usize| state.texel(i);
     if len == 1 {
         tile.value = Tile::uniform(texel(0));
         tile.alpha = [0, 3, 6].map(|k| Plane::Uniform(alpha(k, 0)));
@@ -425,6 +512,77 @@ impl Compositor {
         self.write(stack, maps, stale)
     }
 
+    /// Whether each of tiles `ids` is composited from `stack` as it is now. Asked before an
+    /// edit that writes only part of those tiles, it says which of them
+    /// [`Self::update_regions`] may then recomposite only in part.
+    pub fn current(&self, stack: &LayerStack, ids: &[usize]) -> Vec<bool> {
+        ids.par_iter()
+            .map(|&id| self.signatures.get(id) == Some(&signature(stack, id)))
+            .collect()
+    }
+
+    /// As [`Self::update_tiles`] after an edit that wrote only texels `rect` of each tile `id`
+    /// of `regions` (in one layer's planes or mask), where those tiles were [`Self::current`]
+    /// before it: only those texels are recomposited, into the maps' tiles in place. The
+    /// result is bit-identical to recompositing the whole tiles.
+    pub fn update_regions(
+        &mut self,
+        stack: &LayerStack,
+        maps: &mut MaterialMaps,
+        regions: &[(usize, TileRect)],
+    ) -> Vec<usize> {
+        let count = stack.tile_count();
+        if self.signatures.len() != count {
+            self.signatures = vec![0; count];
+        }
+        let shared: &MaterialMaps = maps;
+        let fresh: Vec<(usize, u64, TileRect, Vec<Texel>, Channels)> = regions
+            .par_iter()
+            .filter_map(|&(id, rect)| {
+                let s = signature(stack, id);
+                if self.signatures[id] == s {
+                    return None;
+                }
+                let texels = composite_rect(stack, id, rect);
+                let old = shared.tile(id);
+                let mut changed = Channels::NONE;
+                for (i, t) in rect.indices().zip(&texels) {
+                    let o = old.texel(i);
+                    changed.kd |= o.kd != t.kd;
+                    changed.ks |= o.ks != t.ks;
+                    changed.n |= o.n != t.n;
+                }
+                Some((id, s, rect, texels, changed))
+            })
+            .collect();
+        let mut written = Vec::new();
+        for (id, s, rect, texels, changed) in fresh {
+            self.signatures[id] = s;
+            if !changed.is_empty() {
+                let tile = maps.tile_mut_in(id, changed);
+                write_rect(tile, rect, &texels, changed);
+                written.push(id);
+            }
+        }
+        written
+    }
+
+    /// Puts a recomposited tile in place if it differs; whether it did.
+    fn replace(maps: &mut MaterialMaps, id: usize, tile: Tile) -> bool {
+        let old = maps.tile(id);
+        let changed = Channels {
+            kd: old.kd != tile.kd,
+            ks: old.ks != tile.ks,
+            n: old.n != tile.n,
+        };
+        if changed.is_empty() {
+            return false;
+        }
+        // Only the planes that changed are marked: the upload stays per channel.
+        maps.replace_tile_in(id, std::sync::Arc::new(tile), changed);
+        true
+    }
+
     /// Composites the `stale` tiles (with their new signatures) and writes those that changed.
     fn write(
         &mut self,
@@ -439,19 +597,31 @@ impl Compositor {
         let mut written = Vec::new();
         for (id, s, tile) in tiles {
             self.signatures[id] = s;
-            let old = maps.tile(id);
-            let changed = crate::model::texel::Channels {
-                kd: old.kd != tile.kd,
-                ks: old.ks != tile.ks,
-                n: old.n != tile.n,
-            };
-            if !changed.is_empty() {
-                // Only the planes that changed are marked: the upload stays per channel.
-                maps.replace_tile_in(id, std::sync::Arc::new(tile), changed);
+            if Self::replace(maps, id, tile) {
                 written.push(id);
             }
         }
         written
+    }
+}
+
+/// Writes `texels` (row by row) into `rect` of `tile`, in the `changed` planes only, and
+/// compacts those planes.
+fn write_rect(tile: &mut Tile, rect: TileRect, texels: &[Texel], changed: Channels) {
+    if changed.kd {
+        let kd = tile.kd.data_mut();
+        rect.indices().zip(texels).for_each(|(i, t)| kd[i] = t.kd);
+        tile.kd.compact();
+    }
+    if changed.ks {
+        let ks = tile.ks.data_mut();
+        rect.indices().zip(texels).for_each(|(i, t)| ks[i] = t.ks);
+        tile.ks.compact();
+    }
+    if changed.n {
+        let n = tile.n.data_mut();
+        rect.indices().zip(texels).for_each(|(i, t)| n[i] = t.n);
+        tile.n.compact();
     }
 }
 

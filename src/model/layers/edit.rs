@@ -11,9 +11,10 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile, Stamped};
+use crate::model::brush::BlendMode;
 use crate::model::paint::{n_bits_from_blend, n_bits_to_blend};
 use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
-use crate::model::tile::{Plane, TILE_SIZE, select_mut};
+use crate::model::tile::{Plane, TILE_SIZE, TileRect, select_mut};
 
 /// A material as the layer kernels blend it: `k_d`, `k_s` linear, `n` in blend space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -196,6 +197,48 @@ impl Slot<'_> {
         }
     }
 
+    /// Writes texels `rect` at coverage `cover` (see [`CoverWrite`]).
+    fn write_cover(&mut self, edit: &LayerEdit, rect: TileRect, cover: &[f32]) {
+        match self {
+            Self::Paint(slot, pre, written) => {
+                let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
+                let pre = pre.map(|p| p.get());
+                for (ch, range) in RANGES.iter().enumerate() {
+                    if !edit.channels[ch] {
+                        continue;
+                    }
+                    let target = &edit.from.c[range.clone()];
+                    let channel = (&mut *tile, pre, ch, target, rect, cover);
+                    // One loop per kind of stroke, each with its arithmetic inlined.
+                    match edit.stroke {
+                        LayerStroke::Brush(BlendMode::Normal) => {
+                            let normal = LayerStroke::Brush(BlendMode::Normal);
+                            cover_channel(channel, |p, t, a| normal.apply(p, t, a));
+                        }
+                        LayerStroke::Erase => {
+                            cover_channel(channel, |p, t, a| LayerStroke::Erase.apply(p, t, a));
+                        }
+                        stroke @ LayerStroke::Brush(_) => {
+                            cover_channel(channel, |p, t, a| stroke.apply(p, t, a));
+                        }
+                    }
+                }
+            }
+            Self::Mask(slot, pre, written) => {
+                let g = edit.gray[0];
+                let plane = writable(slot, written).data_mut();
+                let pre = pre.get();
+                for i in rect.indices() {
+                    let a = cover[i];
+                    if a > 0.0 {
+                        let p = decode_unorm(pre.get(i));
+                        plane[i] = encode_unorm(p + (g - p) * a.min(1.0));
+                    }
+                }
+            }
+        }
+    }
+
     /// Stores uniform planes compactly after the writes.
     fn compact(&mut self) {
         match self {
@@ -206,6 +249,115 @@ impl Slot<'_> {
             }
             Self::Mask(tile, _, written) if *written => writable(tile, written).compact(),
             _ => {}
+        }
+    }
+}
+
+/// Decodes `len` texels of `plane` from texel `start` into `out` through `f`.
+#[inline]
+fn decode_run<T: Copy + PartialEq>(
+    plane: &Plane<T>,
+    start: usize,
+    out: &mut [f32],
+    f: impl Fn(T) -> f32,
+) {
+    match plane {
+        Plane::Uniform(v) => out.fill(f(*v)),
+        Plane::Data(d) => {
+            let len = out.len();
+            for (o, &v) in out.iter_mut().zip(&d[start..start + len]) {
+                *o = f(v);
+            }
+        }
+    }
+}
+
+/// Channel `ch` of a paint tile's texels `rect` after a stroke `f` of `target` (its
+/// components) at coverage `cover`, from the pre-operation tile (none: transparent), a row
+/// at a time: each step a plain loop over the row.
+fn cover_channel(
+    (tile, pre, ch, target, rect, cover): (
+        &mut PaintTile,
+        Option<&PaintTile>,
+        usize,
+        &[f32],
+        TileRect,
+        &[f32],
+    ),
+    f: impl Fn(LayerValue, f32, f32) -> LayerValue,
+) {
+    let width = rect.x1 - rect.x0;
+    let table = crate::model::paint::n_blend_table();
+    let mut pre_alpha = [0.0_f32; TILE_SIZE];
+    let mut pre_value = [0.0_f32; TILE_SIZE];
+    let mut out_alpha = [0.0_f32; TILE_SIZE];
+    let mut out_value = [0.0_f32; TILE_SIZE];
+    let mut alpha = [0_u16; TILE_SIZE];
+    let mut value = [[0_u16; TILE_SIZE]; 3];
+    for y in rect.y0..rect.y1 {
+        let start = y * TILE_SIZE + rect.x0;
+        let cov = &cover[start..start + width];
+        if let Some(p) = pre {
+            decode_run(&p.alpha[ch], start, &mut pre_alpha[..width], decode_unorm);
+        }
+        for (c, &t) in target.iter().enumerate() {
+            if let Some(p) = pre {
+                let out = &mut pre_value[..width];
+                match ch {
+                    0 => decode_run(&p.value.kd, start, out, |v| decode_unorm(v[c])),
+                    1 => decode_run(&p.value.ks, start, out, |v| decode_unorm(v[c])),
+                    _ => decode_run(&p.value.n, start, out, |bits| table[bits as usize]),
+                }
+            }
+            for j in 0..width {
+                let out = f(
+                    LayerValue {
+                        value: pre_value[j],
+                        alpha: pre_alpha[j],
+                    },
+                    t,
+                    cov[j],
+                );
+                (out_value[j], out_alpha[j]) = (out.value, out.alpha);
+            }
+            let encoded = &mut value[c][..width];
+            if ch == 2 {
+                for (e, &v) in encoded.iter_mut().zip(&out_value) {
+                    *e = n_bits_from_blend(v);
+                }
+            } else {
+                for (e, &v) in encoded.iter_mut().zip(&out_value) {
+                    *e = encode_unorm(v);
+                }
+            }
+        }
+        for (e, &a) in alpha[..width].iter_mut().zip(&out_alpha) {
+            *e = encode_unorm(a);
+        }
+        // Only texels the stroke reached change.
+        let covered = (0..width).filter(|&j| cov[j] > 0.0);
+        let a_plane = &mut tile.alpha[ch].data_mut()[start..start + width];
+        for j in covered.clone() {
+            a_plane[j] = alpha[j];
+        }
+        match ch {
+            0 | 1 => {
+                let plane = if ch == 0 {
+                    tile.value.kd.data_mut()
+                } else {
+                    tile.value.ks.data_mut()
+                };
+                let plane = &mut plane[start..start + width];
+                for j in covered {
+                    plane[j] = [value[0][j], value[1][j], value[2][j]];
+                }
+            }
+            _ => {
+                let plane = &mut tile.value.n.data_mut()[start..start + width];
+                for j in covered {
+                    plane[j] = value[0][j];
+                }
+            }
         }
     }
 }
@@ -221,26 +373,59 @@ pub fn edit_tiles<X: Send>(
     visit: impl Fn(usize, X, &mut dyn FnMut(usize, f32, f32)) + Sync,
 ) {
     let ids: Vec<usize> = work.iter().map(|(id, _)| *id).collect();
-    let slots: Vec<Slot<'_>> = match (planes, pre) {
-        (Planes::Paint(tiles), PrePlanes::Paint(pre)) => select_mut(tiles, &ids)
-            .into_iter()
-            .zip(&ids)
-            .map(|(t, &id)| Slot::Paint(t, pre[id].as_ref(), false))
-            .collect(),
-        (Planes::Mask(tiles), PrePlanes::Mask(pre)) => select_mut(tiles, &ids)
-            .into_iter()
-            .zip(&ids)
-            .map(|(t, &id)| Slot::Mask(t, &pre[id], false))
-            .collect(),
-        _ => return,
-    };
-    slots
+    slots(planes, pre, &ids)
         .into_par_iter()
         .zip(work)
         .for_each(|(mut slot, (id, data))| {
             visit(id, data, &mut |i, a, t| slot.write(edit, i, a, t));
             slot.compact();
         });
+}
+
+/// What a dab writes into one tile: texels `rect` of tile `id`, each at the stroke's coverage
+/// so far (`cover`, one value a texel of the tile; texels at zero are left as they are).
+pub struct CoverWrite<'a> {
+    /// The tile.
+    pub id: usize,
+    /// The texels the dab reached.
+    pub rect: TileRect,
+    /// The stroke's coverage.
+    pub cover: &'a [f32],
+}
+
+/// Writes dabs into tiles in parallel (see [`CoverWrite`]): every texel of each rectangle with
+/// a coverage becomes its pre-operation value at that coverage, a row at a time.
+pub fn edit_cover(
+    planes: Planes<'_>,
+    pre: PrePlanes<'_>,
+    edit: &LayerEdit,
+    work: Vec<CoverWrite<'_>>,
+) {
+    let ids: Vec<usize> = work.iter().map(|w| w.id).collect();
+    slots(planes, pre, &ids)
+        .into_par_iter()
+        .zip(work)
+        .for_each(|(mut slot, w)| {
+            slot.write_cover(edit, w.rect, w.cover);
+            slot.compact();
+        });
+}
+
+/// The tiles `ids` (sorted, unique) of `planes` to write, with their pre-operation tiles.
+fn slots<'a>(planes: Planes<'a>, pre: PrePlanes<'a>, ids: &[usize]) -> Vec<Slot<'a>> {
+    match (planes, pre) {
+        (Planes::Paint(tiles), PrePlanes::Paint(pre)) => select_mut(tiles, ids)
+            .into_iter()
+            .zip(ids)
+            .map(|(t, &id)| Slot::Paint(t, pre[id].as_ref(), false))
+            .collect(),
+        (Planes::Mask(tiles), PrePlanes::Mask(pre)) => select_mut(tiles, ids)
+            .into_iter()
+            .zip(ids)
+            .map(|(t, &id)| Slot::Mask(t, &pre[id], false))
+            .collect(),
+        _ => Vec::new(),
+    }
 }
 
 /// Texel indices inside tile `id` of a `width x height` map, with their map coordinates.

@@ -43,14 +43,13 @@ impl LayerStroke {
         match self {
             Self::Brush(BlendMode::Normal) => {
                 let alpha = a + pre.alpha * (1.0 - a);
-                if alpha <= 0.0 {
-                    return pre;
-                }
-                LayerValue {
+                let over = LayerValue {
                     value: ((a * target + (1.0 - a) * pre.alpha * pre.value) / alpha)
                         .clamp(0.0, 1.0),
                     alpha: alpha.min(1.0),
-                }
+                };
+                // Chosen without a branch, so loops over texels vectorise.
+                if alpha > 0.0 { over } else { pre }
             }
             Self::Brush(mode) => LayerValue {
                 value: mode.apply(pre.value, target, a),

@@ -56,9 +56,16 @@ pub(crate) fn n_bits_to_blend(bits: u16) -> f32 {
     n_tables().to_blend[bits as usize]
 }
 
+/// The table [`n_bits_to_blend`] reads: every half-float bit pattern's blend-space value, for
+/// loops that look up many.
+pub(crate) fn n_blend_table() -> &'static [f32] {
+    &n_tables().to_blend
+}
+
 #[inline]
 pub(crate) fn n_bits_from_blend(u: f32) -> u16 {
-    let i = (super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as usize;
+    // Through i32, which vectorises; in range, the same as converting to usize directly.
+    let i = (super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as i32 as usize;
     n_tables().from_blend[i.min(FROM_BLEND_STEPS)]
 }
 
