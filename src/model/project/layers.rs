@@ -17,7 +17,7 @@ use crate::model::layers::{
 };
 use crate::model::maps::MaterialMaps;
 use crate::model::texel::{Channel, MaterialValue};
-use crate::model::tile::{Plane, TILE_TEXELS, Tile};
+use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile};
 
 /// The most layers a project may hold.
 pub const MAX_LAYERS: usize = crate::model::document::MAX_LAYERS;
@@ -59,6 +59,11 @@ pub struct PlanesEntry {
     pub n: ChannelEntry,
     /// Coverage of `k_d`, `k_s` and `n` as RGB.
     pub alpha: ChannelEntry,
+    /// The painted tiles, ascending: the images are then atlases of those tiles alone (see
+    /// [`atlas_size`]), and every other tile is transparent. Absent: the images are the
+    /// whole map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiles: Option<Vec<u32>>,
 }
 
 /// A mask.
@@ -71,6 +76,13 @@ pub struct MaskEntry {
     pub inverted: bool,
     /// Its gray, as RGB.
     pub gray: ChannelEntry,
+    /// The tiles stored, ascending: the image is then an atlas of those tiles alone (see
+    /// [`atlas_size`]), and every other tile is `fill`. Absent: the image is the whole map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiles: Option<Vec<u32>>,
+    /// The gray of the tiles not stored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fill: Option<u16>,
 }
 
 /// One layer in the manifest.
@@ -135,22 +147,54 @@ fn gray_tile(planes: [&Plane<u16>; 3]) -> Tile {
     tile
 }
 
-/// What a writer stores for one layer: its maps to rasterise, named.
+/// Tiles a row of an atlas holds.
+const ATLAS_COLUMNS: usize = 128;
+
+/// The size in texels of an atlas of `count` tiles: up to 128 tiles a row, row-major, so the
+/// atlas of every tile of the largest map is still within the largest map size.
+pub fn atlas_size(count: usize) -> (u32, u32) {
+    let columns = count.clamp(1, ATLAS_COLUMNS);
+    let rows = count.div_ceil(columns).max(1);
+    ((columns * TILE_SIZE) as u32, (rows * TILE_SIZE) as u32)
+}
+
+/// What a writer stores for one layer, or a reader found: its maps, named. The maps are
+/// atlases: their tile `j` is the layer's tile `tiles[j]` (or `mask_tiles[j]`).
 pub struct LayerMaps {
     /// File stem (`layerK`).
     pub stem: String,
-    /// Values, coverages, mask.
+    /// The painted tiles the value and coverage atlases hold, ascending.
+    pub tiles: Vec<u32>,
+    /// Values.
     pub values: Option<MaterialMaps>,
     /// Coverage as `k_d`.
     pub alpha: Option<MaterialMaps>,
+    /// The mask tiles the mask atlas holds, ascending; every other is `mask_fill`.
+    pub mask_tiles: Vec<u32>,
+    /// The gray of the mask tiles not held.
+    pub mask_fill: u16,
     /// Mask as `k_d`.
     pub mask: Option<MaterialMaps>,
 }
 
-/// The stack's layers as maps to store, in the order [`entries`] names them.
+/// The most common uniform gray of a mask's tiles (white where none is uniform): the tiles
+/// of that gray are not stored.
+fn mask_fill(mask: &Mask) -> u16 {
+    let mut counts = std::collections::HashMap::new();
+    for t in &mask.tiles {
+        if let Some(v) = t.get().uniform() {
+            *counts.entry(v).or_insert(0_usize) += 1;
+        }
+    }
+    counts
+        .into_iter()
+        .max_by_key(|&(v, n)| (n, v))
+        .map_or(u16::MAX, |(v, _)| v)
+}
+
+/// The stack's layers as atlases to store, in the order [`entries`] names them: only painted
+/// tiles and mask tiles other than the mask's fill take room.
 pub fn layer_maps(stack: &LayerStack) -> Result<Vec<LayerMaps>, String> {
-    let (w, h) = (stack.width, stack.height);
-    let empty = PaintTile::filled(MaterialValue::default(), [false; 3]);
     stack
         .walk()
         .into_iter()
@@ -158,31 +202,45 @@ pub fn layer_maps(stack: &LayerStack) -> Result<Vec<LayerMaps>, String> {
         .map(|(k, (_, layer))| {
             let mut out = LayerMaps {
                 stem: format!("layer{k}"),
+                tiles: Vec::new(),
                 values: None,
                 alpha: None,
+                mask_tiles: Vec::new(),
+                mask_fill: u16::MAX,
                 mask: None,
             };
-            if let LayerContent::Paint(tiles) = &layer.content
-                && tiles.iter().any(Option::is_some)
-            {
-                let tile = |t: &Option<crate::model::layers::SharedPaintTile>| {
-                    t.as_ref().map_or(&empty, |t| t.get()).clone()
-                };
-                out.values = Some(maps_of(w, h, tiles.iter().map(|t| tile(t).value))?);
-                out.alpha = Some(maps_of(
-                    w,
-                    h,
-                    tiles.iter().map(|t| {
-                        let t = tile(t);
-                        gray_tile([&t.alpha[0], &t.alpha[1], &t.alpha[2]])
-                    }),
-                )?);
+            if let LayerContent::Paint(tiles) = &layer.content {
+                let painted: Vec<(u32, &PaintTile)> = (0u32..)
+                    .zip(tiles)
+                    .filter_map(|(id, t)| Some((id, t.as_ref()?.get())))
+                    .collect();
+                if !painted.is_empty() {
+                    out.tiles = painted.iter().map(|(id, _)| *id).collect();
+                    let (w, h) = atlas_size(painted.len());
+                    out.values = Some(maps_of(w, h, painted.iter().map(|(_, t)| t.value.clone()))?);
+                    out.alpha = Some(maps_of(
+                        w,
+                        h,
+                        painted
+                            .iter()
+                            .map(|(_, t)| gray_tile([&t.alpha[0], &t.alpha[1], &t.alpha[2]])),
+                    )?);
+                }
             }
             if let Some(mask) = &layer.mask {
+                let fill = mask_fill(mask);
+                let stored: Vec<(u32, &Plane<u16>)> = (0u32..)
+                    .zip(&mask.tiles)
+                    .map(|(id, t)| (id, t.get()))
+                    .filter(|(_, p)| p.uniform() != Some(fill))
+                    .collect();
+                out.mask_fill = fill;
+                out.mask_tiles = stored.iter().map(|(id, _)| *id).collect();
+                let (w, h) = atlas_size(stored.len());
                 out.mask = Some(maps_of(
                     w,
                     h,
-                    mask.tiles.iter().map(|t| gray_tile([t.get(); 3])),
+                    stored.iter().map(|(_, p)| gray_tile([p; 3])),
                 )?);
             }
             Ok(out)
@@ -190,19 +248,35 @@ pub fn layer_maps(stack: &LayerStack) -> Result<Vec<LayerMaps>, String> {
         .collect()
 }
 
+/// Checks that `tiles` (ids listed for an atlas) ascend without repeats inside a map of
+/// `tile_count` tiles.
+pub fn check_tiles(tiles: &[u32], tile_count: usize, what: &str) -> Result<(), String> {
+    if tiles.windows(2).any(|w| w[0] >= w[1]) {
+        return Err(format!("{what}: the tile list is not ascending"));
+    }
+    if let Some(&last) = tiles.last()
+        && last as usize >= tile_count
+    {
+        return Err(format!(
+            "{what}: tile {last} is outside the map's {tile_count} tiles"
+        ));
+    }
+    Ok(())
+}
+
 /// The manifest's entries for `layers`, given each layer's stored channels in walk order
 /// (`stored(k)` gives layer `k`'s planes and mask entries).
 pub fn entries(
     layers: &[Layer],
     next: &mut usize,
-    stored: &impl Fn(usize) -> (Option<PlanesEntry>, Option<ChannelEntry>),
+    stored: &impl Fn(usize) -> (Option<PlanesEntry>, Option<MaskEntry>),
 ) -> Vec<LayerEntry> {
     layers
         .iter()
         .map(|layer| {
             let k = *next;
             *next += 1;
-            let (planes, mask_gray) = stored(k);
+            let (planes, mask_stored) = stored(k);
             let p = &layer.props;
             LayerEntry {
                 name: p.name.clone(),
@@ -226,11 +300,11 @@ pub fn entries(
                 mask: layer
                     .mask
                     .as_ref()
-                    .zip(mask_gray)
-                    .map(|(m, gray)| MaskEntry {
+                    .zip(mask_stored)
+                    .map(|(m, stored)| MaskEntry {
                         enabled: m.enabled,
                         inverted: m.inverted,
-                        gray,
+                        ..stored
                     }),
                 children: match &layer.content {
                     LayerContent::Group(children) => entries(children, next, stored),
@@ -321,20 +395,19 @@ pub fn build(
                     LayerContent::Group(build(&e.children, next, tile_count, read)?)
                 }
             };
-            let mask = e.mask.as_ref().map(|m| Mask {
-                tiles: (0..tile_count)
-                    .map(|id| {
-                        let plane = stored
-                            .mask
-                            .as_ref()
-                            .map_or(Plane::Uniform(u16::MAX), |maps| {
-                                gray_plane(maps.tile(id), 0)
-                            });
-                        Arc::new(Stamped::new(plane))
-                    })
-                    .collect(),
-                enabled: m.enabled,
-                inverted: m.inverted,
+            let mask = e.mask.as_ref().map(|m| {
+                let fill = Arc::new(Stamped::new(Plane::Uniform(stored.mask_fill)));
+                let mut tiles = vec![fill; tile_count];
+                if let Some(maps) = &stored.mask {
+                    for (j, &id) in stored.mask_tiles.iter().enumerate() {
+                        tiles[id as usize] = Arc::new(Stamped::new(gray_plane(maps.tile(j), 0)));
+                    }
+                }
+                Mask {
+                    tiles,
+                    enabled: m.enabled,
+                    inverted: m.inverted,
+                }
             });
             Ok(Layer {
                 props,
@@ -359,20 +432,20 @@ fn paint_tiles(
     stored: &LayerMaps,
     tile_count: usize,
 ) -> Vec<Option<crate::model::layers::SharedPaintTile>> {
+    let mut out = vec![None; tile_count];
     let (Some(values), Some(alpha)) = (&stored.values, &stored.alpha) else {
-        return vec![None; tile_count];
+        return out;
     };
-    (0..tile_count)
-        .map(|id| {
-            let a = alpha.tile(id);
-            let alpha = [0, 1, 2].map(|c| gray_plane(a, c));
-            if alpha.iter().all(|p| p.uniform() == Some(0)) {
-                return None;
-            }
-            Some(Arc::new(Stamped::new(PaintTile {
-                value: (**values.tile(id)).clone(),
-                alpha,
-            })))
-        })
-        .collect()
+    for (j, &id) in stored.tiles.iter().enumerate() {
+        let a = alpha.tile(j);
+        let alpha = [0, 1, 2].map(|c| gray_plane(a, c));
+        if alpha.iter().all(|p| p.uniform() == Some(0)) {
+            continue;
+        }
+        out[id as usize] = Some(Arc::new(Stamped::new(PaintTile {
+            value: (**values.tile(j)).clone(),
+            alpha,
+        })));
+    }
+    out
 }

@@ -94,28 +94,53 @@ fn read_layer<R: Read + Seek>(
     let zero1 = Raster::Uniform(vec![0]);
     let mut out = super::layers::LayerMaps {
         stem: format!("layer{k}"),
+        tiles: Vec::new(),
         values: None,
         alpha: None,
+        mask_tiles: Vec::new(),
+        mask_fill: u16::MAX,
         mask: None,
     };
-    let new_maps = || MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string());
+    let tile_count = MaterialMaps::new(w, h, MaterialValue::default())
+        .map_err(|e| e.to_string())?
+        .tile_count();
+    // The images are atlases of the listed tiles, or (without a list) the whole map, whose
+    // tile `j` is tile `j`.
+    let layout = |tiles: &Option<Vec<u32>>, what: &str| -> Result<(Vec<u32>, u32, u32), String> {
+        match tiles {
+            Some(t) => {
+                super::layers::check_tiles(t, tile_count, &name(what))?;
+                let (aw, ah) = super::layers::atlas_size(t.len());
+                Ok((t.clone(), aw, ah))
+            }
+            None => Ok(((0..tile_count as u32).collect(), w, h)),
+        }
+    };
+    let new_maps = |w: u32, h: u32| {
+        MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())
+    };
     if let Some(p) = &e.planes {
-        let kd = read_channel(zip, &p.kd, &name("kd"), w, h, 3)?;
-        let ks = read_channel(zip, &p.ks, &name("ks"), w, h, 3)?;
-        let n = read_channel(zip, &p.n, &name("n"), w, h, 1)?;
+        let (tiles, aw, ah) = layout(&p.tiles, "planes")?;
+        let kd = read_channel(zip, &p.kd, &name("kd"), aw, ah, 3)?;
+        let ks = read_channel(zip, &p.ks, &name("ks"), aw, ah, 3)?;
+        let n = read_channel(zip, &p.n, &name("n"), aw, ah, 1)?;
         check_n(&n)?;
-        let alpha = read_channel(zip, &p.alpha, &name("coverage"), w, h, 3)?;
-        let mut values = new_maps()?;
+        let alpha = read_channel(zip, &p.alpha, &name("coverage"), aw, ah, 3)?;
+        let mut values = new_maps(aw, ah)?;
         fill_maps(&mut values, &kd, &ks, &n);
-        let mut cover = new_maps()?;
+        let mut cover = new_maps(aw, ah)?;
         fill_maps(&mut cover, &alpha, &zero3, &zero1);
+        out.tiles = tiles;
         out.values = Some(values);
         out.alpha = Some(cover);
     }
     if let Some(m) = &e.mask {
-        let gray = read_channel(zip, &m.gray, &name("mask"), w, h, 3)?;
-        let mut mask = new_maps()?;
+        let (tiles, aw, ah) = layout(&m.tiles, "mask")?;
+        let gray = read_channel(zip, &m.gray, &name("mask"), aw, ah, 3)?;
+        let mut mask = new_maps(aw, ah)?;
         fill_maps(&mut mask, &gray, &zero3, &zero1);
+        out.mask_tiles = tiles;
+        out.mask_fill = m.fill.unwrap_or(u16::MAX);
         out.mask = Some(mask);
     }
     Ok(out)

@@ -137,6 +137,8 @@ pub(super) fn write_project(
     let maps = doc.maps();
     let (w, h) = (maps.width(), maps.height());
     let mut rasters: Vec<(String, Raster)> = channel_rasters(maps, "").into();
+    // Each raster's size: the map's, or a layer's atlas.
+    let mut sizes = vec![(w, h); 3];
     let layer_maps = super::layers::layer_maps(doc.stack())?;
     let mut stored = Vec::new();
     for l in &layer_maps {
@@ -146,24 +148,34 @@ pub(super) fn write_project(
             rasters.extend(channel_rasters(v, &format!("{}_", l.stem)));
             let [alpha, _, _] = channel_rasters(a, &format!("{}_alpha_", l.stem));
             rasters.push(alpha);
+            sizes.extend([(v.width(), v.height()); 4]);
             planes = Some(super::layers::PlanesEntry {
                 kd: entry(&rasters[at]),
                 ks: entry(&rasters[at + 1]),
                 n: entry(&rasters[at + 2]),
                 alpha: entry(&rasters[at + 3]),
+                tiles: Some(l.tiles.clone()),
             });
         }
         let mask = l.mask.as_ref().map(|m| {
             let [gray, _, _] = channel_rasters(m, &format!("{}_mask_", l.stem));
             let e = entry(&gray);
             rasters.push(gray);
-            e
+            sizes.push((m.width(), m.height()));
+            super::layers::MaskEntry {
+                enabled: true,
+                inverted: false,
+                gray: e,
+                tiles: Some(l.mask_tiles.clone()),
+                fill: Some(l.mask_fill),
+            }
         });
         stored.push((planes, mask));
     }
     let pngs: Vec<Result<Vec<u8>, String>> = rasters
         .par_iter()
-        .map(|(_, r)| encode_png(r, w, h))
+        .zip(&sizes)
+        .map(|((_, r), &(w, h))| encode_png(r, w, h))
         .collect();
     let layers = super::layers::entries(&doc.stack().layers, &mut 0, &|k| stored[k].clone());
     let manifest = Manifest {
