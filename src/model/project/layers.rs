@@ -177,6 +177,21 @@ pub struct LayerMaps {
     pub mask: Option<MaterialMaps>,
 }
 
+impl LayerMaps {
+    /// Nothing stored yet for layer `k`.
+    pub fn empty(k: usize) -> Self {
+        Self {
+            stem: format!("layer{k}"),
+            tiles: Vec::new(),
+            values: None,
+            alpha: None,
+            mask_tiles: Vec::new(),
+            mask_fill: u16::MAX,
+            mask: None,
+        }
+    }
+}
+
 /// The most common uniform gray of a mask's tiles (white where none is uniform): the tiles
 /// of that gray are not stored.
 fn mask_fill(mask: &Mask) -> u16 {
@@ -200,15 +215,7 @@ pub fn layer_maps(stack: &LayerStack) -> Result<Vec<LayerMaps>, String> {
         .into_iter()
         .enumerate()
         .map(|(k, (_, layer))| {
-            let mut out = LayerMaps {
-                stem: format!("layer{k}"),
-                tiles: Vec::new(),
-                values: None,
-                alpha: None,
-                mask_tiles: Vec::new(),
-                mask_fill: u16::MAX,
-                mask: None,
-            };
+            let mut out = LayerMaps::empty(k);
             if let LayerContent::Paint(tiles) = &layer.content {
                 let painted: Vec<(u32, &PaintTile)> = (0u32..)
                     .zip(tiles)

@@ -92,15 +92,7 @@ fn read_layer<R: Read + Seek>(
     let name = |part: &str| format!("layer {k} ({:?}) {part}", e.name);
     let zero3 = Raster::Uniform(vec![0; 3]);
     let zero1 = Raster::Uniform(vec![0]);
-    let mut out = super::layers::LayerMaps {
-        stem: format!("layer{k}"),
-        tiles: Vec::new(),
-        values: None,
-        alpha: None,
-        mask_tiles: Vec::new(),
-        mask_fill: u16::MAX,
-        mask: None,
-    };
+    let mut out = super::layers::LayerMaps::empty(k);
     let tile_count = MaterialMaps::new(w, h, MaterialValue::default())
         .map_err(|e| e.to_string())?
         .tile_count();

@@ -5,6 +5,7 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::model::layers::{ChannelBlend, LayerBlend, Mask, PaintTile, Stamped};
+use crate::model::maps::MaterialMaps;
 use crate::model::texel::{Channel, MaterialValue};
 use crate::model::tile::{Plane, TileRect};
 

@@ -1,0 +1,212 @@
+//! Keeping the maps the composite of a stack as it changes: per tile, a signature of
+//! everything its composite depends on, and recompositing only tiles (or the texels of them an
+//! edit reached) whose signature changed.
+
+use std::hash::{Hash, Hasher};
+
+use rayon::prelude::*;
+
+use super::{Active, active, composite_rect, composite_tile};
+use crate::model::layers::LayerStack;
+use crate::model::maps::MaterialMaps;
+use crate::model::texel::{Channels, Texel};
+use crate::model::tile::{Tile, TileRect};
+
+/// Hashes what the composite of tile `id` depends on: per active layer, in order, its
+/// settings, its fill value or its tile's stamp, its mask's switches and tile stamp, and its
+/// active children.
+fn hash_active(layers: &[Active<'_>], id: usize, h: &mut impl Hasher) {
+    layers.len().hash(h);
+    for a in layers {
+        let l = a.layer();
+        (l.props.opacity.to_bits(), l.props.channels).hash(h);
+        l.mask
+            .as_ref()
+            .map(|m| (m.enabled, m.inverted, m.tiles[id].stamp()))
+            .hash(h);
+        match a {
+            Active::Paint(_, tile) => (0u8, tile.stamp()).hash(h),
+            Active::Fill(_, v) => (1u8, v.map(f32::to_bits)).hash(h),
+            Active::Group(_, children) => {
+                2u8.hash(h);
+                hash_active(children, id, h);
+            }
+        }
+    }
+}
+
+/// The signature of tile `id`'s inputs (never 0).
+fn signature(stack: &LayerStack, id: usize) -> u64 {
+    let mut h = std::hash::DefaultHasher::new();
+    (stack.width, stack.height, Texel::encode(stack.base)).hash(&mut h);
+    hash_active(&active(&stack.layers, id), id, &mut h);
+    h.finish().max(1)
+}
+
+/// Keeps [`MaterialMaps`] the composite of a [`LayerStack`], recompositing only the tiles
+/// whose inputs changed.
+#[derive(Clone, Debug, Default)]
+pub struct Compositor {
+    /// Per tile, the signature of the inputs it was composited from (0: never).
+    signatures: Vec<u64>,
+}
+
+impl Compositor {
+    /// A compositor that has composited nothing yet (its first update does every tile).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Brings `maps` up to date with `stack` (of the same size): recomposites the tiles whose
+    /// inputs changed since the last update, in parallel, and writes those that came out
+    /// different. Returns the tiles written, ascending.
+    pub fn update(&mut self, stack: &LayerStack, maps: &mut MaterialMaps) -> Vec<usize> {
+        let count = stack.tile_count();
+        debug_assert_eq!(
+            count,
+            maps.tile_count(),
+            "the stack and the maps differ in size"
+        );
+        if self.signatures.len() != count {
+            self.signatures = vec![0; count];
+        }
+        let stale: Vec<(usize, u64)> = (0..count)
+            .into_par_iter()
+            .map(|id| (id, signature(stack, id)))
+            .filter(|&(id, s)| self.signatures[id] != s)
+            .collect();
+        self.write(stack, maps, stale)
+    }
+
+    /// As [`Self::update`], looking only at `ids` (the tiles a stroke touched: no other
+    /// tile's inputs changed).
+    pub fn update_tiles(
+        &mut self,
+        stack: &LayerStack,
+        maps: &mut MaterialMaps,
+        ids: &[usize],
+    ) -> Vec<usize> {
+        let count = stack.tile_count();
+        if self.signatures.len() != count {
+            self.signatures = vec![0; count];
+        }
+        let stale: Vec<(usize, u64)> = ids
+            .par_iter()
+            .map(|&id| (id, signature(stack, id)))
+            .filter(|&(id, s)| self.signatures[id] != s)
+            .collect();
+        self.write(stack, maps, stale)
+    }
+
+    /// Whether each of tiles `ids` is composited from `stack` as it is now. Asked before an
+    /// edit that writes only part of those tiles, it says which of them
+    /// [`Self::update_regions`] may then recomposite only in part.
+    pub fn current(&self, stack: &LayerStack, ids: &[usize]) -> Vec<bool> {
+        ids.par_iter()
+            .map(|&id| self.signatures.get(id) == Some(&signature(stack, id)))
+            .collect()
+    }
+
+    /// As [`Self::update_tiles`] after an edit that wrote only texels `rect` of each tile `id`
+    /// of `regions` (in one layer's planes or mask), where those tiles were [`Self::current`]
+    /// before it: only those texels are recomposited, into the maps' tiles in place. The
+    /// result is bit-identical to recompositing the whole tiles.
+    pub fn update_regions(
+        &mut self,
+        stack: &LayerStack,
+        maps: &mut MaterialMaps,
+        regions: &[(usize, TileRect)],
+    ) -> Vec<usize> {
+        let count = stack.tile_count();
+        if self.signatures.len() != count {
+            self.signatures = vec![0; count];
+        }
+        let shared: &MaterialMaps = maps;
+        let fresh: Vec<(usize, u64, TileRect, Vec<Texel>, Channels)> = regions
+            .par_iter()
+            .filter_map(|&(id, rect)| {
+                let s = signature(stack, id);
+                if self.signatures[id] == s {
+                    return None;
+                }
+                let texels = composite_rect(stack, id, rect);
+                let old = shared.tile(id);
+                let mut changed = Channels::NONE;
+                for (i, t) in rect.indices().zip(&texels) {
+                    let o = old.texel(i);
+                    changed.kd |= o.kd != t.kd;
+                    changed.ks |= o.ks != t.ks;
+                    changed.n |= o.n != t.n;
+                }
+                Some((id, s, rect, texels, changed))
+            })
+            .collect();
+        let mut written = Vec::new();
+        for (id, s, rect, texels, changed) in fresh {
+            self.signatures[id] = s;
+            if !changed.is_empty() {
+                let tile = maps.tile_mut_in(id, changed);
+                write_rect(tile, rect, &texels, changed);
+                written.push(id);
+            }
+        }
+        written
+    }
+
+    /// Puts a recomposited tile in place if it differs; whether it did.
+    fn replace(maps: &mut MaterialMaps, id: usize, tile: Tile) -> bool {
+        let old = maps.tile(id);
+        let changed = Channels {
+            kd: old.kd != tile.kd,
+            ks: old.ks != tile.ks,
+            n: old.n != tile.n,
+        };
+        if changed.is_empty() {
+            return false;
+        }
+        // Only the planes that changed are marked: the upload stays per channel.
+        maps.replace_tile_in(id, std::sync::Arc::new(tile), changed);
+        true
+    }
+
+    /// Composites the `stale` tiles (with their new signatures) and writes those that changed.
+    fn write(
+        &mut self,
+        stack: &LayerStack,
+        maps: &mut MaterialMaps,
+        stale: Vec<(usize, u64)>,
+    ) -> Vec<usize> {
+        let tiles: Vec<(usize, u64, Tile)> = stale
+            .into_par_iter()
+            .map(|(id, s)| (id, s, composite_tile(stack, id)))
+            .collect();
+        let mut written = Vec::new();
+        for (id, s, tile) in tiles {
+            self.signatures[id] = s;
+            if Self::replace(maps, id, tile) {
+                written.push(id);
+            }
+        }
+        written
+    }
+}
+
+/// Writes `texels` (row by row) into `rect` of `tile`, in the `changed` planes only, and
+/// compacts those planes.
+fn write_rect(tile: &mut Tile, rect: TileRect, texels: &[Texel], changed: Channels) {
+    if changed.kd {
+        let kd = tile.kd.data_mut();
+        rect.indices().zip(texels).for_each(|(i, t)| kd[i] = t.kd);
+        tile.kd.compact();
+    }
+    if changed.ks {
+        let ks = tile.ks.data_mut();
+        rect.indices().zip(texels).for_each(|(i, t)| ks[i] = t.ks);
+        tile.ks.compact();
+    }
+    if changed.n {
+        let n = tile.n.data_mut();
+        rect.indices().zip(texels).for_each(|(i, t)| n[i] = t.n);
+        tile.n.compact();
+    }
+}
