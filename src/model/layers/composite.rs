@@ -1,4 +1,4 @@
-//! Flattening a [`LayerStack`] into [`MaterialMaps`], tile by tile.
+//! Flattening a [`LayerStack`] into [`MaterialMaps`](crate::model::MaterialMaps), tile by tile.
 //!
 //! Per texel, bottom-up: the base (opaque), then each visible layer's enabled channels laid on
 //! with their blend mode at `coverage x opacity x mask` (W3C source-over with a separable
