@@ -215,9 +215,22 @@ impl Texel {
 /// `[0, 1]` (NaN -> 0) to unorm16, rounding to nearest.
 #[inline]
 pub fn encode_unorm(v: f32) -> u16 {
-    // Through i32, which converts four at a time where a loop vectorises; in range, the same
-    // as converting to u16 directly.
-    (unit(v) * 65535.0 + 0.5) as i32 as u16
+    // In range, the same as `as u16`; the u32 holds at most 65535.
+    trunc_small(unit(v) * 65535.0 + 0.5) as u16
+}
+
+/// `y as u32` for a `y` in `[0, 2^22)`, in plain float arithmetic: no saturating
+/// conversion (a compare and branches per value), so loops of it vectorise.
+///
+/// Adding 2^23 leaves no fraction bits: `(y + 2^23) - 2^23` is `y` rounded to the nearest
+/// integer, exactly; one less where that rounded up is the floor, which for `y >= 0` is the
+/// truncation; and `floor + 2^23` holds it in its low mantissa bits.
+#[inline]
+pub fn trunc_small(y: f32) -> u32 {
+    const SHIFT: f32 = 8_388_608.0;
+    let near = (y + SHIFT) - SHIFT;
+    let floor = near - if near > y { 1.0 } else { 0.0 };
+    (floor + SHIFT).to_bits() - SHIFT.to_bits()
 }
 
 /// unorm16 to `[0, 1]`.
@@ -295,6 +308,38 @@ pub fn linear_to_srgb8(c: f32) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn trunc_small_is_the_conversion_it_replaces() {
+        // Every float bit pattern in [0, 2^22) at a prime stride, and every integer, half and
+        // neighbour of them up to 2^18 + 1 (the largest argument the encoders pass).
+        let top = (1u32 << 22) as f32;
+        let strided = (0..top.to_bits()).step_by(7919).map(f32::from_bits);
+        let near_integers = (0..=(1u32 << 18) + 1).flat_map(|i| {
+            let f = i as f32;
+            [
+                f,
+                f + 0.5,
+                f.next_down().max(0.0),
+                f.next_up(),
+                (f + 0.5).next_down(),
+            ]
+        });
+        for y in strided.chain(near_integers) {
+            assert_eq!(trunc_small(y), y as u32, "{y}");
+        }
+        // encode_unorm as it was written before: through a saturating conversion.
+        for bits in (0..=1.0f32.to_bits() + 1).step_by(101) {
+            let v = f32::from_bits(bits);
+            assert_eq!(encode_unorm(v), (unit(v) * 65535.0 + 0.5) as u16, "{v}");
+        }
+        for q in 0..=u16::MAX {
+            assert_eq!(encode_unorm(decode_unorm(q)), q);
+        }
+        assert_eq!(encode_unorm(f32::NAN), 0);
+        assert_eq!(encode_unorm(f32::INFINITY), u16::MAX);
+        assert_eq!(encode_unorm(-1.0), 0);
+    }
 
     #[test]
     fn n_step_is_below_a_tenth_of_a_percent() {

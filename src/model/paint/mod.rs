@@ -64,8 +64,8 @@ pub(crate) fn n_blend_table() -> &'static [f32] {
 
 #[inline]
 pub(crate) fn n_bits_from_blend(u: f32) -> u16 {
-    // Through i32, which vectorises; in range, the same as converting to usize directly.
-    let i = (super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as i32 as usize;
+    let i =
+        super::texel::trunc_small(super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as usize;
     n_tables().from_blend[i.min(FROM_BLEND_STEPS)]
 }
 
