@@ -359,10 +359,17 @@ fn layers(c: &mut Criterion) {
     layer_dabs(c);
 }
 
-/// One 128 px dab through the document, as a stroke lays it (paint the selected layer, then
-/// recomposite the tiles it touched and derive `k_a` there): on layer 8 of 16 painted, masked
-/// layers, and on a one-layer document, in the same run (issue 18: <= 1 ms, <= 2x).
+/// One 128 px-radius dab through the document, as a stroke lays it (paint the selected layer,
+/// then recomposite the texels it changed and derive `k_a` on the tiles that changed): on
+/// layer 8 of 16 painted, masked layers, and on a one-layer document, in the same run (issue
+/// 18: <= 1 ms, <= 2x). The stroke moves on by the spacing (25 % of the radius) each dab, along
+/// rows across the map ([`kapaint::report::typical::stroke_path`]), so every dab reaches texels
+/// it has not covered yet; where the path starts over, a new stroke begins, painting over the
+/// first. `..._over_paint_...` paints on a layer filled first (no tile of it new to the layer);
+/// `..._overlapping` goes back and forth over one place, where most of each dab is already
+/// covered.
 fn layer_dabs(c: &mut Criterion) {
+    type Path<'a> = &'a dyn Fn(u32) -> Vec2;
     let mut group = c.benchmark_group("layers_4096");
     group
         .sample_size(20)
@@ -372,28 +379,61 @@ fn layer_dabs(c: &mut Criterion) {
         primary: MaterialValue::new(Vec3::new(0.8, 0.3, 0.1), Vec3::splat(0.3), 60.0),
         ..DocumentSettings::default()
     };
-    let layered = Document::from_stack(
-        kapaint::report::typical::layered_stack(SIDE, 16),
-        settings.clone(),
-    )
-    .expect("size");
-    let single = Document::new(SIDE, SIDE, settings).expect("size");
-    for (name, mut doc, layer) in [
-        ("dab_128px_on_layer_8_of_16", layered, 8),
-        ("dab_128px_on_1_layer", single, 0),
-    ] {
+    let layered = || {
+        Document::from_stack(
+            kapaint::report::typical::layered_stack(SIDE, 16),
+            settings.clone(),
+        )
+        .expect("size")
+    };
+    let single = || Document::new(SIDE, SIDE, settings.clone()).expect("size");
+    let moving = |k: u32| kapaint::report::typical::stroke_path(k);
+    let overlapping = |k: u32| {
+        Vec2::new(
+            2000.5 + if k.is_multiple_of(2) { 0.0 } else { 32.0 },
+            1500.5,
+        )
+    };
+    let filled = || {
+        let mut doc = layered();
+        doc.apply(Command::SelectPath(vec![8])).expect("select");
+        let primary = doc.settings().primary;
+        let under = kapaint::report::typical::under_paint();
+        doc.apply(Command::SetPrimary(under)).expect("primary");
+        doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+        doc.apply(Command::SetPrimary(primary)).expect("primary");
+        doc
+    };
+    let cases: [(&str, Document, usize, Path); 4] = [
+        ("dab_128px_on_layer_8_of_16", layered(), 8, &moving),
+        ("dab_128px_on_1_layer", single(), 0, &moving),
+        (
+            "dab_128px_over_paint_on_layer_8_of_16",
+            filled(),
+            8,
+            &moving,
+        ),
+        (
+            "dab_128px_overlapping_on_layer_8_of_16",
+            layered(),
+            8,
+            &overlapping,
+        ),
+    ];
+    for (name, mut doc, layer, path) in cases {
         doc.apply(Command::SelectPath(vec![layer])).expect("select");
-        doc.apply(Command::BeginStroke(StrokeTool::Brush))
-            .expect("begin");
-        // Back and forth by the spacing (25 % of 128 px): one dab a point.
         let mut k = 0u32;
         let mut version = doc.maps().version();
         group.bench_function(name, |b| {
             b.iter(|| {
+                if k.is_multiple_of(kapaint::report::typical::STROKE_PATH_POINTS) {
+                    doc.apply(Command::EndStroke).expect("end");
+                    doc.apply(Command::BeginStroke(StrokeTool::Brush))
+                        .expect("begin");
+                }
                 k += 1;
-                let x = 2000.5 + if k.is_multiple_of(2) { 0.0 } else { 32.0 };
                 doc.apply(Command::StrokeTo(StrokePoint {
-                    pos: Vec2::new(x, 1500.5),
+                    pos: path(k),
                     pressure: 1.0,
                 }))
                 .expect("dab");

@@ -3,7 +3,11 @@
 //! changed) on a 4096^2 document: on layer 8 of the 16-layer benchmark stack, or with
 //! `single` on a one-layer document. `perf record` this.
 //!
-//! Usage: `cargo run --release --example dab_profile [layers|single] [ROUNDS]`
+//! With `moving`, the dabs go along a stroke instead (32 px apart, row after row across the
+//! map), so every dab reaches texels the stroke has not covered yet; `over` does the same on
+//! the layer filled first (every tile of it painted).
+//!
+//! Usage: `cargo run --release --example dab_profile [layers|single] [ROUNDS] [moving|over]`
 
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
@@ -15,6 +19,8 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let single = args.next().as_deref() == Some("single");
     let rounds: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2000);
+    let how = args.next();
+    let moving = matches!(how.as_deref(), Some("moving" | "over"));
     let settings = DocumentSettings {
         brush: BrushSettings {
             radius_px: 128.0,
@@ -34,19 +40,26 @@ fn main() -> Result<(), String> {
     let doc = doc.as_mut().map_err(|e| e.to_string())?;
     let run = |doc: &mut Document, c| doc.apply(c).map_err(|e| e.to_string());
     run(doc, Command::SelectPath(vec![layer]))?;
+    if how.as_deref() == Some("over") {
+        let primary = doc.settings().primary;
+        run(
+            doc,
+            Command::SetPrimary(kapaint::report::typical::under_paint()),
+        )?;
+        run(doc, Command::Fill(kapaint::model::FillRegion::All))?;
+        run(doc, Command::SetPrimary(primary))?;
+    }
     run(doc, Command::BeginStroke(StrokeTool::Brush))?;
     let mut version = doc.maps().version();
     let start = std::time::Instant::now();
     let mut derived = 0;
     for k in 0..rounds {
-        let x = 2000.5 + if k % 2 == 0 { 0.0 } else { 32.0 };
-        run(
-            doc,
-            Command::StrokeTo(StrokePoint {
-                pos: Vec2::new(x, 1500.5),
-                pressure: 1.0,
-            }),
-        )?;
+        let pos = if moving {
+            kapaint::report::typical::stroke_path(k)
+        } else {
+            Vec2::new(2000.5 + if k % 2 == 0 { 0.0 } else { 32.0 }, 1500.5)
+        };
+        run(doc, Command::StrokeTo(StrokePoint { pos, pressure: 1.0 }))?;
         let dirty = doc.maps().tiles_changed_since(version);
         version = doc.maps().version();
         derived += doc

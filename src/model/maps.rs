@@ -188,6 +188,27 @@ impl MaterialMaps {
         Arc::make_mut(&mut self.tiles[id])
     }
 
+    /// Edits tiles `ids` (sorted ascending, without duplicates) in parallel: `edit(k, tile)`
+    /// gets the `k`-th tile's slot, changes it copy-on-write ([`Arc::make_mut`]) or not at all,
+    /// and returns the channels it changed; only those versions move. Returns them, per tile.
+    pub fn edit_tiles_par(
+        &mut self,
+        ids: &[TileId],
+        edit: impl Fn(usize, &mut Arc<Tile>) -> Channels + Sync,
+    ) -> Vec<Channels> {
+        let changed: Vec<Channels> = super::tile::select_mut(&mut self.tiles, ids)
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, tile)| edit(k, tile))
+            .collect();
+        for (&id, &c) in ids.iter().zip(&changed) {
+            if !c.is_empty() {
+                self.touch(id, c);
+            }
+        }
+        changed
+    }
+
     /// Several tiles for writing at once (each cloned first if shared), for parallel work on
     /// disjoint tiles. `ids` must be sorted ascending without duplicates; bumps versions.
     pub fn tiles_mut_many(&mut self, ids: &[TileId]) -> Vec<&mut Tile> {

@@ -91,6 +91,68 @@ impl TileRect {
     }
 }
 
+/// Texels inside one tile as a run of columns per row: the part of a tile an edit wrote (a
+/// disc's part of a tile is about a fifth smaller than its bounding rectangle).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileSpans {
+    /// Per row, the columns `x0..x1` (none where `x0 >= x1`).
+    rows: [(u8, u8); TILE_SIZE],
+}
+
+impl TileSpans {
+    /// No texel.
+    pub const EMPTY: Self = Self {
+        rows: [(TILE_SIZE as u8, 0); TILE_SIZE],
+    };
+
+    /// The whole tile.
+    pub const FULL: Self = Self {
+        rows: [(0, TILE_SIZE as u8); TILE_SIZE],
+    };
+
+    /// Grows to hold texel `i` (row-major in the tile).
+    #[inline]
+    pub fn include(&mut self, i: usize) {
+        let (x, row) = ((i % TILE_SIZE) as u8, &mut self.rows[i / TILE_SIZE]);
+        *row = (row.0.min(x), row.1.max(x + 1));
+    }
+
+    /// Whether it holds no texel.
+    pub fn is_empty(&self) -> bool {
+        self.rows.iter().all(|&(x0, x1)| x0 >= x1)
+    }
+
+    /// Its rows that hold texels: `(row, x0, x1)`, top down.
+    pub fn rows(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        self.rows
+            .iter()
+            .enumerate()
+            .filter(|(_, (x0, x1))| x0 < x1)
+            .map(|(y, &(x0, x1))| (y, usize::from(x0), usize::from(x1)))
+    }
+
+    /// The texel indices (row-major in the tile) inside, row by row.
+    pub fn indices(&self) -> impl Iterator<Item = usize> + '_ {
+        self.rows()
+            .flat_map(|(y, x0, x1)| (x0..x1).map(move |x| y * TILE_SIZE + x))
+    }
+
+    /// How many texels it holds.
+    pub fn count(&self) -> usize {
+        self.rows().map(|(_, x0, x1)| x1 - x0).sum()
+    }
+}
+
+impl From<TileRect> for TileSpans {
+    fn from(r: TileRect) -> Self {
+        let mut spans = Self::EMPTY;
+        for y in r.y0..r.y1 {
+            spans.rows[y] = (r.x0 as u8, r.x1 as u8);
+        }
+        spans
+    }
+}
+
 /// One channel of a tile: a single value for every texel, or one value per texel.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Plane<T: Copy> {

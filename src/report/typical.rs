@@ -131,3 +131,25 @@ pub fn layered_stack(side: u32, layers: usize) -> crate::model::layers::LayerSta
     }
     stack
 }
+
+/// Points in [`stroke_path`] before it starts over.
+pub const STROKE_PATH_POINTS: u32 = 12 * 112;
+
+/// Point `k` of a long stroke across a 4096^2 map for dab benchmarks: 32 px apart (the
+/// spacing of a 128 px-radius brush) along rows 320 px apart, back and forth, so every dab
+/// reaches texels the stroke has not covered yet; after [`STROKE_PATH_POINTS`] (12 rows) it
+/// starts over (a new stroke there paints over the first).
+pub fn stroke_path(k: u32) -> glam::Vec2 {
+    let (row, col) = ((k / 112) % 12, k % 112);
+    let col = if row % 2 == 0 { col } else { 111 - col };
+    glam::Vec2::new(256.5 + 32.0 * col as f32, 256.5 + 320.0 * row as f32)
+}
+
+/// The material dab benchmarks fill a layer with before painting over it (unlike the brush's).
+pub fn under_paint() -> MaterialValue {
+    MaterialValue::new(
+        glam::Vec3::new(0.2, 0.45, 0.6),
+        glam::Vec3::splat(0.08),
+        900.0,
+    )
+}

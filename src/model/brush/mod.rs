@@ -40,6 +40,18 @@ impl BlendMode {
     /// All modes, for menus.
     pub const ALL: [Self; 4] = [Self::Normal, Self::Add, Self::Subtract, Self::Multiply];
 
+    /// The mode's blend of value `below` with `target` where the stroke fully covers it
+    /// (what [`Self::apply`] moves towards), clamped into `[0, 1]`.
+    #[inline]
+    pub fn mix(self, below: f32, target: f32) -> f32 {
+        super::texel::unit(match self {
+            Self::Normal => target,
+            Self::Add => below + target,
+            Self::Subtract => below - target,
+            Self::Multiply => below * target,
+        })
+    }
+
     /// Applies the mode to one channel value at stroke alpha `a`, clamped into `[0, 1]`.
     #[inline]
     pub fn apply(self, v: f32, target: f32, a: f32) -> f32 {

@@ -1,7 +1,6 @@
 //! Strokes: smoothing and resampling input into dabs, jitter, mirroring, and each dab's tool.
 
 use glam::{Vec2, Vec3};
-use rayon::prelude::*;
 
 use super::{Document, StrokeTool};
 use crate::model::ModelError;
@@ -14,7 +13,7 @@ use crate::model::maps::MaterialMaps;
 use crate::model::paint::{Coverage, DiscFootprint, Footprint};
 use crate::model::surface::{BallFootprint, Surface};
 use crate::model::texel::Channels;
-use crate::model::tile::TileRect;
+use crate::model::tile::TileSpans;
 
 /// A stroke in progress.
 pub(super) struct ActiveStroke {
@@ -282,11 +281,13 @@ impl Document {
             .iter()
             .zip(written)
             .zip(current)
-            .filter_map(|((&id, rect), current)| {
-                if current {
-                    rect.map(|r| (id, r))
+            .filter_map(|((&id, spans), current)| {
+                if !current {
+                    Some((id, TileSpans::FULL))
+                } else if spans.is_empty() {
+                    None
                 } else {
-                    Some((id, TileRect::FULL))
+                    Some((id, spans))
                 }
             })
             .collect();
@@ -354,8 +355,12 @@ impl Document {
 }
 
 /// A brush or eraser dab through `fp` at `(alpha, opacity)`: the stroke's coverage rises
-/// where the dab reaches, then every texel it reached takes its pre-stroke value at that
-/// coverage. Returns, per tile of `ids`, the texels reached.
+/// where the dab reaches, then every texel whose coverage rose takes its pre-stroke value at
+/// that coverage. Returns, per tile of `ids`, the texels written.
+///
+/// A texel whose coverage did not rise (the stroke already covers it as much as this dab
+/// would) already holds its pre-stroke value at that coverage, and is left alone: where dabs
+/// overlap, only what they add is written and recomposited.
 fn cover_dab(
     (planes, pre): (Planes<'_>, PrePlanes<'_>),
     target: &LayerEdit,
@@ -363,36 +368,20 @@ fn cover_dab(
     (maps, ids): (&MaterialMaps, &[usize]),
     fp: &impl Footprint,
     (alpha, opacity): (f32, f32),
-) -> Vec<Option<TileRect>> {
-    let covs = coverage.tiles_mut(maps.tile_count(), ids);
-    let reached: Vec<(Option<TileRect>, &[f32])> = covs
-        .into_par_iter()
-        .zip(ids)
-        .map(|(cov, &id)| {
-            let mut rect = None;
-            fp.visit_tile(id, maps.tile_rect(id), |i, w| {
-                let c = cov[i];
-                let next = c + (opacity - c) * (w * alpha).min(1.0);
-                cov[i] = c.max(next);
-                TileRect::include(&mut rect, i);
-            });
-            let cov: &[f32] = cov;
-            (rect, cov)
-        })
-        .collect();
-    let work = ids
-        .iter()
-        .zip(&reached)
-        .filter_map(|(&id, &(rect, cover))| {
-            Some(edit::CoverWrite {
-                id,
-                rect: rect?,
-                cover,
-            })
-        })
-        .collect();
-    edit::edit_cover(planes, pre, target, work);
-    reached.iter().map(|r| r.0).collect()
+) -> Vec<TileSpans> {
+    let covers = coverage.tiles_mut(maps.tile_count(), ids);
+    edit::edit_cover((planes, pre), target, ids, covers, |id, cov| {
+        let mut rose = TileSpans::EMPTY;
+        fp.visit_tile(id, maps.tile_rect(id), |i, w| {
+            let c = cov[i];
+            let next = c + (opacity - c) * (w * alpha).min(1.0);
+            if next > c {
+                cov[i] = next;
+                rose.include(i);
+            }
+        });
+        rose
+    })
 }
 
 /// A blur dab through `fp` at `strength` over `channels` with a kernel of `radius` texels.
@@ -403,7 +392,7 @@ fn blur_dab(
     fp: &impl Footprint,
     strength: f32,
     (channels, radius): ([bool; 3], u32),
-) -> Vec<Option<TileRect>> {
+) -> Vec<TileSpans> {
     let weights: Vec<_> = ids
         .iter()
         .map(|&id| {
@@ -414,14 +403,14 @@ fn blur_dab(
             (id, texels)
         })
         .collect();
-    let rects = weights
+    let written = weights
         .iter()
         .map(|(_, texels)| {
-            let mut rect = None;
+            let mut spans = TileSpans::EMPTY;
             for &(i, _) in texels {
-                TileRect::include(&mut rect, i);
+                spans.include(i);
             }
-            rect
+            spans
         })
         .collect();
     let size = (maps.width(), maps.height());
@@ -437,7 +426,7 @@ fn blur_dab(
             edit::blur(Planes::Mask(tiles), pre, size, channels, radius, weights);
         }
     }
-    rects
+    written
 }
 
 /// A deterministic number in `[-1, 1)` (SplitMix64), for jitter that replays identically.

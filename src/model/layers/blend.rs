@@ -143,12 +143,44 @@ impl Covered {
         // chosen, without a branch, so loops over texels vectorise.
         if as_ > 0.0 { over } else { self }
     }
+
+    /// [`Self::under_with`] over an opaque `below`, where the result is opaque too: its value
+    /// only, without the division by the coverage (which is one).
+    #[inline]
+    #[must_use]
+    pub fn over_opaque_with(below: f32, source: Self, mix: impl Fn(f32, f32) -> f32) -> f32 {
+        let a = source.alpha;
+        (a * mix(below, source.value) + (1.0 - a) * below).clamp(0.0, 1.0)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::texel::{n_from_blend, n_to_blend};
+
+    #[test]
+    fn laying_over_an_opaque_value_agrees_with_the_general_case() {
+        let steps = [0.0_f32, 0.1, 0.25, 0.5, 0.7, 0.9, 1.0];
+        for mode in LayerBlend::ALL {
+            for below in steps {
+                for value in steps {
+                    for alpha in steps {
+                        let source = Covered { value, alpha };
+                        let general = Covered::opaque(below).under(source, mode);
+                        let opaque =
+                            Covered::over_opaque_with(below, source, |b, l| mode.mix(b, l));
+                        assert!((general.alpha - 1.0).abs() < 1e-6);
+                        assert!(
+                            (general.value - opaque).abs() < 1e-6,
+                            "{mode:?} {below} {value} {alpha}: {} {opaque}",
+                            general.value
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn n_blends_in_log_space() {

@@ -16,8 +16,11 @@
 //! maps' dirty tiles (and the GPU upload) stay the ones that really changed.
 
 use super::{Covered, Layer, LayerContent, LayerStack, PaintTile, SharedPaintTile};
-use crate::model::texel::{Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, n_to_blend};
-use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileRect};
+use crate::model::paint::n_bits_from_blend;
+use crate::model::texel::{
+    Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, encode_unorm, n_to_blend,
+};
+use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileRect, TileSpans};
 use glam::Vec3;
 
 /// The components of `k_d`, `k_s` and `n` in a [`State`].
@@ -87,57 +90,59 @@ fn active(layers: &[Layer], id: usize) -> Vec<Active<'_>> {
 /// `n` in log space): values (not premultiplied) and coverage.
 struct Planes {
     value: [Vec<f32>; 7],
-    alpha: [Vec<f32>; 7],
+    /// Per component, the coverage; `None` where every texel is covered (the stack over its
+    /// opaque base, which stays opaque whatever is laid on it).
+    alpha: Option<[Vec<f32>; 7]>,
+}
+
+/// Texels of a tile encoded as the maps store them, a plane per channel, row by row.
+struct Encoded {
+    kd: Vec<[u16; 3]>,
+    ks: Vec<[u16; 3]>,
+    n: Vec<u16>,
+}
+
+impl Drop for Planes {
+    fn drop(&mut self) {
+        let alpha = self.alpha.take().into_iter().flatten();
+        for v in self.value.iter_mut().map(std::mem::take).chain(alpha) {
+            scratch::recycle(v);
+        }
+    }
 }
 
 impl Planes {
     /// `len` texels of nothing (the start of a group).
     fn clear(len: usize) -> Self {
         Self {
-            value: std::array::from_fn(|_| vec![0.0; len]),
-            alpha: std::array::from_fn(|_| vec![0.0; len]),
+            value: std::array::from_fn(|_| scratch::buffer(len, 0.0)),
+            alpha: Some(std::array::from_fn(|_| scratch::buffer(len, 0.0))),
         }
     }
 
     /// `len` texels of `base`, opaque.
     fn opaque(base: &[f32; 7], len: usize) -> Self {
         Self {
-            value: std::array::from_fn(|k| vec![base[k]; len]),
-            alpha: std::array::from_fn(|_| vec![1.0; len]),
+            value: std::array::from_fn(|k| scratch::buffer(len, base[k])),
+            alpha: None,
         }
     }
 
-    /// Every entry encoded as the maps store it (as [`Self::texel`], a component at a time).
-    fn encode(&self) -> Vec<Texel> {
-        let len = self.value[0].len();
-        let mut out = vec![
-            Texel {
-                kd: [0; 3],
-                ks: [0; 3],
-                n: 0,
-            };
-            len
-        ];
-        let mut bits = vec![0_u16; len];
-        for (k, plane) in self.value.iter().enumerate() {
-            if k == 6 {
-                for (b, &v) in bits.iter_mut().zip(plane) {
-                    *b = crate::model::paint::n_bits_from_blend(v);
-                }
-            } else {
-                for (b, &v) in bits.iter_mut().zip(plane) {
-                    *b = crate::model::texel::encode_unorm(v);
-                }
-            }
-            for (t, &b) in out.iter_mut().zip(&bits) {
-                match k {
-                    0..3 => t.kd[k] = b,
-                    3..6 => t.ks[k - 3] = b,
-                    _ => t.n = b,
-                }
-            }
+    /// Every entry encoded as the maps store it (as [`Self::texel`]).
+    fn encode(&self) -> Encoded {
+        let [r, g, b, sr, sg, sb, n] = &self.value;
+        let rgb = |r: &[f32], g: &[f32], b: &[f32]| -> Vec<[u16; 3]> {
+            r.iter()
+                .zip(g)
+                .zip(b)
+                .map(|((&r, &g), &b)| [encode_unorm(r), encode_unorm(g), encode_unorm(b)])
+                .collect()
+        };
+        Encoded {
+            kd: rgb(r, g, b),
+            ks: rgb(sr, sg, sb),
+            n: n.iter().map(|&v| n_bits_from_blend(v)).collect(),
         }
-        out
     }
 
     /// Entry `j` encoded as the maps store it.
@@ -149,25 +154,26 @@ impl Planes {
             ks: encode_rgb(Vec3::new(v[3][j], v[4][j], v[5][j])),
             // The brushes' table from log space to half floats (exact to well within a half
             // float's step).
-            n: crate::model::paint::n_bits_from_blend(v[6][j]),
+            n: n_bits_from_blend(v[6][j]),
         }
     }
 }
 
 /// The texels `len` entries of planes stand for: the whole tile, or (1) its first texel for
 /// all.
-fn span(len: usize) -> TileRect {
+fn span(len: usize) -> TileSpans {
     if len == 1 {
-        TileRect::texel(0)
+        TileRect::texel(0).into()
     } else {
-        TileRect::FULL
+        TileSpans::FULL
     }
 }
 
-/// Lays `src` (values at coverage `cover`) over component `dst` with `mode`, texel by texel:
-/// [`Covered::under`], with the mode chosen once for the whole run.
+/// Lays `src` (values at coverage `cover`) over component `dst` (its values, and its
+/// coverage unless it is opaque) with `mode`, texel by texel: [`Covered::under`], with the
+/// mode chosen once for the whole run.
 fn lay_plane(
-    (dst_v, dst_a): (&mut [f32], &mut [f32]),
+    (dst_v, dst_a): (&mut [f32], Option<&mut [f32]>),
     src: &[f32],
     cover: &[f32],
     mode: super::LayerBlend,
@@ -177,10 +183,16 @@ fn lay_plane(
     fn run(
         mix: impl Fn(f32, f32) -> f32 + Copy,
         dst_v: &mut [f32],
-        dst_a: &mut [f32],
+        dst_a: Option<&mut [f32]>,
         src: &[f32],
         cover: &[f32],
     ) {
+        let Some(dst_a) = dst_a else {
+            for ((v, &s), &c) in dst_v.iter_mut().zip(src).zip(cover) {
+                *v = Covered::over_opaque_with(*v, Covered { value: s, alpha: c }, mix);
+            }
+            return;
+        };
         for (((v, a), &s), &c) in dst_v.iter_mut().zip(dst_a.iter_mut()).zip(src).zip(cover) {
             let below = Covered {
                 value: *v,
@@ -203,18 +215,20 @@ fn lay_plane(
     }
 }
 
-/// The texels a [`Planes`] holds: rows of a rectangle of the tile, each a contiguous run
-/// `(first texel in the tile, first entry in the planes, length)`; a rectangle as wide as the
-/// tile is one run.
-fn runs(rect: TileRect) -> Vec<(usize, usize, usize)> {
-    let width = rect.x1 - rect.x0;
-    if width == TILE_SIZE {
-        return vec![(rect.y0 * TILE_SIZE, 0, (rect.y1 - rect.y0) * TILE_SIZE)];
+/// The texels a [`Planes`] holds: spans of rows of the tile, as contiguous runs `(first texel
+/// in the tile, first entry in the planes, length)`; whole rows one after another are one run.
+fn runs(spans: &TileSpans) -> Vec<(usize, usize, usize)> {
+    let mut out: Vec<(usize, usize, usize)> = Vec::new();
+    let mut at = 0;
+    for (y, x0, x1) in spans.rows() {
+        let (start, len) = (y * TILE_SIZE + x0, x1 - x0);
+        match out.last_mut() {
+            Some(last) if last.0 + last.2 == start => last.2 += len,
+            _ => out.push((start, at, len)),
+        }
+        at += len;
     }
-    (rect.y0..rect.y1)
-        .enumerate()
-        .map(|(row, y)| (y * TILE_SIZE + rect.x0, row * width, width))
-        .collect()
+    out
 }
 
 /// Decodes `plane` at the texels of `runs` into `out` through `f` (one entry a texel), a run
@@ -254,14 +268,45 @@ fn cover_of(layer: &Layer, id: usize, runs: &[(usize, usize, usize)], out: &mut 
     }
 }
 
-/// Component `k` of a paint tile at the texels of `runs`, as compositing values, into `out`.
-fn component(tile: &PaintTile, k: usize, runs: &[(usize, usize, usize)], out: &mut [f32]) {
-    match k {
-        0..3 => decode_runs(&tile.value.kd, runs, out, |v| decode_unorm(v[k])),
-        3..6 => decode_runs(&tile.value.ks, runs, out, |v| decode_unorm(v[k - 3])),
+/// Channel `c` (`k_d`, `k_s` or `n`) of a paint tile at the texels of `runs`, as compositing
+/// values, into `out` (its first plane for `n`), a texel's components in one pass.
+fn channel_values(
+    tile: &PaintTile,
+    c: usize,
+    runs: &[(usize, usize, usize)],
+    out: &mut [Vec<f32>; 3],
+) {
+    let rgb = match c {
+        0 => &tile.value.kd,
+        1 => &tile.value.ks,
         _ => {
             let table = crate::model::paint::n_blend_table();
-            decode_runs(&tile.value.n, runs, out, |bits| table[bits as usize]);
+            decode_runs(&tile.value.n, runs, &mut out[0], |bits| {
+                table[bits as usize]
+            });
+            return;
+        }
+    };
+    let [r, g, b] = out;
+    match rgb {
+        Plane::Uniform(v) => {
+            r.fill(decode_unorm(v[0]));
+            g.fill(decode_unorm(v[1]));
+            b.fill(decode_unorm(v[2]));
+        }
+        Plane::Data(d) => {
+            for &(start, at, len) in runs {
+                let (r, g, b) = (
+                    &mut r[at..at + len],
+                    &mut g[at..at + len],
+                    &mut b[at..at + len],
+                );
+                for (j, v) in d[start..start + len].iter().enumerate() {
+                    r[j] = decode_unorm(v[0]);
+                    g[j] = decode_unorm(v[1]);
+                    b[j] = decode_unorm(v[2]);
+                }
+            }
         }
     }
 }
@@ -274,9 +319,9 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize, runs: &[(usize, u
         runs.iter().map(|r| r.2).sum::<usize>(),
         "one plane entry per texel"
     );
-    let mut cover = vec![0.0; len];
-    let mut alpha = vec![0.0; len];
-    let mut src = vec![0.0; len];
+    let mut cover = scratch::buffer(len, 0.0);
+    let mut alpha = scratch::buffer(len, 0.0);
+    let mut src: [Vec<f32>; 3] = std::array::from_fn(|_| scratch::buffer(len, 0.0));
     for a in layers {
         let layer = a.layer();
         cover_of(layer, id, runs, &mut cover);
@@ -294,31 +339,41 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize, runs: &[(usize, u
                 continue;
             }
             // The channel's coverage here (a paint layer's and a fill's are one for the
-            // channel; a group's is per component).
+            // channel; a group's is per component), and a paint layer's values.
             match a {
                 Active::Paint(_, tile) => {
-                    decode_runs(&tile.get().alpha[c], runs, &mut alpha, decode_unorm);
+                    let tile = tile.get();
+                    decode_runs(&tile.alpha[c], runs, &mut alpha, decode_unorm);
                     alpha.iter_mut().zip(&cover).for_each(|(al, cv)| *al *= cv);
+                    channel_values(tile, c, runs, &mut src);
                 }
                 Active::Fill(..) => alpha.copy_from_slice(&cover),
                 Active::Group(..) => {}
             }
-            for k in part.clone() {
-                match a {
-                    Active::Paint(_, tile) => component(tile.get(), k, runs, &mut src),
-                    Active::Fill(_, v) => src.fill(v[k]),
+            for (j, k) in part.clone().enumerate() {
+                let from: &[f32] = match a {
+                    Active::Paint(..) => &src[j],
+                    Active::Fill(_, v) => {
+                        src[0].fill(v[k]);
+                        &src[0]
+                    }
                     Active::Group(..) => {
                         let inner = inner.as_ref().unwrap_or_else(|| unreachable!());
-                        src.copy_from_slice(&inner.value[k]);
-                        for ((al, ia), cv) in alpha.iter_mut().zip(&inner.alpha[k]).zip(&cover) {
+                        let inner_alpha = inner.alpha.as_ref().unwrap_or_else(|| unreachable!());
+                        for ((al, ia), cv) in alpha.iter_mut().zip(&inner_alpha[k]).zip(&cover) {
                             *al = ia * cv;
                         }
+                        &inner.value[k]
                     }
-                }
-                let (v, al) = (&mut state.value[k], &mut state.alpha[k]);
-                lay_plane((v, al), &src, &alpha, blend.mode);
+                };
+                let v = &mut state.value[k];
+                let al = state.alpha.as_mut().map(|a| a[k].as_mut_slice());
+                lay_plane((v, al), from, &alpha, blend.mode);
             }
         }
+    }
+    for v in [cover, alpha].into_iter().chain(src) {
+        scratch::recycle(v);
     }
 }
 
@@ -359,31 +414,37 @@ fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Til
         TILE_TEXELS
     };
     let mut state = Planes::opaque(&base, len);
-    apply(&mut state, layers, id, &runs(span(len)));
-    let at = |i: usize| state.texel(i);
+    apply(&mut state, layers, id, &runs(&span(len)));
     if len == 1 {
-        return Tile::uniform(at(0));
+        return Tile::uniform(state.texel(0));
     }
-    let mut tile = Tile::uniform(Texel::default());
-    for i in 0..TILE_TEXELS {
-        tile.set_texel(i, at(i));
-    }
+    let e = state.encode();
+    let mut tile = Tile {
+        kd: Plane::Data(e.kd.into_boxed_slice()),
+        ks: Plane::Data(e.ks.into_boxed_slice()),
+        n: Plane::Data(e.n.into_boxed_slice()),
+    };
     tile.compact();
     tile
 }
 
-/// Texels `rect` of tile `id`'s composite, row by row.
-fn composite_rect(stack: &LayerStack, id: usize, rect: TileRect) -> Vec<Texel> {
+/// Texels `spans` of tile `id`'s composite, row by row.
+fn composite_spans(stack: &LayerStack, id: usize, spans: &TileSpans) -> Encoded {
     let layers = active(&stack.layers, id);
     let base = values(Texel::encode(stack.base));
-    let count = (rect.x1 - rect.x0) * (rect.y1 - rect.y0);
+    let count = spans.count();
     if uniform_inputs(&layers, id) {
         let mut state = Planes::opaque(&base, 1);
-        apply(&mut state, &layers, id, &runs(span(1)));
-        return vec![state.texel(0); count];
+        apply(&mut state, &layers, id, &runs(&span(1)));
+        let t = state.texel(0);
+        return Encoded {
+            kd: vec![t.kd; count],
+            ks: vec![t.ks; count],
+            n: vec![t.n; count],
+        };
     }
     let mut state = Planes::opaque(&base, count);
-    apply(&mut state, &layers, id, &runs(rect));
+    apply(&mut state, &layers, id, &runs(spans));
     state.encode()
 }
 
@@ -400,9 +461,10 @@ pub fn merge_tile(layers: &[Layer], id: usize) -> Option<PaintTile> {
         TILE_TEXELS
     };
     let mut state = Planes::clear(len);
-    apply(&mut state, &act, id, &runs(span(len)));
+    apply(&mut state, &act, id, &runs(&span(len)));
     let mut tile = PaintTile::filled(crate::model::texel::MaterialValue::default(), [false; 3]);
-    let alpha = |k: usize, i: usize| crate::model::texel::encode_unorm(state.alpha[k][i]);
+    let planes = state.alpha.as_ref().unwrap_or_else(|| unreachable!());
+    let alpha = |k: usize, i: usize| encode_unorm(planes[k][i]);
     let texel = |i: usize| state.texel(i);
     if len == 1 {
         tile.value = Tile::uniform(texel(0));
@@ -421,6 +483,7 @@ pub fn merge_tile(layers: &[Layer], id: usize) -> Option<PaintTile> {
 }
 
 mod incremental;
+mod scratch;
 pub use incremental::Compositor;
 
 #[cfg(test)]

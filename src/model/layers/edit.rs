@@ -14,7 +14,7 @@ use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile,
 use crate::model::brush::BlendMode;
 use crate::model::paint::{n_bits_from_blend, n_bits_to_blend};
 use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
-use crate::model::tile::{Plane, TILE_SIZE, TileRect, select_mut};
+use crate::model::tile::{Plane, TILE_SIZE, TileSpans, select_mut};
 
 mod blur;
 pub use blur::blur;
@@ -200,29 +200,52 @@ impl Slot<'_> {
         }
     }
 
-    /// Writes texels `rect` at coverage `cover` (see [`CoverWrite`]).
-    fn write_cover(&mut self, edit: &LayerEdit, rect: TileRect, cover: &[f32]) {
+    /// Writes texels `spans` at coverage `cover` (see [`edit_cover`]).
+    fn write_cover(&mut self, edit: &LayerEdit, spans: &TileSpans, cover: &[f32]) {
         match self {
             Self::Paint(slot, pre, written) => {
+                // A brush on a tile the layer did not have before the stroke: every texel it
+                // reaches takes the target exactly (see `LayerStroke::apply`), so the tile
+                // holds the target in one value per channel and the dabs write coverage only.
+                let fresh = pre.is_none() && matches!(edit.stroke, LayerStroke::Brush(_));
+                let created = slot.is_none();
                 let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
+                if fresh && created {
+                    let c = &edit.from.c;
+                    let rgb = |k: usize| [c[k], c[k + 1], c[k + 2]].map(encode_unorm);
+                    tile.value.kd = Plane::Uniform(rgb(0));
+                    tile.value.ks = Plane::Uniform(rgb(3));
+                    tile.value.n = Plane::Uniform(n_bits_from_blend(c[6]));
+                }
                 let pre = pre.map(|p| p.get());
                 for (ch, range) in RANGES.iter().enumerate() {
                     if !edit.channels[ch] {
                         continue;
                     }
+                    if fresh {
+                        cover_alpha(tile.alpha[ch].data_mut(), spans, cover);
+                        continue;
+                    }
                     let target = &edit.from.c[range.clone()];
-                    let channel = (&mut *tile, pre, ch, target, rect, cover);
-                    // One loop per kind of stroke, each with its arithmetic inlined.
+                    let channel = (&mut *tile, pre, ch, target, spans, cover);
+                    // One loop per mode, each with its arithmetic inlined.
                     match edit.stroke {
-                        LayerStroke::Brush(BlendMode::Normal) => {
-                            let normal = LayerStroke::Brush(BlendMode::Normal);
-                            cover_channel(channel, |p, t, a| normal.apply(p, t, a));
-                        }
+                        LayerStroke::Brush(mode) => match mode {
+                            BlendMode::Normal => cover_channel(channel, |wa, v0, t| {
+                                LayerStroke::value(BlendMode::Normal, wa, v0, t)
+                            }),
+                            BlendMode::Add => cover_channel(channel, |wa, v0, t| {
+                                LayerStroke::value(BlendMode::Add, wa, v0, t)
+                            }),
+                            BlendMode::Subtract => cover_channel(channel, |wa, v0, t| {
+                                LayerStroke::value(BlendMode::Subtract, wa, v0, t)
+                            }),
+                            BlendMode::Multiply => cover_channel(channel, |wa, v0, t| {
+                                LayerStroke::value(BlendMode::Multiply, wa, v0, t)
+                            }),
+                        },
                         LayerStroke::Erase => {
-                            cover_channel(channel, |p, t, a| LayerStroke::Erase.apply(p, t, a));
-                        }
-                        stroke @ LayerStroke::Brush(_) => {
-                            cover_channel(channel, |p, t, a| stroke.apply(p, t, a));
+                            erase_channel((&mut *tile, pre, ch, spans, cover));
                         }
                     }
                 }
@@ -231,7 +254,7 @@ impl Slot<'_> {
                 let g = edit.gray[0];
                 let plane = writable(slot, written).data_mut();
                 let pre = pre.get();
-                for i in rect.indices() {
+                for i in spans.indices() {
                     let a = cover[i];
                     if a > 0.0 {
                         let p = decode_unorm(pre.get(i));
@@ -275,33 +298,49 @@ fn decode_run<T: Copy + PartialEq>(
     }
 }
 
-/// Channel `ch` of a paint tile's texels `rect` after a stroke `f` of `target` (its
-/// components) at coverage `cover`, from the pre-operation tile (none: transparent), a row
-/// at a time: each step a plain loop over the row.
+/// The coverage of a transparent texel after a brush at `cover`, at texels `spans` of a
+/// channel's coverage plane (the value is the target's: see [`Slot::write_cover`]).
+fn cover_alpha(alpha: &mut [u16], spans: &TileSpans, cover: &[f32]) {
+    for (y, x0, x1) in spans.rows() {
+        let (start, end) = (y * TILE_SIZE + x0, y * TILE_SIZE + x1);
+        for (p, &a) in alpha[start..end].iter_mut().zip(&cover[start..end]) {
+            let new = encode_unorm(a.min(1.0));
+            *p = if a > 0.0 { new } else { *p };
+        }
+    }
+}
+
+/// Channel `ch` of a paint tile's texels `spans` after a brush of `target` (its components)
+/// whose mode gives `value` ([`LayerStroke::value`]) at coverage `cover`, from the pre-operation tile (none: transparent), a row at a
+/// time: the coverage and the pre-stroke value's weight once per texel, then each component
+/// in a plain loop over the row ([`LayerStroke::apply`], term for term).
 fn cover_channel(
-    (tile, pre, ch, target, rect, cover): (
+    (tile, pre, ch, target, spans, cover): (
         &mut PaintTile,
         Option<&PaintTile>,
         usize,
         &[f32],
-        TileRect,
+        &TileSpans,
         &[f32],
     ),
-    f: impl Fn(LayerValue, f32, f32) -> LayerValue,
+    value: impl Fn((f32, f32), f32, f32) -> f32,
 ) {
-    let width = rect.x1 - rect.x0;
     let table = crate::model::paint::n_blend_table();
     let mut pre_alpha = [0.0_f32; TILE_SIZE];
     let mut pre_value = [0.0_f32; TILE_SIZE];
-    let mut out_alpha = [0.0_f32; TILE_SIZE];
-    let mut out_value = [0.0_f32; TILE_SIZE];
+    let (mut a, mut w) = ([0.0_f32; TILE_SIZE], [0.0_f32; TILE_SIZE]);
     let mut alpha = [0_u16; TILE_SIZE];
-    let mut value = [[0_u16; TILE_SIZE]; 3];
-    for y in rect.y0..rect.y1 {
-        let start = y * TILE_SIZE + rect.x0;
+    let mut out = [[0_u16; TILE_SIZE]; 3];
+    for (y, x0, x1) in spans.rows() {
+        let (start, width) = (y * TILE_SIZE + x0, x1 - x0);
         let cov = &cover[start..start + width];
         if let Some(p) = pre {
             decode_run(&p.alpha[ch], start, &mut pre_alpha[..width], decode_unorm);
+        }
+        for j in 0..width {
+            let aj = cov[j].clamp(0.0, 1.0);
+            let (coverage, weight) = LayerStroke::cover(pre_alpha[j], aj);
+            (a[j], w[j], alpha[j]) = (aj, weight, encode_unorm(coverage.min(1.0)));
         }
         for (c, &t) in target.iter().enumerate() {
             if let Some(p) = pre {
@@ -312,36 +351,22 @@ fn cover_channel(
                     _ => decode_run(&p.value.n, start, out, |bits| table[bits as usize]),
                 }
             }
-            for j in 0..width {
-                let out = f(
-                    LayerValue {
-                        value: pre_value[j],
-                        alpha: pre_alpha[j],
-                    },
-                    t,
-                    cov[j],
-                );
-                (out_value[j], out_alpha[j]) = (out.value, out.alpha);
-            }
-            let encoded = &mut value[c][..width];
+            let encoded = &mut out[c][..width];
             if ch == 2 {
-                for (e, &v) in encoded.iter_mut().zip(&out_value) {
-                    *e = n_bits_from_blend(v);
+                for j in 0..width {
+                    encoded[j] = n_bits_from_blend(value((w[j], a[j]), pre_value[j], t));
                 }
             } else {
-                for (e, &v) in encoded.iter_mut().zip(&out_value) {
-                    *e = encode_unorm(v);
+                for j in 0..width {
+                    encoded[j] = encode_unorm(value((w[j], a[j]), pre_value[j], t));
                 }
             }
         }
-        for (e, &a) in alpha[..width].iter_mut().zip(&out_alpha) {
-            *e = encode_unorm(a);
-        }
-        // Only texels the stroke reached change.
-        let covered = (0..width).filter(|&j| cov[j] > 0.0);
+        // Only texels the stroke reached change (chosen without a branch, so the loops
+        // vectorise).
         let a_plane = &mut tile.alpha[ch].data_mut()[start..start + width];
-        for j in covered.clone() {
-            a_plane[j] = alpha[j];
+        for ((p, &new), &c) in a_plane.iter_mut().zip(&alpha).zip(cov) {
+            *p = if c > 0.0 { new } else { *p };
         }
         match ch {
             0 | 1 => {
@@ -351,17 +376,52 @@ fn cover_channel(
                     tile.value.ks.data_mut()
                 };
                 let plane = &mut plane[start..start + width];
-                for j in covered {
-                    plane[j] = [value[0][j], value[1][j], value[2][j]];
+                let [r, g, b] = &out;
+                for (j, p) in plane.iter_mut().enumerate() {
+                    *p = if cov[j] > 0.0 { [r[j], g[j], b[j]] } else { *p };
                 }
             }
             _ => {
                 let plane = &mut tile.value.n.data_mut()[start..start + width];
-                for j in covered {
-                    plane[j] = value[0][j];
+                for ((p, &new), &c) in plane.iter_mut().zip(&out[0]).zip(cov) {
+                    *p = if c > 0.0 { new } else { *p };
                 }
             }
         }
+    }
+}
+
+/// The eraser on channel `ch` of a paint tile's texels `spans` at coverage `cover`, from the
+/// pre-operation tile: the coverage falls ([`LayerStroke::apply`]); values stay.
+fn erase_channel(
+    (tile, pre, ch, spans, cover): (
+        &mut PaintTile,
+        Option<&PaintTile>,
+        usize,
+        &TileSpans,
+        &[f32],
+    ),
+) {
+    let Some(pre) = pre else {
+        // Nothing to erase: the tile is as transparent as before the stroke.
+        return;
+    };
+    let plane = tile.alpha[ch].data_mut();
+    for i in spans.indices() {
+        let a = cover[i];
+        let out = LayerStroke::Erase.apply(
+            LayerValue {
+                value: 0.0,
+                alpha: decode_unorm(pre.alpha[ch].get(i)),
+            },
+            0.0,
+            a,
+        );
+        plane[i] = if a > 0.0 {
+            encode_unorm(out.alpha)
+        } else {
+            plane[i]
+        };
     }
 }
 
@@ -385,33 +445,30 @@ pub fn edit_tiles<X: Send>(
         });
 }
 
-/// What a dab writes into one tile: texels `rect` of tile `id`, each at the stroke's coverage
-/// so far (`cover`, one value a texel of the tile; texels at zero are left as they are).
-pub struct CoverWrite<'a> {
-    /// The tile.
-    pub id: usize,
-    /// The texels the dab reached.
-    pub rect: TileRect,
-    /// The stroke's coverage.
-    pub cover: &'a [f32],
-}
-
-/// Writes dabs into tiles in parallel (see [`CoverWrite`]): every texel of each rectangle with
-/// a coverage becomes its pre-operation value at that coverage, a row at a time.
+/// Writes dabs into tiles `ids` (sorted, unique) in parallel, each with the stroke's coverage
+/// so far (`covers`, one value a texel of the tile): `raise(id, cover)` raises a tile's
+/// coverage and returns the texels where it rose, and each of those becomes its
+/// pre-operation value at that coverage, a row at a time. Returns, per tile, those texels.
 pub fn edit_cover(
-    planes: Planes<'_>,
-    pre: PrePlanes<'_>,
+    (planes, pre): (Planes<'_>, PrePlanes<'_>),
     edit: &LayerEdit,
-    work: Vec<CoverWrite<'_>>,
-) {
-    let ids: Vec<usize> = work.iter().map(|w| w.id).collect();
-    slots(planes, pre, &ids)
+    ids: &[usize],
+    covers: Vec<&mut [f32]>,
+    raise: impl Fn(usize, &mut [f32]) -> TileSpans + Sync,
+) -> Vec<TileSpans> {
+    slots(planes, pre, ids)
         .into_par_iter()
-        .zip(work)
-        .for_each(|(mut slot, w)| {
-            slot.write_cover(edit, w.rect, w.cover);
-            slot.compact();
-        });
+        .zip(covers)
+        .zip(ids)
+        .map(|((mut slot, cover), &id)| {
+            let spans = raise(id, cover);
+            if !spans.is_empty() {
+                slot.write_cover(edit, &spans, cover);
+                slot.compact();
+            }
+            spans
+        })
+        .collect()
 }
 
 /// The tiles `ids` (sorted, unique) of `planes` to write, with their pre-operation tiles.

@@ -6,11 +6,11 @@ use std::hash::{Hash, Hasher};
 
 use rayon::prelude::*;
 
-use super::{Active, active, composite_rect, composite_tile};
+use super::{Active, active, composite_spans, composite_tile, runs};
 use crate::model::layers::LayerStack;
 use crate::model::maps::MaterialMaps;
 use crate::model::texel::{Channels, Texel};
-use crate::model::tile::{Tile, TileRect};
+use crate::model::tile::{Plane, Tile, TileSpans};
 
 /// Hashes what the composite of tile `id` depends on: per active layer, in order, its
 /// settings, its fill value or its tile's stamp, its mask's switches and tile stamp, and its
@@ -102,12 +102,13 @@ impl Compositor {
     /// edit that writes only part of those tiles, it says which of them
     /// [`Self::update_regions`] may then recomposite only in part.
     pub fn current(&self, stack: &LayerStack, ids: &[usize]) -> Vec<bool> {
-        ids.par_iter()
+        // A few dozen tiles of a dab: cheaper than handing them to other threads.
+        ids.iter()
             .map(|&id| self.signatures.get(id) == Some(&signature(stack, id)))
             .collect()
     }
 
-    /// As [`Self::update_tiles`] after an edit that wrote only texels `rect` of each tile `id`
+    /// As [`Self::update_tiles`] after an edit that wrote only texels `spans` of each tile `id`
     /// of `regions` (in one layer's planes or mask), where those tiles were [`Self::current`]
     /// before it: only those texels are recomposited, into the maps' tiles in place. The
     /// result is bit-identical to recompositing the whole tiles.
@@ -115,42 +116,51 @@ impl Compositor {
         &mut self,
         stack: &LayerStack,
         maps: &mut MaterialMaps,
-        regions: &[(usize, TileRect)],
+        regions: &[(usize, TileSpans)],
     ) -> Vec<usize> {
         let count = stack.tile_count();
         if self.signatures.len() != count {
             self.signatures = vec![0; count];
         }
-        let shared: &MaterialMaps = maps;
-        let fresh: Vec<(usize, u64, TileRect, Vec<Texel>, Channels)> = regions
-            .par_iter()
-            .filter_map(|&(id, rect)| {
-                let s = signature(stack, id);
-                if self.signatures[id] == s {
-                    return None;
-                }
-                let texels = composite_rect(stack, id, rect);
-                let old = shared.tile(id);
-                let mut changed = Channels::NONE;
-                for (i, t) in rect.indices().zip(&texels) {
-                    let o = old.texel(i);
-                    changed.kd |= o.kd != t.kd;
-                    changed.ks |= o.ks != t.ks;
-                    changed.n |= o.n != t.n;
-                }
-                Some((id, s, rect, texels, changed))
-            })
+        // Signatures first (a few dozen tiles: not worth other threads), then the stale
+        // regions recomposited in parallel straight into the maps' tiles.
+        let stale: Vec<(usize, u64, &TileSpans)> = regions
+            .iter()
+            .map(|(id, spans)| (*id, signature(stack, *id), spans))
+            .filter(|&(id, s, _)| self.signatures[id] != s)
             .collect();
-        let mut written = Vec::new();
-        for (id, s, rect, texels, changed) in fresh {
-            self.signatures[id] = s;
+        let ids: Vec<usize> = stale.iter().map(|r| r.0).collect();
+        let changed = maps.edit_tiles_par(&ids, |k, tile| {
+            let (id, _, spans) = stale[k];
+            let texels = composite_spans(stack, id, spans);
+            let runs = runs(spans);
+            let changed = Channels {
+                kd: differs(&tile.kd, &runs, &texels.kd),
+                ks: differs(&tile.ks, &runs, &texels.ks),
+                n: differs(&tile.n, &runs, &texels.n),
+            };
             if !changed.is_empty() {
-                let tile = maps.tile_mut_in(id, changed);
-                write_rect(tile, rect, &texels, changed);
-                written.push(id);
+                let tile = std::sync::Arc::make_mut(tile);
+                if changed.kd {
+                    write_runs(&mut tile.kd, &runs, &texels.kd);
+                }
+                if changed.ks {
+                    write_runs(&mut tile.ks, &runs, &texels.ks);
+                }
+                if changed.n {
+                    write_runs(&mut tile.n, &runs, &texels.n);
+                }
             }
+            changed
+        });
+        for &(id, s, _) in &stale {
+            self.signatures[id] = s;
         }
-        written
+        ids.into_iter()
+            .zip(changed)
+            .filter(|(_, c)| !c.is_empty())
+            .map(|(id, _)| id)
+            .collect()
     }
 
     /// Puts a recomposited tile in place if it differs; whether it did.
@@ -191,22 +201,29 @@ impl Compositor {
     }
 }
 
-/// Writes `texels` (row by row) into `rect` of `tile`, in the `changed` planes only, and
-/// compacts those planes.
-fn write_rect(tile: &mut Tile, rect: TileRect, texels: &[Texel], changed: Channels) {
-    if changed.kd {
-        let kd = tile.kd.data_mut();
-        rect.indices().zip(texels).for_each(|(i, t)| kd[i] = t.kd);
-        tile.kd.compact();
+/// Whether the texels of `runs` of `plane` differ from `new` (row by row).
+fn differs<T: Copy + PartialEq>(
+    plane: &Plane<T>,
+    runs: &[(usize, usize, usize)],
+    new: &[T],
+) -> bool {
+    match plane {
+        Plane::Uniform(u) => new.iter().any(|v| v != u),
+        Plane::Data(d) => runs
+            .iter()
+            .any(|&(start, at, len)| d[start..start + len] != new[at..at + len]),
     }
-    if changed.ks {
-        let ks = tile.ks.data_mut();
-        rect.indices().zip(texels).for_each(|(i, t)| ks[i] = t.ks);
-        tile.ks.compact();
+}
+
+/// Writes `new` (row by row) into the texels of `runs` of `plane`, and compacts it.
+fn write_runs<T: Copy + PartialEq>(
+    plane: &mut Plane<T>,
+    runs: &[(usize, usize, usize)],
+    new: &[T],
+) {
+    let data = plane.data_mut();
+    for &(start, at, len) in runs {
+        data[start..start + len].copy_from_slice(&new[at..at + len]);
     }
-    if changed.n {
-        let n = tile.n.data_mut();
-        rect.indices().zip(texels).for_each(|(i, t)| n[i] = t.n);
-        tile.n.compact();
-    }
+    plane.compact();
 }

@@ -262,7 +262,7 @@ proptest! {
             prop_assert_eq!(compositor.current(&stack, &ids), vec![true]);
             scribble_in(&mut rng, &mut stack, ids[0], rect);
             let versions: Vec<u64> = (0..tiles).map(|id| maps.tile_version(id)).collect();
-            let written = compositor.update_regions(&stack, &mut maps, &[(ids[0], rect)]);
+            let written = compositor.update_regions(&stack, &mut maps, &[(ids[0], rect.into())]);
             prop_assert!(same(&maps, &flattened(&stack)));
             for (id, version) in versions.iter().enumerate() {
                 if id != ids[0] {
