@@ -10,36 +10,11 @@ use glam::{Vec2, Vec3};
 use kapaint::model::brush::StrokePoint;
 use kapaint::model::layers::LayerContent;
 use kapaint::model::texel::{Channel, Channels, Texel};
-use kapaint::model::{Command, Document, DocumentSettings, MaterialValue};
+use kapaint::model::{Command, Document, MaterialValue};
 
-fn document() -> Document {
-    let settings = DocumentSettings {
-        base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.04), 10.0),
-        ..DocumentSettings::default()
-    };
-    Document::new(192, 128, settings).expect("document")
-}
-
-fn texels(doc: &Document) -> Vec<Texel> {
-    let m = doc.maps();
-    (0..m.height())
-        .flat_map(|y| (0..m.width()).map(move |x| (x, y)))
-        .map(|(x, y)| m.texel(x, y))
-        .collect()
-}
-
-fn run(doc: &mut Document, script: &str) {
-    #[derive(serde::Deserialize)]
-    struct Script {
-        commands: Vec<Command>,
-    }
-    let script: Script = ron::from_str(script).expect("script parses");
-    for c in script.commands {
-        let what = format!("{c:?}");
-        doc.apply(c)
-            .unwrap_or_else(|e| panic!("{}: {e}", &what[..what.len().min(80)]));
-    }
-}
+#[path = "common/layer_doc.rs"]
+mod layer_doc;
+use layer_doc::{document, run, texels};
 
 fn stroke(doc: &mut Document, from: Vec2, to: Vec2) {
     let points = (0..=8)
@@ -567,59 +542,4 @@ fn a_project_with_whole_map_layer_images_opens_and_saves_as_atlases() {
         .filter(|&id| **old.maps().tile(id) != **again.maps().tile(id))
         .count();
     assert_eq!(differing, 0);
-}
-
-/// Every brush mode paints on an empty layer (source-over with the mode's blend, as Krita
-/// paints): multiply used to change only texels the layer already covered, so on an empty
-/// layer it did nothing at all.
-#[test]
-fn a_multiply_brush_on_an_empty_layer_paints_the_target() {
-    let mut doc = document();
-    let base = texels(&doc);
-    run(
-        &mut doc,
-        r"(commands: [
-            SetPrimary((kd: (0.9, 0.1, 0.1), ks: (0.2, 0.2, 0.2), n: 300.0)),
-            SetBrush((radius_px: 12.0, hardness: 1.0, flow: 1.0, opacity: 1.0, blend: Multiply)),
-            Stroke(tool: Brush, points: [(pos: (40.0, 60.0), pressure: 1.0), (pos: (140.0, 60.0), pressure: 1.0)]),
-        ])",
-    );
-    assert_ne!(texels(&doc), base, "the stroke changed nothing");
-    let t = doc.maps().texel(90, 60).decode();
-    assert!(
-        (t.kd - Vec3::new(0.9, 0.1, 0.1)).abs().max_element() < 1e-4,
-        "{t:?}"
-    );
-    assert!((t.n - 300.0).abs() < 0.5, "{t:?}");
-}
-
-/// A brush on tiles the layer did not have writes coverage only (the tile holds the target as
-/// one value per channel); on tiles it has, fully transparent, every texel goes through the
-/// general stroke. The composites are bit-identical.
-#[test]
-fn a_brush_on_new_tiles_composites_as_on_transparent_ones() {
-    let script = r"(commands: [
-        SetPrimary((kd: (0.7, 0.3, 0.2), ks: (0.1, 0.4, 0.3), n: 42.0)),
-        SetBrush((radius_px: 19.0, hardness: 0.4, flow: 0.35, opacity: 0.8)),
-        Stroke(tool: Brush, points: [(pos: (10.0, 20.0), pressure: 0.7), (pos: (170.0, 100.0), pressure: 1.0), (pos: (30.0, 110.0), pressure: 0.4)]),
-    ])";
-    let mut fresh = document();
-    run(&mut fresh, script);
-    // The same layer, its tiles present but transparent: painted over, then erased.
-    let mut erased = document();
-    run(
-        &mut erased,
-        r"(commands: [
-            Fill(All),
-            SetBrush((radius_px: 400.0, hardness: 1.0, flow: 1.0, opacity: 1.0)),
-            Stroke(tool: Eraser, points: [(pos: (96.0, 64.0), pressure: 1.0)]),
-        ])",
-    );
-    assert_eq!(
-        texels(&erased),
-        texels(&document()),
-        "the layer is transparent"
-    );
-    run(&mut erased, script);
-    assert_eq!(texels(&fresh), texels(&erased));
 }

@@ -1,0 +1,67 @@
+//! Brushes on layers: every mode paints on an empty layer, and a brush on tiles new to a layer
+//! (coverage only) composites exactly as on transparent tiles it already had.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use glam::Vec3;
+
+#[path = "common/layer_doc.rs"]
+mod layer_doc;
+use layer_doc::{document, run, texels};
+
+/// Every brush mode paints on an empty layer (source-over with the mode's blend, as Krita
+/// paints): multiply used to change only texels the layer already covered, so on an empty
+/// layer it did nothing at all.
+#[test]
+fn a_multiply_brush_on_an_empty_layer_paints_the_target() {
+    let mut doc = document();
+    let base = texels(&doc);
+    run(
+        &mut doc,
+        r"(commands: [
+            SetPrimary((kd: (0.9, 0.1, 0.1), ks: (0.2, 0.2, 0.2), n: 300.0)),
+            SetBrush((radius_px: 12.0, hardness: 1.0, flow: 1.0, opacity: 1.0, blend: Multiply)),
+            Stroke(tool: Brush, points: [(pos: (40.0, 60.0), pressure: 1.0), (pos: (140.0, 60.0), pressure: 1.0)]),
+        ])",
+    );
+    assert_ne!(texels(&doc), base, "the stroke changed nothing");
+    let t = doc.maps().texel(90, 60).decode();
+    assert!(
+        (t.kd - Vec3::new(0.9, 0.1, 0.1)).abs().max_element() < 1e-4,
+        "{t:?}"
+    );
+    assert!((t.n - 300.0).abs() < 0.5, "{t:?}");
+}
+
+/// A brush on tiles the layer did not have writes coverage only (the tile holds the target as
+/// one value per channel); on tiles it has, fully transparent, every texel goes through the
+/// general stroke. The composites are bit-identical.
+#[test]
+fn a_brush_on_new_tiles_composites_as_on_transparent_ones() {
+    let script = r"(commands: [
+        SetPrimary((kd: (0.7, 0.3, 0.2), ks: (0.1, 0.4, 0.3), n: 42.0)),
+        SetBrush((radius_px: 19.0, hardness: 0.4, flow: 0.35, opacity: 0.8)),
+        Stroke(tool: Brush, points: [(pos: (10.0, 20.0), pressure: 0.7), (pos: (170.0, 100.0), pressure: 1.0), (pos: (30.0, 110.0), pressure: 0.4)]),
+    ])";
+    let mut fresh = document();
+    run(&mut fresh, script);
+    // The same layer, its tiles present but transparent: painted over, then erased.
+    let mut erased = document();
+    run(
+        &mut erased,
+        r"(commands: [
+            Fill(All),
+            SetBrush((radius_px: 400.0, hardness: 1.0, flow: 1.0, opacity: 1.0)),
+            Stroke(tool: Eraser, points: [(pos: (96.0, 64.0), pressure: 1.0)]),
+        ])",
+    );
+    assert_eq!(
+        texels(&erased),
+        texels(&document()),
+        "the layer is transparent"
+    );
+    run(&mut erased, script);
+    assert_eq!(texels(&fresh), texels(&erased));
+}
