@@ -141,7 +141,12 @@ impl Planes {
         Encoded {
             kd: rgb(r, g, b),
             ks: rgb(sr, sg, sb),
-            n: n.iter().map(|&v| n_bits_from_blend(v)).collect(),
+            n: {
+                let table = crate::model::paint::n_bits_table();
+                n.iter()
+                    .map(|&v| crate::model::paint::n_bits_from_blend_in(table, v))
+                    .collect()
+            },
         }
     }
 

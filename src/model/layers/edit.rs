@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile, Stamped};
 use crate::model::brush::BlendMode;
-use crate::model::paint::{n_bits_from_blend, n_bits_to_blend};
+use crate::model::paint::{n_bits_from_blend, n_bits_from_blend_in, n_bits_to_blend};
 use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
 use crate::model::tile::{Plane, TILE_SIZE, TileSpans, select_mut};
 
@@ -326,6 +326,7 @@ fn cover_channel(
     value: impl Fn((f32, f32), f32, f32) -> f32,
 ) {
     let table = crate::model::paint::n_blend_table();
+    let n_bits = crate::model::paint::n_bits_table();
     let mut pre_alpha = [0.0_f32; TILE_SIZE];
     let mut pre_value = [0.0_f32; TILE_SIZE];
     let (mut a, mut w) = ([0.0_f32; TILE_SIZE], [0.0_f32; TILE_SIZE]);
@@ -354,7 +355,8 @@ fn cover_channel(
             let encoded = &mut out[c][..width];
             if ch == 2 {
                 for j in 0..width {
-                    encoded[j] = n_bits_from_blend(value((w[j], a[j]), pre_value[j], t));
+                    let v = value((w[j], a[j]), pre_value[j], t);
+                    encoded[j] = n_bits_from_blend_in(n_bits, v);
                 }
             } else {
                 for j in 0..width {
@@ -362,11 +364,16 @@ fn cover_channel(
                 }
             }
         }
-        // Only texels the stroke reached change (chosen without a branch, so the loops
-        // vectorise).
+        // Only texels the stroke reached change: where it reached the whole run (as a disc
+        // does), a plain copy; else chosen texel by texel, without a branch.
+        let all = cov.iter().all(|&c| c > 0.0);
         let a_plane = &mut tile.alpha[ch].data_mut()[start..start + width];
-        for ((p, &new), &c) in a_plane.iter_mut().zip(&alpha).zip(cov) {
-            *p = if c > 0.0 { new } else { *p };
+        if all {
+            a_plane.copy_from_slice(&alpha[..width]);
+        } else {
+            for ((p, &new), &c) in a_plane.iter_mut().zip(&alpha).zip(cov) {
+                *p = if c > 0.0 { new } else { *p };
+            }
         }
         match ch {
             0 | 1 => {
@@ -377,14 +384,24 @@ fn cover_channel(
                 };
                 let plane = &mut plane[start..start + width];
                 let [r, g, b] = &out;
-                for (j, p) in plane.iter_mut().enumerate() {
-                    *p = if cov[j] > 0.0 { [r[j], g[j], b[j]] } else { *p };
+                if all {
+                    for (j, p) in plane.iter_mut().enumerate() {
+                        *p = [r[j], g[j], b[j]];
+                    }
+                } else {
+                    for (j, p) in plane.iter_mut().enumerate() {
+                        *p = if cov[j] > 0.0 { [r[j], g[j], b[j]] } else { *p };
+                    }
                 }
             }
             _ => {
                 let plane = &mut tile.value.n.data_mut()[start..start + width];
-                for ((p, &new), &c) in plane.iter_mut().zip(&out[0]).zip(cov) {
-                    *p = if c > 0.0 { new } else { *p };
+                if all {
+                    plane.copy_from_slice(&out[0][..width]);
+                } else {
+                    for ((p, &new), &c) in plane.iter_mut().zip(&out[0]).zip(cov) {
+                        *p = if c > 0.0 { new } else { *p };
+                    }
                 }
             }
         }

@@ -35,7 +35,7 @@ use super::tile::{TILE_TEXELS, Tile};
 /// Lookup tables between stored `n` bits and the perceptual blend space.
 struct NTables {
     to_blend: Vec<f32>,
-    from_blend: Vec<u16>,
+    from_blend: Box<NBitsTable>,
 }
 
 /// Resolution of the blend-space to bits table: finer than a half float's step everywhere.
@@ -47,7 +47,9 @@ fn n_tables() -> &'static NTables {
         to_blend: (0..=u16::MAX).map(|b| n_to_blend(decode_n(b))).collect(),
         from_blend: (0..=FROM_BLEND_STEPS)
             .map(|i| super::texel::encode_n(n_from_blend(i as f32 / FROM_BLEND_STEPS as f32)))
-            .collect(),
+            .collect::<Box<[u16]>>()
+            .try_into()
+            .unwrap_or_else(|_| unreachable!("FROM_BLEND_STEPS + 1 entries")),
     })
 }
 
@@ -64,9 +66,23 @@ pub(crate) fn n_blend_table() -> &'static [f32] {
 
 #[inline]
 pub(crate) fn n_bits_from_blend(u: f32) -> u16 {
-    let i =
-        super::texel::trunc_small(super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5) as usize;
-    n_tables().from_blend[i.min(FROM_BLEND_STEPS)]
+    n_bits_from_blend_in(n_bits_table(), u)
+}
+
+/// The blend-space to half-float bits table: [`FROM_BLEND_STEPS`] steps over `[0, 1]`.
+pub(crate) type NBitsTable = [u16; FROM_BLEND_STEPS + 1];
+
+/// The table [`n_bits_from_blend`] reads, for loops that encode many
+/// ([`n_bits_from_blend_in`]).
+pub(crate) fn n_bits_table() -> &'static NBitsTable {
+    &n_tables().from_blend
+}
+
+/// [`n_bits_from_blend`] through `table` ([`n_bits_table`]): no bounds check.
+#[inline]
+pub(crate) fn n_bits_from_blend_in(table: &NBitsTable, u: f32) -> u16 {
+    let i = super::texel::trunc_small(super::texel::unit(u) * FROM_BLEND_STEPS as f32 + 0.5);
+    table[(i as usize).min(FROM_BLEND_STEPS)]
 }
 
 /// What a paint operation writes: per-channel targets in blend space, which channels, how.
