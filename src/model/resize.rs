@@ -126,10 +126,12 @@ fn resize_layers(
                     continue;
                 }
                 let empty = PaintTile::filled(MaterialValue::default(), [false; 3]);
+                // Values premultiplied by their coverage, so a texel counts as much as the
+                // layer covers it: what is under no paint does not darken a stroke's edge.
                 let mut values = MaterialMaps::new(from.0, from.1, MaterialValue::default())?;
                 for (id, t) in tiles.iter().enumerate() {
                     let t = t.as_ref().map_or(&empty, |t| t.get());
-                    values.replace_tile(id, Arc::new(t.value.clone()));
+                    values.replace_tile(id, Arc::new(premultiplied(t)));
                 }
                 let mut alphas = tiles
                     .iter()
@@ -139,13 +141,14 @@ fn resize_layers(
                 *tiles = (0..count)
                     .map(|id| {
                         let a = &alpha.tile(id).kd;
+                        let alpha = std::array::from_fn(|c| {
+                            Plane::Data(
+                                (0..super::tile::TILE_TEXELS).map(|i| a.get(i)[c]).collect(),
+                            )
+                        });
                         let mut tile = PaintTile {
-                            value: (**values.tile(id)).clone(),
-                            alpha: std::array::from_fn(|c| {
-                                Plane::Data(
-                                    (0..super::tile::TILE_TEXELS).map(|i| a.get(i)[c]).collect(),
-                                )
-                            }),
+                            value: unpremultiplied(values.tile(id), &alpha),
+                            alpha,
                         };
                         tile.alpha.iter_mut().for_each(Plane::compact);
                         let empty = tile.alpha.iter().all(|p| p.uniform() == Some(0));
@@ -158,6 +161,52 @@ fn resize_layers(
         }
     }
     Ok(())
+}
+
+/// A paint tile's values (in blend space) times their channel's coverage, as maps store them.
+fn premultiplied(t: &PaintTile) -> super::tile::Tile {
+    per_texel(&t.value, &t.alpha, |v, a| v * a)
+}
+
+/// Values resampled premultiplied back over their resampled coverage (0 where none).
+fn unpremultiplied(
+    value: &super::tile::Tile,
+    alpha: &[super::tile::Plane<u16>; 3],
+) -> super::tile::Tile {
+    per_texel(value, alpha, |v, a| if a > 0.0 { v / a } else { 0.0 })
+}
+
+/// `value` with every component, in blend space, replaced by `f(component, its channel's
+/// coverage)`.
+fn per_texel(
+    value: &super::tile::Tile,
+    alpha: &[super::tile::Plane<u16>; 3],
+    f: impl Fn(f32, f32) -> f32,
+) -> super::tile::Tile {
+    use super::paint::{n_bits_from_blend, n_bits_to_blend};
+    use super::texel::{Texel, decode_unorm, encode_unorm};
+    let texel = |i: usize| {
+        let t = value.texel(i);
+        let a = alpha.each_ref().map(|p| decode_unorm(p.get(i)));
+        Texel {
+            kd: t.kd.map(|q| encode_unorm(f(decode_unorm(q), a[0]))),
+            ks: t.ks.map(|q| encode_unorm(f(decode_unorm(q), a[1]))),
+            n: n_bits_from_blend(f(n_bits_to_blend(t.n), a[2])),
+        }
+    };
+    let uniform = value.kd.uniform().is_some()
+        && value.ks.uniform().is_some()
+        && value.n.uniform().is_some()
+        && alpha.iter().all(|p| p.uniform().is_some());
+    if uniform {
+        return super::tile::Tile::uniform(texel(0));
+    }
+    let mut out = super::tile::Tile::uniform(Texel::default());
+    for i in 0..super::tile::TILE_TEXELS {
+        out.set_texel(i, texel(i));
+    }
+    out.compact();
+    out
 }
 
 /// One channel as a linear float image: `k_d` and `k_s` as they are, `n` as its blend value
@@ -204,6 +253,34 @@ mod tests {
         );
         assert!(resized(&one, 1, 1).is_err(), "same size");
         assert!(resized(&one, 0, 4).is_err());
+    }
+
+    /// Resizing a layer weights its values by coverage: a white stroke's edge stays white
+    /// (where it is half covered), rather than mixing in the black under no paint.
+    #[test]
+    fn a_layer_resizes_its_values_weighted_by_coverage() {
+        use crate::model::layers::{Layer, LayerContent, LayerStack, PaintTile, Stamped};
+        let base = MaterialValue::new(Vec3::splat(0.2), Vec3::splat(0.1), 10.0);
+        let mut stack = LayerStack::new(128, 64, base);
+        let white = MaterialValue::new(Vec3::ONE, Vec3::splat(0.5), 1000.0);
+        let mut layer = Layer::paint(String::from("Stroke"), stack.tile_count());
+        if let LayerContent::Paint(tiles) = &mut layer.content {
+            // The left tile painted white, the right one untouched (black, uncovered).
+            tiles[0] = Some(Arc::new(Stamped::new(PaintTile::filled(white, [true; 3]))));
+        }
+        stack.layers = vec![layer];
+        let half = resized_stack(&stack, 64, 32).unwrap();
+        let LayerContent::Paint(tiles) = &half.layers[0].content else {
+            panic!("a paint layer");
+        };
+        let tile = tiles[0].as_ref().expect("painted").get();
+        // Column 32 of the half-size map straddles the edge: partly covered, still white.
+        let i = 10 * crate::model::tile::TILE_SIZE + 32;
+        let cover = crate::model::texel::decode_unorm(tile.alpha[0].get(i));
+        assert!((0.05..0.95).contains(&cover), "edge coverage {cover}");
+        let t = tile.value.texel(i).decode();
+        assert!((t.kd - Vec3::ONE).abs().max_element() < 1e-3, "{t:?}");
+        assert!((t.n / 1000.0 - 1.0).abs() < 0.01, "{t:?}");
     }
 
     #[test]
