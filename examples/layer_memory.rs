@@ -14,16 +14,9 @@ use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::MaterialValue;
 use kapaint::model::{Command, Document, DocumentSettings, LayerKind, StrokeTool, project};
 
-/// A `/proc/self/status` field in bytes (`VmRSS`, `VmHWM`).
+/// A `/proc/self/status` field in bytes (`VmRSS`, `VmHWM`; 0 where unknown).
 fn status_bytes(field: &str) -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with(field))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
-        })
-        .map_or(0, |kb| kb * 1024)
+    kapaint::memory::process_bytes(field).unwrap_or(0)
 }
 
 fn mib(bytes: u64) -> String {

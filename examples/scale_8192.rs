@@ -10,19 +10,7 @@ use kapaint::model::project;
 use kapaint::report::typical::typical_document;
 
 fn resident_bytes() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmRSS:"))
-                .map(str::to_owned)
-        })
-        .and_then(|l| {
-            l.split_whitespace()
-                .nth(1)
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or(0, |kb| kb * 1024)
+    kapaint::memory::process_bytes("VmRSS:").unwrap_or(0)
 }
 
 fn main() -> Result<(), String> {

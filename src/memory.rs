@@ -5,8 +5,20 @@
 /// Bytes the system says can still be allocated without swapping (`MemAvailable` of
 /// `/proc/meminfo`), or `None` where that is not known (other systems).
 pub fn available_bytes() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    kib_field("/proc/meminfo", "MemAvailable:")
+}
+
+/// A size field of this process's `/proc/self/status` in bytes (`"VmRSS:"`, resident now;
+/// `"VmHWM:"`, its peak), or `None` where that is not known (other systems). For the memory
+/// measurements of examples and benches.
+pub fn process_bytes(field: &str) -> Option<u64> {
+    kib_field("/proc/self/status", field)
+}
+
+/// Field `name` (given in kB) of a `/proc` file, in bytes.
+fn kib_field(path: &str, name: &str) -> Option<u64> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let line = text.lines().find(|l| l.starts_with(name))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     kib.checked_mul(1024)
 }
@@ -39,6 +51,15 @@ pub fn human(bytes: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn this_process_is_resident() {
+        if let Some(now) = process_bytes("VmRSS:") {
+            assert!(now > 0);
+            assert!(process_bytes("VmHWM:").is_some_and(|peak| peak >= now));
+        }
+        assert_eq!(process_bytes("NoSuchField:"), None);
+    }
 
     #[test]
     fn an_absurd_request_does_not_fit() {

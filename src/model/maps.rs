@@ -181,13 +181,6 @@ impl MaterialMaps {
         Arc::make_mut(&mut self.tiles[id])
     }
 
-    /// A tile for writing by a writer that changes only `channels` (see
-    /// [`MaterialMaps::tiles_mut_many_in`]): cloned first if shared; only their versions move.
-    pub fn tile_mut_in(&mut self, id: TileId, channels: Channels) -> &mut Tile {
-        self.touch(id, channels);
-        Arc::make_mut(&mut self.tiles[id])
-    }
-
     /// Edits tiles `ids` (sorted ascending, without duplicates) in parallel: `edit(k, tile)`
     /// gets the `k`-th tile's slot, changes it copy-on-write ([`Arc::make_mut`]) or not at all,
     /// and returns the channels it changed; only those versions move. Returns them, per tile.

@@ -30,67 +30,6 @@ pub fn select_mut<'a, T>(items: &'a mut [T], ids: &[usize]) -> Vec<&'a mut T> {
         .collect()
 }
 
-/// A rectangle of texels inside one tile, in tile coordinates (ends exclusive): the part of a
-/// tile an edit wrote.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TileRect {
-    /// First column.
-    pub x0: usize,
-    /// First row.
-    pub y0: usize,
-    /// One past the last column.
-    pub x1: usize,
-    /// One past the last row.
-    pub y1: usize,
-}
-
-impl TileRect {
-    /// The whole tile.
-    pub const FULL: Self = Self {
-        x0: 0,
-        y0: 0,
-        x1: TILE_SIZE,
-        y1: TILE_SIZE,
-    };
-
-    /// The texel at index `i` (row-major in the tile) alone.
-    #[inline]
-    pub fn texel(i: usize) -> Self {
-        let (x, y) = (i % TILE_SIZE, i / TILE_SIZE);
-        Self {
-            x0: x,
-            y0: y,
-            x1: x + 1,
-            y1: y + 1,
-        }
-    }
-
-    /// Grows `rect` (none: empty) to hold texel `i`.
-    #[inline]
-    pub fn include(rect: &mut Option<Self>, i: usize) {
-        let t = Self::texel(i);
-        *rect = Some(match *rect {
-            None => t,
-            Some(r) => Self {
-                x0: r.x0.min(t.x0),
-                y0: r.y0.min(t.y0),
-                x1: r.x1.max(t.x1),
-                y1: r.y1.max(t.y1),
-            },
-        });
-    }
-
-    /// Whether it is the whole tile.
-    pub fn is_full(self) -> bool {
-        self == Self::FULL
-    }
-
-    /// The texel indices (row-major in the tile) inside, row by row.
-    pub fn indices(self) -> impl Iterator<Item = usize> {
-        (self.y0..self.y1).flat_map(move |y| (self.x0..self.x1).map(move |x| y * TILE_SIZE + x))
-    }
-}
-
 /// Texels inside one tile as a run of columns per row: the part of a tile an edit wrote (a
 /// disc's part of a tile is about a fifth smaller than its bounding rectangle).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,6 +48,13 @@ impl TileSpans {
     pub const FULL: Self = Self {
         rows: [(0, TILE_SIZE as u8); TILE_SIZE],
     };
+
+    /// Texel `i` (row-major in the tile) alone.
+    pub fn texel(i: usize) -> Self {
+        let mut spans = Self::EMPTY;
+        spans.include(i);
+        spans
+    }
 
     /// Grows to hold texel `i` (row-major in the tile).
     #[inline]
@@ -140,16 +86,6 @@ impl TileSpans {
     /// How many texels it holds.
     pub fn count(&self) -> usize {
         self.rows().map(|(_, x0, x1)| x1 - x0).sum()
-    }
-}
-
-impl From<TileRect> for TileSpans {
-    fn from(r: TileRect) -> Self {
-        let mut spans = Self::EMPTY;
-        for y in r.y0..r.y1 {
-            spans.rows[y] = (r.x0 as u8, r.x1 as u8);
-        }
-        spans
     }
 }
 
@@ -267,16 +203,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_tile_rect_grows_to_hold_its_texels() {
-        let mut rect = None;
-        TileRect::include(&mut rect, 5 * TILE_SIZE + 9);
-        TileRect::include(&mut rect, 2 * TILE_SIZE + 30);
-        let r = rect.expect("two texels");
-        assert_eq!((r.x0, r.y0, r.x1, r.y1), (9, 2, 31, 6));
-        assert_eq!(r.indices().count(), 22 * 4);
-        assert_eq!(r.indices().next(), Some(2 * TILE_SIZE + 9));
-        assert!(!r.is_full());
-        assert_eq!(TileRect::FULL.indices().count(), TILE_TEXELS);
+    fn tile_spans_grow_a_run_per_row() {
+        let mut spans = TileSpans::EMPTY;
+        assert!(spans.is_empty());
+        for i in [5 * TILE_SIZE + 9, 5 * TILE_SIZE + 30, 2 * TILE_SIZE + 30] {
+            spans.include(i);
+        }
+        assert_eq!(spans.rows().collect::<Vec<_>>(), [(2, 30, 31), (5, 9, 31)]);
+        assert_eq!(spans.count(), 1 + 22);
+        assert_eq!(spans.indices().next(), Some(2 * TILE_SIZE + 30));
+        assert_eq!(TileSpans::texel(7).indices().collect::<Vec<_>>(), [7]);
+        assert_eq!(TileSpans::FULL.count(), TILE_TEXELS);
+        assert!(TileSpans::FULL.indices().eq(0..TILE_TEXELS));
     }
 
     #[test]

@@ -20,7 +20,7 @@ use crate::model::paint::n_bits_from_blend;
 use crate::model::texel::{
     Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, encode_unorm, n_to_blend,
 };
-use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileRect, TileSpans};
+use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileSpans};
 use glam::Vec3;
 
 /// The components of `k_d`, `k_s` and `n` in a [`State`].
@@ -161,16 +161,6 @@ impl Planes {
             // float's step).
             n: n_bits_from_blend(v[6][j]),
         }
-    }
-}
-
-/// The texels `len` entries of planes stand for: the whole tile, or (1) its first texel for
-/// all.
-fn span(len: usize) -> TileSpans {
-    if len == 1 {
-        TileRect::texel(0).into()
-    } else {
-        TileSpans::FULL
     }
 }
 
@@ -411,16 +401,8 @@ pub fn composite_tile(stack: &LayerStack, id: usize) -> Tile {
 }
 
 fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Tile {
-    let base = values(Texel::encode(stack.base));
-    // Inputs of one value over the tile: one texel stands for all.
-    let len = if uniform_inputs(layers, id) {
-        1
-    } else {
-        TILE_TEXELS
-    };
-    let mut state = Planes::opaque(&base, len);
-    apply(&mut state, layers, id, &runs(&span(len)));
-    if len == 1 {
+    let state = composited(stack, layers, id, &TileSpans::FULL);
+    if state.value[0].len() == 1 {
         return Tile::uniform(state.texel(0));
     }
     let e = state.encode();
@@ -435,22 +417,32 @@ fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Til
 
 /// Texels `spans` of tile `id`'s composite, row by row.
 fn composite_spans(stack: &LayerStack, id: usize, spans: &TileSpans) -> Encoded {
-    let layers = active(&stack.layers, id);
-    let base = values(Texel::encode(stack.base));
-    let count = spans.count();
-    if uniform_inputs(&layers, id) {
-        let mut state = Planes::opaque(&base, 1);
-        apply(&mut state, &layers, id, &runs(&span(1)));
+    let state = composited(stack, &active(&stack.layers, id), id, spans);
+    if state.value[0].len() == 1 {
         let t = state.texel(0);
+        let count = spans.count();
         return Encoded {
             kd: vec![t.kd; count],
             ks: vec![t.ks; count],
             n: vec![t.n; count],
         };
     }
-    let mut state = Planes::opaque(&base, count);
-    apply(&mut state, &layers, id, &runs(spans));
     state.encode()
+}
+
+/// The active `layers` over the stack's base at texels `spans` of tile `id`: one entry a
+/// texel, or one entry for all where every input is one value over the tile.
+fn composited(stack: &LayerStack, layers: &[Active<'_>], id: usize, spans: &TileSpans) -> Planes {
+    let base = values(Texel::encode(stack.base));
+    // Inputs of one value over the tile: one texel stands for all.
+    let spans = if uniform_inputs(layers, id) {
+        TileSpans::texel(0)
+    } else {
+        *spans
+    };
+    let mut state = Planes::opaque(&base, spans.count());
+    apply(&mut state, layers, id, &runs(&spans));
+    state
 }
 
 /// `layers` composited onto nothing at tile `id`, as a paint tile (`None` where none of them
@@ -460,13 +452,14 @@ pub fn merge_tile(layers: &[Layer], id: usize) -> Option<PaintTile> {
     if act.is_empty() {
         return None;
     }
-    let len = if uniform_inputs(&act, id) {
-        1
+    let spans = if uniform_inputs(&act, id) {
+        TileSpans::texel(0)
     } else {
-        TILE_TEXELS
+        TileSpans::FULL
     };
+    let len = spans.count();
     let mut state = Planes::clear(len);
-    apply(&mut state, &act, id, &runs(&span(len)));
+    apply(&mut state, &act, id, &runs(&spans));
     let mut tile = PaintTile::filled(crate::model::texel::MaterialValue::default(), [false; 3]);
     let planes = state.alpha.as_ref().unwrap_or_else(|| unreachable!());
     let alpha = |k: usize, i: usize| encode_unorm(planes[k][i]);

@@ -14,7 +14,7 @@ use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile,
 use crate::model::brush::BlendMode;
 use crate::model::paint::{n_bits_from_blend, n_bits_from_blend_in, n_bits_to_blend};
 use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
-use crate::model::tile::{Plane, TILE_SIZE, TileSpans, select_mut};
+use crate::model::tile::{Plane, TILE_SIZE, Tile, TileSpans, select_mut};
 
 mod blur;
 pub use blur::blur;
@@ -40,6 +40,18 @@ impl EditValue {
                 v.ks.z,
                 n_to_blend(v.n),
             ],
+        }
+    }
+
+    /// This material as a tile of one value, as layer tiles store it (`n` through the
+    /// brushes' table from blend space).
+    fn uniform_tile(&self) -> Tile {
+        let c = &self.c;
+        let rgb = |k: usize| [c[k], c[k + 1], c[k + 2]].map(encode_unorm);
+        Tile {
+            kd: Plane::Uniform(rgb(0)),
+            ks: Plane::Uniform(rgb(3)),
+            n: Plane::Uniform(n_bits_from_blend(c[6])),
         }
     }
 
@@ -211,11 +223,7 @@ impl Slot<'_> {
                 let created = slot.is_none();
                 let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                 if fresh && created {
-                    let c = &edit.from.c;
-                    let rgb = |k: usize| [c[k], c[k + 1], c[k + 2]].map(encode_unorm);
-                    tile.value.kd = Plane::Uniform(rgb(0));
-                    tile.value.ks = Plane::Uniform(rgb(3));
-                    tile.value.n = Plane::Uniform(n_bits_from_blend(c[6]));
+                    tile.value = edit.from.uniform_tile();
                 }
                 let pre = pre.map(|p| p.get());
                 for (ch, range) in RANGES.iter().enumerate() {
@@ -527,14 +535,13 @@ pub fn fill_uniform(planes: Planes<'_>, edit: &LayerEdit, opacity: f32, tile_cou
     }
     match planes {
         Planes::Paint(tiles) => {
-            let v = &edit.from.c;
-            let value = MaterialValue::new(
-                glam::Vec3::new(v[0], v[1], v[2]),
-                glam::Vec3::new(v[3], v[4], v[5]),
-                crate::model::texel::n_from_blend(v[6]),
-            );
             for slot in tiles.iter_mut().take(tile_count) {
-                let mut fresh = PaintTile::filled(value, edit.channels);
+                let mut fresh = PaintTile {
+                    value: edit.from.uniform_tile(),
+                    alpha: edit
+                        .channels
+                        .map(|c| Plane::Uniform(if c { u16::MAX } else { 0 })),
+                };
                 // Keep what the other channels held.
                 if let Some(old) = slot.as_ref() {
                     let old = old.get();
@@ -548,10 +555,6 @@ pub fn fill_uniform(planes: Planes<'_>, edit: &LayerEdit, opacity: f32, tile_cou
                             }
                         }
                     }
-                }
-                // The fill's n is stored through the blend-space table, as brushes store it.
-                if edit.channels[2] {
-                    fresh.value.n = Plane::Uniform(n_bits_from_blend(v[6]));
                 }
                 *slot = Some(Arc::new(Stamped::new(fresh)));
             }

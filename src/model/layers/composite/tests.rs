@@ -7,7 +7,7 @@ use super::*;
 use crate::model::layers::{ChannelBlend, LayerBlend, Mask, PaintTile, Stamped};
 use crate::model::maps::MaterialMaps;
 use crate::model::texel::{Channel, MaterialValue};
-use crate::model::tile::{Plane, TileRect};
+use crate::model::tile::{Plane, TILE_SIZE, TileSpans};
 
 /// A small deterministic generator (xorshift), so one proptest seed makes one whole stack.
 struct Rng(u64);
@@ -185,16 +185,9 @@ proptest! {
     #[test]
     fn incremental_compositing_is_bit_identical_to_a_full_flatten(seed in 1u64.., edits in 1usize..8) {
         let mut rng = Rng(seed);
-        let (w, h) = if rng.chance(0.5) { (128, 128) } else { (100, 70) };
-        let mut stack = LayerStack::new(w, h, rng.value());
+        let size = if rng.chance(0.5) { (128, 128) } else { (100, 70) };
+        let (mut stack, mut maps, mut compositor) = composited_stack(&mut rng, size);
         let tiles = stack.tile_count();
-        stack.layers.clear();
-        for _ in 0..=rng.below(4) {
-            stack.layers.push(random_layer(&mut rng, tiles, 0));
-        }
-        let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).expect("size");
-        let mut compositor = Compositor::new();
-        compositor.update(&stack, &mut maps);
         prop_assert!(same(&maps, &flattened(&stack)));
         for _ in 0..edits {
             edit(&mut rng, &mut stack);
@@ -214,11 +207,43 @@ proptest! {
     }
 }
 
-/// Writes random values, coverages or mask grays inside `rect` of tile `id` of a random layer
-/// (as one dab would).
-fn scribble_in(rng: &mut Rng, stack: &mut LayerStack, id: usize, rect: TileRect) {
+/// A random stack of up to four layers of `size`, with maps composited from it.
+fn composited_stack(rng: &mut Rng, (w, h): (u32, u32)) -> (LayerStack, MaterialMaps, Compositor) {
+    let mut stack = LayerStack::new(w, h, rng.value());
+    let tiles = stack.tile_count();
+    stack.layers.clear();
+    for _ in 0..=rng.below(4) {
+        stack.layers.push(random_layer(rng, tiles, 0));
+    }
+    let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).expect("size");
+    let mut compositor = Compositor::new();
+    compositor.update(&stack, &mut maps);
+    (stack, maps, compositor)
+}
+
+/// Random texels of a tile as a dab writes them: a run of columns in some rows.
+fn random_spans(rng: &mut Rng) -> TileSpans {
+    let mut spans = TileSpans::EMPTY;
+    let (y0, y1) = (rng.below(TILE_SIZE), rng.below(TILE_SIZE));
+    for y in y0.min(y1)..=y0.max(y1) {
+        if rng.chance(0.8) {
+            let x0 = rng.below(TILE_SIZE);
+            let x1 = x0 + rng.below(TILE_SIZE - x0);
+            spans.include(y * TILE_SIZE + x0);
+            spans.include(y * TILE_SIZE + x1);
+        }
+    }
+    if spans.is_empty() {
+        spans.include(rng.below(TILE_SIZE * TILE_SIZE));
+    }
+    spans
+}
+
+/// Writes random values, coverages or mask grays inside `spans` of tile `id` of a random
+/// layer (as one dab would).
+fn scribble_in(rng: &mut Rng, stack: &mut LayerStack, id: usize, spans: &TileSpans) {
     let layer = layer_mut(&mut stack.layers, rng);
-    let texels: Vec<usize> = rect.indices().filter(|_| rng.chance(0.7)).collect();
+    let texels: Vec<usize> = spans.indices().filter(|_| rng.chance(0.7)).collect();
     if rng.chance(0.3)
         && let Some(mask) = &mut layer.mask
     {
@@ -239,30 +264,21 @@ fn scribble_in(rng: &mut Rng, stack: &mut LayerStack, id: usize, rect: TileRect)
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
-    /// An edit inside a rectangle of tiles that were composited up to date, recomposited only
-    /// in that rectangle, gives the maps bit for bit as flattening the whole stack from
+    /// An edit inside row spans of tiles that were composited up to date, recomposited only
+    /// in those spans, gives the maps bit for bit as flattening the whole stack from
     /// scratch; the other tiles are not written.
     #[test]
     fn recompositing_only_what_a_dab_wrote_is_bit_identical(seed in 1u64.., dabs in 1usize..8) {
         let mut rng = Rng(seed);
-        let (w, h) = (128, 128);
-        let mut stack = LayerStack::new(w, h, rng.value());
+        let (mut stack, mut maps, mut compositor) = composited_stack(&mut rng, (128, 128));
         let tiles = stack.tile_count();
-        stack.layers.clear();
-        for _ in 0..=rng.below(4) {
-            stack.layers.push(random_layer(&mut rng, tiles, 0));
-        }
-        let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).expect("size");
-        let mut compositor = Compositor::new();
-        compositor.update(&stack, &mut maps);
         for _ in 0..dabs {
             let ids = [rng.below(tiles)];
-            let (x0, y0) = (rng.below(64), rng.below(64));
-            let rect = TileRect { x0, y0, x1: x0 + 1 + rng.below(64 - x0), y1: y0 + 1 + rng.below(64 - y0) };
+            let spans = random_spans(&mut rng);
             prop_assert_eq!(compositor.current(&stack, &ids), vec![true]);
-            scribble_in(&mut rng, &mut stack, ids[0], rect);
+            scribble_in(&mut rng, &mut stack, ids[0], &spans);
             let versions: Vec<u64> = (0..tiles).map(|id| maps.tile_version(id)).collect();
-            let written = compositor.update_regions(&stack, &mut maps, &[(ids[0], rect.into())]);
+            let written = compositor.update_regions(&stack, &mut maps, &[(ids[0], spans)]);
             prop_assert!(same(&maps, &flattened(&stack)));
             for (id, version) in versions.iter().enumerate() {
                 if id != ids[0] {
