@@ -4,10 +4,13 @@
 //! `single` on a one-layer document. `perf record` this.
 //!
 //! With `moving`, the dabs go along a stroke instead (32 px apart, row after row across the
-//! map), so every dab reaches texels the stroke has not covered yet; `over` does the same on
-//! the layer filled first (every tile of it painted).
+//! map), so every dab reaches texels the stroke has not covered yet, and a new stroke starts
+//! where the path does (as in the benchmark); `over` does the same on
+//! the layer filled first (every tile of it painted); `repaint` paints the path's first pass
+//! untimed, then times new strokes over it (as the benchmark does once the path wraps).
 //!
-//! Usage: `cargo run --release --example dab_profile [layers|single] [ROUNDS] [moving|over]`
+//! Usage: `cargo run --release --example dab_profile [layers|single] [ROUNDS]
+//! [moving|over|repaint]`
 
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
@@ -20,7 +23,7 @@ fn main() -> Result<(), String> {
     let single = args.next().as_deref() == Some("single");
     let rounds: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2000);
     let how = args.next();
-    let moving = matches!(how.as_deref(), Some("moving" | "over"));
+    let moving = matches!(how.as_deref(), Some("moving" | "over" | "repaint"));
     let settings = DocumentSettings {
         brush: BrushSettings {
             radius_px: 128.0,
@@ -49,11 +52,26 @@ fn main() -> Result<(), String> {
         run(doc, Command::Fill(kapaint::model::FillRegion::All))?;
         run(doc, Command::SetPrimary(primary))?;
     }
+    let points = kapaint::report::typical::STROKE_PATH_POINTS;
+    let repaint = how.as_deref() == Some("repaint");
+    if repaint {
+        // The first pass of the path, untimed: the timed dabs paint over its strokes.
+        run(doc, Command::BeginStroke(StrokeTool::Brush))?;
+        for k in 0..points {
+            let pos = kapaint::report::typical::stroke_path(k);
+            run(doc, Command::StrokeTo(StrokePoint { pos, pressure: 1.0 }))?;
+        }
+        run(doc, Command::EndStroke)?;
+    }
     run(doc, Command::BeginStroke(StrokeTool::Brush))?;
     let mut version = doc.maps().version();
     let start = std::time::Instant::now();
     let mut derived = 0;
     for k in 0..rounds {
+        if moving && k > 0 && k % points == 0 {
+            run(doc, Command::EndStroke)?;
+            run(doc, Command::BeginStroke(StrokeTool::Brush))?;
+        }
         let pos = if moving {
             kapaint::report::typical::stroke_path(k)
         } else {

@@ -350,7 +350,7 @@ impl MaterialMaps {
         ids.par_iter()
             .map(|&id| {
                 let mut out = vec![Vec3::ZERO; TILE_TEXELS];
-                derive_tile(&self.tiles[id], lut, diffuse, &mut out);
+                crate::model::simd::vectorized(DeriveTile(&self.tiles[id], lut, diffuse, &mut out));
                 (id, out)
             })
             .collect()
@@ -393,14 +393,26 @@ fn diffuse_factor(approx: AmbientApprox) -> f32 {
 
 /// `k_a` of one tile. `n` is stored as a half float, so `chi` of every possible code is a
 /// 65,536-entry table (256 KiB, built once per model and approximation): one load per texel.
-fn derive_tile(tile: &Tile, lut: &[f32], diffuse: f32, out: &mut [Vec3]) {
-    for (r, row) in out.chunks_exact_mut(TILE_SIZE).enumerate() {
-        derive_row(tile, r * TILE_SIZE, lut, diffuse, row);
+struct DeriveTile<'a>(&'a Tile, &'a [f32], f32, &'a mut [Vec3]);
+
+impl crate::model::simd::Kernel for DeriveTile<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        let Self(tile, lut, diffuse, out) = self;
+        for (r, row) in out.chunks_exact_mut(TILE_SIZE).enumerate() {
+            derive_row(tile, r * TILE_SIZE, lut, diffuse, row);
+        }
     }
 }
 
 /// `k_a` of `out.len()` texels of a tile starting at texel index `start`.
-#[inline]
+#[inline(always)]
 fn derive_row(tile: &Tile, start: usize, lut: &[f32], diffuse: f32, out: &mut [Vec3]) {
     const SCALE: f32 = 1.0 / 65535.0;
     let d = diffuse * SCALE;

@@ -17,6 +17,7 @@ pub mod preset;
 pub mod project;
 pub mod recovery;
 pub mod resize;
+pub mod simd;
 pub mod stats;
 pub mod surface;
 pub mod texel;

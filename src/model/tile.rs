@@ -63,6 +63,14 @@ impl TileSpans {
         *row = (row.0.min(x), row.1.max(x + 1));
     }
 
+    /// Grows to hold texels `start..end` (row-major in the tile) of one row.
+    #[inline]
+    pub fn include_run(&mut self, start: usize, end: usize) {
+        debug_assert!(start < end && (end - 1) / TILE_SIZE == start / TILE_SIZE);
+        self.include(start);
+        self.include(end - 1);
+    }
+
     /// Whether it holds no texel.
     pub fn is_empty(&self) -> bool {
         self.rows.iter().all(|&(x0, x1)| x0 >= x1)
@@ -128,9 +136,18 @@ impl<T: Copy + PartialEq> Plane<T> {
     }
 
     /// Turns a full plane whose texels are all equal back into a uniform one.
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
     pub fn compact(&mut self) {
+        // The last and middle texels first: a tile an edit reached in part usually differs
+        // there, and a whole scan that finds a difference late is the costly case.
         if let Self::Data(d) = self
-            && let Some(&first) = d.first()
+            && let (Some(&first), Some(&last)) = (d.first(), d.last())
+            && last == first
+            && d[d.len() / 2] == first
             && d.iter().all(|&v| v == first)
         {
             *self = Self::Uniform(first);

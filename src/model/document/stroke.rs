@@ -370,18 +370,51 @@ fn cover_dab(
     (alpha, opacity): (f32, f32),
 ) -> Vec<TileSpans> {
     let covers = coverage.tiles_mut(maps.tile_count(), ids);
-    edit::edit_cover((planes, pre), target, ids, covers, |id, cov| {
+    let raise = DabRaise {
+        fp,
+        maps,
+        alpha,
+        opacity,
+    };
+    edit::edit_cover((planes, pre), target, ids, covers, &raise)
+}
+
+/// A dab's raise of the stroke's coverage: towards `opacity` by the footprint's weight
+/// times `alpha`.
+struct DabRaise<'a, F> {
+    fp: &'a F,
+    maps: &'a MaterialMaps,
+    alpha: f32,
+    opacity: f32,
+}
+
+impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn raise(&self, id: usize, cov: &mut [f32]) -> TileSpans {
+        let (alpha, opacity) = (self.alpha, self.opacity);
         let mut rose = TileSpans::EMPTY;
-        fp.visit_tile(id, maps.tile_rect(id), |i, w| {
-            let c = cov[i];
-            let next = c + (opacity - c) * (w * alpha).min(1.0);
-            if next > c {
-                cov[i] = next;
-                rose.include(i);
-            }
-        });
+        // A row's run at a time: the raise in a loop that vectorises, then where it rose.
+        let mut up = [false; crate::model::tile::TILE_SIZE];
+        self.fp
+            .visit_runs(id, self.maps.tile_rect(id), |start, weights| {
+                let row = &mut cov[start..start + weights.len()];
+                let up = &mut up[..weights.len()];
+                for ((c, &w), up) in row.iter_mut().zip(weights).zip(up.iter_mut()) {
+                    let next = *c + (opacity - *c) * (w * alpha).min(1.0);
+                    *up = next > *c;
+                    *c = if *up { next } else { *c };
+                }
+                let first = up.iter().position(|&u| u);
+                if let (Some(first), Some(last)) = (first, up.iter().rposition(|&u| u)) {
+                    rose.include_run(start + first, start + last + 1);
+                }
+            });
         rose
-    })
+    }
 }
 
 /// A blur dab through `fp` at `strength` over `channels` with a kernel of `radius` texels.

@@ -14,9 +14,14 @@
 //! function either way, so the incremental result is bit-identical to flattening the whole
 //! stack from scratch; a recomposited tile that comes out the same is not written, so the
 //! maps' dirty tiles (and the GPU upload) stay the ones that really changed.
+#![expect(
+    clippy::inline_always,
+    reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+)]
 
 use super::{Covered, Layer, LayerContent, LayerStack, PaintTile, SharedPaintTile};
 use crate::model::paint::n_bits_from_blend;
+use crate::model::simd::Kernel;
 use crate::model::texel::{
     Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, encode_unorm, n_to_blend,
 };
@@ -121,6 +126,7 @@ impl Planes {
     }
 
     /// `len` texels of `base`, opaque.
+    #[inline(always)]
     fn opaque(base: &[f32; 7], len: usize) -> Self {
         Self {
             value: std::array::from_fn(|k| scratch::buffer(len, base[k])),
@@ -128,26 +134,17 @@ impl Planes {
         }
     }
 
-    /// Every entry encoded as the maps store it (as [`Self::texel`]).
-    fn encode(&self) -> Encoded {
+    /// Every entry encoded as the maps store it (as [`Self::texel`]), appended to `out`.
+    #[inline(always)]
+    fn encode_into(&self, out: &mut Encoded) {
         let [r, g, b, sr, sg, sb, n] = &self.value;
-        let rgb = |r: &[f32], g: &[f32], b: &[f32]| -> Vec<[u16; 3]> {
-            r.iter()
-                .zip(g)
-                .zip(b)
-                .map(|((&r, &g), &b)| [encode_unorm(r), encode_unorm(g), encode_unorm(b)])
-                .collect()
-        };
-        Encoded {
-            kd: rgb(r, g, b),
-            ks: rgb(sr, sg, sb),
-            n: {
-                let table = crate::model::paint::n_bits_table();
-                n.iter()
-                    .map(|&v| crate::model::paint::n_bits_from_blend_in(table, v))
-                    .collect()
-            },
-        }
+        encode_rgb_planes([r, g, b], &mut out.kd);
+        encode_rgb_planes([sr, sg, sb], &mut out.ks);
+        let table = crate::model::paint::n_bits_table();
+        out.n.extend(
+            n.iter()
+                .map(|&v| crate::model::paint::n_bits_from_blend_in(table, v)),
+        );
     }
 
     /// Entry `j` encoded as the maps store it.
@@ -164,9 +161,31 @@ impl Planes {
     }
 }
 
+/// Planes of red, green and blue encoded as the maps store them, as triples appended to
+/// `out`: a plane at a time through a short buffer (a loop that vectorises), then interleaved.
+#[inline(always)]
+fn encode_rgb_planes(planes: [&[f32]; 3], out: &mut Vec<[u16; 3]>) {
+    const CHUNK: usize = 64;
+    let from = out.len();
+    out.resize(from + planes[0].len(), [0; 3]);
+    let mut q = [[0_u16; CHUNK]; 3];
+    for (at, o) in out[from..].chunks_mut(CHUNK).enumerate() {
+        let range = at * CHUNK..at * CHUNK + o.len();
+        for (q, p) in q.iter_mut().zip(planes) {
+            for (d, &v) in q.iter_mut().zip(&p[range.clone()]) {
+                *d = encode_unorm(v);
+            }
+        }
+        for (j, o) in o.iter_mut().enumerate() {
+            *o = [q[0][j], q[1][j], q[2][j]];
+        }
+    }
+}
+
 /// Lays `src` (values at coverage `cover`) over component `dst` (its values, and its
 /// coverage unless it is opaque) with `mode`, texel by texel: [`Covered::under`], with the
 /// mode chosen once for the whole run.
+#[inline(always)]
 fn lay_plane(
     (dst_v, dst_a): (&mut [f32], Option<&mut [f32]>),
     src: &[f32],
@@ -174,7 +193,7 @@ fn lay_plane(
     mode: super::LayerBlend,
 ) {
     use super::LayerBlend as B;
-    #[inline]
+    #[inline(always)]
     fn run(
         mix: impl Fn(f32, f32) -> f32 + Copy,
         dst_v: &mut [f32],
@@ -228,7 +247,7 @@ fn runs(spans: &TileSpans) -> Vec<(usize, usize, usize)> {
 
 /// Decodes `plane` at the texels of `runs` into `out` through `f` (one entry a texel), a run
 /// at a time.
-#[inline]
+#[inline(always)]
 fn decode_runs<T: Copy + PartialEq>(
     plane: &Plane<T>,
     runs: &[(usize, usize, usize)],
@@ -248,6 +267,7 @@ fn decode_runs<T: Copy + PartialEq>(
 }
 
 /// What the texels of `runs` of a mask show of its layer (opacity included), into `out`.
+#[inline(always)]
 fn cover_of(layer: &Layer, id: usize, runs: &[(usize, usize, usize)], out: &mut [f32]) {
     let opacity = layer.props.opacity.clamp(0.0, 1.0);
     match &layer.mask {
@@ -265,6 +285,7 @@ fn cover_of(layer: &Layer, id: usize, runs: &[(usize, usize, usize)], out: &mut 
 
 /// Channel `c` (`k_d`, `k_s` or `n`) of a paint tile at the texels of `runs`, as compositing
 /// values, into `out` (its first plane for `n`), a texel's components in one pass.
+#[inline(always)]
 fn channel_values(
     tile: &PaintTile,
     c: usize,
@@ -308,6 +329,17 @@ fn channel_values(
 
 /// Lays the active layers (bottom first) over `state`: the texels of `runs` of tile `id`.
 fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize, runs: &[(usize, usize, usize)]) {
+    apply_inline(state, layers, id, runs);
+}
+
+/// [`apply`], inlined where it is called (a group's children go through [`apply`]).
+#[inline(always)]
+fn apply_inline(
+    state: &mut Planes,
+    layers: &[Active<'_>],
+    id: usize,
+    runs: &[(usize, usize, usize)],
+) {
     let len = state.value[0].len();
     debug_assert_eq!(
         len,
@@ -374,6 +406,7 @@ fn apply(state: &mut Planes, layers: &[Active<'_>], id: usize, runs: &[(usize, u
 
 /// Whether every input of the active layers at tile `id` is one value over the tile (then
 /// one texel stands for all).
+#[inline(always)]
 fn uniform_inputs(layers: &[Active<'_>], id: usize) -> bool {
     layers.iter().all(|a| {
         let mask = a
@@ -396,53 +429,87 @@ fn uniform_inputs(layers: &[Active<'_>], id: usize) -> bool {
 }
 
 /// The composite of tile `id`, compacted (a tile of one value is stored as one value).
+#[inline(always)]
 pub fn composite_tile(stack: &LayerStack, id: usize) -> Tile {
     composite_active(stack, &active(&stack.layers, id), id)
 }
 
+#[inline(always)]
 fn composite_active(stack: &LayerStack, layers: &[Active<'_>], id: usize) -> Tile {
-    let state = composited(stack, layers, id, &TileSpans::FULL);
-    if state.value[0].len() == 1 {
-        return Tile::uniform(state.texel(0));
+    match composited(stack, layers, id, &TileSpans::FULL) {
+        Composite::Uniform(t) => Tile::uniform(t),
+        Composite::Texels(e) => {
+            let mut tile = Tile {
+                kd: Plane::Data(e.kd.into_boxed_slice()),
+                ks: Plane::Data(e.ks.into_boxed_slice()),
+                n: Plane::Data(e.n.into_boxed_slice()),
+            };
+            tile.compact();
+            tile
+        }
     }
-    let e = state.encode();
-    let mut tile = Tile {
-        kd: Plane::Data(e.kd.into_boxed_slice()),
-        ks: Plane::Data(e.ks.into_boxed_slice()),
-        n: Plane::Data(e.n.into_boxed_slice()),
-    };
-    tile.compact();
-    tile
 }
 
 /// Texels `spans` of tile `id`'s composite, row by row.
+#[inline(always)]
 fn composite_spans(stack: &LayerStack, id: usize, spans: &TileSpans) -> Encoded {
-    let state = composited(stack, &active(&stack.layers, id), id, spans);
-    if state.value[0].len() == 1 {
-        let t = state.texel(0);
-        let count = spans.count();
-        return Encoded {
-            kd: vec![t.kd; count],
-            ks: vec![t.ks; count],
-            n: vec![t.n; count],
-        };
+    match composited(stack, &active(&stack.layers, id), id, spans) {
+        Composite::Uniform(t) => {
+            let count = spans.count();
+            Encoded {
+                kd: vec![t.kd; count],
+                ks: vec![t.ks; count],
+                n: vec![t.n; count],
+            }
+        }
+        Composite::Texels(e) => e,
     }
-    state.encode()
 }
 
-/// The active `layers` over the stack's base at texels `spans` of tile `id`: one entry a
-/// texel, or one entry for all where every input is one value over the tile.
-fn composited(stack: &LayerStack, layers: &[Active<'_>], id: usize, spans: &TileSpans) -> Planes {
+/// [`composite_tile`] as a [`Kernel`].
+struct CompositeTile<'a>(&'a LayerStack, usize);
+
+impl Kernel for CompositeTile<'_> {
+    type Output = Tile;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> Tile {
+        composite_tile(self.0, self.1)
+    }
+}
+
+/// A composite of some texels of a tile.
+enum Composite {
+    /// Every input is one value over the tile: so is the composite.
+    Uniform(Texel),
+    /// The texels, row by row.
+    Texels(Encoded),
+}
+
+/// The active `layers` over the stack's base at texels `spans` of tile `id`.
+#[inline(always)]
+fn composited(
+    stack: &LayerStack,
+    layers: &[Active<'_>],
+    id: usize,
+    spans: &TileSpans,
+) -> Composite {
     let base = values(Texel::encode(stack.base));
-    // Inputs of one value over the tile: one texel stands for all.
-    let spans = if uniform_inputs(layers, id) {
-        TileSpans::texel(0)
-    } else {
-        *spans
+    if uniform_inputs(layers, id) {
+        let mut state = Planes::opaque(&base, 1);
+        apply(&mut state, layers, id, &runs(&TileSpans::texel(0)));
+        return Composite::Uniform(state.texel(0));
+    }
+    let count = spans.count();
+    let mut out = Encoded {
+        kd: Vec::with_capacity(count),
+        ks: Vec::with_capacity(count),
+        n: Vec::with_capacity(count),
     };
-    let mut state = Planes::opaque(&base, spans.count());
-    apply(&mut state, layers, id, &runs(&spans));
-    state
+    let mut state = Planes::opaque(&base, count);
+    apply_inline(&mut state, layers, id, &runs(spans));
+    state.encode_into(&mut out);
+    Composite::Texels(out)
 }
 
 /// `layers` composited onto nothing at tile `id`, as a paint tile (`None` where none of them

@@ -12,12 +12,16 @@ use rayon::prelude::*;
 
 use super::{LayerStroke, LayerValue, PaintTile, SharedMaskTile, SharedPaintTile, Stamped};
 use crate::model::brush::BlendMode;
-use crate::model::paint::{n_bits_from_blend, n_bits_from_blend_in, n_bits_to_blend};
+use crate::model::paint::{n_bits_from_blend, n_bits_to_blend};
 use crate::model::texel::{MaterialValue, decode_unorm, encode_unorm, n_to_blend};
 use crate::model::tile::{Plane, TILE_SIZE, Tile, TileSpans, select_mut};
 
 mod blur;
+mod cover;
+
 pub use blur::blur;
+pub use cover::{Raise, edit_cover};
+use cover::{cover_alpha, cover_channel, erase_channel};
 
 /// A material as the layer kernels blend it: `k_d`, `k_s` linear, `n` in blend space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -213,6 +217,11 @@ impl Slot<'_> {
     }
 
     /// Writes texels `spans` at coverage `cover` (see [`edit_cover`]).
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
     fn write_cover(&mut self, edit: &LayerEdit, spans: &TileSpans, cover: &[f32]) {
         match self {
             Self::Paint(slot, pre, written) => {
@@ -287,169 +296,6 @@ impl Slot<'_> {
     }
 }
 
-/// Decodes `len` texels of `plane` from texel `start` into `out` through `f`.
-#[inline]
-fn decode_run<T: Copy + PartialEq>(
-    plane: &Plane<T>,
-    start: usize,
-    out: &mut [f32],
-    f: impl Fn(T) -> f32,
-) {
-    match plane {
-        Plane::Uniform(v) => out.fill(f(*v)),
-        Plane::Data(d) => {
-            let len = out.len();
-            for (o, &v) in out.iter_mut().zip(&d[start..start + len]) {
-                *o = f(v);
-            }
-        }
-    }
-}
-
-/// The coverage of a transparent texel after a brush at `cover`, at texels `spans` of a
-/// channel's coverage plane (the value is the target's: see [`Slot::write_cover`]).
-fn cover_alpha(alpha: &mut [u16], spans: &TileSpans, cover: &[f32]) {
-    for (y, x0, x1) in spans.rows() {
-        let (start, end) = (y * TILE_SIZE + x0, y * TILE_SIZE + x1);
-        for (p, &a) in alpha[start..end].iter_mut().zip(&cover[start..end]) {
-            let new = encode_unorm(a.min(1.0));
-            *p = if a > 0.0 { new } else { *p };
-        }
-    }
-}
-
-/// Channel `ch` of a paint tile's texels `spans` after a brush of `target` (its components)
-/// whose mode gives `value` ([`LayerStroke::value`]) at coverage `cover`, from the pre-operation tile (none: transparent), a row at a
-/// time: the coverage and the pre-stroke value's weight once per texel, then each component
-/// in a plain loop over the row ([`LayerStroke::apply`], term for term).
-fn cover_channel(
-    (tile, pre, ch, target, spans, cover): (
-        &mut PaintTile,
-        Option<&PaintTile>,
-        usize,
-        &[f32],
-        &TileSpans,
-        &[f32],
-    ),
-    value: impl Fn((f32, f32), f32, f32) -> f32,
-) {
-    let table = crate::model::paint::n_blend_table();
-    let n_bits = crate::model::paint::n_bits_table();
-    let mut pre_alpha = [0.0_f32; TILE_SIZE];
-    let mut pre_value = [0.0_f32; TILE_SIZE];
-    let (mut a, mut w) = ([0.0_f32; TILE_SIZE], [0.0_f32; TILE_SIZE]);
-    let mut alpha = [0_u16; TILE_SIZE];
-    let mut out = [[0_u16; TILE_SIZE]; 3];
-    for (y, x0, x1) in spans.rows() {
-        let (start, width) = (y * TILE_SIZE + x0, x1 - x0);
-        let cov = &cover[start..start + width];
-        if let Some(p) = pre {
-            decode_run(&p.alpha[ch], start, &mut pre_alpha[..width], decode_unorm);
-        }
-        for j in 0..width {
-            let aj = cov[j].clamp(0.0, 1.0);
-            let (coverage, weight) = LayerStroke::cover(pre_alpha[j], aj);
-            (a[j], w[j], alpha[j]) = (aj, weight, encode_unorm(coverage.min(1.0)));
-        }
-        for (c, &t) in target.iter().enumerate() {
-            if let Some(p) = pre {
-                let out = &mut pre_value[..width];
-                match ch {
-                    0 => decode_run(&p.value.kd, start, out, |v| decode_unorm(v[c])),
-                    1 => decode_run(&p.value.ks, start, out, |v| decode_unorm(v[c])),
-                    _ => decode_run(&p.value.n, start, out, |bits| table[bits as usize]),
-                }
-            }
-            let encoded = &mut out[c][..width];
-            if ch == 2 {
-                for j in 0..width {
-                    let v = value((w[j], a[j]), pre_value[j], t);
-                    encoded[j] = n_bits_from_blend_in(n_bits, v);
-                }
-            } else {
-                for j in 0..width {
-                    encoded[j] = encode_unorm(value((w[j], a[j]), pre_value[j], t));
-                }
-            }
-        }
-        // Only texels the stroke reached change: where it reached the whole run (as a disc
-        // does), a plain copy; else chosen texel by texel, without a branch.
-        let all = cov.iter().all(|&c| c > 0.0);
-        let a_plane = &mut tile.alpha[ch].data_mut()[start..start + width];
-        if all {
-            a_plane.copy_from_slice(&alpha[..width]);
-        } else {
-            for ((p, &new), &c) in a_plane.iter_mut().zip(&alpha).zip(cov) {
-                *p = if c > 0.0 { new } else { *p };
-            }
-        }
-        match ch {
-            0 | 1 => {
-                let plane = if ch == 0 {
-                    tile.value.kd.data_mut()
-                } else {
-                    tile.value.ks.data_mut()
-                };
-                let plane = &mut plane[start..start + width];
-                let [r, g, b] = &out;
-                if all {
-                    for (j, p) in plane.iter_mut().enumerate() {
-                        *p = [r[j], g[j], b[j]];
-                    }
-                } else {
-                    for (j, p) in plane.iter_mut().enumerate() {
-                        *p = if cov[j] > 0.0 { [r[j], g[j], b[j]] } else { *p };
-                    }
-                }
-            }
-            _ => {
-                let plane = &mut tile.value.n.data_mut()[start..start + width];
-                if all {
-                    plane.copy_from_slice(&out[0][..width]);
-                } else {
-                    for ((p, &new), &c) in plane.iter_mut().zip(&out[0]).zip(cov) {
-                        *p = if c > 0.0 { new } else { *p };
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// The eraser on channel `ch` of a paint tile's texels `spans` at coverage `cover`, from the
-/// pre-operation tile: the coverage falls ([`LayerStroke::apply`]); values stay.
-fn erase_channel(
-    (tile, pre, ch, spans, cover): (
-        &mut PaintTile,
-        Option<&PaintTile>,
-        usize,
-        &TileSpans,
-        &[f32],
-    ),
-) {
-    let Some(pre) = pre else {
-        // Nothing to erase: the tile is as transparent as before the stroke.
-        return;
-    };
-    let plane = tile.alpha[ch].data_mut();
-    for i in spans.indices() {
-        let a = cover[i];
-        let out = LayerStroke::Erase.apply(
-            LayerValue {
-                value: 0.0,
-                alpha: decode_unorm(pre.alpha[ch].get(i)),
-            },
-            0.0,
-            a,
-        );
-        plane[i] = if a > 0.0 {
-            encode_unorm(out.alpha)
-        } else {
-            plane[i]
-        };
-    }
-}
-
 /// Writes tiles `work` (each an id and the data its visitor needs) in parallel. For each
 /// tile, `visit` calls its argument with `(texel index in the tile, coverage, t)` for every
 /// texel to write.
@@ -468,32 +314,6 @@ pub fn edit_tiles<X: Send>(
             visit(id, data, &mut |i, a, t| slot.write(edit, i, a, t));
             slot.compact();
         });
-}
-
-/// Writes dabs into tiles `ids` (sorted, unique) in parallel, each with the stroke's coverage
-/// so far (`covers`, one value a texel of the tile): `raise(id, cover)` raises a tile's
-/// coverage and returns the texels where it rose, and each of those becomes its
-/// pre-operation value at that coverage, a row at a time. Returns, per tile, those texels.
-pub fn edit_cover(
-    (planes, pre): (Planes<'_>, PrePlanes<'_>),
-    edit: &LayerEdit,
-    ids: &[usize],
-    covers: Vec<&mut [f32]>,
-    raise: impl Fn(usize, &mut [f32]) -> TileSpans + Sync,
-) -> Vec<TileSpans> {
-    slots(planes, pre, ids)
-        .into_par_iter()
-        .zip(covers)
-        .zip(ids)
-        .map(|((mut slot, cover), &id)| {
-            let spans = raise(id, cover);
-            if !spans.is_empty() {
-                slot.write_cover(edit, &spans, cover);
-                slot.compact();
-            }
-            spans
-        })
-        .collect()
 }
 
 /// The tiles `ids` (sorted, unique) of `planes` to write, with their pre-operation tiles.

@@ -77,6 +77,11 @@ impl Footprint for DiscFootprint<'_> {
         ids
     }
 
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
     fn visit_runs(&self, _id: TileId, rect: TexelRect, mut f: impl FnMut(usize, &[f32])) {
         let TexelRect { x0, y0, x1, y1 } = rect;
         let r = self.radius;

@@ -1,14 +1,19 @@
 //! Keeping the maps the composite of a stack as it changes: per tile, a signature of
 //! everything its composite depends on, and recompositing only tiles (or the texels of them an
 //! edit reached) whose signature changed.
+#![expect(
+    clippy::inline_always,
+    reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+)]
 
 use std::hash::{Hash, Hasher};
 
 use rayon::prelude::*;
 
-use super::{Active, active, composite_spans, composite_tile, runs};
+use super::{Active, CompositeTile, active, composite_spans, runs};
 use crate::model::layers::LayerStack;
 use crate::model::maps::MaterialMaps;
+use crate::model::simd::{Kernel, vectorized};
 use crate::model::texel::{Channels, Texel};
 use crate::model::tile::{Plane, Tile, TileSpans};
 
@@ -132,26 +137,12 @@ impl Compositor {
         let ids: Vec<usize> = stale.iter().map(|r| r.0).collect();
         let changed = maps.edit_tiles_par(&ids, |k, tile| {
             let (id, _, spans) = stale[k];
-            let texels = composite_spans(stack, id, spans);
-            let runs = runs(spans);
-            let changed = Channels {
-                kd: differs(&tile.kd, &runs, &texels.kd),
-                ks: differs(&tile.ks, &runs, &texels.ks),
-                n: differs(&tile.n, &runs, &texels.n),
-            };
-            if !changed.is_empty() {
-                let tile = std::sync::Arc::make_mut(tile);
-                if changed.kd {
-                    write_runs(&mut tile.kd, &runs, &texels.kd);
-                }
-                if changed.ks {
-                    write_runs(&mut tile.ks, &runs, &texels.ks);
-                }
-                if changed.n {
-                    write_runs(&mut tile.n, &runs, &texels.n);
-                }
-            }
-            changed
+            vectorized(Recomposite {
+                stack,
+                id,
+                spans,
+                tile,
+            })
         });
         for &(id, s, _) in &stale {
             self.signatures[id] = s;
@@ -188,7 +179,10 @@ impl Compositor {
     ) -> Vec<usize> {
         let tiles: Vec<(usize, u64, Tile)> = stale
             .into_par_iter()
-            .map(|(id, s)| (id, s, composite_tile(stack, id)))
+            .map(|(id, s)| {
+                let tile = vectorized(CompositeTile(stack, id));
+                (id, s, tile)
+            })
             .collect();
         let mut written = Vec::new();
         for (id, s, tile) in tiles {
@@ -201,7 +195,45 @@ impl Compositor {
     }
 }
 
+/// Texels `spans` of tile `id` of the maps (`tile`) recomposited from `stack`, writing only
+/// the channels that changed; which did.
+struct Recomposite<'a> {
+    stack: &'a LayerStack,
+    id: usize,
+    spans: &'a TileSpans,
+    tile: &'a mut std::sync::Arc<Tile>,
+}
+
+impl Kernel for Recomposite<'_> {
+    type Output = Channels;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> Channels {
+        let texels = composite_spans(self.stack, self.id, self.spans);
+        let runs = runs(self.spans);
+        let changed = Channels {
+            kd: differs(&self.tile.kd, &runs, &texels.kd),
+            ks: differs(&self.tile.ks, &runs, &texels.ks),
+            n: differs(&self.tile.n, &runs, &texels.n),
+        };
+        if !changed.is_empty() {
+            let tile = std::sync::Arc::make_mut(self.tile);
+            if changed.kd {
+                write_runs(&mut tile.kd, &runs, &texels.kd);
+            }
+            if changed.ks {
+                write_runs(&mut tile.ks, &runs, &texels.ks);
+            }
+            if changed.n {
+                write_runs(&mut tile.n, &runs, &texels.n);
+            }
+        }
+        changed
+    }
+}
+
 /// Whether the texels of `runs` of `plane` differ from `new` (row by row).
+#[inline(always)]
 fn differs<T: Copy + PartialEq>(
     plane: &Plane<T>,
     runs: &[(usize, usize, usize)],
@@ -216,6 +248,7 @@ fn differs<T: Copy + PartialEq>(
 }
 
 /// Writes `new` (row by row) into the texels of `runs` of `plane`, and compacts it.
+#[inline(always)]
 fn write_runs<T: Copy + PartialEq>(
     plane: &mut Plane<T>,
     runs: &[(usize, usize, usize)],

@@ -291,6 +291,25 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        ..ProptestConfig::default()
+    })]
+
+    /// The compositor runs tiles through `simd::vectorized` (AVX2 where the CPU has it);
+    /// the same function called plainly is compiled for baseline x86-64.
+    #[test]
+    fn a_vectorized_composite_is_bit_identical_to_the_baseline(seed in 1u64..) {
+        let mut rng = Rng(seed);
+        let (stack, _, _) = composited_stack(&mut rng, (192, 130));
+        for id in 0..stack.tile_count() {
+            let wide = crate::model::simd::vectorized(CompositeTile(&stack, id));
+            prop_assert_eq!(&wide, &composite_tile(&stack, id), "tile {}", id);
+        }
+    }
+}
+
 #[test]
 fn a_new_stack_is_its_base_and_an_empty_layer() {
     let base = MaterialValue::new(Vec3::new(0.5, 0.25, 0.1), Vec3::splat(0.3), 40.0);
