@@ -346,9 +346,11 @@ fn apply_inline(
         runs.iter().map(|r| r.2).sum::<usize>(),
         "one plane entry per texel"
     );
-    let mut cover = scratch::buffer(len, 0.0);
-    let mut alpha = scratch::buffer(len, 0.0);
-    let mut src: [Vec<f32>; 3] = std::array::from_fn(|_| scratch::buffer(len, 0.0));
+    // Each is written whole before it is read: a layer's cover, a channel's coverage and a
+    // component's values.
+    let mut cover = scratch::overwritten(len);
+    let mut alpha = scratch::overwritten(len);
+    let mut src: [Vec<f32>; 3] = std::array::from_fn(|_| scratch::overwritten(len));
     for a in layers {
         let layer = a.layer();
         cover_of(layer, id, runs, &mut cover);

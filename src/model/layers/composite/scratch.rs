@@ -24,6 +24,23 @@ pub(super) fn buffer(len: usize, value: f32) -> Vec<f32> {
     }
 }
 
+/// A buffer of `len` entries whose values are left as they were (the caller writes every
+/// entry before reading it), reusing one this thread gave back.
+pub(super) fn overwritten(len: usize) -> Vec<f32> {
+    let reused = FREE.with_borrow_mut(Vec::pop);
+    match reused {
+        Some(mut v) => {
+            if v.len() >= len {
+                v.truncate(len);
+            } else {
+                v.resize(len, 0.0);
+            }
+            v
+        }
+        None => vec![0.0; len],
+    }
+}
+
 /// Gives `v` back for [`buffer`] to reuse on this thread.
 pub(super) fn recycle(v: Vec<f32>) {
     FREE.with_borrow_mut(|free| {
