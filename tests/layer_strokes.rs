@@ -65,3 +65,41 @@ fn a_brush_on_new_tiles_composites_as_on_transparent_ones() {
     run(&mut erased, script);
     assert_eq!(texels(&fresh), texels(&erased));
 }
+
+/// The brush's energy guard (`k_d + k_s <= 1` per colour channel) holds on a layer as it did
+/// on the flat maps: it used to be ignored there.
+#[test]
+fn the_energy_guard_holds_on_a_layer() {
+    let mut doc = document();
+    run(
+        &mut doc,
+        r"(commands: [
+            SetPrimary((kd: (0.9, 0.6, 0.2), ks: (0.5, 0.5, 0.5), n: 80.0)),
+            SetBrush((radius_px: 14.0, hardness: 1.0, flow: 1.0, opacity: 1.0, energy_guard: true)),
+            Stroke(tool: Brush, points: [(pos: (40.0, 60.0), pressure: 1.0), (pos: (140.0, 60.0), pressure: 1.0)]),
+            SetBrush((radius_px: 14.0, hardness: 0.3, flow: 0.5, opacity: 1.0, energy_guard: true, blend: Add)),
+            Stroke(tool: Brush, points: [(pos: (60.0, 66.0), pressure: 1.0), (pos: (120.0, 66.0), pressure: 1.0)]),
+        ])",
+    );
+    for x in (30..150).step_by(3) {
+        for y in 48..74 {
+            let t = doc.maps().texel(x, y).decode();
+            let sum = t.kd + t.ks;
+            assert!(
+                sum.max_element() <= 1.0 + 2.0 / 65535.0,
+                "({x}, {y}): {t:?}"
+            );
+        }
+    }
+    // Both channels painted: both scale down together, as on the flat maps.
+    let t = doc.maps().texel(90, 50).decode();
+    assert!((t.kd.x - 0.9 / 1.4).abs() < 1e-3, "{t:?}");
+    assert!((t.ks.x - 0.5 / 1.4).abs() < 1e-3, "{t:?}");
+    // A fill on a new layer keeps it too (it no longer takes the one-value-a-tile shortcut).
+    run(
+        &mut doc,
+        r#"(commands: [AddLayer(kind: Paint, name: "fill"), Fill(All)])"#,
+    );
+    let t = doc.maps().texel(5, 120).decode();
+    assert!((t.kd.x - 0.9 / 1.4).abs() < 1e-3, "{t:?}");
+}

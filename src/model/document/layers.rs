@@ -67,6 +67,7 @@ impl Document {
             channels: [c.kd, c.ks, c.n],
             stroke,
             gray: [self.stored_gray(shown); 2],
+            energy_guard: self.settings.brush.energy_guard,
         }
     }
 

@@ -81,6 +81,32 @@ pub struct LayerEdit {
     /// The mask's stored gray at `t = 0` and `t = 1` (the caller maps white and black through
     /// the mask's inversion).
     pub gray: [f32; 2],
+    /// Keep the layer's own `k_d + k_s <= 1` per colour channel where the edit writes (see
+    /// [`guard_texel`]).
+    pub energy_guard: bool,
+}
+
+/// The brushes' energy guard on texel `i` of a paint layer's tile: where the layer holds both
+/// `k_d` and `k_s` (the channel being written, and the other one painted there), their sum per
+/// colour channel is kept at most one, as on flat maps (the channel written gives way, or both
+/// scale down when both are written). Layers below are not looked at: normal layers that each
+/// keep it composite to values that keep it (a mix of two such values keeps it).
+pub(crate) fn guard_texel(tile: &mut PaintTile, channels: [bool; 3], i: usize) {
+    let (kd_on, ks_on) = (channels[0], channels[1]);
+    let holds = |c: usize| tile.alpha[c].get(i) > 0;
+    if !(kd_on || ks_on) || !holds(0) || !holds(1) {
+        return;
+    }
+    let (kd0, ks0) = (tile.value.kd.get(i), tile.value.ks.get(i));
+    let (mut kd, mut ks) = (kd0.map(decode_unorm), ks0.map(decode_unorm));
+    crate::model::paint::guard_energy(&mut kd, &mut ks, kd_on, ks_on);
+    let (kd, ks) = (kd.map(encode_unorm), ks.map(encode_unorm));
+    if kd != kd0 {
+        tile.value.kd.data_mut()[i] = kd;
+    }
+    if ks != ks0 {
+        tile.value.ks.data_mut()[i] = ks;
+    }
 }
 
 /// The planes an edit writes into.
@@ -206,6 +232,9 @@ impl Slot<'_> {
                         _ => tile.value.n.data_mut()[i] = values[0],
                     }
                 }
+                if edit.energy_guard {
+                    guard_texel(tile, edit.channels, i);
+                }
             }
             Self::Mask(slot, pre, written) => {
                 let g = edit.gray[0] + (edit.gray[1] - edit.gray[0]) * t;
@@ -264,6 +293,11 @@ impl Slot<'_> {
                         LayerStroke::Erase => {
                             erase_channel((&mut *tile, pre, ch, spans, cover));
                         }
+                    }
+                }
+                if edit.energy_guard && edit.stroke != LayerStroke::Erase {
+                    for i in spans.indices().filter(|&i| cover[i] > 0.0) {
+                        guard_texel(tile, edit.channels, i);
                     }
                 }
             }
@@ -350,7 +384,7 @@ pub fn tile_texels(width: u32, height: u32, id: usize) -> impl Iterator<Item = (
 /// and no memory. Returns false when the fill needs the per-texel path.
 pub fn fill_uniform(planes: Planes<'_>, edit: &LayerEdit, opacity: f32, tile_count: usize) -> bool {
     let normal = edit.stroke == LayerStroke::Brush(crate::model::brush::BlendMode::Normal);
-    if opacity < 1.0 || !normal || edit.from != edit.to {
+    if opacity < 1.0 || !normal || edit.from != edit.to || edit.energy_guard {
         return false;
     }
     match planes {

@@ -154,7 +154,12 @@ impl PaintTarget {
 
 /// Keeps `k_d + k_s <= 1` per colour channel: the channel being painted gives way to the
 /// other; when both are painted, both scale down together.
-fn guard_energy(kd: &mut [f32; 3], ks: &mut [f32; 3], painting_kd: bool, painting_ks: bool) {
+pub(crate) fn guard_energy(
+    kd: &mut [f32; 3],
+    ks: &mut [f32; 3],
+    painting_kd: bool,
+    painting_ks: bool,
+) {
     for c in 0..3 {
         let sum = kd[c] + ks[c];
         if sum <= 1.0 {
