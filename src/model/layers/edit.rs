@@ -81,8 +81,8 @@ pub struct LayerEdit {
     /// The mask's stored gray at `t = 0` and `t = 1` (the caller maps white and black through
     /// the mask's inversion).
     pub gray: [f32; 2],
-    /// Keep the layer's own `k_d + k_s <= 1` per colour channel where the edit writes (see
-    /// [`guard_texel`]).
+    /// Keep the layer's own `k_d + k_s <= 1` per colour channel where the edit writes and the
+    /// layer holds both channels (the brushes' energy guard).
     pub energy_guard: bool,
 }
 
