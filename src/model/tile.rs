@@ -228,6 +228,13 @@ mod tests {
         }
         assert_eq!(spans.rows().collect::<Vec<_>>(), [(2, 30, 31), (5, 9, 31)]);
         assert_eq!(spans.count(), 1 + 22);
+        let mut run = spans;
+        run.include_run(7 * TILE_SIZE + 3, 7 * TILE_SIZE + 12);
+        run.include_run(5 * TILE_SIZE + 40, 5 * TILE_SIZE + 41);
+        assert_eq!(
+            run.rows().collect::<Vec<_>>(),
+            [(2, 30, 31), (5, 9, 41), (7, 3, 12)]
+        );
         assert_eq!(spans.indices().next(), Some(2 * TILE_SIZE + 30));
         assert_eq!(TileSpans::texel(7).indices().collect::<Vec<_>>(), [7]);
         assert_eq!(TileSpans::FULL.count(), TILE_TEXELS);

@@ -132,16 +132,20 @@ pub fn layered_stack(side: u32, layers: usize) -> crate::model::layers::LayerSta
     stack
 }
 
+/// Dabs along one row of [`stroke_path`], and its rows.
+const PATH_ROW: (u32, u32) = (112, 12);
+
 /// Points in [`stroke_path`] before it starts over.
-pub const STROKE_PATH_POINTS: u32 = 12 * 112;
+pub const STROKE_PATH_POINTS: u32 = PATH_ROW.0 * PATH_ROW.1;
 
 /// Point `k` of a long stroke across a 4096^2 map for dab benchmarks: 32 px apart (the
 /// spacing of a 128 px-radius brush) along rows 320 px apart, back and forth, so every dab
 /// reaches texels the stroke has not covered yet; after [`STROKE_PATH_POINTS`] (12 rows) it
 /// starts over (a new stroke there paints over the first).
 pub fn stroke_path(k: u32) -> glam::Vec2 {
-    let (row, col) = ((k / 112) % 12, k % 112);
-    let col = if row % 2 == 0 { col } else { 111 - col };
+    let (points, rows) = PATH_ROW;
+    let (row, col) = ((k / points) % rows, k % points);
+    let col = if row % 2 == 0 { col } else { points - 1 - col };
     glam::Vec2::new(256.5 + 32.0 * col as f32, 256.5 + 320.0 * row as f32)
 }
 

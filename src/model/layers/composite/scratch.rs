@@ -13,15 +13,9 @@ thread_local! {
 
 /// A buffer of `len` copies of `value`, reusing one this thread gave back.
 pub(super) fn buffer(len: usize, value: f32) -> Vec<f32> {
-    let reused = FREE.with_borrow_mut(Vec::pop);
-    match reused {
-        Some(mut v) => {
-            v.clear();
-            v.resize(len, value);
-            v
-        }
-        None => vec![value; len],
-    }
+    let mut v = overwritten(len);
+    v.fill(value);
+    v
 }
 
 /// A buffer of `len` entries whose values are left as they were (the caller writes every
@@ -41,7 +35,7 @@ pub(super) fn overwritten(len: usize) -> Vec<f32> {
     }
 }
 
-/// Gives `v` back for [`buffer`] to reuse on this thread.
+/// Gives `v` back for [`buffer`] and [`overwritten`] to reuse on this thread.
 pub(super) fn recycle(v: Vec<f32>) {
     FREE.with_borrow_mut(|free| {
         if free.len() < KEPT {
