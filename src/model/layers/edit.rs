@@ -269,7 +269,7 @@ impl Slot<'_> {
                         continue;
                     }
                     if fresh {
-                        cover_alpha(tile.alpha[ch].data_mut(), spans, cover);
+                        cover_alpha(&mut tile.alpha[ch], spans, cover);
                         continue;
                     }
                     let target = &edit.from.c[range.clone()];

@@ -100,13 +100,15 @@ fn decode_run<T: Copy + PartialEq>(
 /// The coverage of a transparent texel after a brush at `cover`, at texels `spans` of a
 /// channel's coverage plane (the value is the target's: see [`Slot::write_cover`]).
 #[inline(always)]
-pub(super) fn cover_alpha(alpha: &mut [u16], spans: &TileSpans, cover: &[f32]) {
+pub(super) fn cover_alpha(alpha: &mut Plane<u16>, spans: &TileSpans, cover: &[f32]) {
+    let mut row = [0_u16; TILE_SIZE];
     for (y, x0, x1) in spans.rows() {
         let (start, end) = (y * TILE_SIZE + x0, y * TILE_SIZE + x1);
-        for (p, &a) in alpha[start..end].iter_mut().zip(&cover[start..end]) {
-            let new = encode_unorm(a.min(1.0));
-            *p = if a > 0.0 { new } else { *p };
+        let cov = &cover[start..end];
+        for (p, &a) in row.iter_mut().zip(cov) {
+            *p = encode_unorm(a.min(1.0));
         }
+        write_row(alpha, start, &row[..end - start], cov, all_reached(cov));
     }
 }
 
@@ -165,46 +167,57 @@ pub(super) fn cover_channel(
                 }
             }
         }
-        // Only texels the stroke reached change: where it reached the whole run (as a disc
-        // does), a plain copy; else chosen texel by texel, without a branch.
-        let all = cov.iter().all(|&c| c > 0.0);
-        let a_plane = &mut tile.alpha[ch].data_mut()[start..start + width];
-        if all {
-            a_plane.copy_from_slice(&alpha[..width]);
-        } else {
-            for ((p, &new), &c) in a_plane.iter_mut().zip(&alpha).zip(cov) {
-                *p = if c > 0.0 { new } else { *p };
-            }
-        }
+        // Only texels the stroke reached change.
+        let all = all_reached(cov);
+        write_row(&mut tile.alpha[ch], start, &alpha[..width], cov, all);
         match ch {
             0 | 1 => {
-                let plane = if ch == 0 {
-                    tile.value.kd.data_mut()
-                } else {
-                    tile.value.ks.data_mut()
-                };
-                let plane = &mut plane[start..start + width];
                 let [r, g, b] = &out;
-                if all {
-                    for (j, p) in plane.iter_mut().enumerate() {
-                        *p = [r[j], g[j], b[j]];
-                    }
-                } else {
-                    for (j, p) in plane.iter_mut().enumerate() {
-                        *p = if cov[j] > 0.0 { [r[j], g[j], b[j]] } else { *p };
-                    }
+                let mut rgb = [[0_u16; 3]; TILE_SIZE];
+                for (j, p) in rgb[..width].iter_mut().enumerate() {
+                    *p = [r[j], g[j], b[j]];
                 }
-            }
-            _ => {
-                let plane = &mut tile.value.n.data_mut()[start..start + width];
-                if all {
-                    plane.copy_from_slice(&out[0][..width]);
+                let plane = if ch == 0 {
+                    &mut tile.value.kd
                 } else {
-                    for ((p, &new), &c) in plane.iter_mut().zip(&out[0]).zip(cov) {
-                        *p = if c > 0.0 { new } else { *p };
-                    }
-                }
+                    &mut tile.value.ks
+                };
+                write_row(plane, start, &rgb[..width], cov, all);
             }
+            _ => write_row(&mut tile.value.n, start, &out[0][..width], cov, all),
+        }
+    }
+}
+
+/// Whether a dab reached every texel of a row's run (as a disc does).
+#[inline(always)]
+fn all_reached(cov: &[f32]) -> bool {
+    cov.iter().all(|&c| c > 0.0)
+}
+
+/// Writes `new` into `plane` from texel `start` where `cov` reached (`all`: everywhere, a
+/// plain copy; else chosen texel by texel, without a branch). A uniform plane those values
+/// leave as it is stays uniform: where a stroke has saturated, its dabs do not expand a tile
+/// only for it to be compacted again.
+#[inline(always)]
+fn write_row<T: Copy + PartialEq>(
+    plane: &mut Plane<T>,
+    start: usize,
+    new: &[T],
+    cov: &[f32],
+    all: bool,
+) {
+    if let Plane::Uniform(u) = plane
+        && new.iter().zip(cov).all(|(v, &c)| v == u || c <= 0.0)
+    {
+        return;
+    }
+    let plane = &mut plane.data_mut()[start..start + new.len()];
+    if all {
+        plane.copy_from_slice(new);
+    } else {
+        for ((p, &new), &c) in plane.iter_mut().zip(new).zip(cov) {
+            *p = if c > 0.0 { new } else { *p };
         }
     }
 }
@@ -241,5 +254,24 @@ pub(super) fn erase_channel(
         } else {
             plane[i]
         };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_row_that_leaves_a_uniform_plane_as_it_is_does_not_expand_it() {
+        let cov = [1.0, 0.0, 0.5];
+        let mut plane = Plane::Uniform(7_u16);
+        // Where the dab reached, the values are the plane's; where it did not, they are not read.
+        write_row(&mut plane, 10, &[7, 9, 7], &cov, false);
+        assert_eq!(plane, Plane::Uniform(7));
+        write_row(&mut plane, 10, &[7, 9, 8], &cov, false);
+        let Plane::Data(d) = &plane else {
+            panic!("a new value expands the plane");
+        };
+        assert_eq!((d[9], d[10], d[11], d[12], d[13]), (7, 7, 7, 8, 7));
     }
 }
