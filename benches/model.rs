@@ -424,6 +424,8 @@ fn layer_dabs(c: &mut Criterion) {
         doc.apply(Command::SelectPath(vec![layer])).expect("select");
         let mut k = 0u32;
         let mut version = doc.maps().version();
+        // The k_a of the dirty tiles, kept from dab to dab as a consumer would.
+        let mut ka = Vec::new();
         group.bench_function(name, |b| {
             b.iter(|| {
                 if k.is_multiple_of(kapaint::report::typical::STROKE_PATH_POINTS) {
@@ -439,9 +441,13 @@ fn layer_dabs(c: &mut Criterion) {
                 .expect("dab");
                 let dirty = doc.maps().tiles_changed_since(version);
                 version = doc.maps().version();
-                doc.maps()
-                    .derive_ka_tiles(ShadingModel::Phong, AmbientApprox::Fast, &dirty)
-                    .len()
+                doc.maps().derive_ka_tiles_into(
+                    ShadingModel::Phong,
+                    AmbientApprox::Fast,
+                    &dirty,
+                    &mut ka,
+                );
+                ka.len()
             });
         });
     }

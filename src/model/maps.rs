@@ -183,20 +183,21 @@ impl MaterialMaps {
 
     /// Edits tiles `ids` (sorted ascending, without duplicates) in parallel: `edit(k, tile)`
     /// gets the `k`-th tile's slot, changes it copy-on-write ([`Arc::make_mut`]) or not at all,
-    /// and returns the channels it changed; only those versions move. Returns them, per tile.
-    pub fn edit_tiles_par(
+    /// and returns the channels it changed (with anything else it has to say); only those
+    /// versions move. Returns what each returned.
+    pub fn edit_tiles_par<X: Send>(
         &mut self,
         ids: &[TileId],
-        edit: impl Fn(usize, &mut Arc<Tile>) -> Channels + Sync,
-    ) -> Vec<Channels> {
-        let changed: Vec<Channels> = super::tile::select_mut(&mut self.tiles, ids)
+        edit: impl Fn(usize, &mut Arc<Tile>) -> (Channels, X) + Sync,
+    ) -> Vec<(Channels, X)> {
+        let changed: Vec<(Channels, X)> = super::tile::select_mut(&mut self.tiles, ids)
             .into_par_iter()
             .enumerate()
             .map(|(k, tile)| edit(k, tile))
             .collect();
-        for (&id, &c) in ids.iter().zip(&changed) {
+        for (&id, (c, _)) in ids.iter().zip(&changed) {
             if !c.is_empty() {
-                self.touch(id, c);
+                self.touch(id, *c);
             }
         }
         changed
@@ -337,23 +338,30 @@ impl MaterialMaps {
         )
     }
 
-    /// Derives `k_a` for the given tiles: per tile, `TILE_TEXELS` values in row-major tile
-    /// order (texels beyond the map edge included, they are well defined). Never stored.
-    pub fn derive_ka_tiles(
+    /// Derives `k_a` for the given tiles into `out`: per tile of `ids` in turn, `TILE_TEXELS`
+    /// values in row-major tile order (texels beyond the map edge included, they are well
+    /// defined). Never stored. `out` is resized to fit and its old values overwritten: a
+    /// caller that derives after every dab keeps one buffer, and no memory is touched for the
+    /// first time on the way (fresh pages cost more than the derive itself).
+    pub fn derive_ka_tiles_into(
         &self,
         model: ShadingModel,
         approx: AmbientApprox,
         ids: &[TileId],
-    ) -> Vec<(TileId, Vec<Vec3>)> {
+        out: &mut Vec<Vec3>,
+    ) {
         let lut = chi_lut(model, approx);
         let diffuse = diffuse_factor(approx);
-        ids.par_iter()
-            .map(|&id| {
-                let mut out = vec![Vec3::ZERO; TILE_TEXELS];
-                crate::model::simd::vectorized(DeriveTile(&self.tiles[id], lut, diffuse, &mut out));
-                (id, out)
-            })
-            .collect()
+        let len = ids.len() * TILE_TEXELS;
+        if out.len() < len {
+            out.resize(len, Vec3::ZERO);
+        }
+        out.truncate(len);
+        out.par_chunks_mut(TILE_TEXELS)
+            .zip(ids)
+            .for_each(|(out, &id)| {
+                crate::model::simd::vectorized(DeriveTile(&self.tiles[id], lut, diffuse, out));
+            });
     }
 
     /// Derives `k_a` for the whole map into `out` (row-major, `width * height` values), in

@@ -127,31 +127,34 @@ impl Compositor {
         if self.signatures.len() != count {
             self.signatures = vec![0; count];
         }
-        // Signatures first (a few dozen tiles: not worth other threads), then the stale
-        // regions recomposited in parallel straight into the maps' tiles.
-        let stale: Vec<(usize, u64, &TileSpans)> = regions
-            .iter()
-            .map(|(id, spans)| (*id, signature(stack, *id), spans))
-            .filter(|&(id, s, _)| self.signatures[id] != s)
-            .collect();
-        let ids: Vec<usize> = stale.iter().map(|r| r.0).collect();
-        let changed = maps.edit_tiles_par(&ids, |k, tile| {
-            let (id, _, spans) = stale[k];
-            vectorized(Recomposite {
+        // Each region's signature is taken in the same parallel pass that recomposites it
+        // where it changed (no serial stretch for the other threads to fall asleep in).
+        let ids: Vec<usize> = regions.iter().map(|r| r.0).collect();
+        let signatures = &self.signatures;
+        let results = maps.edit_tiles_par(&ids, |k, tile| {
+            let (id, spans) = (regions[k].0, &regions[k].1);
+            let s = signature(stack, id);
+            if signatures[id] == s {
+                return (Channels::NONE, None);
+            }
+            let changed = vectorized(Recomposite {
                 stack,
                 id,
                 spans,
                 tile,
-            })
+            });
+            (changed, Some(s))
         });
-        for &(id, s, _) in &stale {
-            self.signatures[id] = s;
+        let mut written = Vec::new();
+        for (id, (changed, s)) in ids.into_iter().zip(results) {
+            if let Some(s) = s {
+                self.signatures[id] = s;
+            }
+            if !changed.is_empty() {
+                written.push(id);
+            }
         }
-        ids.into_iter()
-            .zip(changed)
-            .filter(|(_, c)| !c.is_empty())
-            .map(|(id, _)| id)
-            .collect()
+        written
     }
 
     /// Puts a recomposited tile in place if it differs; whether it did.
