@@ -28,7 +28,12 @@ fn kib_field(path: &str, name: &str) -> Option<u64> {
 /// # Errors
 /// A sentence saying what needs how much, and how much there is.
 pub fn check_fits(what: &str, bytes: u64) -> Result<(), String> {
-    match available_bytes() {
+    fits_in(what, bytes, available_bytes())
+}
+
+/// [`check_fits`] against `available` bytes (`None`: not known, so it fits).
+fn fits_in(what: &str, bytes: u64, available: Option<u64>) -> Result<(), String> {
+    match available {
         Some(available) if bytes > available => Err(format!(
             "{what} needs about {} of memory, and {} is available",
             human(bytes),
@@ -51,6 +56,17 @@ pub fn human(bytes: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn what_does_not_fit_is_refused_with_both_sizes() {
+        let e = fits_in("--size 9000", 3_000_000_000, Some(2_000_000_000)).unwrap_err();
+        assert_eq!(
+            e,
+            "--size 9000 needs about 3.0 GB of memory, and 2.0 GB is available"
+        );
+        assert!(fits_in("x", 2_000_000_000, Some(2_000_000_000)).is_ok());
+        assert!(fits_in("x", u64::MAX, None).is_ok());
+    }
 
     #[test]
     fn this_process_is_resident() {

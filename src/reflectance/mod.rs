@@ -12,6 +12,7 @@
 //!
 //! So every input gives a finite `k_a` in `[0, 2/pi + 1]`, never NaN and never a panic.
 
+pub mod cook_torrance;
 pub mod equivalent;
 pub mod exact;
 pub mod fast;

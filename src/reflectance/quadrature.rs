@@ -77,32 +77,64 @@ impl TanhSinh {
     /// Integrates `f` over `[a, b]`. Nodes that round onto an end point are skipped, so `f` is
     /// never called exactly at `a` or `b` (where it may be singular).
     pub fn integrate(&self, a: f64, b: f64, mut f: impl FnMut(f64) -> f64) -> f64 {
+        let [v] = self.integrate_n(a, b, |x| [f(x)]);
+        v
+    }
+
+    /// [`Self::integrate`] of `K` integrands at once, evaluated at the same nodes (for
+    /// integrands that share most of their work).
+    pub fn integrate_n<const K: usize>(
+        &self,
+        a: f64,
+        b: f64,
+        mut f: impl FnMut(f64) -> [f64; K],
+    ) -> [f64; K] {
+        let mut sum = [0.0; K];
         if b <= a {
-            return 0.0;
+            return sum;
         }
+        let mut add = |w: f64, v: [f64; K]| {
+            for (s, v) in sum.iter_mut().zip(v) {
+                *s += w * v;
+            }
+        };
         let half = 0.5 * (b - a);
         let mid = a + half;
-        let mut sum = self.centre_weight * f(mid);
+        add(self.centre_weight, f(mid));
         for node in &self.nodes {
             let offset = half * node.one_minus_x;
             let right = b - offset;
             let left = a + offset;
             if right < b {
-                sum += node.weight * f(right);
+                add(node.weight, f(right));
             }
             if left > a {
-                sum += node.weight * f(left);
+                add(node.weight, f(left));
             }
         }
-        sum * half
+        sum.map(|v| v * half)
     }
 
     /// Integrates `f` over consecutive intervals between sorted break points.
     pub fn integrate_pieces(&self, breaks: &[f64], mut f: impl FnMut(f64) -> f64) -> f64 {
-        breaks
-            .windows(2)
-            .map(|w| self.integrate(w[0], w[1], &mut f))
-            .sum()
+        let [v] = self.integrate_pieces_n(breaks, |x| [f(x)]);
+        v
+    }
+
+    /// [`Self::integrate_pieces`] of `K` integrands at once.
+    pub fn integrate_pieces_n<const K: usize>(
+        &self,
+        breaks: &[f64],
+        mut f: impl FnMut(f64) -> [f64; K],
+    ) -> [f64; K] {
+        let mut sum = [0.0; K];
+        for w in breaks.windows(2) {
+            let v = self.integrate_n(w[0], w[1], &mut f);
+            for (s, v) in sum.iter_mut().zip(v) {
+                *s += v;
+            }
+        }
+        sum
     }
 }
 
@@ -110,6 +142,16 @@ impl TanhSinh {
     /// [`Self::integrate_pieces`] with the integrand evaluated in parallel. The terms are
     /// summed in a fixed order afterwards, so the result does not depend on the thread count.
     pub fn integrate_pieces_par(&self, breaks: &[f64], f: impl Fn(f64) -> f64 + Sync) -> f64 {
+        let [v] = self.integrate_pieces_par_n(breaks, |x| [f(x)]);
+        v
+    }
+
+    /// [`Self::integrate_pieces_par`] of `K` integrands at once.
+    pub fn integrate_pieces_par_n<const K: usize>(
+        &self,
+        breaks: &[f64],
+        f: impl Fn(f64) -> [f64; K] + Sync,
+    ) -> [f64; K] {
         use rayon::prelude::*;
         let mut terms: Vec<(f64, f64)> = Vec::new();
         for w in breaks.windows(2) {
@@ -129,8 +171,17 @@ impl TanhSinh {
                 }
             }
         }
-        let values: Vec<f64> = terms.par_iter().map(|&(x, w)| w * f(x)).collect();
-        values.iter().sum()
+        let values: Vec<[f64; K]> = terms
+            .par_iter()
+            .map(|&(x, w)| f(x).map(|v| w * v))
+            .collect();
+        let mut sum = [0.0; K];
+        for v in values {
+            for (s, v) in sum.iter_mut().zip(v) {
+                *s += v;
+            }
+        }
+        sum
     }
 }
 
