@@ -214,33 +214,7 @@ fn over_t(rule: &TanhSinh, a: f64, p: f64) -> [f64; 2] {
 /// ([`rho_s_parts`]) with their standard errors: the mean over `samples` uniform points of
 /// the box. Shares no code with [`chi_exact`]'s reduction.
 pub fn chi_monte_carlo(n: f64, samples: u64, seed: u64) -> [(f64, f64); 2] {
-    let mut state = seed;
-    let mut next = move || {
-        // SplitMix64, mapped to [0, 1).
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    };
-    let (mut sum, mut sum_sq) = ([0.0; 2], [0.0; 2]);
-    for _ in 0..samples {
-        let t = next() * FRAC_PI_2;
-        let g = (next() - 0.5) * PI;
-        let p = (next() - 0.5) * PI;
-        let v = rho_s_parts(n, t, g, p);
-        for k in 0..2 {
-            sum[k] += v[k];
-            sum_sq[k] += v[k] * v[k];
-        }
-    }
-    let count = samples as f64;
-    std::array::from_fn(|k| {
-        let mean = sum[k] / count;
-        let var = (sum_sq[k] / count - mean * mean).max(0.0);
-        (mean, (var / count).sqrt())
-    })
+    super::geometry::box_average(samples, seed, |t, g, p| rho_s_parts(n, t, g, p))
 }
 
 /// `chi_1(0) + chi_0(0) = 1 / (4 pi)` (see the module documentation).

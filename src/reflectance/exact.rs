@@ -237,29 +237,10 @@ fn blinn_g_window(n: f64, a: f64, b: f64, e: f64, sin2: impl Fn(f64) -> f64) -> 
 /// [`super::geometry`]: the mean of the lobe over `samples` uniform points of the box, with its
 /// standard error. An independent check of [`chi_exact`] that shares no code with it.
 pub fn chi_monte_carlo(model: ShadingModel, n: f64, samples: u64, seed: u64) -> (f64, f64) {
-    let mut state = seed;
-    let mut next = move || {
-        // SplitMix64, mapped to [0, 1).
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    };
-    let (mut sum, mut sum_sq) = (0.0, 0.0);
-    for _ in 0..samples {
-        let t = next() * FRAC_PI_2;
-        let g = (next() - 0.5) * PI;
-        let p = (next() - 0.5) * PI;
-        let v = super::geometry::rho_s(model, n, t, g, p);
-        sum += v;
-        sum_sq += v * v;
-    }
-    let count = samples as f64;
-    let mean = sum / count;
-    let var = (sum_sq / count - mean * mean).max(0.0);
-    (mean, (var / count).sqrt())
+    let [estimate] = super::geometry::box_average(samples, seed, |t, g, p| {
+        [super::geometry::rho_s(model, n, t, g, p)]
+    });
+    estimate
 }
 
 /// Leading slope of the large-`n` law `chi(n) ~ (A ln n + B) / n`, derived by Laplace's
