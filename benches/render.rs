@@ -187,12 +187,12 @@ fn frames(c: &mut Criterion) {
         depth: &depth,
         mesh: &buffers,
     };
-    let split = Layout::Split(w / 2).parts(phong, blinn, (w, h));
+    let split = Layout::Split(w / 2).parts([phong, blinn, phong], (w, h));
     group.bench_function("compare_split_painted_maps", |b| {
         b.iter(|| frame.draw(&preview, &painted_maps, &s, &split));
     });
     // Side by side: two whole pictures, each half the width.
-    let side = Layout::SideBySide.parts(phong, blinn, (w, h));
+    let side = Layout::SideBySide.parts([phong, blinn, phong], (w, h));
     group.bench_function("compare_side_by_side_painted_maps", |b| {
         b.iter(|| frame.draw(&preview, &painted_maps, &s, &side));
     });

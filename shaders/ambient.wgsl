@@ -2,7 +2,8 @@
 // Do not edit: run `cargo run --release --example gen_wgsl`.
 //
 // k_a = (2/pi) k_d + k_s chi(n): eq. (6) of the paper, with chi by eq. (8)/(11) as
-// printed, with the corrected Blinn exponent, or by kapaint's Fast approximation.
+// printed, with the corrected Blinn exponent, or by kapaint's Fast approximation;
+// k_a = (2/pi) k_d + k_s chi_1(n) + chi_0(n) for Cook-Torrance (GGX).
 
 #include "ids.wgsl"
 
@@ -10,6 +11,8 @@ const TWO_OVER_PI: f32 = 6.3661975e-1f;
 const PAPER_TWO_OVER_PI: f32 = 6.37e-1f;
 const FAST_DEGREE: u32 = 5u;
 const FAST_TAIL_START_X: f32 = 3.2768e4f;
+const CT_DEGREE: u32 = 5u;
+const CT_N_MAX: f32 = 1e6f;
 const F32_MAX: f32 = 3.40282347e38f;
 
 const PHONG_PAPER: vec3<f32> = vec3<f32>(9.7e-1f, 1.3e0f, -8.73e-1f);
@@ -205,6 +208,249 @@ var<private> BLINN_FAST: array<f32, 90> = array<f32, 90>(
 );
 const BLINN_TAIL: vec3<f32> = vec3<f32>(8.1056947e-1f, 1.0296633e0f, 5.307853e-2f);
 
+var<private> CT_FAST: array<f32, 240> = array<f32, 240>(
+    8.923687e-2f,
+    6.9671613e-4f,
+    9.347607e-3f,
+    1.05163956e-4f,
+    -8.1656425e-4f,
+    -3.2748028e-6f,
+    7.536604e-5f,
+    1.7608576e-7f,
+    -7.245273e-6f,
+    -1.4181799e-8f,
+    7.0003193e-7f,
+    1.5259491e-9f,
+    1.1151713e-1f,
+    9.86627e-4f,
+    1.18378475e-2f,
+    1.7836812e-4f,
+    -1.579533e-3f,
+    -8.739757e-6f,
+    2.243449e-4f,
+    6.718622e-7f,
+    -3.3721557e-5f,
+    -6.9830435e-8f,
+    4.947775e-6f,
+    8.659675e-9f,
+    1.3704129e-1f,
+    1.4571544e-3f,
+    1.23297395e-2f,
+    2.7800494e-4f,
+    -2.2003513e-3f,
+    -1.9887626e-5f,
+    4.2991224e-4f,
+    2.0751072e-6f,
+    -9.185674e-5f,
+    -2.790831e-7f,
+    1.8404042e-5f,
+    4.1580993e-8f,
+    1.614933e-1f,
+    2.1530301e-3f,
+    1.0998772e-2f,
+    3.919517e-4f,
+    -2.2464949e-3f,
+    -3.7939033e-5f,
+    5.366468e-4f,
+    5.036611e-6f,
+    -1.4767966e-4f,
+    -8.439125e-7f,
+    3.6576486e-5f,
+    1.496409e-7f,
+    1.8259189e-1f,
+    3.0807683e-3f,
+    9.368781e-3f,
+    4.964965e-4f,
+    -1.8701695e-3f,
+    -6.085694e-5f,
+    4.8383733e-4f,
+    9.706976e-6f,
+    -1.5456337e-4f,
+    -1.9311938e-6f,
+    4.341585e-5f,
+    3.915917e-7f,
+    2.0101522e-1f,
+    4.193245e-3f,
+    8.506049e-3f,
+    5.6585675e-4f,
+    -1.5069874e-3f,
+    -8.328568e-5f,
+    3.7718142e-4f,
+    1.5278863e-5f,
+    -1.2498611e-4f,
+    -3.47082e-6f,
+    3.6833433e-5f,
+    7.7751525e-7f,
+    2.1853197e-1f,
+    5.398407e-3f,
+    8.446297e-3f,
+    5.843409e-4f,
+    -1.3484384e-3f,
+    -9.909147e-5f,
+    3.0924348e-4f,
+    2.0241507e-5f,
+    -9.673091e-5f,
+    -5.100012e-6f,
+    2.7936661e-5f,
+    1.2315921e-6f,
+    2.3643394e-1f,
+    6.5881726e-3f,
+    8.811595e-3f,
+    5.524423e-4f,
+    -1.3527647e-3f,
+    -1.04530365e-4f,
+    2.9167873e-4f,
+    2.3203667e-5f,
+    -8.445153e-5f,
+    -6.3439084e-6f,
+    2.3175728e-5f,
+    1.6228123e-6f,
+    2.552512e-1f,
+    7.6703415e-3f,
+    9.288262e-3f,
+    4.8382307e-4f,
+    -1.4301864e-3f,
+    -9.963953e-5f,
+    3.0289343e-4f,
+    2.3591192e-5f,
+    -8.433022e-5f,
+    -6.8802806e-6f,
+    2.2360664e-5f,
+    1.8402459e-6f,
+    2.7502877e-1f,
+    8.587897e-3f,
+    9.7201085e-3f,
+    3.9722747e-4f,
+    -1.5217065e-3f,
+    -8.7334825e-5f,
+    3.2369414e-4f,
+    2.1738866e-5f,
+    -8.9550704e-5f,
+    -6.6720904e-6f,
+    2.3521623e-5f,
+    1.8473943e-6f,
+    2.9560867e-1f,
+    9.321467e-3f,
+    1.0057137e-2f,
+    3.0918577e-4f,
+    -1.6014553e-3f,
+    -7.148796e-5f,
+    3.441631e-4f,
+    1.8498149e-5f,
+    -9.582892e-5f,
+    -5.91044e-6f,
+    2.5232752e-5f,
+    1.6810852e-6f,
+    3.1678867e-1f,
+    9.880342e-3f,
+    1.0299476e-2f,
+    2.3047558e-4f,
+    -1.662412e-3f,
+    -5.538255e-5f,
+    3.6073342e-4f,
+    1.4766768e-5f,
+    -1.0132106e-4f,
+    -4.869446e-6f,
+    2.682379e-5f,
+    1.414182e-6f,
+    3.3838895e-1f,
+    1.0289934e-2f,
+    1.0464792e-2f,
+    1.6600557e-4f,
+    -1.7056804e-3f,
+    -4.10714e-5f,
+    3.7290246e-4f,
+    1.1205792e-5f,
+    -1.0552591e-4f,
+    -3.7871805e-6f,
+    2.8078573e-5f,
+    1.1177506e-6f,
+    3.6027068e-1f,
+    1.05811e-2f,
+    1.0573403e-2f,
+    1.164302e-4f,
+    -1.7349335e-3f,
+    -2.9436826e-5f,
+    3.81322e-4f,
+    8.172709e-6f,
+    -1.0851357e-4f,
+    -2.8149823e-6f,
+    2.8986215e-5f,
+    8.411687e-7f,
+    3.8233474e-1f,
+    1.0783305e-2f,
+    1.0642726e-2f,
+    8.0046026e-5f,
+    -1.7540216e-3f,
+    -2.0555488e-5f,
+    3.8691107e-4f,
+    5.78121e-6f,
+    -1.1053482e-4f,
+    -2.0201014e-6f,
+    2.960786e-5f,
+    6.093392e-7f,
+    4.045139e-1f,
+    1.0921335e-2f,
+    1.0685951e-2f,
+    5.4252178e-5f,
+    -1.7661377e-3f,
+    -1.4079923e-5f,
+    3.905069e-4f,
+    3.9967513e-6f,
+    -1.1185435e-4f,
+    -1.4114582e-6f,
+    3.001745e-5f,
+    4.287257e-7f,
+    4.2676416e-1f,
+    1.1014441e-2f,
+    1.0712387e-2f,
+    3.642524e-5f,
+    -1.7736573e-3f,
+    -9.514759e-6f,
+    3.927634e-4f,
+    2.7176995e-6f,
+    -1.1269216e-4f,
+    -9.669645e-7f,
+    3.0279409e-5f,
+    2.9517867e-7f,
+    4.4905758e-1f,
+    1.1076778e-2f,
+    1.0728289e-2f,
+    2.4325793e-5f,
+    -1.7782374e-3f,
+    -6.3740476e-6f,
+    3.941505e-4f,
+    1.8273713e-6f,
+    -1.1321223e-4f,
+    -6.533623e-7f,
+    3.0443005e-5f,
+    2.0011488e-7f,
+    4.7137678e-1f,
+    1.111836e-2f,
+    1.0737721e-2f,
+    1.6213344e-5f,
+    -1.7809827e-3f,
+    -4.2501006e-6f,
+    3.949885e-4f,
+    1.2204692e-6f,
+    -1.1352902e-4f,
+    -4.3755819e-7f,
+    3.054315e-5f,
+    1.3428387e-7f,
+    4.9371117e-1f,
+    1.1146078e-2f,
+    1.07432455e-2f,
+    1.08140175e-5f,
+    -1.7826058e-3f,
+    -2.8299369e-6f,
+    3.9548732e-4f,
+    8.126538e-7f,
+    -1.1371892e-4f,
+    -2.9162942e-7f,
+    3.0603438e-5f,
+    8.95778e-8f
+);
+
 // NaN and negative n -> 0, +inf -> the largest float; decided on the bits, since a
 // compiler may assume floats are never NaN.
 fn sanitize_n(n: f32) -> f32 {
@@ -251,6 +497,21 @@ fn chi_fast(model: u32, n: f32) -> f32 {
     return g / x;
 }
 
+// [chi_1(n), chi_0(n)] of Cook-Torrance for a sanitized n: a vec2 Horner chain per octave.
+fn chi_cook_torrance(n: f32) -> vec2<f32> {
+    let x = min(n, CT_N_MAX) + 1.0;
+    let bits = bitcast<u32>(x);
+    let octave = (bits >> 23u) - 127u;
+    let s = 2.0 * bitcast<f32>((bits & 0x007fffffu) | 0x3f800000u) - 3.0;
+    let base = octave * (CT_DEGREE + 1u);
+    var g = vec2<f32>(0.0);
+    for (var k = 0u; k <= CT_DEGREE; k++) {
+        let index = 2u * (base + CT_DEGREE - k);
+        g = g * s + vec2<f32>(CT_FAST[index], CT_FAST[index + 1u]);
+    }
+    return g;
+}
+
 fn paper_constants(model: u32, approx: u32) -> vec3<f32> {
     if model == MODEL_PHONG {
         if approx == APPROX_PAPER_CORRECTED {
@@ -264,9 +525,12 @@ fn paper_constants(model: u32, approx: u32) -> vec3<f32> {
     return BLINN_PAPER;
 }
 
-// chi(n), the specular part of k_a per unit k_s.
+// chi(n), the specular part of k_a per unit k_s (chi_1 for Cook-Torrance).
 fn chi(model: u32, approx: u32, n_raw: f32) -> f32 {
     let n = sanitize_n(n_raw);
+    if model == MODEL_COOK_TORRANCE {
+        return chi_cook_torrance(n).x;
+    }
     if approx == APPROX_FAST {
         return chi_fast(model, n);
     }
@@ -275,8 +539,13 @@ fn chi(model: u32, approx: u32, n_raw: f32) -> f32 {
     return abc.x * pow(n + abc.y, abc.z);
 }
 
-// k_a = (2/pi) k_d + k_s chi(n) (eq. 6; 0.637 for the paper's forms).
+// k_a = (2/pi) k_d + k_s chi(n) (eq. 6; 0.637 for the paper's forms), and
+// (2/pi) k_d + k_s chi_1(n) + chi_0(n) for Cook-Torrance (which has no paper form).
 fn ambient_ka(model: u32, approx: u32, kd: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {
+    if model == MODEL_COOK_TORRANCE {
+        let parts = chi_cook_torrance(sanitize_n(n));
+        return TWO_OVER_PI * sanitize_k(kd) + sanitize_k(ks) * parts.x + parts.y;
+    }
     var diffuse = TWO_OVER_PI;
     if approx != APPROX_FAST {
         diffuse = PAPER_TWO_OVER_PI;

@@ -3,7 +3,8 @@
 // (never stored):
 //
 //   I = I_a k_a + I_l [ k_d max(0, N.L) + k_s rho_s ]
-//   rho_s = max(0, R.V)^n (Phong) or max(0, N.H)^n (Blinn-Phong), zero where N.L <= 0.
+//   rho_s = max(0, R.V)^n (Phong) or max(0, N.H)^n (Blinn-Phong), zero where N.L <= 0;
+//   for Cook-Torrance, I_l rho_s with rho_s = D G2 F / (4 N.V) and k_s as Fresnel's F0.
 //
 // Pipeline-overridable constants choose the model, the approximation and the view, and say
 // what the scene doesn't need: a uniform map is a uniform value (no texture fetch), k_s == 0
@@ -91,7 +92,9 @@ fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
         return vec4<f32>(finite_or_zero(diffuse), 1.0);
     }
     var specular = vec3<f32>(0.0);
-    if HAS_SPECULAR && n_dot_l > 0.0 {
+    if MODEL == MODEL_COOK_TORRANCE {
+        specular = frame.light_intensity * cook_torrance_specular(normal, l, v, ks, n);
+    } else if HAS_SPECULAR && n_dot_l > 0.0 {
         var cosine = 0.0;
         if MODEL == MODEL_PHONG {
             let r = 2.0 * n_dot_l * normal - l;

@@ -230,6 +230,95 @@ fn accuracy_prints_a_markdown_table_for_every_model_and_method() {
     assert_eq!(rows, 2 * 3 * 2, "{text}");
     assert!(text.contains("| blinn | paper-corrected | [1, 200] |"));
     assert!(text.contains("minimax (our integrator)"));
+    // Cook-Torrance: both parts, by kapaint's fit and Karis' two readings, on both ranges.
+    let ct = text
+        .lines()
+        .filter(|l| l.starts_with("| chi1") || l.starts_with("| chi0"))
+        .count();
+    assert_eq!(ct, 2 * 3 * 2, "{text}");
+    assert!(text.contains("| chi0 | karis (view-averaged) | [0, 16384] |"));
+}
+
+#[test]
+fn cook_torrance_chi_prints_both_parts_and_refuses_the_paper_methods() {
+    let o = kapaint(&[
+        "chi",
+        "--model",
+        "cook-torrance",
+        "--method",
+        "exact",
+        "0",
+        "16384",
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("n,chi1,chi0"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().expect("number")).collect())
+        .collect();
+    // chi_1(0) + chi_0(0) = 1/(4 pi), derived in reflectance::cook_torrance.
+    assert_eq!(rows[0][0], 0.0);
+    let sum = rows[0][1] + rows[0][2];
+    assert!(
+        (sum - 1.0 / (4.0 * std::f64::consts::PI)).abs() < 1e-12,
+        "{text}"
+    );
+    assert!((rows[1][1] - 0.369_412_889_873_204).abs() < 1e-12, "{text}");
+    // 17 significant digits in both columns, as for the other models.
+    for line in text.lines().skip(1) {
+        for value in line.split(',').skip(1) {
+            let mantissa = value.split('e').next().expect("mantissa");
+            assert_eq!(
+                mantissa.chars().filter(char::is_ascii_digit).count(),
+                17,
+                "{value}"
+            );
+        }
+    }
+    let fast = stdout(&kapaint(&[
+        "chi",
+        "--model",
+        "cook-torrance",
+        "--method",
+        "fast",
+        "16384",
+    ]));
+    let fast1: f64 = fast
+        .lines()
+        .nth(1)
+        .and_then(|l| l.split(',').nth(1))
+        .and_then(|v| v.parse().ok())
+        .expect("value");
+    assert!((fast1 / rows[1][1] - 1.0).abs() < 2e-5, "{fast}");
+    assert_usage_error(
+        &kapaint(&["chi", "--model", "cook-torrance", "--method", "paper", "1"]),
+        "no approximation for Cook-Torrance",
+    );
+    // k_a = (2/pi) k_d + k_s chi_1 + chi_0 per channel; chi_0 even where k_s = 0.
+    let ka = stdout(&kapaint(&[
+        "ka",
+        "--model",
+        "cook-torrance",
+        "--method",
+        "exact",
+        "--kd",
+        "0,0,0",
+        "--ks",
+        "0,0,1",
+        "--n",
+        "0",
+    ]));
+    let v: Vec<f64> = ka
+        .trim()
+        .split(',')
+        .map(|x| x.parse().expect("number"))
+        .collect();
+    assert!(
+        (v[2] - 1.0 / (4.0 * std::f64::consts::PI)).abs() < 1e-12,
+        "{ka}"
+    );
+    assert!(v[0] > 5e-4 && v[0] == v[1], "{ka}");
 }
 
 #[test]
@@ -252,8 +341,10 @@ fn bench_writes_csv_and_a_decodable_plot() {
             .count(),
         6
     );
+    assert!(stdout(&o).contains("| cook-torrance | fast |"));
+    assert!(stdout(&o).contains("| cook-torrance | karis |"));
     let csv = std::fs::read_to_string(dir.join("bench.csv")).expect("csv written");
-    assert_eq!(csv.lines().count(), 7);
+    assert_eq!(csv.lines().count(), 9);
     assert!(csv.starts_with("model,method,ns_per_texel_1t"));
     let png = image::open(dir.join("bench.png")).expect("plot decodes");
     assert!(png.width() > 100 && png.height() > 100);

@@ -519,6 +519,7 @@ fn snippets_validate_for_every_n_storage_model_and_approximation() {
                 let expected_model = match model {
                     reflectance::ShadingModel::Phong => "MODEL_PHONG",
                     reflectance::ShadingModel::BlinnPhong => "MODEL_BLINN",
+                    reflectance::ShadingModel::CookTorrance => "MODEL_COOK_TORRANCE",
                 };
                 assert!(
                     glsl.contains(&format!("const uint KAPAINT_APPROX = {expected_approx};"))

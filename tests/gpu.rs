@@ -14,6 +14,7 @@ mod common;
 
 use common::gpu;
 use glam::{Vec2, Vec3};
+use kapaint::gpu::preview::COMPARED_MODELS;
 use kapaint::gpu::{Gpu, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::mesh::{self, pick::Bvh};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8};
@@ -44,7 +45,7 @@ fn shader_chi_equals_the_rust_fast_chi() {
         .map(|i| (16385.0_f32.ln() * i as f32 / 2000.0).exp() - 1.0)
         .collect();
     n.extend([0.0, 1e-6, 0.5, 1.0, 32766.0, 32768.0, 1e5, 1e9, f32::MAX]);
-    for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+    for model in ShadingModel::ALL {
         let got =
             kapaint::gpu::check::chi_on_gpu(&gpu, model, AmbientApprox::Fast, &n).expect("compute");
         for (&n, &g) in n.iter().zip(&got) {
@@ -98,6 +99,14 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
             MaterialValue::new(Vec3::splat(0.5), Vec3::ZERO, 0.0),
             ShadingModel::Phong,
         ),
+        (
+            MaterialValue::new(Vec3::new(0.7, 0.2, 0.05), Vec3::new(0.04, 0.5, 0.95), 300.0),
+            ShadingModel::CookTorrance,
+        ),
+        (
+            MaterialValue::new(Vec3::splat(0.2), Vec3::ZERO, 0.0),
+            ShadingModel::CookTorrance,
+        ),
     ] {
         let maps = MaterialMaps::new(32, 32, value).expect("maps");
         let textures = MapTextures::new(&gpu, &maps).expect("map textures");
@@ -113,6 +122,7 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
                         size: (96, 96),
                         linear: true,
                         layout: Layout::Single,
+                        models: COMPARED_MODELS,
                     },
                 )
                 .expect("render"),
@@ -134,6 +144,7 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
                         size: (16, 16),
                         linear: true,
                         layout: Layout::Single,
+                        models: COMPARED_MODELS,
                     },
                 )
                 .expect("render"),
@@ -158,6 +169,19 @@ fn ka_view_of_a_uniform_sphere_equals_the_cpu_ka() {
             covered > 96 * 96 / 4,
             "the sphere fills the frame: {covered}"
         );
+        if model == ShadingModel::CookTorrance {
+            // Against the exact integral: (2/pi) k_d + k_s chi_1(n) + chi_0(n), to 2e-4.
+            let [chi1, chi0] = reflectance::cook_torrance::chi_exact(f64::from(stored.n));
+            let exact = reflectance::TWO_OVER_PI * stored.kd.as_dvec3()
+                + stored.ks.as_dvec3() * chi1
+                + glam::DVec3::splat(chi0);
+            for p in pixels.chunks_exact(4).filter(|p| p[3] > 0.0) {
+                for c in 0..3 {
+                    let err = (f64::from(p[c]) - exact[c]).abs() / exact[c];
+                    assert!(err <= 2e-4, "{p:?} vs exact {exact}: {err:e}");
+                }
+            }
+        }
     }
 }
 
@@ -198,7 +222,7 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
     let textures = MapTextures::new(&gpu, &maps).expect("map textures");
     let preview = Preview::new(&gpu);
     let (w, h) = (192, 192);
-    for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+    for model in ShadingModel::ALL {
         let s = settings(model, ViewMode::Shaded, &sphere.positions);
         // The reference samples level 0 bilinearly; the GPU picks mip levels where the maps
         // are minified, i.e. towards the silhouette. Compare where the surface faces the
@@ -220,6 +244,7 @@ fn shaded_renders_match_the_cpu_reference_renderer() {
                     size: (w, h),
                     linear: false,
                     layout: Layout::Single,
+                    models: COMPARED_MODELS,
                 },
             )
             .expect("render")
@@ -310,6 +335,7 @@ fn split_and_side_by_side_compare_phong_left_and_blinn_right() {
                         size,
                         linear: true,
                         layout,
+                        models: COMPARED_MODELS,
                     },
                 )
                 .expect("render"),
@@ -355,6 +381,22 @@ fn split_and_side_by_side_compare_phong_left_and_blinn_right() {
             assert!(close, "pixel ({x}, {y}): {got:?} vs {want:?}");
         }
     }
+    // All three: thirds of equal width, the spare pixels between them.
+    let third = w / 3;
+    let three = render(ShadingModel::Phong, (w, h), Layout::ThreeWay);
+    let singles = ShadingModel::ALL.map(|m| render(m, (third, h), Layout::Single));
+    assert_ne!(singles[1], singles[2]);
+    for (i, single) in singles.iter().enumerate() {
+        let x0 = (w - third) * i as u32 / 2;
+        for y in 0..h {
+            for x in 0..third {
+                let got = &three[((y * w + x0 + x) * 4) as usize..][..4];
+                let want = &single[((y * third + x) * 4) as usize..][..4];
+                let close = got.iter().zip(want).all(|(a, b)| (a - b).abs() <= 1e-5);
+                assert!(close, "picture {i} pixel ({x}, {y}): {got:?} vs {want:?}");
+            }
+        }
+    }
 }
 
 #[test]
@@ -391,6 +433,7 @@ fn extreme_maps_shade_to_finite_colours() {
                                 size: (32, 32),
                                 linear: true,
                                 layout: Layout::Single,
+                                models: COMPARED_MODELS,
                             },
                         )
                         .expect("render"),
@@ -868,18 +911,20 @@ fn the_exported_glsl_snippet_decodes_like_the_cpu() {
     let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &codes, 512).expect("kernel");
     check_decoded_pairs(&got, &doc, &m);
 
-    // Every model and approximation (slots 3 model + approx), and the sanitizing of k_d and
-    // k_s (slot 6), over awkward values of n.
+    // Every model and approximation (slots 3 model + approx), Cook-Torrance's chi_0 alone
+    // (slot 9: k_d = k_s = 0), and the sanitizing of k_d and k_s (slot 10), over awkward values
+    // of n.
     let kernel = glsl_to_wgsl(&format!(
         "#version 450\n{snippet}\n{buffers}\
          void main() {{\n    uint i = gl_GlobalInvocationID.x;\n\
          if (i < uint(values.length())) {{\n\
          float v = values[i];\n\
-         for (uint model = 0u; model < 2u; model++) {{\n\
+         for (uint model = 0u; model < 3u; model++) {{\n\
          for (uint approx = 0u; approx < 3u; approx++) {{\n\
-         results[7u * i + 3u * model + approx] = ambient_ka(model, approx, vec3(0.3), vec3(0.5), v).x;\n\
+         results[11u * i + 3u * model + approx] = ambient_ka(model, approx, vec3(0.3), vec3(0.5), v).x;\n\
          }}\n}}\n\
-         results[7u * i + 6u] = kapaint_ka(vec3(v), vec3(1.0 - v), 10.0).x;\n    }}\n}}\n"
+         results[11u * i + 9u] = ambient_ka(MODEL_COOK_TORRANCE, APPROX_FAST, vec3(0.0), vec3(0.0), v).x;\n\
+         results[11u * i + 10u] = kapaint_ka(vec3(v), vec3(1.0 - v), 10.0).x;\n    }}\n}}\n"
     ));
     let mut values = vec![
         f32::NAN,
@@ -901,10 +946,13 @@ fn the_exported_glsl_snippet_decodes_like_the_cpu() {
         f32::MAX,
     ];
     values.extend((0..=300).map(|i| (1e6_f32.ln() * i as f32 / 300.0).exp() - 1.0));
-    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &values, 7 * values.len())
+    let got = kapaint::gpu::check::run_kernel(&gpu, &kernel, &[], &values, 11 * values.len())
         .expect("kernel");
     let close = |got: f32, want: f32| (got - want).abs() <= 1e-5 * want.abs();
-    for (&v, row) in values.iter().zip(got.chunks_exact(7)) {
+    for (&v, row) in values.iter().zip(got.chunks_exact(11)) {
+        let chi0 =
+            reflectance::chi_parts_f32(ShadingModel::CookTorrance, AmbientApprox::Fast, v)[1];
+        assert!(close(row[9], chi0), "chi_0({v}): {} vs {chi0}", row[9]);
         for (m, model) in ShadingModel::ALL.into_iter().enumerate() {
             for (a, approx) in AmbientApprox::ALL.into_iter().enumerate() {
                 let want = reflectance::ka(model, approx, Vec3::splat(0.3), Vec3::splat(0.5), v).x;
@@ -923,7 +971,7 @@ fn the_exported_glsl_snippet_decodes_like_the_cpu() {
             10.0,
         )
         .x;
-        assert!(close(row[6], want), "k_d = {v}: {} vs {want}", row[6]);
+        assert!(close(row[10], want), "k_d = {v}: {} vs {want}", row[10]);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -956,6 +1004,7 @@ fn difference_heatmap_on_the_gpu_matches_the_cpu_ramp() {
                     size: (w, h),
                     linear: true,
                     layout: Layout::Single,
+                    models: COMPARED_MODELS,
                 },
             )
             .expect("render")
@@ -1028,6 +1077,7 @@ fn what_does_not_fit_the_gpu_is_an_error_not_a_panic() {
         size,
         linear: true,
         layout: Layout::Single,
+        models: COMPARED_MODELS,
     };
     let rendered = preview.render_offscreen(
         &gpu,
@@ -1066,6 +1116,7 @@ fn a_lost_device_is_an_error_not_a_panic() {
         size: (32, 32),
         linear: false,
         layout: Layout::Single,
+        models: COMPARED_MODELS,
     };
     assert!(MapTextures::new(&gpu, &maps).is_err());
     assert!(MeshBuffers::new(&gpu, &sphere).is_err());

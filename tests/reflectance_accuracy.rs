@@ -14,7 +14,7 @@ fn samples(model: ShadingModel, lo: f64, hi: f64, count: usize) -> ExactSamples 
 
 #[test]
 fn fast_is_within_1e4_on_0_to_16384_for_both_models() {
-    for model in ShadingModel::ALL {
+    for model in ShadingModel::PAPER {
         // Points between the fit's interpolation nodes, where a polynomial's error peaks.
         let exact = samples(model, 0.0, 16384.0, 97);
         let stats = error_stats(AmbientApprox::Fast, &exact);
@@ -65,7 +65,7 @@ fn corrected_exponent_is_the_minimax_of_our_integrator() {
 
 #[test]
 fn fast_is_continuous_across_octaves_and_the_tail() {
-    for model in ShadingModel::ALL {
+    for model in ShadingModel::PAPER {
         for octave in 1..=fit::FIT_OCTAVES {
             let x = (1u64 << octave) as f32;
             let at = x - 1.0;
@@ -81,7 +81,8 @@ fn fast_is_continuous_across_octaves_and_the_tail() {
 
 #[test]
 fn chi_is_monotone_and_within_0_1() {
-    for model in ShadingModel::ALL {
+    // Cook-Torrance's chi_1 grows with n instead: tests/cook_torrance.rs.
+    for model in ShadingModel::PAPER {
         for approx in AmbientApprox::ALL {
             let mut last = chi_f32(model, approx, 0.0);
             assert!(last > 0.0 && last <= 1.0);
@@ -121,7 +122,7 @@ fn f32_and_f64_paths_agree() {
 #[test]
 fn exact_large_n_agrees_with_fast_tail() {
     // Above 16384 Fast switches to the derived log law; it stays close to exact.
-    for model in ShadingModel::ALL {
+    for model in ShadingModel::PAPER {
         for n in [40_000.0, 100_000.0, 1.0e6] {
             let exact = chi_exact(model, n);
             let fast = chi_f64(model, AmbientApprox::Fast, n);

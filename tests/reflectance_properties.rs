@@ -1,10 +1,20 @@
 //! Property tests over the whole `f32` range: every input gives a finite, documented output.
 
 use glam::Vec3;
-use kapaint::reflectance::{AmbientApprox, ShadingModel, chi_f32, chi_f64, ka};
+use kapaint::reflectance::{
+    AmbientApprox, ShadingModel, chi_f32, chi_f64, chi_parts_f32, chi_parts_f64, ka,
+};
 use proptest::prelude::*;
 
 fn any_model() -> impl Strategy<Value = ShadingModel> {
+    prop_oneof![
+        Just(ShadingModel::Phong),
+        Just(ShadingModel::BlinnPhong),
+        Just(ShadingModel::CookTorrance)
+    ]
+}
+
+fn paper_model() -> impl Strategy<Value = ShadingModel> {
     prop_oneof![Just(ShadingModel::Phong), Just(ShadingModel::BlinnPhong)]
 }
 
@@ -33,11 +43,27 @@ proptest! {
     }
 
     #[test]
-    fn chi_is_non_increasing(model in any_model(), approx in any_approx(), a in any_f32_bits(), b in any_f32_bits()) {
+    fn chi_is_non_increasing(model in paper_model(), approx in any_approx(), a in any_f32_bits(), b in any_f32_bits()) {
         let (lo, hi) = if a.max(0.0) <= b.max(0.0) { (a, b) } else { (b, a) };
         let (c_lo, c_hi) = (chi_f32(model, approx, lo), chi_f32(model, approx, hi));
         // Up to f32 rounding of nearly equal arguments.
         prop_assert!(c_hi <= c_lo * (1.0 + 4.0 * f32::EPSILON), "chi({lo}) = {c_lo} < chi({hi}) = {c_hi}");
+    }
+
+    #[test]
+    fn cook_torrance_parts_are_finite_bounded_and_non_decreasing(approx in any_approx(), a in any_f32_bits(), b in any_f32_bits()) {
+        let (lo, hi) = if a.max(0.0) <= b.max(0.0) { (a, b) } else { (b, a) };
+        let (p_lo, p_hi) = (
+            chi_parts_f32(ShadingModel::CookTorrance, approx, lo),
+            chi_parts_f32(ShadingModel::CookTorrance, approx, hi),
+        );
+        for (k, bound) in [(0, 0.52), (1, 0.0113)] {
+            prop_assert!(p_lo[k].is_finite() && p_lo[k] > 0.0 && p_lo[k] <= bound, "part {k} at {lo}: {p_lo:?}");
+            // Up to f32 rounding of nearly equal arguments.
+            prop_assert!(p_hi[k] >= p_lo[k] * (1.0 - 4.0 * f32::EPSILON), "part {k}: {lo} -> {p_lo:?}, {hi} -> {p_hi:?}");
+        }
+        let wide = chi_parts_f64(ShadingModel::CookTorrance, approx, f64::from(lo));
+        prop_assert!(wide.iter().all(|v| v.is_finite() && *v > 0.0));
     }
 
     #[test]

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use kapaint::gpu::difference::Difference;
+use kapaint::gpu::preview::COMPARED_MODELS;
 use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb8};
 use kapaint::model::{Channel, Document, DocumentSettings, import};
@@ -162,6 +163,7 @@ fn the_main_views_match_their_snapshots() {
                     size: SIZE,
                     linear,
                     layout,
+                    models: COMPARED_MODELS,
                 },
             )
             .expect("render")

@@ -18,6 +18,8 @@ pub enum ModelArg {
     Phong,
     /// Blinn-Phong, eq. (11).
     Blinn,
+    /// Cook-Torrance (GGX), k_a = (2/pi) k_d + k_s chi1(n) + chi0(n).
+    CookTorrance,
 }
 
 impl From<ModelArg> for ShadingModel {
@@ -25,8 +27,20 @@ impl From<ModelArg> for ShadingModel {
         match m {
             ModelArg::Phong => Self::Phong,
             ModelArg::Blinn => Self::BlinnPhong,
+            ModelArg::CookTorrance => Self::CookTorrance,
         }
     }
+}
+
+/// Refuses a `--method` the model does not have: the paper printed no form for Cook-Torrance.
+pub(super) fn check_method(model: ShadingModel, method: MethodArg) -> Result<(), CliError> {
+    if !model.has_paper_forms() && matches!(method, MethodArg::Paper | MethodArg::PaperCorrected) {
+        return Err(CliError::usage(format!(
+            "the paper printed no approximation for {}: use --method fast or --method exact",
+            model.label()
+        )));
+    }
+    Ok(())
 }
 
 /// `--method` values.

@@ -1,10 +1,11 @@
-//! `kapaint ka`: k_a = (2/pi) k_d + k_s chi(n) of one texel as `r,g,b`.
+//! `kapaint ka`: k_a = (2/pi) k_d + k_s chi(n) of one texel as `r,g,b` (for Cook-Torrance,
+//! `(2/pi) k_d + k_s chi1(n) + chi0(n)`).
 
 use glam::DVec3;
 
 use super::CliError;
-use super::args::{MethodArg, ModelArg, fmt17, parse_n, parse_rgb};
-use crate::reflectance::{self, ShadingModel, TWO_OVER_PI, exact::chi_exact};
+use super::args::{MethodArg, ModelArg, check_method, fmt17, parse_n, parse_rgb};
+use crate::reflectance::{self, ShadingModel, TWO_OVER_PI, exact::chi_parts_exact};
 
 /// Print k_a = (2/pi) k_d + k_s chi(n) of one texel as `r,g,b`.
 #[derive(Debug, clap::Args)]
@@ -32,6 +33,7 @@ impl KaArgs {
     /// # Errors
     /// Coefficients or an exponent out of range.
     pub fn run(self) -> Result<String, CliError> {
+        check_method(self.model.into(), self.method)?;
         let kd = parse_rgb("--kd", &self.kd, false)?;
         let ks = parse_rgb("--ks", &self.ks, true)?;
         let n = parse_n(&self.n, self.method)?;
@@ -42,7 +44,10 @@ impl KaArgs {
 
 fn ka_value(model: ShadingModel, method: MethodArg, kd: DVec3, ks: DVec3, n: f64) -> DVec3 {
     match method.approx() {
-        None => TWO_OVER_PI * kd + ks * chi_exact(model, n),
+        None => {
+            let [chi1, chi0] = chi_parts_exact(model, n);
+            TWO_OVER_PI * kd + ks * chi1 + DVec3::splat(chi0)
+        }
         Some(approx) => {
             reflectance::ka(model, approx, kd.as_vec3(), ks.as_vec3(), n as f32).as_dvec3()
         }

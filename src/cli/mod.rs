@@ -33,7 +33,7 @@ mod render;
 
 pub use accuracy::MAX_ACCURACY_POINTS;
 pub use args::{MethodArg, ModelArg, fmt17};
-pub use chi::chi_value;
+pub use chi::chi_parts_value;
 pub use info::info_text;
 pub use paint::PaintScript;
 

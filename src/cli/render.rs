@@ -28,14 +28,19 @@ pub struct RenderArgs {
     /// sphere, plane, cube, torus or a mesh file (default: the project's, else sphere).
     #[arg(long)]
     mesh: Option<String>,
-    /// phong, blinn, compare-split (Phong left, Blinn-Phong right), compare-side (the two
-    /// side by side, one camera) or compare-diff (|Phong - Blinn-Phong| heatmap).
-    #[arg(long, value_parser = ["phong", "blinn", "compare-split", "compare-side", "compare-diff"])]
+    /// phong, blinn, cook-torrance, compare-split (the --sides models left and right of a
+    /// divider), compare-side (the two side by side, one camera), compare-diff (|left -
+    /// right| heatmap) or compare-three (Phong, Blinn-Phong and Cook-Torrance side by side).
+    #[arg(long, value_parser = ["phong", "blinn", "cook-torrance", "compare-split", "compare-side", "compare-diff", "compare-three"])]
     model: String,
+    /// The two models a compare-split, compare-side or compare-diff shows, `LEFT,RIGHT`.
+    #[arg(long, default_value = "phong,blinn")]
+    sides: String,
     /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
     #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
     view: String,
-    /// How k_a's chi is computed.
+    /// How k_a's chi is computed (Cook-Torrance always uses its fast fit: the paper printed
+    /// no form for it).
     #[arg(long, value_parser = ["fast", "paper", "paper-corrected"], default_value = "fast")]
     method: String,
     /// Direction towards the light, `X,Y,Z`.
@@ -90,6 +95,27 @@ fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::Pa
     Ok((maps, std::path::PathBuf::from("sphere")))
 }
 
+/// `--sides LEFT,RIGHT`: two model names.
+fn parse_sides(text: &str) -> Result<[ShadingModel; 2], CliError> {
+    let names: Vec<&str> = text.split(',').map(str::trim).collect();
+    let model = |name: &str| {
+        ShadingModel::ALL
+            .into_iter()
+            .find(|m| m.name() == name)
+            .ok_or_else(|| {
+                CliError::usage(format!(
+                    "--sides: unknown model {name:?} (phong, blinn or cook-torrance)"
+                ))
+            })
+    };
+    match names.as_slice() {
+        [a, b] => Ok([model(a)?, model(b)?]),
+        _ => Err(CliError::usage(format!(
+            "--sides takes two models, LEFT,RIGHT; got {text:?}"
+        ))),
+    }
+}
+
 impl RenderArgs {
     /// Runs the command; returns what it prints.
     ///
@@ -130,12 +156,20 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
     if !(a.yaw.is_finite() && a.pitch.is_finite()) {
         return Err(CliError::usage("--yaw and --pitch must be finite"));
     }
+    let sides = parse_sides(&a.sides)?;
     let (model, compare) = match a.model.as_str() {
         "phong" => (ShadingModel::Phong, Compare::Single),
         "blinn" => (ShadingModel::BlinnPhong, Compare::Single),
-        "compare-split" => (ShadingModel::Phong, Compare::Split),
-        "compare-side" => (ShadingModel::Phong, Compare::SideBySide),
-        _ => (ShadingModel::Phong, Compare::Difference),
+        "cook-torrance" => (ShadingModel::CookTorrance, Compare::Single),
+        "compare-split" => (sides[0], Compare::Split),
+        "compare-side" => (sides[0], Compare::SideBySide),
+        "compare-three" => (ShadingModel::Phong, Compare::ThreeWay),
+        _ => (sides[0], Compare::Difference),
+    };
+    let models = if compare == Compare::ThreeWay {
+        ShadingModel::ALL
+    } else {
+        [sides[0], sides[1], ShadingModel::CookTorrance]
     };
     let approx = match a.method.as_str() {
         "paper" => AmbientApprox::PaperPrinted,
@@ -172,6 +206,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
             maps: &maps,
             settings,
             compare,
+            models,
             size: (width, height),
             out: a.out,
         },

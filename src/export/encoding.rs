@@ -170,14 +170,14 @@ pub fn ka_error(
     encoding: NEncoding,
 ) -> KaError {
     let chi = chi_lut(model, approx);
-    // chi after a round trip through the encoding, per stored n code.
-    let quantised: Vec<f32> = (0..=u16::MAX)
+    // [chi_1, chi_0] after a round trip through the encoding, per stored n code.
+    let quantised: Vec<[f32; 2]> = (0..=u16::MAX)
         .map(|bits| {
             let n = decode_n(bits);
-            crate::reflectance::chi_f32(model, approx, encoding.decode(encoding.encode(n)))
+            crate::reflectance::chi_parts_f32(model, approx, encoding.decode(encoding.encode(n)))
         })
         .collect();
-    let diffuse = diffuse_factor(approx) as f32;
+    let diffuse = diffuse_factor(approx.for_model(model)) as f32;
     let (max, sum, count) = (0..maps.tile_count())
         .into_par_iter()
         .map(|id| {
@@ -190,13 +190,13 @@ pub fn ka_error(
                     continue;
                 }
                 let t = tile.texel(i);
-                let (c0, c1) = (chi[t.n as usize], quantised[t.n as usize]);
+                let ([c0, z0], [c1, z1]) = (chi[t.n as usize], quantised[t.n as usize]);
                 for c in 0..3 {
                     let kd = crate::model::texel::decode_unorm(t.kd[c]);
                     let ks = crate::model::texel::decode_unorm(t.ks[c]);
-                    let ka = diffuse * kd + ks * c0;
+                    let ka = diffuse * kd + ks * c0 + z0;
                     let err = if ka > 0.0 {
-                        f64::from((ks * (c1 - c0)).abs() / ka)
+                        f64::from((ks * (c1 - c0) + (z1 - z0)).abs() / ka)
                     } else {
                         0.0
                     };

@@ -22,6 +22,8 @@ pub struct Request<'a> {
     pub settings: FrameSettings,
     /// Single model or a comparison.
     pub compare: Compare,
+    /// The compared models from the left (the first two but for all three).
+    pub models: [ShadingModel; 3],
     /// Image size.
     pub size: (u32, u32),
     /// `.png` or `.exr`.
@@ -73,6 +75,7 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
                 size: req.size,
                 linear,
                 layout,
+                models: req.models,
             },
         )?
     } else {
@@ -85,13 +88,11 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
                 size: req.size,
                 linear: true,
                 layout: Layout::Single,
+                models: req.models,
             };
             preview.render_offscreen(gpu, &mesh, &maps, &settings, offscreen)
         };
-        let (a, b) = (
-            render(ShadingModel::Phong)?,
-            render(ShadingModel::BlinnPhong)?,
-        );
+        let (a, b) = (render(req.models[0])?, render(req.models[1])?);
         let (RenderedImage::Linear { pixels: a, .. }, RenderedImage::Linear { pixels: b, .. }) =
             (a, b)
         else {
@@ -106,7 +107,11 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
             })
             .collect();
         let max = diff.chunks_exact(4).map(|p| p[0]).fold(0.0_f32, f32::max);
-        note = format!(", max |phong - blinn| {max:.6}");
+        note = format!(
+            ", max |{} - {}| {max:.6}",
+            req.models[0].name(),
+            req.models[1].name()
+        );
         if kind == Kind::Exr {
             RenderedImage::Linear {
                 width,
@@ -140,15 +145,22 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
         "wrote {} ({width}x{height}, view {}, {}{note}, adapter {} ({:?}))\n",
         req.out.display(),
         req.settings.view.name(),
-        match req.compare {
-            Compare::Single => req.settings.model.name(),
-            Compare::Split => "phong | blinn",
-            Compare::SideBySide => "phong, blinn side by side",
-            Compare::Difference => "|phong - blinn|",
-        },
+        describe(req),
         gpu.info.name,
         gpu.info.backend,
     ))
+}
+
+/// What the image shows: the model, or the models compared and how.
+fn describe(req: &Request<'_>) -> String {
+    let [a, b, c] = req.models.map(ShadingModel::name);
+    match req.compare {
+        Compare::Single => req.settings.model.name().to_owned(),
+        Compare::Split => format!("{a} | {b}"),
+        Compare::SideBySide => format!("{a}, {b} side by side"),
+        Compare::ThreeWay => format!("{a}, {b}, {c} side by side"),
+        Compare::Difference => format!("|{a} - {b}|"),
+    }
 }
 
 /// Draws the false-colour scale of `n` along the bottom rows (n = 0 left, 16384 right, log).

@@ -261,6 +261,7 @@ mod tests {
         for line in [
             "const MODEL_PHONG: u32 = 0u;",
             "const MODEL_BLINN: u32 = 1u;",
+            "const MODEL_COOK_TORRANCE: u32 = 2u;",
             "const APPROX_PAPER_PRINTED: u32 = 0u;",
             "const APPROX_FAST: u32 = 2u;",
             "const VIEW_SHADED: u32 = 0u;",
@@ -268,6 +269,6 @@ mod tests {
         ] {
             assert!(ids.contains(line), "{line} missing from\n{ids}");
         }
-        assert_eq!(ids.lines().count(), 1 + 2 + 3 + ViewMode::ALL.len());
+        assert_eq!(ids.lines().count(), 1 + 3 + 3 + ViewMode::ALL.len());
     }
 }

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use super::ModelError;
 use super::texel::{Channels, MaterialValue, Texel, decode_n, decode_rgb};
 use super::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile};
-use crate::reflectance::{self, AmbientApprox, PAPER_TWO_OVER_PI, ShadingModel, TWO_OVER_PI};
+use crate::reflectance::{self, AmbientApprox, ShadingModel};
 
 /// Largest map side in texels.
 pub const MAX_SIDE: u32 = 8192;
@@ -351,7 +351,7 @@ impl MaterialMaps {
         out: &mut Vec<Vec3>,
     ) {
         let lut = chi_lut(model, approx);
-        let diffuse = diffuse_factor(approx);
+        let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
         let len = ids.len() * TILE_TEXELS;
         if out.len() < len {
             out.resize(len, Vec3::ZERO);
@@ -373,7 +373,7 @@ impl MaterialMaps {
             "derive_ka_into: wrong output size"
         );
         let lut = chi_lut(model, approx);
-        let diffuse = diffuse_factor(approx);
+        let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
         let width = self.width as usize;
         out.par_chunks_mut(width * TILE_SIZE)
             .enumerate()
@@ -392,16 +392,10 @@ impl MaterialMaps {
     }
 }
 
-fn diffuse_factor(approx: AmbientApprox) -> f32 {
-    match approx {
-        AmbientApprox::Fast => TWO_OVER_PI as f32,
-        AmbientApprox::PaperPrinted | AmbientApprox::PaperCorrected => PAPER_TWO_OVER_PI as f32,
-    }
-}
-
-/// `k_a` of one tile. `n` is stored as a half float, so `chi` of every possible code is a
-/// 65,536-entry table (256 KiB, built once per model and approximation): one load per texel.
-struct DeriveTile<'a>(&'a Tile, &'a [f32], f32, &'a mut [Vec3]);
+/// `k_a` of one tile. `n` is stored as a half float, so `[chi_1, chi_0]` of every possible code
+/// is a 65,536-entry table (512 KiB, built once per model and approximation): one load per
+/// texel.
+struct DeriveTile<'a>(&'a Tile, &'a [[f32; 2]], f32, &'a mut [Vec3]);
 
 impl crate::model::simd::Kernel for DeriveTile<'_> {
     type Output = ();
@@ -421,7 +415,7 @@ impl crate::model::simd::Kernel for DeriveTile<'_> {
 
 /// `k_a` of `out.len()` texels of a tile starting at texel index `start`.
 #[inline(always)]
-fn derive_row(tile: &Tile, start: usize, lut: &[f32], diffuse: f32, out: &mut [Vec3]) {
+fn derive_row(tile: &Tile, start: usize, lut: &[[f32; 2]], diffuse: f32, out: &mut [Vec3]) {
     const SCALE: f32 = 1.0 / 65535.0;
     let d = diffuse * SCALE;
     let len = out.len();
@@ -433,47 +427,54 @@ fn derive_row(tile: &Tile, start: usize, lut: &[f32], diffuse: f32, out: &mut [V
                 &n[start..start + len],
             );
             for (((o, kd), ks), &n) in out.iter_mut().zip(kd).zip(ks).zip(n) {
-                let chi = lut[n as usize] * SCALE;
+                let [slope, offset] = lut[n as usize];
+                let chi = slope * SCALE;
                 *o = Vec3::new(
-                    d * f32::from(kd[0]) + chi * f32::from(ks[0]),
-                    d * f32::from(kd[1]) + chi * f32::from(ks[1]),
-                    d * f32::from(kd[2]) + chi * f32::from(ks[2]),
+                    d * f32::from(kd[0]) + chi * f32::from(ks[0]) + offset,
+                    d * f32::from(kd[1]) + chi * f32::from(ks[1]) + offset,
+                    d * f32::from(kd[2]) + chi * f32::from(ks[2]) + offset,
                 );
             }
         }
         (Plane::Uniform(kd), Plane::Uniform(ks), Plane::Uniform(n)) => {
-            out.fill(diffuse * decode_rgb(*kd) + decode_rgb(*ks) * lut[*n as usize]);
+            let [slope, offset] = lut[*n as usize];
+            out.fill(diffuse * decode_rgb(*kd) + decode_rgb(*ks) * slope + Vec3::splat(offset));
         }
         _ => {
             for (k, o) in out.iter_mut().enumerate() {
                 let i = start + k;
                 let (kd, ks) = (tile.kd.get(i), tile.ks.get(i));
-                let chi = lut[tile.n.get(i) as usize] * SCALE;
+                let [slope, offset] = lut[tile.n.get(i) as usize];
+                let chi = slope * SCALE;
                 *o = Vec3::new(
-                    d * f32::from(kd[0]) + chi * f32::from(ks[0]),
-                    d * f32::from(kd[1]) + chi * f32::from(ks[1]),
-                    d * f32::from(kd[2]) + chi * f32::from(ks[2]),
+                    d * f32::from(kd[0]) + chi * f32::from(ks[0]) + offset,
+                    d * f32::from(kd[1]) + chi * f32::from(ks[1]) + offset,
+                    d * f32::from(kd[2]) + chi * f32::from(ks[2]) + offset,
                 );
             }
         }
     }
 }
 
-/// `chi` of every half-float code, for a model and approximation (built on first use).
-pub fn chi_lut(model: ShadingModel, approx: AmbientApprox) -> &'static [f32] {
-    static LUTS: [OnceLock<Vec<f32>>; 6] = [const { OnceLock::new() }; 6];
+/// `[chi_1, chi_0]` of every half-float code, for a model and approximation (built on first
+/// use; `chi_0 = 0` but for Cook-Torrance, see [`reflectance::chi_parts_f32`]).
+pub fn chi_lut(model: ShadingModel, approx: AmbientApprox) -> &'static [[f32; 2]] {
+    const APPROXES: usize = AmbientApprox::ALL.len();
+    static LUTS: [OnceLock<Vec<[f32; 2]>>; ShadingModel::ALL.len() * APPROXES] =
+        [const { OnceLock::new() }; ShadingModel::ALL.len() * APPROXES];
+    let approx = approx.for_model(model);
     let index = ShadingModel::ALL
         .iter()
         .position(|&m| m == model)
         .unwrap_or(0)
-        * 3
+        * APPROXES
         + AmbientApprox::ALL
             .iter()
             .position(|&a| a == approx)
             .unwrap_or(0);
     LUTS[index].get_or_init(|| {
         (0..=u16::MAX)
-            .map(|bits| reflectance::chi_f32(model, approx, decode_n(bits)))
+            .map(|bits| reflectance::chi_parts_f32(model, approx, decode_n(bits)))
             .collect()
     })
 }

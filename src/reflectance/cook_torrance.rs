@@ -60,8 +60,15 @@ use glam::DVec3;
 
 use super::quadrature::{TanhSinh, break_points, graded_from};
 
-/// Largest exponent the exact integrator accepts; larger values are clamped to it.
-pub const EXACT_N_MAX: f64 = 1.0e6;
+pub mod fast;
+pub(crate) mod fast_coeffs;
+pub mod fit;
+pub mod karis;
+
+/// Largest exponent the exact integrator accepts; larger values are clamped to it. It is
+/// `2^20 - 1`, so that the fit's last octave (`x = n + 1` up to `2^20`) is smooth to its end;
+/// the model itself stops at [`fast::N_MAX`] (`1e6`), where [`super::exact`] clamps.
+pub const EXACT_N_MAX: f64 = ((1u64 << 20) - 1) as f64;
 
 /// The tanh-sinh level used by [`chi_exact`]; the tests compare it with the next level.
 pub const DEFAULT_LEVEL: u32 = 6;

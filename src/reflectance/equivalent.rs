@@ -6,6 +6,10 @@
 //! exponent minimises the squared difference of the two lobes over the hemisphere, weighted by
 //! solid angle (`sin t dt`). For narrow lobes both are Gaussians in `t` and `m / n -> 4`
 //! (measured: `m = 4 n + 1.5` from n = 20 on); for broad lobes the ratio is larger.
+//!
+//! Cook-Torrance takes its roughness from `n` by the Beckmann correspondence to the Blinn-Phong
+//! lobe (`alpha = sqrt(2 / (n + 2))`), so its highlight is matched as Blinn-Phong's, against
+//! Phong.
 
 use super::ShadingModel;
 
@@ -17,7 +21,7 @@ const INTERVALS: usize = 2000;
 fn lobe(model: ShadingModel, n: f64, t: f64) -> f64 {
     let c = match model {
         ShadingModel::Phong => t.cos(),
-        ShadingModel::BlinnPhong => (t / 2.0).cos(),
+        ShadingModel::BlinnPhong | ShadingModel::CookTorrance => (t / 2.0).cos(),
     };
     if c <= 0.0 { 0.0 } else { c.powf(n) }
 }
@@ -43,21 +47,27 @@ fn mismatch(from: ShadingModel, n: f64, to: ShadingModel, m: f64, t_max: f64) ->
         / 3.0
 }
 
-/// The exponent of the other model whose highlight best matches exponent `n` of `from`
+/// The model [`equivalent_exponent`] converts `from`'s exponents into: Phong's counterpart is
+/// Blinn-Phong; Blinn-Phong's and Cook-Torrance's is Phong.
+pub fn counterpart(from: ShadingModel) -> ShadingModel {
+    match from {
+        ShadingModel::Phong => ShadingModel::BlinnPhong,
+        ShadingModel::BlinnPhong | ShadingModel::CookTorrance => ShadingModel::Phong,
+    }
+}
+
+/// The exponent of [`counterpart`]`(from)` whose highlight best matches exponent `n` of `from`
 /// (0 for 0; NaN and negative `n` count as 0).
 pub fn equivalent_exponent(from: ShadingModel, n: f64) -> f64 {
     if n.is_nan() || n <= 0.0 {
         return 0.0;
     }
     let n = n.min(1e9);
-    let to = match from {
-        ShadingModel::Phong => ShadingModel::BlinnPhong,
-        ShadingModel::BlinnPhong => ShadingModel::Phong,
-    };
+    let to = counterpart(from);
     // Integrate where the broader (Blinn) lobe is not negligible.
     let blinn_n = match from {
         ShadingModel::Phong => 4.0 * n,
-        ShadingModel::BlinnPhong => n,
+        ShadingModel::BlinnPhong | ShadingModel::CookTorrance => n,
     };
     let t_max = (12.0 / blinn_n.sqrt()).min(std::f64::consts::FRAC_PI_2);
     // Golden-section search on ln m. A Blinn lobe is broader than a Phong lobe of the same
@@ -66,7 +76,7 @@ pub fn equivalent_exponent(from: ShadingModel, n: f64) -> f64 {
     // hemisphere, so matching cos(t) near t = pi/2 needs a higher exponent).
     let (mut lo, mut hi) = match from {
         ShadingModel::Phong => (n.ln(), (16.0 * n).ln()),
-        ShadingModel::BlinnPhong => ((n / 16.0).ln(), n.ln()),
+        ShadingModel::BlinnPhong | ShadingModel::CookTorrance => ((n / 16.0).ln(), n.ln()),
     };
     let cost = |ln_m: f64| mismatch(from, n, to, ln_m.exp(), t_max);
     let g = (5.0_f64.sqrt() - 1.0) / 2.0;

@@ -53,9 +53,13 @@ thread_local! {
 }
 
 /// How many exact integrals the calling thread has run: the editor's tests check that its
-/// UI thread never runs one (each takes 45 to 320 ms).
+/// UI thread never runs one (each takes 45 ms to 3.5 s).
 pub fn calls_on_this_thread() -> u64 {
     CALLS_ON_THIS_THREAD.with(std::cell::Cell::get)
+}
+
+fn count_call() {
+    CALLS_ON_THIS_THREAD.with(|c| c.set(c.get() + 1));
 }
 
 /// `chi(n)`, the specular average of eq. (6), for `model` at the default quadrature level.
@@ -69,7 +73,7 @@ pub fn chi_exact(model: ShadingModel, n: f64) -> f64 {
 /// [`chi_exact`] with an explicit tanh-sinh level (step `2^(-level/2)`), for convergence
 /// studies: `level + 2` doubles the nodes of every rule.
 pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
-    CALLS_ON_THIS_THREAD.with(|c| c.set(c.get() + 1));
+    count_call();
     let n = if n.is_nan() {
         0.0
     } else {
@@ -81,6 +85,24 @@ pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
         // the 13th digit), which saves a third of its time.
         ShadingModel::Phong => phong(&TanhSinh::new(level.saturating_sub(1)), &rule, n),
         ShadingModel::BlinnPhong => blinn(&rule, n),
+        // chi_1, the part that scales with k_s; see `super::cook_torrance` for both parts.
+        ShadingModel::CookTorrance => {
+            let n = n.min(f64::from(super::cook_torrance::fast::N_MAX));
+            super::cook_torrance::chi_exact_at_level(n, level)[0]
+        }
+    }
+}
+
+/// `[chi_1(n), chi_0(n)]` by the exact integrators: `[chi(n), 0]` for Phong and Blinn-Phong,
+/// both parts of [`super::cook_torrance::chi_exact`] for Cook-Torrance.
+pub fn chi_parts_exact(model: ShadingModel, n: f64) -> [f64; 2] {
+    if model == ShadingModel::CookTorrance {
+        count_call();
+        // The model's limit (the integrator itself reaches a little further).
+        let n = if n.is_nan() { 0.0 } else { n };
+        super::cook_torrance::chi_exact(n.min(f64::from(super::cook_torrance::fast::N_MAX)))
+    } else {
+        [chi_exact(model, n), 0.0]
     }
 }
 
@@ -245,11 +267,14 @@ pub fn chi_monte_carlo(model: ShadingModel, n: f64, samples: u64, seed: u64) -> 
 
 /// Leading slope of the large-`n` law `chi(n) ~ (A ln n + B) / n`, derived by Laplace's
 /// method around the peak curve `g = 0, p = -t`: `A = 2/pi^2` for Phong, `8/pi^2` for
-/// Blinn-Phong (the Blinn lobe is four times wider in solid angle).
+/// Blinn-Phong (the Blinn lobe is four times wider in solid angle). Cook-Torrance's law has
+/// no `1/n` (a normalised lobe keeps its energy): `chi_1 + chi_0 ~ A ln n + B` with
+/// `A = 1/pi^3` ([`super::cook_torrance::SUM_LOG_SLOPE`]).
 pub fn asymptotic_slope(model: ShadingModel) -> f64 {
     match model {
         ShadingModel::Phong => 2.0 / (PI * PI),
         ShadingModel::BlinnPhong => 8.0 / (PI * PI),
+        ShadingModel::CookTorrance => super::cook_torrance::SUM_LOG_SLOPE,
     }
 }
 

@@ -25,11 +25,12 @@ pub struct FastTable {
     pub tail: &'static [f32; 3],
 }
 
-/// The coefficient table and tail of a model.
+/// The coefficient table and tail of a model. Cook-Torrance has a table of pairs of its own
+/// ([`super::cook_torrance::fast`]); callers dispatch to it first, and get Phong's here.
 #[inline]
 pub fn table(model: ShadingModel) -> FastTable {
     match model {
-        ShadingModel::Phong => FastTable {
+        ShadingModel::Phong | ShadingModel::CookTorrance => FastTable {
             octaves: &PHONG_OCTAVES,
             tail: &PHONG_TAIL,
         },

@@ -69,8 +69,18 @@ pub fn lobatto_nodes(degree: usize) -> Vec<f64> {
 }
 
 /// `x` for the node `s` of `octave`.
-fn node_x(octave: usize, s: f64) -> f64 {
+pub fn node_x(octave: usize, s: f64) -> f64 {
     (1u64 << octave) as f64 * (s + 3.0) / 2.0
+}
+
+/// The `x` of every node of the first `octaves` octaves, ascending, each shared end point once.
+pub fn octave_node_xs(octaves: usize, nodes: &[f64]) -> Vec<f64> {
+    let mut xs: Vec<f64> = (0..octaves)
+        .flat_map(|octave| nodes.iter().map(move |&s| node_x(octave, s)))
+        .collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    xs
 }
 
 /// `g(x) = x chi(x - 1)` by the exact integrator.
@@ -119,12 +129,8 @@ pub fn interpolate(nodes: &[f64], values: &[f64]) -> Vec<f64> {
 pub fn fit_with(model: ShadingModel, degree: usize, sample: impl Fn(f64) -> f64 + Sync) -> FastFit {
     let nodes = lobatto_nodes(degree);
     // Every octave's nodes; shared end points are evaluated once.
-    let mut xs: Vec<f64> = (0..FIT_OCTAVES)
-        .flat_map(|octave| nodes.iter().map(move |&s| node_x(octave, s)))
-        .collect();
+    let mut xs = octave_node_xs(FIT_OCTAVES, &nodes);
     xs.push(TAIL_MATCH_X);
-    xs.sort_by(f64::total_cmp);
-    xs.dedup();
     let values: Vec<f64> = xs.par_iter().map(|&x| sample(x)).collect();
     let lookup = |x: f64| -> f64 {
         let i = xs.partition_point(|&v| v < x);

@@ -30,7 +30,8 @@ pub fn view_dir(phi: f64) -> DVec3 {
 }
 
 /// The cosine that the specular lobe raises to the power `n`: `R.V` for original Phong
-/// (eq. 4, `R` the mirror of `L` about `N`) and `N.H` for Blinn-Phong (eq. 9).
+/// (eq. 4, `R` the mirror of `L` about `N`) and `N.H` for Blinn-Phong (eq. 9); `N.H` too for
+/// Cook-Torrance, the cosine its GGX distribution is a function of.
 pub fn lobe_cosine(model: ShadingModel, theta: f64, gamma: f64, phi: f64) -> f64 {
     let l = light_dir(theta, gamma);
     let v = view_dir(phi);
@@ -39,7 +40,7 @@ pub fn lobe_cosine(model: ShadingModel, theta: f64, gamma: f64, phi: f64) -> f64
             let r = DVec3::new(-l.x, l.y, -l.z);
             r.dot(v)
         }
-        ShadingModel::BlinnPhong => {
+        ShadingModel::BlinnPhong | ShadingModel::CookTorrance => {
             let sum = l + v;
             let len = sum.length();
             if len > 0.0 { sum.y / len } else { 0.0 }
@@ -49,8 +50,13 @@ pub fn lobe_cosine(model: ShadingModel, theta: f64, gamma: f64, phi: f64) -> f64
 
 /// The specular reflectance `rho_s = max(0, cos)^n`, with `0^0` taken as 0: at `n = 0` the
 /// lobe is the indicator of the set where the cosine is positive, which is the limit of
-/// `max(0, cos)^n` as `n -> 0`.
+/// `max(0, cos)^n` as `n -> 0`. For Cook-Torrance, its radiance factor with `F0 = 1`
+/// (`chi_1 + chi_0` is its average).
 pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f64 {
+    if model == ShadingModel::CookTorrance {
+        let [first, second] = super::cook_torrance::rho_s_parts(n, theta, gamma, phi);
+        return first + second;
+    }
     let c = lobe_cosine(model, theta, gamma, phi);
     if c <= 0.0 {
         0.0

@@ -2,7 +2,10 @@
 //!
 //! `k_a = (2/pi) k_d + k_s chi(n)` (eq. 6), where `chi(n)` is the average of the specular lobe
 //! over the paper's angle box. [`exact`] computes `chi` to 1e-10; [`AmbientApprox`] selects the
-//! closed forms a renderer evaluates per texel.
+//! closed forms a renderer evaluates per texel. Cook-Torrance ([`cook_torrance`]) carries the
+//! method to microfacets: its Fresnel term makes the average affine in `k_s`,
+//! `k_a = (2/pi) k_d + k_s chi_1(n) + chi_0(n)`; for Phong and Blinn-Phong `chi_1 = chi` and
+//! `chi_0 = 0`, so [`chi_parts_f32`] and [`ka`] treat all three alike.
 //!
 //! # Input handling (the same on every path)
 //!
@@ -11,6 +14,8 @@
 //! * `k_d`, `k_s`: NaN is treated as `0`; every component is clamped into `[0, 1]`.
 //!
 //! So every input gives a finite `k_a` in `[0, 2/pi + 1]`, never NaN and never a panic.
+//! (Cook-Torrance also clamps `n` to [`cook_torrance::fast::N_MAX`], the limit of its roughness
+//! mapping; there `chi_1 + chi_0 <= 0.52`.)
 
 pub mod cook_torrance;
 pub mod equivalent;
@@ -45,18 +50,41 @@ pub enum ShadingModel {
     /// Files say `blinn`; scripts may say `BlinnPhong` as the type does.
     #[serde(rename = "blinn", alias = "BlinnPhong", alias = "blinn-phong")]
     BlinnPhong,
+    /// Cook-Torrance with GGX, height-correlated Smith and Schlick's Fresnel (`k_s` as `F0`),
+    /// roughness from `n` by `alpha = sqrt(2 / (n + 2))`; its ambient is
+    /// `(2/pi) k_d + k_s chi_1(n) + chi_0(n)` (see [`cook_torrance`]).
+    #[serde(rename = "cook-torrance", alias = "CookTorrance")]
+    CookTorrance,
 }
 
 impl ShadingModel {
-    /// Both models, in a fixed order for reports.
-    pub const ALL: [Self; 2] = [Self::Phong, Self::BlinnPhong];
+    /// Every model, in a fixed order for reports (and the shader ids).
+    pub const ALL: [Self; 3] = [Self::Phong, Self::BlinnPhong, Self::CookTorrance];
+
+    /// The two models of the paper, whose ambient has the printed forms.
+    pub const PAPER: [Self; 2] = [Self::Phong, Self::BlinnPhong];
 
     /// The name used on the command line and in files.
     pub fn name(self) -> &'static str {
         match self {
             Self::Phong => "phong",
             Self::BlinnPhong => "blinn",
+            Self::CookTorrance => "cook-torrance",
         }
+    }
+
+    /// The name people read in reports and the editor.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Phong => "Phong",
+            Self::BlinnPhong => "Blinn-Phong",
+            Self::CookTorrance => "Cook-Torrance",
+        }
+    }
+
+    /// Whether the paper printed an approximation of this model's ambient (eq. 8 and 11).
+    pub fn has_paper_forms(self) -> bool {
+        self != Self::CookTorrance
     }
 }
 
@@ -83,6 +111,18 @@ impl AmbientApprox {
     /// All approximations, in a fixed order for reports.
     pub const ALL: [Self; 3] = [Self::PaperPrinted, Self::PaperCorrected, Self::Fast];
 
+    /// The approximation `model` actually uses: the paper printed none for Cook-Torrance, so
+    /// there every method is kapaint's fit.
+    #[inline]
+    #[must_use]
+    pub fn for_model(self, model: ShadingModel) -> Self {
+        if model.has_paper_forms() {
+            self
+        } else {
+            Self::Fast
+        }
+    }
+
     /// The name used on the command line (`--method`) and in files.
     pub fn name(self) -> &'static str {
         match self {
@@ -103,14 +143,16 @@ pub const PAPER_BLINN: (f64, f64, f64) = (2.5235, 3.0, -0.875);
 /// with the printed `a` and `b`: the minimax exponent, found by `fit::paper_exponent_minimax`.
 pub const PAPER_BLINN_CORRECTED_EXPONENT: f64 = -0.858;
 
-/// The constants `(a, b, c)` of `chi ~= a (n + b)^c` for a paper approximation.
-pub fn paper_constants(model: ShadingModel, approx: AmbientApprox) -> (f64, f64, f64) {
+/// The constants `(a, b, c)` of `chi ~= a (n + b)^c` for a paper approximation; `None` for
+/// [`AmbientApprox::Fast`] and for Cook-Torrance (the paper printed no form for it).
+pub fn paper_constants(model: ShadingModel, approx: AmbientApprox) -> Option<(f64, f64, f64)> {
     match (model, approx) {
-        (ShadingModel::Phong, _) => PAPER_PHONG,
+        (_, AmbientApprox::Fast) | (ShadingModel::CookTorrance, _) => None,
+        (ShadingModel::Phong, _) => Some(PAPER_PHONG),
         (ShadingModel::BlinnPhong, AmbientApprox::PaperCorrected) => {
-            (PAPER_BLINN.0, PAPER_BLINN.1, PAPER_BLINN_CORRECTED_EXPONENT)
+            Some((PAPER_BLINN.0, PAPER_BLINN.1, PAPER_BLINN_CORRECTED_EXPONENT))
         }
-        (ShadingModel::BlinnPhong, _) => PAPER_BLINN,
+        (ShadingModel::BlinnPhong, AmbientApprox::PaperPrinted) => Some(PAPER_BLINN),
     }
 }
 
@@ -154,39 +196,63 @@ pub fn sanitize_coefficient(k: f32) -> f32 {
     k.max(0.0).min(1.0)
 }
 
-/// `chi(n)` in `f32`, the precision of the per-texel path and of the shaders.
+/// `[chi_1(n), chi_0(n)]` in `f32`: the specular part of `k_a` is `k_s chi_1 + chi_0`
+/// (`chi_1 = chi`, `chi_0 = 0` for Phong and Blinn-Phong).
+#[inline]
+pub fn chi_parts_f32(model: ShadingModel, approx: AmbientApprox, n: f32) -> [f32; 2] {
+    if model == ShadingModel::CookTorrance {
+        cook_torrance::fast::chi_f32(sanitize_n_f32(n))
+    } else {
+        [chi_f32(model, approx, n), 0.0]
+    }
+}
+
+/// [`chi_parts_f32`] in `f64`.
+pub fn chi_parts_f64(model: ShadingModel, approx: AmbientApprox, n: f64) -> [f64; 2] {
+    if model == ShadingModel::CookTorrance {
+        cook_torrance::fast::chi_f64(sanitize_n_f64(n))
+    } else {
+        [chi_f64(model, approx, n), 0.0]
+    }
+}
+
+/// `chi(n)` in `f32`, the precision of the per-texel path and of the shaders; for
+/// Cook-Torrance, `chi_1(n)` (see [`chi_parts_f32`]).
 #[inline]
 pub fn chi_f32(model: ShadingModel, approx: AmbientApprox, n: f32) -> f32 {
     let n = sanitize_n_f32(n);
-    match approx {
-        AmbientApprox::Fast => fast::chi_f32(model, n),
-        AmbientApprox::PaperPrinted | AmbientApprox::PaperCorrected => {
-            let (a, b, c) = paper_constants(model, approx);
-            // Eq. (8) / (11).
-            a as f32 * (n + b as f32).powf(c as f32)
-        }
+    if model == ShadingModel::CookTorrance {
+        return cook_torrance::fast::chi_f32(n)[0];
+    }
+    match paper_constants(model, approx) {
+        None => fast::chi_f32(model, n),
+        // Eq. (8) / (11).
+        Some((a, b, c)) => a as f32 * (n + b as f32).powf(c as f32),
     }
 }
 
 /// `chi(n)` in `f64`; agrees with [`chi_f32`] to `f32` rounding.
 pub fn chi_f64(model: ShadingModel, approx: AmbientApprox, n: f64) -> f64 {
     let n = sanitize_n_f64(n);
-    match approx {
-        AmbientApprox::Fast => fast::chi_f64(model, n),
-        AmbientApprox::PaperPrinted | AmbientApprox::PaperCorrected => {
-            let (a, b, c) = paper_constants(model, approx);
-            a * (n + b).powf(c)
-        }
+    if model == ShadingModel::CookTorrance {
+        return cook_torrance::fast::chi_f64(n)[0];
+    }
+    match paper_constants(model, approx) {
+        None => fast::chi_f64(model, n),
+        Some((a, b, c)) => a * (n + b).powf(c),
     }
 }
 
 /// The ambient coefficient `k_a = (2/pi) k_d + k_s chi(n)` of one texel (eq. 6 with the
-/// selected approximation of `chi`; eq. (8) or (11) for the paper's forms).
+/// selected approximation of `chi`; eq. (8) or (11) for the paper's forms), and
+/// `(2/pi) k_d + k_s chi_1(n) + chi_0(n)` for Cook-Torrance.
 #[inline]
 pub fn ka(model: ShadingModel, approx: AmbientApprox, kd: Vec3, ks: Vec3, n: f32) -> Vec3 {
+    let approx = approx.for_model(model);
     let kd = kd.map(sanitize_coefficient);
     let ks = ks.map(sanitize_coefficient);
-    diffuse_factor(approx) as f32 * kd + ks * chi_f32(model, approx, n)
+    let [slope, offset] = chi_parts_f32(model, approx, n);
+    diffuse_factor(approx) as f32 * kd + ks * slope + Vec3::splat(offset)
 }
 
 /// Texels per parallel work item of [`derive_ka_par`]: large enough to amortise scheduling,
@@ -210,19 +276,24 @@ pub fn derive_ka(
     out: &mut [Vec3],
 ) {
     assert_same_lengths(kd, ks, n, out);
-    match approx {
+    if model == ShadingModel::CookTorrance {
+        derive_with::<true>(kd, ks, n, out, TWO_OVER_PI as f32, |n| {
+            cook_torrance::fast::chi_f32(sanitize_n_f32(n))
+        });
+        return;
+    }
+    match paper_constants(model, approx) {
         // Monomorphise the hot loop per approximation so the choice is made once per buffer.
-        AmbientApprox::Fast => {
+        None => {
             let table = fast::table(model);
-            derive_with(kd, ks, n, out, TWO_OVER_PI as f32, |n| {
-                fast::chi_f32_with(table, sanitize_n_f32(n))
+            derive_with::<false>(kd, ks, n, out, TWO_OVER_PI as f32, |n| {
+                [fast::chi_f32_with(table, sanitize_n_f32(n)), 0.0]
             });
         }
-        AmbientApprox::PaperPrinted | AmbientApprox::PaperCorrected => {
-            let (a, b, c) = paper_constants(model, approx);
+        Some((a, b, c)) => {
             let (a, b, c) = (a as f32, b as f32, c as f32);
-            derive_with(kd, ks, n, out, PAPER_TWO_OVER_PI as f32, |n| {
-                a * (sanitize_n_f32(n) + b).powf(c)
+            derive_with::<false>(kd, ks, n, out, PAPER_TWO_OVER_PI as f32, |n| {
+                [a * (sanitize_n_f32(n) + b).powf(c), 0.0]
             });
         }
     }
@@ -235,30 +306,55 @@ fn assert_same_lengths(kd: &[Vec3], ks: &[Vec3], n: &[f32], out: &[Vec3]) {
     );
 }
 
+/// The derive's loop with `chi(n) = [chi_1, chi_0]` and the `k_d` factor `diffuse`, on the
+/// calling thread; `OFFSET` says whether `chi` has a `chi_0` to add (Cook-Torrance), so the
+/// other models keep the loop without it. Public so that other fits (Karis', in the bench) are
+/// timed in the very same loop.
 #[inline]
-fn derive_with(
+pub fn derive_with<const OFFSET: bool>(
     kd: &[Vec3],
     ks: &[Vec3],
     n: &[f32],
     out: &mut [Vec3],
     diffuse: f32,
-    chi: impl Fn(f32) -> f32,
+    chi: impl Fn(f32) -> [f32; 2],
 ) {
     let kd: &[f32] = bytemuck::cast_slice(kd);
     let ks: &[f32] = bytemuck::cast_slice(ks);
     let out: &mut [f32] = bytemuck::cast_slice_mut(out);
     let mut chi3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS];
+    let mut offset3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS];
     for (block, n_block) in n.chunks(DERIVE_BLOCK_TEXELS).enumerate() {
         let start = 3 * block * DERIVE_BLOCK_TEXELS;
         let len = 3 * n_block.len();
-        for (c, &e) in chi3.chunks_exact_mut(3).zip(n_block) {
-            c.fill(chi(e));
+        for ((c, z), &e) in chi3
+            .chunks_exact_mut(3)
+            .zip(offset3.chunks_exact_mut(3))
+            .zip(n_block)
+        {
+            let [slope, offset] = chi(e);
+            c.fill(slope);
+            if OFFSET {
+                z.fill(offset);
+            }
         }
         let o = &mut out[start..start + len];
         let d = &kd[start..start + len];
         let s = &ks[start..start + len];
-        for (((o, &d), &s), &c) in o.iter_mut().zip(d).zip(s).zip(&chi3[..len]) {
-            *o = diffuse * sanitize_coefficient(d) + sanitize_coefficient(s) * c;
+        if OFFSET {
+            for ((((o, &d), &s), &c), &z) in o
+                .iter_mut()
+                .zip(d)
+                .zip(s)
+                .zip(&chi3[..len])
+                .zip(&offset3[..len])
+            {
+                *o = diffuse * sanitize_coefficient(d) + sanitize_coefficient(s) * c + z;
+            }
+        } else {
+            for (((o, &d), &s), &c) in o.iter_mut().zip(d).zip(s).zip(&chi3[..len]) {
+                *o = diffuse * sanitize_coefficient(d) + sanitize_coefficient(s) * c;
+            }
         }
     }
 }

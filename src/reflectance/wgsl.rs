@@ -10,6 +10,8 @@
 
 use std::fmt::Write as _;
 
+use super::cook_torrance::fast::N_MAX as CT_N_MAX;
+use super::cook_torrance::fast_coeffs as ct;
 use super::fast_coeffs::{BLINN_OCTAVES, BLINN_TAIL, DEGREE, OCTAVES, PHONG_OCTAVES, PHONG_TAIL};
 use super::{
     AmbientApprox, PAPER_TWO_OVER_PI, ShadingModel, TWO_OVER_PI, fast::TAIL_START_X,
@@ -191,14 +193,18 @@ fn constants(out: &mut String, lang: ShaderLanguage, include_ids: bool) {
         ),
         ("FAST_DEGREE", U32, format!("{DEGREE}u")),
         ("FAST_TAIL_START_X", F32, lang.scientific(TAIL_START_X)),
+        ("CT_DEGREE", U32, format!("{}u", ct::DEGREE)),
+        ("CT_N_MAX", F32, lang.scientific(CT_N_MAX)),
         ("F32_MAX", F32, max),
     ] {
         let _ = writeln!(out, "{}", lang.constant(name, ty, &value));
     }
     out.push('\n');
-    for model in ShadingModel::ALL {
+    for model in ShadingModel::PAPER {
         for approx in [AmbientApprox::PaperPrinted, AmbientApprox::PaperCorrected] {
-            let (a, b, c) = paper_constants(model, approx);
+            let Some((a, b, c)) = paper_constants(model, approx) else {
+                continue;
+            };
             let name = format!(
                 "{}_{}",
                 model.name().to_uppercase(),
@@ -211,6 +217,14 @@ fn constants(out: &mut String, lang: ShaderLanguage, include_ids: bool) {
     out.push('\n');
     fast_table(out, lang, "PHONG", &PHONG_OCTAVES, PHONG_TAIL);
     fast_table(out, lang, "BLINN", &BLINN_OCTAVES, BLINN_TAIL);
+    // Cook-Torrance: per octave and power of s, chi_1 and chi_0 side by side.
+    let pairs: Vec<f32> = ct::CHI_OCTAVES
+        .iter()
+        .flatten()
+        .flatten()
+        .copied()
+        .collect();
+    let _ = writeln!(out, "{}\n", lang.table("CT_FAST", &pairs));
 }
 
 /// The WGSL source of `shaders/ambient.wgsl`.
@@ -227,7 +241,8 @@ fn ambient_wgsl_with(include_ids: bool) -> String {
          // Do not edit: run `cargo run --release --example gen_wgsl`.\n\
          //\n\
          // k_a = (2/pi) k_d + k_s chi(n): eq. (6) of the paper, with chi by eq. (8)/(11) as\n\
-         // printed, with the corrected Blinn exponent, or by kapaint's Fast approximation.\n"
+         // printed, with the corrected Blinn exponent, or by kapaint's Fast approximation;\n\
+         // k_a = (2/pi) k_d + k_s chi_1(n) + chi_0(n) for Cook-Torrance (GGX).\n"
     );
     constants(&mut out, ShaderLanguage::Wgsl, include_ids);
     out.push_str(BODY_WGSL);
@@ -245,7 +260,8 @@ pub fn ambient_glsl() -> String {
          // the GLSL twin of shaders/ambient.wgsl. GLSL 4.50 or GLSL ES 3.00, no extensions.\n\
          //\n\
          // k_a = (2/pi) k_d + k_s chi(n): eq. (6) of the paper, with chi by eq. (8)/(11) as\n\
-         // printed, with the corrected Blinn exponent, or by kapaint's Fast approximation.\n\n\
+         // printed, with the corrected Blinn exponent, or by kapaint's Fast approximation;\n\
+         // k_a = (2/pi) k_d + k_s chi_1(n) + chi_0(n) for Cook-Torrance (GGX).\n\n\
          // The bit tricks and the tables need 32-bit floats and ints (a no-op on desktop GL).\n\
          precision highp float;\nprecision highp int;\n"
     );
@@ -300,6 +316,21 @@ fn chi_fast(model: u32, n: f32) -> f32 {
     return g / x;
 }
 
+// [chi_1(n), chi_0(n)] of Cook-Torrance for a sanitized n: a vec2 Horner chain per octave.
+fn chi_cook_torrance(n: f32) -> vec2<f32> {
+    let x = min(n, CT_N_MAX) + 1.0;
+    let bits = bitcast<u32>(x);
+    let octave = (bits >> 23u) - 127u;
+    let s = 2.0 * bitcast<f32>((bits & 0x007fffffu) | 0x3f800000u) - 3.0;
+    let base = octave * (CT_DEGREE + 1u);
+    var g = vec2<f32>(0.0);
+    for (var k = 0u; k <= CT_DEGREE; k++) {
+        let index = 2u * (base + CT_DEGREE - k);
+        g = g * s + vec2<f32>(CT_FAST[index], CT_FAST[index + 1u]);
+    }
+    return g;
+}
+
 fn paper_constants(model: u32, approx: u32) -> vec3<f32> {
     if model == MODEL_PHONG {
         if approx == APPROX_PAPER_CORRECTED {
@@ -313,9 +344,12 @@ fn paper_constants(model: u32, approx: u32) -> vec3<f32> {
     return BLINN_PAPER;
 }
 
-// chi(n), the specular part of k_a per unit k_s.
+// chi(n), the specular part of k_a per unit k_s (chi_1 for Cook-Torrance).
 fn chi(model: u32, approx: u32, n_raw: f32) -> f32 {
     let n = sanitize_n(n_raw);
+    if model == MODEL_COOK_TORRANCE {
+        return chi_cook_torrance(n).x;
+    }
     if approx == APPROX_FAST {
         return chi_fast(model, n);
     }
@@ -324,8 +358,13 @@ fn chi(model: u32, approx: u32, n_raw: f32) -> f32 {
     return abc.x * pow(n + abc.y, abc.z);
 }
 
-// k_a = (2/pi) k_d + k_s chi(n) (eq. 6; 0.637 for the paper's forms).
+// k_a = (2/pi) k_d + k_s chi(n) (eq. 6; 0.637 for the paper's forms), and
+// (2/pi) k_d + k_s chi_1(n) + chi_0(n) for Cook-Torrance (which has no paper form).
 fn ambient_ka(model: u32, approx: u32, kd: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {
+    if model == MODEL_COOK_TORRANCE {
+        let parts = chi_cook_torrance(sanitize_n(n));
+        return TWO_OVER_PI * sanitize_k(kd) + sanitize_k(ks) * parts.x + parts.y;
+    }
     var diffuse = TWO_OVER_PI;
     if approx != APPROX_FAST {
         diffuse = PAPER_TWO_OVER_PI;
@@ -381,6 +420,21 @@ float chi_fast(uint model, float n) {
     return g / x;
 }
 
+// [chi_1(n), chi_0(n)] of Cook-Torrance for a sanitized n: a vec2 Horner chain per octave.
+vec2 chi_cook_torrance(float n) {
+    float x = min(n, CT_N_MAX) + 1.0;
+    uint bits = floatBitsToUint(x);
+    uint octave = (bits >> 23u) - 127u;
+    float s = 2.0 * uintBitsToFloat((bits & 0x007fffffu) | 0x3f800000u) - 3.0;
+    uint base = octave * (CT_DEGREE + 1u);
+    vec2 g = vec2(0.0);
+    for (uint k = 0u; k <= CT_DEGREE; k++) {
+        uint index = 2u * (base + CT_DEGREE - k);
+        g = g * s + vec2(CT_FAST[index], CT_FAST[index + 1u]);
+    }
+    return g;
+}
+
 vec3 paper_constants(uint model, uint approx) {
     if (model == MODEL_PHONG) {
         if (approx == APPROX_PAPER_CORRECTED) {
@@ -394,9 +448,12 @@ vec3 paper_constants(uint model, uint approx) {
     return BLINN_PAPER;
 }
 
-// chi(n), the specular part of k_a per unit k_s.
+// chi(n), the specular part of k_a per unit k_s (chi_1 for Cook-Torrance).
 float chi(uint model, uint approx, float n_raw) {
     float n = sanitize_n(n_raw);
+    if (model == MODEL_COOK_TORRANCE) {
+        return chi_cook_torrance(n).x;
+    }
     if (approx == APPROX_FAST) {
         return chi_fast(model, n);
     }
@@ -405,8 +462,13 @@ float chi(uint model, uint approx, float n_raw) {
     return abc.x * pow(n + abc.y, abc.z);
 }
 
-// k_a = (2/pi) k_d + k_s chi(n) (eq. 6; 0.637 for the paper's forms).
+// k_a = (2/pi) k_d + k_s chi(n) (eq. 6; 0.637 for the paper's forms), and
+// (2/pi) k_d + k_s chi_1(n) + chi_0(n) for Cook-Torrance (which has no paper form).
 vec3 ambient_ka(uint model, uint approx, vec3 kd, vec3 ks, float n) {
+    if (model == MODEL_COOK_TORRANCE) {
+        vec2 parts = chi_cook_torrance(sanitize_n(n));
+        return TWO_OVER_PI * sanitize_k(kd) + sanitize_k(ks) * parts.x + parts.y;
+    }
     float diffuse = TWO_OVER_PI;
     if (approx != APPROX_FAST) {
         diffuse = PAPER_TWO_OVER_PI;

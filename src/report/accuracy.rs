@@ -4,7 +4,8 @@ use std::fmt::Write as _;
 
 use rayon::prelude::*;
 
-use crate::reflectance::{AmbientApprox, ShadingModel, chi_f32, exact::chi_exact};
+use crate::reflectance::cook_torrance::{self, karis};
+use crate::reflectance::{AmbientApprox, ShadingModel, chi_f32, chi_parts_f32, exact::chi_exact};
 
 /// A range of `n` sampled for an accuracy report.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,6 +68,83 @@ impl ExactSamples {
     }
 }
 
+/// The exact Cook-Torrance `[chi_1, chi_0]` at every point of a grid.
+#[derive(Clone, Debug)]
+pub struct CtSamples {
+    /// `(n, [chi_1, chi_0])`, ascending in `n`.
+    pub samples: Vec<(f64, [f64; 2])>,
+}
+
+impl CtSamples {
+    /// Evaluates the exact integrator on the grid (in parallel across points).
+    pub fn compute(grid: &Grid) -> Self {
+        let samples = grid
+            .points
+            .par_iter()
+            .map(|&n| (n, cook_torrance::chi_exact(n)))
+            .collect();
+        Self { samples }
+    }
+
+    /// The error statistics of `approx(n) = [chi_1, chi_0]`, for each part.
+    pub fn stats(&self, approx: impl Fn(f64) -> [f64; 2]) -> [ErrorStats; 2] {
+        let mut stats = [0, 1].map(|_| ErrorStats {
+            max_rel: 0.0,
+            max_at_n: 0.0,
+            mean_rel: 0.0,
+        });
+        for &(n, exact) in &self.samples {
+            let got = approx(n);
+            for (k, s) in stats.iter_mut().enumerate() {
+                let err = (got[k] / exact[k] - 1.0).abs();
+                s.mean_rel += err;
+                if err > s.max_rel {
+                    s.max_rel = err;
+                    s.max_at_n = n;
+                }
+            }
+        }
+        for s in &mut stats {
+            s.mean_rel /= self.samples.len().max(1) as f64;
+        }
+        stats
+    }
+
+    /// The larger of the two parts' maximum relative errors.
+    pub fn max_rel(&self, approx: impl Fn(f64) -> [f64; 2]) -> f64 {
+        let [a, b] = self.stats(approx);
+        a.max_rel.max(b.max_rel)
+    }
+}
+
+/// `[chi_1(n), chi_0(n)]` by some method.
+pub type ChiParts = fn(f64) -> [f64; 2];
+
+/// The Cook-Torrance methods the reports measure: kapaint's fit (in `f32`, as a renderer
+/// evaluates it), and Karis' published fit at the box's mean view and view-averaged.
+pub fn cook_torrance_methods() -> [(&'static str, ChiParts); 3] {
+    [
+        ("fast", |n| {
+            chi_parts_f32(ShadingModel::CookTorrance, AmbientApprox::Fast, n as f32).map(f64::from)
+        }),
+        ("karis", karis::chi_karis),
+        ("karis (view-averaged)", karis::chi_karis_view_averaged),
+    ]
+}
+
+/// One row of the Cook-Torrance accuracy table: one part of one method on one grid.
+#[derive(Clone, Debug)]
+pub struct CtAccuracyRow {
+    /// `chi1` or `chi0`.
+    pub part: &'static str,
+    /// The method measured.
+    pub method: &'static str,
+    /// The grid's label.
+    pub range: String,
+    /// The measured errors.
+    pub stats: ErrorStats,
+}
+
 /// Error statistics of one approximation over one grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ErrorStats {
@@ -118,6 +196,8 @@ pub struct AccuracyReport {
     pub rows: Vec<AccuracyRow>,
     /// Eq. (11)'s exponent on the first grid (the paper's `[1, 200]`).
     pub exponent: ExponentCheck,
+    /// Cook-Torrance's two parts, every method on every grid.
+    pub cook_torrance: Vec<CtAccuracyRow>,
 }
 
 /// Measures every model and approximation on every grid (at least one), evaluating the
@@ -125,7 +205,7 @@ pub struct AccuracyReport {
 pub fn accuracy_report(grids: &[Grid]) -> AccuracyReport {
     let mut rows = Vec::new();
     let mut exponent = None;
-    for model in ShadingModel::ALL {
+    for model in ShadingModel::PAPER {
         for (i, grid) in grids.iter().enumerate() {
             let exact = ExactSamples::compute(model, grid);
             for approx in AmbientApprox::ALL {
@@ -147,18 +227,64 @@ pub fn accuracy_report(grids: &[Grid]) -> AccuracyReport {
             &Grid::log_spaced(1.0, 200.0, 32),
         ))
     });
-    AccuracyReport { rows, exponent }
+    let mut cook_torrance = Vec::new();
+    for grid in grids {
+        let exact = CtSamples::compute(grid);
+        for (method, approx) in cook_torrance_methods() {
+            for (part, stats) in ["chi1", "chi0"].into_iter().zip(exact.stats(approx)) {
+                cook_torrance.push(CtAccuracyRow {
+                    part,
+                    method,
+                    range: grid.label.clone(),
+                    stats,
+                });
+            }
+        }
+    }
+    AccuracyReport {
+        rows,
+        exponent,
+        cook_torrance,
+    }
 }
 
 impl AccuracyReport {
-    /// Both tables as markdown.
+    /// The three tables as markdown.
     pub fn markdown(&self) -> String {
         format!(
-            "{}\n{}",
+            "{}\n{}\n{}",
             markdown(&self.rows),
-            exponent_markdown(&self.exponent)
+            exponent_markdown(&self.exponent),
+            cook_torrance_markdown(&self.cook_torrance)
         )
     }
+}
+
+/// Renders the Cook-Torrance rows as a markdown table, with a note on Karis' setup.
+pub fn cook_torrance_markdown(rows: &[CtAccuracyRow]) -> String {
+    let mut out = String::from(
+        "| cook-torrance | method | n range | max rel error | at n | mean rel error |\n\
+         |---|---|---|---|---|---|\n",
+    );
+    for row in rows {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.3e} | {} | {:.3e} |",
+            row.part,
+            row.method,
+            row.range,
+            row.stats.max_rel,
+            format_n(row.stats.max_at_n),
+            row.stats.mean_rel,
+        );
+    }
+    out.push_str(
+        "\nkaris: Karis' environment-BRDF fit (UE4, 2014) as k_s A + B, roughness sqrt(alpha), \
+         at N.V = 2/pi or averaged over the box's views. It fits another lighting setup (the \
+         solid-angle, N.L-weighted hemisphere seen from one view), so its error here is what \
+         a user would get by using it for this ambient term, not the fit's own error.\n",
+    );
+    out
 }
 
 /// Renders the rows as a markdown table.

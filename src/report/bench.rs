@@ -2,7 +2,9 @@
 //!
 //! For every model and approximation, derives a full `size x size` k_a map on one thread and
 //! on all threads, and compares both with a plain copy of the derive's input bytes measured in
-//! the same run (the memory-bandwidth limit of the machine).
+//! the same run (the memory-bandwidth limit of the machine). Cook-Torrance has kapaint's fit
+//! and Karis' published environment-BRDF fit (see [`karis`]), each measured against the exact
+//! `chi_1` and `chi_0` (its error is the larger of the two).
 
 use std::path::Path;
 use std::time::Instant;
@@ -12,16 +14,20 @@ use std::fmt::Write as _;
 
 use rayon::prelude::*;
 
-use super::accuracy::{ExactSamples, Grid, error_stats};
-use crate::reflectance::{AmbientApprox, ShadingModel, derive_ka, derive_ka_par};
+use super::accuracy::{CtSamples, ExactSamples, Grid, error_stats};
+use crate::reflectance::cook_torrance::karis;
+use crate::reflectance::{
+    AmbientApprox, DERIVE_CHUNK_TEXELS, ShadingModel, TWO_OVER_PI, derive_ka, derive_ka_par,
+    derive_with,
+};
 
 /// One row of the bench table.
 #[derive(Clone, Debug)]
 pub struct BenchRow {
     /// The lobe.
     pub model: ShadingModel,
-    /// The approximation timed.
-    pub approx: AmbientApprox,
+    /// The method timed: an approximation's name, or `karis`.
+    pub method: &'static str,
     /// Nanoseconds per texel, one thread.
     pub ns_per_texel_1t: f64,
     /// Nanoseconds per texel, all threads.
@@ -116,27 +122,76 @@ pub fn run(size: usize, repeats: usize, error_points: usize) -> Vec<BenchRow> {
     let (copy_1t, copy_mt) = copy_baseline(texels * BenchMaps::BYTES_PER_TEXEL_READ, repeats);
     let grid = Grid::log_spaced(0.0, 16384.0, error_points);
     let mut rows = Vec::new();
-    for model in ShadingModel::ALL {
+    let mut row = |model, method, max_rel_error, (one, all): (f64, f64)| {
+        rows.push(BenchRow {
+            model,
+            method,
+            ns_per_texel_1t: one * 1e9 / texels as f64,
+            ns_per_texel_mt: all * 1e9 / texels as f64,
+            max_rel_error,
+            copy_ratio_1t: one / copy_1t,
+            copy_ratio_mt: all / copy_mt,
+        });
+    };
+    let mut time = |derive: &dyn Fn(&mut [Vec3]), derive_par: &dyn Fn(&mut [Vec3])| {
+        let times = (
+            best_of(repeats, || derive(&mut out)),
+            best_of(repeats, || derive_par(&mut out)),
+        );
+        std::hint::black_box(&out);
+        times
+    };
+    for model in ShadingModel::PAPER {
         let exact = ExactSamples::compute(model, &grid);
         for approx in AmbientApprox::ALL {
-            let one = best_of(repeats, || {
-                derive_ka(model, approx, &maps.kd, &maps.ks, &maps.n, &mut out);
-            });
-            let all = best_of(repeats, || {
-                derive_ka_par(model, approx, &maps.kd, &maps.ks, &maps.n, &mut out);
-            });
-            std::hint::black_box(&out);
-            rows.push(BenchRow {
+            let times = time(
+                &|out| derive_ka(model, approx, &maps.kd, &maps.ks, &maps.n, out),
+                &|out| derive_ka_par(model, approx, &maps.kd, &maps.ks, &maps.n, out),
+            );
+            row(
                 model,
-                approx,
-                ns_per_texel_1t: one * 1e9 / texels as f64,
-                ns_per_texel_mt: all * 1e9 / texels as f64,
-                max_rel_error: error_stats(approx, &exact).max_rel,
-                copy_ratio_1t: one / copy_1t,
-                copy_ratio_mt: all / copy_mt,
-            });
+                approx.name(),
+                error_stats(approx, &exact).max_rel,
+                times,
+            );
         }
     }
+    let ct = ShadingModel::CookTorrance;
+    let exact = CtSamples::compute(&grid);
+    let fast = time(
+        &|out| derive_ka(ct, AmbientApprox::Fast, &maps.kd, &maps.ks, &maps.n, out),
+        &|out| derive_ka_par(ct, AmbientApprox::Fast, &maps.kd, &maps.ks, &maps.n, out),
+    );
+    let karis_derive = |out: &mut [Vec3], start: usize| {
+        let range = start..start + out.len();
+        derive_with::<true>(
+            &maps.kd[range.clone()],
+            &maps.ks[range.clone()],
+            &maps.n[range],
+            out,
+            TWO_OVER_PI as f32,
+            karis::chi_karis_f32,
+        );
+    };
+    let karis_times = time(&|out| karis_derive(out, 0), &|out| {
+        out.par_chunks_mut(DERIVE_CHUNK_TEXELS)
+            .enumerate()
+            .for_each(|(i, chunk)| karis_derive(chunk, i * DERIVE_CHUNK_TEXELS));
+    });
+    row(
+        ct,
+        AmbientApprox::Fast.name(),
+        exact.max_rel(|n| {
+            crate::reflectance::chi_parts_f32(ct, AmbientApprox::Fast, n as f32).map(f64::from)
+        }),
+        fast,
+    );
+    row(
+        ct,
+        "karis",
+        exact.max_rel(|n| karis::chi_karis_f32(n as f32).map(f64::from)),
+        karis_times,
+    );
     rows
 }
 
@@ -153,7 +208,7 @@ pub fn markdown(rows: &[BenchRow], size: usize) -> String {
             out,
             "| {} | {} | {:.2} | {:.2} | {:.2e} | {:.2} | {:.2} |",
             r.model.name(),
-            r.approx.name(),
+            r.method,
             r.ns_per_texel_1t,
             r.ns_per_texel_mt,
             r.max_rel_error,
@@ -174,7 +229,7 @@ pub fn csv(rows: &[BenchRow]) -> String {
             out,
             "{},{},{},{},{},{},{}",
             r.model.name(),
-            r.approx.name(),
+            r.method,
             r.ns_per_texel_1t,
             r.ns_per_texel_mt,
             r.max_rel_error,
@@ -250,7 +305,7 @@ fn draw_plot(rows: &[BenchRow], rgb: &mut [u8]) -> Result<(), Box<dyn std::error
                     colour.stroke_width(2),
                 ),
             ])?
-            .label(format!("{} {}", r.model.name(), r.approx.name()))
+            .label(format!("{} {}", r.model.name(), r.method))
             .legend(move |(x, y)| Circle::new((x, y), 6, colour.filled()));
     }
     chart

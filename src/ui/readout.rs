@@ -1,5 +1,5 @@
 //! The status bar's exact `k_a` under the cursor, without stalling a frame: the exact
-//! integral (45 to 320 ms a value) runs on a worker thread, and its results are kept per
+//! integral (45 ms to 3.5 s a value) runs on a worker thread, and its results are kept per
 //! model and half-float code of `n` (the only values a map holds), so a texel's value is
 //! integrated once. The UI thread never runs the integrator: it shows the value when it
 //! arrives and asks for a repaint.
@@ -9,17 +9,18 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, OnceLock};
 
 use crate::reflectance::ShadingModel;
-use crate::reflectance::exact::chi_exact;
+use crate::reflectance::exact::chi_parts_exact;
 
 /// One value to integrate: a model and the half-float bits of `n`.
 type Key = (ShadingModel, u16);
 
-/// Exact `chi(n)` values, computed on a worker and kept.
+/// Exact `[chi_1(n), chi_0(n)]` values (`chi_0 = 0` but for Cook-Torrance), computed on a
+/// worker and kept.
 pub struct ExactChi {
-    known: HashMap<Key, f64>,
+    known: HashMap<Key, [f64; 2]>,
     asked: Option<Key>,
     requests: Option<Sender<Key>>,
-    results: Receiver<(Key, f64)>,
+    results: Receiver<(Key, [f64; 2])>,
     /// The context to repaint when a value arrives (known from the first frame on).
     ctx: Arc<OnceLock<egui::Context>>,
 }
@@ -50,7 +51,7 @@ impl ExactChi {
                         key = newer;
                     }
                     let n = half::f16::from_bits(key.1).to_f64();
-                    if result_tx.send((key, chi_exact(key.0, n))).is_err() {
+                    if result_tx.send((key, chi_parts_exact(key.0, n))).is_err() {
                         return;
                     }
                     if let Some(ctx) = wake.get() {
@@ -67,10 +68,15 @@ impl ExactChi {
         }
     }
 
-    /// The exact `chi` of `model` at the `n` whose half-float bits are `n_bits`, if it is
-    /// known; else asks the worker for it (`ctx` is repainted when it arrives) and returns
-    /// `None` for now.
-    pub fn get(&mut self, ctx: &egui::Context, model: ShadingModel, n_bits: u16) -> Option<f64> {
+    /// The exact `[chi_1, chi_0]` of `model` at the `n` whose half-float bits are `n_bits`, if
+    /// it is known; else asks the worker for it (`ctx` is repainted when it arrives) and
+    /// returns `None` for now.
+    pub fn get(
+        &mut self,
+        ctx: &egui::Context,
+        model: ShadingModel,
+        n_bits: u16,
+    ) -> Option<[f64; 2]> {
         self.ctx.get_or_init(|| ctx.clone());
         while let Ok((key, value)) = self.results.try_recv() {
             self.known.insert(key, value);

@@ -533,12 +533,11 @@ pub(super) fn is_colour(comp: Comp) -> bool {
 }
 
 pub(super) fn approximation(approx: AmbientApprox, model: ShadingModel) -> Approximation {
+    // What the set's k_a really uses: Cook-Torrance has its fit whatever the method.
+    let approx = approx.for_model(model);
     Approximation {
         name: approx.name().to_string(),
         diffuse_factor: reflectance::diffuse_factor(approx),
-        paper_constants: (approx != AmbientApprox::Fast).then(|| {
-            let (a, b, c) = reflectance::paper_constants(model, approx);
-            [a, b, c]
-        }),
+        paper_constants: reflectance::paper_constants(model, approx).map(|(a, b, c)| [a, b, c]),
     }
 }

@@ -69,31 +69,42 @@ pub(super) fn ka_error_of_set(
     model: ShadingModel,
     approx: AmbientApprox,
 ) -> KaError {
-    let chi = crate::model::maps::chi_lut(model, approx);
-    let diffuse = reflectance::diffuse_factor(approx) as f32;
+    let lut = crate::model::maps::chi_lut(model, approx);
+    // [chi_1, chi_0] as two tables (chi_0 = 0 but for Cook-Torrance).
+    let split = |pairs: &[[f32; 2]]| -> [Vec<f32>; 2] {
+        [0, 1].map(|k| pairs.iter().map(|p| p[k]).collect())
+    };
+    let chi = split(lut);
+    let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
     let exact: Vec<f32> = (0..=u16::MAX).map(decode_unorm).collect();
     let sixteen: Vec<f32> = exact
         .iter()
         .map(|v| (v * 65535.0).round() / 65535.0)
         .collect();
     // n: stored half-float bits -> chi of what the set decodes.
-    let chi_of_set: Vec<f32> = (0..=u16::MAX)
-        .map(|bits| match manifest.n_encoding {
-            Some(e) => reflectance::chi_f32(model, approx, e.decode(e.encode(decode_n(bits)))),
-            None => chi[bits as usize],
-        })
-        .collect();
+    let chi_of_set = split(
+        &(0..=u16::MAX)
+            .map(|bits| match manifest.n_encoding {
+                Some(e) => {
+                    reflectance::chi_parts_f32(model, approx, e.decode(e.encode(decode_n(bits))))
+                }
+                None => lut[bits as usize],
+            })
+            .collect::<Vec<_>>(),
+    );
     let srgb8: Vec<f32> = (0..=255_u8)
         .map(|b| srgb_to_linear(f32::from(b) / 255.0))
         .collect();
     let linear8: Vec<f32> = (0..=255_u8).map(|b| f32::from(b) / 255.0).collect();
-    let chi8: Vec<f32> = (0..=255_u16)
-        .map(|q| {
-            manifest.n_encoding.map_or(0.0, |e| {
-                reflectance::chi_f32(model, approx, e.decode(q.min((1 << e.bits) - 1)))
+    let chi8 = split(
+        &(0..=255_u16)
+            .map(|q| {
+                manifest.n_encoding.map_or([0.0; 2], |e| {
+                    reflectance::chi_parts_f32(model, approx, e.decode(q.min((1 << e.bits) - 1)))
+                })
             })
-        })
-        .collect();
+            .collect::<Vec<_>>(),
+    );
     // The source of each component: an 8-bit file's bytes, else a table.
     let colour_table: &[f32] = if format == Format::Png16 {
         &sixteen
@@ -115,11 +126,13 @@ pub(super) fn ka_error_of_set(
                 .unwrap_or(Read::Table(colour_table))
         }
     });
-    let n = if manifest.constants.n.is_some() {
-        Read::Table(chi)
-    } else {
-        in_file(stored, &[Comp::N], &chi8, &chi8).unwrap_or(Read::Table(&chi_of_set))
-    };
+    let n: [Read<'_>; 2] = std::array::from_fn(|k| {
+        if manifest.constants.n.is_some() {
+            Read::Table(&chi[k])
+        } else {
+            in_file(stored, &[Comp::N], &chi8[k], &chi8[k]).unwrap_or(Read::Table(&chi_of_set[k]))
+        }
+    });
     let w = manifest.width as usize;
     let (max, sum, count) = texels
         .par_chunks(w)
@@ -128,11 +141,14 @@ pub(super) fn ka_error_of_set(
             let (mut max, mut sum) = (0.0_f64, 0.0_f64);
             for (x, t) in row.iter().enumerate() {
                 let i = y * w + x;
-                let chi_t = chi[t.n as usize];
-                let chi_b = n.get(i, t.n);
+                let [chi_t, offset_t] = lut[t.n as usize];
+                let (chi_b, offset_b) = (n[0].get(i, t.n), n[1].get(i, t.n));
                 for c in 0..3 {
-                    let ka = diffuse * exact[t.kd[c] as usize] + exact[t.ks[c] as usize] * chi_t;
-                    let kb = diffuse * kd[c].get(i, t.kd[c]) + ks[c].get(i, t.ks[c]) * chi_b;
+                    let ka = diffuse * exact[t.kd[c] as usize]
+                        + exact[t.ks[c] as usize] * chi_t
+                        + offset_t;
+                    let kb =
+                        diffuse * kd[c].get(i, t.kd[c]) + ks[c].get(i, t.ks[c]) * chi_b + offset_b;
                     let err = if ka > 0.0 {
                         f64::from((kb - ka).abs() / ka)
                     } else {

@@ -1,5 +1,5 @@
-//! How a frame is laid out: one picture, a split, or two side by side, as parts that each
-//! name a pipeline, a scissor and a viewport.
+//! How a frame is laid out: one picture, a split, or two or three side by side, as parts that
+//! each name a pipeline, a scissor and a viewport.
 
 use super::PipelineKey;
 use crate::render::Compare;
@@ -30,7 +30,7 @@ impl DrawPart {
     }
 }
 
-/// How one frame shows the two shading models it compares.
+/// How one frame shows the shading models it compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Layout {
     /// One picture, one model (the left key's).
@@ -40,6 +40,8 @@ pub enum Layout {
     Split(u32),
     /// Two whole pictures, one per half of the target, seen by the one camera.
     SideBySide,
+    /// Three whole pictures, one per third of the target (the three models).
+    ThreeWay,
 }
 
 impl Layout {
@@ -52,13 +54,38 @@ impl Layout {
                 ((split_at.clamp(0.0, 1.0) * width as f32) as u32).min(width),
             )),
             Compare::SideBySide => Some(Self::SideBySide),
+            Compare::ThreeWay => Some(Self::ThreeWay),
             Compare::Difference => None,
         }
     }
 
-    /// The parts of a `(width, height)` frame: `left` and `right` are the two sides' pipelines.
-    pub fn parts(self, left: PipelineKey, right: PipelineKey, (w, h): (u32, u32)) -> Vec<DrawPart> {
+    /// The parts of a `(width, height)` frame: `keys` are the sides' pipelines from the left
+    /// (one used by `Single`, two by `Split` and `SideBySide`, three by `ThreeWay`).
+    pub fn parts(self, keys: [PipelineKey; 3], (w, h): (u32, u32)) -> Vec<DrawPart> {
         let whole = (0, 0, w, h);
+        let [left, right, _] = keys;
+        let columns = |count: u32| -> Vec<DrawPart> {
+            // Columns of equal width, so every picture has one aspect ratio; the spare pixels
+            // (at most count - 1) go between them.
+            let width = w / count;
+            keys.iter()
+                .take(count as usize)
+                .enumerate()
+                .map(|(i, &key)| {
+                    let x = if count == 1 {
+                        0
+                    } else {
+                        (w - width) * i as u32 / (count - 1)
+                    };
+                    let rect = (x, 0, width, h);
+                    DrawPart {
+                        key,
+                        scissor: rect,
+                        viewport: rect,
+                    }
+                })
+                .collect()
+        };
         match self {
             Self::Single => vec![DrawPart::whole(left, (w, h))],
             Self::Split(at) => {
@@ -76,23 +103,8 @@ impl Layout {
                     },
                 ]
             }
-            Self::SideBySide => {
-                // Two halves of equal width, so both pictures have one aspect ratio.
-                let half = w / 2;
-                let (a, b) = ((0, 0, half, h), (w - half, 0, half, h));
-                vec![
-                    DrawPart {
-                        key: left,
-                        scissor: a,
-                        viewport: a,
-                    },
-                    DrawPart {
-                        key: right,
-                        scissor: b,
-                        viewport: b,
-                    },
-                ]
-            }
+            Self::SideBySide => columns(2),
+            Self::ThreeWay => columns(3),
         }
     }
 }

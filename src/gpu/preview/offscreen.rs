@@ -14,10 +14,15 @@ pub struct Offscreen {
     pub size: (u32, u32),
     /// Linear floats even for shaded views (data views are always linear).
     pub linear: bool,
-    /// Single, or Phong and Blinn-Phong compared (split or side by side); the settings'
-    /// model is ignored when comparing.
+    /// Single, or models compared (split, side by side or all three); the settings' model is
+    /// ignored when comparing.
     pub layout: Layout,
+    /// The compared models from the left: the first two for a split or side by side.
+    pub models: [ShadingModel; 3],
 }
+
+/// The models a comparison shows unless told otherwise: Phong, Blinn-Phong, Cook-Torrance.
+pub const COMPARED_MODELS: [ShadingModel; 3] = ShadingModel::ALL;
 
 /// A rendered image read back from the GPU, row-major from the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,8 +49,8 @@ pub enum RenderedImage {
 
 impl Preview {
     /// Renders a frame offscreen and reads it back: sRGB bytes for shaded views unless
-    /// `linear`, linear floats otherwise. A compare layout draws Phong on the left (of the
-    /// split, or in the left half) and Blinn-Phong on the right.
+    /// `linear`, linear floats otherwise. A compare layout draws `offscreen.models` from the
+    /// left (of the split, or in the left half or third).
     ///
     /// # Errors
     /// When the size is zero or above the device's texture limit, or the read-back fails.
@@ -76,6 +81,7 @@ impl Preview {
             size: (width, height),
             linear,
             layout,
+            models,
         } = offscreen;
         let max = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
@@ -97,12 +103,11 @@ impl Preview {
         let depth = texture(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let key = PipelineKey::for_frame(settings, &maps.uniform, format);
         let parts = if layout == Layout::Single {
-            layout.parts(key, key, (width, height))
+            layout.parts([key; 3], (width, height))
         } else {
-            let side = |model| PipelineKey { model, ..key };
+            let settings_of = |model| FrameSettings { model, ..*settings };
             layout.parts(
-                side(ShadingModel::Phong),
-                side(ShadingModel::BlinnPhong),
+                models.map(|m| PipelineKey::for_frame(&settings_of(m), &maps.uniform, format)),
                 (width, height),
             )
         };

@@ -28,7 +28,7 @@ pub struct PipelineKey {
     pub ks_uniform: bool,
     /// `n` from the uniform value.
     pub n_uniform: bool,
-    /// Any specular at all (false when `k_s` is zero everywhere).
+    /// Any specular at all (false when `k_s` is zero everywhere, but never for Cook-Torrance).
     pub has_specular: bool,
     /// Colour target format.
     pub format: wgpu::TextureFormat,
@@ -64,12 +64,13 @@ impl PipelineKey {
     ) -> Self {
         Self {
             model: settings.model,
-            approx: settings.approx,
+            approx: settings.approx.for_model(settings.model),
             view: settings.view,
             kd_uniform: u.kd.is_some(),
             ks_uniform: u.ks.is_some(),
             n_uniform: u.n.is_some(),
-            has_specular: u.ks != Some([0.0; 3]),
+            // Cook-Torrance's Fresnel term reflects even where k_s (its F0) is zero.
+            has_specular: u.ks != Some([0.0; 3]) || settings.model == ShadingModel::CookTorrance,
             format,
         }
     }

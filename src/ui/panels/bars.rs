@@ -38,8 +38,7 @@ impl EditorState {
                 let v = maps.value(x, y);
                 let ka = |m, a| reflectance::ka(m, a, v.kd, v.ks, v.n);
                 let approx = self.doc.settings().approx;
-                let phong = ka(ShadingModel::Phong, approx);
-                let blinn = ka(ShadingModel::BlinnPhong, approx);
+                let [phong, blinn, ct] = ShadingModel::ALL.map(|m| ka(m, approx));
                 let model = self.doc.settings().model;
                 // Integrated on a worker, shown when it arrives: never on this thread.
                 let n_bits = maps.texel(x, y).n;
@@ -48,17 +47,17 @@ impl EditorState {
                     .get(ui.ctx(), model, n_bits)
                     .map_or_else(
                         || "...".to_string(),
-                        |chi| {
+                        |[chi1, chi0]| {
                             let diffuse = reflectance::diffuse_factor(AmbientApprox::Fast) as f32;
-                            format!("{:.4}", diffuse * v.kd.x + v.ks.x * chi as f32)
+                            format!("{:.4}", diffuse * v.kd.x + v.ks.x * chi1 as f32 + chi0 as f32)
                         },
                     );
                 ui.separator();
                 ui.label(format!(
-                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  exact {exact}",
-                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x
+                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  CT {:.4}  exact {exact}",
+                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x, ct.x
                 ))
-                .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), and the exact integral for the current model");
+                .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), Cook-Torrance (GGX) by kapaint's fit, and the exact integral for the current model");
             }
             if let Some(job) = &self.job {
                 ui.separator();

@@ -3,7 +3,7 @@
 use crate::model::Command;
 use crate::model::paint::GradientShape;
 use crate::model::texel::Channel;
-use crate::reflectance::{self, ShadingModel};
+use crate::reflectance;
 use crate::tools::{FillMode, ToolKind};
 use crate::ui::files::FilePurpose;
 use crate::ui::{EditorState, stamp_image, stamp_key};
@@ -149,10 +149,7 @@ impl EditorState {
                 .logarithmic(true)
                 .text("n"),
         );
-        let other = match self.doc.settings().model {
-            ShadingModel::Phong => ShadingModel::BlinnPhong,
-            ShadingModel::BlinnPhong => ShadingModel::Phong,
-        };
+        let other = reflectance::equivalent::counterpart(self.doc.settings().model);
         let eq = reflectance::equivalent::equivalent_exponent(
             self.doc.settings().model,
             f64::from(primary.n),

@@ -41,7 +41,7 @@ impl EditorState {
                 ui.end_row();
                 ui.label("");
                 egui::ComboBox::from_id_salt(("compare approx", name))
-                    .selected_text(side.approx.name())
+                    .selected_text(side.approx.for_model(side.model).name())
                     .width(COMBO_WIDTH)
                     .show_ui(ui, |ui| {
                         for a in AmbientApprox::ALL {
@@ -63,6 +63,9 @@ impl EditorState {
                         .text("Heat scale"),
                 )
                 .on_hover_text("The difference |left - right| shown white");
+            }
+            Compare::ThreeWay => {
+                ui.label("Phong, Blinn-Phong and Cook-Torrance, each with the left side's method");
             }
             Compare::Single | Compare::SideBySide => {}
         }
@@ -99,22 +102,33 @@ impl EditorState {
     pub(in crate::ui) fn view_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Shading");
         let mut model = self.doc.settings().model;
-        ui.horizontal(|ui| {
-            for m in ShadingModel::ALL {
-                ui.selectable_value(&mut model, m, model_label(m));
-            }
-        });
+        // The paper's two models on one row, Cook-Torrance below: rows of fixed content keep
+        // the panel's width the same from the first frame on.
+        for row in [&ShadingModel::PAPER[..], &[ShadingModel::CookTorrance]] {
+            ui.horizontal(|ui| {
+                for &m in row {
+                    ui.selectable_value(&mut model, m, model_label(m));
+                }
+            });
+        }
         if model != self.doc.settings().model {
             self.apply(Command::SetModel(model));
         }
         let mut approx = self.doc.settings().approx;
-        egui::ComboBox::from_label("Approximation")
-            .selected_text(approx.name())
-            .show_ui(ui, |ui| {
-                for a in AmbientApprox::ALL {
-                    ui.selectable_value(&mut approx, a, a.name());
-                }
-            });
+        ui.add_enabled_ui(model.has_paper_forms(), |ui| {
+            egui::ComboBox::from_label("Approximation")
+                .selected_text(approx.for_model(model).name())
+                .show_ui(ui, |ui| {
+                    for a in AmbientApprox::ALL {
+                        ui.selectable_value(&mut approx, a, a.name());
+                    }
+                });
+        })
+        .response
+        .on_disabled_hover_text(
+            "The paper printed no approximation for Cook-Torrance: its k_a always uses \
+             kapaint's fit (within 2e-5 of the exact integral)",
+        );
         if approx != self.doc.settings().approx {
             self.apply(Command::SetApprox(approx));
         }
@@ -251,6 +265,7 @@ pub(in crate::ui) fn model_label(model: ShadingModel) -> &'static str {
     match model {
         ShadingModel::Phong => "Phong (8)",
         ShadingModel::BlinnPhong => "Blinn-Phong (11)",
+        ShadingModel::CookTorrance => "Cook-Torrance",
     }
 }
 

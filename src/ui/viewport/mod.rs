@@ -39,6 +39,8 @@ impl Side {
         let model = match self.model {
             ShadingModel::Phong => "Phong (eq. 8)",
             ShadingModel::BlinnPhong => "Blinn-Phong (eq. 11)",
+            // The paper printed no form for it: the method is always kapaint's fit.
+            ShadingModel::CookTorrance => return "Cook-Torrance (GGX), fast".to_owned(),
         };
         format!("{model}, {}", self.approx.name())
     }
@@ -92,8 +94,8 @@ pub struct Viewport {
     /// Why the last frame could not be drawn (a map beyond the GPU's limits, a lost device).
     pub gpu_error: Option<String>,
     frame_pending: bool,
-    /// The compare mode the camera was last framed for.
-    framed_for: Compare,
+    /// How many pictures side by side the camera was last framed for.
+    framed_columns: usize,
 }
 
 impl Viewport {
@@ -107,7 +109,7 @@ impl Viewport {
             no_gpu: "The 3D preview needs a GPU (wgpu); painting on the mesh still works.".into(),
             gpu_error: None,
             frame_pending: true,
-            framed_for: Compare::Single,
+            framed_columns: 1,
         }
     }
 
@@ -116,20 +118,18 @@ impl Viewport {
         self.frame_pending = true;
     }
 
-    /// The picture under `pos`: the whole viewport, or the half it is in when side by side.
+    /// The picture under `pos`: the whole viewport, or the half (third) it is in when side by
+    /// side (all three), laid out as the renderer's columns are.
     pub fn picture_at(&self, rect: Rect, pos: Pos2) -> Rect {
-        if self.comparison.mode != Compare::SideBySide {
+        let count = self.comparison.mode.columns();
+        if count == 1 {
             return rect;
         }
-        let half = rect.width() / 2.0;
-        if pos.x < rect.center().x {
-            Rect::from_min_size(rect.min, egui::vec2(half, rect.height()))
-        } else {
-            Rect::from_min_size(
-                Pos2::new(rect.max.x - half, rect.min.y),
-                egui::vec2(half, rect.height()),
-            )
-        }
+        let width = rect.width() / count as f32;
+        let column =
+            (((pos.x - rect.min.x) / width.max(1.0)).floor().max(0.0) as usize).min(count - 1);
+        let x = rect.min.x + (rect.width() - width) * column as f32 / (count - 1) as f32;
+        Rect::from_min_size(Pos2::new(x, rect.min.y), egui::vec2(width, rect.height()))
     }
 
     /// The surface point under a screen position, if the ray hits the mesh.
@@ -159,16 +159,15 @@ impl Viewport {
         if self.comparison.mode == Compare::Split {
             self.divider_ui(ui, rect);
         }
-        // Side by side halves the pictures' width: frame again when entering or leaving it.
-        if (self.comparison.mode == Compare::SideBySide) != (self.framed_for == Compare::SideBySide)
-        {
+        // Side by side halves (thirds) the pictures' width: frame again when it changes.
+        if self.comparison.mode.columns() != self.framed_columns {
             self.frame_pending = true;
         }
         if self.frame_pending {
             // Fit the bounding sphere in the narrower of the two fields of view (of one half
             // when side by side).
             self.frame_pending = false;
-            self.framed_for = self.comparison.mode;
+            self.framed_columns = self.comparison.mode.columns();
             self.camera = self.camera.framing(&mesh.1.positions);
             let picture = self.picture_at(rect, rect.min);
             let aspect = picture.width() / picture.height().max(1.0);

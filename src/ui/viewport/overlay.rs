@@ -52,6 +52,20 @@ impl Viewport {
                 let mid = Pos2::new(rect.center().x + 8.0, rect.min.y + 8.0);
                 label(mid, egui::Align2::LEFT_TOP, c.right.label());
             }
+            Compare::ThreeWay => {
+                for (i, model) in crate::reflectance::ShadingModel::ALL
+                    .into_iter()
+                    .enumerate()
+                {
+                    let side = super::Side { model, ..c.left };
+                    let x = rect.min.x + rect.width() * i as f32 / 3.0 + 8.0;
+                    label(
+                        Pos2::new(x, rect.min.y + 8.0),
+                        egui::Align2::LEFT_TOP,
+                        side.label(),
+                    );
+                }
+            }
             Compare::Difference => {
                 label(
                     top_left,

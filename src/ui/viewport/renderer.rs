@@ -12,13 +12,14 @@ use super::{Compare, Comparison, Side};
 use crate::gpu::difference::{Difference, SIDE_FORMAT};
 use crate::gpu::maps::MapTextures;
 use crate::gpu::preview::{
-    DEPTH_FORMAT, DrawPart, Layout, MeshBuffers, Offscreen, PipelineKey, Preview, PreviewDrawData,
-    RenderedImage, begin_pass,
+    COMPARED_MODELS, DEPTH_FORMAT, DrawPart, Layout, MeshBuffers, Offscreen, PipelineKey, Preview,
+    PreviewDrawData, RenderedImage, begin_pass,
 };
 use crate::gpu::{Gpu, GpuError};
 use crate::mesh::Mesh;
 use crate::model::MaterialMaps;
 use crate::model::texel::MaterialValue;
+use crate::reflectance::ShadingModel;
 use crate::render::FrameSettings;
 
 /// GPU objects of the viewport.
@@ -95,6 +96,7 @@ impl ViewportGpu {
             size: (size, size),
             linear: false,
             layout: Layout::Single,
+            models: COMPARED_MODELS,
         };
         let renderer = self.renderer.renderer.read();
         let preview = &renderer.callback_resources.get::<Renderers>()?.preview;
@@ -189,11 +191,13 @@ impl ViewportGpu {
             return TextureId::default();
         };
         let key = PipelineKey::for_frame(settings, &maps.uniform, FORMAT);
-        let side = |s: Side, format| PipelineKey {
-            model: s.model,
-            approx: s.approx,
-            format,
-            ..key
+        let side = |s: Side, format| {
+            let settings = FrameSettings {
+                model: s.model,
+                approx: s.approx,
+                ..*settings
+            };
+            PipelineKey::for_frame(&settings, &maps.uniform, format)
         };
         let mut encoder = self
             .gpu
@@ -204,16 +208,26 @@ impl ViewportGpu {
         let view = target
             .color
             .create_view(&wgpu::TextureViewDescriptor::default());
-        let (left, right) = if comparison.mode == Compare::Single {
-            (key, key)
-        } else {
-            (
+        let keys = match comparison.mode {
+            Compare::Single => [key; 3],
+            // The three models, each with the left side's approximation.
+            Compare::ThreeWay => ShadingModel::ALL.map(|model| {
+                side(
+                    Side {
+                        model,
+                        ..comparison.left
+                    },
+                    FORMAT,
+                )
+            }),
+            _ => [
                 side(comparison.left, FORMAT),
                 side(comparison.right, FORMAT),
-            )
+                key,
+            ],
         };
         let parts = Layout::of(comparison.mode, comparison.split_at, size.0)
-            .map(|layout| layout.parts(left, right, size));
+            .map(|layout| layout.parts(keys, size));
         let frame = |parts: &[DrawPart]| {
             PreviewDrawData::new(preview, &self.gpu, mesh, maps, settings, parts)
         };

@@ -1,0 +1,52 @@
+//! kapaint's real-time approximation of the Cook-Torrance `[chi_1(n), chi_0(n)]`.
+//!
+//! Per octave of `x = n + 1`, one polynomial in the mantissa for each function, evaluated as a
+//! pair (a `vec2` Horner chain in the shaders): a few integer operations and one chain of
+//! multiply-adds, no division, no `powf`, no `ln`. How the constants are fitted is in
+//! [`super::fit`]; they are generated into `fast_coeffs.rs`, the one source for Rust and the
+//! shaders.
+//!
+//! # The mapping's limit
+//!
+//! `n` is clamped to [`N_MAX`] (`alpha = sqrt(2 / (N_MAX + 2)) ~= 1.41e-3`, a near mirror):
+//! the box average of a mirror is unbounded (`chi_1 + chi_0` grows like `ln(n) / pi^3`, see
+//! [`super`]), and a GGX lobe narrower than that is below what `f32` shading resolves. So
+//! `chi_1 <= 0.51` and `k_a <= 2/pi + 1` for every input, as for the other models.
+
+use super::fast_coeffs::{CHI_OCTAVES, DEGREE, OCTAVES};
+
+/// The largest exponent the Cook-Torrance model uses; larger values (and `+inf`) are clamped
+/// to it (the exact integrator reaches a little further, to the end of the fit's last
+/// octave).
+pub const N_MAX: f32 = 1.0e6;
+
+/// `[chi_1(n), chi_0(n)]` in `f32` for a sanitized `n >= 0`.
+#[inline]
+pub fn chi_f32(n: f32) -> [f32; 2] {
+    let x = n.min(N_MAX) + 1.0;
+    let bits = x.to_bits();
+    // x in [1, 2^20): the biased exponent is 127..127+OCTAVES-1.
+    let octave = ((bits >> 23) as usize).saturating_sub(127).min(OCTAVES - 1);
+    let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+    let s = 2.0 * mantissa - 3.0;
+    let coefficients = &CHI_OCTAVES[octave];
+    let mut g = coefficients[DEGREE];
+    for c in coefficients[..DEGREE].iter().rev() {
+        g = [g[0] * s + c[0], g[1] * s + c[1]];
+    }
+    g
+}
+
+/// `[chi_1(n), chi_0(n)]` in `f64` for a sanitized `n >= 0`, from the same constants.
+pub fn chi_f64(n: f64) -> [f64; 2] {
+    let x = n.min(f64::from(N_MAX)) + 1.0;
+    let bits = x.to_bits();
+    let octave = ((bits >> 52) as usize)
+        .saturating_sub(1023)
+        .min(OCTAVES - 1);
+    let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    let s = 2.0 * mantissa - 3.0;
+    CHI_OCTAVES[octave].iter().rev().fold([0.0; 2], |acc, c| {
+        [acc[0] * s + f64::from(c[0]), acc[1] * s + f64::from(c[1])]
+    })
+}
