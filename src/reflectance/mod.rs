@@ -322,20 +322,22 @@ pub fn derive_with<const OFFSET: bool>(
     let kd: &[f32] = bytemuck::cast_slice(kd);
     let ks: &[f32] = bytemuck::cast_slice(ks);
     let out: &mut [f32] = bytemuck::cast_slice_mut(out);
-    let mut chi3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS];
-    let mut offset3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS];
+    // One spare slot: with an offset, each texel's three copies are written as one four-wide
+    // store (the fourth overwritten by the next texel), which halves that loop's stores.
+    let mut chi3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS + 1];
+    let mut offset3 = [0.0_f32; 3 * DERIVE_BLOCK_TEXELS + 1];
     for (block, n_block) in n.chunks(DERIVE_BLOCK_TEXELS).enumerate() {
         let start = 3 * block * DERIVE_BLOCK_TEXELS;
         let len = 3 * n_block.len();
-        for ((c, z), &e) in chi3
-            .chunks_exact_mut(3)
-            .zip(offset3.chunks_exact_mut(3))
-            .zip(n_block)
-        {
-            let [slope, offset] = chi(e);
-            c.fill(slope);
-            if OFFSET {
-                z.fill(offset);
+        if OFFSET {
+            for (i, &e) in n_block.iter().enumerate() {
+                let [slope, offset] = chi(e);
+                chi3[3 * i..3 * i + 4].copy_from_slice(&[slope; 4]);
+                offset3[3 * i..3 * i + 4].copy_from_slice(&[offset; 4]);
+            }
+        } else {
+            for (c, &e) in chi3.chunks_exact_mut(3).zip(n_block) {
+                c.fill(chi(e)[0]);
             }
         }
         let o = &mut out[start..start + len];

@@ -13,6 +13,8 @@
 //! [`super`]), and a GGX lobe narrower than that is below what `f32` shading resolves. So
 //! `chi_1 <= 0.51` and `k_a <= 2/pi + 1` for every input, as for the other models.
 
+use glam::Vec4;
+
 use super::fast_coeffs::{CHI_OCTAVES, DEGREE, OCTAVES};
 
 /// The largest exponent the Cook-Torrance model uses; larger values (and `+inf`) are clamped
@@ -30,11 +32,14 @@ pub fn chi_f32(n: f32) -> [f32; 2] {
     let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
     let s = 2.0 * mantissa - 3.0;
     let coefficients = &CHI_OCTAVES[octave];
-    let mut g = coefficients[DEGREE];
-    for c in coefficients[..DEGREE].iter().rev() {
-        g = [g[0] * s + c[0], g[1] * s + c[1]];
+    // Both parts in the lanes of one SIMD register: one multiply and one add a step.
+    let lanes = |[a, b]: [f32; 2]| Vec4::new(a, b, 0.0, 0.0);
+    let s = Vec4::splat(s);
+    let mut g = lanes(coefficients[DEGREE]);
+    for &c in coefficients[..DEGREE].iter().rev() {
+        g = g * s + lanes(c);
     }
-    g
+    [g.x, g.y]
 }
 
 /// `[chi_1(n), chi_0(n)]` in `f64` for a sanitized `n >= 0`, from the same constants.
