@@ -319,6 +319,31 @@ fn cook_torrance_chi_prints_both_parts_and_refuses_the_paper_methods() {
         "{ka}"
     );
     assert!(v[0] > 5e-4 && v[0] == v[1], "{ka}");
+    // accuracy and bench take one model too.
+    let only = stdout(&kapaint(&[
+        "accuracy",
+        "--points",
+        "3",
+        "--model",
+        "cook-torrance",
+    ]));
+    assert!(
+        only.contains("| chi1 | fast |") && !only.contains("| phong"),
+        "{only}"
+    );
+    let only = stdout(&kapaint(&[
+        "bench",
+        "--size",
+        "16",
+        "--repeats",
+        "1",
+        "--model",
+        "phong",
+    ]));
+    assert!(
+        only.contains("| phong | fast |") && !only.contains("cook-torrance"),
+        "{only}"
+    );
 }
 
 #[test]

@@ -93,3 +93,79 @@ fn karis_fit_is_far_from_this_integral() {
         "{chi1:?} {chi0:?}"
     );
 }
+
+/// A Cook-Torrance project exports like the others: the manifest names the model and its fit,
+/// the measured k_a error counts `chi_0`, and the shader snippets evaluate its k_a.
+#[test]
+fn a_cook_torrance_set_names_its_model_and_measures_its_k_a() {
+    use glam::{Vec2, Vec3};
+    use kapaint::export::{preset, set};
+    use kapaint::model::brush::StrokePoint;
+    use kapaint::model::texel::MaterialValue;
+    use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+    let mut doc = Document::new(
+        160,
+        96,
+        DocumentSettings {
+            base: MaterialValue::new(Vec3::new(0.6, 0.5, 0.4), Vec3::splat(0.04), 20.0),
+            model: CT,
+            // Ignored by Cook-Torrance: the set must say "fast".
+            approx: AmbientApprox::PaperPrinted,
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("doc");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.9, 0.1, 0.05),
+        Vec3::splat(0.9),
+        3000.0,
+    )))
+    .expect("primary");
+    doc.apply(Command::Stroke {
+        tool: StrokeTool::Brush,
+        points: [10.0, 150.0]
+            .map(|x| StrokePoint {
+                pos: Vec2::new(x, 50.0),
+                pressure: 1.0,
+            })
+            .to_vec(),
+    })
+    .expect("stroke");
+    let dir = std::env::temp_dir().join(format!("kapaint-ct-export-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("set");
+    let m = set::export(&doc, &preset::find("compact").expect("preset"), &out).expect("export");
+    assert_eq!(m.model, CT);
+    assert_eq!(m.approximation.name, "fast");
+    let json = std::fs::read_to_string(out.join("material.json")).expect("manifest");
+    assert!(json.contains("\"cook-torrance\""), "{json}");
+    for snippet in ["material.wgsl", "material.glsl"] {
+        let text = std::fs::read_to_string(out.join(snippet)).expect("snippet");
+        assert!(text.contains("MODEL_COOK_TORRANCE"), "{snippet}");
+        assert!(text.contains("chi_cook_torrance"), "{snippet}");
+    }
+    // The reported k_a error is what a round trip through the files gives, chi_0 included.
+    let back = set::import(&out.join("material.json")).expect("import");
+    let mut worst = 0.0_f64;
+    for y in 0..doc.maps().height() {
+        for x in 0..doc.maps().width() {
+            let (p, q) = (doc.maps().value(x, y), back.maps().value(x, y));
+            let ka = |v: MaterialValue| {
+                kapaint::reflectance::ka(CT, AmbientApprox::Fast, v.kd, v.ks, v.n).as_dvec3()
+            };
+            let (a, b) = (ka(p), ka(q));
+            worst = worst.max(((b - a) / a).abs().max_element());
+        }
+    }
+    assert!(
+        m.ka_error.max > 0.0 && m.ka_error.max < 0.05,
+        "{:?}",
+        m.ka_error
+    );
+    assert!(
+        worst <= m.ka_error.max + 1e-3,
+        "{worst} vs {:?}",
+        m.ka_error
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

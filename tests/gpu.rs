@@ -542,6 +542,17 @@ fn render_cli_writes_numerically_checkable_data_views() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `kapaint render` of one uniform test material with `args`, written to `out`.
+fn render_material(args: &[&str], out: &std::path::Path) -> std::process::Output {
+    let mut all = vec!["render", "--kd", "0.6,0.3,0.2", "--ks", "0.4", "--n", "80"];
+    all.extend(args);
+    all.extend(["--out", out.to_str().expect("path")]);
+    std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(&all)
+        .output()
+        .expect("runs")
+}
+
 /// `kapaint render --model cook-torrance`: its k_a view, a difference against Phong chosen by
 /// `--sides`, and all three models side by side.
 #[test]
@@ -549,70 +560,53 @@ fn render_cli_draws_cook_torrance_and_all_three_models() {
     let Some(_gpu) = gpu() else { return };
     let dir = std::env::temp_dir().join(format!("kapaint-render-ct-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
-    let run = |args: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
-            .args(args)
-            .output()
-            .expect("runs")
-    };
-    let material = ["--kd", "0.6,0.3,0.2", "--ks", "0.4", "--n", "80"];
     let ct = dir.join("ct.exr");
-    let mut args = vec![
-        "render",
-        "--model",
-        "cook-torrance",
-        "--view",
-        "ka",
-        "--size",
-        "32",
-    ];
-    args.extend(material);
-    args.extend(["--out", ct.to_str().expect("path")]);
-    assert!(run(&args).status.success());
+    let o = render_material(
+        &["--model", "cook-torrance", "--view", "ka", "--size", "32"],
+        &ct,
+    );
+    assert!(o.status.success(), "{o:?}");
+    let value = MaterialValue::new(Vec3::new(0.6, 0.3, 0.2), Vec3::splat(0.4), 80.0);
     let want = reflectance::ka(
         ShadingModel::CookTorrance,
         AmbientApprox::Fast,
-        MaterialValue::new(Vec3::new(0.6, 0.3, 0.2), Vec3::splat(0.4), 80.0).kd,
-        Vec3::splat(0.4),
-        80.0,
+        value.kd,
+        value.ks,
+        value.n,
     );
     let image = image::open(&ct).expect("EXR decodes").to_rgba32f();
     let p = image.pixels().find(|p| p[3] > 0.0).expect("covered");
     assert!((p[0] - want[0]).abs() <= 1e-4 * want[0], "{p:?} vs {want}");
-    let diff = dir.join("diff.png");
-    let mut args = vec![
-        "render",
-        "--model",
-        "compare-diff",
-        "--sides",
-        "phong,cook-torrance",
-        "--view",
-        "shaded",
-        "--size",
-        "32",
-    ];
-    args.extend(material);
-    args.extend(["--out", diff.to_str().expect("path")]);
-    let o = run(&args);
-    assert!(
-        String::from_utf8_lossy(&o.stdout).contains("|phong - cook-torrance|"),
-        "{o:?}"
+    let o = render_material(
+        &[
+            "--model",
+            "compare-diff",
+            "--sides",
+            "phong,cook-torrance",
+            "--view",
+            "shaded",
+            "--size",
+            "32",
+        ],
+        &dir.join("diff.png"),
     );
+    let says =
+        |o: &std::process::Output, what: &str| String::from_utf8_lossy(&o.stdout).contains(what);
+    assert!(says(&o, "|phong - cook-torrance|"), "{o:?}");
     let three = dir.join("three.png");
-    let mut args = vec![
-        "render",
-        "--model",
-        "compare-three",
-        "--view",
-        "shaded",
-        "--size",
-        "96x32",
-    ];
-    args.extend(material);
-    args.extend(["--out", three.to_str().expect("path")]);
-    let o = run(&args);
+    let o = render_material(
+        &[
+            "--model",
+            "compare-three",
+            "--view",
+            "shaded",
+            "--size",
+            "96x32",
+        ],
+        &three,
+    );
     assert!(
-        String::from_utf8_lossy(&o.stdout).contains("phong, blinn, cook-torrance side by side"),
+        says(&o, "phong, blinn, cook-torrance side by side"),
         "{o:?}"
     );
     let three = image::open(&three).expect("PNG decodes").to_rgba8();
@@ -623,17 +617,17 @@ fn render_cli_draws_cook_torrance_and_all_three_models() {
             .count();
         assert!(covered > 200, "a sphere in the third at {x0}: {covered}");
     }
-    let o = run(&[
-        "render",
-        "--model",
-        "compare-side",
-        "--sides",
-        "phong,cook",
-        "--view",
-        "ka",
-        "--out",
-        "z.png",
-    ]);
+    let o = render_material(
+        &[
+            "--model",
+            "compare-side",
+            "--sides",
+            "phong,cook",
+            "--view",
+            "ka",
+        ],
+        &dir.join("z.png"),
+    );
     assert_eq!(o.status.code(), Some(2), "{o:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }

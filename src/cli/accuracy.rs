@@ -1,6 +1,8 @@
 //! `kapaint accuracy`: the error of every approximation against the exact integrator.
 
 use super::CliError;
+use super::args::ModelArg;
+use crate::reflectance::ShadingModel;
 use crate::report::accuracy;
 
 /// Most sample points `kapaint accuracy` takes per range (each costs an exact integral per
@@ -13,6 +15,9 @@ pub struct AccuracyArgs {
     /// Sample points per n range (2 to 256, spaced evenly in ln(n + 1)).
     #[arg(long, default_value_t = 96)]
     points: usize,
+    /// Only this model's tables (default: all three).
+    #[arg(long, value_enum)]
+    model: Option<ModelArg>,
 }
 
 impl AccuracyArgs {
@@ -27,6 +32,9 @@ impl AccuracyArgs {
                 "--points must be 2 to {MAX_ACCURACY_POINTS}, got {points}"
             )));
         }
-        Ok(accuracy::accuracy_report(&accuracy::Grid::standard(points)).markdown())
+        let models = self
+            .model
+            .map_or(ShadingModel::ALL.to_vec(), |m| vec![m.into()]);
+        Ok(accuracy::accuracy_report(&accuracy::Grid::standard(points), &models).markdown())
     }
 }

@@ -4,6 +4,8 @@
 use std::path::PathBuf;
 
 use super::CliError;
+use super::args::ModelArg;
+use crate::reflectance::ShadingModel;
 use crate::report::bench;
 
 /// Time the k_a derive of a full map per method against its error and a memory copy.
@@ -18,6 +20,9 @@ pub struct BenchArgs {
     /// Timing repetitions (the best is kept).
     #[arg(long, default_value_t = 3)]
     repeats: usize,
+    /// Only this model's rows (default: all three).
+    #[arg(long, value_enum)]
+    model: Option<ModelArg>,
 }
 
 impl BenchArgs {
@@ -37,7 +42,10 @@ impl BenchArgs {
                 CliError::of_io(format!("cannot create {}: {e}", dir.display()), &e)
             })?;
         }
-        let rows = bench::run(size, self.repeats, 48);
+        let models = self
+            .model
+            .map_or(ShadingModel::ALL.to_vec(), |m| vec![m.into()]);
+        let rows = bench::run(size, self.repeats, 48, &models);
         let table = bench::markdown(&rows, size);
         if let Some(dir) = self.out {
             let csv = dir.join("bench.csv");

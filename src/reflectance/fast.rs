@@ -56,11 +56,7 @@ pub fn chi_f32_with(table: FastTable, n: f32) -> f32 {
         let [a, b, c] = *tail;
         return (a * x.ln() + b + c / x.sqrt()) / x;
     }
-    let bits = x.to_bits();
-    // x in [1, 2^OCTAVES): the biased exponent is 127..127+OCTAVES-1.
-    let octave = ((bits >> 23) as usize).saturating_sub(127).min(OCTAVES - 1);
-    let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    let s = 2.0 * mantissa - 3.0;
+    let (octave, s) = octave_f32(x, OCTAVES);
     let coefficients = &octaves[octave];
     let mut g = coefficients[DEGREE];
     for k in (0..DEGREE).rev() {
@@ -77,15 +73,33 @@ pub fn chi_f64(model: ShadingModel, n: f64) -> f64 {
         let [a, b, c] = tail.map(f64::from);
         return (a * x.ln() + b + c / x.sqrt()) / x;
     }
-    let bits = x.to_bits();
-    let octave = ((bits >> 52) as usize)
-        .saturating_sub(1023)
-        .min(OCTAVES - 1);
-    let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-    let s = 2.0 * mantissa - 3.0;
+    let (octave, s) = octave_f64(x, OCTAVES);
     let g = octaves[octave]
         .iter()
         .rev()
         .fold(0.0, |acc, &c| acc * s + f64::from(c));
     g / x
+}
+
+/// The octave of `x >= 1` (its binary exponent, at most `octaves - 1`) and the position in it,
+/// `s = 2 mantissa - 3 in [-1, 1)`: from the float's bits, no `log2`. The fits of both
+/// families are polynomials in `s` per octave.
+#[inline]
+pub fn octave_f32(x: f32, octaves: usize) -> (usize, f32) {
+    let bits = x.to_bits();
+    // x in [1, 2^octaves): the biased exponent is 127..127+octaves-1.
+    let octave = ((bits >> 23) as usize).saturating_sub(127).min(octaves - 1);
+    let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+    (octave, 2.0 * mantissa - 3.0)
+}
+
+/// [`octave_f32`] in `f64`.
+#[inline]
+pub fn octave_f64(x: f64, octaves: usize) -> (usize, f64) {
+    let bits = x.to_bits();
+    let octave = ((bits >> 52) as usize)
+        .saturating_sub(1023)
+        .min(octaves - 1);
+    let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    (octave, 2.0 * mantissa - 3.0)
 }

@@ -194,18 +194,22 @@ pub struct AccuracyRow {
 pub struct AccuracyReport {
     /// Every model and approximation on every grid.
     pub rows: Vec<AccuracyRow>,
-    /// Eq. (11)'s exponent on the first grid (the paper's `[1, 200]`).
-    pub exponent: ExponentCheck,
+    /// Eq. (11)'s exponent on the first grid (the paper's `[1, 200]`), when Blinn-Phong is
+    /// measured.
+    pub exponent: Option<ExponentCheck>,
     /// Cook-Torrance's two parts, every method on every grid.
     pub cook_torrance: Vec<CtAccuracyRow>,
 }
 
-/// Measures every model and approximation on every grid (at least one), evaluating the
+/// Measures every approximation of `models` on every grid (at least one), evaluating the
 /// exact integrator once per model and grid.
-pub fn accuracy_report(grids: &[Grid]) -> AccuracyReport {
+pub fn accuracy_report(grids: &[Grid], models: &[ShadingModel]) -> AccuracyReport {
     let mut rows = Vec::new();
     let mut exponent = None;
-    for model in ShadingModel::PAPER {
+    for model in ShadingModel::PAPER
+        .into_iter()
+        .filter(|m| models.contains(m))
+    {
         for (i, grid) in grids.iter().enumerate() {
             let exact = ExactSamples::compute(model, grid);
             for approx in AmbientApprox::ALL {
@@ -221,14 +225,21 @@ pub fn accuracy_report(grids: &[Grid]) -> AccuracyReport {
             }
         }
     }
-    let exponent = exponent.unwrap_or_else(|| {
-        exponent_check(&ExactSamples::compute(
-            ShadingModel::BlinnPhong,
-            &Grid::log_spaced(1.0, 200.0, 32),
-        ))
+    let exponent = models.contains(&ShadingModel::BlinnPhong).then(|| {
+        exponent.unwrap_or_else(|| {
+            exponent_check(&ExactSamples::compute(
+                ShadingModel::BlinnPhong,
+                &Grid::log_spaced(1.0, 200.0, 32),
+            ))
+        })
     });
     let mut cook_torrance = Vec::new();
-    for grid in grids {
+    let ct_grids = if models.contains(&ShadingModel::CookTorrance) {
+        grids
+    } else {
+        &[]
+    };
+    for grid in ct_grids {
         let exact = CtSamples::compute(grid);
         for (method, approx) in cook_torrance_methods() {
             for (part, stats) in ["chi1", "chi0"].into_iter().zip(exact.stats(approx)) {
@@ -249,14 +260,19 @@ pub fn accuracy_report(grids: &[Grid]) -> AccuracyReport {
 }
 
 impl AccuracyReport {
-    /// The three tables as markdown.
+    /// The tables of the models measured, as markdown, one blank line between them.
     pub fn markdown(&self) -> String {
-        format!(
-            "{}\n{}\n{}",
-            markdown(&self.rows),
-            exponent_markdown(&self.exponent),
-            cook_torrance_markdown(&self.cook_torrance)
-        )
+        let mut tables = Vec::new();
+        if !self.rows.is_empty() {
+            tables.push(markdown(&self.rows));
+        }
+        if let Some(check) = &self.exponent {
+            tables.push(exponent_markdown(check));
+        }
+        if !self.cook_torrance.is_empty() {
+            tables.push(cook_torrance_markdown(&self.cook_torrance));
+        }
+        tables.join("\n")
     }
 }
 
@@ -279,7 +295,7 @@ pub fn cook_torrance_markdown(rows: &[CtAccuracyRow]) -> String {
         );
     }
     out.push_str(
-        "\nkaris: Karis' environment-BRDF fit (UE4, 2014) as k_s A + B, roughness sqrt(alpha), \
+        "\nkaris: Karis' environment-BRDF fit (Unreal Engine 4, 2014) as k_s A + B, roughness sqrt(alpha), \
          at N.V = 2/pi or averaged over the box's views. It fits another lighting setup (the \
          solid-angle, N.L-weighted hemisphere seen from one view), so its error here is what \
          a user would get by using it for this ambient term, not the fit's own error.\n",

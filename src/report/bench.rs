@@ -114,8 +114,13 @@ pub fn bytes_needed(size: usize) -> u64 {
     (size as u64).pow(2) * BYTES_PER_TEXEL
 }
 
-/// Runs the whole bench on `size x size` maps.
-pub fn run(size: usize, repeats: usize, error_points: usize) -> Vec<BenchRow> {
+/// Runs the whole bench on `size x size` maps, for `models` (the copy baseline always).
+pub fn run(
+    size: usize,
+    repeats: usize,
+    error_points: usize,
+    models: &[ShadingModel],
+) -> Vec<BenchRow> {
     let texels = size * size;
     let maps = BenchMaps::new(texels);
     let mut out = vec![Vec3::ZERO; texels];
@@ -141,7 +146,10 @@ pub fn run(size: usize, repeats: usize, error_points: usize) -> Vec<BenchRow> {
         std::hint::black_box(&out);
         times
     };
-    for model in ShadingModel::PAPER {
+    for model in ShadingModel::PAPER
+        .into_iter()
+        .filter(|m| models.contains(m))
+    {
         let exact = ExactSamples::compute(model, &grid);
         for approx in AmbientApprox::ALL {
             let times = time(
@@ -157,41 +165,43 @@ pub fn run(size: usize, repeats: usize, error_points: usize) -> Vec<BenchRow> {
         }
     }
     let ct = ShadingModel::CookTorrance;
-    let exact = CtSamples::compute(&grid);
-    let fast = time(
-        &|out| derive_ka(ct, AmbientApprox::Fast, &maps.kd, &maps.ks, &maps.n, out),
-        &|out| derive_ka_par(ct, AmbientApprox::Fast, &maps.kd, &maps.ks, &maps.n, out),
-    );
-    let karis_derive = |out: &mut [Vec3], start: usize| {
-        let range = start..start + out.len();
-        derive_with::<true>(
-            &maps.kd[range.clone()],
-            &maps.ks[range.clone()],
-            &maps.n[range],
-            out,
-            TWO_OVER_PI as f32,
-            karis::chi_karis_f32,
+    if models.contains(&ct) {
+        let exact = CtSamples::compute(&grid);
+        let fast = time(
+            &|out| derive_ka(ct, AmbientApprox::Fast, &maps.kd, &maps.ks, &maps.n, out),
+            &|out| derive_ka_par(ct, AmbientApprox::Fast, &maps.kd, &maps.ks, &maps.n, out),
         );
-    };
-    let karis_times = time(&|out| karis_derive(out, 0), &|out| {
-        out.par_chunks_mut(DERIVE_CHUNK_TEXELS)
-            .enumerate()
-            .for_each(|(i, chunk)| karis_derive(chunk, i * DERIVE_CHUNK_TEXELS));
-    });
-    row(
-        ct,
-        AmbientApprox::Fast.name(),
-        exact.max_rel(|n| {
-            crate::reflectance::chi_parts_f32(ct, AmbientApprox::Fast, n as f32).map(f64::from)
-        }),
-        fast,
-    );
-    row(
-        ct,
-        "karis",
-        exact.max_rel(|n| karis::chi_karis_f32(n as f32).map(f64::from)),
-        karis_times,
-    );
+        let karis_derive = |out: &mut [Vec3], start: usize| {
+            let range = start..start + out.len();
+            derive_with::<true>(
+                &maps.kd[range.clone()],
+                &maps.ks[range.clone()],
+                &maps.n[range],
+                out,
+                TWO_OVER_PI as f32,
+                karis::chi_karis_f32,
+            );
+        };
+        let karis_times = time(&|out| karis_derive(out, 0), &|out| {
+            out.par_chunks_mut(DERIVE_CHUNK_TEXELS)
+                .enumerate()
+                .for_each(|(i, chunk)| karis_derive(chunk, i * DERIVE_CHUNK_TEXELS));
+        });
+        row(
+            ct,
+            AmbientApprox::Fast.name(),
+            exact.max_rel(|n| {
+                crate::reflectance::chi_parts_f32(ct, AmbientApprox::Fast, n as f32).map(f64::from)
+            }),
+            fast,
+        );
+        row(
+            ct,
+            "karis",
+            exact.max_rel(|n| karis::chi_karis_f32(n as f32).map(f64::from)),
+            karis_times,
+        );
+    }
     rows
 }
 

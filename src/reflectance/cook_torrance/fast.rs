@@ -16,6 +16,7 @@
 use glam::Vec4;
 
 use super::fast_coeffs::{CHI_OCTAVES, DEGREE, OCTAVES};
+use crate::reflectance::fast::{octave_f32, octave_f64};
 
 /// The largest exponent the Cook-Torrance model uses; larger values (and `+inf`) are clamped
 /// to it (the exact integrator reaches a little further, to the end of the fit's last
@@ -26,11 +27,7 @@ pub const N_MAX: f32 = 1.0e6;
 #[inline]
 pub fn chi_f32(n: f32) -> [f32; 2] {
     let x = n.min(N_MAX) + 1.0;
-    let bits = x.to_bits();
-    // x in [1, 2^20): the biased exponent is 127..127+OCTAVES-1.
-    let octave = ((bits >> 23) as usize).saturating_sub(127).min(OCTAVES - 1);
-    let mantissa = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    let s = 2.0 * mantissa - 3.0;
+    let (octave, s) = octave_f32(x, OCTAVES);
     let coefficients = &CHI_OCTAVES[octave];
     // Both parts in the lanes of one SIMD register: one multiply and one add a step.
     let lanes = |[a, b]: [f32; 2]| Vec4::new(a, b, 0.0, 0.0);
@@ -45,12 +42,7 @@ pub fn chi_f32(n: f32) -> [f32; 2] {
 /// `[chi_1(n), chi_0(n)]` in `f64` for a sanitized `n >= 0`, from the same constants.
 pub fn chi_f64(n: f64) -> [f64; 2] {
     let x = n.min(f64::from(N_MAX)) + 1.0;
-    let bits = x.to_bits();
-    let octave = ((bits >> 52) as usize)
-        .saturating_sub(1023)
-        .min(OCTAVES - 1);
-    let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-    let s = 2.0 * mantissa - 3.0;
+    let (octave, s) = octave_f64(x, OCTAVES);
     CHI_OCTAVES[octave].iter().rev().fold([0.0; 2], |acc, c| {
         [acc[0] * s + f64::from(c[0]), acc[1] * s + f64::from(c[1])]
     })
