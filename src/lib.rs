@@ -12,6 +12,7 @@ pub mod gpu;
 pub mod memory;
 pub mod mesh;
 pub mod model;
+pub mod pbr;
 pub mod reflectance;
 pub mod render;
 pub mod report;

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 /// The rooms that must stay free of the GUI and GPU crates.
-const PURE: [&str; 5] = ["model", "reflectance", "mesh", "render", "tools"];
+const PURE: [&str; 6] = ["model", "reflectance", "mesh", "render", "tools", "pbr"];
 
 /// What a file of those rooms may not name.
 const FORBIDDEN: [&str; 6] = [

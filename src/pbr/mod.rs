@@ -1,0 +1,181 @@
+//! PBR interop (issue 20): glTF's metallic-roughness materials to and from kapaint's
+//! `k_d`, `k_s`, `n`.
+//!
+//! Per texel, in linear light (glTF 2.0's metallic-roughness model):
+//!
+//! ```text
+//! k_d = base (1 - metallic)
+//! k_s = F0 = mix(0.04, base, metallic)          per colour channel
+//! alpha = roughness^2                            glTF's GGX roughness
+//! n = 2 / alpha^2 - 2                            the inverse of alpha = sqrt(2 / (n + 2))
+//! ```
+//!
+//! The last line is the Cook-Torrance model's own mapping ([`crate::reflectance::cook_torrance`]),
+//! so a PBR material shaded by that model needs no conversion at all. `n` is clamped to the
+//! painted range `[0, 16384]` (roughness below 0.105 is a mirror there).
+//!
+//! The inverse ([`from_material`]) is exact where the forward mapping made the values: since
+//! `k_d + k_s = base + 0.04 (1 - metallic)`, metallic solves a quadratic in the channels' means
+//! and `base = k_d + k_s - 0.04 (1 - metallic)` follows without a division.
+
+use glam::Vec3;
+
+use crate::model::texel::{MaterialValue, N_MAX};
+
+/// The dielectric `F0` of the metallic-roughness model.
+pub const DIELECTRIC_F0: f32 = 0.04;
+
+/// One texel of a metallic-roughness material, linear light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pbr {
+    /// Base colour, linear RGB in `[0, 1]`.
+    pub base: Vec3,
+    /// Metallic factor in `[0, 1]`.
+    pub metallic: f32,
+    /// Perceptual roughness in `[0, 1]` (`alpha = roughness^2`).
+    pub roughness: f32,
+}
+
+/// `x` clamped into `[0, 1]`, NaN to 0.
+fn unit(x: f32) -> f32 {
+    crate::reflectance::sanitize_coefficient(x)
+}
+
+/// The Phong exponent of a glTF roughness under the Cook-Torrance mapping: `2 / r^4 - 2`,
+/// clamped to `[0, N_MAX]`.
+pub fn n_of_roughness(roughness: f32) -> f32 {
+    let r = unit(roughness);
+    let alpha2 = (r * r) * (r * r);
+    if alpha2 <= 2.0 / (N_MAX + 2.0) {
+        return N_MAX;
+    }
+    (2.0 / alpha2 - 2.0).clamp(0.0, N_MAX)
+}
+
+/// The glTF roughness of a Phong exponent: `(2 / (n + 2))^(1/4)`, the inverse of
+/// [`n_of_roughness`] on its range.
+pub fn roughness_of_n(n: f32) -> f32 {
+    let n = crate::reflectance::sanitize_n_f32(n);
+    (2.0 / (n + 2.0)).sqrt().sqrt()
+}
+
+/// A PBR texel as kapaint's material (the Cook-Torrance mapping of roughness).
+pub fn to_material(p: Pbr) -> MaterialValue {
+    let base = p.base.map(unit);
+    let m = unit(p.metallic);
+    MaterialValue::new(
+        base * (1.0 - m),
+        Vec3::splat(DIELECTRIC_F0).lerp(base, m),
+        n_of_roughness(p.roughness),
+    )
+}
+
+/// The metallic factor from `k_d` and `k_s`: a root in `[0, 1]` of
+/// `0.04 m^2 + (D + S - 0.08) m - (S - 0.04) = 0`, with `D`, `S` the channels' means (what
+/// `S = 0.04 + m (D / (1 - m) - 0.04)` becomes).
+///
+/// Where `S >= 0.04` the one non-negative root (0 for a dielectric). Below, only a metal with a
+/// dark base reaches `S`, and the two roots are two readings that shade the same (a darker
+/// base, less metal): the larger is taken, so a metal comes back a metal. Values no texel of
+/// the model has (no real root) take the `m` nearest to one, the vertex.
+pub fn metallic_of(kd: Vec3, ks: Vec3) -> f32 {
+    let f0 = DIELECTRIC_F0;
+    let (d, s) = (
+        kd.map(unit).element_sum() / 3.0,
+        ks.map(unit).element_sum() / 3.0,
+    );
+    let b = d + s - 2.0 * f0;
+    let c = s - f0;
+    let disc = b * b + 4.0 * f0 * c;
+    let m = if c >= -1e-6 {
+        // The positive root without cancellation: 2c / (b + sqrt(b^2 + 0.16 c)); 0 at c = 0.
+        if c <= 0.0 {
+            0.0
+        } else {
+            2.0 * c / (b + disc.sqrt())
+        }
+    } else if disc >= 0.0 {
+        (-b + disc.sqrt()) / (2.0 * f0)
+    } else {
+        -b / (2.0 * f0)
+    };
+    unit(m)
+}
+
+/// kapaint's material as a PBR texel: the inverse of [`to_material`] (exact where
+/// `to_material` made the values; elsewhere the nearest metallic-roughness reading).
+pub fn from_material(v: MaterialValue) -> Pbr {
+    let (kd, ks) = (v.kd.map(unit), v.ks.map(unit));
+    let m = metallic_of(kd, ks);
+    Pbr {
+        base: (kd + ks - Vec3::splat(DIELECTRIC_F0 * (1.0 - m))).map(unit),
+        metallic: m,
+        roughness: roughness_of_n(v.n),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_inverse_gives_back_the_material_and_pure_dielectrics_and_metals() {
+        for base in [
+            Vec3::new(0.8, 0.3, 0.1),
+            Vec3::splat(0.5),
+            Vec3::ZERO,
+            Vec3::ONE,
+            Vec3::new(0.02, 0.9, 0.4),
+        ] {
+            for metallic in [0.0, 1.0, 0.5, 0.2] {
+                for roughness in [1.0, 0.6, 0.3, 0.12] {
+                    let p = Pbr {
+                        base,
+                        metallic,
+                        roughness,
+                    };
+                    let v = to_material(p);
+                    let back = from_material(MaterialValue::new(v.kd, v.ks, v.n));
+                    let what = format!("{p:?} -> {v:?} -> {back:?}");
+                    assert!((back.roughness - roughness).abs() < 1e-4, "{what}");
+                    // Always the same k_d and k_s again: the same shading.
+                    let again = to_material(back);
+                    assert!((again.kd - v.kd).abs().max_element() < 1e-5, "{what}");
+                    assert!((again.ks - v.ks).abs().max_element() < 1e-5, "{what}");
+                    // Pure dielectrics and metals come back as they were (a dark base with
+                    // metallic in between has a twin reading, a darker base and less metal,
+                    // that shades the same).
+                    if metallic == 0.0 || metallic == 1.0 {
+                        assert!((back.base - base).abs().max_element() < 1e-5, "{what}");
+                        assert!((back.metallic - metallic).abs() < 1e-5, "{what}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn roughness_maps_onto_the_cook_torrance_alpha() {
+        for r in [0.2_f32, 0.5, 0.9, 1.0] {
+            let n = n_of_roughness(r);
+            let alpha = crate::reflectance::cook_torrance::alpha(f64::from(n));
+            assert!(
+                (alpha - f64::from(r * r)).abs() < 1e-5,
+                "r = {r}: alpha {alpha}"
+            );
+        }
+        // A mirror is the painted range's end; hostile values are finite.
+        assert_eq!(n_of_roughness(0.0), N_MAX);
+        assert_eq!(n_of_roughness(f32::NAN), N_MAX);
+        assert_eq!(n_of_roughness(7.0), 0.0);
+        let v = to_material(Pbr {
+            base: Vec3::splat(f32::NAN),
+            metallic: f32::INFINITY,
+            roughness: -1.0,
+        });
+        assert!(
+            v.kd.is_finite() && v.ks.is_finite() && v.n.is_finite(),
+            "{v:?}"
+        );
+    }
+}
