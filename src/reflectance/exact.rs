@@ -87,8 +87,7 @@ pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
         ShadingModel::BlinnPhong => blinn(&rule, n),
         // chi_1, the part that scales with k_s; see `super::cook_torrance` for both parts.
         ShadingModel::CookTorrance => {
-            let n = n.min(f64::from(super::cook_torrance::fast::N_MAX));
-            super::cook_torrance::chi_exact_at_level(n, level)[0]
+            super::cook_torrance::chi_exact_at_level(cook_torrance_n(n), level)[0]
         }
     }
 }
@@ -98,11 +97,19 @@ pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
 pub fn chi_parts_exact(model: ShadingModel, n: f64) -> [f64; 2] {
     if model == ShadingModel::CookTorrance {
         count_call();
-        // The model's limit (the integrator itself reaches a little further).
-        let n = if n.is_nan() { 0.0 } else { n };
-        super::cook_torrance::chi_exact(n.min(f64::from(super::cook_torrance::fast::N_MAX)))
+        super::cook_torrance::chi_exact(cook_torrance_n(n))
     } else {
         [chi_exact(model, n), 0.0]
+    }
+}
+
+/// `n` within the Cook-Torrance model's limit [`super::cook_torrance::fast::N_MAX`] (the
+/// integrator itself reaches a little further, to the end of the fit's last octave); NaN is 0.
+fn cook_torrance_n(n: f64) -> f64 {
+    if n.is_nan() {
+        0.0
+    } else {
+        n.min(f64::from(super::cook_torrance::fast::N_MAX))
     }
 }
 

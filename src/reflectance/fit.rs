@@ -49,8 +49,7 @@ impl FastFit {
             let [a, b, c] = self.tail;
             return (a * x.ln() + b + c / x.sqrt()) / x;
         }
-        let octave = x.log2().floor().clamp(0.0, (FIT_OCTAVES - 1) as f64) as usize;
-        let s = 2.0 * x / (1u64 << octave) as f64 - 3.0;
+        let (octave, s) = super::fast::octave_f64(x, FIT_OCTAVES);
         horner(&self.octaves[octave], s) / x
     }
 }
@@ -81,6 +80,16 @@ pub fn octave_node_xs(octaves: usize, nodes: &[f64]) -> Vec<f64> {
     xs.sort_by(f64::total_cmp);
     xs.dedup();
     xs
+}
+
+/// Samples `sample` once at each of `xs` (ascending; in parallel) and returns the lookup of a
+/// sampled `x`: the truth a fit's octaves are interpolated from.
+pub fn sampled_at<T: Copy + Send>(
+    xs: Vec<f64>,
+    sample: impl Fn(f64) -> T + Sync,
+) -> impl Fn(f64) -> T {
+    let values: Vec<T> = xs.par_iter().map(|&x| sample(x)).collect();
+    move |x| values[xs.partition_point(|&v| v < x)]
 }
 
 /// `g(x) = x chi(x - 1)` by the exact integrator.
@@ -131,11 +140,7 @@ pub fn fit_with(model: ShadingModel, degree: usize, sample: impl Fn(f64) -> f64 
     // Every octave's nodes; shared end points are evaluated once.
     let mut xs = octave_node_xs(FIT_OCTAVES, &nodes);
     xs.push(TAIL_MATCH_X);
-    let values: Vec<f64> = xs.par_iter().map(|&x| sample(x)).collect();
-    let lookup = |x: f64| -> f64 {
-        let i = xs.partition_point(|&v| v < x);
-        values[i]
-    };
+    let lookup = sampled_at(xs, sample);
     let octaves = (0..FIT_OCTAVES)
         .map(|octave| {
             let ys: Vec<f64> = nodes.iter().map(|&s| lookup(node_x(octave, s))).collect();

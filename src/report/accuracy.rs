@@ -88,26 +88,15 @@ impl CtSamples {
 
     /// The error statistics of `approx(n) = [chi_1, chi_0]`, for each part.
     pub fn stats(&self, approx: impl Fn(f64) -> [f64; 2]) -> [ErrorStats; 2] {
-        let mut stats = [0, 1].map(|_| ErrorStats {
-            max_rel: 0.0,
-            max_at_n: 0.0,
-            mean_rel: 0.0,
-        });
-        for &(n, exact) in &self.samples {
-            let got = approx(n);
-            for (k, s) in stats.iter_mut().enumerate() {
-                let err = (got[k] / exact[k] - 1.0).abs();
-                s.mean_rel += err;
-                if err > s.max_rel {
-                    s.max_rel = err;
-                    s.max_at_n = n;
-                }
-            }
-        }
-        for s in &mut stats {
-            s.mean_rel /= self.samples.len().max(1) as f64;
-        }
-        stats
+        let got: Vec<[f64; 2]> = self.samples.iter().map(|&(n, _)| approx(n)).collect();
+        [0, 1].map(|k| {
+            ErrorStats::of(
+                self.samples
+                    .iter()
+                    .zip(&got)
+                    .map(|(&(n, exact), got)| (n, got[k], exact[k])),
+            )
+        })
     }
 
     /// The larger of the two parts' maximum relative errors.
@@ -158,22 +147,36 @@ pub struct ErrorStats {
 
 /// The relative error statistics of `approx` (evaluated in `f32`, as a renderer would).
 pub fn error_stats(approx: AmbientApprox, exact: &ExactSamples) -> ErrorStats {
-    let mut stats = ErrorStats {
-        max_rel: 0.0,
-        max_at_n: 0.0,
-        mean_rel: 0.0,
-    };
-    for &(n, chi) in &exact.samples {
-        let approx_chi = f64::from(chi_f32(exact.model, approx, n as f32));
-        let err = (approx_chi / chi - 1.0).abs();
-        stats.mean_rel += err;
-        if err > stats.max_rel {
-            stats.max_rel = err;
-            stats.max_at_n = n;
+    ErrorStats::of(
+        exact
+            .samples
+            .iter()
+            .map(|&(n, chi)| (n, f64::from(chi_f32(exact.model, approx, n as f32)), chi)),
+    )
+}
+
+impl ErrorStats {
+    /// The statistics of `(n, approximation, exact)` triples: the relative error
+    /// `|approx / exact - 1|`, its largest value and where, and its mean.
+    pub fn of(points: impl Iterator<Item = (f64, f64, f64)>) -> Self {
+        let mut stats = Self {
+            max_rel: 0.0,
+            max_at_n: 0.0,
+            mean_rel: 0.0,
+        };
+        let mut count = 0_usize;
+        for (n, approx, exact) in points {
+            let err = (approx / exact - 1.0).abs();
+            stats.mean_rel += err;
+            count += 1;
+            if err > stats.max_rel {
+                stats.max_rel = err;
+                stats.max_at_n = n;
+            }
         }
+        stats.mean_rel /= count.max(1) as f64;
+        stats
     }
-    stats.mean_rel /= exact.samples.len().max(1) as f64;
-    stats
 }
 
 /// One row of the accuracy table.

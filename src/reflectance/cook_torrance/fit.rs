@@ -12,9 +12,10 @@
 //! `x = 2^20` ([`super::EXACT_N_MAX`] + 1), past the model's limit [`super::fast::N_MAX`] where
 //! `n` is clamped (see [`super::fast`]).
 
-use rayon::prelude::*;
-
-use crate::reflectance::fit::{horner, interpolate, lobatto_nodes, node_x, octave_node_xs};
+use crate::reflectance::fast::octave_f64;
+use crate::reflectance::fit::{
+    horner, interpolate, lobatto_nodes, node_x, octave_node_xs, sampled_at,
+};
 
 /// Octaves covered by polynomials: `x = n + 1 in [1, 2^20)`.
 pub const CT_FIT_OCTAVES: usize = 20;
@@ -35,9 +36,7 @@ pub struct CtFit {
 impl CtFit {
     /// `[chi_1(n), chi_0(n)]` of the fit in `f64`, `n` clamped into the fitted octaves.
     pub fn chi(&self, n: f64) -> [f64; 2] {
-        let x = n.clamp(0.0, TOP_N) + 1.0;
-        let octave = x.log2().floor().clamp(0.0, (CT_FIT_OCTAVES - 1) as f64) as usize;
-        let s = 2.0 * x / (1u64 << octave) as f64 - 3.0;
+        let (octave, s) = octave_f64(n.clamp(0.0, TOP_N) + 1.0, CT_FIT_OCTAVES);
         self.octaves[octave].each_ref().map(|c| horner(c, s))
     }
 }
@@ -46,9 +45,7 @@ impl CtFit {
 /// truth (the exact integrator for the shipped constants, a cheaper reference when exploring).
 pub fn fit_ct_with(degree: usize, sample: impl Fn(f64) -> [f64; 2] + Sync) -> CtFit {
     let nodes = lobatto_nodes(degree);
-    let xs = octave_node_xs(CT_FIT_OCTAVES, &nodes);
-    let values: Vec<[f64; 2]> = xs.par_iter().map(|&x| sample(x)).collect();
-    let lookup = |x: f64| values[xs.partition_point(|&v| v < x)];
+    let lookup = sampled_at(octave_node_xs(CT_FIT_OCTAVES, &nodes), sample);
     let octaves = (0..CT_FIT_OCTAVES)
         .map(|octave| {
             let ys: Vec<[f64; 2]> = nodes.iter().map(|&s| lookup(node_x(octave, s))).collect();
