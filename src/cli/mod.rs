@@ -22,6 +22,7 @@ mod edit;
 mod equivalent_n;
 mod export;
 mod import;
+mod import_pbr;
 mod import_set;
 mod info;
 mod ka;
@@ -121,6 +122,9 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Rebuild a project from an exported set.
     ImportSet(import_set::ImportSetArgs),
+    /// Convert a PBR texture set (glTF material, metallic-roughness or specular-glossiness
+    /// images, or numbers) into a project, and print the conversion error.
+    ImportPbr(import_pbr::ImportPbrArgs),
     /// The exponent of the other model whose highlight matches (CSV "n,equivalent").
     EquivalentN(equivalent_n::EquivalentNArgs),
     /// Render the preview headless (no window, no display) into a PNG or EXR.
@@ -210,6 +214,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
         Command::Paint(a) => a.run(),
         Command::Export(a) => a.run(),
         Command::ImportSet(a) => a.run(),
+        Command::ImportPbr(a) => a.run(),
         Command::EquivalentN(a) => a.run(),
         Command::Render(a) => a.run(),
         Command::MeshInfo(a) => a.run(),

@@ -19,8 +19,19 @@ use super::{MAX_TRIANGLES, Mesh, MeshError};
 /// Deepest node hierarchy followed (deeper means a cycle or an absurd file).
 const MAX_DEPTH: usize = 64;
 
-/// Loads a `.gltf` or `.glb` file.
-pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
+/// A glTF file opened and checked: its document, its buffers' bytes and its folder.
+pub struct Opened {
+    /// The document, validated.
+    pub document: gltf::Document,
+    /// Every buffer's bytes, by index.
+    pub buffers: Vec<Vec<u8>>,
+    /// The folder that relative URIs are taken from.
+    pub dir: std::path::PathBuf,
+}
+
+/// Opens a `.gltf` or `.glb` file: its references checked and its buffers loaded (from the
+/// GLB blob, data: URIs, or files beside it). Errors are one line.
+pub fn open_gltf(path: &Path) -> Result<Opened, MeshError> {
     let invalid = |reason: String| MeshError::Invalid {
         path: path.to_path_buf(),
         reason,
@@ -36,8 +47,25 @@ pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let buffers = load_buffers(&document, dir, blob).map_err(&invalid)?;
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let buffers = load_buffers(&document, &dir, blob).map_err(&invalid)?;
+    Ok(Opened {
+        document,
+        buffers,
+        dir,
+    })
+}
+
+/// Loads a `.gltf` or `.glb` file.
+pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
+    let invalid = |reason: String| MeshError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let Opened {
+        document, buffers, ..
+    } = open_gltf(path)?;
     let buffers: Vec<&[u8]> = buffers.iter().map(Vec::as_slice).collect();
 
     // The default scene (else the first; else every mesh once, untransformed). A node graph
@@ -211,6 +239,25 @@ fn load_buffers(
 /// A buffer file named by a relative `uri`, confined to `dir`; at most `declared` bytes.
 fn read_buffer_file(dir: &Path, uri: &str, declared: u64) -> Result<Vec<u8>, String> {
     use std::io::Read as _;
+    let file = file_beside(dir, uri)?;
+    let len = crate::file_check::regular_file(&file, super::MAX_FILE_BYTES)
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    if len < declared {
+        return Err(format!(
+            "{} holds {len} bytes but the buffer's byteLength is {declared} (truncated?)",
+            file.display()
+        ));
+    }
+    let mut data = Vec::with_capacity(declared as usize);
+    std::fs::File::open(&file)
+        .and_then(|f| f.take(declared).read_to_end(&mut data))
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    Ok(data)
+}
+
+/// The file a relative `uri` names, confined to `dir` (no URI schemes, no absolute paths,
+/// no `..`, no links out of it).
+pub fn file_beside(dir: &Path, uri: &str) -> Result<std::path::PathBuf, String> {
     use std::path::Component;
     if uri.contains(':') {
         return Err(format!(
@@ -237,19 +284,7 @@ fn read_buffer_file(dir: &Path, uri: &str, declared: u64) -> Result<Vec<u8>, Str
             "{uri:?} links outside the glTF's folder, which is not followed"
         ));
     }
-    let len = crate::file_check::regular_file(&file, super::MAX_FILE_BYTES)
-        .map_err(|e| format!("{}: {e}", file.display()))?;
-    if len < declared {
-        return Err(format!(
-            "{} holds {len} bytes but the buffer's byteLength is {declared} (truncated?)",
-            file.display()
-        ));
-    }
-    let mut data = Vec::with_capacity(declared as usize);
-    std::fs::File::open(&file)
-        .and_then(|f| f.take(declared).read_to_end(&mut data))
-        .map_err(|e| format!("{}: {e}", file.display()))?;
-    Ok(data)
+    Ok(file)
 }
 
 /// Walks the node tree, accumulating transforms.

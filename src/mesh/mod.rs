@@ -7,7 +7,7 @@
 
 pub mod bake;
 mod builtin;
-mod gltf_import;
+pub mod gltf_import;
 mod obj;
 pub mod pick;
 

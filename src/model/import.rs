@@ -48,7 +48,50 @@ pub fn read_image(path: &Path) -> Result<DynamicImage, ModelError> {
         other => fail(format!("the file {other}")),
     })?;
     let mut file = std::fs::File::open(path).map_err(|e| ModelError::io(path, e))?;
-    let reader = image::ImageReader::new(std::io::BufReader::new(&mut file))
+    let (image, format) = decode(std::io::BufReader::new(&mut file), path)?;
+    if format == image::ImageFormat::Jpeg
+        && !jpeg_ends(&mut file).map_err(|e| ModelError::io(path, e))?
+    {
+        return Err(truncated_jpeg(path));
+    }
+    Ok(image)
+}
+
+/// Decodes an image held in memory (one embedded in a glTF binary) with the import limits;
+/// `name` says where it came from in errors.
+pub fn decode_bytes(bytes: &[u8], name: &Path) -> Result<DynamicImage, ModelError> {
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(ModelError::Image {
+            path: name.to_path_buf(),
+            reason: format!("it is {} bytes, more than an image may be", bytes.len()),
+        });
+    }
+    let (image, format) = decode(std::io::Cursor::new(bytes), name)?;
+    let tail = &bytes[bytes.len().saturating_sub(JPEG_TAIL_BYTES as usize)..];
+    if format == image::ImageFormat::Jpeg && !tail.windows(2).any(|w| w == [0xFF, 0xD9]) {
+        return Err(truncated_jpeg(name));
+    }
+    Ok(image)
+}
+
+fn truncated_jpeg(path: &Path) -> ModelError {
+    ModelError::Image {
+        path: path.to_path_buf(),
+        reason: "the JPEG is truncated (it has no end-of-image marker)".into(),
+    }
+}
+
+/// Decodes with the limits: the size from the header is checked before anything is
+/// allocated.
+fn decode(
+    reader: impl std::io::BufRead + std::io::Seek,
+    path: &Path,
+) -> Result<(DynamicImage, image::ImageFormat), ModelError> {
+    let fail = |reason: String| ModelError::Image {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let reader = image::ImageReader::new(reader)
         .with_guessed_format()
         .map_err(|e| ModelError::io(path, e))?;
     let Some(format) = reader.format() else {
@@ -78,14 +121,7 @@ pub fn read_image(path: &Path) -> Result<DynamicImage, ModelError> {
         image::ImageError::Limits(l) => too_large(l.to_string()),
         other => fail(decode_error(&other)),
     })?;
-    if format == image::ImageFormat::Jpeg
-        && !jpeg_ends(&mut file).map_err(|e| ModelError::io(path, e))?
-    {
-        return Err(fail(
-            "the JPEG is truncated (it has no end-of-image marker)".into(),
-        ));
-    }
-    Ok(image)
+    Ok((image, format))
 }
 
 /// Whether a JPEG file holds its end-of-image marker (`FF D9`) near its end. Inside the
@@ -120,7 +156,7 @@ fn one_line(text: &str) -> String {
 }
 
 /// Whether the decoded image holds linear floats (EXR) rather than sRGB-encoded integers.
-fn is_float(image: &DynamicImage) -> bool {
+pub fn is_float(image: &DynamicImage) -> bool {
     matches!(
         image,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
@@ -207,57 +243,79 @@ impl ChannelPlanes {
     }
 }
 
-/// The image filtered to `width x height`, a band of tile rows at a time (in parallel): each
-/// band streams its source rows through the horizontal filter into the few output rows they
-/// feed. Row-major RGB per band.
+/// A triangle filter from an image's size to a map's, applied a band of tile rows at a time:
+/// each band streams its source rows through the horizontal filter into the few output rows
+/// they feed, so no float copy of the whole image is made.
+pub struct Resampler {
+    xs: Vec<(u32, Vec<f32>)>,
+    ys: Vec<(u32, Vec<f32>)>,
+    width: usize,
+    height: usize,
+}
+
+impl Resampler {
+    /// The filter from `source` (width, height) to `width x height`.
+    pub fn new(source: (u32, u32), width: u32, height: u32) -> Self {
+        // A decoder never hands over an empty image; if one came, it would read as black.
+        let (sw, sh) = (source.0.max(1), source.1.max(1));
+        Self {
+            xs: triangle_taps(sw, width),
+            ys: triangle_taps(sh, height),
+            width: width as usize,
+            height: height as usize,
+        }
+    }
+
+    /// Tile row `ty` of `image` (the size the filter was made for) filtered: row-major RGB
+    /// samples as the image holds them (integers scaled to `[0, 1]`, floats as they are).
+    pub fn band(&self, image: &DynamicImage, ty: usize) -> Vec<[f32; 3]> {
+        let (w, ys, xs) = (self.width, &self.ys, &self.xs);
+        let y0 = ty * TILE_SIZE;
+        let y1 = (y0 + TILE_SIZE).min(self.height);
+        let mut acc = vec![[0.0_f32; 3]; y1.saturating_sub(y0) * w];
+        if image.width() == 0 || y1 <= y0 {
+            return acc;
+        }
+        let mut source = vec![[0.0_f32; 3]; image.width() as usize];
+        let mut filtered = vec![[0.0_f32; 3]; w];
+        let first = ys[y0].0;
+        let last = ys[y1 - 1].0 + ys[y1 - 1].1.len() as u32;
+        for sy in first..last.min(image.height()) {
+            source_row(image, sy, &mut source);
+            for (x, (left, weights)) in xs.iter().enumerate() {
+                let mut sum = [0.0_f32; 3];
+                for (k, wgt) in weights.iter().enumerate() {
+                    let p = source[*left as usize + k];
+                    for c in 0..3 {
+                        sum[c] += p[c] * wgt;
+                    }
+                }
+                filtered[x] = sum;
+            }
+            for y in y0..y1 {
+                let (top, weights) = &ys[y];
+                let Some(wgt) = sy.checked_sub(*top).and_then(|k| weights.get(k as usize)) else {
+                    continue;
+                };
+                let row = &mut acc[(y - y0) * w..(y - y0 + 1) * w];
+                for (a, f) in row.iter_mut().zip(&filtered) {
+                    for c in 0..3 {
+                        a[c] += f[c] * wgt;
+                    }
+                }
+            }
+        }
+        acc
+    }
+}
+
+/// The image filtered to `width x height`, a band of tile rows at a time (in parallel).
 fn filtered_bands(image: &DynamicImage, width: u32, height: u32) -> Vec<Vec<[f32; 3]>> {
-    // A decoder never hands over an empty image; if one came, it would read as black.
-    let (sw, sh) = (image.width().max(1), image.height().max(1));
-    let xs = triangle_taps(sw, width);
-    let ys = triangle_taps(sh, height);
+    let resampler = Resampler::new((image.width(), image.height()), width, height);
     let tiles_y = (height as usize).div_ceil(TILE_SIZE);
-    let w = width as usize;
     (0..tiles_y)
         .into_par_iter()
-        .map(|ty| {
-            let y0 = ty * TILE_SIZE;
-            let y1 = (y0 + TILE_SIZE).min(height as usize);
-            let mut acc = vec![[0.0_f32; 3]; (y1 - y0) * w];
-            let mut source = vec![[0.0_f32; 3]; sw as usize];
-            if image.width() == 0 {
-                return acc;
-            }
-            let mut filtered = vec![[0.0_f32; 3]; w];
-            let first = ys[y0].0;
-            let last = ys[y1 - 1].0 + ys[y1 - 1].1.len() as u32;
-            for sy in first..last.min(image.height()) {
-                source_row(image, sy, &mut source);
-                for (x, (left, weights)) in xs.iter().enumerate() {
-                    let mut sum = [0.0_f32; 3];
-                    for (k, wgt) in weights.iter().enumerate() {
-                        let p = source[*left as usize + k];
-                        for c in 0..3 {
-                            sum[c] += p[c] * wgt;
-                        }
-                    }
-                    filtered[x] = sum;
-                }
-                for y in y0..y1 {
-                    let (top, weights) = &ys[y];
-                    let Some(wgt) = sy.checked_sub(*top).and_then(|k| weights.get(k as usize))
-                    else {
-                        continue;
-                    };
-                    let row = &mut acc[(y - y0) * w..(y - y0 + 1) * w];
-                    for (a, f) in row.iter_mut().zip(&filtered) {
-                        for c in 0..3 {
-                            a[c] += f[c] * wgt;
-                        }
-                    }
-                }
-            }
-            acc
-        })
+        .map(|ty| resampler.band(image, ty))
         .collect()
 }
 
@@ -341,7 +399,7 @@ pub(super) fn resample_as(
 
 /// Gives the texels of a tile outside the map (past `cols` columns or `rows` rows) the value
 /// of its first texel, so that a tile of one value inside the map is stored as one value.
-fn fill_outside<T: Copy>(data: &mut [T], (cols, rows): (usize, usize)) {
+pub(crate) fn fill_outside<T: Copy>(data: &mut [T], (cols, rows): (usize, usize)) {
     if cols == TILE_SIZE && rows == TILE_SIZE {
         return;
     }

@@ -15,6 +15,7 @@ pub mod mips;
 pub mod paint;
 pub mod preset;
 pub mod project;
+pub mod provenance;
 pub mod recovery;
 pub mod resize;
 pub mod simd;

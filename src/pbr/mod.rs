@@ -20,10 +20,20 @@
 
 use glam::Vec3;
 
+pub mod convert;
+pub mod fit;
+pub mod gltf;
+pub mod import;
+mod table;
+
 use crate::model::texel::{MaterialValue, N_MAX};
 
 /// The dielectric `F0` of the metallic-roughness model.
 pub const DIELECTRIC_F0: f32 = 0.04;
+
+/// How far below the dielectric `F0` a mean `k_s` still reads as a dielectric: a unorm16 step
+/// (`k_s` is stored as unorm16, so 0.04 comes back as 0.039994).
+const F0_TOLERANCE: f32 = 1.0 / 65535.0;
 
 /// One texel of a metallic-roughness material, linear light.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,7 +97,9 @@ pub fn metallic_of(kd: Vec3, ks: Vec3) -> f32 {
     let b = d + s - 2.0 * f0;
     let c = s - f0;
     let disc = b * b + 4.0 * f0 * c;
-    let m = if c >= -1e-6 {
+    // Within storage precision of the dielectric F0 (unorm16 rounds 0.04 to 0.039994) is a
+    // dielectric: the dark-metal reading below is for values clearly under it.
+    let m = if c >= -F0_TOLERANCE {
         // The positive root without cancellation: 2c / (b + sqrt(b^2 + 0.16 c)); 0 at c = 0.
         if c <= 0.0 {
             0.0
@@ -151,6 +163,36 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// A dark dielectric as the project stores it (unorm16 rounds `k_s = 0.04` down to
+    /// 0.039994) was read as a metal with a dark base, metallic 0.93 (found on the spot cow's
+    /// texture).
+    #[test]
+    fn a_stored_dark_dielectric_stays_a_dielectric() {
+        use crate::model::texel::{decode_rgb, encode_rgb};
+        for base in [
+            Vec3::splat(0.0),
+            Vec3::splat(0.004),
+            Vec3::new(0.01, 0.002, 0.0),
+        ] {
+            let v = to_material(Pbr {
+                base,
+                metallic: 0.0,
+                roughness: 0.5,
+            });
+            let stored = MaterialValue::new(
+                decode_rgb(encode_rgb(v.kd)),
+                decode_rgb(encode_rgb(v.ks)),
+                v.n,
+            );
+            let back = from_material(stored);
+            assert!(back.metallic < 1e-3, "{base}: {back:?}");
+            assert!(
+                (back.base - base).abs().max_element() < 1e-4,
+                "{base}: {back:?}"
+            );
         }
     }
 

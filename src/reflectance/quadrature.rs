@@ -139,20 +139,10 @@ impl TanhSinh {
 }
 
 impl TanhSinh {
-    /// [`Self::integrate_pieces`] with the integrand evaluated in parallel. The terms are
-    /// summed in a fixed order afterwards, so the result does not depend on the thread count.
-    pub fn integrate_pieces_par(&self, breaks: &[f64], f: impl Fn(f64) -> f64 + Sync) -> f64 {
-        let [v] = self.integrate_pieces_par_n(breaks, |x| [f(x)]);
-        v
-    }
-
-    /// [`Self::integrate_pieces_par`] of `K` integrands at once.
-    pub fn integrate_pieces_par_n<const K: usize>(
-        &self,
-        breaks: &[f64],
-        f: impl Fn(f64) -> [f64; K] + Sync,
-    ) -> [f64; K] {
-        use rayon::prelude::*;
+    /// The rule's nodes and weights over consecutive intervals between sorted break points,
+    /// as `(x, weight)`: `sum weight * f(x)` is [`Self::integrate_pieces`] of `f`. Nodes that
+    /// round onto an end point are left out.
+    pub fn points(&self, breaks: &[f64]) -> Vec<(f64, f64)> {
         let mut terms: Vec<(f64, f64)> = Vec::new();
         for w in breaks.windows(2) {
             let (a, b) = (w[0], w[1]);
@@ -171,6 +161,24 @@ impl TanhSinh {
                 }
             }
         }
+        terms
+    }
+
+    /// [`Self::integrate_pieces`] with the integrand evaluated in parallel. The terms are
+    /// summed in a fixed order afterwards, so the result does not depend on the thread count.
+    pub fn integrate_pieces_par(&self, breaks: &[f64], f: impl Fn(f64) -> f64 + Sync) -> f64 {
+        let [v] = self.integrate_pieces_par_n(breaks, |x| [f(x)]);
+        v
+    }
+
+    /// [`Self::integrate_pieces_par`] of `K` integrands at once.
+    pub fn integrate_pieces_par_n<const K: usize>(
+        &self,
+        breaks: &[f64],
+        f: impl Fn(f64) -> [f64; K] + Sync,
+    ) -> [f64; K] {
+        use rayon::prelude::*;
+        let terms = self.points(breaks);
         let values: Vec<[f64; K]> = terms
             .par_iter()
             .map(|&(x, w)| f(x).map(|v| w * v))

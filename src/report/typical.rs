@@ -157,3 +157,40 @@ pub fn under_paint() -> MaterialValue {
         900.0,
     )
 }
+
+/// Writes a `side x side` metallic-roughness set into `dir` as a PBR tool would export it:
+/// `base.png` (sRGB, `texture` resampled, or a colour ramp without one) and
+/// `metallic_roughness.png` (roughness in G, a ramp from 0.1 to 1 across; metallic in B,
+/// 0 on the left half and 1 on the right, so both pure cases occur). Returns both paths.
+///
+/// # Errors
+/// A texture that does not read, or a failed write.
+pub fn write_pbr_set(
+    dir: &Path,
+    side: u32,
+    texture: Option<&Path>,
+) -> Result<(std::path::PathBuf, std::path::PathBuf), String> {
+    let base = match texture {
+        Some(t) => {
+            let image = import::read_image(t).map_err(|e| e.to_string())?;
+            image::imageops::resize(
+                &image.to_rgb8(),
+                side,
+                side,
+                image::imageops::FilterType::Triangle,
+            )
+        }
+        None => image::RgbImage::from_fn(side, side, |x, y| {
+            image::Rgb([(x * 255 / side) as u8, (y * 255 / side) as u8, 128])
+        }),
+    };
+    let mr = image::RgbImage::from_fn(side, side, |x, y| {
+        let rough = 0.1 + 0.9 * (y as f32 + 0.5) / side as f32;
+        let metal = if x < side / 2 { 0 } else { 255 };
+        image::Rgb([0, (rough * 255.0).round() as u8, metal])
+    });
+    let (b, m) = (dir.join("base.png"), dir.join("metallic_roughness.png"));
+    base.save(&b).map_err(|e| e.to_string())?;
+    mr.save(&m).map_err(|e| e.to_string())?;
+    Ok((b, m))
+}

@@ -116,6 +116,9 @@ pub struct DocumentSettings {
     /// The material preset the document was made from, if any.
     #[serde(deserialize_with = "super::check::optional_name")]
     pub preset: Option<String>,
+    /// The PBR import the maps were made by, with its measured conversion error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub import: Option<super::provenance::ImportReport>,
 }
 
 impl Default for DocumentSettings {
@@ -135,6 +138,7 @@ impl Default for DocumentSettings {
             brush: BrushSettings::default(),
             mesh: MeshRef::Sphere,
             preset: None,
+            import: None,
         }
     }
 }

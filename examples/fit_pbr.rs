@@ -1,0 +1,59 @@
+//! Regenerates `src/pbr/table.rs`: the fitted exponent per roughness for each target model and
+//! the conversion-error tables (see `kapaint::pbr::fit`), printing each row's fit to stderr.
+//!
+//! Usage: `cargo run --release --example fit_pbr > src/pbr/table.rs`
+
+use kapaint::pbr::fit::{LEVEL, LobeSamples, ct_n, fit_curve, render_rust, table_roughness};
+
+fn main() {
+    if let Some(level) = std::env::args().nth(1).and_then(|a| a.parse::<u32>().ok()) {
+        check(level);
+        return;
+    }
+    let started = std::time::Instant::now();
+    eprintln!(
+        "roughness  n (Phong, Blinn-Phong, Cook-Torrance)  lobe distance / mean (fitted; unconstrained)"
+    );
+    let rows = fit_curve(&table_roughness(), LEVEL, |row| {
+        eprintln!(
+            "{:.4}  {:9.3} {:9.3} {:9.3}  {:.3} {:.3} {:.3}; {:.3} {:.3}",
+            row.roughness,
+            row.n[0],
+            row.n[1],
+            row.n[2],
+            row.distance[0],
+            row.distance[1],
+            row.distance[2],
+            row.free_distance[0],
+            row.free_distance[1],
+        );
+    });
+    eprintln!(
+        "{} rows in {:.0} s",
+        rows.len(),
+        started.elapsed().as_secs_f64()
+    );
+    print!("{}", render_rust(&rows, LEVEL));
+}
+
+/// The box rule of `level` against the exact integrals: GGX's mean and Phong's `chi`.
+fn check(level: u32) {
+    use kapaint::reflectance::{ShadingModel, cook_torrance, exact};
+    for r in [1.0, 0.5, 0.25, 0.125, 1.0 / 32.0] {
+        let t = std::time::Instant::now();
+        let s = LobeSamples::new(r, level);
+        let m = s.ggx_means();
+        let ex = cook_torrance::chi_exact(ct_n(r).min(cook_torrance::EXACT_N_MAX));
+        let np = 2.0 / (r * r * r * r);
+        let phong = s.target_mean(ShadingModel::Phong, np)
+            / exact::chi_exact(ShadingModel::Phong, np)
+            - 1.0;
+        eprintln!(
+            "r {r:.4}: {} nodes, {:.2} s; GGX means {:+.1e} {:+.1e}; Phong chi({np:.0}) {phong:+.1e}",
+            s.len(),
+            t.elapsed().as_secs_f64(),
+            m[0] / ex[0] - 1.0,
+            m[1] / ex[1] - 1.0,
+        );
+    }
+}

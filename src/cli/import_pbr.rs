@@ -1,0 +1,213 @@
+//! `kapaint import-pbr`: a PBR texture set (glTF material, metallic-roughness or
+//! specular-glossiness images, or constants) converted into a project, with the conversion
+//! error of every texel measured.
+
+use std::path::{Path, PathBuf};
+
+use super::args::{ModelArg, parse_size};
+use super::{CliError, mesh_error, model_error};
+use crate::model::document::MeshRef;
+use crate::model::project;
+use crate::pbr::import::{ImportReport, PbrSet, Source};
+use crate::reflectance::ShadingModel;
+
+/// Convert a PBR texture set into a project.
+#[derive(Debug, clap::Args)]
+pub struct ImportPbrArgs {
+    /// Project file to write.
+    #[arg(long)]
+    out: PathBuf,
+    /// Map size, N or WxH (default: the largest input image's size).
+    #[arg(long)]
+    size: Option<String>,
+    /// The target model the set is converted for.
+    #[arg(long, value_enum, default_value = "phong")]
+    model: ModelArg,
+    /// A glTF file (.glb or .gltf): its mesh and its material's textures and factors.
+    #[arg(long, conflicts_with_all = ["base_color", "metallic", "roughness", "metallic_roughness", "specular", "glossiness"])]
+    gltf: Option<PathBuf>,
+    /// With --gltf: the material, by name or index (default: the first primitive's).
+    #[arg(long, requires = "gltf")]
+    material: Option<String>,
+    /// Base colour (sRGB image), or R,G,B or S in linear [0, 1]. With --specular, the diffuse
+    /// colour.
+    #[arg(long)]
+    base_color: Option<String>,
+    /// Metallic: a grey image (linear), or a number in [0, 1].
+    #[arg(long, conflicts_with = "metallic_roughness")]
+    metallic: Option<String>,
+    /// Roughness: a grey image (linear), or a number in [0, 1].
+    #[arg(long, conflicts_with = "metallic_roughness")]
+    roughness: Option<String>,
+    /// glTF's packed image: roughness in G, metallic in B.
+    #[arg(long)]
+    metallic_roughness: Option<PathBuf>,
+    /// Specular colour F0 (sRGB image, or R,G,B or S linear): the specular-glossiness
+    /// workflow.
+    #[arg(long, conflicts_with_all = ["metallic", "roughness", "metallic_roughness"], requires = "glossiness")]
+    specular: Option<String>,
+    /// Glossiness (1 - roughness): a grey image (linear), or a number in [0, 1].
+    #[arg(long, requires = "specular")]
+    glossiness: Option<String>,
+    /// A mesh to paint on (.obj, .gltf, .glb, or sphere, plane, cube, torus).
+    #[arg(long, conflicts_with = "gltf")]
+    mesh: Option<String>,
+    /// Overwrite an existing file.
+    #[arg(long)]
+    force: bool,
+}
+
+/// A flag's value: a number (or R,G,B) where it parses as one, else an image file.
+fn source(
+    flag: &str,
+    text: &str,
+    colour: bool,
+    channel: Option<usize>,
+) -> Result<Source, CliError> {
+    let numeric = text.split(',').all(|p| p.trim().parse::<f64>().is_ok());
+    if numeric {
+        let v = super::args::parse_rgb(flag, text, true)?;
+        return Ok(Source::constant(v.as_vec3()));
+    }
+    let path = Path::new(text);
+    if !path.exists() {
+        return Err(CliError::usage(format!(
+            "{flag}: {text}: no such file (give an image, or a number in [0, 1])"
+        )));
+    }
+    Ok(Source::file(
+        path,
+        if colour { None } else { channel.or(Some(0)) },
+        colour,
+    ))
+}
+
+impl ImportPbrArgs {
+    fn set(&self) -> Result<(PbrSet, Vec<String>), CliError> {
+        if let Some(gltf) = &self.gltf {
+            let m = crate::pbr::gltf::material_set(gltf, self.material.as_deref())
+                .map_err(model_error)?;
+            return Ok((m.set, m.notes));
+        }
+        let need = |flag: &str, v: &Option<String>| -> Result<String, CliError> {
+            v.clone().ok_or_else(|| {
+                CliError::usage(format!(
+                    "{flag} is missing (give --gltf, or --base-color with --metallic and --roughness, --metallic-roughness, or --specular and --glossiness)"
+                ))
+            })
+        };
+        let base = source(
+            "--base-color",
+            &need("--base-color", &self.base_color)?,
+            true,
+            None,
+        )?;
+        if let Some(specular) = &self.specular {
+            let glossiness = need("--glossiness", &self.glossiness)?;
+            return Ok((
+                PbrSet::SpecularGlossiness {
+                    diffuse: base,
+                    specular: source("--specular", specular, true, None)?,
+                    glossiness: source("--glossiness", &glossiness, false, None)?,
+                },
+                Vec::new(),
+            ));
+        }
+        let (metallic, roughness) = match &self.metallic_roughness {
+            Some(packed) => {
+                let text = packed.to_string_lossy();
+                (
+                    source("--metallic-roughness", &text, false, Some(2))?,
+                    source("--metallic-roughness", &text, false, Some(1))?,
+                )
+            }
+            None => (
+                source(
+                    "--metallic",
+                    &need("--metallic", &self.metallic)?,
+                    false,
+                    None,
+                )?,
+                source(
+                    "--roughness",
+                    &need("--roughness", &self.roughness)?,
+                    false,
+                    None,
+                )?,
+            ),
+        };
+        Ok((
+            PbrSet::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+            },
+            Vec::new(),
+        ))
+    }
+
+    /// Runs the command; returns what it prints.
+    ///
+    /// # Errors
+    /// Missing or bad inputs, an existing file without `--force`, a failed write.
+    pub fn run(self) -> Result<String, CliError> {
+        if self.out.exists() && !self.force {
+            return Err(CliError::usage(format!(
+                "{} exists; pass --force to overwrite it",
+                self.out.display()
+            )));
+        }
+        let size = self.size.as_deref().map(parse_size).transpose()?;
+        let model = ShadingModel::from(self.model);
+        // A mesh file must exist and load now, not at the first stroke on it.
+        if let Some(m) = &self.mesh {
+            crate::mesh::open(Path::new(m)).map_err(mesh_error)?;
+        }
+        if let Some(g) = &self.gltf {
+            crate::mesh::open(g).map_err(mesh_error)?;
+        }
+        let (set, notes) = self.set()?;
+        let mesh = match (&self.gltf, &self.mesh) {
+            (Some(gltf), _) => Some(gltf.to_string_lossy().into_owned()),
+            (None, Some(m)) => Some(m.clone()),
+            (None, None) => None,
+        };
+        let mut imported = crate::pbr::import::import(&set, size, model).map_err(model_error)?;
+        imported.report.notes.extend(notes);
+        let mut settings = imported.doc.settings().clone();
+        settings.import = Some(imported.report.clone());
+        imported.doc.replace_settings(settings);
+        if let Some(mesh) = mesh {
+            let mut settings = imported.doc.settings().clone();
+            settings.mesh = MeshRef::from_spec(&mesh);
+            imported.doc.replace_settings(settings);
+        }
+        project::save(&imported.doc, &self.out).map_err(model_error)?;
+        Ok(report_text(&self.out, &imported.doc, &imported.report))
+    }
+}
+
+/// What the command prints: where it wrote, then `key: value` lines a script can read.
+fn report_text(out: &Path, doc: &crate::model::Document, report: &ImportReport) -> String {
+    use std::fmt::Write as _;
+    let mut text = format!(
+        "imported {} into {} ({}x{}, {})\n",
+        report.source,
+        out.display(),
+        doc.maps().width(),
+        doc.maps().height(),
+        report.model
+    );
+    let e = report.error;
+    let _ = writeln!(
+        text,
+        "conversion error (relative, box average): max {:.2} %, mean {:.2} %, p99 {:.2} %",
+        100.0 * e.max,
+        100.0 * e.mean,
+        100.0 * e.p99
+    );
+    for note in &report.notes {
+        let _ = writeln!(text, "note: {note}");
+    }
+    text
+}

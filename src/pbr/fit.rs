@@ -1,0 +1,439 @@
+//! The fitted exponent per roughness and the conversion-error tables, computed over the
+//! paper's box of directions (offline: `cargo run --release --example fit_pbr` writes
+//! `table.rs` from here).
+//!
+//! For a glTF roughness `r` (GGX `alpha = r^2`), the radiance factor of the Cook-Torrance
+//! model is `k_d cos t + k_s rho_1 + rho_0` per colour channel (Schlick's `F` split as in
+//! [`crate::reflectance::cook_torrance`]); a Phong or Blinn-Phong target shades the converted
+//! texel as `k_d cos t + k_s c^n` with `c = max(0, R.V)` or `max(0, N.H)`. `k_d` converts
+//! unchanged, so the difference at one direction is `k_s (rho_1 - c^n) + rho_0`.
+//!
+//! * **The fit.** `n` minimises the box average of `|rho_1 + rho_0 - c^n|`: the GGX lobe with
+//!   `F = 1` against the target lobe (the L1 distance of the two lobes; L2 would weigh the
+//!   peak of a narrow normalised lobe, whose square grows like `1 / alpha^2`, above
+//!   everything else).
+//! * **The error** of a texel is `avg |k_s (rho_1 - c^n) + rho_0|` divided by the
+//!   Cook-Torrance mean `(2/pi) k_d + k_s avg rho_1 + avg rho_0` (the relative mean absolute
+//!   difference of the shading over the box), per channel. The numerator depends on `k_s`
+//!   and `r` only, so it is tabulated on a grid of both ([`KS_NODES`] values of `k_s`,
+//!   dense near the dielectric 0.04).
+//!
+//! The average uses a product tanh-sinh rule on pieces graded geometrically away from the
+//! lobes' common peak (the mirror direction), as the exact integrators do, at a low level:
+//! the rule's own integrals of each lobe alone are checked against the exact `chi` values.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use rayon::prelude::*;
+
+use crate::reflectance::ShadingModel;
+use crate::reflectance::cook_torrance;
+use crate::reflectance::geometry::lobe_cosine;
+use crate::reflectance::quadrature::{TanhSinh, break_points, graded_from};
+
+/// Number of `k_s` values of the error tables: `k_s = (i / (KS_NODES - 1))^2`.
+pub const KS_NODES: usize = 17;
+
+/// The smallest roughness of the tables; below it the tables' end holds (a mirror there:
+/// GGX `alpha < 0.001`, beyond the integrators' range).
+pub const ROUGHNESS_MIN: f64 = 1.0 / 32.0;
+
+/// The tanh-sinh level of the box rule the tables are made with.
+pub const LEVEL: u32 = 2;
+
+/// `k_s` at error-table node `i`.
+pub fn ks_node(i: usize) -> f64 {
+    let u = i as f64 / (KS_NODES - 1) as f64;
+    u * u
+}
+
+/// The targets, in table order.
+pub const TARGETS: [ShadingModel; 3] = [
+    ShadingModel::Phong,
+    ShadingModel::BlinnPhong,
+    ShadingModel::CookTorrance,
+];
+
+/// The exponent the Cook-Torrance model gives `alpha = r^2` (`2 / alpha^2 - 2`), unclamped.
+pub fn ct_n(roughness: f64) -> f64 {
+    let a2 = roughness.powi(4);
+    (2.0 / a2 - 2.0).max(0.0)
+}
+
+/// One node's weight, GGX parts, painted GGX parts and the two cosines.
+type NodeValues = (f64, [f64; 2], [f64; 2], [f64; 2]);
+
+/// The lobes sampled at the nodes of a box rule fitted to one roughness.
+pub struct LobeSamples {
+    /// The Cook-Torrance model's painted exponent for the roughness (clamped to `N_MAX`).
+    n_painted: f64,
+    /// Weights: `sum w f` is the box average of `f`.
+    weight: Vec<f64>,
+    /// GGX `[rho_1, rho_0]` at the roughness.
+    ggx: Vec<[f64; 2]>,
+    /// The Cook-Torrance model's own `[rho_1, rho_0]` at its painted exponent (clamped to
+    /// `N_MAX`): the Cook-Torrance target.
+    ggx_painted: Vec<[f64; 2]>,
+    /// `max(0, R.V)` and `max(0, N.H)`.
+    cosines: Vec<[f64; 2]>,
+}
+
+/// `max(0, c)^n` with `0^0 = 0` (see [`crate::reflectance::geometry::rho_s`]).
+fn lobe(c: f64, n: f64) -> f64 {
+    if c <= 0.0 {
+        0.0
+    } else if n == 0.0 {
+        1.0
+    } else {
+        c.powf(n)
+    }
+}
+
+impl LobeSamples {
+    /// Samples the lobes for `roughness` (clamped to `[ROUGHNESS_MIN, 1]`) with a rule of
+    /// `level` (see [`TanhSinh::new`]).
+    pub fn new(roughness: f64, level: u32) -> Self {
+        let r = roughness.clamp(ROUGHNESS_MIN, 1.0);
+        let alpha = r * r;
+        let n_ggx = ct_n(r);
+        let n_painted = n_ggx.min(f64::from(crate::model::texel::N_MAX));
+        // The target lobes are about as wide as GGX's (the fit makes them so); half of alpha
+        // resolves both.
+        let scale = 0.5 * alpha;
+        let rule = TanhSinh::new(level);
+        let quarter = FRAC_PI_2 / 2.0;
+        let p_breaks = break_points(
+            -FRAC_PI_2,
+            FRAC_PI_2,
+            graded_from(0.0, -1.0, scale, quarter)
+                .chain(graded_from(0.0, 1.0, scale, quarter))
+                .chain(graded_from(-FRAC_PI_2, 1.0, scale, quarter))
+                .chain([0.0]),
+        );
+        // 2 for g folded onto [0, pi/2], 2/pi^3 for the average.
+        let norm = 4.0 / (PI * PI * PI);
+        let clamped = n_painted < n_ggx;
+        let per_phi: Vec<Vec<NodeValues>> = rule
+            .points(&p_breaks)
+            .into_par_iter()
+            .map(|(p, wp)| {
+                let mut out = Vec::new();
+                let peak = (-p).max(0.0);
+                let t_breaks = break_points(
+                    0.0,
+                    FRAC_PI_2,
+                    graded_from(peak, -1.0, scale, FRAC_PI_2)
+                        .chain(graded_from(peak, 1.0, scale, FRAC_PI_2))
+                        .chain([peak]),
+                );
+                let (g_peak, g_sign) = if p < 0.0 {
+                    (0.0, 1.0)
+                } else {
+                    (FRAC_PI_2, -1.0)
+                };
+                for (t, wt) in rule.points(&t_breaks) {
+                    let st = t.sin();
+                    let g_scale = if st > 0.0 { scale / st } else { f64::INFINITY };
+                    let g_breaks = break_points(
+                        0.0,
+                        FRAC_PI_2,
+                        graded_from(g_peak, g_sign, g_scale, FRAC_PI_2),
+                    );
+                    for (g, wg) in rule.points(&g_breaks) {
+                        let ggx = cook_torrance::rho_s_parts(n_ggx, t, g, p);
+                        let painted = if clamped {
+                            cook_torrance::rho_s_parts(n_painted, t, g, p)
+                        } else {
+                            ggx
+                        };
+                        let cosines = [
+                            lobe_cosine(ShadingModel::Phong, t, g, p),
+                            lobe_cosine(ShadingModel::BlinnPhong, t, g, p),
+                        ];
+                        out.push((norm * wp * wt * wg, ggx, painted, cosines));
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut out = Self {
+            n_painted,
+            weight: Vec::new(),
+            ggx: Vec::new(),
+            ggx_painted: Vec::new(),
+            cosines: Vec::new(),
+        };
+        for (w, ggx, painted, cosines) in per_phi.into_iter().flatten() {
+            out.weight.push(w);
+            out.ggx.push(ggx);
+            out.ggx_painted.push(painted);
+            out.cosines.push(cosines);
+        }
+        out
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.weight.len()
+    }
+
+    /// Always false for a built rule.
+    pub fn is_empty(&self) -> bool {
+        self.weight.is_empty()
+    }
+
+    /// The box averages `[avg rho_1, avg rho_0]` of GGX at the roughness.
+    pub fn ggx_means(&self) -> [f64; 2] {
+        self.weight
+            .iter()
+            .zip(&self.ggx)
+            .fold([0.0; 2], |s, (w, g)| [s[0] + w * g[0], s[1] + w * g[1]])
+    }
+
+    /// The box average of `max(0, c)^n` for a Phong or Blinn-Phong target: the rule's
+    /// `chi(n)`, to check it against the exact integral.
+    pub fn target_mean(&self, target: ShadingModel, n: f64) -> f64 {
+        let k = usize::from(target != ShadingModel::Phong);
+        self.weight
+            .iter()
+            .zip(&self.cosines)
+            .map(|(w, c)| w * lobe(c[k], n))
+            .sum()
+    }
+
+    /// The target's `[rho_1, rho_0]` at node `i` for exponent `n` (Cook-Torrance: its painted
+    /// exponent, whatever `n`).
+    fn target_parts(&self, target: ShadingModel, n: f64, i: usize) -> [f64; 2] {
+        match target {
+            ShadingModel::Phong => [lobe(self.cosines[i][0], n), 0.0],
+            ShadingModel::BlinnPhong => [lobe(self.cosines[i][1], n), 0.0],
+            ShadingModel::CookTorrance => self.ggx_painted[i],
+        }
+    }
+
+    /// The L1 distance over the box between the GGX lobe (`F = 1`) and the target's lobe of
+    /// exponent `n`.
+    pub fn lobe_distance(&self, target: ShadingModel, n: f64) -> f64 {
+        // Summed in fixed chunks, in order: the result does not depend on the thread count.
+        let chunks: Vec<f64> = (0..self.len())
+            .collect::<Vec<_>>()
+            .par_chunks(1 << 16)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|&i| {
+                        let [g1, g0] = self.ggx[i];
+                        let [t1, t0] = self.target_parts(target, n, i);
+                        self.weight[i] * (g1 + g0 - t1 - t0).abs()
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        chunks.iter().sum()
+    }
+
+    /// The exponent in `[0, cap]` (`cap` at most `N_MAX`) that minimises
+    /// [`Self::lobe_distance`]: a scan of `u = ln(1 + n)` followed by golden-section search
+    /// around the best point. For the Cook-Torrance target, its own painted exponent.
+    pub fn fit_n(&self, target: ShadingModel, cap: f64) -> f64 {
+        const SCAN: usize = 24;
+        if target == ShadingModel::CookTorrance {
+            return self.n_painted;
+        }
+        let u_max = cap
+            .clamp(0.0, f64::from(crate::model::texel::N_MAX))
+            .ln_1p();
+        let f = |u: f64| self.lobe_distance(target, u.exp_m1());
+        let du = u_max / SCAN as f64;
+        let best = (0..=SCAN)
+            .map(|i| (i, f(i as f64 * du)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(i, _)| i);
+        let (mut lo, mut hi) = (
+            (best as f64 - 1.0).max(0.0) * du,
+            (best as f64 + 1.0).min(SCAN as f64) * du,
+        );
+        let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
+        let (mut a, mut b) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        let (mut fa, mut fb) = (f(a), f(b));
+        while hi - lo > 1e-4 {
+            if fa < fb {
+                hi = b;
+                b = a;
+                fb = fa;
+                a = hi - ratio * (hi - lo);
+                fa = f(a);
+            } else {
+                lo = a;
+                a = b;
+                fa = fb;
+                b = lo + ratio * (hi - lo);
+                fb = f(b);
+            }
+        }
+        (0.5 * (lo + hi)).exp_m1()
+    }
+
+    /// The L1 distance between the two lobes each divided by its mean (their shapes).
+    pub fn shape_distance(&self, target: ShadingModel, n: f64) -> f64 {
+        let chi = self.target_mean(target, n);
+        let [m1, m0] = self.ggx_means();
+        let k = usize::from(target != ShadingModel::Phong);
+        (0..self.len())
+            .map(|i| {
+                let [g1, g0] = self.ggx[i];
+                self.weight[i] * ((g1 + g0) / (m1 + m0) - lobe(self.cosines[i][k], n) / chi).abs()
+            })
+            .sum()
+    }
+
+    /// `[weight, rho_1 - t_1, rho_0 - t_0]` at every node for the target's lobe of exponent
+    /// `n`.
+    fn differences(&self, target: ShadingModel, n: f64) -> Vec<[f64; 3]> {
+        (0..self.len())
+            .into_par_iter()
+            .map(|i| {
+                let [g1, g0] = self.ggx[i];
+                let [t1, t0] = self.target_parts(target, n, i);
+                [self.weight[i], g1 - t1, g0 - t0]
+            })
+            .collect()
+    }
+
+    /// The numerator of the conversion error at `k_s`: the box average of
+    /// `|k_s (rho_1 - t_1) + (rho_0 - t_0)|` for the target's lobe of exponent `n`.
+    pub fn error_at(&self, target: ShadingModel, n: f64, ks: f64) -> f64 {
+        self.differences(target, n)
+            .iter()
+            .map(|[w, a, b]| w * (ks * a + b).abs())
+            .sum()
+    }
+
+    /// [`Self::error_at`] at every `k_s` node.
+    pub fn error_table(&self, target: ShadingModel, n: f64) -> [f64; KS_NODES] {
+        let diffs = self.differences(target, n);
+        std::array::from_fn(|k| {
+            let ks = ks_node(k);
+            diffs.iter().map(|[w, a, b]| w * (ks * a + b).abs()).sum()
+        })
+    }
+}
+
+/// One roughness' row of the tables.
+#[derive(Clone, Debug)]
+pub struct Node {
+    /// The roughness.
+    pub roughness: f64,
+    /// GGX's `[avg rho_1, avg rho_0]`: the Cook-Torrance mean is
+    /// `(2/pi) k_d + k_s means[0] + means[1]`.
+    pub means: [f64; 2],
+    /// The fitted exponent per target ([`TARGETS`] order).
+    pub n: [f64; 3],
+    /// The error numerator per target at every `k_s` node.
+    pub error: [[f64; KS_NODES]; 3],
+    /// The lobe distance at the fitted exponent, over the GGX mean, per target.
+    pub distance: [f64; 3],
+    /// The same without the cap (the unconstrained minimum), per target.
+    pub free_distance: [f64; 3],
+}
+
+/// The tables' rows for `roughness` values sorted from smooth to rough, with a rule of
+/// `level`. The fitted exponent never grows with roughness: each row's search is capped at the
+/// previous row's exponent. Unconstrained, the rough end's minimum is a narrower lobe again
+/// (the target's lobe peaks at `k_s`, GGX's rough lobe far below it, so a lobe of small
+/// support differs least), which would read roughness backwards and leave no inverse for the
+/// export; what the cap costs is in the generator's log and the docs.
+pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node)) -> Vec<Node> {
+    let mut rows: Vec<Node> = Vec::with_capacity(roughness.len());
+    for &r in roughness {
+        let samples = LobeSamples::new(r, level);
+        let cap = rows
+            .last()
+            .map_or([f64::from(crate::model::texel::N_MAX); 3], |row| row.n);
+        let mut n = [0.0; 3];
+        let mut error = [[0.0; KS_NODES]; 3];
+        let (mut distance, mut free_distance) = ([0.0; 3], [0.0; 3]);
+        let means = samples.ggx_means();
+        let mean = means[0] + means[1];
+        for (k, target) in TARGETS.into_iter().enumerate() {
+            let free = samples.fit_n(target, f64::from(crate::model::texel::N_MAX));
+            n[k] = if free <= cap[k] {
+                free
+            } else {
+                samples.fit_n(target, cap[k])
+            };
+            error[k] = samples.error_table(target, n[k]);
+            distance[k] = samples.lobe_distance(target, n[k]) / mean;
+            free_distance[k] = samples.lobe_distance(target, free) / mean;
+        }
+        let row = Node {
+            roughness: r,
+            means,
+            n,
+            error,
+            distance,
+            free_distance,
+        };
+        progress(&row);
+        rows.push(row);
+    }
+    rows
+}
+
+/// The tables' roughness rows: `ROUGHNESS_MIN` to 1 in steps of 1/64.
+pub fn table_roughness() -> Vec<f64> {
+    (2..=64).map(|i| f64::from(i) / 64.0).collect()
+}
+
+/// The Rust source of `table.rs` for `rows` (made by [`fit_curve`] at [`table_roughness`]).
+pub fn render_rust(rows: &[Node], level: u32) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "//! Generated by `cargo run --release --example fit_pbr > src/pbr/table.rs` from\n\
+         //! [`super::fit`] (box rule level {level}); do not edit.\n\n\
+         #![expect(\n    clippy::unreadable_literal,\n    reason = \"generated fit constants, printed in full\"\n)]\n"
+    );
+    let _ = writeln!(out, "/// Rows: roughness `(i + 2) / 64` for row `i`.");
+    let _ = writeln!(out, "pub const ROWS: usize = {};\n", rows.len());
+    let _ = writeln!(
+        out,
+        "/// The fitted exponent per row, for Phong, Blinn-Phong and Cook-Torrance."
+    );
+    let _ = writeln!(out, "pub static FITTED_N: [[f32; 3]; ROWS] = [");
+    for row in rows {
+        let _ = writeln!(
+            out,
+            "    [{:?}, {:?}, {:?}],",
+            row.n[0] as f32, row.n[1] as f32, row.n[2] as f32
+        );
+    }
+    let _ = writeln!(out, "];\n");
+    let _ = writeln!(out, "/// GGX's `[avg rho_1, avg rho_0]` per row.");
+    let _ = writeln!(out, "pub static GGX_MEANS: [[f32; 2]; ROWS] = [");
+    for row in rows {
+        let _ = writeln!(
+            out,
+            "    [{:?}, {:?}],",
+            row.means[0] as f32, row.means[1] as f32
+        );
+    }
+    let _ = writeln!(out, "];\n");
+    let _ = writeln!(
+        out,
+        "/// The error numerator per row and target at `k_s = (k / {})^2`.",
+        KS_NODES - 1
+    );
+    let _ = writeln!(out, "pub static ERROR: [[[f32; {KS_NODES}]; 3]; ROWS] = [");
+    for row in rows {
+        let _ = writeln!(out, "    [");
+        for e in &row.error {
+            let cells: Vec<String> = e.iter().map(|v| format!("{:?}", *v as f32)).collect();
+            let _ = writeln!(out, "        [{}],", cells.join(", "));
+        }
+        let _ = writeln!(out, "    ],");
+    }
+    let _ = writeln!(out, "];");
+    out
+}

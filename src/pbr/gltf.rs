@@ -1,0 +1,285 @@
+//! A glTF material's metallic-roughness set: its textures (from the GLB's buffers, data:
+//! URIs or files beside the `.gltf`), factors, samplers' wrap modes and texture transforms.
+//!
+//! Images are decoded with the import limits; a KTX2 or Basis Universal texture
+//! (`KHR_texture_basisu`) is refused with the reason, as is a texture on another UV set than
+//! the one kapaint paints (`TEXCOORD_0`).
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+use image::DynamicImage;
+
+use super::import::{Input, PbrSet, Source, UvTransform, Wrap};
+use crate::mesh::gltf_import::{Opened, file_beside, open_gltf};
+use crate::model::ModelError;
+use crate::model::import::{decode_bytes, read_image};
+
+/// A material's set, and what to say about it.
+pub struct MaterialSet {
+    /// The set.
+    pub set: PbrSet,
+    /// The material's name (or `#index`).
+    pub name: String,
+    /// What was left out, one line each.
+    pub notes: Vec<String>,
+}
+
+fn fail(path: &Path, reason: impl Into<String>) -> ModelError {
+    ModelError::Image {
+        path: path.to_path_buf(),
+        reason: reason.into(),
+    }
+}
+
+/// The reason a file names Basis Universal or KTX2 textures, if it does.
+fn basis_reason() -> String {
+    "it uses KTX2 / Basis Universal textures (KHR_texture_basisu), which kapaint does not read; \
+     export the material with PNG or JPEG textures"
+        .into()
+}
+
+/// The metallic-roughness set of the material `selector` (a name, or an index) of the glTF
+/// at `path`; with no selector, the material of the first primitive that has one.
+///
+/// # Errors
+/// A file that does not open, a missing material, a texture that does not read (missing,
+/// corrupt, too large, KTX2), or one on another UV set.
+pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, ModelError> {
+    let opened = open_gltf(path).map_err(|e| {
+        // A texture without a `source` (only a KHR_texture_basisu one) fails the JSON
+        // schema; say why rather than which field.
+        let raw = std::fs::read(path).unwrap_or_default();
+        if raw
+            .windows(b"KHR_texture_basisu".len())
+            .any(|w| w == b"KHR_texture_basisu")
+        {
+            fail(path, basis_reason())
+        } else {
+            match e {
+                crate::mesh::MeshError::Io { source, .. } => ModelError::io(path, source),
+                crate::mesh::MeshError::Invalid { reason, .. } => fail(path, reason),
+            }
+        }
+    })?;
+    let document = &opened.document;
+    if document
+        .extensions_used()
+        .any(|e| e == "KHR_texture_basisu")
+    {
+        return Err(fail(path, basis_reason()));
+    }
+    let material = pick_material(document, path, selector)?;
+    let name = material.name().map_or_else(
+        || format!("#{}", material.index().unwrap_or(0)),
+        str::to_string,
+    );
+    let mut images = Images {
+        opened: &opened,
+        path,
+        cache: HashMap::new(),
+    };
+    let pbr = material.pbr_metallic_roughness();
+    let base_factor = Vec3::from_slice(&pbr.base_color_factor()[..3]);
+    let mut base = Source::constant(base_factor);
+    if let Some(info) = pbr.base_color_texture() {
+        base = images.source(&info, "baseColorTexture", None, true)?;
+        base.factor = base_factor;
+    }
+    let (metallic_factor, roughness_factor) = (pbr.metallic_factor(), pbr.roughness_factor());
+    let (mut metallic, mut roughness) = (
+        Source::constant(Vec3::splat(metallic_factor)),
+        Source::constant(Vec3::splat(roughness_factor)),
+    );
+    if let Some(info) = pbr.metallic_roughness_texture() {
+        metallic = images.source(&info, "metallicRoughnessTexture", Some(2), false)?;
+        metallic.factor = Vec3::splat(metallic_factor);
+        roughness = images.source(&info, "metallicRoughnessTexture", Some(1), false)?;
+        roughness.factor = Vec3::splat(roughness_factor);
+    }
+    let mut notes = Vec::new();
+    if material.normal_texture().is_some() {
+        notes.push("the normal map (normalTexture) is not kept yet".to_string());
+    }
+    if material.emissive_texture().is_some() || material.occlusion_texture().is_some() {
+        notes.push(
+            "emissive and occlusion textures have no place in kapaint's material; left out"
+                .to_string(),
+        );
+    }
+    Ok(MaterialSet {
+        set: PbrSet::MetallicRoughness {
+            base,
+            metallic,
+            roughness,
+        },
+        name,
+        notes,
+    })
+}
+
+/// The material `selector` names (a name, or an index), or the first primitive's.
+fn pick_material<'a>(
+    document: &'a gltf::Document,
+    path: &Path,
+    selector: Option<&str>,
+) -> Result<gltf::Material<'a>, ModelError> {
+    let names: Vec<String> = document
+        .materials()
+        .map(|m| {
+            m.name()
+                .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), str::to_string)
+        })
+        .collect();
+    let material = match selector {
+        Some(s) => document
+            .materials()
+            .find(|m| m.name() == Some(s))
+            .or_else(|| {
+                s.parse::<usize>()
+                    .ok()
+                    .and_then(|i| document.materials().nth(i))
+            })
+            .ok_or_else(|| {
+                fail(
+                    path,
+                    format!(
+                        "it has no material {s:?} (its materials: {})",
+                        if names.is_empty() {
+                            "none".to_string()
+                        } else {
+                            names.join(", ")
+                        }
+                    ),
+                )
+            })?,
+        None => document
+            .meshes()
+            .flat_map(|m| m.primitives().collect::<Vec<_>>())
+            .find_map(|p| {
+                p.material()
+                    .index()
+                    .and_then(|i| document.materials().nth(i))
+            })
+            .or_else(|| document.materials().next())
+            .ok_or_else(|| fail(path, "it has no material"))?,
+    };
+    Ok(material)
+}
+
+/// The file's images, each decoded once.
+struct Images<'a> {
+    opened: &'a Opened,
+    path: &'a Path,
+    cache: HashMap<usize, Arc<DynamicImage>>,
+}
+
+impl Images<'_> {
+    /// The source for a texture slot: its image, channel, colour space, transform and wrap.
+    fn source(
+        &mut self,
+        info: &gltf::texture::Info<'_>,
+        slot: &str,
+        channel: Option<usize>,
+        srgb: bool,
+    ) -> Result<Source, ModelError> {
+        let texture = info.texture();
+        let transform = info.texture_transform();
+        let tex_coord = transform
+            .as_ref()
+            .and_then(gltf::texture::TextureTransform::tex_coord)
+            .unwrap_or_else(|| info.tex_coord());
+        if tex_coord != 0 {
+            return Err(fail(
+                self.path,
+                format!("{slot} uses TEXCOORD_{tex_coord}; kapaint paints on TEXCOORD_0 only"),
+            ));
+        }
+        let image = texture.source();
+        let index = image.index();
+        let decoded = if let Some(d) = self.cache.get(&index) {
+            Arc::clone(d)
+        } else {
+            let d = Arc::new(self.decode(&image, slot)?);
+            self.cache.insert(index, Arc::clone(&d));
+            d
+        };
+        let wrap_of = |m: gltf::texture::WrappingMode| match m {
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let sampler = texture.sampler();
+        let transform = transform.map(|t| UvTransform {
+            offset: Vec2::from(t.offset()),
+            rotation: t.rotation(),
+            scale: Vec2::from(t.scale()),
+            wrap: [wrap_of(sampler.wrap_s()), wrap_of(sampler.wrap_t())],
+        });
+        let label = format!(
+            "{} {slot} (image {index}{})",
+            super::import::file_name(self.path),
+            image.name().map_or_else(String::new, |n| format!(" {n:?}"))
+        );
+        Ok(Source {
+            input: Input::Decoded(decoded, label),
+            channel,
+            srgb,
+            factor: Vec3::ONE,
+            transform,
+        })
+    }
+
+    fn decode(&self, image: &gltf::Image<'_>, slot: &str) -> Result<DynamicImage, ModelError> {
+        let what = |reason: String| fail(self.path, format!("{slot}: {reason}"));
+        let refuse_ktx = |mime: Option<&str>, uri: Option<&str>| {
+            let ktx = mime.is_some_and(|m| m.contains("ktx2") || m.contains("basis"))
+                || uri.is_some_and(|u| {
+                    Path::new(u).extension().is_some_and(|e| {
+                        e.eq_ignore_ascii_case("ktx2") || e.eq_ignore_ascii_case("basis")
+                    })
+                });
+            if ktx {
+                Err(what(basis_reason()))
+            } else {
+                Ok(())
+            }
+        };
+        let label = self.path.join(format!("image{}", image.index()));
+        match image.source() {
+            gltf::image::Source::View { view, mime_type } => {
+                refuse_ktx(Some(mime_type), None)?;
+                let buffer = &self.opened.buffers[view.buffer().index()];
+                let (start, len) = (view.offset(), view.length());
+                let bytes = start
+                    .checked_add(len)
+                    .and_then(|end| buffer.get(start..end))
+                    .ok_or_else(|| {
+                        what(format!(
+                            "image {} lies outside its buffer ({} bytes)",
+                            image.index(),
+                            buffer.len()
+                        ))
+                    })?;
+                decode_bytes(bytes, &label).map_err(|e| what(e.to_string()))
+            }
+            gltf::image::Source::Uri { uri, mime_type } => {
+                refuse_ktx(mime_type, Some(uri))?;
+                if uri.starts_with("data:") {
+                    let bytes = gltf::buffer::Data::from_source_and_blob(
+                        gltf::buffer::Source::Uri(uri),
+                        None,
+                        &mut None,
+                    )
+                    .map_err(|e| what(format!("its data: URI does not decode: {e}")))?;
+                    decode_bytes(&bytes.0, &label).map_err(|e| what(e.to_string()))
+                } else {
+                    let file = file_beside(&self.opened.dir, uri).map_err(&what)?;
+                    read_image(&file).map_err(|e| what(e.to_string()))
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,806 @@
+//! PBR interop (issue 20): the fitted exponent and its error tables, the import of real sets
+//! (the spot cow's texture as base colour, in a glTF material written with the `gltf` crate's
+//! JSON types, and as loose images), and bad input.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::Vec3;
+use gltf::json;
+use json::validation::Checked::Valid;
+use kapaint::model::texel::srgb_to_linear;
+use kapaint::pbr::convert::Conversion;
+use kapaint::pbr::fit::{LEVEL, LobeSamples, TARGETS, ks_node};
+use kapaint::pbr::import::{PbrSet, Source, import};
+use kapaint::pbr::{Pbr, from_material};
+use kapaint::reflectance::{ShadingModel, cook_torrance, exact};
+
+fn spot() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot")
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("kapaint-pbr-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("dir");
+    d
+}
+
+fn kapaint(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(args)
+        .output()
+        .expect("run kapaint")
+}
+
+fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+// ---------------------------------------------------------------------------------------
+// The fit and its tables.
+
+#[test]
+fn the_box_rule_agrees_with_the_exact_integrals() {
+    for r in [0.25_f64, 0.5, 1.0] {
+        let s = LobeSamples::new(r, LEVEL);
+        let n = kapaint::pbr::fit::ct_n(r);
+        let [m1, m0] = s.ggx_means();
+        let [e1, e0] = cook_torrance::chi_exact(n);
+        assert!((m1 / e1 - 1.0).abs() < 1e-3, "r {r}: chi1 {m1} vs {e1}");
+        assert!((m0 / e0 - 1.0).abs() < 2e-3, "r {r}: chi0 {m0} vs {e0}");
+        for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+            let got = s.target_mean(model, 0.5 * n + 1.0);
+            let want = exact::chi_exact(model, 0.5 * n + 1.0);
+            assert!(
+                (got / want - 1.0).abs() < 1e-3,
+                "{model:?} r {r}: {got} vs {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_fitted_exponent_falls_with_roughness_and_inverts() {
+    for model in TARGETS {
+        let c = Conversion::for_model(model);
+        let mut last = f32::INFINITY;
+        for i in 0..=1000 {
+            let r = i as f32 / 1000.0;
+            let n = c.n(r);
+            assert!(
+                n.is_finite() && (0.0..=16384.0).contains(&n),
+                "{model:?} {r}: {n}"
+            );
+            assert!(n <= last * (1.0 + 1e-6), "{model:?}: n({r}) = {n} > {last}");
+            last = n;
+        }
+        // Where the fitted exponent still falls (Phong and Blinn-Phong level out above 0.48),
+        // the inverse gives the roughness back.
+        for r in [0.12_f32, 0.2, 0.3, 0.4, 0.45] {
+            let back = c.roughness(c.n(r));
+            assert!(
+                (back - r).abs() < 2e-3,
+                "{model:?}: {r} -> {} -> {back}",
+                c.n(r)
+            );
+        }
+    }
+    // Cook-Torrance is its own mapping.
+    let ct = Conversion::for_model(ShadingModel::CookTorrance);
+    for r in [0.2_f32, 0.5, 0.9] {
+        let want = kapaint::pbr::n_of_roughness(r);
+        assert!((ct.n(r) - want).abs() <= 1e-3 * want.max(1.0), "{r}");
+    }
+}
+
+#[test]
+fn the_committed_table_is_what_the_fit_gives() {
+    // Row 14 (roughness 0.25): the fit there is not capped, so it can be redone alone.
+    let r = 0.25;
+    let s = LobeSamples::new(r, LEVEL);
+    for (k, model) in TARGETS.into_iter().enumerate().take(2) {
+        let n = s.fit_n(model, 16384.0);
+        let table = Conversion::for_model(model).n(r as f32);
+        assert!(
+            (f64::from(table) / n - 1.0).abs() < 2e-3,
+            "{model:?}: table {table}, fit {n}"
+        );
+        let errors = s.error_table(model, n);
+        let c = Conversion::for_model(model);
+        let means = s.ggx_means();
+        for j in [0, 3, 8, 16] {
+            let ks = ks_node(j) as f32;
+            // A texel whose k_d is zero and k_s is the node: the error is the numerator over
+            // the Cook-Torrance mean.
+            let want = errors[j] / (f64::from(ks) * means[0] + means[1]);
+            let got = c.error_of(Vec3::ZERO, Vec3::splat(ks), r as f32);
+            assert!(
+                (f64::from(got) / want - 1.0).abs() < 5e-3,
+                "{model:?} k_s {ks}: {got} vs {want} (column {k})"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_error_between_rows_and_nodes_is_the_direct_one() {
+    // Roughness 0.3 lies between rows; k_s = 0.3 between nodes.
+    let (r, ks) = (0.3_f64, 0.3_f64);
+    let s = LobeSamples::new(r, LEVEL);
+    for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+        let c = Conversion::for_model(model);
+        let n = f64::from(c.n(r as f32));
+        let direct = s.error_at(model, n, ks);
+        let means = s.ggx_means();
+        let kd = 0.2;
+        let want = direct / (std::f64::consts::FRAC_2_PI * kd + ks * means[0] + means[1]);
+        let got = f64::from(c.error_of(Vec3::splat(kd as f32), Vec3::splat(ks as f32), r as f32));
+        assert!(
+            (got / want - 1.0).abs() < 0.02,
+            "{model:?}: {got} vs {want}"
+        );
+    }
+}
+
+#[test]
+fn cook_torrance_loses_nothing_above_the_painted_limit() {
+    let c = Conversion::for_model(ShadingModel::CookTorrance);
+    for r in [0.11_f32, 0.3, 0.7, 1.0] {
+        for ks in [0.0_f32, 0.04, 0.5, 1.0] {
+            let e = c.error_of(Vec3::splat(0.3), Vec3::splat(ks), r);
+            assert!(e < 1e-4, "r {r} k_s {ks}: {e}");
+        }
+    }
+    // Below it, the painted exponent's limit (16384) is a blunter lobe: measured, not hidden.
+    assert!(c.error_of(Vec3::ZERO, Vec3::ONE, 0.05) > 0.3);
+}
+
+// ---------------------------------------------------------------------------------------
+// Loose images.
+
+#[test]
+fn the_spot_set_round_trips_its_base_colour_where_metallic_is_pure() {
+    let d = dir("roundtrip");
+    let (base, mr) =
+        kapaint::report::typical::write_pbr_set(&d, 256, Some(&spot().join("spot_texture.png")))
+            .expect("set");
+    let set = PbrSet::MetallicRoughness {
+        base: Source::file(&base, None, true),
+        metallic: Source::file(&mr, Some(2), false),
+        roughness: Source::file(&mr, Some(1), false),
+    };
+    let out = d.join("spot.kapaint");
+    for model in TARGETS {
+        let imported = import(&set, None, model).expect("import");
+        kapaint::model::project::save(&imported.doc, &out).expect("save");
+        let doc = kapaint::model::project::load(&out).expect("load");
+        let base_png = image::open(&base).expect("base").to_rgb8();
+        let mr_png = image::open(&mr).expect("mr").to_rgb8();
+        let c = Conversion::for_model(model);
+        let mut worst = 0.0_f32;
+        for y in 0..256 {
+            for x in 0..256 {
+                let v = doc.maps().value(x, y);
+                let pbr = from_material(v);
+                let want = base_png.get_pixel(x, y);
+                let got = pbr.base.map(linear_to_srgb);
+                for ch in 0..3 {
+                    worst = worst.max((got[ch] * 255.0 - f32::from(want[ch])).abs());
+                }
+                let m = f32::from(mr_png.get_pixel(x, y)[2]) / 255.0;
+                assert!(
+                    (pbr.metallic - m).abs() < 1e-3,
+                    "({x}, {y}): {}",
+                    pbr.metallic
+                );
+                // The exponent is the target's for the texel's roughness; the roughness
+                // comes back wherever the fitted curve still falls.
+                let rough = f32::from(mr_png.get_pixel(x, y)[1]) / 255.0;
+                let n = c.n(rough);
+                assert!(
+                    (v.n - n).abs() <= 2e-3 * n.max(1.0),
+                    "({x}, {y}): {} vs {n}",
+                    v.n
+                );
+            }
+        }
+        assert!(worst <= 1.0, "{model:?}: base colour off by {worst}/255");
+        let report = doc.settings().import.clone().expect("report kept");
+        assert_eq!(report.model, model.name());
+        assert!(report.error.max >= report.error.p99 && report.error.max >= report.error.mean);
+        eprintln!(
+            "{model:?}: base colour within {worst}/255; error {:?}",
+            report.error
+        );
+    }
+}
+
+fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+#[test]
+fn the_error_summary_is_the_texels_error() {
+    // A set of two halves: the error statistics are those of the two values.
+    let set = PbrSet::MetallicRoughness {
+        base: Source::constant(Vec3::new(0.8, 0.5, 0.2)),
+        metallic: Source::constant(Vec3::ONE),
+        roughness: Source::constant(Vec3::splat(0.4)),
+    };
+    let imported = import(&set, Some((64, 64)), ShadingModel::Phong).expect("import");
+    let c = Conversion::for_model(ShadingModel::Phong);
+    let want = c.error(Pbr {
+        base: Vec3::new(0.8, 0.5, 0.2),
+        metallic: 1.0,
+        roughness: 0.4,
+    });
+    let e = imported.report.error;
+    assert!(
+        (e.max - want).abs() < 1e-6 && (e.mean - want).abs() < 1e-5,
+        "{e:?} vs {want}"
+    );
+    assert!((e.p99 / want - 1.0).abs() < 0.01, "{e:?}");
+}
+
+#[test]
+fn import_pbr_cli_converts_images_and_numbers_and_prints_the_error() {
+    let d = dir("cli");
+    let (base, mr) = kapaint::report::typical::write_pbr_set(&d, 128, None).expect("set");
+    let out = d.join("a.kapaint");
+    let o = kapaint(&[
+        "import-pbr",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--base-color",
+        base.to_str().expect("utf-8"),
+        "--metallic-roughness",
+        mr.to_str().expect("utf-8"),
+        "--model",
+        "blinn",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("(128x128, blinn)"), "{text}");
+    assert!(
+        text.starts_with("imported base.png, metallic_roughness.png into "),
+        "{text}"
+    );
+    assert!(
+        text.lines().any(
+            |l| l.starts_with("conversion error (relative, box average): max ")
+                && l.contains("mean")
+                && l.contains("p99")
+        ),
+        "{text}"
+    );
+    let doc = kapaint::model::project::load(&out).expect("load");
+    assert_eq!(doc.settings().model, ShadingModel::BlinnPhong);
+    // Numbers for every quantity, and the specular-glossiness workflow.
+    let o = kapaint(&[
+        "import-pbr",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--force",
+        "--size",
+        "32",
+        "--base-color",
+        "0.5",
+        "--specular",
+        "0.9,0.6,0.2",
+        "--glossiness",
+        "0.7",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc = kapaint::model::project::load(&out).expect("load");
+    let v = doc.maps().value(5, 5);
+    assert!(
+        (v.ks - Vec3::new(0.9, 0.6, 0.2)).abs().max_element() < 1e-3,
+        "{v:?}"
+    );
+    assert!(
+        (v.kd - Vec3::splat(0.5 * 0.1)).abs().max_element() < 1e-3,
+        "{v:?}"
+    );
+    let n = Conversion::for_model(ShadingModel::Phong).n(0.3);
+    assert!((v.n - n).abs() < 2e-3 * n, "{v:?} vs {n}");
+}
+
+#[test]
+fn images_of_another_size_are_resampled_and_said() {
+    let d = dir("sizes");
+    let base = d.join("base.png");
+    image::RgbImage::from_pixel(64, 64, image::Rgb([200, 100, 50]))
+        .save(&base)
+        .expect("base");
+    let rough = d.join("rough.png");
+    image::GrayImage::from_pixel(16, 16, image::Luma([128]))
+        .save(&rough)
+        .expect("rough");
+    let out = d.join("a.kapaint");
+    let o = kapaint(&[
+        "import-pbr",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--base-color",
+        base.to_str().expect("utf-8"),
+        "--metallic",
+        "0",
+        "--roughness",
+        rough.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("note: resampled rough.png from 16x16 to 64x64"),
+        "{}",
+        stdout(&o)
+    );
+    let doc = kapaint::model::project::load(&out).expect("load");
+    let notes = doc.settings().import.clone().expect("report").notes;
+    assert!(notes.iter().any(|n| n.contains("resampled")), "{notes:?}");
+}
+
+#[test]
+fn bad_sets_are_one_clear_error_and_nothing_written() {
+    let d = dir("bad");
+    let out = d.join("never.kapaint");
+    let o_str = out.to_str().expect("utf-8").to_string();
+    // A 100000^2 PNG header.
+    let huge = d.join("huge.png");
+    std::fs::write(&huge, png_header(100_000, 100_000)).expect("huge");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec![
+                "--base-color".into(),
+                d.join("missing.png").display().to_string(),
+                "--metallic".into(),
+                "0".into(),
+                "--roughness".into(),
+                "0.5".into(),
+            ],
+            "no such file",
+        ),
+        (
+            vec![
+                "--base-color".into(),
+                huge.display().to_string(),
+                "--metallic".into(),
+                "0".into(),
+                "--roughness".into(),
+                "0.5".into(),
+            ],
+            "too large",
+        ),
+        (
+            vec![
+                "--base-color".into(),
+                "0.5".into(),
+                "--metallic".into(),
+                "0".into(),
+            ],
+            "--roughness is missing",
+        ),
+        (
+            vec![
+                "--base-color".into(),
+                "0.5".into(),
+                "--metallic".into(),
+                "2".into(),
+                "--roughness".into(),
+                "0.5".into(),
+            ],
+            "in [0, 1]",
+        ),
+    ];
+    for (args, want) in cases {
+        let mut all = vec!["import-pbr".to_string(), "--out".into(), o_str.clone()];
+        all.extend(args);
+        let refs: Vec<&str> = all.iter().map(String::as_str).collect();
+        let o = kapaint(&refs);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(e.contains(want), "{all:?}: {e}");
+        assert!(!out.exists(), "{all:?} wrote {}", out.display());
+    }
+}
+
+/// A PNG signature and header for `w x h` RGB8, and nothing else.
+fn png_header(w: u32, h: u32) -> Vec<u8> {
+    let mut header = w.to_be_bytes().to_vec();
+    header.extend_from_slice(&h.to_be_bytes());
+    header.extend_from_slice(&[8, 2, 0, 0, 0]);
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    out.extend_from_slice(&13u32.to_be_bytes());
+    out.extend_from_slice(b"IHDR");
+    out.extend_from_slice(&header);
+    out.extend_from_slice(&crc32fast::hash(&[b"IHDR".as_slice(), &header].concat()).to_be_bytes());
+    out
+}
+
+// ---------------------------------------------------------------------------------------
+// A real glTF material: spot's mesh and texture, metallic and roughness made here, written
+// with the gltf crate's JSON types.
+
+/// How the test asset's material is written.
+struct Asset {
+    /// The base colour texture's URI.
+    base_uri: String,
+    /// The base colour texture's MIME type, if given.
+    base_mime: Option<&'static str>,
+    /// A texture transform on the base colour.
+    transform: Option<([f32; 2], f32, [f32; 2])>,
+    /// The base colour's texCoord.
+    tex_coord: u32,
+}
+
+impl Default for Asset {
+    fn default() -> Self {
+        Self {
+            base_uri: "spot_texture.png".into(),
+            base_mime: None,
+            transform: None,
+            tex_coord: 0,
+        }
+    }
+}
+
+fn accessor(
+    view: json::Index<json::buffer::View>,
+    count: usize,
+    component: json::accessor::ComponentType,
+    kind: json::accessor::Type,
+    bounds: Option<(Vec3, Vec3)>,
+) -> json::Accessor {
+    json::Accessor {
+        buffer_view: Some(view),
+        byte_offset: None,
+        count: json::validation::USize64::from(count),
+        component_type: Valid(json::accessor::GenericComponentType(component)),
+        extensions: None,
+        extras: json::Extras::default(),
+        type_: Valid(kind),
+        min: bounds.map(|(lo, _)| json::Value::from(lo.to_array().to_vec())),
+        max: bounds.map(|(_, hi)| json::Value::from(hi.to_array().to_vec())),
+        name: None,
+        normalized: false,
+        sparse: None,
+    }
+}
+
+/// The spot mesh's positions, UVs and indices in one buffer (`spot.bin`): its three
+/// accessors and the bytes.
+fn push_mesh_data(root: &mut json::Root) -> ([json::Index<json::Accessor>; 3], Vec<u8>) {
+    let mesh = kapaint::mesh::load(&spot().join("spot_triangulated.obj")).expect("spot");
+    let uvs = mesh.uvs.clone().expect("spot has UVs");
+    let mut bin: Vec<u8> = Vec::new();
+    let buffer = json::Index::new(0);
+    let view = |bin: &mut Vec<u8>, bytes: Vec<u8>| {
+        let offset = bin.len();
+        bin.extend_from_slice(&bytes);
+        json::buffer::View {
+            buffer,
+            byte_length: json::validation::USize64::from(bytes.len()),
+            byte_offset: Some(json::validation::USize64::from(offset)),
+            byte_stride: None,
+            name: None,
+            target: None,
+            extensions: None,
+            extras: json::Extras::default(),
+        }
+    };
+    let positions: Vec<u8> = mesh
+        .positions
+        .iter()
+        .flat_map(Vec3::to_array)
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let texcoords: Vec<u8> = uvs
+        .iter()
+        .flat_map(glam::Vec2::to_array)
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let indices: Vec<u8> = mesh
+        .triangles
+        .iter()
+        .flatten()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
+    let v_pos = root.push(view(&mut bin, positions));
+    let v_uv = root.push(view(&mut bin, texcoords));
+    let v_idx = root.push(view(&mut bin, indices));
+    let n = mesh.positions.len();
+    let a_pos = root.push(accessor(
+        v_pos,
+        n,
+        json::accessor::ComponentType::F32,
+        json::accessor::Type::Vec3,
+        Some(mesh.bounds()),
+    ));
+    let a_uv = root.push(accessor(
+        v_uv,
+        n,
+        json::accessor::ComponentType::F32,
+        json::accessor::Type::Vec2,
+        None,
+    ));
+    let a_idx = root.push(accessor(
+        v_idx,
+        mesh.triangles.len() * 3,
+        json::accessor::ComponentType::U32,
+        json::accessor::Type::Scalar,
+        None,
+    ));
+    let accessors = [a_pos, a_uv, a_idx];
+    root.buffers.push(json::Buffer {
+        byte_length: json::validation::USize64::from(bin.len()),
+        name: None,
+        uri: Some("spot.bin".into()),
+        extensions: None,
+        extras: json::Extras::default(),
+    });
+    (accessors, bin)
+}
+
+/// Writes `spot.gltf`, `spot.bin`, the base texture and `mr.png` into `d`.
+fn write_asset(d: &Path, asset: &Asset) -> PathBuf {
+    let mut root = json::Root::default();
+    let (accessors, bin) = push_mesh_data(&mut root);
+    std::fs::copy(spot().join("spot_texture.png"), d.join("spot_texture.png")).expect("copy");
+    let (w, h) = image::image_dimensions(spot().join("spot_texture.png")).expect("size");
+    image::RgbImage::from_fn(w, h, |x, y| {
+        image::Rgb([
+            0,
+            (40 + (y * 200 / h)) as u8,
+            if x < w / 2 { 0 } else { 255 },
+        ])
+    })
+    .save(d.join("mr.png"))
+    .expect("mr");
+    let image = |uri: &str, mime: Option<&'static str>| json::Image {
+        buffer_view: None,
+        mime_type: mime.map(|m| json::image::MimeType(m.into())),
+        name: Some(uri.into()),
+        uri: Some(uri.into()),
+        extensions: None,
+        extras: json::Extras::default(),
+    };
+    let i_base = root.push(image(&asset.base_uri, asset.base_mime));
+    let i_mr = root.push(image("mr.png", None));
+    let texture = |source| json::Texture {
+        name: None,
+        sampler: None,
+        source,
+        extensions: None,
+        extras: json::Extras::default(),
+    };
+    let t_base = root.push(texture(i_base));
+    let t_mr = root.push(texture(i_mr));
+    let info =
+        |index, tex_coord, transform: Option<([f32; 2], f32, [f32; 2])>| json::texture::Info {
+            index,
+            tex_coord,
+            extensions: transform.map(|(offset, rotation, scale)| {
+                json::extensions::texture::Info {
+                    texture_transform: Some(json::extensions::texture::TextureTransform {
+                        offset: json::extensions::texture::TextureTransformOffset(offset),
+                        rotation: json::extensions::texture::TextureTransformRotation(rotation),
+                        scale: json::extensions::texture::TextureTransformScale(scale),
+                        tex_coord: None,
+                        extras: json::Extras::default(),
+                    }),
+                }
+            }),
+            extras: json::Extras::default(),
+        };
+    let material = root.push(json::Material {
+        name: Some("cow".into()),
+        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+            base_color_texture: Some(info(t_base, asset.tex_coord, asset.transform)),
+            metallic_roughness_texture: Some(info(t_mr, 0, None)),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    if asset.transform.is_some() {
+        root.extensions_used.push("KHR_texture_transform".into());
+    }
+    push_scene(&mut root, accessors, material);
+    std::fs::write(d.join("spot.bin"), &bin).expect("bin");
+    let path = d.join("spot.gltf");
+    std::fs::write(
+        &path,
+        json::serialize::to_string_pretty(&root).expect("json"),
+    )
+    .expect("gltf");
+    path
+}
+
+/// The spot mesh's primitive with `material`, one node and the default scene.
+fn push_scene(
+    root: &mut json::Root,
+    [a_pos, a_uv, a_idx]: [json::Index<json::Accessor>; 3],
+    material: json::Index<json::Material>,
+) {
+    let mut attributes = std::collections::BTreeMap::new();
+    attributes.insert(Valid(json::mesh::Semantic::Positions), a_pos);
+    attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), a_uv);
+    let m = root.push(json::Mesh {
+        extensions: None,
+        extras: json::Extras::default(),
+        name: Some("spot".into()),
+        primitives: vec![json::mesh::Primitive {
+            attributes,
+            extensions: None,
+            extras: json::Extras::default(),
+            indices: Some(a_idx),
+            material: Some(material),
+            mode: Valid(json::mesh::Mode::Triangles),
+            targets: None,
+        }],
+        weights: None,
+    });
+    let node = root.push(json::Node {
+        mesh: Some(m),
+        ..Default::default()
+    });
+    let scene = root.push(json::Scene {
+        extensions: None,
+        extras: json::Extras::default(),
+        name: None,
+        nodes: vec![node],
+    });
+    root.scene = Some(scene);
+    root.asset.generator = Some("kapaint tests".into());
+}
+
+#[test]
+fn a_gltf_material_imports_with_its_mesh_textures_and_transform() {
+    let d = dir("gltf");
+    let gltf = write_asset(&d, &Asset::default());
+    // The file is valid for the gltf crate (its validation runs on open).
+    gltf::Gltf::open(&gltf).expect("valid glTF");
+    let out = d.join("cow.kapaint");
+    let o = kapaint(&[
+        "import-pbr",
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--gltf",
+        gltf.to_str().expect("utf-8"),
+        "--material",
+        "cow",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc = kapaint::model::project::load(&out).expect("load");
+    assert!(
+        doc.settings().mesh.spec().ends_with("spot.gltf"),
+        "{:?}",
+        doc.settings().mesh
+    );
+    let texture = image::open(spot().join("spot_texture.png"))
+        .expect("png")
+        .to_rgb8();
+    let (w, h) = texture.dimensions();
+    assert_eq!((doc.maps().width(), doc.maps().height()), (w, h));
+    // Left half dielectric: k_d is the texture; right half metal: k_s is.
+    let (x, y) = (w / 4, h / 3);
+    let want = Vec3::from_array(
+        texture
+            .get_pixel(x, y)
+            .0
+            .map(|c| srgb_to_linear(f32::from(c) / 255.0)),
+    );
+    let v = doc.maps().value(x, y);
+    assert!((v.kd - want).abs().max_element() < 2e-3, "{v:?} vs {want}");
+    let v = doc.maps().value(3 * w / 4, y);
+    let want = Vec3::from_array(
+        texture
+            .get_pixel(3 * w / 4, y)
+            .0
+            .map(|c| srgb_to_linear(f32::from(c) / 255.0)),
+    );
+    assert!((v.ks - want).abs().max_element() < 2e-3, "{v:?} vs {want}");
+    assert!(v.kd.max_element() < 1e-4);
+
+    // A texture transform: scale 2 repeats the texture twice across.
+    let d2 = dir("gltf-transform");
+    let gltf2 = write_asset(
+        &d2,
+        &Asset {
+            transform: Some(([0.0, 0.0], 0.0, [2.0, 2.0])),
+            ..Asset::default()
+        },
+    );
+    let out2 = d2.join("cow.kapaint");
+    let o = kapaint(&[
+        "import-pbr",
+        "--out",
+        out2.to_str().expect("utf-8"),
+        "--gltf",
+        gltf2.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc2 = kapaint::model::project::load(&out2).expect("load");
+    // Texel (x, y) samples the texture at (2x + 0.5, 2y + 0.5) texel centres, wrapped.
+    let (x, y) = (w / 8 + 3, h / 5 + 1);
+    let a = doc2.maps().value(x, y).kd;
+    let sx = (2 * x) % w;
+    let sy = (2 * y) % h;
+    let mut want = Vec3::ZERO;
+    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let p = texture.get_pixel((sx + dx) % w, (sy + dy) % h).0;
+        want += 0.25 * Vec3::from_array(p.map(|c| srgb_to_linear(f32::from(c) / 255.0)));
+    }
+    assert!((a - want).abs().max_element() < 3e-3, "{a} vs {want}");
+}
+
+#[test]
+fn bad_gltf_materials_are_one_clear_error_and_nothing_written() {
+    let cases: Vec<(Asset, Option<&str>, &str)> = vec![
+        (
+            Asset::default(),
+            Some("velvet"),
+            "has no material \"velvet\" (its materials: cow)",
+        ),
+        (
+            Asset {
+                base_uri: "gone.png".into(),
+                ..Asset::default()
+            },
+            None,
+            "baseColorTexture",
+        ),
+        (
+            Asset {
+                base_uri: "spot.ktx2".into(),
+                base_mime: Some("image/ktx2"),
+                ..Asset::default()
+            },
+            None,
+            "KTX2",
+        ),
+        (
+            Asset {
+                tex_coord: 1,
+                ..Asset::default()
+            },
+            None,
+            "TEXCOORD_1",
+        ),
+    ];
+    for (k, (asset, material, want)) in cases.into_iter().enumerate() {
+        let d = dir(&format!("badgltf{k}"));
+        let gltf = write_asset(&d, &asset);
+        let out = d.join("never.kapaint");
+        let mut args = vec![
+            "import-pbr".to_string(),
+            "--out".into(),
+            out.display().to_string(),
+            "--gltf".into(),
+            gltf.display().to_string(),
+        ];
+        if let Some(m) = material {
+            args.extend(["--material".to_string(), m.to_string()]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = kapaint(&refs);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "case {k}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(e.contains(want), "case {k}: {e}");
+        assert!(!out.exists(), "case {k} wrote a project");
+    }
+}
