@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The conversion error over a set's texels (relative, see [`Conversion::error`]).
+/// The conversion error over a set's texels (relative, see [`crate::pbr::convert::Conversion::error`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ErrorSummary {
     /// Largest.

@@ -1,5 +1,5 @@
 //! The conversion of a PBR texel for one target model, and its error: table lookups per texel
-//! (the tables are [`super::table`], made by [`super::fit`]).
+//! (the tables are `table.rs`, made by [`super::fit`]).
 //!
 //! Roughness indexes a dense table (`LUT_SIZE + 1` entries over `[0, 1]`, linear between
 //! them) built once per target from the fitted rows: the exponent between rows is linear in
