@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::reflectance::ShadingModel;
 use crate::reflectance::cook_torrance;
-use crate::reflectance::geometry::lobe_cosine;
+use crate::reflectance::geometry::{golden_section, lobe_cosine, lobe_power as lobe};
 use crate::reflectance::quadrature::{TanhSinh, break_points, graded_from};
 
 /// Number of `k_s` values of the error tables: `k_s = (i / (KS_NODES - 1))^2`.
@@ -76,17 +76,6 @@ pub struct LobeSamples {
     ggx_painted: Vec<[f64; 2]>,
     /// `max(0, R.V)` and `max(0, N.H)`.
     cosines: Vec<[f64; 2]>,
-}
-
-/// `max(0, c)^n` with `0^0 = 0` (see [`crate::reflectance::geometry::rho_s`]).
-fn lobe(c: f64, n: f64) -> f64 {
-    if c <= 0.0 {
-        0.0
-    } else if n == 0.0 {
-        1.0
-    } else {
-        c.powf(n)
-    }
 }
 
 impl LobeSamples {
@@ -249,28 +238,14 @@ impl LobeSamples {
             .map(|i| (i, f(i as f64 * du)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map_or(0, |(i, _)| i);
-        let (mut lo, mut hi) = (
+        let (lo, hi) = (
             (best as f64 - 1.0).max(0.0) * du,
             (best as f64 + 1.0).min(SCAN as f64) * du,
         );
-        let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
-        let (mut a, mut b) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
-        let (mut fa, mut fb) = (f(a), f(b));
-        while hi - lo > 1e-4 {
-            if fa < fb {
-                hi = b;
-                b = a;
-                fb = fa;
-                a = hi - ratio * (hi - lo);
-                fa = f(a);
-            } else {
-                lo = a;
-                a = b;
-                fa = fb;
-                b = lo + ratio * (hi - lo);
-                fb = f(b);
-            }
-        }
+        // Steps until the interval is at most 1e-4 wide.
+        let shrink = 2.0 / (5.0_f64.sqrt() - 1.0);
+        let steps = ((hi - lo) / 1e-4).ln() / shrink.ln();
+        let (lo, hi) = golden_section(f, (lo, hi), steps.ceil().max(0.0) as usize);
         (0.5 * (lo + hi)).exp_m1()
     }
 

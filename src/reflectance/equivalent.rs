@@ -74,29 +74,12 @@ pub fn equivalent_exponent(from: ShadingModel, n: f64) -> f64 {
     // exponent, so the ratio lies in [1, 16] (Phong to Blinn) or [1/16, 1]; it is 4 in the
     // narrow limit and larger for broad lobes (cos(t/2) never drops below cos(pi/4) on the
     // hemisphere, so matching cos(t) near t = pi/2 needs a higher exponent).
-    let (mut lo, mut hi) = match from {
+    let (lo, hi) = match from {
         ShadingModel::Phong => (n.ln(), (16.0 * n).ln()),
         ShadingModel::BlinnPhong | ShadingModel::CookTorrance => ((n / 16.0).ln(), n.ln()),
     };
     let cost = |ln_m: f64| mismatch(from, n, to, ln_m.exp(), t_max);
-    let g = (5.0_f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut fa, mut fb) = (cost(a), cost(b));
-    for _ in 0..60 {
-        if fa < fb {
-            hi = b;
-            b = a;
-            fb = fa;
-            a = hi - g * (hi - lo);
-            fa = cost(a);
-        } else {
-            lo = a;
-            a = b;
-            fa = fb;
-            b = lo + g * (hi - lo);
-            fb = cost(b);
-        }
-    }
+    let (lo, hi) = super::geometry::golden_section(cost, (lo, hi), 60);
     f64::midpoint(lo, hi).exp()
 }
 

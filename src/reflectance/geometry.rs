@@ -57,7 +57,11 @@ pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f
         let [first, second] = super::cook_torrance::rho_s_parts(n, theta, gamma, phi);
         return first + second;
     }
-    let c = lobe_cosine(model, theta, gamma, phi);
+    lobe_power(lobe_cosine(model, theta, gamma, phi), n)
+}
+
+/// `max(0, c)^n` with `0^0` taken as 0 (see [`rho_s`]).
+pub fn lobe_power(c: f64, n: f64) -> f64 {
     if c <= 0.0 {
         0.0
     } else if n == 0.0 {
@@ -65,6 +69,34 @@ pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f
     } else {
         c.powf(n)
     }
+}
+
+/// Golden-section search for the minimum of a unimodal `f` on `[lo, hi]`: `iterations`
+/// steps, each shrinking the interval by `(sqrt 5 - 1) / 2`; returns the final interval.
+pub fn golden_section(
+    mut f: impl FnMut(f64) -> f64,
+    (mut lo, mut hi): (f64, f64),
+    iterations: usize,
+) -> (f64, f64) {
+    let g = (5.0_f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut fa, mut fb) = (f(a), f(b));
+    for _ in 0..iterations {
+        if fa < fb {
+            hi = b;
+            b = a;
+            fb = fa;
+            a = hi - g * (hi - lo);
+            fa = f(a);
+        } else {
+            lo = a;
+            a = b;
+            fa = fb;
+            b = lo + g * (hi - lo);
+            fb = f(b);
+        }
+    }
+    (lo, hi)
 }
 
 /// The mean over `samples` uniform points of the box (`t in [0, pi/2]`, `g` and `p` in
