@@ -376,6 +376,7 @@ pub fn render_rust(rows: &[Node], level: u32) -> String {
         out,
         "/// The fitted exponent per row, for Phong, Blinn-Phong and Cook-Torrance."
     );
+    let _ = writeln!(out, "#[rustfmt::skip]");
     let _ = writeln!(out, "pub static FITTED_N: [[f32; 3]; ROWS] = [");
     for row in rows {
         let _ = writeln!(
@@ -386,6 +387,7 @@ pub fn render_rust(rows: &[Node], level: u32) -> String {
     }
     let _ = writeln!(out, "];\n");
     let _ = writeln!(out, "/// GGX's `[avg rho_1, avg rho_0]` per row.");
+    let _ = writeln!(out, "#[rustfmt::skip]");
     let _ = writeln!(out, "pub static GGX_MEANS: [[f32; 2]; ROWS] = [");
     for row in rows {
         let _ = writeln!(
@@ -400,6 +402,7 @@ pub fn render_rust(rows: &[Node], level: u32) -> String {
         "/// The error numerator per row and target at `k_s = (k / {})^2`.",
         KS_NODES - 1
     );
+    let _ = writeln!(out, "#[rustfmt::skip]");
     let _ = writeln!(out, "pub static ERROR: [[[f32; {KS_NODES}]; 3]; ROWS] = [");
     for row in rows {
         let _ = writeln!(out, "    [");
