@@ -1,6 +1,7 @@
 //! Criterion benches for the mesh targets (issue 4): a 4096^2 UV bake of a ~100k-triangle
 //! mesh (target <= 1 s) and of the spot mesh; BVH build and pick on 1M triangles; the
-//! object-space index and a 128 px-equivalent dab on 4096^2 maps (target <= 1 ms).
+//! object-space index and a 128 px-equivalent dab on 4096^2 maps (target <= 1 ms); MikkTSpace
+//! tangents for normal maps.
 
 #![expect(
     clippy::expect_used,
@@ -156,5 +157,27 @@ fn surface_dabs(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bakes, picking, surface_dabs);
+/// MikkTSpace tangents (issue 20's normal maps): what the preview's mesh upload and the `.glb`
+/// export add, on the spot mesh and on ~100k triangles.
+fn tangents(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tangents");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    let sphere = mesh::uv_sphere(317, 158);
+    group.bench_function("uv_sphere_100k_triangles", |b| {
+        b.iter(|| mesh::tangents::generate(&sphere).expect("tangents"));
+    });
+    let spot = mesh::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/testdata/spot/spot_triangulated.obj"),
+    )
+    .expect("spot loads");
+    group.bench_function("spot", |b| {
+        b.iter(|| mesh::tangents::generate(&spot).expect("tangents"));
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bakes, picking, surface_dabs, tangents);
 criterion_main!(benches);

@@ -1,7 +1,8 @@
 //! Criterion benches for the PBR import (issue 20): a 4096^2 metallic-roughness set (the spot
 //! texture as base colour, a packed metallic-roughness PNG) decoded, converted for each
 //! target model with its error measured (target: <= 3 s on 2 cores), and the same saved as
-//! a project, as `kapaint import-pbr` does.
+//! a project, as `kapaint import-pbr` does; and back: the project as glTF textures (the
+//! `gltf-pbr` export), and that conversion alone.
 
 #![expect(
     clippy::expect_used,
@@ -48,6 +49,34 @@ fn imports(c: &mut Criterion) {
         b.iter(|| {
             let imported = import(&set, None, ShadingModel::Phong).expect("import");
             kapaint::model::project::save(&imported.doc, &out).expect("save");
+        });
+    });
+    group.finish();
+    // The way back: the imported project to glTF textures (convert with the round-trip error,
+    // encode both PNGs, write the set), and the conversion alone.
+    let imported = import(&set, None, ShadingModel::Phong).expect("import");
+    let preset = kapaint::export::preset::find("gltf-pbr").expect("preset");
+    let mut group = c.benchmark_group("pbr_export_4096");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(20));
+    let texels: Vec<kapaint::model::texel::Texel> = {
+        let maps = imported.doc.maps();
+        (0..maps.height())
+            .flat_map(|y| (0..maps.width()).map(move |x| (x, y)))
+            .map(|(x, y)| kapaint::model::texel::Texel::encode(maps.value(x, y)))
+            .collect()
+    };
+    group.bench_function("convert_phong", |b| {
+        b.iter(|| kapaint::pbr::export::convert(&texels, ShadingModel::Phong));
+    });
+    let progress = kapaint::task::Progress::default();
+    group.bench_function("gltf_pbr_set", |b| {
+        b.iter(|| {
+            let out = dir.join("set");
+            let _ = std::fs::remove_dir_all(&out);
+            kapaint::pbr::export::export(&imported.doc, &preset, &out, &progress, false, None)
+                .expect("export");
         });
     });
     group.finish();

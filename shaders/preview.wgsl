@@ -23,6 +23,8 @@ override KD_UNIFORM: bool = false;
 override KS_UNIFORM: bool = false;
 override N_UNIFORM: bool = false;
 override HAS_SPECULAR: bool = true;
+// The material has a tangent-space normal map: the lighting (never k_a) uses its normal.
+override NORMAL_MAP: bool = false;
 
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
@@ -30,6 +32,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.clip = frame.view_proj * vec4<f32>(v.position, 1.0);
     out.position = v.position;
     out.normal = v.normal;
+    out.tangent = v.tangent;
     // Mesh UVs have v up; texture rows run down.
     out.uv = vec2<f32>(v.uv.x, 1.0 - v.uv.y);
     return out;
@@ -83,7 +86,11 @@ fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
         return vec4<f32>(finite_or_zero(ambient), 1.0);
     }
 
-    let normal = normalize(f.normal);
+    // k_a is done: from here on the shading normal may come from the normal map.
+    var normal = normalize(f.normal);
+    if NORMAL_MAP {
+        normal = mapped_normal(normal, f.tangent, textureSample(normal_map, map_sampler, f.uv).xyz);
+    }
     let l = frame.light;
     let v = normalize(frame.eye - f.position);
     let n_dot_l = dot(normal, l);

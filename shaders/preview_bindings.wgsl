@@ -1,4 +1,5 @@
-// The preview's bind group: the frame's uniforms, the three maps and their sampler
+// The preview's bind group: the frame's uniforms, the three maps, their sampler and the
+// tangent-space normal map (a flat 1x1 where the material has none)
 // (src/gpu/preview/mod.rs lays out the same bindings).
 
 #include "preview_types.wgsl"
@@ -8,3 +9,4 @@
 @group(0) @binding(2) var ks_map: texture_2d<f32>;
 @group(0) @binding(3) var n_map: texture_2d<f32>;
 @group(0) @binding(4) var map_sampler: sampler;
+@group(0) @binding(5) var normal_map: texture_2d<f32>;

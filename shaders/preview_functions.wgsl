@@ -60,3 +60,22 @@ fn finite_or_zero(c: vec3<f32>) -> vec3<f32> {
     let bits = bitcast<vec3<u32>>(c) & vec3<u32>(0x7fffffffu);
     return select(vec3<f32>(0.0), c, bits < vec3<u32>(0x7f800000u));
 }
+
+// The shading normal of a tangent-space normal-map texel `texel` (RGB in [0, 1], glTF's
+// convention: +Y along the bitangent) in the frame of the unit geometric normal `n` and the
+// MikkTSpace tangent `t` (bitangent `sign(t.w) n x t`). The geometric normal where the
+// tangent is missing.
+fn mapped_normal(n: vec3<f32>, t: vec4<f32>, texel: vec3<f32>) -> vec3<f32> {
+    let along = t.xyz - n * dot(n, t.xyz);
+    if dot(along, along) < 1e-12 {
+        return n;
+    }
+    let tangent = normalize(along);
+    let bitangent = select(-1.0, 1.0, t.w >= 0.0) * cross(n, tangent);
+    let m = texel * 2.0 - vec3<f32>(1.0);
+    let mapped = m.x * tangent + m.y * bitangent + m.z * n;
+    if dot(mapped, mapped) < 1e-12 {
+        return n;
+    }
+    return normalize(mapped);
+}

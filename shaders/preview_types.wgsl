@@ -23,6 +23,8 @@ struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    // MikkTSpace tangent (xyz) and the bitangent's sign (w); zero without UVs.
+    @location(3) tangent: vec4<f32>,
 }
 
 struct VertexOut {
@@ -30,4 +32,5 @@ struct VertexOut {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    @location(3) tangent: vec4<f32>,
 }

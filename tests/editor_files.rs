@@ -99,7 +99,9 @@ fn every_file_request_reaches_its_command() {
             FilePurpose::ImportMesh | FilePurpose::NewMesh => spot.join("spot_triangulated.obj"),
             FilePurpose::ImportImage(_) | FilePurpose::StampImage => spot.join("spot_texture.png"),
             FilePurpose::ExportFolder => std::env::temp_dir().join("kapaint-export-choice"),
-            FilePurpose::OpenProject | FilePurpose::SaveProject => return None,
+            FilePurpose::OpenProject | FilePurpose::SaveProject | FilePurpose::ImportPbr => {
+                return None;
+            }
         })
     }
     let mut harness = editor();

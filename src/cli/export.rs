@@ -68,8 +68,55 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
     );
 }
 
+/// The lines of one exported glTF PBR set.
+fn write_pbr(
+    text: &mut String,
+    file: &std::path::Path,
+    target: &std::path::Path,
+    m: &crate::pbr::export::PbrManifest,
+    report: bool,
+) {
+    let e = m.round_trip;
+    let _ = writeln!(
+        text,
+        "exported {} to {} ({} files, glTF metallic-roughness, {} bytes)",
+        file.display(),
+        target.display(),
+        m.files.len() + 1,
+        m.files.iter().map(|f| f.bytes).sum::<u64>()
+    );
+    let _ = writeln!(
+        text,
+        "round-trip error (relative, box average): max {:.1} %, mean {:.1} %, p99 {:.1} %",
+        100.0 * e.max,
+        100.0 * e.mean,
+        100.0 * e.p99
+    );
+    if report {
+        let _ = writeln!(text, "  preset: {}", m.preset);
+        let _ = writeln!(
+            text,
+            "  n to roughness: {} ({})",
+            m.n_mapping,
+            m.model.name()
+        );
+        for f in &m.files {
+            let _ = writeln!(
+                text,
+                "  {}: {}{}, {} bytes",
+                f.path,
+                f.layout.join(" "),
+                f.colour_space
+                    .map_or_else(String::new, |c| format!(" ({c})")),
+                f.bytes
+            );
+        }
+    }
+}
+
 /// Export projects as compact texture sets (images + material.json).
 #[derive(Debug, clap::Args)]
+#[expect(clippy::struct_excessive_bools, reason = "the command's switches")]
 pub struct ExportArgs {
     /// Project files (several: one set per project, in `OUT/<project name>/`).
     #[arg(required = true)]
@@ -92,6 +139,10 @@ pub struct ExportArgs {
     /// from the nearest island, which needs the project's mesh).
     #[arg(long)]
     no_padding: bool,
+    /// With --preset gltf-pbr: also write model.glb, the project's mesh with the material
+    /// embedded.
+    #[arg(long)]
+    glb: bool,
 }
 
 impl ExportArgs {
@@ -100,46 +151,68 @@ impl ExportArgs {
     /// # Errors
     /// A project or preset that does not load, a busy target, a failed export.
     pub fn run(self) -> Result<String, CliError> {
-        export_command(
-            &self.files,
-            &self.preset,
-            &self.out,
-            self.report,
-            !self.no_padding,
-            self.replace,
-        )
+        export_command(&self)
     }
 }
 
-/// `kapaint export`: every project into its set; one line each, plus the report.
-fn export_command(
+/// A loaded project, and its surface where the mesh is wanted for a `.glb`.
+type Loaded = (
+    crate::model::Document,
+    Option<std::sync::Arc<crate::model::surface::Surface>>,
+);
+
+/// Loads (and so validates) every project before anything is written, with the mesh baked
+/// for padding; the mesh itself where `glb`. Notes go to `text`.
+fn load_projects(
     files: &[PathBuf],
-    preset: &str,
-    out: &std::path::Path,
-    report: bool,
     padding: bool,
-    replace: bool,
-) -> Result<String, CliError> {
-    use std::io::IsTerminal as _;
-    let preset = crate::export::preset::find(preset).map_err(|e| CliError::usage(e.to_string()))?;
-    // Load (and so validate) every project before writing anything; bake the meshes for
-    // padding.
-    let mut text = String::new();
-    let docs = files
+    glb: bool,
+    text: &mut String,
+) -> Result<Vec<Loaded>, CliError> {
+    files
         .iter()
         .map(|f| {
-            if !padding {
-                return project::load(f).map_err(model_error);
+            if !padding && !glb {
+                return project::load(f).map(|d| (d, None)).map_err(model_error);
             }
             let (doc, failed) = project::open_with_mesh(f, None).map_err(model_error)?;
             if let Some(e) = failed {
+                if glb {
+                    return Err(CliError::usage(format!(
+                        "{}: --glb needs the project's mesh: {e}",
+                        f.display()
+                    )));
+                }
                 let _ = writeln!(text, "note: {}: no padding ({e})", f.display());
             }
-            Ok(doc)
+            let mesh = glb.then(|| doc.surface().cloned()).flatten();
+            if !padding {
+                let mut doc = doc;
+                let _ = doc.set_surface(None);
+                return Ok((doc, mesh));
+            }
+            Ok((doc, mesh))
         })
-        .collect::<Result<Vec<_>, CliError>>()?;
+        .collect()
+}
+
+/// `kapaint export`: every project into its set; one line each, plus the report.
+fn export_command(args: &ExportArgs) -> Result<String, CliError> {
+    use std::io::IsTerminal as _;
+    let (files, out, report, replace, glb) =
+        (&args.files, &args.out, args.report, args.replace, args.glb);
+    let preset =
+        crate::export::preset::find(&args.preset).map_err(|e| CliError::usage(e.to_string()))?;
+    if glb && preset.format != crate::export::preset::Format::GltfPbr {
+        return Err(CliError::usage(format!(
+            "--glb writes the mesh with a glTF material: use it with --preset gltf-pbr, not {}",
+            preset.name
+        )));
+    }
+    let mut text = String::new();
+    let docs = load_projects(files, !args.no_padding, glb, &mut text)?;
     let targets: Vec<PathBuf> = if files.len() == 1 {
-        vec![out.to_path_buf()]
+        vec![out.clone()]
     } else {
         files
             .iter()
@@ -148,18 +221,15 @@ fn export_command(
     };
     check_targets(files, &targets, replace)?;
     let terminal = std::io::stderr().is_terminal();
-    for (i, ((file, doc), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
+    for (i, ((file, (doc, mesh)), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
+        let mesh = mesh.as_ref().map(|s| &s.mesh);
         let progress = crate::task::Progress::default();
         // The export runs on a worker; this thread draws the bar while it works.
         let m = std::thread::scope(|scope| {
             let worker = std::thread::Builder::new()
                 .name("kapaint-export".into())
                 .spawn_scoped(scope, || {
-                    if replace {
-                        crate::export::set::export_replacing(doc, &preset, target, &progress)
-                    } else {
-                        crate::export::set::export_with(doc, &preset, target, &progress)
-                    }
+                    crate::export::run(doc, &preset, target, &progress, replace, mesh)
                 })
                 .map_err(|e| CliError::io(format!("cannot start the export: {e}")))?;
             while terminal && !worker.is_finished() {
@@ -186,18 +256,23 @@ fn export_command(
                 })?
                 .map_err(super::set_error)
         })?;
-        let _ = writeln!(
-            text,
-            "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
-            file.display(),
-            target.display(),
-            m.files.len(),
-            m.bytes.exported,
-            m.ka_error.max,
-            m.ka_error.mean
-        );
-        if report {
-            write_report(&mut text, &m);
+        match m {
+            crate::export::Exported::Set(m) => {
+                let _ = writeln!(
+                    text,
+                    "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
+                    file.display(),
+                    target.display(),
+                    m.files.len(),
+                    m.bytes.exported,
+                    m.ka_error.max,
+                    m.ka_error.mean
+                );
+                if report {
+                    write_report(&mut text, &m);
+                }
+            }
+            crate::export::Exported::Pbr(m) => write_pbr(&mut text, file, target, &m, report),
         }
     }
     Ok(text)

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use super::args::{ModelArg, parse_size};
 use super::{CliError, mesh_error, model_error};
 use crate::model::document::MeshRef;
+use crate::model::normal::NormalMap;
 use crate::model::project;
 use crate::pbr::import::{ImportReport, PbrSet, Source};
 use crate::reflectance::ShadingModel;
@@ -49,6 +50,10 @@ pub struct ImportPbrArgs {
     /// Glossiness (1 - roughness): a grey image (linear), or a number in [0, 1].
     #[arg(long, requires = "specular")]
     glossiness: Option<String>,
+    /// A tangent-space normal map (RGB image, glTF's convention: +Y up), kept with the
+    /// project and passed through by the gltf-pbr export.
+    #[arg(long, conflicts_with = "gltf")]
+    normal: Option<PathBuf>,
     /// A mesh to paint on (.obj, .gltf, .glb, or sphere, plane, cube, torus).
     #[arg(long, conflicts_with = "gltf")]
     mesh: Option<String>,
@@ -83,12 +88,26 @@ fn source(
 }
 
 impl ImportPbrArgs {
-    fn set(&self) -> Result<(PbrSet, Vec<String>), CliError> {
+    /// The set, its normal map and the notes on them.
+    fn set(&self) -> Result<(PbrSet, Option<NormalMap>, Vec<String>), CliError> {
         if let Some(gltf) = &self.gltf {
             let m = crate::pbr::gltf::material_set(gltf, self.material.as_deref())
                 .map_err(model_error)?;
-            return Ok((m.set, m.notes));
+            return Ok((m.set, m.normal, m.notes));
         }
+        let mut notes = Vec::new();
+        if let Some(p) = self.normal.as_deref().filter(|p| !p.exists()) {
+            return Err(CliError::usage(format!(
+                "--normal: {}: no such file",
+                p.display()
+            )));
+        }
+        let normal = self
+            .normal
+            .as_deref()
+            .map(|p| crate::pbr::import::normal_map_file(p, &mut notes))
+            .transpose()
+            .map_err(model_error)?;
         let need = |flag: &str, v: &Option<String>| -> Result<String, CliError> {
             v.clone().ok_or_else(|| {
                 CliError::usage(format!(
@@ -110,7 +129,8 @@ impl ImportPbrArgs {
                     specular: source("--specular", specular, true, None)?,
                     glossiness: source("--glossiness", &glossiness, false, None)?,
                 },
-                Vec::new(),
+                normal,
+                notes,
             ));
         }
         let (metallic, roughness) = match &self.metallic_roughness {
@@ -142,7 +162,8 @@ impl ImportPbrArgs {
                 metallic,
                 roughness,
             },
-            Vec::new(),
+            normal,
+            notes,
         ))
     }
 
@@ -166,7 +187,7 @@ impl ImportPbrArgs {
         if let Some(g) = &self.gltf {
             crate::mesh::open(g).map_err(mesh_error)?;
         }
-        let (set, notes) = self.set()?;
+        let (set, normal, notes) = self.set()?;
         let mesh = match (&self.gltf, &self.mesh) {
             (Some(gltf), _) => Some(gltf.to_string_lossy().into_owned()),
             (None, Some(m)) => Some(m.clone()),
@@ -174,6 +195,7 @@ impl ImportPbrArgs {
         };
         let mut imported = crate::pbr::import::import(&set, size, model).map_err(model_error)?;
         imported.report.notes.extend(notes);
+        imported.doc.set_normal(normal.map(std::sync::Arc::new));
         let mut settings = imported.doc.settings().clone();
         settings.import = Some(imported.report.clone());
         imported.doc.replace_settings(settings);
@@ -206,6 +228,14 @@ fn report_text(out: &Path, doc: &crate::model::Document, report: &ImportReport) 
         100.0 * e.mean,
         100.0 * e.p99
     );
+    if let Some(normal) = doc.normal() {
+        let _ = writeln!(
+            text,
+            "normal map: {}x{}, kept with the project (the gltf-pbr export passes it through; k_a never uses it)",
+            normal.width(),
+            normal.height()
+        );
+    }
     for note in &report.notes {
         let _ = writeln!(text, "note: {note}");
     }

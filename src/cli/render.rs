@@ -66,12 +66,21 @@ pub struct RenderArgs {
     out: PathBuf,
 }
 
-/// The maps to render (a project's, or one uniform material) and the mesh they come with.
-fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::PathBuf), CliError> {
+/// What `render` draws: maps, the normal map, and the mesh they come with.
+type Material = (
+    model::MaterialMaps,
+    Option<std::sync::Arc<model::normal::NormalMap>>,
+    std::path::PathBuf,
+);
+
+/// The maps to render (a project's, or one uniform material), the project's normal map and
+/// the mesh they come with.
+fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
     if let Some(file) = &a.project {
         let doc = project::load(file).map_err(model_error)?;
         let spec = PathBuf::from(doc.settings().mesh.spec());
-        return Ok((doc.into_parts().0, spec));
+        let normal = doc.normal().cloned();
+        return Ok((doc.into_parts().0, normal, spec));
     }
     let d = model::MaterialValue::default();
     let kd =
@@ -92,7 +101,7 @@ fn render_material(a: &RenderArgs) -> Result<(model::MaterialMaps, std::path::Pa
         n.map_or(d.n, |v| v as f32),
     );
     let maps = model::MaterialMaps::new(16, 16, value).map_err(model_error)?;
-    Ok((maps, std::path::PathBuf::from("sphere")))
+    Ok((maps, None, std::path::PathBuf::from("sphere")))
 }
 
 /// `--sides LEFT,RIGHT`: two model names.
@@ -141,7 +150,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
             a.out.display()
         )));
     }
-    let (maps, own_mesh) = render_material(&a)?;
+    let (maps, normal, own_mesh) = render_material(&a)?;
     let mesh_spec = a.mesh.map_or(own_mesh, std::path::PathBuf::from);
     let mesh = mesh::open(&mesh_spec).map_err(super::mesh_error)?;
     let light = match &a.light {
@@ -204,6 +213,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
         &headless::Request {
             mesh: &mesh,
             maps: &maps,
+            normal: normal.as_ref(),
             settings,
             compare,
             models,

@@ -19,12 +19,17 @@ pub enum Format {
     /// KTX2 block-compressed with a full mip chain: BC7 for three or four components, BC5
     /// for two, BC4 for one.
     Ktx2Bc,
+    /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
+    /// roughness, B metallic), and the normal map where the project has one; converted back
+    /// from `k_d`, `k_s`, `n` ([`crate::pbr::export`]). `layout`, `n_bits` and `include_ka` do
+    /// not apply.
+    GltfPbr,
 }
 
 impl Format {
     /// Whether files hold 8-bit components (PNG8 and both KTX2 kinds).
     pub fn is_8bit(self) -> bool {
-        matches!(self, Self::Png8 | Self::Ktx2 | Self::Ktx2Bc)
+        matches!(self, Self::Png8 | Self::Ktx2 | Self::Ktx2Bc | Self::GltfPbr)
     }
 
     /// Whether files are KTX2 containers.
@@ -35,7 +40,7 @@ impl Format {
     /// The files' extension.
     pub fn extension(self) -> &'static str {
         match self {
-            Self::Png8 | Self::Png16 => "png",
+            Self::Png8 | Self::Png16 | Self::GltfPbr => "png",
             Self::Exr => "exr",
             Self::Ktx2 | Self::Ktx2Bc => "ktx2",
         }
@@ -125,6 +130,9 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
                 f.format
             ));
         }
+        if f.format == Format::GltfPbr && f.include_ka {
+            return Err("a glTF PBR set has no k_a map (include_ka: false)".into());
+        }
         if f.format == Format::Png16 && f.n_bits != 16 {
             return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
         }
@@ -165,6 +173,10 @@ const BUILTIN: &[(&str, &str)] = &[
     ("16-bit", include_str!("../../presets/export/16-bit.ron")),
     ("compact", include_str!("../../presets/export/compact.ron")),
     ("exr", include_str!("../../presets/export/exr.ron")),
+    (
+        "gltf-pbr",
+        include_str!("../../presets/export/gltf-pbr.ron"),
+    ),
     ("ktx2", include_str!("../../presets/export/ktx2.ron")),
     (
         "ktx2-raw",
@@ -197,6 +209,14 @@ pub fn builtin() -> Vec<ExportPreset> {
         .filter_map(|(stem, text)| {
             ExportPreset::parse(&PathBuf::from(format!("presets/export/{stem}.ron")), text).ok()
         })
+        .collect()
+}
+
+/// The built-in presets that write kapaint sets (every one but the glTF PBR export).
+pub fn builtin_sets() -> Vec<ExportPreset> {
+    builtin()
+        .into_iter()
+        .filter(|p| p.format != Format::GltfPbr)
         .collect()
 }
 
@@ -247,7 +267,7 @@ mod tests {
     fn every_builtin_parses_and_is_found() {
         assert_eq!(builtin().len(), BUILTIN.len());
         for name in [
-            "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw",
+            "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw", "gltf-pbr",
         ] {
             assert_eq!(find(name).unwrap().name, name);
         }

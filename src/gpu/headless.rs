@@ -18,6 +18,8 @@ pub struct Request<'a> {
     pub mesh: &'a Mesh,
     /// The maps.
     pub maps: &'a MaterialMaps,
+    /// The material's normal map, if it has one.
+    pub normal: Option<&'a std::sync::Arc<crate::model::normal::NormalMap>>,
     /// Model, approximation, view, lights, camera.
     pub settings: FrameSettings,
     /// Single model or a comparison.
@@ -62,7 +64,8 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
     let (width, height) = req.size;
     let preview = Preview::new(gpu);
     let mesh = MeshBuffers::new(gpu, req.mesh)?;
-    let maps = MapTextures::new(gpu, req.maps)?;
+    let mut maps = MapTextures::new(gpu, req.maps)?;
+    maps.set_normal(gpu, req.normal)?;
     let linear = kind == Kind::Exr || req.settings.view.is_data();
     let mut note = String::new();
     let pixels: RenderedImage = if let Some(layout) = Layout::of(req.compare, 0.5, width) {

@@ -20,6 +20,8 @@ pub struct UniformChannels {
     pub ks: Option<[f32; 3]>,
     /// `n` everywhere, if uniform.
     pub n: Option<f32>,
+    /// A normal map is bound (else the preview skips its fetch and tangent frame).
+    pub normal_map: bool,
 }
 
 impl UniformChannels {
@@ -31,6 +33,7 @@ impl UniformChannels {
             kd: kd.map(rgb),
             ks: ks.map(rgb),
             n: n.map(crate::model::texel::decode_n),
+            normal_map: false,
         }
     }
 }
@@ -56,6 +59,8 @@ pub struct MapTextures {
     pub n: wgpu::Texture,
     /// Channels that are uniform over the map, as of the last sync.
     pub uniform: UniformChannels,
+    /// The material's normal map (flat where it has none).
+    pub normal: super::normal::NormalTexture,
     version: u64,
     size: (u32, u32),
     unorm16: bool,
@@ -129,6 +134,7 @@ impl MapTextures {
             ks: texture("k_s", rgb_format),
             n: texture("n", wgpu::TextureFormat::R16Float),
             uniform: UniformChannels::of(maps),
+            normal: super::normal::NormalTexture::flat(gpu),
             version: 0,
             size: (maps.width(), maps.height()),
             unorm16: gpu.unorm16,
@@ -136,6 +142,20 @@ impl MapTextures {
             staging: StagingPool::default(),
             staged_bytes: 0,
         }
+    }
+
+    /// Mirrors the material's normal map (uploaded when it changed; a flat texel for none).
+    ///
+    /// # Errors
+    /// A map larger than the device's largest texture, or a device out of memory or lost.
+    pub fn set_normal(
+        &mut self,
+        gpu: &Gpu,
+        normal: Option<&std::sync::Arc<crate::model::normal::NormalMap>>,
+    ) -> Result<(), GpuError> {
+        self.normal.sync(gpu, normal)?;
+        self.uniform.normal_map = self.normal.present();
+        Ok(())
     }
 
     /// Bytes the last sync staged (and copied into the textures), for tests and diagnostics.
@@ -168,7 +188,10 @@ impl MapTextures {
         {
             return Ok(0);
         }
-        self.uniform = UniformChannels::of(maps);
+        self.uniform = UniformChannels {
+            normal_map: self.normal.present(),
+            ..UniformChannels::of(maps)
+        };
         self.version = maps.version();
         Ok(dirty.len())
     }

@@ -5,6 +5,7 @@ pub mod check;
 pub mod difference;
 pub mod headless;
 pub mod maps;
+pub mod normal;
 pub mod preview;
 pub mod shader;
 mod upload;

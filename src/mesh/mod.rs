@@ -10,6 +10,7 @@ mod builtin;
 pub mod gltf_import;
 mod obj;
 pub mod pick;
+pub mod tangents;
 
 use std::path::{Path, PathBuf};
 

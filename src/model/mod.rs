@@ -12,6 +12,7 @@ pub mod import;
 pub mod layers;
 pub mod maps;
 pub mod mips;
+pub mod normal;
 pub mod paint;
 pub mod preset;
 pub mod project;

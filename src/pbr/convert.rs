@@ -14,6 +14,7 @@ use glam::Vec3;
 use super::fit::KS_NODES;
 use super::table::{ERROR, FITTED_N, GGX_MEANS, ROWS};
 use super::{DIELECTRIC_F0, Pbr, n_of_roughness, unit};
+use crate::model::provenance::ErrorSummary;
 use crate::model::texel::{MaterialValue, N_MAX};
 use crate::reflectance::ShadingModel;
 
@@ -164,6 +165,14 @@ impl Conversion {
 
     /// [`Self::error`] of a texel given as its `k_d`, `k_s` (any workflow) and roughness.
     pub fn error_of(&self, kd: Vec3, ks: Vec3, roughness: f32) -> f32 {
+        self.error_parts(kd, ks, roughness)
+            .iter()
+            .filter(|[_, mean]| *mean > 0.0)
+            .fold(0.0_f32, |worst, [num, mean]| worst.max(num / mean))
+    }
+
+    /// Per channel, the error's `[numerator, Cook-Torrance mean]` (see [`Self::error`]).
+    pub fn error_parts(&self, kd: Vec3, ks: Vec3, roughness: f32) -> [[f32; 2]; 3] {
         let (kd, ks) = (kd.map(unit), ks.map(unit));
         let (i, t) = Self::locate(roughness);
         let lerp = |a: f32, b: f32| a + (b - a) * t;
@@ -172,20 +181,105 @@ impl Conversion {
             lerp(self.means[i][1], self.means[i + 1][1]),
         ];
         let (e0, e1) = (&self.error[i], &self.error[i + 1]);
-        let mut worst = 0.0_f32;
-        for c in 0..3 {
+        std::array::from_fn(|c| {
             let (d, s) = (kd[c], ks[c]);
             // k_s nodes are (j / (KS_NODES - 1))^2: interpolate in sqrt(k_s).
             let x = s.sqrt() * (KS_NODES - 1) as f32;
             let j = (x as usize).min(KS_NODES - 2);
             let u = (x - j as f32).min(1.0);
             let at = |e: &[f32; KS_NODES]| e[j] + (e[j + 1] - e[j]) * u;
-            let numerator = lerp(at(e0), at(e1)).max(0.0);
-            let mean = std::f32::consts::FRAC_2_PI * d + s * means[0] + means[1];
-            if mean > 0.0 {
-                worst = worst.max(numerator / mean);
+            [
+                lerp(at(e0), at(e1)).max(0.0),
+                std::f32::consts::FRAC_2_PI * d + s * means[0] + means[1],
+            ]
+        })
+    }
+}
+
+/// Histogram bins of the error, logarithmic from `1e-6` to `1e3` (0.5 % wide).
+const BINS: usize = 4096;
+const LOG_LO: f32 = -6.0;
+const LOG_HI: f32 = 3.0;
+
+fn bin_of(e: f32) -> usize {
+    if e <= 0.0 || e.is_nan() {
+        return 0;
+    }
+    let x = (e.log10() - LOG_LO) / (LOG_HI - LOG_LO) * BINS as f32;
+    (x.max(0.0) as usize).min(BINS - 1)
+}
+
+fn bin_top(i: usize) -> f32 {
+    10f32.powf(LOG_LO + (i + 1) as f32 / BINS as f32 * (LOG_HI - LOG_LO))
+}
+
+/// Statistics of per-texel conversion errors: max, mean, and the 99th percentile from a
+/// histogram (merged across bands).
+#[derive(Clone)]
+pub struct ErrorStats {
+    max: f32,
+    sum: f64,
+    count: u64,
+    bins: Vec<u64>,
+}
+
+impl Default for ErrorStats {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ErrorStats {
+    /// No texels yet.
+    pub fn new() -> Self {
+        Self {
+            max: 0.0,
+            sum: 0.0,
+            count: 0,
+            bins: vec![0; BINS],
+        }
+    }
+
+    /// One texel's error.
+    pub fn add(&mut self, e: f32) {
+        self.max = self.max.max(e);
+        self.sum += f64::from(e);
+        self.count += 1;
+        self.bins[bin_of(e)] += 1;
+    }
+
+    /// Both sets of texels.
+    #[must_use]
+    pub fn merge(mut self, other: &Self) -> Self {
+        self.max = self.max.max(other.max);
+        self.sum += other.sum;
+        self.count += other.count;
+        for (a, b) in self.bins.iter_mut().zip(&other.bins) {
+            *a += b;
+        }
+        self
+    }
+
+    /// Max, mean and 99th percentile (to the histogram's 0.5 %).
+    pub fn summary(&self) -> ErrorSummary {
+        let target = (self.count as f64 * 0.99).ceil() as u64;
+        let mut seen = 0;
+        let mut p99 = self.max;
+        for (i, b) in self.bins.iter().enumerate() {
+            seen += b;
+            if seen >= target {
+                p99 = bin_top(i).min(self.max);
+                break;
             }
         }
-        worst
+        ErrorSummary {
+            max: self.max,
+            mean: if self.count > 0 {
+                (self.sum / self.count as f64) as f32
+            } else {
+                0.0
+            },
+            p99,
+        }
     }
 }

@@ -16,6 +16,7 @@ use super::import::{Input, PbrSet, Source, UvTransform, Wrap};
 use crate::mesh::gltf_import::{Opened, file_beside, open_gltf};
 use crate::model::ModelError;
 use crate::model::import::{decode_bytes, read_image};
+use crate::model::normal::NormalMap;
 
 /// A material's set, and what to say about it.
 pub struct MaterialSet {
@@ -23,6 +24,8 @@ pub struct MaterialSet {
     pub set: PbrSet,
     /// The material's name (or `#index`).
     pub name: String,
+    /// The material's normal map (`normalTexture`), its scale baked in.
+    pub normal: Option<NormalMap>,
     /// What was left out, one line each.
     pub notes: Vec<String>,
 }
@@ -100,9 +103,10 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
         roughness.factor = Vec3::splat(roughness_factor);
     }
     let mut notes = Vec::new();
-    if material.normal_texture().is_some() {
-        notes.push("the normal map (normalTexture) is not kept yet".to_string());
-    }
+    let normal = material
+        .normal_texture()
+        .map(|t| images.normal(&t, &mut notes))
+        .transpose()?;
     if material.emissive_texture().is_some() || material.occlusion_texture().is_some() {
         notes.push(
             "emissive and occlusion textures have no place in kapaint's material; left out"
@@ -116,7 +120,26 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
             roughness,
         },
         name,
+        normal,
         notes,
+    })
+}
+
+/// Whether the glTF at `path` has a material with a base colour, metallic-roughness or
+/// normal texture (what the editor offers to bring in with the mesh). Reads the JSON only; a
+/// file that does not parse has none.
+pub fn has_textured_material(path: &Path) -> bool {
+    let Ok(bytes) = crate::file_check::read_limited(path, crate::mesh::MAX_FILE_BYTES) else {
+        return false;
+    };
+    let Ok(gltf) = gltf::Gltf::from_slice_without_validation(&bytes) else {
+        return false;
+    };
+    gltf.materials().any(|m| {
+        let pbr = m.pbr_metallic_roughness();
+        pbr.base_color_texture().is_some()
+            || pbr.metallic_roughness_texture().is_some()
+            || m.normal_texture().is_some()
     })
 }
 
@@ -230,6 +253,33 @@ impl Images<'_> {
             factor: Vec3::ONE,
             transform,
         })
+    }
+
+    /// The normal map of `normalTexture` (on `TEXCOORD_0`), its scale baked in. It is kept as
+    /// stored, at its own size: a texture transform on it (which the gltf crate does not
+    /// read for normal textures) is not applied.
+    fn normal(
+        &self,
+        t: &gltf::material::NormalTexture<'_>,
+        notes: &mut Vec<String>,
+    ) -> Result<NormalMap, ModelError> {
+        if t.tex_coord() != 0 {
+            return Err(fail(
+                self.path,
+                format!(
+                    "normalTexture uses TEXCOORD_{}; kapaint paints on TEXCOORD_0 only",
+                    t.tex_coord()
+                ),
+            ));
+        }
+        let image = t.texture().source();
+        let decoded = self.decode(&image, "normalTexture")?;
+        let label = format!(
+            "{} normalTexture (image {})",
+            super::import::file_name(self.path),
+            image.index()
+        );
+        super::import::normal_map(&decoded, t.scale(), &label, notes)
     }
 
     fn decode(&self, image: &gltf::Image<'_>, slot: &str) -> Result<DynamicImage, ModelError> {

@@ -6,18 +6,19 @@
 //! floats, only as the decoded images and one band. A texture under a glTF texture transform
 //! is sampled bilinearly at the transformed coordinates instead, with the sampler's wrap.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use image::DynamicImage;
 use rayon::prelude::*;
 
-use super::convert::Conversion;
+use super::convert::{Conversion, ErrorStats};
 use crate::model::ModelError;
 use crate::model::document::{Document, DocumentSettings};
 use crate::model::import::{Resampler, fill_outside, is_float, read_image};
 use crate::model::maps::MaterialMaps;
+use crate::model::normal::NormalMap;
 pub use crate::model::provenance::{ErrorSummary, ImportReport};
 use crate::model::texel::{MaterialValue, encode_n, encode_rgb, srgb_to_linear};
 use crate::model::tile::{Plane, TILE_SIZE, Tile};
@@ -219,82 +220,6 @@ fn load(input: &Input) -> Result<Loaded, ModelError> {
     })
 }
 
-/// Histogram bins of the error, logarithmic from `1e-6` to `1e3` (0.5 % wide).
-const BINS: usize = 4096;
-const LOG_LO: f32 = -6.0;
-const LOG_HI: f32 = 3.0;
-
-fn bin_of(e: f32) -> usize {
-    if e <= 0.0 || e.is_nan() {
-        return 0;
-    }
-    let x = (e.log10() - LOG_LO) / (LOG_HI - LOG_LO) * BINS as f32;
-    (x.max(0.0) as usize).min(BINS - 1)
-}
-
-fn bin_top(i: usize) -> f32 {
-    10f32.powf(LOG_LO + (i + 1) as f32 / BINS as f32 * (LOG_HI - LOG_LO))
-}
-
-/// One band's statistics.
-#[derive(Clone)]
-struct Stats {
-    max: f32,
-    sum: f64,
-    count: u64,
-    bins: Vec<u64>,
-}
-
-impl Stats {
-    fn new() -> Self {
-        Self {
-            max: 0.0,
-            sum: 0.0,
-            count: 0,
-            bins: vec![0; BINS],
-        }
-    }
-
-    fn add(&mut self, e: f32) {
-        self.max = self.max.max(e);
-        self.sum += f64::from(e);
-        self.count += 1;
-        self.bins[bin_of(e)] += 1;
-    }
-
-    fn merge(mut self, other: &Self) -> Self {
-        self.max = self.max.max(other.max);
-        self.sum += other.sum;
-        self.count += other.count;
-        for (a, b) in self.bins.iter_mut().zip(&other.bins) {
-            *a += b;
-        }
-        self
-    }
-
-    fn summary(&self) -> ErrorSummary {
-        let target = (self.count as f64 * 0.99).ceil() as u64;
-        let mut seen = 0;
-        let mut p99 = self.max;
-        for (i, b) in self.bins.iter().enumerate() {
-            seen += b;
-            if seen >= target {
-                p99 = bin_top(i).min(self.max);
-                break;
-            }
-        }
-        ErrorSummary {
-            max: self.max,
-            mean: if self.count > 0 {
-                (self.sum / self.count as f64) as f32
-            } else {
-                0.0
-            },
-            p99,
-        }
-    }
-}
-
 /// Imports `set` at `size` (or the largest input image's size) for `model`.
 ///
 /// # Errors
@@ -344,7 +269,7 @@ pub fn import(
     let conversion = Conversion::for_model(model);
     let tiles_x = maps.tiles_x() as usize;
     let tiles_y = maps.tiles_y() as usize;
-    let bands: Vec<(Vec<Tile>, Stats)> = (0..tiles_y)
+    let bands: Vec<(Vec<Tile>, ErrorStats)> = (0..tiles_y)
         .into_par_iter()
         .map(|ty| {
             convert_band(
@@ -357,7 +282,7 @@ pub fn import(
             )
         })
         .collect();
-    let mut stats = Stats::new();
+    let mut stats = ErrorStats::new();
     for (ty, (tiles, band_stats)) in bands.into_iter().enumerate() {
         stats = stats.merge(&band_stats);
         for (tx, tile) in tiles.into_iter().enumerate() {
@@ -534,10 +459,10 @@ fn convert_band(
     ty: usize,
     width: usize,
     height: usize,
-) -> (Vec<Tile>, Stats) {
+) -> (Vec<Tile>, ErrorStats) {
     let values: Vec<Vec<Vec3>> = samplers.iter().map(|s| s.band(ty, width, height)).collect();
     let rows = TILE_SIZE.min(height - ty * TILE_SIZE);
-    let mut stats = Stats::new();
+    let mut stats = ErrorStats::new();
     let mut tiles = Vec::new();
     for tx in 0..width.div_ceil(TILE_SIZE) {
         let x0 = tx * TILE_SIZE;
@@ -569,6 +494,62 @@ fn convert_band(
         tiles.push(tile);
     }
     (tiles, stats)
+}
+
+/// A decoded image as a tangent-space normal map (`name` for the notes): 8-bit RGB as
+/// stored, with glTF's `scale` baked in where it is not 1 (each normal's x and y times it,
+/// then renormalised). A deeper image is reduced to 8 bits, and a note says so.
+///
+/// # Errors
+/// An image larger than the maps may be.
+pub fn normal_map(
+    image: &DynamicImage,
+    scale: f32,
+    name: &str,
+    notes: &mut Vec<String>,
+) -> Result<NormalMap, ModelError> {
+    if !matches!(
+        image,
+        DynamicImage::ImageRgb8(_) | DynamicImage::ImageRgba8(_)
+    ) {
+        notes.push(format!(
+            "normal map {name}: {:?} reduced to 8-bit RGB",
+            image.color()
+        ));
+    }
+    let mut rgb = image.to_rgb8();
+    if scale.is_finite() && (scale - 1.0).abs() > f32::EPSILON {
+        notes.push(format!(
+            "normal map {name}: its scale {scale} is baked into the texels"
+        ));
+        rgb.par_chunks_mut(3).for_each(|c| {
+            let v = Vec3::new(
+                f32::from(c[0]) / 127.5 - 1.0,
+                f32::from(c[1]) / 127.5 - 1.0,
+                f32::from(c[2]) / 127.5 - 1.0,
+            );
+            let v = Vec3::new(v.x * scale, v.y * scale, v.z)
+                .try_normalize()
+                .unwrap_or(Vec3::Z);
+            for (k, x) in v.to_array().into_iter().enumerate() {
+                c[k] = ((x + 1.0) * 127.5).round().clamp(0.0, 255.0) as u8;
+            }
+        });
+    }
+    NormalMap::new(rgb).map_err(|reason| ModelError::Image {
+        path: PathBuf::from(name),
+        reason,
+    })
+}
+
+/// The normal map in the image file at `path` ([`normal_map`] with scale 1), read with the
+/// import limits.
+///
+/// # Errors
+/// A file that does not read, or too large.
+pub fn normal_map_file(path: &Path, notes: &mut Vec<String>) -> Result<NormalMap, ModelError> {
+    let image = read_image(path)?;
+    normal_map(&image, 1.0, &file_name(path), notes)
 }
 
 /// The file name of a path, for messages.

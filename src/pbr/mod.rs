@@ -21,7 +21,9 @@
 use glam::Vec3;
 
 pub mod convert;
+pub mod export;
 pub mod fit;
+pub mod glb;
 pub mod gltf;
 pub mod import;
 mod table;

@@ -43,6 +43,10 @@ impl Editor {
     /// given: a project there opens on a worker once the window is up (the window shows at
     /// once, with the opening in progress over it); a missing file becomes a new project
     /// saved there.
+    #[expect(
+        clippy::too_many_lines,
+        reason = "the editor's state, one field per line"
+    )]
     pub fn new(
         render_state: Option<&eframe::egui_wgpu::RenderState>,
         path: Option<PathBuf>,
@@ -112,6 +116,7 @@ impl Editor {
                 new_dialog: None,
                 resize_dialog: None,
                 pending_open: None,
+                material_prompt: None,
                 recent: load_recent(),
                 stamp_preview: None,
                 pressure: 1.0,
@@ -194,7 +199,10 @@ impl TabViewer for Tabs<'_> {
                 }
                 let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
                 let maps = s.layers_panel.view_maps.get(&s.doc, s.layer_view);
-                let (response, rect) = s.viewport.show(ui, maps, &mesh, &settings);
+                let normal = s.doc.normal().cloned();
+                let (response, rect) =
+                    s.viewport
+                        .show(ui, (maps.0, maps.1, normal.as_ref()), &mesh, &settings);
                 s.painting_label(ui, rect);
                 s.viewport_input(&response, rect);
             }
@@ -274,6 +282,7 @@ impl Editor {
         s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
+        s.material_prompt_window(&ctx);
         s.modal_job_ui(&ctx);
         s.files_ui(&ctx);
         if s.job.is_some() {

@@ -17,9 +17,16 @@ use crate::model::{Document, DocumentSettings};
 
 /// The export dialog's preview: the packed layout of each file, the constants, the memory
 /// report and the `k_a` error that `n`'s quantisation costs.
-pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPlan) {
+pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPlan, pbr: bool) {
     let mb = |b: u64| b as f64 / 1e6;
-    ui.label(egui::RichText::new("Packed layout").strong());
+    ui.label(
+        egui::RichText::new(if pbr {
+            "glTF metallic-roughness textures"
+        } else {
+            "Packed layout"
+        })
+        .strong(),
+    );
     egui::Grid::new("export layout")
         .striped(true)
         .show(ui, |ui| {
@@ -56,11 +63,18 @@ pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPl
             e.curve, e.lo, e.hi, e.bits
         ));
     }
-    ui.label(format!(
-        "Estimated k_a error (n quantisation): max {:.3} %, mean {:.4} %",
-        plan.ka_error.max * 100.0,
-        plan.ka_error.mean * 100.0
-    ));
+    if pbr {
+        ui.label(
+            "Base colour, metallic and roughness are converted back from k_d, k_s and n; \
+             the round-trip error is measured as the set is written (material.json).",
+        );
+    } else {
+        ui.label(format!(
+            "Estimated k_a error (n quantisation): max {:.3} %, mean {:.4} %",
+            plan.ka_error.max * 100.0,
+            plan.ka_error.mean * 100.0
+        ));
+    }
     let b = &plan.bytes;
     ui.label(format!(
         "Memory: set {:.1} MB uncompressed (files are smaller), naive k_a + k_d + k_s + n {:.1} MB, project {:.1} MB",
@@ -146,6 +160,8 @@ pub(super) struct ExportDialog {
     plan: Option<(usize, u64, crate::export::set::SetPlan)>,
     /// A preview being computed on a worker thread.
     planning: Option<(usize, u64, JoinHandle<crate::export::set::SetPlan>)>,
+    /// With a glTF PBR preset: also write the mesh with the material as a `.glb`.
+    glb: bool,
 }
 
 impl ExportDialog {
@@ -313,15 +329,17 @@ impl EditorState {
         };
         let out = PathBuf::from(dialog.folder.trim());
         self.export_choice = Some((preset.name.clone(), dialog.folder.clone()));
+        let pbr = preset.format == crate::export::preset::Format::GltfPbr;
+        let mesh = self
+            .doc
+            .surface()
+            .filter(|_| pbr && dialog.glb)
+            .map(Arc::clone);
         let snapshot = self.snapshot();
         self.export = None;
         self.start_job("Export", move |progress| {
-            let export = if replace {
-                crate::export::set::export_replacing
-            } else {
-                crate::export::set::export_with
-            };
-            match export(&snapshot, &preset, &out, progress) {
+            let glb = mesh.as_ref().map(|s| &s.mesh);
+            match crate::export::run(&snapshot, &preset, &out, progress, replace, glb) {
                 Ok(m) => JobResult::Exported(out, Box::new(m)),
                 Err(e) => JobResult::Failed(format!("export failed: {e}")),
             }
@@ -352,6 +370,7 @@ impl EditorState {
             problem: None,
             plan: None,
             planning: None,
+            glb: false,
         });
     }
 
@@ -403,6 +422,7 @@ impl EditorState {
 
     pub(super) fn export_window(&mut self, ctx: &egui::Context) {
         self.update_export_plan(ctx);
+        let has_mesh = self.doc.surface().is_some();
         let Some(dialog) = &mut self.export else {
             return;
         };
@@ -429,8 +449,12 @@ impl EditorState {
                     ui.label(&p.description);
                 }
                 ui.separator();
+                let pbr = dialog
+                    .presets
+                    .get(dialog.chosen)
+                    .is_some_and(|p| p.format == crate::export::preset::Format::GltfPbr);
                 match &dialog.plan {
-                    Some((p, _, plan)) if *p == dialog.chosen => export_plan_ui(ui, plan),
+                    Some((p, _, plan)) if *p == dialog.chosen => export_plan_ui(ui, plan, pbr),
                     _ => {
                         ui.horizontal(|ui| {
                             ui.spinner();
@@ -448,6 +472,16 @@ impl EditorState {
                         choose = true;
                     }
                 });
+                if pbr {
+                    ui.add_enabled(
+                        has_mesh,
+                        egui::Checkbox::new(
+                            &mut dialog.glb,
+                            "Also write model.glb (the mesh with this material)",
+                        ),
+                    )
+                    .on_disabled_hover_text("The project's mesh is not loaded.");
+                }
                 if let Some(problem) = &dialog.problem {
                     ui.colored_label(ui.visuals().error_fg_color, problem);
                 }
@@ -494,6 +528,36 @@ impl EditorState {
                 ));
             }
             Err(e) => dialog.problem = Some(e.to_string()),
+        }
+    }
+
+    /// After a glTF mesh import: asks whether to bring its material's textures in too.
+    pub(super) fn material_prompt_window(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.material_prompt.clone() else {
+            return;
+        };
+        let (mut bring, mut skip) = (false, false);
+        centred(egui::Window::new("Import the material too?"), ctx)
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "{} has a material with textures. Bring it in too? Its base colour, \
+                     metallic and roughness are converted for {} into the selected layer's \
+                     k_d, k_s and n (one undo step), and its normal map is kept.",
+                    path.display(),
+                    self.doc.settings().model.label()
+                ));
+                ui.horizontal(|ui| {
+                    bring = ui.button("Bring the material in").clicked();
+                    skip = ui.button("Mesh only").clicked();
+                });
+            });
+        if bring {
+            self.material_prompt = None;
+            self.import_pbr(path);
+        } else if skip {
+            self.material_prompt = None;
         }
     }
 

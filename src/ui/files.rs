@@ -28,6 +28,8 @@ pub enum FilePurpose {
     ImportMesh,
     /// File > Import image into a channel.
     ImportImage(Channel),
+    /// File > Import PBR material (a glTF file's material).
+    ImportPbr,
     /// The brush stamp's Load.
     StampImage,
     /// New > File: the mesh of the new project.
@@ -47,6 +49,7 @@ enum Mode {
 const PROJECT: (&str, &[&str]) = ("kapaint project", &["kapaint"]);
 const MESH: (&str, &[&str]) = ("mesh", &["obj", "gltf", "glb"]);
 const IMAGE: (&str, &[&str]) = ("image", &["png", "jpg", "jpeg", "tga", "exr"]);
+const GLTF: (&str, &[&str]) = ("glTF material", &["glb", "gltf"]);
 
 impl FilePurpose {
     fn mode(self) -> Mode {
@@ -67,6 +70,7 @@ impl FilePurpose {
                 format!("Import image into {}", super::panels::channel_label(c))
             }
             Self::StampImage => "Load brush stamp".into(),
+            Self::ImportPbr => "Import PBR material (glTF)".into(),
             Self::NewMesh => "Mesh of the new project".into(),
             Self::ExportFolder => "Export into folder".into(),
         }
@@ -77,6 +81,7 @@ impl FilePurpose {
             Self::OpenProject | Self::SaveProject => Some(PROJECT),
             Self::ImportMesh | Self::NewMesh => Some(MESH),
             Self::ImportImage(_) | Self::StampImage => Some(IMAGE),
+            Self::ImportPbr => Some(GLTF),
             Self::ExportFolder => None,
         }
     }
@@ -472,6 +477,7 @@ impl super::EditorState {
                 FilePurpose::SaveProject => self.save_to(with_project_extension(path)),
                 FilePurpose::ImportMesh => self.import_mesh(path),
                 FilePurpose::ImportImage(channel) => self.import_image(path, channel),
+                FilePurpose::ImportPbr => self.import_pbr(path),
                 FilePurpose::StampImage => self.load_stamp(path),
                 FilePurpose::NewMesh => {
                     if let Some(dialog) = &mut self.new_dialog {

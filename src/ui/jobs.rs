@@ -20,9 +20,12 @@ pub(super) enum JobResult {
     /// came from a recovery copy, and a note for the user (its mesh could not be loaded).
     Opened(Option<PathBuf>, Box<Document>, bool, Option<String>),
     Saved(PathBuf, u64),
-    Exported(PathBuf, Box<crate::export::set::Manifest>),
-    /// A mesh loaded and baked at the map size.
-    Mesh(PathBuf, Arc<Surface>),
+    Exported(PathBuf, Box<crate::export::Exported>),
+    /// A mesh loaded and baked at the map size, and whether its file has a textured material
+    /// (the editor then offers to bring it in).
+    Mesh(PathBuf, Arc<Surface>, bool),
+    /// A PBR material converted at the map size for the document's model.
+    Material(PathBuf, Box<PbrMaterial>),
     /// An image decoded and resampled into a channel's planes.
     Image(PathBuf, Box<crate::model::import::ChannelPlanes>),
     /// The maps resized, with the mesh baked at their size.
@@ -32,6 +35,13 @@ pub(super) enum JobResult {
     /// A brush stamp read from an image.
     Stamp(PathBuf, crate::model::brush::Stamp),
     Failed(String),
+}
+
+/// A glTF material converted on a worker (File > Import PBR material).
+pub(super) struct PbrMaterial {
+    maps: crate::model::MaterialMaps,
+    normal: Option<crate::model::normal::NormalMap>,
+    report: crate::model::provenance::ImportReport,
 }
 
 /// Long work on a worker thread.
@@ -184,18 +194,14 @@ impl EditorState {
                     self.open_now(next);
                 }
             }
-            JobResult::Exported(dir, m) => self.notices.push(notice(
-                format!(
-                    "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
-                    dir.display(),
-                    m.file_count(),
-                    m.bytes.exported,
-                    m.ka_error.max * 100.0,
-                    m.ka_error.mean * 100.0
-                ),
-                false,
-            )),
-            JobResult::Mesh(path, surface) => {
+            JobResult::Exported(dir, m) => {
+                self.notices.push(notice(exported_notice(&dir, *m), false));
+            }
+            JobResult::Material(path, m) => self.take_material(&path, *m),
+            JobResult::Mesh(path, surface, textured) => {
+                if textured {
+                    self.material_prompt = Some(path.clone());
+                }
                 let mesh = surface.mesh.clone();
                 let spec = MeshRef::from_spec(&path.display().to_string());
                 match self.doc.set_mesh(spec, surface) {
@@ -311,10 +317,73 @@ impl EditorState {
             };
             progress.start("bake", 1);
             match Surface::new(mesh, w, h) {
-                Ok(s) => JobResult::Mesh(path, Arc::new(s)),
+                Ok(s) => {
+                    let textured = crate::pbr::gltf::has_textured_material(&path);
+                    JobResult::Mesh(path, Arc::new(s), textured)
+                }
                 Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
             }
         });
+    }
+
+    /// Converts the material of the glTF at `path` for the document's model at the map size,
+    /// on a worker; it replaces the selected layer's channels (one undo step) when it arrives.
+    pub fn import_pbr(&mut self, path: PathBuf) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        let model = self.doc.settings().model;
+        self.start_job("Material", move |progress| {
+            progress.start("decode", 1);
+            let converted = crate::pbr::gltf::material_set(&path, None).and_then(|m| {
+                progress.start("convert", 1);
+                let imported = crate::pbr::import::import(&m.set, Some((w, h)), model)?;
+                let mut report = imported.report;
+                report.notes.extend(m.notes);
+                let (maps, _) = imported.doc.into_parts();
+                Ok(PbrMaterial {
+                    maps,
+                    normal: m.normal,
+                    report,
+                })
+            });
+            match converted {
+                Ok(m) => JobResult::Material(path, Box::new(m)),
+                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Takes a converted PBR material: its maps into the selected layer (one undo step), its
+    /// normal map and its report into the document.
+    fn take_material(&mut self, path: &Path, m: PbrMaterial) {
+        let PbrMaterial {
+            maps,
+            normal,
+            report,
+        } = m;
+        let imported = crate::model::document::ImportedMaterial(Arc::new(maps));
+        if let Err(e) = self.doc.apply(Command::ImportMaterial(imported)) {
+            self.notices.push(notice(e.to_string(), true));
+            return;
+        }
+        self.doc.set_normal(normal.map(Arc::new));
+        let e = report.error;
+        self.notices.push(notice(
+            format!(
+                "{} imported for {}: conversion error max {:.1}%, mean {:.1}%, p99 {:.1}%",
+                path.display(),
+                report.model,
+                e.max * 100.0,
+                e.mean * 100.0,
+                e.p99 * 100.0
+            ),
+            false,
+        ));
+        for note in &report.notes {
+            self.notices.push(notice(note.clone(), false));
+        }
+        let mut settings = self.doc.settings().clone();
+        settings.import = Some(report);
+        self.doc.replace_settings(settings);
     }
 
     /// Loads a brush stamp from an image on a worker thread.
@@ -430,5 +499,27 @@ impl EditorState {
                 ui.label(text);
             });
         });
+    }
+}
+
+/// The notice of a finished export.
+fn exported_notice(dir: &std::path::Path, m: crate::export::Exported) -> String {
+    match m {
+        crate::export::Exported::Set(m) => format!(
+            "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
+            dir.display(),
+            m.file_count(),
+            m.bytes.exported,
+            m.ka_error.max * 100.0,
+            m.ka_error.mean * 100.0
+        ),
+        crate::export::Exported::Pbr(m) => format!(
+            "exported {} as glTF PBR ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%)",
+            dir.display(),
+            m.files.len() + 1,
+            m.round_trip.max * 100.0,
+            m.round_trip.mean * 100.0,
+            m.round_trip.p99 * 100.0
+        ),
     }
 }

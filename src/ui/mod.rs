@@ -200,6 +200,8 @@ pub struct EditorState {
     new_dialog: Option<NewDialog>,
     /// A project to open once the user has decided about the unsaved changes.
     pending_open: Option<PathBuf>,
+    /// An imported glTF mesh whose material has textures: asking whether to bring them in.
+    material_prompt: Option<PathBuf>,
     /// Recently opened or saved projects, newest first.
     recent: Vec<PathBuf>,
     /// The pen's last pressure in the current stroke (1 with a mouse).

@@ -72,7 +72,11 @@ fn file_tables(srgb: bool, n_enc: Option<NEncoding>) -> (Vec<f32>, Vec<f32>) {
 }
 
 /// A PNG of `data` (16-bit words native-endian) with `color`.
-fn png_bytes(data: &[u8], (width, height): (u32, u32), color: C) -> Result<Vec<u8>, String> {
+pub(crate) fn png_bytes(
+    data: &[u8],
+    (width, height): (u32, u32),
+    color: C,
+) -> Result<Vec<u8>, String> {
     let mut out = std::io::Cursor::new(Vec::new());
     image::ImageEncoder::write_image(
         image::codecs::png::PngEncoder::new_with_quality(
@@ -129,7 +133,7 @@ pub(super) fn encode_image(
         }
     };
     match format {
-        Format::Png8 => {
+        Format::Png8 | Format::GltfPbr => {
             let data: Vec<u8> = (0..count * channels)
                 .into_par_iter()
                 .map(|j| (value(j / channels, j % channels).clamp(0.0, 1.0) * 255.0).round() as u8)

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use rayon::prelude::*;
 
+pub(crate) use self::encode::png_bytes;
 use self::encode::{Encoded, StoredImage, encode_image, rows};
 pub use self::import::import;
 use self::manifest::approximation;
@@ -144,7 +145,7 @@ pub fn export_replacing(
 
 #[expect(
     clippy::too_many_lines,
-    reason = "one pass: analyse, encode in parallel, measure, commit"
+    reason = "one pass: analyse, encode in parallel, measure"
 )]
 fn export_into(
     doc: &Document,
@@ -155,15 +156,11 @@ fn export_into(
 ) -> Result<Manifest, SetError> {
     let cancelled = |_| SetError::Cancelled;
     progress.start("analyse", 1);
-    let found = target(out)?;
-    if found == Target::Taken || (found == Target::Set && !replace) {
-        return Err(SetError::Target {
+    let found = claim(out, replace)?;
+    if preset.format == Format::GltfPbr {
+        return Err(SetError::Invalid {
             path: out.to_path_buf(),
-            reason: if found == Target::Set {
-                "holds an exported set already: replace it, or choose another folder".into()
-            } else {
-                "exists and is not an empty folder".into()
-            },
+            reason: "a glTF PBR set is written by crate::export::run (crate::pbr::export)".into(),
         });
     }
     let maps = doc.maps();
@@ -171,24 +168,7 @@ fn export_into(
     let (w, h) = (maps.width(), maps.height());
     let (planned, mono_ks, images) = plan_set(doc, preset);
     let (constants, n_enc) = (planned.constants, planned.n_encoding);
-    let mut texels = rows(maps);
-    // Outside the mesh's UV islands, texels copy the nearest island's, so mips and filtering
-    // do not pull the background into the edges.
-    let dilated = doc.surface().is_some_and(|surface| {
-        let mut filled: Vec<bool> = surface
-            .bake
-            .coverage
-            .iter()
-            .map(|c| *c == Coverage::Surface)
-            .collect();
-        let any = filled.iter().any(|f| *f);
-        if any {
-            crate::mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
-                texels[k] = texels[src];
-            });
-        }
-        any
-    });
+    let (texels, dilated) = padded_texels(doc);
     let ka: Vec<Vec3> = if preset.include_ka {
         texels
             .par_iter()
@@ -205,21 +185,7 @@ fn export_into(
     progress.check().map_err(cancelled)?;
     progress.start("encode", images.len() as u64 * u64::from(h));
 
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
-    let name = out
-        .file_name()
-        .map_or_else(|| "set".into(), |n| n.to_string_lossy().into_owned());
-    remove_stale_sets(parent, &name);
-    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir(&tmp).map_err(|e| io(&tmp, e))?;
-    // Removed on every way out but the last rename.
-    let guard = crate::atomic::TempPath::new(tmp.clone());
-    let result = (|| {
+    commit(out, found, |tmp| {
         let encoded: Vec<Result<Encoded, SetError>> = images
             .par_iter()
             .map(|(stem, comps)| {
@@ -262,7 +228,7 @@ fn export_into(
                     ColourSpace::Linear
                 },
                 bit_depth: match preset.format {
-                    Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 8,
+                    Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 8,
                     Format::Png16 => 16,
                     Format::Exr => 32,
                 },
@@ -282,7 +248,7 @@ fn export_into(
             }
         }
         let depth = match preset.format {
-            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 1,
+            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 1,
             Format::Png16 => 2,
             Format::Exr => 4,
         };
@@ -324,7 +290,7 @@ fn export_into(
         // The manifest counts itself, and its length depends on the count's digits: repeat
         // until they agree (the count only grows, so this ends, in two or three rounds).
         let json = loop {
-            let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(&tmp, e))?;
+            let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(tmp, e))?;
             let total = exported + json.len() as u64;
             if manifest.bytes.exported == total {
                 break json;
@@ -334,8 +300,79 @@ fn export_into(
         let path = tmp.join("material.json");
         crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
         Ok(manifest)
-    })();
-    let manifest = result?;
+    })
+}
+
+/// Whether `out` can take a set (free, or a set when `replace`): what is there.
+///
+/// # Errors
+/// A target that is taken, or a set when not replacing.
+pub(crate) fn claim(out: &Path, replace: bool) -> Result<Target, SetError> {
+    let found = target(out)?;
+    if found == Target::Taken || (found == Target::Set && !replace) {
+        return Err(SetError::Target {
+            path: out.to_path_buf(),
+            reason: if found == Target::Set {
+                "holds an exported set already: replace it, or choose another folder".into()
+            } else {
+                "exists and is not an empty folder".into()
+            },
+        });
+    }
+    Ok(found)
+}
+
+/// The document's texels, row-major; outside the mesh's UV islands they copy the nearest
+/// island's, so mips and filtering do not pull the background into the edges (`true` when
+/// that was done: the document has a surface with UVs).
+pub(crate) fn padded_texels(doc: &Document) -> (Vec<crate::model::texel::Texel>, bool) {
+    let maps = doc.maps();
+    let (w, h) = (maps.width(), maps.height());
+    let mut texels = rows(maps);
+    let dilated = doc.surface().is_some_and(|surface| {
+        let mut filled: Vec<bool> = surface
+            .bake
+            .coverage
+            .iter()
+            .map(|c| *c == Coverage::Surface)
+            .collect();
+        let any = filled.iter().any(|f| *f);
+        if any {
+            crate::mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
+                texels[k] = texels[src];
+            });
+        }
+        any
+    });
+    (texels, dilated)
+}
+
+/// Writes a set with `write` into a temporary folder beside `out` and moves it into place
+/// (`found` is what [`claim`] found there: a set is swapped out, so `out` always holds a whole
+/// set). Nothing is left behind when `write` fails.
+///
+/// # Errors
+/// What `write` returns; a folder that cannot be made or renamed.
+pub(crate) fn commit<T>(
+    out: &Path,
+    found: Target,
+    write: impl FnOnce(&Path) -> Result<T, SetError>,
+) -> Result<T, SetError> {
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
+    let name = out
+        .file_name()
+        .map_or_else(|| "set".into(), |n| n.to_string_lossy().into_owned());
+    remove_stale_sets(parent, &name);
+    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir(&tmp).map_err(|e| io(&tmp, e))?;
+    // Removed on every way out but the last rename.
+    let guard = crate::atomic::TempPath::new(tmp.clone());
+    let manifest = write(&tmp)?;
     if found == Target::Set {
         // Swap: the old set moves aside, the new one takes its name, the old one goes. Should
         // the second rename fail, the old set is put back.

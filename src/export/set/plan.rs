@@ -103,6 +103,9 @@ pub(super) fn plan_set(
     preset: &ExportPreset,
 ) -> (SetPlan, bool, Vec<(&'static str, Vec<Comp>)>) {
     let maps = doc.maps();
+    if preset.format == Format::GltfPbr {
+        return (gltf_pbr_plan(maps), false, Vec::new());
+    }
     let (model, approx) = (doc.settings().model, doc.settings().approx);
     let (kd, ks, n) = maps.uniform_channels();
     let constants = Constants {
@@ -119,7 +122,7 @@ pub(super) fn plan_set(
     };
     let images = plan_images(preset, &constants, mono_ks);
     let depth: u64 = match preset.format {
-        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc => 1,
+        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 1,
         Format::Png16 => 2,
         Format::Exr => 4,
     };
@@ -149,4 +152,36 @@ pub(super) fn plan_set(
         mono_ks,
         images,
     )
+}
+
+/// A glTF PBR set's plan: base colour and metallic-roughness, three 8-bit channels each.
+fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
+    use crate::pbr::export::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE};
+    let texels = u64::from(maps.width()) * u64::from(maps.height());
+    let files: Vec<PlannedFile> = [
+        (BASE_COLOR_FILE, ["base.r", "base.g", "base.b"]),
+        (METALLIC_ROUGHNESS_FILE, ["-", "roughness", "metallic"]),
+    ]
+    .into_iter()
+    .map(|(path, layout)| PlannedFile {
+        path: path.into(),
+        layout: layout.map(String::from).to_vec(),
+        raw_bytes: texels * 3,
+    })
+    .collect();
+    SetPlan {
+        bytes: MemoryReport {
+            exported: files.iter().map(|f| f.raw_bytes).sum(),
+            naive: texels * 10,
+            project: texels * 14,
+        },
+        files,
+        constants: Constants {
+            kd: None,
+            ks: None,
+            n: None,
+        },
+        n_encoding: None,
+        ka_error: KaError::default(),
+    }
 }

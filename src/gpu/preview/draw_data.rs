@@ -83,6 +83,7 @@ impl PreviewDrawData {
             });
         let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
         let (kd, ks, n) = (view(&maps.kd), view(&maps.ks), view(&maps.n));
+        let normal = view(&maps.normal.texture);
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("preview"),
             layout: &preview.bind_layout,
@@ -106,6 +107,10 @@ impl PreviewDrawData {
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: wgpu::BindingResource::Sampler(&preview.sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&normal),
                 },
             ],
         });

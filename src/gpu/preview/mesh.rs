@@ -5,13 +5,14 @@ use glam::Vec3;
 use crate::gpu::{Gpu, GpuError};
 use crate::mesh::Mesh;
 
-/// Interleaved vertex: position, normal, UV.
+/// Interleaved vertex: position, normal, UV, MikkTSpace tangent.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(super) struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
     uv: [f32; 2],
+    tangent: [f32; 4],
 }
 
 /// A mesh on the GPU.
@@ -32,7 +33,9 @@ impl std::fmt::Debug for MeshBuffers {
 }
 
 impl MeshBuffers {
-    /// Uploads `mesh` (a mesh without UVs gets UV (0, 0): it previews, it cannot be painted).
+    /// Uploads `mesh` (a mesh without UVs gets UV (0, 0) and no tangents: it previews, it
+    /// cannot be painted). A mesh with UVs gets MikkTSpace tangents, for a normal map; its
+    /// vertices are split where a seam needs two tangents.
     ///
     /// # Errors
     /// Buffers beyond the device's limits, or a device out of memory or lost.
@@ -50,11 +53,17 @@ impl MeshBuffers {
 
     fn upload(gpu: &Gpu, mesh: &Mesh) -> Self {
         use wgpu::util::DeviceExt;
+        let with_tangents = crate::mesh::tangents::generate(mesh);
+        let (mesh, tangents) = match &with_tangents {
+            Some(t) => (&t.mesh, Some(&t.tangents)),
+            None => (mesh, None),
+        };
         let vertices: Vec<Vertex> = (0..mesh.positions.len())
             .map(|i| Vertex {
                 position: mesh.positions[i].to_array(),
                 normal: mesh.normals[i].to_array(),
                 uv: mesh.uvs.as_ref().map_or([0.0; 2], |u| u[i].to_array()),
+                tangent: tangents.map_or([0.0; 4], |t| t[i]),
             })
             .collect();
         let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();

@@ -30,6 +30,8 @@ pub struct PipelineKey {
     pub n_uniform: bool,
     /// Any specular at all (false when `k_s` is zero everywhere, but never for Cook-Torrance).
     pub has_specular: bool,
+    /// The material has a normal map (the lighting reads it; `k_a` never does).
+    pub normal_map: bool,
     /// Colour target format.
     pub format: wgpu::TextureFormat,
 }
@@ -37,7 +39,7 @@ pub struct PipelineKey {
 impl PipelineKey {
     /// The shader's overridable constants for this key, by name: the ids come from the same
     /// functions that generate `ids.wgsl`.
-    pub fn constants(&self) -> [(&'static str, f64); 7] {
+    pub fn constants(&self) -> [(&'static str, f64); 8] {
         let b = |v: bool| if v { 1.0 } else { 0.0 };
         [
             (
@@ -53,6 +55,7 @@ impl PipelineKey {
             ("KS_UNIFORM", b(self.ks_uniform)),
             ("N_UNIFORM", b(self.n_uniform)),
             ("HAS_SPECULAR", b(self.has_specular)),
+            ("NORMAL_MAP", b(self.normal_map)),
         ]
     }
 
@@ -71,6 +74,7 @@ impl PipelineKey {
             n_uniform: u.n.is_some(),
             // Cook-Torrance's Fresnel term reflects even where k_s (its F0) is zero.
             has_specular: u.ks != Some([0.0; 3]) || settings.model == ShadingModel::CookTorrance,
+            normal_map: u.normal_map,
             format,
         }
     }
@@ -110,7 +114,7 @@ pub(super) fn compile(
                 array_stride: std::mem::size_of::<Vertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &wgpu::vertex_attr_array![
-                    0 => Float32x3, 1 => Float32x3, 2 => Float32x2
+                    0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4
                 ],
             })],
         },

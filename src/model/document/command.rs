@@ -128,6 +128,10 @@ pub enum Command {
     /// see [`crate::model::import`]). Not for scripts: its planes come from a decoder.
     #[serde(skip)]
     ImportChannel(ImportedChannel),
+    /// Replaces `k_d`, `k_s` and `n` of the selected paint layer with maps of the document's
+    /// size (a PBR material converted on a worker), as one undo step. Not for scripts.
+    #[serde(skip)]
+    ImportMaterial(ImportedMaterial),
     /// Installs maps resized on a worker ([`crate::model::resize::resized`]) with the mesh
     /// surface baked at their size, as one undo step. Not for scripts: its maps come from a
     /// worker.
@@ -271,6 +275,17 @@ pub enum LayerPlace {
 /// clones cheaply.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImportedChannel(pub Arc<crate::model::import::ChannelPlanes>);
+
+/// Maps made on a worker for [`Command::ImportMaterial`], shared so that the command clones
+/// cheaply (equal when they are the same maps).
+#[derive(Clone, Debug)]
+pub struct ImportedMaterial(pub Arc<crate::model::MaterialMaps>);
+
+impl PartialEq for ImportedMaterial {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
 
 impl Command {
     /// Whether the command paints on the mesh (and so needs

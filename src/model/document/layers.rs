@@ -166,6 +166,41 @@ impl Document {
     }
 
     /// Replaces one channel of the selected paint layer with imported planes, opaque there.
+    /// [`Command::ImportMaterial`]: every channel of the selected paint layer from `maps`.
+    pub(super) fn import_material(
+        &mut self,
+        maps: &crate::model::MaterialMaps,
+    ) -> Result<(), ModelError> {
+        self.end_stroke();
+        if (maps.width(), maps.height()) != (self.maps.width(), self.maps.height()) {
+            return Err(ModelError::Internal(format!(
+                "the material was made at {}x{}, but the maps are {}x{}",
+                maps.width(),
+                maps.height(),
+                self.maps.width(),
+                self.maps.height()
+            )));
+        }
+        if self.state.selection.mask {
+            return Err(command_error(
+                "a material imports into a paint layer, not a mask: select the layer's content",
+            ));
+        }
+        self.edit_planes("Import material", |planes, _, _| {
+            let Planes::Paint(tiles) = planes else { return };
+            for (id, slot) in tiles.iter_mut().enumerate() {
+                let tile = Stamped::write(
+                    slot.get_or_insert_with(crate::model::layers::edit::empty_paint_tile),
+                );
+                let source = maps.tile(id);
+                tile.value.kd = source.kd.clone();
+                tile.value.ks = source.ks.clone();
+                tile.value.n = source.n.clone();
+                tile.alpha = std::array::from_fn(|_| Plane::Uniform(u16::MAX));
+            }
+        })
+    }
+
     pub(super) fn import_channel(&mut self, imported: &ChannelPlanes) -> Result<(), ModelError> {
         self.end_stroke();
         let count = match imported {

@@ -12,7 +12,8 @@ pub use layers::MAX_LAYERS;
 mod stroke;
 
 pub use command::{
-    Command, FillRegion, ImportedChannel, LayerKind, LayerMove, LayerPlace, LayerRef, StrokeTool,
+    Command, FillRegion, ImportedChannel, ImportedMaterial, LayerKind, LayerMove, LayerPlace,
+    LayerRef, StrokeTool,
 };
 
 use std::sync::Arc;
@@ -23,6 +24,7 @@ use super::ModelError;
 use super::brush::BrushSettings;
 use super::layers::{Compositor, LayerStack, Selection, StackHistory, State};
 use super::maps::MaterialMaps;
+use super::normal::NormalMap;
 use super::surface::Surface;
 use super::texel::{Channels, MaterialValue};
 use crate::reflectance::{AmbientApprox, ShadingModel};
@@ -160,6 +162,9 @@ pub struct Document {
     /// The layer whose opacity the last command set: the next opacity change of that layer
     /// joins its undo step (a slider's drag is one step).
     opacity_run: Option<Vec<usize>>,
+    /// The tangent-space normal map an imported material brought (not painted; never in
+    /// `k_a`).
+    normal: Option<Arc<NormalMap>>,
 }
 
 impl std::fmt::Debug for Document {
@@ -206,6 +211,7 @@ impl Document {
             self.settings.clone(),
         );
         doc.state.selection = self.state.selection.clone();
+        doc.normal.clone_from(&self.normal);
         doc
     }
 
@@ -231,7 +237,35 @@ impl Document {
             settings_version: 0,
             layers_version: 0,
             opacity_run: None,
+            normal: None,
         }
+    }
+
+    /// [`Command::Pick`] (the composite's value) and [`Command::PickLayer`] (the selected
+    /// layer's) into the primary material.
+    fn pick(&mut self, x: u32, y: u32, layer: bool) -> Result<(), ModelError> {
+        self.check_texel(x, y, "pick")?;
+        let picked = if layer {
+            self.layer_value(x, y, self.settings.primary)
+        } else {
+            self.maps.value(x, y)
+        };
+        if self.settings.primary != picked {
+            self.settings.primary = picked;
+            self.settings_version += 1;
+        }
+        Ok(())
+    }
+
+    /// The tangent-space normal map, if the material has one.
+    pub fn normal(&self) -> Option<&Arc<NormalMap>> {
+        self.normal.as_ref()
+    }
+
+    /// Keeps `normal` as the material's normal map (or drops it), without an undo step: an
+    /// importer or loader sets it as the document is made.
+    pub fn set_normal(&mut self, normal: Option<Arc<NormalMap>>) {
+        self.normal = normal;
     }
 
     /// Replaces the settings wholesale (a loader adjusting paths), without an undo step.
@@ -388,25 +422,10 @@ impl Document {
             }
             Command::Fill(region) => self.fill(region)?,
             Command::Gradient { shape, start, end } => self.gradient(shape, start, end)?,
-            Command::Pick { x, y } => {
-                self.check_texel(x, y, "pick")?;
-                let picked = self.maps.value(x, y);
-                set(
-                    &mut self.settings.primary,
-                    picked,
-                    &mut self.settings_version,
-                );
-            }
-            Command::PickLayer { x, y } => {
-                self.check_texel(x, y, "pick")?;
-                let picked = self.layer_value(x, y, self.settings.primary);
-                set(
-                    &mut self.settings.primary,
-                    picked,
-                    &mut self.settings_version,
-                );
-            }
+            Command::Pick { x, y } => self.pick(x, y, false)?,
+            Command::PickLayer { x, y } => self.pick(x, y, true)?,
             Command::ImportChannel(imported) => self.import_channel(&imported.0)?,
+            Command::ImportMaterial(imported) => self.import_material(&imported.0)?,
             Command::Undo => {
                 self.end_stroke();
                 if self.history.undo(&mut self.state) {

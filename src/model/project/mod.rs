@@ -81,7 +81,29 @@ pub struct Manifest {
     /// for readers that do not composite.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub layers: Option<Vec<layers::LayerEntry>>,
+    /// The tangent-space normal map, when the material has one (an 8-bit RGB PNG at its own
+    /// size).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<NormalEntry>,
 }
+
+/// Where a project keeps its normal map.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct NormalEntry {
+    /// Entry name in the archive ([`NORMAL_FILE`]).
+    pub file: String,
+    /// [`NORMAL_ENCODING`].
+    pub encoding: String,
+    /// Size in texels.
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+}
+
+/// The normal map's entry in the archive.
+pub const NORMAL_FILE: &str = "normal.png";
+/// How the normal map's PNG is read: 8-bit RGB, `2 c - 1` in the tangent frame.
+pub const NORMAL_ENCODING: &str = "png-rgb8-tangent-normal";
 
 const RGB_ENCODING: &str = "png-rgb16-unorm-linear";
 const N_ENCODING: &str = "png-gray16-half-float-bits";

@@ -69,6 +69,8 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         if (0..stored.tile_count()).into_par_iter().any(differs) {
             return Err("the stored composite differs from what the layers composite to".into());
         }
+        let mut doc = doc;
+        doc.set_normal(read_normal(&mut zip, manifest.normal.as_ref())?);
         return Ok(doc);
     }
     let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
@@ -78,7 +80,63 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
     let settings = manifest.settings;
     let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
     fill_maps(&mut maps, &kd, &ks, &n);
-    Ok(Document::from_parts(maps, settings))
+    let mut doc = Document::from_parts(maps, settings);
+    doc.set_normal(read_normal(&mut zip, manifest.normal.as_ref())?);
+    Ok(doc)
+}
+
+/// The normal map of the manifest's entry, checked against it.
+fn read_normal<R: Read + Seek>(
+    zip: &mut zip::ZipArchive<R>,
+    entry: Option<&super::NormalEntry>,
+) -> Result<Option<std::sync::Arc<crate::model::normal::NormalMap>>, String> {
+    let Some(e) = entry else {
+        return Ok(None);
+    };
+    if e.encoding != super::NORMAL_ENCODING {
+        return Err(format!(
+            "{}: encoding {:?} is not supported for the normal map",
+            e.file, e.encoding
+        ));
+    }
+    let max = crate::model::maps::MAX_SIDE;
+    if e.width == 0 || e.height == 0 || e.width > max || e.height > max {
+        return Err(format!(
+            "{}: size {}x{} is outside 1..={max}",
+            e.file, e.width, e.height
+        ));
+    }
+    let mut file = zip
+        .by_name(&e.file)
+        .map_err(|err| format!("{}: {err}", e.file))?;
+    let limit = u64::from(e.width) * u64::from(e.height) * 3 * 2 + (1 << 20);
+    if file.size() > limit {
+        return Err(format!(
+            "{} claims {} bytes, more than a {}x{} map can need",
+            e.file,
+            file.size(),
+            e.width,
+            e.height
+        ));
+    }
+    let mut bytes = Vec::new();
+    (&mut file)
+        .take(limit)
+        .read_to_end(&mut bytes)
+        .map_err(|err| format!("{}: {err}", e.file))?;
+    let map = crate::model::normal::NormalMap::from_png(&bytes)
+        .map_err(|err| format!("{}: {err}", e.file))?;
+    if (map.width(), map.height()) != (e.width, e.height) {
+        return Err(format!(
+            "{} is {}x{}, the manifest says {}x{}",
+            e.file,
+            map.width(),
+            map.height(),
+            e.width,
+            e.height
+        ));
+    }
+    Ok(Some(std::sync::Arc::new(map)))
 }
 
 /// Reads the maps of layer `k`: values and coverage for a painted paint layer, and its mask.

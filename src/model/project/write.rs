@@ -189,6 +189,12 @@ pub(super) fn write_project(
         n: entry(&rasters[2]),
         base: Some(doc.stack().base),
         layers: Some(layers),
+        normal: doc.normal().map(|m| super::NormalEntry {
+            file: super::NORMAL_FILE.into(),
+            encoding: super::NORMAL_ENCODING.into(),
+            width: m.width(),
+            height: m.height(),
+        }),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
     // Never write what the loader would refuse: the manifest goes through the loader's own
@@ -217,6 +223,12 @@ pub(super) fn write_project(
                 .map_err(|e| e.to_string())?;
             zip.write_all(&png).map_err(|e| e.to_string())?;
         }
+    }
+    if let Some(normal) = doc.normal() {
+        let png = normal.to_png()?;
+        zip.start_file(super::NORMAL_FILE, stored_file)
+            .map_err(|e| e.to_string())?;
+        zip.write_all(&png).map_err(|e| e.to_string())?;
     }
     zip.finish().map_err(|e| e.to_string())?;
     Ok(())

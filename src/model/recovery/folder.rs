@@ -111,6 +111,7 @@ fn replay(doc: Document, journal: &Path, base: &Path) -> Document {
         // No record: the generation as written, layers and all.
         return doc;
     }
+    let normal = doc.normal().cloned();
     let (mut maps, mut settings) = doc.into_parts();
     if let Ok(mut file) = std::fs::File::open(journal) {
         let mut magic = [0_u8; 8];
@@ -126,7 +127,9 @@ fn replay(doc: Document, journal: &Path, base: &Path) -> Document {
             }
         }
     }
-    Document::from_parts(maps, settings)
+    let mut doc = Document::from_parts(maps, settings);
+    doc.set_normal(normal);
+    doc
 }
 
 /// Writes a new generation (a base copy and an empty journal) into `dir`, then removes the

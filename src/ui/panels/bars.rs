@@ -124,6 +124,16 @@ impl EditorState {
                 if ui.button("Import mesh…").clicked() {
                     self.choose_file(FilePurpose::ImportMesh);
                 }
+                if ui
+                    .button("Import PBR material (glTF)…")
+                    .on_hover_text(
+                        "A glTF material's base colour, metallic-roughness and normal map, \
+                         converted for the current model into the selected layer",
+                    )
+                    .clicked()
+                {
+                    self.choose_file(FilePurpose::ImportPbr);
+                }
                 for channel in [Channel::Kd, Channel::Ks, Channel::N] {
                     if ui
                         .button(format!("Import image into {}…", channel_label(channel)))

@@ -24,6 +24,14 @@ pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
 
 pub use crate::render::Compare;
 
+/// What the viewport shows: the maps with their source id (a new id means new textures), and
+/// the material's normal map.
+pub type MapsIn<'a> = (
+    &'a MaterialMaps,
+    u64,
+    Option<&'a Arc<crate::model::normal::NormalMap>>,
+);
+
 /// One side of a comparison: its shading model and approximation of `chi`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Side {
@@ -148,7 +156,7 @@ impl Viewport {
     pub fn show(
         &mut self,
         ui: &mut egui::Ui,
-        maps: (&MaterialMaps, u64),
+        maps: MapsIn<'_>,
         mesh: &(u64, Arc<Mesh>),
         settings: &FrameSettings,
     ) -> (egui::Response, Rect) {

@@ -128,7 +128,7 @@ impl ViewportGpu {
     /// lost: the viewport says so, and painting goes on.
     pub(super) fn render(
         &mut self,
-        (maps, source): (&MaterialMaps, u64),
+        (maps, source, normal): super::MapsIn<'_>,
         mesh: &(u64, Arc<Mesh>),
         settings: &FrameSettings,
         comparison: &Comparison,
@@ -148,6 +148,9 @@ impl ViewportGpu {
                 self.maps = Some(MapTextures::new(&self.gpu, maps)?);
                 self.maps_source = source;
             }
+        }
+        if let Some(m) = &mut self.maps {
+            m.set_normal(&self.gpu, normal)?;
         }
         if self.target.as_ref().is_none_or(|t| t.size != size) {
             self.gpu.check_texture_size("the viewport", size)?;
