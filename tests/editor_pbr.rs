@@ -10,6 +10,10 @@
 mod kit;
 
 #[path = "common/gltf_asset.rs"]
+#[expect(
+    dead_code,
+    reason = "the command runner and scratch folders serve the CLI tests"
+)]
 mod gltf_asset;
 
 use egui::Modifiers;

@@ -30,7 +30,7 @@ fn uniform_normal(n: Vec3) -> Arc<NormalMap> {
 /// The centre pixel of `view` of the plane lit from `light`, with `normal` as its normal map.
 fn centre(gpu: &Gpu, view: ViewMode, light: Vec3, normal: Option<&Arc<NormalMap>>) -> [f32; 3] {
     let plane = kapaint::mesh::builtin("plane").expect("plane");
-    let buffers = MeshBuffers::new(gpu, &plane).expect("mesh");
+    let buffers = MeshBuffers::with_tangents(gpu, &plane).expect("mesh");
     let maps = MaterialMaps::new(
         16,
         16,

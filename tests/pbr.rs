@@ -7,8 +7,7 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use glam::Vec3;
 use kapaint::model::texel::srgb_to_linear;
@@ -20,21 +19,7 @@ use kapaint::reflectance::{ShadingModel, cook_torrance, exact};
 
 #[path = "common/gltf_asset.rs"]
 mod gltf_asset;
-use gltf_asset::{Asset, spot, write_asset};
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kapaint-pbr-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("dir");
-    d
-}
-
-fn kapaint(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kapaint"))
-        .args(args)
-        .output()
-        .expect("run kapaint")
-}
+use gltf_asset::{Asset, dir, kapaint, spot, write_asset};
 
 fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

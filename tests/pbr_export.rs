@@ -7,8 +7,7 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use kapaint::pbr::convert::Conversion;
 use kapaint::pbr::export::PbrManifest;
@@ -17,21 +16,7 @@ use kapaint::reflectance::ShadingModel;
 
 #[path = "common/gltf_asset.rs"]
 mod gltf_asset;
-use gltf_asset::{Asset, spot, write_asset};
-
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kapaint-pbr-export-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("dir");
-    d
-}
-
-fn kapaint(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kapaint"))
-        .args(args)
-        .output()
-        .expect("run kapaint")
-}
+use gltf_asset::{Asset, dir, kapaint, spot, write_asset};
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
@@ -402,16 +387,12 @@ fn the_normal_map_is_kept_passed_through_and_never_in_ka() {
     );
 }
 
-#[test]
-fn a_loose_normal_map_imports_and_a_bad_one_is_refused() {
-    let d = dir("loose-normal");
-    let normal = d.join("bumps.png");
-    gltf_asset::bumps(64, 32).save(&normal).expect("save");
-    let out = d.join("loose.kapaint");
-    let o = kapaint(&[
+/// `import-pbr` of a grey dielectric with `normal` as its normal map into `out`.
+fn import_with_normal(out: &Path, normal: &Path) -> std::process::Output {
+    kapaint(&[
         "import-pbr",
         "--out",
-        s(&out),
+        s(out),
         "--base-color",
         "0.5",
         "--metallic",
@@ -419,8 +400,17 @@ fn a_loose_normal_map_imports_and_a_bad_one_is_refused() {
         "--roughness",
         "0.5",
         "--normal",
-        s(&normal),
-    ]);
+        s(normal),
+    ])
+}
+
+#[test]
+fn a_loose_normal_map_imports_and_a_bad_one_is_refused() {
+    let d = dir("loose-normal");
+    let normal = d.join("bumps.png");
+    gltf_asset::bumps(64, 32).save(&normal).expect("save");
+    let out = d.join("loose.kapaint");
+    let o = import_with_normal(&out, &normal);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(
         text(&o.stdout).contains("normal map: 64x32, kept with the project"),
@@ -433,22 +423,10 @@ fn a_loose_normal_map_imports_and_a_bad_one_is_refused() {
         Some((64, 32))
     );
     // Missing, or not an image: one error, nothing written.
+    std::fs::write(d.join("junk.png"), b"not a png").expect("junk");
     for bad in [d.join("missing.png"), d.join("junk.png")] {
-        std::fs::write(d.join("junk.png"), b"not a png").expect("junk");
         let out = d.join("bad.kapaint");
-        let o = kapaint(&[
-            "import-pbr",
-            "--out",
-            s(&out),
-            "--base-color",
-            "0.5",
-            "--metallic",
-            "0",
-            "--roughness",
-            "0.5",
-            "--normal",
-            s(&bad),
-        ]);
+        let o = import_with_normal(&out, &bad);
         assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
         assert_eq!(text(&o.stderr).lines().count(), 1, "{}", text(&o.stderr));
         assert!(!out.exists());

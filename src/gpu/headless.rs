@@ -63,7 +63,11 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
     let kind = kind_of(&req.out)?;
     let (width, height) = req.size;
     let preview = Preview::new(gpu);
-    let mesh = MeshBuffers::new(gpu, req.mesh)?;
+    let mesh = if req.normal.is_some() {
+        MeshBuffers::with_tangents(gpu, req.mesh)?
+    } else {
+        MeshBuffers::new(gpu, req.mesh)?
+    };
     let mut maps = MapTextures::new(gpu, req.maps)?;
     maps.set_normal(gpu, req.normal)?;
     let linear = kind == Kind::Exr || req.settings.view.is_data();

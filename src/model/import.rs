@@ -478,6 +478,32 @@ pub fn import_file(doc: &mut Document, channel: Channel, path: &Path) -> Result<
     Ok(())
 }
 
+/// A PNG of `data` (samples in the encoder's order; 16-bit words native-endian) with `color`,
+/// fast deflate and adaptive filtering: what sets and normal maps are written as.
+///
+/// # Errors
+/// The encoder's (a size that does not match `data`).
+pub fn encode_png(
+    data: &[u8],
+    (width, height): (u32, u32),
+    color: image::ExtendedColorType,
+) -> Result<Vec<u8>, String> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new_with_quality(
+            &mut out,
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Adaptive,
+        ),
+        data,
+        width,
+        height,
+        color,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -89,20 +89,11 @@ impl NormalMap {
     /// # Errors
     /// The encoder's.
     pub fn to_png(&self) -> Result<Vec<u8>, String> {
-        let mut out = std::io::Cursor::new(Vec::new());
-        image::ImageEncoder::write_image(
-            image::codecs::png::PngEncoder::new_with_quality(
-                &mut out,
-                image::codecs::png::CompressionType::Fast,
-                image::codecs::png::FilterType::Adaptive,
-            ),
+        super::import::encode_png(
             self.image.as_raw(),
-            self.width(),
-            self.height(),
+            (self.width(), self.height()),
             image::ExtendedColorType::Rgb8,
         )
-        .map_err(|e| e.to_string())?;
-        Ok(out.into_inner())
     }
 
     /// Decodes an 8-bit RGB PNG of at most `MAX_SIDE` texels a side (what [`Self::to_png`]

@@ -21,13 +21,13 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::convert::{Conversion, ErrorStats};
-use super::{Pbr, from_material};
+use super::from_material;
 use crate::export::preset::ExportPreset;
 use crate::export::set::{ColourSpace, SetError, claim, commit, padded_texels, png_bytes};
 use crate::mesh::Mesh;
 use crate::model::Document;
 use crate::model::provenance::ErrorSummary;
-use crate::model::texel::{MaterialValue, Texel, decode_n, linear_to_srgb8, srgb_to_linear};
+use crate::model::texel::{Texel, decode_n, linear_to_srgb8, srgb_to_linear};
 use crate::reflectance::{AmbientApprox, ShadingModel, chi_parts_f32};
 use crate::task::Progress;
 
@@ -93,17 +93,6 @@ pub struct Converted {
     pub error: ErrorSummary,
 }
 
-/// What one exported 8-bit PBR texel reads back as: its PBR values, then the same in the
-/// model's terms.
-fn read_back(base: [u8; 3], mr: [u8; 3], conversion: &Conversion) -> (Pbr, MaterialValue) {
-    let p = Pbr {
-        base: Vec3::from_array(base.map(|c| srgb_to_linear(f32::from(c) / 255.0))),
-        metallic: f32::from(mr[2]) / 255.0,
-        roughness: f32::from(mr[1]) / 255.0,
-    };
-    (p, conversion.material(p))
-}
-
 /// One chunk's base colours, metallic-roughness texels and error statistics.
 type Chunk = (Vec<[u8; 3]>, Vec<[u8; 3]>, ErrorStats);
 
@@ -121,20 +110,31 @@ pub fn convert(texels: &[Texel], model: ShadingModel) -> Converted {
             (r, chi_parts_f32(model, approx, n))
         })
         .collect();
+    // What each stored byte reads back as: sRGB base colour, and per roughness byte the
+    // exponent's [chi_1, chi_0].
+    let srgb: [f32; 256] = std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0));
+    let chi_of_byte: [[f32; 2]; 256] =
+        std::array::from_fn(|r| chi_parts_f32(model, approx, conversion.n(r as f32 / 255.0)));
     let texel = |t: &Texel| {
         let v = t.decode();
         let p = from_material(v);
         let base = p.base.to_array().map(linear_to_srgb8);
         let (r, chi) = n_table[usize::from(t.n)];
         let mr = [255, r, (p.metallic * 255.0 + 0.5) as u8];
-        let (back_p, back) = read_back(base, mr, conversion);
-        let chi_back = chi_parts_f32(model, approx, back.n);
-        let parts = conversion.error_parts(back.kd, back.ks, back_p.roughness);
+        // The texel as a consumer reads the files, in the model's terms.
+        let (back_base, m) = (
+            Vec3::from_array(base.map(|c| srgb[usize::from(c)])),
+            f32::from(mr[2]) / 255.0,
+        );
+        let back_kd = back_base * (1.0 - m);
+        let back_ks = Vec3::splat(super::DIELECTRIC_F0).lerp(back_base, m);
+        let chi_back = chi_of_byte[usize::from(r)];
+        let parts = conversion.error_parts(back_kd, back_ks, f32::from(r) / 255.0);
         let mut worst = 0.0_f32;
         for (c, [numerator, mean]) in parts.into_iter().enumerate() {
-            let drift = std::f32::consts::FRAC_2_PI * (v.kd[c] - back.kd[c]).abs()
-                + (v.ks[c] - back.ks[c]).abs() * chi[0]
-                + back.ks[c] * (chi[0] - chi_back[0]).abs()
+            let drift = std::f32::consts::FRAC_2_PI * (v.kd[c] - back_kd[c]).abs()
+                + (v.ks[c] - back_ks[c]).abs() * chi[0]
+                + back_ks[c] * (chi[0] - chi_back[0]).abs()
                 + (chi[1] - chi_back[1]).abs();
             if mean > 0.0 {
                 worst = worst.max((numerator + drift) / mean);
@@ -333,6 +333,8 @@ pub fn export(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::texel::MaterialValue;
+    use crate::pbr::Pbr;
 
     #[test]
     fn the_round_trip_error_is_the_imports_where_the_texel_survives_and_more_where_not() {

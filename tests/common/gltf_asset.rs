@@ -1,12 +1,28 @@
 //! A real glTF PBR material for tests: spot's mesh and texture, metallic and roughness made
-//! here, written with the `gltf` crate's JSON types (shared by `tests/pbr.rs` and
-//! `tests/pbr_export.rs`).
+//! here, written with the `gltf` crate's JSON types; and the PBR tests' scratch folders and
+//! command runner (shared by `tests/pbr.rs`, `tests/pbr_export.rs` and `tests/editor_pbr.rs`).
 
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use gltf::json;
 use json::validation::Checked::Valid;
+
+/// A fresh scratch folder `name` for this test process.
+pub fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("kapaint-pbr-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("dir");
+    d
+}
+
+/// Runs the kapaint binary with `args`.
+pub fn kapaint(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(args)
+        .output()
+        .expect("run kapaint")
+}
 
 /// The spot test data's folder.
 pub fn spot() -> PathBuf {

@@ -72,25 +72,8 @@ fn file_tables(srgb: bool, n_enc: Option<NEncoding>) -> (Vec<f32>, Vec<f32>) {
 }
 
 /// A PNG of `data` (16-bit words native-endian) with `color`.
-pub(crate) fn png_bytes(
-    data: &[u8],
-    (width, height): (u32, u32),
-    color: C,
-) -> Result<Vec<u8>, String> {
-    let mut out = std::io::Cursor::new(Vec::new());
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new_with_quality(
-            &mut out,
-            image::codecs::png::CompressionType::Fast,
-            image::codecs::png::FilterType::Adaptive,
-        ),
-        data,
-        width,
-        height,
-        color,
-    )
-    .map_err(|e| e.to_string())?;
-    Ok(out.into_inner())
+pub(crate) fn png_bytes(data: &[u8], size: (u32, u32), color: C) -> Result<Vec<u8>, String> {
+    crate::model::import::encode_png(data, size, color)
 }
 
 /// Encodes one image of `comps` components from the texels.

@@ -22,6 +22,8 @@ pub struct MeshBuffers {
     pub(super) index_count: u32,
     /// Object-space bounds, for framing.
     pub bounds: (Vec3, Vec3),
+    /// Whether the vertices carry MikkTSpace tangents (else zero: no normal map is read).
+    pub tangents: bool,
 }
 
 impl std::fmt::Debug for MeshBuffers {
@@ -33,13 +35,25 @@ impl std::fmt::Debug for MeshBuffers {
 }
 
 impl MeshBuffers {
-    /// Uploads `mesh` (a mesh without UVs gets UV (0, 0) and no tangents: it previews, it
-    /// cannot be painted). A mesh with UVs gets MikkTSpace tangents, for a normal map; its
-    /// vertices are split where a seam needs two tangents.
+    /// Uploads `mesh` (a mesh without UVs gets UV (0, 0): it previews, it cannot be painted),
+    /// without tangents.
     ///
     /// # Errors
     /// Buffers beyond the device's limits, or a device out of memory or lost.
     pub fn new(gpu: &Gpu, mesh: &Mesh) -> Result<Self, GpuError> {
+        Self::upload_checked(gpu, mesh, false)
+    }
+
+    /// [`Self::new`] with MikkTSpace tangents where the mesh has UVs, for a normal map (its
+    /// vertices split where a seam needs two tangents; about 1 ms per 1,000 triangles).
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn with_tangents(gpu: &Gpu, mesh: &Mesh) -> Result<Self, GpuError> {
+        Self::upload_checked(gpu, mesh, true)
+    }
+
+    fn upload_checked(gpu: &Gpu, mesh: &Mesh, tangents: bool) -> Result<Self, GpuError> {
         let max = gpu.device.limits().max_buffer_size;
         let bytes = (mesh.positions.len() * std::mem::size_of::<Vertex>()) as u64;
         if bytes > max {
@@ -48,12 +62,14 @@ impl MeshBuffers {
                 mesh.positions.len()
             )));
         }
-        gpu.checked("uploading the mesh", || Self::upload(gpu, mesh))
+        gpu.checked("uploading the mesh", || Self::upload(gpu, mesh, tangents))
     }
 
-    fn upload(gpu: &Gpu, mesh: &Mesh) -> Self {
+    fn upload(gpu: &Gpu, mesh: &Mesh, tangents: bool) -> Self {
         use wgpu::util::DeviceExt;
-        let with_tangents = crate::mesh::tangents::generate(mesh);
+        let with_tangents = tangents
+            .then(|| crate::mesh::tangents::generate(mesh))
+            .flatten();
         let (mesh, tangents) = match &with_tangents {
             Some(t) => (&t.mesh, Some(&t.tangents)),
             None => (mesh, None),
@@ -84,6 +100,7 @@ impl MeshBuffers {
                 }),
             index_count: indices.len() as u32,
             bounds: mesh.bounds(),
+            tangents: with_tangents.is_some(),
         }
     }
 }

@@ -134,9 +134,22 @@ impl ViewportGpu {
         comparison: &Comparison,
         size: (u32, u32),
     ) -> Result<TextureId, GpuError> {
-        if self.mesh.as_ref().is_none_or(|(id, _)| *id != mesh.0) {
+        // Tangents (for a normal map) only when there is one to read.
+        let tangents = normal.is_some();
+        if self
+            .mesh
+            .as_ref()
+            .is_none_or(|(id, b)| *id != mesh.0 || (tangents && !b.tangents))
+        {
             self.mesh = None;
-            self.mesh = Some((mesh.0, MeshBuffers::new(&self.gpu, &mesh.1)?));
+            self.mesh = Some((
+                mesh.0,
+                if tangents {
+                    MeshBuffers::with_tangents(&self.gpu, &mesh.1)?
+                } else {
+                    MeshBuffers::new(&self.gpu, &mesh.1)?
+                },
+            ));
         }
         let maps_size = (maps.width(), maps.height());
         match &mut self.maps {
