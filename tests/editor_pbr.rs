@@ -73,6 +73,9 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
     assert_eq!(report.model, doc.settings().model.name());
     assert!(kit::changed(&before, &texels(harness.state())) > 0);
     assert!(harness.state().state.dirty());
+    // The Layers panel says the material has a normal map.
+    harness.run_steps(2);
+    harness.get_by_label_contains("Normal map 1024x1024");
 
     // One undo step puts the layer back.
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);

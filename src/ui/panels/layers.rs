@@ -190,6 +190,20 @@ impl EditorState {
                     ))
                     .weak(),
                 );
+                if let Some(normal) = self.doc.normal() {
+                    ui.label(
+                        egui::RichText::new(format!(
+                            "Normal map {}x{} (imported; lighting only, never in k_a)",
+                            normal.width(),
+                            normal.height()
+                        ))
+                        .weak(),
+                    )
+                    .on_hover_text(
+                        "A tangent-space normal map from the imported material: the preview \
+                         lights with it, the gltf-pbr export passes it through. It is not painted.",
+                    );
+                }
             });
         for (path, action) in actions {
             self.row_action(path, action);
