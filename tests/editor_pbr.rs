@@ -76,6 +76,12 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
     // The Layers panel says the material has a normal map.
     harness.run_steps(2);
     harness.get_by_label_contains("Normal map 1024x1024");
+    // The canvas shows what each texel loses as a PBR material, with its scale.
+    harness.get_by_label("Canvas shows").click();
+    harness.run_steps(2);
+    harness.get_by_label("PBR error").click();
+    harness.run_steps(3);
+    harness.get_by_label(kapaint::ui::canvas::PBR_ERROR_SCALE_LABEL);
 
     // One undo step puts the layer back.
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);

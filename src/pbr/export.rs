@@ -93,43 +93,73 @@ pub struct Converted {
     pub error: ErrorSummary,
 }
 
-/// One chunk's base colours, metallic-roughness texels and error statistics.
-type Chunk = (Vec<[u8; 3]>, Vec<[u8; 3]>, ErrorStats);
+/// One model's round trip, texel by texel: the tables that turn a stored texel into its
+/// 8-bit PBR values and their round-trip error (built once per process and model).
+pub struct RoundTrip {
+    conversion: &'static Conversion,
+    /// Per stored `n` code: its roughness byte and the model's `[chi_1, chi_0]`.
+    n_table: Vec<(u8, [f32; 2])>,
+    /// A stored sRGB byte in linear light.
+    srgb: [f32; 256],
+    /// Per roughness byte, the `[chi_1, chi_0]` of the exponent it reads back as.
+    chi_of_byte: [[f32; 2]; 256],
+}
 
-/// Converts texels (row-major) read in `model`'s terms to 8-bit PBR values, with the
-/// round-trip error (see the module docs).
-pub fn convert(texels: &[Texel], model: ShadingModel) -> Converted {
-    let conversion = Conversion::for_model(model);
-    let approx = AmbientApprox::Fast;
-    // Per stored n code: its roughness byte and the model's [chi_1, chi_0].
-    let n_table: Vec<(u8, [f32; 2])> = (0..=u16::MAX)
-        .into_par_iter()
-        .map(|bits| {
-            let n = decode_n(bits);
-            let r = (conversion.roughness(n) * 255.0 + 0.5) as u8;
-            (r, chi_parts_f32(model, approx, n))
-        })
-        .collect();
-    // What each stored byte reads back as: sRGB base colour, and per roughness byte the
-    // exponent's [chi_1, chi_0].
-    let srgb: [f32; 256] = std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0));
-    let chi_of_byte: [[f32; 2]; 256] =
-        std::array::from_fn(|r| chi_parts_f32(model, approx, conversion.n(r as f32 / 255.0)));
-    let texel = |t: &Texel| {
+impl RoundTrip {
+    /// The tables for `model` (built on first use, about 10 ms).
+    pub fn for_model(model: ShadingModel) -> &'static Self {
+        static TABLES: [std::sync::OnceLock<RoundTrip>; 3] = [
+            std::sync::OnceLock::new(),
+            std::sync::OnceLock::new(),
+            std::sync::OnceLock::new(),
+        ];
+        let k = match model {
+            ShadingModel::Phong => 0,
+            ShadingModel::BlinnPhong => 1,
+            ShadingModel::CookTorrance => 2,
+        };
+        TABLES[k].get_or_init(|| Self::build(model))
+    }
+
+    fn build(model: ShadingModel) -> Self {
+        let conversion = Conversion::for_model(model);
+        let approx = AmbientApprox::Fast;
+        Self {
+            conversion,
+            n_table: (0..=u16::MAX)
+                .into_par_iter()
+                .map(|bits| {
+                    let n = decode_n(bits);
+                    let r = (conversion.roughness(n) * 255.0 + 0.5) as u8;
+                    (r, chi_parts_f32(model, approx, n))
+                })
+                .collect(),
+            srgb: std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0)),
+            chi_of_byte: std::array::from_fn(|r| {
+                chi_parts_f32(model, approx, conversion.n(r as f32 / 255.0))
+            }),
+        }
+    }
+
+    /// A stored texel's base colour (sRGB bytes), metallic-roughness bytes (255, roughness,
+    /// metallic) and round-trip error (see the module docs).
+    pub fn texel(&self, t: &Texel) -> ([u8; 3], [u8; 3], f32) {
         let v = t.decode();
         let p = from_material(v);
         let base = p.base.to_array().map(linear_to_srgb8);
-        let (r, chi) = n_table[usize::from(t.n)];
+        let (r, chi) = self.n_table[usize::from(t.n)];
         let mr = [255, r, (p.metallic * 255.0 + 0.5) as u8];
         // The texel as a consumer reads the files, in the model's terms.
         let (back_base, m) = (
-            Vec3::from_array(base.map(|c| srgb[usize::from(c)])),
+            Vec3::from_array(base.map(|c| self.srgb[usize::from(c)])),
             f32::from(mr[2]) / 255.0,
         );
         let back_kd = back_base * (1.0 - m);
         let back_ks = Vec3::splat(super::DIELECTRIC_F0).lerp(back_base, m);
-        let chi_back = chi_of_byte[usize::from(r)];
-        let parts = conversion.error_parts(back_kd, back_ks, f32::from(r) / 255.0);
+        let chi_back = self.chi_of_byte[usize::from(r)];
+        let parts = self
+            .conversion
+            .error_parts(back_kd, back_ks, f32::from(r) / 255.0);
         let mut worst = 0.0_f32;
         for (c, [numerator, mean]) in parts.into_iter().enumerate() {
             let drift = std::f32::consts::FRAC_2_PI * (v.kd[c] - back_kd[c]).abs()
@@ -141,7 +171,23 @@ pub fn convert(texels: &[Texel], model: ShadingModel) -> Converted {
             }
         }
         (base, mr, worst)
-    };
+    }
+
+    /// The round-trip error of one material value: what the texel loses as a glTF PBR
+    /// material (the editor's "PBR error" canvas).
+    pub fn error(&self, v: crate::model::texel::MaterialValue) -> f32 {
+        self.texel(&Texel::encode(v)).2
+    }
+}
+
+/// One chunk's base colours, metallic-roughness texels and error statistics.
+type Chunk = (Vec<[u8; 3]>, Vec<[u8; 3]>, ErrorStats);
+
+/// Converts texels (row-major) read in `model`'s terms to 8-bit PBR values, with the
+/// round-trip error (see the module docs).
+pub fn convert(texels: &[Texel], model: ShadingModel) -> Converted {
+    let round_trip = RoundTrip::for_model(model);
+    let texel = |t: &Texel| round_trip.texel(t);
     let chunks: Vec<Chunk> = texels
         .par_chunks(1 << 16)
         .map(|chunk| {

@@ -22,11 +22,14 @@ pub enum CanvasChannel {
     N,
     /// Derived ambient coefficient.
     Ka,
+    /// What each texel loses as a glTF PBR material: its round-trip error against the
+    /// Cook-Torrance shading of its PBR reading, as a heatmap (0 to 100 %).
+    PbrError,
 }
 
 impl CanvasChannel {
     /// Every choice, in menu order.
-    pub const ALL: [Self; 4] = [Self::Kd, Self::Ks, Self::N, Self::Ka];
+    pub const ALL: [Self; 5] = [Self::Kd, Self::Ks, Self::N, Self::Ka, Self::PbrError];
 
     /// Label for menus.
     pub fn label(self) -> &'static str {
@@ -35,9 +38,16 @@ impl CanvasChannel {
             Self::Ks => "k_s",
             Self::N => "n",
             Self::Ka => "k_a",
+            Self::PbrError => "PBR error",
         }
     }
 }
+
+/// The top of the "PBR error" heatmap's scale (relative error; 1 = 100 %).
+pub const PBR_ERROR_TOP: f32 = 1.0;
+
+/// The accessible name of the "PBR error" scale bar.
+pub const PBR_ERROR_SCALE_LABEL: &str = "PBR error scale, 0 to 100 %";
 
 /// The canvas's state: its texture, which map version it mirrors, and the view.
 pub struct Canvas {
@@ -75,6 +85,9 @@ fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
         CanvasChannel::Ka => {
             reflectance::ka(doc.settings().model, doc.settings().approx, v.kd, v.ks, v.n)
         }
+        CanvasChannel::PbrError => crate::render::heat_ramp(
+            crate::pbr::export::RoundTrip::for_model(doc.settings().model).error(v) / PBR_ERROR_TOP,
+        ),
     };
     let c = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8;
     Color32::from_rgb(c(rgb.x), c(rgb.y), c(rgb.z))
@@ -225,6 +238,24 @@ impl Canvas {
                 Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
                 Color32::WHITE,
             );
+        }
+        if self.channel == CanvasChannel::PbrError {
+            // Along the top: the bottom left holds the painting label.
+            let top = Rect::from_min_size(panel.min, Vec2::new(panel.width(), 52.0));
+            crate::ui::viewport::overlay::heat_bar(&painter, top, "0 %", "100 %+");
+            ui.interact(
+                crate::ui::viewport::overlay::scale_bar(top),
+                ui.id().with("pbr error scale"),
+                Sense::hover(),
+            )
+            .on_hover_text(
+                "Per texel, the box-average difference between this material's shading and the \
+                 Cook-Torrance shading of its glTF PBR reading (base colour, metallic, roughness \
+                 in 8 bits), over the Cook-Torrance mean: what it loses as a PBR material",
+            )
+            .widget_info(|| {
+                egui::WidgetInfo::labeled(egui::WidgetType::Other, true, PBR_ERROR_SCALE_LABEL)
+            });
         }
         if self.wireframe {
             let stroke = egui::Stroke::new(1.0, Color32::from_white_alpha(70));

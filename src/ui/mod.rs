@@ -397,7 +397,7 @@ impl EditorState {
         match self.canvas.channel {
             CanvasChannel::Ks => Channel::Ks,
             CanvasChannel::N => Channel::N,
-            CanvasChannel::Kd | CanvasChannel::Ka => Channel::Kd,
+            CanvasChannel::Kd | CanvasChannel::Ka | CanvasChannel::PbrError => Channel::Kd,
         }
     }
 

@@ -2,7 +2,7 @@
 //! controls, and picking for painting on the mesh. Without a GPU (tests, broken drivers) the
 //! viewport still picks and paints; it only cannot draw.
 
-mod overlay;
+pub(crate) mod overlay;
 mod renderer;
 
 pub use overlay::{DIVIDER_LABEL, N_LEGEND_LABEL};

@@ -83,10 +83,15 @@ pub const DIVIDER_LABEL: &str = "Split divider";
 
 /// The heatmap's scale bar along the bottom of `rect`: the ramp from 0 to `max`.
 fn heat_scale_ui(painter: &egui::Painter, rect: Rect, max: f32) {
+    heat_bar(painter, rect, "0", &format!("{max:.3}"));
+}
+
+/// The heat ramp as a scale bar along the bottom of `rect`, `low` and `high` under its ends.
+pub(crate) fn heat_bar(painter: &egui::Painter, rect: Rect, low: &str, high: &str) {
     let bar = scale_bar(rect);
     ramp_ui(painter, bar, crate::render::heat_ramp);
-    tick(painter, bar, 0.0, "0");
-    tick(painter, bar, 1.0, &format!("{max:.3}"));
+    tick(painter, bar, 0.0, low);
+    tick(painter, bar, 1.0, high);
 }
 
 /// The accessible name of the `n` false-colour legend.
@@ -109,7 +114,7 @@ pub(super) fn n_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect: Rect) {
 }
 
 /// Where a scale bar goes: along the bottom of `rect`.
-fn scale_bar(rect: Rect) -> Rect {
+pub(crate) fn scale_bar(rect: Rect) -> Rect {
     Rect::from_min_size(
         Pos2::new(rect.min.x + 16.0, rect.max.y - 34.0),
         egui::vec2((rect.width() - 32.0).clamp(40.0, 320.0), 12.0),
