@@ -60,7 +60,7 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
 
     harness.get_by_label("File").click();
     harness.run_steps(2);
-    harness.get_by_label("Import PBR material (glTF)…").click();
+    harness.get_by_label("Import PBR material…").click();
     harness.run_steps(2);
     wait_until(
         &mut harness,
@@ -108,5 +108,48 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
             == 2
     });
     assert!(kit::changed(&before, &texels(harness.state())) > 0);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Where the second test's texture set is written.
+fn set_dir() -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("kapaint-editor-pbr-set-{}", std::process::id()))
+}
+
+fn answer_set(request: &FileRequest) -> Option<std::path::PathBuf> {
+    (request.purpose == FilePurpose::ImportPbr).then(|| set_dir().join("Bricks_ORM.png"))
+}
+
+#[test]
+fn a_texture_set_imports_from_any_one_of_its_images() {
+    let d = set_dir();
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("dir");
+    image::RgbImage::from_pixel(32, 32, image::Rgb([200, 80, 60]))
+        .save(d.join("Bricks_BaseColor.png"))
+        .expect("base");
+    image::RgbImage::from_pixel(32, 32, image::Rgb([255, 200, 0]))
+        .save(d.join("Bricks_ORM.png"))
+        .expect("orm");
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer_set);
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Import PBR material…").click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "set imported", notice("conversion error max"));
+    let doc = harness.state().state.doc();
+    assert!(doc.normal().is_none(), "the set has no normal map");
+    let report = doc.settings().import.clone().expect("report");
+    assert!(
+        report.source.contains("Bricks_BaseColor.png"),
+        "{}",
+        report.source
+    );
+    // A dielectric everywhere: k_s is the dielectric F0.
+    let v = doc.maps().value(3, 3);
+    assert!((v.ks.x - 0.04).abs() < 1e-3, "{v:?}");
     let _ = std::fs::remove_dir_all(&d);
 }

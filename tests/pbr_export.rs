@@ -432,3 +432,58 @@ fn a_loose_normal_map_imports_and_a_bad_one_is_refused() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn a_texture_set_is_found_by_its_names_from_any_one_of_its_images() {
+    let d = dir("named-set");
+    let texture = image::open(spot().join("spot_texture.png"))
+        .expect("spot")
+        .to_rgb8();
+    let small = image::imageops::resize(&texture, 64, 64, image::imageops::FilterType::Triangle);
+    small.save(d.join("Cow_BaseColor.png")).expect("base");
+    // glTF's packing in an ORM image: occlusion R, roughness G, metallic B.
+    image::RgbImage::from_fn(64, 64, |x, _| {
+        image::Rgb([255, 128, if x < 32 { 0 } else { 255 }])
+    })
+    .save(d.join("Cow_ORM.png"))
+    .expect("orm");
+    // A DirectX normal map: green points down, so a +Y tilt is stored with green below 128.
+    image::RgbImage::from_pixel(64, 64, image::Rgb([128, 50, 230]))
+        .save(d.join("Cow_Normal_DX.png"))
+        .expect("normal");
+    std::fs::write(d.join("Other_BaseColor.png"), b"not this set").expect("other");
+    let out = d.join("cow.kapaint");
+    let o = kapaint(&[
+        "import-pbr",
+        "--out",
+        s(&out),
+        "--set",
+        s(&d.join("Cow_Normal_DX.png")),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(stdout.contains("Cow_BaseColor.png"), "{stdout}");
+    assert!(stdout.contains("Cow_ORM.png"), "{stdout}");
+    assert!(stdout.contains("flipped to glTF's"), "{stdout}");
+    let doc = kapaint::model::project::load(&out).expect("load");
+    // Metallic from B: the right half is a metal (k_d black), the left a dielectric.
+    let (left, right) = (doc.maps().value(10, 10), doc.maps().value(50, 10));
+    assert!(left.kd.max_element() > 0.01 && right.kd.max_element() < 1e-3);
+    assert!((left.ks.x - 0.04).abs() < 1e-3);
+    // The DirectX green is flipped: the stored normal tilts to +Y in glTF's convention.
+    let normal = doc.normal().expect("normal map").normal(5, 5);
+    assert!(normal.y > 0.5, "{normal}");
+    // A name that says no map, or a set without a base colour: one error, nothing written.
+    std::fs::copy(d.join("Cow_ORM.png"), d.join("Lonely_Roughness.png")).expect("copy");
+    std::fs::copy(d.join("Cow_ORM.png"), d.join("untitled.png")).expect("copy");
+    for (file, want) in [
+        ("untitled.png", "does not say which map"),
+        ("Lonely_Roughness.png", "no base colour beside it"),
+    ] {
+        let bad = d.join("bad.kapaint");
+        let o = kapaint(&["import-pbr", "--out", s(&bad), "--set", s(&d.join(file))]);
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+        assert!(text(&o.stderr).contains(want), "{}", text(&o.stderr));
+        assert!(!bad.exists());
+    }
+}

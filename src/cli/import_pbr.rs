@@ -27,6 +27,11 @@ pub struct ImportPbrArgs {
     /// A glTF file (.glb or .gltf): its mesh and its material's textures and factors.
     #[arg(long, conflicts_with_all = ["base_color", "metallic", "roughness", "metallic_roughness", "specular", "glossiness"])]
     gltf: Option<PathBuf>,
+    /// A texture set by its file names: any one image of it (NAME_BaseColor, NAME_Metallic,
+    /// NAME_Roughness or NAME_ORM / NAME_MetallicRoughness, NAME_Normal, ...), the others
+    /// found beside it.
+    #[arg(long, conflicts_with_all = ["gltf", "base_color", "metallic", "roughness", "metallic_roughness", "specular", "glossiness", "normal"])]
+    set: Option<PathBuf>,
     /// With --gltf: the material, by name or index (default: the first primitive's).
     #[arg(long, requires = "gltf")]
     material: Option<String>,
@@ -95,6 +100,18 @@ impl ImportPbrArgs {
                 .map_err(model_error)?;
             return Ok((m.set, m.normal, m.notes));
         }
+        if let Some(file) = &self.set {
+            if !file.exists() {
+                return Err(CliError::usage(format!(
+                    "--set: {}: no such file",
+                    file.display()
+                )));
+            }
+            let named = crate::pbr::names::set_of(file).map_err(model_error)?;
+            let mut notes = named.notes.clone();
+            let normal = named.load_normal(&mut notes).map_err(model_error)?;
+            return Ok((named.set, normal, notes));
+        }
         let mut notes = Vec::new();
         if let Some(p) = self.normal.as_deref().filter(|p| !p.exists()) {
             return Err(CliError::usage(format!(
@@ -111,7 +128,7 @@ impl ImportPbrArgs {
         let need = |flag: &str, v: &Option<String>| -> Result<String, CliError> {
             v.clone().ok_or_else(|| {
                 CliError::usage(format!(
-                    "{flag} is missing (give --gltf, or --base-color with --metallic and --roughness, --metallic-roughness, or --specular and --glossiness)"
+                    "{flag} is missing (give --gltf, --set, or --base-color with --metallic and --roughness, --metallic-roughness, or --specular and --glossiness)"
                 ))
             })
         };

@@ -26,6 +26,7 @@ pub mod fit;
 pub mod glb;
 pub mod gltf;
 pub mod import;
+pub mod names;
 mod table;
 
 use crate::model::texel::{MaterialValue, N_MAX};

@@ -49,7 +49,10 @@ enum Mode {
 const PROJECT: (&str, &[&str]) = ("kapaint project", &["kapaint"]);
 const MESH: (&str, &[&str]) = ("mesh", &["obj", "gltf", "glb"]);
 const IMAGE: (&str, &[&str]) = ("image", &["png", "jpg", "jpeg", "tga", "exr"]);
-const GLTF: (&str, &[&str]) = ("glTF material", &["glb", "gltf"]);
+const PBR: (&str, &[&str]) = (
+    "PBR material (glTF, or one image of a texture set)",
+    &["glb", "gltf", "png", "jpg", "jpeg", "tga", "exr"],
+);
 
 impl FilePurpose {
     fn mode(self) -> Mode {
@@ -70,7 +73,7 @@ impl FilePurpose {
                 format!("Import image into {}", super::panels::channel_label(c))
             }
             Self::StampImage => "Load brush stamp".into(),
-            Self::ImportPbr => "Import PBR material (glTF)".into(),
+            Self::ImportPbr => "Import PBR material".into(),
             Self::NewMesh => "Mesh of the new project".into(),
             Self::ExportFolder => "Export into folder".into(),
         }
@@ -81,7 +84,7 @@ impl FilePurpose {
             Self::OpenProject | Self::SaveProject => Some(PROJECT),
             Self::ImportMesh | Self::NewMesh => Some(MESH),
             Self::ImportImage(_) | Self::StampImage => Some(IMAGE),
-            Self::ImportPbr => Some(GLTF),
+            Self::ImportPbr => Some(PBR),
             Self::ExportFolder => None,
         }
     }

@@ -326,22 +326,36 @@ impl EditorState {
         });
     }
 
-    /// Converts the material of the glTF at `path` for the document's model at the map size,
-    /// on a worker; it replaces the selected layer's channels (one undo step) when it arrives.
+    /// Converts the material of the glTF at `path`, or the texture set `path` is one image of
+    /// ([`crate::pbr::names`]), for the document's model at the map size, on a worker; it
+    /// replaces the selected layer's channels (one undo step) when it arrives.
     pub fn import_pbr(&mut self, path: PathBuf) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
         let model = self.doc.settings().model;
         self.start_job("Material", move |progress| {
             progress.start("decode", 1);
-            let converted = crate::pbr::gltf::material_set(&path, None).and_then(|m| {
+            let gltf = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+            let set = if gltf {
+                crate::pbr::gltf::material_set(&path, None).map(|m| (m.set, m.normal, m.notes))
+            } else {
+                crate::pbr::names::set_of(&path).and_then(|named| {
+                    let mut notes = named.notes.clone();
+                    let normal = named.load_normal(&mut notes)?;
+                    Ok((named.set, normal, notes))
+                })
+            };
+            let converted = set.and_then(|(set, normal, notes)| {
                 progress.start("convert", 1);
-                let imported = crate::pbr::import::import(&m.set, Some((w, h)), model)?;
+                let imported = crate::pbr::import::import(&set, Some((w, h)), model)?;
                 let mut report = imported.report;
-                report.notes.extend(m.notes);
+                report.notes.extend(notes);
                 let (maps, _) = imported.doc.into_parts();
                 Ok(PbrMaterial {
                     maps,
-                    normal: m.normal,
+                    normal,
                     report,
                 })
             });

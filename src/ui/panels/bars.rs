@@ -125,9 +125,10 @@ impl EditorState {
                     self.choose_file(FilePurpose::ImportMesh);
                 }
                 if ui
-                    .button("Import PBR material (glTF)…")
+                    .button("Import PBR material…")
                     .on_hover_text(
-                        "A glTF material's base colour, metallic-roughness and normal map, \
+                        "A glTF file's material, or a texture set (choose any one of its \
+                         images: name_BaseColor, _Metallic, _Roughness or _ORM, _Normal): \
                          converted for the current model into the selected layer",
                     )
                     .clicked()
