@@ -44,6 +44,14 @@ fn import_gltf(asset: &Path, model: ShadingModel, out: &Path) {
     assert!(o.status.success(), "{}", text(&o.stderr));
 }
 
+/// `kapaint export PROJECT --preset gltf-pbr FLAGS... --out SET`.
+fn export_gltf_pbr(project: &Path, set: &Path, flags: &[&str]) -> std::process::Output {
+    let mut args = vec!["export", s(project), "--preset", "gltf-pbr"];
+    args.extend_from_slice(flags);
+    args.extend(["--out", s(set)]);
+    kapaint(&args)
+}
+
 fn manifest(set: &Path) -> PbrManifest {
     serde_json::from_slice(&std::fs::read(set.join("material.json")).expect("manifest"))
         .expect("a glTF PBR manifest")
@@ -61,15 +69,7 @@ fn a_gltf_material_round_trips_through_a_project_within_one_code() {
         let project = d.join(format!("{model:?}.kapaint"));
         import_gltf(&asset, model, &project);
         let set = d.join(format!("{model:?}-set"));
-        let o = kapaint(&[
-            "export",
-            s(&project),
-            "--preset",
-            "gltf-pbr",
-            "--no-padding",
-            "--out",
-            s(&set),
-        ]);
+        let o = export_gltf_pbr(&project, &set, &["--no-padding"]);
         assert!(o.status.success(), "{}", text(&o.stderr));
         let stdout = text(&o.stdout);
         assert!(
@@ -143,15 +143,7 @@ fn the_glb_is_valid_gltf_with_the_material_embedded_and_imports_back() {
     let project = d.join("cow.kapaint");
     import_gltf(&asset, ShadingModel::BlinnPhong, &project);
     let set = d.join("set");
-    let o = kapaint(&[
-        "export",
-        s(&project),
-        "--preset",
-        "gltf-pbr",
-        "--glb",
-        "--out",
-        s(&set),
-    ]);
+    let o = export_gltf_pbr(&project, &set, &["--glb"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let bytes = std::fs::read(set.join("model.glb")).expect("glb");
     // The gltf crate validates the document as it parses it.
@@ -222,14 +214,7 @@ fn the_glb_is_valid_gltf_with_the_material_embedded_and_imports_back() {
     let again = d.join("again.kapaint");
     import_gltf(&set.join("model.glb"), ShadingModel::BlinnPhong, &again);
     let set2 = d.join("set2");
-    let o = kapaint(&[
-        "export",
-        s(&again),
-        "--preset",
-        "gltf-pbr",
-        "--out",
-        s(&set2),
-    ]);
+    let o = export_gltf_pbr(&again, &set2, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     for file in ["base_color.png", "metallic_roughness.png"] {
         let a = image::open(set.join(file)).expect("a").to_rgb8();
@@ -260,15 +245,7 @@ fn glb_without_the_preset_or_a_mesh_is_one_clear_error_and_nothing_written() {
     let o = kapaint(&["new", "--out", s(&cow), "--size", "64", "--mesh", s(&mesh)]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     std::fs::remove_file(&mesh).expect("rm");
-    let o = kapaint(&[
-        "export",
-        s(&cow),
-        "--preset",
-        "gltf-pbr",
-        "--glb",
-        "--out",
-        s(&out),
-    ]);
+    let o = export_gltf_pbr(&cow, &out, &["--glb"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
     assert!(
         text(&o.stderr).contains("--glb needs the project's mesh"),
@@ -297,15 +274,7 @@ fn the_normal_map_is_kept_passed_through_and_never_in_ka() {
 
     // Passed through by the gltf-pbr export, as a file and in the .glb.
     let set = d.join("set");
-    let o = kapaint(&[
-        "export",
-        s(&project),
-        "--preset",
-        "gltf-pbr",
-        "--glb",
-        "--out",
-        s(&set),
-    ]);
+    let o = export_gltf_pbr(&project, &set, &["--glb"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let written = image::open(set.join("normal.png"))
         .expect("normal")

@@ -15,6 +15,7 @@ pub mod keys;
 mod layer_view;
 mod layout;
 mod panels;
+mod prompts;
 pub use panels::layers::LayerView;
 mod readout;
 pub mod resize;

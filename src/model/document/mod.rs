@@ -6,6 +6,7 @@
 
 mod command;
 mod fill;
+mod import;
 mod layers;
 mod moves;
 pub use layers::MAX_LAYERS;

@@ -1,0 +1,91 @@
+//! Imports into the selected paint layer: one channel from an image, or every channel from a
+//! converted material, each one undo step.
+
+use super::Document;
+use super::layers::command_error;
+use crate::model::ModelError;
+use crate::model::import::ChannelPlanes;
+use crate::model::layers::Stamped;
+use crate::model::layers::edit::Planes;
+use crate::model::texel::Channel;
+use crate::model::tile::Plane;
+
+impl Document {
+    /// [`Command::ImportMaterial`]: every channel of the selected paint layer from `maps`.
+    pub(super) fn import_material(
+        &mut self,
+        maps: &crate::model::MaterialMaps,
+    ) -> Result<(), ModelError> {
+        self.end_stroke();
+        if (maps.width(), maps.height()) != (self.maps.width(), self.maps.height()) {
+            return Err(ModelError::Internal(format!(
+                "the material was made at {}x{}, but the maps are {}x{}",
+                maps.width(),
+                maps.height(),
+                self.maps.width(),
+                self.maps.height()
+            )));
+        }
+        if self.state.selection.mask {
+            return Err(command_error(
+                "a material imports into a paint layer, not a mask: select the layer's content",
+            ));
+        }
+        self.edit_planes("Import material", |planes, _, _| {
+            let Planes::Paint(tiles) = planes else { return };
+            for (id, slot) in tiles.iter_mut().enumerate() {
+                let tile = Stamped::write(
+                    slot.get_or_insert_with(crate::model::layers::edit::empty_paint_tile),
+                );
+                let source = maps.tile(id);
+                tile.value.kd = source.kd.clone();
+                tile.value.ks = source.ks.clone();
+                tile.value.n = source.n.clone();
+                tile.alpha = std::array::from_fn(|_| Plane::Uniform(u16::MAX));
+            }
+        })
+    }
+
+    /// Replaces one channel of the selected paint layer with imported planes, opaque there.
+    pub(super) fn import_channel(&mut self, imported: &ChannelPlanes) -> Result<(), ModelError> {
+        self.end_stroke();
+        let count = match imported {
+            ChannelPlanes::Rgb(_, p) => p.len(),
+            ChannelPlanes::N(p) => p.len(),
+        };
+        if count != self.maps.tile_count() {
+            return Err(ModelError::Internal(format!(
+                "the image was resampled for {count} tiles, but the maps have {}",
+                self.maps.tile_count()
+            )));
+        }
+        if self.state.selection.mask {
+            return Err(command_error(
+                "an image imports into a paint layer's channel, not a mask: select the layer's content",
+            ));
+        }
+        let label = format!("Import {}", imported.channel().name());
+        self.edit_planes(&label, |planes, _, _| {
+            let Planes::Paint(tiles) = planes else { return };
+            for (id, slot) in tiles.iter_mut().enumerate() {
+                let tile = Stamped::write(
+                    slot.get_or_insert_with(crate::model::layers::edit::empty_paint_tile),
+                );
+                match imported {
+                    ChannelPlanes::Rgb(Channel::Ks, p) => {
+                        tile.value.ks = p[id].clone();
+                        tile.alpha[1] = Plane::Uniform(u16::MAX);
+                    }
+                    ChannelPlanes::Rgb(_, p) => {
+                        tile.value.kd = p[id].clone();
+                        tile.alpha[0] = Plane::Uniform(u16::MAX);
+                    }
+                    ChannelPlanes::N(p) => {
+                        tile.value.n = p[id].clone();
+                        tile.alpha[2] = Plane::Uniform(u16::MAX);
+                    }
+                }
+            }
+        })
+    }
+}

@@ -1,0 +1,102 @@
+//! The editor's questions before it goes on: unsaved changes before another project opens or
+//! the window closes, and whether a glTF mesh's material comes in with it.
+
+use super::EditorState;
+use super::dialogs::centred;
+
+impl EditorState {
+    /// After a glTF mesh import: asks whether to bring its material's textures in too.
+    pub(super) fn material_prompt_window(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.material_prompt.clone() else {
+            return;
+        };
+        let (mut bring, mut skip) = (false, false);
+        centred(egui::Window::new("Import the material too?"), ctx)
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "{} has a material with textures. Bring it in too? Its base colour, \
+                     metallic and roughness are converted for {} into the selected layer's \
+                     k_d, k_s and n (one undo step), and its normal map is kept.",
+                    path.display(),
+                    self.doc.settings().model.label()
+                ));
+                ui.horizontal(|ui| {
+                    bring = ui.button("Bring the material in").clicked();
+                    skip = ui.button("Mesh only").clicked();
+                });
+            });
+        if bring {
+            self.material_prompt = None;
+            self.import_pbr(path);
+        } else if skip {
+            self.material_prompt = None;
+        }
+    }
+
+    /// Asks what to do with unsaved changes before opening another project: save them first
+    /// (the project opens once saved), discard them, or cancel.
+    pub(super) fn open_prompt(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.pending_open.clone() else {
+            return;
+        };
+        let (mut save, mut discard, mut cancel) = (false, false, false);
+        egui::Window::new("Open: unsaved changes")
+            .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "The material has unsaved changes. Save them before opening {}?",
+                    path.display()
+                ));
+                ui.horizontal(|ui| {
+                    save = ui.button("Save, then open").clicked();
+                    discard = ui.button("Discard and open").clicked();
+                    cancel = ui.button("Cancel").clicked();
+                });
+            });
+        if discard {
+            self.pending_open = None;
+            self.open_now(path);
+        } else if cancel {
+            self.pending_open = None;
+        } else if save {
+            self.save();
+        }
+    }
+
+    pub(super) fn close_prompt(&mut self, ctx: &egui::Context) {
+        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit.asked;
+        if close_requested && self.dirty() && !self.quit.allowed {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.quit.asked = true;
+        } else if self.quit.asked && (self.quit.allowed || !self.dirty()) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        }
+        if self.quit.asked && self.dirty() && !self.quit.allowed {
+            egui::Window::new("Unsaved changes")
+                .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+                .collapsible(false)
+                .show(ctx, |ui| {
+                    ui.label("The material has unsaved changes.");
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            // Untitled work asks where first; the window closes once saved.
+                            self.quit.after_save = true;
+                            self.save();
+                            self.quit.asked = false;
+                        }
+                        if ui.button("Discard").clicked() {
+                            self.quit.allowed = true;
+                        }
+                        if ui.button("Cancel").clicked() {
+                            self.quit.asked = false;
+                        }
+                    });
+                });
+        }
+    }
+}
