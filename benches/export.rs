@@ -47,5 +47,62 @@ fn exports(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-criterion_group!(benches, exports);
+/// Issue 21's project (the spot texture in k_d, soft strokes of n = 3000 and n = 2): the
+/// `ktx2` export with its effort search and full mip chains (target <= 5 s on 2 cores), and,
+/// side by side in the same run, the BC7 encoders alone on one thread on the packed level 0:
+/// Intel's ISPC kernels and `block_compression`'s port.
+fn block_compression(c: &mut Criterion) {
+    use kapaint::export::blocks::{self, BlockKind, Encoder};
+    use kapaint::export::preset::Bc7Quality;
+    let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot/spot_texture.png");
+    let doc = kapaint::report::typical::stroke_edge_document(
+        4096,
+        texture.exists().then_some(texture.as_path()),
+    )
+    .expect("document");
+    let dir = std::env::temp_dir().join(format!("kapaint-bc-bench-{}", std::process::id()));
+    let mut group = c.benchmark_group("ktx2_4096");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    let p = preset::find("ktx2").expect("preset");
+    group.bench_function("ktx2_stroke_edges", |b| {
+        b.iter(|| {
+            let _ = std::fs::remove_dir_all(&dir);
+            set::export(&doc, &p, &dir).expect("export")
+        });
+    });
+    let maps = doc.maps();
+    let (w, h) = (maps.width(), maps.height());
+    let rgba: Vec<u8> = (0..w * h)
+        .flat_map(|i| {
+            let v = maps.texel(i % w, i / w).decode();
+            let n = (v.n.ln_1p() / 3000.0_f32.ln_1p() * 255.0).round() as u8;
+            let s = |c: f32| kapaint::model::texel::linear_to_srgb8(c);
+            [s(v.kd.x), s(v.kd.y), s(v.kd.z), n]
+        })
+        .collect();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    for (encoder, effort) in [
+        (Encoder::Ispc, Bc7Quality::UltraFast),
+        (Encoder::Portable, Bc7Quality::UltraFast),
+        (Encoder::Ispc, Bc7Quality::VeryFast),
+    ] {
+        let kind = BlockKind::Bc7 {
+            alpha: true,
+            effort,
+        };
+        group.bench_function(format!("bc7_one_thread_{encoder:?}_{effort:?}"), |b| {
+            b.iter(|| one.install(|| blocks::encode(encoder, kind, &rgba, (w, h), None)));
+        });
+    }
+    group.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+criterion_group!(benches, exports, block_compression);
 criterion_main!(benches);

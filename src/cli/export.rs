@@ -56,6 +56,42 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
         }
         text.push('\n');
     }
+    if let Some(b) = &m.blocks {
+        let _ = writeln!(
+            text,
+            "  blocks: {:?} at {:?} ({:?} encoder), {}: {}",
+            b.layout,
+            b.bc7_effort,
+            b.encoder,
+            if b.within_budget {
+                "within the budget"
+            } else {
+                "over the budget"
+            },
+            b.reason
+        );
+        for t in &b.trials {
+            let _ = writeln!(
+                text,
+                "    trial {:?} {:?}: k_a max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
+                t.layout,
+                t.bc7_effort,
+                t.ka_error.max,
+                t.ka_error.mean,
+                t.min_psnr
+                    .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB")),
+                t.seconds
+            );
+        }
+    }
+    if !m.level_ka_error.is_empty() {
+        let levels: Vec<String> = m
+            .level_ka_error
+            .iter()
+            .map(|e| format!("{:.2e}", e.max))
+            .collect();
+        let _ = writeln!(text, "  k_a error max per mip level: {}", levels.join(" "));
+    }
     let b = m.bytes;
     let _ = writeln!(
         text,

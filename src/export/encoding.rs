@@ -118,6 +118,16 @@ impl NEncoding {
         ((v - a) / (b - a) * self.max_code()).round() as u16
     }
 
+    /// The `n` at `t` of the way along the code range (`decode(q)` is
+    /// `decode_fraction(q / (2^bits - 1))`).
+    pub fn decode_fraction(self, t: f64) -> f32 {
+        let (a, b) = (
+            self.curve.forward(f64::from(self.lo)),
+            self.curve.forward(f64::from(self.hi)),
+        );
+        self.curve.inverse(a + t.clamp(0.0, 1.0) * (b - a)) as f32
+    }
+
     /// The `n` a code stands for.
     pub fn decode(self, q: u16) -> f32 {
         let (a, b) = (

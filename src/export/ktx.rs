@@ -3,34 +3,305 @@
 //!
 //! The container is written by hand from the `ktx2` crate's header, level index and data
 //! format descriptor types (that crate reads KTX2 but does not assemble files); blocks come
-//! from `block_compression`'s CPU encoders, run in parallel over strips of block rows.
+//! from [`super::blocks`]. Mips are 2x2 boxes, each component averaged in its own space
+//! ([`Space`]): colour in linear light, `n` in the log space the brushes blend it in.
 
-use block_compression::decode::decompress_blocks_as_rgba8;
-use block_compression::encode::compress_rgba8;
-use block_compression::{BC7Settings, CompressionVariant};
 use ktx2::{Format as KtxFormat, Header, Index, LevelIndex, dfd};
 use rayon::prelude::*;
 
+use super::blocks::{self, BlockKind, Encoder};
+use super::encoding::NEncoding;
 use super::preset::Bc7Quality;
 use super::set::Compression;
-use crate::model::texel::{linear_to_srgb, srgb_to_linear};
+use crate::model::texel::{n_to_blend, srgb_to_linear};
 use crate::task::Progress;
 
-/// An image in the file's value domain: `channels` components per texel in `[0, 1]`, row
-/// major. With `srgb`, the first three components of a three- or four-component image are
-/// sRGB-encoded colour (alpha is always linear).
-#[derive(Clone, Copy, Debug)]
+/// How a component is averaged into the next mip level, and stored as a byte.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Space {
+    /// Colour: averaged in linear light, stored sRGB-encoded.
+    Srgb,
+    /// Averaged and stored as is (`[0, 1]`).
+    Linear,
+    /// `n`: averaged in the brushes' log space ([`n_to_blend`]), stored as the 8-bit code of
+    /// its encoding.
+    N(NEncoding),
+}
+
+impl Space {
+    /// The 255 boundaries between consecutive bytes, in the averaging space: a value's byte
+    /// is the number of boundaries at or below it (rounding to the nearest stored value).
+    pub fn boundaries(self) -> Vec<f32> {
+        (0..255)
+            .map(|b| {
+                let mid = (f64::from(b) + 0.5) / 255.0;
+                match self {
+                    Self::Srgb => srgb_to_linear(mid as f32),
+                    Self::Linear => mid as f32,
+                    Self::N(e) if e.lo >= e.hi => f32::INFINITY,
+                    Self::N(e) => n_to_blend(e.decode_fraction(mid)),
+                }
+            })
+            .collect()
+    }
+
+    /// The value in the averaging space that a stored byte stands for.
+    pub fn value_of(self, byte: u8) -> f32 {
+        let v = f32::from(byte) / 255.0;
+        match self {
+            Self::Srgb => srgb_to_linear(v),
+            Self::Linear => v,
+            Self::N(e) => n_to_blend(e.decode(u16::from(byte))),
+        }
+    }
+
+    fn is_colour(self) -> bool {
+        self == Self::Srgb
+    }
+}
+
+/// The byte of `v` between `boundaries` ([`Space::boundaries`]).
+#[inline]
+pub fn quantise(boundaries: &[f32], v: f32) -> u8 {
+    boundaries.partition_point(|b| *b <= v) as u8
+}
+
+/// A texel's component in its averaging space (`value(texel, component)`, unquantised).
+pub trait Values: Sync {
+    /// Texel `i`'s component `k`.
+    fn value(&self, i: usize, k: usize) -> f32;
+}
+
+impl<F: Fn(usize, usize) -> f32 + Sync> Values for F {
+    fn value(&self, i: usize, k: usize) -> f32 {
+        self(i, k)
+    }
+}
+
+/// An image to write: its size, each component's space, level 0 as stored bytes (one per
+/// component per texel, row major) and, for the mips, each texel's value in the averaging
+/// space (`value(texel, component)`, unquantised).
 pub struct Source<'a> {
     /// Size in texels.
     pub width: u32,
     /// Size in texels.
     pub height: u32,
-    /// Components per texel, 1 to 4.
-    pub channels: usize,
-    /// `width * height * channels` values.
-    pub values: &'a [f32],
-    /// Colour components are sRGB-encoded.
-    pub srgb: bool,
+    /// One per component (1 to 4).
+    pub spaces: &'a [Space],
+    /// Level 0: `width * height * spaces.len()` bytes.
+    pub level0: &'a [u8],
+    /// A texel's component in its averaging space.
+    pub value: &'a dyn Values,
+}
+
+impl Source<'_> {
+    fn channels(&self) -> usize {
+        self.spaces.len()
+    }
+
+    /// Colour components are sRGB (three or four components whose first is colour).
+    pub fn srgb(&self) -> bool {
+        self.channels() >= 3 && self.spaces[0].is_colour()
+    }
+
+    fn check(&self) -> Result<(), String> {
+        let (w, h, ch) = (self.width, self.height, self.channels());
+        if w == 0
+            || h == 0
+            || !(1..=4).contains(&ch)
+            || self.level0.len() != w as usize * h as usize * ch
+        {
+            return Err(format!("cannot write a {w}x{h} image of {ch} components"));
+        }
+        Ok(())
+    }
+}
+
+/// Mip levels in a full chain for a `w x h` image.
+pub fn level_count(w: u32, h: u32) -> u32 {
+    32 - w.max(h).leading_zeros()
+}
+
+/// The size of the level after `(w, h)`.
+fn half((w, h): (u32, u32)) -> (u32, u32) {
+    ((w / 2).max(1), (h / 2).max(1))
+}
+
+/// One 2x2 box of the level `(w, h)`, clamped at odd edges: the four source indices of
+/// output texel `(x, y)`.
+fn footprint((w, h): (u32, u32), x: usize, y: usize) -> [usize; 4] {
+    let (w, h) = (w as usize, h as usize);
+    let xs = [(2 * x).min(w - 1), (2 * x + 1).min(w - 1)];
+    let ys = [(2 * y).min(h - 1), (2 * y + 1).min(h - 1)];
+    [
+        ys[0] * w + xs[0],
+        ys[0] * w + xs[1],
+        ys[1] * w + xs[0],
+        ys[1] * w + xs[1],
+    ]
+}
+
+/// The 2x2 box mean (clamped at odd edges) of a level of `(w, h)` triples given by `value`.
+pub fn box_down(size: (u32, u32), value: impl Fn(usize) -> [f32; 3] + Sync) -> Vec<[f32; 3]> {
+    let (nw, nh) = half(size);
+    (0..nw as usize * nh as usize)
+        .into_par_iter()
+        .map(|j| {
+            let f = footprint(size, j % nw as usize, j / nw as usize);
+            let mut sum = [0.0_f32; 3];
+            for i in f {
+                let v = value(i);
+                for c in 0..3 {
+                    sum[c] += v[c];
+                }
+            }
+            sum.map(|s| s * 0.25)
+        })
+        .collect()
+}
+
+/// The next level of values (in the averaging space) from `value` over level `size`.
+fn downsample(value: &dyn Values, size: (u32, u32), channels: usize) -> Vec<f32> {
+    let (nw, nh) = half(size);
+    let mut out = vec![0.0_f32; nw as usize * nh as usize * channels];
+    out.par_chunks_mut(nw as usize * channels)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for x in 0..nw as usize {
+                let f = footprint(size, x, y);
+                for k in 0..channels {
+                    row[x * channels + k] =
+                        f.iter().map(|i| value.value(*i, k)).sum::<f32>() * 0.25;
+                }
+            }
+        });
+    out
+}
+
+/// Levels 1 and on, as stored bytes (level 0 is the source's).
+pub fn mips(source: &Source<'_>) -> Vec<((u32, u32), Vec<u8>)> {
+    let ch = source.channels();
+    let bounds: Vec<Vec<f32>> = source.spaces.iter().map(|s| s.boundaries()).collect();
+    let mut size = (source.width, source.height);
+    let mut values: Option<Vec<f32>> = None;
+    let mut out = Vec::new();
+    for _ in 1..level_count(source.width, source.height) {
+        let next = match &values {
+            None => downsample(source.value, size, ch),
+            Some(v) => downsample(&|i, k| v[i * ch + k], size, ch),
+        };
+        size = half(size);
+        let bytes: Vec<u8> = next
+            .par_iter()
+            .enumerate()
+            .map(|(j, v)| quantise(&bounds[j % ch], *v))
+            .collect();
+        out.push((size, bytes));
+        values = Some(next);
+    }
+    out
+}
+
+/// `bytes` (`per` per texel, `(w, h)`) padded to whole blocks by repeating the last row and
+/// column.
+fn pad(bytes: &[u8], (w, h): (u32, u32), per: usize, (pw, ph): (u32, u32)) -> Vec<u8> {
+    let mut out = vec![0_u8; pw as usize * ph as usize * per];
+    out.par_chunks_mut(pw as usize * per)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let sy = y.min(h as usize - 1);
+            let src = &bytes[sy * w as usize * per..][..w as usize * per];
+            row[..src.len()].copy_from_slice(src);
+            for x in w as usize..pw as usize {
+                row.copy_within((w as usize - 1) * per..w as usize * per, x * per);
+            }
+        });
+    out
+}
+
+/// `channels` of `per` bytes per texel, cropped from `(pw, ph)` to `(w, h)`.
+fn crop(bytes: &[u8], pw: u32, (w, h): (u32, u32), per: usize, channels: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(w as usize * h as usize * channels);
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            out.extend_from_slice(&bytes[(y * pw as usize + x) * per..][..channels]);
+        }
+    }
+    out
+}
+
+/// The block kind for `channels` components at `effort`.
+pub fn block_kind(channels: usize, effort: Bc7Quality) -> BlockKind {
+    BlockKind::for_channels(channels, effort)
+}
+
+/// One level block-compressed: its blocks, and its texels as a consumer decodes them
+/// (`channels` bytes per texel, the level's own size).
+pub struct Compressed {
+    /// The blocks.
+    pub blocks: Vec<u8>,
+    /// Decoded, cropped to the level.
+    pub decoded: Vec<u8>,
+}
+
+/// Compresses one level (`channels` bytes per texel) as `kind` with `encoder`. Rows advance
+/// `progress`.
+pub fn compress_level(
+    encoder: Encoder,
+    kind: BlockKind,
+    bytes: &[u8],
+    (w, h): (u32, u32),
+    channels: usize,
+    progress: Option<&Progress>,
+) -> Compressed {
+    let per = kind.texel_bytes();
+    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+    let widened: std::borrow::Cow<'_, [u8]> = if per == channels {
+        bytes.into()
+    } else {
+        bytes
+            .chunks_exact(channels)
+            .flat_map(|t| {
+                let mut px = [0, 0, 0, 255];
+                px[..channels].copy_from_slice(t);
+                px
+            })
+            .take(w as usize * h as usize * per)
+            .collect::<Vec<u8>>()
+            .into()
+    };
+    let input = if padded == (w, h) {
+        widened
+    } else {
+        pad(&widened, (w, h), per, padded).into()
+    };
+    let blocks = blocks::encode(encoder, kind, &input, padded, progress);
+    let decoded = blocks::decode(kind, &blocks, padded);
+    let decoded = if padded == (w, h) && per == channels {
+        decoded
+    } else {
+        crop(&decoded, padded.0, (w, h), per, channels)
+    };
+    Compressed { blocks, decoded }
+}
+
+/// Per component, PSNR (dB) of `decoded` against `reference` (`channels` bytes per texel),
+/// `None` where they are identical.
+pub fn psnr(reference: &[u8], decoded: &[u8], channels: usize) -> Vec<Option<f64>> {
+    (0..channels)
+        .map(|k| {
+            let sum: u64 = reference
+                .par_chunks(channels)
+                .zip(decoded.par_chunks(channels))
+                .map(|(a, b)| {
+                    let d = i64::from(a[k]) - i64::from(b[k]);
+                    (d * d) as u64
+                })
+                .sum();
+            let mse = sum as f64 / (reference.len() / channels).max(1) as f64;
+            (mse > 0.0).then(|| 10.0 * (255.0_f64 * 255.0 / mse).log10())
+        })
+        .collect()
 }
 
 /// A written KTX2 file.
@@ -38,8 +309,8 @@ pub struct Source<'a> {
 pub struct Written {
     /// The file.
     pub bytes: Vec<u8>,
-    /// Level 0 as a consumer decodes it, `channels` bytes per texel.
-    pub level0: Vec<u8>,
+    /// Every level as a consumer decodes it, finest first, `channels` bytes per texel.
+    pub decoded: Vec<Vec<u8>>,
     /// Per component, PSNR (dB) of the decoded level 0 against the uncompressed 8-bit values,
     /// `None` where they are identical (`None` altogether for uncompressed files).
     pub psnr: Option<Vec<Option<f64>>>,
@@ -47,6 +318,93 @@ pub struct Written {
     pub levels: u32,
     /// The file's compression: plain KTX2, or BC4, BC5 or BC7 blocks.
     pub compression: Compression,
+}
+
+/// The KTX2 format and compression name of `channels` components, block-compressed or not.
+fn format_of(channels: usize, srgb: bool, compressed: bool) -> (KtxFormat, Compression) {
+    match (compressed, channels) {
+        (false, 1) => (KtxFormat::R8_UNORM, Compression::Ktx2),
+        (false, 2) => (KtxFormat::R8G8_UNORM, Compression::Ktx2),
+        (false, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, Compression::Ktx2),
+        (false, _) => (KtxFormat::R8G8B8A8_UNORM, Compression::Ktx2),
+        (true, 1) => (KtxFormat::BC4_UNORM_BLOCK, Compression::Ktx2Bc4),
+        (true, 2) => (KtxFormat::BC5_UNORM_BLOCK, Compression::Ktx2Bc5),
+        (true, _) if srgb => (KtxFormat::BC7_SRGB_BLOCK, Compression::Ktx2Bc7),
+        (true, _) => (KtxFormat::BC7_UNORM_BLOCK, Compression::Ktx2Bc7),
+    }
+}
+
+/// Writes `source` as a KTX2 file with a full mip chain: uncompressed, or with
+/// `compressed = Some((encoder, effort))` block-compressed. `level0`, when given, is level 0
+/// already compressed (the export's effort search keeps the one it chose). Level 0's rows
+/// advance `progress`; a cancel stops the block encoder between strips.
+///
+/// # Errors
+/// An empty image, a component count outside 1..=4, or cancelled.
+pub fn encode(
+    source: &Source<'_>,
+    compressed: Option<(Encoder, Bc7Quality)>,
+    level0: Option<Compressed>,
+    progress: &Progress,
+) -> Result<Written, String> {
+    source.check()?;
+    let (w, h, ch) = (source.width, source.height, source.channels());
+    let srgb = source.srgb();
+    let (format, compression) = format_of(ch, srgb, compressed.is_some());
+    let chain = mips(source);
+    let mut level_bytes = Vec::with_capacity(chain.len() + 1);
+    let mut decoded = Vec::with_capacity(chain.len() + 1);
+    let mut psnr_values = None;
+    match compressed {
+        None => {
+            let widen = |bytes: &[u8]| -> Vec<u8> {
+                if ch == 3 {
+                    bytes
+                        .chunks_exact(3)
+                        .flat_map(|t| [t[0], t[1], t[2], 255])
+                        .collect()
+                } else {
+                    bytes.to_vec()
+                }
+            };
+            progress.advance(u64::from(h));
+            level_bytes.push(widen(source.level0));
+            decoded.push(source.level0.to_vec());
+            for (_, bytes) in &chain {
+                level_bytes.push(widen(bytes));
+                decoded.push(bytes.clone());
+            }
+        }
+        Some((encoder, effort)) => {
+            let kind = block_kind(ch, effort);
+            let first = match level0 {
+                Some(c) => {
+                    progress.advance(u64::from(h));
+                    c
+                }
+                None => compress_level(encoder, kind, source.level0, (w, h), ch, Some(progress)),
+            };
+            if progress.is_cancelled() {
+                return Err("cancelled".into());
+            }
+            psnr_values = Some(psnr(source.level0, &first.decoded, ch));
+            level_bytes.push(first.blocks);
+            decoded.push(first.decoded);
+            for (size, bytes) in &chain {
+                let c = compress_level(encoder, kind, bytes, *size, ch, None);
+                level_bytes.push(c.blocks);
+                decoded.push(c.decoded);
+            }
+        }
+    }
+    let bytes = container(format, (w, h), &level_bytes)?;
+    Ok(Written {
+        bytes,
+        decoded,
+        psnr: psnr_values,
+        levels: level_count(w, h),
+        compression,
+    })
 }
 
 /// Level 0 of a KTX2 file as decoded texels.
@@ -60,229 +418,6 @@ pub struct Decoded {
     pub channels: usize,
     /// RGBA8 per texel (components past `channels` are filler).
     pub rgba: Vec<u8>,
-}
-
-fn bc7_settings(quality: Bc7Quality, alpha: bool) -> BC7Settings {
-    match (quality, alpha) {
-        (Bc7Quality::UltraFast, false) => BC7Settings::opaque_ultra_fast(),
-        (Bc7Quality::VeryFast, false) => BC7Settings::opaque_very_fast(),
-        (Bc7Quality::Fast, false) => BC7Settings::opaque_fast(),
-        (Bc7Quality::Basic, false) => BC7Settings::opaque_basic(),
-        (Bc7Quality::Slow, false) => BC7Settings::opaque_slow(),
-        (Bc7Quality::UltraFast, true) => BC7Settings::alpha_ultrafast(),
-        (Bc7Quality::VeryFast, true) => BC7Settings::alpha_very_fast(),
-        (Bc7Quality::Fast, true) => BC7Settings::alpha_fast(),
-        (Bc7Quality::Basic, true) => BC7Settings::alpha_basic(),
-        (Bc7Quality::Slow, true) => BC7Settings::alpha_slow(),
-    }
-}
-
-/// The next mip level: a 2x2 box (clamped at odd edges), colour averaged in linear light.
-fn downsample(values: &[f32], (w, h): (u32, u32), channels: usize, srgb: bool) -> Vec<f32> {
-    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-    let colour = |k: usize| srgb && channels >= 3 && k < 3;
-    let mut out = vec![0.0_f32; nw as usize * nh as usize * channels];
-    out.par_chunks_mut(nw as usize * channels)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let ys = [(2 * y).min(h as usize - 1), (2 * y + 1).min(h as usize - 1)];
-            for x in 0..nw as usize {
-                let xs = [(2 * x).min(w as usize - 1), (2 * x + 1).min(w as usize - 1)];
-                for k in 0..channels {
-                    let mut sum = 0.0;
-                    for sy in ys {
-                        for sx in xs {
-                            let v = values[(sy * w as usize + sx) * channels + k];
-                            sum += if colour(k) { srgb_to_linear(v) } else { v };
-                        }
-                    }
-                    let mean = sum * 0.25;
-                    row[x * channels + k] = if colour(k) {
-                        linear_to_srgb(mean)
-                    } else {
-                        mean
-                    };
-                }
-            }
-        });
-    out
-}
-
-fn quantise(v: f32) -> u8 {
-    (v.clamp(0.0, 1.0) * 255.0).round() as u8
-}
-
-/// RGBA8 texels of a level, padded by repeating the last row and column to `(pw, ph)`.
-fn rgba8(values: &[f32], (w, h): (u32, u32), channels: usize, (pw, ph): (u32, u32)) -> Vec<u8> {
-    let mut out = vec![0_u8; pw as usize * ph as usize * 4];
-    out.par_chunks_mut(pw as usize * 4)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let sy = y.min(h as usize - 1);
-            for x in 0..pw as usize {
-                let sx = x.min(w as usize - 1);
-                let src = &values[(sy * w as usize + sx) * channels..][..channels];
-                let px = &mut row[x * 4..x * 4 + 4];
-                px[3] = 255;
-                for (k, v) in src.iter().enumerate() {
-                    px[k] = quantise(*v);
-                }
-            }
-        });
-    out
-}
-
-/// Block-compresses RGBA8 texels (sides multiples of 4) in parallel strips of block rows,
-/// advancing `progress` by texel rows (strips are skipped once it is cancelled).
-fn compress(
-    variant: CompressionVariant,
-    rgba: &[u8],
-    (w, h): (u32, u32),
-    progress: Option<&Progress>,
-) -> Vec<u8> {
-    const STRIP: u32 = 8; // Block rows per task.
-    let row_bytes = variant.blocks_byte_size(w, 4);
-    let mut blocks = vec![0_u8; variant.blocks_byte_size(w, h)];
-    blocks
-        .par_chunks_mut(row_bytes * STRIP as usize)
-        .enumerate()
-        .for_each(|(i, out)| {
-            let rows = (out.len() / row_bytes) as u32 * 4;
-            if progress.is_some_and(Progress::is_cancelled) {
-                return;
-            }
-            let first = i * STRIP as usize * 4 * w as usize * 4;
-            let src = &rgba[first..first + rows as usize * w as usize * 4];
-            compress_rgba8(variant, src, out, w, rows, w * 4);
-            if let Some(p) = progress {
-                p.advance(u64::from(rows));
-            }
-        });
-    blocks
-}
-
-fn psnr(reference: &[u8], decoded: &[u8], channels: usize) -> Vec<Option<f64>> {
-    (0..channels)
-        .map(|k| {
-            let (sum, count) = reference
-                .par_chunks(channels)
-                .zip(decoded.par_chunks(channels))
-                .map(|(a, b)| {
-                    let d = f64::from(a[k]) - f64::from(b[k]);
-                    (d * d, 1_u64)
-                })
-                .reduce(|| (0.0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
-            let mse = sum / count.max(1) as f64;
-            (mse > 0.0).then(|| 10.0 * (255.0_f64 * 255.0 / mse).log10())
-        })
-        .collect()
-}
-
-/// The first `channels` bytes of each RGBA8 texel of a `pw`-wide level, cropped to `(w, h)`.
-fn crop(rgba: &[u8], pw: u32, (w, h): (u32, u32), channels: usize) -> Vec<u8> {
-    let mut out = Vec::with_capacity(w as usize * h as usize * channels);
-    for y in 0..h as usize {
-        for x in 0..w as usize {
-            out.extend_from_slice(&rgba[(y * pw as usize + x) * 4..][..channels]);
-        }
-    }
-    out
-}
-
-/// Writes `source` as a KTX2 file with a full mip chain; `compressed` picks block
-/// compression and BC7's effort. Level 0's rows advance `progress`; a cancel stops the
-/// block encoder between strips.
-///
-/// # Errors
-/// An empty image, a component count outside 1..=4, or cancelled.
-pub fn encode(
-    source: &Source<'_>,
-    compressed: Option<Bc7Quality>,
-    progress: &Progress,
-) -> Result<Written, String> {
-    let (w, h, ch) = (source.width, source.height, source.channels);
-    if w == 0
-        || h == 0
-        || !(1..=4).contains(&ch)
-        || source.values.len() != w as usize * h as usize * ch
-    {
-        return Err(format!("cannot write a {w}x{h} image of {ch} components"));
-    }
-    let srgb = source.srgb && ch >= 3;
-    let levels = 32 - w.max(h).leading_zeros();
-    // Level values, finest first.
-    let mut chain: Vec<((u32, u32), Vec<f32>)> = vec![((w, h), source.values.to_vec())];
-    for _ in 1..levels {
-        let (size, values) = chain.last().map(|(s, v)| (*s, v)).ok_or("no level")?;
-        let next = downsample(values, size, ch, srgb);
-        chain.push((((size.0 / 2).max(1), (size.1 / 2).max(1)), next));
-    }
-    let (format, variant, compression) = match (compressed, ch) {
-        (None, 1) => (KtxFormat::R8_UNORM, None, Compression::Ktx2),
-        (None, 2) => (KtxFormat::R8G8_UNORM, None, Compression::Ktx2),
-        (None, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, None, Compression::Ktx2),
-        (None, _) => (KtxFormat::R8G8B8A8_UNORM, None, Compression::Ktx2),
-        (Some(_), 1) => (
-            KtxFormat::BC4_UNORM_BLOCK,
-            Some(CompressionVariant::BC4),
-            Compression::Ktx2Bc4,
-        ),
-        (Some(_), 2) => (
-            KtxFormat::BC5_UNORM_BLOCK,
-            Some(CompressionVariant::BC5),
-            Compression::Ktx2Bc5,
-        ),
-        (Some(q), _) => (
-            if srgb {
-                KtxFormat::BC7_SRGB_BLOCK
-            } else {
-                KtxFormat::BC7_UNORM_BLOCK
-            },
-            Some(CompressionVariant::BC7(bc7_settings(q, ch == 4))),
-            Compression::Ktx2Bc7,
-        ),
-    };
-    let stored_channels = if variant.is_none() && ch == 3 { 4 } else { ch };
-    let mut level_bytes = Vec::with_capacity(chain.len());
-    let mut level0 = Vec::new();
-    let mut psnr_values = None;
-    for (i, ((lw, lh), values)) in chain.iter().enumerate() {
-        let (lw, lh) = (*lw, *lh);
-        match variant {
-            None => {
-                let rgba = rgba8(values, (lw, lh), ch, (lw, lh));
-                if i == 0 {
-                    level0 = crop(&rgba, lw, (lw, lh), ch);
-                    progress.advance(u64::from(lh));
-                }
-                level_bytes.push(crop(&rgba, lw, (lw, lh), stored_channels));
-            }
-            Some(variant) => {
-                let padded = (lw.div_ceil(4) * 4, lh.div_ceil(4) * 4);
-                let rgba = rgba8(values, (lw, lh), ch, padded);
-                let blocks = compress(variant, &rgba, padded, (i == 0).then_some(progress));
-                if progress.is_cancelled() {
-                    return Err("cancelled".into());
-                }
-                if i == 0 {
-                    let mut decoded = vec![0_u8; rgba.len()];
-                    decompress_blocks_as_rgba8(variant, padded.0, padded.1, &blocks, &mut decoded);
-                    level0 = crop(&decoded, padded.0, (lw, lh), ch);
-                    let reference = crop(&rgba, padded.0, (lw, lh), ch);
-                    psnr_values = Some(psnr(&reference, &level0, ch));
-                }
-                level_bytes.push(blocks);
-            }
-        }
-    }
-    let bytes = container(format, (w, h), &level_bytes)?;
-    Ok(Written {
-        bytes,
-        level0,
-        psnr: psnr_values,
-        levels,
-        compression,
-    })
 }
 
 /// Assembles a KTX2 file: header, level index, data format descriptor, the writer's name,
@@ -403,19 +538,24 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             | KtxFormat::BC7_UNORM_BLOCK
             | KtxFormat::BC7_SRGB_BLOCK),
         ) => {
-            let (variant, ch) = match f {
-                KtxFormat::BC4_UNORM_BLOCK => (CompressionVariant::BC4, 1),
-                KtxFormat::BC5_UNORM_BLOCK => (CompressionVariant::BC5, 2),
-                _ => (CompressionVariant::BC7(BC7Settings::alpha_very_fast()), 4),
+            let kind = match f {
+                KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
+                KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
+                _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
             };
             let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
-            let size = variant.blocks_byte_size(padded.0, padded.1);
+            let size = (padded.0 as usize / 4) * (padded.1 as usize / 4) * kind.block_bytes();
             if data.len() < size {
                 return Err("level 0 is truncated".into());
             }
-            let mut rgba = vec![0_u8; padded.0 as usize * padded.1 as usize * 4];
-            decompress_blocks_as_rgba8(variant, padded.0, padded.1, &data[..size], &mut rgba);
-            (ch, crop(&rgba, padded.0, (w, h), 4))
+            let per = kind.texel_bytes();
+            let texels = blocks::decode(kind, &data[..size], padded);
+            let tight = crop(&texels, padded.0, (w, h), per, per);
+            let mut rgba = vec![255_u8; w as usize * h as usize * 4];
+            for (px, t) in rgba.chunks_exact_mut(4).zip(tight.chunks_exact(per)) {
+                px[..per].copy_from_slice(t);
+            }
+            (per, rgba)
         }
         other => return Err(format!("KTX2 format {other:?} is not one kapaint writes")),
     };
@@ -430,6 +570,8 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::encoding::NCurve;
+    use crate::model::texel::n_from_blend;
 
     fn gradient(w: u32, h: u32, ch: usize) -> Vec<f32> {
         (0..w * h)
@@ -438,6 +580,37 @@ mod tests {
                 (0..ch).map(move |k| ((x + y * 3 + k as u32 * 17) % 64) as f32 / 63.0)
             })
             .collect()
+    }
+
+    /// Writes `values` (in the averaging space of `spaces`) as a KTX2 file.
+    fn write(
+        (w, h): (u32, u32),
+        spaces: &[Space],
+        values: &[f32],
+        compressed: Option<Bc7Quality>,
+    ) -> Written {
+        let ch = spaces.len();
+        let bounds: Vec<Vec<f32>> = spaces.iter().map(|s| s.boundaries()).collect();
+        let level0: Vec<u8> = values
+            .iter()
+            .enumerate()
+            .map(|(j, v)| quantise(&bounds[j % ch], *v))
+            .collect();
+        let value = |i: usize, k: usize| values[i * ch + k];
+        let source = Source {
+            width: w,
+            height: h,
+            spaces,
+            level0: &level0,
+            value: &value,
+        };
+        encode(
+            &source,
+            compressed.map(|q| (Encoder::best(), q)),
+            None,
+            &Progress::default(),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -453,15 +626,15 @@ mod tests {
         ] {
             let (w, h) = (37, 20);
             let values = gradient(w, h, ch);
-            let source = Source {
-                width: w,
-                height: h,
-                channels: ch,
-                values: &values,
-                srgb: true,
+            let spaces = [Space::Srgb, Space::Srgb, Space::Srgb, Space::Linear];
+            let spaces = if ch >= 3 {
+                &spaces[..ch]
+            } else {
+                &[Space::Linear; 2][..ch]
             };
-            let written = encode(&source, compressed, &Progress::default()).unwrap();
+            let written = write((w, h), spaces, &values, compressed);
             assert_eq!(written.levels, 6);
+            assert_eq!(written.decoded.len(), 6);
             let reader = ktx2::Reader::new(&written.bytes[..]).unwrap();
             assert_eq!(reader.header().level_count, 6);
             assert_eq!(reader.levels().count(), 6);
@@ -473,10 +646,14 @@ mod tests {
                 .chunks(4)
                 .flat_map(|p| p[..ch].to_vec())
                 .collect();
-            assert_eq!(first, written.level0, "{ch} {compressed:?}");
+            assert_eq!(first, written.decoded[0], "{ch} {compressed:?}");
             if compressed.is_none() {
-                let exact: Vec<u8> = values.iter().map(|v| quantise(*v)).collect();
-                assert_eq!(written.level0, exact);
+                let exact: Vec<u8> = values
+                    .iter()
+                    .enumerate()
+                    .map(|(j, v)| quantise(&spaces[j % ch].boundaries(), *v))
+                    .collect();
+                assert_eq!(written.decoded[0], exact);
             } else {
                 let p = written.psnr.unwrap();
                 assert!(p.iter().all(|p| p.is_none_or(|p| p > 30.0)), "{p:?}");
@@ -485,34 +662,64 @@ mod tests {
     }
 
     #[test]
-    fn mips_average_colour_in_linear_light() {
-        // Black and white columns: the sRGB mean of linear 0.5, not 0.5.
-        let values: Vec<f32> = (0..4 * 3)
-            .map(|i| if (i / 3) % 2 == 0 { 0.0 } else { 1.0 })
+    fn quantising_by_boundaries_rounds_to_the_nearest_stored_value() {
+        let e = NEncoding {
+            curve: NCurve::Sqrt,
+            lo: 2.0,
+            hi: 3000.0,
+            bits: 8,
+        };
+        for space in [Space::Srgb, Space::Linear, Space::N(e)] {
+            let bounds = space.boundaries();
+            for b in 0..=255_u8 {
+                assert_eq!(quantise(&bounds, space.value_of(b)), b, "{space:?} {b}");
+            }
+        }
+        // The same byte as the encodings' own rounding.
+        let bounds = Space::N(e).boundaries();
+        for n in [2.0, 2.5, 17.0, 400.0, 2999.0, 3000.0] {
+            assert_eq!(
+                u16::from(quantise(&bounds, n_to_blend(n))),
+                e.encode(n),
+                "{n}"
+            );
+        }
+    }
+
+    #[test]
+    fn mips_average_colour_in_linear_light_and_n_in_log_space() {
+        let e = NEncoding {
+            curve: NCurve::Linear,
+            lo: 1.0,
+            hi: 3001.0,
+            bits: 8,
+        };
+        // Black and white columns of k_d, n = 1 and 3001 likewise.
+        let values: Vec<f32> = (0..4)
+            .flat_map(|i| {
+                let on = i % 2 == 1;
+                [
+                    if on { 1.0 } else { 0.0 },
+                    n_to_blend(if on { 3001.0 } else { 1.0 }),
+                ]
+            })
             .collect();
-        let next = downsample(&values, (2, 2), 3, true);
-        assert!((next[0] - linear_to_srgb(0.5)).abs() < 1e-6);
-        let linear = downsample(&values, (2, 2), 3, false);
-        assert!((linear[0] - 0.5).abs() < 1e-6);
+        let value = |i: usize, k: usize| values[i * 2 + k];
+        let next = downsample(&value, (2, 2), 2);
+        assert!((next[0] - 0.5).abs() < 1e-6, "linear light");
+        // The log-space mean of n: sqrt(2 * 3002) - 1, not 1501.
+        let n = n_from_blend(next[1]);
+        assert!((n - ((2.0_f32 * 3002.0).sqrt() - 1.0)).abs() < 0.05, "{n}");
+        let bounds = Space::N(e).boundaries();
+        assert_eq!(quantise(&bounds, next[1]), e.encode(n) as u8);
+        assert!(Space::Srgb.boundaries()[127] > 0.2 && Space::Srgb.boundaries()[127] < 0.22);
     }
 
     #[test]
     fn garbage_is_an_error() {
         assert!(decode(b"not a ktx2 file at all").is_err());
         let values = gradient(8, 8, 1);
-        let mut bytes = encode(
-            &Source {
-                width: 8,
-                height: 8,
-                channels: 1,
-                values: &values,
-                srgb: false,
-            },
-            None,
-            &Progress::default(),
-        )
-        .unwrap()
-        .bytes;
+        let mut bytes = write((8, 8), &[Space::Linear], &values, None).bytes;
         bytes.truncate(bytes.len() - 10);
         assert!(decode(&bytes).is_err());
     }

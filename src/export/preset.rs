@@ -47,20 +47,56 @@ impl Format {
     }
 }
 
-/// BC7 encoder effort (BC4 and BC5 have one speed): slower finds better endpoints.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// BC7 encoder effort (BC4 and BC5 have one speed): slower finds better endpoints. Ordered
+/// from the cheapest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum Bc7Quality {
     /// Fewest partitions and modes tried.
     UltraFast,
-    /// The default: about 1 dB under `Basic` at a fraction of the time.
-    #[default]
+    /// About 1 dB under `Basic` at a fraction of the time.
     VeryFast,
     /// More modes.
     Fast,
-    /// The reference encoder's basic profile.
+    /// The reference encoder's basic profile: the most a preset spends by default.
+    #[default]
     Basic,
     /// Exhaustive.
     Slow,
+}
+
+impl Bc7Quality {
+    /// Every effort, cheapest first.
+    pub const ALL: [Self; 5] = [
+        Self::UltraFast,
+        Self::VeryFast,
+        Self::Fast,
+        Self::Basic,
+        Self::Slow,
+    ];
+}
+
+/// What a block-compressed set may lose. The export encodes with the cheapest layout and
+/// effort first and spends more only while one of these is not met (`k_a` errors relative,
+/// per texel and colour channel; PSNR per component, in dB, of level 0 against the
+/// uncompressed 8-bit values).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlockBudget {
+    /// Largest `k_a` error allowed.
+    pub max_ka_error: f64,
+    /// Mean `k_a` error allowed.
+    pub mean_ka_error: f64,
+    /// Smallest PSNR allowed of any component.
+    pub min_psnr: f64,
+}
+
+impl Default for BlockBudget {
+    fn default() -> Self {
+        Self {
+            max_ka_error: 0.02,
+            mean_ka_error: 0.002,
+            min_psnr: 45.0,
+        }
+    }
 }
 
 /// How channels are packed into files.
@@ -93,9 +129,10 @@ pub struct ExportPreset {
     /// Also write a baked `k_a` map.
     #[serde(default)]
     pub include_ka: bool,
-    /// BC7 effort, for `Ktx2Bc`.
-    #[serde(default)]
-    pub bc7_quality: Bc7Quality,
+    /// The most BC7 effort a `Ktx2Bc` export may spend meeting its budget.
+    pub max_bc7_effort: Bc7Quality,
+    /// What a `Ktx2Bc` set may lose.
+    pub budget: BlockBudget,
 }
 
 /// An export preset as its file spells it, before it is checked.
@@ -110,8 +147,27 @@ struct ExportPresetFile {
     n_bits: u8,
     #[serde(default)]
     include_ka: bool,
-    #[serde(default)]
-    bc7_quality: Bc7Quality,
+    /// Older presets name the ceiling `bc7_quality`.
+    #[serde(default, alias = "bc7_quality")]
+    max_bc7_effort: Bc7Quality,
+    #[serde(default = "default_max_ka_error")]
+    max_ka_error: f64,
+    #[serde(default = "default_mean_ka_error")]
+    mean_ka_error: f64,
+    #[serde(default = "default_min_psnr")]
+    min_psnr: f64,
+}
+
+fn default_max_ka_error() -> f64 {
+    BlockBudget::default().max_ka_error
+}
+
+fn default_mean_ka_error() -> f64 {
+    BlockBudget::default().mean_ka_error
+}
+
+fn default_min_psnr() -> f64 {
+    BlockBudget::default().min_psnr
 }
 
 impl TryFrom<ExportPresetFile> for ExportPreset {
@@ -136,6 +192,24 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
         if f.format == Format::Png16 && f.n_bits != 16 {
             return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
         }
+        let budget = BlockBudget {
+            max_ka_error: f.max_ka_error,
+            mean_ka_error: f.mean_ka_error,
+            min_psnr: f.min_psnr,
+        };
+        for (field, value, range) in [
+            ("max_ka_error", budget.max_ka_error, 0.0..=100.0),
+            ("mean_ka_error", budget.mean_ka_error, 0.0..=100.0),
+            ("min_psnr", budget.min_psnr, 0.0..=200.0),
+        ] {
+            if !range.contains(&value) {
+                return Err(format!(
+                    "{field} must be in {}..={}, got {value}",
+                    range.start(),
+                    range.end()
+                ));
+            }
+        }
         Ok(Self {
             name: f.name,
             description: f.description,
@@ -143,7 +217,8 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             layout: f.layout,
             n_bits: f.n_bits,
             include_ka: f.include_ka,
-            bc7_quality: f.bc7_quality,
+            max_bc7_effort: f.max_bc7_effort,
+            budget,
         })
     }
 }
@@ -283,6 +358,8 @@ mod tests {
             "(name: \"a\", format: Png16, layout: Packed, n_bits: 8)",
             "(name: \"a\", format: Gif, layout: Packed, n_bits: 8)",
             "(name: \"a\", format: Png8, layout: Packed, n_bits: 8, extra: 1)",
+            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, max_ka_error: -1.0)",
+            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, min_psnr: NaN)",
         ] {
             let err = ExportPreset::parse(path, text).unwrap_err().to_string();
             assert!(err.starts_with("x.ron: "), "{err}");

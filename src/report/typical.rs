@@ -93,6 +93,62 @@ pub fn typical_document(
     Ok(doc)
 }
 
+/// The block-compression test project (issue 21's): `texture` (if given and readable) in
+/// `k_d`, the default `k_s` (grey, constant) and `n`, and over that `n` two soft strokes
+/// 200 px wide, one of `n = 3000` and one of `n = 2`, crossing the map (scaled with `side`
+/// from 4096): the hard case for `n` in shared blocks, whose edges sweep `n` across its range.
+///
+/// # Errors
+/// A document that cannot be made, or a texture that does not read.
+pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Document, String> {
+    let mut doc =
+        Document::new(side, side, DocumentSettings::default()).map_err(|e| e.to_string())?;
+    if let Some(path) = texture {
+        import::import_file(&mut doc, Channel::Kd, path).map_err(|e| e.to_string())?;
+    }
+    let scale = side as f32 / 4096.0;
+    let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
+    apply(
+        &mut doc,
+        Command::SetChannels(Channels {
+            kd: false,
+            ks: false,
+            n: true,
+        }),
+    )?;
+    apply(
+        &mut doc,
+        Command::SetBrush(BrushSettings {
+            radius_px: 100.0 * scale,
+            hardness: 0.0,
+            ..BrushSettings::default()
+        }),
+    )?;
+    for (n, from, to) in [
+        (3000.0, Vec2::new(0.1, 0.3), Vec2::new(0.9, 0.7)),
+        (2.0, Vec2::new(0.2, 0.85), Vec2::new(0.8, 0.15)),
+    ] {
+        apply(
+            &mut doc,
+            Command::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, n)),
+        )?;
+        let points = (0..=32)
+            .map(|k| StrokePoint {
+                pos: from.lerp(to, k as f32 / 32.0) * side as f32,
+                pressure: 1.0,
+            })
+            .collect();
+        apply(
+            &mut doc,
+            Command::Stroke {
+                tool: StrokeTool::Brush,
+                points,
+            },
+        )?;
+    }
+    Ok(doc)
+}
+
 /// A `side x side` stack of `layers` paint layers over the default base, each painted over
 /// about 10 % of the map (every tenth band of tiles, a different band per layer: a uniform
 /// material at varied coverage) with a varied mask there: the layered document of the layer

@@ -6,9 +6,12 @@ use rayon::prelude::*;
 
 use super::manifest::{Comp, Compression, is_colour};
 use crate::export::encoding::NEncoding;
+use crate::export::ktx::{Space, quantise};
 use crate::export::preset::{ExportPreset, Format};
 use crate::model::MaterialMaps;
-use crate::model::texel::{MaterialValue, Texel, decode_n, decode_unorm, linear_to_srgb};
+use crate::model::texel::{
+    MaterialValue, Texel, decode_n, decode_unorm, linear_to_srgb, n_to_blend,
+};
 use crate::task::Progress;
 
 /// Texels of the map in row-major order, read in parallel by rows.
@@ -40,11 +43,13 @@ pub(super) struct KtxInfo {
     pub levels: u32,
     pub psnr: Option<Vec<Option<f64>>>,
     pub compression: Compression,
+    /// Levels 1 and on as a consumer decodes them.
+    pub mips: Vec<Vec<u8>>,
 }
 
 /// Whether an image's colour components are sRGB-encoded: in 8-bit PNGs always, in KTX2
 /// where the format has an sRGB variant (three or four components).
-fn srgb_image(format: Format, comps: &[Comp]) -> bool {
+pub(super) fn srgb_image(format: Format, comps: &[Comp]) -> bool {
     let colour = comps.iter().any(|c| is_colour(*c));
     colour && (format == Format::Png8 || (format.is_ktx2() && comps.len() >= 3))
 }
@@ -152,30 +157,174 @@ pub(super) fn encode_image(
             Ok(plain(out.into_inner()))
         }
         Format::Ktx2 | Format::Ktx2Bc => {
-            let values: Vec<f32> = (0..count * channels)
-                .into_par_iter()
-                .map(|j| value(j / channels, j % channels))
-                .collect();
-            let source = crate::export::ktx::Source {
-                width,
-                height,
-                channels,
-                values: &values,
-                srgb,
-            };
-            let compressed = (format == Format::Ktx2Bc).then_some(preset.bc7_quality);
-            let written = crate::export::ktx::encode(&source, compressed, progress)?;
-            Ok(EncodedImage {
-                bytes: written.bytes,
-                stored: Some(written.level0),
-                srgb,
-                ktx: Some(KtxInfo {
-                    levels: written.levels,
-                    psnr: written.psnr,
-                    compression: written.compression,
-                }),
-            })
+            let source = KtxTexels::new(texels, ka, comps, srgb, n_enc);
+            let level0 = source.level0();
+            let compressed = (format == Format::Ktx2Bc).then_some((
+                crate::export::blocks::Encoder::best(),
+                preset.max_bc7_effort,
+            ));
+            let written = crate::export::ktx::encode(
+                &source.source((width, height), &level0),
+                compressed,
+                None,
+                progress,
+            )?;
+            Ok(ktx_image(written, srgb))
         }
+    }
+}
+
+/// An encoded image of a written KTX2 file.
+pub(super) fn ktx_image(written: crate::export::ktx::Written, srgb: bool) -> EncodedImage {
+    let mut decoded = written.decoded;
+    let level0 = if decoded.is_empty() {
+        Vec::new()
+    } else {
+        decoded.remove(0)
+    };
+    EncodedImage {
+        bytes: written.bytes,
+        stored: Some(level0),
+        srgb,
+        ktx: Some(KtxInfo {
+            levels: written.levels,
+            psnr: written.psnr,
+            compression: written.compression,
+            mips: decoded,
+        }),
+    }
+}
+
+/// Where a KTX2 image's component comes from: a texel's 16-bit code through two tables (its
+/// value in the averaging space, and its stored byte), or the baked `k_a`.
+enum CompSource {
+    Code {
+        comp: Comp,
+        value: Vec<f32>,
+        byte: Vec<u8>,
+    },
+    Ka {
+        channel: usize,
+        bounds: Vec<f32>,
+    },
+}
+
+/// The texels of one KTX2 image: its components' spaces, stored bytes and values.
+pub(super) struct KtxTexels<'a> {
+    texels: &'a [Texel],
+    ka: &'a [Vec3],
+    spaces: Vec<Space>,
+    sources: Vec<CompSource>,
+}
+
+impl<'a> KtxTexels<'a> {
+    /// The image of `comps` (colour sRGB-encoded where `srgb`; `n` by `n_enc`).
+    pub(super) fn new(
+        texels: &'a [Texel],
+        ka: &'a [Vec3],
+        comps: &[Comp],
+        srgb: bool,
+        n_enc: Option<NEncoding>,
+    ) -> Self {
+        let spaces: Vec<Space> = comps
+            .iter()
+            .map(|c| match (c, n_enc) {
+                (Comp::N, Some(e)) => Space::N(e),
+                (Comp::N, None) => Space::Linear,
+                _ if srgb => Space::Srgb,
+                _ => Space::Linear,
+            })
+            .collect();
+        let sources = comps
+            .iter()
+            .zip(&spaces)
+            .map(|(comp, space)| {
+                let bounds = space.boundaries();
+                if let Comp::Ka(channel) = comp {
+                    return CompSource::Ka {
+                        channel: *channel,
+                        bounds,
+                    };
+                }
+                let value: Vec<f32> = (0..=u16::MAX)
+                    .map(|code| match comp {
+                        Comp::N => n_to_blend(decode_n(code)),
+                        _ => decode_unorm(code),
+                    })
+                    .collect();
+                let byte = value.iter().map(|v| quantise(&bounds, *v)).collect();
+                CompSource::Code {
+                    comp: *comp,
+                    value,
+                    byte,
+                }
+            })
+            .collect();
+        Self {
+            texels,
+            ka,
+            spaces,
+            sources,
+        }
+    }
+
+    fn code(&self, i: usize, comp: Comp) -> usize {
+        let t = &self.texels[i];
+        match comp {
+            Comp::Kd(c) => t.kd[c] as usize,
+            Comp::Ks(c) => t.ks[c.min(2)] as usize,
+            Comp::N | Comp::Ka(_) => t.n as usize,
+        }
+    }
+
+    fn ka_of(&self, i: usize, channel: usize) -> f32 {
+        self.ka.get(i).map_or(0.0, |k| k[channel])
+    }
+
+    /// Texel `i`'s component `k` in its averaging space.
+    fn value_of(&self, i: usize, k: usize) -> f32 {
+        match &self.sources[k] {
+            CompSource::Code { comp, value, .. } => value[self.code(i, *comp)],
+            CompSource::Ka { channel, .. } => self.ka_of(i, *channel),
+        }
+    }
+
+    /// Texel `i`'s component `k` as stored.
+    pub(super) fn byte(&self, i: usize, k: usize) -> u8 {
+        match &self.sources[k] {
+            CompSource::Code { comp, byte, .. } => byte[self.code(i, *comp)],
+            CompSource::Ka { channel, bounds } => quantise(bounds, self.ka_of(i, *channel)),
+        }
+    }
+
+    /// Level 0 as stored bytes.
+    pub(super) fn level0(&self) -> Vec<u8> {
+        let ch = self.spaces.len();
+        (0..self.texels.len() * ch)
+            .into_par_iter()
+            .map(|j| self.byte(j / ch, j % ch))
+            .collect()
+    }
+
+    /// The image as the KTX2 writer takes it, with its stored level 0.
+    pub(super) fn source<'s>(
+        &'s self,
+        (width, height): (u32, u32),
+        level0: &'s [u8],
+    ) -> crate::export::ktx::Source<'s> {
+        crate::export::ktx::Source {
+            width,
+            height,
+            spaces: &self.spaces,
+            level0,
+            value: self,
+        }
+    }
+}
+
+impl crate::export::ktx::Values for KtxTexels<'_> {
+    fn value(&self, i: usize, k: usize) -> f32 {
+        self.value_of(i, k)
     }
 }
 

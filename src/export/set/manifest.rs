@@ -382,6 +382,13 @@ pub struct Manifest {
     /// the set (0 in sets from before layers).
     #[serde(default)]
     pub layers: u32,
+    /// KTX2 sets: the `k_a` error of every mip level, finest first (level 0 is `ka_error`;
+    /// each further level against the mean of the exact level 0's `k_a` over its footprint).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub level_ka_error: Vec<KaError>,
+    /// Block-compressed sets: how the layout and BC7 effort were chosen.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<Box<super::choose::BlockChoice>>,
 }
 
 impl Manifest {
@@ -411,6 +418,10 @@ struct ManifestFile {
     preset: String,
     #[serde(default)]
     layers: u32,
+    #[serde(default)]
+    level_ka_error: Vec<KaError>,
+    #[serde(default)]
+    blocks: Option<Box<super::choose::BlockChoice>>,
 }
 
 impl TryFrom<ManifestFile> for Manifest {
@@ -489,6 +500,8 @@ impl TryFrom<ManifestFile> for Manifest {
             bytes: f.bytes,
             preset: f.preset,
             layers: f.layers,
+            level_ka_error: f.level_ka_error,
+            blocks: f.blocks,
         })
     }
 }

@@ -3,8 +3,9 @@
 use rayon::prelude::*;
 
 use super::encode::StoredImage;
-use super::manifest::{Comp, Manifest};
+use super::manifest::{Comp, Constants};
 use crate::export::encoding::KaError;
+use crate::export::encoding::NEncoding;
 use crate::export::preset::Format;
 use crate::model::texel::{Texel, decode_n, decode_unorm, srgb_to_linear};
 use crate::reflectance::{self, AmbientApprox, ShadingModel};
@@ -58,12 +59,24 @@ fn in_file<'r>(
     })
 }
 
+/// What a measure needs of a set besides its images: the row length, the constants, and how
+/// stored `n` decodes.
+#[derive(Clone, Copy)]
+pub(super) struct Shape<'a> {
+    /// Texels per row of level 0.
+    pub width: u32,
+    /// Constant channels.
+    pub constants: &'a Constants,
+    /// `n`'s encoding, where it is stored in an integer image.
+    pub n_encoding: Option<NEncoding>,
+}
+
 /// Relative `k_a` error of the set described by `manifest` against the texels it was made
 /// from, per texel and colour channel: every value goes through what a consumer reads (the
 /// bytes an 8-bit file holds after compression, or 16-bit and float codes by table) and back.
 pub(super) fn ka_error_of_set(
     texels: &[Texel],
-    manifest: &Manifest,
+    manifest: Shape<'_>,
     stored: &[StoredImage],
     format: Format,
     model: ShadingModel,
@@ -168,4 +181,102 @@ pub(super) fn ka_error_of_set(
         max,
         mean: if count > 0 { sum / count as f64 } else { 0.0 },
     }
+}
+
+/// Relative `k_a` error of one mip level as a consumer decodes it (`stored`: the level's
+/// images, decoded) against `reference`: per texel, the mean of the exact level 0's `k_a`
+/// over its footprint, what the level should look like. Per texel and colour channel.
+pub(super) fn ka_error_of_level(
+    shape: Shape<'_>,
+    stored: &[StoredImage],
+    reference: &[[f32; 3]],
+    model: ShadingModel,
+    approx: AmbientApprox,
+) -> KaError {
+    let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
+    let srgb8: Vec<f32> = (0..=255_u8)
+        .map(|b| srgb_to_linear(f32::from(b) / 255.0))
+        .collect();
+    let linear8: Vec<f32> = (0..=255_u8).map(|b| f32::from(b) / 255.0).collect();
+    let chi_of = |n: f32| reflectance::chi_parts_f32(model, approx, n);
+    let chi8: [Vec<f32>; 2] = [0, 1].map(|k| {
+        (0..=255_u16)
+            .map(|q| shape.n_encoding.map_or(0.0, |e| chi_of(e.decode(q))[k]))
+            .collect()
+    });
+    let kd_const = shape.constants.kd.map(|v| v.map(|c| [c]));
+    let ks_const = shape.constants.ks.map(|v| v.map(|c| [c]));
+    let n_const = shape.constants.n.map(|n| chi_of(n).map(|c| [c]));
+    let zero = [0.0_f32];
+    let kd: [Read<'_>; 3] = std::array::from_fn(|c| match &kd_const {
+        Some(v) => Read::Table(&v[c]),
+        None => in_file(stored, &[Comp::Kd(c)], &srgb8, &linear8).unwrap_or(Read::Table(&zero)),
+    });
+    let ks: [Read<'_>; 3] = std::array::from_fn(|c| match &ks_const {
+        Some(v) => Read::Table(&v[c]),
+        None => in_file(stored, &[Comp::Ks(c), Comp::Ks(0)], &srgb8, &linear8)
+            .unwrap_or(Read::Table(&zero)),
+    });
+    let n: [Read<'_>; 2] = std::array::from_fn(|k| match &n_const {
+        Some(v) => Read::Table(&v[k]),
+        None => in_file(stored, &[Comp::N], &chi8[k], &chi8[k]).unwrap_or(Read::Table(&zero)),
+    });
+    let (max, sum) = reference
+        .par_iter()
+        .enumerate()
+        .map(|(i, want)| {
+            let (chi, offset) = (n[0].get(i, 0), n[1].get(i, 0));
+            let mut max = 0.0_f64;
+            let mut sum = 0.0_f64;
+            for c in 0..3 {
+                let got = diffuse * kd[c].get(i, 0) + ks[c].get(i, 0) * chi + offset;
+                let err = if want[c] > 0.0 {
+                    f64::from((got - want[c]).abs() / want[c])
+                } else {
+                    0.0
+                };
+                max = max.max(err);
+                sum += err;
+            }
+            (max, sum)
+        })
+        .reduce(|| (0.0, 0.0), |x, y| (x.0.max(y.0), x.1 + y.1));
+    KaError {
+        max,
+        mean: if reference.is_empty() {
+            0.0
+        } else {
+            sum / (reference.len() * 3) as f64
+        },
+    }
+}
+
+/// The reference of every mip level past 0 (see [`ka_error_of_level`]): level 1 from the
+/// texels' exact `k_a`, each further level the 2x2 mean of the one before (clamped at odd
+/// edges, as the mips are made).
+pub(super) fn reference_levels(
+    texels: &[Texel],
+    (w, h): (u32, u32),
+    model: ShadingModel,
+    approx: AmbientApprox,
+) -> Vec<Vec<[f32; 3]>> {
+    let lut = crate::model::maps::chi_lut(model, approx);
+    let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
+    let ka = |t: &Texel| -> [f32; 3] {
+        let [chi, offset] = lut[t.n as usize];
+        std::array::from_fn(|c| {
+            diffuse * decode_unorm(t.kd[c]) + decode_unorm(t.ks[c]) * chi + offset
+        })
+    };
+    let mut out: Vec<Vec<[f32; 3]>> = Vec::new();
+    let mut size = (w, h);
+    for _ in 1..crate::export::ktx::level_count(w, h) {
+        let next = crate::export::ktx::box_down(size, |i| match out.last() {
+            None => ka(&texels[i]),
+            Some(prev) => prev[i],
+        });
+        size = ((size.0 / 2).max(1), (size.1 / 2).max(1));
+        out.push(next);
+    }
+    out
 }

@@ -3,6 +3,7 @@
 //! A set is written into a temporary folder beside the target and renamed into place at the
 //! end, so a half-written set is never left where the target should be.
 
+mod choose;
 mod encode;
 mod import;
 mod manifest;
@@ -14,14 +15,15 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use rayon::prelude::*;
 
+pub use self::choose::{BlockChoice, BlockLayout, Trial};
 pub(crate) use self::encode::png_bytes;
 use self::encode::{Encoded, StoredImage, encode_image, rows};
 pub use self::import::import;
-use self::manifest::approximation;
 pub use self::manifest::{
     Approximation, ColourSpace, Compression, Constants, FileEntry, MANIFEST_FORMAT,
     MANIFEST_VERSION, Manifest, MemoryReport,
 };
+use self::manifest::{Comp, approximation};
 use self::measure::ka_error_of_set;
 use self::plan::plan_set;
 pub use self::plan::{PlannedFile, SetPlan, plan};
@@ -186,32 +188,65 @@ fn export_into(
     progress.start("encode", images.len() as u64 * u64::from(h));
 
     commit(out, found, |tmp| {
-        let encoded: Vec<Result<Encoded, SetError>> = images
-            .par_iter()
-            .map(|(stem, comps)| {
-                let file = format!("{stem}.{ext}");
-                if progress.is_cancelled() {
-                    return Err(SetError::Cancelled);
-                }
-                let image = encode_image(&texels, &ka, (w, h), comps, preset, n_enc, progress)
-                    .map_err(|e| {
-                        if progress.is_cancelled() {
-                            SetError::Cancelled
-                        } else {
-                            io(&tmp.join(&file), e)
-                        }
-                    })?;
-                if progress.is_cancelled() {
-                    return Err(SetError::Cancelled);
-                }
-                Ok((file, comps.clone(), image))
-            })
-            .collect();
+        let fail = |e: String, file: &str| {
+            if progress.is_cancelled() {
+                SetError::Cancelled
+            } else {
+                io(&tmp.join(file), e)
+            }
+        };
+        let shape = measure::Shape {
+            width: w,
+            constants: &constants,
+            n_encoding: n_enc,
+        };
+        let (encoded, blocks): (Vec<Result<Encoded, SetError>>, _) = if preset.format
+            == Format::Ktx2Bc
+        {
+            let job = choose::Job {
+                texels: &texels,
+                ka: &ka,
+                size: (w, h),
+                preset,
+                n_enc,
+                shape,
+                model,
+                approx,
+            };
+            let apart = choose::n_apart(&images, mono_ks);
+            let (encoded, choice) = choose::encode_blocks(&job, &images, apart.as_ref(), progress)
+                .map_err(|e| fail(e, "material.json"))?;
+            (
+                encoded.into_iter().map(Ok).collect(),
+                Some(Box::new(choice)),
+            )
+        } else {
+            let encoded = images
+                .par_iter()
+                .map(|(stem, comps)| {
+                    let file = format!("{stem}.{ext}");
+                    if progress.is_cancelled() {
+                        return Err(SetError::Cancelled);
+                    }
+                    let image = encode_image(&texels, &ka, (w, h), comps, preset, n_enc, progress)
+                        .map_err(|e| fail(e, &file))?;
+                    if progress.is_cancelled() {
+                        return Err(SetError::Cancelled);
+                    }
+                    Ok((file, comps.clone(), image))
+                })
+                .collect();
+            (encoded, None)
+        };
         progress.start("measure", 1);
         let mut files = Vec::new();
         let mut stored = Vec::new();
+        let mut mips: Vec<Mips> = Vec::new();
         for item in encoded {
-            let (file, comps, image) = item?;
+            let (file, comps, mut image) = item?;
+            if let Some(k) = image.ktx.as_mut() {
+                mips.push((comps.clone(), std::mem::take(&mut k.mips), image.srgb));
+            }
             let path = tmp.join(&file);
             crate::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
             let (mip_levels, psnr, compression) = match image.ktx {
@@ -272,10 +307,15 @@ fn export_into(
             },
             preset: preset.name.clone(),
             layers: u32::try_from(doc.stack().walk().len()).unwrap_or(u32::MAX),
+            level_ka_error: Vec::new(),
+            blocks,
         };
         // The k_a error, measured on the set as a consumer decodes it.
-        manifest.ka_error =
-            ka_error_of_set(&texels, &manifest, &stored, preset.format, model, approx);
+        manifest.ka_error = ka_error_of_set(&texels, shape, &stored, preset.format, model, approx);
+        if preset.format.is_ktx2() {
+            manifest.level_ka_error = level_errors(&texels, (w, h), shape, &mips, model, approx);
+            manifest.level_ka_error.insert(0, manifest.ka_error);
+        }
         // The decode + k_a snippets for engines (WGSL and GLSL), beside the images.
         let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
         for (name, snippet) in [
@@ -301,6 +341,40 @@ fn export_into(
         crate::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
         Ok(manifest)
     })
+}
+
+/// A KTX2 file's components, its levels past 0 as decoded, and whether its colour is sRGB.
+type Mips = (Vec<Comp>, Vec<Vec<u8>>, bool);
+
+/// The `k_a` error of every mip level past 0 of a KTX2 set (`mips`: per file, its
+/// components and levels 1 and on as decoded), against the exact level 0 averaged over each
+/// texel's footprint.
+fn level_errors(
+    texels: &[crate::model::texel::Texel],
+    size: (u32, u32),
+    shape: measure::Shape<'_>,
+    mips: &[Mips],
+    model: reflectance::ShadingModel,
+    approx: reflectance::AmbientApprox,
+) -> Vec<KaError> {
+    let reference = measure::reference_levels(texels, size, model, approx);
+    reference
+        .iter()
+        .enumerate()
+        .map(|(l, want)| {
+            let stored: Vec<StoredImage> = mips
+                .iter()
+                .filter_map(|(comps, levels, srgb)| {
+                    Some(StoredImage {
+                        comps: comps.clone(),
+                        data: levels.get(l)?.clone(),
+                        srgb: *srgb,
+                    })
+                })
+                .collect();
+            measure::ka_error_of_level(shape, &stored, want, model, approx)
+        })
+        .collect()
 }
 
 /// Whether `out` can take a set (free, or a set when `replace`): what is there.

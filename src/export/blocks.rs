@@ -1,0 +1,302 @@
+//! Block encoders for the KTX2 export: BC7 (three or four components), BC5 (two), BC4 (one).
+//!
+//! On `x86_64` the blocks come from Intel's ISPC texture compressor kernels (`intel_tex_2`,
+//! which ships them precompiled); elsewhere from `block_compression`'s port of the same
+//! encoder. Either runs in parallel over strips of block rows. Decoding (to measure what a
+//! consumer sees) is `block_compression`'s CPU decoder, also in strips.
+
+use block_compression::decode::decompress_blocks_as_rgba8;
+use block_compression::{BC7Settings, CompressionVariant};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::preset::Bc7Quality;
+use crate::task::Progress;
+
+/// What blocks hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockKind {
+    /// One component, 8 bytes per block.
+    Bc4,
+    /// Two components, 16 bytes per block.
+    Bc5,
+    /// RGB (`alpha` false) or RGBA, 16 bytes per block, at an effort.
+    Bc7 {
+        /// The fourth component is stored (otherwise the encoder may ignore it).
+        alpha: bool,
+        /// How hard the encoder searches.
+        effort: Bc7Quality,
+    },
+}
+
+impl BlockKind {
+    /// The kind for `channels` components (1, 2, 3 or 4) at `effort` (BC7 only).
+    pub fn for_channels(channels: usize, effort: Bc7Quality) -> Self {
+        match channels {
+            1 => Self::Bc4,
+            2 => Self::Bc5,
+            c => Self::Bc7 {
+                alpha: c == 4,
+                effort,
+            },
+        }
+    }
+
+    /// Bytes per 4x4 block.
+    pub fn block_bytes(self) -> usize {
+        match self {
+            Self::Bc4 => 8,
+            Self::Bc5 | Self::Bc7 { .. } => 16,
+        }
+    }
+
+    /// Bytes per texel of the input (and of [`decode`]'s output): 1, 2 or 4.
+    pub fn texel_bytes(self) -> usize {
+        match self {
+            Self::Bc4 => 1,
+            Self::Bc5 => 2,
+            Self::Bc7 { .. } => 4,
+        }
+    }
+
+    fn variant(self) -> CompressionVariant {
+        match self {
+            Self::Bc4 => CompressionVariant::BC4,
+            Self::Bc5 => CompressionVariant::BC5,
+            Self::Bc7 { alpha, effort } => CompressionVariant::BC7(portable_bc7(effort, alpha)),
+        }
+    }
+}
+
+/// Which code encodes the blocks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Encoder {
+    /// Intel's ISPC kernels (`x86_64`).
+    Ispc,
+    /// `block_compression`'s CPU port.
+    Portable,
+}
+
+impl Encoder {
+    /// The fastest encoder this CPU has.
+    pub fn best() -> Self {
+        if cfg!(target_arch = "x86_64") {
+            Self::Ispc
+        } else {
+            Self::Portable
+        }
+    }
+}
+
+fn portable_bc7(effort: Bc7Quality, alpha: bool) -> BC7Settings {
+    match (effort, alpha) {
+        (Bc7Quality::UltraFast, false) => BC7Settings::opaque_ultra_fast(),
+        (Bc7Quality::VeryFast, false) => BC7Settings::opaque_very_fast(),
+        (Bc7Quality::Fast, false) => BC7Settings::opaque_fast(),
+        (Bc7Quality::Basic, false) => BC7Settings::opaque_basic(),
+        (Bc7Quality::Slow, false) => BC7Settings::opaque_slow(),
+        (Bc7Quality::UltraFast, true) => BC7Settings::alpha_ultrafast(),
+        (Bc7Quality::VeryFast, true) => BC7Settings::alpha_very_fast(),
+        (Bc7Quality::Fast, true) => BC7Settings::alpha_fast(),
+        (Bc7Quality::Basic, true) => BC7Settings::alpha_basic(),
+        (Bc7Quality::Slow, true) => BC7Settings::alpha_slow(),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod ispc {
+    use intel_tex_2::{RSurface, RgSurface, RgbaSurface, bc4, bc5, bc7};
+
+    use super::{Bc7Quality, BlockKind};
+
+    fn bc7_settings(effort: Bc7Quality, alpha: bool) -> bc7::EncodeSettings {
+        match (effort, alpha) {
+            (Bc7Quality::UltraFast, false) => bc7::opaque_ultra_fast_settings(),
+            (Bc7Quality::VeryFast, false) => bc7::opaque_very_fast_settings(),
+            (Bc7Quality::Fast, false) => bc7::opaque_fast_settings(),
+            (Bc7Quality::Basic, false) => bc7::opaque_basic_settings(),
+            (Bc7Quality::Slow, false) => bc7::opaque_slow_settings(),
+            (Bc7Quality::UltraFast, true) => bc7::alpha_ultra_fast_settings(),
+            (Bc7Quality::VeryFast, true) => bc7::alpha_very_fast_settings(),
+            (Bc7Quality::Fast, true) => bc7::alpha_fast_settings(),
+            (Bc7Quality::Basic, true) => bc7::alpha_basic_settings(),
+            (Bc7Quality::Slow, true) => bc7::alpha_slow_settings(),
+        }
+    }
+
+    /// Encodes `rows` texel rows (a multiple of 4) of a `width`-wide image into `out`.
+    pub(super) fn encode(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mut [u8]) {
+        let stride = width * kind.texel_bytes() as u32;
+        match kind {
+            BlockKind::Bc4 => bc4::compress_blocks_into(
+                &RSurface {
+                    data,
+                    width,
+                    height: rows,
+                    stride,
+                },
+                out,
+            ),
+            BlockKind::Bc5 => bc5::compress_blocks_into(
+                &RgSurface {
+                    data,
+                    width,
+                    height: rows,
+                    stride,
+                },
+                out,
+            ),
+            BlockKind::Bc7 { alpha, effort } => bc7::compress_blocks_into(
+                &bc7_settings(effort, alpha),
+                &RgbaSurface {
+                    data,
+                    width,
+                    height: rows,
+                    stride,
+                },
+                out,
+            ),
+        }
+    }
+}
+
+/// Encodes one strip with the portable encoder (which reads RGBA8 whatever the kind).
+fn encode_portable(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mut [u8]) {
+    let per = kind.texel_bytes();
+    let rgba: std::borrow::Cow<'_, [u8]> = if per == 4 {
+        data.into()
+    } else {
+        data.chunks_exact(per)
+            .flat_map(|t| {
+                let mut px = [0, 0, 0, 255];
+                px[..per].copy_from_slice(t);
+                px
+            })
+            .collect::<Vec<u8>>()
+            .into()
+    };
+    block_compression::encode::compress_rgba8(kind.variant(), &rgba, out, width, rows, width * 4);
+}
+
+/// Block rows per parallel task.
+const STRIP: usize = 8;
+
+/// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
+/// bytes per texel, in parallel strips of block rows. Each strip advances `progress` by its
+/// texel rows; once it is cancelled the remaining strips are skipped (the result is then
+/// garbage: check [`Progress::is_cancelled`]).
+pub fn encode(
+    encoder: Encoder,
+    kind: BlockKind,
+    texels: &[u8],
+    (width, height): (u32, u32),
+    progress: Option<&Progress>,
+) -> Vec<u8> {
+    debug_assert!(width % 4 == 0 && height % 4 == 0);
+    let per = kind.texel_bytes();
+    let row_bytes = (width as usize / 4) * kind.block_bytes();
+    let mut blocks = vec![0_u8; row_bytes * (height as usize / 4)];
+    let strip_texels = STRIP * 4 * width as usize * per;
+    blocks
+        .par_chunks_mut(row_bytes * STRIP)
+        .zip(texels.par_chunks(strip_texels))
+        .for_each(|(out, src)| {
+            if progress.is_some_and(Progress::is_cancelled) {
+                return;
+            }
+            let rows = (out.len() / row_bytes * 4) as u32;
+            match encoder {
+                #[cfg(target_arch = "x86_64")]
+                Encoder::Ispc => ispc::encode(kind, src, width, rows, out),
+                _ => encode_portable(kind, src, width, rows, out),
+            }
+            if let Some(p) = progress {
+                p.advance(u64::from(rows));
+            }
+        });
+    blocks
+}
+
+/// Decodes blocks of `kind` covering `(width, height)` (sides multiples of 4) into
+/// [`BlockKind::texel_bytes`] bytes per texel, in parallel strips.
+pub fn decode(kind: BlockKind, blocks: &[u8], (width, height): (u32, u32)) -> Vec<u8> {
+    let per = kind.texel_bytes();
+    let row_bytes = (width as usize / 4) * kind.block_bytes();
+    let mut out = vec![0_u8; width as usize * height as usize * per];
+    let variant = kind.variant();
+    out.par_chunks_mut(STRIP * 4 * width as usize * per)
+        .zip(blocks.par_chunks(row_bytes * STRIP))
+        .for_each(|(dst, src)| {
+            let rows = (src.len() / row_bytes * 4) as u32;
+            let mut rgba = vec![0_u8; width as usize * rows as usize * 4];
+            decompress_blocks_as_rgba8(variant, width, rows, src, &mut rgba);
+            if per == 4 {
+                dst.copy_from_slice(&rgba);
+            } else {
+                for (d, s) in dst.chunks_exact_mut(per).zip(rgba.chunks_exact(4)) {
+                    d.copy_from_slice(&s[..per]);
+                }
+            }
+        });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pattern(w: u32, h: u32, per: usize) -> Vec<u8> {
+        (0..w as usize * h as usize * per)
+            .map(|i| {
+                let (t, k) = (i / per, i % per);
+                let (x, y) = (t % w as usize, t / w as usize);
+                ((x * 7 + y * 3 + k * 50) % 256) as u8
+            })
+            .collect()
+    }
+
+    fn psnr(a: &[u8], b: &[u8]) -> f64 {
+        let mse = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (f64::from(*x) - f64::from(*y)).powi(2))
+            .sum::<f64>()
+            / a.len() as f64;
+        10.0 * (255.0_f64 * 255.0 / mse.max(1e-9)).log10()
+    }
+
+    #[test]
+    fn every_encoder_and_kind_round_trips_closely() {
+        let (w, h) = (64, 40);
+        for encoder in [Encoder::best(), Encoder::Portable] {
+            for kind in [
+                BlockKind::Bc4,
+                BlockKind::Bc5,
+                BlockKind::Bc7 {
+                    alpha: false,
+                    effort: Bc7Quality::UltraFast,
+                },
+                BlockKind::Bc7 {
+                    alpha: true,
+                    effort: Bc7Quality::VeryFast,
+                },
+            ] {
+                let mut src = pattern(w, h, kind.texel_bytes());
+                if kind
+                    == (BlockKind::Bc7 {
+                        alpha: false,
+                        effort: Bc7Quality::UltraFast,
+                    })
+                {
+                    src.chunks_exact_mut(4).for_each(|p| p[3] = 255);
+                }
+                let blocks = encode(encoder, kind, &src, (w, h), None);
+                assert_eq!(blocks.len(), (w * h) as usize / 16 * kind.block_bytes());
+                let back = decode(kind, &blocks, (w, h));
+                let p = psnr(&src, &back);
+                assert!(p > 30.0, "{encoder:?} {kind:?}: {p:.1} dB");
+            }
+        }
+    }
+}

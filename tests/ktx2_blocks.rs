@@ -1,0 +1,419 @@
+//! Block-compressed export (issue 21), checked independently of kapaint's own code: every
+//! KTX2 file the tests write is parsed with the `ktx2` crate's reader and held to the KTX2
+//! specification's rules for its header, level index and data format descriptor, and every
+//! mip level is decoded with `bcdec_rs` (not `block_compression`) and compared with the same
+//! project's uncompressed levels. The effort search is checked for what it chooses and why.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use kapaint::export::preset::{self, Bc7Quality, BlockBudget, ExportPreset};
+use kapaint::export::set::{self, BlockLayout, Manifest};
+use kapaint::model::Document;
+use kapaint::report::typical::stroke_edge_document;
+
+fn temp(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-ktx2-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn spot() -> Option<PathBuf> {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_texture.png");
+    path.exists().then_some(path)
+}
+
+/// The stroke-edge project at `side`: the spot texture in k_d, soft strokes of n = 3000 and 2.
+fn project(side: u32) -> Document {
+    stroke_edge_document(side, spot().as_deref()).expect("project")
+}
+
+fn export(doc: &Document, preset: &ExportPreset, tag: &str) -> (PathBuf, Manifest) {
+    let out = temp(tag);
+    let manifest = set::export(doc, preset, &out).expect("export");
+    (out, manifest)
+}
+
+/// Bytes per block (or per texel, uncompressed), and the texel block's side.
+fn block_of(format: ktx2::Format) -> (usize, u32) {
+    match format {
+        ktx2::Format::BC4_UNORM_BLOCK => (8, 4),
+        ktx2::Format::BC5_UNORM_BLOCK
+        | ktx2::Format::BC7_UNORM_BLOCK
+        | ktx2::Format::BC7_SRGB_BLOCK => (16, 4),
+        ktx2::Format::R8_UNORM => (1, 1),
+        ktx2::Format::R8G8_UNORM => (2, 1),
+        ktx2::Format::R8G8B8A8_UNORM | ktx2::Format::R8G8B8A8_SRGB => (4, 1),
+        other => panic!("kapaint does not write {other:?}"),
+    }
+}
+
+/// Checks a KTX2 file against the specification's rules; returns its levels as decoded by
+/// `bcdec_rs` (or read as they are), finest first, four bytes per texel.
+fn check_and_decode(path: &Path) -> Vec<Vec<u8>> {
+    let bytes = std::fs::read(path).expect("read");
+    let what = path.display();
+    let reader = ktx2::Reader::new(&bytes[..]).expect("a KTX2 file");
+    let header = reader.header();
+    let format = header.format.expect("a vkFormat");
+    let (block_bytes, block_side) = block_of(format);
+    // Header (spec 3.1-3.10): a 2D texture, one face, no layers, a full mip chain.
+    let (w, h) = (header.pixel_width, header.pixel_height);
+    assert!(w > 0 && h > 0, "{what}");
+    assert_eq!(header.pixel_depth, 0, "{what}: pixelDepth");
+    assert_eq!(header.layer_count, 0, "{what}: layerCount");
+    assert_eq!(header.face_count, 1, "{what}: faceCount");
+    assert_eq!(
+        header.level_count,
+        32 - w.max(h).leading_zeros(),
+        "{what}: a full chain"
+    );
+    assert!(header.supercompression_scheme.is_none(), "{what}");
+    // typeSize: 1 for block-compressed formats and 8-bit components.
+    assert_eq!(header.type_size, 1, "{what}: typeSize");
+    // Level index (spec 3.9.7): byteLength of each level's blocks, uncompressedByteLength
+    // equal without supercompression, offsets aligned to lcm(texel block size, 4), levels
+    // stored smallest first without overlap, inside the file.
+    let align = block_bytes.max(4);
+    let mut end_of_previous = None;
+    let index_at = 80;
+    let mut levels = Vec::new();
+    for (i, level) in reader.levels().enumerate() {
+        let at = index_at + i * 24;
+        let entry = ktx2::LevelIndex::from_bytes(bytes[at..at + 24].try_into().expect("24 bytes"));
+        let (lw, lh) = ((w >> i).max(1), (h >> i).max(1));
+        let blocks = lw.div_ceil(block_side) as usize * lh.div_ceil(block_side) as usize;
+        assert_eq!(
+            entry.byte_length as usize,
+            blocks * block_bytes,
+            "{what}: level {i}"
+        );
+        assert_eq!(
+            entry.uncompressed_byte_length, entry.byte_length,
+            "{what}: level {i}"
+        );
+        assert_eq!(
+            entry.byte_offset as usize % align,
+            0,
+            "{what}: level {i} alignment"
+        );
+        assert!(
+            (entry.byte_offset + entry.byte_length) as usize <= bytes.len(),
+            "{what}: level {i} past the end"
+        );
+        if let Some(next_start) = end_of_previous {
+            // Levels are stored coarsest first: level i ends at or before level i - 1.
+            assert!(
+                entry.byte_offset + entry.byte_length <= next_start,
+                "{what}: level {i}"
+            );
+        }
+        end_of_previous = Some(entry.byte_offset);
+        assert_eq!(level.data.len(), entry.byte_length as usize);
+        levels.push(decode_level(format, level.data, (lw, lh)));
+    }
+    // Data format descriptor (spec 3.10, Khronos Data Format 1.3 section 5): one basic block,
+    // its total size first, the colour model of the format, sRGB transfer exactly for the
+    // _SRGB formats, 4x4 texel blocks for BC formats (stored as dimension - 1), and the bytes
+    // of one block or texel in plane 0.
+    let dfd_at = header.index.dfd_byte_offset as usize;
+    let total = u32::from_le_bytes(bytes[dfd_at..dfd_at + 4].try_into().expect("4 bytes"));
+    assert_eq!(total, header.index.dfd_byte_length, "{what}: dfdTotalSize");
+    let blocks = reader.dfd_blocks();
+    assert_eq!(blocks.len(), 1, "{what}: one descriptor block");
+    let basic = reader.basic_dfd().expect("a basic descriptor block");
+    let (model, samples) = match format {
+        ktx2::Format::BC4_UNORM_BLOCK => (ktx2::ColorModel::BC4, 1),
+        ktx2::Format::BC5_UNORM_BLOCK => (ktx2::ColorModel::BC5, 2),
+        ktx2::Format::BC7_UNORM_BLOCK | ktx2::Format::BC7_SRGB_BLOCK => (ktx2::ColorModel::BC7, 1),
+        ktx2::Format::R8_UNORM => (ktx2::ColorModel::RGBSDA, 1),
+        ktx2::Format::R8G8_UNORM => (ktx2::ColorModel::RGBSDA, 2),
+        _ => (ktx2::ColorModel::RGBSDA, 4),
+    };
+    assert_eq!(basic.color_model, Some(model), "{what}: colorModel");
+    let srgb = matches!(
+        format,
+        ktx2::Format::BC7_SRGB_BLOCK | ktx2::Format::R8G8B8A8_SRGB
+    );
+    assert_eq!(
+        basic.transfer_function,
+        Some(if srgb {
+            ktx2::TransferFunction::SRGB
+        } else {
+            ktx2::TransferFunction::Linear
+        }),
+        "{what}: transferFunction"
+    );
+    let dims: Vec<u8> = basic
+        .texel_block_dimensions
+        .iter()
+        .map(|d| d.get())
+        .collect();
+    assert_eq!(
+        dims,
+        [block_side as u8, block_side as u8, 1, 1],
+        "{what}: texelBlockDimension"
+    );
+    assert_eq!(
+        basic.bytes_planes[0] as usize, block_bytes,
+        "{what}: bytesPlane0"
+    );
+    assert!(basic.bytes_planes[1..].iter().all(|b| *b == 0), "{what}");
+    assert_eq!(basic.sample_information.len(), samples, "{what}: samples");
+    levels
+}
+
+/// One level as RGBA8, by `bcdec_rs` for blocks.
+fn decode_level(format: ktx2::Format, data: &[u8], (w, h): (u32, u32)) -> Vec<u8> {
+    let (w, h) = (w as usize, h as usize);
+    let mut out = vec![255_u8; w * h * 4];
+    let per = match format {
+        ktx2::Format::R8_UNORM => Some(1),
+        ktx2::Format::R8G8_UNORM => Some(2),
+        ktx2::Format::R8G8B8A8_UNORM | ktx2::Format::R8G8B8A8_SRGB => Some(4),
+        _ => None,
+    };
+    if let Some(per) = per {
+        for (px, src) in out.chunks_exact_mut(4).zip(data.chunks_exact(per)) {
+            px[..per].copy_from_slice(src);
+        }
+        return out;
+    }
+    let (bw, bh) = (w.div_ceil(4), h.div_ceil(4));
+    let (block_bytes, _) = block_of(format);
+    for by in 0..bh {
+        for bx in 0..bw {
+            let block = &data[(by * bw + bx) * block_bytes..][..block_bytes];
+            let mut texels = [255_u8; 64];
+            match format {
+                ktx2::Format::BC4_UNORM_BLOCK => {
+                    let mut r = [0_u8; 16];
+                    bcdec_rs::bc4(block, &mut r, 4, false);
+                    for (t, v) in r.iter().enumerate() {
+                        texels[t * 4] = *v;
+                    }
+                }
+                ktx2::Format::BC5_UNORM_BLOCK => {
+                    let mut rg = [0_u8; 32];
+                    bcdec_rs::bc5(block, &mut rg, 8, false);
+                    for t in 0..16 {
+                        texels[t * 4] = rg[t * 2];
+                        texels[t * 4 + 1] = rg[t * 2 + 1];
+                    }
+                }
+                _ => bcdec_rs::bc7(block, &mut texels, 16),
+            }
+            for y in 0..4 {
+                for x in 0..4 {
+                    let (tx, ty) = (bx * 4 + x, by * 4 + y);
+                    if tx < w && ty < h {
+                        out[(ty * w + tx) * 4..][..4]
+                            .copy_from_slice(&texels[(y * 4 + x) * 4..][..4]);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Per component name, every level's bytes of a set, and the file holding it.
+fn components(dir: &Path, manifest: &Manifest) -> HashMap<String, (String, Vec<Vec<u8>>)> {
+    let mut out = HashMap::new();
+    for file in &manifest.files {
+        let levels = check_and_decode(&dir.join(&file.path));
+        for (k, name) in file.layout.iter().enumerate() {
+            let per_level = levels
+                .iter()
+                .map(|rgba| rgba.chunks_exact(4).map(|p| p[k]).collect())
+                .collect();
+            out.insert(name.clone(), (file.path.clone(), per_level));
+        }
+    }
+    out
+}
+
+fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (f64::from(*x) - f64::from(*y)).powi(2))
+        .sum::<f64>()
+        / a.len().max(1) as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0_f64 * 255.0 / mse).log10()
+    }
+}
+
+#[test]
+fn every_level_of_every_file_decodes_independently_close_to_the_uncompressed_levels() {
+    let doc = project(256);
+    let (raw_dir, raw) = export(&doc, &preset::find("ktx2-raw").expect("preset"), "raw");
+    let (bc_dir, bc) = export(&doc, &preset::find("ktx2").expect("preset"), "bc");
+    let reference = components(&raw_dir, &raw);
+    let compressed = components(&bc_dir, &bc);
+    assert_eq!(bc.level_ka_error.len(), 9, "a k_a error per level");
+    assert_eq!(raw.level_ka_error.len(), 9);
+    for (name, (file, levels)) in &compressed {
+        let (_, want) = &reference[name];
+        assert_eq!(levels.len(), want.len(), "{name}");
+        for (l, (got, want)) in levels.iter().zip(want).enumerate() {
+            // A wrong format, layout or level order decodes far below this (under 20 dB);
+            // BC7's fastest effort on the finer levels of this texture, over 40 dB.
+            let p = psnr(want, got);
+            assert!(p >= 30.0, "{file} {name} level {l}: {p:.1} dB");
+            if l == 0 {
+                assert!(p >= 40.0, "{file} {name} level 0: {p:.1} dB");
+            }
+        }
+    }
+    // Level 0 as bcdec decodes it is what the manifest's PSNR measured (within the rounding
+    // by which decoders may differ: BC4/BC5 interpolate at 8 bits or more).
+    for file in &bc.files {
+        let psnr_listed = file
+            .psnr
+            .as_ref()
+            .expect("compressed files list their PSNR");
+        for (k, name) in file.layout.iter().enumerate() {
+            let (_, levels) = &compressed[name];
+            let p = psnr(&reference[name].1[0], &levels[0]);
+            if let Some(listed) = psnr_listed[k] {
+                assert!((p - listed).abs() < 0.5, "{name}: {p} vs {listed}");
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(raw_dir);
+    let _ = std::fs::remove_dir_all(bc_dir);
+}
+
+fn with_budget(budget: BlockBudget, ceiling: Bc7Quality) -> ExportPreset {
+    let mut p = preset::find("ktx2").expect("preset");
+    p.budget = budget;
+    p.max_bc7_effort = ceiling;
+    p
+}
+
+#[test]
+fn the_cheapest_encoding_that_meets_the_budget_is_kept_and_no_more_is_spent() {
+    let doc = project(128);
+    let loose = with_budget(
+        BlockBudget {
+            max_ka_error: 10.0,
+            mean_ka_error: 1.0,
+            min_psnr: 20.0,
+        },
+        Bc7Quality::Basic,
+    );
+    let (dir, manifest) = export(&doc, &loose, "loose");
+    let blocks = manifest.blocks.expect("a block choice");
+    assert_eq!(blocks.trials.len(), 1, "{blocks:?}");
+    assert_eq!(blocks.layout, BlockLayout::Packed);
+    assert_eq!(blocks.bc7_effort, Bc7Quality::UltraFast);
+    assert!(blocks.within_budget && blocks.reason.contains("within the budget"));
+    assert!(
+        cfg!(not(target_arch = "x86_64"))
+            || blocks.encoder == kapaint::export::blocks::Encoder::Ispc
+    );
+    // The choice is in material.json, and a set with it imports.
+    let text = std::fs::read_to_string(dir.join("material.json")).expect("manifest");
+    assert!(
+        text.contains("\"blocks\"") && text.contains("\"trials\""),
+        "{text}"
+    );
+    assert!(text.contains("\"level_ka_error\""));
+    set::import(&dir.join("material.json")).expect("import");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn n_moves_out_of_the_colour_blocks_when_packing_it_fails_the_budget() {
+    // Regression: n in k_d's BC7 alpha shares endpoints with k_d, which ruins both at the
+    // strokes' edges; the export kept that layout whatever it cost.
+    let doc = project(256);
+    let strict = with_budget(
+        BlockBudget {
+            max_ka_error: 1e-6,
+            mean_ka_error: 1e-7,
+            min_psnr: 90.0,
+        },
+        Bc7Quality::VeryFast,
+    );
+    let (dir, manifest) = export(&doc, &strict, "strict");
+    let blocks = manifest.blocks.expect("a block choice");
+    let packed = &blocks.trials[0];
+    let apart = &blocks.trials[1];
+    assert_eq!(
+        (packed.layout, packed.bc7_effort),
+        (BlockLayout::Packed, Bc7Quality::UltraFast),
+        "the cheapest first"
+    );
+    assert_eq!(
+        apart.layout,
+        BlockLayout::NApart,
+        "then n apart at the same effort"
+    );
+    assert!(
+        apart.ka_error.mean < packed.ka_error.mean,
+        "n apart lowers the k_a error: {apart:?} vs {packed:?}"
+    );
+    assert!(
+        !blocks.within_budget && blocks.reason.contains("no trial"),
+        "{}",
+        blocks.reason
+    );
+    assert!(
+        blocks.trials.len() <= 3,
+        "effort stops at the ceiling: {blocks:?}"
+    );
+    // The chosen trial is the one with the smallest k_a error, and the files are its layout.
+    let best = blocks
+        .trials
+        .iter()
+        .map(|t| t.ka_error.max)
+        .fold(f64::INFINITY, f64::min);
+    let chosen = blocks
+        .trials
+        .iter()
+        .find(|t| t.layout == blocks.layout && t.bc7_effort == blocks.bc7_effort)
+        .expect("the chosen trial");
+    assert_eq!(chosen.ka_error.max, best);
+    assert!((manifest.ka_error.max - chosen.ka_error.max).abs() < 1e-12);
+    let names: Vec<&str> = manifest.files.iter().map(|f| f.path.as_str()).collect();
+    if blocks.layout == BlockLayout::NApart {
+        assert_eq!(names, ["kd.ktx2", "n.ktx2"]);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn presets_name_their_budget_and_bad_budgets_are_refused() {
+    let p = preset::find("ktx2").expect("preset");
+    assert_eq!(p.budget, BlockBudget::default());
+    assert_eq!(p.max_bc7_effort, Bc7Quality::Basic);
+    // Older presets named the ceiling bc7_quality.
+    let old = ExportPreset::parse(
+        Path::new("old.ron"),
+        "(name: \"old\", format: Ktx2Bc, layout: Packed, n_bits: 8, bc7_quality: Fast)",
+    )
+    .expect("an older preset");
+    assert_eq!(old.max_bc7_effort, Bc7Quality::Fast);
+    for bad in [
+        "max_ka_error: -0.1",
+        "mean_ka_error: inf",
+        "min_psnr: 500.0",
+    ] {
+        let text = format!("(name: \"b\", format: Ktx2Bc, layout: Packed, n_bits: 8, {bad})");
+        assert!(
+            ExportPreset::parse(Path::new("b.ron"), &text).is_err(),
+            "{bad}"
+        );
+    }
+}
