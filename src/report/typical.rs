@@ -11,6 +11,16 @@ use crate::model::{
     Channel, Channels, Command, Document, DocumentSettings, MaterialValue, StrokeTool, import,
 };
 
+/// A `side x side` document of the default material with `texture` (if given) in `k_d`.
+fn textured(side: u32, texture: Option<&Path>) -> Result<Document, String> {
+    let mut doc =
+        Document::new(side, side, DocumentSettings::default()).map_err(|e| e.to_string())?;
+    if let Some(path) = texture {
+        import::import_file(&mut doc, Channel::Kd, path).map_err(|e| e.to_string())?;
+    }
+    Ok(doc)
+}
+
 /// Builds a `side x side` document: `texture` (if given and readable) imported into `k_d`, a
 /// radial gradient over `n`, then `strokes` brush strokes of 64 px radius with varied
 /// materials, each one undo step.
@@ -19,11 +29,7 @@ pub fn typical_document(
     texture: Option<&Path>,
     strokes: usize,
 ) -> Result<Document, String> {
-    let mut doc =
-        Document::new(side, side, DocumentSettings::default()).map_err(|e| e.to_string())?;
-    if let Some(path) = texture {
-        import::import_file(&mut doc, Channel::Kd, path).map_err(|e| e.to_string())?;
-    }
+    let mut doc = textured(side, texture)?;
     let s = side as f32;
     let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
     apply(
@@ -101,11 +107,7 @@ pub fn typical_document(
 /// # Errors
 /// A document that cannot be made, or a texture that does not read.
 pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Document, String> {
-    let mut doc =
-        Document::new(side, side, DocumentSettings::default()).map_err(|e| e.to_string())?;
-    if let Some(path) = texture {
-        import::import_file(&mut doc, Channel::Kd, path).map_err(|e| e.to_string())?;
-    }
+    let mut doc = textured(side, texture)?;
     let scale = side as f32 / 4096.0;
     let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
     apply(
