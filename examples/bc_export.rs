@@ -3,7 +3,9 @@
 //! same run, the block encoders alone on the packed RGBA8 level 0 on one thread: Intel's ISPC
 //! kernels and `block_compression`'s port at each BC7 effort, with their PSNR.
 //!
-//! Usage: `cargo run --release --example bc_export [SIDE] [PRESET]`
+//! Usage: `cargo run --release --example bc_export [SIDE] [PRESET] [export-only]`
+//! (`export-only` skips the encoders' comparison, e.g. to measure the export's peak memory
+//! with `/usr/bin/time -v`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -72,6 +74,9 @@ fn main() -> Result<(), String> {
         }
     }
     let _ = std::fs::remove_dir_all(&out);
+    if args.next().as_deref() == Some("export-only") {
+        return Ok(());
+    }
 
     // The encoders alone, one thread, on the packed level 0 (k_d sRGB + n code in alpha).
     let maps = doc.maps();

@@ -1,12 +1,14 @@
-//! Block encoders for the KTX2 export: BC7 (three or four components), BC5 (two), BC4 (one).
+//! Block encoders for the KTX2 export: BC7 (three or four components), BC6H (three linear
+//! half floats), BC5 (two), BC4 (one).
 //!
 //! On `x86_64` the blocks come from Intel's ISPC texture compressor kernels (`intel_tex_2`,
 //! which ships them precompiled); elsewhere from `block_compression`'s port of the same
 //! encoder. Either runs in parallel over strips of block rows. Decoding (to measure what a
 //! consumer sees) is `block_compression`'s CPU decoder, also in strips.
 
-use block_compression::decode::decompress_blocks_as_rgba8;
-use block_compression::{BC7Settings, CompressionVariant};
+use block_compression::decode::{decode_block_bc6h, decompress_blocks_as_rgba8};
+use block_compression::{BC6HSettings, BC7Settings, CompressionVariant};
+use half::f16;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -24,6 +26,12 @@ pub enum BlockKind {
     Bc7 {
         /// The fourth component is stored (otherwise the encoder may ignore it).
         alpha: bool,
+        /// How hard the encoder searches.
+        effort: Bc7Quality,
+    },
+    /// RGB as unsigned half floats (linear), 16 bytes per block, at an effort (BC7's scale:
+    /// both ultra-fast and very-fast are BC6H's very-fast).
+    Bc6h {
         /// How hard the encoder searches.
         effort: Bc7Quality,
     },
@@ -46,16 +54,30 @@ impl BlockKind {
     pub fn block_bytes(self) -> usize {
         match self {
             Self::Bc4 => 8,
-            Self::Bc5 | Self::Bc7 { .. } => 16,
+            Self::Bc5 | Self::Bc7 { .. } | Self::Bc6h { .. } => 16,
         }
     }
 
-    /// Bytes per texel of the input (and of [`decode`]'s output): 1, 2 or 4.
+    /// Bytes per texel of the input (and of [`decode`]'s output): 1, 2 or 4 bytes, or four
+    /// little-endian half floats (8 bytes) for BC6H.
     pub fn texel_bytes(self) -> usize {
         match self {
             Self::Bc4 => 1,
             Self::Bc5 => 2,
             Self::Bc7 { .. } => 4,
+            Self::Bc6h { .. } => 8,
+        }
+    }
+
+    /// A whole input texel whose leading bytes a stored texel replaces: the filler of
+    /// components the file does not hold (opaque alpha: 255, or half-float 1.0).
+    pub fn filler(self) -> [u8; 8] {
+        match self {
+            Self::Bc6h { .. } => {
+                let one = f16::ONE.to_le_bytes();
+                [0, 0, 0, 0, 0, 0, one[0], one[1]]
+            }
+            _ => [0, 0, 0, 255, 0, 0, 0, 0],
         }
     }
 
@@ -64,6 +86,12 @@ impl BlockKind {
             Self::Bc4 => CompressionVariant::BC4,
             Self::Bc5 => CompressionVariant::BC5,
             Self::Bc7 { alpha, effort } => CompressionVariant::BC7(portable_bc7(effort, alpha)),
+            Self::Bc6h { effort } => CompressionVariant::BC6H(match effort {
+                Bc7Quality::UltraFast | Bc7Quality::VeryFast => BC6HSettings::very_fast(),
+                Bc7Quality::Fast => BC6HSettings::fast(),
+                Bc7Quality::Basic => BC6HSettings::basic(),
+                Bc7Quality::Slow => BC6HSettings::slow(),
+            }),
         }
     }
 }
@@ -106,7 +134,7 @@ fn portable_bc7(effort: Bc7Quality, alpha: bool) -> BC7Settings {
 
 #[cfg(target_arch = "x86_64")]
 mod ispc {
-    use intel_tex_2::{RSurface, RgSurface, RgbaSurface, bc4, bc5, bc7};
+    use intel_tex_2::{RSurface, RgSurface, RgbaSurface, bc4, bc5, bc6h, bc7};
 
     use super::{Bc7Quality, BlockKind};
 
@@ -122,6 +150,15 @@ mod ispc {
             (Bc7Quality::Fast, true) => bc7::alpha_fast_settings(),
             (Bc7Quality::Basic, true) => bc7::alpha_basic_settings(),
             (Bc7Quality::Slow, true) => bc7::alpha_slow_settings(),
+        }
+    }
+
+    fn bc6h_settings(effort: Bc7Quality) -> bc6h::EncodeSettings {
+        match effort {
+            Bc7Quality::UltraFast | Bc7Quality::VeryFast => bc6h::very_fast_settings(),
+            Bc7Quality::Fast => bc6h::fast_settings(),
+            Bc7Quality::Basic => bc6h::basic_settings(),
+            Bc7Quality::Slow => bc6h::slow_settings(),
         }
     }
 
@@ -157,12 +194,35 @@ mod ispc {
                 },
                 out,
             ),
+            BlockKind::Bc6h { effort } => bc6h::compress_blocks_into(
+                &bc6h_settings(effort),
+                &RgbaSurface {
+                    data,
+                    width,
+                    height: rows,
+                    stride,
+                },
+                out,
+            ),
         }
     }
 }
 
-/// Encodes one strip with the portable encoder (which reads RGBA8 whatever the kind).
+/// Encodes one strip with the portable encoder (which reads RGBA8 whatever the kind, RGBA16F
+/// for BC6H).
 fn encode_portable(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mut [u8]) {
+    if let BlockKind::Bc6h { .. } = kind {
+        let halves: Vec<f16> = bytemuck::pod_collect_to_vec(data);
+        block_compression::encode::compress_rgba16(
+            kind.variant(),
+            &halves,
+            out,
+            width,
+            rows,
+            width * 4,
+        );
+        return;
+    }
     let per = kind.texel_bytes();
     let rgba: std::borrow::Cow<'_, [u8]> = if per == 4 {
         data.into()
@@ -190,6 +250,20 @@ pub fn encode(
     encoder: Encoder,
     kind: BlockKind,
     texels: &[u8],
+    size: (u32, u32),
+    progress: Option<&Progress>,
+) -> Vec<u8> {
+    encode_stored(encoder, kind, texels, kind.texel_bytes(), size, progress)
+}
+
+/// [`encode`] of texels of `stored` bytes (the leading bytes of [`BlockKind::texel_bytes`]:
+/// three colour components without alpha, say), each strip widened with
+/// [`BlockKind::filler`] as it is encoded, so no widened copy of the image is ever whole.
+pub fn encode_stored(
+    encoder: Encoder,
+    kind: BlockKind,
+    texels: &[u8],
+    stored: usize,
     (width, height): (u32, u32),
     progress: Option<&Progress>,
 ) -> Vec<u8> {
@@ -197,7 +271,8 @@ pub fn encode(
     let per = kind.texel_bytes();
     let row_bytes = (width as usize / 4) * kind.block_bytes();
     let mut blocks = vec![0_u8; row_bytes * (height as usize / 4)];
-    let strip_texels = STRIP * 4 * width as usize * per;
+    let strip_texels = STRIP * 4 * width as usize * stored;
+    let filler = kind.filler();
     blocks
         .par_chunks_mut(row_bytes * STRIP)
         .zip(texels.par_chunks(strip_texels))
@@ -206,10 +281,22 @@ pub fn encode(
                 return;
             }
             let rows = (out.len() / row_bytes * 4) as u32;
+            let wide: std::borrow::Cow<'_, [u8]> = if stored == per {
+                src.into()
+            } else {
+                src.chunks_exact(stored)
+                    .flat_map(|t| {
+                        let mut px = filler;
+                        px[..stored].copy_from_slice(t);
+                        px.into_iter().take(per)
+                    })
+                    .collect::<Vec<u8>>()
+                    .into()
+            };
             match encoder {
                 #[cfg(target_arch = "x86_64")]
-                Encoder::Ispc => ispc::encode(kind, src, width, rows, out),
-                _ => encode_portable(kind, src, width, rows, out),
+                Encoder::Ispc => ispc::encode(kind, &wide, width, rows, out),
+                _ => encode_portable(kind, &wide, width, rows, out),
             }
             if let Some(p) = progress {
                 p.advance(u64::from(rows));
@@ -218,24 +305,68 @@ pub fn encode(
     blocks
 }
 
+/// Decodes a strip of BC6H blocks, `width` texels wide, into RGBA half floats (alpha 1),
+/// block by block: `block_compression`'s whole-image RGBA16F helper writes three halves per
+/// texel at a four-half pitch.
+fn decode_bc6h(blocks: &[u8], width: usize, dst: &mut [u8]) {
+    let across = width / 4;
+    let one = f16::ONE.to_le_bytes();
+    for (b, block) in blocks.chunks_exact(16).enumerate() {
+        let mut rgb = [f16::ZERO; 48];
+        decode_block_bc6h(block, &mut rgb, 12, false);
+        let (bx, by) = (b % across, b / across);
+        for y in 0..4 {
+            for x in 0..4 {
+                let at = ((by * 4 + y) * width + bx * 4 + x) * 8;
+                let texel = &mut dst[at..at + 8];
+                for c in 0..3 {
+                    texel[2 * c..2 * c + 2].copy_from_slice(&rgb[y * 12 + x * 3 + c].to_le_bytes());
+                }
+                texel[6..].copy_from_slice(&one);
+            }
+        }
+    }
+}
+
 /// Decodes blocks of `kind` covering `(width, height)` (sides multiples of 4) into
 /// [`BlockKind::texel_bytes`] bytes per texel, in parallel strips.
-pub fn decode(kind: BlockKind, blocks: &[u8], (width, height): (u32, u32)) -> Vec<u8> {
+pub fn decode(kind: BlockKind, blocks: &[u8], size: (u32, u32)) -> Vec<u8> {
+    decode_stored(kind, blocks, size, kind.texel_bytes())
+}
+
+/// [`decode`] keeping the leading `stored` bytes of each texel (as [`encode_stored`] took
+/// them), strip by strip.
+pub fn decode_stored(
+    kind: BlockKind,
+    blocks: &[u8],
+    (width, height): (u32, u32),
+    stored: usize,
+) -> Vec<u8> {
     let per = kind.texel_bytes();
     let row_bytes = (width as usize / 4) * kind.block_bytes();
-    let mut out = vec![0_u8; width as usize * height as usize * per];
+    let mut out = vec![0_u8; width as usize * height as usize * stored];
     let variant = kind.variant();
-    out.par_chunks_mut(STRIP * 4 * width as usize * per)
+    out.par_chunks_mut(STRIP * 4 * width as usize * stored)
         .zip(blocks.par_chunks(row_bytes * STRIP))
         .for_each(|(dst, src)| {
             let rows = (src.len() / row_bytes * 4) as u32;
-            let mut rgba = vec![0_u8; width as usize * rows as usize * 4];
-            decompress_blocks_as_rgba8(variant, width, rows, src, &mut rgba);
-            if per == 4 {
-                dst.copy_from_slice(&rgba);
+            let mut wide = vec![0_u8; width as usize * rows as usize * per];
+            if let BlockKind::Bc6h { .. } = kind {
+                decode_bc6h(src, width as usize, &mut wide);
+            } else if per == 4 {
+                decompress_blocks_as_rgba8(variant, width, rows, src, &mut wide);
             } else {
-                for (d, s) in dst.chunks_exact_mut(per).zip(rgba.chunks_exact(4)) {
+                let mut rgba = vec![0_u8; width as usize * rows as usize * 4];
+                decompress_blocks_as_rgba8(variant, width, rows, src, &mut rgba);
+                for (d, s) in wide.chunks_exact_mut(per).zip(rgba.chunks_exact(4)) {
                     d.copy_from_slice(&s[..per]);
+                }
+            }
+            if stored == per {
+                dst.copy_from_slice(&wide);
+            } else {
+                for (d, s) in dst.chunks_exact_mut(stored).zip(wide.chunks_exact(per)) {
+                    d.copy_from_slice(&s[..stored]);
                 }
             }
         });
@@ -284,12 +415,55 @@ mod tests {
                 let blocks = encode(encoder, kind, &src, (w, h), None);
                 assert_eq!(blocks.len(), (w * h) as usize / 16 * kind.block_bytes());
                 let back = decode(kind, &blocks, (w, h));
-                let p = crate::export::ktx::psnr(&src, &back, kind.texel_bytes());
+                let linear = vec![crate::export::ktx::Space::Linear; kind.texel_bytes()];
+                let p = crate::export::ktx::psnr(&src, &back, &linear);
                 assert!(
                     p.iter().all(|p| p.is_none_or(|p| p > 30.0)),
                     "{encoder:?} {kind:?}: {p:?} dB"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn bc6h_keeps_linear_half_floats_close() {
+        let (w, h) = (32, 16);
+        // Smooth linear colour, as BC6H's input (RGBA half floats, alpha 1).
+        let values: Vec<f32> = (0..w * h * 4)
+            .map(|i| {
+                let (t, k) = (i / 4, i % 4);
+                let (x, y) = (t % w, t / w);
+                if k == 3 {
+                    1.0
+                } else {
+                    0.05 + 0.1 * (x + y + k * 5) as f32 / (w + h + 10) as f32
+                }
+            })
+            .collect();
+        let src: Vec<u8> = values
+            .iter()
+            .flat_map(|v| f16::from_f32(*v).to_le_bytes())
+            .collect();
+        for encoder in [Encoder::Portable, Encoder::best()] {
+            let kind = BlockKind::Bc6h {
+                effort: Bc7Quality::UltraFast,
+            };
+            let blocks = encode(encoder, kind, &src, (w as u32, h as u32), None);
+            assert_eq!(blocks.len(), w * h / 16 * 16);
+            let back = decode(kind, &blocks, (w as u32, h as u32));
+            let errors: Vec<(f32, f32)> = back
+                .chunks_exact(8)
+                .zip(values.chunks_exact(4))
+                .flat_map(|(b, v)| {
+                    (0..4).map(move |k| {
+                        let got = f16::from_le_bytes([b[2 * k], b[2 * k + 1]]).to_f32();
+                        ((got - v[k]).abs(), ((got - v[k]) / v[k]).abs())
+                    })
+                })
+                .collect();
+            let worst = errors.iter().map(|e| e.0).fold(0.0_f32, f32::max);
+            let mean = errors.iter().map(|e| e.1).sum::<f32>() / errors.len() as f32;
+            assert!(worst < 0.002 && mean < 0.005, "{encoder:?}: {worst} {mean}");
         }
     }
 }

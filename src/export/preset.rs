@@ -133,6 +133,9 @@ pub struct ExportPreset {
     pub max_bc7_effort: Bc7Quality,
     /// What a `Ktx2Bc` set may lose.
     pub budget: BlockBudget,
+    /// Whether a `Ktx2Bc` export may store colour as BC6H (linear half floats) when BC7
+    /// misses the budget; off for consumers that sample only BC7 (RON `bc6h`, default on).
+    pub bc6h: bool,
 }
 
 /// An export preset as its file spells it, before it is checked.
@@ -156,6 +159,12 @@ struct ExportPresetFile {
     mean_ka_error: f64,
     #[serde(default = "default_min_psnr")]
     min_psnr: f64,
+    #[serde(default = "default_bc6h")]
+    bc6h: bool,
+}
+
+fn default_bc6h() -> bool {
+    true
 }
 
 fn default_max_ka_error() -> f64 {
@@ -219,6 +228,7 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             include_ka: f.include_ka,
             max_bc7_effort: f.max_bc7_effort,
             budget,
+            bc6h: f.bc6h,
         })
     }
 }

@@ -493,7 +493,7 @@ pub fn encode_png(
         image::codecs::png::PngEncoder::new_with_quality(
             &mut out,
             image::codecs::png::CompressionType::Fast,
-            image::codecs::png::FilterType::Adaptive,
+            image::codecs::png::FilterType::Paeth,
         ),
         data,
         width,

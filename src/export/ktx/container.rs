@@ -14,10 +14,11 @@ pub struct Decoded {
     pub width: u32,
     /// Size in texels.
     pub height: u32,
-    /// Meaningful components per texel (1, 2 or 4).
+    /// Meaningful components per texel (1, 2, 3 or 4).
     pub channels: usize,
-    /// RGBA8 per texel (components past `channels` are filler).
-    pub rgba: Vec<u8>,
+    /// RGBA per texel (components past `channels` are filler): bytes as fractions of 255,
+    /// or BC6H's half floats.
+    pub rgba: Vec<f32>,
 }
 
 /// Assembles a KTX2 file: header, level index, data format descriptor, the writer's name,
@@ -40,7 +41,10 @@ pub(super) fn container(
     // Level data alignment: lcm(texel block size, 4).
     let block_bytes = match format {
         KtxFormat::BC4_UNORM_BLOCK => 8,
-        KtxFormat::BC5_UNORM_BLOCK | KtxFormat::BC7_SRGB_BLOCK | KtxFormat::BC7_UNORM_BLOCK => 16,
+        KtxFormat::BC5_UNORM_BLOCK
+        | KtxFormat::BC7_SRGB_BLOCK
+        | KtxFormat::BC7_UNORM_BLOCK
+        | KtxFormat::BC6H_UFLOAT_BLOCK => 16,
         _ => 4,
     };
     let index_at = Header::LENGTH;
@@ -140,11 +144,15 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             f @ (KtxFormat::BC4_UNORM_BLOCK
             | KtxFormat::BC5_UNORM_BLOCK
             | KtxFormat::BC7_UNORM_BLOCK
-            | KtxFormat::BC7_SRGB_BLOCK),
+            | KtxFormat::BC7_SRGB_BLOCK
+            | KtxFormat::BC6H_UFLOAT_BLOCK),
         ) => {
             let kind = match f {
                 KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
                 KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
+                KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
+                    effort: Bc7Quality::UltraFast,
+                },
                 _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
             };
             let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
@@ -155,6 +163,18 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             let per = kind.texel_bytes();
             let texels = blocks::decode(kind, &data[..size], padded);
             let tight = crop(&texels, padded.0, (w, h), per, per);
+            if per == 8 {
+                let rgba = tight
+                    .chunks_exact(2)
+                    .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+                    .collect();
+                return Ok(Decoded {
+                    width: w,
+                    height: h,
+                    channels: 3,
+                    rgba,
+                });
+            }
             let mut rgba = vec![255_u8; w as usize * h as usize * 4];
             for (px, t) in rgba.chunks_exact_mut(4).zip(tight.chunks_exact(per)) {
                 px[..per].copy_from_slice(t);
@@ -163,6 +183,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         }
         other => return Err(format!("KTX2 format {other:?} is not one kapaint writes")),
     };
+    let rgba = rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
     Ok(Decoded {
         width: w,
         height: h,

@@ -1,7 +1,8 @@
 //! Mip levels: each component averaged in its own space ([`Space`]), colour in linear
 //! light, `n` in the log space the brushes blend it in, and stored through exact byte
-//! boundaries.
+//! boundaries (or as half floats).
 
+use half::f16;
 use rayon::prelude::*;
 
 use super::{Source, Values};
@@ -18,18 +19,30 @@ pub enum Space {
     /// `n`: averaged in the brushes' log space ([`n_to_blend`]), stored as the 8-bit code of
     /// its encoding.
     N(NEncoding),
+    /// Colour: averaged in linear light, stored as a linear half float (two bytes,
+    /// little-endian; BC6H's input).
+    Half,
 }
 
 impl Space {
+    /// Bytes a stored component takes.
+    pub fn bytes(self) -> usize {
+        if self == Self::Half { 2 } else { 1 }
+    }
+
     /// The 255 boundaries between consecutive bytes, in the averaging space: a value's byte
     /// is the number of boundaries at or below it (rounding to the nearest stored value).
+    /// Half floats round by themselves: none.
     pub fn boundaries(self) -> Vec<f32> {
+        if self == Self::Half {
+            return Vec::new();
+        }
         (0..255)
             .map(|b| {
                 let mid = (f64::from(b) + 0.5) / 255.0;
                 match self {
                     Self::Srgb => srgb_to_linear(mid as f32),
-                    Self::Linear => mid as f32,
+                    Self::Linear | Self::Half => mid as f32,
                     Self::N(e) if e.lo >= e.hi => f32::INFINITY,
                     Self::N(e) => n_to_blend(e.decode_fraction(mid)),
                 }
@@ -37,19 +50,45 @@ impl Space {
             .collect()
     }
 
-    /// The value in the averaging space that a stored byte stands for.
+    /// The value in the averaging space that a stored byte stands for (for
+    /// [`Space::Half`], the byte as a fraction of 255).
     pub fn value_of(self, byte: u8) -> f32 {
         let v = f32::from(byte) / 255.0;
         match self {
             Self::Srgb => srgb_to_linear(v),
-            Self::Linear => v,
+            Self::Linear | Self::Half => v,
             Self::N(e) => n_to_blend(e.decode(u16::from(byte))),
+        }
+    }
+
+    /// Stores `v` (in the averaging space) at the start of `out`: a byte between
+    /// `boundaries`, or a half float.
+    #[inline]
+    pub fn store(self, boundaries: &[f32], v: f32, out: &mut [u8]) {
+        if self == Self::Half {
+            out[..2].copy_from_slice(&f16::from_f32(v.max(0.0)).to_le_bytes());
+        } else {
+            out[0] = quantise(boundaries, v);
         }
     }
 
     pub(super) fn is_colour(self) -> bool {
         self == Self::Srgb
     }
+}
+
+/// Bytes per texel of components in `spaces`, and each component's offset in it.
+pub fn texel_layout(spaces: &[Space]) -> (usize, Vec<usize>) {
+    let mut at = 0;
+    let offsets = spaces
+        .iter()
+        .map(|s| {
+            let o = at;
+            at += s.bytes();
+            o
+        })
+        .collect();
+    (at, offsets)
 }
 
 /// The byte of `v` between `boundaries` ([`Space::boundaries`]).
@@ -82,17 +121,20 @@ fn footprint((w, h): (u32, u32), x: usize, y: usize) -> [usize; 4] {
     ]
 }
 
-/// The 2x2 box mean (clamped at odd edges) of a level of `(w, h)` triples given by `value`.
-pub fn box_down(size: (u32, u32), value: impl Fn(usize) -> [f32; 3] + Sync) -> Vec<[f32; 3]> {
+/// The 2x2 box mean (clamped at odd edges) of a level of `(w, h)` tuples given by `value`.
+pub fn box_down<const N: usize>(
+    size: (u32, u32),
+    value: impl Fn(usize) -> [f32; N] + Sync,
+) -> Vec<[f32; N]> {
     let (nw, nh) = half(size);
     (0..nw as usize * nh as usize)
         .into_par_iter()
         .map(|j| {
             let f = footprint(size, j % nw as usize, j / nw as usize);
-            let mut sum = [0.0_f32; 3];
+            let mut sum = [0.0_f32; N];
             for i in f {
                 let v = value(i);
-                for c in 0..3 {
+                for c in 0..N {
                     sum[c] += v[c];
                 }
             }
@@ -123,6 +165,7 @@ fn downsample(value: &dyn Values, size: (u32, u32), channels: usize) -> Vec<f32>
 pub fn mips(source: &Source<'_>) -> Vec<((u32, u32), Vec<u8>)> {
     let ch = source.channels();
     let bounds: Vec<Vec<f32>> = source.spaces.iter().map(|s| s.boundaries()).collect();
+    let (per, offsets) = texel_layout(source.spaces);
     let mut size = (source.width, source.height);
     let mut values: Option<Vec<f32>> = None;
     let mut out = Vec::new();
@@ -132,11 +175,15 @@ pub fn mips(source: &Source<'_>) -> Vec<((u32, u32), Vec<u8>)> {
             Some(v) => downsample(&|i, k| v[i * ch + k], size, ch),
         };
         size = half(size);
-        let bytes: Vec<u8> = next
-            .par_iter()
-            .enumerate()
-            .map(|(j, v)| quantise(&bounds[j % ch], *v))
-            .collect();
+        let mut bytes = vec![0_u8; next.len() / ch * per];
+        bytes
+            .par_chunks_mut(per)
+            .zip(next.par_chunks(ch))
+            .for_each(|(out, v)| {
+                for (k, space) in source.spaces.iter().enumerate() {
+                    space.store(&bounds[k], v[k], &mut out[offsets[k]..]);
+                }
+            });
         out.push((size, bytes));
         values = Some(next);
     }

@@ -1,5 +1,6 @@
 //! KTX2 files with a full mip chain: 8-bit components uncompressed, or block-compressed
-//! (BC7 for three or four components, BC5 for two, BC4 for one).
+//! (BC7 for three or four components, BC5 for two, BC4 for one, BC6H for three linear half
+//! floats).
 //!
 //! The container is assembled from the `ktx2` crate's header, level index and data format
 //! descriptor types (`container.rs`); blocks come from [`super::blocks`]; mips
@@ -13,7 +14,7 @@ use rayon::prelude::*;
 
 use self::container::container;
 pub use self::container::{Decoded, decode};
-pub use self::levels::{Space, box_down, level_count, mips, quantise};
+pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 use super::blocks::{self, BlockKind, Encoder};
 use super::preset::Bc7Quality;
 use super::set::Compression;
@@ -31,8 +32,8 @@ impl<F: Fn(usize, usize) -> f32 + Sync> Values for F {
     }
 }
 
-/// An image to write: its size, each component's space, level 0 as stored bytes (one per
-/// component per texel, row major) and, for the mips, each texel's value in the averaging
+/// An image to write: its size, each component's space, level 0 as stored bytes (per
+/// component per texel, row major: one byte, or two for a half float) and, for the mips, each texel's value in the averaging
 /// space (`value(texel, component)`, unquantised).
 pub struct Source<'a> {
     /// Size in texels.
@@ -41,7 +42,7 @@ pub struct Source<'a> {
     pub height: u32,
     /// One per component (1 to 4).
     pub spaces: &'a [Space],
-    /// Level 0: `width * height * spaces.len()` bytes.
+    /// Level 0: `width * height` texels of [`texel_layout`] bytes.
     pub level0: &'a [u8],
     /// A texel's component in its averaging space.
     pub value: &'a dyn Values,
@@ -57,12 +58,19 @@ impl Source<'_> {
         self.channels() >= 3 && self.spaces[0].is_colour()
     }
 
+    /// Bytes per stored texel.
+    fn texel_bytes(&self) -> usize {
+        texel_layout(self.spaces).0
+    }
+
     fn check(&self) -> Result<(), String> {
         let (w, h, ch) = (self.width, self.height, self.channels());
+        let half = self.spaces.iter().filter(|s| **s == Space::Half).count();
         if w == 0
             || h == 0
             || !(1..=4).contains(&ch)
-            || self.level0.len() != w as usize * h as usize * ch
+            || (half > 0 && (half != ch || ch != 3))
+            || self.level0.len() != w as usize * h as usize * self.texel_bytes()
         {
             return Err(format!("cannot write a {w}x{h} image of {ch} components"));
         }
@@ -95,12 +103,15 @@ pub(super) fn crop(
     per: usize,
     channels: usize,
 ) -> Vec<u8> {
-    let mut out = Vec::with_capacity(w as usize * h as usize * channels);
-    for y in 0..h as usize {
-        for x in 0..w as usize {
-            out.extend_from_slice(&bytes[(y * pw as usize + x) * per..][..channels]);
-        }
-    }
+    let mut out = vec![0_u8; w as usize * h as usize * channels];
+    out.par_chunks_mut(w as usize * channels)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let src = &bytes[y * pw as usize * per..];
+            for (x, t) in row.chunks_exact_mut(channels).enumerate() {
+                t.copy_from_slice(&src[x * per..x * per + channels]);
+            }
+        });
     out
 }
 
@@ -113,8 +124,18 @@ pub struct Compressed {
     pub decoded: Vec<u8>,
 }
 
-/// Compresses one level (`channels` bytes per texel) as `kind` with `encoder`. Rows advance
-/// `progress`.
+/// The block kind of an image of `spaces` at `effort` (BC7 and BC6H only): BC6H for half
+/// floats, else by the component count.
+pub fn block_kind(spaces: &[Space], effort: Bc7Quality) -> BlockKind {
+    if spaces.first() == Some(&Space::Half) {
+        BlockKind::Bc6h { effort }
+    } else {
+        BlockKind::for_channels(spaces.len(), effort)
+    }
+}
+
+/// Compresses one level (`channels` bytes per stored texel) as `kind` with `encoder`. Rows
+/// advance `progress`.
 pub fn compress_level(
     encoder: Encoder,
     kind: BlockKind,
@@ -123,51 +144,59 @@ pub fn compress_level(
     channels: usize,
     progress: Option<&Progress>,
 ) -> Compressed {
-    let per = kind.texel_bytes();
     let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
-    let widened: std::borrow::Cow<'_, [u8]> = if per == channels {
+    let input: std::borrow::Cow<'_, [u8]> = if padded == (w, h) {
         bytes.into()
     } else {
-        bytes
-            .chunks_exact(channels)
-            .flat_map(|t| {
-                let mut px = [0, 0, 0, 255];
-                px[..channels].copy_from_slice(t);
-                px
-            })
-            .take(w as usize * h as usize * per)
-            .collect::<Vec<u8>>()
-            .into()
+        pad(bytes, (w, h), channels, padded).into()
     };
-    let input = if padded == (w, h) {
-        widened
-    } else {
-        pad(&widened, (w, h), per, padded).into()
-    };
-    let blocks = blocks::encode(encoder, kind, &input, padded, progress);
-    let decoded = blocks::decode(kind, &blocks, padded);
-    let decoded = if padded == (w, h) && per == channels {
+    let blocks = blocks::encode_stored(encoder, kind, &input, channels, padded, progress);
+    let decoded = blocks::decode_stored(kind, &blocks, padded, channels);
+    let decoded = if padded == (w, h) {
         decoded
     } else {
-        crop(&decoded, padded.0, (w, h), per, channels)
+        crop(&decoded, padded.0, (w, h), channels, channels)
     };
     Compressed { blocks, decoded }
 }
 
-/// Per component, PSNR (dB) of `decoded` against `reference` (`channels` bytes per texel),
-/// `None` where they are identical.
-pub fn psnr(reference: &[u8], decoded: &[u8], channels: usize) -> Vec<Option<f64>> {
-    (0..channels)
+/// Per component, PSNR (dB) of `decoded` against `reference` (texels of components in
+/// `spaces`), `None` where they are identical. Bytes compare as stored (peak 255); half
+/// floats compare sRGB-encoded, on the same scale, so a BC6H image's PSNR reads like a BC7
+/// image's.
+pub fn psnr(reference: &[u8], decoded: &[u8], spaces: &[Space]) -> Vec<Option<f64>> {
+    let (per, offsets) = texel_layout(spaces);
+    // Half floats by their bits: sRGB-encoded, on the byte scale.
+    let halves: Vec<f32> = if spaces.contains(&Space::Half) {
+        (0..=u16::MAX)
+            .map(|b| {
+                let v = half::f16::from_bits(b).to_f32();
+                let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+                crate::model::texel::linear_to_srgb(v) * 255.0
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let level = |t: &[u8], k: usize| -> f64 {
+        let o = offsets[k];
+        if spaces[k] == Space::Half {
+            f64::from(halves[usize::from(u16::from_le_bytes([t[o], t[o + 1]]))])
+        } else {
+            f64::from(t[o])
+        }
+    };
+    (0..spaces.len())
         .map(|k| {
-            let sum: u64 = reference
-                .par_chunks(channels)
-                .zip(decoded.par_chunks(channels))
+            let sum: f64 = reference
+                .par_chunks(per)
+                .zip(decoded.par_chunks(per))
                 .map(|(a, b)| {
-                    let d = i64::from(a[k]) - i64::from(b[k]);
-                    (d * d) as u64
+                    let d = level(a, k) - level(b, k);
+                    d * d
                 })
                 .sum();
-            let mse = sum as f64 / (reference.len() / channels).max(1) as f64;
+            let mse = sum / (reference.len() / per).max(1) as f64;
             (mse > 0.0).then(|| 10.0 * (255.0_f64 * 255.0 / mse).log10())
         })
         .collect()
@@ -178,20 +207,23 @@ pub fn psnr(reference: &[u8], decoded: &[u8], channels: usize) -> Vec<Option<f64
 pub struct Written {
     /// The file.
     pub bytes: Vec<u8>,
-    /// Every level as a consumer decodes it, finest first, `channels` bytes per texel.
+    /// Every level as a consumer decodes it, finest first, texels as the source stores them.
     pub decoded: Vec<Vec<u8>>,
     /// Per component, PSNR (dB) of the decoded level 0 against the uncompressed 8-bit values,
     /// `None` where they are identical (`None` altogether for uncompressed files).
     pub psnr: Option<Vec<Option<f64>>>,
     /// Mip levels in the file.
     pub levels: u32,
-    /// The file's compression: plain KTX2, or BC4, BC5 or BC7 blocks.
+    /// The file's compression: plain KTX2, or BC4, BC5, BC7 or BC6H blocks.
     pub compression: Compression,
 }
 
 /// The KTX2 format and compression name of `channels` components, block-compressed or not.
-fn format_of(channels: usize, srgb: bool, compressed: bool) -> (KtxFormat, Compression) {
-    match (compressed, channels) {
+fn format_of(spaces: &[Space], srgb: bool, compressed: bool) -> (KtxFormat, Compression) {
+    if spaces.first() == Some(&Space::Half) {
+        return (KtxFormat::BC6H_UFLOAT_BLOCK, Compression::Ktx2Bc6h);
+    }
+    match (compressed, spaces.len()) {
         (false, 1) => (KtxFormat::R8_UNORM, Compression::Ktx2),
         (false, 2) => (KtxFormat::R8G8_UNORM, Compression::Ktx2),
         (false, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, Compression::Ktx2),
@@ -209,7 +241,8 @@ fn format_of(channels: usize, srgb: bool, compressed: bool) -> (KtxFormat, Compr
 /// advance `progress`; a cancel stops the block encoder between strips.
 ///
 /// # Errors
-/// An empty image, a component count outside 1..=4, or cancelled.
+/// An empty image, a component count outside 1..=4, half floats uncompressed or not as
+/// three components, or cancelled.
 pub fn encode(
     source: &Source<'_>,
     compressed: Option<(Encoder, Bc7Quality)>,
@@ -218,8 +251,12 @@ pub fn encode(
 ) -> Result<Written, String> {
     source.check()?;
     let (w, h, ch) = (source.width, source.height, source.channels());
+    let per = source.texel_bytes();
     let srgb = source.srgb();
-    let (format, compression) = format_of(ch, srgb, compressed.is_some());
+    if compressed.is_none() && per != ch {
+        return Err("half floats are written only as BC6H blocks".into());
+    }
+    let (format, compression) = format_of(source.spaces, srgb, compressed.is_some());
     let chain = mips(source);
     let mut level_bytes = Vec::with_capacity(chain.len() + 1);
     let mut decoded = Vec::with_capacity(chain.len() + 1);
@@ -245,22 +282,22 @@ pub fn encode(
             }
         }
         Some((encoder, effort)) => {
-            let kind = BlockKind::for_channels(ch, effort);
+            let kind = block_kind(source.spaces, effort);
             let first = match level0 {
                 Some(c) => {
                     progress.advance(u64::from(h));
                     c
                 }
-                None => compress_level(encoder, kind, source.level0, (w, h), ch, Some(progress)),
+                None => compress_level(encoder, kind, source.level0, (w, h), per, Some(progress)),
             };
             if progress.is_cancelled() {
                 return Err("cancelled".into());
             }
-            psnr_values = Some(psnr(source.level0, &first.decoded, ch));
+            psnr_values = Some(psnr(source.level0, &first.decoded, source.spaces));
             level_bytes.push(first.blocks);
             decoded.push(first.decoded);
             for (size, bytes) in &chain {
-                let c = compress_level(encoder, kind, bytes, *size, ch, None);
+                let c = compress_level(encoder, kind, bytes, *size, per, None);
                 level_bytes.push(c.blocks);
                 decoded.push(c.decoded);
             }
@@ -298,11 +335,13 @@ mod tests {
     ) -> Written {
         let ch = spaces.len();
         let bounds: Vec<Vec<f32>> = spaces.iter().map(|s| s.boundaries()).collect();
-        let level0: Vec<u8> = values
-            .iter()
-            .enumerate()
-            .map(|(j, v)| quantise(&bounds[j % ch], *v))
-            .collect();
+        let (per, offsets) = texel_layout(spaces);
+        let mut level0 = vec![0_u8; values.len() / ch * per];
+        for (t, v) in level0.chunks_exact_mut(per).zip(values.chunks_exact(ch)) {
+            for k in 0..ch {
+                spaces[k].store(&bounds[k], v[k], &mut t[offsets[k]..]);
+            }
+        }
         let value = |i: usize, k: usize| values[i * ch + k];
         let source = Source {
             width: w,
@@ -330,11 +369,17 @@ mod tests {
             (1, Some(Bc7Quality::VeryFast)),
             (2, Some(Bc7Quality::VeryFast)),
             (4, Some(Bc7Quality::UltraFast)),
+            (5, Some(Bc7Quality::UltraFast)),
         ] {
+            // 5: three half floats, as BC6H.
+            let half = ch == 5;
+            let ch = ch.min(4) - usize::from(half);
             let (w, h) = (37, 20);
             let values = gradient(w, h, ch);
             let spaces = [Space::Srgb, Space::Srgb, Space::Srgb, Space::Linear];
-            let spaces = if ch >= 3 {
+            let spaces = if half {
+                &[Space::Half; 3][..]
+            } else if ch >= 3 {
                 &spaces[..ch]
             } else {
                 &[Space::Linear; 2][..ch]
@@ -348,12 +393,36 @@ mod tests {
             let decoded = decode(&written.bytes).unwrap();
             assert_eq!((decoded.width, decoded.height), (w, h));
             // What decode reads is what encode says a consumer gets.
-            let first: Vec<u8> = decoded
+            let first: Vec<f32> = decoded
                 .rgba
                 .chunks(4)
                 .flat_map(|p| p[..ch].to_vec())
                 .collect();
-            assert_eq!(first, written.decoded[0], "{ch} {compressed:?}");
+            let said: Vec<f32> = if half {
+                written.decoded[0]
+                    .chunks_exact(2)
+                    .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+                    .collect()
+            } else {
+                written.decoded[0]
+                    .iter()
+                    .map(|b| f32::from(*b) / 255.0)
+                    .collect()
+            };
+            assert_eq!(first, said, "{ch} {compressed:?}");
+            if half {
+                assert_eq!(written.compression, Compression::Ktx2Bc6h);
+                assert_eq!(reader.header().format, Some(KtxFormat::BC6H_UFLOAT_BLOCK));
+                // Linear light, decoded close to the values written (the sawtooth's jumps
+                // inside blocks cost the most).
+                let mean = first
+                    .iter()
+                    .zip(&values)
+                    .map(|(a, b)| (a - b).abs())
+                    .sum::<f32>()
+                    / values.len() as f32;
+                assert!(mean < 0.05, "{mean}");
+            }
             if compressed.is_none() {
                 let exact: Vec<u8> = values
                     .iter()

@@ -6,10 +6,15 @@
 //! - where the packed layout fails, `n` moves out of the colour blocks (its own BC4 plane,
 //!   or beside a grey `k_s` in a BC5 image) at the same effort: `n`'s endpoints no longer
 //!   shared with `k_d`'s, both come out better;
-//! - then the layout with the smaller `k_a` error takes more BC7 effort, a step at a time up
+//! - where that fails too, the colour images become BC6H (linear half floats, the same
+//!   bytes as BC7): BC7 keeps 8-bit sRGB and its mode 6 shares one p-bit across channels,
+//!   so flat blocks come out a level off, a large relative error in dark texels where `k_s`
+//!   adds little;
+//! - then the layout nearest the budget (fewest failing measures, then the worst measure
+//!   nearest its limit) takes more effort, a step at a time up
 //!   to the preset's ceiling, while the rate at which the last step improved each failing
 //!   measure could still meet the budget;
-//! - at the ceiling, the trial with the smallest `k_a` error is kept, and the manifest says
+//! - at the ceiling, the trial nearest the budget is kept, and the manifest says
 //!   the budget was not met.
 //!
 //! The manifest records every trial and why the chosen one was chosen.
@@ -20,7 +25,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
-use super::manifest::Comp;
+use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
 use crate::export::blocks::{BlockKind, Encoder};
 use crate::export::encoding::{KaError, NEncoding};
@@ -38,6 +43,21 @@ pub enum BlockLayout {
     Packed,
     /// Out of the colour blocks: a BC4 plane of its own, or with grey `k_s` in a BC5 image.
     NApart,
+    /// `n` apart, and the three-component colour images BC6H: linear half floats instead
+    /// of BC7's 8-bit sRGB (the same bytes as `n-apart`).
+    HalfColour,
+}
+
+impl BlockLayout {
+    /// Whether colour images are half floats.
+    fn half(self) -> bool {
+        self == Self::HalfColour
+    }
+}
+
+/// Whether an image of `comps` is colour that BC6H can hold: three colour components.
+fn half_image(comps: &[Comp]) -> bool {
+    comps.len() == 3 && comps.iter().all(|c| is_colour(*c))
 }
 
 /// One encoding of level 0 that the export measured.
@@ -45,7 +65,7 @@ pub enum BlockLayout {
 pub struct Trial {
     /// Where `n` was.
     pub layout: BlockLayout,
-    /// BC7's effort.
+    /// BC7's (and BC6H's) effort.
     pub bc7_effort: Bc7Quality,
     /// The set's `k_a` error, level 0 as a consumer decodes it.
     pub ka_error: KaError,
@@ -109,57 +129,63 @@ struct TrialImage<'a> {
     stem: &'static str,
     comps: Vec<Comp>,
     srgb: bool,
+    half: bool,
     texels: KtxTexels<'a>,
     level0: Vec<u8>,
     compressed: Option<(Bc7Quality, Compressed)>,
 }
 
 impl TrialImage<'_> {
-    fn kind(&self, effort: Bc7Quality) -> BlockKind {
-        BlockKind::for_channels(self.comps.len(), effort)
-    }
-
     /// Compresses level 0 at `effort`, unless it already is (BC4 and BC5 have one effort).
     fn compress(&mut self, encoder: Encoder, effort: Bc7Quality, size: (u32, u32), p: &Progress) {
-        let kind = self.kind(effort);
+        let kind = ktx::block_kind(self.texels.spaces(), effort);
         let fresh = match &self.compressed {
-            Some((e, _)) => matches!(kind, BlockKind::Bc7 { .. }) && *e != effort,
+            Some((e, _)) => {
+                matches!(kind, BlockKind::Bc7 { .. } | BlockKind::Bc6h { .. }) && *e != effort
+            }
             None => true,
         };
         if fresh {
-            let c =
-                ktx::compress_level(encoder, kind, &self.level0, size, self.comps.len(), Some(p));
+            let per = ktx::texel_layout(self.texels.spaces()).0;
+            let c = ktx::compress_level(encoder, kind, &self.level0, size, per, Some(p));
             self.compressed = Some((effort, c));
         } else {
             p.advance(u64::from(size.1));
         }
     }
 
-    fn stored(&self) -> StoredImage {
+    fn stored(&self) -> StoredImage<'_> {
         StoredImage {
             comps: self.comps.clone(),
             data: self
                 .compressed
                 .as_ref()
-                .map_or_else(Vec::new, |(_, c)| c.decoded.clone()),
+                .map_or_else(Default::default, |(_, c)| c.decoded[..].into()),
             srgb: self.srgb,
+            half: self.half,
         }
     }
 }
 
-/// The images of `want`: what the last trial shares with it is kept (with its blocks), what
-/// it lacks is made.
-fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, job: &Job<'a>) {
-    images.retain(|i| want.iter().any(|(s, c)| *s == i.stem && *c == i.comps));
+/// The images of `want` (three-component colour as half floats where `half`): what the
+/// last trial shares with it is kept (with its blocks), what it lacks is made.
+fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, half: bool, job: &Job<'a>) {
+    let half_of = |comps: &[Comp]| half && half_image(comps);
+    images.retain(|i| {
+        want.iter()
+            .any(|(s, c)| *s == i.stem && *c == i.comps && half_of(c) == i.half)
+    });
     for (stem, comps) in want {
         if !images.iter().any(|i| i.stem == *stem) {
-            let srgb = srgb_image(Format::Ktx2Bc, comps);
-            let texels = KtxTexels::new(job.texels, job.ka, comps, srgb, job.n_enc);
+            let half = half_of(comps);
+            let srgb = !half && srgb_image(Format::Ktx2Bc, comps);
+            let texels = KtxTexels::new(job.texels, job.ka, comps, srgb, half, job.n_enc);
             let level0 = texels.level0();
             images.push(TrialImage {
                 stem,
                 comps: comps.clone(),
                 srgb,
+                half,
                 texels,
                 level0,
                 compressed: None,
@@ -170,7 +196,7 @@ fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, job: &Job<'a>) {
 }
 
 impl Job<'_> {
-    fn measure(&self, stored: &[StoredImage]) -> KaError {
+    fn measure(&self, stored: &[StoredImage<'_>]) -> KaError {
         ka_error_of_set(
             self.texels,
             self.shape,
@@ -193,14 +219,32 @@ fn tried(trials: &[Trial], layout: BlockLayout) -> bool {
     trials.iter().any(|t| t.layout == layout)
 }
 
-/// The better of two trials: the smaller `k_a` max error (the packed layout on a tie: fewer
-/// bytes).
-fn better<'t>(a: &'t Trial, b: &'t Trial) -> &'t Trial {
-    if b.ka_error.max < a.ka_error.max * (1.0 - MIN_GAIN) {
-        b
-    } else {
-        a
-    }
+/// How far a trial falls short of the budget: how many of its three measures fail, and the
+/// worst measure over its limit (each as a ratio: the `k_a` errors to theirs, PSNR as the
+/// ratio of squared errors).
+fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
+    let ratios = [
+        t.ka_error.max / budget.max_ka_error,
+        t.ka_error.mean / budget.mean_ka_error,
+        t.min_psnr
+            .map_or(0.0, |p| 10_f64.powf((budget.min_psnr - p) / 10.0)),
+    ];
+    let failing = ratios.iter().filter(|r| **r > 1.0).count();
+    (failing, ratios.into_iter().fold(0.0, f64::max))
+}
+
+/// The better of two trials against `budget`: the one that fails fewer measures, then the one
+/// whose worst measure is nearer its limit (the earlier on a tie: fewer bytes, or the more
+/// common format).
+fn better<'t>(a: &'t Trial, b: &'t Trial, budget: &BlockBudget) -> &'t Trial {
+    if nearer(a, b, budget) { b } else { a }
+}
+
+/// Whether `b` is nearer `budget` than `a` (see [`better`]).
+fn nearer(a: &Trial, b: &Trial, budget: &BlockBudget) -> bool {
+    let (fa, wa) = shortfall(a, budget);
+    let (fb, wb) = shortfall(b, budget);
+    fb < fa || (fb == fa && wb < wa * (1.0 - MIN_GAIN))
 }
 
 /// Whether more effort in `layout` may still meet the budget: the first step is always
@@ -259,6 +303,20 @@ pub(super) fn encode_blocks(
         .into_iter()
         .filter(|e| *e <= job.preset.max_bc7_effort)
         .collect();
+    // The layouts to try at the lowest effort, in order: fewest bytes first; then, for the
+    // same bytes, BC6H colour where there is a colour image and the preset allows it (its
+    // k_d is 15 dB closer than BC7's at the same effort), else n apart in BC7.
+    let apart_images = apart.unwrap_or(packed);
+    let mut layouts = vec![BlockLayout::Packed];
+    if job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
+        layouts.push(BlockLayout::HalfColour);
+    } else if apart.is_some() {
+        layouts.push(BlockLayout::NApart);
+    }
+    let want_of = |layout: BlockLayout| match layout {
+        BlockLayout::Packed => packed,
+        BlockLayout::NApart | BlockLayout::HalfColour => apart_images,
+    };
     let mut layout = BlockLayout::Packed;
     let mut step = 0;
     let mut trials: Vec<Trial> = Vec::new();
@@ -268,11 +326,7 @@ pub(super) fn encode_blocks(
     let chosen;
     loop {
         let effort = efforts[step];
-        let want = match layout {
-            BlockLayout::NApart => apart.unwrap_or(packed),
-            BlockLayout::Packed => packed,
-        };
-        prepare(&mut images, want, job);
+        prepare(&mut images, want_of(layout), layout.half(), job);
         let started = Instant::now();
         progress.start("encode", images.len() as u64 * u64::from(h));
         for image in &mut images {
@@ -287,7 +341,7 @@ pub(super) fn encode_blocks(
             .iter()
             .filter_map(|i| {
                 let (_, c) = i.compressed.as_ref()?;
-                ktx::psnr(&i.level0, &c.decoded, i.comps.len())
+                ktx::psnr(&i.level0, &c.decoded, i.texels.spaces())
                     .into_iter()
                     .flatten()
                     .reduce(f64::min)
@@ -313,39 +367,45 @@ pub(super) fn encode_blocks(
             chosen = trials.len() - 1;
             break;
         }
-        // The packed layout failed: n apart, at the same effort, next.
-        if layout == BlockLayout::Packed && apart.is_some() && !tried(&trials, BlockLayout::NApart)
-        {
-            layout = BlockLayout::NApart;
+        // The layout failed: the next one, at the same effort.
+        if let Some(next) = layouts.iter().find(|l| !tried(&trials, **l)) {
+            layout = *next;
             continue;
         }
-        // Then more effort for the better layout, while it buys something.
-        if trials.len() == 2 && apart.is_some() {
-            layout = better(&trials[0], &trials[1]).layout;
+        // Then more effort for the best layout, while it buys something.
+        if trials.len() == layouts.len() {
+            layout = trials
+                .iter()
+                .reduce(|a, b| better(a, b, &budget))
+                .map_or(layout, |t| t.layout);
         }
         if step + 1 < efforts.len() && reachable(&trials, layout, &budget, efforts.len() - step - 1)
         {
             step += 1;
+            // BC6H has no effort between ultra-fast and very-fast: skip a step that would
+            // encode the same blocks again.
+            if layout.half() && efforts[step] == Bc7Quality::VeryFast && step + 1 < efforts.len() {
+                step += 1;
+            }
             continue;
         }
-        // Nothing met the budget: the smallest k_a error, at the highest PSNR among equals.
+        // Nothing met the budget: the trial nearest it.
         chosen = (0..trials.len())
-            .min_by(|a, b| {
-                let (x, y) = (&trials[*a], &trials[*b]);
-                x.ka_error.max.total_cmp(&y.ka_error.max).then(
-                    y.min_psnr
-                        .unwrap_or(f64::MAX)
-                        .total_cmp(&x.min_psnr.unwrap_or(f64::MAX)),
-                )
+            .reduce(|a, b| {
+                if nearer(&trials[a], &trials[b], &budget) {
+                    b
+                } else {
+                    a
+                }
             })
             .unwrap_or(0);
         reason = if step + 1 < efforts.len() {
             format!(
-                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the smallest k_a error ({here} last)"
+                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it ({here} last)"
             )
         } else {
             format!(
-                "no trial up to {:?} met the budget: kept the smallest k_a error ({here} last)",
+                "no trial up to {:?} met the budget: kept the trial nearest it ({here} last)",
                 job.preset.max_bc7_effort
             )
         };
@@ -354,11 +414,7 @@ pub(super) fn encode_blocks(
     let pick = trials[chosen].clone();
     if pick.layout != layout || pick.bc7_effort != efforts[step] {
         // The pick is an earlier trial: encode its level 0 again.
-        let want = match pick.layout {
-            BlockLayout::NApart => apart.unwrap_or(packed),
-            BlockLayout::Packed => packed,
-        };
-        prepare(&mut images, want, job);
+        prepare(&mut images, want_of(pick.layout), pick.layout.half(), job);
         progress.start("encode", images.len() as u64 * u64::from(h));
         for image in &mut images {
             image.compress(encoder, pick.bc7_effort, (w, h), progress);
@@ -381,7 +437,7 @@ pub(super) fn encode_blocks(
         encoded.push((
             format!("{}.ktx2", image.stem),
             image.comps,
-            ktx_image(written, image.srgb),
+            ktx_image(written, image.srgb, image.half),
         ));
     }
     let within_budget =

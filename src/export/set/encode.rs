@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use super::manifest::{Comp, Compression, is_colour};
 use crate::export::encoding::NEncoding;
-use crate::export::ktx::{Space, quantise};
+use crate::export::ktx::{Space, texel_layout};
 use crate::export::preset::{ExportPreset, Format};
 use crate::model::MaterialMaps;
 use crate::model::texel::{
@@ -34,6 +34,8 @@ pub(super) struct EncodedImage {
     pub stored: Option<Vec<u8>>,
     /// The colour components are sRGB-encoded.
     pub srgb: bool,
+    /// The components are linear half floats (BC6H; `stored` holds two bytes each).
+    pub half: bool,
     /// KTX2: mip levels, PSNR, compression name.
     pub ktx: Option<KtxInfo>,
 }
@@ -117,6 +119,7 @@ pub(super) fn encode_image(
             bytes,
             stored: None,
             srgb,
+            half: false,
             ktx: None,
         }
     };
@@ -157,7 +160,7 @@ pub(super) fn encode_image(
             Ok(plain(out.into_inner()))
         }
         Format::Ktx2 | Format::Ktx2Bc => {
-            let source = KtxTexels::new(texels, ka, comps, srgb, n_enc);
+            let source = KtxTexels::new(texels, ka, comps, srgb, false, n_enc);
             let level0 = source.level0();
             let compressed = (format == Format::Ktx2Bc).then_some((
                 crate::export::blocks::Encoder::best(),
@@ -169,13 +172,17 @@ pub(super) fn encode_image(
                 None,
                 progress,
             )?;
-            Ok(ktx_image(written, srgb))
+            Ok(ktx_image(written, srgb, false))
         }
     }
 }
 
 /// An encoded image of a written KTX2 file.
-pub(super) fn ktx_image(written: crate::export::ktx::Written, srgb: bool) -> EncodedImage {
+pub(super) fn ktx_image(
+    written: crate::export::ktx::Written,
+    srgb: bool,
+    half: bool,
+) -> EncodedImage {
     let mut decoded = written.decoded;
     let level0 = if decoded.is_empty() {
         Vec::new()
@@ -186,6 +193,7 @@ pub(super) fn ktx_image(written: crate::export::ktx::Written, srgb: bool) -> Enc
         bytes: written.bytes,
         stored: Some(level0),
         srgb,
+        half,
         ktx: Some(KtxInfo {
             levels: written.levels,
             psnr: written.psnr,
@@ -196,12 +204,13 @@ pub(super) fn ktx_image(written: crate::export::ktx::Written, srgb: bool) -> Enc
 }
 
 /// Where a KTX2 image's component comes from: a texel's 16-bit code through two tables (its
-/// value in the averaging space, and its stored byte), or the baked `k_a`.
+/// value in the averaging space, and what is stored: a byte, or a half float's two), or the
+/// baked `k_a`.
 enum CompSource {
     Code {
         comp: Comp,
         value: Vec<f32>,
-        byte: Vec<u8>,
+        stored: Vec<[u8; 2]>,
     },
     Ka {
         channel: usize,
@@ -218,12 +227,14 @@ pub(super) struct KtxTexels<'a> {
 }
 
 impl<'a> KtxTexels<'a> {
-    /// The image of `comps` (colour sRGB-encoded where `srgb`; `n` by `n_enc`).
+    /// The image of `comps` (colour sRGB-encoded where `srgb`, linear half floats where
+    /// `half`; `n` by `n_enc`).
     pub(super) fn new(
         texels: &'a [Texel],
         ka: &'a [Vec3],
         comps: &[Comp],
         srgb: bool,
+        half: bool,
         n_enc: Option<NEncoding>,
     ) -> Self {
         let spaces: Vec<Space> = comps
@@ -231,6 +242,7 @@ impl<'a> KtxTexels<'a> {
             .map(|c| match (c, n_enc) {
                 (Comp::N, Some(e)) => Space::N(e),
                 (Comp::N, None) => Space::Linear,
+                _ if half => Space::Half,
                 _ if srgb => Space::Srgb,
                 _ => Space::Linear,
             })
@@ -252,11 +264,18 @@ impl<'a> KtxTexels<'a> {
                         _ => decode_unorm(code),
                     })
                     .collect();
-                let byte = value.iter().map(|v| quantise(&bounds, *v)).collect();
+                let stored = value
+                    .iter()
+                    .map(|v| {
+                        let mut out = [0; 2];
+                        space.store(&bounds, *v, &mut out);
+                        out
+                    })
+                    .collect();
                 CompSource::Code {
                     comp: *comp,
                     value,
-                    byte,
+                    stored,
                 }
             })
             .collect();
@@ -289,21 +308,34 @@ impl<'a> KtxTexels<'a> {
         }
     }
 
-    /// Texel `i`'s component `k` as stored.
-    pub(super) fn byte(&self, i: usize, k: usize) -> u8 {
+    /// Texel `i`'s component `k` as stored, into `out`.
+    fn store(&self, i: usize, k: usize, out: &mut [u8]) {
         match &self.sources[k] {
-            CompSource::Code { comp, byte, .. } => byte[self.code(i, *comp)],
-            CompSource::Ka { channel, bounds } => quantise(bounds, self.ka_of(i, *channel)),
+            CompSource::Code { comp, stored, .. } => {
+                let s = &stored[self.code(i, *comp)];
+                out[..self.spaces[k].bytes()].copy_from_slice(&s[..self.spaces[k].bytes()]);
+            }
+            CompSource::Ka { channel, bounds } => {
+                self.spaces[k].store(bounds, self.ka_of(i, *channel), out);
+            }
         }
     }
 
     /// Level 0 as stored bytes.
     pub(super) fn level0(&self) -> Vec<u8> {
-        let ch = self.spaces.len();
-        (0..self.texels.len() * ch)
-            .into_par_iter()
-            .map(|j| self.byte(j / ch, j % ch))
-            .collect()
+        let (per, offsets) = texel_layout(&self.spaces);
+        let mut out = vec![0_u8; self.texels.len() * per];
+        out.par_chunks_mut(per).enumerate().for_each(|(i, t)| {
+            for (k, o) in offsets.iter().enumerate() {
+                self.store(i, k, &mut t[*o..]);
+            }
+        });
+        out
+    }
+
+    /// Each component's space.
+    pub(super) fn spaces(&self) -> &[Space] {
+        &self.spaces
     }
 
     /// The image as the KTX2 writer takes it, with its stored level 0.
@@ -331,9 +363,12 @@ impl crate::export::ktx::Values for KtxTexels<'_> {
 /// An encoded image with its file name and components.
 pub(super) type Encoded = (String, Vec<Comp>, EncodedImage);
 
-/// The bytes a consumer decodes from an 8-bit image, `comps.len()` per texel.
-pub(super) struct StoredImage {
+/// What a consumer decodes from an 8-bit image (`comps.len()` bytes per texel) or a BC6H
+/// image (`half`: little-endian half floats, two bytes per component).
+pub(super) struct StoredImage<'a> {
     pub comps: Vec<Comp>,
-    pub data: Vec<u8>,
+    /// Borrowed from a trial's blocks, or owned.
+    pub data: std::borrow::Cow<'a, [u8]>,
     pub srgb: bool,
+    pub half: bool,
 }

@@ -32,8 +32,7 @@ fn read_pixels(path: &Path) -> Result<Pixels, SetError> {
                 }
             })?;
         let decoded = crate::export::ktx::decode(&bytes).map_err(invalid)?;
-        let pixels = decoded.rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
-        Ok((true, (decoded.width, decoded.height), pixels))
+        Ok((true, (decoded.width, decoded.height), decoded.rgba))
     } else {
         let image = crate::model::import::read_image(path).map_err(|e| invalid(e.to_string()))?;
         Ok((

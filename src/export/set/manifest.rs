@@ -62,17 +62,21 @@ pub enum Compression {
     /// KTX2 with BC7 blocks (three or four components).
     #[serde(rename = "ktx2-bc7")]
     Ktx2Bc7,
+    /// KTX2 with BC6H blocks: three components, linear unsigned half floats.
+    #[serde(rename = "ktx2-bc6h")]
+    Ktx2Bc6h,
 }
 
 impl Compression {
     /// Every compression, in the order the docs list them.
-    pub const ALL: [Self; 6] = [
+    pub const ALL: [Self; 7] = [
         Self::Png,
         Self::Exr,
         Self::Ktx2,
         Self::Ktx2Bc4,
         Self::Ktx2Bc5,
         Self::Ktx2Bc7,
+        Self::Ktx2Bc6h,
     ];
 
     /// The name a manifest spells.
@@ -84,6 +88,7 @@ impl Compression {
             Self::Ktx2Bc4 => "ktx2-bc4",
             Self::Ktx2Bc5 => "ktx2-bc5",
             Self::Ktx2Bc7 => "ktx2-bc7",
+            Self::Ktx2Bc6h => "ktx2-bc6h",
         }
     }
 
@@ -97,7 +102,7 @@ impl Compression {
         match self {
             Self::Png => "png",
             Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 => "ktx2",
+            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 | Self::Ktx2Bc6h => "ktx2",
         }
     }
 
@@ -107,6 +112,7 @@ impl Compression {
             Self::Png => &[8, 16],
             Self::Exr => &[32],
             Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 => &[8],
+            Self::Ktx2Bc6h => &[16],
         }
     }
 }

@@ -7,7 +7,9 @@ use super::manifest::{Comp, Constants};
 use crate::export::encoding::KaError;
 use crate::export::encoding::NEncoding;
 use crate::export::preset::Format;
-use crate::model::texel::{Texel, decode_n, decode_unorm, srgb_to_linear};
+use crate::model::texel::{
+    Texel, decode_n, decode_unorm, n_from_blend, n_to_blend, srgb_to_linear,
+};
 use crate::reflectance::{self, AmbientApprox, ShadingModel};
 
 /// Where a consumer's value of one component comes from.
@@ -17,6 +19,14 @@ enum Read<'a> {
     Table(&'a [f32]),
     /// A table per byte of an 8-bit file as written (after block compression).
     Bytes {
+        data: &'a [u8],
+        stride: usize,
+        offset: usize,
+        table: &'a [f32],
+    },
+    /// A table per half float (its bits) of a BC6H file as decoded: `stride` and `offset` in
+    /// bytes.
+    Halves {
         data: &'a [u8],
         stride: usize,
         offset: usize,
@@ -34,23 +44,69 @@ impl Read<'_> {
                 offset,
                 table,
             } => table[data[i * stride + offset] as usize],
+            Self::Halves {
+                data,
+                stride,
+                offset,
+                table,
+            } => {
+                let at = i * stride + offset;
+                table[u16::from_le_bytes([data[at], data[at + 1]]) as usize]
+            }
         }
     }
 }
 
-/// The first of `want` that an 8-bit image holds, read through `table` (sRGB image) or
-/// `linear`.
+/// What a stored colour component stands for, in linear light: per byte of an sRGB or a
+/// linear 8-bit image, and per half float (by its bits; negatives as 0, what an unsigned
+/// BC6H decodes).
+struct ColourTables {
+    srgb8: Vec<f32>,
+    linear8: Vec<f32>,
+    halves: Vec<f32>,
+}
+
+impl ColourTables {
+    fn new() -> Self {
+        Self {
+            srgb8: (0..=255_u8)
+                .map(|b| srgb_to_linear(f32::from(b) / 255.0))
+                .collect(),
+            linear8: (0..=255_u8).map(|b| f32::from(b) / 255.0).collect(),
+            halves: (0..=u16::MAX)
+                .map(|b| half::f16::from_bits(b).to_f32().max(0.0))
+                .collect(),
+        }
+    }
+
+    /// The first of `want` that an image holds.
+    fn read<'r>(&'r self, stored: &'r [StoredImage<'_>], want: &[Comp]) -> Option<Read<'r>> {
+        in_file(stored, want, &self.srgb8, &self.linear8, Some(&self.halves))
+    }
+}
+
+/// The first of `want` that an image holds: an 8-bit image's through `table` (sRGB image)
+/// or `linear`, a BC6H image's through `halves` (colour only).
 fn in_file<'r>(
-    stored: &'r [StoredImage],
+    stored: &'r [StoredImage<'_>],
     want: &[Comp],
     table: &'r [f32],
     linear: &'r [f32],
+    halves: Option<&'r [f32]>,
 ) -> Option<Read<'r>> {
     want.iter().find_map(|w| {
         stored.iter().find_map(|image| {
             let offset = image.comps.iter().position(|c| c == w)?;
+            if image.half {
+                return Some(Read::Halves {
+                    data: &image.data[..],
+                    stride: image.comps.len() * 2,
+                    offset: offset * 2,
+                    table: halves?,
+                });
+            }
             Some(Read::Bytes {
-                data: &image.data,
+                data: &image.data[..],
                 stride: image.comps.len(),
                 offset,
                 table: if image.srgb { table } else { linear },
@@ -77,7 +133,7 @@ pub(super) struct Shape<'a> {
 pub(super) fn ka_error_of_set(
     texels: &[Texel],
     manifest: Shape<'_>,
-    stored: &[StoredImage],
+    stored: &[StoredImage<'_>],
     format: Format,
     model: ShadingModel,
     approx: AmbientApprox,
@@ -105,10 +161,7 @@ pub(super) fn ka_error_of_set(
             })
             .collect::<Vec<_>>(),
     );
-    let srgb8: Vec<f32> = (0..=255_u8)
-        .map(|b| srgb_to_linear(f32::from(b) / 255.0))
-        .collect();
-    let linear8: Vec<f32> = (0..=255_u8).map(|b| f32::from(b) / 255.0).collect();
+    let tables = ColourTables::new();
     let chi8 = split(
         &(0..=255_u16)
             .map(|q| {
@@ -128,14 +181,17 @@ pub(super) fn ka_error_of_set(
         if manifest.constants.kd.is_some() {
             Read::Table(&exact)
         } else {
-            in_file(stored, &[Comp::Kd(c)], &srgb8, &linear8).unwrap_or(Read::Table(colour_table))
+            tables
+                .read(stored, &[Comp::Kd(c)])
+                .unwrap_or(Read::Table(colour_table))
         }
     });
     let ks: [Read<'_>; 3] = std::array::from_fn(|c| {
         if manifest.constants.ks.is_some() {
             Read::Table(&exact)
         } else {
-            in_file(stored, &[Comp::Ks(c), Comp::Ks(0)], &srgb8, &linear8)
+            tables
+                .read(stored, &[Comp::Ks(c), Comp::Ks(0)])
                 .unwrap_or(Read::Table(colour_table))
         }
     });
@@ -143,7 +199,8 @@ pub(super) fn ka_error_of_set(
         if manifest.constants.n.is_some() {
             Read::Table(&chi[k])
         } else {
-            in_file(stored, &[Comp::N], &chi8[k], &chi8[k]).unwrap_or(Read::Table(&chi_of_set[k]))
+            in_file(stored, &[Comp::N], &chi8[k], &chi8[k], None)
+                .unwrap_or(Read::Table(&chi_of_set[k]))
         }
     });
     let w = manifest.width as usize;
@@ -184,20 +241,17 @@ pub(super) fn ka_error_of_set(
 }
 
 /// Relative `k_a` error of one mip level as a consumer decodes it (`stored`: the level's
-/// images, decoded) against `reference`: per texel, the mean of the exact level 0's `k_a`
-/// over its footprint, what the level should look like. Per texel and colour channel.
+/// images, decoded) against `reference` ([`reference_levels`]). Per texel and colour
+/// channel.
 pub(super) fn ka_error_of_level(
     shape: Shape<'_>,
-    stored: &[StoredImage],
+    stored: &[StoredImage<'_>],
     reference: &[[f32; 3]],
     model: ShadingModel,
     approx: AmbientApprox,
 ) -> KaError {
     let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
-    let srgb8: Vec<f32> = (0..=255_u8)
-        .map(|b| srgb_to_linear(f32::from(b) / 255.0))
-        .collect();
-    let linear8: Vec<f32> = (0..=255_u8).map(|b| f32::from(b) / 255.0).collect();
+    let tables = ColourTables::new();
     let chi_of = |n: f32| reflectance::chi_parts_f32(model, approx, n);
     let chi8: [Vec<f32>; 2] = [0, 1].map(|k| {
         (0..=255_u16)
@@ -210,16 +264,19 @@ pub(super) fn ka_error_of_level(
     let zero = [0.0_f32];
     let kd: [Read<'_>; 3] = std::array::from_fn(|c| match &kd_const {
         Some(v) => Read::Table(&v[c]),
-        None => in_file(stored, &[Comp::Kd(c)], &srgb8, &linear8).unwrap_or(Read::Table(&zero)),
+        None => tables
+            .read(stored, &[Comp::Kd(c)])
+            .unwrap_or(Read::Table(&zero)),
     });
     let ks: [Read<'_>; 3] = std::array::from_fn(|c| match &ks_const {
         Some(v) => Read::Table(&v[c]),
-        None => in_file(stored, &[Comp::Ks(c), Comp::Ks(0)], &srgb8, &linear8)
+        None => tables
+            .read(stored, &[Comp::Ks(c), Comp::Ks(0)])
             .unwrap_or(Read::Table(&zero)),
     });
     let n: [Read<'_>; 2] = std::array::from_fn(|k| match &n_const {
         Some(v) => Read::Table(&v[k]),
-        None => in_file(stored, &[Comp::N], &chi8[k], &chi8[k]).unwrap_or(Read::Table(&zero)),
+        None => in_file(stored, &[Comp::N], &chi8[k], &chi8[k], None).unwrap_or(Read::Table(&zero)),
     });
     let (max, sum) = reference
         .par_iter()
@@ -251,32 +308,47 @@ pub(super) fn ka_error_of_level(
     }
 }
 
-/// The reference of every mip level past 0 (see [`ka_error_of_level`]): level 1 from the
-/// texels' exact `k_a`, each further level the 2x2 mean of the one before (clamped at odd
-/// edges, as the mips are made).
+/// The reference of every mip level past 0 (see [`ka_error_of_level`]): the `k_a` of what
+/// the level should hold before it is stored, the exact texels averaged as the mips average
+/// them (`k_d` and `k_s` in linear light, `n` in the brushes' log space), level after level
+/// (2x2 boxes, clamped at odd edges). So a level's error is what storing it costs, as at
+/// level 0, and not the filter's own choice of `n`.
 pub(super) fn reference_levels(
     texels: &[Texel],
     (w, h): (u32, u32),
     model: ShadingModel,
     approx: AmbientApprox,
 ) -> Vec<Vec<[f32; 3]>> {
-    let lut = crate::model::maps::chi_lut(model, approx);
     let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
-    let ka = |t: &Texel| -> [f32; 3] {
-        let [chi, offset] = lut[t.n as usize];
-        std::array::from_fn(|c| {
-            diffuse * decode_unorm(t.kd[c]) + decode_unorm(t.ks[c]) * chi + offset
-        })
+    // k_d, k_s (linear), n in blend space.
+    let exact = |t: &Texel| -> [f32; 7] {
+        let mut v = [0.0; 7];
+        for c in 0..3 {
+            v[c] = decode_unorm(t.kd[c]);
+            v[3 + c] = decode_unorm(t.ks[c]);
+        }
+        v[6] = n_to_blend(decode_n(t.n));
+        v
     };
     let mut out: Vec<Vec<[f32; 3]>> = Vec::new();
     let mut size = (w, h);
+    let mut prev: Option<Vec<[f32; 7]>> = None;
     for _ in 1..crate::export::ktx::level_count(w, h) {
-        let next = crate::export::ktx::box_down(size, |i| match out.last() {
-            None => ka(&texels[i]),
-            Some(prev) => prev[i],
+        let next = crate::export::ktx::box_down(size, |i| match &prev {
+            None => exact(&texels[i]),
+            Some(p) => p[i],
         });
         size = ((size.0 / 2).max(1), (size.1 / 2).max(1));
-        out.push(next);
+        out.push(
+            next.par_iter()
+                .map(|v| {
+                    let [chi, offset] =
+                        reflectance::chi_parts_f32(model, approx, n_from_blend(v[6]));
+                    std::array::from_fn(|c| diffuse * v[c] + v[3 + c] * chi + offset)
+                })
+                .collect(),
+        );
+        prev = Some(next);
     }
     out
 }

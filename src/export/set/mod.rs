@@ -245,7 +245,12 @@ fn export_into(
         for item in encoded {
             let (file, comps, mut image) = item?;
             if let Some(k) = image.ktx.as_mut() {
-                mips.push((comps.clone(), std::mem::take(&mut k.mips), image.srgb));
+                mips.push(Mips {
+                    comps: comps.clone(),
+                    levels: std::mem::take(&mut k.mips),
+                    srgb: image.srgb,
+                    half: image.half,
+                });
             }
             let path = tmp.join(&file);
             crate::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
@@ -263,6 +268,7 @@ fn export_into(
                     ColourSpace::Linear
                 },
                 bit_depth: match preset.format {
+                    _ if image.half => 16,
                     Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 8,
                     Format::Png16 => 16,
                     Format::Exr => 32,
@@ -277,8 +283,9 @@ fn export_into(
             if let Some(data) = image.stored {
                 stored.push(StoredImage {
                     comps,
-                    data,
+                    data: data.into(),
                     srgb: image.srgb,
+                    half: image.half,
                 });
             }
         }
@@ -343,8 +350,13 @@ fn export_into(
     })
 }
 
-/// A KTX2 file's components, its levels past 0 as decoded, and whether its colour is sRGB.
-type Mips = (Vec<Comp>, Vec<Vec<u8>>, bool);
+/// A KTX2 file's components, its levels past 0 as decoded, and how its colour is stored.
+struct Mips {
+    comps: Vec<Comp>,
+    levels: Vec<Vec<u8>>,
+    srgb: bool,
+    half: bool,
+}
 
 /// The `k_a` error of every mip level past 0 of a KTX2 set (`mips`: per file, its
 /// components and levels 1 and on as decoded), against the exact level 0 averaged over each
@@ -364,11 +376,12 @@ fn level_errors(
         .map(|(l, want)| {
             let stored: Vec<StoredImage> = mips
                 .iter()
-                .filter_map(|(comps, levels, srgb)| {
+                .filter_map(|m| {
                     Some(StoredImage {
-                        comps: comps.clone(),
-                        data: levels.get(l)?.clone(),
-                        srgb: *srgb,
+                        comps: m.comps.clone(),
+                        data: m.levels.get(l)?[..].into(),
+                        srgb: m.srgb,
+                        half: m.half,
                     })
                 })
                 .collect();
