@@ -165,6 +165,13 @@ mod ispc {
     /// Encodes `rows` texel rows (a multiple of 4) of a `width`-wide image into `out`.
     pub(super) fn encode(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mut [u8]) {
         let stride = width * kind.texel_bytes() as u32;
+        // BC7 and BC6H read four components (bytes or half floats).
+        let rgba = RgbaSurface {
+            data,
+            width,
+            height: rows,
+            stride,
+        };
         match kind {
             BlockKind::Bc4 => bc4::compress_blocks_into(
                 &RSurface {
@@ -184,26 +191,12 @@ mod ispc {
                 },
                 out,
             ),
-            BlockKind::Bc7 { alpha, effort } => bc7::compress_blocks_into(
-                &bc7_settings(effort, alpha),
-                &RgbaSurface {
-                    data,
-                    width,
-                    height: rows,
-                    stride,
-                },
-                out,
-            ),
-            BlockKind::Bc6h { effort } => bc6h::compress_blocks_into(
-                &bc6h_settings(effort),
-                &RgbaSurface {
-                    data,
-                    width,
-                    height: rows,
-                    stride,
-                },
-                out,
-            ),
+            BlockKind::Bc7 { alpha, effort } => {
+                bc7::compress_blocks_into(&bc7_settings(effort, alpha), &rgba, out);
+            }
+            BlockKind::Bc6h { effort } => {
+                bc6h::compress_blocks_into(&bc6h_settings(effort), &rgba, out);
+            }
         }
     }
 }
@@ -342,7 +335,6 @@ pub fn decode_stored(
     (width, height): (u32, u32),
     stored: usize,
 ) -> Vec<u8> {
-    let per = kind.texel_bytes();
     let row_bytes = (width as usize / 4) * kind.block_bytes();
     let mut out = vec![0_u8; width as usize * height as usize * stored];
     let variant = kind.variant();
@@ -350,22 +342,27 @@ pub fn decode_stored(
         .zip(blocks.par_chunks(row_bytes * STRIP))
         .for_each(|(dst, src)| {
             let rows = (src.len() / row_bytes * 4) as u32;
-            let mut wide = vec![0_u8; width as usize * rows as usize * per];
-            if let BlockKind::Bc6h { .. } = kind {
-                decode_bc6h(src, width as usize, &mut wide);
-            } else if per == 4 {
-                decompress_blocks_as_rgba8(variant, width, rows, src, &mut wide);
+            // Whole texels as the decoder writes them (BC6H's halves, else RGBA8): into `dst`
+            // where it holds them whole, else into a strip narrowed into it.
+            let whole = if let BlockKind::Bc6h { .. } = kind {
+                8
             } else {
-                let mut rgba = vec![0_u8; width as usize * rows as usize * 4];
-                decompress_blocks_as_rgba8(variant, width, rows, src, &mut rgba);
-                for (d, s) in wide.chunks_exact_mut(per).zip(rgba.chunks_exact(4)) {
-                    d.copy_from_slice(&s[..per]);
-                }
+                4
+            };
+            let mut strip = Vec::new();
+            let texels: &mut [u8] = if stored == whole {
+                &mut *dst
+            } else {
+                strip.resize(width as usize * rows as usize * whole, 0);
+                &mut strip
+            };
+            if whole == 8 {
+                decode_bc6h(src, width as usize, texels);
+            } else {
+                decompress_blocks_as_rgba8(variant, width, rows, src, texels);
             }
-            if stored == per {
-                dst.copy_from_slice(&wide);
-            } else {
-                for (d, s) in dst.chunks_exact_mut(stored).zip(wide.chunks_exact(per)) {
+            if stored != whole {
+                for (d, s) in dst.chunks_exact_mut(stored).zip(strip.chunks_exact(whole)) {
                     d.copy_from_slice(&s[..stored]);
                 }
             }
