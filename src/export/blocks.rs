@@ -81,7 +81,8 @@ impl BlockKind {
         }
     }
 
-    fn variant(self) -> CompressionVariant {
+    /// `block_compression`'s name and settings for the kind.
+    pub(crate) fn variant(self) -> CompressionVariant {
         match self {
             Self::Bc4 => CompressionVariant::BC4,
             Self::Bc5 => CompressionVariant::BC5,
@@ -104,11 +105,24 @@ pub enum Encoder {
     Ispc,
     /// `block_compression`'s CPU port.
     Portable,
+    /// `block_compression`'s compute shaders on a GPU ([`crate::gpu::blocks`]); the CPU's
+    /// best encoder wherever the GPU fails.
+    Gpu,
 }
 
 impl Encoder {
-    /// The fastest encoder this CPU has.
+    /// The fastest encoder here: a hardware GPU's (see [`crate::gpu::blocks::shared`]), else
+    /// the CPU's.
     pub fn best() -> Self {
+        if crate::gpu::blocks::shared().is_some() {
+            Self::Gpu
+        } else {
+            Self::best_cpu()
+        }
+    }
+
+    /// The fastest encoder this CPU has.
+    pub fn best_cpu() -> Self {
         if cfg!(target_arch = "x86_64") {
             Self::Ispc
         } else {
@@ -262,10 +276,17 @@ pub fn encode_stored(
 ) -> Vec<u8> {
     debug_assert!(width % 4 == 0 && height % 4 == 0);
     let per = kind.texel_bytes();
+    let filler = kind.filler();
+    let encoder = match encoder {
+        Encoder::Gpu => match encode_on_gpu(kind, texels, stored, (width, height), progress) {
+            Some(blocks) => return blocks,
+            None => Encoder::best_cpu(),
+        },
+        cpu => cpu,
+    };
     let row_bytes = (width as usize / 4) * kind.block_bytes();
     let mut blocks = vec![0_u8; row_bytes * (height as usize / 4)];
     let strip_texels = STRIP * 4 * width as usize * stored;
-    let filler = kind.filler();
     blocks
         .par_chunks_mut(row_bytes * STRIP)
         .zip(texels.par_chunks(strip_texels))
@@ -296,6 +317,45 @@ pub fn encode_stored(
             }
         });
     blocks
+}
+
+/// [`encode_stored`] on the shared GPU encoder, each strip widened as it goes up; `None`
+/// where there is none or it failed (it is then given up for the rest of the process).
+fn encode_on_gpu(
+    kind: BlockKind,
+    texels: &[u8],
+    stored: usize,
+    (width, height): (u32, u32),
+    progress: Option<&Progress>,
+) -> Option<Vec<u8>> {
+    let gpu = crate::gpu::blocks::shared()?;
+    let filler = kind.filler();
+    let per = kind.texel_bytes();
+    let row_texels = width as usize * stored;
+    let mut fill = |row: u32, rows: u32, out: &mut [u8]| {
+        let src = &texels[row as usize * row_texels..(row + rows) as usize * row_texels];
+        if stored == per {
+            out.copy_from_slice(src);
+        } else {
+            for (d, s) in out.chunks_exact_mut(per).zip(src.chunks_exact(stored)) {
+                d.copy_from_slice(&filler[..per]);
+                d[..stored].copy_from_slice(s);
+            }
+        }
+    };
+    let mut strip_done = |rows: u32| {
+        progress.is_none_or(|p| {
+            p.advance(u64::from(rows));
+            !p.is_cancelled()
+        })
+    };
+    match gpu.encode(kind, (width, height), &mut fill, &mut strip_done) {
+        Ok(blocks) => Some(blocks),
+        Err(e) => {
+            crate::gpu::blocks::give_up(&e);
+            None
+        }
+    }
 }
 
 /// Decodes a strip of BC6H blocks, `width` texels wide, into RGBA half floats (alpha 1),

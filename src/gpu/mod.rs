@@ -1,6 +1,7 @@
 //! The wgpu side: it only mirrors the model (dirty tiles of the maps, the mesh) and shades it
 //! with `shaders/preview.wgsl`. Works headless on any adapter wgpu finds (lavapipe in CI).
 
+pub mod blocks;
 pub mod check;
 pub mod difference;
 pub mod headless;

@@ -519,14 +519,21 @@ impl EditorState {
 /// The notice of a finished export.
 fn exported_notice(dir: &std::path::Path, m: crate::export::Exported) -> String {
     match m {
-        crate::export::Exported::Set(m) => format!(
-            "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
-            dir.display(),
-            m.file_count(),
-            m.bytes.exported,
-            m.ka_error.max * 100.0,
-            m.ka_error.mean * 100.0
-        ),
+        crate::export::Exported::Set(m) => {
+            let mut text = format!(
+                "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
+                dir.display(),
+                m.file_count(),
+                m.bytes.exported,
+                m.ka_error.max * 100.0,
+                m.ka_error.mean * 100.0
+            );
+            if let Some(blocks) = &m.blocks {
+                text.push_str("; blocks: ");
+                text.push_str(&blocks.summary());
+            }
+            text
+        }
         crate::export::Exported::Pbr(m) => format!(
             "exported {} as glTF PBR ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%)",
             dir.display(),
@@ -535,5 +542,28 @@ fn exported_notice(dir: &std::path::Path, m: crate::export::Exported) -> String 
             m.round_trip.mean * 100.0,
             m.round_trip.p99 * 100.0
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_block_compressed_exports_notice_names_its_layout_encoder_and_verdict() {
+        let doc = crate::report::typical::stroke_edge_document(32, None).expect("project");
+        let out = std::env::temp_dir().join(format!("kapaint-notice-{}", std::process::id()));
+        let preset = crate::export::preset::find("ktx2").expect("preset");
+        let m = crate::export::set::export(&doc, &preset, &out).expect("export");
+        let blocks = m.blocks.clone().expect("a block-compressed set");
+        let text = exported_notice(&out, crate::export::Exported::Set(m));
+        let _ = std::fs::remove_dir_all(&out);
+        assert!(text.contains("; blocks: "), "{text}");
+        assert!(
+            text.contains(&format!("at {:?}", blocks.bc7_effort)),
+            "{text}"
+        );
+        assert!(text.contains("encoder"), "{text}");
+        assert!(text.contains("k_a budget"), "{text}");
     }
 }

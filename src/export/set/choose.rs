@@ -94,6 +94,37 @@ pub struct BlockChoice {
     pub trials: Vec<Trial>,
 }
 
+impl BlockChoice {
+    /// One line for people: the layout and effort chosen, the encoder, and the budget's
+    /// verdict (the manifest's `blocks` has the trials and the reason).
+    pub fn summary(&self) -> String {
+        let layout = match self.layout {
+            BlockLayout::Packed => "n packed in k_d's BC7",
+            BlockLayout::NApart => "n apart (BC4/BC5), colour BC7",
+            BlockLayout::HalfColour => "n apart (BC4/BC5), colour BC6H",
+        };
+        let encoder = match self.encoder {
+            Encoder::Ispc => "ISPC",
+            Encoder::Portable => "portable CPU",
+            Encoder::Gpu => "GPU",
+        };
+        let verdict = if self.within_budget {
+            "within the k_a budget".to_owned()
+        } else {
+            format!(
+                "over the k_a budget (max {}, mean {}): kept the nearest of {} trials",
+                pct(self.budget.max_ka_error),
+                pct(self.budget.mean_ka_error),
+                self.trials.len()
+            )
+        };
+        format!(
+            "{layout} at {:?}, {encoder} encoder, {verdict}",
+            self.bc7_effort
+        )
+    }
+}
+
 /// A set's images: file stem and components.
 pub(super) type Images = Vec<(&'static str, Vec<Comp>)>;
 

@@ -1,0 +1,198 @@
+//! Block encoding on the GPU (issue 21): `block_compression`'s compute shaders through
+//! `kapaint::gpu::blocks`, on whatever adapter there is (lavapipe here and in CI). Its blocks
+//! decode as close to the source as the CPU encoder's, strip by strip, for every kind; a
+//! whole `ktx2` export on it records the GPU encoder and reads back; and the command line
+//! leaves a software adapter alone unless asked.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use kapaint::export::blocks::{self, BlockKind, Encoder};
+use kapaint::export::ktx::{Space, psnr};
+use kapaint::export::preset::{self, Bc7Quality};
+use kapaint::export::set;
+use kapaint::gpu::blocks::{self as gpu_blocks, GpuBlockEncoder};
+use kapaint::report::typical::stroke_edge_document;
+
+fn spot() -> Option<PathBuf> {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_texture.png");
+    path.exists().then_some(path)
+}
+
+/// Soft gradients with a few hard edges, `per` bytes per texel (alpha opaque).
+fn pattern((w, h): (u32, u32), per: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(w as usize * h as usize * per);
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            for k in 0..per {
+                let edge = if (x / 9 + y / 7) % 3 == 0 { 60 } else { 0 };
+                let v = (x + y * 2 + k * 20 + edge).min(255);
+                out.push(if per == 4 && k == 3 { 255 } else { v as u8 });
+            }
+        }
+    }
+    out
+}
+
+/// The same texels as linear half floats (RGBA, alpha 1), BC6H's input.
+fn halves(bytes: &[u8]) -> Vec<u8> {
+    bytes
+        .chunks_exact(4)
+        .flat_map(|t| {
+            let v = [t[0], t[1], t[2]].map(|b| 0.01 + f32::from(b) / 255.0);
+            [v[0], v[1], v[2], 1.0]
+        })
+        .flat_map(|v| half::f16::from_f32(v).to_le_bytes())
+        .collect()
+}
+
+fn quality(kind: BlockKind, src: &[u8], blocks: &[u8], size: (u32, u32)) -> Vec<Option<f64>> {
+    let back = blocks::decode(kind, blocks, size);
+    if let BlockKind::Bc6h { .. } = kind {
+        // Compare as 8-bit values: the halves' relative error shows as dB like the rest.
+        let bytes = |d: &[u8]| -> Vec<u8> {
+            d.chunks_exact(2)
+                .map(|h| (half::f16::from_le_bytes([h[0], h[1]]).to_f32() * 255.0).round() as u8)
+                .collect()
+        };
+        let spaces = vec![Space::Linear; 4];
+        return psnr(&bytes(src), &bytes(&back), &spaces);
+    }
+    psnr(src, &back, &vec![Space::Linear; kind.texel_bytes()])
+}
+
+#[test]
+fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them() {
+    let Some(gpu) = common::gpu() else { return };
+    let adapter = format!("{} ({:?})", gpu.info.name, gpu.info.device_type);
+    // Strips of 8 texel rows: 44 rows are five whole strips and a short one. Building the
+    // pipelines takes a minute on lavapipe: one encoder serves the whole test.
+    let installed = gpu_blocks::install(GpuBlockEncoder::new(gpu).with_strip_rows(8));
+    assert!(installed, "nothing asked for the GPU encoder before");
+    let encoder = gpu_blocks::shared().expect("the installed encoder");
+    assert_eq!(Encoder::best(), Encoder::Gpu);
+    let size = (64, 44);
+    let kinds = [
+        BlockKind::Bc4,
+        BlockKind::Bc5,
+        BlockKind::Bc7 {
+            alpha: false,
+            effort: Bc7Quality::UltraFast,
+        },
+        BlockKind::Bc7 {
+            alpha: true,
+            effort: Bc7Quality::VeryFast,
+        },
+        BlockKind::Bc6h {
+            effort: Bc7Quality::UltraFast,
+        },
+    ];
+    for kind in kinds {
+        let src = if let BlockKind::Bc6h { .. } = kind {
+            halves(&pattern(size, 4))
+        } else {
+            pattern(size, kind.texel_bytes())
+        };
+        let row = size.0 as usize * kind.texel_bytes();
+        let mut strips = Vec::new();
+        let gpu_blocks = encoder
+            .encode(
+                kind,
+                size,
+                &mut |y, rows, out: &mut [u8]| {
+                    out.copy_from_slice(&src[y as usize * row..(y + rows) as usize * row]);
+                },
+                &mut |rows| {
+                    strips.push(rows);
+                    true
+                },
+            )
+            .expect("GPU encode");
+        assert_eq!(strips, [8, 8, 8, 8, 8, 4], "{kind:?}");
+        assert_eq!(
+            gpu_blocks.len(),
+            (size.0 * size.1) as usize / 16 * kind.block_bytes()
+        );
+        // Through the exporter's entry point too (texels widened strip by strip).
+        assert_eq!(
+            blocks::encode(Encoder::Gpu, kind, &src, size, None),
+            gpu_blocks,
+            "{kind:?}"
+        );
+        let cpu_blocks = blocks::encode(Encoder::best_cpu(), kind, &src, size, None);
+        let (on_gpu, on_cpu) = (
+            quality(kind, &src, &gpu_blocks, size),
+            quality(kind, &src, &cpu_blocks, size),
+        );
+        for (g, c) in on_gpu.iter().zip(&on_cpu) {
+            let (g, c) = (g.unwrap_or(99.0), c.unwrap_or(99.0));
+            // The shaders port the CPU kernels: the same quality, give or take rounding. A
+            // strip written to the wrong rows or a wrong source format falls below 20 dB.
+            assert!(
+                g > 30.0 && g > c - 1.0,
+                "{kind:?} on {adapter}: GPU {on_gpu:?} dB, CPU {on_cpu:?} dB"
+            );
+        }
+    }
+
+    // A whole export: the manifest names the GPU encoder, and the set reads back close.
+    let out = std::env::temp_dir().join(format!("kapaint-gpu-set-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let doc = stroke_edge_document(64, spot().as_deref()).expect("project");
+    let manifest = set::export(&doc, &preset::find("ktx2").expect("preset"), &out).expect("export");
+    let choice = manifest.blocks.as_ref().expect("a block-compressed set");
+    assert_eq!(choice.encoder, Encoder::Gpu);
+    assert!(
+        choice.trials.iter().all(|t| t.ka_error.mean < 0.02),
+        "{choice:?}"
+    );
+    for file in &manifest.files {
+        for p in file.psnr.iter().flatten().flatten() {
+            assert!(*p > 40.0, "{}: {p} dB", file.path);
+        }
+    }
+    set::import(&out.join("material.json")).expect("the set reads back");
+    let _ = std::fs::remove_dir_all(out);
+}
+
+#[test]
+fn the_cli_takes_the_gpu_encoder_only_on_a_hardware_adapter() {
+    let Some(gpu) = common::gpu() else { return };
+    let software = gpu_blocks::is_software(&gpu.info);
+    drop(gpu);
+    let dir = std::env::temp_dir().join(format!("kapaint-gpu-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let doc = stroke_edge_document(32, spot().as_deref()).expect("project");
+    let project = dir.join("p.kapaint");
+    kapaint::model::project::save(&doc, &project).expect("save");
+    let out = dir.join("set");
+    let export = |choice: &str| {
+        let _ = std::fs::remove_dir_all(&out);
+        let run = Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args(["export", "--preset", "ktx2", "--report", "--out"])
+            .arg(&out)
+            .arg(&project)
+            .env("KAPAINT_BLOCK_ENCODER", choice)
+            .output()
+            .expect("kapaint runs");
+        let report = String::from_utf8_lossy(&run.stdout).into_owned();
+        assert!(
+            run.status.success(),
+            "{report}{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        set::import(&out.join("material.json")).expect("the set reads back");
+        report
+    };
+    // `auto` (the default) leaves a software adapter alone: lavapipe builds the pipelines for
+    // a minute and encodes slower than the CPU. `cpu` never opens the GPU.
+    let auto = export("auto");
+    assert_eq!(auto.contains("(Gpu encoder)"), !software, "{auto}");
+    let cpu = export("cpu");
+    assert!(!cpu.contains("(Gpu encoder)"), "{cpu}");
+    let _ = std::fs::remove_dir_all(dir);
+}
