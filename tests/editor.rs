@@ -711,3 +711,30 @@ fn preset_thumbnails_follow_the_mesh() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_export_dialog_says_a_block_compressed_layout_is_chosen_at_export() {
+    let mut harness = editor();
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
+    harness.step();
+    harness.step();
+    harness
+        .get_by_role_and_label(Role::ComboBox, "Preset")
+        .click();
+    harness.step();
+    harness.get_by_label("ktx2").click();
+    harness.step();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness
+        .query_by_label_contains("chosen at export by the measured k_a error")
+        .is_none()
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the ktx2 preview never said how blocks are chosen"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+    harness.get_by_label_contains("then n apart with colour as BC6H");
+}

@@ -433,6 +433,12 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
         "{}",
         blocks.reason
     );
+    // The reason names the trial kept, not only the last one tried.
+    let kept = format!(
+        "kept the trial nearest it, {:?} at {:?}",
+        blocks.layout, blocks.bc7_effort
+    );
+    assert!(blocks.reason.contains(&kept), "{}", blocks.reason);
     // BC6H has no very-fast step of its own: ultra-fast, then fast, at most.
     assert!(
         blocks.trials.len() <= 3

@@ -147,6 +147,29 @@ pub(super) fn save_recent(list: &[PathBuf]) {
     }
 }
 
+/// For a block-compressed preset: the layout above is the search's first trial; the export
+/// measures and may move `n` out and colour to BC6H (the notice says what it chose).
+fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
+    if preset.format != crate::export::preset::Format::Ktx2Bc {
+        return;
+    }
+    let b = &preset.budget;
+    let then = if preset.bc6h {
+        "n apart with colour as BC6H"
+    } else {
+        "n apart"
+    };
+    ui.label(format!(
+        "Blocks: the layout and effort are chosen at export by the measured k_a error \
+         (budget max {:.2} %, mean {:.2} %, PSNR {:.0} dB or more): this layout first, then \
+         {then}, then more effort up to {:?}. The notice and material.json say what was kept.",
+        b.max_ka_error * 100.0,
+        b.mean_ka_error * 100.0,
+        b.min_psnr,
+        preset.max_bc7_effort
+    ));
+}
+
 /// The export dialog's state.
 pub(super) struct ExportDialog {
     presets: Vec<ExportPreset>,
@@ -454,7 +477,12 @@ impl EditorState {
                     .get(dialog.chosen)
                     .is_some_and(|p| p.format == crate::export::preset::Format::GltfPbr);
                 match &dialog.plan {
-                    Some((p, _, plan)) if *p == dialog.chosen => export_plan_ui(ui, plan, pbr),
+                    Some((p, _, plan)) if *p == dialog.chosen => {
+                        export_plan_ui(ui, plan, pbr);
+                        if let Some(preset) = dialog.presets.get(dialog.chosen) {
+                            block_search_ui(ui, preset);
+                        }
+                    }
                     _ => {
                         ui.horizontal(|ui| {
                             ui.spinner();

@@ -75,6 +75,21 @@ pub struct Trial {
     pub seconds: f64,
 }
 
+impl Trial {
+    /// The trial and its measures, for the manifest's reason.
+    fn describe(&self) -> String {
+        format!(
+            "{:?} at {:?}: k_a max {}, mean {}, PSNR {}",
+            self.layout,
+            self.bc7_effort,
+            pct(self.ka_error.max),
+            pct(self.ka_error.mean),
+            self.min_psnr
+                .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
+        )
+    }
+}
+
 /// How a block-compressed set's layout and effort were chosen.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BlockChoice {
@@ -387,12 +402,7 @@ pub(super) fn encode_blocks(
             min_psnr,
             seconds: started.elapsed().as_secs_f64(),
         });
-        let here = format!(
-            "{layout:?} at {effort:?}: k_a max {}, mean {}, PSNR {}",
-            pct(ka_error.max),
-            pct(ka_error.mean),
-            min_psnr.map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
-        );
+        let here = trials.last().map(Trial::describe).unwrap_or_default();
         if ka_ok && psnr_ok {
             reason = format!("{here}: within the budget");
             chosen = trials.len() - 1;
@@ -430,13 +440,14 @@ pub(super) fn encode_blocks(
                 }
             })
             .unwrap_or(0);
+        let kept = trials[chosen].describe();
         reason = if step + 1 < efforts.len() {
             format!(
-                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it ({here} last)"
+                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept} (the last: {here})"
             )
         } else {
             format!(
-                "no trial up to {:?} met the budget: kept the trial nearest it ({here} last)",
+                "no trial up to {:?} met the budget: kept the trial nearest it, {kept} (the last: {here})",
                 job.preset.max_bc7_effort
             )
         };
