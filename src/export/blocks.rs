@@ -215,6 +215,26 @@ mod ispc {
     }
 }
 
+/// `src`'s texels of `stored` bytes widened to `kind`'s whole texels (`to` bytes, at most
+/// [`BlockKind::texel_bytes`]) with its [`BlockKind::filler`], into `out`.
+fn widen_into(kind: BlockKind, src: &[u8], stored: usize, to: usize, out: &mut [u8]) {
+    let filler = kind.filler();
+    for (d, s) in out.chunks_exact_mut(to).zip(src.chunks_exact(stored)) {
+        d.copy_from_slice(&filler[..to]);
+        d[..stored].copy_from_slice(s);
+    }
+}
+
+/// `src` as [`widen_into`] widens it: borrowed where it already has `to` bytes per texel.
+fn widen(kind: BlockKind, src: &[u8], stored: usize, to: usize) -> std::borrow::Cow<'_, [u8]> {
+    if stored == to {
+        return src.into();
+    }
+    let mut out = vec![0; src.len() / stored * to];
+    widen_into(kind, src, stored, to, &mut out);
+    out.into()
+}
+
 /// Encodes one strip with the portable encoder (which reads RGBA8 whatever the kind, RGBA16F
 /// for BC6H).
 fn encode_portable(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mut [u8]) {
@@ -230,19 +250,7 @@ fn encode_portable(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mu
         );
         return;
     }
-    let per = kind.texel_bytes();
-    let rgba: std::borrow::Cow<'_, [u8]> = if per == 4 {
-        data.into()
-    } else {
-        data.chunks_exact(per)
-            .flat_map(|t| {
-                let mut px = [0, 0, 0, 255];
-                px[..per].copy_from_slice(t);
-                px
-            })
-            .collect::<Vec<u8>>()
-            .into()
-    };
+    let rgba = widen(kind, data, kind.texel_bytes(), 4);
     block_compression::encode::compress_rgba8(kind.variant(), &rgba, out, width, rows, width * 4);
 }
 
@@ -276,7 +284,6 @@ pub fn encode_stored(
 ) -> Vec<u8> {
     debug_assert!(width % 4 == 0 && height % 4 == 0);
     let per = kind.texel_bytes();
-    let filler = kind.filler();
     let encoder = match encoder {
         Encoder::Gpu => match encode_on_gpu(kind, texels, stored, (width, height), progress) {
             Some(blocks) => return blocks,
@@ -295,18 +302,7 @@ pub fn encode_stored(
                 return;
             }
             let rows = (out.len() / row_bytes * 4) as u32;
-            let wide: std::borrow::Cow<'_, [u8]> = if stored == per {
-                src.into()
-            } else {
-                src.chunks_exact(stored)
-                    .flat_map(|t| {
-                        let mut px = filler;
-                        px[..stored].copy_from_slice(t);
-                        px.into_iter().take(per)
-                    })
-                    .collect::<Vec<u8>>()
-                    .into()
-            };
+            let wide = widen(kind, src, stored, per);
             match encoder {
                 #[cfg(target_arch = "x86_64")]
                 Encoder::Ispc => ispc::encode(kind, &wide, width, rows, out),
@@ -329,19 +325,11 @@ fn encode_on_gpu(
     progress: Option<&Progress>,
 ) -> Option<Vec<u8>> {
     let gpu = crate::gpu::blocks::shared()?;
-    let filler = kind.filler();
     let per = kind.texel_bytes();
     let row_texels = width as usize * stored;
     let mut fill = |row: u32, rows: u32, out: &mut [u8]| {
         let src = &texels[row as usize * row_texels..(row + rows) as usize * row_texels];
-        if stored == per {
-            out.copy_from_slice(src);
-        } else {
-            for (d, s) in out.chunks_exact_mut(per).zip(src.chunks_exact(stored)) {
-                d.copy_from_slice(&filler[..per]);
-                d[..stored].copy_from_slice(s);
-            }
-        }
+        widen_into(kind, src, stored, per, out);
     };
     let mut strip_done = |rows: u32| {
         progress.is_none_or(|p| {

@@ -282,17 +282,9 @@ impl Strip {
         let bytes = dst.len() as u64;
         commands.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, bytes);
         gpu.queue.submit([commands.finish()]);
-        let slice = self.staging.slice(..bytes);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        gpu.wait();
+        let blocks = super::preview::read_buffer_prefix(gpu, &self.staging, bytes);
         scope.finish("block encoding")?;
-        let failed = |e: &dyn std::fmt::Display| GpuError(format!("block read-back failed: {e}"));
-        rx.recv().map_err(|e| failed(&e))?.map_err(|e| failed(&e))?;
-        dst.copy_from_slice(&slice.get_mapped_range().map_err(|e| failed(&e))?);
-        self.staging.unmap();
+        dst.copy_from_slice(&blocks?);
         Ok(())
     }
 }

@@ -11,6 +11,18 @@ use crate::model::{
     Channel, Channels, Command, Document, DocumentSettings, MaterialValue, StrokeTool, import,
 };
 
+/// [`textured`] with painting on `n` alone (what the documents then paint).
+fn textured_n_only(side: u32, texture: Option<&Path>) -> Result<Document, String> {
+    let mut doc = textured(side, texture)?;
+    doc.apply(Command::SetChannels(Channels {
+        kd: false,
+        ks: false,
+        n: true,
+    }))
+    .map_err(|e| e.to_string())?;
+    Ok(doc)
+}
+
 /// A `side x side` document of the default material with `texture` (if given) in `k_d`.
 fn textured(side: u32, texture: Option<&Path>) -> Result<Document, String> {
     let mut doc =
@@ -29,17 +41,9 @@ pub fn typical_document(
     texture: Option<&Path>,
     strokes: usize,
 ) -> Result<Document, String> {
-    let mut doc = textured(side, texture)?;
+    let mut doc = textured_n_only(side, texture)?;
     let s = side as f32;
     let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
-    apply(
-        &mut doc,
-        Command::SetChannels(Channels {
-            kd: false,
-            ks: false,
-            n: true,
-        }),
-    )?;
     apply(
         &mut doc,
         Command::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 2000.0)),
@@ -107,17 +111,9 @@ pub fn typical_document(
 /// # Errors
 /// A document that cannot be made, or a texture that does not read.
 pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Document, String> {
-    let mut doc = textured(side, texture)?;
+    let mut doc = textured_n_only(side, texture)?;
     let scale = side as f32 / 4096.0;
     let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
-    apply(
-        &mut doc,
-        Command::SetChannels(Channels {
-            kd: false,
-            ks: false,
-            n: true,
-        }),
-    )?;
     apply(
         &mut doc,
         Command::SetBrush(BrushSettings {

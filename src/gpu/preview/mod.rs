@@ -19,7 +19,9 @@ mod pipeline;
 pub use draw_data::{FrameUniforms, PreviewDrawData};
 pub use layout::{DrawPart, Layout, Scissor};
 pub use mesh::MeshBuffers;
-pub use offscreen::{COMPARED_MODELS, Offscreen, RenderedImage, read_buffer, read_texture};
+pub use offscreen::{
+    COMPARED_MODELS, Offscreen, RenderedImage, read_buffer, read_buffer_prefix, read_texture,
+};
 pub use pipeline::PipelineKey;
 
 use super::{Gpu, PipelineCache};

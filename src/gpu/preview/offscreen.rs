@@ -194,7 +194,19 @@ pub fn read_texture(
 /// # Errors
 /// When mapping fails.
 pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
-    let slice = buffer.slice(..);
+    read_buffer_prefix(gpu, buffer, buffer.size())
+}
+
+/// [`read_buffer`] of the first `bytes` of `buffer`.
+///
+/// # Errors
+/// When mapping fails.
+pub fn read_buffer_prefix(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<u8>, GpuError> {
+    let slice = buffer.slice(..bytes);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
