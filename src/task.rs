@@ -34,6 +34,16 @@ impl Progress {
         self.done.fetch_add(units, Ordering::Relaxed);
     }
 
+    /// Units of the current stage done so far.
+    pub fn done(&self) -> u64 {
+        self.done.load(Ordering::Relaxed)
+    }
+
+    /// Units in the current stage.
+    pub fn total(&self) -> u64 {
+        self.total.load(Ordering::Relaxed)
+    }
+
     /// The fraction of the current stage done, in `[0, 1]`.
     pub fn fraction(&self) -> f32 {
         let total = self.total.load(Ordering::Relaxed);

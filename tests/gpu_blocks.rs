@@ -1,13 +1,21 @@
 //! Block encoding on the GPU (issue 21): `block_compression`'s compute shaders through
 //! `kapaint::gpu::blocks`, on whatever adapter there is (lavapipe here and in CI). Its blocks
 //! decode as close to the source as the CPU encoder's, strip by strip, for every kind; a
-//! whole `ktx2` export on it records the GPU encoder and reads back; and the command line
-//! leaves a software adapter alone unless asked.
+//! whole `ktx2` export on it records the GPU encoder and reads back; a device lost part-way
+//! hands the rest to the CPU; and the command line leaves a software adapter alone unless
+//! asked.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
 mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 use kapaint::export::blocks::{self, BlockKind, Encoder};
 use kapaint::export::ktx::{Space, psnr};
@@ -15,6 +23,7 @@ use kapaint::export::preset::{self, Bc7Quality};
 use kapaint::export::set;
 use kapaint::gpu::blocks::{self as gpu_blocks, GpuBlockEncoder};
 use kapaint::report::typical::stroke_edge_document;
+use kapaint::task::Progress;
 
 fn spot() -> Option<PathBuf> {
     let path =
@@ -155,7 +164,58 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
         }
     }
     set::import(&out.join("material.json")).expect("the set reads back");
+
+    // Last: it ends this process's GPU encoder.
+    lost_part_way_through_an_export(encoder, &out);
     let _ = std::fs::remove_dir_all(out);
+}
+
+/// The device lost after the first strip of an export: the CPU goes on from the strip that
+/// failed, so no strip is missing and none is counted twice, and the manifest names the CPU
+/// encoder that finished, and why.
+fn lost_part_way_through_an_export(encoder: &GpuBlockEncoder, out: &Path) {
+    assert!(gpu_blocks::failure().is_none());
+    let _ = std::fs::remove_dir_all(out);
+    let doc = stroke_edge_document(256, spot().as_deref()).expect("project");
+    let (progress, finished) = (Progress::default(), AtomicBool::new(false));
+    let (manifest, (lost_in, most, total)) = std::thread::scope(|s| {
+        let watch = s.spawn(|| {
+            let running = || !finished.load(Ordering::Relaxed);
+            // As soon as the first strip of the first trial is counted.
+            while running() && !(progress.stage() == "encode" && progress.done() > 0) {
+                std::thread::sleep(Duration::from_micros(50));
+            }
+            encoder.gpu().device.destroy();
+            let (lost_in, total) = (progress.done(), progress.total());
+            let mut most = 0;
+            while running() && progress.stage() == "encode" && progress.total() == total {
+                most = most.max(progress.done());
+                std::thread::yield_now();
+            }
+            (lost_in, most, total)
+        });
+        let manifest =
+            set::export_with(&doc, &preset::find("ktx2").expect("preset"), out, &progress);
+        finished.store(true, Ordering::Relaxed);
+        (manifest, watch.join().expect("watcher"))
+    });
+    let manifest = manifest.expect("the CPU finishes the export");
+    let why = gpu_blocks::failure().expect("the lost device was noticed");
+    let choice = manifest.blocks.as_ref().expect("a block-compressed set");
+    assert_eq!(choice.encoder, Encoder::best_cpu(), "{choice:?}");
+    assert_eq!(choice.gpu_failed.as_deref(), Some(why));
+    assert!(choice.summary().contains("the GPU encoder failed part-way"));
+    assert!(
+        lost_in > 0 && lost_in < total && most <= total,
+        "lost after {lost_in} of {total} rows, counted {most}"
+    );
+    for file in &manifest.files {
+        // A strip left empty or written to the wrong rows falls far below this.
+        for p in file.psnr.iter().flatten().flatten() {
+            assert!(*p > 40.0, "{}: {p} dB", file.path);
+        }
+    }
+    set::import(&out.join("material.json")).expect("the set reads back");
 }
 
 #[test]

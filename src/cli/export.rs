@@ -70,6 +70,12 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
             },
             b.reason
         );
+        if let Some(why) = &b.gpu_failed {
+            let _ = writeln!(
+                text,
+                "  the GPU encoder failed part-way ({why}): the CPU finished"
+            );
+        }
         for t in &b.trials {
             let _ = writeln!(
                 text,

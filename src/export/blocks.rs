@@ -58,6 +58,11 @@ impl BlockKind {
         }
     }
 
+    /// Bytes of the blocks covering a `(width, height)` image (sides multiples of 4).
+    pub fn blocks_len(self, (width, height): (u32, u32)) -> usize {
+        (width as usize / 4) * (height as usize / 4) * self.block_bytes()
+    }
+
     /// Bytes per texel of the input (and of [`decode`]'s output): 1, 2 or 4 bytes, or four
     /// little-endian half floats (8 bytes) for BC6H.
     pub fn texel_bytes(self) -> usize {
@@ -284,19 +289,25 @@ pub fn encode_stored(
 ) -> Vec<u8> {
     debug_assert!(width % 4 == 0 && height % 4 == 0);
     let per = kind.texel_bytes();
-    let encoder = match encoder {
-        Encoder::Gpu => match encode_on_gpu(kind, texels, stored, (width, height), progress) {
-            Some(blocks) => return blocks,
-            None => Encoder::best_cpu(),
-        },
-        cpu => cpu,
+    let mut blocks = vec![0_u8; kind.blocks_len((width, height))];
+    let (encoder, from_row) = match encoder {
+        Encoder::Gpu => {
+            let done = encode_on_gpu(kind, texels, stored, (width, height), progress, &mut blocks);
+            if done == height {
+                return blocks;
+            }
+            (Encoder::best_cpu(), done)
+        }
+        cpu => (cpu, 0),
     };
+    // The rows the GPU did not encode (all of them, mostly).
     let row_bytes = (width as usize / 4) * kind.block_bytes();
-    let mut blocks = vec![0_u8; row_bytes * (height as usize / 4)];
+    let first_block = row_bytes * from_row as usize / 4;
+    let first_texel = from_row as usize * width as usize * stored;
     let strip_texels = STRIP * 4 * width as usize * stored;
-    blocks
+    blocks[first_block..]
         .par_chunks_mut(row_bytes * STRIP)
-        .zip(texels.par_chunks(strip_texels))
+        .zip(texels[first_texel..].par_chunks(strip_texels))
         .for_each(|(out, src)| {
             if progress.is_some_and(Progress::is_cancelled) {
                 return;
@@ -315,16 +326,21 @@ pub fn encode_stored(
     blocks
 }
 
-/// [`encode_stored`] on the shared GPU encoder, each strip widened as it goes up; `None`
-/// where there is none or it failed (it is then given up for the rest of the process).
+/// [`encode_stored`] on the shared GPU encoder into `blocks`, each strip widened as it goes
+/// up: the texel rows whose blocks are in place, from the top. Short of `height` where there
+/// is no GPU encoder (0) or it failed part-way (it is then given up for the rest of the
+/// process, and the CPU goes on from there: no strip is encoded or counted twice).
 fn encode_on_gpu(
     kind: BlockKind,
     texels: &[u8],
     stored: usize,
     (width, height): (u32, u32),
     progress: Option<&Progress>,
-) -> Option<Vec<u8>> {
-    let gpu = crate::gpu::blocks::shared()?;
+    blocks: &mut [u8],
+) -> u32 {
+    let Some(gpu) = crate::gpu::blocks::shared() else {
+        return 0;
+    };
     let per = kind.texel_bytes();
     let row_texels = width as usize * stored;
     let mut fill = |row: u32, rows: u32, out: &mut [u8]| {
@@ -337,11 +353,11 @@ fn encode_on_gpu(
             !p.is_cancelled()
         })
     };
-    match gpu.encode(kind, (width, height), &mut fill, &mut strip_done) {
-        Ok(blocks) => Some(blocks),
-        Err(e) => {
-            crate::gpu::blocks::give_up(&e);
-            None
+    match gpu.encode_into(kind, (width, height), &mut fill, &mut strip_done, blocks) {
+        Ok(()) => height,
+        Err(stopped) => {
+            crate::gpu::blocks::give_up(&stopped.error);
+            stopped.rows_done
         }
     }
 }

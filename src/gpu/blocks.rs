@@ -9,7 +9,6 @@
 //! so [`shared`] opens only a hardware one unless `KAPAINT_BLOCK_ENCODER=gpu` asks for
 //! any adapter (how the tests reach this code on a machine without a GPU).
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, OnceLock};
 
 use block_compression::GpuBlockCompressor;
@@ -68,8 +67,8 @@ impl Choice {
     }
 }
 
-/// Set once a GPU encode failed: later encodes stay on the CPU.
-static FAILED: AtomicBool = AtomicBool::new(false);
+/// Why the first GPU encode that failed did: once set, later encodes stay on the CPU.
+static FAILED: OnceLock<String> = OnceLock::new();
 
 /// The process's GPU block encoder, once opened or installed.
 static SHARED: OnceLock<Option<GpuBlockEncoder>> = OnceLock::new();
@@ -88,7 +87,7 @@ pub fn install(encoder: GpuBlockEncoder) -> bool {
 ///
 /// Opening builds the compute pipelines: 67 s on lavapipe on 2 cores, once per process.
 pub fn shared() -> Option<&'static GpuBlockEncoder> {
-    if FAILED.load(Ordering::Relaxed) {
+    if FAILED.get().is_some() {
         return None;
     }
     SHARED
@@ -106,10 +105,26 @@ pub fn shared() -> Option<&'static GpuBlockEncoder> {
         .as_ref()
 }
 
-/// Marks the GPU encoder as failed: [`shared`] answers `None` from now on.
+/// Marks the GPU encoder as failed: [`shared`] answers `None` from now on, and [`failure`]
+/// says why (the first reason given).
 pub fn give_up(why: &GpuError) {
     eprintln!("kapaint: GPU block encoding failed ({why}); encoding on the CPU from now on");
-    FAILED.store(true, Ordering::Relaxed);
+    let _ = FAILED.set(why.to_string());
+}
+
+/// Why the GPU encoder was given up, if it was ([`give_up`]).
+pub fn failure() -> Option<&'static str> {
+    FAILED.get().map(String::as_str)
+}
+
+/// A GPU encode stopped by a failure part-way: the error, and the texel rows from the top whose
+/// blocks were encoded and read back before it (they are in place; the rest is not).
+#[derive(Debug)]
+pub struct Interrupted {
+    /// What failed.
+    pub error: GpuError,
+    /// Texel rows encoded before it, a multiple of 4.
+    pub rows_done: u32,
 }
 
 /// The texture format the shaders read a kind's texels from.
@@ -143,6 +158,11 @@ impl GpuBlockEncoder {
         }
     }
 
+    /// The device it encodes on.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
     /// The adapter's name and backend, for reports.
     pub fn adapter(&self) -> &wgpu::AdapterInfo {
         &self.gpu.info
@@ -158,25 +178,52 @@ impl GpuBlockEncoder {
     pub fn encode(
         &self,
         kind: BlockKind,
-        (width, height): (u32, u32),
+        size: (u32, u32),
         fill: &mut dyn FnMut(u32, u32, &mut [u8]),
         strip_done: &mut dyn FnMut(u32) -> bool,
     ) -> Result<Vec<u8>, GpuError> {
+        let mut blocks = vec![0_u8; kind.blocks_len(size)];
+        self.encode_into(kind, size, fill, strip_done, &mut blocks)
+            .map_err(|e| e.error)?;
+        Ok(blocks)
+    }
+
+    /// [`encode`](Self::encode) into `blocks` ([`BlockKind::blocks_len`] bytes), which keeps
+    /// the strips finished before a failure.
+    ///
+    /// # Errors
+    /// As [`encode`](Self::encode), with the rows whose blocks are in place.
+    pub fn encode_into(
+        &self,
+        kind: BlockKind,
+        (width, height): (u32, u32),
+        fill: &mut dyn FnMut(u32, u32, &mut [u8]),
+        strip_done: &mut dyn FnMut(u32) -> bool,
+        blocks: &mut [u8],
+    ) -> Result<(), Interrupted> {
         debug_assert!(width % 4 == 0 && height % 4 == 0);
+        debug_assert_eq!(blocks.len(), kind.blocks_len((width, height)));
+        let at_start = |error| Interrupted {
+            error,
+            rows_done: 0,
+        };
         let row_bytes = width as usize * kind.texel_bytes();
         let fit = u32::try_from(STRIP_BYTES / row_bytes.max(1)).unwrap_or(u32::MAX);
         let strip_rows = (fit.min(self.strip_rows) / 4 * 4).clamp(4, height);
         self.gpu
-            .check_texture_size("a level to block-encode", (width, strip_rows))?;
+            .check_texture_size("a level to block-encode", (width, strip_rows))
+            .map_err(at_start)?;
         let blocks_row = (width as usize / 4) * kind.block_bytes();
-        let mut blocks = vec![0_u8; blocks_row * (height as usize / 4)];
         let mut compressor = self
             .compressor
             .lock()
-            .map_err(|_| GpuError("the GPU block encoder is poisoned".into()))?;
-        let strip = self.gpu.checked("block encoding", || {
-            Strip::new(&self.gpu, kind, (width, strip_rows))
-        })?;
+            .map_err(|_| at_start(GpuError("the GPU block encoder is poisoned".into())))?;
+        let strip = self
+            .gpu
+            .checked("block encoding", || {
+                Strip::new(&self.gpu, kind, (width, strip_rows))
+            })
+            .map_err(at_start)?;
         let mut texels = vec![0_u8; row_bytes * strip_rows as usize];
         let mut row = 0;
         while row < height {
@@ -185,13 +232,18 @@ impl GpuBlockEncoder {
             fill(row, rows, src);
             let at = blocks_row * row as usize / 4;
             let dst = &mut blocks[at..at + blocks_row * rows as usize / 4];
-            strip.encode(&self.gpu, &mut compressor, kind, src, rows, dst)?;
+            strip
+                .encode(&self.gpu, &mut compressor, kind, src, rows, dst)
+                .map_err(|error| Interrupted {
+                    error,
+                    rows_done: row,
+                })?;
             row += rows;
             if !strip_done(rows) {
                 break;
             }
         }
-        Ok(blocks)
+        Ok(())
     }
 }
 

@@ -93,8 +93,12 @@ impl Trial {
 /// How a block-compressed set's layout and effort were chosen.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BlockChoice {
-    /// The block encoder that ran.
+    /// The block encoder that finished the set.
     pub encoder: Encoder,
+    /// Why the GPU encoder failed, where it began this set and a CPU encoder (`encoder`)
+    /// finished it. Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gpu_failed: Option<String>,
     /// Where `n` went.
     pub layout: BlockLayout,
     /// BC7's effort.
@@ -123,6 +127,11 @@ impl BlockChoice {
             Encoder::Portable => "portable CPU",
             Encoder::Gpu => "GPU",
         };
+        let encoder = if self.gpu_failed.is_some() {
+            format!("{encoder} encoder (the GPU encoder failed part-way)")
+        } else {
+            format!("{encoder} encoder")
+        };
         let verdict = if self.within_budget {
             "within the k_a budget".to_owned()
         } else {
@@ -133,10 +142,7 @@ impl BlockChoice {
                 self.trials.len()
             )
         };
-        format!(
-            "{layout} at {:?}, {encoder} encoder, {verdict}",
-            self.bc7_effort
-        )
+        format!("{layout} at {:?}, {encoder}, {verdict}", self.bc7_effort)
     }
 }
 
@@ -484,10 +490,20 @@ pub(super) fn encode_blocks(
     }
     let within_budget =
         within(&budget, pick.ka_error) && pick.min_psnr.is_none_or(|p| p >= budget.min_psnr);
+    // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
+    let gpu_failed = (encoder == Encoder::Gpu)
+        .then(crate::gpu::blocks::failure)
+        .flatten()
+        .map(str::to_owned);
     Ok((
         encoded,
         BlockChoice {
-            encoder,
+            encoder: if gpu_failed.is_some() {
+                Encoder::best_cpu()
+            } else {
+                encoder
+            },
+            gpu_failed,
             layout: pick.layout,
             bc7_effort: pick.bc7_effort,
             budget,
