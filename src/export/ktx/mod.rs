@@ -122,6 +122,18 @@ pub struct Compressed {
     pub blocks: Vec<u8>,
     /// Decoded, cropped to the level.
     pub decoded: Vec<u8>,
+    /// Per component, [`psnr`] of `decoded` against the level, once measured
+    /// ([`Compressed::psnr`]).
+    pub psnr: Option<Vec<Option<f64>>>,
+}
+
+impl Compressed {
+    /// Per component, [`psnr`] of the decoded blocks against `level` (the texels they were
+    /// encoded from, of components in `spaces`), measured once.
+    pub fn psnr(&mut self, level: &[u8], spaces: &[Space]) -> &[Option<f64>] {
+        self.psnr
+            .get_or_insert_with(|| psnr(level, &self.decoded, spaces))
+    }
 }
 
 /// The block kind of an image of `spaces` at `effort` (BC7 and BC6H only): BC6H for half
@@ -157,7 +169,11 @@ pub fn compress_level(
     } else {
         crop(&decoded, padded.0, (w, h), channels, channels)
     };
-    Compressed { blocks, decoded }
+    Compressed {
+        blocks,
+        decoded,
+        psnr: None,
+    }
 }
 
 /// Per component, PSNR (dB) of `decoded` against `reference` (texels of components in
@@ -165,42 +181,60 @@ pub fn compress_level(
 /// floats compare sRGB-encoded, on the same scale, so a BC6H image's PSNR reads like a BC7
 /// image's.
 pub fn psnr(reference: &[u8], decoded: &[u8], spaces: &[Space]) -> Vec<Option<f64>> {
+    /// Texels per parallel run: a run of both images stays in cache while each component's
+    /// differences are summed.
+    const RUN: usize = 1 << 14;
     let (per, offsets) = texel_layout(spaces);
-    // Half floats by their bits: sRGB-encoded, on the byte scale.
-    let halves: Vec<f32> = if spaces.contains(&Space::Half) {
-        (0..=u16::MAX)
-            .map(|b| {
-                let v = half::f16::from_bits(b).to_f32();
-                let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-                crate::model::texel::linear_to_srgb(v) * 255.0
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let level = |t: &[u8], k: usize| -> f64 {
-        let o = offsets[k];
-        if spaces[k] == Space::Half {
-            f64::from(halves[usize::from(u16::from_le_bytes([t[o], t[o + 1]]))])
-        } else {
-            f64::from(t[o])
-        }
-    };
-    (0..spaces.len())
-        .map(|k| {
-            let sum: f64 = reference
-                .par_chunks(per)
-                .zip(decoded.par_chunks(per))
-                .map(|(a, b)| {
-                    let d = level(a, k) - level(b, k);
-                    d * d
+    let n = spaces.len();
+    let sums = reference
+        .par_chunks(per * RUN)
+        .zip(decoded.par_chunks(per * RUN))
+        .map(|(a, b)| {
+            let pairs = || a.chunks_exact(per).zip(b.chunks_exact(per));
+            (0..n)
+                .map(|k| {
+                    let o = offsets[k];
+                    if spaces[k] == Space::Half {
+                        let level = |t: &[u8]| {
+                            f64::from(
+                                HALF_LEVELS[usize::from(u16::from_le_bytes([t[o], t[o + 1]]))],
+                            )
+                        };
+                        pairs().map(|(x, y)| (level(x) - level(y)).powi(2)).sum()
+                    } else {
+                        // Whole bytes: exact integer sums.
+                        let sum: u64 = pairs()
+                            .map(|(x, y)| u64::from(x[o].abs_diff(y[o])).pow(2))
+                            .sum();
+                        sum as f64
+                    }
                 })
-                .sum();
-            let mse = sum / (reference.len() / per).max(1) as f64;
+                .collect::<Vec<f64>>()
+        })
+        .reduce(
+            || vec![0.0; n],
+            |x, y| x.iter().zip(&y).map(|(x, y)| x + y).collect(),
+        );
+    let texels = (reference.len() / per).max(1) as f64;
+    sums.into_iter()
+        .map(|sum| {
+            let mse = sum / texels;
             (mse > 0.0).then(|| 10.0 * (255.0_f64 * 255.0 / mse).log10())
         })
         .collect()
 }
+
+/// Every half float's bits as the byte-scale level [`psnr`] compares: clamped to `[0, 1]`
+/// (NaN as 0) and sRGB-encoded.
+static HALF_LEVELS: std::sync::LazyLock<Vec<f32>> = std::sync::LazyLock::new(|| {
+    (0..=u16::MAX)
+        .map(|b| {
+            let v = half::f16::from_bits(b).to_f32();
+            let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+            crate::model::texel::linear_to_srgb(v) * 255.0
+        })
+        .collect()
+});
 
 /// A written KTX2 file.
 #[derive(Clone, Debug)]
@@ -283,7 +317,7 @@ pub fn encode(
         }
         Some((encoder, effort)) => {
             let kind = block_kind(source.spaces, effort);
-            let first = match level0 {
+            let mut first = match level0 {
                 Some(c) => {
                     progress.advance(u64::from(h));
                     c
@@ -293,7 +327,7 @@ pub fn encode(
             if progress.is_cancelled() {
                 return Err("cancelled".into());
             }
-            psnr_values = Some(psnr(source.level0, &first.decoded, source.spaces));
+            psnr_values = Some(first.psnr(source.level0, source.spaces).to_vec());
             level_bytes.push(first.blocks);
             decoded.push(first.decoded);
             for (size, bytes) in &chain {
@@ -435,6 +469,56 @@ mod tests {
                 assert!(p.iter().all(|p| p.is_none_or(|p| p > 30.0)), "{p:?}");
             }
         }
+    }
+
+    #[test]
+    fn psnr_sums_every_texel_of_every_component() {
+        // A byte component and a half float one, more texels than one parallel run, and a
+        // texel that differs only in the last run's tail.
+        let spaces = [Space::Linear, Space::Half];
+        let texels = (1 << 14) * 3 + 5;
+        let texel = |i: usize, shift: u8| {
+            let h = half::f16::from_f32((i % 97) as f32 / 97.0);
+            let [lo, hi] = h.to_le_bytes();
+            [(i % 251) as u8 ^ shift, lo, hi]
+        };
+        let a: Vec<u8> = (0..texels).flat_map(|i| texel(i, 0)).collect();
+        let mut b: Vec<u8> = (0..texels)
+            .flat_map(|i| texel(i, u8::from(i % 7 == 0)))
+            .collect();
+        let last = b.len() - 2;
+        b[last] ^= 1;
+        let to_level = |t: &[u8]| {
+            let v = half::f16::from_le_bytes([t[1], t[2]])
+                .to_f32()
+                .clamp(0.0, 1.0);
+            f64::from(crate::model::texel::linear_to_srgb(v) * 255.0)
+        };
+        let naive = |k: usize| {
+            let sum: f64 = a
+                .chunks_exact(3)
+                .zip(b.chunks_exact(3))
+                .map(|(x, y)| {
+                    let d = if k == 0 {
+                        f64::from(x[0]) - f64::from(y[0])
+                    } else {
+                        to_level(x) - to_level(y)
+                    };
+                    d * d
+                })
+                .sum();
+            10.0 * (255.0_f64 * 255.0 / (sum / texels as f64)).log10()
+        };
+        let got = psnr(&a, &b, &spaces);
+        for (k, p) in got.iter().enumerate() {
+            let p = p.expect("they differ");
+            assert!(
+                (p - naive(k)).abs() < 1e-9,
+                "component {k}: {p} vs {}",
+                naive(k)
+            );
+        }
+        assert_eq!(psnr(&a, &a, &spaces), [None, None]);
     }
 
     #[test]

@@ -390,12 +390,13 @@ pub(super) fn encode_blocks(
         let stored: Vec<StoredImage> = images.iter().map(TrialImage::stored).collect();
         let ka_error = job.measure(&stored);
         let min_psnr = images
-            .iter()
+            .iter_mut()
             .filter_map(|i| {
-                let (_, c) = i.compressed.as_ref()?;
-                ktx::psnr(&i.level0, &c.decoded, i.texels.spaces())
-                    .into_iter()
+                let (_, c) = i.compressed.as_mut()?;
+                c.psnr(&i.level0, i.texels.spaces())
+                    .iter()
                     .flatten()
+                    .copied()
                     .reduce(f64::min)
             })
             .reduce(f64::min);
