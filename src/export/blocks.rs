@@ -326,6 +326,12 @@ pub fn encode_stored(
     blocks
 }
 
+/// Why the GPU encoder was given up in this process, if it was: blocks asked of
+/// [`Encoder::Gpu`] are then encoded on the CPU.
+pub fn gpu_failure() -> Option<&'static str> {
+    crate::gpu::blocks::failure()
+}
+
 /// [`encode_stored`] on the shared GPU encoder into `blocks`, each strip widened as it goes
 /// up: the texel rows whose blocks are in place, from the top. Short of `height` where there
 /// is no GPU encoder (0) or it failed part-way (it is then given up for the rest of the
@@ -353,7 +359,7 @@ fn encode_on_gpu(
             !p.is_cancelled()
         })
     };
-    match gpu.encode_into(kind, (width, height), &mut fill, &mut strip_done, blocks) {
+    match gpu.encode(kind, (width, height), &mut fill, &mut strip_done, blocks) {
         Ok(()) => height,
         Err(stopped) => {
             crate::gpu::blocks::give_up(&stopped.error);

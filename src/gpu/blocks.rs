@@ -169,31 +169,15 @@ impl GpuBlockEncoder {
     }
 
     /// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
-    /// bytes per texel, strip by strip: `fill(row, rows, texels)` writes texel rows
-    /// `row..row + rows` into `texels` (exactly `rows` rows). `strip_done(rows)` follows each
-    /// strip; it answers `false` to stop (the rest is then zeros).
+    /// bytes per texel into `blocks` ([`BlockKind::blocks_len`] bytes), strip by strip:
+    /// `fill(row, rows, texels)` writes texel rows `row..row + rows` into `texels` (exactly
+    /// `rows` rows). `strip_done(rows)` follows each strip; it answers `false` to stop (the
+    /// rest is then left as it was).
     ///
     /// # Errors
-    /// A side beyond the device's largest texture, or the device failed (out of memory, lost).
+    /// A side beyond the device's largest texture, or the device failed (out of memory,
+    /// lost), with the texel rows from the top whose blocks are in place.
     pub fn encode(
-        &self,
-        kind: BlockKind,
-        size: (u32, u32),
-        fill: &mut dyn FnMut(u32, u32, &mut [u8]),
-        strip_done: &mut dyn FnMut(u32) -> bool,
-    ) -> Result<Vec<u8>, GpuError> {
-        let mut blocks = vec![0_u8; kind.blocks_len(size)];
-        self.encode_into(kind, size, fill, strip_done, &mut blocks)
-            .map_err(|e| e.error)?;
-        Ok(blocks)
-    }
-
-    /// [`encode`](Self::encode) into `blocks` ([`BlockKind::blocks_len`] bytes), which keeps
-    /// the strips finished before a failure.
-    ///
-    /// # Errors
-    /// As [`encode`](Self::encode), with the rows whose blocks are in place.
-    pub fn encode_into(
         &self,
         kind: BlockKind,
         (width, height): (u32, u32),

@@ -124,7 +124,7 @@ pub struct Compressed {
     pub decoded: Vec<u8>,
     /// Per component, [`psnr`] of `decoded` against the level, once measured
     /// ([`Compressed::psnr`]).
-    pub psnr: Option<Vec<Option<f64>>>,
+    psnr: Option<Vec<Option<f64>>>,
 }
 
 impl Compressed {

@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
-use crate::export::blocks::{BlockKind, Encoder};
+use crate::export::blocks::{self, BlockKind, Encoder};
 use crate::export::encoding::{KaError, NEncoding};
 use crate::export::ktx::{self, Compressed};
 use crate::export::preset::{Bc7Quality, BlockBudget, ExportPreset, Format};
@@ -493,7 +493,7 @@ pub(super) fn encode_blocks(
         within(&budget, pick.ka_error) && pick.min_psnr.is_none_or(|p| p >= budget.min_psnr);
     // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
     let gpu_failed = (encoder == Encoder::Gpu)
-        .then(crate::gpu::blocks::failure)
+        .then(blocks::gpu_failure)
         .flatten()
         .map(str::to_owned);
     Ok((
