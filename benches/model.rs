@@ -246,7 +246,7 @@ fn autosave(c: &mut Criterion) {
     .expect("brush");
     let dir = std::env::temp_dir().join(format!("kapaint-bench-autosave-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let mut saver = Autosaver::new(Duration::ZERO, dir.join(".p.kapaint-recovery"), &doc);
+    let mut saver = Autosaver::new(Duration::ZERO, Some(&dir.join("p.kapaint")), &doc);
     let mut y = 200.0_f32;
     let mut stroke = |doc: &mut Document| {
         y = if y > 3800.0 { 200.0 } else { y + 300.0 };

@@ -1,9 +1,13 @@
 //! Atomic file writes, used by every save: a crash, a kill or a full disk never leaves a
 //! half-written file where the user's file was.
 //!
-//! A save writes a temporary file beside the target (`.NAME.PID.tmp`), flushes it to disk and
-//! renames it over the target. On top of that:
-//! - a write-protected target is refused, and any other target keeps its permissions;
+//! A save writes a temporary file beside the target (`.NAME.PID.RANDOM.tmp`), flushes it to
+//! disk and renames it over the target. On top of that:
+//! - the temporary file is made new (`O_CREAT | O_EXCL`, so never through a link planted at
+//!   its name) under a name nobody can guess, by the `tempfile` crate; it is readable by its
+//!   owner alone until it takes the target's mode;
+//! - a write-protected target is refused, and any other target keeps its permissions (a new
+//!   file gets the usual `0666` less the umask);
 //! - a symbolic link is written through: its target is replaced, the link stays a link;
 //! - temporary files that killed processes left beside the target are removed.
 
@@ -48,25 +52,55 @@ pub fn write_atomic_with(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     remove_stale(dir, &name);
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let guard = TempPath::new(tmp.clone());
-    let mut file = BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
+    let (file, tmp) = temporary_file(dir, &name, existing.is_none())?.into_parts();
+    let mut file = BufWriter::with_capacity(1 << 20, file);
     write(&mut file)?;
     let file = file
         .into_inner()
         .map_err(std::io::IntoInnerError::into_error)?;
     if let Some(meta) = &existing {
+        // On the open file: a link swapped in at the temporary's name changes nothing.
         file.set_permissions(meta.permissions())?;
     }
     file.sync_all()?;
     drop(file);
-    std::fs::rename(&tmp, path)?;
-    guard.keep();
+    tmp.persist(path).map_err(|e| e.error)?;
     if let Ok(d) = File::open(dir) {
         // Best effort: some file systems cannot sync a directory.
         let _ = d.sync_all();
     }
     Ok(())
+}
+
+/// A new temporary file in `dir` for a save to `name`: `.NAME.PID.RANDOM.tmp`, made with
+/// `O_EXCL` (a link or file already there is never opened), removed when dropped. A file that
+/// is `new` gets `0666` less the umask, as any new file would; a replacement starts owner-only
+/// and takes the target's mode once written.
+fn temporary_file(dir: &Path, name: &str, new: bool) -> std::io::Result<tempfile::NamedTempFile> {
+    let prefix = format!(".{name}.{}.", std::process::id());
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp").rand_bytes(10);
+    #[cfg(unix)]
+    if new {
+        use std::os::unix::fs::PermissionsExt as _;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    #[cfg(not(unix))]
+    let _ = new;
+    builder.tempfile_in(dir)
+}
+
+/// A new temporary folder in `dir` for work that becomes `name` (`.NAME.tmp-PID-RANDOM`),
+/// made with `mkdir`, which never follows a link; removed on every way out unless kept.
+///
+/// # Errors
+/// A folder that cannot be made.
+pub fn temporary_dir(dir: &Path, name: &str, tag: &str) -> std::io::Result<TempPath> {
+    let made = tempfile::Builder::new()
+        .prefix(&format!(".{name}.{tag}-{}-", std::process::id()))
+        .rand_bytes(10)
+        .tempdir_in(dir)?;
+    Ok(TempPath::new(made.keep()))
 }
 
 /// The folder a path is in (`.` for a bare name).
@@ -100,22 +134,30 @@ pub fn through_links(path: &Path) -> PathBuf {
 /// Removes the temporary files of earlier saves to `name` in `dir` whose process is gone
 /// (a save killed half-way leaves one, as large as the project).
 fn remove_stale(dir: &Path, name: &str) {
+    remove_stale_with(dir, &format!(".{name}."), ".tmp", |path| {
+        let _ = std::fs::remove_file(path);
+    });
+}
+
+/// Calls `remove` on every entry of `dir` named `PREFIX PID [.RANDOM] SUFFIX` (`-` also
+/// parts the PID from the rest) whose process `PID` has ended.
+pub fn remove_stale_with(dir: &Path, prefix: &str, suffix: &str, remove: impl Fn(&Path)) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
-    let prefix = format!(".{name}.");
     for entry in entries.filter_map(Result::ok) {
         let file_name = entry.file_name();
         let Some(pid) = file_name
             .to_str()
-            .and_then(|n| n.strip_prefix(&prefix))
-            .and_then(|rest| rest.strip_suffix(".tmp"))
+            .and_then(|n| n.strip_prefix(prefix))
+            .and_then(|rest| rest.strip_suffix(suffix))
+            .and_then(|rest| rest.split(['.', '-']).next())
             .and_then(|pid| pid.parse::<u32>().ok())
         else {
             continue;
         };
         if pid != std::process::id() && process_gone(pid) == Some(true) {
-            let _ = std::fs::remove_file(entry.path());
+            remove(&entry.path());
         }
     }
 }
@@ -309,6 +351,46 @@ mod tests {
         let _ = std::fs::remove_dir_all(&other);
     }
 
+    /// The process's umask, from `/proc/self/status`.
+    #[cfg(unix)]
+    fn umask() -> Option<u32> {
+        let status = std::fs::read_to_string("/proc/self/status").ok()?;
+        let line = status.lines().find(|l| l.starts_with("Umask:"))?;
+        u32::from_str_radix(line.trim_start_matches("Umask:").trim(), 8).ok()
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_planted_at_the_temporary_name_is_never_followed() {
+        use std::os::unix::fs::PermissionsExt as _;
+        let dir = temp("planted");
+        let victim = dir.join("victim.txt");
+        std::fs::write(&victim, b"a stranger's file").unwrap();
+        std::fs::set_permissions(&victim, std::fs::Permissions::from_mode(0o600)).unwrap();
+        let path = dir.join("p.kapaint");
+        // Where earlier builds put the temporary: `.NAME.PID.tmp`.
+        let planted = dir.join(format!(".p.kapaint.{}.tmp", std::process::id()));
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        write_atomic(&path, b"the project").unwrap();
+        assert_eq!(std::fs::read(&victim).unwrap(), b"a stranger's file");
+        let victim_mode = std::fs::metadata(&victim).unwrap().permissions().mode() & 0o777;
+        assert_eq!(victim_mode, 0o600, "the stranger's file keeps its mode");
+        let meta = std::fs::symlink_metadata(&path).unwrap();
+        assert!(
+            meta.file_type().is_file(),
+            "the project is a file, not a link"
+        );
+        assert_eq!(std::fs::read(&path).unwrap(), b"the project");
+        if let Some(mask) = umask() {
+            assert_eq!(
+                meta.permissions().mode() & 0o777,
+                0o666 & !mask,
+                "a new file gets the usual mode"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn temporaries_of_dead_processes_are_removed() {
         if process_gone(1) != Some(false) {
@@ -318,9 +400,9 @@ mod tests {
         let dir = temp("stale");
         let path = dir.join("p.kapaint");
         // A PID above the kernel's limit never runs; PID 1 always does.
-        let dead = dir.join(".p.kapaint.4194305.tmp");
-        let alive = dir.join(".p.kapaint.1.tmp");
-        let other = dir.join(".q.kapaint.4194305.tmp");
+        let dead = dir.join(".p.kapaint.4194305.x7Gq2Lm0aZ.tmp");
+        let alive = dir.join(".p.kapaint.1.Hq8sKx02Lp.tmp");
+        let other = dir.join(".q.kapaint.4194305.x7Gq2Lm0aZ.tmp");
         for f in [&dead, &alive, &other] {
             std::fs::write(f, b"half a save").unwrap();
         }

@@ -76,6 +76,12 @@ fn write_report(report: &str) -> Option<PathBuf> {
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
     let path = dir.join(format!("crash-{seconds}-{}.log", std::process::id()));
-    std::fs::write(&path, report).ok()?;
+    // Made new: a link planted at the name is never followed.
+    let mut file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&path)
+        .ok()?;
+    std::io::Write::write_all(&mut file, report.as_bytes()).ok()?;
     Some(path)
 }

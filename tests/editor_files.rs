@@ -203,7 +203,7 @@ fn a_project_named_at_start_opens_on_a_worker_and_takes_no_strokes_meanwhile() {
 
 #[test]
 fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
-    use kapaint::model::recovery::{Autosaver, recovery_path};
+    use kapaint::model::recovery::Autosaver;
     let dir = scratch("recovery-modal");
     let project = dir.join("work.kapaint");
     let mut doc =
@@ -212,17 +212,15 @@ fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
     kapaint::model::project::save(&doc, &project).expect("saved");
     std::thread::sleep(std::time::Duration::from_millis(20));
     // Unsaved work since: a fill, in a recovery copy newer than the project.
-    let mut autosaver = Autosaver::new(
-        std::time::Duration::ZERO,
-        recovery_path(Some(&project)),
-        &doc,
-    );
+    let mut autosaver = Autosaver::new(std::time::Duration::ZERO, Some(&project), &doc);
     doc.apply(kapaint::model::Command::Fill(
         kapaint::model::FillRegion::All,
     ))
     .expect("fill");
     let _ = autosaver.poll(&doc, std::time::Instant::now());
     autosaver.wait().expect("autosaved").expect("written");
+    // Left by an editor that was killed.
+    as_ended(&autosaver.session());
     let mut harness = Harness::builder()
         .with_size(Vec2::new(1400.0, 900.0))
         .with_max_steps(40)
@@ -261,22 +259,184 @@ fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
 
 #[test]
 fn an_export_goes_into_the_folder_chosen_unless_it_holds_other_things() {
+    use kapaint::export::set::SetKind;
     use kapaint::ui::export_folder_in;
     let dir = scratch("export-folder-choice");
-    assert_eq!(export_folder_in(&dir), dir, "an empty folder takes the set");
+    let kind = SetKind::Material;
+    assert_eq!(
+        export_folder_in(&dir, kind),
+        dir,
+        "an empty folder takes the set"
+    );
     std::fs::write(dir.join("notes.txt"), "mine").expect("write");
     assert_eq!(
-        export_folder_in(&dir),
+        export_folder_in(&dir, kind),
         dir.join("set"),
         "never over other files"
     );
     let set = dir.join("old-set");
     std::fs::create_dir(&set).expect("folder");
-    std::fs::write(set.join("material.json"), "{}").expect("write");
+    std::fs::write(
+        set.join("material.json"),
+        r#"{"format": "kapaint-material", "files": [{"path": "kd.png"}]}"#,
+    )
+    .expect("write");
+    std::fs::write(set.join("kd.png"), "png").expect("write");
     assert_eq!(
-        export_folder_in(&set),
+        export_folder_in(&set, kind),
         set,
         "a set is replaced after the prompt"
     );
+    assert_eq!(
+        export_folder_in(&set, SetKind::Pbr),
+        set.join("set"),
+        "never a set of another kind"
+    );
+    std::fs::write(set.join("notes.txt"), "mine").expect("write");
+    assert_eq!(
+        export_folder_in(&set, kind),
+        set.join("set"),
+        "never a set beside files no export wrote"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_first_save_of_untitled_work_takes_its_recovery_copy_along() {
+    use kapaint::model::recovery;
+    let dir = scratch("first-save-recovery");
+    let mut harness = editor_without_portal(&dir);
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness
+        .state_mut()
+        .state
+        .autosave_now()
+        .expect("the untitled copy");
+    let untitled = harness.state().state.recovery_copy();
+    assert!(untitled.exists());
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    harness.get_by_role_and_label(Role::Button, "Save").click();
+    harness.run();
+    let saved = dir.join("material.kapaint");
+    wait_until(&mut harness, "saved", |e| !e.state.dirty());
+    // A second stroke, autosaved: its copy is the project's now, the untitled one is gone.
+    drag(
+        &mut harness,
+        centre + Vec2::new(0.0, 60.0),
+        centre + Vec2::new(40.0, 70.0),
+    );
+    assert!(harness.state().state.dirty(), "the second stroke painted");
+    harness.state_mut().state.autosave_now().expect("autosaved");
+    let copy = harness.state().state.recovery_copy();
+    assert_eq!(
+        copy.parent(),
+        Some(recovery::recovery_path(Some(&saved)).as_path())
+    );
+    assert!(!untitled.exists(), "the untitled copy was left behind");
+    // Killed now: `kapaint edit material.kapaint` offers the second stroke back.
+    let want = texels(harness.state());
+    drop(harness);
+    let ended = as_ended(&copy);
+    assert_eq!(recovery::offer(Some(&saved)), Some(ended.clone()));
+    let back = recovery::load(&ended).expect("recovered");
+    let mut got = Vec::new();
+    back.maps().for_each_texel(|_, _, t| got.push(t));
+    assert!(got == want, "the recovered copy is the work as it was");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn save_as_moves_the_recovery_copy_to_the_new_project() {
+    use kapaint::model::recovery;
+    let dir = scratch("save-as-recovery");
+    let (a, b) = (dir.join("A.kapaint"), dir.join("B.kapaint"));
+    let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+        .expect("document");
+    kapaint::model::project::save(&doc, &a).expect("saved");
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(40)
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, Some(a.clone())),
+        );
+    harness.run();
+    wait_until(&mut harness, "opened", |e| {
+        e.state.opening().is_none() && e.state.doc().maps().width() == 64
+    });
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.state_mut().state.autosave_now().expect("autosaved");
+    harness.state_mut().state.save_to(b.clone());
+    wait_until(&mut harness, "saved as B", |e| !e.state.dirty());
+    drag(
+        &mut harness,
+        centre + Vec2::new(0.0, 60.0),
+        centre + Vec2::new(40.0, 70.0),
+    );
+    assert!(harness.state().state.dirty(), "the second stroke painted");
+    harness.state_mut().state.autosave_now().expect("autosaved");
+    let copy = harness.state().state.recovery_copy();
+    assert_eq!(
+        copy.parent(),
+        Some(recovery::recovery_path(Some(&b)).as_path())
+    );
+    drop(harness);
+    let ended = as_ended(&copy);
+    // `kapaint edit A` offers nothing (B's work is not A's); `edit B` offers it.
+    assert_eq!(recovery::offer(Some(&a)), None);
+    assert!(!recovery::recovery_path(Some(&a)).exists());
+    assert_eq!(recovery::offer(Some(&b)), Some(ended));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_layered_project_opens_clean_on_its_saved_selection() {
+    use kapaint::model::{Command, LayerKind, LayerRef};
+    let dir = scratch("layered-clean");
+    let project = dir.join("layered.kapaint");
+    let mut doc =
+        kapaint::model::Document::new(128, 128, kapaint::model::DocumentSettings::default())
+            .expect("document");
+    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+        .expect("fill");
+    doc.apply(Command::AddLayer {
+        kind: LayerKind::Paint,
+        name: "Scratches".into(),
+    })
+    .expect("layer");
+    doc.apply(Command::AddMask).expect("mask");
+    doc.apply(Command::AddLayer {
+        kind: LayerKind::Group,
+        name: "Folder".into(),
+    })
+    .expect("group");
+    // Saved with "Scratches" selected (a group sits above it).
+    doc.apply(Command::SelectLayer(LayerRef::Name("Scratches".into())))
+        .expect("select");
+    kapaint::model::project::save(&doc, &project).expect("saved");
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(40)
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, Some(project.clone())),
+        );
+    harness.run();
+    wait_until(&mut harness, "opened", |e| {
+        e.state.opening().is_none() && e.state.doc().maps().width() == 128
+    });
+    harness.run();
+    let s = &harness.state().state;
+    assert!(!s.dirty(), "a project opened and not changed is clean");
+    assert_eq!(s.window_title(), "layered.kapaint - kapaint");
+    let selected = s
+        .doc()
+        .stack()
+        .layer(&s.doc().selection().path)
+        .expect("a layer");
+    assert_eq!(selected.props.name, "Scratches", "the saved selection");
     let _ = std::fs::remove_dir_all(&dir);
 }

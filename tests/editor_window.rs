@@ -159,6 +159,58 @@ save_and_quit
 }
 
 #[test]
+fn work_painted_after_the_first_save_survives_kill_9() {
+    // Untitled work saved once with Ctrl+S, painted again, autosaved, killed: `kapaint edit`
+    // on the saved project offers the second stroke back (the copy followed the save).
+    let script = r#"
+cd "$(dirname "$project")"
+project="$PWD/material.kapaint"
+: > "$log"
+KAPAINT_LOG_STARTUP=1 "$bin" 2>>"$log" & pid=$!
+for _ in $(seq 1 600); do grep -q "first frame" "$log" && break; sleep 0.1; done
+sleep 1
+win=$(xdotool search --sync --name '^untitled - kapaint$' | head -1)
+xdotool windowfocus --sync "$win" 2>/dev/null || true
+stroke
+xdotool key --clearmodifiers ctrl+s
+sleep 2
+xdotool key --clearmodifiers Return
+for _ in $(seq 1 300); do [ -f "$project" ] && break; sleep 0.1; done
+[ -f "$project" ] || { echo "nothing saved"; cat "$log"; kill $pid; exit 10; }
+sleep 1
+cp "$project" first.kapaint
+xdotool windowfocus --sync "$win" 2>/dev/null || true
+xdotool mousemove 890 380 sleep 0.3 mousedown 1 sleep 0.3
+for x in 900 920 940 960 980 1000 1020; do xdotool mousemove $x 400 sleep 0.1; done
+xdotool sleep 0.3 mouseup 1 sleep 0.5
+sleep 7
+kill -9 $pid; wait $pid 2>/dev/null
+cmp -s "$project" first.kapaint || { echo "the project changed before the kill"; exit 6; }
+start
+# The recovery offer is up: Enter recovers, then save and quit.
+xdotool key --clearmodifiers Return
+sleep 2
+save_and_quit
+"#;
+    if let Some(project) = run_in_window("first-save", script, &[("KAPAINT_AUTOSAVE_SECONDS", "4")])
+    {
+        let saved = project.with_file_name("material.kapaint");
+        let first = kapaint::model::project::load(&project.with_file_name("first.kapaint"))
+            .expect("first save loads");
+        let last = kapaint::model::project::load(&saved).expect("the recovered project loads");
+        let differ = (0..last.maps().height())
+            .flat_map(|y| (0..last.maps().width()).map(move |x| (x, y)))
+            .filter(|&(x, y)| first.maps().texel(x, y) != last.maps().texel(x, y))
+            .count();
+        assert!(
+            differ > 100,
+            "the second stroke was not recovered ({differ} texels differ)"
+        );
+        assert_painted(&saved, "the recovered project holds the strokes");
+    }
+}
+
+#[test]
 fn untitled_work_is_saved_through_kapaints_own_file_dialog_without_a_portal() {
     // No desktop portal runs here: Ctrl+S on an untitled project must still ask where (in
     // kapaint's own dialog, which starts in the working folder with the name filled in) and

@@ -1155,7 +1155,7 @@ fn autosave_on_a_full_disk_is_an_error_that_leaves_nothing_half_written() {
     let Some(mount) = tmpfs(&dir.join("full"), "size=256k") else {
         return;
     };
-    let path = dir.join("full/.p.kapaint-recovery");
+    let project = dir.join("full/p.kapaint");
     // Noise in every channel: a project far larger than the disk.
     let mut doc = Document::new(256, 256, DocumentSettings::default()).expect("doc");
     let noise = dir.join("noise.png");
@@ -1168,7 +1168,8 @@ fn autosave_on_a_full_disk_is_an_error_that_leaves_nothing_half_written() {
     })
     .save(&noise)
     .expect("noise");
-    let mut saver = Autosaver::new(Duration::ZERO, path.clone(), &doc);
+    let mut saver = Autosaver::new(Duration::ZERO, Some(&project), &doc);
+    let path = saver.session();
     kapaint::model::import::import_file(&mut doc, kapaint::model::Channel::Kd, &noise)
         .expect("import");
     saver.poll(&doc, Instant::now());
@@ -1181,12 +1182,13 @@ fn autosave_on_a_full_disk_is_an_error_that_leaves_nothing_half_written() {
         "{err}"
     );
     assert!(!err.to_string().contains('\n'));
-    // Nothing half-written: no base, and nothing a recovery could mistake for one.
+    // Nothing half-written: no journal, and nothing a recovery could mistake for one.
     let left: Vec<_> = std::fs::read_dir(&path)
         .map(|d| d.filter_map(Result::ok).map(|e| e.file_name()).collect())
         .unwrap_or_default();
     assert!(left.is_empty(), "{left:?}");
     assert!(recovery::load(&path).is_err());
+    assert_eq!(recovery::offer(Some(&project)), None);
     drop(mount);
     let _ = std::fs::remove_dir_all(&dir);
 }

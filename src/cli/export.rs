@@ -240,6 +240,7 @@ fn load_projects(
 
 /// `kapaint export`: every project into its set; one line each, plus the report.
 fn export_command(args: &ExportArgs) -> Result<String, CliError> {
+    use crate::export::set::SetKind;
     use std::io::IsTerminal as _;
     let (files, out, report, replace, glb) =
         (&args.files, &args.out, args.report, args.replace, args.glb);
@@ -261,7 +262,7 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
             .map(|f| out.join(f.file_stem().unwrap_or_default()))
             .collect()
     };
-    check_targets(files, &targets, replace)?;
+    check_targets(files, &targets, replace, SetKind::of(&preset))?;
     let terminal = std::io::stderr().is_terminal();
     for (i, ((file, (doc, mesh)), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
         let mesh = mesh.as_ref().map(|s| &s.mesh);
@@ -320,10 +321,16 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
     Ok(text)
 }
 
-/// Every target is free (absent, or an empty folder) and no two projects share one, before
-/// anything is written: a failed batch leaves nothing behind.
-fn check_targets(files: &[PathBuf], targets: &[PathBuf], replace: bool) -> Result<(), CliError> {
-    use crate::export::set::{Target, target as target_of};
+/// Every target is free (absent, or an empty folder; with `replace`, a set of the same kind
+/// holding only what its export wrote), holds no project, and no two projects share one,
+/// before anything is written: a failed batch leaves nothing behind.
+fn check_targets(
+    files: &[PathBuf],
+    targets: &[PathBuf],
+    replace: bool,
+    kind: crate::export::set::SetKind,
+) -> Result<(), CliError> {
+    use crate::export::set::{Target, holds, target as target_of};
     for (k, target) in targets.iter().enumerate() {
         if let Some(j) = targets[..k].iter().position(|t| t == target) {
             return Err(CliError::usage(format!(
@@ -333,7 +340,14 @@ fn check_targets(files: &[PathBuf], targets: &[PathBuf], replace: bool) -> Resul
                 target.display()
             )));
         }
-        match target_of(target).map_err(super::set_error)? {
+        if let Some(project) = files.iter().find(|f| holds(target, f)) {
+            return Err(CliError::usage(format!(
+                "{}: holds the project {}; export into another folder",
+                target.display(),
+                project.display()
+            )));
+        }
+        match target_of(target, kind).map_err(super::set_error)? {
             Target::Free => {}
             Target::Set if replace => {}
             Target::Set => {
@@ -342,11 +356,8 @@ fn check_targets(files: &[PathBuf], targets: &[PathBuf], replace: bool) -> Resul
                     target.display()
                 )));
             }
-            Target::Taken => {
-                return Err(CliError::usage(format!(
-                    "{}: exists and is not an empty folder",
-                    target.display()
-                )));
+            Target::Taken(why) => {
+                return Err(CliError::usage(format!("{}: {why}", target.display())));
             }
         }
     }

@@ -29,10 +29,17 @@ impl ImportArgs {
     pub fn run(self) -> Result<String, CliError> {
         let channel = Channel::from_name(&self.channel)
             .ok_or_else(|| CliError::usage(format!("unknown channel {:?}", self.channel)))?;
+        // The file as read: a save finds out if another run saved over it meanwhile.
+        let on_disk = project::OnDisk::of(&self.file);
         let mut doc = project::load(&self.file).map_err(model_error)?;
         import::import_file(&mut doc, channel, &self.image).map_err(model_error)?;
+        let expected = if self.out.is_none() {
+            on_disk.as_ref()
+        } else {
+            None
+        };
         let target = self.out.unwrap_or(self.file);
-        project::save(&doc, &target).map_err(model_error)?;
+        project::save_checked(&doc, &target, expected).map_err(model_error)?;
         Ok(format!(
             "imported {} into {} of {}\n",
             self.image.display(),

@@ -232,6 +232,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
 pub(super) fn model_error(e: ModelError) -> CliError {
     match &e {
         ModelError::Io { source, .. } => CliError::of_io(e.to_string(), source),
+        ModelError::Conflict { .. } => CliError::io(e.to_string()),
         ModelError::Internal(_) => CliError {
             message: e.to_string(),
             code: crate::crash::EXIT_INTERNAL,
@@ -242,6 +243,7 @@ pub(super) fn model_error(e: ModelError) -> CliError {
         | ModelError::UnknownPreset { .. }
         | ModelError::Image { .. }
         | ModelError::Script { .. }
+        | ModelError::Unsaveable { .. }
         | ModelError::Command(_) => CliError::usage(e.to_string()),
     }
 }

@@ -32,6 +32,8 @@ impl PaintArgs {
     /// failed write; the project is untouched then.
     pub fn run(self) -> Result<String, CliError> {
         let commands = read_script(&self.script)?;
+        // The file as read: a save finds out if another run saved over it meanwhile.
+        let on_disk = project::OnDisk::of(&self.file);
         let mut doc = project::load(&self.file).map_err(model_error)?;
         if commands.iter().any(model::Command::needs_surface) {
             let spec = self
@@ -46,8 +48,13 @@ impl PaintArgs {
             })?;
         }
         doc.apply(model::Command::EndStroke).map_err(model_error)?;
+        let expected = if self.out.is_none() {
+            on_disk.as_ref()
+        } else {
+            None
+        };
         let target = self.out.unwrap_or(self.file);
-        project::save(&doc, &target).map_err(model_error)?;
+        project::save_checked(&doc, &target, expected).map_err(model_error)?;
         Ok(format!(
             "applied {count} commands, saved {}\n",
             target.display()

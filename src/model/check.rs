@@ -71,6 +71,27 @@ pub fn name(field: &str, text: &str) -> Result<(), String> {
     bounded_text(field, text, MAX_NAME_BYTES)
 }
 
+/// `text` made a name [`name`] accepts: control characters as spaces, cut at a character
+/// boundary to leave room for `suffix` within [`MAX_NAME_BYTES`], then `suffix`; `fallback`
+/// where nothing is left.
+pub fn fit_name(text: &str, suffix: &str, fallback: &str) -> String {
+    let clean: String = text
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    let room = MAX_NAME_BYTES.saturating_sub(suffix.len());
+    let mut end = clean.len().min(room);
+    while !clean.is_char_boundary(end) {
+        end -= 1;
+    }
+    let fitted = format!("{}{suffix}", &clean[..end]);
+    if fitted.trim().is_empty() {
+        fallback.to_string()
+    } else {
+        fitted
+    }
+}
+
 /// Text of at most `max_bytes` without control characters.
 pub fn bounded_text(field: &str, text: &str, max_bytes: usize) -> Result<(), String> {
     if text.len() > max_bytes {
@@ -188,6 +209,20 @@ pub fn layer_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     Ok(v)
 }
 
+/// A path of indices into layer groups: at most one index per level a project may nest, each
+/// under the most layers a project may hold.
+pub fn layer_path<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<usize>, D::Error> {
+    let v = Vec::<usize>::deserialize(d)?;
+    let depth = crate::model::project::layers::MAX_DEPTH + 1;
+    let most = crate::model::document::MAX_LAYERS;
+    if v.len() > depth || v.iter().any(|&i| i >= most) {
+        return Err(D::Error::custom(format!(
+            "a layer path has at most {depth} indices, each under {most}"
+        )));
+    }
+    Ok(v)
+}
+
 /// An optional name ([`name`]).
 pub fn optional_name<'de, D: Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     let v = Option::<String>::deserialize(d)?;
@@ -220,5 +255,22 @@ mod tests {
         assert!(name("name", &"a".repeat(MAX_NAME_BYTES + 1)).is_err());
         assert!(name("name", "a\nb").is_err());
         assert!(name("name", "Brass (polished)").is_ok());
+    }
+
+    #[test]
+    fn fitted_names_are_always_names() {
+        let long = "é".repeat(MAX_NAME_BYTES);
+        for (text, suffix) in [
+            (long.as_str(), ""),
+            (long.as_str(), " copy"),
+            ("a\u{7}b", ""),
+            ("   ", ""),
+            ("", " copy"),
+        ] {
+            let fitted = fit_name(text, suffix, "Layer");
+            assert!(name("name", &fitted).is_ok(), "{fitted:?}");
+            assert!(fitted.ends_with(suffix));
+        }
+        assert_eq!(fit_name("Layer 1", " copy", "Layer"), "Layer 1 copy");
     }
 }

@@ -61,6 +61,25 @@ pub enum ModelError {
         /// What is wrong.
         reason: String,
     },
+    /// A save found the project changed on disk since it was read (another kapaint saved it):
+    /// the result went beside it instead.
+    #[error(
+        "{path} changed on disk since it was opened (another kapaint saved it); this result was written to {written} instead"
+    )]
+    Conflict {
+        /// The project.
+        path: PathBuf,
+        /// Where this save's result went.
+        written: PathBuf,
+    },
+    /// A document the project format cannot hold (a field past its limit): nothing was written.
+    #[error("{path}: cannot be saved: {reason}")]
+    Unsaveable {
+        /// The file.
+        path: PathBuf,
+        /// Which field, and why.
+        reason: String,
+    },
     /// A command that cannot run in the document's state (e.g. a pick outside the map).
     #[error("{0}")]
     Command(String),

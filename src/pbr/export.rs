@@ -277,7 +277,7 @@ pub fn export(
     glb: Option<&Mesh>,
 ) -> Result<PbrManifest, SetError> {
     progress.start("analyse", 1);
-    let found = claim(out, replace)?;
+    let found = claim(out, replace, crate::export::set::SetKind::Pbr)?;
     let (w, h) = (doc.maps().width(), doc.maps().height());
     let model = doc.settings().model;
     let (texels, dilated) = padded_texels(doc);
@@ -351,7 +351,7 @@ pub fn export(
         files,
         preset: preset.name.clone(),
     };
-    commit(out, found, |tmp| {
+    commit(out, &found, |tmp| {
         let io = |path: &Path, e: std::io::Error| SetError::Io {
             path: path.to_path_buf(),
             reason: e.to_string(),

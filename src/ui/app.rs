@@ -1,7 +1,7 @@
 //! The app around the editor's state: start-up (on a new document, or opening a project on a
 //! worker), one frame of the whole window (panels, dock, dialogs), exit, and `run`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -43,10 +43,6 @@ impl Editor {
     /// given: a project there opens on a worker once the window is up (the window shows at
     /// once, with the opening in progress over it); a missing file becomes a new project
     /// saved there.
-    #[expect(
-        clippy::too_many_lines,
-        reason = "the editor's state, one field per line"
-    )]
     pub fn new(
         render_state: Option<&eframe::egui_wgpu::RenderState>,
         path: Option<PathBuf>,
@@ -77,18 +73,9 @@ impl Editor {
         let path = existing.as_deref().or(untitled_until_open.as_deref());
         let mut viewport = Viewport::new(gpu);
         viewport.frame(&mesh.mesh);
-        let recovery = recovery::recovery_path(path);
-        let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
-        let recovery_offer = match (recovery::modified(&recovery), path.and_then(modified)) {
-            (Some(copy), Some(saved)) if copy > saved => Some(recovery.clone()),
-            (Some(_), None) => Some(recovery.clone()),
-            _ => None,
-        };
-        let autosaver = recovery::Autosaver::new(
-            autosave_interval(),
-            recovery::recovery_path(untitled_until_open.as_deref()),
-            &doc,
-        );
+        let recovery_offer = recovery::offer(path);
+        let autosaver =
+            recovery::Autosaver::new(autosave_interval(), untitled_until_open.as_deref(), &doc);
         let preset_dir = crate::model::preset::user_dir();
         let presets =
             super::panels::presets::load_material_presets(preset_dir.as_deref(), &mut notices);
@@ -139,6 +126,7 @@ impl Editor {
                 naming: None,
                 preset_dir,
                 autosaver,
+                claim: super::claim::Claim::default(),
                 layers_panel: super::panels::layers::PanelState::default(),
                 layer_view: LayerView::Composite,
             },
@@ -282,6 +270,7 @@ impl Editor {
         s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
+        s.claim_prompt(&ctx);
         s.material_prompt_window(&ctx);
         s.modal_job_ui(&ctx);
         s.files_ui(&ctx);
@@ -311,10 +300,11 @@ impl eframe::App for Editor {
 
     fn on_exit(&mut self) {
         save_layout(&self.dock);
-        // A clean exit leaves no recovery file behind.
-        if !self.state.dirty() {
-            recovery::remove(self.state.autosaver.path());
+        // A clean exit, or one whose changes the user discarded, leaves no recovery copy.
+        if !self.state.dirty() || self.state.quit.allowed == Some(super::QuitAllowed::Discarded) {
+            self.state.autosaver.discard();
         }
+        self.state.claim.release();
     }
 }
 

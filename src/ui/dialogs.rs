@@ -196,7 +196,8 @@ impl ExportDialog {
     /// Exports into the chosen `dir` where it is empty or a set already (replaced after a
     /// prompt), else into a new `set` folder inside it.
     pub(super) fn choose_folder(&mut self, dir: &Path) {
-        self.folder = export_folder_in(dir).display().to_string();
+        let kind = crate::export::set::SetKind::of(&self.presets[self.chosen]);
+        self.folder = export_folder_in(dir, kind).display().to_string();
         (self.confirm_replace, self.problem) = (false, None);
     }
 }
@@ -542,17 +543,26 @@ impl EditorState {
     /// Exports into a free folder; asks first where a set is there already; says why where
     /// something else is. The dialog and its choices stay until the export starts.
     fn ask_or_export(&mut self) {
-        use crate::export::set::{Target, target};
+        use crate::export::set::{SetKind, Target, holds, target};
         let Some(dialog) = &mut self.export else {
             return;
         };
-        match target(Path::new(dialog.folder.trim())) {
+        let folder = Path::new(dialog.folder.trim());
+        if let Some(project) = self.path.as_deref().filter(|p| holds(folder, p)) {
+            dialog.problem = Some(format!(
+                "{} holds the project {}: choose another folder",
+                folder.display(),
+                project.display()
+            ));
+            return;
+        }
+        match target(folder, SetKind::of(&dialog.presets[dialog.chosen])) {
             Ok(Target::Free) => self.export_now(false),
             Ok(Target::Set) => dialog.confirm_replace = true,
-            Ok(Target::Taken) => {
+            Ok(Target::Taken(why)) => {
                 dialog.problem = Some(format!(
-                    "{} is not empty and holds no exported set: choose another folder",
-                    dialog.folder.trim()
+                    "{}: {why}; choose another folder",
+                    folder.display()
                 ));
             }
             Err(e) => dialog.problem = Some(e.to_string()),
@@ -561,11 +571,11 @@ impl EditorState {
 }
 
 /// Where an export into the folder `dir` the user chose goes: `dir` itself when it is free (or
-/// empty) or holds a set, else a `set` folder inside it (a folder of other things is never
-/// replaced).
-pub fn export_folder_in(dir: &Path) -> PathBuf {
+/// empty) or holds a set of `kind`, else a `set` folder inside it (a folder of other things is
+/// never replaced).
+pub fn export_folder_in(dir: &Path, kind: crate::export::set::SetKind) -> PathBuf {
     use crate::export::set::{Target, target};
-    match target(dir) {
+    match target(dir, kind) {
         Ok(Target::Free | Target::Set) => dir.to_path_buf(),
         _ => dir.join("set"),
     }

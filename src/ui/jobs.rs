@@ -16,10 +16,20 @@ use crate::task::Progress;
 
 /// What a worker hands back.
 pub(super) enum JobResult {
-    /// A project (to be saved at the path; `None` for recovered untitled work), whether it
-    /// came from a recovery copy, and a note for the user (its mesh could not be loaded).
-    Opened(Option<PathBuf>, Box<Document>, bool, Option<String>),
-    Saved(PathBuf, u64),
+    /// A project opened (or recovered).
+    Opened(Box<OpenedProject>),
+    /// Saved at the path: the document version saved, and the file as written.
+    Saved(PathBuf, u64, project::OnDisk),
+    /// A save that found its project changed on disk (another kapaint saved it): the work went
+    /// to `written` instead, as the document version `version`.
+    Conflicted {
+        /// What happened, for the notice.
+        message: String,
+        /// Where the work went.
+        written: PathBuf,
+        /// The document version written there.
+        version: u64,
+    },
     Exported(PathBuf, Box<crate::export::Exported>),
     /// A mesh loaded and baked at the map size, and whether its file has a textured material
     /// (the editor then offers to bring it in).
@@ -35,6 +45,21 @@ pub(super) enum JobResult {
     /// A brush stamp read from an image.
     Stamp(PathBuf, crate::model::brush::Stamp),
     Failed(String),
+}
+
+/// A project a worker opened or recovered.
+pub(super) struct OpenedProject {
+    /// Where it is saved (`None` for recovered untitled work).
+    path: Option<PathBuf>,
+    doc: Document,
+    /// The recovery copy it came from, if it did.
+    recovered: Option<PathBuf>,
+    /// A note for the user (its mesh could not be loaded, its recovery failed).
+    note: Option<String>,
+    /// The project file as it was when read: what a save expects to replace.
+    on_disk: Option<project::OnDisk>,
+    /// Opened read-only (another kapaint has it open).
+    read_only: bool,
 }
 
 /// A glTF material converted on a worker (File > Import PBR material).
@@ -171,29 +196,19 @@ impl EditorState {
             .join()
             .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
         match result {
-            JobResult::Opened(path, doc, recovered, note) => {
-                self.opened(path, *doc, recovered);
+            JobResult::Opened(opened) => {
+                let note = opened.note.clone();
+                self.opened(*opened);
                 if let Some(note) = note {
                     self.notices.push(notice(note, true));
                 }
             }
-            JobResult::Saved(path, version) => {
-                self.saved_version = version;
-                self.notices
-                    .push(notice(format!("saved {}", path.display()), false));
-                self.remember(&path);
-                self.path = Some(path);
-                if std::mem::take(&mut self.quit.after_save) && !self.dirty() {
-                    // The quit prompt's Save: the work is safe, so the window closes.
-                    self.quit.allowed = true;
-                    self.quit.asked = true;
-                }
-                if !self.dirty()
-                    && let Some(next) = self.pending_open.take()
-                {
-                    self.open_now(next);
-                }
-            }
+            JobResult::Conflicted {
+                message,
+                written,
+                version,
+            } => self.conflicted(message, written, version),
+            JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
             JobResult::Exported(dir, m) => {
                 self.notices.push(notice(exported_notice(&dir, *m), false));
             }
@@ -239,11 +254,10 @@ impl EditorState {
                 self.replace_document(*doc);
                 self.saved_version = self.doc.version();
                 self.path = None;
-                self.autosaver = recovery::Autosaver::new(
-                    autosave_interval(),
-                    recovery::recovery_path(None),
-                    &self.doc,
-                );
+                self.claim.hold(None, None, false);
+                // The old document was saved or its changes discarded (asked before).
+                self.autosaver.discard();
+                self.autosaver = recovery::Autosaver::new(autosave_interval(), None, &self.doc);
             }
             JobResult::Stamp(path, stamp) => {
                 let mut brush = self.doc.settings().brush.clone();
@@ -259,26 +273,78 @@ impl EditorState {
         }
     }
 
+    /// A save finished: the document version it holds, and the file as written.
+    fn saved(&mut self, path: PathBuf, version: u64, on_disk: project::OnDisk) {
+        self.saved_version = version;
+        self.claim.hold(Some(&path), Some(on_disk), false);
+        self.notices
+            .push(notice(format!("saved {}", path.display()), false));
+        self.remember(&path);
+        if self.path.as_deref() != Some(path.as_path()) {
+            // Save As (or the first save): the recovery copy follows the work.
+            self.autosaver.relocate(Some(&path));
+        }
+        self.path = Some(path);
+        if std::mem::take(&mut self.quit.after_save) && !self.dirty() {
+            // The quit prompt's Save: the work is safe, so the window closes.
+            self.quit.allowed = Some(super::QuitAllowed::Saved);
+            self.quit.asked = true;
+        }
+        if !self.dirty()
+            && let Some(next) = self.pending_open.take()
+        {
+            self.open_now(next);
+        }
+    }
+
+    /// A save found its project changed on disk: the work went to `written` instead.
+    fn conflicted(&mut self, message: String, written: PathBuf, version: u64) {
+        // The work is safe beside the project: the editor goes on with that file.
+        self.saved_version = version;
+        self.notices.push(notice(message, true));
+        self.remember(&written);
+        self.autosaver.relocate(Some(&written));
+        self.claim
+            .hold(Some(&written), project::OnDisk::of(&written), false);
+        self.path = Some(written);
+        self.quit.after_save = false;
+    }
+
     /// Makes `doc` the document, with its mesh shown and framed.
     /// Takes an opened (or recovered) project as the document.
-    fn opened(&mut self, path: Option<PathBuf>, doc: Document, recovered: bool) {
+    fn opened(&mut self, opened: OpenedProject) {
+        let OpenedProject {
+            path,
+            doc,
+            recovered,
+            on_disk,
+            read_only,
+            ..
+        } = opened;
+        self.claim.hold(path.as_deref(), on_disk, read_only);
         self.replace_document(doc);
-        // Recovered work is unsaved work.
-        self.saved_version = if recovered {
-            u64::MAX
-        } else {
-            self.doc.version()
+        // The old document was saved or its changes discarded (asked before).
+        self.autosaver.discard();
+        let interval = autosave_interval();
+        // Recovered work is unsaved work, and its copy stays until this editor has its own.
+        (self.saved_version, self.autosaver) = match recovered.clone() {
+            Some(from) => (
+                u64::MAX,
+                recovery::Autosaver::recovering(interval, path.as_deref(), &self.doc, from),
+            ),
+            None => (
+                self.doc.version(),
+                recovery::Autosaver::new(interval, path.as_deref(), &self.doc),
+            ),
         };
-        self.autosaver = recovery::Autosaver::new(
-            autosave_interval(),
-            recovery::recovery_path(path.as_deref()),
-            &self.doc,
-        );
+        let recovered = recovered.is_some();
         let name = path
             .as_deref()
             .map_or_else(|| "an untitled project".into(), |p| p.display().to_string());
         let text = if recovered {
             format!("recovered the unsaved work of {name}: save to keep it")
+        } else if read_only {
+            format!("opened {name} read-only: Save asks for another file")
         } else {
             format!("opened {name}")
         };
@@ -432,10 +498,25 @@ impl EditorState {
     pub fn save_to(&mut self, path: PathBuf) {
         let snapshot = self.doc.snapshot();
         let version = self.doc.version();
+        // Over its own file, a save expects the file as this editor last read or wrote it;
+        // elsewhere (Save As) the user chose to replace what is there.
+        let expected = (self.path.as_deref() == Some(path.as_path()))
+            .then(|| self.claim.on_disk.clone())
+            .flatten();
         self.start_job("Save", move |progress| {
             progress.start("save", 1);
-            match project::save(&snapshot, &path) {
-                Ok(()) => JobResult::Saved(path, version),
+            match project::save_checked(&snapshot, &path, expected.as_ref()) {
+                Ok(on_disk) => JobResult::Saved(path, version, on_disk),
+                Err(e @ crate::model::ModelError::Conflict { .. }) => {
+                    let crate::model::ModelError::Conflict { written, .. } = &e else {
+                        unreachable!("matched above")
+                    };
+                    JobResult::Conflicted {
+                        written: written.clone(),
+                        message: e.to_string(),
+                        version,
+                    }
+                }
                 Err(e) => JobResult::Failed(format!("could not save: {e}")),
             }
         });
@@ -451,21 +532,37 @@ impl EditorState {
         self.open_now(path);
     }
 
+    /// Opens `path` on a worker, once the user has answered if another kapaint has it open.
     pub(super) fn open_now(&mut self, path: PathBuf) {
+        let Some(read_only) = self.may_open(&path) else {
+            return;
+        };
         self.start_job_opening("Open", Some(path.clone()), move |progress| {
             progress.start("open", 1);
+            let on_disk = project::OnDisk::of(&path);
             match load_project(&path) {
-                Ok((doc, note)) => JobResult::Opened(Some(path), Box::new(doc), false, note),
+                Ok((doc, note)) => JobResult::Opened(Box::new(OpenedProject {
+                    path: Some(path),
+                    doc,
+                    recovered: None,
+                    note,
+                    on_disk,
+                    read_only,
+                })),
                 Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
             }
         });
     }
 
-    /// Opens the recovery copy `from` as the project at `path` (unsaved).
+    /// Opens the recovery copy `from` as the project at `path` (unsaved). A copy that cannot
+    /// be recovered is removed (it would be offered at every start) and the project opens as
+    /// saved, with a notice saying why.
     pub(super) fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
         let opens = path.clone().unwrap_or_else(|| from.clone());
         self.start_job_opening("Recover", Some(opens), move |progress| {
             progress.start("open", 1);
+            // Recovered work replaces the project as it is on disk now.
+            let on_disk = path.as_deref().and_then(project::OnDisk::of);
             let recovered = recovery::load(&from)
                 .map_err(|e| e.to_string())
                 .and_then(|mut doc| {
@@ -473,17 +570,40 @@ impl EditorState {
                     let failed = project::attach_mesh(&mut doc, &own).err();
                     with_fallback(doc, failed)
                 });
-            match recovered {
-                Ok((doc, note)) => JobResult::Opened(path, Box::new(doc), true, note),
-                Err(e) => JobResult::Failed(format!("could not recover {}: {e}", from.display())),
+            let e = match recovered {
+                Ok((doc, note)) => {
+                    return JobResult::Opened(Box::new(OpenedProject {
+                        path,
+                        doc,
+                        recovered: Some(from),
+                        note,
+                        on_disk,
+                        read_only: false,
+                    }));
+                }
+                Err(e) => e,
+            };
+            recovery::remove(&from);
+            let why = format!("could not recover {}: {e}", from.display());
+            match path.as_deref().filter(|p| p.exists()).map(load_project) {
+                Some(Ok((doc, _))) => JobResult::Opened(Box::new(OpenedProject {
+                    path,
+                    doc,
+                    recovered: None,
+                    note: Some(format!("{why}; opened the saved project")),
+                    on_disk,
+                    read_only: false,
+                })),
+                Some(Err(open)) => JobResult::Failed(format!("{why}; {open}")),
+                None => JobResult::Failed(why),
             }
         });
     }
 
     pub(super) fn save(&mut self) {
         match self.path.clone() {
-            Some(p) => self.save_to(p),
-            None => self.save_as(),
+            Some(p) if !self.claim.read_only => self.save_to(p),
+            _ => self.save_as(),
         }
     }
 

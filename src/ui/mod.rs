@@ -7,6 +7,7 @@
 
 mod app;
 pub mod canvas;
+mod claim;
 mod dialogs;
 pub mod files;
 mod input;
@@ -247,6 +248,8 @@ pub struct EditorState {
     /// A preset's name being typed, what it names, and whether its field opened this frame.
     naming: Option<(panels::presets::Naming, String, bool)>,
     autosaver: recovery::Autosaver,
+    /// The project file as read or saved, its lock, and whether it opened read-only.
+    claim: claim::Claim,
     /// The Layers tab's thumbnails and the name being typed.
     layers_panel: panels::layers::PanelState,
     /// What the viewport and canvas show of the layers.
@@ -260,8 +263,17 @@ struct Quit {
     asked: bool,
     /// Quit once the save under way is done (the quit prompt's Save).
     after_save: bool,
-    /// The user confirmed closing with unsaved changes.
-    allowed: bool,
+    /// The window may close with unsaved changes: saved meanwhile, or the user discarded them.
+    allowed: Option<QuitAllowed>,
+}
+
+/// Why the window may close although the document changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum QuitAllowed {
+    /// The quit prompt's Save finished.
+    Saved,
+    /// The user discarded the changes: their recovery copy goes too.
+    Discarded,
 }
 
 /// A preset's thumbnail: the id of the mesh it shows, and its texture.
@@ -329,7 +341,7 @@ impl EditorState {
 
     /// Whether the window is closing (quit asked, and nothing unsaved, or discarded).
     pub fn closing(&self) -> bool {
-        self.quit.asked && (self.quit.allowed || !self.dirty())
+        self.quit.asked && (self.quit.allowed.is_some() || !self.dirty())
     }
 
     /// The export dialog's folder, while it is open.
@@ -345,6 +357,22 @@ impl EditorState {
     /// The messages shown in the corner.
     pub fn notices(&self) -> &[Notice] {
         &self.notices
+    }
+
+    /// Writes the recovery copy now if the document differs from it, and waits until it is
+    /// on disk: what the timer does every interval, at once.
+    ///
+    /// # Errors
+    /// The autosave's failure.
+    pub fn autosave_now(&mut self) -> Result<(), String> {
+        self.autosaver
+            .save_now(&self.doc)
+            .map_err(|e| e.to_string())
+    }
+
+    /// This editor's recovery copy (its session folder; it may not exist yet).
+    pub fn recovery_copy(&self) -> std::path::PathBuf {
+        self.autosaver.session()
     }
 
     /// Whether anything the project file stores (maps or settings) changed since the last
@@ -379,7 +407,12 @@ impl EditorState {
             .and_then(Path::file_name)
             .map_or_else(|| "untitled".into(), |n| n.to_string_lossy().into_owned());
         let marker = if self.dirty() { "*" } else { "" };
-        format!("{name}{marker} - kapaint")
+        let read_only = if self.claim.read_only {
+            " [read-only]"
+        } else {
+            ""
+        };
+        format!("{name}{marker}{read_only} - kapaint")
     }
 
     /// Applies a command as the panels do (an error becomes a notice).

@@ -69,14 +69,14 @@ impl EditorState {
 
     pub(super) fn close_prompt(&mut self, ctx: &egui::Context) {
         let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit.asked;
-        if close_requested && self.dirty() && !self.quit.allowed {
+        if close_requested && self.dirty() && self.quit.allowed.is_none() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.quit.asked = true;
-        } else if self.quit.asked && (self.quit.allowed || !self.dirty()) {
+        } else if self.quit.asked && (self.quit.allowed.is_some() || !self.dirty()) {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             return;
         }
-        if self.quit.asked && self.dirty() && !self.quit.allowed {
+        if self.quit.asked && self.dirty() && self.quit.allowed.is_none() {
             egui::Window::new("Unsaved changes")
                 .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
                 .collapsible(false)
@@ -90,7 +90,7 @@ impl EditorState {
                             self.quit.asked = false;
                         }
                         if ui.button("Discard").clicked() {
-                            self.quit.allowed = true;
+                            self.quit.allowed = Some(super::QuitAllowed::Discarded);
                         }
                         if ui.button("Cancel").clicked() {
                             self.quit.asked = false;

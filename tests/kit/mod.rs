@@ -145,3 +145,17 @@ pub fn right_drag(harness: &mut Harness<'_, Editor>, modifiers: Modifiers, by: V
     harness.step();
     harness.step();
 }
+
+/// The recovery copy (session folder) `copy` made to look like one an ended editor left: renamed
+/// to a process that no longer runs, as after `kill -9`.
+#[expect(clippy::expect_used, reason = "a test helper: no rename, no test")]
+pub fn as_ended(copy: &std::path::Path) -> std::path::PathBuf {
+    use kapaint::model::recovery::session::Owner;
+    let gone = Owner {
+        pid: 4_194_305,
+        ..Owner::this_process().clone()
+    };
+    let to = copy.with_file_name(gone.file_name());
+    std::fs::rename(copy, &to).expect("renamed");
+    to
+}

@@ -207,7 +207,7 @@ impl Document {
                 })
             }
             Command::RenameLayer(name) => self.props("Rename layer", |l| {
-                l.props.name = name;
+                l.props.name = crate::model::check::fit_name(&name, "", &l.props.name);
                 Ok(())
             }),
             Command::SetLayerBlend { channel, mode } => self.props("Layer blend mode", |l| {
@@ -292,7 +292,8 @@ impl Document {
                 let (parent, i) = split(&st.selection.path)?;
                 let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
                 let mut copy = list[i].clone();
-                copy.props.name = format!("{} copy", copy.props.name);
+                // Never past what a project holds: the name is cut to leave room for " copy".
+                copy.props.name = crate::model::check::fit_name(&copy.props.name, " copy", "copy");
                 list.insert(i + 1, copy);
                 st.selection.path = [parent, vec![i + 1]].concat();
                 Ok(())

@@ -146,6 +146,18 @@ impl Default for DocumentSettings {
     }
 }
 
+/// The layer a stack opens with selected: the topmost paint layer (inside groups too), else the
+/// topmost layer; empty for an empty stack.
+fn topmost_paintable(stack: &LayerStack) -> Vec<usize> {
+    let walk = stack.walk();
+    walk.iter()
+        .rev()
+        .find(|(_, l)| matches!(l.content, super::layers::LayerContent::Paint(_)))
+        .map(|(p, _)| p.clone())
+        .or_else(|| stack.layers.len().checked_sub(1).map(|i| vec![i]))
+        .unwrap_or_default()
+}
+
 /// A material being painted: a layer stack over a base material, and its composite.
 pub struct Document {
     /// The composite of the stack: what the renderer, `k_a` and export read.
@@ -166,6 +178,47 @@ pub struct Document {
     /// The tangent-space normal map an imported material brought (not painted; never in
     /// `k_a`).
     normal: Option<Arc<NormalMap>>,
+    /// Which document this is: kept in its project file and its recovery journal, so a
+    /// journal is only ever recovered into the project it was written for.
+    id: DocumentId,
+}
+
+/// A document's identity: random when the document is made, then kept in its project file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct DocumentId(pub u128);
+
+impl DocumentId {
+    /// A new identity, unguessable and different in every process and call.
+    pub fn random() -> Self {
+        use std::hash::{BuildHasher as _, Hasher as _};
+        use std::sync::atomic::{AtomicU64, Ordering};
+        static CALLS: AtomicU64 = AtomicU64::new(0);
+        // The standard library seeds each `RandomState` from the system's randomness.
+        let half = || {
+            let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+            h.write_u64(CALLS.fetch_add(1, Ordering::Relaxed));
+            h.write_u32(std::process::id());
+            h.write_u128(
+                std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map_or(0, |d| d.as_nanos()),
+            );
+            h.finish()
+        };
+        Self(u128::from(half()) << 64 | u128::from(half()))
+    }
+
+    /// As a project file and a journal write it: 32 hex digits.
+    pub fn to_hex(self) -> String {
+        format!("{:032x}", self.0)
+    }
+
+    /// From 32 hex digits.
+    pub fn from_hex(text: &str) -> Option<Self> {
+        (text.len() == 32 && text.bytes().all(|b| b.is_ascii_hexdigit()))
+            .then(|| u128::from_str_radix(text, 16).ok().map(Self))
+            .flatten()
+    }
 }
 
 impl std::fmt::Debug for Document {
@@ -213,17 +266,47 @@ impl Document {
         );
         doc.state.selection = self.state.selection.clone();
         doc.normal.clone_from(&self.normal);
+        doc.id = self.id;
         doc
+    }
+
+    /// This document with `selection` selected, where it names a layer of the stack (a
+    /// project or recovery copy restoring what was selected); otherwise as it was.
+    #[must_use]
+    pub fn with_selection(mut self, selection: Selection) -> Self {
+        if let Some(layer) = self.state.stack.layer(&selection.path) {
+            let mask = selection.mask && layer.mask.is_some();
+            self.state.selection = Selection {
+                path: selection.path,
+                mask,
+            };
+        }
+        self
+    }
+
+    /// This document with `normal` as its normal map (a loader making it).
+    #[must_use]
+    pub fn with_normal(mut self, normal: Option<Arc<NormalMap>>) -> Self {
+        self.normal = normal;
+        self
+    }
+
+    /// This document with the identity `id` (a loader making it from a file that has one).
+    #[must_use]
+    pub fn with_id(mut self, id: DocumentId) -> Self {
+        self.id = id;
+        self
+    }
+
+    /// Which document this is.
+    pub fn id(&self) -> DocumentId {
+        self.id
     }
 
     fn assemble(mut maps: MaterialMaps, stack: LayerStack, settings: DocumentSettings) -> Self {
         let mut compositor = Compositor::new();
         compositor.update(&stack, &mut maps);
-        let path = stack
-            .layers
-            .len()
-            .checked_sub(1)
-            .map_or_else(Vec::new, |i| vec![i]);
+        let path = topmost_paintable(&stack);
         Self {
             maps,
             state: State {
@@ -239,6 +322,7 @@ impl Document {
             layers_version: 0,
             opacity_run: None,
             normal: None,
+            id: DocumentId::random(),
         }
     }
 

@@ -162,10 +162,11 @@ pub struct LayerProps {
 }
 
 impl LayerProps {
-    /// A visible, unlocked, opaque layer of every channel in normal mode.
+    /// A visible, unlocked, opaque layer of every channel in normal mode (its name fitted to
+    /// what a project can hold, see [`crate::model::check::fit_name`]).
     pub fn named(name: impl Into<String>) -> Self {
         Self {
-            name: name.into(),
+            name: crate::model::check::fit_name(&name.into(), "", "Layer"),
             visible: true,
             locked: false,
             opacity: 1.0,

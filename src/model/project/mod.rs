@@ -11,9 +11,11 @@
 //! the first problem as one error; it never panics on any input.
 
 pub mod layers;
+pub mod lock;
 mod read;
 mod write;
 
+pub use lock::{OnDisk, ProjectLock, save_checked};
 pub use read::from_reader;
 pub use write::{to_bytes, write_to};
 
@@ -85,6 +87,41 @@ pub struct Manifest {
     /// size).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub normal: Option<NormalEntry>,
+    /// The document's identity (32 hex digits), which its recovery journals carry too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
+    /// The layer selected when it was saved (version 2): the editor opens on it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub selection: Option<SelectionEntry>,
+}
+
+/// The selected layer as a project stores it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SelectionEntry {
+    /// Indices from the top-level list down into groups.
+    #[serde(deserialize_with = "super::check::layer_path")]
+    pub path: Vec<usize>,
+    /// Tools paint its mask.
+    pub mask: bool,
+}
+
+impl SelectionEntry {
+    /// The entry of a selection.
+    pub fn of(selection: &super::layers::Selection) -> Self {
+        Self {
+            path: selection.path.clone(),
+            mask: selection.mask,
+        }
+    }
+
+    /// The selection it stores.
+    pub fn selection(&self) -> super::layers::Selection {
+        super::layers::Selection {
+            path: self.path.clone(),
+            mask: self.mask,
+        }
+    }
 }
 
 /// Where a project keeps its normal map.
@@ -196,10 +233,15 @@ fn relative_path(base: &Path, target: &Path) -> Option<PathBuf> {
 }
 
 /// Saves a document to `path` atomically.
+///
+/// # Errors
+/// [`ModelError::Unsaveable`] (nothing written) when the document holds what a project cannot
+/// (the loader's checks, run before a byte is written, say which field); else an I/O error.
 pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
+    let mut unloadable = None;
     // A serialisation failure (e.g. the disk filling up inside the zip writer) is reported as
     // an I/O error on the file, like any other write failure.
-    crate::atomic::write_atomic_with(path, |file| {
+    let written = crate::atomic::write_atomic_with(path, |file| {
         // The first write error (a full disk) is the one reported; the zip writer then
         // finishes quietly instead of printing its own failure.
         let mut out = crate::atomic::FirstError::new(file);
@@ -207,9 +249,23 @@ pub fn save(doc: &Document, path: &Path) -> Result<(), ModelError> {
         if let Some(e) = out.take_error() {
             return Err(e);
         }
-        written.map_err(std::io::Error::other)
-    })
-    .map_err(|e| ModelError::io(path, e))
+        written.map_err(|e| match e {
+            write::WriteFailure::Unloadable(reason) => {
+                let e = std::io::Error::other(reason.clone());
+                unloadable = Some(reason);
+                e
+            }
+            write::WriteFailure::Other(e) => std::io::Error::other(e),
+        })
+    });
+    match (written, unloadable) {
+        (Ok(()), _) => Ok(()),
+        (Err(_), Some(reason)) => Err(ModelError::Unsaveable {
+            path: path.to_path_buf(),
+            reason,
+        }),
+        (Err(e), None) => Err(ModelError::io(path, e)),
+    }
 }
 
 /// Loads `mesh` (a built-in name or a mesh file), bakes it at the document's size and
@@ -268,6 +324,26 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
     let settings = settings_from_file(doc.settings().clone(), path);
     doc.replace_settings(settings);
     Ok(doc)
+}
+
+/// The identity of the project at `path` (from its manifest alone), if it is a project that
+/// has one.
+pub fn read_id(path: &Path) -> Option<super::document::DocumentId> {
+    #[derive(Deserialize)]
+    struct Id {
+        id: Option<String>,
+    }
+    crate::file_check::regular_file(path, MAX_PROJECT_BYTES).ok()?;
+    let mut zip = zip::ZipArchive::new(File::open(path).ok()?).ok()?;
+    let entry = zip.by_name("manifest.json").ok()?;
+    let mut text = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(entry, MAX_MANIFEST_BYTES),
+        &mut text,
+    )
+    .ok()?;
+    let id: Id = serde_json::from_slice(&text).ok()?;
+    super::document::DocumentId::from_hex(&id.id?)
 }
 
 /// Whether half-float bits hold a storable exponent: finite, not negative, at most `N_MAX`.

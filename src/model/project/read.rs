@@ -69,9 +69,15 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         if (0..stored.tile_count()).into_par_iter().any(differs) {
             return Err("the stored composite differs from what the layers composite to".into());
         }
-        let mut doc = doc;
-        doc.set_normal(read_normal(&mut zip, manifest.normal.as_ref())?);
-        return Ok(doc);
+        let normal = read_normal(&mut zip, manifest.normal.as_ref())?;
+        let doc = doc.with_normal(normal).with_selection(
+            manifest
+                .selection
+                .as_ref()
+                .map(super::SelectionEntry::selection)
+                .unwrap_or_default(),
+        );
+        return Ok(with_id(doc, manifest.id.as_deref()));
     }
     let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
     let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
@@ -80,9 +86,18 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
     let settings = manifest.settings;
     let mut maps = MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
     fill_maps(&mut maps, &kd, &ks, &n);
-    let mut doc = Document::from_parts(maps, settings);
-    doc.set_normal(read_normal(&mut zip, manifest.normal.as_ref())?);
-    Ok(doc)
+    let doc = Document::from_parts(maps, settings)
+        .with_normal(read_normal(&mut zip, manifest.normal.as_ref())?);
+    Ok(with_id(doc, manifest.id.as_deref()))
+}
+
+/// `doc` with the identity the manifest names (`id`) (a project written before projects had one
+/// keeps the new one it was given).
+fn with_id(doc: Document, id: Option<&str>) -> Document {
+    match id.and_then(crate::model::document::DocumentId::from_hex) {
+        Some(id) => doc.with_id(id),
+        None => doc,
+    }
 }
 
 /// The normal map of the manifest's entry, checked against it.

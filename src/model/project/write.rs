@@ -116,6 +116,30 @@ fn entry((name, raster): &(String, Raster)) -> ChannelEntry {
     }
 }
 
+/// Why a project was not written.
+pub(super) enum WriteFailure {
+    /// The document holds what a project cannot (the loader would refuse it): which field.
+    Unloadable(String),
+    /// Encoding or writing failed.
+    Other(String),
+}
+
+impl From<String> for WriteFailure {
+    fn from(e: String) -> Self {
+        Self::Other(e)
+    }
+}
+
+impl WriteFailure {
+    /// As one line.
+    pub(super) fn into_text(self) -> String {
+        match self {
+            Self::Unloadable(e) => format!("the project would not load back ({e})"),
+            Self::Other(e) => e,
+        }
+    }
+}
+
 /// Serialises a document into project bytes (what [`save`](super::save) writes).
 pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
     let mut cursor = std::io::Cursor::new(Vec::new());
@@ -125,7 +149,7 @@ pub fn to_bytes(doc: &Document) -> Result<Vec<u8>, String> {
 
 /// Serialises a document as a project into `out` (its mesh path as the document holds it).
 pub fn write_to(doc: &Document, out: impl Write + Seek) -> Result<(), String> {
-    write_project(doc, doc.settings().clone(), out)
+    write_project(doc, doc.settings().clone(), out).map_err(WriteFailure::into_text)
 }
 
 /// Serialises a document with `settings` into `out`.
@@ -133,7 +157,7 @@ pub(super) fn write_project(
     doc: &Document,
     settings: DocumentSettings,
     out: impl Write + Seek,
-) -> Result<(), String> {
+) -> Result<(), WriteFailure> {
     let maps = doc.maps();
     let (w, h) = (maps.width(), maps.height());
     let mut rasters: Vec<(String, Raster)> = channel_rasters(maps, "").into();
@@ -195,17 +219,19 @@ pub(super) fn write_project(
             width: m.width(),
             height: m.height(),
         }),
+        id: Some(doc.id().to_hex()),
+        selection: Some(super::SelectionEntry::of(doc.selection())),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
     // Never write what the loader would refuse: the manifest goes through the loader's own
     // checks, and every stored exponent through its test, before a byte is written.
-    parse_manifest(&json).map_err(|e| format!("the project would not load back ({e})"))?;
+    parse_manifest(&json).map_err(WriteFailure::Unloadable)?;
     let mut all_maps = vec![maps];
     all_maps.extend(layer_maps.iter().filter_map(|l| l.values.as_ref()));
     if let Some(bits) = all_maps.into_iter().find_map(invalid_n_in) {
-        return Err(format!(
-            "the project would not load back (n holds half-float bits {bits:#06x})"
-        ));
+        return Err(WriteFailure::Unloadable(format!(
+            "n holds half-float bits {bits:#06x}"
+        )));
     }
     let mut zip = zip::ZipWriter::new(out);
     let deflated = zip::write::SimpleFileOptions::default()

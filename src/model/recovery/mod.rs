@@ -1,105 +1,179 @@
-//! Crash recovery: autosave copies that cost only what changed.
+//! Crash recovery: autosave copies that cost only what changed, one per editor process.
 //!
-//! A recovery copy is a folder (`.NAME.kapaint-recovery` beside the project, or
-//! `untitled.kapaint-recovery` in kapaint's state folder) holding one generation:
-//! - `base-STAMP.kapaint`, a whole project written at the first autosave;
-//! - `journal-STAMP.bin`, to which every later autosave appends one record: the settings and
-//!   the tiles changed since the record before, with a checksum.
+//! Each editor process keeps its copy in a session folder of its own inside the project's
+//! recovery folder (see [`folder`]), so two editors on one project never touch each other's
+//! copy. A copy is a journal: its first record is the whole document (layers, masks, settings,
+//! selection, normal map), and every later record holds the layer structure and only the tiles
+//! changed since the record before, each record checksummed and flushed to disk before the next
+//! autosave. A kill therefore loses at most the work since the last record plus the record
+//! being written, whatever the document's size: a record cut short fails its check and
+//! recovery takes the one before.
 //!
 //! An autosave is due every [`AUTOSAVE_INTERVAL`] while the document changes, and runs on a
-//! background thread: the editor only takes a snapshot of the changed tiles (shared
-//! copy-on-write, no copy). When the journal outgrows its base, the next autosave starts a
-//! new generation and removes the old one once the new one is on disk. A record cut short by
-//! a crash fails its checksum and is ignored, so recovery gets every autosave before it. A
-//! failed autosave is truncated away and retried one interval later.
+//! background thread: the editor only takes a snapshot (tiles shared copy-on-write, no copy).
+//! When the journal outgrows its first record, the next autosave starts a new generation (a
+//! new journal whose first record is the whole document) and removes the old one once the new
+//! one is on disk. A failed autosave is cut back and retried one interval later, as a new
+//! generation.
 
 mod folder;
+mod journal;
 mod record;
+pub mod session;
 #[cfg(test)]
 mod tests;
 
-pub use folder::{load, modified, recovery_path, remove};
+pub use folder::{load, offer, recovery_path, remove};
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::ModelError;
 use super::document::Document;
-use super::tile::Tile;
-use folder::{append_record, write_generation};
+use folder::{Generation, session_dir};
+use journal::Snapshot;
 
 /// Time between recovery copies while the document changes: at most this much work is lost
 /// when the process is killed.
 pub const AUTOSAVE_INTERVAL: Duration = Duration::from_secs(20);
 
-/// The generation an autosaver appends to.
-#[derive(Clone, Copy, Debug)]
-struct Generation {
-    stamp: u64,
-    base_bytes: u64,
-    journal_bytes: u64,
-    size: (u32, u32),
-}
+/// Journals smaller than this are never compacted into a new generation (bytes).
+const MIN_COMPACT_BYTES: u64 = 64 << 20;
 
 /// What a finished autosave reports back.
 type Outcome = Result<Generation, ModelError>;
 
-/// An autosave on its thread: the document version it makes safe, the maps version its
-/// tiles go up to, and the thread.
+/// An autosave on its thread: the document version it makes safe, and the thread.
 struct Job {
     version: u64,
-    maps_version: u64,
     handle: std::thread::JoinHandle<Outcome>,
 }
 
-/// Autosave on a timer: [`Autosaver::poll`] (each frame, or from any loop) snapshots what
-/// changed when a recovery copy is due, and writes it on a named background thread, so
+/// Autosave on a timer: [`Autosaver::poll`] (each frame, or from any loop) snapshots the
+/// document when a recovery copy is due, and writes it on a named background thread, so
 /// painting never waits on the disk.
 pub struct Autosaver {
     interval: Duration,
-    path: PathBuf,
+    /// The project's recovery folder; this process's copy is its session folder inside.
+    recovery: PathBuf,
     last_time: Instant,
     /// The document version the recovery copy holds.
     saved_version: u64,
-    /// The maps version whose tiles the recovery copy holds.
-    maps_version: u64,
     generation: Option<Generation>,
     job: Option<Job>,
+    /// Copies this one replaces (a recovered copy, one left where a moved copy could not
+    /// follow): removed once this one holds a record.
+    superseded: Vec<PathBuf>,
+    /// The recovery folder to move to once the autosave in flight is done.
+    moving_to: Option<PathBuf>,
 }
 
 impl std::fmt::Debug for Autosaver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Autosaver")
-            .field("path", &self.path)
+            .field("recovery", &self.recovery)
             .field("interval", &self.interval)
             .finish_non_exhaustive()
     }
 }
 
 impl Autosaver {
-    /// Writes recovery copies to the folder `path` every `interval` while the document
-    /// changes; the document's current state counts as safe (it was just opened or saved).
-    pub fn new(interval: Duration, path: PathBuf, doc: &Document) -> Self {
+    /// Writes recovery copies of the project at `project` (untitled work: `None`) every
+    /// `interval` while the document changes; the document's current state counts as safe (it
+    /// was just opened or saved).
+    pub fn new(interval: Duration, project: Option<&Path>, doc: &Document) -> Self {
         Self {
             interval,
-            path,
+            recovery: recovery_path(project),
             last_time: Instant::now(),
             saved_version: doc.version(),
-            maps_version: doc.maps().version(),
             generation: None,
             job: None,
+            superseded: Vec::new(),
+            moving_to: None,
         }
     }
 
-    /// Where recovery copies go.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// Like [`Autosaver::new`], for a document recovered from the copy `from`: its first copy
+    /// is due at once, and `from` is removed once that copy is on disk (until then, it is all
+    /// that holds the recovered work).
+    pub fn recovering(
+        interval: Duration,
+        project: Option<&Path>,
+        doc: &Document,
+        from: PathBuf,
+    ) -> Self {
+        let mut saver = Self::new(interval, project, doc);
+        saver.saved_version = doc.version().wrapping_add(1);
+        saver.last_time = Instant::now()
+            .checked_sub(interval)
+            .unwrap_or_else(Instant::now);
+        if from != saver.session() {
+            saver.superseded.push(from);
+        }
+        saver
+    }
+
+    /// This process's recovery copy: its session folder.
+    pub fn session(&self) -> PathBuf {
+        session_dir(&self.recovery)
+    }
+
+    /// The recovery folder of the project (this process's copy is inside it).
+    pub fn recovery_folder(&self) -> &Path {
+        &self.recovery
     }
 
     /// Whether the recovery copy holds the document as it is.
     pub fn is_current(&self, doc: &Document) -> bool {
         self.job.is_none() && self.saved_version == doc.version()
+    }
+
+    /// After the document was saved under another name (`Save As`, or the first save of
+    /// untitled work): the recovery copy follows it to the new project's recovery folder, so
+    /// it is never offered as the old project's work. Where it cannot be moved (another file
+    /// system), the next copy is written there whole and the old one removed after it.
+    pub fn relocate(&mut self, project: Option<&Path>) {
+        self.moving_to = Some(recovery_path(project));
+        if self.job.is_none() {
+            self.apply_move();
+        }
+    }
+
+    fn apply_move(&mut self) {
+        let Some(to) = self.moving_to.take() else {
+            return;
+        };
+        if to == self.recovery {
+            return;
+        }
+        let from = self.session();
+        self.recovery = to;
+        let moved = !from.exists()
+            || (folder::private_dir(&self.recovery).is_ok()
+                && std::fs::rename(&from, self.session()).is_ok());
+        if moved {
+            if let Some(old) = from.parent() {
+                // Only when empty: another editor's copy may be in it.
+                let _ = std::fs::remove_dir(old);
+            }
+        } else {
+            self.superseded.push(from);
+            self.generation = None;
+            // Due at the next interval, even if nothing changes meanwhile.
+            self.saved_version = self.saved_version.wrapping_add(1);
+        }
+    }
+
+    /// Removes this process's recovery copy (and any it replaces), after waiting for an
+    /// autosave in flight: the work was saved, or the user discarded it.
+    pub fn discard(&mut self) {
+        let _ = self.finish();
+        remove(&self.session());
+        for old in self.superseded.drain(..) {
+            remove(&old);
+        }
+        self.generation = None;
     }
 
     /// How long until [`Autosaver::poll`] has something to do: the rest of the interval while
@@ -136,40 +210,39 @@ impl Autosaver {
         finished
     }
 
-    /// Starts an autosave now (a new generation, or a record appended to this one).
+    /// Starts an autosave now: a record appended to this generation, or a new generation when
+    /// there is none or its journal has outgrown its first record.
     fn start(&mut self, doc: &Document) -> Result<(), ModelError> {
-        let size = (doc.maps().width(), doc.maps().height());
         let version = doc.version();
-        let maps_version = doc.maps().version();
-        let append = self
+        let generation = self
             .generation
-            .filter(|g| g.size == size && g.journal_bytes <= g.base_bytes.max(64 << 20))
-            // The journal holds composite tiles: only a stack of one plain layer is that.
-            .filter(|_| doc.stack().is_flat());
-        let dir = self.path.clone();
-        let work: Box<dyn FnOnce() -> Outcome + Send> = if let Some(generation) = append {
-            let tiles: Vec<(usize, Arc<Tile>)> = doc
-                .maps()
-                .tiles_changed_since(self.maps_version)
-                .into_iter()
-                .map(|id| (id, Arc::clone(doc.maps().tile(id))))
-                .collect();
-            let settings = doc.settings().clone();
-            Box::new(move || append_record(&dir, generation, size, &settings, &tiles))
-        } else {
-            let snapshot = doc.snapshot();
-            Box::new(move || write_generation(&dir, &snapshot))
-        };
+            .take()
+            .filter(|g| g.bytes <= g.first_bytes.saturating_mul(2).max(MIN_COMPACT_BYTES));
+        let snapshot = Snapshot::of(doc);
+        let dir = self.session();
         let handle = std::thread::Builder::new()
             .name("kapaint-autosave".into())
-            .spawn(work)
-            .map_err(|e| ModelError::io(&self.path, e))?;
-        self.job = Some(Job {
-            version,
-            maps_version,
-            handle,
-        });
+            .spawn(move || folder::write(&dir, generation, &snapshot))
+            .map_err(|e| ModelError::io(&self.recovery, e))?;
+        self.job = Some(Job { version, handle });
         Ok(())
+    }
+
+    /// Writes a copy now, whatever the timer says, if the document differs from its copy, and
+    /// waits for it (and for one in flight).
+    ///
+    /// # Errors
+    /// The autosave's failure.
+    pub fn save_now(&mut self, doc: &Document) -> Result<(), ModelError> {
+        if let Some(Err(e)) = self.finish() {
+            return Err(e);
+        }
+        if doc.version() == self.saved_version {
+            return Ok(());
+        }
+        self.last_time = Instant::now();
+        self.start(doc)?;
+        self.finish().unwrap_or(Ok(PathBuf::new())).map(|_| ())
     }
 
     /// Waits for an autosave in flight, if any, and reports it.
@@ -181,23 +254,24 @@ impl Autosaver {
         let job = self.job.take()?;
         let outcome = job.handle.join().unwrap_or_else(|_| {
             Err(ModelError::io(
-                &self.path,
+                &self.recovery,
                 std::io::Error::other("the autosave thread stopped unexpectedly"),
             ))
         });
-        Some(match outcome {
+        let reported = match outcome {
             Ok(generation) => {
                 self.generation = Some(generation);
                 self.saved_version = job.version;
-                self.maps_version = job.maps_version;
-                Ok(self.path.clone())
+                for old in self.superseded.drain(..) {
+                    remove(&old);
+                }
+                Ok(self.session())
             }
-            Err(e) => {
-                // Nothing counts as saved: the same changes go into the next attempt (a new
-                // generation if the journal may be damaged).
-                self.generation = None;
-                Err(e)
-            }
-        })
+            // Nothing counts as saved: the same changes go into the next attempt, a new
+            // generation (the journal may be damaged).
+            Err(e) => Err(e),
+        };
+        self.apply_move();
+        Some(reported)
     }
 }
