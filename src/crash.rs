@@ -24,8 +24,9 @@ pub enum OnPanic {
 /// exit (or, in the editor, for their turn).
 static REPORTING: Mutex<()> = Mutex::new(());
 
-/// Installs the panic hook.
+/// Installs the panic hook, and keeps a write past the file-size limit an error.
 pub fn install(on_panic: OnPanic) {
+    keep_file_size_errors();
     std::panic::set_hook(Box::new(move |info| {
         let guard = REPORTING.lock();
         let thread = std::thread::current();
@@ -65,6 +66,18 @@ pub fn install(on_panic: OnPanic) {
         }
         drop(guard);
     }));
+}
+
+/// Under `ulimit -f`, a write past the limit raises SIGXFSZ, whose default action ends the
+/// process with no word (exit 153). With a handler in place the write fails with `EFBIG`
+/// instead, and the save that made it reports it in one line like any other write error.
+fn keep_file_size_errors() {
+    #[cfg(unix)]
+    {
+        let seen = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        // Best effort: without it, the default action stays.
+        let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, seen);
+    }
 }
 
 /// Writes the report into `crash-<seconds>-<pid>.log` in the state folder; `None` when it

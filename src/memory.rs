@@ -2,10 +2,46 @@
 //! image) are checked against it first, so they fail with a clear error instead of an
 //! out-of-memory kill.
 
-/// Bytes the system says can still be allocated without swapping (`MemAvailable` of
-/// `/proc/meminfo`), or `None` where that is not known (other systems).
+/// Bytes this process can still allocate: what the system says it can give without swapping
+/// (`MemAvailable` of `/proc/meminfo`), less where a limit on the process is nearer (its
+/// cgroup's `memory.max`, its address-space limit `ulimit -v`); `None` where none of that is
+/// known (other systems).
 pub fn available_bytes() -> Option<u64> {
-    kib_field("/proc/meminfo", "MemAvailable:")
+    [
+        kib_field("/proc/meminfo", "MemAvailable:"),
+        cgroup_room(),
+        address_space_room(),
+    ]
+    .into_iter()
+    .flatten()
+    .min()
+}
+
+/// What this process's cgroup (v2) still allows: `memory.max` less `memory.current`.
+fn cgroup_room() -> Option<u64> {
+    let cgroup = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let path = cgroup.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let dir = std::path::Path::new("/sys/fs/cgroup").join(path.trim_start_matches('/'));
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).ok();
+    let max: u64 = read("memory.max")?.trim().parse().ok()?;
+    let current: u64 = read("memory.current")?.trim().parse().ok()?;
+    Some(max.saturating_sub(current))
+}
+
+/// What the address-space limit (`ulimit -v`) still allows: the soft limit less the process's
+/// virtual size.
+fn address_space_room() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    let soft: u64 = line
+        .trim_start_matches("Max address space")
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    Some(soft.saturating_sub(process_bytes("VmSize:")?))
 }
 
 /// A size field of this process's `/proc/self/status` in bytes (`"VmRSS:"`, resident now;

@@ -399,7 +399,7 @@ fn the_primary_material_and_the_brush_are_saved_as_presets_of_ones_own() {
         state
             .notices()
             .iter()
-            .any(|n| n.error && n.text.contains("broken.ron")),
+            .any(|n| n.is_error() && n.text.contains("broken.ron")),
         "{:?}",
         state.notices().iter().map(|n| &n.text).collect::<Vec<_>>()
     );

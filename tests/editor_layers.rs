@@ -227,3 +227,20 @@ fn alt_click_on_a_mask_shows_it_alone_and_the_viewport_says_what_is_painted() {
         Some("Painting the mask of \"Layer 1\" · showing mask")
     );
 }
+
+#[test]
+fn a_mask_being_painted_shows_alone_in_grey() {
+    use kapaint::model::Command;
+    let mut harness = editor();
+    let state = &mut harness.state_mut().state;
+    assert_eq!(state.shown_layer_view(), LayerView::Composite);
+    state.apply_command(Command::AddMask);
+    state.apply_command(Command::SelectMask);
+    assert_eq!(
+        state.shown_layer_view(),
+        LayerView::Mask,
+        "the mask is the target"
+    );
+    state.apply_command(Command::SelectContent);
+    assert_eq!(state.shown_layer_view(), LayerView::Composite);
+}

@@ -339,3 +339,148 @@ fn mesh_info_reads_glb() {
     assert!(text.contains("triangles: 5856"), "{text}");
     assert!(text.contains("normals: computed"), "{text}");
 }
+
+/// A GLB like the ones artists download: the spot mesh, and a PBR material whose base colour
+/// and metallic-roughness PNGs sit in the binary chunk (bufferView images), the base colour
+/// with a texture transform.
+fn textured_glb() -> Vec<u8> {
+    let (json, mut bin) = mesh_gltf(&spot(), true, r#"[{"mesh":0}]"#, 4);
+    let mut root: serde_json::Value = serde_json::from_str(&json).expect("json");
+    let png = |rgb: [u8; 3]| {
+        let mut bytes = Vec::new();
+        image::RgbImage::from_fn(16, 16, |x, y| {
+            image::Rgb([rgb[0] ^ (x as u8 * 9), rgb[1], rgb[2] ^ (y as u8 * 7)])
+        })
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .expect("png");
+        bytes
+    };
+    let views = root["bufferViews"].as_array_mut().expect("views");
+    let mut image_views = Vec::new();
+    for bytes in [png([200, 120, 40]), png([0, 160, 255])] {
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        image_views.push(views.len());
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}),
+        );
+        bin.extend_from_slice(&bytes);
+    }
+    root["buffers"][0]["byteLength"] = bin.len().into();
+    root["images"] = serde_json::json!([
+        {"bufferView": image_views[0], "mimeType": "image/png", "name": "base"},
+        {"bufferView": image_views[1], "mimeType": "image/png", "name": "mr"}
+    ]);
+    root["samplers"] = serde_json::json!([{"wrapS": 10497, "wrapT": 33648}]);
+    root["textures"] = serde_json::json!([{"source": 0, "sampler": 0}, {"source": 1}]);
+    root["materials"] = serde_json::json!([{
+        "name": "barrel",
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [1.0, 0.9, 0.8, 1.0],
+            "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.1, 0.0], "rotation": 0.2, "scale": [2.0, 2.0]}}},
+            "metallicFactor": 1.0, "roughnessFactor": 0.8,
+            "metallicRoughnessTexture": {"index": 1}
+        }
+    }]);
+    root["extensionsUsed"] = serde_json::json!(["KHR_texture_transform"]);
+    root["meshes"][0]["primitives"][0]["material"] = 0.into();
+    glb(&serde_json::to_string(&root).expect("json"), &bin)
+}
+
+#[test]
+fn byte_flips_and_truncations_of_a_textured_glb_never_panic_in_import_pbr_or_mesh_info() {
+    let file = textured_glb();
+    let path = temp("barrel.glb", &file);
+    let set = kapaint::pbr::gltf::material_set(&path, None).expect("the unflipped file imports");
+    assert_eq!(set.name, "barrel");
+    let json_len = u32::from_le_bytes(file[12..16].try_into().expect("len")) as usize;
+    let mut state = 0x2545_F491_u32;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state
+    };
+    let (mut panics, mut imported) = (Vec::new(), 0);
+    for k in 0..1500 {
+        let r = next();
+        let copy = match k % 3 {
+            // A character of the JSON replaced by one that changes its meaning.
+            0 | 1 => {
+                let mut c = file.clone();
+                let at = 20 + r as usize % json_len;
+                c[at] = b"0123456789-e.,:[]{}\" xE+"[(r >> 24) as usize % 24];
+                c
+            }
+            // A bit anywhere, or the file cut short.
+            _ if r % 2 == 0 => {
+                let mut c = file.clone();
+                let at = (r >> 1) as usize % c.len();
+                c[at] ^= 1 << (r >> 28);
+                c
+            }
+            _ => file[..(r >> 1) as usize % file.len()].to_vec(),
+        };
+        let path = temp("barrel_mutant.glb", &copy);
+        let outcome = std::panic::catch_unwind(|| {
+            let imported = kapaint::pbr::gltf::material_set(&path, None).is_ok();
+            let _ = mesh::load(&path);
+            imported
+        });
+        match outcome {
+            Ok(ok) => imported += usize::from(ok),
+            Err(_) => panics.push(k),
+        }
+    }
+    assert!(
+        panics.is_empty(),
+        "{} of 1500 mutations panicked: {panics:?}",
+        panics.len()
+    );
+    assert!(
+        imported > 100,
+        "few mutations kept a readable material: {imported}"
+    );
+}
+
+#[test]
+fn an_image_without_a_source_is_one_line_and_exit_2() {
+    let file = textured_glb();
+    let json_len = u32::from_le_bytes(file[12..16].try_into().expect("len")) as usize;
+    let json = std::str::from_utf8(&file[20..20 + json_len]).expect("utf-8");
+    let bin = &file[20 + json_len + 8..];
+    let dir = std::env::temp_dir().join(format!("kapaint-gltf-src-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let cases: [(&str, &str, &str); 2] = [
+        ("nosource", "bufferView", "neither"),
+        ("nomime", "mimeType", "no mimeType"),
+    ];
+    for (tag, field, says) in cases {
+        let mut root: serde_json::Value = serde_json::from_str(json).expect("json");
+        root["images"][1]
+            .as_object_mut()
+            .expect("image")
+            .remove(field);
+        let text = serde_json::to_string(&root).expect("json");
+        let path = temp(&format!("{tag}.glb"), &glb(&text, bin));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args([
+                "import-pbr",
+                "--gltf",
+                path.to_str().expect("path"),
+                "--out",
+            ])
+            .arg(dir.join(format!("{tag}.kapaint")))
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{tag}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(says), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -103,3 +103,45 @@ fn the_energy_guard_holds_on_a_layer() {
     let t = doc.maps().texel(5, 120).decode();
     assert!((t.kd.x - 0.9 / 1.4).abs() < 1e-3, "{t:?}");
 }
+
+/// A mask takes the value of the brush's colour (as Krita and Substance paint masks): black
+/// hides, mid grey half shows, white reveals; the eraser hides. It used to paint white with any
+/// colour.
+#[test]
+fn a_mask_is_painted_with_the_value_of_the_primary_colour() {
+    use kapaint::model::layers::LayerContent;
+    let mask_at = |doc: &kapaint::model::Document, x: usize, y: usize| -> f32 {
+        let layer = doc.stack().layer(&doc.selection().path).expect("layer");
+        assert!(matches!(layer.content, LayerContent::Paint(_)));
+        let mask = layer.mask.as_ref().expect("a mask");
+        let (tx, ty) = (x / 64, y / 64);
+        let tile = &mask.tiles[ty * 3 + tx];
+        f32::from(tile.get().get((y % 64) * 64 + x % 64)) / 65535.0
+    };
+    let mut doc = document();
+    run(
+        &mut doc,
+        r"(commands: [
+            AddMask, SelectMask,
+            SetBrush((radius_px: 10.0, hardness: 1.0, flow: 1.0, opacity: 1.0)),
+            SetPrimary((kd: (0.0, 0.0, 0.0), ks: (0.5, 0.5, 0.5), n: 10.0)),
+            Stroke(tool: Brush, points: [(pos: (20.0, 30.0), pressure: 1.0), (pos: (60.0, 30.0), pressure: 1.0)]),
+            SetPrimary((kd: (0.2140, 0.2140, 0.2140), ks: (0.5, 0.5, 0.5), n: 10.0)),
+            Stroke(tool: Brush, points: [(pos: (20.0, 90.0), pressure: 1.0), (pos: (60.0, 90.0), pressure: 1.0)]),
+            SetPrimary((kd: (1.0, 0.2, 0.2), ks: (0.5, 0.5, 0.5), n: 10.0)),
+            Stroke(tool: Eraser, points: [(pos: (120.0, 30.0), pressure: 1.0), (pos: (160.0, 30.0), pressure: 1.0)]),
+        ])",
+    );
+    assert!(
+        mask_at(&doc, 40, 30) < 0.01,
+        "black hides: {}",
+        mask_at(&doc, 40, 30)
+    );
+    let grey = mask_at(&doc, 40, 90);
+    assert!(
+        (grey - 0.5).abs() < 0.01,
+        "mid grey (sRGB 0.5) half shows: {grey}"
+    );
+    assert!(mask_at(&doc, 140, 30) < 0.01, "the eraser hides");
+    assert!(mask_at(&doc, 100, 100) > 0.99, "untouched stays white");
+}

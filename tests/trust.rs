@@ -171,6 +171,8 @@ fn two_paint_runs_on_one_project_keep_both_edits() {
         let run = |script: &Path| {
             Command::new(env!("CARGO_BIN_EXE_kapaint"))
                 .args(["paint", s(&project), "--script", s(script)])
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
                 .spawn()
                 .expect("paint starts")
         };
@@ -225,5 +227,290 @@ fn duplicating_a_layer_never_makes_the_project_unsaveable() {
     let long_copy = names.last().expect("layers");
     assert!(long_copy.ends_with(" copy") && long_copy.starts_with("nnn"));
     assert!(names[names.len() - 2].ends_with(" copy"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_script_that_outgrows_memory_is_refused_with_the_bytes_needed() {
+    let dir = scratch("memory");
+    let project = dir.join("P.kapaint");
+    let o = kapaint(&["new", "--size", "4096", "--out", s(&project)]);
+    assert!(o.status.success(), "{o:?}");
+    let layer = r#"AddLayer(kind: Paint, name: "G"), Gradient(shape: Linear, start: (0.0, 0.0), end: (4096.0, 4096.0)),"#;
+    let script = dir.join("layers.ron");
+    std::fs::write(&script, format!("(commands: [{}])", layer.repeat(40))).expect("script");
+    let before = std::fs::read(&project).expect("project");
+    // A machine with 3 GB for this process: 40 full layers of 4096^2 need far more.
+    let o = Command::new("bash")
+        .args([
+            "-c",
+            "ulimit -v 3000000; exec \"$0\" paint \"$1\" --script \"$2\"",
+            env!("CARGO_BIN_EXE_kapaint"),
+            s(&project),
+            s(&script),
+        ])
+        .output()
+        .expect("bash");
+    assert_refused(&o, "needs about");
+    assert_eq!(
+        std::fs::read(&project).expect("project"),
+        before,
+        "the project changed"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Rewrites `manifest.json` inside a project through `edit`.
+fn edit_manifest(path: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
+    use std::io::{Read as _, Write as _};
+    let bytes = std::fs::read(path).expect("read project");
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).expect("zip");
+    let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let mut edit = Some(edit);
+    for i in 0..zip.len() {
+        let mut entry = zip.by_index(i).expect("entry");
+        let name = entry.name().expect("entry name").to_string();
+        let mut data = Vec::new();
+        entry.read_to_end(&mut data).expect("entry bytes");
+        if name == "manifest.json"
+            && let Some(edit) = edit.take()
+        {
+            let mut json: serde_json::Value = serde_json::from_slice(&data).expect("json");
+            edit(&mut json);
+            data = serde_json::to_vec(&json).expect("json out");
+        }
+        out.start_file(name, zip::write::SimpleFileOptions::default())
+            .expect("start");
+        out.write_all(&data).expect("write");
+    }
+    let bytes = out.finish().expect("finish").into_inner();
+    std::fs::write(path, bytes).expect("write project");
+}
+
+#[test]
+fn a_project_declaring_more_than_memory_or_one_image_many_times_is_refused_at_once() {
+    let dir = scratch("declared");
+    let project = dir.join("P.kapaint");
+    new_project(&project);
+    let script = dir.join("paint.ron");
+    std::fs::write(
+        &script,
+        "(commands: [Stroke(tool: Brush, points: [(pos: (3.0, 3.0), pressure: 1.0), (pos: (60.0, 50.0), pressure: 1.0)])])",
+    )
+    .expect("script");
+    let o = kapaint(&["paint", s(&project), "--script", s(&script)]);
+    assert!(o.status.success(), "{o:?}");
+    // 256 layers naming the one layer's images.
+    let shared = dir.join("shared.kapaint");
+    std::fs::copy(&project, &shared).expect("copy");
+    edit_manifest(&shared, |m| {
+        let layer = m["layers"][0].clone();
+        assert!(layer["planes"].is_object(), "{layer}");
+        m["layers"] = serde_json::Value::Array(vec![layer; 256]);
+    });
+    let start = std::time::Instant::now();
+    let o = kapaint(&["info", s(&shared)]);
+    assert_refused(&o, "more than once");
+    assert!(start.elapsed().as_secs() < 10);
+    // 256 whole-map layers of 8192^2: far more than any machine here holds.
+    let huge = dir.join("huge.kapaint");
+    std::fs::copy(&project, &huge).expect("copy");
+    edit_manifest(&huge, |m| {
+        m["width"] = 8192.into();
+        m["height"] = 8192.into();
+        let mut layer = m["layers"][0].clone();
+        layer["planes"]
+            .as_object_mut()
+            .expect("planes")
+            .remove("tiles");
+        let layers: Vec<serde_json::Value> = (0..256)
+            .map(|k| {
+                let mut l = layer.clone();
+                for c in ["kd", "ks", "n", "alpha"] {
+                    l["planes"][c] = serde_json::json!({
+                        "kind": "image", "file": format!("l{k}_{c}.png"),
+                        "encoding": if c == "n" { "png-gray16-half-float-bits" } else { "png-rgb16-unorm-linear" }
+                    });
+                }
+                l
+            })
+            .collect();
+        m["layers"] = serde_json::Value::Array(layers);
+    });
+    let o = kapaint(&["info", s(&huge)]);
+    assert_refused(&o, "needs about");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_write_past_the_file_size_limit_is_one_line_not_a_silent_death() {
+    let dir = scratch("fsize");
+    let project = dir.join("P.kapaint");
+    let o = kapaint(&["new", "--size", "512", "--out", s(&project)]);
+    assert!(o.status.success(), "{o:?}");
+    let script = dir.join("g.ron");
+    std::fs::write(
+        &script,
+        "(commands: [Gradient(shape: Radial, start: (0.0, 0.0), end: (512.0, 300.0))])",
+    )
+    .expect("script");
+    let before = std::fs::read(&project).expect("project");
+    // 20 KiB: the painted project is larger.
+    let o = Command::new("bash")
+        .args([
+            "-c",
+            "ulimit -f 20; exec \"$0\" paint \"$1\" --script \"$2\"",
+            env!("CARGO_BIN_EXE_kapaint"),
+            s(&project),
+            s(&script),
+        ])
+        .output()
+        .expect("bash");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{o:?}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("File too large"), "{err}");
+    assert_eq!(std::fs::read(&project).expect("project"), before);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[cfg(unix)]
+#[test]
+fn faults_of_the_input_exit_2() {
+    let dir = scratch("input-faults");
+    let project = dir.join("P.kapaint");
+    new_project(&project);
+    // A --set image that is a link looping onto itself.
+    let looped = dir.join("wood_BaseColor.png");
+    std::os::unix::fs::symlink(&looped, &looped).expect("link");
+    let o = kapaint(&[
+        "import-pbr",
+        "--set",
+        s(&looped),
+        "--out",
+        s(&dir.join("Q.kapaint")),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    // --out inside a file.
+    let file = dir.join("notes.txt");
+    std::fs::write(&file, "mine").expect("write");
+    let o = kapaint(&["export", s(&project), "--out", s(&file.join("set"))]);
+    assert_refused(&o, "is a file");
+    // --out a link to nothing.
+    let dangling = dir.join("dangling");
+    std::os::unix::fs::symlink(dir.join("gone/set"), &dangling).expect("link");
+    let o = kapaint(&["export", s(&project), "--out", s(&dangling)]);
+    assert_refused(&o, "does not exist");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_headless_render_prints_nothing_of_the_window_system() {
+    let dir = scratch("render-quiet");
+    let out = dir.join("r.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args([
+            "render",
+            "--kd",
+            "0.5,0.2,0.1",
+            "--ks",
+            "0.3",
+            "--n",
+            "40",
+            "--model",
+            "phong",
+            "--view",
+            "shaded",
+            "--size",
+            "64",
+            "--out",
+            s(&out),
+        ])
+        .env("XDG_RUNTIME_DIR", dir.join("not-there"))
+        .output()
+        .expect("kapaint runs");
+    if !o.status.success() && std::env::var_os("KAPAINT_REQUIRE_GPU").is_none() {
+        eprintln!("SKIPPED: no GPU adapter here");
+        return;
+    }
+    assert!(o.status.success(), "{o:?}");
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn every_set_preset_carries_the_normal_map_and_help_lists_every_preset() {
+    let dir = scratch("normal-sets");
+    let bumps = dir.join("bumps.png");
+    image::RgbImage::from_fn(32, 16, |x, y| {
+        image::Rgb([128 + (x as u8 % 9), 120 + (y as u8 % 7), 250])
+    })
+    .save(&bumps)
+    .expect("png");
+    let project = dir.join("P.kapaint");
+    let o = kapaint(&[
+        "import-pbr",
+        "--base-color",
+        "0.6,0.4,0.3",
+        "--metallic",
+        "0",
+        "--roughness",
+        "0.5",
+        "--normal",
+        s(&bumps),
+        "--size",
+        "64",
+        "--out",
+        s(&project),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    for preset in [
+        "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw",
+    ] {
+        let out = dir.join(preset);
+        let o = kapaint(&["export", s(&project), "--preset", preset, "--out", s(&out)]);
+        assert!(o.status.success(), "{preset}: {o:?}");
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("material.json")).expect("manifest"))
+                .expect("json");
+        assert_eq!(
+            manifest["normal"]["path"], "normal.png",
+            "{preset}: {manifest}"
+        );
+        assert_eq!(
+            image::image_dimensions(out.join("normal.png")).expect("normal.png"),
+            (32, 16),
+            "{preset}"
+        );
+        // Read back, the set keeps it.
+        let back = dir.join(format!("{preset}.kapaint"));
+        let o = kapaint(&[
+            "import-set",
+            s(&out.join("material.json")),
+            "--out",
+            s(&back),
+        ]);
+        assert!(o.status.success(), "{preset}: {o:?}");
+        let doc = kapaint::model::project::load(&back).expect("loads");
+        assert_eq!(
+            doc.normal().map(|n| (n.width(), n.height())),
+            Some((32, 16))
+        );
+    }
+    let help = kapaint(&["export", "--help"]);
+    let text = String::from_utf8_lossy(&help.stdout);
+    for p in kapaint::export::preset::builtin() {
+        assert!(
+            text.contains(&p.name),
+            "--help does not name {}: {text}",
+            p.name
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

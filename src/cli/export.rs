@@ -163,9 +163,8 @@ pub struct ExportArgs {
     /// Project files (several: one set per project, in `OUT/<project name>/`).
     #[arg(required = true)]
     files: Vec<PathBuf>,
-    /// Export preset: compact, 16-bit, separate, exr, with-ka, ktx2, ktx2-raw, or a user
-    /// preset.
-    #[arg(long, default_value = "compact")]
+    /// Export preset: every built-in one (listed from the presets themselves), or a user preset.
+    #[arg(long, default_value = "compact", help = preset_help())]
     preset: String,
     /// Target folder (must not exist, or be empty, or with --replace hold an exported set).
     #[arg(long)]
@@ -236,6 +235,18 @@ fn load_projects(
             Ok((doc, mesh))
         })
         .collect()
+}
+
+/// `--preset`'s help: every built-in preset by name, from the presets themselves.
+fn preset_help() -> String {
+    let names: Vec<String> = crate::export::preset::builtin()
+        .into_iter()
+        .map(|p| p.name)
+        .collect();
+    format!(
+        "Export preset: {} (gltf-pbr writes glTF's metallic-roughness maps; the others kapaint sets), or a user preset",
+        names.join(", ")
+    )
 }
 
 /// `kapaint export`: every project into its set; one line each, plus the report.

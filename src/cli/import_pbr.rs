@@ -56,7 +56,7 @@ pub struct ImportPbrArgs {
     #[arg(long, requires = "specular")]
     glossiness: Option<String>,
     /// A tangent-space normal map (RGB image, glTF's convention: +Y up), kept with the
-    /// project and passed through by the gltf-pbr export.
+    /// project and passed through by every export.
     #[arg(long, conflicts_with = "gltf")]
     normal: Option<PathBuf>,
     /// A mesh to paint on (.obj, .gltf, .glb, or sphere, plane, cube, torus).

@@ -74,10 +74,15 @@ impl CliError {
     /// input; anything else (no space, no permission, a read-only disk) the system's.
     pub fn of_io(message: impl Into<String>, e: &std::io::Error) -> Self {
         use std::io::ErrorKind as K;
+        // A link that loops (ELOOP) names nothing: the input's fault, like a missing file.
+        const LINK_LOOP: i32 = if cfg!(target_os = "macos") { 62 } else { 40 };
         match e.kind() {
-            K::NotFound | K::NotADirectory | K::IsADirectory | K::InvalidInput => {
-                Self::usage(message)
-            }
+            K::NotFound
+            | K::NotADirectory
+            | K::IsADirectory
+            | K::InvalidInput
+            | K::InvalidFilename => Self::usage(message),
+            _ if cfg!(unix) && e.raw_os_error() == Some(LINK_LOOP) => Self::usage(message),
             _ => Self::io(message),
         }
     }

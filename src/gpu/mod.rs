@@ -373,19 +373,35 @@ impl Gpu {
     /// # Errors
     /// When there is none.
     pub fn adapter() -> Result<wgpu::Adapter, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| {
-            GpuError(format!(
-                "no GPU adapter found ({e}); install a Vulkan driver (e.g. Mesa's lavapipe, package mesa-vulkan-drivers)"
-            ))
-        })
+        let request = |desc: wgpu::InstanceDescriptor| {
+            let instance = wgpu::Instance::new(desc);
+            pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: None,
+                apply_limit_buckets: false,
+            }))
+        };
+        // Without a display, the primary backends first: the GL backend probes for a Wayland
+        // display, and libwayland prints an error of its own to stderr where XDG_RUNTIME_DIR
+        // is not valid (a headless command's output is its own). GL only where they find none.
+        let chosen = std::env::var_os("WGPU_BACKEND").is_some();
+        let mut primary = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        if !chosen {
+            primary.backends &= wgpu::Backends::PRIMARY;
+        }
+        request(primary)
+            .or_else(|e| {
+                if chosen {
+                    return Err(e);
+                }
+                request(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+            })
+            .map_err(|e| {
+                GpuError(format!(
+                    "no GPU adapter found ({e}); install a Vulkan driver (e.g. Mesa's lavapipe, package mesa-vulkan-drivers)"
+                ))
+            })
     }
 
     /// Blocks until the queue's work is done.

@@ -27,6 +27,9 @@ pub struct Opened {
     pub buffers: Vec<Vec<u8>>,
     /// The folder that relative URIs are taken from.
     pub dir: std::path::PathBuf,
+    /// The file's JSON as written (the `gltf` crate reads some fields lossily: an index past
+    /// `u32` wraps), for checks that need the numbers as they are.
+    pub json: Vec<u8>,
 }
 
 /// Opens a `.gltf` or `.glb` file: its references checked and its buffers loaded (from the
@@ -38,6 +41,14 @@ pub fn open_gltf(path: &Path) -> Result<Opened, MeshError> {
     };
     let bytes = super::read_mesh_file(path)?;
     let not_gltf = |e: gltf::Error| invalid(format!("not a valid glTF file: {e}"));
+    let json = if bytes.starts_with(b"glTF") {
+        gltf::binary::Glb::from_slice(&bytes)
+            .map_err(not_gltf)?
+            .json
+            .into_owned()
+    } else {
+        bytes.clone()
+    };
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(not_gltf)?;
     // gltf-json 1.4.1's own validation indexes the accessor list with the POSITION
@@ -54,6 +65,7 @@ pub fn open_gltf(path: &Path) -> Result<Opened, MeshError> {
         document,
         buffers,
         dir,
+        json,
     })
 }
 

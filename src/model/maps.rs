@@ -64,14 +64,40 @@ impl TexelRect {
     }
 }
 
+/// The next maps identity.
+fn next_maps_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+impl Clone for MaterialMaps {
+    /// A copy shares the tiles (copy-on-write) but is other maps: it gets its own identity.
+    fn clone(&self) -> Self {
+        Self {
+            id: next_maps_id(),
+            width: self.width,
+            height: self.height,
+            tiles_x: self.tiles_x,
+            tiles_y: self.tiles_y,
+            tiles: self.tiles.clone(),
+            versions: self.versions.clone(),
+            clock: self.clock,
+        }
+    }
+}
+
 /// The maps of one material: any size up to `MAX_SIDE` square, stored as 64 x 64 tiles.
 ///
 /// Tiles are shared (`Arc`) so that history can keep old versions without copying: writing
 /// to a tile clones it only if history still holds it. Every write bumps the versions of the
 /// tile's channels it may change, so consumers (the GPU mirror, k_a caches) can ask what
 /// changed since they last looked, tile by tile and channel by channel.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct MaterialMaps {
+    /// Which maps these are: no other maps in the process had this number, so a mirror keyed
+    /// on it and the version never mistakes another document's maps of the same size for
+    /// these (a new or opened document is mirrored whole).
+    id: u64,
     width: u32,
     height: u32,
     tiles_x: u32,
@@ -93,6 +119,7 @@ impl MaterialMaps {
         let count = (tiles_x * tiles_y) as usize;
         let tile = Arc::new(Tile::uniform(Texel::encode(base.sanitized())));
         Ok(Self {
+            id: next_maps_id(),
             width,
             height,
             tiles_x,
@@ -101,6 +128,11 @@ impl MaterialMaps {
             versions: vec![[1; 3]; count],
             clock: 1,
         })
+    }
+
+    /// Which maps these are (see the field): a copy is other maps, with another number.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// Width in texels.

@@ -74,6 +74,9 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
     {
         return Err(fail(path, basis_reason()));
     }
+    // Before anything reads an image or a factor: what the gltf crate would panic on, misread
+    // or pass on out of range.
+    super::gltf_check::check_materials(&opened.json).map_err(|e| fail(path, e))?;
     let material = pick_material(document, path, selector)?;
     let name = material.name().map_or_else(
         || format!("#{}", material.index().unwrap_or(0)),

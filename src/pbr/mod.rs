@@ -25,6 +25,7 @@ pub mod export;
 pub mod fit;
 pub mod glb;
 pub mod gltf;
+mod gltf_check;
 pub mod import;
 pub mod names;
 mod table;

@@ -1,7 +1,9 @@
 //! A texture set found by its file names, the way painting tools export them:
 //! `wood_BaseColor.png`, `wood_Metallic.png`, `wood_Roughness.png`, `wood_Normal.png` (or
 //! `_albedo`, `_metalness`, `_rough`, `_nrm`, a packed `_MetallicRoughness` or `_ORM`, ...).
-//! Any one file of the set names it: the others are found beside it by the shared prefix.
+//! Any one file of the set names it: the others are found beside it by the same prefix and
+//! separator, exactly as written (`wood_BaseColor.png` never takes `wood-col.png` or
+//! `Wood_Roughness.png`). Two files for one map are an error that names them.
 
 use std::path::{Path, PathBuf};
 
@@ -38,7 +40,6 @@ const SUFFIXES: &[(&str, Slot)] = &[
     ("col", Slot::Base),
     ("metalness", Slot::Metallic),
     ("metallic", Slot::Metallic),
-    ("metal", Slot::Metallic),
     ("roughness", Slot::Roughness),
     ("rough", Slot::Roughness),
     ("normaldx", Slot::NormalDx),
@@ -51,17 +52,56 @@ const SUFFIXES: &[(&str, Slot)] = &[
 
 const IMAGE_EXTENSIONS: &[&str] = &["png", "jpg", "jpeg", "tga", "exr"];
 
-/// A file stem as `(prefix, slot)`: the prefix lower-cased with separators dropped, where the
-/// stem ends in a known suffix.
-fn split(stem: &str) -> Option<(String, Slot)> {
-    let flat: String = stem
-        .chars()
-        .filter(|c| !matches!(c, '_' | '-' | '.' | ' '))
+/// Characters that part a set's name from a map's.
+const SEPARATORS: [char; 4] = ['_', '-', '.', ' '];
+
+/// A suffix as it is compared: lower case, separators dropped.
+fn flat(text: &str) -> String {
+    text.chars()
+        .filter(|c| !SEPARATORS.contains(c))
         .flat_map(char::to_lowercase)
-        .collect();
+        .collect()
+}
+
+/// Where a set's file name parts: its prefix as written, the separator after it (none when
+/// the map's name follows directly), and the map.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Parts {
+    prefix: String,
+    separator: Option<char>,
+    slot: Slot,
+}
+
+/// A file stem as the set's prefix, separator and map: the first separator whose rest is a
+/// known map name (`wood_base_color`: `wood`, `_`, base colour), else a known map name ending
+/// the stem directly (`woodAlbedo`).
+fn split(stem: &str) -> Option<Parts> {
+    let known = |rest: &str| {
+        let rest = flat(rest);
+        SUFFIXES
+            .iter()
+            .find(|(suffix, _)| *suffix == rest)
+            .map(|(_, slot)| *slot)
+    };
+    for (i, c) in stem.char_indices().filter(|(_, c)| SEPARATORS.contains(c)) {
+        if let Some(slot) = known(&stem[i + c.len_utf8()..])
+            && i > 0
+        {
+            return Some(Parts {
+                prefix: stem[..i].to_string(),
+                separator: Some(c),
+                slot,
+            });
+        }
+    }
+    let lower = stem.to_lowercase();
     SUFFIXES.iter().find_map(|(suffix, slot)| {
-        flat.strip_suffix(suffix)
-            .map(|prefix| (prefix.to_string(), *slot))
+        let cut = stem.len().checked_sub(suffix.len())?;
+        (cut > 0 && stem.is_char_boundary(cut) && lower.ends_with(suffix)).then(|| Parts {
+            prefix: stem[..cut].to_string(),
+            separator: None,
+            slot: *slot,
+        })
     })
 }
 
@@ -90,7 +130,7 @@ pub fn set_of(path: &Path) -> Result<NamedSet, ModelError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let (prefix, _) = split(&stem).ok_or_else(|| {
+    let named = split(&stem).ok_or_else(|| {
         fail(
             "the name does not say which map it is: a set's files end in _BaseColor (or \
              _Albedo), _Metallic, _Roughness, _MetallicRoughness / _ORM and _Normal"
@@ -101,7 +141,7 @@ pub fn set_of(path: &Path) -> Result<NamedSet, ModelError> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let mut found: Vec<(Slot, PathBuf)> = Vec::new();
+    let mut found: Vec<(Slot, Vec<PathBuf>)> = Vec::new();
     let entries = std::fs::read_dir(dir).map_err(|e| ModelError::io(dir, e))?;
     let mut files: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
     files.sort();
@@ -113,19 +153,30 @@ pub fn set_of(path: &Path) -> Result<NamedSet, ModelError> {
         let Some(stem) = file.file_stem().map(|s| s.to_string_lossy().into_owned()) else {
             continue;
         };
-        if let (true, Some((p, slot))) = (is_image, split(&stem))
-            && p == prefix
-            && !found.iter().any(|(s, _)| *s == slot)
+        if let (true, Some(parts)) = (is_image, split(&stem))
+            && parts.prefix == named.prefix
+            && parts.separator == named.separator
         {
-            found.push((slot, file));
+            match found.iter_mut().find(|(s, _)| *s == parts.slot) {
+                Some((_, files)) => files.push(file),
+                None => found.push((parts.slot, vec![file])),
+            }
         }
+    }
+    if let Some((_, files)) = found.iter().find(|(_, files)| files.len() > 1) {
+        let names: Vec<String> = files.iter().map(|f| super::import::file_name(f)).collect();
+        return Err(fail(format!(
+            "more than one file beside it is the same map: {}; keep one, or rename the others",
+            names.join(", ")
+        )));
     }
     let of = |slot: Slot| {
         found
             .iter()
             .find(|(s, _)| *s == slot)
-            .map(|(_, f)| f.clone())
+            .map(|(_, f)| f[0].clone())
     };
+    let prefix = named.prefix;
     let base = of(Slot::Base).ok_or_else(|| {
         fail(format!(
             "no base colour beside it (looked in {} for {prefix}_BaseColor, _Albedo, _Diffuse, _Color)",
@@ -208,26 +259,72 @@ impl NamedSet {
 mod tests {
     use super::*;
 
+    fn parts(prefix: &str, separator: Option<char>, slot: Slot) -> Parts {
+        Parts {
+            prefix: prefix.into(),
+            separator,
+            slot,
+        }
+    }
+
     #[test]
-    fn suffixes_name_the_maps_whatever_the_separators_and_case() {
-        assert_eq!(split("Wood_BaseColor"), Some(("wood".into(), Slot::Base)));
-        assert_eq!(split("wood-base-color"), Some(("wood".into(), Slot::Base)));
-        assert_eq!(split("wood_albedo"), Some(("wood".into(), Slot::Base)));
-        assert_eq!(
-            split("Wood_Metalness"),
-            Some(("wood".into(), Slot::Metallic))
-        );
-        assert_eq!(split("wood_rough"), Some(("wood".into(), Slot::Roughness)));
-        assert_eq!(split("wood_ORM"), Some(("wood".into(), Slot::Packed)));
-        assert_eq!(
-            split("wood_metallicRoughness"),
-            Some(("wood".into(), Slot::Packed))
-        );
-        assert_eq!(
-            split("wood_Normal_DX"),
-            Some(("wood".into(), Slot::NormalDx))
-        );
-        assert_eq!(split("wood_nrm"), Some(("wood".into(), Slot::Normal)));
+    fn suffixes_name_the_maps_and_the_prefix_is_kept_as_written() {
+        let cases = [
+            ("Wood_BaseColor", "Wood", Some('_'), Slot::Base),
+            ("wood-base-color", "wood", Some('-'), Slot::Base),
+            ("my_wood_albedo", "my_wood", Some('_'), Slot::Base),
+            ("Wood_Metalness", "Wood", Some('_'), Slot::Metallic),
+            ("wood_rough", "wood", Some('_'), Slot::Roughness),
+            ("wood_ORM", "wood", Some('_'), Slot::Packed),
+            ("wood_metallicRoughness", "wood", Some('_'), Slot::Packed),
+            ("wood_Normal_DX", "wood", Some('_'), Slot::NormalDx),
+            ("wood_nrm", "wood", Some('_'), Slot::Normal),
+            ("woodAlbedo", "wood", None, Slot::Base),
+        ];
+        for (stem, prefix, separator, slot) in cases {
+            assert_eq!(split(stem), Some(parts(prefix, separator, slot)), "{stem}");
+        }
         assert_eq!(split("wood"), None);
+        assert_eq!(split("gun_metal"), None, "gunmetal is a colour, not a map");
+    }
+
+    #[test]
+    fn a_set_is_its_exact_prefix_and_separator_and_two_files_for_one_map_are_refused() {
+        let dir = std::env::temp_dir().join(format!("kapaint-names-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let png = |name: &str| {
+            image::RgbImage::new(4, 4).save(dir.join(name)).unwrap();
+        };
+        for name in [
+            "wood_BaseColor.png",
+            "wood_Roughness.png",
+            "wood-col.png",
+            "wood-Metallic.png",
+            "Wood_Normal.png",
+            "gun_BaseColor.png",
+            "gun_metal.png",
+        ] {
+            png(name);
+        }
+        let set = set_of(&dir.join("wood_BaseColor.png")).unwrap();
+        assert_eq!(set.normal, None, "Wood_ is another prefix");
+        assert!(
+            set.notes.iter().any(|n| n.contains("no metallic map")),
+            "wood-Metallic has another separator: {:?}",
+            set.notes
+        );
+        let gun = set_of(&dir.join("gun_BaseColor.png")).unwrap();
+        assert!(gun.notes.iter().any(|n| n.contains("no metallic map")));
+        png("wood_Albedo.png");
+        let err = set_of(&dir.join("wood_Roughness.png"))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            err.contains("wood_Albedo.png") && err.contains("wood_BaseColor.png"),
+            "{err}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -48,7 +48,7 @@ impl Editor {
         path: Option<PathBuf>,
     ) -> Self {
         let gpu = render_state.map(ViewportGpu::new);
-        let mut notices = Vec::new();
+        let mut notices = super::Notices::default();
         // A project that is there opens on a worker; until then the document is untitled,
         // so nothing can be saved over the file.
         let (existing, untitled_until_open) = match path {
@@ -182,11 +182,11 @@ impl TabViewer for Tabs<'_> {
         match tab {
             Tab::Viewport => {
                 let mut settings = s.frame_settings();
-                if s.layer_view == LayerView::Mask {
+                if s.shown_layer_view() == LayerView::Mask {
                     settings.view = ViewMode::Kd;
                 }
                 let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
-                let maps = s.layers_panel.view_maps.get(&s.doc, s.layer_view);
+                let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
                 let normal = s.doc.normal().cloned();
                 let (response, rect) =
                     s.viewport
@@ -197,10 +197,10 @@ impl TabViewer for Tabs<'_> {
             Tab::Canvas => {
                 let lines = std::mem::take(&mut s.mesh.uv_lines);
                 let channel = s.canvas.channel;
-                if s.layer_view == LayerView::Mask {
+                if s.shown_layer_view() == LayerView::Mask {
                     s.canvas.channel = CanvasChannel::Kd;
                 }
-                let maps = s.layers_panel.view_maps.get(&s.doc, s.layer_view);
+                let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
                 let (response, rect) = s.canvas.show(ui, &s.doc, maps, &lines);
                 s.canvas.channel = channel;
                 s.mesh.uv_lines = lines;

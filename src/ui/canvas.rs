@@ -60,7 +60,28 @@ pub struct Canvas {
     /// Draw the UV wireframe.
     pub wireframe: bool,
     texture: Option<TextureHandle>,
-    mirrored: Option<(u64, CanvasChannel, (u32, u32), u64)>,
+    /// What the texture shows.
+    mirrored: Option<Mirrored>,
+}
+
+/// What the canvas texture shows: which maps at which version, in which channel and shading,
+/// and whether as one texel (the maps were one value everywhere).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Mirrored {
+    maps: u64,
+    version: u64,
+    channel: CanvasChannel,
+    size: (u32, u32),
+    shading: u64,
+    uniform: bool,
+}
+
+impl Mirrored {
+    /// The same maps, size, channel and shading (the version aside).
+    fn same_maps(&self, other: &Self) -> bool {
+        (self.maps, self.channel, self.size, self.shading)
+            == (other.maps, other.channel, other.size, other.shading)
+    }
 }
 
 impl Default for Canvas {
@@ -113,8 +134,11 @@ fn tile_image(
 
 impl Canvas {
     /// Brings the texture up to date with `maps` (the document's composite, or a layer view's
-    /// maps, `source` telling them apart): changed tiles only, unless the size, channel,
-    /// source or shading settings changed. Returns the tiles uploaded.
+    /// maps, `source` their identity, [`MaterialMaps::id`]): changed tiles only, unless the
+    /// maps, size, channel or shading settings changed (another document's maps of the same
+    /// size are uploaded whole). Maps that are one value everywhere are one texel, stretched:
+    /// an unpainted 8192^2 canvas costs 4 bytes, not 256 MB. Returns the tiles uploaded (all
+    /// of them for a whole upload).
     pub fn sync(
         &mut self,
         ctx: &egui::Context,
@@ -122,20 +146,24 @@ impl Canvas {
         maps: &MaterialMaps,
         source: u64,
     ) -> usize {
-        let size = (maps.width(), maps.height());
-        // k_a depends on the model and approximation too.
-        let settings_key = source << 16
-            | u64::from(doc.settings().model as u8) << 8
-            | doc.settings().approx as u64;
+        let now = Mirrored {
+            maps: source,
+            version: maps.version(),
+            channel: self.channel,
+            size: (maps.width(), maps.height()),
+            // k_a depends on the model and approximation too.
+            shading: u64::from(doc.settings().model as u8) << 8 | doc.settings().approx as u64,
+            uniform: false,
+        };
         let options = TextureOptions::NEAREST;
-        match (&mut self.texture, self.mirrored) {
-            (Some(tex), Some((version, channel, s, key)))
-                if channel == self.channel && s == size && key == settings_key =>
-            {
-                if version == maps.version() {
-                    return 0;
-                }
-                let dirty = maps.tiles_changed_since(version);
+        if let (Some(tex), Some(was)) = (&mut self.texture, self.mirrored)
+            && was.same_maps(&now)
+        {
+            if was.version == now.version {
+                return 0;
+            }
+            if !was.uniform {
+                let dirty = maps.tiles_changed_since(was.version);
                 for &id in &dirty {
                     let crate::model::maps::TexelRect { x0: x, y0: y, .. } = maps.tile_rect(id);
                     tex.set_partial(
@@ -144,34 +172,37 @@ impl Canvas {
                         options,
                     );
                 }
-                self.mirrored = Some((maps.version(), channel, size, key));
-                dirty.len()
-            }
-            _ => {
-                // Maps of another size (a resize, or its undo): the same extent on screen.
-                if let Some((.., old, _)) = self.mirrored
-                    && old != size
-                    && self.zoom > 0.0
-                {
-                    self.zoom *= old.0 as f32 / size.0 as f32;
-                }
-                let mut image =
-                    ColorImage::filled([size.0 as usize, size.1 as usize], Color32::BLACK);
-                for id in 0..maps.tile_count() {
-                    let crate::model::maps::TexelRect { x0, y0, x1, .. } = maps.tile_rect(id);
-                    let w = x1 - x0;
-                    let tile = tile_image(doc, maps, id, self.channel);
-                    for y in 0..tile.size[1] {
-                        let row = (y0 as usize + y) * size.0 as usize + x0 as usize;
-                        image.pixels[row..row + w as usize]
-                            .copy_from_slice(&tile.pixels[y * w as usize..(y + 1) * w as usize]);
-                    }
-                }
-                self.texture = Some(ctx.load_texture("uv-canvas", image, options));
-                self.mirrored = Some((maps.version(), self.channel, size, settings_key));
-                maps.tile_count()
+                self.mirrored = Some(now);
+                return dirty.len();
             }
         }
+        // Maps of another size (a resize, or its undo): the same extent on screen.
+        if let Some(was) = self.mirrored
+            && was.size != now.size
+            && self.zoom > 0.0
+        {
+            self.zoom *= was.size.0 as f32 / now.size.0 as f32;
+        }
+        let (w, h) = now.size;
+        let image = if maps.uniform_texel().is_some() {
+            ColorImage::new([1, 1], vec![colour(doc, self.channel, maps.value(0, 0))])
+        } else {
+            let mut image = ColorImage::filled([w as usize, h as usize], Color32::BLACK);
+            for id in 0..maps.tile_count() {
+                let crate::model::maps::TexelRect { x0, y0, x1, .. } = maps.tile_rect(id);
+                let tw = (x1 - x0) as usize;
+                let tile = tile_image(doc, maps, id, self.channel);
+                for y in 0..tile.size[1] {
+                    let row = (y0 as usize + y) * w as usize + x0 as usize;
+                    image.pixels[row..row + tw].copy_from_slice(&tile.pixels[y * tw..(y + 1) * tw]);
+                }
+            }
+            image
+        };
+        let uniform = image.size == [1, 1] && (w, h) != (1, 1);
+        self.texture = Some(ctx.load_texture("uv-canvas", image, options));
+        self.mirrored = Some(Mirrored { uniform, ..now });
+        maps.tile_count()
     }
 
     /// Fits the whole map in the panel at the next frame, centred.
@@ -265,5 +296,33 @@ impl Canvas {
             }
         }
         (response, rect)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Command, DocumentSettings, FillRegion};
+
+    #[test]
+    fn another_document_of_the_same_size_is_mirrored_whole() {
+        let ctx = egui::Context::default();
+        let mut canvas = Canvas::default();
+        let mut painted = Document::new(256, 256, DocumentSettings::default()).unwrap();
+        painted.apply(Command::Fill(FillRegion::All)).unwrap();
+        let all = painted.maps().tile_count();
+        let sync = |canvas: &mut Canvas, doc: &Document| {
+            canvas.sync(&ctx, doc, doc.maps(), doc.maps().id())
+        };
+        assert_eq!(sync(&mut canvas, &painted), all);
+        assert_eq!(sync(&mut canvas, &painted), 0, "nothing changed");
+        // File > New (or Open) at the same size: its maps have lower versions than the ones
+        // shown, so the dirty tiles of a version comparison were none: the old paint stayed.
+        let fresh = Document::new(256, 256, DocumentSettings::default()).unwrap();
+        assert_eq!(
+            sync(&mut canvas, &fresh),
+            all,
+            "the new document is mirrored whole"
+        );
     }
 }

@@ -48,7 +48,13 @@ pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &crate::export::set::SetPl
     if let Some(n) = c.n {
         constants.push(format!("n = {n:.2}"));
     }
-    if plan.files.is_empty() {
+    if let Some((w, h)) = plan.normal {
+        ui.label(format!(
+            "normal.png: the project's normal map ({w}x{h}, 8-bit tangent space, as stored); \
+             it lights only, k_a never reads it"
+        ));
+    }
+    if plan.files.is_empty() && plan.normal.is_none() {
         ui.label("Every channel is constant: the set is a manifest alone.");
     }
     if !constants.is_empty() {

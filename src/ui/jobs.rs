@@ -209,9 +209,7 @@ impl EditorState {
                 version,
             } => self.conflicted(message, written, version),
             JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
-            JobResult::Exported(dir, m) => {
-                self.notices.push(notice(exported_notice(&dir, *m), false));
-            }
+            JobResult::Exported(dir, m) => self.notices.push(exported_notice(&dir, *m)),
             JobResult::Material(path, m) => self.take_material(&path, *m),
             JobResult::Mesh(path, surface, textured) => {
                 if textured {
@@ -447,17 +445,22 @@ impl EditorState {
         }
         self.doc.set_normal(normal.map(Arc::new));
         let e = report.error;
-        self.notices.push(notice(
-            format!(
-                "{} imported for {}: conversion error max {:.1}%, mean {:.1}%, p99 {:.1}%",
-                path.display(),
-                report.model,
-                e.max * 100.0,
-                e.mean * 100.0,
-                e.p99 * 100.0
-            ),
-            false,
-        ));
+        let text = format!(
+            "{} imported for {}: conversion error max {:.1}%, mean {:.1}%, p99 {:.1}%",
+            path.display(),
+            report.model,
+            e.max * 100.0,
+            e.mean * 100.0,
+            e.p99 * 100.0
+        );
+        self.notices.push(if e.max > PBR_ERROR_WARNING {
+            super::warning(format!(
+                "{text}: over the {:.0}% a faithful conversion keeps",
+                PBR_ERROR_WARNING * 100.0
+            ))
+        } else {
+            notice(text, false)
+        });
         for note in &report.notes {
             self.notices.push(notice(note.clone(), false));
         }
@@ -636,8 +639,27 @@ impl EditorState {
     }
 }
 
-/// The notice of a finished export.
-fn exported_notice(dir: &std::path::Path, m: crate::export::Exported) -> String {
+/// A PBR conversion whose largest relative error passes this is a warning: a quarter of the
+/// shading lost somewhere on the material.
+const PBR_ERROR_WARNING: f32 = 0.25;
+
+/// The notice of a finished export: a warning, with the number that missed, when the set is
+/// over its `k_a` budget or the PBR round trip loses more than [`PBR_ERROR_WARNING`].
+fn exported_notice(dir: &std::path::Path, m: crate::export::Exported) -> super::Notice {
+    let missed = match &m {
+        crate::export::Exported::Set(m) => m.blocks.as_ref().is_some_and(|b| !b.within_budget),
+        crate::export::Exported::Pbr(m) => m.round_trip.max > PBR_ERROR_WARNING,
+    };
+    let mut text = exported_text(dir, m);
+    if missed {
+        text = format!("{text} (over budget)");
+        return super::warning(text);
+    }
+    notice(text, false)
+}
+
+/// What a finished export says.
+fn exported_text(dir: &std::path::Path, m: crate::export::Exported) -> String {
     match m {
         crate::export::Exported::Set(m) => {
             let mut text = format!(
@@ -676,8 +698,14 @@ mod tests {
         let preset = crate::export::preset::find("ktx2").expect("preset");
         let m = crate::export::set::export(&doc, &preset, &out).expect("export");
         let blocks = m.blocks.clone().expect("a block-compressed set");
-        let text = exported_notice(&out, crate::export::Exported::Set(m));
+        let n = exported_notice(&out, crate::export::Exported::Set(m));
         let _ = std::fs::remove_dir_all(&out);
+        let text = n.text.clone();
+        // The stroke's dark-beside-light blocks miss the k_a budget: a warning with the
+        // numbers it missed, never a green notice.
+        assert!(!blocks.within_budget, "{text}");
+        assert_eq!(n.level, crate::ui::NoticeLevel::Warning, "{text}");
+        assert!(text.contains("over the k_a budget (max"), "{text}");
         assert!(text.contains("; blocks: "), "{text}");
         assert!(
             text.contains(&format!("at {:?}", blocks.bc7_effort)),

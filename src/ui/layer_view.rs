@@ -13,13 +13,11 @@ pub struct ViewMaps {
     key: Option<(LayerView, Vec<usize>)>,
     compositor: Compositor,
     maps: Option<MaterialMaps>,
-    /// Changes whenever the maps shown become other maps (mirrors upload them whole).
-    source: u64,
 }
 
 impl ViewMaps {
-    /// The maps `view` shows of `doc`, and a number that changes whenever they become other
-    /// maps (0: the composite). A view of a layer without a mask shows the composite.
+    /// The maps `view` shows of `doc`, and their identity ([`MaterialMaps::id`]: mirrors
+    /// upload other maps whole). A view of a layer without a mask shows the composite.
     pub fn get<'a>(&'a mut self, doc: &'a Document, view: LayerView) -> (&'a MaterialMaps, u64) {
         let path = &doc.selection().path;
         let stack = match view {
@@ -30,7 +28,7 @@ impl ViewMaps {
         let Some(stack) = stack else {
             self.key = None;
             self.maps = None;
-            return (doc.maps(), 0);
+            return (doc.maps(), doc.maps().id());
         };
         let key = Some((view, path.clone()));
         let fits = self
@@ -41,14 +39,13 @@ impl ViewMaps {
             self.key = key;
             self.compositor = Compositor::new();
             self.maps = MaterialMaps::new(stack.width, stack.height, stack.base).ok();
-            self.source += 1;
         }
         match &mut self.maps {
             Some(maps) => {
                 self.compositor.update(&stack, maps);
-                (maps, self.source)
+                (maps, maps.id())
             }
-            None => (doc.maps(), 0),
+            None => (doc.maps(), doc.maps().id()),
         }
     }
 }

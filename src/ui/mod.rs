@@ -15,6 +15,8 @@ mod jobs;
 pub mod keys;
 mod layer_view;
 mod layout;
+pub mod notices;
+pub use notices::{Notice, NoticeLevel, Notices};
 mod panels;
 mod prompts;
 pub use panels::layers::LayerView;
@@ -31,7 +33,7 @@ pub use layout::{default_layout, layout_json, parse_layout};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use egui::Color32;
 use glam::Vec2;
@@ -58,16 +60,6 @@ pub enum Tab {
     Canvas,
     /// The layer stack.
     Layers,
-}
-
-/// A message for the user, shown for a while.
-#[derive(Clone, Debug)]
-pub struct Notice {
-    /// Text.
-    pub text: String,
-    /// An error (red) rather than information.
-    pub error: bool,
-    at: Instant,
 }
 
 /// Where `world` falls in `picture` through `view_proj`, if in front of the camera.
@@ -191,7 +183,7 @@ pub struct EditorState {
     canvas: Canvas,
     mesh: MeshState,
     /// Messages.
-    notices: Vec<Notice>,
+    notices: Notices,
     job: Option<Job>,
     export: Option<ExportDialog>,
     /// The last export's preset and folder, offered again by the next.
@@ -289,12 +281,21 @@ fn autosave_interval() -> Duration {
         .map_or(recovery::AUTOSAVE_INTERVAL, Duration::from_secs_f64)
 }
 
+/// Information, or an error.
 fn notice(text: impl Into<String>, error: bool) -> Notice {
-    Notice {
-        text: text.into(),
-        error,
-        at: Instant::now(),
-    }
+    Notice::new(
+        text,
+        if error {
+            NoticeLevel::Error
+        } else {
+            NoticeLevel::Info
+        },
+    )
+}
+
+/// A warning: done, but short of what was asked (with the number that missed).
+fn warning(text: impl Into<String>) -> Notice {
+    Notice::new(text, NoticeLevel::Warning)
 }
 
 impl EditorState {
@@ -373,6 +374,17 @@ impl EditorState {
     /// This editor's recovery copy (its session folder; it may not exist yet).
     pub fn recovery_copy(&self) -> std::path::PathBuf {
         self.autosaver.session()
+    }
+
+    /// What the viewport and canvas show of the layers: the chosen view, except that a mask
+    /// tools paint shows alone, in grey, while the chosen view is the whole stack.
+    pub fn shown_layer_view(&self) -> panels::layers::LayerView {
+        use panels::layers::LayerView;
+        if self.doc.selection().mask && self.layer_view == LayerView::Composite {
+            LayerView::Mask
+        } else {
+            self.layer_view
+        }
     }
 
     /// Whether anything the project file stores (maps or settings) changed since the last

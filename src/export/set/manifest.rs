@@ -395,13 +395,37 @@ pub struct Manifest {
     /// Block-compressed sets: how the layout and BC7 effort were chosen.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blocks: Option<Box<super::choose::BlockChoice>>,
+    /// The project's tangent-space normal map, beside the maps as it stores it (it lights
+    /// only: `k_a` never reads it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<Box<NormalFile>>,
 }
 
+/// A set's normal map: `normal.png`, 8-bit RGB, `2 c - 1` in the tangent frame (glTF's
+/// convention, +Y up), at its own size.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NormalFile {
+    /// [`NORMAL_FILE`].
+    pub path: String,
+    /// The project's normal encoding (`png-rgb8-tangent-normal`).
+    pub encoding: String,
+    /// Size in texels.
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+    /// Size in bytes.
+    pub bytes: u64,
+}
+
+/// The normal map's file in a set.
+pub const NORMAL_FILE: &str = "normal.png";
+
 impl Manifest {
-    /// Every file the set's folder holds: the images, `material.json`, `material.wgsl` and
-    /// `material.glsl`.
+    /// Every file the set's folder holds: the images, the normal map, `material.json`,
+    /// `material.wgsl` and `material.glsl`.
     pub fn file_count(&self) -> usize {
-        self.files.len() + 3
+        self.files.len() + usize::from(self.normal.is_some()) + 3
     }
 }
 
@@ -428,6 +452,8 @@ struct ManifestFile {
     level_ka_error: Vec<KaError>,
     #[serde(default)]
     blocks: Option<Box<super::choose::BlockChoice>>,
+    #[serde(default)]
+    normal: Option<Box<NormalFile>>,
 }
 
 impl TryFrom<ManifestFile> for Manifest {
@@ -477,6 +503,19 @@ impl TryFrom<ManifestFile> for Manifest {
                 comps.push(c);
             }
         }
+        if let Some(n) = &f.normal
+            && (n.path != NORMAL_FILE
+                || n.encoding != crate::model::project::NORMAL_ENCODING
+                || n.width == 0
+                || n.height == 0
+                || n.width > max
+                || n.height > max)
+        {
+            return Err(format!(
+                "the normal map must be {NORMAL_FILE}, {}, 1..={max} a side",
+                crate::model::project::NORMAL_ENCODING
+            ));
+        }
         let has = |c: Comp| comps.contains(&c);
         let kd = (0..3).all(|c| has(Comp::Kd(c)));
         let ks = has(Comp::Ks(3)) || (0..3).all(|c| has(Comp::Ks(c)));
@@ -508,6 +547,7 @@ impl TryFrom<ManifestFile> for Manifest {
             layers: f.layers,
             level_ka_error: f.level_ka_error,
             blocks: f.blocks,
+            normal: f.normal,
         })
     }
 }

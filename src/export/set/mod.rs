@@ -21,7 +21,7 @@ use self::encode::{Encoded, StoredImage, encode_image, rows};
 pub use self::import::import;
 pub use self::manifest::{
     Approximation, ColourSpace, Compression, Constants, FileEntry, MANIFEST_FORMAT,
-    MANIFEST_VERSION, Manifest, MemoryReport,
+    MANIFEST_VERSION, Manifest, MemoryReport, NORMAL_FILE, NormalFile,
 };
 use self::manifest::{Comp, approximation};
 use self::measure::ka_error_of_set;
@@ -143,11 +143,20 @@ fn listed_files(dir: &Path, kind: SetKind) -> Option<Vec<String>> {
     struct Listing {
         format: String,
         files: Vec<Listed>,
+        #[serde(default)]
+        normal: Option<Listed>,
     }
     let bytes =
         crate::file_check::read_limited(&dir.join("material.json"), MAX_LISTING_BYTES).ok()?;
     let listing: Listing = serde_json::from_slice(&bytes).ok()?;
-    (listing.format == kind.format()).then(|| listing.files.into_iter().map(|f| f.path).collect())
+    (listing.format == kind.format()).then(|| {
+        listing
+            .files
+            .into_iter()
+            .chain(listing.normal)
+            .map(|f| f.path)
+            .collect()
+    })
 }
 
 /// What is at `out` (a link to a folder is looked through: a set there is written through the
@@ -156,7 +165,24 @@ fn listed_files(dir: &Path, kind: SetKind) -> Option<Vec<String>> {
 /// # Errors
 /// A folder that cannot be read.
 pub fn target(out: &Path, kind: SetKind) -> Result<Target, SetError> {
-    let out = &crate::atomic::through_links(out);
+    let linked = crate::atomic::through_links(out);
+    if linked.as_path() != out && std::fs::symlink_metadata(&linked).is_err() {
+        return Ok(Target::Taken(format!(
+            "is a link to {}, which does not exist",
+            linked.display()
+        )));
+    }
+    let out = &linked;
+    if let Some(file) = out
+        .ancestors()
+        .skip(1)
+        .find(|a| std::fs::metadata(a).is_ok_and(|m| !m.is_dir()))
+    {
+        return Ok(Target::Taken(format!(
+            "lies inside {}, which is a file, not a folder",
+            file.display()
+        )));
+    }
     if !out.exists() {
         return Ok(Target::Free);
     }
@@ -419,6 +445,7 @@ fn export_into(
             layers: u32::try_from(doc.stack().walk().len()).unwrap_or(u32::MAX),
             level_ka_error: Vec::new(),
             blocks,
+            normal: None,
         };
         // The k_a error, measured on the set as a consumer decodes it.
         manifest.ka_error = ka_error_of_set(&texels, shape, &stored, preset.format, model, approx);
@@ -428,6 +455,20 @@ fn export_into(
         }
         // The decode + k_a snippets for engines (WGSL and GLSL), beside the images.
         let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
+        if let Some(normal) = doc.normal() {
+            // As the project stores it: it lights only, and never enters k_a.
+            let png = normal.to_png().map_err(|e| fail(e, NORMAL_FILE))?;
+            let path = tmp.join(NORMAL_FILE);
+            crate::atomic::write_atomic(&path, &png).map_err(|e| io(&path, e))?;
+            exported += png.len() as u64;
+            manifest.normal = Some(Box::new(NormalFile {
+                path: NORMAL_FILE.into(),
+                encoding: crate::model::project::NORMAL_ENCODING.into(),
+                width: normal.width(),
+                height: normal.height(),
+                bytes: png.len() as u64,
+            }));
+        }
         for (name, snippet) in [
             ("material.wgsl", crate::export::snippet::wgsl(&manifest)),
             ("material.glsl", crate::export::snippet::glsl(&manifest)),

@@ -88,11 +88,15 @@ pub struct SetPlan {
     pub ka_error: KaError,
     /// Bytes: the images uncompressed, the naive maps, the project's maps.
     pub bytes: MemoryReport,
+    /// The size of the project's normal map, written beside the maps as `normal.png` (as the
+    /// project stores it), when it has one.
+    pub normal: Option<(u32, u32)>,
 }
 
 /// The plan of exporting `doc` with `preset` (see [`SetPlan`]).
 pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
-    let (plan, _, _) = plan_set(doc, preset);
+    let (mut plan, _, _) = plan_set(doc, preset);
+    plan.normal = doc.normal().map(|n| (n.width(), n.height()));
     plan
 }
 
@@ -143,6 +147,7 @@ pub(super) fn plan_set(
     };
     (
         SetPlan {
+            normal: None,
             files,
             constants,
             n_encoding,
@@ -170,6 +175,7 @@ fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
     })
     .collect();
     SetPlan {
+        normal: None,
         bytes: MemoryReport {
             exported: files.iter().map(|f| f.raw_bytes).sum(),
             naive: texels * 10,

@@ -12,8 +12,9 @@ pub trait StrokePos: Copy {
     /// along a long segment is exact).
     #[must_use]
     fn lerp_to(self, other: Self, t: f64) -> Self;
-    /// Distance to `other` (texels, or object units on a mesh).
-    fn distance_to(self, other: Self) -> f32;
+    /// Distance to `other` (texels, or object units on a mesh), in `f64`: two finite `f32`
+    /// points are never an infinite distance apart (in `f32` the square of a 2e19 step is).
+    fn distance_to(self, other: Self) -> f64;
     /// Whether every coordinate is finite.
     fn finite(self) -> bool;
     /// Where a stroke whose first input is not finite starts.
@@ -25,8 +26,8 @@ impl StrokePos for Vec2 {
         let a = self.as_dvec2();
         (a + (other.as_dvec2() - a) * t).as_vec2()
     }
-    fn distance_to(self, other: Self) -> f32 {
-        self.distance(other)
+    fn distance_to(self, other: Self) -> f64 {
+        self.as_dvec2().distance(other.as_dvec2())
     }
     fn finite(self) -> bool {
         self.is_finite()
@@ -56,8 +57,8 @@ impl StrokePos for SurfacePos {
             normal: normal.try_normalize().unwrap_or(self.normal),
         }
     }
-    fn distance_to(self, other: Self) -> f32 {
-        self.point.distance(other.point)
+    fn distance_to(self, other: Self) -> f64 {
+        self.point.as_dvec3().distance(other.point.as_dvec3())
     }
     fn finite(self) -> bool {
         self.point.is_finite() && self.normal.is_finite()
@@ -185,8 +186,8 @@ impl<P: StrokePos> Resampler<P> {
             self.last = Some(point);
             return Ok(());
         };
-        let length = f64::from(last.pos.distance_to(point.pos));
-        if length <= 0.0 || !length.is_finite() {
+        let length = last.pos.distance_to(point.pos);
+        if length <= 0.0 {
             return Ok(());
         }
         // Distance along this segment to its first dab, then one dab per whole step.
@@ -196,7 +197,11 @@ impl<P: StrokePos> Resampler<P> {
             self.travelled += length;
             return Ok(());
         }
-        let steps = ((length - first) / self.spacing).floor() as u64 + 1;
+        // Capped past the limit: a segment of 1e30 texels has more steps than u64 counts.
+        let steps = ((length - first) / self.spacing)
+            .floor()
+            .min(MAX_STROKE_DABS as f64) as u64
+            + 1;
         let placed = steps.min(MAX_STROKE_DABS - self.dabs);
         out.reserve(placed as usize);
         for k in 0..placed {
@@ -240,10 +245,11 @@ impl<P: StrokePos> Smoother<P> {
             return Some(pointer);
         };
         let distance = brush.distance_to(pointer);
-        if distance <= self.radius {
+        let radius = f64::from(self.radius);
+        if distance <= radius {
             return (self.radius == 0.0 && distance > 0.0).then_some(pointer);
         }
-        let moved = brush.lerp_to(pointer, 1.0 - f64::from(self.radius / distance));
+        let moved = brush.lerp_to(pointer, 1.0 - radius / distance);
         self.brush = Some(moved);
         Some(moved)
     }

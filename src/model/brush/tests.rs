@@ -91,6 +91,22 @@ fn a_segment_a_billion_texels_long_places_every_dab_and_then_stops() {
 }
 
 #[test]
+fn a_stroke_longer_than_f32_squares_reach_is_clipped_with_an_error_never_dropped() {
+    // In f32, the square of a 2e19-texel step is infinite: the segment was dropped in silence.
+    for far in [2e19_f32, 1e30, f32::MAX] {
+        let mut r = Resampler::new(8.0);
+        let mut out = Vec::new();
+        let at = |x: f32| StrokePoint {
+            pos: Vec2::new(x, -x),
+            pressure: 1.0,
+        };
+        r.push(at(0.0), &mut out).unwrap();
+        assert_eq!(r.push(at(far), &mut out), Err(DabLimit), "{far}");
+        assert_eq!(out.len() as u64, MAX_STROKE_DABS, "{far}");
+    }
+}
+
+#[test]
 fn pressure_is_interpolated() {
     let mut r = Resampler::new(5.0);
     let mut out = Vec::new();

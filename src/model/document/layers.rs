@@ -43,8 +43,8 @@ impl Document {
         Ok(())
     }
 
-    /// What tools write: the material from `from` to `to` in the tool channels, or white on a
-    /// mask.
+    /// What tools write: the material from `from` to `to` in the tool channels, or on a mask
+    /// their gray.
     pub(super) fn layer_edit(
         &self,
         from: MaterialValue,
@@ -52,19 +52,22 @@ impl Document {
         stroke: LayerStroke,
     ) -> LayerEdit {
         let c = self.settings.channels;
-        // On a mask, tools reveal (white) and the eraser hides (black), as seen through the
-        // mask's inversion.
-        let shown = if stroke == LayerStroke::Erase {
-            0.0
-        } else {
-            1.0
+        // On a mask, tools paint the value of their colour (as Krita and Substance do: white
+        // reveals, black hides, grey between) and the eraser hides (black), as seen through
+        // the mask's inversion.
+        let shown = |v: MaterialValue| {
+            if stroke == LayerStroke::Erase {
+                0.0
+            } else {
+                mask_gray(v)
+            }
         };
         LayerEdit {
             from: EditValue::of(from),
             to: EditValue::of(to),
             channels: [c.kd, c.ks, c.n],
             stroke,
-            gray: [self.stored_gray(shown); 2],
+            gray: [self.stored_gray(shown(from)), self.stored_gray(shown(to))],
             energy_guard: self.settings.brush.energy_guard,
         }
     }
@@ -491,6 +494,13 @@ impl Document {
             Ok(())
         })
     }
+}
+
+/// The gray a material paints on a mask: the value (HSV's V) of its `k_d` as displayed, in
+/// sRGB, so the swatch's brightness is the mask's.
+pub fn mask_gray(v: MaterialValue) -> f32 {
+    let kd = v.sanitized().kd;
+    crate::model::texel::linear_to_srgb(kd.max_element()).clamp(0.0, 1.0)
 }
 
 pub(super) fn no_layer() -> ModelError {

@@ -465,6 +465,7 @@ impl Document {
                 *version += 1;
             }
         }
+        self.check_memory(&command)?;
         let opacity_run = self.opacity_run.take();
         if let Command::SetLayerOpacity(opacity) = command {
             return self.set_opacity(opacity, opacity_run.as_deref());
@@ -544,6 +545,41 @@ impl Document {
             other => self.layer_command(other)?,
         }
         Ok(())
+    }
+
+    /// Refuses a command that may fill a whole layer (or a mask, or a merged layer) when the
+    /// memory available could not hold one more layer and its composite: a clear error instead
+    /// of an out-of-memory abort part-way through a script.
+    fn check_memory(&self, command: &Command) -> Result<(), ModelError> {
+        let writes_a_layer = matches!(
+            command,
+            Command::BeginStroke(_)
+                | Command::Stroke { .. }
+                | Command::SurfaceStroke { .. }
+                | Command::Fill(_)
+                | Command::Gradient { .. }
+                | Command::ImportChannel(_)
+                | Command::ImportMaterial(_)
+                | Command::MergeDown
+                | Command::Flatten
+                | Command::AddMask
+                | Command::ApplyMask
+                | Command::InvertMask
+                | Command::MaskFromChannel { .. }
+        );
+        if !writes_a_layer {
+            return Ok(());
+        }
+        let tiles = self.maps.tile_count() as u64;
+        let texels = tiles * crate::model::tile::TILE_TEXELS as u64;
+        // A paint layer's values and coverage (20 bytes a texel), and the composite's (14).
+        let bytes = texels * (20 + 14);
+        crate::memory::check_fits("painting a whole layer", bytes).map_err(|e| {
+            ModelError::Command(format!(
+                "{e}: the document has {} layers; merge or delete some, or use a smaller map",
+                layers::count_layers(&self.state.stack.layers)
+            ))
+        })
     }
 
     /// An error when `(x, y)` is outside the map.

@@ -33,6 +33,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             .map_err(|e| format!("manifest.json: {e}"))?;
         parse_manifest(&text)?
     };
+    check_declared(&manifest)?;
     let (w, h) = (manifest.width, manifest.height);
     if let Some(entries) = &manifest.layers {
         let tile_count = MaterialMaps::new(w, h, MaterialValue::default())
@@ -98,6 +99,51 @@ fn with_id(doc: Document, id: Option<&str>) -> Document {
         Some(id) => doc.with_id(id),
         None => doc,
     }
+}
+
+/// What the manifest declares, checked before a byte of an image is decoded: no image entry is
+/// named twice (a writer never shares one; a manifest naming one 8192^2 PNG in 256 layers
+/// would decode it 256 times), and everything it declares fits in the memory available
+/// (decoded rasters, and the tiles made from them).
+fn check_declared(manifest: &super::Manifest) -> Result<(), String> {
+    let mut names = std::collections::HashSet::new();
+    let mut texel_bytes: u64 = 0;
+    let mut name = |entry: &ChannelEntry| -> Result<(), String> {
+        match entry {
+            ChannelEntry::Image { file, .. } if !names.insert(file.clone()) => Err(format!(
+                "the manifest names the image {file} more than once (a project stores each image once)"
+            )),
+            _ => Ok(()),
+        }
+    };
+    let (w, h) = (u64::from(manifest.width), u64::from(manifest.height));
+    for e in [&manifest.kd, &manifest.ks, &manifest.n] {
+        name(e)?;
+    }
+    // The composite: its rasters (14 bytes a texel) and its tiles (14 more).
+    texel_bytes += w * h * 28;
+    let atlas_texels = |tiles: &Option<Vec<u32>>| -> u64 {
+        tiles.as_ref().map_or(w * h, |t| {
+            let (aw, ah) = super::layers::atlas_size(t.len());
+            u64::from(aw) * u64::from(ah)
+        })
+    };
+    let mut stack = manifest.layers.iter().flatten().collect::<Vec<_>>();
+    while let Some(e) = stack.pop() {
+        stack.extend(&e.children);
+        if let Some(p) = &e.planes {
+            for c in [&p.kd, &p.ks, &p.n, &p.alpha] {
+                name(c)?;
+            }
+            // Values and coverage: rasters (20 bytes a texel) and maps (20 more).
+            texel_bytes += atlas_texels(&p.tiles) * 40;
+        }
+        if let Some(m) = &e.mask {
+            name(&m.gray)?;
+            texel_bytes += atlas_texels(&m.tiles) * 20;
+        }
+    }
+    crate::memory::check_fits("opening it", texel_bytes)
 }
 
 /// The normal map of the manifest's entry, checked against it.

@@ -205,22 +205,19 @@ impl EditorState {
     }
 
     pub(in crate::ui) fn notices_ui(&mut self, ctx: &egui::Context) {
-        self.notices
-            .retain(|n| n.at.elapsed() < Duration::from_secs(if n.error { 12 } else { 5 }));
+        self.notices.expire();
         if self.notices.is_empty() {
             return;
         }
         egui::Area::new(egui::Id::new("notices"))
             .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -36.0))
             .show(ctx, |ui| {
-                for n in &self.notices {
-                    let colour = if n.error {
-                        egui::Color32::from_rgb(220, 80, 80)
-                    } else {
-                        egui::Color32::from_rgb(120, 200, 120)
-                    };
+                for n in self.notices.iter() {
                     egui::Frame::popup(ui.style()).show(ui, |ui| {
-                        ui.colored_label(colour, &n.text);
+                        ui.colored_label(
+                            n.level.colour(),
+                            format!("{} {}", n.level.mark(), n.shown()),
+                        );
                     });
                 }
             });

@@ -142,9 +142,9 @@ impl EditorState {
         } else {
             format!("Painting \"{}\"", layer.props.name)
         };
-        if self.layer_view != LayerView::Composite {
+        if self.shown_layer_view() != LayerView::Composite {
             text.push_str(" · showing ");
-            text.push_str(&self.layer_view.label().to_lowercase());
+            text.push_str(&self.shown_layer_view().label().to_lowercase());
         }
         Some(text)
     }

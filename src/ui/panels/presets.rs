@@ -7,7 +7,7 @@ use std::path::Path;
 use crate::model::Command;
 use crate::model::brush::preset::{self as brush_preset, BrushPreset};
 use crate::model::texel::MaterialValue;
-use crate::ui::{EditorState, Notice, notice};
+use crate::ui::{EditorState, notice};
 
 /// A material preset in the browser.
 pub(in crate::ui) struct PresetEntry {
@@ -34,7 +34,7 @@ pub(in crate::ui) enum Naming {
 /// preset).
 pub(in crate::ui) fn load_material_presets(
     dir: Option<&Path>,
-    notices: &mut Vec<Notice>,
+    notices: &mut crate::ui::Notices,
 ) -> Vec<PresetEntry> {
     let entry = |stem: String, p: &crate::model::preset::MaterialPreset| PresetEntry {
         stem,
@@ -64,7 +64,7 @@ pub(in crate::ui) fn load_material_presets(
 /// The shipped brush presets, then the user's.
 pub(in crate::ui) fn load_brush_presets(
     dir: Option<&Path>,
-    notices: &mut Vec<Notice>,
+    notices: &mut crate::ui::Notices,
 ) -> Vec<BrushPreset> {
     let mut list = brush_preset::builtin();
     if let Some(dir) = dir {
