@@ -585,7 +585,7 @@ fn padding_fills_outside_the_islands_from_the_mesh_bake() {
     let mesh = kapaint::mesh::open(&obj).expect("spot");
     let mut doc = painted();
     let surface = kapaint::model::surface::Surface::new(mesh, 200, 120).expect("bake");
-    let coverage = surface.bake.coverage.clone();
+    let coverage = surface.bake.coverage_grid();
     doc.set_surface(Some(std::sync::Arc::new(surface)))
         .expect("surface");
     let dir = temp("padding");

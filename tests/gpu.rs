@@ -299,11 +299,22 @@ fn sync_uploads_only_dirty_tiles_and_the_render_follows() {
         0,
         "nothing changed"
     );
+    // Unpainted, every channel is one texel: no texture memory for a uniform map.
+    assert_eq!(
+        textures.kd.size().width,
+        1,
+        "an unpainted channel is one texel"
+    );
     brush_stroke(&mut doc, &[Vec2::new(100.0, 100.0)]);
-    // A 32 px dab at (100, 100) touches the 4 tiles around (64..192)^2 at most.
+    // The first stroke gives the channels it paints their full textures, uploaded whole.
+    let uploaded = textures.sync(&gpu, doc.maps()).expect("sync");
+    assert_eq!(uploaded, doc.maps().tile_count());
+    assert_eq!(textures.kd.size().width, 512);
+    assert!(textures.uniform.kd.is_none(), "k_d is no longer uniform");
+    // A 32 px dab at (300, 300) touches the 4 tiles around it at most.
+    brush_stroke(&mut doc, &[Vec2::new(300.0, 300.0)]);
     let uploaded = textures.sync(&gpu, doc.maps()).expect("sync");
     assert!((1..=4).contains(&uploaded), "{uploaded} tiles");
-    assert!(textures.uniform.kd.is_none(), "k_d is no longer uniform");
 }
 
 #[test]

@@ -198,7 +198,7 @@ fn check_coverage(m: &Mesh, w: u32, h: u32) {
     }
     let missed = must
         .iter()
-        .zip(&baked.coverage)
+        .zip(&baked.coverage_grid())
         .filter(|(m, c)| **m && **c == Coverage::Empty)
         .count();
     assert_eq!(
@@ -207,15 +207,15 @@ fn check_coverage(m: &Mesh, w: u32, h: u32) {
     );
     // Every covered texel holds a finite point of the surface and a unit normal.
     for k in 0..must.len() {
-        if baked.coverage[k] != Coverage::Empty {
-            assert!(baked.position[k].is_finite());
-            assert!((baked.normal[k].length() - 1.0).abs() < 1e-3);
-            assert!(baked.triangle[k] != u32::MAX && baked.island[k] != u32::MAX);
+        if baked.coverage(k) != Coverage::Empty {
+            assert!(baked.position(k).is_finite());
+            assert!((baked.normal(k).length() - 1.0).abs() < 1e-3);
+            assert!(baked.triangle(k).is_some() && baked.island(k).is_some());
         }
     }
     // Conservative, not sloppy: covered texels beyond the centre-inside set are a thin rim.
     let extra = baked
-        .coverage
+        .coverage_grid()
         .iter()
         .zip(&must)
         .filter(|(c, m)| **c != Coverage::Empty && !**m)
@@ -242,7 +242,7 @@ fn bake_padding_grows_islands() {
     let plain = bake(&cube, 256, 256, 0).expect("bakes");
     let padded = bake(&cube, 256, 256, 3).expect("bakes");
     let count = |b: &kapaint::mesh::bake::UvBake, c: Coverage| {
-        b.coverage.iter().filter(|x| **x == c).count()
+        b.coverage_grid().iter().filter(|x| **x == c).count()
     };
     assert_eq!(count(&plain, Coverage::Padding), 0);
     assert!(count(&padded, Coverage::Padding) > 0);
@@ -251,9 +251,9 @@ fn bake_padding_grows_islands() {
         count(&padded, Coverage::Surface)
     );
     // Padding copies a neighbour's surface point: its island is a real one.
-    for (k, c) in padded.coverage.iter().enumerate() {
+    for (k, c) in padded.coverage_grid().iter().enumerate() {
         if *c == Coverage::Padding {
-            assert!(padded.island[k] < 6);
+            assert!(padded.island(k).is_some_and(|i| i < 6));
         }
     }
     let no_uv = Mesh {

@@ -94,14 +94,14 @@ fn ball_footprint_visits_exactly_the_texels_within_the_ball() {
         }
         let r2 = radius * radius;
         for (i, &w) in got.iter().enumerate() {
-            let want = if surface.bake.coverage[i] == Baked::Empty {
+            let want = if surface.bake.coverage(i) == Baked::Empty {
                 0.0
             } else {
-                let d2 = surface.bake.position[i].distance_squared(center);
+                let d2 = surface.bake.position(i).distance_squared(center);
                 let facing = if normal == Vec3::ZERO {
                     1.0
                 } else {
-                    (surface.bake.normal[i].dot(normal) * 4.0).clamp(0.0, 1.0)
+                    (surface.bake.normal(i).dot(normal) * 4.0).clamp(0.0, 1.0)
                 };
                 if d2 < r2 {
                     brush.falloff_sq(d2, r2) * facing
@@ -156,8 +156,8 @@ fn a_stroke_across_the_sphere_seam_matches_the_same_stroke_away_from_it() {
         for x in 0..w {
             let i = y * w + x;
             let j = y * w + (x + w / 2) % w;
-            if surface.bake.coverage[i] != Baked::Surface
-                || surface.bake.coverage[j] != Baked::Surface
+            if surface.bake.coverage(i) != Baked::Surface
+                || surface.bake.coverage(j) != Baked::Surface
             {
                 continue;
             }
@@ -273,9 +273,9 @@ fn a_stroke_across_a_seam_of_spot_paints_both_sides_as_one() {
     let (w, got) = (side as usize, kd_map(&doc));
     for (i, &kd) in got.iter().enumerate() {
         let mut coverage = 0.0_f32;
-        if surface.bake.coverage[i] != Baked::Empty {
+        if surface.bake.coverage(i) != Baked::Empty {
             for dab in &dabs {
-                let d2 = surface.bake.position[i].distance_squared(dab.pos.point);
+                let d2 = surface.bake.position(i).distance_squared(dab.pos.point);
                 let wgt = if d2 < r2 {
                     brush.falloff_sq(d2, r2)
                 } else {
@@ -295,8 +295,8 @@ fn a_stroke_across_a_seam_of_spot_paints_both_sides_as_one() {
                 i / w
             );
         }
-        if coverage > 0.5 && surface.bake.coverage[i] == Baked::Surface {
-            islands.insert(surface.bake.island[i]);
+        if coverage > 0.5 && surface.bake.coverage(i) == Baked::Surface {
+            islands.insert(surface.bake.island(i));
         }
     }
     assert!(
@@ -406,12 +406,9 @@ fn front_faces_only_keeps_a_big_brush_on_the_near_side() {
         })
         .expect("stroke");
         let painted = |pos: Vec3| {
-            let (i, _) = surface
-                .bake
-                .position
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| surface.bake.coverage[*i] == Baked::Surface)
+            let (i, _) = (0..surface.bake.len())
+                .map(|i| (i, surface.bake.position(i)))
+                .filter(|(i, _)| surface.bake.coverage(*i) == Baked::Surface)
                 .min_by(|a, b| a.1.distance(pos).total_cmp(&b.1.distance(pos)))
                 .expect("texel");
             let (x, y) = ((i % 128) as u32, (i / 128) as u32);
@@ -430,24 +427,24 @@ fn front_faces_only_keeps_a_big_brush_on_the_near_side() {
 fn fills_by_island_and_by_part() {
     let surface = Arc::new(Surface::new(builtin::cube(), 128, 128).expect("bake"));
     let (x, y) = (0..128 * 128)
-        .find(|&i| surface.bake.coverage[i] == Baked::Surface)
+        .find(|&i| surface.bake.coverage(i) == Baked::Surface)
         .map(|i| ((i % 128) as u32, (i / 128) as u32))
         .expect("a covered texel");
-    let island = surface.bake.island[(y * 128 + x) as usize];
+    let island = surface.bake.island((y * 128 + x) as usize);
     let mut doc = document(&surface, BrushSettings::default());
     doc.apply(Command::Fill(FillRegion::Island { x, y }))
         .expect("fill island");
     let kd = kd_map(&doc);
     let painted = Texel::encode(doc.settings().primary).kd;
     for (i, v) in kd.iter().enumerate() {
-        let inside = surface.bake.island[i] == island;
+        let inside = surface.bake.island(i) == island;
         assert_eq!(*v == painted, inside, "texel {i}");
     }
     doc.apply(Command::Fill(FillRegion::Part { x, y }))
         .expect("fill part");
     let kd = kd_map(&doc);
     for (i, v) in kd.iter().enumerate() {
-        let on_mesh = surface.bake.triangle[i] != u32::MAX;
+        let on_mesh = surface.bake.triangle(i).is_some();
         assert_eq!(*v == painted, on_mesh, "texel {i}");
     }
     doc.apply(Command::Undo).expect("undo");

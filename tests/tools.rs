@@ -67,11 +67,11 @@ fn on_surface(doc: &Document, point: Vec3) -> Place {
     let texel = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter(|&(x, y)| {
-            surface.bake.coverage[(y * w + x) as usize] != kapaint::mesh::bake::Coverage::Empty
+            surface.bake.coverage((y * w + x) as usize) != kapaint::mesh::bake::Coverage::Empty
         })
         .min_by(|a, b| {
             let d =
-                |(x, y): (u32, u32)| surface.bake.position[(y * w + x) as usize].distance(point);
+                |(x, y): (u32, u32)| surface.bake.position((y * w + x) as usize).distance(point);
             d(*a).total_cmp(&d(*b))
         })
         .expect("a covered texel");

@@ -49,7 +49,10 @@ pub enum MapChannel {
     N,
 }
 
-/// The three map textures and the version of the maps they mirror.
+/// The three map textures and the version of the maps they mirror. A channel that is one
+/// value over the whole map (the preview then reads its value from the uniforms, never the
+/// texture) gets a one-texel texture until it is painted: an unpainted 8192^2 map costs no
+/// texture memory (a full one is 24 bytes a texel with its mips).
 pub struct MapTextures {
     /// `k_d`, RGBA (A unused).
     pub kd: wgpu::Texture,
@@ -63,6 +66,8 @@ pub struct MapTextures {
     pub normal: super::normal::NormalTexture,
     version: u64,
     size: (u32, u32),
+    /// Which of `kd`, `ks`, `n` are at the map's size (the others are one texel).
+    full: Channels,
     unorm16: bool,
     /// Sums per tile and per block of tiles (what the mip levels above one texel per tile
     /// are built from).
@@ -102,46 +107,84 @@ impl MapTextures {
         Ok(out)
     }
 
-    /// The textures for `maps`, nothing uploaded yet.
+    /// The textures for `maps`, nothing uploaded yet: full size for the channels that vary,
+    /// one texel for the uniform ones.
     fn textures(gpu: &Gpu, maps: &MaterialMaps) -> Self {
-        let size = wgpu::Extent3d {
-            width: maps.width(),
-            height: maps.height(),
-            depth_or_array_layers: 1,
+        let uniform = UniformChannels::of(maps);
+        let full = Channels {
+            kd: uniform.kd.is_none(),
+            ks: uniform.ks.is_none(),
+            n: uniform.n.is_none(),
         };
-        let mip_level_count = size.max_mips(wgpu::TextureDimension::D2);
-        let texture = |label: &str, format: wgpu::TextureFormat| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_DST
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
-        let rgb_format = if gpu.unorm16 {
-            wgpu::TextureFormat::Rgba16Unorm
-        } else {
-            wgpu::TextureFormat::Rgba16Float
-        };
+        let size = (maps.width(), maps.height());
         Self {
-            kd: texture("k_d", rgb_format),
-            ks: texture("k_s", rgb_format),
-            n: texture("n", wgpu::TextureFormat::R16Float),
-            uniform: UniformChannels::of(maps),
+            kd: Self::texture(gpu, MapChannel::Kd, full.kd.then_some(size)),
+            ks: Self::texture(gpu, MapChannel::Ks, full.ks.then_some(size)),
+            n: Self::texture(gpu, MapChannel::N, full.n.then_some(size)),
+            uniform,
             normal: super::normal::NormalTexture::flat(gpu),
             version: 0,
-            size: (maps.width(), maps.height()),
+            size,
+            full,
             unorm16: gpu.unorm16,
             top_sums: TopSums::new(maps.tiles_x() as usize, maps.tiles_y() as usize),
             staging: StagingPool::default(),
             staged_bytes: 0,
         }
+    }
+
+    /// One channel's texture: at `size` with its full mip chain, or one texel (`None`).
+    fn texture(gpu: &Gpu, channel: MapChannel, size: Option<(u32, u32)>) -> wgpu::Texture {
+        let (width, height) = size.unwrap_or((1, 1));
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let format = match channel {
+            MapChannel::N => wgpu::TextureFormat::R16Float,
+            _ if gpu.unorm16 => wgpu::TextureFormat::Rgba16Unorm,
+            _ => wgpu::TextureFormat::Rgba16Float,
+        };
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(match channel {
+                MapChannel::Kd => "k_d",
+                MapChannel::Ks => "k_s",
+                MapChannel::N => "n",
+            }),
+            size,
+            mip_level_count: size.max_mips(wgpu::TextureDimension::D2),
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    }
+
+    /// Gives the channels that now vary their full-size textures; returns whether any did
+    /// (every tile must then be uploaded again: the new textures hold nothing yet).
+    fn grow(&mut self, gpu: &Gpu, uniform: &UniformChannels) -> bool {
+        let mut grew = false;
+        for (channel, varies, full) in [
+            (MapChannel::Kd, uniform.kd.is_none(), &mut self.full.kd),
+            (MapChannel::Ks, uniform.ks.is_none(), &mut self.full.ks),
+            (MapChannel::N, uniform.n.is_none(), &mut self.full.n),
+        ] {
+            if varies && !*full {
+                let texture = Self::texture(gpu, channel, Some(self.size));
+                match channel {
+                    MapChannel::Kd => self.kd = texture,
+                    MapChannel::Ks => self.ks = texture,
+                    MapChannel::N => self.n = texture,
+                }
+                *full = true;
+                grew = true;
+            }
+        }
+        grew
     }
 
     /// Mirrors the material's normal map (uploaded when it changed; a flat texel for none).
@@ -178,8 +221,14 @@ impl MapTextures {
         if maps.version() == self.version {
             return Ok(0);
         }
-        let dirty = maps.tiles_changed_since(self.version);
-        let from = self.version;
+        let uniform = UniformChannels::of(maps);
+        let grew = gpu.checked("making the map textures", || self.grow(gpu, &uniform))?;
+        // A texture just made full holds nothing: every tile, every channel.
+        let (dirty, from) = if grew {
+            ((0..maps.tile_count()).collect(), 0)
+        } else {
+            (maps.tiles_changed_since(self.version), self.version)
+        };
         if gpu
             .checked("uploading the maps", || {
                 self.upload(gpu, maps, &dirty, from)
@@ -190,7 +239,7 @@ impl MapTextures {
         }
         self.uniform = UniformChannels {
             normal_map: self.normal.present(),
-            ..UniformChannels::of(maps)
+            ..uniform
         };
         self.version = maps.version();
         Ok(dirty.len())
@@ -241,10 +290,26 @@ impl MapTextures {
                 let changed = ids.fold(Channels::NONE, |c, id| {
                     c.union(maps.channels_changed_since(id, since))
                 });
-                (r, changed)
+                // One-texel textures take nothing: their channel is one value everywhere.
+                let staged = Channels {
+                    kd: changed.kd && self.full.kd,
+                    ks: changed.ks && self.full.ks,
+                    n: changed.n && self.full.n,
+                };
+                (r, staged)
             })
+            .filter(|(_, staged)| *staged != Channels::NONE)
             .collect();
-        let batches = upload::batches(&rects, self.size, self.kd.mip_level_count());
+        if rects.is_empty() {
+            return Ok(());
+        }
+        let extent = wgpu::Extent3d {
+            width: self.size.0,
+            height: self.size.1,
+            depth_or_array_layers: 1,
+        };
+        let levels = extent.max_mips(wgpu::TextureDimension::D2);
+        let batches = upload::batches(&rects, self.size, levels);
         self.staged_bytes = batches.iter().map(|b| b.len).sum();
         for batch in &batches {
             // Every staged byte is written (row padding may keep stale bytes: never read).

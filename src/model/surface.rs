@@ -91,10 +91,10 @@ impl Surface {
                 for y in ty * TILE_SIZE..((ty + 1) * TILE_SIZE).min(h) {
                     let row = y * w;
                     for x in tx * TILE_SIZE..((tx + 1) * TILE_SIZE).min(w) {
-                        if bake.coverage[row + x] != Coverage::Empty {
+                        if bake.coverage(row + x) != Coverage::Empty {
                             let b = ((y % TILE_SIZE) / BLOCK) * BLOCKS_PER_TILE
                                 + (x % TILE_SIZE) / BLOCK;
-                            boxes[b].grow(bake.position[row + x]);
+                            boxes[b].grow(bake.position(row + x));
                         }
                     }
                 }
@@ -155,12 +155,12 @@ impl Surface {
                 for y in by..(by + BLOCK).min(self.bake.height as usize) {
                     for x in bx..(bx + BLOCK).min(w) {
                         let i = y * w + x;
-                        if self.bake.coverage[i] != Coverage::Surface {
+                        if self.bake.coverage(i) != Coverage::Surface {
                             continue;
                         }
-                        let d2 = self.bake.position[i].distance_squared(point);
+                        let d2 = self.bake.position(i).distance_squared(point);
                         if d2 <= r2 && best.is_none_or(|(bd, _)| d2 < bd) {
-                            best = Some((d2, self.bake.normal[i]));
+                            best = Some((d2, self.bake.normal(i)));
                         }
                     }
                 }
@@ -173,25 +173,28 @@ impl Surface {
     /// `None` where no island is.
     pub fn island_mask(&self, x: u32, y: u32) -> Option<Vec<bool>> {
         let i = self.index(x, y)?;
-        let island = self.bake.island[i];
-        (island != u32::MAX).then(|| self.bake.island.iter().map(|&k| k == island).collect())
+        let island = self.bake.island(i)?;
+        Some(
+            (0..self.bake.len())
+                .map(|k| self.bake.island(k) == Some(island))
+                .collect(),
+        )
     }
 
     /// A mask of the texels of the mesh part (connected piece of surface, through shared
     /// positions) under texel `(x, y)`, or `None` where the mesh is not.
     pub fn part_mask(&self, x: u32, y: u32) -> Option<Vec<bool>> {
         let i = self.index(x, y)?;
-        let triangle = self.bake.triangle[i];
-        if triangle == u32::MAX {
-            return None;
-        }
+        let triangle = self.bake.triangle(i)?;
         let parts = self.mesh.parts();
         let part = parts[triangle as usize];
         Some(
-            self.bake
-                .triangle
-                .iter()
-                .map(|&t| t != u32::MAX && parts[t as usize] == part)
+            (0..self.bake.len())
+                .map(|k| {
+                    self.bake
+                        .triangle(k)
+                        .is_some_and(|t| parts[t as usize] == part)
+                })
                 .collect(),
         )
     }
@@ -305,12 +308,12 @@ impl Footprint for BallFootprint<'_> {
                     let run = &mut weights[..xe - xs];
                     for (k, wt) in run.iter_mut().enumerate() {
                         let i = row + xs + k;
-                        *wt = if s.bake.coverage[i] == Coverage::Empty {
+                        *wt = if s.bake.coverage(i) == Coverage::Empty {
                             0.0
                         } else {
-                            let d2 = s.bake.position[i].distance_squared(self.center);
+                            let d2 = s.bake.position(i).distance_squared(self.center);
                             if d2 < r2 {
-                                self.weight(d2, r2, s.bake.normal[i])
+                                self.weight(d2, r2, s.bake.normal(i))
                             } else {
                                 0.0
                             }

@@ -52,7 +52,7 @@ impl Fill {
             FillMode::Island => {
                 let on_island = doc.surface().is_some_and(|s| {
                     let k = (y * s.bake.width + x) as usize;
-                    s.bake.island.get(k).is_some_and(|i| *i != u32::MAX)
+                    k < s.bake.len() && s.bake.island(k).is_some()
                 });
                 if on_island {
                     FillRegion::Island { x, y }

@@ -560,11 +560,8 @@ pub(crate) fn padded_texels(doc: &Document) -> (Vec<crate::model::texel::Texel>,
     let (w, h) = (maps.width(), maps.height());
     let mut texels = rows(maps);
     let dilated = doc.surface().is_some_and(|surface| {
-        let mut filled: Vec<bool> = surface
-            .bake
-            .coverage
-            .iter()
-            .map(|c| *c == Coverage::Surface)
+        let mut filled: Vec<bool> = (0..surface.bake.len())
+            .map(|i| surface.bake.coverage(i) == Coverage::Surface)
             .collect();
         let any = filled.iter().any(|f| *f);
         if any {

@@ -26,5 +26,9 @@ const BATCH_BYTES: u64 = 64 << 20;
 /// next sync fills another.
 const KEPT_BUFFERS: usize = 2;
 
+/// The largest staging buffer kept after its sync: a stroke's few tiles reuse it; the buffers
+/// of a whole-map upload (64 MB batches) go once copied, not held while the user paints.
+const KEPT_BUFFER_BYTES: u64 = 16 << 20;
+
 /// The mip level at which a tile is one texel.
 const TILE_LEVEL: u32 = TILE_SIZE.trailing_zeros();

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::KEPT_BUFFERS;
+use super::{KEPT_BUFFER_BYTES, KEPT_BUFFERS};
 use crate::gpu::Gpu;
 
 /// Staging buffers kept between syncs, each with whether its mapping for writing has
@@ -40,8 +40,11 @@ impl StagingPool {
     }
 
     /// Keeps `buffer` (submitted for copying) and maps it again; the smallest goes when more
-    /// than [`KEPT_BUFFERS`] are kept.
+    /// than [`KEPT_BUFFERS`] are kept, and one larger than [`KEPT_BUFFER_BYTES`] is let go.
     pub fn keep(&mut self, buffer: wgpu::Buffer) {
+        if buffer.size() > KEPT_BUFFER_BYTES {
+            return;
+        }
         let mapped = Arc::new(AtomicBool::new(false));
         let done = Arc::clone(&mapped);
         buffer.map_async(wgpu::MapMode::Write, .., move |r| {
