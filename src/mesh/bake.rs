@@ -97,9 +97,20 @@ impl UvBake {
     }
 
     /// The barycentric weights of texel `i`'s point on its triangle.
-    fn barycentric(&self, i: usize) -> Vec3 {
+    pub fn barycentric(&self, i: usize) -> Vec3 {
         let [b, c] = self.weights[i].map(|w| f32::from(w) / 65535.0);
         Vec3::new((1.0 - b - c).max(0.0), b, c)
+    }
+
+    /// The object-space corners of triangle `t` (neighbouring texels mostly share one: a loop
+    /// over texels keeps them while the triangle stays the same).
+    pub fn corners(&self, t: u32) -> [Vec3; 3] {
+        self.triangles[t as usize].map(|v| self.positions[v as usize])
+    }
+
+    /// The unit normals at the corners of triangle `t` (see [`UvBake::corners`]).
+    pub fn corner_normals(&self, t: u32) -> [Vec3; 3] {
+        self.triangles[t as usize].map(|v| self.normals[v as usize])
     }
 
     /// Object-space position of texel `i` (zero where it is empty).

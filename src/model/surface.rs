@@ -303,20 +303,34 @@ impl Footprint for BallFootprint<'_> {
                 if xe <= xs {
                     continue;
                 }
+                // The triangle of the texel before: its corners are loaded once a run of
+                // texels on it.
+                let mut corners: (u32, [Vec3; 3], [Vec3; 3]) =
+                    (u32::MAX, [Vec3::ZERO; 3], [Vec3::ZERO; 3]);
                 for y in rows.clone() {
                     let row = y * w;
                     let run = &mut weights[..xe - xs];
                     for (k, wt) in run.iter_mut().enumerate() {
                         let i = row + xs + k;
-                        *wt = if s.bake.coverage(i) == Coverage::Empty {
-                            0.0
+                        let Some(t) = s.bake.triangle(i) else {
+                            *wt = 0.0;
+                            continue;
+                        };
+                        if t != corners.0 {
+                            corners = (t, s.bake.corners(t), s.bake.corner_normals(t));
+                        }
+                        let b = s.bake.barycentric(i);
+                        let [pa, pb, pc] = corners.1;
+                        let d2 = (pa * b.x + pb * b.y + pc * b.z).distance_squared(self.center);
+                        *wt = if d2 < r2 {
+                            // As the bake's normal: the corners' blend, made unit.
+                            let [na, nb, nc] = corners.2;
+                            let n = (na * b.x + nb * b.y + nc * b.z)
+                                .try_normalize()
+                                .unwrap_or(na);
+                            self.weight(d2, r2, n)
                         } else {
-                            let d2 = s.bake.position(i).distance_squared(self.center);
-                            if d2 < r2 {
-                                self.weight(d2, r2, s.bake.normal(i))
-                            } else {
-                                0.0
-                            }
+                            0.0
                         };
                     }
                     f(
