@@ -1,7 +1,7 @@
 //! Crash recovery: autosave copies that cost only what changed, one per editor process.
 //!
 //! Each editor process keeps its copy in a session folder of its own inside the project's
-//! recovery folder (see [`folder`]), so two editors on one project never touch each other's
+//! recovery folder (see [`recovery_path`]), so two editors on one project never touch each other's
 //! copy. A copy is a journal: its first record is the whole document (layers, masks, settings,
 //! selection, normal map), and every later record holds the layer structure and only the tiles
 //! changed since the record before, each record checksummed and flushed to disk before the next
