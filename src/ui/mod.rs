@@ -18,6 +18,7 @@ mod layout;
 pub mod notices;
 pub use notices::{Notice, NoticeLevel, Notices};
 mod panels;
+mod project_jobs;
 mod prompts;
 pub use panels::layers::LayerView;
 mod readout;

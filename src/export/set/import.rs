@@ -164,39 +164,9 @@ pub fn import(manifest_path: &Path) -> Result<Document, SetError> {
     };
     let normal = match &manifest.normal {
         None => None,
-        Some(n) => Some(std::sync::Arc::new(read_normal(&dir.join(&n.path), n)?)),
+        Some(n) => Some(std::sync::Arc::new(n.read(dir)?)),
     };
     Ok(Document::from_parts(maps, settings).with_normal(normal))
-}
-
-/// A set's normal map, checked against what its manifest says.
-fn read_normal(
-    path: &Path,
-    entry: &super::manifest::NormalFile,
-) -> Result<crate::model::normal::NormalMap, SetError> {
-    let invalid = |reason: String| SetError::Invalid {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let bytes = crate::file_check::read_limited(path, crate::model::import::MAX_DECODED_BYTES)
-        .map_err(|e| {
-            if e.is_io() {
-                io(path, e)
-            } else {
-                invalid(format!("the file {e}"))
-            }
-        })?;
-    let map = crate::model::normal::NormalMap::from_png(&bytes).map_err(&invalid)?;
-    if (map.width(), map.height()) != (entry.width, entry.height) {
-        return Err(invalid(format!(
-            "it is {}x{}, the manifest says {}x{}",
-            map.width(),
-            map.height(),
-            entry.width,
-            entry.height
-        )));
-    }
-    Ok(map)
 }
 
 /// Largest manifest read (bytes).

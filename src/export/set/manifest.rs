@@ -398,28 +398,8 @@ pub struct Manifest {
     /// The project's tangent-space normal map, beside the maps as it stores it (it lights
     /// only: `k_a` never reads it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub normal: Option<Box<NormalFile>>,
+    pub normal: Option<Box<super::normal::NormalFile>>,
 }
-
-/// A set's normal map: `normal.png`, 8-bit RGB, `2 c - 1` in the tangent frame (glTF's
-/// convention, +Y up), at its own size.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct NormalFile {
-    /// [`NORMAL_FILE`].
-    pub path: String,
-    /// The project's normal encoding (`png-rgb8-tangent-normal`).
-    pub encoding: String,
-    /// Size in texels.
-    pub width: u32,
-    /// Size in texels.
-    pub height: u32,
-    /// Size in bytes.
-    pub bytes: u64,
-}
-
-/// The normal map's file in a set.
-pub const NORMAL_FILE: &str = "normal.png";
 
 impl Manifest {
     /// Every file the set's folder holds: the images, the normal map, `material.json`,
@@ -453,7 +433,7 @@ struct ManifestFile {
     #[serde(default)]
     blocks: Option<Box<super::choose::BlockChoice>>,
     #[serde(default)]
-    normal: Option<Box<NormalFile>>,
+    normal: Option<Box<super::normal::NormalFile>>,
 }
 
 impl TryFrom<ManifestFile> for Manifest {
@@ -503,18 +483,8 @@ impl TryFrom<ManifestFile> for Manifest {
                 comps.push(c);
             }
         }
-        if let Some(n) = &f.normal
-            && (n.path != NORMAL_FILE
-                || n.encoding != crate::model::project::NORMAL_ENCODING
-                || n.width == 0
-                || n.height == 0
-                || n.width > max
-                || n.height > max)
-        {
-            return Err(format!(
-                "the normal map must be {NORMAL_FILE}, {}, 1..={max} a side",
-                crate::model::project::NORMAL_ENCODING
-            ));
+        if let Some(n) = &f.normal {
+            n.check()?;
         }
         let has = |c: Comp| comps.contains(&c);
         let kd = (0..3).all(|c| has(Comp::Kd(c)));

@@ -8,7 +8,9 @@ mod encode;
 mod import;
 mod manifest;
 mod measure;
+mod normal;
 mod plan;
+mod target;
 
 use std::path::{Path, PathBuf};
 
@@ -21,12 +23,15 @@ use self::encode::{Encoded, StoredImage, encode_image, rows};
 pub use self::import::import;
 pub use self::manifest::{
     Approximation, ColourSpace, Compression, Constants, FileEntry, MANIFEST_FORMAT,
-    MANIFEST_VERSION, Manifest, MemoryReport, NORMAL_FILE, NormalFile,
+    MANIFEST_VERSION, Manifest, MemoryReport,
 };
 use self::manifest::{Comp, approximation};
 use self::measure::ka_error_of_set;
+pub use self::normal::{NORMAL_FILE, NormalFile};
 use self::plan::plan_set;
 pub use self::plan::{PlannedFile, SetPlan, plan};
+pub use self::target::{SetKind, Target, holds, target};
+pub(crate) use self::target::{claim, commit};
 use super::encoding::KaError;
 use super::preset::{ExportPreset, Format};
 use crate::mesh::bake::Coverage;
@@ -78,171 +83,6 @@ fn io(path: &Path, e: impl std::fmt::Display) -> SetError {
 /// An unwritable or non-empty target, or a failed encode or write: nothing is left at `out`.
 pub fn export(doc: &Document, preset: &ExportPreset, out: &Path) -> Result<Manifest, SetError> {
     export_with(doc, preset, out, &Progress::default())
-}
-
-/// What is at an export's target folder.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Target {
-    /// Nothing, or an empty folder: the set goes there.
-    Free,
-    /// A set an export of the same kind wrote, holding nothing but what its `material.json`
-    /// lists: it can be replaced.
-    Set,
-    /// Something else (a file, a folder of other things, or a set beside files no export
-    /// wrote): never replaced. Why, in words.
-    Taken(String),
-}
-
-/// The kind of set an export writes, by its manifest's `format`: `--replace` replaces only a
-/// set of the same kind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SetKind {
-    /// Material sets (`kapaint-material`): images, `material.json` and the shader snippets.
-    Material,
-    /// glTF PBR sets (`kapaint-gltf-pbr`): images, `material.json` and maybe a `.glb`.
-    Pbr,
-}
-
-impl SetKind {
-    /// The kind of set `preset` writes.
-    pub fn of(preset: &ExportPreset) -> Self {
-        if preset.format == crate::export::preset::Format::GltfPbr {
-            Self::Pbr
-        } else {
-            Self::Material
-        }
-    }
-
-    /// Its manifest's `format`.
-    fn format(self) -> &'static str {
-        match self {
-            Self::Material => MANIFEST_FORMAT,
-            Self::Pbr => crate::pbr::export::PBR_MANIFEST_FORMAT,
-        }
-    }
-
-    /// Files a set of this kind holds that its manifest does not list.
-    fn unlisted(self) -> &'static [&'static str] {
-        match self {
-            Self::Material => &["material.json", "material.wgsl", "material.glsl"],
-            Self::Pbr => &["material.json"],
-        }
-    }
-}
-
-/// Largest `material.json` read to learn what a set holds (bytes).
-const MAX_LISTING_BYTES: u64 = 16 << 20;
-
-/// The files `dir/material.json` says its export wrote, if it is a manifest of `kind`.
-fn listed_files(dir: &Path, kind: SetKind) -> Option<Vec<String>> {
-    #[derive(serde::Deserialize)]
-    struct Listed {
-        path: String,
-    }
-    #[derive(serde::Deserialize)]
-    struct Listing {
-        format: String,
-        files: Vec<Listed>,
-        #[serde(default)]
-        normal: Option<Listed>,
-    }
-    let bytes =
-        crate::file_check::read_limited(&dir.join("material.json"), MAX_LISTING_BYTES).ok()?;
-    let listing: Listing = serde_json::from_slice(&bytes).ok()?;
-    (listing.format == kind.format()).then(|| {
-        listing
-            .files
-            .into_iter()
-            .chain(listing.normal)
-            .map(|f| f.path)
-            .collect()
-    })
-}
-
-/// What is at `out` (a link to a folder is looked through: a set there is written through the
-/// link, which stays), for an export of `kind`.
-///
-/// # Errors
-/// A folder that cannot be read.
-pub fn target(out: &Path, kind: SetKind) -> Result<Target, SetError> {
-    let linked = crate::atomic::through_links(out);
-    if linked.as_path() != out && std::fs::symlink_metadata(&linked).is_err() {
-        return Ok(Target::Taken(format!(
-            "is a link to {}, which does not exist",
-            linked.display()
-        )));
-    }
-    let out = &linked;
-    if let Some(file) = out
-        .ancestors()
-        .skip(1)
-        .find(|a| std::fs::metadata(a).is_ok_and(|m| !m.is_dir()))
-    {
-        return Ok(Target::Taken(format!(
-            "lies inside {}, which is a file, not a folder",
-            file.display()
-        )));
-    }
-    if !out.exists() {
-        return Ok(Target::Free);
-    }
-    if !out.is_dir() {
-        return Ok(Target::Taken(
-            "exists and is not an empty folder (it is a file)".into(),
-        ));
-    }
-    let mut names = Vec::new();
-    for entry in std::fs::read_dir(out).map_err(|e| io(out, e))? {
-        let entry = entry.map_err(|e| io(out, e))?;
-        let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-        let mut name = entry.file_name().to_string_lossy().into_owned();
-        if !is_file {
-            name.push('/');
-        }
-        names.push(name);
-    }
-    if names.is_empty() {
-        return Ok(Target::Free);
-    }
-    let Some(listed) = listed_files(out, kind) else {
-        return Ok(Target::Taken(if out.join("material.json").exists() {
-            format!(
-                "exists and is not an empty folder (its material.json is not a {} set's)",
-                kind.format()
-            )
-        } else {
-            "exists and is not an empty folder".into()
-        }));
-    };
-    let mut strays: Vec<String> = names
-        .into_iter()
-        .filter(|n| !kind.unlisted().contains(&n.as_str()) && !listed.contains(n))
-        .collect();
-    if strays.is_empty() {
-        return Ok(Target::Set);
-    }
-    strays.sort();
-    let more = strays.len().saturating_sub(5);
-    strays.truncate(5);
-    Ok(Target::Taken(format!(
-        "exists and is not an empty folder: besides an exported set it holds {}{} (a replace removes only what an export wrote)",
-        strays.join(", "),
-        if more > 0 {
-            format!(" and {more} more")
-        } else {
-            String::new()
-        }
-    )))
-}
-
-/// Whether the folder `out` holds the file `project` (at any depth): an export there would
-/// mix the set with the project, and a replace could remove it.
-pub fn holds(out: &Path, project: &Path) -> bool {
-    let (Ok(out), Ok(project)) = (std::fs::canonicalize(out), std::fs::canonicalize(project))
-    else {
-        return false;
-    };
-    project.starts_with(out)
 }
 
 /// [`export`], reporting to `progress` (stages `analyse`, `encode`, `measure`) and stopping
@@ -456,18 +296,9 @@ fn export_into(
         // The decode + k_a snippets for engines (WGSL and GLSL), beside the images.
         let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
         if let Some(normal) = doc.normal() {
-            // As the project stores it: it lights only, and never enters k_a.
-            let png = normal.to_png().map_err(|e| fail(e, NORMAL_FILE))?;
-            let path = tmp.join(NORMAL_FILE);
-            crate::atomic::write_atomic(&path, &png).map_err(|e| io(&path, e))?;
-            exported += png.len() as u64;
-            manifest.normal = Some(Box::new(NormalFile {
-                path: NORMAL_FILE.into(),
-                encoding: crate::model::project::NORMAL_ENCODING.into(),
-                width: normal.width(),
-                height: normal.height(),
-                bytes: png.len() as u64,
-            }));
+            let file = NormalFile::write(normal, tmp)?;
+            exported += file.bytes;
+            manifest.normal = Some(Box::new(file));
         }
         for (name, snippet) in [
             ("material.wgsl", crate::export::snippet::wgsl(&manifest)),
@@ -534,24 +365,6 @@ fn level_errors(
         .collect()
 }
 
-/// Whether `out` can take a set (free, or a set when `replace`): what is there.
-///
-/// # Errors
-/// A target that is taken, or a set when not replacing.
-pub(crate) fn claim(out: &Path, replace: bool, kind: SetKind) -> Result<Target, SetError> {
-    let found = target(out, kind)?;
-    let reason = match &found {
-        Target::Free => return Ok(found),
-        Target::Set if replace => return Ok(found),
-        Target::Set => "holds an exported set already: replace it, or choose another folder".into(),
-        Target::Taken(why) => format!("cannot take the set: {why}"),
-    };
-    Err(SetError::Target {
-        path: out.to_path_buf(),
-        reason,
-    })
-}
-
 /// The document's texels, row-major; outside the mesh's UV islands they copy the nearest
 /// island's, so mips and filtering do not pull the background into the edges (`true` when
 /// that was done: the document has a surface with UVs).
@@ -572,63 +385,4 @@ pub(crate) fn padded_texels(doc: &Document) -> (Vec<crate::model::texel::Texel>,
         any
     });
     (texels, dilated)
-}
-
-/// Writes a set with `write` into a temporary folder beside `out` and moves it into place
-/// (`found` is what [`claim`] found there: a set is swapped out, so `out` always holds a whole
-/// set). Nothing is left behind when `write` fails.
-///
-/// # Errors
-/// What `write` returns; a folder that cannot be made or renamed.
-pub(crate) fn commit<T>(
-    out: &Path,
-    found: &Target,
-    write: impl FnOnce(&Path) -> Result<T, SetError>,
-) -> Result<T, SetError> {
-    // Through a link to the folder: the set is swapped in where the link points, and the
-    // link stays a link.
-    let out = &crate::atomic::through_links(out);
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
-    let name = out
-        .file_name()
-        .map_or_else(|| "set".into(), |n| n.to_string_lossy().into_owned());
-    remove_stale_sets(parent, &name);
-    // Removed on every way out but the last rename; made new, so never a planted link.
-    let guard = crate::atomic::temporary_dir(parent, &name, "tmp").map_err(|e| io(parent, e))?;
-    let tmp = guard.path().to_path_buf();
-    let manifest = write(&tmp)?;
-    if *found == Target::Set {
-        // Swap: the old set moves aside, the new one takes its name, the old one goes. Should
-        // the second rename fail, the old set is put back.
-        let old = crate::atomic::temporary_dir(parent, &name, "old").map_err(|e| io(parent, e))?;
-        // Onto the empty folder just made: the name was never free for anyone else to take.
-        std::fs::rename(out, old.path()).map_err(|e| io(out, e))?;
-        if let Err(e) = std::fs::rename(&tmp, out) {
-            let _ = std::fs::rename(old.path(), out);
-            return Err(io(out, e));
-        }
-        guard.keep();
-        // The old set goes with its guard.
-        drop(old);
-        return Ok(manifest);
-    }
-    if out.exists() {
-        std::fs::remove_dir(out).map_err(|e| io(out, e))?;
-    }
-    std::fs::rename(&tmp, out).map_err(|e| io(out, e))?;
-    guard.keep();
-    Ok(manifest)
-}
-
-/// Removes the temporary folders of earlier exports to `name` in `dir` whose process is gone.
-fn remove_stale_sets(dir: &Path, name: &str) {
-    for tag in ["tmp", "old"] {
-        crate::atomic::remove_stale_with(dir, &format!(".{name}.{tag}-"), "", |path| {
-            let _ = std::fs::remove_dir_all(path);
-        });
-    }
 }

@@ -6,10 +6,14 @@
 
 mod command;
 mod fill;
+mod id;
 mod import;
 mod layers;
+mod mesh_ref;
 mod moves;
+pub use id::DocumentId;
 pub use layers::MAX_LAYERS;
+pub use mesh_ref::MeshRef;
 mod stroke;
 
 pub use command::{
@@ -30,71 +34,6 @@ use super::surface::Surface;
 use super::texel::{Channels, MaterialValue};
 use crate::reflectance::{AmbientApprox, ShadingModel};
 use stroke::ActiveStroke;
-
-/// The mesh a document is painted on.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(try_from = "MeshRefFile")]
-pub enum MeshRef {
-    /// The built-in UV sphere.
-    #[default]
-    Sphere,
-    /// A mesh file, by path.
-    File(String),
-    /// Another built-in mesh (plane, cube, torus), by name.
-    Builtin(String),
-}
-
-/// A mesh reference as a file spells it, before it is checked.
-#[derive(Deserialize)]
-enum MeshRefFile {
-    Sphere,
-    File(String),
-    Builtin(String),
-}
-
-impl TryFrom<MeshRefFile> for MeshRef {
-    type Error = String;
-
-    fn try_from(f: MeshRefFile) -> Result<Self, String> {
-        use super::check::{MAX_PATH_BYTES, bounded_text};
-        match f {
-            MeshRefFile::Sphere => Ok(Self::Sphere),
-            MeshRefFile::File(path) => {
-                if path.is_empty() {
-                    return Err("the mesh path is empty".into());
-                }
-                bounded_text("the mesh path", &path, MAX_PATH_BYTES)?;
-                Ok(Self::File(path))
-            }
-            MeshRefFile::Builtin(name) if crate::mesh::BUILTIN_NAMES.contains(&name.as_str()) => {
-                Ok(Self::Builtin(name))
-            }
-            MeshRefFile::Builtin(name) => Err(format!(
-                "no built-in mesh is named {name:?} (known: {})",
-                crate::mesh::BUILTIN_NAMES.join(", ")
-            )),
-        }
-    }
-}
-
-impl MeshRef {
-    /// What `kapaint` commands take for it: a built-in name or a path.
-    pub fn spec(&self) -> &str {
-        match self {
-            Self::Sphere => "sphere",
-            Self::File(p) | Self::Builtin(p) => p,
-        }
-    }
-
-    /// From a built-in name or a path.
-    pub fn from_spec(spec: &str) -> Self {
-        match spec {
-            "sphere" => Self::Sphere,
-            s if crate::mesh::BUILTIN_NAMES.contains(&s) => Self::Builtin(s.to_string()),
-            s => Self::File(s.to_string()),
-        }
-    }
-}
 
 /// Everything about a document that is not the maps; saved with the project.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -181,44 +120,6 @@ pub struct Document {
     /// Which document this is: kept in its project file and its recovery journal, so a
     /// journal is only ever recovered into the project it was written for.
     id: DocumentId,
-}
-
-/// A document's identity: random when the document is made, then kept in its project file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct DocumentId(pub u128);
-
-impl DocumentId {
-    /// A new identity, unguessable and different in every process and call.
-    pub fn random() -> Self {
-        use std::hash::{BuildHasher as _, Hasher as _};
-        use std::sync::atomic::{AtomicU64, Ordering};
-        static CALLS: AtomicU64 = AtomicU64::new(0);
-        // The standard library seeds each `RandomState` from the system's randomness.
-        let half = || {
-            let mut h = std::collections::hash_map::RandomState::new().build_hasher();
-            h.write_u64(CALLS.fetch_add(1, Ordering::Relaxed));
-            h.write_u32(std::process::id());
-            h.write_u128(
-                std::time::SystemTime::now()
-                    .duration_since(std::time::UNIX_EPOCH)
-                    .map_or(0, |d| d.as_nanos()),
-            );
-            h.finish()
-        };
-        Self(u128::from(half()) << 64 | u128::from(half()))
-    }
-
-    /// As a project file and a journal write it: 32 hex digits.
-    pub fn to_hex(self) -> String {
-        format!("{:032x}", self.0)
-    }
-
-    /// From 32 hex digits.
-    pub fn from_hex(text: &str) -> Option<Self> {
-        (text.len() == 32 && text.bytes().all(|b| b.is_ascii_hexdigit()))
-            .then(|| u128::from_str_radix(text, 16).ok().map(Self))
-            .flatten()
-    }
 }
 
 impl std::fmt::Debug for Document {

@@ -12,8 +12,9 @@ use std::io::{BufReader, Read as _, Seek as _, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use super::journal::{self, Known, Replay, Snapshot};
+use super::journal::{self, Known, Snapshot};
 use super::record::{self, JOURNAL_MAGIC, Next};
+use super::replay::{self, Replay};
 use super::session::Owner;
 use crate::model::ModelError;
 use crate::model::document::{Document, DocumentId};
@@ -122,7 +123,7 @@ fn peek(session: &Path) -> Option<Peek> {
             JOURNAL_MAGIC.len() as u64 + record::RECORD_HEAD,
         ))
         .ok()?;
-        let id = journal::peek_id(&mut BufReader::new(&mut file).take(len), len).ok()?;
+        let id = replay::peek_id(&mut BufReader::new(&mut file).take(len), len).ok()?;
         Some(Peek {
             id,
             modified: file.metadata().ok()?.modified().ok()?,
@@ -228,7 +229,7 @@ fn replay(journal: &Path) -> Option<Document> {
     let mut state = Replay::default();
     let mut at = JOURNAL_MAGIC.len() as u64;
     while let Next::Record((decoded, next)) =
-        record::read_next(&mut reader, at, size, journal::decode)
+        record::read_next(&mut reader, at, size, replay::decode)
     {
         if state.apply(decoded).is_err() {
             break;

@@ -19,6 +19,7 @@
 mod folder;
 mod journal;
 mod record;
+mod replay;
 pub mod session;
 #[cfg(test)]
 mod tests;
