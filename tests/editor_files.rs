@@ -440,3 +440,52 @@ fn a_layered_project_opens_clean_on_its_saved_selection() {
     assert_eq!(selected.props.name, "Scratches", "the saved selection");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_project_another_kapaint_has_open_asks_and_opens_read_only() {
+    use kapaint::model::recovery::session::Owner;
+    let dir = scratch("in-use");
+    let project = dir.join("shared.kapaint");
+    let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+        .expect("document");
+    kapaint::model::project::save(&doc, &project).expect("saved");
+    // Another editor's lock: process 1 runs on every Linux machine.
+    if !std::path::Path::new("/proc/1").exists() {
+        eprintln!("SKIPPED: this system does not say which processes run");
+        return;
+    }
+    let other = Owner {
+        pid: 1,
+        start: 0,
+        ..Owner::this_process().clone()
+    };
+    std::fs::write(dir.join(".shared.kapaint.lock"), other.file_name()).expect("lock");
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(40)
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, Some(project.clone())),
+        );
+    harness.run();
+    harness.get_by_label_contains("is open in another kapaint");
+    harness
+        .get_by_role_and_label(Role::Button, "Open read-only")
+        .click();
+    harness.run();
+    wait_until(&mut harness, "opened", |e| {
+        e.state.opening().is_none() && e.state.doc().maps().width() == 64
+    });
+    assert_eq!(
+        harness.state().state.window_title(),
+        "shared.kapaint [read-only] - kapaint"
+    );
+    // Save asks for another file: the other editor's project is never written.
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    assert_eq!(
+        harness.state().state.file_dialog_open_for(),
+        Some(FilePurpose::SaveProject)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use super::EditorState;
-use super::dialogs::centred;
 use crate::model::project::lock::{self, OnDisk, ProjectLock};
 use crate::model::recovery::session::Owner;
 
@@ -72,23 +71,23 @@ impl EditorState {
             |n| n.to_string_lossy().into_owned(),
         );
         let (mut read_only, mut anyway, mut cancel) = (false, false, false);
-        centred(egui::Window::new("Open: in use"), ctx)
-            .collapsible(false)
-            .resizable(false)
-            .show(ctx, |ui| {
-                ui.label(format!(
-                    "{name} is open in another kapaint (process {} on {}). Two editors saving \
-                     one project would each keep only their own work: open it read-only (Save \
-                     then asks for another file), or open it anyway (a save that finds the \
-                     other's work on disk goes beside it instead of over it).",
-                    owner.pid, owner.host
-                ));
-                ui.horizontal(|ui| {
-                    read_only = ui.button("Open read-only").clicked();
-                    anyway = ui.button("Open anyway").clicked();
-                    cancel = ui.button("Cancel").clicked();
-                });
+        // Modal: until it is answered the document is what was open before (or a placeholder),
+        // and a stroke on it would be lost when the project opens.
+        egui::Modal::new(egui::Id::new("kapaint-open-in-use")).show(ctx, |ui| {
+            ui.heading("Open: in use");
+            ui.label(format!(
+                "{name} is open in another kapaint (process {} on {}). Two editors saving \
+                 one project would each keep only their own work: open it read-only (Save \
+                 then asks for another file), or open it anyway (a save that finds the \
+                 other's work on disk goes beside it instead of over it).",
+                owner.pid, owner.host
+            ));
+            ui.horizontal(|ui| {
+                read_only = ui.button("Open read-only").clicked();
+                anyway = ui.button("Open anyway").clicked();
+                cancel = ui.button("Cancel").clicked();
             });
+        });
         if read_only || anyway {
             self.claim.asking = None;
             self.claim.answered = Some((path.clone(), read_only));
