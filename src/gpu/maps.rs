@@ -235,6 +235,10 @@ impl MapTextures {
             })?
             .is_err()
         {
+            if grew {
+                // The new textures hold nothing yet: the next sync uploads every tile.
+                self.version = 0;
+            }
             return Ok(0);
         }
         self.uniform = UniformChannels {
