@@ -221,14 +221,7 @@ fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
     autosaver.wait().expect("autosaved").expect("written");
     // Left by an editor that was killed.
     as_ended(&autosaver.session());
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .with_max_steps(40)
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, Some(project.clone())),
-        );
-    harness.run();
+    let mut harness = editor_on(&project);
     harness.get_by_label_contains("found a recovery copy");
     let version = harness.state().state.doc().version();
     // A stroke on the canvas and Ctrl+S while the offer is up change nothing.
@@ -355,14 +348,7 @@ fn save_as_moves_the_recovery_copy_to_the_new_project() {
     let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
         .expect("document");
     kapaint::model::project::save(&doc, &a).expect("saved");
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .with_max_steps(40)
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, Some(a.clone())),
-        );
-    harness.run();
+    let mut harness = editor_on(&a);
     wait_until(&mut harness, "opened", |e| {
         e.state.opening().is_none() && e.state.doc().maps().width() == 64
     });
@@ -417,14 +403,7 @@ fn a_layered_project_opens_clean_on_its_saved_selection() {
     doc.apply(Command::SelectLayer(LayerRef::Name("Scratches".into())))
         .expect("select");
     kapaint::model::project::save(&doc, &project).expect("saved");
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .with_max_steps(40)
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, Some(project.clone())),
-        );
-    harness.run();
+    let mut harness = editor_on(&project);
     wait_until(&mut harness, "opened", |e| {
         e.state.opening().is_none() && e.state.doc().maps().width() == 128
     });
@@ -460,14 +439,7 @@ fn a_project_another_kapaint_has_open_asks_and_opens_read_only() {
         ..Owner::this_process().clone()
     };
     std::fs::write(dir.join(".shared.kapaint.lock"), other.file_name()).expect("lock");
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1400.0, 900.0))
-        .with_max_steps(40)
-        .build_ui_state(
-            |ui, editor: &mut Editor| editor.frame(ui),
-            Editor::new(None, Some(project.clone())),
-        );
-    harness.run();
+    let mut harness = editor_on(&project);
     harness.get_by_label_contains("is open in another kapaint");
     harness
         .get_by_role_and_label(Role::Button, "Open read-only")

@@ -32,6 +32,19 @@ pub fn editor() -> Harness<'static, Editor> {
     harness
 }
 
+/// The editor started on the project at `path` (as `kapaint edit PATH`), its first frame drawn.
+pub fn editor_on(path: &std::path::Path) -> Harness<'static, Editor> {
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1400.0, 900.0))
+        .with_max_steps(40)
+        .build_ui_state(
+            |ui, editor: &mut Editor| editor.frame(ui),
+            Editor::new(None, Some(path.to_path_buf())),
+        );
+    harness.run();
+    harness
+}
+
 /// Drags the primary button from `a` to `b` in steps, a frame per step.
 pub fn drag(harness: &mut Harness<'_, Editor>, a: Pos2, b: Pos2) {
     harness.hover_at(a);
