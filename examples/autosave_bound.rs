@@ -42,7 +42,11 @@ fn document() -> Document {
                 );
             }
         }
-        kapaint::model::document::ImportedMaterial(std::sync::Arc::new(maps))
+        kapaint::model::document::ImportedMaterial {
+            maps: std::sync::Arc::new(maps),
+            normal: None,
+            report: None,
+        }
     };
     doc.apply(Command::ImportMaterial(noise(1)))
         .expect("layer 1");

@@ -675,3 +675,58 @@ fn a_paint_script_builds_layers_and_kapaint_layers_lists_them() {
     assert_eq!(lines[3], "2,fill,Gloss,false,0.5,off,off,max,none,0");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `kapaint import` onto a layer that cannot take the image: a locked layer, a fill layer, the
+/// mask of a layer. Each is refused with exit 2 and one line, and the project is left byte for
+/// byte as it was (the import's failure was once dropped and the project saved as if done).
+#[test]
+fn import_onto_a_locked_layer_a_fill_layer_or_a_mask_exits_2_and_changes_nothing() {
+    let dir = std::env::temp_dir().join(format!("kapaint-import-refused-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let image = dir.join("grey.png");
+    image::GrayImage::from_fn(32, 32, |x, y| image::Luma([(x * 7 + y * 3) as u8]))
+        .save(&image)
+        .expect("image");
+    let cases = [
+        ("locked", "SetLayerLocked(true)", "is locked"),
+        (
+            "fill",
+            "AddLayer(kind: Fill, name: \"Gloss\")",
+            "has no pixels to paint",
+        ),
+        ("mask", "AddMask, SelectMask", "not a mask"),
+    ];
+    for (name, commands, says) in cases {
+        let project = dir.join(format!("{name}.kapaint"));
+        let path = project.to_str().expect("path");
+        let o = kapaint(&["new", "--size", "64", "--out", path]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let script = dir.join(format!("{name}.ron"));
+        std::fs::write(&script, format!("(commands: [{commands}])")).expect("script");
+        let o = kapaint(&["paint", path, "--script", script.to_str().expect("path")]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let before = std::fs::read(&project).expect("read");
+        for channel in ["kd", "ks", "n"] {
+            let o = kapaint(&[
+                "import",
+                "--channel",
+                channel,
+                "--image",
+                image.to_str().expect("path"),
+                path,
+            ]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{name} {channel}: {err}");
+            assert_eq!(err.lines().count(), 1, "{name} {channel}: {err}");
+            assert!(err.contains(says), "{name} {channel}: {err}");
+            assert!(o.stdout.is_empty(), "{name} {channel}");
+            assert_eq!(
+                std::fs::read(&project).expect("read"),
+                before,
+                "{name} {channel}: the project is untouched"
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -83,10 +83,28 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
     harness.run_steps(3);
     harness.get_by_label(kapaint::ui::canvas::PBR_ERROR_SCALE_LABEL);
 
-    // One undo step puts the layer back.
+    // One undo step puts the layer back, and takes the normal map and the report with it:
+    // the document is as it was opened, so the title is clean again.
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     harness.run_steps(2);
     assert_eq!(kit::changed(&before, &texels(harness.state())), 0);
+    let doc = harness.state().state.doc();
+    assert!(doc.normal().is_none(), "undo takes the normal map back");
+    assert!(doc.settings().import.is_none(), "and the import report");
+    assert!(!harness.state().state.dirty(), "the title is clean again");
+    assert!(
+        harness
+            .query_by_label_contains("Normal map 1024x1024")
+            .is_none()
+    );
+    // Redo brings all three back.
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::Z);
+    harness.run_steps(2);
+    let doc = harness.state().state.doc();
+    assert!(doc.normal().is_some() && doc.settings().import.is_some());
+    assert!(harness.state().state.dirty());
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
 
     // A glTF mesh import asks whether to bring its material in too.
     harness.get_by_label("File").click();
@@ -95,6 +113,18 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
     harness.run_steps(2);
     wait_until(&mut harness, "mesh imported", notice("mesh "));
     harness.run_steps(2);
+    assert!(
+        harness
+            .state()
+            .state
+            .doc()
+            .settings()
+            .mesh
+            .spec()
+            .ends_with("spot.gltf"),
+        "the mesh is the project's"
+    );
+    assert!(harness.state().state.dirty());
     harness
         .get_by_role_and_label(Role::Button, "Bring the material in")
         .click();
@@ -108,6 +138,21 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
             == 2
     });
     assert!(kit::changed(&before, &texels(harness.state())) > 0);
+
+    // Undo takes the material back, then the mesh: the sphere again, and a clean title.
+    for _ in 0..2 {
+        harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+        harness.run_steps(2);
+    }
+    let doc = harness.state().state.doc();
+    assert_eq!(doc.settings().mesh, kapaint::model::MeshRef::Sphere);
+    let surface = doc.surface().expect("a surface");
+    assert_eq!(
+        surface.mesh,
+        kapaint::mesh::builtin("sphere").expect("sphere"),
+        "the sphere's bake is back"
+    );
+    assert!(!harness.state().state.dirty());
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -583,10 +583,10 @@ fn padding_fills_outside_the_islands_from_the_mesh_bake() {
     let obj =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_triangulated.obj");
     let mesh = kapaint::mesh::open(&obj).expect("spot");
-    let mut doc = painted();
     let surface = kapaint::model::surface::Surface::new(mesh, 200, 120).expect("bake");
     let coverage = surface.bake.coverage_grid();
-    doc.set_surface(Some(std::sync::Arc::new(surface)))
+    let doc = painted()
+        .with_surface(Some(std::sync::Arc::new(surface)))
         .expect("surface");
     let dir = temp("padding");
     let out = dir.join("set");

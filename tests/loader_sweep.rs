@@ -348,8 +348,9 @@ fn paint_scripts() {
         let Ok(script) = ron::from_str::<PaintScript>(&String::from_utf8_lossy(case)) else {
             return;
         };
-        let mut doc = Document::new(64, 48, DocumentSettings::default()).expect("doc");
-        doc.set_surface(Some(std::sync::Arc::clone(&surface)))
+        let mut doc = Document::new(64, 48, DocumentSettings::default())
+            .expect("doc")
+            .with_surface(Some(std::sync::Arc::clone(&surface)))
             .expect("surface");
         for command in script.commands {
             let _ = doc.apply(command);

@@ -316,7 +316,10 @@ fn the_normal_map_is_kept_passed_through_and_never_in_ka() {
     // k_a never reads it: the same maps with and without the normal map export the same
     // baked k_a.
     let mut bare = kapaint::model::project::load(&project).expect("load");
-    bare.set_normal(None);
+    bare.apply(kapaint::model::Command::SetNormal(
+        kapaint::model::document::AttachedNormal(None),
+    ))
+    .expect("clear");
     let bare_path = d.join("bare.kapaint");
     kapaint::model::project::save(&bare, &bare_path).expect("save");
     let ka = |p: &Path, out: &str| {

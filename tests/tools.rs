@@ -84,11 +84,10 @@ fn on_surface(doc: &Document, point: Vec3) -> Place {
     }
 }
 
-fn with_sphere(mut doc: Document) -> Document {
+fn with_sphere(doc: Document) -> Document {
     let surface =
         Surface::new(uv_sphere(32, 16), doc.maps().width(), doc.maps().height()).expect("bake");
-    doc.set_surface(Some(Arc::new(surface))).expect("surface");
-    doc
+    doc.with_surface(Some(Arc::new(surface))).expect("surface")
 }
 
 #[test]

@@ -229,7 +229,7 @@ fn load_projects(
             let mesh = glb.then(|| doc.surface().cloned()).flatten();
             if !padding {
                 let mut doc = doc;
-                let _ = doc.set_surface(None);
+                let _ = doc.attach_surface(None);
                 return Ok((doc, mesh));
             }
             Ok((doc, mesh))

@@ -212,17 +212,17 @@ impl ImportPbrArgs {
         };
         let mut imported = crate::pbr::import::import(&set, size, model).map_err(model_error)?;
         imported.report.notes.extend(notes);
-        imported.doc.set_normal(normal.map(std::sync::Arc::new));
         let mut settings = imported.doc.settings().clone();
         settings.import = Some(imported.report.clone());
-        imported.doc.replace_settings(settings);
         if let Some(mesh) = mesh {
-            let mut settings = imported.doc.settings().clone();
             settings.mesh = MeshRef::from_spec(&mesh);
-            imported.doc.replace_settings(settings);
         }
-        project::save(&imported.doc, &self.out).map_err(model_error)?;
-        Ok(report_text(&self.out, &imported.doc, &imported.report))
+        let doc = imported
+            .doc
+            .with_normal(normal.map(std::sync::Arc::new))
+            .with_settings(settings);
+        project::save(&doc, &self.out).map_err(model_error)?;
+        Ok(report_text(&self.out, &doc, &imported.report))
     }
 }
 

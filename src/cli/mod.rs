@@ -290,11 +290,11 @@ mod tests {
     #[test]
     fn a_broken_invariant_in_the_model_is_an_internal_error() {
         use crate::model::{Document, DocumentSettings, surface::Surface};
-        let mut doc = Document::new(8, 8, DocumentSettings::default()).expect("document");
+        let doc = Document::new(8, 8, DocumentSettings::default()).expect("document");
         let sphere = mesh::builtin("sphere").expect("sphere");
         let surface = Surface::new(sphere, 16, 16).expect("bake");
         let e = doc
-            .set_surface(Some(std::sync::Arc::new(surface)))
+            .with_surface(Some(std::sync::Arc::new(surface)))
             .expect_err("sizes differ");
         let e = model_error(e);
         assert_eq!(e.code, crate::crash::EXIT_INTERNAL, "{}", e.message);

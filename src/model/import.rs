@@ -433,14 +433,21 @@ pub(super) fn write_planes(maps: &mut MaterialMaps, planes: &ChannelPlanes) {
     }
 }
 
-/// Writes `image` into `channel` of the document as one undo step.
-pub fn import_into(doc: &mut Document, channel: Channel, image: &DynamicImage) {
+/// Writes `image` into `channel` of the selected paint layer as one undo step.
+///
+/// # Errors
+/// The command's: the selected layer is locked, a fill layer or a group, or its mask is
+/// selected; the document is unchanged then.
+pub fn import_into(
+    doc: &mut Document,
+    channel: Channel,
+    image: &DynamicImage,
+) -> Result<(), ModelError> {
     let (w, h) = (doc.maps().width(), doc.maps().height());
     let planes = resample(image, channel, w, h);
-    // The planes are made for these maps, so the sizes agree.
-    let _ = doc.apply(super::Command::ImportChannel(ImportedChannel(
+    doc.apply(super::Command::ImportChannel(ImportedChannel(
         std::sync::Arc::new(planes),
-    )));
+    )))
 }
 
 /// Reads a grayscale brush stamp from an image file (luminance of the decoded image; an
@@ -471,11 +478,13 @@ pub fn read_stamp(path: &Path) -> Result<super::brush::Stamp, ModelError> {
     })
 }
 
-/// Reads `path` and imports it into `channel`.
+/// Reads `path` and imports it into `channel` of the selected paint layer.
+///
+/// # Errors
+/// The image's, or the command's ([`import_into`]).
 pub fn import_file(doc: &mut Document, channel: Channel, path: &Path) -> Result<(), ModelError> {
     let image = read_image(path)?;
-    import_into(doc, channel, &image);
-    Ok(())
+    import_into(doc, channel, &image)
 }
 
 /// A PNG of `data` (samples in the encoder's order; 16-bit words native-endian) with `color`,

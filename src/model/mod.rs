@@ -11,6 +11,7 @@ pub mod history;
 pub mod import;
 pub mod layers;
 pub mod maps;
+pub mod mesh_ref;
 pub mod mips;
 pub mod normal;
 pub mod paint;
@@ -31,4 +32,5 @@ pub use document::{
 };
 pub use error::ModelError;
 pub use maps::MaterialMaps;
+pub use mesh_ref::MeshRef;
 pub use texel::{Channel, Channels, MaterialValue};

@@ -229,6 +229,7 @@ impl Editor {
         s.poll_job();
         s.track_pressure(&ctx);
         s.hotkeys(&ctx);
+        s.follow_mesh();
         s.dropped_files(&ctx);
         let now = Instant::now();
         if let Some(Err(e)) = s.autosaver.poll(&s.doc, now) {

@@ -406,11 +406,7 @@ impl EditorState {
 
     /// A copy of the document for a worker thread (the maps' tiles are shared, not copied).
     pub(super) fn snapshot(&self) -> Document {
-        let mut d = self.doc.snapshot();
-        if let Some(s) = self.doc.surface() {
-            let _ = d.set_surface(Some(Arc::clone(s)));
-        }
-        d
+        self.doc.snapshot()
     }
 
     /// Keeps the export dialog's preview current: starts planning on a worker thread when the

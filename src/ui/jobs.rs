@@ -200,12 +200,11 @@ impl EditorState {
                 if textured {
                     self.material_prompt = Some(path.clone());
                 }
-                let mesh = surface.mesh.clone();
-                let spec = MeshRef::from_spec(&path.display().to_string());
-                match self.doc.set_mesh(spec, surface) {
+                let mesh = MeshRef::from_spec(&path.display().to_string());
+                let attached = crate::model::document::AttachedMesh { mesh, surface };
+                match self.doc.apply(Command::SetMesh(attached)) {
                     Ok(()) => {
-                        self.mesh = MeshState::new(mesh, self.mesh.id + 1);
-                        self.viewport.frame(&self.mesh.mesh);
+                        self.follow_mesh();
                         self.notices
                             .push(notice(format!("mesh {}", path.display()), false));
                     }
@@ -341,12 +340,15 @@ impl EditorState {
             normal,
             report,
         } = m;
-        let imported = crate::model::document::ImportedMaterial(Arc::new(maps));
+        let imported = crate::model::document::ImportedMaterial {
+            maps: Arc::new(maps),
+            normal: normal.map(Arc::new),
+            report: Some(report.clone()),
+        };
         if let Err(e) = self.doc.apply(Command::ImportMaterial(imported)) {
             self.notices.push(notice(e.to_string(), true));
             return;
         }
-        self.doc.set_normal(normal.map(Arc::new));
         let e = report.error;
         let text = format!(
             "{} imported for {}: conversion error max {:.1}%, mean {:.1}%, p99 {:.1}%",
@@ -367,9 +369,6 @@ impl EditorState {
         for note in &report.notes {
             self.notices.push(notice(note.clone(), false));
         }
-        let mut settings = self.doc.settings().clone();
-        settings.import = Some(report);
-        self.doc.replace_settings(settings);
     }
 
     /// Loads a brush stamp from an image on a worker thread.

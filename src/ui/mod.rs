@@ -131,6 +131,9 @@ fn stamp_image(stamp: &crate::model::brush::Stamp, size: usize) -> egui::ColorIm
 /// The mesh being painted, with what picking and the renderer need.
 struct MeshState {
     id: u64,
+    /// The document's bake this was made from: when the document's differs (undo of a mesh
+    /// import, a resize), the state follows it.
+    from: std::sync::Weak<crate::model::surface::Surface>,
     mesh: Arc<Mesh>,
     bvh: Bvh,
     /// UV edges in map fractions (u, 1 - v), for the canvas wireframe.
@@ -154,6 +157,7 @@ impl MeshState {
         }
         Self {
             id,
+            from: std::sync::Weak::new(),
             mesh: Arc::new(mesh),
             bvh,
             uv_lines,
@@ -437,6 +441,29 @@ impl EditorState {
         if let Err(e) = self.doc.apply(command) {
             self.notices.push(notice(e.to_string(), true));
         }
+        self.follow_mesh();
+    }
+
+    /// The mesh shown, picked and drawn on follows the document's (a mesh import, its undo):
+    /// rebuilt, and the view framed, only when the mesh itself changed.
+    fn follow_mesh(&mut self) {
+        let Some(surface) = self.doc.surface() else {
+            return;
+        };
+        // Upgraded, not compared by address: a freed bake's address may be reused.
+        if self
+            .mesh
+            .from
+            .upgrade()
+            .is_some_and(|from| Arc::ptr_eq(&from, surface))
+        {
+            return;
+        }
+        if *self.mesh.mesh != surface.mesh {
+            self.mesh = MeshState::new(surface.mesh.clone(), self.mesh.id + 1);
+            self.viewport.frame(&self.mesh.mesh);
+        }
+        self.mesh.from = Arc::downgrade(surface);
     }
 
     /// The channel the canvas shows (`k_d` for the derived `k_a`): where dropped images go.

@@ -132,6 +132,14 @@ pub enum Command {
     /// size (a PBR material converted on a worker), as one undo step. Not for scripts.
     #[serde(skip)]
     ImportMaterial(ImportedMaterial),
+    /// Sets or clears the material's normal map, as one undo step. Not for scripts: its map
+    /// comes from a decoder.
+    #[serde(skip)]
+    SetNormal(AttachedNormal),
+    /// Makes a mesh, baked at the map size on a worker, the project's mesh, as one undo step.
+    /// Not for scripts: its bake comes from a worker.
+    #[serde(skip)]
+    SetMesh(AttachedMesh),
     /// Installs maps resized on a worker ([`crate::model::resize::resized`]) with the mesh
     /// surface baked at their size, as one undo step. Not for scripts: its maps come from a
     /// worker.
@@ -276,20 +284,57 @@ pub enum LayerPlace {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImportedChannel(pub Arc<crate::model::import::ChannelPlanes>);
 
-/// Maps made on a worker for [`Command::ImportMaterial`], shared so that the command clones
-/// cheaply (equal when they are the same maps).
+/// A material converted on a worker for [`Command::ImportMaterial`]: its maps, the normal map
+/// it brought and the report of its conversion, all undone together. Shared so that the
+/// command clones cheaply (equal when they are the same maps).
 #[derive(Clone, Debug)]
-pub struct ImportedMaterial(pub Arc<crate::model::MaterialMaps>);
+pub struct ImportedMaterial {
+    /// The maps, at the document's size.
+    pub maps: Arc<crate::model::MaterialMaps>,
+    /// Its normal map (none: the document keeps no normal map).
+    pub normal: Option<Arc<crate::model::normal::NormalMap>>,
+    /// How it was converted, with the measured error.
+    pub report: Option<crate::model::provenance::ImportReport>,
+}
 
 impl PartialEq for ImportedMaterial {
     fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
+        Arc::ptr_eq(&self.maps, &other.maps)
+    }
+}
+
+/// A normal map for [`Command::SetNormal`] (none: cleared); equal when it is the same map.
+#[derive(Clone, Debug)]
+pub struct AttachedNormal(pub Option<Arc<crate::model::normal::NormalMap>>);
+
+impl PartialEq for AttachedNormal {
+    fn eq(&self, other: &Self) -> bool {
+        match (&self.0, &other.0) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (a, b) => a.is_none() && b.is_none(),
+        }
+    }
+}
+
+/// A mesh for [`Command::SetMesh`]: how the project names it and its bake at the map size;
+/// equal when it is the same bake.
+#[derive(Clone, Debug)]
+pub struct AttachedMesh {
+    /// The mesh as the project stores it.
+    pub mesh: crate::model::MeshRef,
+    /// Its bake at the map size.
+    pub surface: Arc<crate::model::surface::Surface>,
+}
+
+impl PartialEq for AttachedMesh {
+    fn eq(&self, other: &Self) -> bool {
+        self.mesh == other.mesh && Arc::ptr_eq(&self.surface, &other.surface)
     }
 }
 
 impl Command {
     /// Whether the command paints on the mesh (and so needs
-    /// [`Document::set_surface`](super::Document::set_surface)).
+    /// [`Document::with_surface`](super::Document::with_surface)).
     pub fn needs_surface(&self) -> bool {
         matches!(
             self,

@@ -6,7 +6,7 @@ use super::layers::command_error;
 use crate::model::ModelError;
 use crate::model::import::ChannelPlanes;
 use crate::model::layers::Stamped;
-use crate::model::layers::edit::Planes;
+use crate::model::layers::edit::{Planes, PrePlanes};
 use crate::model::texel::Channel;
 use crate::model::tile::Plane;
 
@@ -14,8 +14,9 @@ impl Document {
     /// [`Command::ImportMaterial`]: every channel of the selected paint layer from `maps`.
     pub(super) fn import_material(
         &mut self,
-        maps: &crate::model::MaterialMaps,
+        imported: &super::ImportedMaterial,
     ) -> Result<(), ModelError> {
+        let maps = &*imported.maps;
         self.end_stroke();
         if (maps.width(), maps.height()) != (self.maps.width(), self.maps.height()) {
             return Err(ModelError::Internal(format!(
@@ -31,7 +32,7 @@ impl Document {
                 "a material imports into a paint layer, not a mask: select the layer's content",
             ));
         }
-        self.edit_planes("Import material", |planes, _, _| {
+        let write = |planes: Planes<'_>, _: PrePlanes<'_>, _: usize| {
             let Planes::Paint(tiles) = planes else { return };
             for (id, slot) in tiles.iter_mut().enumerate() {
                 let tile = Stamped::write(
@@ -43,6 +44,11 @@ impl Document {
                 tile.value.n = source.n.clone();
                 tile.alpha = std::array::from_fn(|_| Plane::Uniform(u16::MAX));
             }
+        };
+        // The normal map and the report join the maps' undo step.
+        self.edit_planes_and("Import material", write, |state| {
+            state.normal.clone_from(&imported.normal);
+            state.import.clone_from(&imported.report);
         })
     }
 

@@ -118,6 +118,17 @@ impl Document {
         label: &str,
         f: impl FnOnce(Planes<'_>, PrePlanes<'_>, usize),
     ) -> Result<(), ModelError> {
+        self.edit_planes_and(label, f, |_| {})
+    }
+
+    /// As [`Document::edit_planes`], with `and` changing the rest of the state in the same
+    /// undo step.
+    pub(super) fn edit_planes_and(
+        &mut self,
+        label: &str,
+        f: impl FnOnce(Planes<'_>, PrePlanes<'_>, usize),
+        and: impl FnOnce(&mut State),
+    ) -> Result<(), ModelError> {
         self.check_paintable()?;
         let before = self.state.clone();
         let count = self.state.stack.tile_count();
@@ -134,15 +145,15 @@ impl Document {
         if let (Some(planes), Some(pre)) = (planes, pre) {
             f(planes, pre, count);
         }
+        and(&mut self.state);
         self.commit(label, before);
         Ok(())
     }
 
     /// Records `before` as one undo step and brings the composite up to date.
     fn commit(&mut self, label: &str, before: State) {
-        self.history.push(label, before, &self.state);
+        self.record(label, before);
         self.compositor.update(&self.state.stack, &mut self.maps);
-        self.layers_version += 1;
     }
 
     /// Runs `f` on the state as one undo step; on an error nothing changes.

@@ -9,16 +9,16 @@ mod fill;
 mod id;
 mod import;
 mod layers;
-mod mesh_ref;
+
 mod moves;
+pub use super::mesh_ref::MeshRef;
 pub use id::DocumentId;
 pub use layers::MAX_LAYERS;
-pub use mesh_ref::MeshRef;
 mod stroke;
 
 pub use command::{
-    Command, FillRegion, ImportedChannel, ImportedMaterial, LayerKind, LayerMove, LayerPlace,
-    LayerRef, StrokeTool,
+    AttachedMesh, AttachedNormal, Command, FillRegion, ImportedChannel, ImportedMaterial,
+    LayerKind, LayerMove, LayerPlace, LayerRef, StrokeTool,
 };
 
 use std::sync::Arc;
@@ -109,14 +109,11 @@ pub struct Document {
     stroke: Option<ActiveStroke>,
     /// Bumped by every command that changes the settings (which are saved too).
     settings_version: u64,
-    /// Bumped by every change to the stack (which may leave the composite as it was).
-    layers_version: u64,
+    /// The last revision number given to a state ([`State::revision`]).
+    revisions: u64,
     /// The layer whose opacity the last command set: the next opacity change of that layer
     /// joins its undo step (a slider's drag is one step).
     opacity_run: Option<Vec<usize>>,
-    /// The tangent-space normal map an imported material brought (not painted; never in
-    /// `k_a`).
-    normal: Option<Arc<NormalMap>>,
     /// Which document this is: kept in its project file and its recovery journal, so a
     /// journal is only ever recovered into the project it was written for.
     id: DocumentId,
@@ -157,7 +154,8 @@ impl Document {
         Ok(Self::assemble(maps, stack, settings))
     }
 
-    /// A copy of the stack and settings without history or mesh (autosave, background saves).
+    /// A copy of the document without its history (autosave, background saves, export): the
+    /// same content, mesh surface and version.
     #[must_use]
     pub fn snapshot(&self) -> Self {
         let mut doc = Self::assemble(
@@ -165,8 +163,9 @@ impl Document {
             self.state.stack.clone(),
             self.settings.clone(),
         );
-        doc.state.selection = self.state.selection.clone();
-        doc.normal.clone_from(&self.normal);
+        doc.state = self.state.clone();
+        doc.settings_version = self.settings_version;
+        doc.revisions = self.revisions;
         doc.id = self.id;
         doc
     }
@@ -188,8 +187,46 @@ impl Document {
     /// This document with `normal` as its normal map (a loader making it).
     #[must_use]
     pub fn with_normal(mut self, normal: Option<Arc<NormalMap>>) -> Self {
-        self.normal = normal;
+        self.state.normal = normal;
         self
+    }
+
+    /// This document with `settings` (a loader adjusting paths, an importer recording its
+    /// report and mesh), as it is made: no undo step.
+    #[must_use]
+    pub fn with_settings(mut self, settings: DocumentSettings) -> Self {
+        self.state.mesh.clone_from(&settings.mesh);
+        self.state.import.clone_from(&settings.import);
+        self.settings = settings;
+        self
+    }
+
+    /// This document with the mesh surface that object-space strokes and island/part fills
+    /// paint on (the bake of its mesh at the map size), or without one, as it is made or
+    /// opened: no undo step (changing the mesh is [`Command::SetMesh`]).
+    ///
+    /// # Errors
+    /// When the bake's size differs from the maps'.
+    pub fn with_surface(mut self, surface: Option<Arc<Surface>>) -> Result<Self, ModelError> {
+        self.attach_surface(surface)?;
+        Ok(self)
+    }
+
+    /// Attaches the bake of the document's mesh (or another mesh a command paints on, such as
+    /// `paint --mesh`), or detaches it, as a document is opened. A bake is derived data the
+    /// project never stores, so this is no undo step; the project's mesh changes only through
+    /// [`Command::SetMesh`].
+    ///
+    /// # Errors
+    /// When the bake's size differs from the maps'; nothing changes then.
+    pub(crate) fn attach_surface(
+        &mut self,
+        surface: Option<Arc<Surface>>,
+    ) -> Result<(), ModelError> {
+        self.check_surface(surface.as_deref())?;
+        self.end_stroke();
+        self.state.surface = surface;
+        Ok(())
     }
 
     /// This document with the identity `id` (a loader making it from a file that has one).
@@ -214,15 +251,18 @@ impl Document {
                 stack,
                 selection: Selection { path, mask: false },
                 surface: None,
+                mesh: settings.mesh.clone(),
+                normal: None,
+                import: settings.import.clone(),
+                revision: 0,
             },
             compositor,
             history: StackHistory::default(),
             settings,
             stroke: None,
             settings_version: 0,
-            layers_version: 0,
+            revisions: 0,
             opacity_run: None,
-            normal: None,
             id: DocumentId::random(),
         }
     }
@@ -243,20 +283,9 @@ impl Document {
         Ok(())
     }
 
-    /// The tangent-space normal map, if the material has one.
+    /// The tangent-space normal map, if the material has one (not painted; never in `k_a`).
     pub fn normal(&self) -> Option<&Arc<NormalMap>> {
-        self.normal.as_ref()
-    }
-
-    /// Keeps `normal` as the material's normal map (or drops it), without an undo step: an
-    /// importer or loader sets it as the document is made.
-    pub fn set_normal(&mut self, normal: Option<Arc<NormalMap>>) {
-        self.normal = normal;
-    }
-
-    /// Replaces the settings wholesale (a loader adjusting paths), without an undo step.
-    pub fn replace_settings(&mut self, settings: DocumentSettings) {
-        self.settings = settings;
+        self.state.normal.as_ref()
     }
 
     /// The layer stack: read it freely; it changes only through [`Document::apply`].
@@ -290,49 +319,81 @@ impl Document {
         (self.maps, self.settings)
     }
 
-    /// Attaches the mesh surface that object-space strokes and island/part fills paint on
-    /// (baked at the map size), or detaches it.
-    ///
-    /// # Errors
-    /// When the bake's size differs from the maps'.
-    pub fn set_surface(&mut self, surface: Option<Arc<Surface>>) -> Result<(), ModelError> {
-        if let Some(s) = &surface
-            && (s.width(), s.height()) != (self.maps.width(), self.maps.height())
-        {
-            return Err(ModelError::Internal(format!(
-                "the mesh is baked at {}x{} but the maps are {}x{}",
-                s.width(),
-                s.height(),
-                self.maps.width(),
-                self.maps.height()
-            )));
+    /// An error when a bake's size differs from the maps'.
+    fn check_surface(&self, surface: Option<&Surface>) -> Result<(), ModelError> {
+        match surface {
+            Some(s) if (s.width(), s.height()) != (self.maps.width(), self.maps.height()) => {
+                Err(ModelError::Internal(format!(
+                    "the mesh is baked at {}x{} but the maps are {}x{}",
+                    s.width(),
+                    s.height(),
+                    self.maps.width(),
+                    self.maps.height()
+                )))
+            }
+            _ => Ok(()),
         }
+    }
+
+    /// [`Command::SetMesh`]: the project's mesh and its bake, as one undo step.
+    fn set_mesh(&mut self, mesh: &AttachedMesh) -> Result<(), ModelError> {
+        self.check_surface(Some(&mesh.surface))?;
         self.end_stroke();
-        self.state.surface = surface;
+        let before = self.state.clone();
+        self.state.surface = Some(Arc::clone(&mesh.surface));
+        self.state.mesh = mesh.mesh.clone();
+        self.record("Mesh", before);
         Ok(())
     }
 
-    /// Makes `mesh` the project's mesh (saved with it) and attaches its baked surface.
-    ///
-    /// # Errors
-    /// As [`set_surface`](Self::set_surface); nothing changes then.
-    pub fn set_mesh(&mut self, mesh: MeshRef, surface: Arc<Surface>) -> Result<(), ModelError> {
-        self.set_surface(Some(surface))?;
-        if self.settings.mesh != mesh {
-            self.settings.mesh = mesh;
-            self.settings_version += 1;
-        }
-        Ok(())
+    /// [`Command::SetNormal`]: the normal map set or cleared, as one undo step.
+    fn set_normal(&mut self, normal: Option<Arc<NormalMap>>) {
+        self.end_stroke();
+        let label = if normal.is_some() {
+            "Normal map"
+        } else {
+            "Clear normal map"
+        };
+        let before = self.state.clone();
+        self.state.normal = normal;
+        self.record(label, before);
     }
 
-    /// A number that changes whenever anything a project file stores changes (the maps, or
-    /// a setting through a command): what "unsaved changes" and autosave compare.
+    /// Records `before` as one undo step, the state now as a new revision.
+    fn record(&mut self, label: &str, before: State) {
+        self.revisions += 1;
+        self.state.revision = self.revisions;
+        self.history.push(label, before, &self.state);
+        self.sync_settings();
+    }
+
+    /// The settings that mirror the state (saved in the project's settings) follow it.
+    fn sync_settings(&mut self) {
+        self.settings.mesh.clone_from(&self.state.mesh);
+        self.settings.import.clone_from(&self.state.import);
+    }
+
+    /// A number that identifies what a project file stores (the state's revision, the saved
+    /// settings and a stroke in progress): it changes with every change, and undo back to a
+    /// state brings that state's number back. What "unsaved changes" and autosave compare.
     pub fn version(&self) -> u64 {
-        // Every part only grows, so their sum changes whenever any does.
-        self.maps
-            .version()
-            .wrapping_add(self.settings_version)
-            .wrapping_add(self.layers_version)
+        /// splitmix64's finaliser: every input bit moves every output bit.
+        fn mix(h: u64, v: u64) -> u64 {
+            let mut z = (h ^ v).wrapping_add(0x9E37_79B9_7F4A_7C15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+        // A stroke changes the maps dab by dab before it is recorded as a step.
+        let stroke = if self.stroking() {
+            self.maps.version() | 1 << 63
+        } else {
+            0
+        };
+        mix(
+            mix(mix(0, self.state.revision), self.settings_version),
+            stroke,
+        )
     }
 
     /// The attached mesh surface.
@@ -412,7 +473,9 @@ impl Document {
             Command::Pick { x, y } => self.pick(x, y, false)?,
             Command::PickLayer { x, y } => self.pick(x, y, true)?,
             Command::ImportChannel(imported) => self.import_channel(&imported.0)?,
-            Command::ImportMaterial(imported) => self.import_material(&imported.0)?,
+            Command::ImportMaterial(imported) => self.import_material(&imported)?,
+            Command::SetNormal(normal) => self.set_normal(normal.0),
+            Command::SetMesh(mesh) => self.set_mesh(&mesh)?,
             Command::Undo => {
                 self.end_stroke();
                 if self.history.undo(&mut self.state) {
@@ -508,7 +571,7 @@ impl Document {
             }
         }
         self.compositor.update(&self.state.stack, &mut self.maps);
-        self.layers_version += 1;
+        self.sync_settings();
     }
 
     /// Puts a resized stack and its surface in place, keeping the old ones as one undo step.
@@ -540,7 +603,7 @@ impl Document {
         let before = self.state.clone();
         self.state.stack = stack.clone();
         self.state.surface.clone_from(surface);
-        self.history.push(label, before, &self.state);
+        self.record(&label, before);
         self.after_history();
         Ok(())
     }

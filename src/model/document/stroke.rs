@@ -340,8 +340,7 @@ impl Document {
         if let Some(stroke) = self.stroke.take()
             && stroke.touched
         {
-            self.history.push(stroke.label, stroke.before, &self.state);
-            self.layers_version += 1;
+            self.record(stroke.label, stroke.before);
         }
     }
 

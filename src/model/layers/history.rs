@@ -10,6 +10,9 @@ use std::collections::{HashSet, VecDeque};
 use std::sync::Arc;
 
 use super::{Layer, LayerContent, LayerStack};
+use crate::model::mesh_ref::MeshRef;
+use crate::model::normal::NormalMap;
+use crate::model::provenance::ImportReport;
 use crate::model::surface::Surface;
 
 /// Default cap on the memory history may hold: 1 GiB.
@@ -24,7 +27,8 @@ pub struct Selection {
     pub mask: bool,
 }
 
-/// What a step restores.
+/// What a step restores: everything a project stores except the settings a tool reads
+/// (brush, materials, channels, model), which are not undone.
 #[derive(Clone, Debug)]
 pub struct State {
     /// The layer stack.
@@ -33,6 +37,15 @@ pub struct State {
     pub selection: Selection,
     /// The mesh surface baked at the stack's size.
     pub surface: Option<Arc<Surface>>,
+    /// The mesh the project is painted on.
+    pub mesh: MeshRef,
+    /// The tangent-space normal map an imported material brought.
+    pub normal: Option<Arc<NormalMap>>,
+    /// The PBR import the maps were made by.
+    pub import: Option<ImportReport>,
+    /// Which revision of the content this is: a new number for every step, so that undo back to
+    /// a state brings its number back (what "unsaved changes" compares).
+    pub revision: u64,
 }
 
 /// One undoable step.

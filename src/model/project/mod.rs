@@ -282,7 +282,7 @@ pub fn attach_mesh(doc: &mut Document, mesh: &Path) -> Result<(), ModelError> {
     })?;
     let surface = super::surface::Surface::new(loaded, doc.maps().width(), doc.maps().height())
         .map_err(|e| ModelError::Command(format!("{}: {e}", mesh.display())))?;
-    doc.set_surface(Some(std::sync::Arc::new(surface)))
+    doc.attach_surface(Some(std::sync::Arc::new(surface)))
 }
 
 /// Opens a project with its mesh attached (`mesh` instead of the project's own, when given):
@@ -320,10 +320,8 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
         path: path.to_path_buf(),
         reason,
     })?;
-    let mut doc = doc;
     let settings = settings_from_file(doc.settings().clone(), path);
-    doc.replace_settings(settings);
-    Ok(doc)
+    Ok(doc.with_settings(settings))
 }
 
 /// The identity of the project at `path` (from its manifest alone), if it is a project that
