@@ -138,8 +138,12 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
             == 2
     });
     assert!(kit::changed(&before, &texels(harness.state())) > 0);
+    undo_back_to_the_sphere(&mut harness);
+    let _ = std::fs::remove_dir_all(&d);
+}
 
-    // Undo takes the material back, then the mesh: the sphere again, and a clean title.
+/// Undo takes the material back, then the mesh: the sphere again, and a clean title.
+fn undo_back_to_the_sphere(harness: &mut egui_kittest::Harness<'_, Editor>) {
     for _ in 0..2 {
         harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
         harness.run_steps(2);
@@ -153,7 +157,6 @@ fn a_gltf_material_imports_into_the_layer_with_its_normal_map_and_undoes() {
         "the sphere's bake is back"
     );
     assert!(!harness.state().state.dirty());
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Where the second test's texture set is written.
