@@ -52,7 +52,7 @@ fn exports(c: &mut Criterion) {
 /// side by side in the same run, the BC7 encoders alone on one thread on the packed level 0:
 /// Intel's ISPC kernels and `block_compression`'s port.
 fn block_compression(c: &mut Criterion) {
-    use kapaint::export::blocks::{self, BlockKind, Encoder};
+    use kapaint::export::blocks::{self, BlockKind, Coder};
     use kapaint::export::preset::Bc7Quality;
     let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/testdata/spot/spot_texture.png");
@@ -88,9 +88,9 @@ fn block_compression(c: &mut Criterion) {
         .build()
         .expect("pool");
     for (encoder, effort) in [
-        (Encoder::Ispc, Bc7Quality::UltraFast),
-        (Encoder::Portable, Bc7Quality::UltraFast),
-        (Encoder::Ispc, Bc7Quality::VeryFast),
+        (Coder::Ispc, Bc7Quality::UltraFast),
+        (Coder::Portable, Bc7Quality::UltraFast),
+        (Coder::Ispc, Bc7Quality::VeryFast),
     ] {
         let kind = BlockKind::Bc7 {
             alpha: true,

@@ -68,14 +68,14 @@ fn imports(c: &mut Criterion) {
             .collect()
     };
     group.bench_function("convert_phong", |b| {
-        b.iter(|| kapaint::pbr::export::convert(&texels, ShadingModel::Phong));
+        b.iter(|| kapaint::pbr::round_trip::convert(&texels, ShadingModel::Phong));
     });
     let progress = kapaint::task::Progress::default();
     group.bench_function("gltf_pbr_set", |b| {
         b.iter(|| {
             let out = dir.join("set");
             let _ = std::fs::remove_dir_all(&out);
-            kapaint::pbr::export::export(&imported.doc, &preset, &out, &progress, false, None)
+            kapaint::export::gltf_pbr::export(&imported.doc, &preset, &out, &progress, false, None)
                 .expect("export");
         });
     });

@@ -10,7 +10,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use kapaint::export::blocks::{self, BlockKind, Encoder};
+use kapaint::export::blocks::{self, BlockKind, Coder};
 use kapaint::export::preset::{self, Bc7Quality};
 use kapaint::export::set;
 use kapaint::report::typical::stroke_edge_document;
@@ -103,7 +103,7 @@ fn main() -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     println!("one thread, BC7 RGBA {w}x{h} level 0:");
     for effort in [Bc7Quality::UltraFast, Bc7Quality::VeryFast] {
-        for encoder in [Encoder::Ispc, Encoder::Portable] {
+        for encoder in [Coder::Ispc, Coder::Portable] {
             let kind = BlockKind::Bc7 {
                 alpha: true,
                 effort,

@@ -8,7 +8,7 @@
 
 use std::time::Instant;
 
-use kapaint::export::blocks::{self, BlockKind, Encoder};
+use kapaint::export::blocks::{self, BlockKind, Coder};
 use kapaint::export::ktx::{Space, psnr};
 use kapaint::export::preset::Bc7Quality;
 
@@ -51,9 +51,6 @@ fn main() -> Result<(), String> {
         "{adapter}: pipelines built in {:.2} s",
         t.elapsed().as_secs_f64()
     );
-    if !kapaint::gpu::blocks::install(encoder) {
-        return Err("the GPU encoder was already open".into());
-    }
     let size = (side, side);
     let spaces = [Space::Srgb, Space::Srgb, Space::Srgb, Space::Linear];
     for effort in efforts {
@@ -61,7 +58,7 @@ fn main() -> Result<(), String> {
             alpha: false,
             effort,
         };
-        for encoder in [Encoder::Gpu, Encoder::best_cpu()] {
+        for encoder in [Coder::Brought(&encoder), Coder::best_cpu()] {
             let t = Instant::now();
             let out = blocks::encode(encoder, kind, &texels, size, None);
             let seconds = t.elapsed().as_secs_f64();

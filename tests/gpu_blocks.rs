@@ -17,11 +17,11 @@ use std::process::Command;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use kapaint::export::blocks::{self, BlockKind, Encoder};
+use kapaint::export::blocks::{self, BlockEncoder, BlockKind, Coder, Encoder};
 use kapaint::export::ktx::{Space, psnr};
 use kapaint::export::preset::{self, Bc7Quality};
 use kapaint::export::set;
-use kapaint::gpu::blocks::{self as gpu_blocks, GpuBlockEncoder};
+use kapaint::gpu::blocks::GpuBlockEncoder;
 use kapaint::report::typical::stroke_edge_document;
 use kapaint::task::Progress;
 
@@ -79,10 +79,11 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
     let adapter = format!("{} ({:?})", gpu.info.name, gpu.info.device_type);
     // Strips of 8 texel rows: 44 rows are five whole strips and a short one. Building the
     // pipelines takes a minute on lavapipe: one encoder serves the whole test.
-    let installed = gpu_blocks::install(GpuBlockEncoder::new(gpu).with_strip_rows(8));
-    assert!(installed, "nothing asked for the GPU encoder before");
-    let encoder = gpu_blocks::shared().expect("the installed encoder");
-    assert_eq!(Encoder::best(), Encoder::Gpu);
+    // The export is handed the encoder; nothing in it opens a device of its own.
+    let encoder = GpuBlockEncoder::new(gpu).with_strip_rows(8);
+    let encoder = &encoder;
+    assert_eq!(Coder::best(Some(encoder)).name(), Encoder::Gpu);
+    assert_eq!(Coder::best(None).name(), Encoder::best_cpu());
     let size = (64, 44);
     let kinds = [
         BlockKind::Bc4,
@@ -125,11 +126,11 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
         assert_eq!(strips, [8, 8, 8, 8, 8, 4], "{kind:?}");
         // Through the exporter's entry point too (texels widened strip by strip).
         assert_eq!(
-            blocks::encode(Encoder::Gpu, kind, &src, size, None),
+            blocks::encode(Coder::Brought(encoder), kind, &src, size, None),
             gpu_blocks,
             "{kind:?}"
         );
-        let cpu_blocks = blocks::encode(Encoder::best_cpu(), kind, &src, size, None);
+        let cpu_blocks = blocks::encode(Coder::best_cpu(), kind, &src, size, None);
         let (on_gpu, on_cpu) = (
             quality(kind, &src, &gpu_blocks, size),
             quality(kind, &src, &cpu_blocks, size),
@@ -149,7 +150,7 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
     let out = std::env::temp_dir().join(format!("kapaint-gpu-set-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let doc = stroke_edge_document(64, spot().as_deref()).expect("project");
-    let manifest = set::export(&doc, &preset::find("ktx2").expect("preset"), &out).expect("export");
+    let manifest = ktx2_export(&doc, &out, &Progress::default(), encoder).expect("export");
     let choice = manifest.blocks.as_ref().expect("a block-compressed set");
     assert_eq!(choice.encoder, Encoder::Gpu);
     assert!(
@@ -168,11 +169,25 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
     let _ = std::fs::remove_dir_all(out);
 }
 
+/// The `ktx2` preset exported into `out` with `encoder` handed in.
+fn ktx2_export(
+    doc: &kapaint::model::Document,
+    out: &Path,
+    progress: &Progress,
+    encoder: &GpuBlockEncoder,
+) -> Result<set::Manifest, set::SetError> {
+    let preset = preset::find("ktx2").expect("preset");
+    match kapaint::export::run(doc, &preset, out, progress, false, None, Some(encoder))? {
+        kapaint::export::Exported::Set(m) => Ok(m),
+        kapaint::export::Exported::Pbr(_) => panic!("a kapaint set"),
+    }
+}
+
 /// The device lost after the first strip of an export: the CPU goes on from the strip that
 /// failed, so no strip is missing and none is counted twice, and the manifest names the CPU
 /// encoder that finished, and why.
 fn lost_part_way_through_an_export(encoder: &GpuBlockEncoder, out: &Path) {
-    assert!(gpu_blocks::failure().is_none());
+    assert!(encoder.failure().is_none());
     let _ = std::fs::remove_dir_all(out);
     let doc = stroke_edge_document(256, spot().as_deref()).expect("project");
     let (progress, finished) = (Progress::default(), AtomicBool::new(false));
@@ -192,16 +207,19 @@ fn lost_part_way_through_an_export(encoder: &GpuBlockEncoder, out: &Path) {
             }
             (lost_in, most, total)
         });
-        let manifest =
-            set::export_with(&doc, &preset::find("ktx2").expect("preset"), out, &progress);
+        let manifest = ktx2_export(&doc, out, &progress, encoder);
         finished.store(true, Ordering::Relaxed);
         (manifest, watch.join().expect("watcher"))
     });
     let manifest = manifest.expect("the CPU finishes the export");
-    let why = gpu_blocks::failure().expect("the lost device was noticed");
+    let why = encoder.failure().expect("the lost device was noticed");
+    assert!(
+        Coder::best(Some(encoder)).name() == Encoder::best_cpu(),
+        "a given-up encoder is not used again"
+    );
     let choice = manifest.blocks.as_ref().expect("a block-compressed set");
     assert_eq!(choice.encoder, Encoder::best_cpu(), "{choice:?}");
-    assert_eq!(choice.gpu_failed.as_deref(), Some(why));
+    assert_eq!(choice.gpu_failed.as_deref(), Some(why.as_str()));
     assert!(choice.summary().contains("the GPU encoder failed part-way"));
     assert!(
         lost_in > 0 && lost_in < total && most <= total,
@@ -219,7 +237,7 @@ fn lost_part_way_through_an_export(encoder: &GpuBlockEncoder, out: &Path) {
 #[test]
 fn the_cli_takes_the_gpu_encoder_only_on_a_hardware_adapter() {
     let Some(gpu) = common::gpu() else { return };
-    let software = gpu_blocks::is_software(&gpu.info);
+    let software = kapaint::gpu::blocks::is_software(&gpu.info);
     drop(gpu);
     let dir = std::env::temp_dir().join(format!("kapaint-gpu-cli-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);

@@ -9,8 +9,8 @@
 
 use std::path::Path;
 
+use kapaint::export::gltf_pbr::PbrManifest;
 use kapaint::pbr::convert::Conversion;
-use kapaint::pbr::export::PbrManifest;
 use kapaint::pbr::fit::TARGETS;
 use kapaint::reflectance::ShadingModel;
 

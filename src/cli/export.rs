@@ -115,7 +115,7 @@ fn write_pbr(
     text: &mut String,
     file: &std::path::Path,
     target: &std::path::Path,
-    m: &crate::pbr::export::PbrManifest,
+    m: &crate::export::gltf_pbr::PbrManifest,
     report: bool,
 ) {
     let e = m.round_trip;
@@ -275,6 +275,7 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
     };
     check_targets(files, &targets, replace, SetKind::of(&preset))?;
     let terminal = std::io::stderr().is_terminal();
+    let gpu = crate::gpu::blocks::for_export(&preset);
     for (i, ((file, (doc, mesh)), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
         let mesh = mesh.as_ref().map(|s| &s.mesh);
         let progress = crate::task::Progress::default();
@@ -283,7 +284,7 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
             let worker = std::thread::Builder::new()
                 .name("kapaint-export".into())
                 .spawn_scoped(scope, || {
-                    crate::export::run(doc, &preset, target, &progress, replace, mesh)
+                    crate::export::run(doc, &preset, target, &progress, replace, mesh, gpu)
                 })
                 .map_err(|e| CliError::io(format!("cannot start the export: {e}")))?;
             while terminal && !worker.is_finished() {

@@ -3,8 +3,10 @@
 //!
 //! On `x86_64` the blocks come from Intel's ISPC texture compressor kernels (`intel_tex_2`,
 //! which ships them precompiled); elsewhere from `block_compression`'s port of the same
-//! encoder. Either runs in parallel over strips of block rows. Decoding (to measure what a
-//! consumer sees) is `block_compression`'s CPU decoder, also in strips.
+//! encoder. Either runs in parallel over strips of block rows. A caller may bring another
+//! encoder behind [`BlockEncoder`] (the GPU crate's compute shaders): an export uses it only
+//! when handed one ([`Coder::best`]); nothing here reaches for a device of its own. Decoding
+//! (to measure what a consumer sees) is `block_compression`'s CPU decoder, also in strips.
 
 use block_compression::decode::{decode_block_bc6h, decompress_blocks_as_rgba8};
 use block_compression::{BC6HSettings, BC7Settings, CompressionVariant};
@@ -102,7 +104,7 @@ impl BlockKind {
     }
 }
 
-/// Which code encodes the blocks.
+/// Which code encoded the blocks, as a manifest names it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Encoder {
@@ -110,28 +112,106 @@ pub enum Encoder {
     Ispc,
     /// `block_compression`'s CPU port.
     Portable,
-    /// `block_compression`'s compute shaders on a GPU ([`crate::gpu::blocks`]); the CPU's
-    /// best encoder wherever the GPU fails.
+    /// An encoder the caller brought ([`BlockEncoder`]: a GPU's compute shaders); the CPU's
+    /// best encoder wherever it fails.
     Gpu,
 }
 
 impl Encoder {
-    /// The fastest encoder here: a hardware GPU's (see [`crate::gpu::blocks::shared`]), else
-    /// the CPU's.
-    pub fn best() -> Self {
-        if crate::gpu::blocks::shared().is_some() {
-            Self::Gpu
-        } else {
-            Self::best_cpu()
-        }
-    }
-
     /// The fastest encoder this CPU has.
     pub fn best_cpu() -> Self {
         if cfg!(target_arch = "x86_64") {
             Self::Ispc
         } else {
             Self::Portable
+        }
+    }
+}
+
+/// An encode that a [`BlockEncoder`] stopped part-way: why, and the texel rows from the top
+/// whose blocks are in place.
+#[derive(Debug)]
+pub struct Interrupted {
+    /// What failed.
+    pub error: String,
+    /// Texel rows encoded before it, a multiple of 4.
+    pub rows_done: u32,
+}
+
+/// A block encoder a caller brings beside the CPU's (the GPU crate's compute shaders), handed
+/// to an export rather than found by it.
+pub trait BlockEncoder: Send + Sync {
+    /// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
+    /// bytes per texel into `blocks` ([`BlockKind::blocks_len`] bytes), strip by strip:
+    /// `fill(row, rows, texels)` writes texel rows `row..row + rows` into `texels`;
+    /// `strip_done(rows)` follows each strip and answers `false` to stop.
+    ///
+    /// # Errors
+    /// A failure part-way, with the rows whose blocks are in place.
+    fn encode(
+        &self,
+        kind: BlockKind,
+        size: (u32, u32),
+        fill: &mut dyn FnMut(u32, u32, &mut [u8]),
+        strip_done: &mut dyn FnMut(u32) -> bool,
+        blocks: &mut [u8],
+    ) -> Result<(), Interrupted>;
+
+    /// Why it was given up, if it was: it is then never asked again.
+    fn failure(&self) -> Option<String>;
+
+    /// Gives it up after a failure (the first reason is kept).
+    fn give_up(&self, why: &str);
+}
+
+/// An encoder as it runs: one of the CPU's, or the one the caller brought.
+#[derive(Clone, Copy)]
+pub enum Coder<'a> {
+    /// Intel's ISPC kernels (`x86_64`).
+    Ispc,
+    /// `block_compression`'s CPU port.
+    Portable,
+    /// The caller's encoder; the CPU's best goes on where it fails.
+    Brought(&'a dyn BlockEncoder),
+}
+
+impl std::fmt::Debug for Coder<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.name())
+    }
+}
+
+impl<'a> Coder<'a> {
+    /// The fastest encoder: `brought` where given and not given up, else the CPU's.
+    pub fn best(brought: Option<&'a dyn BlockEncoder>) -> Self {
+        match brought {
+            Some(b) if b.failure().is_none() => Self::Brought(b),
+            _ => Self::best_cpu(),
+        }
+    }
+
+    /// The fastest encoder this CPU has.
+    pub fn best_cpu() -> Self {
+        match Encoder::best_cpu() {
+            Encoder::Ispc => Self::Ispc,
+            _ => Self::Portable,
+        }
+    }
+
+    /// How a manifest names it.
+    pub fn name(self) -> Encoder {
+        match self {
+            Self::Ispc => Encoder::Ispc,
+            Self::Portable => Encoder::Portable,
+            Self::Brought(_) => Encoder::Gpu,
+        }
+    }
+
+    /// Why the brought encoder was given up, if this is it and it was.
+    pub fn failure(self) -> Option<String> {
+        match self {
+            Self::Brought(b) => b.failure(),
+            _ => None,
         }
     }
 }
@@ -267,7 +347,7 @@ const STRIP: usize = 8;
 /// texel rows; once it is cancelled the remaining strips are skipped (the result is then
 /// garbage: check [`Progress::is_cancelled`]).
 pub fn encode(
-    encoder: Encoder,
+    encoder: Coder<'_>,
     kind: BlockKind,
     texels: &[u8],
     size: (u32, u32),
@@ -280,7 +360,7 @@ pub fn encode(
 /// three colour components without alpha, say), each strip widened with
 /// [`BlockKind::filler`] as it is encoded, so no widened copy of the image is ever whole.
 pub fn encode_stored(
-    encoder: Encoder,
+    encoder: Coder<'_>,
     kind: BlockKind,
     texels: &[u8],
     stored: usize,
@@ -291,12 +371,20 @@ pub fn encode_stored(
     let per = kind.texel_bytes();
     let mut blocks = vec![0_u8; kind.blocks_len((width, height))];
     let (encoder, from_row) = match encoder {
-        Encoder::Gpu => {
-            let done = encode_on_gpu(kind, texels, stored, (width, height), progress, &mut blocks);
+        Coder::Brought(b) => {
+            let done = encode_brought(
+                b,
+                kind,
+                texels,
+                stored,
+                (width, height),
+                progress,
+                &mut blocks,
+            );
             if done == height {
                 return blocks;
             }
-            (Encoder::best_cpu(), done)
+            (Coder::best_cpu(), done)
         }
         cpu => (cpu, 0),
     };
@@ -316,7 +404,7 @@ pub fn encode_stored(
             let wide = widen(kind, src, stored, per);
             match encoder {
                 #[cfg(target_arch = "x86_64")]
-                Encoder::Ispc => ispc::encode(kind, &wide, width, rows, out),
+                Coder::Ispc => ispc::encode(kind, &wide, width, rows, out),
                 _ => encode_portable(kind, &wide, width, rows, out),
             }
             if let Some(p) = progress {
@@ -326,17 +414,12 @@ pub fn encode_stored(
     blocks
 }
 
-/// Why the GPU encoder was given up in this process, if it was: blocks asked of
-/// [`Encoder::Gpu`] are then encoded on the CPU.
-pub fn gpu_failure() -> Option<&'static str> {
-    crate::gpu::blocks::failure()
-}
-
-/// [`encode_stored`] on the shared GPU encoder into `blocks`, each strip widened as it goes
-/// up: the texel rows whose blocks are in place, from the top. Short of `height` where there
-/// is no GPU encoder (0) or it failed part-way (it is then given up for the rest of the
-/// process, and the CPU goes on from there: no strip is encoded or counted twice).
-fn encode_on_gpu(
+/// [`encode_stored`] on a brought encoder into `blocks`, each strip widened as it goes
+/// up: the texel rows whose blocks are in place, from the top. Short of `height` where it
+/// failed part-way (it is then given up, and the CPU goes on from there: no strip is encoded
+/// or counted twice).
+fn encode_brought(
+    brought: &dyn BlockEncoder,
     kind: BlockKind,
     texels: &[u8],
     stored: usize,
@@ -344,9 +427,9 @@ fn encode_on_gpu(
     progress: Option<&Progress>,
     blocks: &mut [u8],
 ) -> u32 {
-    let Some(gpu) = crate::gpu::blocks::shared() else {
+    if brought.failure().is_some() {
         return 0;
-    };
+    }
     let per = kind.texel_bytes();
     let row_texels = width as usize * stored;
     let mut fill = |row: u32, rows: u32, out: &mut [u8]| {
@@ -359,10 +442,10 @@ fn encode_on_gpu(
             !p.is_cancelled()
         })
     };
-    match gpu.encode(kind, (width, height), &mut fill, &mut strip_done, blocks) {
+    match brought.encode(kind, (width, height), &mut fill, &mut strip_done, blocks) {
         Ok(()) => height,
         Err(stopped) => {
-            crate::gpu::blocks::give_up(&stopped.error);
+            brought.give_up(&stopped.error);
             stopped.rows_done
         }
     }
@@ -457,7 +540,7 @@ mod tests {
     #[test]
     fn every_encoder_and_kind_round_trips_closely() {
         let (w, h) = (64, 40);
-        for encoder in [Encoder::best(), Encoder::Portable] {
+        for encoder in [Coder::best_cpu(), Coder::Portable] {
             for kind in [
                 BlockKind::Bc4,
                 BlockKind::Bc5,
@@ -511,7 +594,7 @@ mod tests {
             .iter()
             .flat_map(|v| f16::from_f32(*v).to_le_bytes())
             .collect();
-        for encoder in [Encoder::Portable, Encoder::best()] {
+        for encoder in [Coder::Portable, Coder::best_cpu()] {
             let kind = BlockKind::Bc6h {
                 effort: Bc7Quality::UltraFast,
             };

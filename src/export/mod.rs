@@ -4,6 +4,8 @@
 
 pub mod blocks;
 pub mod encoding;
+pub mod glb;
+pub mod gltf_pbr;
 pub mod ktx;
 pub mod preset;
 pub mod set;
@@ -17,12 +19,13 @@ pub enum Exported {
     /// A kapaint set (`material.json` in [`set::MANIFEST_FORMAT`]).
     Set(set::Manifest),
     /// A glTF PBR set (the `gltf-pbr` preset).
-    Pbr(crate::pbr::export::PbrManifest),
+    Pbr(gltf_pbr::PbrManifest),
 }
 
 /// Exports `doc` with `preset` into the folder `out`: a kapaint set ([`set::export_with`],
 /// [`set::export_replacing`] where `replace`), or for a [`preset::Format::GltfPbr`] preset a
-/// glTF PBR set, with the `glb` mesh and the material as a `.glb` where given.
+/// glTF PBR set, with the `glb` mesh and the material as a `.glb` where given. Blocks are
+/// encoded by `brought` (a GPU's encoder) where given, else on the CPU.
 ///
 /// # Errors
 /// As the exports; `glb` with a preset that is not glTF PBR.
@@ -33,10 +36,10 @@ pub fn run(
     progress: &crate::task::Progress,
     replace: bool,
     glb: Option<&crate::mesh::Mesh>,
+    brought: Option<&dyn blocks::BlockEncoder>,
 ) -> Result<Exported, set::SetError> {
     if preset.format == preset::Format::GltfPbr {
-        return crate::pbr::export::export(doc, preset, out, progress, replace, glb)
-            .map(Exported::Pbr);
+        return gltf_pbr::export(doc, preset, out, progress, replace, glb).map(Exported::Pbr);
     }
     if glb.is_some() {
         return Err(set::SetError::Invalid {
@@ -47,10 +50,5 @@ pub fn run(
             ),
         });
     }
-    if replace {
-        set::export_replacing(doc, preset, out, progress)
-    } else {
-        set::export_with(doc, preset, out, progress)
-    }
-    .map(Exported::Set)
+    set::export_into(doc, preset, out, progress, replace, brought).map(Exported::Set)
 }

@@ -21,7 +21,7 @@ pub enum Format {
     Ktx2Bc,
     /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
     /// roughness, B metallic), and the normal map where the project has one; converted back
-    /// from `k_d`, `k_s`, `n` ([`crate::pbr::export`]). `layout`, `n_bits` and `include_ka` do
+    /// from `k_d`, `k_s`, `n` ([`crate::export::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
     /// not apply.
     GltfPbr,
 }

@@ -14,7 +14,7 @@ use std::sync::{Mutex, OnceLock};
 use block_compression::GpuBlockCompressor;
 
 use super::{Gpu, GpuError};
-use crate::export::blocks::BlockKind;
+use crate::export::blocks::{BlockEncoder, BlockKind};
 
 /// The most texel bytes one strip uploads.
 pub const STRIP_BYTES: usize = 32 << 20;
@@ -24,6 +24,8 @@ pub struct GpuBlockEncoder {
     gpu: Gpu,
     compressor: Mutex<GpuBlockCompressor>,
     strip_rows: u32,
+    /// Why the first encode that failed did: once set, the export encodes on the CPU.
+    failed: OnceLock<String>,
 }
 
 impl std::fmt::Debug for GpuBlockEncoder {
@@ -67,29 +69,15 @@ impl Choice {
     }
 }
 
-/// Why the first GPU encode that failed did: once set, later encodes stay on the CPU.
-static FAILED: OnceLock<String> = OnceLock::new();
-
-/// The process's GPU block encoder, once opened or installed.
+/// The process's GPU block encoder, once opened.
 static SHARED: OnceLock<Option<GpuBlockEncoder>> = OnceLock::new();
 
-/// Makes `encoder` the process's GPU block encoder (before anything asked for [`shared`]):
-/// how a program that already opened a device, or a test, chooses the adapter.
-///
-/// `false` (and `encoder` dropped) when [`shared`] already answered.
-pub fn install(encoder: GpuBlockEncoder) -> bool {
-    SHARED.set(Some(encoder)).is_ok()
-}
-
-/// The process's GPU block encoder, opened on first use as [`Choice::from_env`] allows (or
-/// [`install`]ed), or `None` (no adapter, a software one under `auto`, `cpu`, or an earlier
+/// The process's GPU block encoder, opened on first use as [`Choice::from_env`] allows, or
+/// `None` (no adapter, a software one under `auto`, `cpu`, or an earlier
 /// failure).
 ///
 /// Opening builds the compute pipelines: 67 s on lavapipe on 2 cores, once per process.
 pub fn shared() -> Option<&'static GpuBlockEncoder> {
-    if FAILED.get().is_some() {
-        return None;
-    }
     SHARED
         .get_or_init(|| {
             let choice = Choice::from_env();
@@ -103,18 +91,49 @@ pub fn shared() -> Option<&'static GpuBlockEncoder> {
             Gpu::from_adapter(&adapter).ok().map(GpuBlockEncoder::new)
         })
         .as_ref()
+        .filter(|e| e.failed.get().is_none())
 }
 
-/// Marks the GPU encoder as failed: [`shared`] answers `None` from now on, and [`failure`]
-/// says why (the first reason given).
-pub fn give_up(why: &GpuError) {
-    eprintln!("kapaint: GPU block encoding failed ({why}); encoding on the CPU from now on");
-    let _ = FAILED.set(why.to_string());
+/// The encoder an export with `preset` is handed: the process's ([`shared`]) for a
+/// block-compressed preset, where this machine has one; `None` for the others (nothing is
+/// opened for them).
+pub fn for_export(
+    preset: &crate::export::preset::ExportPreset,
+) -> Option<&'static dyn BlockEncoder> {
+    if preset.format != crate::export::preset::Format::Ktx2Bc {
+        return None;
+    }
+    let encoder = shared()?;
+    Some(encoder)
 }
 
-/// Why the GPU encoder was given up, if it was ([`give_up`]).
-pub fn failure() -> Option<&'static str> {
-    FAILED.get().map(String::as_str)
+impl BlockEncoder for GpuBlockEncoder {
+    fn encode(
+        &self,
+        kind: BlockKind,
+        size: (u32, u32),
+        fill: &mut dyn FnMut(u32, u32, &mut [u8]),
+        strip_done: &mut dyn FnMut(u32) -> bool,
+        blocks: &mut [u8],
+    ) -> Result<(), crate::export::blocks::Interrupted> {
+        GpuBlockEncoder::encode(self, kind, size, fill, strip_done, blocks).map_err(|stopped| {
+            crate::export::blocks::Interrupted {
+                error: stopped.error.to_string(),
+                rows_done: stopped.rows_done,
+            }
+        })
+    }
+
+    fn failure(&self) -> Option<String> {
+        self.failed.get().cloned()
+    }
+
+    /// Gives the encoder up: [`shared`] answers `None` from now on, and
+    /// [`BlockEncoder::failure`] says why (the first reason given).
+    fn give_up(&self, why: &str) {
+        eprintln!("kapaint: GPU block encoding failed ({why}); encoding on the CPU from now on");
+        let _ = self.failed.set(why.to_owned());
+    }
 }
 
 /// A GPU encode stopped by a failure part-way: the error, and the texel rows from the top whose
@@ -145,6 +164,7 @@ impl GpuBlockEncoder {
             gpu,
             compressor: Mutex::new(compressor),
             strip_rows: u32::MAX,
+            failed: OnceLock::new(),
         }
     }
 

@@ -21,13 +21,12 @@
 use glam::Vec3;
 
 pub mod convert;
-pub mod export;
 pub mod fit;
-pub mod glb;
 pub mod gltf;
 mod gltf_check;
 pub mod import;
 pub mod names;
+pub mod round_trip;
 mod table;
 
 use crate::model::texel::{MaterialValue, N_MAX};

@@ -107,7 +107,8 @@ fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
             reflectance::ka(doc.settings().model, doc.settings().approx, v.kd, v.ks, v.n)
         }
         CanvasChannel::PbrError => crate::render::heat_ramp(
-            crate::pbr::export::RoundTrip::for_model(doc.settings().model).error(v) / PBR_ERROR_TOP,
+            crate::pbr::round_trip::RoundTrip::for_model(doc.settings().model).error(v)
+                / PBR_ERROR_TOP,
         ),
     };
     let c = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8;

@@ -369,7 +369,8 @@ impl EditorState {
         self.export = None;
         self.start_job("Export", move |progress| {
             let glb = mesh.as_ref().map(|s| &s.mesh);
-            match crate::export::run(&snapshot, &preset, &out, progress, replace, glb) {
+            let gpu = crate::gpu::blocks::for_export(&preset);
+            match crate::export::run(&snapshot, &preset, &out, progress, replace, glb, gpu) {
                 Ok(m) => JobResult::Exported(out, Box::new(m)),
                 Err(e) => JobResult::Failed(format!("export failed: {e}")),
             }

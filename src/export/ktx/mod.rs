@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use self::container::container;
 pub use self::container::{Decoded, decode};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
-use super::blocks::{self, BlockKind, Encoder};
+use super::blocks::{self, BlockKind, Coder};
 use super::preset::Bc7Quality;
 use super::set::Compression;
 use crate::task::Progress;
@@ -149,7 +149,7 @@ pub fn block_kind(spaces: &[Space], effort: Bc7Quality) -> BlockKind {
 /// Compresses one level (`channels` bytes per stored texel) as `kind` with `encoder`. Rows
 /// advance `progress`.
 pub fn compress_level(
-    encoder: Encoder,
+    encoder: Coder<'_>,
     kind: BlockKind,
     bytes: &[u8],
     (w, h): (u32, u32),
@@ -279,7 +279,7 @@ fn format_of(spaces: &[Space], srgb: bool, compressed: bool) -> (KtxFormat, Comp
 /// three components, or cancelled.
 pub fn encode(
     source: &Source<'_>,
-    compressed: Option<(Encoder, Bc7Quality)>,
+    compressed: Option<(Coder<'_>, Bc7Quality)>,
     level0: Option<Compressed>,
     progress: &Progress,
 ) -> Result<Written, String> {
@@ -386,7 +386,7 @@ mod tests {
         };
         encode(
             &source,
-            compressed.map(|q| (Encoder::best(), q)),
+            compressed.map(|q| (Coder::best_cpu(), q)),
             None,
             &Progress::default(),
         )

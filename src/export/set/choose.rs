@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
-use crate::export::blocks::{self, BlockKind, Encoder};
+use crate::export::blocks::{BlockEncoder, BlockKind, Coder, Encoder};
 use crate::export::encoding::{KaError, NEncoding};
 use crate::export::ktx::{self, Compressed};
 use crate::export::preset::{Bc7Quality, BlockBudget, ExportPreset, Format};
@@ -174,6 +174,8 @@ pub(super) struct Job<'a> {
     pub shape: Shape<'a>,
     pub model: ShadingModel,
     pub approx: AmbientApprox,
+    /// A block encoder the caller brought (a GPU's), used before the CPU's.
+    pub brought: Option<&'a dyn BlockEncoder>,
 }
 
 /// One image of a trial: its texels, level 0 as stored, and level 0 compressed.
@@ -189,7 +191,7 @@ struct TrialImage<'a> {
 
 impl TrialImage<'_> {
     /// Compresses level 0 at `effort`, unless it already is (BC4 and BC5 have one effort).
-    fn compress(&mut self, encoder: Encoder, effort: Bc7Quality, size: (u32, u32), p: &Progress) {
+    fn compress(&mut self, encoder: Coder<'_>, effort: Bc7Quality, size: (u32, u32), p: &Progress) {
         let kind = ktx::block_kind(self.texels.spaces(), effort);
         let fresh = match &self.compressed {
             Some((e, _)) => {
@@ -349,7 +351,7 @@ pub(super) fn encode_blocks(
     apart: Option<&Images>,
     progress: &Progress,
 ) -> Result<(Vec<Encoded>, BlockChoice), String> {
-    let encoder = Encoder::best();
+    let encoder = Coder::best(job.brought);
     let budget = job.preset.budget;
     let efforts: Vec<Bc7Quality> = Bc7Quality::ALL
         .into_iter()
@@ -492,17 +494,14 @@ pub(super) fn encode_blocks(
     let within_budget =
         within(&budget, pick.ka_error) && pick.min_psnr.is_none_or(|p| p >= budget.min_psnr);
     // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
-    let gpu_failed = (encoder == Encoder::Gpu)
-        .then(blocks::gpu_failure)
-        .flatten()
-        .map(str::to_owned);
+    let gpu_failed = encoder.failure();
     Ok((
         encoded,
         BlockChoice {
             encoder: if gpu_failed.is_some() {
                 Encoder::best_cpu()
             } else {
-                encoder
+                encoder.name()
             },
             gpu_failed,
             layout: pick.layout,

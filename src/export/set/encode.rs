@@ -163,7 +163,7 @@ pub(super) fn encode_image(
             let source = KtxTexels::new(texels, ka, comps, srgb, false, n_enc);
             let level0 = source.level0();
             let compressed = (format == Format::Ktx2Bc).then_some((
-                crate::export::blocks::Encoder::best(),
+                crate::export::blocks::Coder::best_cpu(),
                 preset.max_bc7_effort,
             ));
             let written = crate::export::ktx::encode(

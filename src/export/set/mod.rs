@@ -96,7 +96,7 @@ pub fn export_with(
     out: &Path,
     progress: &Progress,
 ) -> Result<Manifest, SetError> {
-    export_into(doc, preset, out, progress, false)
+    export_into(doc, preset, out, progress, false, None)
 }
 
 /// [`export_with`] that may also replace a set already at `out` ([`Target::Set`]): the new
@@ -111,19 +111,20 @@ pub fn export_replacing(
     out: &Path,
     progress: &Progress,
 ) -> Result<Manifest, SetError> {
-    export_into(doc, preset, out, progress, true)
+    export_into(doc, preset, out, progress, true, None)
 }
 
 #[expect(
     clippy::too_many_lines,
     reason = "one pass: analyse, encode in parallel, measure"
 )]
-fn export_into(
+pub(super) fn export_into(
     doc: &Document,
     preset: &ExportPreset,
     out: &Path,
     progress: &Progress,
     replace: bool,
+    brought: Option<&dyn crate::export::blocks::BlockEncoder>,
 ) -> Result<Manifest, SetError> {
     let cancelled = |_| SetError::Cancelled;
     progress.start("analyse", 1);
@@ -131,7 +132,8 @@ fn export_into(
     if preset.format == Format::GltfPbr {
         return Err(SetError::Invalid {
             path: out.to_path_buf(),
-            reason: "a glTF PBR set is written by crate::export::run (crate::pbr::export)".into(),
+            reason: "a glTF PBR set is written by crate::export::run (crate::export::gltf_pbr)"
+                .into(),
         });
     }
     let maps = doc.maps();
@@ -181,6 +183,7 @@ fn export_into(
                 shape,
                 model,
                 approx,
+                brought,
             };
             let apart = choose::n_apart(&images, mono_ks);
             let (encoded, choice) = choose::encode_blocks(&job, &images, apart.as_ref(), progress)

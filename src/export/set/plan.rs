@@ -161,7 +161,7 @@ pub(super) fn plan_set(
 
 /// A glTF PBR set's plan: base colour and metallic-roughness, three 8-bit channels each.
 fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
-    use crate::pbr::export::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE};
+    use crate::export::gltf_pbr::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE};
     let texels = u64::from(maps.width()) * u64::from(maps.height());
     let files: Vec<PlannedFile> = [
         (BASE_COLOR_FILE, ["base.r", "base.g", "base.b"]),

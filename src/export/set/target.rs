@@ -44,7 +44,7 @@ impl SetKind {
     fn format(self) -> &'static str {
         match self {
             Self::Material => MANIFEST_FORMAT,
-            Self::Pbr => crate::pbr::export::PBR_MANIFEST_FORMAT,
+            Self::Pbr => crate::export::gltf_pbr::PBR_MANIFEST_FORMAT,
         }
     }
 
