@@ -1,21 +1,16 @@
 //! kapaint: paint per-texel Phong reflectance and preview it with a derived ambient term.
 //!
-//! The library holds all logic; the `kapaint` binary is a thin shell around [`cli::main`].
-//! [`reflectance`] is the numerical core (no GUI or GPU code), [`report`] measures it.
+//! The library is the command line ([`cli`]) over the workspace's crates, re-exported here by
+//! their room names so that one path names each thing: [`kapaint_core`] (the reflectance
+//! maths, the model, meshes, render maths, tools, PBR conversion; no GUI or GPU crate),
+//! [`export`] (`kapaint-export`), [`gpu`] (`kapaint-gpu`) and [`ui`] (`kapaint-editor`). The
+//! `kapaint` binary is a thin shell around [`cli::main`].
 
-pub mod atomic;
+pub use kapaint_core::{
+    atomic, crash, file_check, memory, mesh, model, pbr, reflectance, render, report, task, tools,
+};
+pub use kapaint_editor as ui;
+pub use kapaint_export as export;
+pub use kapaint_gpu as gpu;
+
 pub mod cli;
-pub mod crash;
-pub mod export;
-pub mod file_check;
-pub mod gpu;
-pub mod memory;
-pub mod mesh;
-pub mod model;
-pub mod pbr;
-pub mod reflectance;
-pub mod render;
-pub mod report;
-pub mod task;
-pub mod tools;
-pub mod ui;

@@ -1,83 +1,102 @@
-//! The layering, checked: the model, the reflectance core, meshes, the render math and the
-//! tools know nothing of egui, eframe or wgpu, directly or through the crate's own `ui` and
-//! `gpu` modules. They are where almost all logic and tests live, and must stay testable
-//! without a window or a device.
+//! The layering, as far as Cargo cannot see it.
+//!
+//! Cargo already enforces that no crate imports one above it: `kapaint-core` has no kapaint
+//! crate to import, `kapaint-export` only the core, `kapaint-gpu` the core and the export,
+//! `kapaint-editor` those three, and a crate cannot name a module of a crate it does not
+//! depend on. What Cargo does not stop is a dependency added to a crate's manifest that pulls a
+//! GUI or GPU crate into a room that must build and test without a window or a device. This
+//! test asks `cargo tree` (features resolved for that crate alone) what each crate links.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
 
-use std::path::Path;
+use std::collections::BTreeSet;
+use std::process::Command;
 
-/// The rooms that must stay free of the GUI and GPU crates.
-const PURE: [&str; 6] = ["model", "reflectance", "mesh", "render", "tools", "pbr"];
+/// The window, GUI and device crates.
+const GUI: [&str; 6] = ["egui", "eframe", "egui_dock", "rfd", "zbus", "winit"];
 
-/// What a file of those rooms may not name.
-const FORBIDDEN: [&str; 6] = [
-    "egui",
-    "eframe",
-    "wgpu",
-    "crate::ui",
-    "crate::gpu",
-    "super::ui",
-];
-
-fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.filter_map(Result::ok) {
-        let path = entry.path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
+/// Every package in `krate`'s normal (not dev, not build) dependency tree.
+fn normal_tree(krate: &str) -> BTreeSet<String> {
+    let out = Command::new(env!("CARGO"))
+        .args([
+            "tree",
+            "--offline",
+            "-p",
+            krate,
+            "-e",
+            "normal",
+            "--prefix",
+            "none",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        out.status.success(),
+        "cargo tree -p {krate}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout)
+        .expect("utf-8")
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_owned)
+        .collect()
 }
 
-/// Whether `line` names `word` as code (not inside a comment).
-fn names(line: &str, word: &str) -> bool {
-    let code = line.split("//").next().unwrap_or("");
-    code.match_indices(word).any(|(at, _)| {
-        let before = code[..at].chars().next_back();
-        let after = code[at + word.len()..].chars().next();
-        !before.is_some_and(|c| c.is_alphanumeric() || c == '_')
-            && !after.is_some_and(|c| c.is_alphanumeric() || c == '_')
-    })
+fn assert_free_of(krate: &str, forbidden: &[&str]) {
+    let tree = normal_tree(krate);
+    assert!(tree.len() > 1, "{krate} has a tree: {tree:?}");
+    let found: Vec<&&str> = forbidden.iter().filter(|f| tree.contains(**f)).collect();
+    assert!(found.is_empty(), "{krate} links {found:?}");
+}
+
+/// The kapaint crates `krate` depends on.
+fn kapaint_deps(krate: &str) -> BTreeSet<String> {
+    normal_tree(krate)
+        .into_iter()
+        .filter(|p| p.starts_with("kapaint") && p != krate)
+        .collect()
 }
 
 #[test]
-fn the_pure_rooms_import_neither_egui_nor_wgpu() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    for room in PURE {
-        rust_files(&src.join(room), &mut files);
-        let single = src.join(format!("{room}.rs"));
-        if single.exists() {
-            files.push(single);
-        }
-    }
-    assert!(files.len() > 30, "the rooms were not found: {files:?}");
-    let mut found = Vec::new();
-    for file in &files {
-        let text = std::fs::read_to_string(file).unwrap_or_default();
-        for (k, line) in text.lines().enumerate() {
-            for word in FORBIDDEN {
-                if names(line, word) {
-                    found.push(format!("{}:{}: {word}", file.display(), k + 1));
-                }
-            }
-        }
-    }
-    assert!(
-        found.is_empty(),
-        "GUI or GPU code in a pure room:\n{}",
-        found.join("\n")
+fn the_core_links_no_gui_or_gpu_crate() {
+    let mut forbidden = GUI.to_vec();
+    forbidden.push("wgpu");
+    assert_free_of("kapaint-core", &forbidden);
+    assert!(kapaint_deps("kapaint-core").is_empty());
+}
+
+#[test]
+fn the_export_links_no_gui_or_gpu_crate_and_only_the_core() {
+    let mut forbidden = GUI.to_vec();
+    forbidden.push("wgpu");
+    assert_free_of("kapaint-export", &forbidden);
+    assert_eq!(
+        kapaint_deps("kapaint-export"),
+        BTreeSet::from(["kapaint-core".to_owned()])
     );
 }
 
 #[test]
-fn the_check_sees_what_it_looks_for() {
-    assert!(names("use egui::Ui;", "egui"));
-    assert!(names("    let t: wgpu::Texture;", "wgpu"));
-    assert!(!names("// egui is not used here", "egui"));
-    assert!(!names("let legui = 1;", "egui"));
-    assert!(names("use crate::gpu::Gpu;", "crate::gpu"));
+fn the_gpu_crate_links_no_gui_crate_and_nothing_above_it() {
+    assert_free_of("kapaint-gpu", &GUI);
+    assert_eq!(
+        kapaint_deps("kapaint-gpu"),
+        BTreeSet::from(["kapaint-core".to_owned(), "kapaint-export".to_owned()])
+    );
+}
+
+#[test]
+fn the_editor_sits_below_the_command_line() {
+    assert_eq!(
+        kapaint_deps("kapaint-editor"),
+        BTreeSet::from([
+            "kapaint-core".to_owned(),
+            "kapaint-export".to_owned(),
+            "kapaint-gpu".to_owned()
+        ])
+    );
 }

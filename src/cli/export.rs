@@ -228,9 +228,7 @@ fn load_projects(
             }
             let mesh = glb.then(|| doc.surface().cloned()).flatten();
             if !padding {
-                let mut doc = doc;
-                let _ = doc.attach_surface(None);
-                return Ok((doc, mesh));
+                return Ok((doc.with_surface(None).map_err(model_error)?, mesh));
             }
             Ok((doc, mesh))
         })

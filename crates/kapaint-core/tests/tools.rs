@@ -1,0 +1,383 @@
+//! The tools without a window: events in, commands out, and the document after them.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+use kapaint_core::mesh::uv_sphere;
+use kapaint_core::model::brush::SurfacePos;
+use kapaint_core::model::paint::GradientShape;
+use kapaint_core::model::surface::Surface;
+use kapaint_core::model::texel::{Channel, MaterialValue, Texel};
+use kapaint_core::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
+use kapaint_core::tools::{FillMode, Place, ToolEvent, ToolKind, Tools};
+
+fn document() -> Document {
+    let mut doc = Document::new(128, 64, DocumentSettings::default()).expect("doc");
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.9, 0.1, 0.1),
+        Vec3::splat(0.4),
+        500.0,
+    )))
+    .expect("primary");
+    doc
+}
+
+fn texels(doc: &Document) -> Vec<Texel> {
+    let mut out = Vec::new();
+    doc.maps().for_each_texel(|_, _, t| out.push(t));
+    out
+}
+
+/// Runs events through the tools and applies every command; returns the commands.
+fn run(tools: &mut Tools, doc: &mut Document, events: &[ToolEvent]) -> Vec<Command> {
+    let mut all = Vec::new();
+    for &event in events {
+        for command in tools.handle(event, doc) {
+            doc.apply(command.clone())
+                .expect("a tool's command applies");
+            all.push(command);
+        }
+    }
+    all
+}
+
+fn press(x: f32, y: f32) -> ToolEvent {
+    ToolEvent::Press {
+        at: Place::Canvas(Vec2::new(x, y)),
+        pressure: 1.0,
+    }
+}
+
+fn drag(x: f32, y: f32) -> ToolEvent {
+    ToolEvent::Drag {
+        at: Place::Canvas(Vec2::new(x, y)),
+        pressure: 1.0,
+    }
+}
+
+/// A place on the sphere, with the texel its UV falls on.
+fn on_surface(doc: &Document, point: Vec3) -> Place {
+    let surface = doc.surface().expect("a mesh");
+    let (w, h) = (surface.bake.width, surface.bake.height);
+    let texel = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            surface.bake.coverage((y * w + x) as usize) != kapaint_core::mesh::bake::Coverage::Empty
+        })
+        .min_by(|a, b| {
+            let d =
+                |(x, y): (u32, u32)| surface.bake.position((y * w + x) as usize).distance(point);
+            d(*a).total_cmp(&d(*b))
+        })
+        .expect("a covered texel");
+    Place::Surface {
+        pos: SurfacePos {
+            point,
+            normal: Vec3::ZERO,
+        },
+        texel: Some(Vec2::new(texel.0 as f32 + 0.5, texel.1 as f32 + 0.5)),
+    }
+}
+
+fn with_sphere(doc: Document) -> Document {
+    let surface =
+        Surface::new(uv_sphere(32, 16), doc.maps().width(), doc.maps().height()).expect("bake");
+    doc.with_surface(Some(Arc::new(surface))).expect("surface")
+}
+
+#[test]
+fn a_brush_stroke_is_one_undo_step_from_press_to_release() {
+    let mut doc = document();
+    let before = texels(&doc);
+    let mut tools = Tools::default();
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[press(10.0, 10.0), drag(40.0, 20.0), drag(80.0, 30.0)],
+    );
+    assert!(matches!(
+        commands[0],
+        Command::BeginStroke(StrokeTool::Brush)
+    ));
+    assert!(tools.busy(), "drawing until released");
+    assert!(doc.stroking());
+    run(&mut tools, &mut doc, &[ToolEvent::Release]);
+    assert!(!tools.busy() && !doc.stroking());
+    assert_ne!(texels(&doc), before, "painted");
+    assert_eq!(doc.history().undo_steps().count(), 1, "one step");
+    doc.apply(Command::Undo).expect("undo");
+    assert_eq!(texels(&doc), before, "undone bit-exactly");
+}
+
+#[test]
+fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
+    for kind in [ToolKind::Brush, ToolKind::Eraser, ToolKind::Blur] {
+        for on_mesh in [false, true] {
+            let mut doc = with_sphere(document());
+            // Something for the eraser and the blur to change.
+            doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+            doc.apply(Command::SetPrimary(MaterialValue::new(
+                Vec3::ZERO,
+                Vec3::ZERO,
+                2.0,
+            )))
+            .expect("primary");
+            run(
+                &mut Tools::default(),
+                &mut doc,
+                &[press(60.0, 30.0), ToolEvent::Release],
+            );
+            let before = texels(&doc);
+            let steps = doc.history().undo_steps().count();
+            let mut tools = Tools::default();
+            tools.select(kind, &doc);
+            let (a, b) = if on_mesh {
+                (
+                    on_surface(&doc, Vec3::new(0.0, 0.2, 0.98).normalize()),
+                    on_surface(&doc, Vec3::new(0.5, 0.1, 0.86).normalize()),
+                )
+            } else {
+                (
+                    Place::Canvas(Vec2::new(40.0, 20.0)),
+                    Place::Canvas(Vec2::new(90.0, 40.0)),
+                )
+            };
+            let commands = run(
+                &mut tools,
+                &mut doc,
+                &[
+                    ToolEvent::Press {
+                        at: a,
+                        pressure: 1.0,
+                    },
+                    ToolEvent::Drag {
+                        at: b,
+                        pressure: 1.0,
+                    },
+                ],
+            );
+            assert!(!commands.is_empty(), "{kind:?} started a stroke");
+            assert_ne!(texels(&doc), before, "{kind:?} painted before Escape");
+            let aborted = run(&mut tools, &mut doc, &[ToolEvent::Escape]);
+            assert_eq!(aborted, vec![Command::AbortStroke], "{kind:?}");
+            assert_eq!(
+                texels(&doc),
+                before,
+                "{kind:?} (mesh: {on_mesh}) left its stroke"
+            );
+            assert_eq!(doc.history().undo_steps().count(), steps, "no undo step");
+            assert!(!tools.busy());
+            assert!(
+                run(&mut tools, &mut doc, &[ToolEvent::Release]).is_empty(),
+                "the release after Escape does nothing"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_gradient_dragged_on_the_mesh_lays_a_gradient_not_a_pick() {
+    let mut doc = with_sphere(document());
+    let before = texels(&doc);
+    let primary = doc.settings().primary;
+    let mut tools = Tools::default();
+    tools.select(ToolKind::Gradient, &doc);
+    let (a, b) = (
+        on_surface(&doc, Vec3::new(0.0, 0.0, 1.0)),
+        on_surface(&doc, Vec3::new(1.0, 0.0, 0.0)),
+    );
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[
+            ToolEvent::Press {
+                at: a,
+                pressure: 1.0,
+            },
+            ToolEvent::Drag {
+                at: b,
+                pressure: 1.0,
+            },
+            ToolEvent::Release,
+        ],
+    );
+    assert_eq!(commands.len(), 1, "{commands:?}");
+    let Command::Gradient { shape, start, end } = commands[0] else {
+        panic!("not a gradient: {commands:?}");
+    };
+    assert_eq!(shape, GradientShape::Linear);
+    assert_eq!((Some(start), Some(end)), (a.texel(), b.texel()));
+    assert_ne!(texels(&doc), before);
+    assert_eq!(doc.settings().primary, primary, "nothing was picked");
+}
+
+#[test]
+fn a_gradient_can_be_radial_and_escape_drops_it() {
+    let mut doc = document();
+    let mut tools = Tools::default();
+    tools.select(ToolKind::Gradient, &doc);
+    tools.gradient.shape = GradientShape::Radial;
+    let before = texels(&doc);
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[
+            press(64.0, 32.0),
+            drag(100.0, 32.0),
+            ToolEvent::Escape,
+            ToolEvent::Release,
+        ],
+    );
+    assert!(commands.is_empty(), "{commands:?}");
+    assert_eq!(texels(&doc), before);
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[press(64.0, 32.0), drag(100.0, 32.0), ToolEvent::Release],
+    );
+    assert!(matches!(
+        commands[..],
+        [Command::Gradient {
+            shape: GradientShape::Radial,
+            ..
+        }]
+    ));
+    // Radial: equal values at equal distances from the start.
+    let (l, r) = (doc.maps().value(43, 32), doc.maps().value(84, 32)); // centres 20.5 away
+    assert!((l.kd - r.kd).abs().max_element() < 1e-3, "{l:?} {r:?}");
+}
+
+#[test]
+fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
+    // Two halves: a red one painted, the other still the base.
+    let mut doc = document();
+    doc.apply(Command::Gradient {
+        shape: GradientShape::Linear,
+        start: Vec2::new(63.0, 0.0),
+        end: Vec2::new(64.0, 0.0),
+    })
+    .expect("halves");
+    let mut tools = Tools::default();
+    tools.select(ToolKind::Fill, &doc);
+    tools.fill.mode = FillMode::Similar {
+        channel: Channel::Kd,
+        tolerance: 0.01,
+    };
+    doc.apply(Command::SetPrimary(MaterialValue::new(
+        Vec3::new(0.0, 0.8, 0.0),
+        Vec3::ZERO,
+        4.0,
+    )))
+    .expect("green");
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[press(10.0, 10.0), ToolEvent::Release],
+    );
+    assert!(matches!(
+        commands[..],
+        [Command::Fill(FillRegion::Similar {
+            x: 10,
+            y: 10,
+            channel: Channel::Kd,
+            ..
+        })]
+    ));
+    assert!(
+        doc.maps().value(10, 10).kd.y > 0.7,
+        "the left half is filled"
+    );
+    assert!(
+        doc.maps().value(120, 10).kd.y < 0.7,
+        "the right half is not"
+    );
+    tools.fill.mode = FillMode::All;
+    let commands = run(&mut tools, &mut doc, &[press(10.0, 10.0)]);
+    assert_eq!(commands, vec![Command::Fill(FillRegion::All)]);
+    // Island: on the mesh's UVs an island, off them (no mesh here) the whole map.
+    tools.fill.mode = FillMode::Island;
+    assert_eq!(
+        tools.handle(press(10.0, 10.0), &doc),
+        vec![Command::Fill(FillRegion::All)]
+    );
+    let doc = with_sphere(doc);
+    assert!(matches!(
+        tools.handle(press(10.0, 10.0), &doc)[..],
+        [Command::Fill(FillRegion::Island { x: 10, y: 10 })]
+    ));
+    // Off the map: nothing.
+    assert!(tools.handle(press(-3.0, 10.0), &doc).is_empty());
+}
+
+#[test]
+fn the_picker_reads_the_texel_under_the_pointer_in_either_view() {
+    let mut doc = with_sphere(document());
+    run(
+        &mut Tools::default(),
+        &mut doc,
+        &[press(60.0, 30.0), ToolEvent::Release],
+    );
+    let mut tools = Tools::default();
+    tools.select(ToolKind::Picker, &doc);
+    let commands = run(&mut tools, &mut doc, &[press(60.5, 30.5)]);
+    assert_eq!(commands, vec![Command::Pick { x: 60, y: 30 }]);
+    let place = on_surface(&doc, Vec3::new(0.0, 0.0, 1.0));
+    let (x, y) = place.texel_index((128, 64)).expect("on the map");
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[ToolEvent::Press {
+            at: place,
+            pressure: 1.0,
+        }],
+    );
+    assert_eq!(commands, vec![Command::Pick { x, y }]);
+    assert_eq!(doc.settings().primary, doc.maps().value(x, y));
+}
+
+#[test]
+fn switching_tools_mid_stroke_keeps_the_stroke_and_drops_a_gradient() {
+    let mut doc = document();
+    let mut tools = Tools::default();
+    run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
+    let ended = tools.select(ToolKind::Picker, &doc);
+    assert_eq!(ended, vec![Command::EndStroke]);
+    doc.apply(Command::EndStroke).expect("end");
+    assert_eq!(doc.history().undo_steps().count(), 1, "the stroke is kept");
+    tools.select(ToolKind::Gradient, &doc);
+    run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
+    assert!(
+        tools.select(ToolKind::Brush, &doc).is_empty(),
+        "no gradient laid"
+    );
+    assert_eq!(doc.history().undo_steps().count(), 1);
+}
+
+#[test]
+fn a_stroke_stays_in_the_view_it_began_in() {
+    let mut doc = with_sphere(document());
+    let mut tools = Tools::default();
+    let on_mesh = on_surface(&doc, Vec3::new(0.0, 0.0, 1.0));
+    let commands = run(
+        &mut tools,
+        &mut doc,
+        &[
+            ToolEvent::Press {
+                at: on_mesh,
+                pressure: 1.0,
+            },
+            drag(10.0, 10.0),
+            ToolEvent::Release,
+        ],
+    );
+    assert!(matches!(commands[1], Command::SurfaceStrokeTo(_)));
+    assert!(
+        !commands.iter().any(|c| matches!(c, Command::StrokeTo(_))),
+        "the canvas drag is not part of a mesh stroke: {commands:?}"
+    );
+}

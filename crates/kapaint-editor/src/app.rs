@@ -1,0 +1,338 @@
+//! The app around the editor's state: start-up (on a new document, or opening a project on a
+//! worker), one frame of the whole window (panels, dock, dialogs), exit, and `run`.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use egui_dock::{DockArea, DockState, TabViewer};
+
+use super::canvas::Canvas;
+use super::canvas::CanvasChannel;
+use super::dialogs::load_recent;
+use super::jobs::new_document;
+use super::layout::{load_layout, save_layout};
+use super::panels::layers::LayerView;
+use super::viewport::{Viewport, ViewportGpu};
+use super::{
+    DEFAULT_SIZE, EditorState, MeshState, Quit, Tab, autosave_interval, default_layout, files,
+    notice, readout,
+};
+use kapaint_core::model::texel::MaterialValue;
+use kapaint_core::model::{Document, DocumentSettings, recovery};
+use kapaint_core::render::{Lighting, ViewMode};
+use kapaint_core::tools::Tools;
+
+/// The map size of the document shown while a project named at start opens.
+const PLACEHOLDER_SIZE: u32 = 16;
+
+/// The editor app.
+pub struct Editor {
+    /// Panels' state.
+    pub state: EditorState,
+    dock: DockState<Tab>,
+    /// When the process started, until the first frame is drawn (then logged to stderr when
+    /// `KAPAINT_LOG_STARTUP` is set).
+    started: Option<Instant>,
+    /// The window title last sent.
+    title: String,
+}
+
+impl Editor {
+    /// The editor on a new default document (sphere, default material), or on `path` when
+    /// given: a project there opens on a worker once the window is up (the window shows at
+    /// once, with the opening in progress over it); a missing file becomes a new project
+    /// saved there.
+    pub fn new(
+        render_state: Option<&eframe::egui_wgpu::RenderState>,
+        path: Option<PathBuf>,
+    ) -> Self {
+        let gpu = render_state.map(ViewportGpu::new);
+        let mut notices = super::Notices::default();
+        // A project that is there opens on a worker; until then the document is untitled,
+        // so nothing can be saved over the file.
+        let (existing, untitled_until_open) = match path {
+            Some(p) if p.exists() => (Some(p), None),
+            other => (None, other),
+        };
+        // Under a project being opened, a placeholder costs next to nothing to make.
+        let size = if existing.is_some() {
+            PLACEHOLDER_SIZE
+        } else {
+            DEFAULT_SIZE
+        };
+        let (doc, mesh) = match new_document(size) {
+            Ok(x) => x,
+            Err(e) => {
+                notices.push(notice(e, true));
+                let doc = Document::new(16, 16, DocumentSettings::default())
+                    .unwrap_or_else(|_| unreachable_doc());
+                (doc, MeshState::new(kapaint_core::mesh::plane(), 1))
+            }
+        };
+        let path = existing.as_deref().or(untitled_until_open.as_deref());
+        let mut viewport = Viewport::new(gpu);
+        viewport.frame(&mesh.mesh);
+        let recovery_offer = recovery::offer(path);
+        let autosaver =
+            recovery::Autosaver::new(autosave_interval(), untitled_until_open.as_deref(), &doc);
+        let preset_dir = kapaint_core::model::preset::user_dir();
+        let presets =
+            super::panels::presets::load_material_presets(preset_dir.as_deref(), &mut notices);
+        let brush_presets =
+            super::panels::presets::load_brush_presets(preset_dir.as_deref(), &mut notices);
+        let dock = load_layout().unwrap_or_else(default_layout);
+        let saved_version = doc.version();
+        let mut editor = Self {
+            state: EditorState {
+                doc,
+                path: untitled_until_open,
+                starting: None,
+                saved_version,
+                tools: Tools::default(),
+                view: ViewMode::Shaded,
+                lighting: Lighting::default(),
+                light_follows_camera: false,
+                viewport,
+                canvas: Canvas::default(),
+                mesh,
+                notices,
+                job: None,
+                export: None,
+                export_choice: None,
+                new_dialog: None,
+                resize_dialog: None,
+                pending_open: None,
+                material_prompt: None,
+                recent: load_recent(),
+                stamp_preview: None,
+                pressure: 1.0,
+                held: None,
+                hover: None,
+                hover_tab: None,
+                canvas_outline: None,
+                brush_size: super::screen_brush::BrushSize::default(),
+                texels_per_point: None,
+                hex_text: None,
+                recent_materials: Vec::new(),
+                shown_hover: None,
+                exact_chi: readout::ExactChi::new(),
+                quit: Quit::default(),
+                files: files::FileChooser::new(),
+                shortcuts_open: false,
+                recovery_offer,
+                presets,
+                brush_presets,
+                naming: None,
+                preset_dir,
+                autosaver,
+                claim: super::claim::Claim::default(),
+                layers_panel: super::panels::layers::PanelState::default(),
+                layer_view: LayerView::Composite,
+            },
+            dock,
+            started: None,
+            title: String::new(),
+        };
+        if let Some(p) = existing {
+            let s = &mut editor.state;
+            if s.recovery_offer.is_some() {
+                // Recover or Discard decides what opens.
+                s.starting = Some(p);
+            } else {
+                s.open_now(p);
+            }
+        }
+        editor
+    }
+}
+
+/// A 16 x 16 document cannot fail to allocate; this is only for the type checker.
+fn unreachable_doc() -> Document {
+    Document::from_parts(
+        kapaint_core::model::MaterialMaps::new(1, 1, MaterialValue::default())
+            .unwrap_or_else(|_| std::process::abort()),
+        DocumentSettings::default(),
+    )
+}
+
+struct Tabs<'a>(&'a mut EditorState);
+
+impl TabViewer for Tabs<'_> {
+    type Tab = Tab;
+
+    fn title(&mut self, tab: &mut Tab) -> egui::WidgetText {
+        match tab {
+            Tab::Viewport => "3D viewport".into(),
+            Tab::Canvas => "UV canvas".into(),
+            Tab::Layers => "Layers".into(),
+        }
+    }
+
+    fn id(&mut self, tab: &mut Tab) -> egui::Id {
+        egui::Id::new(*tab)
+    }
+
+    fn closeable(&mut self, _tab: &mut Tab) -> bool {
+        false
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, tab: &mut Tab) {
+        let s = &mut *self.0;
+        match tab {
+            Tab::Viewport => {
+                let mut settings = s.frame_settings();
+                if s.shown_layer_view() == LayerView::Mask {
+                    settings.view = ViewMode::Kd;
+                }
+                let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
+                let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
+                let normal = s.doc.normal().cloned();
+                let (response, rect) =
+                    s.viewport
+                        .show(ui, (maps.0, maps.1, normal.as_ref()), &mesh, &settings);
+                s.painting_label(ui, rect);
+                s.viewport_input(&response, rect);
+            }
+            Tab::Canvas => {
+                let lines = std::mem::take(&mut s.mesh.uv_lines);
+                let channel = s.canvas.channel;
+                if s.shown_layer_view() == LayerView::Mask {
+                    s.canvas.channel = CanvasChannel::Kd;
+                }
+                let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
+                let (response, rect) = s.canvas.show(ui, &s.doc, maps, &lines);
+                s.canvas.channel = channel;
+                s.mesh.uv_lines = lines;
+                s.painting_label(ui, rect);
+                s.canvas_input(&response, rect);
+            }
+            Tab::Layers => {
+                egui::ScrollArea::vertical()
+                    .id_salt("layers tab")
+                    .show(ui, |ui| s.layers_ui(ui));
+            }
+        }
+    }
+}
+
+impl Editor {
+    /// Replaces the dock layout (as a saved one is restored at start).
+    pub fn set_layout(&mut self, dock: DockState<Tab>) {
+        self.dock = dock;
+    }
+
+    /// One frame of the whole editor.
+    pub fn frame(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let s = &mut self.state;
+        s.poll_job();
+        s.track_pressure(&ctx);
+        s.hotkeys(&ctx);
+        s.follow_mesh();
+        s.dropped_files(&ctx);
+        let now = Instant::now();
+        if let Some(Err(e)) = s.autosaver.poll(&s.doc, now) {
+            s.notices
+                .push(notice(format!("autosave failed: {e}"), true));
+        }
+        // An idle window draws no frames: wake up when the recovery copy falls due.
+        if let Some(wait) = s.autosaver.next_poll(&s.doc, now) {
+            ctx.request_repaint_after(wait);
+        }
+        s.shown_hover = s.hover.take();
+        s.hover_tab = None;
+        egui::Panel::top("menu").show(ui, |ui| s.menu_ui(ui));
+        egui::Panel::bottom("status").show(ui, |ui| s.status_bar_ui(ui));
+        egui::Panel::left("tools")
+            .resizable(true)
+            .default_size(250.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| s.tools_ui(ui));
+            });
+        egui::Panel::right("view")
+            .resizable(true)
+            .default_size(240.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| s.view_ui(ui));
+            });
+        egui::CentralPanel::default().show(ui, |ui| {
+            DockArea::new(&mut self.dock)
+                .show_close_buttons(false)
+                .show_leaf_close_all_buttons(false)
+                .show_leaf_collapse_buttons(false)
+                .show_inside(ui, &mut Tabs(s));
+        });
+        s.export_window(&ctx);
+        s.new_window(&ctx);
+        s.resize_window(&ctx);
+        s.recovery_window(&ctx);
+        s.shortcuts_window(&ctx);
+        s.notices_ui(&ctx);
+        s.close_prompt(&ctx);
+        s.open_prompt(&ctx);
+        s.claim_prompt(&ctx);
+        s.material_prompt_window(&ctx);
+        s.modal_job_ui(&ctx);
+        s.files_ui(&ctx);
+        if s.job.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(100));
+        }
+        let title = s.window_title();
+        if title != self.title {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
+            self.title = title;
+        }
+        if let Some(start) = self.started.take()
+            && std::env::var_os("KAPAINT_LOG_STARTUP").is_some()
+        {
+            eprintln!(
+                "kapaint: first frame after {:.0} ms",
+                start.elapsed().as_secs_f64() * 1000.0
+            );
+        }
+    }
+}
+
+impl eframe::App for Editor {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame(ui);
+    }
+
+    fn on_exit(&mut self) {
+        save_layout(&self.dock);
+        // A clean exit, or one whose changes the user discarded, leaves no recovery copy.
+        if !self.state.dirty() || self.state.quit.allowed == Some(super::QuitAllowed::Discarded) {
+            self.state.autosaver.discard();
+        }
+        self.state.claim.release();
+    }
+}
+
+/// Opens the editor window (on `path` when given); returns the process exit code.
+pub fn run(path: Option<PathBuf>) -> i32 {
+    let start = Instant::now();
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("kapaint")
+            .with_inner_size([1400.0, 900.0])
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    match eframe::run_native(
+        "kapaint",
+        options,
+        Box::new(move |cc| {
+            let mut editor = Editor::new(cc.wgpu_render_state.as_ref(), path);
+            editor.started = Some(start);
+            Ok(Box::new(editor))
+        }),
+    ) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("kapaint: cannot open the editor window: {e}");
+            1
+        }
+    }
+}

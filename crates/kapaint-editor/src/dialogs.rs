@@ -1,0 +1,597 @@
+//! The editor's dialogs and prompts: New (resolution, base preset, mesh), the recent files,
+//! the export dialog with its preview of the set, and the prompts that keep unsaved work
+//! (before opening another project, before closing, recovery after a crash).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use super::files::FilePurpose;
+use super::jobs::new_document_with;
+use super::layout::layout_path;
+use super::{EditorState, JobResult};
+use kapaint_core::model::document::MeshRef;
+use kapaint_core::model::{Document, DocumentSettings};
+use kapaint_export::preset::ExportPreset;
+
+/// The export dialog's preview: the packed layout of each file, the constants, the memory
+/// report and the `k_a` error that `n`'s quantisation costs.
+pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetPlan, pbr: bool) {
+    let mb = |b: u64| b as f64 / 1e6;
+    ui.label(
+        egui::RichText::new(if pbr {
+            "glTF metallic-roughness textures"
+        } else {
+            "Packed layout"
+        })
+        .strong(),
+    );
+    egui::Grid::new("export layout")
+        .striped(true)
+        .show(ui, |ui| {
+            for f in &plan.files {
+                ui.monospace(&f.path);
+                ui.monospace(f.layout.join(" | "));
+                ui.label(format!("{:.1} MB raw", mb(f.raw_bytes)));
+                ui.end_row();
+            }
+        });
+    let c = &plan.constants;
+    let mut constants = Vec::new();
+    if let Some([r, g, b]) = c.kd {
+        constants.push(format!("k_d = ({r:.3}, {g:.3}, {b:.3})"));
+    }
+    if let Some([r, g, b]) = c.ks {
+        constants.push(format!("k_s = ({r:.3}, {g:.3}, {b:.3})"));
+    }
+    if let Some(n) = c.n {
+        constants.push(format!("n = {n:.2}"));
+    }
+    if let Some((w, h)) = plan.normal {
+        ui.label(format!(
+            "normal.png: the project's normal map ({w}x{h}, 8-bit tangent space, as stored); \
+             it lights only, k_a never reads it"
+        ));
+    }
+    if plan.files.is_empty() && plan.normal.is_none() {
+        ui.label("Every channel is constant: the set is a manifest alone.");
+    }
+    if !constants.is_empty() {
+        ui.label(format!(
+            "Constants in the manifest: {}",
+            constants.join(", ")
+        ));
+    }
+    if let Some(e) = plan.n_encoding {
+        ui.label(format!(
+            "n: {:?} curve over [{:.2}, {:.1}], {} bits",
+            e.curve, e.lo, e.hi, e.bits
+        ));
+    }
+    if pbr {
+        ui.label(
+            "Base colour, metallic and roughness are converted back from k_d, k_s and n; \
+             the round-trip error is measured as the set is written (material.json).",
+        );
+    } else {
+        ui.label(format!(
+            "Estimated k_a error (n quantisation): max {:.3} %, mean {:.4} %",
+            plan.ka_error.max * 100.0,
+            plan.ka_error.mean * 100.0
+        ));
+    }
+    let b = &plan.bytes;
+    ui.label(format!(
+        "Memory: set {:.1} MB uncompressed (files are smaller), naive k_a + k_d + k_s + n {:.1} MB, project {:.1} MB",
+        mb(b.exported),
+        mb(b.naive),
+        mb(b.project)
+    ));
+}
+
+/// The New dialog's choices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewDialog {
+    /// Map size (square), texels.
+    pub size: u32,
+    /// Index into the material presets: the base material.
+    pub preset: usize,
+    /// A built-in mesh name, or a mesh file's path.
+    pub mesh: String,
+}
+
+/// Map sizes the New dialog offers.
+pub const NEW_SIZES: [u32; 5] = [512, 1024, 2048, 4096, 8192];
+
+/// How many recent files are kept.
+pub const RECENT_MAX: usize = 10;
+
+/// `list` with `path` moved to the front, without duplicates, at most [`RECENT_MAX`] long.
+pub fn push_recent(list: &mut Vec<PathBuf>, path: &Path) {
+    let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    list.retain(|p| *p != path);
+    list.insert(0, path);
+    list.truncate(RECENT_MAX);
+}
+
+pub(super) fn recent_path() -> Option<PathBuf> {
+    layout_path().map(|p| p.with_file_name("recent.json"))
+}
+
+pub(super) fn load_recent() -> Vec<PathBuf> {
+    recent_path()
+        .and_then(|p| kapaint_core::file_check::read_limited(&p, 1 << 20).ok())
+        .map(|text| parse_recent(&text))
+        .unwrap_or_default()
+}
+
+/// The recent-files list from its JSON: at most [`RECENT_MAX`] entries, each a path of at
+/// most 4096 bytes without control characters (anything else is dropped, a list that does
+/// not parse is empty).
+pub fn parse_recent(json: &[u8]) -> Vec<PathBuf> {
+    let Ok(list) = serde_json::from_slice::<Vec<String>>(json) else {
+        return Vec::new();
+    };
+    list.into_iter()
+        .filter(|p| {
+            !p.is_empty()
+                && kapaint_core::model::check::bounded_text(
+                    "path",
+                    p,
+                    kapaint_core::model::check::MAX_PATH_BYTES,
+                )
+                .is_ok()
+        })
+        .take(RECENT_MAX)
+        .map(PathBuf::from)
+        .collect()
+}
+
+pub(super) fn save_recent(list: &[PathBuf]) {
+    if let (Some(path), Ok(json)) = (recent_path(), serde_json::to_vec_pretty(list)) {
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let _ = kapaint_core::atomic::write_atomic(&path, &json);
+    }
+}
+
+/// For a block-compressed preset: the layout above is the search's first trial; the export
+/// measures and may move `n` out and colour to BC6H (the notice says what it chose).
+fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
+    if preset.format != kapaint_export::preset::Format::Ktx2Bc {
+        return;
+    }
+    let b = &preset.budget;
+    let then = if preset.bc6h {
+        "n apart with colour as BC6H"
+    } else {
+        "n apart"
+    };
+    ui.label(format!(
+        "Blocks: the layout and effort are chosen at export by the measured k_a error \
+         (budget max {:.2} %, mean {:.2} %, PSNR {:.0} dB or more): this layout first, then \
+         {then}, then more effort up to {:?}. The notice and material.json say what was kept.",
+        b.max_ka_error * 100.0,
+        b.mean_ka_error * 100.0,
+        b.min_psnr,
+        preset.max_bc7_effort
+    ));
+}
+
+/// The export dialog's state.
+pub(super) struct ExportDialog {
+    presets: Vec<ExportPreset>,
+    chosen: usize,
+    folder: String,
+    /// The folder holds a set: asking whether to replace it.
+    confirm_replace: bool,
+    /// Why the folder cannot take the set, shown in the dialog.
+    problem: Option<String>,
+    /// The preview of the chosen preset: for which preset and maps version, and the plan.
+    plan: Option<(usize, u64, kapaint_export::set::SetPlan)>,
+    /// A preview being computed on a worker thread.
+    planning: Option<(usize, u64, JoinHandle<kapaint_export::set::SetPlan>)>,
+    /// With a glTF PBR preset: also write the mesh with the material as a `.glb`.
+    glb: bool,
+}
+
+impl ExportDialog {
+    /// The folder the set goes to, as typed or chosen.
+    pub(super) fn folder(&self) -> &str {
+        &self.folder
+    }
+
+    /// Exports into the chosen `dir` where it is empty or a set already (replaced after a
+    /// prompt), else into a new `set` folder inside it.
+    pub(super) fn choose_folder(&mut self, dir: &Path) {
+        let kind = kapaint_export::set::SetKind::of(&self.presets[self.chosen]);
+        self.folder = export_folder_in(dir, kind).display().to_string();
+        (self.confirm_replace, self.problem) = (false, None);
+    }
+}
+
+impl EditorState {
+    /// The recovery offer at start: recover the copy, or discard it. Modal: until it is
+    /// answered the document is a placeholder, and a stroke on it would be autosaved over the
+    /// untitled recovery copy.
+    pub(super) fn recovery_window(&mut self, ctx: &egui::Context) {
+        let Some(copy) = self.recovery_offer.clone() else {
+            return;
+        };
+        egui::Modal::new(egui::Id::new("kapaint-recovery-offer")).show(ctx, |ui| {
+            ui.heading("Recover unsaved work?");
+            ui.label(format!(
+                "kapaint found a recovery copy of unsaved work:\n{}",
+                copy.display()
+            ));
+            ui.horizontal(|ui| {
+                // Recover is the default: Enter takes it.
+                let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
+                let recover = ui.button("Recover").on_hover_text("Enter");
+                if recover.clicked() || enter {
+                    self.recovery_offer = None;
+                    let path = self.starting.take().or_else(|| self.path.clone());
+                    self.recover(copy.clone(), path);
+                }
+                if ui.button("Discard").clicked() {
+                    self.recovery_offer = None;
+                    kapaint_core::model::recovery::remove(&copy);
+                    // The project named at start opens as saved.
+                    if let Some(p) = self.starting.take() {
+                        self.open_now(p);
+                    }
+                }
+            });
+        });
+    }
+
+    /// Opens the New dialog (Ctrl+N), starting from the current document's size.
+    pub(super) fn new_project(&mut self) {
+        let preset = self
+            .presets
+            .iter()
+            .position(|p| Some(&p.stem) == self.doc.settings().preset.as_ref())
+            .or_else(|| self.presets.iter().position(|p| p.stem == "default"))
+            .unwrap_or(0);
+        self.new_dialog = Some(NewDialog {
+            size: self.doc.maps().width(),
+            preset,
+            mesh: "sphere".into(),
+        });
+    }
+
+    /// Replaces the document with a new one as `dialog` says (the old one's unsaved changes
+    /// are in its recovery copy and were asked about before).
+    pub fn create_project(&mut self, dialog: &NewDialog) {
+        let mut settings = DocumentSettings {
+            mesh: MeshRef::from_spec(&dialog.mesh),
+            ..DocumentSettings::default()
+        };
+        if let Some(p) = self.presets.get(dialog.preset) {
+            settings.base = p.value;
+            settings.secondary = p.value;
+            settings.preset = Some(p.stem.clone());
+        }
+        let size = dialog.size;
+        // Loading and baking the mesh at up to 8192^2 takes seconds: a worker does it.
+        self.start_job("New", move |progress| {
+            progress.start("bake", 1);
+            match new_document_with(size, settings) {
+                Ok(doc) => JobResult::Created(Box::new(doc)),
+                Err(e) => JobResult::Failed(format!("new project: {e}")),
+            }
+        });
+    }
+
+    /// The New dialog: resolution, base preset, mesh.
+    pub(super) fn new_window(&mut self, ctx: &egui::Context) {
+        let Some(mut dialog) = self.new_dialog.take() else {
+            return;
+        };
+        let (mut open, mut create, mut choose) = (true, false, false);
+        centred(egui::Window::new("New project"), ctx)
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::ComboBox::from_label("Resolution")
+                    .selected_text(format!("{0}x{0}", dialog.size))
+                    .show_ui(ui, |ui| {
+                        for size in NEW_SIZES {
+                            ui.selectable_value(&mut dialog.size, size, format!("{size}x{size}"));
+                        }
+                    });
+                egui::ComboBox::from_label("Base preset")
+                    .selected_text(
+                        self.presets
+                            .get(dialog.preset)
+                            .map_or("", |p| p.name.as_str()),
+                    )
+                    .show_ui(ui, |ui| {
+                        for (i, p) in self.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.preset, i, &p.name);
+                        }
+                    });
+                ui.horizontal(|ui| {
+                    egui::ComboBox::from_label("Mesh")
+                        .selected_text(&dialog.mesh)
+                        .show_ui(ui, |ui| {
+                            for m in kapaint_core::mesh::BUILTIN_NAMES {
+                                ui.selectable_value(&mut dialog.mesh, m.to_string(), m);
+                            }
+                        });
+                    if ui.button("File…").clicked() {
+                        choose = true;
+                    }
+                });
+                let bytes = u64::from(dialog.size).pow(2) * 14;
+                ui.label(format!("Maps: {:.0} MB", bytes as f64 / 1e6));
+                let label = if self.dirty() {
+                    ui.colored_label(
+                        ui.visuals().warn_fg_color,
+                        "The current project has unsaved changes.",
+                    );
+                    "Discard changes and create"
+                } else {
+                    "Create"
+                };
+                create = ui.button(label).clicked();
+            });
+        if create {
+            self.create_project(&dialog);
+        } else if open {
+            self.new_dialog = Some(dialog);
+            if choose {
+                self.choose_file(FilePurpose::NewMesh);
+            }
+        }
+    }
+
+    /// Remembers `path` at the top of the recent files.
+    pub(super) fn remember(&mut self, path: &Path) {
+        push_recent(&mut self.recent, path);
+        save_recent(&self.recent);
+    }
+
+    /// Starts the export on a worker (replacing the set at the folder where `replace`); the
+    /// dialog's choices are kept for the next export.
+    pub(super) fn export_now(&mut self, replace: bool) {
+        let Some(dialog) = &self.export else { return };
+        let Some(preset) = dialog.presets.get(dialog.chosen).cloned() else {
+            return;
+        };
+        let out = PathBuf::from(dialog.folder.trim());
+        self.export_choice = Some((preset.name.clone(), dialog.folder.clone()));
+        let pbr = preset.format == kapaint_export::preset::Format::GltfPbr;
+        let mesh = self
+            .doc
+            .surface()
+            .filter(|_| pbr && dialog.glb)
+            .map(Arc::clone);
+        let snapshot = self.snapshot();
+        self.export = None;
+        self.start_job("Export", move |progress| {
+            let glb = mesh.as_ref().map(|s| &s.mesh);
+            let gpu = kapaint_gpu::blocks::for_export(&preset);
+            match kapaint_export::run(&snapshot, &preset, &out, progress, replace, glb, gpu) {
+                Ok(m) => JobResult::Exported(out, Box::new(m)),
+                Err(e) => JobResult::Failed(format!("export failed: {e}")),
+            }
+        });
+    }
+
+    pub(super) fn open_export(&mut self) {
+        let presets = kapaint_export::preset::builtin();
+        // The last export's choices, else the project's name and the first preset.
+        let (chosen, folder) = match &self.export_choice {
+            Some((name, folder)) => (
+                presets.iter().position(|p| &p.name == name).unwrap_or(0),
+                folder.clone(),
+            ),
+            None => (
+                0,
+                self.path.as_ref().map_or_else(
+                    || "export".to_string(),
+                    |p| p.with_extension("").display().to_string() + "-set",
+                ),
+            ),
+        };
+        self.export = Some(ExportDialog {
+            presets,
+            chosen,
+            folder,
+            confirm_replace: false,
+            problem: None,
+            plan: None,
+            planning: None,
+            glb: false,
+        });
+    }
+
+    /// A copy of the document for a worker thread (the maps' tiles are shared, not copied).
+    pub(super) fn snapshot(&self) -> Document {
+        self.doc.snapshot()
+    }
+
+    /// Keeps the export dialog's preview current: starts planning on a worker thread when the
+    /// preset or the maps changed, and takes the result when it is done.
+    pub(super) fn update_export_plan(&mut self, ctx: &egui::Context) {
+        let version = self.doc.maps().version();
+        let snapshot = self.export.as_ref().and_then(|d| {
+            let current = |(p, v): (usize, u64)| p == d.chosen && v == version;
+            let planned = d.plan.as_ref().is_some_and(|(p, v, _)| current((*p, *v)));
+            // One plan at a time: a stale one finishes first, then the current one starts.
+            (!planned && d.planning.is_none()).then(|| self.snapshot())
+        });
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        if let Some(doc) = snapshot
+            && let Some(preset) = dialog.presets.get(dialog.chosen).cloned()
+        {
+            let spawned = std::thread::Builder::new()
+                .name("kapaint export preview".into())
+                .spawn(move || kapaint_export::set::plan(&doc, &preset));
+            if let Ok(handle) = spawned {
+                dialog.planning = Some((dialog.chosen, version, handle));
+            }
+        }
+        if dialog
+            .planning
+            .as_ref()
+            .is_some_and(|(_, _, h)| h.is_finished())
+            && let Some((p, v, handle)) = dialog.planning.take()
+            && let Ok(plan) = handle.join()
+        {
+            dialog.plan = Some((p, v, plan));
+        }
+        if dialog.planning.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(50));
+        }
+    }
+
+    pub(super) fn export_window(&mut self, ctx: &egui::Context) {
+        self.update_export_plan(ctx);
+        let has_mesh = self.doc.surface().is_some();
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        let mut open = true;
+        let (mut go, mut replace, mut choose) = (false, false, false);
+        centred(egui::Window::new("Export"), ctx)
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::ComboBox::from_label("Preset")
+                    .selected_text(
+                        dialog
+                            .presets
+                            .get(dialog.chosen)
+                            .map_or("", |p| p.name.as_str()),
+                    )
+                    .show_ui(ui, |ui| {
+                        for (i, p) in dialog.presets.iter().enumerate() {
+                            ui.selectable_value(&mut dialog.chosen, i, &p.name)
+                                .on_hover_text(&p.description);
+                        }
+                    });
+                if let Some(p) = dialog.presets.get(dialog.chosen) {
+                    ui.label(&p.description);
+                }
+                ui.separator();
+                let pbr = dialog
+                    .presets
+                    .get(dialog.chosen)
+                    .is_some_and(|p| p.format == kapaint_export::preset::Format::GltfPbr);
+                match &dialog.plan {
+                    Some((p, _, plan)) if *p == dialog.chosen => {
+                        export_plan_ui(ui, plan, pbr);
+                        if let Some(preset) = dialog.presets.get(dialog.chosen) {
+                            block_search_ui(ui, preset);
+                        }
+                    }
+                    _ => {
+                        ui.horizontal(|ui| {
+                            ui.spinner();
+                            ui.label("Measuring the set…");
+                        });
+                    }
+                }
+                ui.separator();
+                ui.horizontal(|ui| {
+                    ui.label("Folder");
+                    if ui.text_edit_singleline(&mut dialog.folder).changed() {
+                        (dialog.confirm_replace, dialog.problem) = (false, None);
+                    }
+                    if ui.button("…").clicked() {
+                        choose = true;
+                    }
+                });
+                if pbr {
+                    ui.add_enabled(
+                        has_mesh,
+                        egui::Checkbox::new(
+                            &mut dialog.glb,
+                            "Also write model.glb (the mesh with this material)",
+                        ),
+                    )
+                    .on_disabled_hover_text("The project's mesh is not loaded.");
+                }
+                if let Some(problem) = &dialog.problem {
+                    ui.colored_label(ui.visuals().error_fg_color, problem);
+                }
+                if dialog.confirm_replace {
+                    ui.label(format!(
+                        "{} holds an exported set already. Replace it?",
+                        dialog.folder.trim()
+                    ));
+                    ui.horizontal(|ui| {
+                        replace = ui.button("Replace").clicked();
+                        if ui.button("Cancel").clicked() {
+                            dialog.confirm_replace = false;
+                        }
+                    });
+                } else {
+                    go = ui.button("Export").clicked();
+                }
+            });
+        if !open {
+            self.export = None;
+        } else if choose {
+            self.choose_file(FilePurpose::ExportFolder);
+        } else if replace {
+            self.export_now(true);
+        } else if go {
+            self.ask_or_export();
+        }
+    }
+
+    /// Exports into a free folder; asks first where a set is there already; says why where
+    /// something else is. The dialog and its choices stay until the export starts.
+    fn ask_or_export(&mut self) {
+        use kapaint_export::set::{SetKind, Target, holds, target};
+        let Some(dialog) = &mut self.export else {
+            return;
+        };
+        let folder = Path::new(dialog.folder.trim());
+        if let Some(project) = self.path.as_deref().filter(|p| holds(folder, p)) {
+            dialog.problem = Some(format!(
+                "{} holds the project {}: choose another folder",
+                folder.display(),
+                project.display()
+            ));
+            return;
+        }
+        match target(folder, SetKind::of(&dialog.presets[dialog.chosen])) {
+            Ok(Target::Free) => self.export_now(false),
+            Ok(Target::Set) => dialog.confirm_replace = true,
+            Ok(Target::Taken(why)) => {
+                dialog.problem = Some(format!(
+                    "{}: {why}; choose another folder",
+                    folder.display()
+                ));
+            }
+            Err(e) => dialog.problem = Some(e.to_string()),
+        }
+    }
+}
+
+/// Where an export into the folder `dir` the user chose goes: `dir` itself when it is free (or
+/// empty) or holds a set of `kind`, else a `set` folder inside it (a folder of other things is
+/// never replaced).
+pub fn export_folder_in(dir: &Path, kind: kapaint_export::set::SetKind) -> PathBuf {
+    use kapaint_export::set::{Target, target};
+    match target(dir, kind) {
+        Ok(Target::Free | Target::Set) => dir.to_path_buf(),
+        _ => dir.join("set"),
+    }
+}
+
+/// A window that opens about the middle of the editor (not at the top left, over the tools);
+/// it can still be moved. Its top left is placed once, half a typical dialog's size from the
+/// centre, so it stays put when its content grows (a centred pivot would move its buttons
+/// from under the pointer).
+pub(super) fn centred<'a>(window: egui::Window<'a>, ctx: &egui::Context) -> egui::Window<'a> {
+    window.default_pos(ctx.content_rect().center() - egui::vec2(200.0, 150.0))
+}

@@ -1,0 +1,331 @@
+//! Pointer input on the UV canvas and the 3D viewport: every pointer event egui delivers in a
+//! frame (press, each move, release, in order, with their positions) becomes a [`ToolEvent`]
+//! for the active tool, whose commands are applied to the document, so a quick stroke keeps
+//! its shape and its tail up to the release point however few frames it spans. The camera
+//! and the light drag stay here. Space (canvas) and Alt (viewport) keep the primary button
+//! for panning and orbiting.
+
+use egui::Key;
+use glam::Vec2;
+
+use super::screen_brush::points_per_world;
+use super::{EditorState, Tab, brush_outline};
+use kapaint_core::model::brush::SurfacePos;
+use kapaint_core::model::{Command, StrokeTool};
+use kapaint_core::render::FrameSettings;
+use kapaint_core::tools::{Place, ToolEvent, ToolKind};
+
+impl EditorState {
+    /// The texel under a map-space position, if inside.
+    fn texel_at(&self, p: Vec2) -> Option<(u32, u32)> {
+        Place::Canvas(p).texel_index((self.doc.maps().width(), self.doc.maps().height()))
+    }
+
+    /// Follows the pen's pressure where the platform delivers it (egui reports a tablet pen's
+    /// force with its touch events); kept until the stroke ends, 1 for a mouse.
+    pub(super) fn track_pressure(&mut self, ctx: &egui::Context) {
+        let force = ctx.input(|i| {
+            i.events.iter().rev().find_map(|e| match e {
+                egui::Event::Touch { force: Some(f), .. } if f.is_finite() => {
+                    Some(f.clamp(0.0, 1.0))
+                }
+                _ => None,
+            })
+        });
+        if let Some(f) = force {
+            self.pressure = f;
+        }
+    }
+
+    /// Makes `kind` the active tool (ending what the old one had under way).
+    pub(super) fn select_tool(&mut self, kind: ToolKind) {
+        for command in self.tools.select(kind, &self.doc) {
+            self.apply(command);
+        }
+    }
+
+    /// Hands an event to the active tool and applies its commands.
+    pub(super) fn tool_event(&mut self, event: ToolEvent) {
+        for command in self.tools.handle(event, &self.doc) {
+            let lays = matches!(
+                command,
+                Command::BeginStroke(StrokeTool::Brush)
+                    | Command::Fill(_)
+                    | Command::Gradient { .. }
+            );
+            self.apply(command);
+            if lays {
+                self.remember_material();
+            }
+        }
+    }
+
+    /// The tool events of one view this frame, from `samples` (this frame's primary-button
+    /// events, in order, each with the place under it): a press on the view (not while
+    /// `reserved`, the modifier that gives the button to the camera, nor under a window over
+    /// it), a drag for every move while it is held, a drag to where it came up and the
+    /// release. A press off the map or the mesh still holds the button, so a drag that reaches
+    /// them starts there.
+    fn pointer_input(
+        &mut self,
+        tab: Tab,
+        response: &egui::Response,
+        samples: Vec<(Sample, Option<Place>)>,
+        reserved: bool,
+    ) {
+        let pressure = self.pressure;
+        for (sample, at) in samples {
+            match sample {
+                Sample::Down(p) => {
+                    let on_view = response.interact_rect.contains(p)
+                        && response.ctx.layer_id_at(p) == Some(response.layer_id);
+                    if self.held.is_none() && on_view && !reserved {
+                        self.held = Some(tab);
+                        if self.tools.active().strokes() {
+                            self.fit_brush_to_screen();
+                        }
+                        if let Some(at) = at {
+                            self.tool_event(ToolEvent::Press { at, pressure });
+                        }
+                    }
+                }
+                Sample::Move(_) | Sample::Up(_) if self.held == Some(tab) => {
+                    if let Some(at) = at {
+                        self.tool_event(ToolEvent::Drag { at, pressure });
+                    }
+                    if matches!(sample, Sample::Up(_)) {
+                        self.release();
+                    }
+                }
+                Sample::Move(_) | Sample::Up(_) => {}
+            }
+        }
+        // A release egui never reported (the pointer left the window): end the stroke.
+        if self.held == Some(tab) && !response.ctx.input(|i| i.pointer.primary_down()) {
+            self.release();
+        }
+    }
+
+    /// Ends the stroke under way.
+    fn release(&mut self) {
+        self.held = None;
+        self.pressure = 1.0;
+        self.tool_event(ToolEvent::Release);
+    }
+
+    /// The canvas: hover readout, tool events, the gradient being dragged.
+    pub(super) fn canvas_input(&mut self, response: &egui::Response, rect: egui::Rect) {
+        let size = (self.doc.maps().width(), self.doc.maps().height());
+        let pointer = response.interact_pointer_pos().or(response.hover_pos());
+        let pos = pointer.map(|p| self.canvas.to_texel(rect, p, size));
+        if response.hovered() {
+            self.hover = pos.and_then(|p| self.texel_at(p));
+            self.hover_tab = Some(Tab::Canvas);
+        }
+        if pointer.is_some() && (response.hovered() || self.held == Some(Tab::Canvas)) {
+            self.texels_per_point = Some(size.0 as f32 / rect.width().max(1e-3));
+        }
+        let space = response.ctx.input(|i| i.key_down(Key::Space));
+        let samples = pointer_samples(&response.ctx)
+            .into_iter()
+            .map(|s| {
+                let at = Place::Canvas(self.canvas.to_texel(rect, s.pos(), size));
+                (s, Some(at))
+            })
+            .collect();
+        self.pointer_input(Tab::Canvas, response, samples, space);
+        // The brush circle: the dab's radius in texels, at the canvas's zoom.
+        self.canvas_outline = None;
+        if let Some(p) = response.hover_pos()
+            && self.tools.active().strokes()
+            && !space
+        {
+            let radius = if self.brush_size.on_screen {
+                self.brush_size.screen_radius
+            } else {
+                self.doc.settings().brush.radius_px * rect.width() / size.0 as f32
+            };
+            let painter = response.ctx.layer_painter(response.layer_id);
+            // Dark under light, so it shows on any material.
+            painter.circle_stroke(
+                p,
+                radius + 1.0,
+                egui::Stroke::new(1.0, egui::Color32::BLACK),
+            );
+            painter.circle_stroke(p, radius, egui::Stroke::new(1.0, egui::Color32::WHITE));
+            self.canvas_outline = Some((p, radius));
+        }
+        if self.tools.active() == ToolKind::Gradient
+            && let Some((start, end)) = self.tools.gradient.drag()
+        {
+            let at = |p: Vec2| {
+                rect.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * rect.size()
+            };
+            response.ctx.layer_painter(response.layer_id).arrow(
+                at(start),
+                at(end) - at(start),
+                egui::Stroke::new(2.0, egui::Color32::WHITE),
+            );
+        }
+    }
+
+    /// The viewport: hover readout, tool events on the mesh (left button, not with Alt), the
+    /// brush outline.
+    pub(super) fn viewport_input(&mut self, response: &egui::Response, rect: egui::Rect) {
+        let alt = response.ctx.input(|i| i.modifiers.alt);
+        let pointer = response.interact_pointer_pos().or(response.hover_pos());
+        let hit =
+            pointer.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
+        let (w, h) = (
+            self.doc.maps().width() as f32,
+            self.doc.maps().height() as f32,
+        );
+        let place_of = |hit: &kapaint_core::mesh::pick::Hit| Place::Surface {
+            pos: SurfacePos {
+                point: hit.position,
+                normal: hit.normal,
+            },
+            texel: hit.uv.map(|uv| Vec2::new(uv.x * w, (1.0 - uv.y) * h)),
+        };
+        let place = hit.as_ref().map(place_of);
+        if response.hovered() {
+            self.hover_tab = Some(Tab::Viewport);
+            self.hover = place.and_then(Place::texel).and_then(|p| self.texel_at(p));
+        }
+        // A screen point's size on the surface under the cursor, in texels.
+        if let (Some(p), Some(hit), Some(surface)) = (pointer, &hit, self.doc.surface())
+            && (response.hovered() || self.held == Some(Tab::Viewport))
+        {
+            let picture = self.viewport.picture_at(rect, p);
+            self.texels_per_point = points_per_world(&self.viewport.camera, picture, hit.position)
+                .map(|ppw| 1.0 / (ppw * surface.units_per_texel));
+        }
+        // Picking every sample costs a ray each; only while a stroke may start or is held.
+        let samples = pointer_samples(&response.ctx)
+            .into_iter()
+            .filter(|_| self.held.is_none() || self.held == Some(Tab::Viewport))
+            .map(|s| {
+                let hit = self
+                    .viewport
+                    .pick(rect, s.pos(), &self.mesh.mesh, &self.mesh.bvh);
+                (s, hit.as_ref().map(place_of))
+            })
+            .collect();
+        self.pointer_input(Tab::Viewport, response, samples, alt);
+        // Shift + right drag turns the light: across for its yaw, up and down for its height.
+        if response.dragged_by(egui::PointerButton::Secondary)
+            && response.ctx.input(|i| i.modifiers.shift)
+        {
+            let d = response.drag_delta();
+            self.turn_light(d.x * 0.01, -d.y * 0.01);
+        }
+        // The brush circle, projected on the surface: a circle of the dab's world radius in
+        // the tangent plane under the cursor, drawn through the camera.
+        if let (Some(p), Some(surface)) = (response.hover_pos(), self.doc.surface())
+            && self.tools.active().strokes()
+            && let Some(hit) = self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh)
+        {
+            let picture = self.viewport.picture_at(rect, p);
+            let world = if self.brush_size.on_screen {
+                points_per_world(&self.viewport.camera, picture, hit.position)
+                    .map_or(0.0, |ppw| self.brush_size.screen_radius / ppw)
+            } else {
+                self.doc.settings().brush.radius_px * surface.units_per_texel
+            };
+            let points = brush_outline(
+                &self.viewport.camera,
+                picture,
+                hit.position,
+                hit.normal,
+                world,
+            );
+            response
+                .ctx
+                .layer_painter(response.layer_id)
+                .add(egui::Shape::closed_line(
+                    points,
+                    egui::Stroke::new(1.0, egui::Color32::WHITE),
+                ));
+        }
+    }
+
+    /// What the viewport draws this frame: the light in the world (turned with the camera
+    /// when it follows the camera).
+    pub fn frame_settings(&self) -> FrameSettings {
+        let mut lighting = self.lighting;
+        if self.light_follows_camera {
+            lighting.light = self.viewport.camera.rotation() * lighting.direction();
+        }
+        FrameSettings {
+            model: self.doc.settings().model,
+            approx: self.doc.settings().approx,
+            view: self.view,
+            lighting,
+            camera: self.viewport.camera,
+        }
+    }
+
+    /// Turns the light by `yaw` about the vertical and raises it by `pitch` (radians; its
+    /// height stays within 89 degrees of the horizon).
+    pub(super) fn turn_light(&mut self, yaw: f32, pitch: f32) {
+        let (around, height) = self.lighting.angles();
+        let limit = 89f32.to_radians();
+        self.lighting
+            .set_angles(around + yaw, (height + pitch).clamp(-limit, limit));
+    }
+
+    /// Makes the light follow the camera (kept relative to the view, so turning the model
+    /// never leaves it dark) or stay put in the world; it does not jump either way.
+    pub fn set_light_follows_camera(&mut self, follow: bool) {
+        if follow == self.light_follows_camera {
+            return;
+        }
+        let turn = self.viewport.camera.rotation();
+        let l = self.lighting.direction();
+        self.lighting.light = if follow { turn.inverse() * l } else { turn * l };
+        self.light_follows_camera = follow;
+    }
+}
+
+/// One primary-button pointer event of a frame, with its position in points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Sample {
+    /// The button went down.
+    Down(egui::Pos2),
+    /// The pointer moved.
+    Move(egui::Pos2),
+    /// The button came up.
+    Up(egui::Pos2),
+}
+
+impl Sample {
+    fn pos(self) -> egui::Pos2 {
+        match self {
+            Self::Down(p) | Self::Move(p) | Self::Up(p) => p,
+        }
+    }
+}
+
+/// This frame's pointer events, in the order egui delivered them: presses and releases of
+/// the primary button and every move.
+fn pointer_samples(ctx: &egui::Context) -> Vec<Sample> {
+    ctx.input(|i| {
+        i.events
+            .iter()
+            .filter_map(|e| match e {
+                egui::Event::PointerMoved(p) => Some(Sample::Move(*p)),
+                egui::Event::PointerButton {
+                    pos,
+                    button: egui::PointerButton::Primary,
+                    pressed,
+                    ..
+                } => Some(if *pressed {
+                    Sample::Down(*pos)
+                } else {
+                    Sample::Up(*pos)
+                }),
+                _ => None,
+            })
+            .collect()
+    })
+}

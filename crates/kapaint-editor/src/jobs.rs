@@ -1,0 +1,499 @@
+//! Long work on named worker threads (open, save, recover, export, mesh and image import,
+//! stamps), each reporting through a [`Progress`], polled every frame; and the documents
+//! they make, with their meshes attached.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+
+use super::project_jobs::OpenedProject;
+use super::{EditorState, MeshState, autosave_interval, notice};
+use kapaint_core::model::document::MeshRef;
+use kapaint_core::model::surface::Surface;
+use kapaint_core::model::texel::Channel;
+use kapaint_core::model::{Command, Document, DocumentSettings, ModelError, project, recovery};
+use kapaint_core::task::Progress;
+
+/// What a worker hands back.
+pub(super) enum JobResult {
+    /// A project opened (or recovered).
+    Opened(Box<OpenedProject>),
+    /// Saved at the path: the document version saved, and the file as written.
+    Saved(PathBuf, u64, project::OnDisk),
+    /// A save that found its project changed on disk (another kapaint saved it): the work went
+    /// to `written` instead, as the document version `version`.
+    Conflicted {
+        /// What happened, for the notice.
+        message: String,
+        /// Where the work went.
+        written: PathBuf,
+        /// The document version written there.
+        version: u64,
+    },
+    Exported(PathBuf, Box<kapaint_export::Exported>),
+    /// A mesh loaded and baked at the map size, and whether its file has a textured material
+    /// (the editor then offers to bring it in).
+    Mesh(PathBuf, Arc<Surface>, bool),
+    /// A PBR material converted at the map size for the document's model.
+    Material(PathBuf, Box<PbrMaterial>),
+    /// An image decoded and resampled into a channel's planes.
+    Image(PathBuf, Box<kapaint_core::model::import::ChannelPlanes>),
+    /// The maps resized, with the mesh baked at their size.
+    Resized(kapaint_core::model::resize::ResizedMaps),
+    /// A new project (File > New), its mesh baked.
+    Created(Box<Document>),
+    /// A brush stamp read from an image.
+    Stamp(PathBuf, kapaint_core::model::brush::Stamp),
+    Failed(String),
+}
+
+/// A glTF material converted on a worker (File > Import PBR material).
+pub(super) struct PbrMaterial {
+    maps: kapaint_core::model::MaterialMaps,
+    normal: Option<kapaint_core::model::normal::NormalMap>,
+    report: kapaint_core::model::provenance::ImportReport,
+}
+
+/// Long work on a worker thread.
+pub(super) struct Job {
+    pub(super) label: String,
+    /// The project it opens (or the recovery copy it recovers), replacing the document.
+    pub(super) opens: Option<PathBuf>,
+    /// What a window over the editor says while the job runs: the editor takes no input
+    /// until it is done (the document is about to be replaced or resized).
+    pub(super) modal: Option<String>,
+    pub(super) progress: Arc<Progress>,
+    pub(super) handle: JoinHandle<JobResult>,
+}
+
+/// A new `size`^2 document on the default settings, with its mesh.
+pub(super) fn new_document(size: u32) -> Result<(Document, MeshState), String> {
+    let doc = new_document_with(size, DocumentSettings::default())?;
+    let mesh = doc.surface().map(|s| s.mesh.clone()).ok_or("no mesh")?;
+    Ok((doc, MeshState::new(mesh, 1)))
+}
+
+/// A new `size`^2 document with `settings`, its mesh (built in or a file, as the settings
+/// name it) attached and baked.
+pub(super) fn new_document_with(size: u32, settings: DocumentSettings) -> Result<Document, String> {
+    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
+    let spec = PathBuf::from(doc.settings().mesh.spec());
+    project::attach_mesh(&mut doc, &spec).map_err(|e| e.to_string())?;
+    Ok(doc)
+}
+
+/// Loads a project with its mesh (the sphere, and a note saying why, where the mesh cannot
+/// be attached).
+pub(super) fn load_project(path: &Path) -> Result<(Document, Option<String>), String> {
+    let (doc, failed) = project::open_with_mesh(path, None).map_err(|e| e.to_string())?;
+    with_fallback(doc, failed)
+}
+
+/// `doc` as it is, or, when its mesh `failed`, with the built-in sphere and a note.
+pub(super) fn with_fallback(
+    mut doc: Document,
+    failed: Option<ModelError>,
+) -> Result<(Document, Option<String>), String> {
+    let Some(e) = failed else {
+        return Ok((doc, None));
+    };
+    project::attach_mesh(&mut doc, Path::new("sphere")).map_err(|e| e.to_string())?;
+    Ok((doc, Some(format!("{e}; showing the sphere instead"))))
+}
+
+impl EditorState {
+    pub(super) fn start_job(
+        &mut self,
+        label: &str,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        self.start_job_opening(label, None, work);
+    }
+
+    /// Starts a job; one that `opens` a project replaces the document when done, and the
+    /// editor takes no input until then.
+    pub(super) fn start_job_opening(
+        &mut self,
+        label: &str,
+        opens: Option<PathBuf>,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        let modal = opens.as_ref().map(|path| {
+            let name = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            format!("Opening {name}…")
+        });
+        self.start_job_with(label, opens, modal, work);
+    }
+
+    /// Starts a job that the editor waits for behind a window saying `modal`.
+    pub(super) fn start_job_modal(
+        &mut self,
+        label: &str,
+        modal: String,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        self.start_job_with(label, None, Some(modal), work);
+    }
+
+    fn start_job_with(
+        &mut self,
+        label: &str,
+        opens: Option<PathBuf>,
+        modal: Option<String>,
+        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+    ) {
+        if self.busy() {
+            self.notices
+                .push(notice("wait for the current job to finish", true));
+            return;
+        }
+        let progress = Arc::new(Progress::default());
+        let shared = Arc::clone(&progress);
+        match std::thread::Builder::new()
+            .name(format!("kapaint-{}", label.to_lowercase()))
+            .spawn(move || work(&shared))
+        {
+            Ok(handle) => {
+                self.job = Some(Job {
+                    label: label.into(),
+                    opens,
+                    modal,
+                    progress,
+                    handle,
+                });
+            }
+            Err(e) => self
+                .notices
+                .push(notice(format!("cannot start {label}: {e}"), true)),
+        }
+    }
+
+    pub(super) fn poll_job(&mut self) {
+        if !self.job.as_ref().is_some_and(|j| j.handle.is_finished()) {
+            return;
+        }
+        let Some(job) = self.job.take() else { return };
+        let result = job
+            .handle
+            .join()
+            .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
+        match result {
+            JobResult::Opened(opened) => {
+                let note = opened.note.clone();
+                self.opened(*opened);
+                if let Some(note) = note {
+                    self.notices.push(notice(note, true));
+                }
+            }
+            JobResult::Conflicted {
+                message,
+                written,
+                version,
+            } => self.conflicted(message, written, version),
+            JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
+            JobResult::Exported(dir, m) => self.notices.push(exported_notice(&dir, *m)),
+            JobResult::Material(path, m) => self.take_material(&path, *m),
+            JobResult::Mesh(path, surface, textured) => {
+                if textured {
+                    self.material_prompt = Some(path.clone());
+                }
+                let mesh = MeshRef::from_spec(&path.display().to_string());
+                let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
+                match self.doc.apply(Command::SetMesh(attached)) {
+                    Ok(()) => {
+                        self.follow_mesh();
+                        self.notices
+                            .push(notice(format!("mesh {}", path.display()), false));
+                    }
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Image(path, planes) => {
+                let channel = planes.channel();
+                let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
+                match self.doc.apply(Command::ImportChannel(imported)) {
+                    Ok(()) => self.notices.push(notice(
+                        format!(
+                            "{} imported into {}",
+                            path.display(),
+                            crate::panels::channel_label(channel)
+                        ),
+                        false,
+                    )),
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Resized(resized) => {
+                let (w, h) = (resized.0.0.width, resized.0.0.height);
+                self.apply(Command::Resize(resized));
+                self.notices
+                    .push(notice(format!("Resized the maps to {w}x{h}"), false));
+            }
+            JobResult::Created(doc) => {
+                self.replace_document(*doc);
+                self.saved_version = self.doc.version();
+                self.path = None;
+                self.claim.hold(None, None, false);
+                // The old document was saved or its changes discarded (asked before).
+                self.autosaver.discard();
+                self.autosaver = recovery::Autosaver::new(autosave_interval(), None, &self.doc);
+            }
+            JobResult::Stamp(path, stamp) => {
+                let mut brush = self.doc.settings().brush.clone();
+                brush.stamp = Some(stamp);
+                self.apply(Command::SetBrush(brush));
+                self.notices
+                    .push(notice(format!("stamp {}", path.display()), false));
+            }
+            JobResult::Failed(e) => {
+                self.quit.after_save = false;
+                self.notices.push(notice(e, true));
+            }
+        }
+    }
+
+    pub(super) fn replace_document(&mut self, doc: Document) {
+        let mesh = doc.surface().map(|s| s.mesh.clone());
+        let size = |d: &Document| (d.maps().width(), d.maps().height());
+        if size(&doc) != size(&self.doc) {
+            // A map of another size: fit it anew (the old zoom would show a 4096^2 map 4x).
+            self.canvas.fit();
+        }
+        // The texel under the cursor was found on the old maps.
+        self.hover = None;
+        self.shown_hover = None;
+        self.doc = doc;
+        if let Some(mesh) = mesh {
+            self.mesh = MeshState::new(mesh, self.mesh.id + 1);
+            self.viewport.frame(&self.mesh.mesh);
+        }
+    }
+
+    /// Loads and bakes a mesh on a worker; it becomes the project's mesh.
+    pub fn import_mesh(&mut self, path: PathBuf) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Mesh", move |progress| {
+            progress.start("load", 1);
+            let mesh = match kapaint_core::mesh::open(&path) {
+                Ok(m) => m,
+                Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
+            };
+            progress.start("bake", 1);
+            match Surface::new(mesh, w, h) {
+                Ok(s) => {
+                    let textured = kapaint_core::pbr::gltf::has_textured_material(&path);
+                    JobResult::Mesh(path, Arc::new(s), textured)
+                }
+                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Converts the material of the glTF at `path`, or the texture set `path` is one image of
+    /// ([`kapaint_core::pbr::names`]), for the document's model at the map size, on a worker; it
+    /// replaces the selected layer's channels (one undo step) when it arrives.
+    pub fn import_pbr(&mut self, path: PathBuf) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        let model = self.doc.settings().model;
+        self.start_job("Material", move |progress| {
+            progress.start("decode", 1);
+            let gltf = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+            let set = if gltf {
+                kapaint_core::pbr::gltf::material_set(&path, None)
+                    .map(|m| (m.set, m.normal, m.notes))
+            } else {
+                kapaint_core::pbr::names::set_of(&path).and_then(|named| {
+                    let mut notes = named.notes.clone();
+                    let normal = named.load_normal(&mut notes)?;
+                    Ok((named.set, normal, notes))
+                })
+            };
+            let converted = set.and_then(|(set, normal, notes)| {
+                progress.start("convert", 1);
+                let imported = kapaint_core::pbr::import::import(&set, Some((w, h)), model)?;
+                let mut report = imported.report;
+                report.notes.extend(notes);
+                let (maps, _) = imported.doc.into_parts();
+                Ok(PbrMaterial {
+                    maps,
+                    normal,
+                    report,
+                })
+            });
+            match converted {
+                Ok(m) => JobResult::Material(path, Box::new(m)),
+                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Takes a converted PBR material: its maps into the selected layer (one undo step), its
+    /// normal map and its report into the document.
+    fn take_material(&mut self, path: &Path, m: PbrMaterial) {
+        let PbrMaterial {
+            maps,
+            normal,
+            report,
+        } = m;
+        let imported = kapaint_core::model::document::ImportedMaterial {
+            maps: Arc::new(maps),
+            normal: normal.map(Arc::new),
+            report: Some(report.clone()),
+        };
+        if let Err(e) = self.doc.apply(Command::ImportMaterial(imported)) {
+            self.notices.push(notice(e.to_string(), true));
+            return;
+        }
+        let e = report.error;
+        let text = format!(
+            "{} imported for {}: conversion error max {:.1}%, mean {:.1}%, p99 {:.1}%",
+            path.display(),
+            report.model,
+            e.max * 100.0,
+            e.mean * 100.0,
+            e.p99 * 100.0
+        );
+        self.notices.push(if e.max > PBR_ERROR_WARNING {
+            super::warning(format!(
+                "{text}: over the {:.0}% a faithful conversion keeps",
+                PBR_ERROR_WARNING * 100.0
+            ))
+        } else {
+            notice(text, false)
+        });
+        for note in &report.notes {
+            self.notices.push(notice(note.clone(), false));
+        }
+    }
+
+    /// Loads a brush stamp from an image on a worker thread.
+    pub fn load_stamp(&mut self, path: PathBuf) {
+        self.start_job("Stamp", move |progress| {
+            progress.start("decode", 1);
+            match kapaint_core::model::import::read_stamp(&path) {
+                Ok(stamp) => JobResult::Stamp(path, stamp),
+                Err(e) => JobResult::Failed(e.to_string()),
+            }
+        });
+    }
+
+    /// Decodes and resamples an image on a worker; it is written into `channel` (one undo
+    /// step) when it arrives.
+    pub fn import_image(&mut self, path: PathBuf, channel: Channel) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Image", move |progress| {
+            progress.start("decode", 1);
+            match kapaint_core::model::import::read_image(&path) {
+                Ok(image) => {
+                    progress.start("resample", 1);
+                    let planes = kapaint_core::model::import::resample(&image, channel, w, h);
+                    JobResult::Image(path, Box::new(planes))
+                }
+                Err(e) => JobResult::Failed(e.to_string()),
+            }
+        });
+    }
+
+    /// What the window over the editor says while a job it waits for runs (a project
+    /// opening, the maps being resized), if one does.
+    pub(super) fn modal_job(&self) -> Option<&str> {
+        self.job.as_ref().and_then(|j| j.modal.as_deref())
+    }
+
+    /// While a project opens or the maps are resized: a window over the editor saying so,
+    /// that takes the pointer (a stroke on the document about to be replaced would be lost).
+    pub(super) fn modal_job_ui(&self, ctx: &egui::Context) {
+        let Some(text) = self.modal_job() else {
+            return;
+        };
+        egui::Modal::new(egui::Id::new("kapaint-opening")).show(ctx, |ui| {
+            ui.horizontal(|ui| {
+                ui.spinner();
+                ui.label(text);
+            });
+        });
+    }
+}
+
+/// A PBR conversion whose largest relative error passes this is a warning: a quarter of the
+/// shading lost somewhere on the material.
+const PBR_ERROR_WARNING: f32 = 0.25;
+
+/// The notice of a finished export: a warning, with the number that missed, when the set is
+/// over its `k_a` budget or the PBR round trip loses more than [`PBR_ERROR_WARNING`].
+fn exported_notice(dir: &std::path::Path, m: kapaint_export::Exported) -> super::Notice {
+    let missed = match &m {
+        kapaint_export::Exported::Set(m) => m.blocks.as_ref().is_some_and(|b| !b.within_budget),
+        kapaint_export::Exported::Pbr(m) => m.round_trip.max > PBR_ERROR_WARNING,
+    };
+    let mut text = exported_text(dir, m);
+    if missed {
+        text = format!("{text} (over budget)");
+        return super::warning(text);
+    }
+    notice(text, false)
+}
+
+/// What a finished export says.
+fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
+    match m {
+        kapaint_export::Exported::Set(m) => {
+            let mut text = format!(
+                "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
+                dir.display(),
+                m.file_count(),
+                m.bytes.exported,
+                m.ka_error.max * 100.0,
+                m.ka_error.mean * 100.0
+            );
+            if let Some(blocks) = &m.blocks {
+                text.push_str("; blocks: ");
+                text.push_str(&blocks.summary());
+            }
+            text
+        }
+        kapaint_export::Exported::Pbr(m) => format!(
+            "exported {} as glTF PBR ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%)",
+            dir.display(),
+            m.files.len() + 1,
+            m.round_trip.max * 100.0,
+            m.round_trip.mean * 100.0,
+            m.round_trip.p99 * 100.0
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_block_compressed_exports_notice_names_its_layout_encoder_and_verdict() {
+        let doc = kapaint_core::report::typical::stroke_edge_document(32, None).expect("project");
+        let out = std::env::temp_dir().join(format!("kapaint-notice-{}", std::process::id()));
+        let preset = kapaint_export::preset::find("ktx2").expect("preset");
+        let m = kapaint_export::set::export(&doc, &preset, &out).expect("export");
+        let blocks = m.blocks.clone().expect("a block-compressed set");
+        let n = exported_notice(&out, kapaint_export::Exported::Set(m));
+        let _ = std::fs::remove_dir_all(&out);
+        let text = n.text.clone();
+        // The stroke's dark-beside-light blocks miss the k_a budget: a warning with the
+        // numbers it missed, never a green notice.
+        assert!(!blocks.within_budget, "{text}");
+        assert_eq!(n.level, crate::NoticeLevel::Warning, "{text}");
+        assert!(text.contains("over the k_a budget (max"), "{text}");
+        assert!(text.contains("; blocks: "), "{text}");
+        assert!(
+            text.contains(&format!("at {:?}", blocks.bc7_effort)),
+            "{text}"
+        );
+        assert!(text.contains("encoder"), "{text}");
+        assert!(text.contains("k_a budget"), "{text}");
+    }
+}

@@ -1,0 +1,369 @@
+//! The keymap: one table of every key binding. The input code matches keys against it and
+//! the shortcut sheet (Help > Keyboard shortcuts) and the menus show it, so they cannot
+//! disagree.
+
+use egui::{Key, KeyboardShortcut, Modifiers};
+
+use super::{EditorState, Tab};
+use kapaint_core::model::Command;
+use kapaint_core::tools::{ToolEvent, ToolKind};
+
+/// What a key does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// Undo the last step.
+    Undo,
+    /// Redo the last undone step.
+    Redo,
+    /// Save (Save As for an untitled project).
+    Save,
+    /// Save under another name.
+    SaveAs,
+    /// Open a project.
+    Open,
+    /// A new project.
+    New,
+    /// Export a texture set.
+    Export,
+    /// Quit (asking first about unsaved changes).
+    Quit,
+    /// Make a tool active.
+    Tool(ToolKind),
+    /// The fill tool over the UV canvas; frame the mesh over the 3D viewport.
+    FillOrFrame,
+    /// Fit the whole map in the UV canvas.
+    FitCanvas,
+    /// Swap the primary and secondary materials.
+    SwapMaterials,
+    /// A smaller brush.
+    SmallerBrush,
+    /// A larger brush.
+    LargerBrush,
+    /// A softer brush.
+    SofterBrush,
+    /// A harder brush.
+    HarderBrush,
+    /// Abandon the stroke or gradient under way.
+    Abort,
+    /// Show the keyboard shortcuts.
+    Shortcuts,
+    /// A new paint layer above the selected one.
+    NewLayer,
+    /// Duplicate the selected layer.
+    DuplicateLayer,
+    /// Merge the selected layer down.
+    MergeDown,
+}
+
+/// One key binding.
+#[derive(Clone, Copy, Debug)]
+pub struct Binding {
+    /// The key, with its modifiers (`COMMAND` is Ctrl, or Cmd on a Mac).
+    pub shortcut: KeyboardShortcut,
+    /// What it does.
+    pub action: Action,
+    /// What the shortcut sheet says.
+    pub description: &'static str,
+}
+
+const fn bind(
+    modifiers: Modifiers,
+    key: Key,
+    action: Action,
+    description: &'static str,
+) -> Binding {
+    Binding {
+        shortcut: KeyboardShortcut::new(modifiers, key),
+        action,
+        description,
+    }
+}
+
+const CTRL: Modifiers = Modifiers::COMMAND;
+const CTRL_SHIFT: Modifiers = Modifiers::COMMAND.plus(Modifiers::SHIFT);
+const NONE: Modifiers = Modifiers::NONE;
+
+/// Every binding. Where two share a key, the one with more modifiers comes first (egui
+/// matches modifiers loosely: Ctrl+Shift+Z would also match Ctrl+Z).
+pub const KEYMAP: &[Binding] = &[
+    bind(CTRL_SHIFT, Key::Z, Action::Redo, "redo"),
+    bind(CTRL, Key::Y, Action::Redo, "redo"),
+    bind(CTRL, Key::Z, Action::Undo, "undo"),
+    bind(CTRL_SHIFT, Key::S, Action::SaveAs, "save as"),
+    bind(CTRL, Key::S, Action::Save, "save"),
+    bind(CTRL, Key::O, Action::Open, "open"),
+    bind(CTRL_SHIFT, Key::N, Action::NewLayer, "new layer"),
+    bind(CTRL, Key::N, Action::New, "new"),
+    bind(CTRL_SHIFT, Key::E, Action::Export, "export"),
+    bind(CTRL, Key::E, Action::MergeDown, "merge layer down"),
+    bind(CTRL, Key::J, Action::DuplicateLayer, "duplicate layer"),
+    bind(CTRL, Key::Q, Action::Quit, "quit"),
+    bind(NONE, Key::B, Action::Tool(ToolKind::Brush), "brush"),
+    bind(NONE, Key::E, Action::Tool(ToolKind::Eraser), "eraser"),
+    bind(NONE, Key::R, Action::Tool(ToolKind::Blur), "blur"),
+    bind(
+        NONE,
+        Key::G,
+        Action::Tool(ToolKind::Gradient),
+        "gradient (drag, on the canvas or the mesh)",
+    ),
+    bind(NONE, Key::I, Action::Tool(ToolKind::Picker), "picker"),
+    bind(
+        NONE,
+        Key::F,
+        Action::FillOrFrame,
+        "fill (UV canvas) / frame mesh (viewport)",
+    ),
+    bind(
+        NONE,
+        Key::Home,
+        Action::FitCanvas,
+        "fit the map in the UV canvas",
+    ),
+    bind(
+        NONE,
+        Key::X,
+        Action::SwapMaterials,
+        "swap primary / secondary",
+    ),
+    bind(
+        Modifiers::SHIFT,
+        Key::OpenBracket,
+        Action::SofterBrush,
+        "softer brush",
+    ),
+    bind(
+        Modifiers::SHIFT,
+        Key::CloseBracket,
+        Action::HarderBrush,
+        "harder brush",
+    ),
+    bind(
+        NONE,
+        Key::OpenBracket,
+        Action::SmallerBrush,
+        "smaller brush",
+    ),
+    bind(NONE, Key::CloseBracket, Action::LargerBrush, "larger brush"),
+    bind(
+        NONE,
+        Key::F1,
+        Action::Shortcuts,
+        "keyboard shortcuts (this sheet)",
+    ),
+    bind(
+        NONE,
+        Key::Escape,
+        Action::Abort,
+        "abandon the stroke or gradient under way",
+    ),
+];
+
+/// The first binding of `action`, for menus.
+pub fn shortcut(action: Action) -> Option<KeyboardShortcut> {
+    KEYMAP
+        .iter()
+        .find(|b| b.action == action)
+        .map(|b| b.shortcut)
+}
+
+/// What a shifted symbol key arrives as: with Shift held, egui reports the symbol the layout
+/// makes (`{` for Shift+`[` on US and most layouts), not the key.
+fn shifted(shortcut: KeyboardShortcut) -> Option<KeyboardShortcut> {
+    let key = match shortcut.logical_key {
+        Key::OpenBracket => Key::OpenCurlyBracket,
+        Key::CloseBracket => Key::CloseCurlyBracket,
+        _ => return None,
+    };
+    shortcut
+        .modifiers
+        .shift
+        .then(|| KeyboardShortcut::new(shortcut.modifiers, key))
+}
+
+/// A binding as people write it (`Ctrl+Shift+Z`, `Shift+[`, `B`), independent of the platform
+/// (the README and the tests use it; the editor shows egui's own formatting).
+pub fn written(shortcut: &KeyboardShortcut) -> String {
+    let m = shortcut.modifiers;
+    let mut out = String::new();
+    if m.command || m.ctrl {
+        out.push_str("Ctrl+");
+    }
+    if m.alt {
+        out.push_str("Alt+");
+    }
+    if m.shift {
+        out.push_str("Shift+");
+    }
+    out.push_str(shortcut.logical_key.symbol_or_name());
+    out
+}
+
+impl EditorState {
+    /// Runs the actions of the keys pressed this frame (none while a text field has the
+    /// keyboard).
+    pub(super) fn hotkeys(&mut self, ctx: &egui::Context) {
+        // Nor while a file dialog is open: its keys are its own.
+        if ctx.egui_wants_keyboard_input()
+            || self.files.open_for().is_some()
+            || self.modal_job().is_some()
+            || self.recovery_offer.is_some()
+        {
+            return;
+        }
+        let actions: Vec<Action> = ctx.input_mut(|i| {
+            KEYMAP
+                .iter()
+                .filter(|b| {
+                    i.consume_shortcut(&b.shortcut)
+                        || shifted(b.shortcut).is_some_and(|s| i.consume_shortcut(&s))
+                })
+                .map(|b| b.action)
+                .collect()
+        });
+        let mut brush = self.doc.settings().brush.clone();
+        for action in actions {
+            match action {
+                Action::Undo => self.apply(Command::Undo),
+                Action::Redo => self.apply(Command::Redo),
+                Action::Save => self.save(),
+                Action::SaveAs => self.save_as(),
+                Action::Open => self.open_dialog(),
+                Action::New => self.new_project(),
+                Action::Export => self.open_export(),
+                Action::NewLayer => self.new_layer(kapaint_core::model::LayerKind::Paint),
+                Action::DuplicateLayer => self.apply(Command::DuplicateLayer),
+                Action::MergeDown => self.apply(Command::MergeDown),
+                Action::Quit => self.quit.asked = true,
+                Action::Tool(kind) => self.select_tool(kind),
+                Action::FillOrFrame => {
+                    if self.hover_tab == Some(Tab::Canvas) {
+                        self.select_tool(ToolKind::Fill);
+                    } else {
+                        self.viewport.frame(&self.mesh.mesh);
+                    }
+                }
+                Action::FitCanvas => self.canvas.fit(),
+                Action::Shortcuts => self.shortcuts_open = !self.shortcuts_open,
+                Action::SwapMaterials => self.apply(Command::SwapMaterials),
+                Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
+                Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
+                Action::SmallerBrush => self.scale_brush(&mut brush, 1.0 / 1.25),
+                Action::LargerBrush => self.scale_brush(&mut brush, 1.25),
+                Action::Abort => {
+                    self.tool_event(ToolEvent::Escape);
+                    // The button stays with nobody until it is released and pressed again:
+                    // the rest of the drag and its release paint nothing.
+                    self.held = None;
+                    self.pressure = 1.0;
+                }
+            }
+        }
+        if brush != self.doc.settings().brush {
+            self.apply(Command::SetBrush(brush));
+        }
+    }
+
+    /// Help > Keyboard shortcuts: the keymap, as the input code reads it.
+    pub(super) fn shortcuts_window(&mut self, ctx: &egui::Context) {
+        let mut open = self.shortcuts_open;
+        super::dialogs::centred(egui::Window::new("Keyboard shortcuts"), ctx)
+            .open(&mut open)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::Grid::new("keymap").striped(true).show(ui, |ui| {
+                    for b in KEYMAP {
+                        ui.label(ctx.format_shortcut(&b.shortcut));
+                        ui.label(b.description);
+                        ui.end_row();
+                    }
+                    for (keys, what) in MOUSE {
+                        ui.label(*keys);
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+            });
+        self.shortcuts_open = open;
+    }
+}
+
+/// The pointer's bindings (egui reads these from the pointer, not the keymap).
+pub const MOUSE: &[(&str, &str)] = &[
+    ("Left drag", "paint with the active tool"),
+    ("Right drag, Alt + left drag", "orbit (viewport)"),
+    ("Middle drag", "pan (viewport)"),
+    ("Shift + right drag", "turn the light (viewport)"),
+    ("Space + drag", "pan the UV canvas"),
+    ("Wheel", "zoom"),
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_action_has_a_key_and_no_key_does_two_things() {
+        let actions = [
+            Action::Undo,
+            Action::Redo,
+            Action::Save,
+            Action::SaveAs,
+            Action::Open,
+            Action::New,
+            Action::Export,
+            Action::Quit,
+            Action::FillOrFrame,
+            Action::FitCanvas,
+            Action::SwapMaterials,
+            Action::SmallerBrush,
+            Action::LargerBrush,
+            Action::SofterBrush,
+            Action::HarderBrush,
+            Action::Abort,
+            Action::NewLayer,
+            Action::DuplicateLayer,
+            Action::MergeDown,
+        ];
+        for action in actions {
+            assert!(shortcut(action).is_some(), "{action:?} has no key");
+        }
+        for kind in ToolKind::ALL {
+            let bound = shortcut(Action::Tool(kind)).is_some() || kind == ToolKind::Fill;
+            assert!(bound, "{kind:?} has no key");
+        }
+        for (k, a) in KEYMAP.iter().enumerate() {
+            for b in &KEYMAP[k + 1..] {
+                assert_ne!(
+                    (a.shortcut.modifiers, a.shortcut.logical_key),
+                    (b.shortcut.modifiers, b.shortcut.logical_key),
+                    "{} and {} share a key",
+                    a.description,
+                    b.description
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_readme_lists_every_key() {
+        // Every cell of the README's tables, split where one cell lists several keys.
+        let readme = include_str!("../../../README.md");
+        let cells: Vec<&str> = readme
+            .lines()
+            .filter(|l| l.starts_with('|'))
+            .flat_map(|l| l.split('|'))
+            .flat_map(|c| c.split(", "))
+            .flat_map(|c| c.split(" / "))
+            .map(str::trim)
+            .collect();
+        for b in KEYMAP {
+            let key = written(&b.shortcut);
+            assert!(
+                cells.contains(&key.as_str()),
+                "the README's key table lacks {key} ({})",
+                b.description
+            );
+        }
+    }
+}

@@ -1,0 +1,487 @@
+//! The editor: an eframe app around the model. The UI reads the document and
+//! changes it only through [`Command`]s; the GPU side ([`viewport`]) mirrors the maps.
+//!
+//! Layout: menu bar, tool and material panel on the left, view panel on the right, a dock
+//! with the 3D viewport and the UV canvas in the middle, status bar at the bottom. Long work
+//! (open, save, export) runs on named worker threads with a progress bar and cancel.
+
+mod app;
+pub mod canvas;
+mod claim;
+mod dialogs;
+pub mod files;
+mod input;
+mod jobs;
+pub mod keys;
+mod layer_view;
+mod layout;
+pub mod notices;
+pub use notices::{Notice, NoticeLevel, Notices};
+mod panels;
+mod project_jobs;
+mod prompts;
+pub use panels::layers::LayerView;
+mod readout;
+pub mod resize;
+pub mod screen_brush;
+pub mod viewport;
+
+pub use app::{Editor, run};
+use dialogs::ExportDialog;
+pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, export_folder_in, parse_recent, push_recent};
+use jobs::{Job, JobResult};
+pub use layout::{default_layout, layout_json, parse_layout};
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+use egui::Color32;
+use glam::Vec2;
+
+use canvas::{Canvas, CanvasChannel};
+use kapaint_core::mesh::Mesh;
+use kapaint_core::mesh::pick::Bvh;
+use kapaint_core::model::texel::Channel;
+use kapaint_core::model::texel::MaterialValue;
+use kapaint_core::model::{Command, Document, recovery};
+use kapaint_core::render::{Lighting, ViewMode};
+use kapaint_core::tools::Tools;
+use viewport::Viewport;
+
+/// Default map size of a new project.
+pub const DEFAULT_SIZE: u32 = 1024;
+
+/// Dock tabs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Tab {
+    /// The 3D viewport.
+    Viewport,
+    /// The UV canvas.
+    Canvas,
+    /// The layer stack.
+    Layers,
+}
+
+/// Where `world` falls in `picture` through `view_proj`, if in front of the camera.
+pub(crate) fn project(
+    view_proj: glam::Mat4,
+    picture: egui::Rect,
+    world: glam::Vec3,
+) -> Option<egui::Pos2> {
+    let clip = view_proj * world.extend(1.0);
+    (clip.w > 1e-6).then(|| {
+        let ndc = clip.truncate() / clip.w;
+        egui::Pos2::new(
+            picture.min.x + (ndc.x * 0.5 + 0.5) * picture.width(),
+            picture.min.y + (0.5 - ndc.y * 0.5) * picture.height(),
+        )
+    })
+}
+
+/// Screen points of a circle of `radius` (world units) around `centre` in the plane normal
+/// to `normal`, seen by `camera` in `picture`.
+pub fn brush_outline(
+    camera: &kapaint_core::render::Camera,
+    picture: egui::Rect,
+    centre: glam::Vec3,
+    normal: glam::Vec3,
+    radius: f32,
+) -> Vec<egui::Pos2> {
+    let n = normal.normalize_or(glam::Vec3::Z);
+    let (t, b) = n.any_orthonormal_pair();
+    let view_proj = camera.view_proj(picture.width() / picture.height().max(1.0));
+    (0..48)
+        .filter_map(|i| {
+            let a = i as f32 / 48.0 * std::f32::consts::TAU;
+            project(
+                view_proj,
+                picture,
+                centre + (t * a.cos() + b * a.sin()) * radius,
+            )
+        })
+        .collect()
+}
+
+/// A cheap identity of a stamp for its preview cache: size and a few samples' bits.
+fn stamp_key(stamp: &kapaint_core::model::brush::Stamp) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (stamp.width(), stamp.height()).hash(&mut h);
+    let step = (stamp.alpha().len() / 61).max(1);
+    for v in stamp.alpha().iter().step_by(step) {
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
+}
+
+/// A `size`^2 grey picture of a stamp (white where it paints).
+fn stamp_image(stamp: &kapaint_core::model::brush::Stamp, size: usize) -> egui::ColorImage {
+    let mut pixels = Vec::with_capacity(size * size);
+    for y in 0..size {
+        for x in 0..size {
+            let at = |i: usize| (i as f32 + 0.5) / size as f32 * 2.0 - 1.0;
+            let a = stamp.sample(at(x), at(y));
+            pixels.push(Color32::from_gray((a * 255.0 + 0.5) as u8));
+        }
+    }
+    egui::ColorImage::new([size, size], pixels)
+}
+
+/// The mesh being painted, with what picking and the renderer need.
+struct MeshState {
+    id: u64,
+    /// The document's bake this was made from: when the document's differs (undo of a mesh
+    /// import, a resize), the state follows it.
+    from: std::sync::Weak<kapaint_core::model::surface::Surface>,
+    mesh: Arc<Mesh>,
+    bvh: Bvh,
+    /// UV edges in map fractions (u, 1 - v), for the canvas wireframe.
+    uv_lines: Vec<[Vec2; 2]>,
+}
+
+impl MeshState {
+    fn new(mesh: Mesh, id: u64) -> Self {
+        let bvh = Bvh::build(&mesh);
+        let mut uv_lines = Vec::new();
+        if let Some(uvs) = &mesh.uvs {
+            for tri in &mesh.triangles {
+                for k in 0..3 {
+                    let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
+                    if a < b || mesh.triangles.len() < 4 {
+                        let at = |i: usize| Vec2::new(uvs[i].x, 1.0 - uvs[i].y);
+                        uv_lines.push([at(a), at(b)]);
+                    }
+                }
+            }
+        }
+        Self {
+            id,
+            from: std::sync::Weak::new(),
+            mesh: Arc::new(mesh),
+            bvh,
+            uv_lines,
+        }
+    }
+}
+
+/// Everything the panels and tabs read and change (the dock lives beside it).
+pub struct EditorState {
+    /// The document.
+    doc: Document,
+    /// Where it is saved.
+    path: Option<PathBuf>,
+    /// The project named at start, while the recovery offer decides how it opens.
+    starting: Option<PathBuf>,
+    saved_version: u64,
+    /// The tools and which one is active.
+    tools: Tools,
+    /// View mode of the viewport.
+    view: ViewMode,
+    /// Lights (relative to the camera while `light_follows_camera`).
+    lighting: Lighting,
+    /// The light turns with the camera.
+    light_follows_camera: bool,
+    /// The 3D viewport.
+    viewport: Viewport,
+    /// The UV canvas.
+    canvas: Canvas,
+    mesh: MeshState,
+    /// Messages.
+    notices: Notices,
+    job: Option<Job>,
+    export: Option<ExportDialog>,
+    /// The last export's preset and folder, offered again by the next.
+    export_choice: Option<(String, String)>,
+    /// The Resize dialog, while open.
+    resize_dialog: Option<resize::ResizeDialog>,
+    /// The New dialog, while open.
+    new_dialog: Option<NewDialog>,
+    /// A project to open once the user has decided about the unsaved changes.
+    pending_open: Option<PathBuf>,
+    /// An imported glTF mesh whose material has textures: asking whether to bring them in.
+    material_prompt: Option<PathBuf>,
+    /// Recently opened or saved projects, newest first.
+    recent: Vec<PathBuf>,
+    /// The pen's last pressure in the current stroke (1 with a mouse).
+    pressure: f32,
+    /// The view the primary button went down on, until it goes up.
+    held: Option<Tab>,
+    /// The brush stamp's preview texture, and which stamp it shows.
+    stamp_preview: Option<(u64, egui::TextureHandle)>,
+    /// The texel under the cursor, in either view.
+    hover: Option<(u32, u32)>,
+    /// The tab under the cursor.
+    hover_tab: Option<Tab>,
+    /// How the brush's size is given: in texels, or on screen.
+    brush_size: screen_brush::BrushSize,
+    /// The hex field's text while it is typed in (`None`: it shows the primary's `k_d`).
+    hex_text: Option<String>,
+    /// Materials laid last by a stroke, fill or gradient, newest first.
+    recent_materials: Vec<MaterialValue>,
+    /// Texels per screen point under the cursor (canvas zoom, or the surface's scale).
+    texels_per_point: Option<f32>,
+    /// The brush circle drawn on the UV canvas this frame: centre and radius in points.
+    canvas_outline: Option<(egui::Pos2, f32)>,
+    /// `hover` as of the last frame (the status bar is drawn before the tabs).
+    shown_hover: Option<(u32, u32)>,
+    /// Exact `chi` values for the status bar, integrated on a worker.
+    exact_chi: readout::ExactChi,
+    /// Quitting: asked, waiting for a save, or allowed.
+    quit: Quit,
+    /// The file chooser: the system's, or kapaint's own without a desktop portal.
+    files: files::FileChooser,
+    /// Whether Help > Keyboard shortcuts is open.
+    shortcuts_open: bool,
+    /// A recovery copy found at start, newer than the project.
+    recovery_offer: Option<PathBuf>,
+    /// Material presets with their thumbnails (rendered a few per frame) and the mesh each
+    /// thumbnail shows.
+    presets: Vec<panels::presets::PresetEntry>,
+    /// Brush presets, shipped and the user's.
+    brush_presets: Vec<kapaint_core::model::brush::preset::BrushPreset>,
+    /// The user preset folder presets are saved to.
+    preset_dir: Option<PathBuf>,
+    /// A preset's name being typed, what it names, and whether its field opened this frame.
+    naming: Option<(panels::presets::Naming, String, bool)>,
+    autosaver: recovery::Autosaver,
+    /// The project file as read or saved, its lock, and whether it opened read-only.
+    claim: claim::Claim,
+    /// The Layers tab's thumbnails and the name being typed.
+    layers_panel: panels::layers::PanelState,
+    /// What the viewport and canvas show of the layers.
+    pub layer_view: panels::layers::LayerView,
+}
+
+/// Where quitting stands.
+#[derive(Default)]
+struct Quit {
+    /// Quit was asked (menu, key or the window's close button).
+    asked: bool,
+    /// Quit once the save under way is done (the quit prompt's Save).
+    after_save: bool,
+    /// The window may close with unsaved changes: saved meanwhile, or the user discarded them.
+    allowed: Option<QuitAllowed>,
+}
+
+/// Why the window may close although the document changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum QuitAllowed {
+    /// The quit prompt's Save finished.
+    Saved,
+    /// The user discarded the changes: their recovery copy goes too.
+    Discarded,
+}
+
+/// A preset's thumbnail: the id of the mesh it shows, and its texture.
+type Thumbnail = (u64, egui::TextureHandle);
+
+/// How often the editor autosaves: [`recovery::AUTOSAVE_INTERVAL`], or
+/// `KAPAINT_AUTOSAVE_SECONDS` (the crash test uses a short one).
+fn autosave_interval() -> Duration {
+    std::env::var("KAPAINT_AUTOSAVE_SECONDS")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .map_or(recovery::AUTOSAVE_INTERVAL, Duration::from_secs_f64)
+}
+
+/// Information, or an error.
+fn notice(text: impl Into<String>, error: bool) -> Notice {
+    Notice::new(
+        text,
+        if error {
+            NoticeLevel::Error
+        } else {
+            NoticeLevel::Info
+        },
+    )
+}
+
+/// A warning: done, but short of what was asked (with the number that missed).
+fn warning(text: impl Into<String>) -> Notice {
+    Notice::new(text, NoticeLevel::Warning)
+}
+
+impl EditorState {
+    /// The document.
+    pub fn doc(&self) -> &Document {
+        &self.doc
+    }
+
+    /// Where the document is saved, if anywhere yet.
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    /// The tools and which one is active.
+    pub fn tools(&self) -> &Tools {
+        &self.tools
+    }
+
+    /// What the 3D viewport compares, and how.
+    pub fn comparison(&self) -> viewport::Comparison {
+        self.viewport.comparison
+    }
+
+    /// The New dialog's choices, while it is open.
+    pub fn new_dialog(&self) -> Option<&NewDialog> {
+        self.new_dialog.as_ref()
+    }
+
+    /// Sets the New dialog's choices (opening it).
+    pub fn set_new_dialog(&mut self, dialog: NewDialog) {
+        self.new_dialog = Some(dialog);
+    }
+
+    /// The brush circle on the UV canvas (centre and radius in points), while the cursor is
+    /// over it with a painting tool.
+    pub fn canvas_outline(&self) -> Option<(egui::Pos2, f32)> {
+        self.canvas_outline
+    }
+
+    /// What the open file dialog is for, if one is open.
+    pub fn file_dialog_open_for(&self) -> Option<files::FilePurpose> {
+        self.files.open_for()
+    }
+
+    /// Whether the window is closing (quit asked, and nothing unsaved, or discarded).
+    pub fn closing(&self) -> bool {
+        self.quit.asked && (self.quit.allowed.is_some() || !self.dirty())
+    }
+
+    /// The export dialog's folder, while it is open.
+    pub fn export_folder(&self) -> Option<&str> {
+        self.export.as_ref().map(dialogs::ExportDialog::folder)
+    }
+
+    /// A project waiting to be opened until the user decides about unsaved changes.
+    pub fn pending_open(&self) -> Option<&Path> {
+        self.pending_open.as_deref()
+    }
+
+    /// The messages shown in the corner.
+    pub fn notices(&self) -> &[Notice] {
+        &self.notices
+    }
+
+    /// Writes the recovery copy now if the document differs from it, and waits until it is
+    /// on disk: what the timer does every interval, at once.
+    ///
+    /// # Errors
+    /// The autosave's failure.
+    pub fn autosave_now(&mut self) -> Result<(), String> {
+        self.autosaver
+            .save_now(&self.doc)
+            .map_err(|e| e.to_string())
+    }
+
+    /// This editor's recovery copy (its session folder; it may not exist yet).
+    pub fn recovery_copy(&self) -> std::path::PathBuf {
+        self.autosaver.session()
+    }
+
+    /// What the viewport and canvas show of the layers: the chosen view, except that a mask
+    /// tools paint shows alone, in grey, while the chosen view is the whole stack.
+    pub fn shown_layer_view(&self) -> panels::layers::LayerView {
+        use panels::layers::LayerView;
+        if self.doc.selection().mask && self.layer_view == LayerView::Composite {
+            LayerView::Mask
+        } else {
+            self.layer_view
+        }
+    }
+
+    /// Whether anything the project file stores (maps or settings) changed since the last
+    /// save.
+    pub fn dirty(&self) -> bool {
+        self.doc.version() != self.saved_version
+    }
+
+    /// The UV canvas's zoom, in screen points per texel (0 until it is fitted to its
+    /// panel).
+    pub fn canvas_zoom(&self) -> f32 {
+        self.canvas.zoom
+    }
+
+    /// The mesh each preset thumbnail shows (`None` until it is drawn) and the mesh the
+    /// document is on now: thumbnails follow the mesh after New, Open or an import.
+    pub fn thumbnail_meshes(&self) -> (Vec<Option<u64>>, u64) {
+        let shown = self
+            .presets
+            .iter()
+            .map(|p| p.thumbnail.as_ref().map(|(id, _)| *id))
+            .collect();
+        (shown, self.mesh.id)
+    }
+
+    /// The window's title: the project's file name (or "untitled"), a `*` while it has
+    /// unsaved changes, then the program's name.
+    pub fn window_title(&self) -> String {
+        let name = self
+            .path
+            .as_deref()
+            .and_then(Path::file_name)
+            .map_or_else(|| "untitled".into(), |n| n.to_string_lossy().into_owned());
+        let marker = if self.dirty() { "*" } else { "" };
+        let read_only = if self.claim.read_only {
+            " [read-only]"
+        } else {
+            ""
+        };
+        format!("{name}{marker}{read_only} - kapaint")
+    }
+
+    /// Applies a command as the panels do (an error becomes a notice).
+    pub fn apply_command(&mut self, command: Command) {
+        self.apply(command);
+    }
+
+    fn apply(&mut self, command: Command) {
+        if let Err(e) = self.doc.apply(command) {
+            self.notices.push(notice(e.to_string(), true));
+        }
+        self.follow_mesh();
+    }
+
+    /// The mesh shown, picked and drawn on follows the document's (a mesh import, its undo):
+    /// rebuilt, and the view framed, only when the mesh itself changed.
+    fn follow_mesh(&mut self) {
+        let Some(surface) = self.doc.surface() else {
+            return;
+        };
+        // Upgraded, not compared by address: a freed bake's address may be reused.
+        if self
+            .mesh
+            .from
+            .upgrade()
+            .is_some_and(|from| Arc::ptr_eq(&from, surface))
+        {
+            return;
+        }
+        if *self.mesh.mesh != surface.mesh {
+            self.mesh = MeshState::new(surface.mesh.clone(), self.mesh.id + 1);
+            self.viewport.frame(&self.mesh.mesh);
+        }
+        self.mesh.from = Arc::downgrade(surface);
+    }
+
+    /// The channel the canvas shows (`k_d` for the derived `k_a`): where dropped images go.
+    fn canvas_target(&self) -> Channel {
+        match self.canvas.channel {
+            CanvasChannel::Ks => Channel::Ks,
+            CanvasChannel::N => Channel::N,
+            CanvasChannel::Kd | CanvasChannel::Ka | CanvasChannel::PbrError => Channel::Kd,
+        }
+    }
+
+    fn busy(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// The project being opened (or recovered) on a worker, if one is: the document is about
+    /// to be replaced, so it takes no input meanwhile.
+    pub fn opening(&self) -> Option<&Path> {
+        self.job.as_ref().and_then(|j| j.opens.as_deref())
+    }
+}

@@ -1,0 +1,254 @@
+//! The menu bar, the status bar, dropped files and notices.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use crate::files::FilePurpose;
+use crate::keys::{self, Action};
+use crate::{EditorState, notice};
+use kapaint_core::model::Command;
+use kapaint_core::model::texel::Channel;
+use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
+
+impl EditorState {
+    pub(crate) fn status_bar_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let maps = self.doc.maps();
+            ui.label(format!("{}x{}", maps.width(), maps.height()));
+            ui.separator();
+            ui.label(format!(
+                "maps {}, history {}",
+                super::view_panel::megabytes(maps.heap_bytes()),
+                super::view_panel::megabytes(self.doc.history().bytes())
+            ));
+            ui.separator();
+            match &self.viewport.gpu {
+                Some(g) => ui.label(format!(
+                    "frame {:.1} ms, viewport {:.1} ms ({})",
+                    ui.input(|i| i.stable_dt) * 1000.0,
+                    self.viewport.frame_ms,
+                    g.adapter()
+                )),
+                None => ui.label("no GPU"),
+            };
+            if let Some((x, y)) = self
+                .shown_hover
+                .filter(|&(x, y)| x < maps.width() && y < maps.height())
+            {
+                let v = maps.value(x, y);
+                let ka = |m, a| reflectance::ka(m, a, v.kd, v.ks, v.n);
+                let approx = self.doc.settings().approx;
+                let [phong, blinn, ct] = ShadingModel::ALL.map(|m| ka(m, approx));
+                let model = self.doc.settings().model;
+                // Integrated on a worker, shown when it arrives: never on this thread.
+                let n_bits = maps.texel(x, y).n;
+                let exact = self
+                    .exact_chi
+                    .get(ui.ctx(), model, n_bits)
+                    .map_or_else(
+                        || "...".to_string(),
+                        |[chi1, chi0]| {
+                            let diffuse = reflectance::diffuse_factor(AmbientApprox::Fast) as f32;
+                            format!("{:.4}", diffuse * v.kd.x + v.ks.x * chi1 as f32 + chi0 as f32)
+                        },
+                    );
+                ui.separator();
+                ui.label(format!(
+                    "({x}, {y}) k_d {:.3} {:.3} {:.3}  k_s {:.3}  n {:.1}  k_a eq.8 {:.4}  eq.11 {:.4}  CT {:.4}  exact {exact}",
+                    v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n, phong.x, blinn.x, ct.x
+                ))
+                .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), Cook-Torrance (GGX) by kapaint's fit, and the exact integral for the current model");
+            }
+            if let Some(job) = &self.job {
+                ui.separator();
+                ui.add(
+                    egui::ProgressBar::new(job.progress.fraction())
+                        .desired_width(160.0)
+                        .text(job_text(&job.label, &job.progress.stage())),
+                );
+                if ui.button("Cancel").clicked() {
+                    job.progress.cancel();
+                }
+            }
+        });
+    }
+
+    pub(crate) fn menu_ui(&mut self, ui: &mut egui::Ui) {
+        // A menu entry showing its shortcut; whether it was clicked.
+        let item = |ui: &mut egui::Ui, label: &str, action: Action| {
+            let text =
+                keys::shortcut(action).map_or_else(String::new, |k| ui.ctx().format_shortcut(&k));
+            ui.add(egui::Button::new(label).shortcut_text(text))
+                .clicked()
+        };
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if item(ui, "New", Action::New) {
+                    self.new_project();
+                }
+                if item(ui, "Open…", Action::Open) {
+                    self.open_dialog();
+                }
+                ui.menu_button("Open Recent", |ui| {
+                    if self.recent.is_empty() {
+                        ui.label("No recent files");
+                    }
+                    let mut chosen = None;
+                    for p in &self.recent {
+                        let name = p.file_name().map_or_else(
+                            || p.display().to_string(),
+                            |n| n.to_string_lossy().into_owned(),
+                        );
+                        if ui
+                            .button(name)
+                            .on_hover_text(p.display().to_string())
+                            .clicked()
+                        {
+                            chosen = Some(p.clone());
+                        }
+                    }
+                    if let Some(p) = chosen {
+                        self.open(p);
+                    }
+                });
+                if item(ui, "Save", Action::Save) {
+                    self.save();
+                }
+                if item(ui, "Save As…", Action::SaveAs) {
+                    self.save_as();
+                }
+                if item(ui, "Export…", Action::Export) {
+                    self.open_export();
+                }
+                ui.separator();
+                if ui.button("Import mesh…").clicked() {
+                    self.choose_file(FilePurpose::ImportMesh);
+                }
+                if ui
+                    .button("Import PBR material…")
+                    .on_hover_text(
+                        "A glTF file's material, or a texture set (choose any one of its \
+                         images: name_BaseColor, _Metallic, _Roughness or _ORM, _Normal): \
+                         converted for the current model into the selected layer",
+                    )
+                    .clicked()
+                {
+                    self.choose_file(FilePurpose::ImportPbr);
+                }
+                for channel in [Channel::Kd, Channel::Ks, Channel::N] {
+                    if ui
+                        .button(format!("Import image into {}…", channel_label(channel)))
+                        .clicked()
+                    {
+                        self.choose_file(FilePurpose::ImportImage(channel));
+                    }
+                }
+                ui.separator();
+                if item(ui, "Quit", Action::Quit) {
+                    self.quit.asked = true;
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if item(ui, "Undo", Action::Undo) {
+                    self.apply(Command::Undo);
+                }
+                if item(ui, "Redo", Action::Redo) {
+                    self.apply(Command::Redo);
+                }
+            });
+            ui.menu_button("Image", |ui| {
+                if ui
+                    .button("Resize…")
+                    .on_hover_text("Resample the maps to another size (one undo step)")
+                    .clicked()
+                {
+                    self.open_resize();
+                }
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.button("Keyboard shortcuts").clicked() {
+                    self.shortcuts_open = true;
+                }
+            });
+        });
+    }
+
+    pub(crate) fn dropped_files(&mut self, ctx: &egui::Context) {
+        let files: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
+        for path in files {
+            let ext = path
+                .extension()
+                .map(|e| e.to_string_lossy().to_lowercase())
+                .unwrap_or_default();
+            match ext.as_str() {
+                "kapaint" => self.open(path),
+                "obj" | "gltf" | "glb" => self.import_mesh(path),
+                "png" | "jpg" | "jpeg" | "tga" | "exr" => {
+                    let channel = self.canvas_target();
+                    self.import_image(path, channel);
+                }
+                _ => self.notices.push(notice(
+                    format!(
+                        "{}: drop a project (.kapaint), a mesh (.obj, .gltf, .glb) or an image",
+                        path.display()
+                    ),
+                    true,
+                )),
+            }
+        }
+    }
+
+    pub(crate) fn notices_ui(&mut self, ctx: &egui::Context) {
+        self.notices.expire();
+        if self.notices.is_empty() {
+            return;
+        }
+        egui::Area::new(egui::Id::new("notices"))
+            .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -36.0))
+            .show(ctx, |ui| {
+                for n in self.notices.iter() {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| {
+                        ui.colored_label(
+                            n.level.colour(),
+                            format!("{} {}", n.level.mark(), n.shown()),
+                        );
+                    });
+                }
+            });
+        ctx.request_repaint_after(Duration::from_millis(500));
+    }
+}
+
+/// A channel as the editor names it everywhere: `k_d`, `k_s`, `n`.
+pub(crate) fn channel_label(channel: Channel) -> &'static str {
+    match channel {
+        Channel::Kd => "k_d",
+        Channel::Ks => "k_s",
+        Channel::N => "n",
+    }
+}
+
+/// A job's progress text: "Export: encode", or only "Open" where the stage repeats the label.
+fn job_text(label: &str, stage: &str) -> String {
+    if stage.is_empty() || stage.eq_ignore_ascii_case(label) {
+        label.to_string()
+    } else {
+        format!("{label}: {stage}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_stage_that_repeats_the_label_is_said_once() {
+        assert_eq!(super::job_text("Open", "open"), "Open");
+        assert_eq!(super::job_text("Export", "encode"), "Export: encode");
+        assert_eq!(super::job_text("Save", ""), "Save");
+    }
+}

@@ -1,0 +1,147 @@
+//! The Layers tab's lower half: the selected layer's name, opacity, channel enables and blend
+//! modes, a fill layer's material, its mask's switches and the moves. Each change is a
+//! [`Command`].
+
+use crate::EditorState;
+use kapaint_core::model::layers::{Layer, LayerBlend, LayerContent};
+use kapaint_core::model::texel::{Channel, Channels};
+use kapaint_core::model::{Command, LayerMove};
+
+impl EditorState {
+    /// The selected layer's name, opacity, channels and blends, fill material, mask and moves.
+    pub(super) fn selected_layer_ui(&mut self, ui: &mut egui::Ui) {
+        let Some(layer) = self.doc.stack().layer(&self.doc.selection().path).cloned() else {
+            ui.label("No layer is selected.");
+            return;
+        };
+        let mut commands = Vec::new();
+        if let Some(name) = &mut self.layers_panel.rename {
+            let edit = ui.text_edit_singleline(name);
+            edit.request_focus();
+            if edit.lost_focus() {
+                let entered = ui.input(|i| !i.key_pressed(egui::Key::Escape));
+                if entered && !name.trim().is_empty() && *name != layer.props.name {
+                    commands.push(Command::RenameLayer(name.trim().to_owned()));
+                }
+                self.layers_panel.rename = None;
+            }
+        } else {
+            ui.label(egui::RichText::new(&layer.props.name).strong())
+                .on_hover_text("Double-click the name in the list to rename");
+        }
+        let mut opacity = layer.props.opacity * 100.0;
+        if ui
+            .add(
+                egui::Slider::new(&mut opacity, 0.0..=100.0)
+                    .suffix(" %")
+                    .text("Opacity"),
+            )
+            .changed()
+        {
+            commands.push(Command::SetLayerOpacity(opacity / 100.0));
+        }
+        commands.extend(channels_ui(ui, &layer));
+        if let LayerContent::Fill(value) = layer.content
+            && ui
+                .button("Fill with the primary material")
+                .on_hover_text(format!("Now: n {:.0}", value.n))
+                .clicked()
+        {
+            commands.push(Command::SetLayerFill(self.doc.settings().primary));
+        }
+        commands.extend(mask_ui(ui, &layer, self.doc.selection().mask));
+        ui.horizontal_wrapped(|ui| {
+            for (text, m) in [
+                ("Up", LayerMove::Up),
+                ("Down", LayerMove::Down),
+                ("Into group", LayerMove::IntoGroup),
+                ("Out of group", LayerMove::OutOfGroup),
+            ] {
+                if ui.button(text).clicked() {
+                    commands.push(Command::MoveLayer(m));
+                }
+            }
+            if ui.button("Group").clicked() {
+                commands.push(Command::Group);
+            }
+            if matches!(layer.content, LayerContent::Group(_)) && ui.button("Ungroup").clicked() {
+                commands.push(Command::Ungroup);
+            }
+        });
+        for c in commands {
+            self.apply(c);
+        }
+    }
+}
+
+/// Per channel: whether the layer lays it over those below, and its blend mode.
+fn channels_ui(ui: &mut egui::Ui, layer: &Layer) -> Vec<Command> {
+    let mut commands = Vec::new();
+    let mut on = layer.props.channels.map(|c| c.enabled);
+    egui::Grid::new("layer channels").show(ui, |ui| {
+        for (k, channel) in Channel::ALL.into_iter().enumerate() {
+            if ui.checkbox(&mut on[k], channel.name()).changed() {
+                commands.push(Command::SetLayerChannels(Channels {
+                    kd: on[0],
+                    ks: on[1],
+                    n: on[2],
+                }));
+            }
+            let mode = layer.props.channels[k].mode;
+            egui::ComboBox::from_id_salt(("layer blend", k))
+                .selected_text(mode.name(channel))
+                .width(110.0)
+                .show_ui(ui, |ui| {
+                    for m in LayerBlend::ALL
+                        .into_iter()
+                        .filter(|m| m.allowed_for(channel))
+                    {
+                        if ui.selectable_label(m == mode, m.name(channel)).clicked() && m != mode {
+                            commands.push(Command::SetLayerBlend { channel, mode: m });
+                        }
+                    }
+                });
+            ui.end_row();
+        }
+    });
+    commands
+}
+
+/// The mask's switches, or a button adding one.
+fn mask_ui(ui: &mut egui::Ui, layer: &Layer, painting_mask: bool) -> Vec<Command> {
+    let mut commands = Vec::new();
+    ui.horizontal_wrapped(|ui| {
+        let Some(mask) = &layer.mask else {
+            if ui
+                .button("Add mask")
+                .on_hover_text("A white mask: paint black to hide")
+                .clicked()
+            {
+                commands.push(Command::AddMask);
+            }
+            return;
+        };
+        let (text, command) = if painting_mask {
+            ("Paint the layer", Command::SelectContent)
+        } else {
+            ("Paint the mask", Command::SelectMask)
+        };
+        if ui.button(text).clicked() {
+            commands.push(command);
+        }
+        let mut enabled = mask.enabled;
+        if ui.checkbox(&mut enabled, "Mask on").changed() {
+            commands.push(Command::SetMaskEnabled(enabled));
+        }
+        for (text, command) in [
+            ("Invert", Command::InvertMask),
+            ("Apply", Command::ApplyMask),
+            ("Delete mask", Command::DeleteMask),
+        ] {
+            if ui.button(text).clicked() {
+                commands.push(command);
+            }
+        }
+    });
+    commands
+}

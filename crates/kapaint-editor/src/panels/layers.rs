@@ -1,0 +1,518 @@
+//! The Layers dock tab: the stack, top layer first, as Krita and Substance show it. Each row
+//! has an eye, a lock, a drag handle, a thumbnail of the content and of the mask, the name and
+//! the memory the layer holds. Below the list: adding, duplicating, deleting and merging
+//! layers, and the selected layer's opacity, channel blends and mask. Every change is a
+//! [`Command`]; the panel only reads the document.
+
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+use egui::{Color32, Rect, Sense, Vec2};
+
+use crate::EditorState;
+use kapaint_core::model::layers::{Layer, LayerContent, thumbnail};
+use kapaint_core::model::{Command, Document, LayerKind, LayerPlace};
+
+/// Thumbnails' side in texels.
+const THUMB: u32 = 32;
+/// Thumbnails' side on screen, in points.
+const THUMB_POINTS: f32 = 28.0;
+/// While a stroke goes on, thumbnails are made at most this often.
+const STROKE_REFRESH: Duration = Duration::from_millis(300);
+
+/// What the viewport and canvas show of the layers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayerView {
+    /// The composite of the stack (what export ships).
+    #[default]
+    Composite,
+    /// The selected layer alone over the base material.
+    Selected,
+    /// The selected layer's mask, in grey.
+    Mask,
+}
+
+impl LayerView {
+    /// Every view, in the order the view panel lists them.
+    pub const ALL: [Self; 3] = [Self::Composite, Self::Selected, Self::Mask];
+
+    /// Its label.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Composite => "All layers",
+            Self::Selected => "Selected layer only",
+            Self::Mask => "Mask",
+        }
+    }
+}
+
+/// A layer being dragged in the panel: its path.
+#[derive(Clone, Debug)]
+struct DraggedLayer(Vec<usize>);
+
+/// The panel's thumbnails and per-layer memory, made again when the document changes (at most
+/// every [`STROKE_REFRESH`] during a stroke).
+#[derive(Default)]
+struct LayerThumbs {
+    version: Option<u64>,
+    made: Option<Instant>,
+    content: HashMap<Vec<usize>, egui::TextureHandle>,
+    masks: HashMap<Vec<usize>, egui::TextureHandle>,
+    bytes: HashMap<Vec<usize>, usize>,
+}
+
+impl LayerThumbs {
+    fn refresh(&mut self, ctx: &egui::Context, doc: &Document) {
+        let version = doc.version();
+        let recent = self.made.is_some_and(|t| t.elapsed() < STROKE_REFRESH);
+        if self.version == Some(version) || (doc.stroking() && recent) {
+            return;
+        }
+        self.version = Some(version);
+        self.made = Some(Instant::now());
+        let stack = doc.stack();
+        let walk = stack.walk();
+        let side = usize::try_from(THUMB).unwrap_or(1);
+        let texture = |map: &mut HashMap<Vec<usize>, egui::TextureHandle>,
+                       path: &[usize],
+                       kind: &str,
+                       pixels: Option<Vec<[u8; 4]>>| {
+            let Some(pixels) = pixels else {
+                map.remove(path);
+                return;
+            };
+            let image =
+                egui::ColorImage::from_rgba_unmultiplied([side, side], pixels.as_flattened());
+            if let Some(handle) = map.get_mut(path) {
+                handle.set(image, egui::TextureOptions::NEAREST);
+            } else {
+                let name = format!("layer {kind} {path:?}");
+                let handle = ctx.load_texture(name, image, egui::TextureOptions::NEAREST);
+                map.insert(path.to_vec(), handle);
+            }
+        };
+        let paths: Vec<&Vec<usize>> = walk.iter().map(|(p, _)| p).collect();
+        self.content.retain(|p, _| paths.contains(&p));
+        self.masks.retain(|p, _| paths.contains(&p));
+        self.bytes.clear();
+        for (path, layer) in &walk {
+            texture(
+                &mut self.content,
+                path,
+                "content",
+                thumbnail::content(stack, layer, THUMB),
+            );
+            texture(
+                &mut self.masks,
+                path,
+                "mask",
+                thumbnail::mask(stack, layer, THUMB),
+            );
+            self.bytes.insert(path.clone(), layer.heap_bytes());
+        }
+    }
+}
+
+/// The Layers tab's own state.
+#[derive(Default)]
+pub struct PanelState {
+    thumbs: LayerThumbs,
+    /// The selected layer's new name being typed.
+    pub(super) rename: Option<String>,
+    /// The maps a layer view shows.
+    pub(crate) view_maps: crate::layer_view::ViewMaps,
+}
+
+/// What a row asked for this frame.
+enum RowAction {
+    Select { mask: bool, alone: bool },
+    Toggle(Command),
+    Rename,
+    Drop(Vec<usize>, LayerPlace),
+}
+
+impl EditorState {
+    /// What tools paint (a layer or its mask) and which layer view is shown, as the viewport
+    /// and canvas say it.
+    pub fn painting_text(&self) -> Option<String> {
+        let selection = self.doc.selection();
+        let layer = self.doc.stack().layer(&selection.path)?;
+        let mut text = if selection.mask {
+            format!("Painting the mask of \"{}\"", layer.props.name)
+        } else {
+            format!("Painting \"{}\"", layer.props.name)
+        };
+        if self.shown_layer_view() != LayerView::Composite {
+            text.push_str(" · showing ");
+            text.push_str(&self.shown_layer_view().label().to_lowercase());
+        }
+        Some(text)
+    }
+
+    /// Says in a corner of the viewport or canvas (`rect`) what tools paint (a layer or its
+    /// mask) and which layer view is shown.
+    pub(crate) fn painting_label(&self, ui: &egui::Ui, rect: Rect) {
+        let Some(text) = self.painting_text() else {
+            return;
+        };
+        let colour = if self.doc.selection().mask {
+            Color32::from_rgb(255, 200, 120)
+        } else {
+            Color32::from_gray(220)
+        };
+        let painter = ui.painter_at(rect);
+        let galley = painter.layout_no_wrap(text, egui::FontId::proportional(13.0), colour);
+        let at = rect.left_bottom() + Vec2::new(8.0, -8.0 - galley.size().y);
+        painter.rect_filled(
+            Rect::from_min_size(at, galley.size()).expand(4.0),
+            3.0,
+            Color32::from_black_alpha(150),
+        );
+        painter.galley(at, galley, colour);
+    }
+
+    /// The Layers tab.
+    pub(crate) fn layers_ui(&mut self, ui: &mut egui::Ui) {
+        self.layers_panel.thumbs.refresh(ui.ctx(), &self.doc);
+        self.layer_buttons_ui(ui);
+        ui.separator();
+        let mut actions = Vec::new();
+        egui::ScrollArea::vertical()
+            .id_salt("layers")
+            .max_height((ui.available_height() - 230.0).max(120.0))
+            .show(ui, |ui| {
+                let layers = &self.doc.stack().layers;
+                self.rows_ui(ui, layers, &[], &mut actions);
+                ui.label(
+                    egui::RichText::new(format!(
+                        "Base material (n {:.0})",
+                        self.doc.stack().base.n
+                    ))
+                    .weak(),
+                );
+                if let Some(normal) = self.doc.normal() {
+                    ui.label(
+                        egui::RichText::new(format!(
+                            "Normal map {}x{} (imported; lighting only, never in k_a)",
+                            normal.width(),
+                            normal.height()
+                        ))
+                        .weak(),
+                    )
+                    .on_hover_text(
+                        "A tangent-space normal map from the imported material: the preview \
+                         lights with it, the gltf-pbr export passes it through. It is not painted.",
+                    );
+                }
+            });
+        for (path, action) in actions {
+            self.row_action(path, action);
+        }
+        ui.separator();
+        self.selected_layer_ui(ui);
+    }
+
+    fn layer_buttons_ui(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal_wrapped(|ui| {
+            let add = |ui: &mut egui::Ui, text: &str, tip: &str| {
+                ui.button(text).on_hover_text(tip).clicked()
+            };
+            if add(
+                ui,
+                "+ Paint",
+                "A new paint layer above the selected one (Ctrl+Shift+N)",
+            ) {
+                self.new_layer(LayerKind::Paint);
+            }
+            if add(
+                ui,
+                "+ Fill",
+                "A fill layer of the primary material, shaped by its mask",
+            ) {
+                self.new_layer(LayerKind::Fill);
+            }
+            if add(ui, "+ Group", "A new, empty group") {
+                self.new_layer(LayerKind::Group);
+            }
+            if add(ui, "Duplicate", "Duplicate the selected layer (Ctrl+J)") {
+                self.apply(Command::DuplicateLayer);
+            }
+            if add(ui, "Delete", "Delete the selected layer") {
+                self.apply(Command::DeleteLayer);
+            }
+            if add(ui, "Merge down", "Merge into the layer below (Ctrl+E)") {
+                self.apply(Command::MergeDown);
+            }
+            if add(ui, "Flatten", "Every layer into one paint layer") {
+                self.apply(Command::Flatten);
+            }
+        });
+    }
+
+    /// Adds a layer of `kind`, named after how many layers there are.
+    pub(crate) fn new_layer(&mut self, kind: LayerKind) {
+        let count = self.doc.stack().walk().len();
+        let name = match kind {
+            LayerKind::Paint => format!("Layer {}", count + 1),
+            LayerKind::Fill => format!("Fill {}", count + 1),
+            LayerKind::Group => format!("Group {}", count + 1),
+        };
+        self.apply(Command::AddLayer { kind, name });
+    }
+
+    /// Rows of `layers` (top first), groups' children indented under them.
+    fn rows_ui(
+        &self,
+        ui: &mut egui::Ui,
+        layers: &[Layer],
+        parent: &[usize],
+        actions: &mut Vec<(Vec<usize>, RowAction)>,
+    ) {
+        for (i, layer) in layers.iter().enumerate().rev() {
+            let path = [parent, &[i]].concat();
+            if let Some(action) = self.row_ui(ui, layer, &path) {
+                actions.push((path.clone(), action));
+            }
+            if let LayerContent::Group(children) = &layer.content {
+                self.rows_ui(ui, children, &path, actions);
+            }
+        }
+    }
+
+    fn row_ui(&self, ui: &mut egui::Ui, layer: &Layer, path: &[usize]) -> Option<RowAction> {
+        let selection = self.doc.selection();
+        let selected = selection.path == path;
+        let mut action = None;
+        let row = ui.horizontal(|ui| {
+            ui.add_space(14.0 * (path.len() - 1) as f32);
+            let p = &layer.props;
+            let (eye, tip) = if p.visible {
+                ("👁", "Hide")
+            } else {
+                ("–", "Show")
+            };
+            if icon_button(ui, eye, tip) {
+                action = Some(RowAction::Toggle(Command::SetLayerVisible(!p.visible)));
+            }
+            let (lock, tip) = if p.locked {
+                ("🔒", "Unlock")
+            } else {
+                ("🔓", "Lock")
+            };
+            if icon_button(ui, lock, tip) {
+                action = Some(RowAction::Toggle(Command::SetLayerLocked(!p.locked)));
+            }
+            let handle = egui::Id::new(("layer drag", path));
+            ui.dnd_drag_source(handle, DraggedLayer(path.to_vec()), |ui| {
+                ui.label("☰").on_hover_text("Drag to move");
+            });
+            let content = Self::thumb_ui(
+                ui,
+                self.layers_panel.thumbs.content.get(path),
+                selected && !selection.mask,
+                &format!("Content of {}", p.name),
+            );
+            if content.clicked() {
+                action = Some(RowAction::Select {
+                    mask: false,
+                    alone: false,
+                });
+            }
+            if let Some(mask) = &layer.mask {
+                let r = Self::thumb_ui(
+                    ui,
+                    self.layers_panel.thumbs.masks.get(path),
+                    selected && selection.mask,
+                    &format!("Mask of {}", p.name),
+                )
+                .on_hover_text("Paint the mask (Alt + click: show it alone)");
+                if !mask.enabled {
+                    ui.painter().line_segment(
+                        [r.rect.left_bottom(), r.rect.right_top()],
+                        egui::Stroke::new(2.0, Color32::RED),
+                    );
+                }
+                if r.clicked() {
+                    let alone = ui.input(|i| i.modifiers.alt);
+                    action = Some(RowAction::Select { mask: true, alone });
+                }
+            }
+            let name = ui.selectable_label(selected, &p.name);
+            if name.double_clicked() {
+                action = Some(RowAction::Rename);
+            } else if name.clicked() {
+                action = Some(RowAction::Select {
+                    mask: false,
+                    alone: false,
+                });
+            }
+            let bytes = self
+                .layers_panel
+                .thumbs
+                .bytes
+                .get(path)
+                .copied()
+                .unwrap_or(0);
+            ui.label(
+                egui::RichText::new(super::view_panel::megabytes(bytes))
+                    .weak()
+                    .small(),
+            )
+            .on_hover_text("Memory this layer's tiles and mask hold");
+        });
+        drop_target(ui, row.response.rect, path, &layer.content).or(action)
+    }
+
+    /// A thumbnail over a checkerboard (transparent is unpainted), framed when selected.
+    fn thumb_ui(
+        ui: &mut egui::Ui,
+        texture: Option<&egui::TextureHandle>,
+        selected: bool,
+        label: &str,
+    ) -> egui::Response {
+        let (rect, response) = ui.allocate_exact_size(Vec2::splat(THUMB_POINTS), Sense::click());
+        response.widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Button, true, label));
+        let painter = ui.painter_at(rect);
+        match texture {
+            Some(t) => {
+                let cell = THUMB_POINTS / 4.0;
+                for k in 0..16 {
+                    let (cx, cy) = ((k % 4) as f32, (k / 4) as f32);
+                    let grey = if (k % 4 + k / 4) % 2 == 0 { 90 } else { 140 };
+                    let min = rect.min + Vec2::new(cx * cell, cy * cell);
+                    painter.rect_filled(
+                        Rect::from_min_size(min, Vec2::splat(cell)),
+                        0.0,
+                        Color32::from_gray(grey),
+                    );
+                }
+                painter.image(
+                    t.id(),
+                    rect,
+                    Rect::from_min_max(egui::Pos2::ZERO, egui::Pos2::new(1.0, 1.0)),
+                    Color32::WHITE,
+                );
+            }
+            None => {
+                painter.text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    "🗀",
+                    egui::FontId::proportional(20.0),
+                    ui.visuals().text_color(),
+                );
+            }
+        }
+        if selected {
+            painter.rect_stroke(
+                rect,
+                0.0,
+                egui::Stroke::new(2.0, ui.visuals().selection.stroke.color),
+                egui::StrokeKind::Inside,
+            );
+        }
+        response
+    }
+
+    fn row_action(&mut self, path: Vec<usize>, action: RowAction) {
+        match action {
+            RowAction::Select { mask, alone } => {
+                self.apply(Command::SelectPath(path));
+                if mask {
+                    self.apply(Command::SelectMask);
+                }
+                if alone {
+                    self.layer_view = LayerView::Mask;
+                }
+            }
+            RowAction::Toggle(command) => {
+                // The eye and the lock act on their row's layer, leaving the selection be.
+                let before = self.doc.selection().clone();
+                self.apply(Command::SelectPath(path));
+                self.apply(command);
+                if self.doc.stack().layer(&before.path).is_some() {
+                    self.apply(Command::SelectPath(before.path));
+                    if before.mask {
+                        self.apply(Command::SelectMask);
+                    }
+                }
+            }
+            RowAction::Rename => {
+                self.apply(Command::SelectPath(path));
+                self.layers_panel.rename = Some(
+                    self.doc
+                        .stack()
+                        .layer(&self.doc.selection().path)
+                        .map(|l| l.props.name.clone())
+                        .unwrap_or_default(),
+                );
+            }
+            RowAction::Drop(from, place) => {
+                self.apply(Command::SelectPath(from));
+                self.apply(Command::MoveLayerTo {
+                    target: path,
+                    place,
+                });
+            }
+        }
+    }
+}
+
+/// A frameless icon button; whether it was clicked.
+fn icon_button(ui: &mut egui::Ui, icon: &str, tip: &str) -> bool {
+    ui.add(
+        egui::Button::new(icon)
+            .frame(false)
+            .min_size(Vec2::splat(18.0)),
+    )
+    .on_hover_text(tip)
+    .clicked()
+}
+
+/// A row as a drop target for a dragged layer: a line above or below it, or a frame around a
+/// group, while one hovers; where it lands when released.
+fn drop_target(
+    ui: &egui::Ui,
+    rect: Rect,
+    path: &[usize],
+    content: &LayerContent,
+) -> Option<RowAction> {
+    let response = ui.interact(rect, egui::Id::new(("layer row", path)), Sense::hover());
+    let place = |pointer: egui::Pos2| drop_place(rect, pointer, content);
+    if let (Some(_), Some(pointer)) = (
+        response.dnd_hover_payload::<DraggedLayer>(),
+        ui.input(|i| i.pointer.hover_pos()),
+    ) {
+        let stroke = egui::Stroke::new(2.0, ui.visuals().selection.stroke.color);
+        match place(pointer) {
+            LayerPlace::Above => {
+                ui.painter().hline(rect.x_range(), rect.top(), stroke);
+            }
+            LayerPlace::Below => {
+                ui.painter().hline(rect.x_range(), rect.bottom(), stroke);
+            }
+            LayerPlace::Into => {
+                ui.painter()
+                    .rect_stroke(rect, 2.0, stroke, egui::StrokeKind::Inside);
+            }
+        }
+    }
+    if let (Some(dragged), Some(pointer)) = (
+        response.dnd_release_payload::<DraggedLayer>(),
+        ui.input(|i| i.pointer.interact_pos()),
+    ) {
+        return Some(RowAction::Drop(dragged.0.clone(), place(pointer)));
+    }
+    None
+}
+
+/// Where a layer dropped at `pointer` on a row lands: the row's top third above it, its bottom
+/// third below, the middle into it when it is a group.
+fn drop_place(rect: Rect, pointer: egui::Pos2, content: &LayerContent) -> LayerPlace {
+    let t = (pointer.y - rect.top()) / rect.height().max(1.0);
+    match content {
+        LayerContent::Group(_) if (0.3..0.7).contains(&t) => LayerPlace::Into,
+        _ if t < 0.5 => LayerPlace::Above,
+        _ => LayerPlace::Below,
+    }
+}

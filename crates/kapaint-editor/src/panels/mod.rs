@@ -1,0 +1,13 @@
+//! The editor's panels: tools, brush and material on the left; shading, compare, view, light
+//! and presets on the right; the menu bar, the status bar, dropped files and notices. Each
+//! reads the state and issues [`Command`](kapaint_core::model::Command)s.
+
+mod bars;
+pub mod colour;
+mod layer_settings;
+pub mod layers;
+pub(super) mod presets;
+mod tool_panel;
+mod view_panel;
+
+pub(super) use bars::channel_label;

@@ -1,0 +1,288 @@
+//! Presets of the artist's own: the material preset browser (thumbnails with their names,
+//! the shipped presets and the user's), saving the primary material as a preset, and named
+//! brush presets.
+
+use std::path::Path;
+
+use crate::{EditorState, notice};
+use kapaint_core::model::Command;
+use kapaint_core::model::brush::preset::{self as brush_preset, BrushPreset};
+use kapaint_core::model::texel::MaterialValue;
+
+/// A material preset in the browser.
+pub(crate) struct PresetEntry {
+    /// The file stem: what a project names as its base preset.
+    pub stem: String,
+    /// The name shown under the thumbnail.
+    pub name: String,
+    /// The material.
+    pub value: MaterialValue,
+    /// The thumbnail, once drawn, and the mesh it shows.
+    pub thumbnail: Option<super::super::Thumbnail>,
+}
+
+/// What a name is being typed for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Naming {
+    /// The primary material, as a material preset.
+    Material,
+    /// The brush settings, as a brush preset.
+    Brush,
+}
+
+/// The shipped material presets, then the user's (a malformed user file is a notice, not a
+/// preset).
+pub(crate) fn load_material_presets(
+    dir: Option<&Path>,
+    notices: &mut crate::Notices,
+) -> Vec<PresetEntry> {
+    let entry = |stem: String, p: &kapaint_core::model::preset::MaterialPreset| PresetEntry {
+        stem,
+        name: p.name.clone(),
+        value: p.value(),
+        thumbnail: None,
+    };
+    let mut list: Vec<PresetEntry> = kapaint_core::model::preset::builtin()
+        .iter()
+        .map(|(stem, p)| entry(stem.clone(), p))
+        .collect();
+    if let Some(dir) = dir {
+        for found in kapaint_core::model::preset::load_dir(dir) {
+            match found {
+                Ok((stem, p)) => {
+                    // A user preset of a shipped preset's file name takes its place.
+                    list.retain(|e| e.stem != stem);
+                    list.push(entry(stem, &p));
+                }
+                Err(e) => notices.push(notice(format!("skipped {e}"), true)),
+            }
+        }
+    }
+    list
+}
+
+/// The shipped brush presets, then the user's.
+pub(crate) fn load_brush_presets(
+    dir: Option<&Path>,
+    notices: &mut crate::Notices,
+) -> Vec<BrushPreset> {
+    let mut list = brush_preset::builtin();
+    if let Some(dir) = dir {
+        for found in brush_preset::load_dir(&dir.join("brushes")) {
+            match found {
+                Ok(p) => {
+                    list.retain(|q| q.name != p.name);
+                    list.push(p);
+                }
+                Err(e) => notices.push(notice(format!("skipped {e}"), true)),
+            }
+        }
+    }
+    list
+}
+
+impl EditorState {
+    /// The material presets: thumbnails with their names (a click makes one the primary),
+    /// and saving the primary as a preset of the user's.
+    pub(super) fn presets_ui(&mut self, ui: &mut egui::Ui) {
+        // A few thumbnails per frame keep the first frames fast.
+        // A thumbnail of another mesh (before New, Open or a mesh import) is drawn again.
+        let mut budget = 3;
+        let mesh = self.mesh.id;
+        for i in 0..self.presets.len() {
+            let stale = self.presets[i]
+                .thumbnail
+                .as_ref()
+                .is_none_or(|(id, _)| *id != mesh);
+            if stale && budget > 0 {
+                budget -= 1;
+                let image = self.thumbnail(self.presets[i].value);
+                let texture = ui.ctx().load_texture(
+                    format!("preset {}", self.presets[i].stem),
+                    image,
+                    egui::TextureOptions::LINEAR,
+                );
+                self.presets[i].thumbnail = Some((mesh, texture));
+            }
+        }
+        if budget == 0 {
+            ui.ctx().request_repaint();
+        }
+        self.naming_ui(ui, Naming::Material, "Save primary as preset…");
+        let mut chosen = None;
+        // A few rows high, scrolled: the history below stays in view.
+        egui::ScrollArea::vertical()
+            .id_salt("material presets")
+            .max_height(200.0)
+            .show(ui, |ui| {
+                ui.horizontal_wrapped(|ui| {
+                    for p in &self.presets {
+                        ui.allocate_ui(egui::vec2(58.0, 62.0), |ui| {
+                            ui.vertical_centered(|ui| {
+                                let response = match &p.thumbnail {
+                                    Some((_, t)) => ui.add(egui::Button::image(
+                                        egui::Image::from_texture(
+                                            egui::load::SizedTexture::from_handle(t),
+                                        )
+                                        .fit_to_exact_size(egui::vec2(40.0, 40.0)),
+                                    )),
+                                    None => ui.add_sized([48.0, 48.0], egui::Button::new("…")),
+                                };
+                                let v = p.value;
+                                if response
+                                    .on_hover_text(format!(
+                                        "{}: k_d {:.2} {:.2} {:.2}, k_s {:.2}, n {:.0}",
+                                        p.name, v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n
+                                    ))
+                                    .clicked()
+                                {
+                                    chosen = Some(v);
+                                }
+                                ui.add(
+                                    egui::Label::new(egui::RichText::new(&p.name).small())
+                                        .truncate(),
+                                );
+                            });
+                        });
+                    }
+                });
+            });
+        if let Some(v) = chosen {
+            self.apply(Command::SetPrimary(v));
+        }
+    }
+
+    /// The brush presets: a choice applies one; the current settings can be saved as one.
+    pub(super) fn brush_presets_ui(&mut self, ui: &mut egui::Ui) {
+        let current = &self.doc.settings().brush;
+        let shown = self
+            .brush_presets
+            .iter()
+            .find(|p| p.brush == *current)
+            .map_or("(custom)", |p| p.name.as_str())
+            .to_string();
+        let mut chosen = None;
+        egui::ComboBox::from_label("Brush preset")
+            .selected_text(shown)
+            .show_ui(ui, |ui| {
+                for p in &self.brush_presets {
+                    if ui.selectable_label(p.brush == *current, &p.name).clicked() {
+                        chosen = Some(p.brush.clone());
+                    }
+                }
+            });
+        if let Some(b) = chosen {
+            self.apply(Command::SetBrush(b));
+        }
+        self.naming_ui(ui, Naming::Brush, "Save brush…");
+    }
+
+    /// A button that opens a name field, then saves what `kind` names under that name.
+    fn naming_ui(&mut self, ui: &mut egui::Ui, kind: Naming, button: &str) {
+        match &mut self.naming {
+            Some((k, name, just_opened)) if *k == kind => {
+                let mut save = false;
+                let mut cancel = false;
+                ui.horizontal(|ui| {
+                    let label = ui.label("Preset name");
+                    let field = ui
+                        .add(egui::TextEdit::singleline(name).desired_width(120.0))
+                        .labelled_by(label.id);
+                    if std::mem::take(just_opened) {
+                        field.request_focus();
+                    }
+                    save = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    save |= ui.button("Save").clicked();
+                    cancel = ui.button("Cancel").clicked();
+                });
+                if save {
+                    let name = name.clone();
+                    self.save_preset(kind, &name);
+                } else if cancel {
+                    self.naming = None;
+                }
+            }
+            _ => {
+                if ui.button(button).clicked() {
+                    self.naming = Some((kind, String::new(), true));
+                }
+            }
+        }
+    }
+
+    /// Saves the primary material or the brush as the user's preset `name` (the naming row
+    /// stays open on an error).
+    fn save_preset(&mut self, kind: Naming, name: &str) {
+        let saved = match kind {
+            Naming::Material => self
+                .preset_dir
+                .clone()
+                .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
+                .and_then(|dir| {
+                    let value = self.doc.settings().primary;
+                    kapaint_core::model::preset::save_user(&dir, name, value)
+                        .map_err(|e| e.to_string())
+                        .map(|(stem, path)| {
+                            self.presets.retain(|p| p.stem != stem);
+                            self.presets.push(PresetEntry {
+                                stem,
+                                name: name.trim().to_string(),
+                                value: value.sanitized(),
+                                thumbnail: None,
+                            });
+                            path
+                        })
+                }),
+            Naming::Brush => self
+                .preset_dir
+                .as_ref()
+                .map(|d| d.join("brushes"))
+                .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
+                .and_then(|dir| {
+                    let preset = BrushPreset {
+                        name: name.trim().to_string(),
+                        brush: self.doc.settings().brush.clone(),
+                    };
+                    let path = preset.save(&dir).map_err(|e| e.to_string())?;
+                    self.brush_presets.retain(|p| p.name != preset.name);
+                    self.brush_presets.push(preset);
+                    Ok(path)
+                }),
+        };
+        match saved {
+            Ok(path) => {
+                self.naming = None;
+                self.notices.push(notice(
+                    format!("Saved preset {:?} to {}", name.trim(), path.display()),
+                    false,
+                ));
+            }
+            Err(e) => self
+                .notices
+                .push(notice(format!("preset not saved: {e}"), true)),
+        }
+    }
+
+    /// Saves presets into `dir` from now on (the user preset folder by default).
+    pub fn set_preset_dir(&mut self, dir: std::path::PathBuf) {
+        self.preset_dir = Some(dir);
+    }
+
+    /// Reads the presets again: the shipped ones, then the user's from the preset folder (a
+    /// malformed file is a notice).
+    pub fn reload_presets(&mut self) {
+        let dir = self.preset_dir.clone();
+        self.presets = load_material_presets(dir.as_deref(), &mut self.notices);
+        self.brush_presets = load_brush_presets(dir.as_deref(), &mut self.notices);
+    }
+
+    /// The names of the material presets, as the browser shows them.
+    pub fn preset_names(&self) -> Vec<&str> {
+        self.presets.iter().map(|p| p.name.as_str()).collect()
+    }
+
+    /// The brush presets' names.
+    pub fn brush_preset_names(&self) -> Vec<&str> {
+        self.brush_presets.iter().map(|p| p.name.as_str()).collect()
+    }
+}

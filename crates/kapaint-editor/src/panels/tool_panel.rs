@@ -1,0 +1,283 @@
+//! The left panel: tools and their options, brush settings and stamp, material, channels.
+
+use crate::files::FilePurpose;
+use crate::{EditorState, stamp_image, stamp_key};
+use kapaint_core::model::Command;
+use kapaint_core::model::paint::GradientShape;
+use kapaint_core::model::texel::Channel;
+use kapaint_core::reflectance;
+use kapaint_core::tools::{FillMode, ToolKind};
+
+/// The key that selects a tool.
+fn tool_key(kind: ToolKind) -> &'static str {
+    match kind {
+        ToolKind::Brush => "B",
+        ToolKind::Eraser => "E",
+        ToolKind::Blur => "R",
+        ToolKind::Fill => "F on the UV canvas",
+        ToolKind::Gradient => "G",
+        ToolKind::Picker => "I",
+    }
+}
+
+impl EditorState {
+    /// The active tool's options: the fill's mode, the gradient's shape.
+    fn tool_options_ui(&mut self, ui: &mut egui::Ui) {
+        match self.tools.active() {
+            ToolKind::Fill => {
+                let mode = &mut self.tools.fill.mode;
+                let name = match mode {
+                    FillMode::Island => "UV island (or all)",
+                    FillMode::Similar { .. } => "Similar texels",
+                    FillMode::All => "Whole map",
+                };
+                egui::ComboBox::from_label("Fill")
+                    .selected_text(name)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(mode, FillMode::Island, "UV island (or all)");
+                        if ui
+                            .selectable_label(
+                                matches!(mode, FillMode::Similar { .. }),
+                                "Similar texels",
+                            )
+                            .clicked()
+                        {
+                            *mode = FillMode::Similar {
+                                channel: Channel::Kd,
+                                tolerance: 0.05,
+                            };
+                        }
+                        ui.selectable_value(mode, FillMode::All, "Whole map");
+                    });
+                if let FillMode::Similar { channel, tolerance } = mode {
+                    egui::ComboBox::from_label("Compared channel")
+                        .selected_text(super::bars::channel_label(*channel))
+                        .show_ui(ui, |ui| {
+                            for c in Channel::ALL {
+                                ui.selectable_value(channel, c, super::bars::channel_label(c));
+                            }
+                        });
+                    ui.add(egui::Slider::new(tolerance, 0.0..=1.0).text("Tolerance"))
+                        .on_hover_text("The largest difference still filled, in blend space");
+                }
+            }
+            ToolKind::Gradient => {
+                let shape = &mut self.tools.gradient.shape;
+                ui.horizontal(|ui| {
+                    ui.selectable_value(shape, GradientShape::Linear, "Linear");
+                    ui.selectable_value(shape, GradientShape::Radial, "Radial");
+                });
+            }
+            ToolKind::Blur => {
+                let mut brush = self.doc.settings().brush.clone();
+                ui.add(egui::Slider::new(&mut brush.blur_radius_px, 1..=16).text("Blur radius"))
+                    .on_hover_text("Kernel radius in texels");
+                if brush != self.doc.settings().brush {
+                    self.apply(Command::SetBrush(brush));
+                }
+            }
+            ToolKind::Picker => {
+                let from = &mut self.tools.picker.from_layer;
+                ui.horizontal(|ui| {
+                    ui.selectable_value(from, false, "All layers");
+                    ui.selectable_value(from, true, "Selected layer");
+                })
+                .response
+                .on_hover_text("Read the composite, or what the selected layer holds");
+            }
+            ToolKind::Brush | ToolKind::Eraser => {}
+        }
+    }
+
+    /// Left panel: tools, brush, material, channels.
+    pub(crate) fn tools_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Tools");
+        let mut chosen = self.tools.active();
+        ui.horizontal_wrapped(|ui| {
+            for kind in ToolKind::ALL {
+                ui.selectable_value(&mut chosen, kind, kind.label())
+                    .on_hover_text(format!("{} ({})", kind.label(), tool_key(kind)));
+            }
+        });
+        if chosen != self.tools.active() {
+            self.select_tool(chosen);
+        }
+        self.tool_options_ui(ui);
+        ui.separator();
+        ui.heading("Brush settings");
+        self.brush_presets_ui(ui);
+        let mut brush = self.doc.settings().brush.clone();
+        self.brush_radius_ui(ui, &mut brush);
+        ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
+            .on_hover_text("Shift+[ and Shift+] change the hardness");
+        ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
+        ui.add(egui::Slider::new(&mut brush.flow, 0.0..=1.0).text("Flow"));
+        ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing %"));
+        ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
+        ui.checkbox(&mut brush.pressure_size, "Pressure: size");
+        ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
+        self.stamp_ui(ui, &mut brush);
+        stroke_options_ui(ui, &mut brush);
+        if brush != self.doc.settings().brush {
+            self.apply(Command::SetBrush(brush));
+        }
+        ui.separator();
+        ui.heading("Material");
+        let mut primary = self.doc.settings().primary;
+        self.colour_ui(ui, &mut primary);
+        ui.horizontal(|ui| {
+            let mut kd = primary.kd.to_array();
+            egui::color_picker::color_edit_button_rgb(ui, &mut kd)
+                .on_hover_text("Diffuse colour k_d (linear)");
+            ui.label("k_d");
+            primary.kd = glam::Vec3::from(kd);
+            let mut ks = primary.ks.to_array();
+            egui::color_picker::color_edit_button_rgb(ui, &mut ks)
+                .on_hover_text("Specular colour k_s (linear)");
+            ui.label("k_s");
+            primary.ks = glam::Vec3::from(ks);
+        });
+        let mut grey = primary.ks.max_element();
+        if ui
+            .add(egui::Slider::new(&mut grey, 0.0..=1.0).text("k_s (grey)"))
+            .changed()
+        {
+            primary.ks = glam::Vec3::splat(grey);
+        }
+        ui.add(
+            egui::Slider::new(&mut primary.n, 0.0..=kapaint_core::model::texel::N_MAX)
+                .logarithmic(true)
+                .text("n"),
+        );
+        let other = reflectance::equivalent::counterpart(self.doc.settings().model);
+        let eq = reflectance::equivalent::equivalent_exponent(
+            self.doc.settings().model,
+            f64::from(primary.n),
+        );
+        ui.label(format!(
+            "≈ n {eq:.1} in {}",
+            super::view_panel::model_label(other)
+        ))
+        .on_hover_text("The exponent of the other model with the closest highlight");
+        if primary != self.doc.settings().primary {
+            self.apply(Command::SetPrimary(primary));
+        }
+        if ui
+            .button("Swap primary / secondary")
+            .on_hover_text("X")
+            .clicked()
+        {
+            self.apply(Command::SwapMaterials);
+        }
+        self.recent_materials_ui(ui);
+        ui.separator();
+        ui.heading("Channels");
+        let mut ch = self.doc.settings().channels;
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut ch.kd, "k_d");
+            ui.checkbox(&mut ch.ks, "k_s");
+            ui.checkbox(&mut ch.n, "n");
+        });
+        if ch != self.doc.settings().channels {
+            self.apply(Command::SetChannels(ch));
+        }
+    }
+
+    /// The brush's stamp row: a preview of the stamp, the built-in grain, loading one from an
+    /// image, and back to the round dab.
+    fn stamp_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        brush: &mut kapaint_core::model::brush::BrushSettings,
+    ) {
+        ui.horizontal(|ui| {
+            ui.label("Stamp");
+            match &brush.stamp {
+                None => {
+                    ui.label("round");
+                }
+                Some(stamp) => {
+                    let key = stamp_key(stamp);
+                    if self.stamp_preview.as_ref().is_none_or(|(k, _)| *k != key) {
+                        let image = stamp_image(stamp, 32);
+                        let texture = ui.ctx().load_texture(
+                            "brush stamp",
+                            image,
+                            egui::TextureOptions::LINEAR,
+                        );
+                        self.stamp_preview = Some((key, texture));
+                    }
+                    if let Some((_, texture)) = &self.stamp_preview {
+                        ui.image((texture.id(), egui::vec2(32.0, 32.0)))
+                            .on_hover_text(format!("{}x{} stamp", stamp.width(), stamp.height()));
+                    }
+                }
+            }
+            if ui
+                .button("Grain")
+                .on_hover_text("A built-in grainy stamp")
+                .clicked()
+            {
+                brush.stamp = Some(kapaint_core::model::brush::Stamp::grain(64));
+            }
+            if ui
+                .button("Load…")
+                .on_hover_text("A stamp from an image (luminance times alpha)")
+                .clicked()
+            {
+                self.choose_file(FilePurpose::StampImage);
+            }
+            if brush.stamp.is_some() && ui.button("Round").clicked() {
+                brush.stamp = None;
+            }
+        });
+    }
+}
+
+/// The stroke's options: blend mode, lazy mouse, mirrors, front faces only, energy guard.
+fn stroke_options_ui(ui: &mut egui::Ui, brush: &mut kapaint_core::model::brush::BrushSettings) {
+    use kapaint_core::model::brush::BlendMode;
+    egui::ComboBox::from_label("Blend")
+        .selected_text(blend_label(brush.blend))
+        .show_ui(ui, |ui| {
+            for mode in BlendMode::ALL {
+                ui.selectable_value(&mut brush.blend, mode, blend_label(mode));
+            }
+        })
+        .response
+        .on_hover_text("How the material is laid over the map (n blends in log space)");
+    ui.add(
+        egui::Slider::new(&mut brush.smoothing_px, 0.0..=64.0)
+            .text("Lazy mouse")
+            .suffix(" px"),
+    )
+    .on_hover_text("The brush trails the pointer by this many texels: steadier lines (0: off)");
+    ui.horizontal(|ui| {
+        ui.label("Mirror");
+        ui.checkbox(&mut brush.mirror_u, "U")
+            .on_hover_text("Across the UV map's vertical centre line");
+        ui.checkbox(&mut brush.mirror_v, "V")
+            .on_hover_text("Across the UV map's horizontal centre line");
+        ui.checkbox(&mut brush.mirror_x, "X")
+            .on_hover_text("On the mesh, across its X = 0 plane");
+        ui.checkbox(&mut brush.mirror_y, "Y")
+            .on_hover_text("On the mesh, across its Y = 0 plane");
+        ui.checkbox(&mut brush.mirror_z, "Z")
+            .on_hover_text("On the mesh, across its Z = 0 plane");
+    });
+    ui.checkbox(&mut brush.front_faces_only, "Front faces only")
+        .on_hover_text("On the mesh: paint only where the surface faces you, not through it");
+    ui.checkbox(&mut brush.energy_guard, "Energy guard")
+        .on_hover_text("Keep k_d + k_s at most 1 per colour channel while painting");
+}
+
+/// A blend mode's name in the panel.
+fn blend_label(mode: kapaint_core::model::brush::BlendMode) -> &'static str {
+    use kapaint_core::model::brush::BlendMode;
+    match mode {
+        BlendMode::Normal => "Normal",
+        BlendMode::Add => "Add",
+        BlendMode::Subtract => "Subtract",
+        BlendMode::Multiply => "Multiply",
+    }
+}

@@ -1,0 +1,294 @@
+//! The right panel: shading, compare, view, light, material presets and history.
+
+use std::sync::Arc;
+
+use crate::EditorState;
+use crate::canvas::CanvasChannel;
+use crate::panels::layers::LayerView;
+use crate::viewport::Compare;
+use kapaint_core::model::Command;
+use kapaint_core::model::texel::MaterialValue;
+use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
+use kapaint_core::render::{FrameSettings, ViewMode};
+
+impl EditorState {
+    /// Compare controls: the mode, then each side's model and approximation, the divider or
+    /// the heatmap's scale.
+    fn compare_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Compare");
+        let c = &mut self.viewport.comparison;
+        ui.horizontal_wrapped(|ui| {
+            for (mode, label) in Compare::ALL {
+                ui.selectable_value(&mut c.mode, mode, label);
+            }
+        });
+        if c.mode == Compare::Single {
+            return;
+        }
+        // One combo box a row, within the panel's width whatever the mode (the panel would
+        // grow to fit a wider row, and the layout jump as the mode changes).
+        egui::Grid::new("compare sides").show(ui, |ui| {
+            for (name, side) in [("Left", &mut c.left), ("Right", &mut c.right)] {
+                ui.label(name);
+                egui::ComboBox::from_id_salt(("compare model", name))
+                    .selected_text(model_label(side.model))
+                    .width(COMBO_WIDTH)
+                    .show_ui(ui, |ui| {
+                        for m in ShadingModel::ALL {
+                            ui.selectable_value(&mut side.model, m, model_label(m));
+                        }
+                    });
+                ui.end_row();
+                ui.label("");
+                egui::ComboBox::from_id_salt(("compare approx", name))
+                    .selected_text(side.approx.for_model(side.model).name())
+                    .width(COMBO_WIDTH)
+                    .show_ui(ui, |ui| {
+                        for a in AmbientApprox::ALL {
+                            ui.selectable_value(&mut side.approx, a, a.name());
+                        }
+                    });
+                ui.end_row();
+            }
+        });
+        match c.mode {
+            Compare::Split => {
+                ui.add(egui::Slider::new(&mut c.split_at, 0.0..=1.0).text("Divider"))
+                    .on_hover_text("Or drag the line in the viewport");
+            }
+            Compare::Difference => {
+                ui.add(
+                    egui::Slider::new(&mut c.diff_max, 1e-4..=1.0)
+                        .logarithmic(true)
+                        .text("Heat scale"),
+                )
+                .on_hover_text("The difference |left - right| shown white");
+            }
+            Compare::ThreeWay => {
+                ui.label("Phong, Blinn-Phong and Cook-Torrance, each with the left side's method");
+            }
+            Compare::Single | Compare::SideBySide => {}
+        }
+    }
+
+    /// The light: yaw and pitch in degrees, following the camera, intensities.
+    fn light_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Light");
+        // Shown and edited in degrees, as artists think of angles; kept as a direction.
+        let (yaw, pitch) = self.lighting.angles();
+        let (mut yaw, mut pitch) = (yaw.to_degrees(), pitch.to_degrees());
+        let a = ui.add(degrees(&mut yaw, 180.0, "Light yaw"));
+        let b = ui.add(degrees(&mut pitch, 89.0, "Light pitch"));
+        if a.changed() || b.changed() {
+            self.lighting
+                .set_angles(yaw.to_radians(), pitch.to_radians());
+        }
+        let mut follow = self.light_follows_camera;
+        if ui
+            .checkbox(&mut follow, "Light follows camera")
+            .on_hover_text(
+                "Keep the light where it is relative to the view while orbiting \
+                 (yaw and pitch are then relative to the camera); Shift + right drag turns it",
+            )
+            .changed()
+        {
+            self.set_light_follows_camera(follow);
+        }
+        ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
+        ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+    }
+
+    /// Right panel: model, view, compare, light, canvas channel, history.
+    pub(crate) fn view_ui(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Shading");
+        let mut model = self.doc.settings().model;
+        // The paper's two models on one row, Cook-Torrance below: rows of fixed content keep
+        // the panel's width the same from the first frame on.
+        for row in [&ShadingModel::PAPER[..], &[ShadingModel::CookTorrance]] {
+            ui.horizontal(|ui| {
+                for &m in row {
+                    ui.selectable_value(&mut model, m, model_label(m));
+                }
+            });
+        }
+        if model != self.doc.settings().model {
+            self.apply(Command::SetModel(model));
+        }
+        let mut approx = self.doc.settings().approx;
+        ui.add_enabled_ui(model.has_paper_forms(), |ui| {
+            egui::ComboBox::from_label("Approximation")
+                .selected_text(approx.for_model(model).name())
+                .show_ui(ui, |ui| {
+                    for a in AmbientApprox::ALL {
+                        ui.selectable_value(&mut approx, a, a.name());
+                    }
+                });
+        })
+        .response
+        .on_disabled_hover_text(
+            "The paper printed no approximation for Cook-Torrance: its k_a always uses \
+             kapaint's fit (within 2e-5 of the exact integral)",
+        );
+        if approx != self.doc.settings().approx {
+            self.apply(Command::SetApprox(approx));
+        }
+        self.compare_ui(ui);
+        ui.heading("View");
+        egui::ComboBox::from_label("View mode")
+            .selected_text(self.view.label())
+            .width(COMBO_WIDTH)
+            .show_ui(ui, |ui| {
+                for v in ViewMode::ALL {
+                    ui.selectable_value(&mut self.view, v, v.label());
+                }
+            });
+        egui::ComboBox::from_label("Layers shown")
+            .selected_text(self.layer_view.label())
+            .width(COMBO_WIDTH)
+            .show_ui(ui, |ui| {
+                for v in LayerView::ALL {
+                    ui.selectable_value(&mut self.layer_view, v, v.label());
+                }
+            })
+            .response
+            .on_hover_text("The selected layer alone over the base, or its mask in grey");
+        egui::ComboBox::from_label("Canvas shows")
+            .selected_text(self.canvas.channel.label())
+            .show_ui(ui, |ui| {
+                for c in CanvasChannel::ALL {
+                    ui.selectable_value(&mut self.canvas.channel, c, c.label());
+                }
+            });
+        ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
+        self.light_ui(ui);
+        egui::CollapsingHeader::new("Material presets")
+            .default_open(true)
+            .show(ui, |ui| self.presets_ui(ui));
+        ui.heading("History");
+        ui.label(history_summary(
+            self.doc.history().undo_steps().count(),
+            self.doc.history().bytes(),
+        ));
+        self.history_list_ui(ui);
+    }
+
+    /// The steps, oldest first: a click jumps to the state after a step (undone steps stay
+    /// listed, greyed, until a new edit drops them); "Original" is the state before them.
+    fn history_list_ui(&mut self, ui: &mut egui::Ui) {
+        let history = self.doc.history();
+        let applied = history.undo_steps().count();
+        let mut jump = None;
+        egui::ScrollArea::vertical()
+            .id_salt("history")
+            .max_height(160.0)
+            .stick_to_bottom(true)
+            .show(ui, |ui| {
+                if ui
+                    .selectable_label(applied == 0, "Original")
+                    .on_hover_text("Before the oldest step kept")
+                    .clicked()
+                {
+                    jump = Some(0);
+                }
+                for (i, step) in history.undo_steps().chain(history.redo_steps()).enumerate() {
+                    let text = format!("{}. {} · {} KB", i + 1, step.label, step.bytes() / 1024);
+                    let text = if i < applied {
+                        egui::RichText::new(text)
+                    } else {
+                        egui::RichText::new(text).weak().italics()
+                    };
+                    let response = ui.selectable_label(i + 1 == applied, text);
+                    let response = if i < applied {
+                        response
+                    } else {
+                        response.on_hover_text("Undone: a click redoes up to here")
+                    };
+                    if response.clicked() {
+                        jump = Some(i + 1);
+                    }
+                }
+            });
+        if let Some(n) = jump {
+            self.apply(Command::HistoryJump(n));
+        }
+    }
+
+    /// Renders a thumbnail: on the GPU with the preview renderer, else with the CPU reference
+    /// renderer (the same shading, ray traced).
+    pub(super) fn thumbnail(&mut self, value: MaterialValue) -> egui::ColorImage {
+        const SIZE: u32 = 56;
+        let camera = kapaint_core::render::Camera::default()
+            .orbit(0.5, 0.35)
+            .framing(&self.mesh.mesh.positions);
+        let settings = FrameSettings {
+            camera,
+            view: ViewMode::Shaded,
+            ..self.frame_settings()
+        };
+        let mesh = (self.mesh.id, Arc::clone(&self.mesh.mesh));
+        if let Some(image) = self
+            .viewport
+            .gpu
+            .as_mut()
+            .and_then(|g| g.thumbnail(&mesh, value, &settings, SIZE))
+        {
+            return image;
+        }
+        let material =
+            kapaint_core::render::reference::Material::Uniform(kapaint_core::render::Sample {
+                kd: value.kd,
+                ks: value.ks,
+                n: value.n,
+            });
+        let pixels = kapaint_core::render::reference::render(
+            &self.mesh.mesh,
+            &self.mesh.bvh,
+            &material,
+            &settings,
+            SIZE,
+            SIZE,
+        );
+        let c =
+            |x: f32| (kapaint_core::model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
+        let rgba: Vec<u8> = pixels
+            .iter()
+            .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])
+            .collect();
+        egui::ColorImage::from_rgba_unmultiplied([SIZE as usize; 2], &rgba)
+    }
+}
+
+/// The width of the right panel's drop-down menus: wide enough for the longest entry
+/// ("n false colour", "Blinn-Phong (11)").
+const COMBO_WIDTH: f32 = 130.0;
+
+/// A shading model as the editor names it: with the paper's equation of its `k_a`.
+pub(crate) fn model_label(model: ShadingModel) -> &'static str {
+    match model {
+        ShadingModel::Phong => "Phong (8)",
+        ShadingModel::BlinnPhong => "Blinn-Phong (11)",
+        ShadingModel::CookTorrance => "Cook-Torrance",
+    }
+}
+
+/// The history's size: "1 step, 0.2 MB", "3 steps, 1.5 MB" (the status bar shows the same
+/// memory figure).
+pub(crate) fn history_summary(steps: usize, bytes: usize) -> String {
+    let noun = if steps == 1 { "step" } else { "steps" };
+    format!("{steps} {noun}, {}", megabytes(bytes))
+}
+
+/// Bytes as megabytes with one decimal, as the panel and the status bar both show them.
+pub(crate) fn megabytes(bytes: usize) -> String {
+    format!("{:.1} MB", bytes as f64 / 1e6)
+}
+
+/// A slider of an angle in degrees within `±limit`, shown to 0.1 degree but not rounded (a
+/// rounding slider would change the value every frame it is drawn).
+fn degrees<'a>(value: &'a mut f32, limit: f32, text: &str) -> egui::Slider<'a> {
+    egui::Slider::new(value, -limit..=limit)
+        .suffix("°")
+        .custom_formatter(|v, _| format!("{v:.1}"))
+        .clamping(egui::SliderClamping::Never)
+        .text(text)
+}

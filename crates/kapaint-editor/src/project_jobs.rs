@@ -1,0 +1,230 @@
+//! The jobs that open, recover and save the project, and what the editor does with their
+//! results: the recovery copy and the claim on the file follow the work.
+
+use std::path::PathBuf;
+
+use super::files::FilePurpose;
+use super::jobs::{JobResult, load_project, with_fallback};
+use super::{EditorState, autosave_interval, notice};
+use kapaint_core::model::Document;
+use kapaint_core::model::{project, recovery};
+
+/// A project a worker opened or recovered.
+pub(super) struct OpenedProject {
+    /// Where it is saved (`None` for recovered untitled work).
+    pub(super) path: Option<PathBuf>,
+    pub(super) doc: Document,
+    /// The recovery copy it came from, if it did.
+    pub(super) recovered: Option<PathBuf>,
+    /// A note for the user (its mesh could not be loaded, its recovery failed).
+    pub(super) note: Option<String>,
+    /// The project file as it was when read: what a save expects to replace.
+    pub(super) on_disk: Option<project::OnDisk>,
+    /// Opened read-only (another kapaint has it open).
+    pub(super) read_only: bool,
+}
+
+impl EditorState {
+    /// A save finished: the document version it holds, and the file as written.
+    pub(super) fn saved(&mut self, path: PathBuf, version: u64, on_disk: project::OnDisk) {
+        self.saved_version = version;
+        self.claim.hold(Some(&path), Some(on_disk), false);
+        self.notices
+            .push(notice(format!("saved {}", path.display()), false));
+        self.remember(&path);
+        if self.path.as_deref() != Some(path.as_path()) {
+            // Save As (or the first save): the recovery copy follows the work.
+            self.autosaver.relocate(Some(&path));
+        }
+        self.path = Some(path);
+        if std::mem::take(&mut self.quit.after_save) && !self.dirty() {
+            // The quit prompt's Save: the work is safe, so the window closes.
+            self.quit.allowed = Some(super::QuitAllowed::Saved);
+            self.quit.asked = true;
+        }
+        if !self.dirty()
+            && let Some(next) = self.pending_open.take()
+        {
+            self.open_now(next);
+        }
+    }
+
+    /// A save found its project changed on disk: the work went to `written` instead.
+    pub(super) fn conflicted(&mut self, message: String, written: PathBuf, version: u64) {
+        // The work is safe beside the project: the editor goes on with that file.
+        self.saved_version = version;
+        self.notices.push(notice(message, true));
+        self.remember(&written);
+        self.autosaver.relocate(Some(&written));
+        self.claim
+            .hold(Some(&written), project::OnDisk::of(&written), false);
+        self.path = Some(written);
+        self.quit.after_save = false;
+    }
+
+    /// Makes `doc` the document, with its mesh shown and framed.
+    /// Takes an opened (or recovered) project as the document.
+    pub(super) fn opened(&mut self, opened: OpenedProject) {
+        let OpenedProject {
+            path,
+            doc,
+            recovered,
+            on_disk,
+            read_only,
+            ..
+        } = opened;
+        self.claim.hold(path.as_deref(), on_disk, read_only);
+        self.replace_document(doc);
+        // The old document was saved or its changes discarded (asked before).
+        self.autosaver.discard();
+        let interval = autosave_interval();
+        // Recovered work is unsaved work, and its copy stays until this editor has its own.
+        (self.saved_version, self.autosaver) = match recovered.clone() {
+            Some(from) => (
+                u64::MAX,
+                recovery::Autosaver::recovering(interval, path.as_deref(), &self.doc, from),
+            ),
+            None => (
+                self.doc.version(),
+                recovery::Autosaver::new(interval, path.as_deref(), &self.doc),
+            ),
+        };
+        let recovered = recovered.is_some();
+        let name = path
+            .as_deref()
+            .map_or_else(|| "an untitled project".into(), |p| p.display().to_string());
+        let text = if recovered {
+            format!("recovered the unsaved work of {name}: save to keep it")
+        } else if read_only {
+            format!("opened {name} read-only: Save asks for another file")
+        } else {
+            format!("opened {name}")
+        };
+        self.notices.push(notice(text, false));
+        if let Some(p) = &path {
+            self.remember(p);
+        }
+        self.path = path;
+    }
+
+    /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
+    pub fn save_to(&mut self, path: PathBuf) {
+        let snapshot = self.doc.snapshot();
+        let version = self.doc.version();
+        // Over its own file, a save expects the file as this editor last read or wrote it;
+        // elsewhere (Save As) the user chose to replace what is there.
+        let expected = (self.path.as_deref() == Some(path.as_path()))
+            .then(|| self.claim.on_disk.clone())
+            .flatten();
+        self.start_job("Save", move |progress| {
+            progress.start("save", 1);
+            match project::save_checked(&snapshot, &path, expected.as_ref()) {
+                Ok(on_disk) => JobResult::Saved(path, version, on_disk),
+                Err(e @ kapaint_core::model::ModelError::Conflict { .. }) => {
+                    let kapaint_core::model::ModelError::Conflict { written, .. } = &e else {
+                        unreachable!("matched above")
+                    };
+                    JobResult::Conflicted {
+                        written: written.clone(),
+                        message: e.to_string(),
+                        version,
+                    }
+                }
+                Err(e) => JobResult::Failed(format!("could not save: {e}")),
+            }
+        });
+    }
+
+    /// Opens `path` on a worker.
+    pub fn open(&mut self, path: PathBuf) {
+        if self.dirty() {
+            // Unsaved work is never dropped: ask first (see `open_prompt`).
+            self.pending_open = Some(path);
+            return;
+        }
+        self.open_now(path);
+    }
+
+    /// Opens `path` on a worker, once the user has answered if another kapaint has it open.
+    pub(super) fn open_now(&mut self, path: PathBuf) {
+        let Some(read_only) = self.may_open(&path) else {
+            return;
+        };
+        self.start_job_opening("Open", Some(path.clone()), move |progress| {
+            progress.start("open", 1);
+            let on_disk = project::OnDisk::of(&path);
+            match load_project(&path) {
+                Ok((doc, note)) => JobResult::Opened(Box::new(OpenedProject {
+                    path: Some(path),
+                    doc,
+                    recovered: None,
+                    note,
+                    on_disk,
+                    read_only,
+                })),
+                Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
+            }
+        });
+    }
+
+    /// Opens the recovery copy `from` as the project at `path` (unsaved). A copy that cannot
+    /// be recovered is removed (it would be offered at every start) and the project opens as
+    /// saved, with a notice saying why.
+    pub(super) fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
+        let opens = path.clone().unwrap_or_else(|| from.clone());
+        self.start_job_opening("Recover", Some(opens), move |progress| {
+            progress.start("open", 1);
+            // Recovered work replaces the project as it is on disk now.
+            let on_disk = path.as_deref().and_then(project::OnDisk::of);
+            let recovered = recovery::load(&from)
+                .map_err(|e| e.to_string())
+                .and_then(|mut doc| {
+                    let own = PathBuf::from(doc.settings().mesh.spec());
+                    let failed = project::attach_mesh(&mut doc, &own).err();
+                    with_fallback(doc, failed)
+                });
+            let e = match recovered {
+                Ok((doc, note)) => {
+                    return JobResult::Opened(Box::new(OpenedProject {
+                        path,
+                        doc,
+                        recovered: Some(from),
+                        note,
+                        on_disk,
+                        read_only: false,
+                    }));
+                }
+                Err(e) => e,
+            };
+            recovery::remove(&from);
+            let why = format!("could not recover {}: {e}", from.display());
+            match path.as_deref().filter(|p| p.exists()).map(load_project) {
+                Some(Ok((doc, _))) => JobResult::Opened(Box::new(OpenedProject {
+                    path,
+                    doc,
+                    recovered: None,
+                    note: Some(format!("{why}; opened the saved project")),
+                    on_disk,
+                    read_only: false,
+                })),
+                Some(Err(open)) => JobResult::Failed(format!("{why}; {open}")),
+                None => JobResult::Failed(why),
+            }
+        });
+    }
+
+    pub(super) fn save(&mut self) {
+        match self.path.clone() {
+            Some(p) if !self.claim.read_only => self.save_to(p),
+            _ => self.save_as(),
+        }
+    }
+
+    pub(super) fn save_as(&mut self) {
+        self.choose_file(FilePurpose::SaveProject);
+    }
+
+    pub(super) fn open_dialog(&mut self) {
+        self.choose_file(FilePurpose::OpenProject);
+    }
+}

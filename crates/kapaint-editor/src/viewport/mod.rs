@@ -1,0 +1,260 @@
+//! The 3D viewport: the wgpu preview renderer drawing into a texture that egui shows, camera
+//! controls, and picking for painting on the mesh. Without a GPU (tests, broken drivers) the
+//! viewport still picks and paints; it only cannot draw.
+
+pub(crate) mod overlay;
+mod renderer;
+
+pub use overlay::{DIVIDER_LABEL, N_LEGEND_LABEL};
+pub use renderer::ViewportGpu;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use egui::{Color32, Pos2, Rect, Sense};
+
+use kapaint_core::mesh::Mesh;
+use kapaint_core::mesh::pick::{Bvh, Hit};
+use kapaint_core::model::MaterialMaps;
+use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
+use kapaint_core::render::{Camera, FrameSettings};
+
+/// The viewport's accessible name.
+pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
+
+pub use kapaint_core::render::Compare;
+
+/// What the viewport shows: the maps with their source id (a new id means new textures), and
+/// the material's normal map.
+pub type MapsIn<'a> = (
+    &'a MaterialMaps,
+    u64,
+    Option<&'a Arc<kapaint_core::model::normal::NormalMap>>,
+);
+
+/// One side of a comparison: its shading model and approximation of `chi`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Side {
+    /// Shading model.
+    pub model: ShadingModel,
+    /// Approximation of `chi`.
+    pub approx: AmbientApprox,
+}
+
+impl Side {
+    /// The label drawn over this side of the viewport.
+    pub fn label(self) -> String {
+        let model = match self.model {
+            ShadingModel::Phong => "Phong (eq. 8)",
+            ShadingModel::BlinnPhong => "Blinn-Phong (eq. 11)",
+            // The paper printed no form for it: the method is always kapaint's fit.
+            ShadingModel::CookTorrance => return "Cook-Torrance (GGX), fast".to_owned(),
+        };
+        format!("{model}, {}", self.approx.name())
+    }
+}
+
+/// What the viewport compares: the mode, the two sides and where the divider is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Comparison {
+    /// Compare mode.
+    pub mode: Compare,
+    /// The left side (Phong by default).
+    pub left: Side,
+    /// The right side (Blinn-Phong by default).
+    pub right: Side,
+    /// Split position, a fraction of the width.
+    pub split_at: f32,
+    /// The difference shown white in the heatmap (linear radiance).
+    pub diff_max: f32,
+}
+
+impl Default for Comparison {
+    fn default() -> Self {
+        Self {
+            mode: Compare::Single,
+            left: Side {
+                model: ShadingModel::Phong,
+                approx: AmbientApprox::Fast,
+            },
+            right: Side {
+                model: ShadingModel::BlinnPhong,
+                approx: AmbientApprox::Fast,
+            },
+            split_at: 0.5,
+            diff_max: 0.1,
+        }
+    }
+}
+
+/// The viewport's state.
+pub struct Viewport {
+    /// Camera.
+    pub camera: Camera,
+    /// What is compared, and how.
+    pub comparison: Comparison,
+    /// The renderer, when there is a GPU.
+    pub gpu: Option<ViewportGpu>,
+    /// Milliseconds the last frame took to record and submit.
+    pub frame_ms: f32,
+    /// Why there is no GPU, for the placeholder.
+    pub no_gpu: String,
+    /// Why the last frame could not be drawn (a map beyond the GPU's limits, a lost device).
+    pub gpu_error: Option<String>,
+    frame_pending: bool,
+    /// How many pictures side by side the camera was last framed for.
+    framed_columns: usize,
+}
+
+impl Viewport {
+    /// A viewport; `gpu` from eframe's render state when it has one.
+    pub fn new(gpu: Option<ViewportGpu>) -> Self {
+        Self {
+            camera: Camera::default().orbit(0.5, 0.35),
+            comparison: Comparison::default(),
+            gpu,
+            frame_ms: 0.0,
+            no_gpu: "The 3D preview needs a GPU (wgpu); painting on the mesh still works.".into(),
+            gpu_error: None,
+            frame_pending: true,
+            framed_columns: 1,
+        }
+    }
+
+    /// Frames the mesh (F) at the next draw, when the viewport's aspect is known.
+    pub fn frame(&mut self, _mesh: &Mesh) {
+        self.frame_pending = true;
+    }
+
+    /// The picture under `pos`: the whole viewport, or the half (third) it is in when side by
+    /// side (all three), laid out as the renderer's columns are.
+    pub fn picture_at(&self, rect: Rect, pos: Pos2) -> Rect {
+        let count = self.comparison.mode.columns();
+        if count == 1 {
+            return rect;
+        }
+        let width = rect.width() / count as f32;
+        let column =
+            (((pos.x - rect.min.x) / width.max(1.0)).floor().max(0.0) as usize).min(count - 1);
+        let x = rect.min.x + (rect.width() - width) * column as f32 / (count - 1) as f32;
+        Rect::from_min_size(Pos2::new(x, rect.min.y), egui::vec2(width, rect.height()))
+    }
+
+    /// The surface point under a screen position, if the ray hits the mesh.
+    pub fn pick(&self, rect: Rect, pos: Pos2, mesh: &Mesh, bvh: &Bvh) -> Option<Hit> {
+        let rect = self.picture_at(rect, pos);
+        let (w, h) = (rect.width().max(1.0), rect.height().max(1.0));
+        let (origin, dir) =
+            self.camera
+                .ray(pos.x - rect.min.x, pos.y - rect.min.y, w as u32, h as u32);
+        bvh.pick(mesh, origin, dir)
+    }
+
+    /// Draws the viewport and handles the camera (right drag or Alt + left: orbit; middle or
+    /// Shift + right: pan; wheel: zoom). Returns the response for painting with the left
+    /// button (not while Alt is held).
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        maps: MapsIn<'_>,
+        mesh: &(u64, Arc<Mesh>),
+        settings: &FrameSettings,
+    ) -> (egui::Response, Rect) {
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        response.widget_info(|| {
+            egui::WidgetInfo::labeled(egui::WidgetType::Other, true, VIEWPORT_LABEL)
+        });
+        if self.comparison.mode == Compare::Split {
+            self.divider_ui(ui, rect);
+        }
+        // Side by side halves (thirds) the pictures' width: frame again when it changes.
+        if self.comparison.mode.columns() != self.framed_columns {
+            self.frame_pending = true;
+        }
+        if self.frame_pending {
+            // Fit the bounding sphere in the narrower of the two fields of view (of one half
+            // when side by side).
+            self.frame_pending = false;
+            self.framed_columns = self.comparison.mode.columns();
+            self.camera = self.camera.framing(&mesh.1.positions);
+            let picture = self.picture_at(rect, rect.min);
+            let aspect = picture.width() / picture.height().max(1.0);
+            if aspect < 1.0 {
+                self.camera.distance /= aspect.max(0.05);
+            }
+        }
+        let (alt, shift) = ui.input(|i| (i.modifiers.alt, i.modifiers.shift));
+        let delta = response.drag_delta();
+        let right = response.dragged_by(egui::PointerButton::Secondary);
+        let middle = response.dragged_by(egui::PointerButton::Middle);
+        let left = response.dragged_by(egui::PointerButton::Primary);
+        // Shift + right drag turns the light (the editor reads it from the response).
+        if middle {
+            self.camera = self
+                .camera
+                .pan(delta.x / rect.height(), delta.y / rect.height());
+        } else if (right && !shift) || (left && alt) {
+            self.camera = self.camera.orbit(-delta.x * 0.01, delta.y * 0.01);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                self.camera = self.camera.zoom((scroll * 0.002).exp());
+            }
+        }
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(40));
+        let ppp = ui.ctx().pixels_per_point();
+        let size = (
+            ((rect.width() * ppp) as u32).max(1),
+            ((rect.height() * ppp) as u32).max(1),
+        );
+        let mut frame = *settings;
+        frame.camera = self.camera;
+        match &mut self.gpu {
+            Some(gpu) => {
+                let start = Instant::now();
+                match gpu.render(maps, mesh, &frame, &self.comparison, size) {
+                    Ok(id) => {
+                        self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
+                        self.gpu_error = None;
+                        painter.image(
+                            id,
+                            rect,
+                            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+                            Color32::WHITE,
+                        );
+                    }
+                    Err(e) => {
+                        painter.text(
+                            rect.center(),
+                            egui::Align2::CENTER_CENTER,
+                            format!(
+                                "The 3D preview cannot draw: {e}\nPainting on the UV canvas and saving still work."
+                            ),
+                            egui::FontId::proportional(14.0),
+                            Color32::from_rgb(230, 120, 110),
+                        );
+                        self.gpu_error = Some(e.to_string());
+                    }
+                }
+            }
+            None => {
+                painter.text(
+                    rect.center(),
+                    egui::Align2::CENTER_CENTER,
+                    &self.no_gpu,
+                    egui::FontId::proportional(14.0),
+                    Color32::GRAY,
+                );
+            }
+        }
+        self.labels_ui(&painter, rect);
+        if settings.view == kapaint_core::render::ViewMode::NFalseColour
+            && self.comparison.mode != Compare::Difference
+        {
+            overlay::n_legend_ui(ui, &painter, rect);
+        }
+        (response, rect)
+    }
+}

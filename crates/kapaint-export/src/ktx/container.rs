@@ -1,0 +1,193 @@
+//! The KTX2 container: written from the `ktx2` crate's header, level index and data format
+//! descriptor types (that crate reads KTX2 but does not assemble files), and level 0 read back.
+
+use ktx2::{Format as KtxFormat, Header, Index, LevelIndex, dfd};
+
+use super::crop;
+use crate::blocks::{self, BlockKind};
+use crate::preset::Bc7Quality;
+
+/// Level 0 of a KTX2 file as decoded texels.
+#[derive(Clone, Debug)]
+pub struct Decoded {
+    /// Size in texels.
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+    /// Meaningful components per texel (1, 2, 3 or 4).
+    pub channels: usize,
+    /// RGBA per texel (components past `channels` are filler): bytes as fractions of 255,
+    /// or BC6H's half floats.
+    pub rgba: Vec<f32>,
+}
+
+/// Assembles a KTX2 file: header, level index, data format descriptor, the writer's name,
+/// then the levels from smallest to largest, each aligned as the specification asks.
+pub(super) fn container(
+    format: KtxFormat,
+    (w, h): (u32, u32),
+    levels: &[Vec<u8>],
+) -> Result<Vec<u8>, String> {
+    let (basic, type_size) =
+        dfd::Basic::from_format(format).map_err(|e| format!("data format descriptor: {e:?}"))?;
+    let block = dfd::Block::Basic(basic).to_vec();
+    let mut dfd_bytes = ((block.len() + 4) as u32).to_le_bytes().to_vec();
+    dfd_bytes.extend_from_slice(&block);
+    let mut kvd = Vec::new();
+    let entry = format!("KTXwriter\0kapaint {}\0", env!("CARGO_PKG_VERSION"));
+    kvd.extend_from_slice(&(entry.len() as u32).to_le_bytes());
+    kvd.extend_from_slice(entry.as_bytes());
+    kvd.resize(kvd.len().div_ceil(4) * 4, 0);
+    // Level data alignment: lcm(texel block size, 4).
+    let block_bytes = match format {
+        KtxFormat::BC4_UNORM_BLOCK => 8,
+        KtxFormat::BC5_UNORM_BLOCK
+        | KtxFormat::BC7_SRGB_BLOCK
+        | KtxFormat::BC7_UNORM_BLOCK
+        | KtxFormat::BC6H_UFLOAT_BLOCK => 16,
+        _ => 4,
+    };
+    let index_at = Header::LENGTH;
+    let dfd_at = index_at + levels.len() * LevelIndex::LENGTH;
+    let kvd_at = dfd_at + dfd_bytes.len();
+    let mut at = kvd_at + kvd.len();
+    let mut index = vec![
+        LevelIndex {
+            byte_offset: 0,
+            byte_length: 0,
+            uncompressed_byte_length: 0,
+        };
+        levels.len()
+    ];
+    let mut body = Vec::new();
+    for (i, level) in levels.iter().enumerate().rev() {
+        let aligned = at.div_ceil(block_bytes) * block_bytes;
+        body.resize(body.len() + (aligned - at), 0);
+        index[i] = LevelIndex {
+            byte_offset: aligned as u64,
+            byte_length: level.len() as u64,
+            uncompressed_byte_length: level.len() as u64,
+        };
+        body.extend_from_slice(level);
+        at = aligned + level.len();
+    }
+    let header = Header {
+        format: Some(format),
+        type_size,
+        pixel_width: w,
+        pixel_height: h,
+        pixel_depth: 0,
+        layer_count: 0,
+        face_count: 1,
+        level_count: levels.len() as u32,
+        supercompression_scheme: None,
+        index: Index {
+            dfd_byte_offset: dfd_at as u32,
+            dfd_byte_length: dfd_bytes.len() as u32,
+            kvd_byte_offset: kvd_at as u32,
+            kvd_byte_length: kvd.len() as u32,
+            sgd_byte_offset: 0,
+            sgd_byte_length: 0,
+        },
+    };
+    let mut out = Vec::with_capacity(at);
+    out.extend_from_slice(&header.as_bytes());
+    for entry in &index {
+        out.extend_from_slice(&entry.as_bytes());
+    }
+    out.extend_from_slice(&dfd_bytes);
+    out.extend_from_slice(&kvd);
+    out.extend_from_slice(&body);
+    Ok(out)
+}
+
+/// Reads level 0 of a KTX2 file kapaint writes (the formats above, no supercompression).
+///
+/// # Errors
+/// A malformed file or a format kapaint does not write.
+pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
+    let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a KTX2 file: {e}"))?;
+    let header = reader.header();
+    if header.supercompression_scheme.is_some() {
+        return Err("supercompressed KTX2 is not supported".into());
+    }
+    let (w, h) = (header.pixel_width, header.pixel_height.max(1));
+    if w > kapaint_core::model::maps::MAX_SIDE || h > kapaint_core::model::maps::MAX_SIDE {
+        return Err(format!("{w}x{h} is larger than kapaint's maps"));
+    }
+    let level = reader.levels().next().ok_or("the file has no levels")?;
+    let data = level.data;
+    let texels = w as usize * h as usize;
+    let (channels, rgba) = match header.format {
+        Some(KtxFormat::R8_UNORM | KtxFormat::R8G8_UNORM) => {
+            let ch = if header.format == Some(KtxFormat::R8_UNORM) {
+                1
+            } else {
+                2
+            };
+            if data.len() < texels * ch {
+                return Err("level 0 is truncated".into());
+            }
+            let mut rgba = vec![255_u8; texels * 4];
+            for (px, src) in rgba.chunks_mut(4).zip(data.chunks(ch)) {
+                px[..ch].copy_from_slice(src);
+            }
+            (ch, rgba)
+        }
+        Some(KtxFormat::R8G8B8A8_UNORM | KtxFormat::R8G8B8A8_SRGB) => {
+            if data.len() < texels * 4 {
+                return Err("level 0 is truncated".into());
+            }
+            (4, data[..texels * 4].to_vec())
+        }
+        Some(
+            f @ (KtxFormat::BC4_UNORM_BLOCK
+            | KtxFormat::BC5_UNORM_BLOCK
+            | KtxFormat::BC7_UNORM_BLOCK
+            | KtxFormat::BC7_SRGB_BLOCK
+            | KtxFormat::BC6H_UFLOAT_BLOCK),
+        ) => {
+            let kind = match f {
+                KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
+                KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
+                KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
+                    effort: Bc7Quality::UltraFast,
+                },
+                _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
+            };
+            let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+            let size = (padded.0 as usize / 4) * (padded.1 as usize / 4) * kind.block_bytes();
+            if data.len() < size {
+                return Err("level 0 is truncated".into());
+            }
+            let per = kind.texel_bytes();
+            let texels = blocks::decode(kind, &data[..size], padded);
+            let tight = crop(&texels, padded.0, (w, h), per, per);
+            if per == 8 {
+                let rgba = tight
+                    .chunks_exact(2)
+                    .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+                    .collect();
+                return Ok(Decoded {
+                    width: w,
+                    height: h,
+                    channels: 3,
+                    rgba,
+                });
+            }
+            let mut rgba = vec![255_u8; w as usize * h as usize * 4];
+            for (px, t) in rgba.chunks_exact_mut(4).zip(tight.chunks_exact(per)) {
+                px[..per].copy_from_slice(t);
+            }
+            (per, rgba)
+        }
+        other => return Err(format!("KTX2 format {other:?} is not one kapaint writes")),
+    };
+    let rgba = rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
+    Ok(Decoded {
+        width: w,
+        height: h,
+        channels,
+        rgba,
+    })
+}

@@ -1,0 +1,532 @@
+//! KTX2 files with a full mip chain: 8-bit components uncompressed, or block-compressed
+//! (BC7 for three or four components, BC5 for two, BC4 for one, BC6H for three linear half
+//! floats).
+//!
+//! The container is assembled from the `ktx2` crate's header, level index and data format
+//! descriptor types (`container.rs`); blocks come from [`super::blocks`]; mips
+//! (`levels.rs`) are 2x2 boxes, each component averaged in its own space ([`Space`]).
+
+mod container;
+mod levels;
+
+use ktx2::Format as KtxFormat;
+use rayon::prelude::*;
+
+use self::container::container;
+pub use self::container::{Decoded, decode};
+pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
+use super::blocks::{self, BlockKind, Coder};
+use super::preset::Bc7Quality;
+use super::set::Compression;
+use kapaint_core::task::Progress;
+
+/// A texel's component in its averaging space (`value(texel, component)`, unquantised).
+pub trait Values: Sync {
+    /// Texel `i`'s component `k`.
+    fn value(&self, i: usize, k: usize) -> f32;
+}
+
+impl<F: Fn(usize, usize) -> f32 + Sync> Values for F {
+    fn value(&self, i: usize, k: usize) -> f32 {
+        self(i, k)
+    }
+}
+
+/// An image to write: its size, each component's space, level 0 as stored bytes (per
+/// component per texel, row major: one byte, or two for a half float) and, for the mips, each texel's value in the averaging
+/// space (`value(texel, component)`, unquantised).
+pub struct Source<'a> {
+    /// Size in texels.
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+    /// One per component (1 to 4).
+    pub spaces: &'a [Space],
+    /// Level 0: `width * height` texels of [`texel_layout`] bytes.
+    pub level0: &'a [u8],
+    /// A texel's component in its averaging space.
+    pub value: &'a dyn Values,
+}
+
+impl Source<'_> {
+    fn channels(&self) -> usize {
+        self.spaces.len()
+    }
+
+    /// Colour components are sRGB (three or four components whose first is colour).
+    pub fn srgb(&self) -> bool {
+        self.channels() >= 3 && self.spaces[0].is_colour()
+    }
+
+    /// Bytes per stored texel.
+    fn texel_bytes(&self) -> usize {
+        texel_layout(self.spaces).0
+    }
+
+    fn check(&self) -> Result<(), String> {
+        let (w, h, ch) = (self.width, self.height, self.channels());
+        let half = self.spaces.iter().filter(|s| **s == Space::Half).count();
+        if w == 0
+            || h == 0
+            || !(1..=4).contains(&ch)
+            || (half > 0 && (half != ch || ch != 3))
+            || self.level0.len() != w as usize * h as usize * self.texel_bytes()
+        {
+            return Err(format!("cannot write a {w}x{h} image of {ch} components"));
+        }
+        Ok(())
+    }
+}
+
+/// `bytes` (`per` per texel, `(w, h)`) padded to whole blocks by repeating the last row and
+/// column.
+fn pad(bytes: &[u8], (w, h): (u32, u32), per: usize, (pw, ph): (u32, u32)) -> Vec<u8> {
+    let mut out = vec![0_u8; pw as usize * ph as usize * per];
+    out.par_chunks_mut(pw as usize * per)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let sy = y.min(h as usize - 1);
+            let src = &bytes[sy * w as usize * per..][..w as usize * per];
+            row[..src.len()].copy_from_slice(src);
+            for x in w as usize..pw as usize {
+                row.copy_within((w as usize - 1) * per..w as usize * per, x * per);
+            }
+        });
+    out
+}
+
+/// `channels` of `per` bytes per texel, cropped from `(pw, ph)` to `(w, h)`.
+pub(super) fn crop(
+    bytes: &[u8],
+    pw: u32,
+    (w, h): (u32, u32),
+    per: usize,
+    channels: usize,
+) -> Vec<u8> {
+    let mut out = vec![0_u8; w as usize * h as usize * channels];
+    out.par_chunks_mut(w as usize * channels)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let src = &bytes[y * pw as usize * per..];
+            for (x, t) in row.chunks_exact_mut(channels).enumerate() {
+                t.copy_from_slice(&src[x * per..x * per + channels]);
+            }
+        });
+    out
+}
+
+/// One level block-compressed: its blocks, and its texels as a consumer decodes them
+/// (`channels` bytes per texel, the level's own size).
+pub struct Compressed {
+    /// The blocks.
+    pub blocks: Vec<u8>,
+    /// Decoded, cropped to the level.
+    pub decoded: Vec<u8>,
+    /// Per component, [`psnr`] of `decoded` against the level, once measured
+    /// ([`Compressed::psnr`]).
+    psnr: Option<Vec<Option<f64>>>,
+}
+
+impl Compressed {
+    /// Per component, [`psnr`] of the decoded blocks against `level` (the texels they were
+    /// encoded from, of components in `spaces`), measured once.
+    pub fn psnr(&mut self, level: &[u8], spaces: &[Space]) -> &[Option<f64>] {
+        self.psnr
+            .get_or_insert_with(|| psnr(level, &self.decoded, spaces))
+    }
+}
+
+/// The block kind of an image of `spaces` at `effort` (BC7 and BC6H only): BC6H for half
+/// floats, else by the component count.
+pub fn block_kind(spaces: &[Space], effort: Bc7Quality) -> BlockKind {
+    if spaces.first() == Some(&Space::Half) {
+        BlockKind::Bc6h { effort }
+    } else {
+        BlockKind::for_channels(spaces.len(), effort)
+    }
+}
+
+/// Compresses one level (`channels` bytes per stored texel) as `kind` with `encoder`. Rows
+/// advance `progress`.
+pub fn compress_level(
+    encoder: Coder<'_>,
+    kind: BlockKind,
+    bytes: &[u8],
+    (w, h): (u32, u32),
+    channels: usize,
+    progress: Option<&Progress>,
+) -> Compressed {
+    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+    let input: std::borrow::Cow<'_, [u8]> = if padded == (w, h) {
+        bytes.into()
+    } else {
+        pad(bytes, (w, h), channels, padded).into()
+    };
+    let blocks = blocks::encode_stored(encoder, kind, &input, channels, padded, progress);
+    let decoded = blocks::decode_stored(kind, &blocks, padded, channels);
+    let decoded = if padded == (w, h) {
+        decoded
+    } else {
+        crop(&decoded, padded.0, (w, h), channels, channels)
+    };
+    Compressed {
+        blocks,
+        decoded,
+        psnr: None,
+    }
+}
+
+/// Per component, PSNR (dB) of `decoded` against `reference` (texels of components in
+/// `spaces`), `None` where they are identical. Bytes compare as stored (peak 255); half
+/// floats compare sRGB-encoded, on the same scale, so a BC6H image's PSNR reads like a BC7
+/// image's.
+pub fn psnr(reference: &[u8], decoded: &[u8], spaces: &[Space]) -> Vec<Option<f64>> {
+    /// Texels per parallel run: a run of both images stays in cache while each component's
+    /// differences are summed.
+    const RUN: usize = 1 << 14;
+    let (per, offsets) = texel_layout(spaces);
+    let n = spaces.len();
+    let sums = reference
+        .par_chunks(per * RUN)
+        .zip(decoded.par_chunks(per * RUN))
+        .map(|(a, b)| {
+            let pairs = || a.chunks_exact(per).zip(b.chunks_exact(per));
+            (0..n)
+                .map(|k| {
+                    let o = offsets[k];
+                    if spaces[k] == Space::Half {
+                        let level = |t: &[u8]| {
+                            f64::from(
+                                HALF_LEVELS[usize::from(u16::from_le_bytes([t[o], t[o + 1]]))],
+                            )
+                        };
+                        pairs().map(|(x, y)| (level(x) - level(y)).powi(2)).sum()
+                    } else {
+                        // Whole bytes: exact integer sums.
+                        let sum: u64 = pairs()
+                            .map(|(x, y)| u64::from(x[o].abs_diff(y[o])).pow(2))
+                            .sum();
+                        sum as f64
+                    }
+                })
+                .collect::<Vec<f64>>()
+        })
+        .reduce(
+            || vec![0.0; n],
+            |x, y| x.iter().zip(&y).map(|(x, y)| x + y).collect(),
+        );
+    let texels = (reference.len() / per).max(1) as f64;
+    sums.into_iter()
+        .map(|sum| {
+            let mse = sum / texels;
+            (mse > 0.0).then(|| 10.0 * (255.0_f64 * 255.0 / mse).log10())
+        })
+        .collect()
+}
+
+/// Every half float's bits as the byte-scale level [`psnr`] compares: clamped to `[0, 1]`
+/// (NaN as 0) and sRGB-encoded.
+static HALF_LEVELS: std::sync::LazyLock<Vec<f32>> = std::sync::LazyLock::new(|| {
+    (0..=u16::MAX)
+        .map(|b| {
+            let v = half::f16::from_bits(b).to_f32();
+            let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+            kapaint_core::model::texel::linear_to_srgb(v) * 255.0
+        })
+        .collect()
+});
+
+/// A written KTX2 file.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// The file.
+    pub bytes: Vec<u8>,
+    /// Every level as a consumer decodes it, finest first, texels as the source stores them.
+    pub decoded: Vec<Vec<u8>>,
+    /// Per component, PSNR (dB) of the decoded level 0 against the uncompressed 8-bit values,
+    /// `None` where they are identical (`None` altogether for uncompressed files).
+    pub psnr: Option<Vec<Option<f64>>>,
+    /// Mip levels in the file.
+    pub levels: u32,
+    /// The file's compression: plain KTX2, or BC4, BC5, BC7 or BC6H blocks.
+    pub compression: Compression,
+}
+
+/// The KTX2 format and compression name of `channels` components, block-compressed or not.
+fn format_of(spaces: &[Space], srgb: bool, compressed: bool) -> (KtxFormat, Compression) {
+    if spaces.first() == Some(&Space::Half) {
+        return (KtxFormat::BC6H_UFLOAT_BLOCK, Compression::Ktx2Bc6h);
+    }
+    match (compressed, spaces.len()) {
+        (false, 1) => (KtxFormat::R8_UNORM, Compression::Ktx2),
+        (false, 2) => (KtxFormat::R8G8_UNORM, Compression::Ktx2),
+        (false, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, Compression::Ktx2),
+        (false, _) => (KtxFormat::R8G8B8A8_UNORM, Compression::Ktx2),
+        (true, 1) => (KtxFormat::BC4_UNORM_BLOCK, Compression::Ktx2Bc4),
+        (true, 2) => (KtxFormat::BC5_UNORM_BLOCK, Compression::Ktx2Bc5),
+        (true, _) if srgb => (KtxFormat::BC7_SRGB_BLOCK, Compression::Ktx2Bc7),
+        (true, _) => (KtxFormat::BC7_UNORM_BLOCK, Compression::Ktx2Bc7),
+    }
+}
+
+/// Writes `source` as a KTX2 file with a full mip chain: uncompressed, or with
+/// `compressed = Some((encoder, effort))` block-compressed. `level0`, when given, is level 0
+/// already compressed (the export's effort search keeps the one it chose). Level 0's rows
+/// advance `progress`; a cancel stops the block encoder between strips.
+///
+/// # Errors
+/// An empty image, a component count outside 1..=4, half floats uncompressed or not as
+/// three components, or cancelled.
+pub fn encode(
+    source: &Source<'_>,
+    compressed: Option<(Coder<'_>, Bc7Quality)>,
+    level0: Option<Compressed>,
+    progress: &Progress,
+) -> Result<Written, String> {
+    source.check()?;
+    let (w, h, ch) = (source.width, source.height, source.channels());
+    let per = source.texel_bytes();
+    let srgb = source.srgb();
+    if compressed.is_none() && per != ch {
+        return Err("half floats are written only as BC6H blocks".into());
+    }
+    let (format, compression) = format_of(source.spaces, srgb, compressed.is_some());
+    let chain = mips(source);
+    let mut level_bytes = Vec::with_capacity(chain.len() + 1);
+    let mut decoded = Vec::with_capacity(chain.len() + 1);
+    let mut psnr_values = None;
+    match compressed {
+        None => {
+            let widen = |bytes: &[u8]| -> Vec<u8> {
+                if ch == 3 {
+                    bytes
+                        .chunks_exact(3)
+                        .flat_map(|t| [t[0], t[1], t[2], 255])
+                        .collect()
+                } else {
+                    bytes.to_vec()
+                }
+            };
+            progress.advance(u64::from(h));
+            level_bytes.push(widen(source.level0));
+            decoded.push(source.level0.to_vec());
+            for (_, bytes) in &chain {
+                level_bytes.push(widen(bytes));
+                decoded.push(bytes.clone());
+            }
+        }
+        Some((encoder, effort)) => {
+            let kind = block_kind(source.spaces, effort);
+            let mut first = match level0 {
+                Some(c) => {
+                    progress.advance(u64::from(h));
+                    c
+                }
+                None => compress_level(encoder, kind, source.level0, (w, h), per, Some(progress)),
+            };
+            if progress.is_cancelled() {
+                return Err("cancelled".into());
+            }
+            psnr_values = Some(first.psnr(source.level0, source.spaces).to_vec());
+            level_bytes.push(first.blocks);
+            decoded.push(first.decoded);
+            for (size, bytes) in &chain {
+                let c = compress_level(encoder, kind, bytes, *size, per, None);
+                level_bytes.push(c.blocks);
+                decoded.push(c.decoded);
+            }
+        }
+    }
+    let bytes = container(format, (w, h), &level_bytes)?;
+    Ok(Written {
+        bytes,
+        decoded,
+        psnr: psnr_values,
+        levels: level_count(w, h),
+        compression,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient(w: u32, h: u32, ch: usize) -> Vec<f32> {
+        (0..w * h)
+            .flat_map(|i| {
+                let (x, y) = (i % w, i / w);
+                (0..ch).map(move |k| ((x + y * 3 + k as u32 * 17) % 64) as f32 / 63.0)
+            })
+            .collect()
+    }
+
+    /// Writes `values` (in the averaging space of `spaces`) as a KTX2 file.
+    fn write(
+        (w, h): (u32, u32),
+        spaces: &[Space],
+        values: &[f32],
+        compressed: Option<Bc7Quality>,
+    ) -> Written {
+        let ch = spaces.len();
+        let bounds: Vec<Vec<f32>> = spaces.iter().map(|s| s.boundaries()).collect();
+        let (per, offsets) = texel_layout(spaces);
+        let mut level0 = vec![0_u8; values.len() / ch * per];
+        for (t, v) in level0.chunks_exact_mut(per).zip(values.chunks_exact(ch)) {
+            for k in 0..ch {
+                spaces[k].store(&bounds[k], v[k], &mut t[offsets[k]..]);
+            }
+        }
+        let value = |i: usize, k: usize| values[i * ch + k];
+        let source = Source {
+            width: w,
+            height: h,
+            spaces,
+            level0: &level0,
+            value: &value,
+        };
+        encode(
+            &source,
+            compressed.map(|q| (Coder::best_cpu(), q)),
+            None,
+            &Progress::default(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn files_read_back_through_the_ktx2_crate() {
+        for (ch, compressed) in [
+            (1, None),
+            (2, None),
+            (3, None),
+            (4, None),
+            (1, Some(Bc7Quality::VeryFast)),
+            (2, Some(Bc7Quality::VeryFast)),
+            (4, Some(Bc7Quality::UltraFast)),
+            (5, Some(Bc7Quality::UltraFast)),
+        ] {
+            // 5: three half floats, as BC6H.
+            let half = ch == 5;
+            let ch = ch.min(4) - usize::from(half);
+            let (w, h) = (37, 20);
+            let values = gradient(w, h, ch);
+            let spaces = [Space::Srgb, Space::Srgb, Space::Srgb, Space::Linear];
+            let spaces = if half {
+                &[Space::Half; 3][..]
+            } else if ch >= 3 {
+                &spaces[..ch]
+            } else {
+                &[Space::Linear; 2][..ch]
+            };
+            let written = write((w, h), spaces, &values, compressed);
+            assert_eq!(written.levels, 6);
+            assert_eq!(written.decoded.len(), 6);
+            let reader = ktx2::Reader::new(&written.bytes[..]).unwrap();
+            assert_eq!(reader.header().level_count, 6);
+            assert_eq!(reader.levels().count(), 6);
+            let decoded = decode(&written.bytes).unwrap();
+            assert_eq!((decoded.width, decoded.height), (w, h));
+            // What decode reads is what encode says a consumer gets.
+            let first: Vec<f32> = decoded
+                .rgba
+                .chunks(4)
+                .flat_map(|p| p[..ch].to_vec())
+                .collect();
+            let said: Vec<f32> = if half {
+                written.decoded[0]
+                    .chunks_exact(2)
+                    .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+                    .collect()
+            } else {
+                written.decoded[0]
+                    .iter()
+                    .map(|b| f32::from(*b) / 255.0)
+                    .collect()
+            };
+            assert_eq!(first, said, "{ch} {compressed:?}");
+            if half {
+                assert_eq!(written.compression, Compression::Ktx2Bc6h);
+                assert_eq!(reader.header().format, Some(KtxFormat::BC6H_UFLOAT_BLOCK));
+                // Linear light, decoded close to the values written (the sawtooth's jumps
+                // inside blocks cost the most).
+                let mean = first
+                    .iter()
+                    .zip(&values)
+                    .map(|(a, b)| (a - b).abs())
+                    .sum::<f32>()
+                    / values.len() as f32;
+                assert!(mean < 0.05, "{mean}");
+            }
+            if compressed.is_none() {
+                let exact: Vec<u8> = values
+                    .iter()
+                    .enumerate()
+                    .map(|(j, v)| quantise(&spaces[j % ch].boundaries(), *v))
+                    .collect();
+                assert_eq!(written.decoded[0], exact);
+            } else {
+                let p = written.psnr.unwrap();
+                assert!(p.iter().all(|p| p.is_none_or(|p| p > 30.0)), "{p:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn psnr_sums_every_texel_of_every_component() {
+        // A byte component and a half float one, more texels than one parallel run, and a
+        // texel that differs only in the last run's tail.
+        let spaces = [Space::Linear, Space::Half];
+        let texels = (1 << 14) * 3 + 5;
+        let texel = |i: usize, shift: u8| {
+            let h = half::f16::from_f32((i % 97) as f32 / 97.0);
+            let [lo, hi] = h.to_le_bytes();
+            [(i % 251) as u8 ^ shift, lo, hi]
+        };
+        let a: Vec<u8> = (0..texels).flat_map(|i| texel(i, 0)).collect();
+        let mut b: Vec<u8> = (0..texels)
+            .flat_map(|i| texel(i, u8::from(i % 7 == 0)))
+            .collect();
+        let last = b.len() - 2;
+        b[last] ^= 1;
+        let to_level = |t: &[u8]| {
+            let v = half::f16::from_le_bytes([t[1], t[2]])
+                .to_f32()
+                .clamp(0.0, 1.0);
+            f64::from(kapaint_core::model::texel::linear_to_srgb(v) * 255.0)
+        };
+        let naive = |k: usize| {
+            let sum: f64 = a
+                .chunks_exact(3)
+                .zip(b.chunks_exact(3))
+                .map(|(x, y)| {
+                    let d = if k == 0 {
+                        f64::from(x[0]) - f64::from(y[0])
+                    } else {
+                        to_level(x) - to_level(y)
+                    };
+                    d * d
+                })
+                .sum();
+            10.0 * (255.0_f64 * 255.0 / (sum / texels as f64)).log10()
+        };
+        let got = psnr(&a, &b, &spaces);
+        for (k, p) in got.iter().enumerate() {
+            let p = p.expect("they differ");
+            assert!(
+                (p - naive(k)).abs() < 1e-9,
+                "component {k}: {p} vs {}",
+                naive(k)
+            );
+        }
+        assert_eq!(psnr(&a, &a, &spaces), [None, None]);
+    }
+
+    #[test]
+    fn garbage_is_an_error() {
+        assert!(decode(b"not a ktx2 file at all").is_err());
+        let values = gradient(8, 8, 1);
+        let mut bytes = write((8, 8), &[Space::Linear], &values, None).bytes;
+        bytes.truncate(bytes.len() - 10);
+        assert!(decode(&bytes).is_err());
+    }
+}

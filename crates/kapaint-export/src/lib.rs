@@ -1,0 +1,54 @@
+//! Exporting compact texture sets: presets ([`preset`]), the choice of `n`'s
+//! encoding by the `k_a` error it causes ([`encoding`]), and sets of images with a
+//! `material.json` manifest written atomically and read back ([`set`]).
+
+pub mod blocks;
+pub mod encoding;
+pub mod glb;
+pub mod gltf_pbr;
+pub mod ktx;
+pub mod preset;
+pub mod set;
+pub mod snippet;
+
+use std::path::Path;
+
+/// What an export wrote: a kapaint set, or a glTF PBR set.
+#[derive(Clone, Debug)]
+pub enum Exported {
+    /// A kapaint set (`material.json` in [`set::MANIFEST_FORMAT`]).
+    Set(set::Manifest),
+    /// A glTF PBR set (the `gltf-pbr` preset).
+    Pbr(gltf_pbr::PbrManifest),
+}
+
+/// Exports `doc` with `preset` into the folder `out`: a kapaint set ([`set::export_with`],
+/// [`set::export_replacing`] where `replace`), or for a [`preset::Format::GltfPbr`] preset a
+/// glTF PBR set, with the `glb` mesh and the material as a `.glb` where given. Blocks are
+/// encoded by `brought` (a GPU's encoder) where given, else on the CPU.
+///
+/// # Errors
+/// As the exports; `glb` with a preset that is not glTF PBR.
+pub fn run(
+    doc: &kapaint_core::model::Document,
+    preset: &preset::ExportPreset,
+    out: &Path,
+    progress: &kapaint_core::task::Progress,
+    replace: bool,
+    glb: Option<&kapaint_core::mesh::Mesh>,
+    brought: Option<&dyn blocks::BlockEncoder>,
+) -> Result<Exported, set::SetError> {
+    if preset.format == preset::Format::GltfPbr {
+        return gltf_pbr::export(doc, preset, out, progress, replace, glb).map(Exported::Pbr);
+    }
+    if glb.is_some() {
+        return Err(set::SetError::Invalid {
+            path: out.to_path_buf(),
+            reason: format!(
+                "a .glb is written with the gltf-pbr preset, not {}",
+                preset.name
+            ),
+        });
+    }
+    set::export_into(doc, preset, out, progress, replace, brought).map(Exported::Set)
+}

@@ -1,0 +1,384 @@
+//! Export presets: `presets/export/*.ron`, built into the binary, plus the user's own from
+//! `$KAPAINT_EXPORT_PRESET_DIR`.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// Image format of the exported files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Format {
+    /// 8-bit PNG (colour in sRGB).
+    Png8,
+    /// 16-bit PNG (linear).
+    Png16,
+    /// Float OpenEXR (linear; `n` as is).
+    Exr,
+    /// KTX2, 8 bits per component, uncompressed, with a full mip chain.
+    Ktx2,
+    /// KTX2 block-compressed with a full mip chain: BC7 for three or four components, BC5
+    /// for two, BC4 for one.
+    Ktx2Bc,
+    /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
+    /// roughness, B metallic), and the normal map where the project has one; converted back
+    /// from `k_d`, `k_s`, `n` ([`crate::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
+    /// not apply.
+    GltfPbr,
+}
+
+impl Format {
+    /// Whether files hold 8-bit components (PNG8 and both KTX2 kinds).
+    pub fn is_8bit(self) -> bool {
+        matches!(self, Self::Png8 | Self::Ktx2 | Self::Ktx2Bc | Self::GltfPbr)
+    }
+
+    /// Whether files are KTX2 containers.
+    pub fn is_ktx2(self) -> bool {
+        matches!(self, Self::Ktx2 | Self::Ktx2Bc)
+    }
+
+    /// The files' extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Png8 | Self::Png16 | Self::GltfPbr => "png",
+            Self::Exr => "exr",
+            Self::Ktx2 | Self::Ktx2Bc => "ktx2",
+        }
+    }
+}
+
+/// BC7 encoder effort (BC4 and BC5 have one speed): slower finds better endpoints. Ordered
+/// from the cheapest.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Bc7Quality {
+    /// Fewest partitions and modes tried.
+    UltraFast,
+    /// About 1 dB under `Basic` at a fraction of the time.
+    VeryFast,
+    /// More modes.
+    Fast,
+    /// The reference encoder's basic profile: the most a preset spends by default.
+    #[default]
+    Basic,
+    /// Exhaustive.
+    Slow,
+}
+
+impl Bc7Quality {
+    /// Every effort, cheapest first.
+    pub const ALL: [Self; 5] = [
+        Self::UltraFast,
+        Self::VeryFast,
+        Self::Fast,
+        Self::Basic,
+        Self::Slow,
+    ];
+}
+
+/// What a block-compressed set may lose. The export encodes with the cheapest layout and
+/// effort first and spends more only while one of these is not met (`k_a` errors relative,
+/// per texel and colour channel; PSNR per component, in dB, of level 0 against the
+/// uncompressed 8-bit values).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlockBudget {
+    /// Largest `k_a` error allowed.
+    pub max_ka_error: f64,
+    /// Mean `k_a` error allowed.
+    pub mean_ka_error: f64,
+    /// Smallest PSNR allowed of any component.
+    pub min_psnr: f64,
+}
+
+impl Default for BlockBudget {
+    fn default() -> Self {
+        Self {
+            max_ka_error: 0.02,
+            mean_ka_error: 0.002,
+            min_psnr: 45.0,
+        }
+    }
+}
+
+/// How channels are packed into files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Layout {
+    /// `k_d` RGB with `n` in alpha; `k_s` alone (one channel when monochrome).
+    Packed,
+    /// One file per channel.
+    Separate,
+}
+
+/// An export preset.
+///
+/// Read only through its checks (`ExportPresetFile`): a name, and `n_bits` that the
+/// format can store.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ExportPresetFile")]
+pub struct ExportPreset {
+    /// Name (what `--preset` takes, with the file stem).
+    pub name: String,
+    /// One line for menus.
+    #[serde(default)]
+    pub description: String,
+    /// Image format.
+    pub format: Format,
+    /// Channel packing.
+    pub layout: Layout,
+    /// Bits per stored `n` code (8 or 16; EXR stores `n` as is).
+    pub n_bits: u8,
+    /// Also write a baked `k_a` map.
+    #[serde(default)]
+    pub include_ka: bool,
+    /// The most BC7 effort a `Ktx2Bc` export may spend meeting its budget.
+    pub max_bc7_effort: Bc7Quality,
+    /// What a `Ktx2Bc` set may lose.
+    pub budget: BlockBudget,
+    /// Whether a `Ktx2Bc` export may store colour as BC6H (linear half floats) when BC7
+    /// misses the budget; off for consumers that sample only BC7 (RON `bc6h`, default on).
+    pub bc6h: bool,
+}
+
+/// An export preset as its file spells it, before it is checked.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExportPresetFile {
+    name: String,
+    #[serde(default)]
+    description: String,
+    format: Format,
+    layout: Layout,
+    n_bits: u8,
+    #[serde(default)]
+    include_ka: bool,
+    /// Older presets name the ceiling `bc7_quality`.
+    #[serde(default, alias = "bc7_quality")]
+    max_bc7_effort: Bc7Quality,
+    #[serde(default = "default_max_ka_error")]
+    max_ka_error: f64,
+    #[serde(default = "default_mean_ka_error")]
+    mean_ka_error: f64,
+    #[serde(default = "default_min_psnr")]
+    min_psnr: f64,
+    #[serde(default = "default_bc6h")]
+    bc6h: bool,
+}
+
+fn default_bc6h() -> bool {
+    true
+}
+
+fn default_max_ka_error() -> f64 {
+    BlockBudget::default().max_ka_error
+}
+
+fn default_mean_ka_error() -> f64 {
+    BlockBudget::default().mean_ka_error
+}
+
+fn default_min_psnr() -> f64 {
+    BlockBudget::default().min_psnr
+}
+
+impl TryFrom<ExportPresetFile> for ExportPreset {
+    type Error = String;
+
+    fn try_from(f: ExportPresetFile) -> Result<Self, String> {
+        use kapaint_core::model::check::{MAX_PATH_BYTES, bounded_text, name};
+        name("name", &f.name)?;
+        bounded_text("description", &f.description, MAX_PATH_BYTES)?;
+        if !matches!(f.n_bits, 8 | 16) {
+            return Err(format!("n_bits must be 8 or 16, got {}", f.n_bits));
+        }
+        if f.format.is_8bit() && f.n_bits != 8 {
+            return Err(format!(
+                "{:?} stores 8-bit components (n_bits: 8)",
+                f.format
+            ));
+        }
+        if f.format == Format::GltfPbr && f.include_ka {
+            return Err("a glTF PBR set has no k_a map (include_ka: false)".into());
+        }
+        if f.format == Format::Png16 && f.n_bits != 16 {
+            return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
+        }
+        let budget = BlockBudget {
+            max_ka_error: f.max_ka_error,
+            mean_ka_error: f.mean_ka_error,
+            min_psnr: f.min_psnr,
+        };
+        for (field, value, range) in [
+            ("max_ka_error", budget.max_ka_error, 0.0..=100.0),
+            ("mean_ka_error", budget.mean_ka_error, 0.0..=100.0),
+            ("min_psnr", budget.min_psnr, 0.0..=200.0),
+        ] {
+            if !range.contains(&value) {
+                return Err(format!(
+                    "{field} must be in {}..={}, got {value}",
+                    range.start(),
+                    range.end()
+                ));
+            }
+        }
+        Ok(Self {
+            name: f.name,
+            description: f.description,
+            format: f.format,
+            layout: f.layout,
+            n_bits: f.n_bits,
+            include_ka: f.include_ka,
+            max_bc7_effort: f.max_bc7_effort,
+            budget,
+            bc6h: f.bc6h,
+        })
+    }
+}
+
+/// Why a preset could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum PresetError {
+    /// The file is malformed.
+    #[error("{path}: {reason}")]
+    Malformed {
+        /// The preset file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// No preset of that name.
+    #[error("unknown export preset {name:?} (known: {known})")]
+    Unknown {
+        /// The name asked for.
+        name: String,
+        /// The names there are.
+        known: String,
+    },
+}
+
+const BUILTIN: &[(&str, &str)] = &[
+    ("16-bit", include_str!("../../../presets/export/16-bit.ron")),
+    (
+        "compact",
+        include_str!("../../../presets/export/compact.ron"),
+    ),
+    ("exr", include_str!("../../../presets/export/exr.ron")),
+    (
+        "gltf-pbr",
+        include_str!("../../../presets/export/gltf-pbr.ron"),
+    ),
+    ("ktx2", include_str!("../../../presets/export/ktx2.ron")),
+    (
+        "ktx2-raw",
+        include_str!("../../../presets/export/ktx2-raw.ron"),
+    ),
+    (
+        "separate",
+        include_str!("../../../presets/export/separate.ron"),
+    ),
+    (
+        "with-ka",
+        include_str!("../../../presets/export/with-ka.ron"),
+    ),
+];
+
+impl ExportPreset {
+    /// Parses and checks a preset's text (`path` names it in errors).
+    ///
+    /// # Errors
+    /// Malformed RON, unknown fields, or values out of range.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, PresetError> {
+        ron::from_str(text).map_err(|e| PresetError::Malformed {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })
+    }
+}
+
+/// The built-in presets.
+pub fn builtin() -> Vec<ExportPreset> {
+    BUILTIN
+        .iter()
+        .filter_map(|(stem, text)| {
+            ExportPreset::parse(&PathBuf::from(format!("presets/export/{stem}.ron")), text).ok()
+        })
+        .collect()
+}
+
+/// The built-in presets that write kapaint sets (every one but the glTF PBR export).
+pub fn builtin_sets() -> Vec<ExportPreset> {
+    builtin()
+        .into_iter()
+        .filter(|p| p.format != Format::GltfPbr)
+        .collect()
+}
+
+/// Finds a preset by name or file stem: a user file (`$KAPAINT_EXPORT_PRESET_DIR/NAME.ron`)
+/// first, then the built-in ones.
+///
+/// # Errors
+/// A malformed user preset, or no preset of that name.
+pub fn find(name: &str) -> Result<ExportPreset, PresetError> {
+    if let Some(dir) = std::env::var_os("KAPAINT_EXPORT_PRESET_DIR").map(PathBuf::from) {
+        let path = dir.join(format!("{name}.ron"));
+        if path.exists() {
+            let malformed = |reason: String| PresetError::Malformed {
+                path: path.clone(),
+                reason,
+            };
+            let bytes = kapaint_core::file_check::read_limited(&path, 1 << 20)
+                .map_err(|e| malformed(format!("the file {e}")))?;
+            let text = String::from_utf8(bytes).map_err(|_| malformed("not UTF-8 text".into()))?;
+            return ExportPreset::parse(&path, &text);
+        }
+    }
+    let all = builtin();
+    if let Some((_, text)) = BUILTIN
+        .iter()
+        .find(|(stem, _)| stem.eq_ignore_ascii_case(name))
+    {
+        return ExportPreset::parse(&PathBuf::from(format!("presets/export/{name}.ron")), text);
+    }
+    all.iter()
+        .find(|p| p.name.eq_ignore_ascii_case(name))
+        .cloned()
+        .ok_or_else(|| PresetError::Unknown {
+            name: name.to_string(),
+            known: all
+                .iter()
+                .map(|p| p.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_parses_and_is_found() {
+        assert_eq!(builtin().len(), BUILTIN.len());
+        for name in [
+            "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw", "gltf-pbr",
+        ] {
+            assert_eq!(find(name).unwrap().name, name);
+        }
+        assert!(matches!(find("nope"), Err(PresetError::Unknown { .. })));
+    }
+
+    #[test]
+    fn malformed_presets_name_the_file() {
+        let path = Path::new("x.ron");
+        for text in [
+            "(",
+            "(name: \"a\", format: Png8, layout: Packed, n_bits: 7)",
+            "(name: \"a\", format: Png16, layout: Packed, n_bits: 8)",
+            "(name: \"a\", format: Gif, layout: Packed, n_bits: 8)",
+            "(name: \"a\", format: Png8, layout: Packed, n_bits: 8, extra: 1)",
+            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, max_ka_error: -1.0)",
+            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, min_psnr: NaN)",
+        ] {
+            let err = ExportPreset::parse(path, text).unwrap_err().to_string();
+            assert!(err.starts_with("x.ron: "), "{err}");
+        }
+    }
+}

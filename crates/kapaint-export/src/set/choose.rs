@@ -1,0 +1,544 @@
+//! Block-compressed sets: the layout and BC7 effort, chosen by measurement.
+//!
+//! The export encodes level 0 with the cheapest profile first (the packed layout, `n` in
+//! `k_d`'s BC7 alpha, at BC7's lowest effort), measures the set's `k_a` error and PSNR as a
+//! consumer decodes them, and spends more only while the preset's budget is not met:
+//! - where the packed layout fails, `n` moves out of the colour blocks (its own BC4 plane,
+//!   or beside a grey `k_s` in a BC5 image) at the same effort: `n`'s endpoints no longer
+//!   shared with `k_d`'s, both come out better;
+//! - where that fails too, the colour images become BC6H (linear half floats, the same
+//!   bytes as BC7): BC7 keeps 8-bit sRGB and its mode 6 shares one p-bit across channels,
+//!   so flat blocks come out a level off, a large relative error in dark texels where `k_s`
+//!   adds little;
+//! - then the layout nearest the budget (fewest failing measures, then the worst measure
+//!   nearest its limit) takes more effort, a step at a time up
+//!   to the preset's ceiling, while the rate at which the last step improved each failing
+//!   measure could still meet the budget;
+//! - at the ceiling, the trial nearest the budget is kept, and the manifest says
+//!   the budget was not met.
+//!
+//! The manifest records every trial and why the chosen one was chosen.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
+use super::manifest::{Comp, is_colour};
+use super::measure::{Shape, ka_error_of_set};
+use crate::blocks::{BlockEncoder, BlockKind, Coder, Encoder};
+use crate::encoding::{KaError, NEncoding};
+use crate::ktx::{self, Compressed};
+use crate::preset::{Bc7Quality, BlockBudget, ExportPreset, Format};
+use kapaint_core::model::texel::Texel;
+use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
+use kapaint_core::task::Progress;
+
+/// Where `n` goes in a block-compressed set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BlockLayout {
+    /// In `k_d`'s BC7 alpha (the fewest bytes).
+    Packed,
+    /// Out of the colour blocks: a BC4 plane of its own, or with grey `k_s` in a BC5 image.
+    NApart,
+    /// `n` apart, and the three-component colour images BC6H: linear half floats instead
+    /// of BC7's 8-bit sRGB (the same bytes as `n-apart`).
+    HalfColour,
+}
+
+impl BlockLayout {
+    /// Whether colour images are half floats.
+    fn half(self) -> bool {
+        self == Self::HalfColour
+    }
+}
+
+/// Whether an image of `comps` is colour that BC6H can hold: three colour components.
+fn half_image(comps: &[Comp]) -> bool {
+    comps.len() == 3 && comps.iter().all(|c| is_colour(*c))
+}
+
+/// One encoding of level 0 that the export measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Trial {
+    /// Where `n` was.
+    pub layout: BlockLayout,
+    /// BC7's (and BC6H's) effort.
+    pub bc7_effort: Bc7Quality,
+    /// The set's `k_a` error, level 0 as a consumer decodes it.
+    pub ka_error: KaError,
+    /// The smallest PSNR of any compressed component (dB; `None` where all are exact).
+    pub min_psnr: Option<f64>,
+    /// Seconds spent encoding and measuring.
+    pub seconds: f64,
+}
+
+impl Trial {
+    /// The trial and its measures, for the manifest's reason.
+    fn describe(&self) -> String {
+        format!(
+            "{:?} at {:?}: k_a max {}, mean {}, PSNR {}",
+            self.layout,
+            self.bc7_effort,
+            pct(self.ka_error.max),
+            pct(self.ka_error.mean),
+            self.min_psnr
+                .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
+        )
+    }
+}
+
+/// How a block-compressed set's layout and effort were chosen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlockChoice {
+    /// The block encoder that finished the set.
+    pub encoder: Encoder,
+    /// Why the GPU encoder failed, where it began this set and a CPU encoder (`encoder`)
+    /// finished it. Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gpu_failed: Option<String>,
+    /// Where `n` went.
+    pub layout: BlockLayout,
+    /// BC7's effort.
+    pub bc7_effort: Bc7Quality,
+    /// The preset's budget.
+    pub budget: BlockBudget,
+    /// Whether the chosen trial meets it.
+    pub within_budget: bool,
+    /// Why this one, in a sentence.
+    pub reason: String,
+    /// Every trial, in the order run.
+    pub trials: Vec<Trial>,
+}
+
+impl BlockChoice {
+    /// One line for people: the layout and effort chosen, the encoder, and the budget's
+    /// verdict (the manifest's `blocks` has the trials and the reason).
+    pub fn summary(&self) -> String {
+        let layout = match self.layout {
+            BlockLayout::Packed => "n packed in k_d's BC7",
+            BlockLayout::NApart => "n apart (BC4/BC5), colour BC7",
+            BlockLayout::HalfColour => "n apart (BC4/BC5), colour BC6H",
+        };
+        let encoder = match self.encoder {
+            Encoder::Ispc => "ISPC",
+            Encoder::Portable => "portable CPU",
+            Encoder::Gpu => "GPU",
+        };
+        let encoder = if self.gpu_failed.is_some() {
+            format!("{encoder} encoder (the GPU encoder failed part-way)")
+        } else {
+            format!("{encoder} encoder")
+        };
+        let verdict = if self.within_budget {
+            "within the k_a budget".to_owned()
+        } else {
+            format!(
+                "over the k_a budget (max {}, mean {}): kept the nearest of {} trials",
+                pct(self.budget.max_ka_error),
+                pct(self.budget.mean_ka_error),
+                self.trials.len()
+            )
+        };
+        format!("{layout} at {:?}, {encoder}, {verdict}", self.bc7_effort)
+    }
+}
+
+/// A set's images: file stem and components.
+pub(super) type Images = Vec<(&'static str, Vec<Comp>)>;
+
+/// The images of the n-apart layout for the packed `images`, or `None` where `n` is not in a
+/// colour image (constant, or already beside `k_s`).
+pub(super) fn n_apart(images: &Images, mono_ks: bool) -> Option<Images> {
+    let packed = images
+        .iter()
+        .position(|(_, c)| c.len() == 4 && c[3] == Comp::N)?;
+    let mut out = images.clone();
+    out[packed] = ("kd", out[packed].1[..3].to_vec());
+    match out.iter().position(|(stem, _)| *stem == "ks") {
+        Some(ks) if mono_ks => out[ks] = ("ks_n", vec![Comp::Ks(0), Comp::N]),
+        _ => out.insert(packed + 1, ("n", vec![Comp::N])),
+    }
+    Some(out)
+}
+
+/// Everything the trials share.
+pub(super) struct Job<'a> {
+    pub texels: &'a [Texel],
+    pub ka: &'a [Vec3],
+    pub size: (u32, u32),
+    pub preset: &'a ExportPreset,
+    pub n_enc: Option<NEncoding>,
+    pub shape: Shape<'a>,
+    pub model: ShadingModel,
+    pub approx: AmbientApprox,
+    /// A block encoder the caller brought (a GPU's), used before the CPU's.
+    pub brought: Option<&'a dyn BlockEncoder>,
+}
+
+/// One image of a trial: its texels, level 0 as stored, and level 0 compressed.
+struct TrialImage<'a> {
+    stem: &'static str,
+    comps: Vec<Comp>,
+    srgb: bool,
+    half: bool,
+    texels: KtxTexels<'a>,
+    level0: Vec<u8>,
+    compressed: Option<(Bc7Quality, Compressed)>,
+}
+
+impl TrialImage<'_> {
+    /// Compresses level 0 at `effort`, unless it already is (BC4 and BC5 have one effort).
+    fn compress(&mut self, encoder: Coder<'_>, effort: Bc7Quality, size: (u32, u32), p: &Progress) {
+        let kind = ktx::block_kind(self.texels.spaces(), effort);
+        let fresh = match &self.compressed {
+            Some((e, _)) => {
+                matches!(kind, BlockKind::Bc7 { .. } | BlockKind::Bc6h { .. }) && *e != effort
+            }
+            None => true,
+        };
+        if fresh {
+            let per = ktx::texel_layout(self.texels.spaces()).0;
+            let c = ktx::compress_level(encoder, kind, &self.level0, size, per, Some(p));
+            self.compressed = Some((effort, c));
+        } else {
+            p.advance(u64::from(size.1));
+        }
+    }
+
+    fn stored(&self) -> StoredImage<'_> {
+        StoredImage {
+            comps: self.comps.clone(),
+            data: self
+                .compressed
+                .as_ref()
+                .map_or_else(Default::default, |(_, c)| c.decoded[..].into()),
+            srgb: self.srgb,
+            half: self.half,
+        }
+    }
+}
+
+/// The images of `want` (three-component colour as half floats where `half`): what the
+/// last trial shares with it is kept (with its blocks), what it lacks is made.
+fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, half: bool, job: &Job<'a>) {
+    let half_of = |comps: &[Comp]| half && half_image(comps);
+    images.retain(|i| {
+        want.iter()
+            .any(|(s, c)| *s == i.stem && *c == i.comps && half_of(c) == i.half)
+    });
+    for (stem, comps) in want {
+        if !images.iter().any(|i| i.stem == *stem) {
+            let half = half_of(comps);
+            let srgb = !half && srgb_image(Format::Ktx2Bc, comps);
+            let texels = KtxTexels::new(job.texels, job.ka, comps, srgb, half, job.n_enc);
+            let level0 = texels.level0();
+            images.push(TrialImage {
+                stem,
+                comps: comps.clone(),
+                srgb,
+                half,
+                texels,
+                level0,
+                compressed: None,
+            });
+        }
+    }
+    images.sort_by_key(|i| want.iter().position(|(s, _)| *s == i.stem));
+}
+
+impl Job<'_> {
+    fn measure(&self, stored: &[StoredImage<'_>]) -> KaError {
+        ka_error_of_set(
+            self.texels,
+            self.shape,
+            stored,
+            Format::Ktx2Bc,
+            self.model,
+            self.approx,
+        )
+    }
+}
+
+fn within(budget: &BlockBudget, ka: KaError) -> bool {
+    ka.max <= budget.max_ka_error && ka.mean <= budget.mean_ka_error
+}
+
+/// How much better one trial must be than another to count as better (relative).
+const MIN_GAIN: f64 = 0.05;
+
+fn tried(trials: &[Trial], layout: BlockLayout) -> bool {
+    trials.iter().any(|t| t.layout == layout)
+}
+
+/// How far a trial falls short of the budget: how many of its three measures fail, and the
+/// worst measure over its limit (each as a ratio: the `k_a` errors to theirs, PSNR as the
+/// ratio of squared errors).
+fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
+    let ratios = [
+        t.ka_error.max / budget.max_ka_error,
+        t.ka_error.mean / budget.mean_ka_error,
+        t.min_psnr
+            .map_or(0.0, |p| 10_f64.powf((budget.min_psnr - p) / 10.0)),
+    ];
+    let failing = ratios.iter().filter(|r| **r > 1.0).count();
+    (failing, ratios.into_iter().fold(0.0, f64::max))
+}
+
+/// The better of two trials against `budget`: the one that fails fewer measures, then the one
+/// whose worst measure is nearer its limit (the earlier on a tie: fewer bytes, or the more
+/// common format).
+fn better<'t>(a: &'t Trial, b: &'t Trial, budget: &BlockBudget) -> &'t Trial {
+    if nearer(a, b, budget) { b } else { a }
+}
+
+/// Whether `b` is nearer `budget` than `a` (see [`better`]).
+fn nearer(a: &Trial, b: &Trial, budget: &BlockBudget) -> bool {
+    let (fa, wa) = shortfall(a, budget);
+    let (fb, wb) = shortfall(b, budget);
+    fb < fa || (fb == fa && wb < wa * (1.0 - MIN_GAIN))
+}
+
+/// Whether more effort in `layout` may still meet the budget: the first step is always
+/// taken; after that, each failing measure, improving at the rate the last step improved it
+/// (a factor for the `k_a` errors, dB for PSNR), must reach its budget within the `left`
+/// steps there are. A step that bought nothing ends the search.
+fn reachable(trials: &[Trial], layout: BlockLayout, budget: &BlockBudget, left: usize) -> bool {
+    let mut same = trials.iter().rev().filter(|t| t.layout == layout);
+    let Some(now) = same.next() else {
+        return true;
+    };
+    let Some(before) = same.next() else {
+        return true;
+    };
+    let steps = i32::try_from(left).unwrap_or(i32::MAX);
+    let error_ok = |now: f64, before: f64, limit: f64| {
+        now <= limit || (before > 0.0 && now < before && now * (now / before).powi(steps) <= limit)
+    };
+    let psnr_ok = match (now.min_psnr, before.min_psnr) {
+        (None, _) => true,
+        (Some(p), _) if p >= budget.min_psnr => true,
+        (Some(p), Some(q)) => p > q && p + (p - q) * f64::from(steps) >= budget.min_psnr,
+        (Some(_), None) => false,
+    };
+    error_ok(now.ka_error.max, before.ka_error.max, budget.max_ka_error)
+        && error_ok(
+            now.ka_error.mean,
+            before.ka_error.mean,
+            budget.mean_ka_error,
+        )
+        && psnr_ok
+}
+
+fn pct(v: f64) -> String {
+    format!("{:.2} %", v * 100.0)
+}
+
+/// Encodes a block-compressed set: trials on level 0 from the cheapest profile up (see the
+/// module), then the chosen images with their mip chains.
+///
+/// # Errors
+/// A failed encode, or cancelled (`"cancelled"`).
+#[expect(
+    clippy::too_many_lines,
+    reason = "one search: encode, measure, decide, in a loop"
+)]
+pub(super) fn encode_blocks(
+    job: &Job<'_>,
+    packed: &Images,
+    apart: Option<&Images>,
+    progress: &Progress,
+) -> Result<(Vec<Encoded>, BlockChoice), String> {
+    let encoder = Coder::best(job.brought);
+    let budget = job.preset.budget;
+    let efforts: Vec<Bc7Quality> = Bc7Quality::ALL
+        .into_iter()
+        .filter(|e| *e <= job.preset.max_bc7_effort)
+        .collect();
+    // The layouts to try at the lowest effort, in order: fewest bytes first; then, for the
+    // same bytes, BC6H colour where there is a colour image and the preset allows it (its
+    // k_d is 15 dB closer than BC7's at the same effort), else n apart in BC7.
+    let apart_images = apart.unwrap_or(packed);
+    let mut layouts = vec![BlockLayout::Packed];
+    if job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
+        layouts.push(BlockLayout::HalfColour);
+    } else if apart.is_some() {
+        layouts.push(BlockLayout::NApart);
+    }
+    let want_of = |layout: BlockLayout| match layout {
+        BlockLayout::Packed => packed,
+        BlockLayout::NApart | BlockLayout::HalfColour => apart_images,
+    };
+    let mut layout = BlockLayout::Packed;
+    let mut step = 0;
+    let mut trials: Vec<Trial> = Vec::new();
+    let mut images: Vec<TrialImage<'_>> = Vec::new();
+    let (w, h) = job.size;
+    let reason;
+    let chosen;
+    loop {
+        let effort = efforts[step];
+        prepare(&mut images, want_of(layout), layout.half(), job);
+        let started = Instant::now();
+        progress.start("encode", images.len() as u64 * u64::from(h));
+        for image in &mut images {
+            image.compress(encoder, effort, (w, h), progress);
+            if progress.is_cancelled() {
+                return Err("cancelled".into());
+            }
+        }
+        let stored: Vec<StoredImage> = images.iter().map(TrialImage::stored).collect();
+        let ka_error = job.measure(&stored);
+        let min_psnr = images
+            .iter_mut()
+            .filter_map(|i| {
+                let (_, c) = i.compressed.as_mut()?;
+                c.psnr(&i.level0, i.texels.spaces())
+                    .iter()
+                    .flatten()
+                    .copied()
+                    .reduce(f64::min)
+            })
+            .reduce(f64::min);
+        let psnr_ok = min_psnr.is_none_or(|p| p >= budget.min_psnr);
+        let ka_ok = within(&budget, ka_error);
+        trials.push(Trial {
+            layout,
+            bc7_effort: effort,
+            ka_error,
+            min_psnr,
+            seconds: started.elapsed().as_secs_f64(),
+        });
+        let here = trials.last().map(Trial::describe).unwrap_or_default();
+        if ka_ok && psnr_ok {
+            reason = format!("{here}: within the budget");
+            chosen = trials.len() - 1;
+            break;
+        }
+        // The layout failed: the next one, at the same effort.
+        if let Some(next) = layouts.iter().find(|l| !tried(&trials, **l)) {
+            layout = *next;
+            continue;
+        }
+        // Then more effort for the best layout, while it buys something.
+        if trials.len() == layouts.len() {
+            layout = trials
+                .iter()
+                .reduce(|a, b| better(a, b, &budget))
+                .map_or(layout, |t| t.layout);
+        }
+        if step + 1 < efforts.len() && reachable(&trials, layout, &budget, efforts.len() - step - 1)
+        {
+            step += 1;
+            // BC6H has no effort between ultra-fast and very-fast: skip a step that would
+            // encode the same blocks again.
+            if layout.half() && efforts[step] == Bc7Quality::VeryFast && step + 1 < efforts.len() {
+                step += 1;
+            }
+            continue;
+        }
+        // Nothing met the budget: the trial nearest it.
+        chosen = (0..trials.len())
+            .reduce(|a, b| {
+                if nearer(&trials[a], &trials[b], &budget) {
+                    b
+                } else {
+                    a
+                }
+            })
+            .unwrap_or(0);
+        let kept = trials[chosen].describe();
+        reason = if step + 1 < efforts.len() {
+            format!(
+                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept} (the last: {here})"
+            )
+        } else {
+            format!(
+                "no trial up to {:?} met the budget: kept the trial nearest it, {kept} (the last: {here})",
+                job.preset.max_bc7_effort
+            )
+        };
+        break;
+    }
+    let pick = trials[chosen].clone();
+    if pick.layout != layout || pick.bc7_effort != efforts[step] {
+        // The pick is an earlier trial: encode its level 0 again.
+        prepare(&mut images, want_of(pick.layout), pick.layout.half(), job);
+        progress.start("encode", images.len() as u64 * u64::from(h));
+        for image in &mut images {
+            image.compress(encoder, pick.bc7_effort, (w, h), progress);
+        }
+    }
+    // The chosen images with their mips.
+    progress.start("encode", images.len() as u64 * u64::from(h));
+    let mut encoded = Vec::with_capacity(images.len());
+    for image in images {
+        let compressed = image.compressed.map(|(_, c)| c);
+        let written = ktx::encode(
+            &image.texels.source((w, h), &image.level0),
+            Some((encoder, pick.bc7_effort)),
+            compressed,
+            progress,
+        )?;
+        if progress.is_cancelled() {
+            return Err("cancelled".into());
+        }
+        encoded.push((
+            format!("{}.ktx2", image.stem),
+            image.comps,
+            ktx_image(written, image.srgb, image.half),
+        ));
+    }
+    let within_budget =
+        within(&budget, pick.ka_error) && pick.min_psnr.is_none_or(|p| p >= budget.min_psnr);
+    // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
+    let gpu_failed = encoder.failure();
+    Ok((
+        encoded,
+        BlockChoice {
+            encoder: if gpu_failed.is_some() {
+                Encoder::best_cpu()
+            } else {
+                encoder.name()
+            },
+            gpu_failed,
+            layout: pick.layout,
+            bc7_effort: pick.bc7_effort,
+            budget,
+            within_budget,
+            reason,
+            trials,
+        },
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn n_apart_takes_n_out_of_the_colour_image() {
+        let kd_n = ("kd_n", vec![Comp::Kd(0), Comp::Kd(1), Comp::Kd(2), Comp::N]);
+        let kd = ("kd", vec![Comp::Kd(0), Comp::Kd(1), Comp::Kd(2)]);
+        // Grey k_s: n joins it in a BC5 image.
+        let grey = vec![kd_n.clone(), ("ks", vec![Comp::Ks(0)])];
+        assert_eq!(
+            n_apart(&grey, true).unwrap(),
+            vec![kd.clone(), ("ks_n", vec![Comp::Ks(0), Comp::N])]
+        );
+        // Colour k_s, or k_s constant: n alone, as BC4.
+        let colour = vec![
+            kd_n.clone(),
+            ("ks", vec![Comp::Ks(0), Comp::Ks(1), Comp::Ks(2)]),
+        ];
+        assert_eq!(n_apart(&colour, false).unwrap()[1], ("n", vec![Comp::N]));
+        assert_eq!(
+            n_apart(&vec![kd_n], true).unwrap(),
+            vec![kd, ("n", vec![Comp::N])]
+        );
+        // n already apart from colour: nothing to move.
+        assert!(n_apart(&vec![("ks_n", vec![Comp::Ks(0), Comp::N])], true).is_none());
+    }
+}

@@ -1,0 +1,354 @@
+//! The `k_a` error of a set as a consumer decodes it, against the texels it was made from.
+
+use rayon::prelude::*;
+
+use super::encode::StoredImage;
+use super::manifest::{Comp, Constants};
+use crate::encoding::KaError;
+use crate::encoding::NEncoding;
+use crate::preset::Format;
+use kapaint_core::model::texel::{
+    Texel, decode_n, decode_unorm, n_from_blend, n_to_blend, srgb_to_linear,
+};
+use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
+
+/// Where a consumer's value of one component comes from.
+#[derive(Clone, Copy)]
+enum Read<'a> {
+    /// Through a table per stored 16-bit code (constants, 16-bit and float files).
+    Table(&'a [f32]),
+    /// A table per byte of an 8-bit file as written (after block compression).
+    Bytes {
+        data: &'a [u8],
+        stride: usize,
+        offset: usize,
+        table: &'a [f32],
+    },
+    /// A table per half float (its bits) of a BC6H file as decoded: `stride` and `offset` in
+    /// bytes.
+    Halves {
+        data: &'a [u8],
+        stride: usize,
+        offset: usize,
+        table: &'a [f32],
+    },
+}
+
+impl Read<'_> {
+    fn get(self, i: usize, code: u16) -> f32 {
+        match self {
+            Self::Table(t) => t[code as usize],
+            Self::Bytes {
+                data,
+                stride,
+                offset,
+                table,
+            } => table[data[i * stride + offset] as usize],
+            Self::Halves {
+                data,
+                stride,
+                offset,
+                table,
+            } => {
+                let at = i * stride + offset;
+                table[u16::from_le_bytes([data[at], data[at + 1]]) as usize]
+            }
+        }
+    }
+}
+
+/// What a stored colour component stands for, in linear light: per byte of an sRGB or a
+/// linear 8-bit image, and per half float (by its bits; negatives as 0, what an unsigned
+/// BC6H decodes).
+struct ColourTables {
+    srgb8: Vec<f32>,
+    linear8: Vec<f32>,
+    halves: Vec<f32>,
+}
+
+impl ColourTables {
+    fn new() -> Self {
+        Self {
+            srgb8: (0..=255_u8)
+                .map(|b| srgb_to_linear(f32::from(b) / 255.0))
+                .collect(),
+            linear8: (0..=255_u8).map(|b| f32::from(b) / 255.0).collect(),
+            halves: (0..=u16::MAX)
+                .map(|b| half::f16::from_bits(b).to_f32().max(0.0))
+                .collect(),
+        }
+    }
+
+    /// The first of `want` that an image holds.
+    fn read<'r>(&'r self, stored: &'r [StoredImage<'_>], want: &[Comp]) -> Option<Read<'r>> {
+        in_file(stored, want, &self.srgb8, &self.linear8, Some(&self.halves))
+    }
+}
+
+/// The first of `want` that an image holds: an 8-bit image's through `table` (sRGB image)
+/// or `linear`, a BC6H image's through `halves` (colour only).
+fn in_file<'r>(
+    stored: &'r [StoredImage<'_>],
+    want: &[Comp],
+    table: &'r [f32],
+    linear: &'r [f32],
+    halves: Option<&'r [f32]>,
+) -> Option<Read<'r>> {
+    want.iter().find_map(|w| {
+        stored.iter().find_map(|image| {
+            let offset = image.comps.iter().position(|c| c == w)?;
+            if image.half {
+                return Some(Read::Halves {
+                    data: &image.data[..],
+                    stride: image.comps.len() * 2,
+                    offset: offset * 2,
+                    table: halves?,
+                });
+            }
+            Some(Read::Bytes {
+                data: &image.data[..],
+                stride: image.comps.len(),
+                offset,
+                table: if image.srgb { table } else { linear },
+            })
+        })
+    })
+}
+
+/// What a measure needs of a set besides its images: the row length, the constants, and how
+/// stored `n` decodes.
+#[derive(Clone, Copy)]
+pub(super) struct Shape<'a> {
+    /// Texels per row of level 0.
+    pub width: u32,
+    /// Constant channels.
+    pub constants: &'a Constants,
+    /// `n`'s encoding, where it is stored in an integer image.
+    pub n_encoding: Option<NEncoding>,
+}
+
+/// Relative `k_a` error of the set described by `manifest` against the texels it was made
+/// from, per texel and colour channel: every value goes through what a consumer reads (the
+/// bytes an 8-bit file holds after compression, or 16-bit and float codes by table) and back.
+pub(super) fn ka_error_of_set(
+    texels: &[Texel],
+    manifest: Shape<'_>,
+    stored: &[StoredImage<'_>],
+    format: Format,
+    model: ShadingModel,
+    approx: AmbientApprox,
+) -> KaError {
+    let lut = kapaint_core::model::maps::chi_lut(model, approx);
+    // [chi_1, chi_0] as two tables (chi_0 = 0 but for Cook-Torrance).
+    let split = |pairs: &[[f32; 2]]| -> [Vec<f32>; 2] {
+        [0, 1].map(|k| pairs.iter().map(|p| p[k]).collect())
+    };
+    let chi = split(lut);
+    let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
+    let exact: Vec<f32> = (0..=u16::MAX).map(decode_unorm).collect();
+    let sixteen: Vec<f32> = exact
+        .iter()
+        .map(|v| (v * 65535.0).round() / 65535.0)
+        .collect();
+    // n: stored half-float bits -> chi of what the set decodes.
+    let chi_of_set = split(
+        &(0..=u16::MAX)
+            .map(|bits| match manifest.n_encoding {
+                Some(e) => {
+                    reflectance::chi_parts_f32(model, approx, e.decode(e.encode(decode_n(bits))))
+                }
+                None => lut[bits as usize],
+            })
+            .collect::<Vec<_>>(),
+    );
+    let tables = ColourTables::new();
+    let chi8 = split(
+        &(0..=255_u16)
+            .map(|q| {
+                manifest.n_encoding.map_or([0.0; 2], |e| {
+                    reflectance::chi_parts_f32(model, approx, e.decode(q.min((1 << e.bits) - 1)))
+                })
+            })
+            .collect::<Vec<_>>(),
+    );
+    // The source of each component: an 8-bit file's bytes, else a table.
+    let colour_table: &[f32] = if format == Format::Png16 {
+        &sixteen
+    } else {
+        &exact
+    };
+    let kd: [Read<'_>; 3] = std::array::from_fn(|c| {
+        if manifest.constants.kd.is_some() {
+            Read::Table(&exact)
+        } else {
+            tables
+                .read(stored, &[Comp::Kd(c)])
+                .unwrap_or(Read::Table(colour_table))
+        }
+    });
+    let ks: [Read<'_>; 3] = std::array::from_fn(|c| {
+        if manifest.constants.ks.is_some() {
+            Read::Table(&exact)
+        } else {
+            tables
+                .read(stored, &[Comp::Ks(c), Comp::Ks(0)])
+                .unwrap_or(Read::Table(colour_table))
+        }
+    });
+    let n: [Read<'_>; 2] = std::array::from_fn(|k| {
+        if manifest.constants.n.is_some() {
+            Read::Table(&chi[k])
+        } else {
+            in_file(stored, &[Comp::N], &chi8[k], &chi8[k], None)
+                .unwrap_or(Read::Table(&chi_of_set[k]))
+        }
+    });
+    let w = manifest.width as usize;
+    let (max, sum, count) = texels
+        .par_chunks(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let (mut max, mut sum) = (0.0_f64, 0.0_f64);
+            for (x, t) in row.iter().enumerate() {
+                let i = y * w + x;
+                let [chi_t, offset_t] = lut[t.n as usize];
+                let (chi_b, offset_b) = (n[0].get(i, t.n), n[1].get(i, t.n));
+                for c in 0..3 {
+                    let ka = diffuse * exact[t.kd[c] as usize]
+                        + exact[t.ks[c] as usize] * chi_t
+                        + offset_t;
+                    let kb =
+                        diffuse * kd[c].get(i, t.kd[c]) + ks[c].get(i, t.ks[c]) * chi_b + offset_b;
+                    let err = if ka > 0.0 {
+                        f64::from((kb - ka).abs() / ka)
+                    } else {
+                        0.0
+                    };
+                    max = max.max(err);
+                    sum += err;
+                }
+            }
+            (max, sum, row.len() as u64 * 3)
+        })
+        .reduce(
+            || (0.0, 0.0, 0),
+            |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2),
+        );
+    KaError {
+        max,
+        mean: if count > 0 { sum / count as f64 } else { 0.0 },
+    }
+}
+
+/// Relative `k_a` error of one mip level as a consumer decodes it (`stored`: the level's
+/// images, decoded) against `reference` ([`reference_levels`]). Per texel and colour
+/// channel.
+pub(super) fn ka_error_of_level(
+    shape: Shape<'_>,
+    stored: &[StoredImage<'_>],
+    reference: &[[f32; 3]],
+    model: ShadingModel,
+    approx: AmbientApprox,
+) -> KaError {
+    let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
+    let tables = ColourTables::new();
+    let chi_of = |n: f32| reflectance::chi_parts_f32(model, approx, n);
+    let chi8: [Vec<f32>; 2] = [0, 1].map(|k| {
+        (0..=255_u16)
+            .map(|q| shape.n_encoding.map_or(0.0, |e| chi_of(e.decode(q))[k]))
+            .collect()
+    });
+    let kd_const = shape.constants.kd.map(|v| v.map(|c| [c]));
+    let ks_const = shape.constants.ks.map(|v| v.map(|c| [c]));
+    let n_const = shape.constants.n.map(|n| chi_of(n).map(|c| [c]));
+    let zero = [0.0_f32];
+    let kd: [Read<'_>; 3] = std::array::from_fn(|c| match &kd_const {
+        Some(v) => Read::Table(&v[c]),
+        None => tables
+            .read(stored, &[Comp::Kd(c)])
+            .unwrap_or(Read::Table(&zero)),
+    });
+    let ks: [Read<'_>; 3] = std::array::from_fn(|c| match &ks_const {
+        Some(v) => Read::Table(&v[c]),
+        None => tables
+            .read(stored, &[Comp::Ks(c), Comp::Ks(0)])
+            .unwrap_or(Read::Table(&zero)),
+    });
+    let n: [Read<'_>; 2] = std::array::from_fn(|k| match &n_const {
+        Some(v) => Read::Table(&v[k]),
+        None => in_file(stored, &[Comp::N], &chi8[k], &chi8[k], None).unwrap_or(Read::Table(&zero)),
+    });
+    let (max, sum) = reference
+        .par_iter()
+        .enumerate()
+        .map(|(i, want)| {
+            let (chi, offset) = (n[0].get(i, 0), n[1].get(i, 0));
+            let mut max = 0.0_f64;
+            let mut sum = 0.0_f64;
+            for c in 0..3 {
+                let got = diffuse * kd[c].get(i, 0) + ks[c].get(i, 0) * chi + offset;
+                let err = if want[c] > 0.0 {
+                    f64::from((got - want[c]).abs() / want[c])
+                } else {
+                    0.0
+                };
+                max = max.max(err);
+                sum += err;
+            }
+            (max, sum)
+        })
+        .reduce(|| (0.0, 0.0), |x, y| (x.0.max(y.0), x.1 + y.1));
+    KaError {
+        max,
+        mean: if reference.is_empty() {
+            0.0
+        } else {
+            sum / (reference.len() * 3) as f64
+        },
+    }
+}
+
+/// The reference of every mip level past 0 (see [`ka_error_of_level`]): the `k_a` of what
+/// the level should hold before it is stored, the exact texels averaged as the mips average
+/// them (`k_d` and `k_s` in linear light, `n` in the brushes' log space), level after level
+/// (2x2 boxes, clamped at odd edges). So a level's error is what storing it costs, as at
+/// level 0, and not the filter's own choice of `n`.
+pub(super) fn reference_levels(
+    texels: &[Texel],
+    (w, h): (u32, u32),
+    model: ShadingModel,
+    approx: AmbientApprox,
+) -> Vec<Vec<[f32; 3]>> {
+    let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
+    // k_d, k_s (linear), n in blend space.
+    let exact = |t: &Texel| -> [f32; 7] {
+        let mut v = [0.0; 7];
+        for c in 0..3 {
+            v[c] = decode_unorm(t.kd[c]);
+            v[3 + c] = decode_unorm(t.ks[c]);
+        }
+        v[6] = n_to_blend(decode_n(t.n));
+        v
+    };
+    let mut out: Vec<Vec<[f32; 3]>> = Vec::new();
+    let mut size = (w, h);
+    let mut prev: Option<Vec<[f32; 7]>> = None;
+    for _ in 1..crate::ktx::level_count(w, h) {
+        let next = crate::ktx::box_down(size, |i| match &prev {
+            None => exact(&texels[i]),
+            Some(p) => p[i],
+        });
+        size = ((size.0 / 2).max(1), (size.1 / 2).max(1));
+        out.push(
+            next.par_iter()
+                .map(|v| {
+                    let [chi, offset] =
+                        reflectance::chi_parts_f32(model, approx, n_from_blend(v[6]));
+                    std::array::from_fn(|c| diffuse * v[c] + v[3 + c] * chi + offset)
+                })
+                .collect(),
+        );
+        prev = Some(next);
+    }
+    out
+}

@@ -1,0 +1,193 @@
+//! Planning a set before anything is encoded: which images, with which components, what
+//! stays a constant, `n`'s encoding and what it costs (the export dialog's preview).
+
+use rayon::prelude::*;
+
+use super::manifest::{Comp, Constants, MemoryReport};
+use crate::encoding::{KaError, NEncoding, rank_encodings};
+use crate::preset::{ExportPreset, Format, Layout};
+use kapaint_core::model::texel::{decode_n, decode_unorm};
+use kapaint_core::model::tile::Plane;
+use kapaint_core::model::{Document, MaterialMaps};
+
+/// Whether `k_s` is grey everywhere.
+fn ks_monochrome(maps: &MaterialMaps) -> bool {
+    (0..maps.tile_count())
+        .into_par_iter()
+        .all(|id| match &maps.tile(id).ks {
+            Plane::Uniform(v) => v[0] == v[1] && v[1] == v[2],
+            Plane::Data(d) => d.iter().all(|v| v[0] == v[1] && v[1] == v[2]),
+        })
+}
+
+/// Which images a set holds, with which components: what is constant is left out, `k_s` is
+/// one channel when grey, and the packed layout puts `n` in `k_d`'s alpha.
+fn plan_images(
+    preset: &ExportPreset,
+    constants: &Constants,
+    mono_ks: bool,
+) -> Vec<(&'static str, Vec<Comp>)> {
+    let kd: Vec<Comp> = (0..3).map(Comp::Kd).collect();
+    let ks: Vec<Comp> = if mono_ks {
+        vec![Comp::Ks(0)]
+    } else {
+        (0..3).map(Comp::Ks).collect()
+    };
+    let (with_kd, with_n) = (constants.kd.is_none(), constants.n.is_none());
+    let mut images: Vec<(&'static str, Vec<Comp>)> = Vec::new();
+    let with_ks = constants.ks.is_none();
+    if preset.layout == Layout::Packed && with_kd && with_n {
+        images.push(("kd_n", [kd, vec![Comp::N]].concat()));
+    } else if preset.layout == Layout::Packed && with_n && with_ks && mono_ks {
+        // k_d constant: grey k_s and n share a two-component image.
+        images.push(("ks_n", vec![Comp::Ks(0), Comp::N]));
+        if preset.include_ka {
+            images.push(("ka", (0..3).map(Comp::Ka).collect()));
+        }
+        return images;
+    } else {
+        if with_kd {
+            images.push(("kd", kd));
+        }
+        if with_n {
+            images.push(("n", vec![Comp::N]));
+        }
+    }
+    if constants.ks.is_none() {
+        images.push(("ks", ks));
+    }
+    if preset.include_ka {
+        images.push(("ka", (0..3).map(Comp::Ka).collect()));
+    }
+    images
+}
+
+/// One file a set will hold, as planned before anything is encoded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedFile {
+    /// File name.
+    pub path: String,
+    /// Components in channel order (`kd.r`, `n`, `ks`, ...).
+    pub layout: Vec<String>,
+    /// Bytes of the image uncompressed, at the preset's depth (the file is smaller when the
+    /// format compresses).
+    pub raw_bytes: u64,
+}
+
+/// What exporting a document with a preset will write, and the `k_a` error that `n`'s
+/// quantisation alone will cost: the export dialog's preview, computed without encoding.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SetPlan {
+    /// The images, in the order they are written.
+    pub files: Vec<PlannedFile>,
+    /// Channels that become constants in the manifest instead of images.
+    pub constants: Constants,
+    /// `n`'s curve, range and bits, when `n` is stored in an integer image.
+    pub n_encoding: Option<NEncoding>,
+    /// The relative `k_a` error of that quantisation (block compression adds to it).
+    pub ka_error: KaError,
+    /// Bytes: the images uncompressed, the naive maps, the project's maps.
+    pub bytes: MemoryReport,
+    /// The size of the project's normal map, written beside the maps as `normal.png` (as the
+    /// project stores it), when it has one.
+    pub normal: Option<(u32, u32)>,
+}
+
+/// The plan of exporting `doc` with `preset` (see [`SetPlan`]).
+pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
+    let (mut plan, _, _) = plan_set(doc, preset);
+    plan.normal = doc.normal().map(|n| (n.width(), n.height()));
+    plan
+}
+
+/// [`plan`], with the two facts the writer needs besides: whether `k_s` is grey, and the
+/// planned images' components.
+pub(super) fn plan_set(
+    doc: &Document,
+    preset: &ExportPreset,
+) -> (SetPlan, bool, Vec<(&'static str, Vec<Comp>)>) {
+    let maps = doc.maps();
+    if preset.format == Format::GltfPbr {
+        return (gltf_pbr_plan(maps), false, Vec::new());
+    }
+    let (model, approx) = (doc.settings().model, doc.settings().approx);
+    let (kd, ks, n) = maps.uniform_channels();
+    let constants = Constants {
+        kd: kd.map(|v| v.map(decode_unorm)),
+        ks: ks.map(|v| v.map(decode_unorm)),
+        n: n.map(decode_n),
+    };
+    let mono_ks = ks_monochrome(maps);
+    let (n_encoding, ka_error) = match (constants.n, preset.format) {
+        (Some(_), _) | (None, Format::Exr) => (None, KaError::default()),
+        (None, _) => rank_encodings(maps, model, approx, preset.n_bits)
+            .first()
+            .map_or((None, KaError::default()), |(e, err)| (Some(*e), *err)),
+    };
+    let images = plan_images(preset, &constants, mono_ks);
+    let depth: u64 = match preset.format {
+        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 1,
+        Format::Png16 => 2,
+        Format::Exr => 4,
+    };
+    let texels = u64::from(maps.width()) * u64::from(maps.height());
+    let ext = preset.format.extension();
+    let files: Vec<PlannedFile> = images
+        .iter()
+        .map(|(stem, comps)| PlannedFile {
+            path: format!("{stem}.{ext}"),
+            layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
+            raw_bytes: texels * depth * comps.len() as u64,
+        })
+        .collect();
+    let bytes = MemoryReport {
+        exported: files.iter().map(|f| f.raw_bytes).sum(),
+        naive: texels * 10 * depth,
+        project: texels * 14,
+    };
+    (
+        SetPlan {
+            normal: None,
+            files,
+            constants,
+            n_encoding,
+            ka_error,
+            bytes,
+        },
+        mono_ks,
+        images,
+    )
+}
+
+/// A glTF PBR set's plan: base colour and metallic-roughness, three 8-bit channels each.
+fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
+    use crate::gltf_pbr::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE};
+    let texels = u64::from(maps.width()) * u64::from(maps.height());
+    let files: Vec<PlannedFile> = [
+        (BASE_COLOR_FILE, ["base.r", "base.g", "base.b"]),
+        (METALLIC_ROUGHNESS_FILE, ["-", "roughness", "metallic"]),
+    ]
+    .into_iter()
+    .map(|(path, layout)| PlannedFile {
+        path: path.into(),
+        layout: layout.map(String::from).to_vec(),
+        raw_bytes: texels * 3,
+    })
+    .collect();
+    SetPlan {
+        normal: None,
+        bytes: MemoryReport {
+            exported: files.iter().map(|f| f.raw_bytes).sum(),
+            naive: texels * 10,
+            project: texels * 14,
+        },
+        files,
+        constants: Constants {
+            kd: None,
+            ks: None,
+            n: None,
+        },
+        n_encoding: None,
+        ka_error: KaError::default(),
+    }
+}

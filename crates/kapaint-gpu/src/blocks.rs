@@ -1,0 +1,346 @@
+//! Block encoding on the GPU: `block_compression`'s compute shaders (its WGSL port of Intel's
+//! ISPC kernels) for the KTX2 export, on a real GPU adapter.
+//!
+//! The image goes up in strips of texel rows (at most [`STRIP_BYTES`] each by default), so neither the
+//! host nor the device ever holds a widened copy of the whole level. Each strip is encoded
+//! into its own storage buffer and read back before the next goes up.
+//!
+//! A software adapter (Mesa's lavapipe, `DeviceType::Cpu`) is slower than the CPU encoders,
+//! so [`shared`] opens only a hardware one unless `KAPAINT_BLOCK_ENCODER=gpu` asks for
+//! any adapter (how the tests reach this code on a machine without a GPU).
+
+use std::sync::{Mutex, OnceLock};
+
+use block_compression::GpuBlockCompressor;
+
+use super::{Gpu, GpuError};
+use kapaint_export::blocks::{BlockEncoder, BlockKind};
+
+/// The most texel bytes one strip uploads.
+pub const STRIP_BYTES: usize = 32 << 20;
+
+/// A device with the block encoder's pipelines built on it.
+pub struct GpuBlockEncoder {
+    gpu: Gpu,
+    compressor: Mutex<GpuBlockCompressor>,
+    strip_rows: u32,
+    /// Why the first encode that failed did: once set, the export encodes on the CPU.
+    failed: OnceLock<String>,
+}
+
+impl std::fmt::Debug for GpuBlockEncoder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuBlockEncoder")
+            .field("gpu", &self.gpu)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Whether `info` names a software rasteriser (lavapipe, `WARP`, `SwiftShader`): no faster
+/// at block encoding than the CPU encoders it would compete with for the same cores.
+pub fn is_software(info: &wgpu::AdapterInfo) -> bool {
+    info.device_type == wgpu::DeviceType::Cpu
+}
+
+/// What `KAPAINT_BLOCK_ENCODER` asks for: `auto` (default: the GPU when it is a real one),
+/// `gpu` (any adapter, software included), or `cpu` (never the GPU).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Choice {
+    /// A hardware GPU if there is one, else the CPU.
+    Auto,
+    /// Any GPU adapter, software ones included.
+    Gpu,
+    /// The CPU encoders only.
+    Cpu,
+}
+
+impl Choice {
+    /// The choice in the environment (`auto` when unset or unknown).
+    pub fn from_env() -> Self {
+        match std::env::var("KAPAINT_BLOCK_ENCODER")
+            .unwrap_or_default()
+            .to_ascii_lowercase()
+            .as_str()
+        {
+            "gpu" => Self::Gpu,
+            "cpu" => Self::Cpu,
+            _ => Self::Auto,
+        }
+    }
+}
+
+/// The process's GPU block encoder, once opened.
+static SHARED: OnceLock<Option<GpuBlockEncoder>> = OnceLock::new();
+
+/// The process's GPU block encoder, opened on first use as [`Choice::from_env`] allows, or
+/// `None` (no adapter, a software one under `auto`, `cpu`, or an earlier
+/// failure).
+///
+/// Opening builds the compute pipelines: 67 s on lavapipe on 2 cores, once per process.
+pub fn shared() -> Option<&'static GpuBlockEncoder> {
+    SHARED
+        .get_or_init(|| {
+            let choice = Choice::from_env();
+            if choice == Choice::Cpu {
+                return None;
+            }
+            let adapter = Gpu::adapter().ok()?;
+            if choice == Choice::Auto && is_software(&adapter.get_info()) {
+                return None;
+            }
+            Gpu::from_adapter(&adapter).ok().map(GpuBlockEncoder::new)
+        })
+        .as_ref()
+        .filter(|e| e.failed.get().is_none())
+}
+
+/// The encoder an export with `preset` is handed: the process's ([`shared`]) for a
+/// block-compressed preset, where this machine has one; `None` for the others (nothing is
+/// opened for them).
+pub fn for_export(
+    preset: &kapaint_export::preset::ExportPreset,
+) -> Option<&'static dyn BlockEncoder> {
+    if preset.format != kapaint_export::preset::Format::Ktx2Bc {
+        return None;
+    }
+    let encoder = shared()?;
+    Some(encoder)
+}
+
+impl BlockEncoder for GpuBlockEncoder {
+    fn encode(
+        &self,
+        kind: BlockKind,
+        size: (u32, u32),
+        fill: &mut dyn FnMut(u32, u32, &mut [u8]),
+        strip_done: &mut dyn FnMut(u32) -> bool,
+        blocks: &mut [u8],
+    ) -> Result<(), kapaint_export::blocks::Interrupted> {
+        GpuBlockEncoder::encode(self, kind, size, fill, strip_done, blocks).map_err(|stopped| {
+            kapaint_export::blocks::Interrupted {
+                error: stopped.error.to_string(),
+                rows_done: stopped.rows_done,
+            }
+        })
+    }
+
+    fn failure(&self) -> Option<String> {
+        self.failed.get().cloned()
+    }
+
+    /// Gives the encoder up: [`shared`] answers `None` from now on, and
+    /// [`BlockEncoder::failure`] says why (the first reason given).
+    fn give_up(&self, why: &str) {
+        eprintln!("kapaint: GPU block encoding failed ({why}); encoding on the CPU from now on");
+        let _ = self.failed.set(why.to_owned());
+    }
+}
+
+/// A GPU encode stopped by a failure part-way: the error, and the texel rows from the top whose
+/// blocks were encoded and read back before it (they are in place; the rest is not).
+#[derive(Debug)]
+pub struct Interrupted {
+    /// What failed.
+    pub error: GpuError,
+    /// Texel rows encoded before it, a multiple of 4.
+    pub rows_done: u32,
+}
+
+/// The texture format the shaders read a kind's texels from.
+fn source_format(kind: BlockKind) -> wgpu::TextureFormat {
+    match kind {
+        BlockKind::Bc4 => wgpu::TextureFormat::R8Unorm,
+        BlockKind::Bc5 => wgpu::TextureFormat::Rg8Unorm,
+        BlockKind::Bc7 { .. } => wgpu::TextureFormat::Rgba8Unorm,
+        BlockKind::Bc6h { .. } => wgpu::TextureFormat::Rgba16Float,
+    }
+}
+
+impl GpuBlockEncoder {
+    /// Builds the encoder's pipelines on `gpu`.
+    pub fn new(gpu: Gpu) -> Self {
+        let compressor = GpuBlockCompressor::new(gpu.device.clone(), gpu.queue.clone());
+        Self {
+            gpu,
+            compressor: Mutex::new(compressor),
+            strip_rows: u32::MAX,
+            failed: OnceLock::new(),
+        }
+    }
+
+    /// The same with strips of at most `rows` texel rows (a multiple of 4; else the
+    /// [`STRIP_BYTES`] a strip holds at most decides alone).
+    #[must_use]
+    pub fn with_strip_rows(self, rows: u32) -> Self {
+        Self {
+            strip_rows: rows,
+            ..self
+        }
+    }
+
+    /// The device it encodes on.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// The adapter's name and backend, for reports.
+    pub fn adapter(&self) -> &wgpu::AdapterInfo {
+        &self.gpu.info
+    }
+
+    /// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
+    /// bytes per texel into `blocks` ([`BlockKind::blocks_len`] bytes), strip by strip:
+    /// `fill(row, rows, texels)` writes texel rows `row..row + rows` into `texels` (exactly
+    /// `rows` rows). `strip_done(rows)` follows each strip; it answers `false` to stop (the
+    /// rest is then left as it was).
+    ///
+    /// # Errors
+    /// A side beyond the device's largest texture, or the device failed (out of memory,
+    /// lost), with the texel rows from the top whose blocks are in place.
+    pub fn encode(
+        &self,
+        kind: BlockKind,
+        (width, height): (u32, u32),
+        fill: &mut dyn FnMut(u32, u32, &mut [u8]),
+        strip_done: &mut dyn FnMut(u32) -> bool,
+        blocks: &mut [u8],
+    ) -> Result<(), Interrupted> {
+        debug_assert!(width % 4 == 0 && height % 4 == 0);
+        debug_assert_eq!(blocks.len(), kind.blocks_len((width, height)));
+        let at_start = |error| Interrupted {
+            error,
+            rows_done: 0,
+        };
+        let row_bytes = width as usize * kind.texel_bytes();
+        let fit = u32::try_from(STRIP_BYTES / row_bytes.max(1)).unwrap_or(u32::MAX);
+        let strip_rows = (fit.min(self.strip_rows) / 4 * 4).clamp(4, height);
+        self.gpu
+            .check_texture_size("a level to block-encode", (width, strip_rows))
+            .map_err(at_start)?;
+        let blocks_row = (width as usize / 4) * kind.block_bytes();
+        let mut compressor = self
+            .compressor
+            .lock()
+            .map_err(|_| at_start(GpuError("the GPU block encoder is poisoned".into())))?;
+        let strip = self
+            .gpu
+            .checked("block encoding", || {
+                Strip::new(&self.gpu, kind, (width, strip_rows))
+            })
+            .map_err(at_start)?;
+        let mut texels = vec![0_u8; row_bytes * strip_rows as usize];
+        let mut row = 0;
+        while row < height {
+            let rows = strip_rows.min(height - row);
+            let src = &mut texels[..row_bytes * rows as usize];
+            fill(row, rows, src);
+            let at = blocks_row * row as usize / 4;
+            let dst = &mut blocks[at..at + blocks_row * rows as usize / 4];
+            strip
+                .encode(&self.gpu, &mut compressor, kind, src, rows, dst)
+                .map_err(|error| Interrupted {
+                    error,
+                    rows_done: row,
+                })?;
+            row += rows;
+            if !strip_done(rows) {
+                break;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The device side of one strip: its source texture, its blocks, and their read-back.
+struct Strip {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    out: wgpu::Buffer,
+    staging: wgpu::Buffer,
+}
+
+impl Strip {
+    fn new(gpu: &Gpu, kind: BlockKind, (width, rows): (u32, u32)) -> Self {
+        let texture = gpu.texture_2d(
+            "blocks source strip",
+            (width, rows),
+            source_format(kind),
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        );
+        let size = ((width as usize / 4) * kind.block_bytes() * rows as usize / 4) as u64;
+        let buffer = |label, usage| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            view: texture.create_view(&wgpu::TextureViewDescriptor::default()),
+            texture,
+            out: buffer(
+                "blocks strip",
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            ),
+            staging: buffer(
+                "blocks read-back",
+                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            ),
+        }
+    }
+
+    /// Uploads `rows` rows of `texels`, encodes them and reads the blocks back into `dst`.
+    fn encode(
+        &self,
+        gpu: &Gpu,
+        compressor: &mut GpuBlockCompressor,
+        kind: BlockKind,
+        texels: &[u8],
+        rows: u32,
+        dst: &mut [u8],
+    ) -> Result<(), GpuError> {
+        let width = self.texture.width();
+        let scope = gpu.scope()?;
+        gpu.queue.write_texture(
+            self.texture.as_image_copy(),
+            texels,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(width * kind.texel_bytes() as u32),
+                rows_per_image: Some(rows),
+            },
+            wgpu::Extent3d {
+                width,
+                height: rows,
+                depth_or_array_layers: 1,
+            },
+        );
+        let mut commands = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        {
+            let mut pass = commands.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("block encoding"),
+                timestamp_writes: None,
+            });
+            compressor.add_compression_task(
+                kind.variant(),
+                &self.view,
+                width,
+                rows,
+                &self.out,
+                None,
+                None,
+            );
+            compressor.compress(&mut pass);
+        }
+        let bytes = dst.len() as u64;
+        commands.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, bytes);
+        gpu.queue.submit([commands.finish()]);
+        let blocks = super::preview::read_buffer_prefix(gpu, &self.staging, bytes);
+        scope.finish("block encoding")?;
+        dst.copy_from_slice(&blocks?);
+        Ok(())
+    }
+}

@@ -1,0 +1,104 @@
+//! Small compute kernels on the GPU: the shader's `chi` (`shaders/chi_check.wgsl`) checked
+//! against the Rust core, and any WGSL function over a list of values ([`run_kernel`]).
+
+use kapaint_core::reflectance::wgsl::shader_id;
+use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
+
+use super::{Gpu, GpuError, shader_source};
+
+/// `chi(model, approx, n)` for every `n`, computed by the WGSL the preview uses.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn chi_on_gpu(
+    gpu: &Gpu,
+    model: ShadingModel,
+    approx: AmbientApprox,
+    n: &[f32],
+) -> Result<Vec<f32>, GpuError> {
+    let constants = [
+        ("MODEL", f64::from(shader_id(&ShadingModel::ALL, &model))),
+        ("APPROX", f64::from(shader_id(&AmbientApprox::ALL, &approx))),
+    ];
+    let source = shader_source("chi_check.wgsl");
+    run_kernel(gpu, &source, &constants, n, n.len())
+}
+
+/// Runs the compute entry `cs_main` of `source` (binding 0: `array<f32>` input, binding 1:
+/// `array<f32>` output of `out_len` values; workgroups of 64 over the input) and returns
+/// the output.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn run_kernel(
+    gpu: &Gpu,
+    source: &str,
+    constants: &[(&str, f64)],
+    input: &[f32],
+    out_len: usize,
+) -> Result<Vec<f32>, GpuError> {
+    use wgpu::util::DeviceExt;
+    if input.is_empty() || out_len == 0 {
+        return Ok(Vec::new());
+    }
+    let device = &gpu.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("kernel"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("kernel"),
+        layout: None,
+        module: &module,
+        entry_point: Some("cs_main"),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            zero_initialize_workgroup_memory: false,
+        },
+        cache: None,
+    });
+    let input_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("input"),
+        contents: bytemuck::cast_slice(input),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let bytes = (out_len * 4) as u64;
+    let output = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("output"),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: bytes,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("kernel"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input_buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: output.as_entire_binding(),
+            },
+        ],
+    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups((input.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
+    gpu.queue.submit([encoder.finish()]);
+    let out = super::preview::read_buffer(gpu, &readback)?;
+    Ok(bytemuck::pod_collect_to_vec(&out))
+}

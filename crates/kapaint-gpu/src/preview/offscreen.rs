@@ -1,0 +1,224 @@
+//! Offscreen renders read back to the CPU (the command line, thumbnails, tests), and the
+//! read-back helpers.
+
+use super::{DEPTH_FORMAT, Layout, MeshBuffers, PipelineKey, Preview, PreviewDrawData, begin_pass};
+use crate::maps::MapTextures;
+use crate::{Gpu, GpuError};
+use kapaint_core::reflectance::ShadingModel;
+use kapaint_core::render::FrameSettings;
+
+/// What an offscreen render produces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Offscreen {
+    /// Image size.
+    pub size: (u32, u32),
+    /// Linear floats even for shaded views (data views are always linear).
+    pub linear: bool,
+    /// Single, or models compared (split, side by side or all three); the settings' model is
+    /// ignored when comparing.
+    pub layout: Layout,
+    /// The compared models from the left: the first two for a split or side by side.
+    pub models: [ShadingModel; 3],
+}
+
+/// The models a comparison shows unless told otherwise: Phong, Blinn-Phong, Cook-Torrance.
+pub const COMPARED_MODELS: [ShadingModel; 3] = ShadingModel::ALL;
+
+/// A rendered image read back from the GPU, row-major from the top.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RenderedImage {
+    /// sRGB-encoded RGBA8 (shaded views).
+    Srgb8 {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// `width * height * 4` bytes.
+        pixels: Vec<u8>,
+    },
+    /// Linear RGBA floats (data views, and shaded views for comparisons).
+    Linear {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// `width * height * 4` floats.
+        pixels: Vec<f32>,
+    },
+}
+
+impl Preview {
+    /// Renders a frame offscreen and reads it back: sRGB bytes for shaded views unless
+    /// `linear`, linear floats otherwise. A compare layout draws `offscreen.models` from the
+    /// left (of the split, or in the left half or third).
+    ///
+    /// # Errors
+    /// When the size is zero or above the device's texture limit, or the read-back fails.
+    pub fn render_offscreen(
+        &self,
+        gpu: &Gpu,
+        mesh: &MeshBuffers,
+        maps: &MapTextures,
+        settings: &FrameSettings,
+        offscreen: Offscreen,
+    ) -> Result<RenderedImage, GpuError> {
+        let scope = gpu.scope()?;
+        let image = self.render_offscreen_in_scope(gpu, mesh, maps, settings, offscreen);
+        scope.finish("rendering the preview")?;
+        image
+    }
+
+    /// [`Preview::render_offscreen`], inside its error scope.
+    fn render_offscreen_in_scope(
+        &self,
+        gpu: &Gpu,
+        mesh: &MeshBuffers,
+        maps: &MapTextures,
+        settings: &FrameSettings,
+        offscreen: Offscreen,
+    ) -> Result<RenderedImage, GpuError> {
+        let Offscreen {
+            size: (width, height),
+            linear,
+            layout,
+            models,
+        } = offscreen;
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(GpuError(format!(
+                "image size {width}x{height} is outside 1..={max}"
+            )));
+        }
+        let linear = linear || settings.view.is_data();
+        let format = if linear {
+            wgpu::TextureFormat::Rgba32Float
+        } else {
+            wgpu::TextureFormat::Rgba8UnormSrgb
+        };
+        let texture = |format, usage| gpu.texture_2d("offscreen", (width, height), format, usage);
+        let color = texture(
+            format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let depth = texture(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let key = PipelineKey::for_frame(settings, &maps.uniform, format);
+        let parts = if layout == Layout::Single {
+            layout.parts([key; 3], (width, height))
+        } else {
+            let settings_of = |model| FrameSettings { model, ..*settings };
+            layout.parts(
+                models.map(|m| PipelineKey::for_frame(&settings_of(m), &maps.uniform, format)),
+                (width, height),
+            )
+        };
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        let data = PreviewDrawData::new(self, gpu, mesh, maps, settings, &parts);
+        {
+            let color = color.create_view(&wgpu::TextureViewDescriptor::default());
+            let depth = depth.create_view(&wgpu::TextureViewDescriptor::default());
+            let mut pass = begin_pass(&mut encoder, &color, &depth);
+            self.draw(&mut pass, &data);
+        }
+        let texel = if linear { 16 } else { 4 };
+        let packed = read_texture(gpu, encoder, &color, texel, 0)?;
+        Ok(if linear {
+            RenderedImage::Linear {
+                width,
+                height,
+                pixels: bytemuck::pod_collect_to_vec(&packed),
+            }
+        } else {
+            RenderedImage::Srgb8 {
+                width,
+                height,
+                pixels: packed,
+            }
+        })
+    }
+}
+
+/// Copies mip `level` of `texture` (`texel` bytes per texel) out after the work in
+/// `encoder`, rows packed.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn read_texture(
+    gpu: &Gpu,
+    mut encoder: wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    texel: u32,
+    level: u32,
+) -> Result<Vec<u8>, GpuError> {
+    let extent = texture
+        .size()
+        .mip_level_size(level, wgpu::TextureDimension::D2);
+    let (width, height) = (extent.width, extent.height);
+    let row = (width * texel).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: u64::from(row) * u64::from(height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: level,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &readback,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(height),
+            },
+        },
+        extent,
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let bytes = read_buffer(gpu, &readback)?;
+    let mut packed = Vec::with_capacity((width * height * texel) as usize);
+    for y in 0..height as usize {
+        let start = y * row as usize;
+        packed.extend_from_slice(&bytes[start..start + (width * texel) as usize]);
+    }
+    Ok(packed)
+}
+
+/// Maps a buffer for reading, waits, and copies its bytes out.
+///
+/// # Errors
+/// When mapping fails.
+pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    read_buffer_prefix(gpu, buffer, buffer.size())
+}
+
+/// [`read_buffer`] of the first `bytes` of `buffer`.
+///
+/// # Errors
+/// When mapping fails.
+pub fn read_buffer_prefix(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<u8>, GpuError> {
+    let slice = buffer.slice(..bytes);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    gpu.wait();
+    rx.recv()
+        .map_err(|e| GpuError(format!("read-back lost: {e}")))?
+        .map_err(|e| GpuError(format!("read-back failed: {e}")))?;
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| GpuError(format!("read-back failed: {e}")))?
+        .to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
