@@ -79,14 +79,15 @@ fn picking(c: &mut Criterion) {
     group.finish();
 }
 
+/// Object-space dabs as the editor paints them: `SurfaceStrokeTo` on a one-layer 4096^2
+/// document with the mesh attached, each step 32 texels from the last (one 128 px dab at 25 %
+/// spacing), back and forth across one spot so the stroke's tiles stay the same.
 fn surface_dabs(c: &mut Criterion) {
     use glam::Vec3;
-    use kapaint::model::brush::BrushSettings;
-    use kapaint::model::history::History;
-    use kapaint::model::paint::{Coverage, PaintTarget, paint_dab};
-    use kapaint::model::surface::{BallFootprint, Surface};
+    use kapaint::model::brush::{BrushSettings, StrokePoint, SurfacePos};
+    use kapaint::model::surface::Surface;
     use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{Channels, MaterialMaps};
+    use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
     let mut group = c.benchmark_group("surface_4096");
     group
         .sample_size(20)
@@ -95,22 +96,16 @@ fn surface_dabs(c: &mut Criterion) {
     group.bench_function("surface_index_sphere", |b| {
         b.iter(|| Surface::new(sphere.clone(), 4096, 4096).expect("bakes"));
     });
-    let brush = BrushSettings {
-        radius_px: 128.0,
-        hardness: 0.5,
-        flow: 0.5,
-        ..BrushSettings::default()
+    let settings = DocumentSettings {
+        brush: BrushSettings {
+            radius_px: 128.0,
+            hardness: 0.5,
+            flow: 0.5,
+            ..BrushSettings::default()
+        },
+        primary: MaterialValue::new(Vec3::new(1.0, 0.2, 0.1), Vec3::splat(0.6), 300.0),
+        ..DocumentSettings::default()
     };
-    let target = PaintTarget::new(
-        MaterialValue::new(Vec3::new(1.0, 0.2, 0.1), Vec3::splat(0.6), 300.0),
-        Channels::ALL,
-        brush.blend,
-        false,
-    );
-    let mut maps = MaterialMaps::new(4096, 4096, MaterialValue::default()).expect("size");
-    let mut history = History::default();
-    history.begin("bench stroke");
-    let mut coverage = Coverage::default();
     let spot = mesh::load(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../shared/testdata/spot/spot_triangulated.obj"),
@@ -119,38 +114,35 @@ fn surface_dabs(c: &mut Criterion) {
     for (name, mesh) in [("dab_128px_sphere", sphere), ("dab_128px_spot", spot)] {
         // A vertex half-way through the file: somewhere on the body.
         let center = mesh.positions[mesh.positions.len() / 2];
-        let surface = Surface::new(mesh, 4096, 4096).expect("bakes");
-        let radius = 128.0 * surface.units_per_texel;
-        let normal = surface.normal_near(center, radius).expect("on the surface");
-        let fp = BallFootprint {
-            surface: &surface,
-            center,
-            radius,
-            normal,
-            brush: &brush,
-        };
-        // As the 2D dab bench: tiles already private to the stroke, coverage zeroed.
-        paint_dab(
-            &mut maps,
-            &mut history,
-            &mut coverage,
-            &target,
-            1.0,
-            0.5,
-            &fp,
-        );
+        let surface = std::sync::Arc::new(Surface::new(mesh, 4096, 4096).expect("bakes"));
+        let step = 32.0 * surface.units_per_texel;
+        let normal = surface
+            .normal_near(center, 128.0 * surface.units_per_texel)
+            .expect("on the surface");
+        let across = normal.any_orthonormal_vector() * step;
+        let mut doc = Document::new(4096, 4096, settings.clone())
+            .expect("size")
+            .with_surface(Some(surface))
+            .expect("surface");
+        let mut k = 0_u32;
         group.bench_function(name, |b| {
             b.iter(|| {
-                coverage.clear();
-                paint_dab(
-                    &mut maps,
-                    &mut history,
-                    &mut coverage,
-                    &target,
-                    1.0,
-                    0.5,
-                    &fp,
-                );
+                if k.is_multiple_of(256) {
+                    doc.apply(Command::EndStroke).expect("end");
+                    doc.apply(Command::BeginStroke(StrokeTool::Brush))
+                        .expect("begin");
+                }
+                k += 1;
+                let point = if k.is_multiple_of(2) {
+                    center
+                } else {
+                    center + across
+                };
+                doc.apply(Command::SurfaceStrokeTo(StrokePoint {
+                    pos: SurfacePos { point, normal },
+                    pressure: 1.0,
+                }))
+                .expect("dab");
             });
         });
     }

@@ -13,12 +13,10 @@ use std::time::Duration;
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
-use kapaint::model::history::History;
-use kapaint::model::paint::{Coverage, DiscFootprint, PaintTarget, paint_dab};
 use kapaint::model::texel::{MaterialValue, Texel};
 use kapaint::model::tile::TILE_TEXELS;
 use kapaint::model::{
-    Channels, Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool, project,
+    Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool, project,
 };
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use rayon::prelude::*;
@@ -62,50 +60,6 @@ fn dabs(c: &mut Criterion) {
     group
         .sample_size(20)
         .measurement_time(Duration::from_secs(4));
-    let brush = brush128();
-    let target = PaintTarget::new(
-        MaterialValue::new(Vec3::new(1.0, 0.2, 0.1), Vec3::splat(0.6), 300.0),
-        Channels::ALL,
-        brush.blend,
-        false,
-    );
-    // One dab inside a stroke: tiles already private to the stroke, zero coverage (every
-    // texel of the dab written).
-    let mut maps = MaterialMaps::new(SIDE, SIDE, MaterialValue::default()).expect("size");
-    let mut history = History::default();
-    history.begin("bench stroke");
-    let fp = DiscFootprint {
-        center: Vec2::new(2000.5, 1500.5),
-        radius: 128.0,
-        brush: &brush,
-    };
-    paint_dab(
-        &mut maps,
-        &mut history,
-        &mut Coverage::default(),
-        &target,
-        1.0,
-        0.5,
-        &fp,
-    );
-    group.throughput(Throughput::Elements(1));
-    // The coverage is zeroed inside the timed loop (every texel of the dab is written afresh)
-    // but keeps its allocation: thousands of live fresh coverages would time page faults.
-    let mut coverage = Coverage::default();
-    group.bench_function("dab_128px_all_channels", |b| {
-        b.iter(|| {
-            coverage.clear();
-            paint_dab(
-                &mut maps,
-                &mut history,
-                &mut coverage,
-                &target,
-                1.0,
-                0.5,
-                &fp,
-            );
-        });
-    });
     // A whole stroke of 100 dabs (spacing 25 % of 128 px) on a fresh document, including
     // the copy-on-write of every tile it touches.
     let base = Document::new(

@@ -37,6 +37,8 @@ struct Frame<'a> {
     color: &'a wgpu::TextureView,
     depth: &'a wgpu::TextureView,
     mesh: &'a MeshBuffers,
+    /// Reused from frame to frame, as the editor's viewport does.
+    bindings: std::cell::RefCell<kapaint::gpu::preview::FrameBindings>,
 }
 
 impl Frame<'_> {
@@ -51,7 +53,16 @@ impl Frame<'_> {
             .gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        let data = PreviewDrawData::new(preview, self.gpu, self.mesh, maps, settings, parts);
+        let mut bindings = self.bindings.borrow_mut();
+        bindings.begin_frame();
+        let data = PreviewDrawData::new(
+            preview,
+            self.gpu,
+            (self.mesh, maps),
+            settings,
+            parts,
+            &mut bindings,
+        );
         {
             let mut pass = begin_pass(&mut encoder, self.color, self.depth);
             preview.draw(&mut pass, &data);
@@ -165,6 +176,7 @@ fn frames(c: &mut Criterion) {
             color: &color,
             depth: &depth,
             mesh: &buffers,
+            bindings: std::cell::RefCell::default(),
         };
         group.bench_function(name, |b| {
             b.iter(|| frame.draw(&preview, maps, &s, &[DrawPart::whole(key, (w, h))]));
@@ -186,6 +198,7 @@ fn frames(c: &mut Criterion) {
         color: &color,
         depth: &depth,
         mesh: &buffers,
+        bindings: std::cell::RefCell::default(),
     };
     let split = Layout::Split(w / 2).parts([phong, blinn, phong], (w, h));
     group.bench_function("compare_split_painted_maps", |b| {
@@ -297,6 +310,7 @@ fn painting(c: &mut Criterion) {
         color: &color,
         depth: &depth,
         mesh: &buffers,
+        bindings: std::cell::RefCell::default(),
     };
     let mut k = 0_u32;
     group.bench_function("dab_sync_frame_1280x720", |b| {

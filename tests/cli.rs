@@ -730,3 +730,56 @@ fn import_onto_a_locked_layer_a_fill_layer_or_a_mask_exits_2_and_changes_nothing
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `kapaint render`'s model, view, method and sides are closed lists: an unknown value exits 2
+/// with the valid ones, before anything is opened or drawn (none falls back to a default).
+#[test]
+fn render_refuses_unknown_models_views_methods_and_sides_with_the_valid_ones() {
+    let out = std::env::temp_dir().join(format!("kapaint-render-args-{}.png", std::process::id()));
+    let out = out.to_str().expect("path");
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["--model", "bogus", "--view", "shaded"],
+            "phong, blinn, cook-torrance, compare-split, compare-side, compare-diff, compare-three",
+        ),
+        (
+            &["--model", "phong", "--view", "bogus"],
+            "shaded, ka, kd, ks, n, diffuse, specular, ambient, checker, n-false-colour",
+        ),
+        (
+            &["--model", "phong", "--view", "ka", "--method", "exactly"],
+            "fast, paper, paper-corrected",
+        ),
+        (
+            &[
+                "--model",
+                "compare-diff",
+                "--view",
+                "ka",
+                "--sides",
+                "phong,bogus",
+            ],
+            "phong, blinn, cook-torrance",
+        ),
+        (
+            &[
+                "--model",
+                "compare-diff",
+                "--view",
+                "ka",
+                "--sides",
+                "phong,blinn,phong",
+            ],
+            "two models",
+        ),
+    ];
+    for (args, says) in cases {
+        let mut all = vec!["render", "--out", out];
+        all.extend_from_slice(args);
+        let o = kapaint(&all);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!std::path::Path::new(out).exists(), "{args:?} drew nothing");
+    }
+}

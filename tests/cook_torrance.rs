@@ -136,7 +136,7 @@ fn a_cook_torrance_set_names_its_model_and_measures_its_k_a() {
     let out = dir.join("set");
     let m = set::export(&doc, &preset::find("compact").expect("preset"), &out).expect("export");
     assert_eq!(m.model, CT);
-    assert_eq!(m.approximation.name, "fast");
+    assert_eq!(m.approximation.name.name(), "fast");
     let json = std::fs::read_to_string(out.join("material.json")).expect("manifest");
     assert!(json.contains("\"cook-torrance\""), "{json}");
     for snippet in ["material.wgsl", "material.glsl"] {

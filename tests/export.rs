@@ -509,7 +509,7 @@ fn snippets_validate_for_every_n_storage_model_and_approximation() {
                 m.n_encoding = n_encoding;
                 m.constants.n = n;
                 m.model = model;
-                m.approximation.name = approx.into();
+                m.approximation.name = reflectance::AmbientApprox::from_name(approx).expect("name");
                 let what = format!("{n_encoding:?} {n:?} {model:?} {approx}");
                 let glsl = snippet::glsl(&m);
                 let wgsl = snippet::wgsl(&m);

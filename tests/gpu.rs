@@ -1230,3 +1230,115 @@ fn a_lost_device_is_an_error_not_a_panic() {
     doc.apply(Command::Fill(FillRegion::All)).expect("fill");
     assert!(textures.sync(&gpu, doc.maps()).is_err());
 }
+
+/// Steady frames make no GPU object: the preview's uniform buffer and bind group (and the
+/// heatmap's) are reused while the maps' textures are the same, the uniforms rewritten in
+/// place; a new mirror of the maps makes one new bind group and keeps the buffer. A frame
+/// drawn through the reused bindings is the image a one-off render gives.
+#[test]
+fn steady_frames_reuse_their_buffers_and_bind_groups() {
+    use kapaint::gpu::difference::{Difference, DifferenceBindings};
+    use kapaint::gpu::preview::{
+        DEPTH_FORMAT, DrawPart, FrameBindings, PipelineKey, PreviewDrawData, begin_pass,
+        read_texture,
+    };
+    let Some(gpu) = gpu() else { return };
+    let sphere = mesh::uv_sphere(32, 16);
+    let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
+    let preview = Preview::new(&gpu);
+    let maps = painted_maps();
+    let textures = MapTextures::new(&gpu, &maps).expect("map textures");
+    let size = (48, 40);
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+        | wgpu::TextureUsages::COPY_SRC
+        | wgpu::TextureUsages::TEXTURE_BINDING;
+    let color = gpu.texture_2d("test", size, format, usage);
+    let view = color.create_view(&wgpu::TextureViewDescriptor::default());
+    let depth = gpu
+        .texture_2d(
+            "test",
+            size,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&wgpu::TextureViewDescriptor::default());
+    let mut bindings = FrameBindings::default();
+    let frame = |textures: &MapTextures, yaw: f32, bindings: &mut FrameBindings| {
+        let mut s = settings(ShadingModel::Phong, ViewMode::Shaded, &sphere.positions);
+        s.camera.yaw = yaw;
+        bindings.begin_frame();
+        let parts = [DrawPart::whole(
+            PipelineKey::for_frame(&s, &textures.uniform, format),
+            size,
+        )];
+        let data = PreviewDrawData::new(&preview, &gpu, (&buffers, textures), &s, &parts, bindings);
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        {
+            let mut pass = begin_pass(&mut encoder, &view, &depth);
+            preview.draw(&mut pass, &data);
+        }
+        (s, encoder)
+    };
+    for k in 0..5 {
+        let (_, encoder) = frame(&textures, 0.1 * k as f32, &mut bindings);
+        gpu.queue.submit([encoder.finish()]);
+        assert_eq!(
+            bindings.made(),
+            6,
+            "frame {k}: one buffer, four views, one group"
+        );
+    }
+    // The last steady frame is what a one-off render of its settings gives.
+    let (s, encoder) = frame(&textures, 0.9, &mut bindings);
+    let drawn = read_texture(&gpu, encoder, &color, 4, 0).expect("read back");
+    let RenderedImage::Srgb8 { pixels, .. } = preview
+        .render_offscreen(
+            &gpu,
+            &buffers,
+            &textures,
+            &s,
+            Offscreen {
+                size,
+                linear: false,
+                layout: Layout::Single,
+                models: COMPARED_MODELS,
+            },
+        )
+        .expect("render")
+    else {
+        panic!("an sRGB image");
+    };
+    assert_eq!(
+        drawn, pixels,
+        "the reused uniforms hold this frame's camera"
+    );
+    assert_eq!(bindings.made(), 6);
+    // A new mirror of the maps: a new bind group (four views), the buffer kept.
+    let again = MapTextures::new(&gpu, &maps).expect("map textures");
+    let _ = frame(&again, 0.3, &mut bindings);
+    assert_eq!(bindings.made(), 11);
+
+    // The heatmap: its buffer and group once, while the sides stay the same views.
+    let difference = Difference::new(&gpu);
+    let mut heat = DifferenceBindings::default();
+    let side = || {
+        gpu.texture_2d(
+            "side",
+            size,
+            kapaint::gpu::difference::SIDE_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        )
+        .create_view(&wgpu::TextureViewDescriptor::default())
+    };
+    let (a, b) = (side(), side());
+    for max in [0.1, 0.2, 0.3] {
+        let _ = difference.draw_data(&gpu, [&a, &b], format, max, &mut heat);
+        assert_eq!(heat.made(), 2);
+    }
+    let c = side();
+    let _ = difference.draw_data(&gpu, [&a, &c], format, 0.1, &mut heat);
+    assert_eq!(heat.made(), 3, "new sides: a new group, the buffer kept");
+}

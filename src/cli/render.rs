@@ -4,7 +4,9 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 
-use super::args::{MethodArg, parse_light, parse_n, parse_rgb, parse_size};
+use clap::ValueEnum;
+
+use super::args::{MethodArg, ModelArg, parse_light, parse_n, parse_rgb, parse_size};
 use super::{CliError, model_error};
 use crate::mesh;
 use crate::model::{self, project};
@@ -28,21 +30,19 @@ pub struct RenderArgs {
     /// sphere, plane, cube, torus or a mesh file (default: the project's, else sphere).
     #[arg(long)]
     mesh: Option<String>,
-    /// phong, blinn, cook-torrance, compare-split (the --sides models left and right of a
-    /// divider), compare-side (the two side by side, one camera), compare-diff (|left -
-    /// right| heatmap) or compare-three (Phong, Blinn-Phong and Cook-Torrance side by side).
-    #[arg(long, value_parser = ["phong", "blinn", "cook-torrance", "compare-split", "compare-side", "compare-diff", "compare-three"])]
-    model: String,
+    /// One model, or a comparison of the --sides models.
+    #[arg(long, value_enum)]
+    model: RenderModel,
     /// The two models a compare-split, compare-side or compare-diff shows, `LEFT,RIGHT`.
-    #[arg(long, default_value = "phong,blinn")]
-    sides: String,
-    /// shaded, ka, kd, ks, n, diffuse, specular, ambient (or checker, n-false-colour).
-    #[arg(long, value_parser = ["shaded", "ka", "kd", "ks", "n", "diffuse", "specular", "ambient", "checker", "n-false-colour"])]
-    view: String,
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "phong,blinn")]
+    sides: Vec<ModelArg>,
+    /// What the image shows.
+    #[arg(long, value_enum)]
+    view: ViewArg,
     /// How k_a's chi is computed (Cook-Torrance always uses its fast fit: the paper printed
     /// no form for it).
-    #[arg(long, value_parser = ["fast", "paper", "paper-corrected"], default_value = "fast")]
-    method: String,
+    #[arg(long, value_enum, default_value = "fast")]
+    method: ApproxArg,
     /// Direction towards the light, `X,Y,Z`.
     #[arg(long, allow_hyphen_values = true)]
     light: Option<String>,
@@ -64,6 +64,88 @@ pub struct RenderArgs {
     /// Output image: .png or .exr.
     #[arg(long)]
     out: PathBuf,
+}
+
+/// `kapaint render --model`: one model, or a comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RenderModel {
+    /// Original Phong, eq. (8).
+    Phong,
+    /// Blinn-Phong, eq. (11).
+    Blinn,
+    /// Cook-Torrance (GGX).
+    CookTorrance,
+    /// The --sides models left and right of a divider.
+    CompareSplit,
+    /// The --sides models side by side, one camera.
+    CompareSide,
+    /// |left - right| of the --sides models, as a heatmap.
+    CompareDiff,
+    /// Phong, Blinn-Phong and Cook-Torrance side by side.
+    CompareThree,
+}
+
+/// `kapaint render --view`: the render's view modes by their names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ViewArg {
+    /// Lit by the ambient and the light.
+    Shaded,
+    /// The derived k_a (a data view: 16-bit, linear).
+    Ka,
+    /// The diffuse coefficient.
+    Kd,
+    /// The specular coefficient.
+    Ks,
+    /// The exponent.
+    N,
+    /// The diffuse term alone.
+    Diffuse,
+    /// The specular term alone.
+    Specular,
+    /// The ambient term alone.
+    Ambient,
+    /// The UV checker.
+    Checker,
+    /// The exponent in false colour.
+    NFalseColour,
+}
+
+impl From<ViewArg> for crate::render::ViewMode {
+    fn from(v: ViewArg) -> Self {
+        match v {
+            ViewArg::Shaded => Self::Shaded,
+            ViewArg::Ka => Self::Ka,
+            ViewArg::Kd => Self::Kd,
+            ViewArg::Ks => Self::Ks,
+            ViewArg::N => Self::N,
+            ViewArg::Diffuse => Self::Diffuse,
+            ViewArg::Specular => Self::Specular,
+            ViewArg::Ambient => Self::Ambient,
+            ViewArg::Checker => Self::Checker,
+            ViewArg::NFalseColour => Self::NFalseColour,
+        }
+    }
+}
+
+/// `kapaint render --method`: the approximations of chi (the render has no exact integral).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ApproxArg {
+    /// kapaint's fast approximation.
+    Fast,
+    /// Eq. (8) / (11) as printed.
+    Paper,
+    /// Eq. (8) / (11) with the Blinn exponent corrected.
+    PaperCorrected,
+}
+
+impl From<ApproxArg> for AmbientApprox {
+    fn from(a: ApproxArg) -> Self {
+        match a {
+            ApproxArg::Fast => Self::Fast,
+            ApproxArg::Paper => Self::PaperPrinted,
+            ApproxArg::PaperCorrected => Self::PaperCorrected,
+        }
+    }
 }
 
 /// What `render` draws: maps, the normal map, and the mesh they come with.
@@ -104,23 +186,13 @@ fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
     Ok((maps, None, std::path::PathBuf::from("sphere")))
 }
 
-/// `--sides LEFT,RIGHT`: two model names.
-fn parse_sides(text: &str) -> Result<[ShadingModel; 2], CliError> {
-    let names: Vec<&str> = text.split(',').map(str::trim).collect();
-    let model = |name: &str| {
-        ShadingModel::ALL
-            .into_iter()
-            .find(|m| m.name() == name)
-            .ok_or_else(|| {
-                CliError::usage(format!(
-                    "--sides: unknown model {name:?} (phong, blinn or cook-torrance)"
-                ))
-            })
-    };
-    match names.as_slice() {
-        [a, b] => Ok([model(a)?, model(b)?]),
+/// `--sides LEFT,RIGHT`: exactly two models.
+fn sides(models: &[ModelArg]) -> Result<[ShadingModel; 2], CliError> {
+    match models {
+        [a, b] => Ok([(*a).into(), (*b).into()]),
         _ => Err(CliError::usage(format!(
-            "--sides takes two models, LEFT,RIGHT; got {text:?}"
+            "--sides takes two models, LEFT,RIGHT; got {}",
+            models.len()
         ))),
     }
 }
@@ -165,28 +237,23 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
     if !(a.yaw.is_finite() && a.pitch.is_finite()) {
         return Err(CliError::usage("--yaw and --pitch must be finite"));
     }
-    let sides = parse_sides(&a.sides)?;
-    let (model, compare) = match a.model.as_str() {
-        "phong" => (ShadingModel::Phong, Compare::Single),
-        "blinn" => (ShadingModel::BlinnPhong, Compare::Single),
-        "cook-torrance" => (ShadingModel::CookTorrance, Compare::Single),
-        "compare-split" => (sides[0], Compare::Split),
-        "compare-side" => (sides[0], Compare::SideBySide),
-        "compare-three" => (ShadingModel::Phong, Compare::ThreeWay),
-        _ => (sides[0], Compare::Difference),
+    let sides = sides(&a.sides)?;
+    let (model, compare) = match a.model {
+        RenderModel::Phong => (ShadingModel::Phong, Compare::Single),
+        RenderModel::Blinn => (ShadingModel::BlinnPhong, Compare::Single),
+        RenderModel::CookTorrance => (ShadingModel::CookTorrance, Compare::Single),
+        RenderModel::CompareSplit => (sides[0], Compare::Split),
+        RenderModel::CompareSide => (sides[0], Compare::SideBySide),
+        RenderModel::CompareDiff => (sides[0], Compare::Difference),
+        RenderModel::CompareThree => (ShadingModel::Phong, Compare::ThreeWay),
     };
     let models = if compare == Compare::ThreeWay {
         ShadingModel::ALL
     } else {
         [sides[0], sides[1], ShadingModel::CookTorrance]
     };
-    let approx = match a.method.as_str() {
-        "paper" => AmbientApprox::PaperPrinted,
-        "paper-corrected" => AmbientApprox::PaperCorrected,
-        _ => AmbientApprox::Fast,
-    };
-    let view = ViewMode::from_name(&a.view)
-        .ok_or_else(|| CliError::usage(format!("unknown view {:?}", a.view)))?;
+    let approx = AmbientApprox::from(a.method);
+    let view = ViewMode::from(a.view);
     let camera = Camera {
         yaw: a.yaw.to_radians(),
         pitch: a.pitch.to_radians().clamp(-1.55, 1.55),

@@ -9,7 +9,6 @@ use std::fmt::Write as _;
 
 use super::encoding::NCurve;
 use super::set::Manifest;
-use kapaint_core::reflectance::AmbientApprox;
 use kapaint_core::reflectance::wgsl::{
     ShaderLanguage, ambient_glsl, ambient_wgsl_standalone, approx_constant, model_constant,
 };
@@ -46,12 +45,7 @@ fn snippet(manifest: &Manifest, lang: ShaderLanguage) -> String {
         ShaderLanguage::Glsl => s += &ambient_glsl(),
     }
     let model = model_constant(manifest.model);
-    let approx = match manifest.approximation.name.as_str() {
-        "paper" => AmbientApprox::PaperPrinted,
-        "paper-corrected" => AmbientApprox::PaperCorrected,
-        _ => AmbientApprox::Fast,
-    };
-    let approx = approx_constant(approx);
+    let approx = approx_constant(manifest.approximation.name);
     match lang {
         ShaderLanguage::Wgsl => {
             let _ = writeln!(s, "\nconst KAPAINT_MODEL: u32 = {model};");

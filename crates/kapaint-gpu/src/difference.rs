@@ -39,6 +39,21 @@ impl std::fmt::Debug for Difference {
     }
 }
 
+/// The heatmap's uniform buffer and bind group, kept by the caller from frame to frame: the
+/// group is made again only when the two sides' views change.
+#[derive(Debug, Default)]
+pub struct DifferenceBindings {
+    slot: Option<(wgpu::Buffer, [wgpu::TextureView; 2], wgpu::BindGroup)>,
+    made: u64,
+}
+
+impl DifferenceBindings {
+    /// How many GPU objects (buffers, bind groups) the bindings have made.
+    pub fn made(&self) -> u64 {
+        self.made
+    }
+}
+
 /// One heatmap's draw data: its bind group (the two sides and the uniforms) and pipeline.
 #[derive(Debug)]
 pub struct DifferenceDrawData {
@@ -116,32 +131,67 @@ impl Difference {
     }
 
     /// The draw data of the heatmap of `|left - right|` (two linear renders of one size) into
-    /// a target of `format`: white at `max` and above, black at 0.
+    /// a target of `format`: white at `max` and above, black at 0. The uniforms go into the
+    /// buffer of `bindings`, whose bind group is reused while the sides are the same views.
     pub fn draw_data(
         &self,
         gpu: &Gpu,
-        left: &wgpu::TextureView,
-        right: &wgpu::TextureView,
+        [left, right]: [&wgpu::TextureView; 2],
         format: wgpu::TextureFormat,
         max: f32,
+        bindings: &mut DifferenceBindings,
     ) -> DifferenceDrawData {
-        use wgpu::util::DeviceExt;
         let inv_max = if max.is_finite() && max > 0.0 {
             1.0 / max
         } else {
             0.0
         };
-        let uniforms = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("difference"),
-                contents: bytemuck::bytes_of(&HeatUniforms {
-                    inv_max,
-                    ..HeatUniforms::default()
-                }),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let sides = [left.clone(), right.clone()];
+        let (buffer, sides, bind_group) = match bindings.slot.take() {
+            Some(slot) if slot.1 == sides => slot,
+            old => {
+                let buffer = old.map_or_else(
+                    || {
+                        bindings.made += 1;
+                        gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                            label: Some("difference"),
+                            size: std::mem::size_of::<HeatUniforms>() as u64,
+                            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                            mapped_at_creation: false,
+                        })
+                    },
+                    |(buffer, ..)| buffer,
+                );
+                bindings.made += 1;
+                let group = self.bind_group(gpu, left, right, &buffer);
+                (buffer, sides, group)
+            }
+        };
+        gpu.queue.write_buffer(
+            &buffer,
+            0,
+            bytemuck::bytes_of(&HeatUniforms {
+                inv_max,
+                ..HeatUniforms::default()
+            }),
+        );
+        let data = DifferenceDrawData {
+            bind_group: bind_group.clone(),
+            pipeline: self.pipeline(gpu, format),
+        };
+        bindings.slot = Some((buffer, sides, bind_group));
+        data
+    }
+
+    /// The bind group of the two sides and the uniforms.
+    fn bind_group(
+        &self,
+        gpu: &Gpu,
+        left: &wgpu::TextureView,
+        right: &wgpu::TextureView,
+        uniforms: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("difference"),
             layout: &self.bind_layout,
             entries: &[
@@ -158,11 +208,7 @@ impl Difference {
                     resource: uniforms.as_entire_binding(),
                 },
             ],
-        });
-        DifferenceDrawData {
-            bind_group,
-            pipeline: self.pipeline(gpu, format),
-        }
+        })
     }
 
     /// Records `data` into `pass` (one triangle over the target).
@@ -243,7 +289,8 @@ impl Difference {
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        let data = self.draw_data(gpu, &a, &b, format, max);
+        let mut bindings = DifferenceBindings::default();
+        let data = self.draw_data(gpu, [&a, &b], format, max, &mut bindings);
         {
             let target = out.create_view(&wgpu::TextureViewDescriptor::default());
             let mut pass = Self::begin_pass(&mut encoder, &target);

@@ -7,7 +7,6 @@ pub mod brush;
 pub mod check;
 pub mod document;
 mod error;
-pub mod history;
 pub mod import;
 pub mod layers;
 pub mod maps;

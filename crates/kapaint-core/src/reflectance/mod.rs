@@ -73,6 +73,11 @@ impl ShadingModel {
         }
     }
 
+    /// The model [`ShadingModel::name`] names.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
     /// The name people read in reports and the editor.
     pub fn label(self) -> &'static str {
         match self {
@@ -130,6 +135,11 @@ impl AmbientApprox {
             Self::PaperCorrected => "paper-corrected",
             Self::Fast => "fast",
         }
+    }
+
+    /// The approximation [`AmbientApprox::name`] names.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|a| a.name() == name)
     }
 }
 

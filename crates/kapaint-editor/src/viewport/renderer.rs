@@ -14,11 +14,11 @@ use kapaint_core::model::MaterialMaps;
 use kapaint_core::model::texel::MaterialValue;
 use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::render::FrameSettings;
-use kapaint_gpu::difference::{Difference, SIDE_FORMAT};
+use kapaint_gpu::difference::{Difference, DifferenceBindings, SIDE_FORMAT};
 use kapaint_gpu::maps::MapTextures;
 use kapaint_gpu::preview::{
-    COMPARED_MODELS, DEPTH_FORMAT, DrawPart, Layout, MeshBuffers, Offscreen, PipelineKey, Preview,
-    PreviewDrawData, RenderedImage, begin_pass,
+    COMPARED_MODELS, DEPTH_FORMAT, DrawPart, FrameBindings, Layout, MeshBuffers, Offscreen,
+    PipelineKey, Preview, PreviewDrawData, RenderedImage, begin_pass,
 };
 use kapaint_gpu::{Gpu, GpuError};
 
@@ -31,6 +31,10 @@ pub struct ViewportGpu {
     /// Which maps `maps` mirrors (the composite, or a layer view's).
     maps_source: u64,
     target: Option<Target>,
+    /// The preview's uniform buffers and bind groups, reused from frame to frame.
+    bindings: FrameBindings,
+    /// The heatmap's.
+    difference_bindings: DifferenceBindings,
 }
 
 /// The viewport's renderers, immutable once made: kept in egui_wgpu's callback resources.
@@ -43,7 +47,8 @@ pub struct Renderers {
 
 struct Target {
     size: (u32, u32),
-    color: wgpu::Texture,
+    /// The colour target's view (egui shows the texture).
+    view: wgpu::TextureView,
     depth: wgpu::TextureView,
     id: TextureId,
     /// The two linear renders the difference mode compares, made when first needed.
@@ -75,6 +80,8 @@ impl ViewportGpu {
             maps: None,
             maps_source: 0,
             target: None,
+            bindings: FrameBindings::default(),
+            difference_bindings: DifferenceBindings::default(),
         }
     }
 
@@ -189,7 +196,7 @@ impl ViewportGpu {
 
     /// Records and submits the frame into the current target.
     fn draw(
-        &self,
+        &mut self,
         settings: &FrameSettings,
         comparison: &Comparison,
         size: (u32, u32),
@@ -198,6 +205,8 @@ impl ViewportGpu {
         else {
             return TextureId::default();
         };
+        let (bindings, difference_bindings) = (&mut self.bindings, &mut self.difference_bindings);
+        bindings.begin_frame();
         let renderer = self.renderer.renderer.read();
         let Some(Renderers {
             preview,
@@ -221,9 +230,7 @@ impl ViewportGpu {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("viewport"),
             });
-        let view = target
-            .color
-            .create_view(&wgpu::TextureViewDescriptor::default());
+        let view = &target.view;
         let keys = match comparison.mode {
             Compare::Single => [key; 3],
             // The three models, each with the left side's approximation.
@@ -244,13 +251,13 @@ impl ViewportGpu {
         };
         let parts = Layout::of(comparison.mode, comparison.split_at, size.0)
             .map(|layout| layout.parts(keys, size));
-        let frame = |parts: &[DrawPart]| {
-            PreviewDrawData::new(preview, &self.gpu, mesh, maps, settings, parts)
+        let mut frame = |parts: &[DrawPart]| {
+            PreviewDrawData::new(preview, &self.gpu, (mesh, maps), settings, parts, bindings)
         };
         match (parts, &target.sides) {
             (Some(parts), _) => {
                 let data = frame(&parts);
-                let mut pass = begin_pass(&mut encoder, &view, &target.depth);
+                let mut pass = begin_pass(&mut encoder, view, &target.depth);
                 preview.draw(&mut pass, &data);
             }
             (None, Some((a, b))) => {
@@ -259,8 +266,14 @@ impl ViewportGpu {
                     let mut pass = begin_pass(&mut encoder, out, &target.depth);
                     preview.draw(&mut pass, &data);
                 }
-                let data = difference.draw_data(&self.gpu, a, b, FORMAT, comparison.diff_max);
-                let mut pass = Difference::begin_pass(&mut encoder, &view);
+                let data = difference.draw_data(
+                    &self.gpu,
+                    [a, b],
+                    FORMAT,
+                    comparison.diff_max,
+                    difference_bindings,
+                );
+                let mut pass = Difference::begin_pass(&mut encoder, view);
                 difference.draw(&mut pass, &data);
             }
             (None, None) => {}
@@ -295,7 +308,7 @@ impl ViewportGpu {
         };
         Target {
             size,
-            color,
+            view,
             depth,
             id,
             sides: None,

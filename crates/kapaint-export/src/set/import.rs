@@ -5,7 +5,7 @@ use std::path::Path;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::manifest::{Approximation, ColourSpace, Comp, Compression, Manifest};
+use super::manifest::{ColourSpace, Comp, Compression, Manifest};
 use super::{SetError, io};
 use kapaint_core::model::texel::{MaterialValue, Texel, srgb_to_linear};
 use kapaint_core::model::{Document, DocumentSettings, MaterialMaps};
@@ -155,12 +155,7 @@ pub fn import(manifest_path: &Path) -> Result<Document, SetError> {
     })?;
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
     let maps = read_maps(&manifest, dir)?;
-    let approx = Approximation::of_name(&manifest.approximation.name).map_err(|reason| {
-        SetError::Invalid {
-            path: manifest_path.to_path_buf(),
-            reason,
-        }
-    })?;
+    let approx = manifest.approximation.name;
     let settings = DocumentSettings {
         model: manifest.model,
         approx,

@@ -292,7 +292,7 @@ impl TryFrom<ConstantsFile> for Constants {
 #[serde(try_from = "ApproximationFile")]
 pub struct Approximation {
     /// `fast`, `paper` or `paper-corrected`.
-    pub name: String,
+    pub name: AmbientApprox,
     /// The factor of `k_d` in `k_a` (2/pi, or the paper's 0.637).
     pub diffuse_factor: f64,
     /// For the paper's forms: `chi(n) = a (n + b)^c`.
@@ -311,9 +311,8 @@ impl TryFrom<ApproximationFile> for Approximation {
     type Error = String;
 
     fn try_from(f: ApproximationFile) -> Result<Self, String> {
-        Approximation::of_name(&f.name)?;
         Ok(Self {
-            name: f.name,
+            name: Approximation::of_name(&f.name)?,
             diffuse_factor: f.diffuse_factor,
             paper_constants: f.paper_constants,
         })
@@ -326,15 +325,12 @@ impl Approximation {
     /// # Errors
     /// A name kapaint does not know.
     pub fn of_name(name: &str) -> Result<AmbientApprox, String> {
-        AmbientApprox::ALL
-            .into_iter()
-            .find(|a| a.name() == name)
-            .ok_or_else(|| {
-                format!(
-                    "approximation {name:?} is not one kapaint knows (known: {})",
-                    AmbientApprox::ALL.map(AmbientApprox::name).join(", ")
-                )
-            })
+        AmbientApprox::from_name(name).ok_or_else(|| {
+            format!(
+                "approximation {name:?} is not one kapaint knows (known: {})",
+                AmbientApprox::ALL.map(AmbientApprox::name).join(", ")
+            )
+        })
     }
 }
 
@@ -565,7 +561,7 @@ pub(super) fn approximation(approx: AmbientApprox, model: ShadingModel) -> Appro
     // What the set's k_a really uses: Cook-Torrance has its fit whatever the method.
     let approx = approx.for_model(model);
     Approximation {
-        name: approx.name().to_string(),
+        name: approx,
         diffuse_factor: reflectance::diffuse_factor(approx),
         paper_constants: reflectance::paper_constants(model, approx).map(|(a, b, c)| [a, b, c]),
     }

@@ -1,5 +1,7 @@
 //! One frame's draw data: its uniforms, its bind group (uniforms, maps, sampler), its parts
-//! with their pipelines, and the mesh. Made fresh each frame; the renderer only reads it.
+//! with their pipelines, and the mesh. The uniform buffers and bind groups live in the
+//! caller's [`FrameBindings`] and are reused while the maps' textures stay the same: a steady
+//! frame writes its uniforms and makes no GPU object. The renderer only reads the data.
 
 use super::{DrawPart, MeshBuffers, Preview};
 use crate::Gpu;
@@ -49,6 +51,121 @@ impl FrameUniforms {
     }
 }
 
+/// One draw's uniform buffer and bind group, and the textures the group binds.
+#[derive(Debug)]
+struct Slot {
+    buffer: wgpu::Buffer,
+    textures: [wgpu::Texture; 4],
+    bind_group: wgpu::BindGroup,
+}
+
+/// The uniform buffers and bind groups a caller's frames reuse, one slot per draw of a frame
+/// (a difference compare draws two previews a frame). Each frame starts with
+/// [`FrameBindings::begin_frame`]; a draw writes its uniforms into its slot's buffer, and the
+/// slot's bind group is made again only when the map textures it binds changed.
+#[derive(Debug, Default)]
+pub struct FrameBindings {
+    slots: Vec<Slot>,
+    next: usize,
+    made: u64,
+}
+
+impl FrameBindings {
+    /// A new frame: its draws take the slots from the first.
+    pub fn begin_frame(&mut self) {
+        self.next = 0;
+    }
+
+    /// How many GPU objects (buffers, texture views, bind groups) the bindings have made: what
+    /// a test reads to see that steady frames make none.
+    pub fn made(&self) -> u64 {
+        self.made
+    }
+
+    /// The next slot's bind group for `maps`, its buffer holding `uniforms`.
+    fn bind(
+        &mut self,
+        preview: &Preview,
+        gpu: &Gpu,
+        maps: &MapTextures,
+        uniforms: &FrameUniforms,
+    ) -> wgpu::BindGroup {
+        let textures = [
+            maps.kd.clone(),
+            maps.ks.clone(),
+            maps.n.clone(),
+            maps.normal.texture.clone(),
+        ];
+        let at = self.next;
+        self.next += 1;
+        if at == self.slots.len() {
+            let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame"),
+                size: std::mem::size_of::<FrameUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let bind_group = bind_group(preview, gpu, &buffer, &textures);
+            self.made += 6;
+            self.slots.push(Slot {
+                buffer,
+                textures,
+                bind_group,
+            });
+        } else if self.slots[at].textures != textures {
+            let slot = &mut self.slots[at];
+            slot.bind_group = bind_group(preview, gpu, &slot.buffer, &textures);
+            slot.textures = textures;
+            self.made += 5;
+        }
+        let slot = &self.slots[at];
+        gpu.queue
+            .write_buffer(&slot.buffer, 0, bytemuck::bytes_of(uniforms));
+        slot.bind_group.clone()
+    }
+}
+
+/// The preview's bind group of `buffer` and the `k_d`, `k_s`, `n` and normal textures.
+fn bind_group(
+    preview: &Preview,
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    [kd, ks, n, normal]: &[wgpu::Texture; 4],
+) -> wgpu::BindGroup {
+    let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+    let (kd, ks, n, normal) = (view(kd), view(ks), view(n), view(normal));
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("preview"),
+        layout: &preview.bind_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&kd),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&ks),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&n),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::Sampler(&preview.sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::TextureView(&normal),
+            },
+        ],
+    })
+}
+
 /// One frame of the preview, ready to record (see [`Preview::draw`]).
 #[derive(Debug)]
 pub struct PreviewDrawData {
@@ -61,59 +178,19 @@ pub struct PreviewDrawData {
 
 impl PreviewDrawData {
     /// The draw data of `parts` of a frame of `settings`, `mesh` and `maps`: the uniforms
-    /// (the projection's aspect is the first part's viewport's), the bind group, and each
-    /// part's pipeline, compiled now if it is new.
+    /// (the projection's aspect is the first part's viewport's) written into the next slot of
+    /// `bindings`, its bind group, and each part's pipeline, compiled now if it is new.
     pub fn new(
         preview: &Preview,
         gpu: &Gpu,
-        mesh: &MeshBuffers,
-        maps: &MapTextures,
+        (mesh, maps): (&MeshBuffers, &MapTextures),
         settings: &FrameSettings,
         parts: &[DrawPart],
+        bindings: &mut FrameBindings,
     ) -> Self {
-        use wgpu::util::DeviceExt;
         let (_, _, vw, vh) = parts.first().map_or((0, 0, 1, 1), |p| p.viewport);
         let uniforms = FrameUniforms::new(settings, vw as f32 / vh.max(1) as f32, &maps.uniform);
-        let buffer = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("frame"),
-                contents: bytemuck::bytes_of(&uniforms),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-        let (kd, ks, n) = (view(&maps.kd), view(&maps.ks), view(&maps.n));
-        let normal = view(&maps.normal.texture);
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("preview"),
-            layout: &preview.bind_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&kd),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&ks),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&n),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::Sampler(&preview.sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&normal),
-                },
-            ],
-        });
+        let bind_group = bindings.bind(preview, gpu, maps, &uniforms);
         Self {
             bind_group,
             parts: parts

@@ -4,7 +4,8 @@
 //!   combination of overridable constants a frame uses ([`PipelineKey`]: model,
 //!   approximation, view, which maps are uniform, whether there is any specular);
 //! - [`PreviewDrawData`] is one frame's data: its uniforms, its bind group, its parts (a
-//!   pipeline, a scissor and a viewport each) and the mesh to draw;
+//!   pipeline, a scissor and a viewport each) and the mesh to draw; the uniform buffers and
+//!   bind groups are the caller's [`FrameBindings`], reused from frame to frame;
 //! - [`Preview::draw`] records a frame's data into a render pass and changes nothing.
 //!
 //! It draws into any colour target, and headless into an offscreen image that is read back
@@ -16,7 +17,7 @@ mod mesh;
 mod offscreen;
 mod pipeline;
 
-pub use draw_data::{FrameUniforms, PreviewDrawData};
+pub use draw_data::{FrameBindings, FrameUniforms, PreviewDrawData};
 pub use layout::{DrawPart, Layout, Scissor};
 pub use mesh::MeshBuffers;
 pub use offscreen::{

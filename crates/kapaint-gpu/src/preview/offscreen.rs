@@ -114,7 +114,9 @@ impl Preview {
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        let data = PreviewDrawData::new(self, gpu, mesh, maps, settings, &parts);
+        // A one-off render: its own bindings.
+        let mut bindings = super::FrameBindings::default();
+        let data = PreviewDrawData::new(self, gpu, (mesh, maps), settings, &parts, &mut bindings);
         {
             let color = color.create_view(&wgpu::TextureViewDescriptor::default());
             let depth = depth.create_view(&wgpu::TextureViewDescriptor::default());

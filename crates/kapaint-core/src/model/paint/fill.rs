@@ -1,63 +1,9 @@
-//! Fills: the whole map, a flood-filled region of similar texels, or any mask.
+//! The flood fill's region: the texels connected to a seed whose channel stays within a
+//! tolerance (the layer engine fills it: `model::document`).
 
-use super::{PaintTarget, n_bits_from_blend, n_bits_to_blend, pre_tile};
-use crate::model::brush::BlendMode;
-use crate::model::history::History;
+use super::n_bits_to_blend;
 use crate::model::maps::MaterialMaps;
-use crate::model::texel::{MaterialValue, Texel, decode_unorm, n_from_blend};
-use crate::model::tile::{TILE_SIZE, TILE_TEXELS, Tile};
-
-/// Writes `target` over every texel of the maps at alpha `opacity`. A full-opacity normal
-/// fill makes the written planes uniform: no per-texel work and no memory.
-pub fn fill_all(
-    maps: &mut MaterialMaps,
-    history: &mut History,
-    target: &PaintTarget,
-    opacity: f32,
-) {
-    use crate::model::tile::Plane;
-    let uniform = opacity >= 1.0 && target.mode == BlendMode::Normal && !target.energy_guard;
-    let value = Texel::encode(MaterialValue {
-        kd: target.kd,
-        ks: target.ks,
-        n: n_from_blend(target.n_blend),
-    });
-    let value = Texel {
-        n: n_bits_from_blend(target.n_blend),
-        ..value
-    };
-    for id in 0..maps.tile_count() {
-        if uniform {
-            // Build the new tile from the old one's untouched planes: no copy of what is
-            // overwritten.
-            let old = maps.tile(id);
-            let tile = Tile {
-                kd: if target.channels.kd {
-                    Plane::Uniform(value.kd)
-                } else {
-                    old.kd.clone()
-                },
-                ks: if target.channels.ks {
-                    Plane::Uniform(value.ks)
-                } else {
-                    old.ks.clone()
-                },
-                n: if target.channels.n {
-                    Plane::Uniform(value.n)
-                } else {
-                    old.n.clone()
-                },
-            };
-            history.replace_for_write(maps, id, tile);
-        } else {
-            let pre = pre_tile(history, maps, id);
-            let tile = history.tile_for_write(maps, id);
-            for i in 0..TILE_TEXELS {
-                tile.set_texel(i, target.blend(pre.texel(i), opacity));
-            }
-        }
-    }
-}
+use crate::model::texel::{Texel, decode_unorm};
 
 /// The 4-connected region around `(x, y)` whose `channel` stays within `tolerance` of the
 /// seed's (in blend space, max over colour components), as a bit per texel.
@@ -111,34 +57,4 @@ pub fn flood_region(
         }
     }
     inside
-}
-
-/// Writes `target` at alpha `opacity` over the texels of `mask` (row-major, one per texel).
-pub fn fill_mask(
-    maps: &mut MaterialMaps,
-    history: &mut History,
-    target: &PaintTarget,
-    opacity: f32,
-    mask: &[bool],
-) {
-    let w = maps.width() as usize;
-    for id in 0..maps.tile_count() {
-        let crate::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
-        let any = (y0..y1).any(|y| {
-            mask[y as usize * w + x0 as usize..y as usize * w + x1 as usize].contains(&true)
-        });
-        if !any {
-            continue;
-        }
-        let pre = pre_tile(history, maps, id);
-        let tile = history.tile_for_write(maps, id);
-        for y in y0..y1 {
-            for x in x0..x1 {
-                if mask[y as usize * w + x as usize] {
-                    let i = (y - y0) as usize * TILE_SIZE + (x - x0) as usize;
-                    tile.set_texel(i, target.blend(pre.texel(i), opacity));
-                }
-            }
-        }
-    }
 }

@@ -1,36 +1,28 @@
-//! Dabs and fills: where they land ([`Footprint`]) and what they write ([`PaintTarget`]).
+//! What the layer engine's tools share: where a dab lands ([`Footprint`]), a stroke's
+//! per-texel [`Coverage`], the flood fill's region, the gradient shapes, the energy guard, and
+//! the tables between stored `n` bits and the perceptual blend space.
 //!
 //! A stroke keeps a coverage value per texel, the alpha it has reached so far. Each dab raises
-//! coverage towards the brush opacity by its flow; the texel is then the blend of its value
-//! *before the stroke* (kept by the open history transaction) with the target at that
-//! coverage. Overlapping dabs (or mirrored copies of one) therefore never exceed the opacity,
-//! and a stroke's result does not depend on dab order.
+//! coverage towards the brush opacity by its flow; the layer's texel is then the blend of its
+//! value before the stroke with the target at that coverage. Overlapping dabs (or mirrored
+//! copies of one) therefore never exceed the opacity, and a stroke's result does not depend
+//! on dab order.
 
-mod blur;
-mod dab;
 mod fill;
 mod footprint;
 mod gradient;
 #[cfg(test)]
 mod tests;
 
-pub use blur::blur_dab;
-pub use dab::paint_dab;
-pub use fill::{fill_all, fill_mask, flood_region};
+pub use fill::flood_region;
 pub use footprint::{DiscFootprint, Footprint};
-pub use gradient::{GradientShape, gradient};
+pub use gradient::GradientShape;
 
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 
-use glam::Vec3;
-
-use super::brush::BlendMode;
-use super::history::History;
-use super::maps::{MaterialMaps, TileId};
-use super::texel::{
-    MaterialValue, Texel, decode_n, decode_unorm, encode_unorm, n_from_blend, n_to_blend,
-};
-use super::tile::{TILE_TEXELS, Tile};
+use super::maps::TileId;
+use super::texel::{decode_n, n_from_blend, n_to_blend};
+use super::tile::TILE_TEXELS;
 
 /// Lookup tables between stored `n` bits and the perceptual blend space.
 struct NTables {
@@ -85,73 +77,6 @@ pub(crate) fn n_bits_from_blend_in(table: &NBitsTable, u: f32) -> u16 {
     table[(i as usize).min(FROM_BLEND_STEPS)]
 }
 
-/// What a paint operation writes: per-channel targets in blend space, which channels, how.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PaintTarget {
-    /// Target `k_d`.
-    pub kd: Vec3,
-    /// Target `k_s`.
-    pub ks: Vec3,
-    /// Target `n` in blend space.
-    pub n_blend: f32,
-    /// Channels written.
-    pub channels: super::texel::Channels,
-    /// Blend mode.
-    pub mode: BlendMode,
-    /// Keep `k_d + k_s <= 1` per colour channel.
-    pub energy_guard: bool,
-}
-
-impl PaintTarget {
-    /// A target from a material value.
-    pub fn new(
-        value: MaterialValue,
-        channels: super::texel::Channels,
-        mode: BlendMode,
-        energy_guard: bool,
-    ) -> Self {
-        let v = value.sanitized();
-        Self {
-            kd: v.kd,
-            ks: v.ks,
-            n_blend: n_to_blend(v.n),
-            channels,
-            mode,
-            energy_guard,
-        }
-    }
-
-    /// The texel `pre` blended towards the target at alpha `a`.
-    #[inline]
-    pub fn blend(&self, pre: Texel, a: f32) -> Texel {
-        let mut out = pre;
-        let mode = self.mode;
-        let mut kd = [0.0; 3];
-        let mut ks = [0.0; 3];
-        for c in 0..3 {
-            kd[c] = decode_unorm(pre.kd[c]);
-            ks[c] = decode_unorm(pre.ks[c]);
-            if self.channels.kd {
-                kd[c] = mode.apply(kd[c], self.kd[c], a);
-            }
-            if self.channels.ks {
-                ks[c] = mode.apply(ks[c], self.ks[c], a);
-            }
-        }
-        if self.energy_guard && (self.channels.kd || self.channels.ks) {
-            guard_energy(&mut kd, &mut ks, self.channels.kd, self.channels.ks);
-        }
-        for c in 0..3 {
-            out.kd[c] = encode_unorm(kd[c]);
-            out.ks[c] = encode_unorm(ks[c]);
-        }
-        if self.channels.n {
-            out.n = n_bits_from_blend(mode.apply(n_bits_to_blend(pre.n), self.n_blend, a));
-        }
-        out
-    }
-}
-
 /// Keeps `k_d + k_s <= 1` per colour channel: the channel being painted gives way to the
 /// other; when both are painted, both scale down together.
 pub(crate) fn guard_energy(
@@ -203,12 +128,4 @@ impl Coverage {
             .filter_map(|slot| slot.as_deref_mut())
             .collect()
     }
-}
-
-/// The pre-operation version of a tile: the one the open transaction saved, else the current.
-fn pre_tile(history: &History, maps: &MaterialMaps, id: TileId) -> Arc<Tile> {
-    history
-        .saved_tile(id)
-        .cloned()
-        .unwrap_or_else(|| Arc::clone(maps.tile(id)))
 }
