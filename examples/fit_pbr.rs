@@ -1,7 +1,7 @@
-//! Regenerates `src/pbr/table.rs`: the fitted exponent per roughness for each target model and
+//! Regenerates `crates/kapaint-core/src/pbr/table.rs`: the fitted exponent per roughness for each target model and
 //! the conversion-error tables (see `kapaint::pbr::fit`), printing each row's fit to stderr.
 //!
-//! Usage: `cargo run --release --example fit_pbr > src/pbr/table.rs`
+//! Usage: `cargo run --release --example fit_pbr > crates/kapaint-core/src/pbr/table.rs`
 
 use kapaint::pbr::fit::{LEVEL, LobeSamples, ct_n, fit_curve, render_rust, table_roughness};
 

@@ -656,7 +656,7 @@ fn a_paint_script_builds_layers_and_kapaint_layers_lists_them() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(
         lines[0],
-        "index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes"
+        "index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes,id"
     );
     assert!(
         lines[1].starts_with("0,paint,Layer 1,true,1,normal,normal,normal,none,0"),
@@ -668,11 +668,25 @@ fn a_paint_script_builds_layers_and_kapaint_layers_lists_them() {
     );
     let bytes: u64 = lines[2]
         .rsplit(',')
-        .next()
+        .nth(1)
         .and_then(|b| b.parse().ok())
         .expect("bytes");
     assert!(bytes > 0, "a painted layer holds tiles: {text}");
-    assert_eq!(lines[3], "2,fill,Gloss,false,0.5,off,off,max,none,0");
+    assert!(
+        lines[3].starts_with("2,fill,Gloss,false,0.5,off,off,max,none,0,"),
+        "{text}"
+    );
+    // The id column comes last: one id a layer, each its own.
+    let ids: std::collections::BTreeSet<u64> = lines[1..]
+        .iter()
+        .map(|l| {
+            l.rsplit(',')
+                .next()
+                .and_then(|i| i.parse().ok())
+                .expect("id")
+        })
+        .collect();
+    assert_eq!(ids.len(), 3, "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -35,13 +35,15 @@ fn field(text: &str) -> String {
     }
 }
 
-/// The CSV: header `index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes`, a
+/// The CSV: header `index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes,id`, a
 /// row per layer bottom first. The index of a layer in a group is its path (`1.0` is the
 /// bottom layer of the group at index 1); `mask` is `none`, `on`, `off` or `inverted`;
-/// `bytes` is the memory its tiles and mask hold. A disabled channel's blend is `off`.
+/// `bytes` is the memory its tiles and mask hold; `id` is the layer's id (kept through moves
+/// and saves; scripts select by it with `SelectLayer((id: N))`). A disabled channel's blend is
+/// `off`.
 pub fn layers_csv(stack: &LayerStack) -> String {
     let mut out =
-        String::from("index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes\n");
+        String::from("index,kind,name,visible,opacity,kd_blend,ks_blend,n_blend,mask,bytes,id\n");
     for (path, layer) in stack.walk() {
         let p = &layer.props;
         let index: Vec<String> = path.iter().map(ToString::to_string).collect();
@@ -61,7 +63,7 @@ pub fn layers_csv(stack: &LayerStack) -> String {
         };
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{}",
             index.join("."),
             layer.kind_name(),
             field(&p.name),
@@ -71,7 +73,8 @@ pub fn layers_csv(stack: &LayerStack) -> String {
             blend(Channel::Ks),
             blend(Channel::N),
             mask,
-            layer.heap_bytes()
+            layer.heap_bytes(),
+            p.id
         );
     }
     out

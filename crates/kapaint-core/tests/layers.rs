@@ -622,3 +622,107 @@ fn imports_normal_maps_and_meshes_are_undo_steps_and_undo_restores_the_version()
     );
     assert_eq!(doc.version(), before);
 }
+
+/// A layer's id survives moves, grouping, undo and a save and load; a duplicate (and every
+/// layer in a duplicated group) gets its own; a script selects by id whatever moved; a file
+/// from before ids opens with one id a layer.
+#[test]
+fn layer_ids_survive_moves_grouping_undo_and_saves_and_copies_get_their_own() {
+    use kapaint_core::model::document::LayerRef;
+    use kapaint_core::model::project;
+    let mut doc = document();
+    run(
+        &mut doc,
+        r#"(commands: [AddLayer(kind: Paint, name: "A"), AddLayer(kind: Fill, name: "B"), AddLayer(kind: Paint, name: "C")])"#,
+    );
+    let id_of = |doc: &Document, name: &str| {
+        doc.stack()
+            .walk()
+            .into_iter()
+            .find(|(_, l)| l.props.name == name)
+            .map(|(_, l)| l.props.id)
+            .expect("layer")
+    };
+    let ids: Vec<_> = ["Layer 1", "A", "B", "C"]
+        .iter()
+        .map(|n| id_of(&doc, n))
+        .collect();
+    let unique: std::collections::BTreeSet<_> = ids.iter().collect();
+    assert_eq!(unique.len(), 4);
+    // Move A to the top and group it: the same id, at a new path.
+    doc.apply(Command::SelectLayer(LayerRef::Name("A".into())))
+        .expect("select");
+    doc.apply(Command::MoveLayer(kapaint_core::model::LayerMove::Top))
+        .expect("move");
+    doc.apply(Command::Group).expect("group");
+    assert_eq!(id_of(&doc, "A"), ids[1]);
+    // A script's id selects A wherever it went.
+    doc.apply(Command::SelectLayer(LayerRef::Name("B".into())))
+        .expect("select");
+    doc.apply(Command::SelectLayer(LayerRef::Id { id: ids[1].0 }))
+        .expect("select by id");
+    assert_eq!(
+        doc.stack()
+            .layer(&doc.selection().path)
+            .expect("layer")
+            .props
+            .name,
+        "A"
+    );
+    assert!(
+        doc.apply(Command::SelectLayer(LayerRef::Id { id: u64::MAX }))
+            .is_err()
+    );
+    // A copy of the group: new ids for the group and for A's copy inside it.
+    doc.apply(Command::SelectLayer(LayerRef::Name("Group".into())))
+        .expect("select group");
+    let group = id_of(&doc, "Group");
+    doc.apply(Command::DuplicateLayer).expect("duplicate");
+    let all: Vec<_> = doc.stack().walk().iter().map(|(_, l)| l.props.id).collect();
+    let unique: std::collections::BTreeSet<_> = all.iter().collect();
+    assert_eq!(unique.len(), all.len(), "every layer its own id: {all:?}");
+    assert_eq!(
+        id_of(&doc, "Group"),
+        group,
+        "the first of that name is the original"
+    );
+    // Undo the copy, the group and the move: the ids are the ones they had.
+    for _ in 0..3 {
+        doc.apply(Command::Undo).expect("undo");
+    }
+    let back: Vec<_> = ["Layer 1", "A", "B", "C"]
+        .iter()
+        .map(|n| id_of(&doc, n))
+        .collect();
+    assert_eq!(back, ids);
+    // Saved and opened: the same ids.
+    let dir = std::env::temp_dir().join(format!("kapaint-layer-ids-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("ids.kapaint");
+    project::save(&doc, &path).expect("save");
+    let opened = project::load(&path).expect("load");
+    let reopened: Vec<_> = ["Layer 1", "A", "B", "C"]
+        .iter()
+        .map(|n| id_of(&opened, n))
+        .collect();
+    assert_eq!(reopened, ids);
+    // A new layer after opening never takes an id the file holds.
+    let mut opened = opened;
+    opened
+        .apply(Command::AddLayer {
+            kind: kapaint_core::model::LayerKind::Paint,
+            name: "D".into(),
+        })
+        .expect("add");
+    assert!(!ids.contains(&id_of(&opened, "D")));
+    let _ = std::fs::remove_dir_all(&dir);
+    // A project saved before ids were kept: one id a layer.
+    let old = kapaint_core::model::project::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../tests/data/layers_v2_full.kapaint"),
+    )
+    .expect("the old file opens");
+    let all: Vec<_> = old.stack().walk().iter().map(|(_, l)| l.props.id).collect();
+    let unique: std::collections::BTreeSet<_> = all.iter().collect();
+    assert_eq!(unique.len(), all.len());
+}

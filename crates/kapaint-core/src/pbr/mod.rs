@@ -1,4 +1,4 @@
-//! PBR interop (issue 20): glTF's metallic-roughness materials to and from kapaint's
+//! PBR interop: glTF's metallic-roughness materials to and from kapaint's
 //! `k_d`, `k_s`, `n`.
 //!
 //! Per texel, in linear light (glTF 2.0's metallic-roughness model):

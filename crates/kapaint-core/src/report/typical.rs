@@ -103,7 +103,7 @@ pub fn typical_document(
     Ok(doc)
 }
 
-/// The block-compression test project (issue 21's): `texture` (if given and readable) in
+/// The block-compression test project: `texture` (if given and readable) in
 /// `k_d`, the default `k_s` (grey, constant) and `n`, and over that `n` two soft strokes
 /// 200 px wide, one of `n = 3000` and one of `n = 2`, crossing the map (scaled with `side`
 /// from 4096): the hard case for `n` in shared blocks, whose edges sweep `n` across its range.

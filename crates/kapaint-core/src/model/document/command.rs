@@ -241,7 +241,8 @@ pub enum LayerKind {
     Group,
 }
 
-/// A layer named in a script: its index in the top-level list or its name.
+/// A layer named in a script: its index in the top-level list, its name, or its id
+/// (`(id: 7)`, as `kapaint layers` prints it: the same layer whatever moved).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum LayerRef {
@@ -249,6 +250,11 @@ pub enum LayerRef {
     Index(usize),
     /// Name (the topmost layer of that name, at any depth).
     Name(String),
+    /// Id, at any depth.
+    Id {
+        /// The layer's id.
+        id: u64,
+    },
 }
 
 /// Where [`Command::MoveLayer`] moves a layer.

@@ -305,7 +305,7 @@ impl Document {
                 }
                 let (parent, i) = split(&st.selection.path)?;
                 let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                let mut copy = list[i].clone();
+                let mut copy = list[i].clone().with_fresh_ids();
                 // Never past what a project holds: the name is cut to leave room for " copy".
                 copy.props.name = crate::model::check::fit_name(&copy.props.name, " copy", "copy");
                 list.insert(i + 1, copy);
@@ -557,6 +557,9 @@ fn resolve(stack: &LayerStack, r: &LayerRef) -> Result<Vec<usize>, ModelError> {
             .find(|(_, l)| &l.props.name == name)
             .map(|(p, _)| p)
             .ok_or_else(|| command_error(format!("no layer is named \"{name}\""))),
+        LayerRef::Id { id } => stack
+            .path_of(crate::model::layers::LayerId(*id))
+            .ok_or_else(|| command_error(format!("no layer has id {id}"))),
     }
 }
 

@@ -149,7 +149,11 @@ impl Document {
     ///
     /// # Errors
     /// A stack of a size the maps cannot have.
-    pub fn from_stack(stack: LayerStack, settings: DocumentSettings) -> Result<Self, ModelError> {
+    pub fn from_stack(
+        mut stack: LayerStack,
+        settings: DocumentSettings,
+    ) -> Result<Self, ModelError> {
+        stack.make_ids_unique();
         let maps = MaterialMaps::new(stack.width, stack.height, stack.base)?;
         Ok(Self::assemble(maps, stack, settings))
     }

@@ -1,5 +1,4 @@
-//! Layers and masks (issue 18, first step: the stack and its composite; not yet wired into
-//! [`super::Document`]).
+//! Layers and masks: the stack a [`super::Document`] paints on, and its composite.
 //!
 //! A [`LayerStack`] is a base material under an ordered list of layers, bottom first. A layer
 //! is a paint layer (its own `k_d`, `k_s`, `n` and per-channel coverage in 64 x 64
@@ -149,6 +148,8 @@ pub struct ChannelBlend {
 /// What every layer and group has.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LayerProps {
+    /// Which layer this is: kept through moves, grouping, undo and saves; a copy gets its own.
+    pub id: LayerId,
     /// Display name.
     pub name: String,
     /// Shown (and composited).
@@ -161,11 +162,54 @@ pub struct LayerProps {
     pub channels: [ChannelBlend; 3],
 }
 
+/// A layer's identity within its document (never reused while the process runs): what
+/// scripts may address a layer by (`SelectLayer((id: 7))`) and what `kapaint layers` prints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct LayerId(pub u64);
+
+/// The next fresh [`LayerId`]: above every id made or read in this process.
+static NEXT_LAYER_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+
+impl LayerId {
+    /// A new id, unlike any made or read before in this process.
+    pub fn fresh() -> Self {
+        Self(NEXT_LAYER_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+    }
+
+    /// An id read from a file: fresh ids stay above it from now on.
+    pub fn loaded(id: u64) -> Self {
+        NEXT_LAYER_ID.fetch_max(id.saturating_add(1), std::sync::atomic::Ordering::Relaxed);
+        Self(id)
+    }
+}
+
+impl std::fmt::Display for LayerId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl Layer {
+    /// This layer, and every layer in it, with fresh ids (a copy).
+    #[must_use]
+    pub fn with_fresh_ids(mut self) -> Self {
+        fn refresh(layer: &mut Layer) {
+            layer.props.id = LayerId::fresh();
+            if let LayerContent::Group(children) = &mut layer.content {
+                children.iter_mut().for_each(refresh);
+            }
+        }
+        refresh(&mut self);
+        self
+    }
+}
+
 impl LayerProps {
     /// A visible, unlocked, opaque layer of every channel in normal mode (its name fitted to
     /// what a project can hold, see [`crate::model::check::fit_name`]).
     pub fn named(name: impl Into<String>) -> Self {
         Self {
+            id: LayerId::fresh(),
             name: crate::model::check::fit_name(&name.into(), "", "Layer"),
             visible: true,
             locked: false,
@@ -374,6 +418,31 @@ impl LayerStack {
             }
         }
         Some(list)
+    }
+
+    /// Gives a fresh id to every layer whose id an earlier layer (depth first) already has: a
+    /// stack read from a file holds each id once.
+    pub fn make_ids_unique(&mut self) {
+        fn go(list: &mut [Layer], seen: &mut std::collections::HashSet<LayerId>) {
+            for layer in list {
+                if !seen.insert(layer.props.id) {
+                    layer.props.id = LayerId::fresh();
+                    seen.insert(layer.props.id);
+                }
+                if let LayerContent::Group(children) = &mut layer.content {
+                    go(children, seen);
+                }
+            }
+        }
+        go(&mut self.layers, &mut std::collections::HashSet::new());
+    }
+
+    /// The path of the layer with `id`, at any depth.
+    pub fn path_of(&self, id: LayerId) -> Option<Vec<usize>> {
+        self.walk()
+            .into_iter()
+            .find(|(_, l)| l.props.id == id)
+            .map(|(p, _)| p)
     }
 
     /// Every layer, depth first, bottom first within each list, with its path.

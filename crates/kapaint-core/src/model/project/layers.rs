@@ -13,7 +13,8 @@ use serde::{Deserialize, Serialize};
 
 use super::ChannelEntry;
 use crate::model::layers::{
-    ChannelBlend, Layer, LayerBlend, LayerContent, LayerProps, LayerStack, Mask, PaintTile, Stamped,
+    ChannelBlend, Layer, LayerBlend, LayerContent, LayerId, LayerProps, LayerStack, Mask,
+    PaintTile, Stamped,
 };
 use crate::model::maps::MaterialMaps;
 use crate::model::texel::{Channel, MaterialValue};
@@ -89,6 +90,9 @@ pub struct MaskEntry {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LayerEntry {
+    /// The layer's id (files written before ids were kept have none: the layer gets a new one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<u64>,
     /// Name.
     #[serde(deserialize_with = "crate::model::check::layer_name")]
     pub name: String,
@@ -286,6 +290,7 @@ pub fn entries(
             let (planes, mask_stored) = stored(k);
             let p = &layer.props;
             LayerEntry {
+                id: Some(p.id.0),
                 name: p.name.clone(),
                 kind: match layer.content {
                     LayerContent::Paint(_) => KindEntry::Paint,
@@ -386,6 +391,7 @@ pub fn build(
             *next += 1;
             let stored = read(k, e)?;
             let props = LayerProps {
+                id: e.id.map_or_else(LayerId::fresh, LayerId::loaded),
                 name: e.name.clone(),
                 visible: e.visible,
                 locked: e.locked,

@@ -76,6 +76,8 @@ pub(super) struct Meta {
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct LayerMeta {
+    #[serde(default)]
+    pub(super) id: Option<u64>,
     #[serde(deserialize_with = "crate::model::check::layer_name")]
     pub(super) name: String,
     pub(super) kind: KindEntry,
@@ -179,6 +181,7 @@ impl<'a> Gathered<'a> {
             }
         });
         LayerMeta {
+            id: Some(l.props.id.0),
             name: l.props.name.clone(),
             kind,
             visible: l.props.visible,

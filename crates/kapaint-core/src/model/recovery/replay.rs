@@ -12,8 +12,8 @@ use super::journal::{LayerMeta, MAX_META_BYTES, Meta, swap_pairs};
 use super::record::Payload;
 use crate::model::document::{Document, DocumentId};
 use crate::model::layers::{
-    ChannelBlend, Layer, LayerContent, LayerProps, LayerStack, Mask, PaintTile, SharedMaskTile,
-    SharedPaintTile, Stamped,
+    ChannelBlend, Layer, LayerContent, LayerId, LayerProps, LayerStack, Mask, PaintTile,
+    SharedMaskTile, SharedPaintTile, Stamped,
 };
 use crate::model::normal::NormalMap;
 use crate::model::project::layers::{KindEntry, MAX_DEPTH, MAX_LAYERS};
@@ -323,6 +323,7 @@ impl Taken<'_> {
         };
         Ok(Layer {
             props: LayerProps {
+                id: m.id.map_or_else(LayerId::fresh, LayerId::loaded),
                 name: m.name.clone(),
                 visible: m.visible,
                 locked: m.locked,
