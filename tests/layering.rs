@@ -21,14 +21,7 @@ const GUI: [&str; 6] = ["egui", "eframe", "egui_dock", "rfd", "zbus", "winit"];
 fn normal_tree(krate: &str) -> BTreeSet<String> {
     let out = Command::new(env!("CARGO"))
         .args([
-            "tree",
-            "--offline",
-            "-p",
-            krate,
-            "-e",
-            "normal",
-            "--prefix",
-            "none",
+            "tree", "--locked", "-p", krate, "-e", "normal", "--prefix", "none",
         ])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
