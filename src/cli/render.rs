@@ -11,6 +11,7 @@ use super::{CliError, model_error};
 use crate::mesh;
 use crate::model::{self, project};
 use crate::reflectance::{AmbientApprox, ShadingModel};
+use crate::render::ViewMode;
 
 /// The arguments of `kapaint render`.
 #[derive(Debug, clap::Args)]
@@ -85,45 +86,20 @@ pub enum RenderModel {
     CompareThree,
 }
 
-/// `kapaint render --view`: the render's view modes by their names.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ViewArg {
-    /// Lit by the ambient and the light.
-    Shaded,
-    /// The derived k_a (a data view: 16-bit, linear).
-    Ka,
-    /// The diffuse coefficient.
-    Kd,
-    /// The specular coefficient.
-    Ks,
-    /// The exponent.
-    N,
-    /// The diffuse term alone.
-    Diffuse,
-    /// The specular term alone.
-    Specular,
-    /// The ambient term alone.
-    Ambient,
-    /// The UV checker.
-    Checker,
-    /// The exponent in false colour.
-    NFalseColour,
-}
+/// `kapaint render --view`: a view mode by its name ([`ViewMode::name`]), the list of valid
+/// values made from [`ViewMode::ALL`] so that it cannot drift from the views.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ViewArg(pub ViewMode);
 
-impl From<ViewArg> for crate::render::ViewMode {
-    fn from(v: ViewArg) -> Self {
-        match v {
-            ViewArg::Shaded => Self::Shaded,
-            ViewArg::Ka => Self::Ka,
-            ViewArg::Kd => Self::Kd,
-            ViewArg::Ks => Self::Ks,
-            ViewArg::N => Self::N,
-            ViewArg::Diffuse => Self::Diffuse,
-            ViewArg::Specular => Self::Specular,
-            ViewArg::Ambient => Self::Ambient,
-            ViewArg::Checker => Self::Checker,
-            ViewArg::NFalseColour => Self::NFalseColour,
-        }
+impl ValueEnum for ViewArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: std::sync::LazyLock<Vec<ViewArg>> =
+            std::sync::LazyLock::new(|| ViewMode::ALL.into_iter().map(ViewArg).collect());
+        &VARIANTS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()))
     }
 }
 
@@ -209,7 +185,7 @@ impl RenderArgs {
 
 fn render_command(a: RenderArgs) -> Result<String, CliError> {
     use crate::gpu::headless::{self, Compare};
-    use crate::render::{Camera, FrameSettings, Lighting, ViewMode};
+    use crate::render::{Camera, FrameSettings, Lighting};
     let (width, height) = parse_size(&a.size)?;
     let ext = a
         .out
@@ -253,7 +229,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
         [sides[0], sides[1], ShadingModel::CookTorrance]
     };
     let approx = AmbientApprox::from(a.method);
-    let view = ViewMode::from(a.view);
+    let ViewArg(view) = a.view;
     let camera = Camera {
         yaw: a.yaw.to_radians(),
         pitch: a.pitch.to_radians().clamp(-1.55, 1.55),

@@ -11,6 +11,7 @@ mod import;
 mod layers;
 
 mod moves;
+mod surface;
 pub use super::mesh_ref::MeshRef;
 pub use id::DocumentId;
 pub use layers::MAX_LAYERS;
@@ -205,34 +206,6 @@ impl Document {
         self
     }
 
-    /// This document with the mesh surface that object-space strokes and island/part fills
-    /// paint on (the bake of its mesh at the map size), or without one, as it is made or
-    /// opened: no undo step (changing the mesh is [`Command::SetMesh`]).
-    ///
-    /// # Errors
-    /// When the bake's size differs from the maps'.
-    pub fn with_surface(mut self, surface: Option<Arc<Surface>>) -> Result<Self, ModelError> {
-        self.attach_surface(surface)?;
-        Ok(self)
-    }
-
-    /// Attaches the bake of the document's mesh (or another mesh a command paints on, such as
-    /// `paint --mesh`), or detaches it, as a document is opened. A bake is derived data the
-    /// project never stores, so this is no undo step; the project's mesh changes only through
-    /// [`Command::SetMesh`].
-    ///
-    /// # Errors
-    /// When the bake's size differs from the maps'; nothing changes then.
-    pub(crate) fn attach_surface(
-        &mut self,
-        surface: Option<Arc<Surface>>,
-    ) -> Result<(), ModelError> {
-        self.check_surface(surface.as_deref())?;
-        self.end_stroke();
-        self.state.surface = surface;
-        Ok(())
-    }
-
     /// This document with the identity `id` (a loader making it from a file that has one).
     #[must_use]
     pub fn with_id(mut self, id: DocumentId) -> Self {
@@ -321,46 +294,6 @@ impl Document {
     /// renders them (the layers, history and attached mesh are dropped).
     pub fn into_parts(self) -> (MaterialMaps, DocumentSettings) {
         (self.maps, self.settings)
-    }
-
-    /// An error when a bake's size differs from the maps'.
-    fn check_surface(&self, surface: Option<&Surface>) -> Result<(), ModelError> {
-        match surface {
-            Some(s) if (s.width(), s.height()) != (self.maps.width(), self.maps.height()) => {
-                Err(ModelError::Internal(format!(
-                    "the mesh is baked at {}x{} but the maps are {}x{}",
-                    s.width(),
-                    s.height(),
-                    self.maps.width(),
-                    self.maps.height()
-                )))
-            }
-            _ => Ok(()),
-        }
-    }
-
-    /// [`Command::SetMesh`]: the project's mesh and its bake, as one undo step.
-    fn set_mesh(&mut self, mesh: &AttachedMesh) -> Result<(), ModelError> {
-        self.check_surface(Some(&mesh.surface))?;
-        self.end_stroke();
-        let before = self.state.clone();
-        self.state.surface = Some(Arc::clone(&mesh.surface));
-        self.state.mesh = mesh.mesh.clone();
-        self.record("Mesh", before);
-        Ok(())
-    }
-
-    /// [`Command::SetNormal`]: the normal map set or cleared, as one undo step.
-    fn set_normal(&mut self, normal: Option<Arc<NormalMap>>) {
-        self.end_stroke();
-        let label = if normal.is_some() {
-            "Normal map"
-        } else {
-            "Clear normal map"
-        };
-        let before = self.state.clone();
-        self.state.normal = normal;
-        self.record(label, before);
     }
 
     /// Records `before` as one undo step, the state now as a new revision.
