@@ -84,10 +84,11 @@ fn picking(c: &mut Criterion) {
 /// spacing), back and forth across one spot so the stroke's tiles stay the same.
 fn surface_dabs(c: &mut Criterion) {
     use glam::Vec3;
+    use kapaint::model::StrokeCommand;
     use kapaint::model::brush::{BrushSettings, StrokePoint, SurfacePos};
     use kapaint::model::surface::Surface;
     use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+    use kapaint::model::{Document, DocumentSettings, StrokeTool};
     let mut group = c.benchmark_group("surface_4096");
     group
         .sample_size(20)
@@ -128,8 +129,8 @@ fn surface_dabs(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 if k.is_multiple_of(256) {
-                    doc.apply(Command::EndStroke).expect("end");
-                    doc.apply(Command::BeginStroke(StrokeTool::Brush))
+                    doc.apply(StrokeCommand::EndStroke).expect("end");
+                    doc.apply(StrokeCommand::BeginStroke(StrokeTool::Brush))
                         .expect("begin");
                 }
                 k += 1;
@@ -138,7 +139,7 @@ fn surface_dabs(c: &mut Criterion) {
                 } else {
                     center + across
                 };
-                doc.apply(Command::SurfaceStrokeTo(StrokePoint {
+                doc.apply(StrokeCommand::SurfaceStrokeTo(StrokePoint {
                     pos: SurfacePos { point, normal },
                     pressure: 1.0,
                 }))

@@ -15,9 +15,8 @@ use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::{MaterialValue, Texel};
 use kapaint::model::tile::TILE_TEXELS;
-use kapaint::model::{
-    Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool, project,
-};
+use kapaint::model::{Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool, project};
+use kapaint::model::{HistoryCommand, LayerCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use rayon::prelude::*;
 
@@ -85,7 +84,7 @@ fn dabs(c: &mut Criterion) {
         b.iter_batched(
             || Document::from_parts(base.maps().clone(), base.settings().clone()),
             |mut doc| {
-                doc.apply(Command::Stroke {
+                doc.apply(StrokeCommand::Stroke {
                     tool: StrokeTool::Brush,
                     points: points.clone(),
                 })
@@ -108,7 +107,8 @@ fn fills_and_derive(c: &mut Criterion) {
         b.iter_batched(
             || Document::from_parts(painted.maps().clone(), painted.settings().clone()),
             |mut doc| {
-                doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+                doc.apply(PaintCommand::Fill(FillRegion::All))
+                    .expect("fill");
                 doc
             },
             BatchSize::LargeInput,
@@ -119,11 +119,12 @@ fn fills_and_derive(c: &mut Criterion) {
             || {
                 let mut doc =
                     Document::from_parts(painted.maps().clone(), painted.settings().clone());
-                doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+                doc.apply(PaintCommand::Fill(FillRegion::All))
+                    .expect("fill");
                 doc
             },
             |mut doc| {
-                doc.apply(Command::Undo).expect("undo");
+                doc.apply(HistoryCommand::Undo).expect("undo");
                 doc
             },
             BatchSize::LargeInput,
@@ -193,7 +194,7 @@ fn autosave(c: &mut Criterion) {
         .sample_size(20)
         .measurement_time(Duration::from_secs(10));
     let mut doc = painted_document(SIDE);
-    doc.apply(Command::SetBrush(BrushSettings {
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 128.0,
         ..BrushSettings::default()
     }))
@@ -204,7 +205,7 @@ fn autosave(c: &mut Criterion) {
     let mut y = 200.0_f32;
     let mut stroke = |doc: &mut Document| {
         y = if y > 3800.0 { 200.0 } else { y + 300.0 };
-        doc.apply(Command::Stroke {
+        doc.apply(StrokeCommand::Stroke {
             tool: StrokeTool::Brush,
             points: vec![
                 StrokePoint {
@@ -350,12 +351,16 @@ fn layer_dabs(c: &mut Criterion) {
     };
     let filled = || {
         let mut doc = layered();
-        doc.apply(Command::SelectPath(vec![8])).expect("select");
+        doc.apply(LayerCommand::SelectPath(vec![8]))
+            .expect("select");
         let primary = doc.settings().primary;
         let under = kapaint::report::typical::under_paint();
-        doc.apply(Command::SetPrimary(under)).expect("primary");
-        doc.apply(Command::Fill(FillRegion::All)).expect("fill");
-        doc.apply(Command::SetPrimary(primary)).expect("primary");
+        doc.apply(SettingsCommand::SetPrimary(under))
+            .expect("primary");
+        doc.apply(PaintCommand::Fill(FillRegion::All))
+            .expect("fill");
+        doc.apply(SettingsCommand::SetPrimary(primary))
+            .expect("primary");
         doc
     };
     let cases: [(&str, Document, usize, Path); 4] = [
@@ -375,7 +380,8 @@ fn layer_dabs(c: &mut Criterion) {
         ),
     ];
     for (name, mut doc, layer, path) in cases {
-        doc.apply(Command::SelectPath(vec![layer])).expect("select");
+        doc.apply(LayerCommand::SelectPath(vec![layer]))
+            .expect("select");
         let mut k = 0u32;
         let mut version = doc.maps().version();
         // The k_a of the dirty tiles, kept from dab to dab as a consumer would.
@@ -383,12 +389,12 @@ fn layer_dabs(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 if k.is_multiple_of(kapaint::report::typical::STROKE_PATH_POINTS) {
-                    doc.apply(Command::EndStroke).expect("end");
-                    doc.apply(Command::BeginStroke(StrokeTool::Brush))
+                    doc.apply(StrokeCommand::EndStroke).expect("end");
+                    doc.apply(StrokeCommand::BeginStroke(StrokeTool::Brush))
                         .expect("begin");
                 }
                 k += 1;
-                doc.apply(Command::StrokeTo(StrokePoint {
+                doc.apply(StrokeCommand::StrokeTo(StrokePoint {
                     pos: path(k),
                     pressure: 1.0,
                 }))

@@ -17,7 +17,8 @@ use kapaint::gpu::{Gpu, MapTextures, MeshBuffers, Preview};
 use kapaint::mesh;
 use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::MaterialValue;
-use kapaint::model::{Channels, Command, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{Channels, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{SettingsCommand, StrokeCommand};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
 
@@ -78,7 +79,7 @@ fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
         .iter()
         .map(|&pos| StrokePoint { pos, pressure: 1.0 })
         .collect();
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points,
     })
@@ -228,14 +229,15 @@ fn uploads(c: &mut Criterion) {
     let mut k = 0_u32;
     // Each iteration paints a hard 128 px dab inside one 256x256 square (16 tiles), then the
     // timed part: sync (upload the dirty tiles) and wait for the queue.
-    doc.apply(Command::SetBrush(BrushSettings {
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 128.0,
         hardness: 1.0,
         ..BrushSettings::default()
     }))
     .expect("brush");
     let mut bench = |b: &mut criterion::Bencher<'_>, wait: bool, channels: Channels| {
-        doc.apply(Command::SetChannels(channels)).expect("channels");
+        doc.apply(SettingsCommand::SetChannels(channels))
+            .expect("channels");
         b.iter_custom(|iters| {
             let mut total = Duration::ZERO;
             for _ in 0..iters {
@@ -287,7 +289,7 @@ fn painting(c: &mut Criterion) {
     let sphere = mesh::builtin("sphere").expect("sphere");
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");
     let (mut doc, _) = documents();
-    doc.apply(Command::SetBrush(BrushSettings {
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 64.0,
         ..BrushSettings::default()
     }))

@@ -17,7 +17,10 @@ use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::recovery::{self, Autosaver};
 use kapaint::model::texel::{MaterialValue, Texel};
-use kapaint::model::{Command, Document, DocumentSettings, LayerKind, StrokeTool};
+use kapaint::model::{Document, DocumentSettings, LayerKind, StrokeTool};
+use kapaint::model::{
+    ImportCommand, LayerCommand, MaskCommand, PaintCommand, SettingsCommand, StrokeCommand,
+};
 
 const SIDE: u32 = 4096;
 
@@ -48,29 +51,29 @@ fn document() -> Document {
             report: None,
         }
     };
-    doc.apply(Command::ImportMaterial(noise(1)))
+    doc.apply(ImportCommand::ImportMaterial(noise(1)))
         .expect("layer 1");
-    doc.apply(Command::AddLayer {
+    doc.apply(LayerCommand::AddLayer {
         kind: LayerKind::Paint,
         name: "Scratches".into(),
     })
     .expect("layer 2");
-    doc.apply(Command::ImportMaterial(noise(7)))
+    doc.apply(ImportCommand::ImportMaterial(noise(7)))
         .expect("layer 2");
-    doc.apply(Command::AddMask).expect("mask");
+    doc.apply(MaskCommand::AddMask).expect("mask");
     doc
 }
 
 fn stroke(doc: &mut Document, k: u32) {
     let y = 200.0 + (k * 97 % 3700) as f32;
     // The stroke's number rides along in the primary's exponent: what recovery got back.
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.8, 0.2, 0.1),
         Vec3::splat(0.5),
         k as f32 + 1.0,
     )))
     .expect("primary");
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![
             StrokePoint {
@@ -91,7 +94,7 @@ fn child(dir: &Path) {
     let start = Instant::now();
     let ms = || start.elapsed().as_millis();
     let mut doc = document();
-    doc.apply(Command::SetBrush(BrushSettings {
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 96.0,
         ..BrushSettings::default()
     }))
@@ -120,16 +123,20 @@ fn child(dir: &Path) {
         if k % 4 == 3 {
             // A layer painted all over: a record as large as the layer, so the journal
             // outgrows its first record and a new generation (a whole record) follows.
-            doc.apply(Command::SelectLayer(kapaint::model::LayerRef::Index(0)))
-                .expect("select");
-            doc.apply(Command::Gradient {
+            doc.apply(LayerCommand::SelectLayer(kapaint::model::LayerRef::Index(
+                0,
+            )))
+            .expect("select");
+            doc.apply(PaintCommand::Gradient {
                 shape: kapaint::model::paint::GradientShape::Linear,
                 start: Vec2::ZERO,
                 end: Vec2::splat(SIDE as f32),
             })
             .expect("gradient");
-            doc.apply(Command::SelectLayer(kapaint::model::LayerRef::Index(1)))
-                .expect("select");
+            doc.apply(LayerCommand::SelectLayer(kapaint::model::LayerRef::Index(
+                1,
+            )))
+            .expect("select");
         }
     }
 }

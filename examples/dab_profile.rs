@@ -16,6 +16,7 @@ use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::MaterialValue;
 use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{LayerCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 
 fn main() -> Result<(), String> {
@@ -41,44 +42,53 @@ fn main() -> Result<(), String> {
         (Document::from_stack(stack, settings), 8)
     };
     let doc = doc.as_mut().map_err(|e| e.to_string())?;
-    let run = |doc: &mut Document, c| doc.apply(c).map_err(|e| e.to_string());
-    run(doc, Command::SelectPath(vec![layer]))?;
+    let run = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
+    run(doc, LayerCommand::SelectPath(vec![layer]).into())?;
     if how.as_deref() == Some("over") {
         let primary = doc.settings().primary;
         run(
             doc,
-            Command::SetPrimary(kapaint::report::typical::under_paint()),
+            SettingsCommand::SetPrimary(kapaint::report::typical::under_paint()).into(),
         )?;
-        run(doc, Command::Fill(kapaint::model::FillRegion::All))?;
-        run(doc, Command::SetPrimary(primary))?;
+        run(
+            doc,
+            PaintCommand::Fill(kapaint::model::FillRegion::All).into(),
+        )?;
+        run(doc, SettingsCommand::SetPrimary(primary).into())?;
     }
     let points = kapaint::report::typical::STROKE_PATH_POINTS;
     let repaint = how.as_deref() == Some("repaint");
     if repaint {
         // The first pass of the path, untimed: the timed dabs paint over its strokes.
-        run(doc, Command::BeginStroke(StrokeTool::Brush))?;
+        run(doc, StrokeCommand::BeginStroke(StrokeTool::Brush).into())?;
         for k in 0..points {
             let pos = kapaint::report::typical::stroke_path(k);
-            run(doc, Command::StrokeTo(StrokePoint { pos, pressure: 1.0 }))?;
+            run(
+                doc,
+                StrokeCommand::StrokeTo(StrokePoint { pos, pressure: 1.0 }).into(),
+            )?;
         }
-        run(doc, Command::EndStroke)?;
+        run(doc, StrokeCommand::EndStroke.into())?;
     }
-    run(doc, Command::BeginStroke(StrokeTool::Brush))?;
+    run(doc, StrokeCommand::BeginStroke(StrokeTool::Brush).into())?;
     let mut version = doc.maps().version();
     let start = std::time::Instant::now();
     let mut derived = 0;
     let mut ka = Vec::new();
     for k in 0..rounds {
         if moving && k > 0 && k % points == 0 {
-            run(doc, Command::EndStroke)?;
-            run(doc, Command::BeginStroke(StrokeTool::Brush))?;
+            run(doc, StrokeCommand::EndStroke.into())?;
+            run(doc, StrokeCommand::BeginStroke(StrokeTool::Brush).into())?;
         }
         let pos = if moving {
             kapaint::report::typical::stroke_path(k)
         } else {
             Vec2::new(2000.5 + if k % 2 == 0 { 0.0 } else { 32.0 }, 1500.5)
         };
-        run(doc, Command::StrokeTo(StrokePoint { pos, pressure: 1.0 }))?;
+        run(
+            doc,
+            StrokeCommand::StrokeTo(StrokePoint { pos, pressure: 1.0 }).into(),
+        )?;
         let dirty = doc.maps().tiles_changed_since(version);
         version = doc.maps().version();
         doc.maps()

@@ -13,6 +13,7 @@ use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
 use kapaint::model::texel::MaterialValue;
 use kapaint::model::{Command, Document, DocumentSettings, LayerKind, StrokeTool, project};
+use kapaint::model::{LayerCommand, MaskCommand, SettingsCommand, StrokeCommand};
 
 /// A `/proc/self/status` field in bytes (`VmRSS`, `VmHWM`; 0 where unknown).
 fn status_bytes(field: &str) -> u64 {
@@ -37,10 +38,11 @@ fn stroke(doc: &mut Document, y: f32, (x0, x1): (f32, f32)) -> Result<(), String
         .collect();
     run(
         doc,
-        Command::Stroke {
+        StrokeCommand::Stroke {
             tool: StrokeTool::Brush,
             points,
-        },
+        }
+        .into(),
     )
 }
 
@@ -56,44 +58,47 @@ fn main() -> Result<(), String> {
     let radius = s / 25.0;
     run(
         &mut doc,
-        Command::SetBrush(BrushSettings {
+        SettingsCommand::SetBrush(BrushSettings {
             radius_px: radius,
             hardness: 0.8,
             flow: 1.0,
             ..BrushSettings::default()
-        }),
+        })
+        .into(),
     )?;
     for l in 0..layers {
         if l > 0 {
             run(
                 &mut doc,
-                Command::AddLayer {
+                LayerCommand::AddLayer {
                     kind: LayerKind::Paint,
                     name: format!("Layer {}", l + 1),
-                },
+                }
+                .into(),
             )?;
         }
         let t = l as f32 / layers as f32;
         run(
             &mut doc,
-            Command::SetPrimary(MaterialValue::new(
+            SettingsCommand::SetPrimary(MaterialValue::new(
                 Vec3::new(t, 0.5, 1.0 - t),
                 Vec3::splat(0.2),
                 (1.0 + 12.0 * t).exp2(),
-            )),
+            ))
+            .into(),
         )?;
         let y = s * (0.1 + 0.8 * t);
         stroke(&mut doc, y, (s * 0.1, s * 0.77))?;
         stroke(&mut doc, (y + s * 0.45) % s, (s * 0.2, s * 0.87))?;
         // A mask, black where one shorter stroke crosses the paint.
-        run(&mut doc, Command::AddMask)?;
-        run(&mut doc, Command::SelectMask)?;
+        run(&mut doc, MaskCommand::AddMask.into())?;
+        run(&mut doc, MaskCommand::SelectMask.into())?;
         run(
             &mut doc,
-            Command::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 1.0)),
+            SettingsCommand::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 1.0)).into(),
         )?;
         stroke(&mut doc, y, (s * 0.3, s * 0.5))?;
-        run(&mut doc, Command::SelectContent)?;
+        run(&mut doc, MaskCommand::SelectContent.into())?;
     }
     println!(
         "built {side}x{side}, {layers} layers in {:.1} s",
@@ -110,10 +115,11 @@ fn main() -> Result<(), String> {
     println!("resident peak: {}", mib(status_bytes("VmHWM:")));
     run(
         &mut doc,
-        Command::AddLayer {
+        LayerCommand::AddLayer {
             kind: LayerKind::Paint,
             name: "Empty".into(),
-        },
+        }
+        .into(),
     )?;
     let empty = doc.stack().heap_bytes() as u64 - stack;
     println!(
@@ -121,7 +127,7 @@ fn main() -> Result<(), String> {
         doc.stack().tile_count()
             * std::mem::size_of::<Option<kapaint::model::layers::SharedPaintTile>>()
     );
-    run(&mut doc, Command::DeleteLayer)?;
+    run(&mut doc, LayerCommand::DeleteLayer.into())?;
     let path = std::env::temp_dir().join(format!("kapaint-layers-{}.kapaint", std::process::id()));
     for round in 0..2 {
         let t = Instant::now();

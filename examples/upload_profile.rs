@@ -7,8 +7,9 @@ use std::time::{Duration, Instant};
 
 use glam::Vec2;
 use kapaint::gpu::{Gpu, MapTextures};
+use kapaint::model::StrokeCommand;
 use kapaint::model::brush::{BrushSettings, StrokePoint};
-use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{Document, DocumentSettings, StrokeTool};
 
 fn main() -> Result<(), String> {
     let gpu = Gpu::headless().map_err(|e| e.to_string())?;
@@ -35,7 +36,7 @@ fn main() -> Result<(), String> {
     let (mut cpu, mut whole) = (Duration::ZERO, Duration::ZERO);
     for k in 0..rounds {
         let x0 = f32::from((k % 15) as u16) * 256.0;
-        doc.apply(Command::Stroke {
+        doc.apply(StrokeCommand::Stroke {
             tool: StrokeTool::Brush,
             points: vec![StrokePoint {
                 pos: Vec2::new(x0 + 128.0, 128.0 + 256.0 * (k % 7) as f32),

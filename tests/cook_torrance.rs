@@ -102,7 +102,8 @@ fn a_cook_torrance_set_names_its_model_and_measures_its_k_a() {
     use kapaint::export::{preset, set};
     use kapaint::model::brush::StrokePoint;
     use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{Command, Document, DocumentSettings, StrokeTool};
+    use kapaint::model::{Document, DocumentSettings, StrokeTool};
+    use kapaint::model::{SettingsCommand, StrokeCommand};
     let mut doc = Document::new(
         160,
         96,
@@ -115,13 +116,13 @@ fn a_cook_torrance_set_names_its_model_and_measures_its_k_a() {
         },
     )
     .expect("doc");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.1, 0.05),
         Vec3::splat(0.9),
         3000.0,
     )))
     .expect("primary");
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: [10.0, 150.0]
             .map(|x| StrokePoint {

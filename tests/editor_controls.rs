@@ -365,7 +365,7 @@ fn the_primary_material_and_the_brush_are_saved_as_presets_of_ones_own() {
     harness
         .state_mut()
         .state
-        .apply_command(kapaint::model::Command::SetBrush(brush.clone()));
+        .apply_command(kapaint::model::SettingsCommand::SetBrush(brush.clone()));
     harness.run();
     harness.get_by_label("Save brush…").click();
     harness.run();

@@ -213,7 +213,7 @@ fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
     std::thread::sleep(std::time::Duration::from_millis(20));
     // Unsaved work since: a fill, in a recovery copy newer than the project.
     let mut autosaver = Autosaver::new(std::time::Duration::ZERO, Some(&project), &doc);
-    doc.apply(kapaint::model::Command::Fill(
+    doc.apply(kapaint::model::PaintCommand::Fill(
         kapaint::model::FillRegion::All,
     ))
     .expect("fill");
@@ -380,28 +380,31 @@ fn save_as_moves_the_recovery_copy_to_the_new_project() {
 
 #[test]
 fn a_layered_project_opens_clean_on_its_saved_selection() {
-    use kapaint::model::{Command, LayerKind, LayerRef};
+    use kapaint::model::{LayerCommand, MaskCommand, PaintCommand};
+    use kapaint::model::{LayerKind, LayerRef};
     let dir = scratch("layered-clean");
     let project = dir.join("layered.kapaint");
     let mut doc =
         kapaint::model::Document::new(128, 128, kapaint::model::DocumentSettings::default())
             .expect("document");
-    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::All))
         .expect("fill");
-    doc.apply(Command::AddLayer {
+    doc.apply(LayerCommand::AddLayer {
         kind: LayerKind::Paint,
         name: "Scratches".into(),
     })
     .expect("layer");
-    doc.apply(Command::AddMask).expect("mask");
-    doc.apply(Command::AddLayer {
+    doc.apply(MaskCommand::AddMask).expect("mask");
+    doc.apply(LayerCommand::AddLayer {
         kind: LayerKind::Group,
         name: "Folder".into(),
     })
     .expect("group");
     // Saved with "Scratches" selected (a group sits above it).
-    doc.apply(Command::SelectLayer(LayerRef::Name("Scratches".into())))
-        .expect("select");
+    doc.apply(LayerCommand::SelectLayer(LayerRef::Name(
+        "Scratches".into(),
+    )))
+    .expect("select");
     kapaint::model::project::save(&doc, &project).expect("saved");
     let mut harness = editor_on(&project);
     wait_until(&mut harness, "opened", |e| {

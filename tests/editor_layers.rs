@@ -230,17 +230,17 @@ fn alt_click_on_a_mask_shows_it_alone_and_the_viewport_says_what_is_painted() {
 
 #[test]
 fn a_mask_being_painted_shows_alone_in_grey() {
-    use kapaint::model::Command;
+    use kapaint::model::MaskCommand;
     let mut harness = editor();
     let state = &mut harness.state_mut().state;
     assert_eq!(state.shown_layer_view(), LayerView::Composite);
-    state.apply_command(Command::AddMask);
-    state.apply_command(Command::SelectMask);
+    state.apply_command(MaskCommand::AddMask);
+    state.apply_command(MaskCommand::SelectMask);
     assert_eq!(
         state.shown_layer_view(),
         LayerView::Mask,
         "the mask is the target"
     );
-    state.apply_command(Command::SelectContent);
+    state.apply_command(MaskCommand::SelectContent);
     assert_eq!(state.shown_layer_view(), LayerView::Composite);
 }

@@ -16,7 +16,8 @@ use kapaint::export::preset::{self, Format};
 use kapaint::export::set;
 use kapaint::model::brush::StrokePoint;
 use kapaint::model::texel::MaterialValue;
-use kapaint::model::{Channels, Command, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{Channels, Document, DocumentSettings, StrokeTool};
+use kapaint::model::{PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint::reflectance;
 
 fn temp(tag: &str) -> PathBuf {
@@ -37,19 +38,19 @@ fn painted() -> Document {
         },
     )
     .expect("doc");
-    doc.apply(Command::SetChannels(Channels {
+    doc.apply(SettingsCommand::SetChannels(Channels {
         kd: true,
         ks: false,
         n: true,
     }))
     .expect("channels");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.1, 0.05),
         Vec3::splat(0.3),
         900.0,
     )))
     .expect("primary");
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![
             StrokePoint {
@@ -148,9 +149,9 @@ fn every_builtin_preset_exports_and_imports() {
     let dir = temp("all");
     let mut doc = painted();
     // Colour k_s too, so it gets an RGB image.
-    doc.apply(Command::SetChannels(Channels::ALL))
+    doc.apply(SettingsCommand::SetChannels(Channels::ALL))
         .expect("channels");
-    doc.apply(Command::Fill(kapaint::model::FillRegion::Similar {
+    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::Similar {
         x: 5,
         y: 5,
         channel: kapaint::model::Channel::Kd,
@@ -206,19 +207,19 @@ fn every_builtin_preset_exports_and_imports() {
 fn two_component_images_pack_ks_with_n() {
     let dir = temp("ks_n");
     let mut doc = painted();
-    doc.apply(Command::SetChannels(Channels {
+    doc.apply(SettingsCommand::SetChannels(Channels {
         kd: false,
         ks: true,
         n: true,
     }))
     .expect("channels");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::splat(0.5),
         Vec3::splat(0.8),
         3.0,
     )))
     .expect("primary");
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![
             StrokePoint {
@@ -233,19 +234,19 @@ fn two_component_images_pack_ks_with_n() {
     })
     .expect("stroke");
     // Undo the k_d part of the first stroke: paint k_d back to the base everywhere.
-    doc.apply(Command::SetChannels(Channels {
+    doc.apply(SettingsCommand::SetChannels(Channels {
         kd: true,
         ks: false,
         n: false,
     }))
     .expect("channels");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.6, 0.5, 0.4),
         Vec3::splat(0.8),
         3.0,
     )))
     .expect("primary");
-    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::All))
         .expect("fill");
     for name in ["compact", "ktx2", "ktx2-raw"] {
         let out = dir.join(name);

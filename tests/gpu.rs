@@ -18,7 +18,8 @@ use kapaint::gpu::preview::COMPARED_MODELS;
 use kapaint::gpu::{Gpu, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::mesh::{self, pick::Bvh};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8};
-use kapaint::model::{Command, Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool};
+use kapaint::model::{Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool};
+use kapaint::model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint::reflectance::{self, AmbientApprox, ShadingModel};
 use kapaint::render::reference::{self, Material};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
@@ -196,14 +197,15 @@ fn painted_maps() -> MaterialMaps {
     .into_iter()
     .enumerate()
     {
-        doc.apply(Command::SetPrimary(MaterialValue::new(
+        doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
             kd,
             Vec3::splat(ks),
             n,
         )))
         .expect("primary");
         if i == 0 {
-            doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+            doc.apply(PaintCommand::Fill(FillRegion::All))
+                .expect("fill");
             continue;
         }
         let y = 60.0 + 80.0 * i as f32;
@@ -662,7 +664,7 @@ fn every_mip_level_is_the_box_mean_on_maps_of_any_size() {
     let (w, h) = (200_usize, 120_usize);
     let mut doc = Document::new(w as u32, h as u32, DocumentSettings::default()).expect("doc");
     let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.2, 0.1),
         Vec3::splat(0.7),
         900.0,
@@ -682,7 +684,7 @@ fn without_16_bit_norm_textures_the_maps_upload_as_half_floats() {
     gpu.unorm16 = false;
     let (w, h) = (200_u32, 120_u32);
     let mut doc = Document::new(w, h, DocumentSettings::default()).expect("doc");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.2, 0.001),
         Vec3::splat(0.7),
         900.0,
@@ -708,7 +710,7 @@ fn brush_stroke(doc: &mut Document, points: &[Vec2]) {
         .iter()
         .map(|&pos| kapaint::model::brush::StrokePoint { pos, pressure: 1.0 })
         .collect();
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points,
     })
@@ -800,7 +802,8 @@ fn large_uploads_in_several_batches_and_scattered_tiles_mirror_the_maps() {
     // 2048 x 1536 with mips stages about 75 MB: the first upload takes two batches.
     let mut doc = Document::new(2048, 1536, DocumentSettings::default()).expect("doc");
     let stroke = |doc: &mut Document, value: MaterialValue, from: Vec2, to: Vec2| {
-        doc.apply(Command::SetPrimary(value)).expect("primary");
+        doc.apply(SettingsCommand::SetPrimary(value))
+            .expect("primary");
         brush_stroke(doc, &[from, to]);
     };
     let red = MaterialValue::new(Vec3::new(0.9, 0.2, 0.1), Vec3::splat(0.3), 40.0);
@@ -835,8 +838,10 @@ fn a_stroke_on_some_channels_stages_only_those() {
     let mut doc = Document::new(512, 384, DocumentSettings::default()).expect("doc");
     let mut textures = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     let mut dab = |doc: &mut Document, channels: Channels, value: MaterialValue| {
-        doc.apply(Command::SetChannels(channels)).expect("channels");
-        doc.apply(Command::SetPrimary(value)).expect("primary");
+        doc.apply(SettingsCommand::SetChannels(channels))
+            .expect("channels");
+        doc.apply(SettingsCommand::SetPrimary(value))
+            .expect("primary");
         brush_stroke(doc, &[Vec2::new(200.0, 150.0)]);
         assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
         for level in [0, 1, 3, 7] {
@@ -875,7 +880,7 @@ fn a_stroke_on_some_channels_stages_only_those() {
     assert!(n * 10 < all * 2, "n only staged {n} of {all} bytes");
     // Undo recomposites: the composite's changed planes (only n here) are staged again,
     // and the mirror stays exact.
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert!(textures.sync(&gpu, doc.maps()).expect("sync") > 0);
     assert_eq!(textures.staged_bytes(), n);
     for level in [0, 2, 8] {
@@ -889,25 +894,25 @@ fn n_gradient_set(dir: &std::path::Path) -> (Document, kapaint::export::set::Man
     use kapaint::export::{preset, set};
     let _ = std::fs::remove_dir_all(dir);
     let mut doc = Document::new(64, 8, DocumentSettings::default()).expect("doc");
-    doc.apply(Command::SetChannels(kapaint::model::Channels {
+    doc.apply(SettingsCommand::SetChannels(kapaint::model::Channels {
         kd: false,
         ks: false,
         n: true,
     }))
     .expect("channels");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::ONE,
         Vec3::ONE,
         1.0,
     )))
     .expect("primary");
-    doc.apply(Command::SetSecondary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetSecondary(MaterialValue::new(
         Vec3::ONE,
         Vec3::ONE,
         5000.0,
     )))
     .expect("secondary");
-    doc.apply(Command::Gradient {
+    doc.apply(PaintCommand::Gradient {
         shape: kapaint::model::paint::GradientShape::Linear,
         start: Vec2::new(0.0, 0.0),
         end: Vec2::new(64.0, 0.0),
@@ -1227,7 +1232,8 @@ fn a_lost_device_is_an_error_not_a_panic() {
             .is_err()
     );
     let mut doc = Document::new(64, 64, DocumentSettings::default()).expect("doc");
-    doc.apply(Command::Fill(FillRegion::All)).expect("fill");
+    doc.apply(PaintCommand::Fill(FillRegion::All))
+        .expect("fill");
     assert!(textures.sync(&gpu, doc.maps()).is_err());
 }
 

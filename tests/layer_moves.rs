@@ -11,7 +11,10 @@ use kapaint::model::brush::StrokePoint;
 use kapaint::model::layers::{Compositor, ops, thumbnail};
 use kapaint::model::texel::Texel;
 use kapaint::model::{
-    Command, Document, DocumentSettings, LayerKind, LayerPlace, MaterialMaps, MaterialValue,
+    Document, DocumentSettings, LayerKind, LayerPlace, MaterialMaps, MaterialValue,
+};
+use kapaint::model::{
+    HistoryCommand, LayerCommand, MaskCommand, PaintCommand, SettingsCommand, StrokeCommand,
 };
 
 fn document() -> Document {
@@ -23,7 +26,7 @@ fn document() -> Document {
 }
 
 fn add(doc: &mut Document, kind: LayerKind, name: &str) {
-    doc.apply(Command::AddLayer {
+    doc.apply(LayerCommand::AddLayer {
         kind,
         name: name.into(),
     })
@@ -39,7 +42,7 @@ fn names(doc: &Document) -> Vec<String> {
 }
 
 fn select(doc: &mut Document, path: &[usize]) {
-    doc.apply(Command::SelectPath(path.to_vec()))
+    doc.apply(LayerCommand::SelectPath(path.to_vec()))
         .expect("select");
 }
 
@@ -54,7 +57,8 @@ fn stroke_with(doc: &mut Document, tool: kapaint::model::StrokeTool, from: Vec2,
             pressure: 1.0,
         })
         .collect();
-    doc.apply(Command::Stroke { tool, points }).expect("stroke");
+    doc.apply(StrokeCommand::Stroke { tool, points })
+        .expect("stroke");
 }
 
 #[test]
@@ -65,7 +69,7 @@ fn a_dropped_layer_lands_above_below_or_into_its_target() {
     add(&mut doc, LayerKind::Paint, "B");
     assert_eq!(names(&doc), ["[0]Layer 1", "[1]A", "[2]G", "[3]B"]);
     // B into the group G.
-    doc.apply(Command::MoveLayerTo {
+    doc.apply(LayerCommand::MoveLayerTo {
         target: vec![2],
         place: LayerPlace::Into,
     })
@@ -75,7 +79,7 @@ fn a_dropped_layer_lands_above_below_or_into_its_target() {
     // Layer 1 (below the group, in the list the group is in) above B, inside the group: the
     // target's path is counted before the move.
     select(&mut doc, &[0]);
-    doc.apply(Command::MoveLayerTo {
+    doc.apply(LayerCommand::MoveLayerTo {
         target: vec![2, 0],
         place: LayerPlace::Above,
     })
@@ -83,7 +87,7 @@ fn a_dropped_layer_lands_above_below_or_into_its_target() {
     assert_eq!(names(&doc), ["[0]A", "[1]G", "[1, 0]B", "[1, 1]Layer 1"]);
     assert_eq!(doc.selection().path, [1, 1]);
     // Back out, below A.
-    doc.apply(Command::MoveLayerTo {
+    doc.apply(LayerCommand::MoveLayerTo {
         target: vec![0],
         place: LayerPlace::Below,
     })
@@ -100,14 +104,15 @@ fn a_dropped_layer_lands_above_below_or_into_its_target() {
         let before = names(&doc);
         let steps = doc.history().undo_steps().count();
         assert!(
-            doc.apply(Command::MoveLayerTo { target, place }).is_err(),
+            doc.apply(LayerCommand::MoveLayerTo { target, place })
+                .is_err(),
             "refused"
         );
         assert_eq!(names(&doc), before, "nothing moved");
         assert_eq!(doc.history().undo_steps().count(), steps);
     }
     // Each move is one step, undone exactly.
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(names(&doc), ["[0]A", "[1]G", "[1, 0]B", "[1, 1]Layer 1"]);
 }
 
@@ -116,7 +121,7 @@ fn groups_nest_no_deeper_than_a_project_stores() {
     let mut doc = document();
     let mut refused = None;
     for k in 0..20 {
-        if let Err(e) = doc.apply(Command::Group) {
+        if let Err(e) = doc.apply(LayerCommand::Group) {
             refused = Some((k, e.to_string()));
             break;
         }
@@ -138,17 +143,21 @@ fn an_opacity_drag_is_one_undo_step() {
     let painted = row(&doc);
     let steps = doc.history().undo_steps().count();
     for v in [0.9, 0.7, 0.4, 0.25] {
-        doc.apply(Command::SetLayerOpacity(v)).expect("opacity");
+        doc.apply(LayerCommand::SetLayerOpacity(v))
+            .expect("opacity");
     }
     assert_eq!(doc.history().undo_steps().count(), steps + 1, "one step");
     assert!((doc.stack().layers[0].props.opacity - 0.25).abs() < 1e-6);
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert!((doc.stack().layers[0].props.opacity - 1.0).abs() < 1e-6);
     assert_eq!(row(&doc), painted, "undo restores the whole drag");
     // Anything between two changes makes them two steps.
-    doc.apply(Command::SetLayerOpacity(0.5)).expect("opacity");
-    doc.apply(Command::SetLayerVisible(true)).expect("show");
-    doc.apply(Command::SetLayerOpacity(0.6)).expect("opacity");
+    doc.apply(LayerCommand::SetLayerOpacity(0.5))
+        .expect("opacity");
+    doc.apply(LayerCommand::SetLayerVisible(true))
+        .expect("show");
+    doc.apply(LayerCommand::SetLayerOpacity(0.6))
+        .expect("opacity");
     assert_eq!(doc.history().undo_steps().count(), steps + 3);
 }
 
@@ -156,29 +165,35 @@ fn an_opacity_drag_is_one_undo_step() {
 fn the_picker_reads_the_selected_layer_or_the_composite() {
     let mut doc = document();
     let red = MaterialValue::new(Vec3::new(0.8, 0.1, 0.1), Vec3::splat(0.2), 500.0);
-    doc.apply(Command::SetPrimary(red)).expect("primary");
-    doc.apply(Command::SetChannels(kapaint::model::texel::Channels {
-        kd: true,
-        ks: false,
-        n: false,
-    }))
+    doc.apply(SettingsCommand::SetPrimary(red))
+        .expect("primary");
+    doc.apply(SettingsCommand::SetChannels(
+        kapaint::model::texel::Channels {
+            kd: true,
+            ks: false,
+            n: false,
+        },
+    ))
     .expect("channels");
     stroke(&mut doc, Vec2::new(10.0, 64.0), Vec2::new(180.0, 64.0));
-    doc.apply(Command::SetLayerOpacity(0.5)).expect("opacity");
+    doc.apply(LayerCommand::SetLayerOpacity(0.5))
+        .expect("opacity");
     let blank = MaterialValue::new(Vec3::ZERO, Vec3::ONE, 1.0);
-    doc.apply(Command::SetPrimary(blank)).expect("primary");
+    doc.apply(SettingsCommand::SetPrimary(blank))
+        .expect("primary");
     // The layer: its k_d (covered), the primary's k_s and n (not covered).
-    doc.apply(Command::PickLayer { x: 96, y: 64 })
+    doc.apply(PaintCommand::PickLayer { x: 96, y: 64 })
         .expect("pick");
     let p = doc.settings().primary;
     assert!((p.kd - red.kd).abs().max_element() < 1e-3, "{p:?}");
     assert_eq!((p.ks, p.n), (blank.ks, blank.n));
     // The composite: half the red over the base.
-    doc.apply(Command::Pick { x: 96, y: 64 }).expect("pick");
+    doc.apply(PaintCommand::Pick { x: 96, y: 64 })
+        .expect("pick");
     let c = doc.settings().primary;
     assert!((c.kd.x - 0.65).abs() < 1e-2, "{c:?}");
     assert!(
-        doc.apply(Command::PickLayer { x: 999, y: 0 }).is_err(),
+        doc.apply(PaintCommand::PickLayer { x: 999, y: 0 }).is_err(),
         "outside the map"
     );
 }
@@ -190,16 +205,16 @@ fn thumbnails_show_content_coverage_and_masks() {
     let empty = thumbnail::content(&stack, &stack.layers[0], 8).expect("paint layer");
     assert_eq!(empty.len(), 64);
     assert!(empty.iter().all(|p| p[3] == 0), "nothing painted: clear");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(1.0, 0.0, 0.0),
         Vec3::ZERO,
         10.0,
     )))
     .expect("primary");
-    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::All))
         .expect("fill");
-    doc.apply(Command::AddMask).expect("mask");
-    doc.apply(Command::InvertMask).expect("invert");
+    doc.apply(MaskCommand::AddMask).expect("mask");
+    doc.apply(MaskCommand::InvertMask).expect("invert");
     let stack = doc.stack();
     let content = thumbnail::content(stack, &stack.layers[0], 8).expect("paint layer");
     assert!(
@@ -224,20 +239,22 @@ fn composite(stack: &kapaint::model::layers::LayerStack) -> MaterialMaps {
 fn the_layer_views_show_one_layer_over_the_base_or_its_mask_in_grey() {
     let mut doc = document();
     let green = MaterialValue::new(Vec3::new(0.1, 0.7, 0.2), Vec3::splat(0.1), 80.0);
-    doc.apply(Command::SetPrimary(green)).expect("primary");
+    doc.apply(SettingsCommand::SetPrimary(green))
+        .expect("primary");
     stroke(&mut doc, Vec2::new(10.0, 30.0), Vec2::new(180.0, 30.0));
     add(&mut doc, LayerKind::Paint, "Top");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::ONE,
         Vec3::ONE,
         5.0,
     )))
     .expect("primary");
-    doc.apply(Command::Fill(kapaint::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::All))
         .expect("fill");
-    doc.apply(Command::SetLayerVisible(false)).expect("hide");
-    doc.apply(Command::AddMask).expect("mask");
-    doc.apply(Command::SelectMask).expect("mask");
+    doc.apply(LayerCommand::SetLayerVisible(false))
+        .expect("hide");
+    doc.apply(MaskCommand::AddMask).expect("mask");
+    doc.apply(MaskCommand::SelectMask).expect("mask");
     stroke_with(
         &mut doc,
         kapaint::model::StrokeTool::Eraser,
@@ -260,7 +277,7 @@ fn the_layer_views_show_one_layer_over_the_base_or_its_mask_in_grey() {
     let mask = composite(&ops::mask_alone(doc.stack(), &[1]).expect("mask"));
     assert_eq!(mask.value(5, 5).kd, Vec3::ONE);
     assert_eq!(mask.value(96, 64).kd, Vec3::ZERO);
-    doc.apply(Command::InvertMask).expect("invert");
+    doc.apply(MaskCommand::InvertMask).expect("invert");
     let inverted = composite(&ops::mask_alone(doc.stack(), &[1]).expect("mask"));
     assert_eq!(inverted.value(5, 5).kd, Vec3::ZERO);
     assert_eq!(inverted.value(96, 64).kd, Vec3::ONE);
@@ -272,7 +289,7 @@ fn an_export_manifest_says_how_many_layers_it_flattened() {
     let mut doc = document();
     add(&mut doc, LayerKind::Group, "G");
     add(&mut doc, LayerKind::Paint, "In G");
-    doc.apply(Command::MoveLayer(kapaint::model::LayerMove::Down))
+    doc.apply(LayerCommand::MoveLayer(kapaint::model::LayerMove::Down))
         .expect("move");
     let dir = std::env::temp_dir().join(format!("kapaint-layer-count-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);

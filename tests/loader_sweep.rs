@@ -20,7 +20,8 @@ use glam::Vec2;
 use kapaint::cli::PaintScript;
 use kapaint::export::{preset::ExportPreset, set};
 use kapaint::model::brush::{BrushSettings, Stamp, StrokePoint};
-use kapaint::model::{Channel, Command, Document, DocumentSettings, StrokeTool, import, project};
+use kapaint::model::{Channel, Document, DocumentSettings, StrokeTool, import, project};
+use kapaint::model::{SettingsCommand, StrokeCommand};
 
 /// A deterministic xorshift generator: the same cases on every run.
 struct Rng(u64);
@@ -158,13 +159,13 @@ fn temp(tag: &str) -> PathBuf {
 /// A painted 64^2 document with a stamp in its brush: every field a project can hold.
 fn painted() -> Document {
     let mut doc = Document::new(64, 48, DocumentSettings::default()).expect("doc");
-    doc.apply(Command::SetBrush(BrushSettings {
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 6.0,
         stamp: Some(Stamp::new(2, 2, vec![0.0, 0.5, 1.0, 0.25]).expect("stamp")),
         ..BrushSettings::default()
     }))
     .expect("brush");
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![
             StrokePoint {

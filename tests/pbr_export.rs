@@ -316,7 +316,7 @@ fn the_normal_map_is_kept_passed_through_and_never_in_ka() {
     // k_a never reads it: the same maps with and without the normal map export the same
     // baked k_a.
     let mut bare = kapaint::model::project::load(&project).expect("load");
-    bare.apply(kapaint::model::Command::SetNormal(
+    bare.apply(kapaint::model::ImportCommand::SetNormal(
         kapaint::model::document::AttachedNormal(None),
     ))
     .expect("clear");

@@ -47,7 +47,8 @@ impl PaintArgs {
                 CliError::usage(format!("{}: command {}: {e}", self.script.display(), i + 1))
             })?;
         }
-        doc.apply(model::Command::EndStroke).map_err(model_error)?;
+        doc.apply(model::StrokeCommand::EndStroke)
+            .map_err(model_error)?;
         let expected = if self.out.is_none() {
             on_disk.as_ref()
         } else {

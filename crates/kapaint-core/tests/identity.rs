@@ -6,7 +6,8 @@
 )]
 
 use glam::Vec3;
-use kapaint_core::model::{Command, Document, MaterialValue};
+use kapaint_core::model::{Document, MaterialValue};
+use kapaint_core::model::{HistoryCommand, ImportCommand, LayerCommand};
 
 #[path = "common/layer_doc.rs"]
 #[expect(dead_code, reason = "each test file uses some of the helpers")]
@@ -35,7 +36,7 @@ fn imports_normal_maps_and_meshes_are_undo_steps_and_undo_restores_the_version()
         serde_json::from_str(r#"{"source":"constant","model":"phong","n_mapping":"lobe","error":{"max":0.1,"mean":0.05,"p99":0.09}}"#)
             .expect("report");
     let normal = Arc::new(NormalMap::flat(192, 128).expect("normal"));
-    doc.apply(Command::ImportMaterial(ImportedMaterial {
+    doc.apply(ImportCommand::ImportMaterial(ImportedMaterial {
         maps: Arc::new(maps),
         normal: Some(Arc::clone(&normal)),
         report: Some(report.clone()),
@@ -45,19 +46,19 @@ fn imports_normal_maps_and_meshes_are_undo_steps_and_undo_restores_the_version()
     assert_eq!(doc.settings().import.as_ref(), Some(&report));
     let imported = doc.version();
     assert_ne!(imported, opened);
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert!(doc.normal().is_none() && doc.settings().import.is_none());
     assert_eq!(doc.version(), opened, "undone to where it was opened");
-    doc.apply(Command::Redo).expect("redo");
+    doc.apply(HistoryCommand::Redo).expect("redo");
     assert!(doc.normal().is_some() && doc.settings().import.is_some());
     assert_eq!(doc.version(), imported);
 
     // Clearing the normal map is a step of its own.
-    doc.apply(Command::SetNormal(AttachedNormal(None)))
+    doc.apply(ImportCommand::SetNormal(AttachedNormal(None)))
         .expect("clear");
     assert!(doc.normal().is_none());
     assert_eq!(doc.history().undo_steps().count(), 2);
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert!(doc.normal().is_some());
 
     // The mesh and its bake.
@@ -65,14 +66,14 @@ fn imports_normal_maps_and_meshes_are_undo_steps_and_undo_restores_the_version()
     let surface =
         Arc::new(kapaint_core::model::surface::Surface::new(cube, 192, 128).expect("bake"));
     let before = doc.version();
-    doc.apply(Command::SetMesh(AttachedMesh {
+    doc.apply(ImportCommand::SetMesh(AttachedMesh {
         mesh: MeshRef::Builtin("cube".into()),
         surface: Arc::clone(&surface),
     }))
     .expect("mesh");
     assert_eq!(doc.settings().mesh, MeshRef::Builtin("cube".into()));
     assert!(Arc::ptr_eq(doc.surface().expect("surface"), &surface));
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(doc.settings().mesh, MeshRef::Sphere);
     assert!(doc.surface().is_none_or(|s| !Arc::ptr_eq(s, &surface)));
     assert_eq!(doc.version(), before);
@@ -81,7 +82,7 @@ fn imports_normal_maps_and_meshes_are_undo_steps_and_undo_restores_the_version()
     let small = kapaint_core::mesh::builtin("cube").expect("cube");
     let small = Arc::new(kapaint_core::model::surface::Surface::new(small, 8, 8).expect("bake"));
     assert!(
-        doc.apply(Command::SetMesh(AttachedMesh {
+        doc.apply(ImportCommand::SetMesh(AttachedMesh {
             mesh: MeshRef::Builtin("cube".into()),
             surface: small,
         }))
@@ -117,16 +118,16 @@ fn layer_ids_survive_moves_grouping_undo_and_saves_and_copies_get_their_own() {
     let unique: std::collections::BTreeSet<_> = ids.iter().collect();
     assert_eq!(unique.len(), 4);
     // Move A to the top and group it: the same id, at a new path.
-    doc.apply(Command::SelectLayer(LayerRef::Name("A".into())))
+    doc.apply(LayerCommand::SelectLayer(LayerRef::Name("A".into())))
         .expect("select");
-    doc.apply(Command::MoveLayer(kapaint_core::model::LayerMove::Top))
+    doc.apply(LayerCommand::MoveLayer(kapaint_core::model::LayerMove::Top))
         .expect("move");
-    doc.apply(Command::Group).expect("group");
+    doc.apply(LayerCommand::Group).expect("group");
     assert_eq!(id_of(&doc, "A"), ids[1]);
     // A script's id selects A wherever it went.
-    doc.apply(Command::SelectLayer(LayerRef::Name("B".into())))
+    doc.apply(LayerCommand::SelectLayer(LayerRef::Name("B".into())))
         .expect("select");
-    doc.apply(Command::SelectLayer(LayerRef::Id { id: ids[1].0 }))
+    doc.apply(LayerCommand::SelectLayer(LayerRef::Id { id: ids[1].0 }))
         .expect("select by id");
     assert_eq!(
         doc.stack()
@@ -137,14 +138,14 @@ fn layer_ids_survive_moves_grouping_undo_and_saves_and_copies_get_their_own() {
         "A"
     );
     assert!(
-        doc.apply(Command::SelectLayer(LayerRef::Id { id: u64::MAX }))
+        doc.apply(LayerCommand::SelectLayer(LayerRef::Id { id: u64::MAX }))
             .is_err()
     );
     // A copy of the group: new ids for the group and for A's copy inside it.
-    doc.apply(Command::SelectLayer(LayerRef::Name("Group".into())))
+    doc.apply(LayerCommand::SelectLayer(LayerRef::Name("Group".into())))
         .expect("select group");
     let group = id_of(&doc, "Group");
-    doc.apply(Command::DuplicateLayer).expect("duplicate");
+    doc.apply(LayerCommand::DuplicateLayer).expect("duplicate");
     let all: Vec<_> = doc.stack().walk().iter().map(|(_, l)| l.props.id).collect();
     let unique: std::collections::BTreeSet<_> = all.iter().collect();
     assert_eq!(unique.len(), all.len(), "every layer its own id: {all:?}");
@@ -155,7 +156,7 @@ fn layer_ids_survive_moves_grouping_undo_and_saves_and_copies_get_their_own() {
     );
     // Undo the copy, the group and the move: the ids are the ones they had.
     for _ in 0..3 {
-        doc.apply(Command::Undo).expect("undo");
+        doc.apply(HistoryCommand::Undo).expect("undo");
     }
     let back: Vec<_> = ["Layer 1", "A", "B", "C"]
         .iter()
@@ -176,7 +177,7 @@ fn layer_ids_survive_moves_grouping_undo_and_saves_and_copies_get_their_own() {
     // A new layer after opening never takes an id the file holds.
     let mut opened = opened;
     opened
-        .apply(Command::AddLayer {
+        .apply(LayerCommand::AddLayer {
             kind: kapaint_core::model::LayerKind::Paint,
             name: "D".into(),
         })

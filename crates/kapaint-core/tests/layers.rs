@@ -11,6 +11,9 @@ use kapaint_core::model::brush::StrokePoint;
 use kapaint_core::model::layers::LayerContent;
 use kapaint_core::model::texel::{Channel, Channels, Texel};
 use kapaint_core::model::{Command, Document, MaterialValue};
+use kapaint_core::model::{
+    HistoryCommand, LayerCommand, MaskCommand, PaintCommand, SettingsCommand, StrokeCommand,
+};
 
 #[path = "common/layer_doc.rs"]
 mod layer_doc;
@@ -23,7 +26,7 @@ fn stroke(doc: &mut Document, from: Vec2, to: Vec2) {
             pressure: 1.0,
         })
         .collect();
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: kapaint_core::model::StrokeTool::Brush,
         points,
     })
@@ -59,15 +62,17 @@ fn hiding_a_painted_layer_returns_the_maps_to_the_state_below_bit_exactly() {
     let painted = texels(&doc);
     assert_ne!(painted, below);
     let version = doc.version();
-    doc.apply(Command::SetLayerVisible(false)).expect("hide");
+    doc.apply(LayerCommand::SetLayerVisible(false))
+        .expect("hide");
     assert_eq!(texels(&doc), below, "hidden: the layers below, exactly");
     assert_ne!(doc.version(), version, "hiding is a change to save");
-    doc.apply(Command::SetLayerVisible(true)).expect("show");
+    doc.apply(LayerCommand::SetLayerVisible(true))
+        .expect("show");
     assert_eq!(texels(&doc), painted);
     // Undo of the show and the hide.
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(texels(&doc), below);
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(texels(&doc), painted);
 }
 
@@ -134,19 +139,19 @@ fn the_contract_script_builds_a_base_a_masked_rust_layer_and_a_gloss_layer() {
 #[test]
 fn a_paint_layer_fill_is_opaque_in_the_enabled_channels_only() {
     let mut doc = document();
-    doc.apply(Command::SetChannels(Channels {
+    doc.apply(SettingsCommand::SetChannels(Channels {
         kd: false,
         ks: false,
         n: true,
     }))
     .expect("channels");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::splat(0.9),
         Vec3::splat(0.9),
         500.0,
     )))
     .expect("primary");
-    doc.apply(Command::Fill(kapaint_core::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint_core::model::FillRegion::All))
         .expect("fill");
     let v = doc.maps().value(3, 3);
     assert!((v.kd.x - 0.5).abs() < 1e-3, "k_d stays the base's: {v:?}");
@@ -178,7 +183,7 @@ fn check_undo(doc: &mut Document, command: Command) {
         doc.selection().clone(),
     );
     let after_stack = doc.stack().clone();
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(
         (
             texels(doc),
@@ -188,7 +193,7 @@ fn check_undo(doc: &mut Document, command: Command) {
         before,
         "{label}: undo"
     );
-    doc.apply(Command::Redo).expect("redo");
+    doc.apply(HistoryCommand::Redo).expect("redo");
     assert_eq!(
         (
             texels(doc),
@@ -207,74 +212,79 @@ fn every_layer_operation_is_one_undo_step_and_undo_and_redo_are_bit_exact() {
     use kapaint_core::model::{LayerKind, LayerMove, LayerRef};
     let mut doc = document();
     stroke(&mut doc, Vec2::new(10.0, 10.0), Vec2::new(120.0, 100.0));
-    let add = |kind, name: &str| Command::AddLayer {
+    let add = |kind, name: &str| LayerCommand::AddLayer {
         kind,
         name: name.into(),
     };
-    check_undo(&mut doc, add(LayerKind::Paint, "Two"));
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    check_undo(&mut doc, add(LayerKind::Paint, "Two").into());
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.1, 0.7, 0.2),
         Vec3::splat(0.2),
         900.0,
     )))
     .expect("primary");
     stroke(&mut doc, Vec2::new(100.0, 10.0), Vec2::new(20.0, 110.0));
-    for c in [
-        Command::SetLayerOpacity(0.4),
-        Command::SetLayerBlend {
+    let commands: Vec<Command> = vec![
+        LayerCommand::SetLayerOpacity(0.4).into(),
+        LayerCommand::SetLayerBlend {
             channel: Channel::Kd,
             mode: LayerBlend::Screen,
-        },
-        Command::SetLayerBlend {
+        }
+        .into(),
+        LayerCommand::SetLayerBlend {
             channel: Channel::N,
             mode: LayerBlend::Add,
-        },
-        Command::SetLayerChannels(Channels {
+        }
+        .into(),
+        LayerCommand::SetLayerChannels(Channels {
             kd: true,
             ks: false,
             n: true,
-        }),
-        Command::RenameLayer("Renamed".into()),
-        Command::SetLayerLocked(true),
-        Command::SetLayerLocked(false),
-        Command::AddMask,
-        Command::InvertMask,
-        Command::MaskFromChannel {
+        })
+        .into(),
+        LayerCommand::RenameLayer("Renamed".into()).into(),
+        LayerCommand::SetLayerLocked(true).into(),
+        LayerCommand::SetLayerLocked(false).into(),
+        MaskCommand::AddMask.into(),
+        MaskCommand::InvertMask.into(),
+        MaskCommand::MaskFromChannel {
             channel: Channel::N,
             threshold: 100.0,
-        },
-        Command::SetMaskEnabled(false),
-        Command::SetMaskEnabled(true),
-        Command::DuplicateLayer,
-        Command::MoveLayer(LayerMove::Down),
-        Command::MoveLayer(LayerMove::Top),
-        Command::ApplyMask,
-        Command::Group,
-        Command::Ungroup,
-        add(LayerKind::Fill, "Fill"),
-        Command::SetLayerFill(MaterialValue::new(Vec3::splat(0.2), Vec3::ZERO, 2.0)),
-        Command::AddMask,
-        Command::DeleteMask,
-        add(LayerKind::Group, "Folder"),
-    ] {
+        }
+        .into(),
+        MaskCommand::SetMaskEnabled(false).into(),
+        MaskCommand::SetMaskEnabled(true).into(),
+        LayerCommand::DuplicateLayer.into(),
+        LayerCommand::MoveLayer(LayerMove::Down).into(),
+        LayerCommand::MoveLayer(LayerMove::Top).into(),
+        MaskCommand::ApplyMask.into(),
+        LayerCommand::Group.into(),
+        LayerCommand::Ungroup.into(),
+        add(LayerKind::Fill, "Fill").into(),
+        LayerCommand::SetLayerFill(MaterialValue::new(Vec3::splat(0.2), Vec3::ZERO, 2.0)).into(),
+        MaskCommand::AddMask.into(),
+        MaskCommand::DeleteMask.into(),
+        add(LayerKind::Group, "Folder").into(),
+    ];
+    for c in commands {
         check_undo(&mut doc, c);
     }
     // Selecting is not a step.
-    doc.apply(Command::SelectLayer(LayerRef::Name("Renamed".into())))
+    doc.apply(LayerCommand::SelectLayer(LayerRef::Name("Renamed".into())))
         .expect("select");
     assert_eq!(doc.selection().path, vec![1]);
     for c in [
-        Command::SetLayerVisible(false),
-        Command::SetLayerVisible(true),
-        Command::MergeDown,
-        Command::DeleteLayer,
-        Command::Flatten,
+        LayerCommand::SetLayerVisible(false),
+        LayerCommand::SetLayerVisible(true),
+        LayerCommand::MergeDown,
+        LayerCommand::DeleteLayer,
+        LayerCommand::Flatten,
     ] {
-        check_undo(&mut doc, c);
+        check_undo(&mut doc, c.into());
     }
     // A stroke on a mask is one step too.
-    doc.apply(Command::AddMask).expect("mask");
-    doc.apply(Command::SelectMask).expect("select mask");
+    doc.apply(MaskCommand::AddMask).expect("mask");
+    doc.apply(MaskCommand::SelectMask).expect("select mask");
     let steps = doc.history().undo_steps().count();
     stroke(&mut doc, Vec2::new(10.0, 60.0), Vec2::new(180.0, 60.0));
     assert_eq!(doc.history().undo_steps().count(), steps + 1);
@@ -285,29 +295,31 @@ fn the_n_blend_refuses_modes_n_has_not_and_a_locked_layer_refuses_paint() {
     use kapaint_core::model::layers::LayerBlend;
     let mut doc = document();
     let err = doc
-        .apply(Command::SetLayerBlend {
+        .apply(LayerCommand::SetLayerBlend {
             channel: Channel::N,
             mode: LayerBlend::Screen,
         })
         .unwrap_err()
         .to_string();
     assert!(err.contains("Normal, Multiply, Add, Min, Max"), "{err}");
-    doc.apply(Command::SetLayerLocked(true)).expect("lock");
+    doc.apply(LayerCommand::SetLayerLocked(true)).expect("lock");
     let before = texels(&doc);
     let err = doc
-        .apply(Command::Fill(kapaint_core::model::FillRegion::All))
+        .apply(PaintCommand::Fill(kapaint_core::model::FillRegion::All))
         .unwrap_err()
         .to_string();
     assert!(err.contains("locked"), "{err}");
     assert_eq!(texels(&doc), before);
     // A fill layer's content has no pixels to paint.
-    doc.apply(Command::AddLayer {
+    doc.apply(LayerCommand::AddLayer {
         kind: kapaint_core::model::LayerKind::Fill,
         name: "F".into(),
     })
     .expect("fill layer");
     let err = doc
-        .apply(Command::BeginStroke(kapaint_core::model::StrokeTool::Brush))
+        .apply(StrokeCommand::BeginStroke(
+            kapaint_core::model::StrokeTool::Brush,
+        ))
         .unwrap_err()
         .to_string();
     assert!(err.contains("no pixels to paint"), "{err}");
@@ -319,7 +331,7 @@ fn the_eraser_on_a_layer_uncovers_the_layers_below() {
     let base = texels(&doc);
     stroke(&mut doc, Vec2::new(20.0, 64.0), Vec2::new(170.0, 64.0));
     assert_ne!(texels(&doc), base);
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: kapaint_core::model::StrokeTool::Eraser,
         points: (0..=16)
             .map(|k| StrokePoint {
@@ -384,8 +396,9 @@ fn a_version_2_project_keeps_the_stack_and_its_composite() {
     let mut a = doc;
     let mut b = back;
     for d in [&mut a, &mut b] {
-        d.apply(Command::SelectPath(vec![1])).expect("select group");
-        d.apply(Command::SetLayerVisible(false)).expect("hide");
+        d.apply(LayerCommand::SelectPath(vec![1]))
+            .expect("select group");
+        d.apply(LayerCommand::SetLayerVisible(false)).expect("hide");
     }
     assert_eq!(texels(&a), texels(&b));
 }

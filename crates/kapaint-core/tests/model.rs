@@ -10,9 +10,10 @@ use kapaint_core::model::brush::{BlendMode, BrushSettings, StrokePoint};
 use kapaint_core::model::paint::GradientShape;
 use kapaint_core::model::texel::{N_MAX, Texel, srgb_to_linear};
 use kapaint_core::model::{
-    Channel, Channels, Command, Document, DocumentSettings, FillRegion, MaterialMaps,
-    MaterialValue, StrokeTool, import, project,
+    Channel, Channels, Document, DocumentSettings, FillRegion, MaterialMaps, MaterialValue,
+    StrokeTool, import, project,
 };
+use kapaint_core::model::{Command, HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 
 fn doc(w: u32, h: u32) -> Document {
     Document::new(w, h, DocumentSettings::default()).expect("valid size")
@@ -53,56 +54,66 @@ fn red() -> MaterialValue {
 fn every_command_keeps_the_maps_valid_and_undo_restores_bit_exactly() {
     let mut d = doc(300, 200);
     let initial = snapshot(d.maps());
-    let commands = vec![
-        Command::SetPrimary(red()),
-        Command::SetBrush(BrushSettings {
+    let commands: Vec<Command> = vec![
+        SettingsCommand::SetPrimary(red()).into(),
+        SettingsCommand::SetBrush(BrushSettings {
             radius_px: 12.0,
             jitter: 0.5,
             ..BrushSettings::default()
-        }),
-        Command::Stroke {
+        })
+        .into(),
+        StrokeCommand::Stroke {
             tool: StrokeTool::Brush,
             points: vec![point(5.0, 5.0), point(290.0, 190.0)],
-        },
-        Command::SetBrush(BrushSettings {
+        }
+        .into(),
+        SettingsCommand::SetBrush(BrushSettings {
             blend: BlendMode::Multiply,
             opacity: 0.5,
             ..BrushSettings::default()
-        }),
-        Command::Stroke {
+        })
+        .into(),
+        StrokeCommand::Stroke {
             tool: StrokeTool::Brush,
             points: vec![point(0.0, 100.0), point(300.0, 100.0)],
-        },
-        Command::Stroke {
+        }
+        .into(),
+        StrokeCommand::Stroke {
             tool: StrokeTool::Blur,
             points: vec![point(50.0, 50.0), point(150.0, 150.0)],
-        },
-        Command::Stroke {
+        }
+        .into(),
+        StrokeCommand::Stroke {
             tool: StrokeTool::Eraser,
             points: vec![point(100.0, 0.0), point(100.0, 200.0)],
-        },
-        Command::SetChannels(Channels {
+        }
+        .into(),
+        SettingsCommand::SetChannels(Channels {
             kd: false,
             ks: true,
             n: true,
-        }),
-        Command::Fill(FillRegion::Similar {
+        })
+        .into(),
+        PaintCommand::Fill(FillRegion::Similar {
             x: 250,
             y: 20,
             channel: Channel::Kd,
             tolerance: 0.05,
-        }),
-        Command::Gradient {
+        })
+        .into(),
+        PaintCommand::Gradient {
             shape: GradientShape::Radial,
             start: Vec2::new(150.0, 100.0),
             end: Vec2::new(300.0, 100.0),
-        },
-        Command::SetBrush(BrushSettings {
+        }
+        .into(),
+        SettingsCommand::SetBrush(BrushSettings {
             blend: BlendMode::Add,
             energy_guard: true,
             ..BrushSettings::default()
-        }),
-        Command::Fill(FillRegion::All),
+        })
+        .into(),
+        PaintCommand::Fill(FillRegion::All).into(),
     ];
     let mut snapshots = vec![initial.clone()];
     for command in commands {
@@ -124,12 +135,12 @@ fn every_command_keeps_the_maps_valid_and_undo_restores_bit_exactly() {
     };
     assert_eq!(changed.len(), steps + 1);
     for want in changed.iter().rev().skip(1) {
-        d.apply(Command::Undo).expect("undo");
+        d.apply(HistoryCommand::Undo).expect("undo");
         assert!(snapshot(d.maps()) == **want, "undo is not bit-exact");
     }
     assert_eq!(snapshot(d.maps()), initial);
     for want in changed.iter().skip(1) {
-        d.apply(Command::Redo).expect("redo");
+        d.apply(HistoryCommand::Redo).expect("redo");
         assert!(snapshot(d.maps()) == **want, "redo is not bit-exact");
     }
 }
@@ -138,14 +149,14 @@ fn every_command_keeps_the_maps_valid_and_undo_restores_bit_exactly() {
 fn stroke_result_does_not_depend_on_input_sampling() {
     let paint = |points: Vec<StrokePoint>| {
         let mut d = doc(256, 256);
-        d.apply(Command::SetPrimary(red())).expect("set");
-        d.apply(Command::SetBrush(BrushSettings {
+        d.apply(SettingsCommand::SetPrimary(red())).expect("set");
+        d.apply(SettingsCommand::SetBrush(BrushSettings {
             radius_px: 9.0,
             flow: 0.3,
             ..BrushSettings::default()
         }))
         .expect("set");
-        d.apply(Command::Stroke {
+        d.apply(StrokeCommand::Stroke {
             tool: StrokeTool::Brush,
             points,
         })
@@ -201,13 +212,13 @@ fn stroke_result_does_not_depend_on_input_sampling() {
 #[test]
 fn opacity_caps_a_stroke_however_many_dabs_overlap() {
     let mut d = doc(128, 128);
-    d.apply(Command::SetPrimary(MaterialValue::new(
+    d.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::ONE,
         Vec3::ZERO,
         10.0,
     )))
     .expect("set");
-    d.apply(Command::SetBrush(BrushSettings {
+    d.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 20.0,
         hardness: 1.0,
         opacity: 0.5,
@@ -220,7 +231,7 @@ fn opacity_caps_a_stroke_however_many_dabs_overlap() {
     let points = (0..40)
         .map(|i| point(60.0 + (i % 2) as f32 * 8.0, 64.0))
         .collect();
-    d.apply(Command::Stroke {
+    d.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points,
     })
@@ -233,14 +244,14 @@ fn opacity_caps_a_stroke_however_many_dabs_overlap() {
 #[test]
 fn mirror_eraser_and_picker() {
     let mut d = doc(200, 100);
-    d.apply(Command::SetPrimary(red())).expect("set");
-    d.apply(Command::SetBrush(BrushSettings {
+    d.apply(SettingsCommand::SetPrimary(red())).expect("set");
+    d.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 6.0,
         mirror_u: true,
         ..BrushSettings::default()
     }))
     .expect("set");
-    d.apply(Command::Stroke {
+    d.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![point(30.5, 20.5), point(30.5, 80.5)],
     })
@@ -254,17 +265,17 @@ fn mirror_eraser_and_picker() {
             );
         }
     }
-    d.apply(Command::Pick { x: 30, y: 50 }).expect("pick");
+    d.apply(PaintCommand::Pick { x: 30, y: 50 }).expect("pick");
     assert_eq!(d.settings().primary, red().quantized());
-    assert!(d.apply(Command::Pick { x: 200, y: 0 }).is_err());
+    assert!(d.apply(PaintCommand::Pick { x: 200, y: 0 }).is_err());
     // The eraser paints the base material back.
-    d.apply(Command::SetBrush(BrushSettings {
+    d.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 20.0,
         hardness: 1.0,
         ..BrushSettings::default()
     }))
     .expect("set");
-    d.apply(Command::Stroke {
+    d.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Eraser,
         points: vec![point(30.0, 0.0), point(30.0, 100.0)],
     })
@@ -275,19 +286,19 @@ fn mirror_eraser_and_picker() {
 #[test]
 fn gradient_and_fill_write_what_they_say() {
     let mut d = doc(256, 64);
-    d.apply(Command::SetPrimary(MaterialValue::new(
+    d.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::ZERO,
         Vec3::ZERO,
         0.0,
     )))
     .expect("set");
-    d.apply(Command::SetSecondary(MaterialValue::new(
+    d.apply(SettingsCommand::SetSecondary(MaterialValue::new(
         Vec3::ONE,
         Vec3::ONE,
         N_MAX,
     )))
     .expect("set");
-    d.apply(Command::Gradient {
+    d.apply(PaintCommand::Gradient {
         shape: GradientShape::Linear,
         start: Vec2::new(0.0, 0.0),
         end: Vec2::new(256.0, 0.0),
@@ -306,7 +317,7 @@ fn gradient_and_fill_write_what_they_say() {
         mid.n
     );
     // A full-opacity fill makes every tile uniform again: no memory.
-    d.apply(Command::Fill(FillRegion::All)).expect("fill");
+    d.apply(PaintCommand::Fill(FillRegion::All)).expect("fill");
     assert_eq!(d.maps().heap_bytes(), 0);
     assert_eq!(d.maps().value(200, 50), d.settings().primary.quantized());
 }
@@ -314,26 +325,26 @@ fn gradient_and_fill_write_what_they_say() {
 #[test]
 fn flood_fill_stops_at_the_tolerance() {
     let mut d = doc(100, 100);
-    d.apply(Command::SetPrimary(red())).expect("set");
-    d.apply(Command::SetBrush(BrushSettings {
+    d.apply(SettingsCommand::SetPrimary(red())).expect("set");
+    d.apply(SettingsCommand::SetBrush(BrushSettings {
         radius_px: 3.0,
         hardness: 1.0,
         ..BrushSettings::default()
     }))
     .expect("set");
     // A red wall at x = 50 splits the map.
-    d.apply(Command::Stroke {
+    d.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![point(50.0, -5.0), point(50.0, 105.0)],
     })
     .expect("stroke");
-    d.apply(Command::SetPrimary(MaterialValue::new(
+    d.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.0, 0.0, 1.0),
         Vec3::ZERO,
         1.0,
     )))
     .expect("set");
-    d.apply(Command::Fill(FillRegion::Similar {
+    d.apply(PaintCommand::Fill(FillRegion::Similar {
         x: 10,
         y: 10,
         channel: Channel::Kd,
@@ -347,13 +358,13 @@ fn flood_fill_stops_at_the_tolerance() {
 
 fn small_project() -> Document {
     let mut d = doc(96, 80);
-    d.apply(Command::SetPrimary(red())).expect("set");
-    d.apply(Command::Stroke {
+    d.apply(SettingsCommand::SetPrimary(red())).expect("set");
+    d.apply(StrokeCommand::Stroke {
         tool: StrokeTool::Brush,
         points: vec![point(3.0, 3.0), point(90.0, 70.0)],
     })
     .expect("stroke");
-    d.apply(Command::SetModel(
+    d.apply(SettingsCommand::SetModel(
         kapaint_core::reflectance::ShadingModel::BlinnPhong,
     ))
     .expect("set");
@@ -442,7 +453,7 @@ fn importing_the_spot_texture_converts_srgb_to_linear() {
         );
     }
     // One undo step restores the base.
-    d.apply(Command::Undo).expect("undo");
+    d.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(d.maps().value(512, 300), d.settings().base.quantized());
 }
 

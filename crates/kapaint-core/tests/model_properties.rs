@@ -8,6 +8,7 @@ use kapaint_core::model::texel::{N_MAX, Texel};
 use kapaint_core::model::{
     Channel, Channels, Command, Document, DocumentSettings, FillRegion, MaterialValue, StrokeTool,
 };
+use kapaint_core::model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use proptest::prelude::*;
 
 fn any_value() -> impl Strategy<Value = MaterialValue> {
@@ -63,26 +64,30 @@ fn any_command() -> impl Strategy<Value = Command> {
         pressure: p,
     });
     prop_oneof![
-        any_value().prop_map(Command::SetPrimary),
-        any_value().prop_map(Command::SetSecondary),
-        any_brush().prop_map(Command::SetBrush),
+        any_value().prop_map(|v| Command::from(SettingsCommand::SetPrimary(v))),
+        any_value().prop_map(|v| Command::from(SettingsCommand::SetSecondary(v))),
+        any_brush().prop_map(|v| Command::from(SettingsCommand::SetBrush(v))),
         (any::<bool>(), any::<bool>(), any::<bool>())
-            .prop_map(|(kd, ks, n)| Command::SetChannels(Channels { kd, ks, n })),
-        (0usize..3, prop::collection::vec(pt, 1..6)).prop_map(|(t, points)| Command::Stroke {
-            tool: [StrokeTool::Brush, StrokeTool::Eraser, StrokeTool::Blur][t],
-            points
+            .prop_map(|(kd, ks, n)| SettingsCommand::SetChannels(Channels { kd, ks, n }).into()),
+        (0usize..3, prop::collection::vec(pt, 1..6)).prop_map(|(t, points)| {
+            StrokeCommand::Stroke {
+                tool: [StrokeTool::Brush, StrokeTool::Eraser, StrokeTool::Blur][t],
+                points,
+            }
+            .into()
         }),
-        Just(Command::Fill(FillRegion::All)),
+        Just(Command::from(PaintCommand::Fill(FillRegion::All))),
         (0u32..100, 0u32..70, 0usize..3, 0.0f32..0.5).prop_map(|(x, y, c, tolerance)| {
-            Command::Fill(FillRegion::Similar {
+            PaintCommand::Fill(FillRegion::Similar {
                 x,
                 y,
                 channel: Channel::ALL[c],
                 tolerance,
             })
+            .into()
         }),
         (any::<bool>(), -10.0f32..110.0, -10.0f32..80.0).prop_map(|(radial, x, y)| {
-            Command::Gradient {
+            PaintCommand::Gradient {
                 shape: if radial {
                     GradientShape::Radial
                 } else {
@@ -91,11 +96,12 @@ fn any_command() -> impl Strategy<Value = Command> {
                 start: Vec2::new(x, y),
                 end: Vec2::new(100.0 - x, 70.0 - y),
             }
+            .into()
         }),
-        (0u32..100, 0u32..70).prop_map(|(x, y)| Command::Pick { x, y }),
-        Just(Command::SwapMaterials),
-        Just(Command::Undo),
-        Just(Command::Redo),
+        (0u32..100, 0u32..70).prop_map(|(x, y)| PaintCommand::Pick { x, y }.into()),
+        Just(Command::from(SettingsCommand::SwapMaterials)),
+        Just(Command::from(HistoryCommand::Undo)),
+        Just(Command::from(HistoryCommand::Redo)),
     ]
 }
 
@@ -124,7 +130,7 @@ proptest! {
             prop_assert!(s.primary.kd.is_finite() && s.primary.n.is_finite());
         }
         while doc.history().undo_steps().next().is_some() {
-            doc.apply(Command::Undo).expect("undo");
+            doc.apply(HistoryCommand::Undo).expect("undo");
         }
         prop_assert!(snapshot(&doc) == start, "undoing everything did not restore the start");
     }

@@ -20,6 +20,7 @@ use kapaint_core::model::surface::{BallFootprint, Surface};
 use kapaint_core::model::texel::{MaterialValue, Texel};
 use kapaint_core::model::tile::TILE_SIZE;
 use kapaint_core::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
+use kapaint_core::model::{HistoryCommand, ImportCommand, PaintCommand, StrokeCommand};
 
 fn sphere_surface(side: u32) -> Arc<Surface> {
     Arc::new(Surface::new(builtin::uv_sphere(64, 32), side, side).expect("bake"))
@@ -125,10 +126,11 @@ fn parallel_stroke(from: f32, to: f32) -> Command {
             at(Vec3::new(r * phi.cos(), y, -r * phi.sin()))
         })
         .collect();
-    Command::SurfaceStroke {
+    StrokeCommand::SurfaceStroke {
         tool: StrokeTool::Brush,
         points,
     }
+    .into()
 }
 
 #[test]
@@ -255,7 +257,7 @@ fn a_stroke_across_a_seam_of_spot_paints_both_sides_as_one() {
         .map(|k| at(mid + across * (reach * (k as f32 / 5.0 - 1.0))))
         .collect();
     let mut doc = document(&surface, brush.clone());
-    doc.apply(Command::SurfaceStroke {
+    doc.apply(StrokeCommand::SurfaceStroke {
         tool: StrokeTool::Brush,
         points: input.clone(),
     })
@@ -340,7 +342,7 @@ fn spacing_on_the_surface_does_not_depend_on_input_sampling() {
     };
     let paint = |points| {
         let mut doc = document(&surface, brush.clone());
-        doc.apply(Command::SurfaceStroke {
+        doc.apply(StrokeCommand::SurfaceStroke {
             tool: StrokeTool::Brush,
             points,
         })
@@ -369,7 +371,7 @@ fn object_space_mirror_paints_the_reflected_dab() {
         ..BrushSettings::default()
     };
     let mut one = document(&surface, brush.clone());
-    one.apply(Command::SurfaceStroke {
+    one.apply(StrokeCommand::SurfaceStroke {
         tool: StrokeTool::Brush,
         points: vec![at(p)],
     })
@@ -381,16 +383,17 @@ fn object_space_mirror_paints_the_reflected_dab() {
             ..brush
         },
     );
-    two.apply(Command::BeginStroke(StrokeTool::Brush))
+    two.apply(StrokeCommand::BeginStroke(StrokeTool::Brush))
         .expect("begin");
     // Two separate dabs in one stroke: the same as one mirrored dab.
-    two.apply(Command::SurfaceStrokeTo(at(p))).expect("dab");
-    two.apply(Command::EndStroke).expect("end");
-    two.apply(Command::BeginStroke(StrokeTool::Brush))
-        .expect("begin");
-    two.apply(Command::SurfaceStrokeTo(at(mirrored)))
+    two.apply(StrokeCommand::SurfaceStrokeTo(at(p)))
         .expect("dab");
-    two.apply(Command::EndStroke).expect("end");
+    two.apply(StrokeCommand::EndStroke).expect("end");
+    two.apply(StrokeCommand::BeginStroke(StrokeTool::Brush))
+        .expect("begin");
+    two.apply(StrokeCommand::SurfaceStrokeTo(at(mirrored)))
+        .expect("dab");
+    two.apply(StrokeCommand::EndStroke).expect("end");
     assert_eq!(kd_map(&one), kd_map(&two));
     assert_ne!(
         kd_map(&one),
@@ -411,7 +414,7 @@ fn front_faces_only_keeps_a_big_brush_on_the_near_side() {
                 ..BrushSettings::default()
             },
         );
-        doc.apply(Command::SurfaceStroke {
+        doc.apply(StrokeCommand::SurfaceStroke {
             tool: StrokeTool::Brush,
             points: vec![at(Vec3::Y)],
         })
@@ -443,7 +446,7 @@ fn fills_by_island_and_by_part() {
         .expect("a covered texel");
     let island = surface.bake.island((y * 128 + x) as usize);
     let mut doc = document(&surface, BrushSettings::default());
-    doc.apply(Command::Fill(FillRegion::Island { x, y }))
+    doc.apply(PaintCommand::Fill(FillRegion::Island { x, y }))
         .expect("fill island");
     let kd = kd_map(&doc);
     let painted = Texel::encode(doc.settings().primary).kd;
@@ -451,15 +454,15 @@ fn fills_by_island_and_by_part() {
         let inside = surface.bake.island(i) == island;
         assert_eq!(*v == painted, inside, "texel {i}");
     }
-    doc.apply(Command::Fill(FillRegion::Part { x, y }))
+    doc.apply(PaintCommand::Fill(FillRegion::Part { x, y }))
         .expect("fill part");
     let kd = kd_map(&doc);
     for (i, v) in kd.iter().enumerate() {
         let on_mesh = surface.bake.triangle(i).is_some();
         assert_eq!(*v == painted, on_mesh, "texel {i}");
     }
-    doc.apply(Command::Undo).expect("undo");
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert!(kd_map(&doc).iter().all(|v| *v != painted));
 }
 
@@ -467,14 +470,14 @@ fn fills_by_island_and_by_part() {
 fn mesh_commands_without_a_mesh_are_clear_errors() {
     let mut doc = Document::new(64, 64, DocumentSettings::default()).expect("doc");
     let err = doc
-        .apply(Command::SurfaceStroke {
+        .apply(StrokeCommand::SurfaceStroke {
             tool: StrokeTool::Brush,
             points: vec![at(Vec3::Y)],
         })
         .expect_err("no surface");
     assert!(err.to_string().contains("needs a mesh"), "{err}");
     let err = doc
-        .apply(Command::Fill(FillRegion::Island { x: 1, y: 1 }))
+        .apply(PaintCommand::Fill(FillRegion::Island { x: 1, y: 1 }))
         .expect_err("no surface");
     assert!(err.to_string().contains("needs a mesh"), "{err}");
     let other = sphere_surface(32);
@@ -491,7 +494,7 @@ fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
             point: Vec3::new(0.0, 0.0, 1.0),
             normal: Vec3::Z,
         };
-        doc.apply(Command::SurfaceStroke {
+        doc.apply(StrokeCommand::SurfaceStroke {
             tool: StrokeTool::Brush,
             points: vec![SurfacePoint { pos, pressure: 1.0 }],
         })
@@ -502,8 +505,11 @@ fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
     let version = doc.version();
     let small = resized_stack(doc.stack(), 64, 64).expect("resized");
     let baked = Arc::new(Surface::new(surface.mesh.clone(), 64, 64).expect("bake"));
-    doc.apply(Command::Resize(ResizedMaps(Arc::new((small, Some(baked))))))
-        .expect("resize");
+    doc.apply(ImportCommand::Resize(ResizedMaps(Arc::new((
+        small,
+        Some(baked),
+    )))))
+    .expect("resize");
     assert_eq!(
         (doc.maps().width(), doc.surface().map(|s| s.width())),
         (64, Some(64))
@@ -513,9 +519,9 @@ fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
     // Painting on the mesh at the new size works (the surface follows the maps).
     on_sphere(&mut doc);
     // Two steps back: the stroke, then the resize; the maps and the surface return exactly.
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(texels(&doc), after);
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(texels(&doc), before);
     assert!(Arc::ptr_eq(doc.surface().expect("surface"), &surface));
     assert_eq!(
@@ -524,15 +530,18 @@ fn a_resize_is_one_undo_step_that_brings_back_the_maps_and_their_surface() {
         "undone to the state it had: the version it had"
     );
     // Redo brings the resized maps back, bit-exactly.
-    doc.apply(Command::Redo).expect("redo");
+    doc.apply(HistoryCommand::Redo).expect("redo");
     assert_eq!(texels(&doc), after);
     assert_eq!(doc.surface().map(|s| s.width()), Some(64));
     // A baked surface of another size is refused, and nothing changes.
     let wrong = Arc::new(Surface::new(surface.mesh.clone(), 32, 32).expect("bake"));
     let big = resized_stack(doc.stack(), 128, 128).expect("resized");
     assert!(
-        doc.apply(Command::Resize(ResizedMaps(Arc::new((big, Some(wrong))))))
-            .is_err()
+        doc.apply(ImportCommand::Resize(ResizedMaps(Arc::new((
+            big,
+            Some(wrong)
+        )))))
+        .is_err()
     );
     assert_eq!(texels(&doc), after);
 }

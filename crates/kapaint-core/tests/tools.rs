@@ -14,11 +14,12 @@ use kapaint_core::model::paint::GradientShape;
 use kapaint_core::model::surface::Surface;
 use kapaint_core::model::texel::{Channel, MaterialValue, Texel};
 use kapaint_core::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
+use kapaint_core::model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint_core::tools::{FillMode, Place, ToolEvent, ToolKind, Tools};
 
 fn document() -> Document {
     let mut doc = Document::new(128, 64, DocumentSettings::default()).expect("doc");
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.9, 0.1, 0.1),
         Vec3::splat(0.4),
         500.0,
@@ -102,7 +103,7 @@ fn a_brush_stroke_is_one_undo_step_from_press_to_release() {
     );
     assert!(matches!(
         commands[0],
-        Command::BeginStroke(StrokeTool::Brush)
+        Command::Stroke(StrokeCommand::BeginStroke(StrokeTool::Brush))
     ));
     assert!(tools.busy(), "drawing until released");
     assert!(doc.stroking());
@@ -110,7 +111,7 @@ fn a_brush_stroke_is_one_undo_step_from_press_to_release() {
     assert!(!tools.busy() && !doc.stroking());
     assert_ne!(texels(&doc), before, "painted");
     assert_eq!(doc.history().undo_steps().count(), 1, "one step");
-    doc.apply(Command::Undo).expect("undo");
+    doc.apply(HistoryCommand::Undo).expect("undo");
     assert_eq!(texels(&doc), before, "undone bit-exactly");
 }
 
@@ -120,8 +121,9 @@ fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
         for on_mesh in [false, true] {
             let mut doc = with_sphere(document());
             // Something for the eraser and the blur to change.
-            doc.apply(Command::Fill(FillRegion::All)).expect("fill");
-            doc.apply(Command::SetPrimary(MaterialValue::new(
+            doc.apply(PaintCommand::Fill(FillRegion::All))
+                .expect("fill");
+            doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
                 Vec3::ZERO,
                 Vec3::ZERO,
                 2.0,
@@ -164,7 +166,11 @@ fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
             assert!(!commands.is_empty(), "{kind:?} started a stroke");
             assert_ne!(texels(&doc), before, "{kind:?} painted before Escape");
             let aborted = run(&mut tools, &mut doc, &[ToolEvent::Escape]);
-            assert_eq!(aborted, vec![Command::AbortStroke], "{kind:?}");
+            assert_eq!(
+                aborted,
+                vec![Command::from(StrokeCommand::AbortStroke)],
+                "{kind:?}"
+            );
             assert_eq!(
                 texels(&doc),
                 before,
@@ -207,7 +213,7 @@ fn a_gradient_dragged_on_the_mesh_lays_a_gradient_not_a_pick() {
         ],
     );
     assert_eq!(commands.len(), 1, "{commands:?}");
-    let Command::Gradient { shape, start, end } = commands[0] else {
+    let Command::Paint(PaintCommand::Gradient { shape, start, end }) = commands[0] else {
         panic!("not a gradient: {commands:?}");
     };
     assert_eq!(shape, GradientShape::Linear);
@@ -242,10 +248,10 @@ fn a_gradient_can_be_radial_and_escape_drops_it() {
     );
     assert!(matches!(
         commands[..],
-        [Command::Gradient {
+        [Command::Paint(PaintCommand::Gradient {
             shape: GradientShape::Radial,
             ..
-        }]
+        })]
     ));
     // Radial: equal values at equal distances from the start.
     let (l, r) = (doc.maps().value(43, 32), doc.maps().value(84, 32)); // centres 20.5 away
@@ -256,7 +262,7 @@ fn a_gradient_can_be_radial_and_escape_drops_it() {
 fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
     // Two halves: a red one painted, the other still the base.
     let mut doc = document();
-    doc.apply(Command::Gradient {
+    doc.apply(PaintCommand::Gradient {
         shape: GradientShape::Linear,
         start: Vec2::new(63.0, 0.0),
         end: Vec2::new(64.0, 0.0),
@@ -268,7 +274,7 @@ fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
         channel: Channel::Kd,
         tolerance: 0.01,
     };
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         Vec3::new(0.0, 0.8, 0.0),
         Vec3::ZERO,
         4.0,
@@ -281,12 +287,12 @@ fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
     );
     assert!(matches!(
         commands[..],
-        [Command::Fill(FillRegion::Similar {
+        [Command::Paint(PaintCommand::Fill(FillRegion::Similar {
             x: 10,
             y: 10,
             channel: Channel::Kd,
             ..
-        })]
+        }))]
     ));
     assert!(
         doc.maps().value(10, 10).kd.y > 0.7,
@@ -298,17 +304,23 @@ fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
     );
     tools.fill.mode = FillMode::All;
     let commands = run(&mut tools, &mut doc, &[press(10.0, 10.0)]);
-    assert_eq!(commands, vec![Command::Fill(FillRegion::All)]);
+    assert_eq!(
+        commands,
+        vec![Command::from(PaintCommand::Fill(FillRegion::All))]
+    );
     // Island: on the mesh's UVs an island, off them (no mesh here) the whole map.
     tools.fill.mode = FillMode::Island;
     assert_eq!(
         tools.handle(press(10.0, 10.0), &doc),
-        vec![Command::Fill(FillRegion::All)]
+        vec![Command::from(PaintCommand::Fill(FillRegion::All))]
     );
     let doc = with_sphere(doc);
     assert!(matches!(
         tools.handle(press(10.0, 10.0), &doc)[..],
-        [Command::Fill(FillRegion::Island { x: 10, y: 10 })]
+        [Command::Paint(PaintCommand::Fill(FillRegion::Island {
+            x: 10,
+            y: 10
+        }))]
     ));
     // Off the map: nothing.
     assert!(tools.handle(press(-3.0, 10.0), &doc).is_empty());
@@ -325,7 +337,10 @@ fn the_picker_reads_the_texel_under_the_pointer_in_either_view() {
     let mut tools = Tools::default();
     tools.select(ToolKind::Picker, &doc);
     let commands = run(&mut tools, &mut doc, &[press(60.5, 30.5)]);
-    assert_eq!(commands, vec![Command::Pick { x: 60, y: 30 }]);
+    assert_eq!(
+        commands,
+        vec![Command::from(PaintCommand::Pick { x: 60, y: 30 })]
+    );
     let place = on_surface(&doc, Vec3::new(0.0, 0.0, 1.0));
     let (x, y) = place.texel_index((128, 64)).expect("on the map");
     let commands = run(
@@ -336,7 +351,7 @@ fn the_picker_reads_the_texel_under_the_pointer_in_either_view() {
             pressure: 1.0,
         }],
     );
-    assert_eq!(commands, vec![Command::Pick { x, y }]);
+    assert_eq!(commands, vec![Command::from(PaintCommand::Pick { x, y })]);
     assert_eq!(doc.settings().primary, doc.maps().value(x, y));
 }
 
@@ -346,8 +361,8 @@ fn switching_tools_mid_stroke_keeps_the_stroke_and_drops_a_gradient() {
     let mut tools = Tools::default();
     run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
     let ended = tools.select(ToolKind::Picker, &doc);
-    assert_eq!(ended, vec![Command::EndStroke]);
-    doc.apply(Command::EndStroke).expect("end");
+    assert_eq!(ended, vec![Command::from(StrokeCommand::EndStroke)]);
+    doc.apply(StrokeCommand::EndStroke).expect("end");
     assert_eq!(doc.history().undo_steps().count(), 1, "the stroke is kept");
     tools.select(ToolKind::Gradient, &doc);
     run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
@@ -375,9 +390,14 @@ fn a_stroke_stays_in_the_view_it_began_in() {
             ToolEvent::Release,
         ],
     );
-    assert!(matches!(commands[1], Command::SurfaceStrokeTo(_)));
+    assert!(matches!(
+        commands[1],
+        Command::Stroke(StrokeCommand::SurfaceStrokeTo(_))
+    ));
     assert!(
-        !commands.iter().any(|c| matches!(c, Command::StrokeTo(_))),
+        !commands
+            .iter()
+            .any(|c| matches!(c, Command::Stroke(StrokeCommand::StrokeTo(_)))),
         "the canvas drag is not part of a mesh stroke: {commands:?}"
     );
 }

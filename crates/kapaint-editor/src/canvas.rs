@@ -304,14 +304,15 @@ impl Canvas {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use kapaint_core::model::{Command, DocumentSettings, FillRegion};
+    use kapaint_core::model::PaintCommand;
+    use kapaint_core::model::{DocumentSettings, FillRegion};
 
     #[test]
     fn another_document_of_the_same_size_is_mirrored_whole() {
         let ctx = egui::Context::default();
         let mut canvas = Canvas::default();
         let mut painted = Document::new(256, 256, DocumentSettings::default()).unwrap();
-        painted.apply(Command::Fill(FillRegion::All)).unwrap();
+        painted.apply(PaintCommand::Fill(FillRegion::All)).unwrap();
         let all = painted.maps().tile_count();
         let sync = |canvas: &mut Canvas, doc: &Document| {
             canvas.sync(&ctx, doc, doc.maps(), doc.maps().id())

@@ -12,6 +12,7 @@ use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
 use kapaint_core::model::brush::SurfacePos;
 use kapaint_core::model::{Command, StrokeTool};
+use kapaint_core::model::{PaintCommand, StrokeCommand};
 use kapaint_core::render::FrameSettings;
 use kapaint_core::tools::{Place, ToolEvent, ToolKind};
 
@@ -49,9 +50,8 @@ impl EditorState {
         for command in self.tools.handle(event, &self.doc) {
             let lays = matches!(
                 command,
-                Command::BeginStroke(StrokeTool::Brush)
-                    | Command::Fill(_)
-                    | Command::Gradient { .. }
+                Command::Stroke(StrokeCommand::BeginStroke(StrokeTool::Brush))
+                    | Command::Paint(PaintCommand::Fill(_) | PaintCommand::Gradient { .. })
             );
             self.apply(command);
             if lays {

@@ -11,7 +11,8 @@ use super::{EditorState, MeshState, autosave_interval, notice};
 use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::surface::Surface;
 use kapaint_core::model::texel::Channel;
-use kapaint_core::model::{Command, Document, DocumentSettings, ModelError, project, recovery};
+use kapaint_core::model::{Document, DocumentSettings, ModelError, project, recovery};
+use kapaint_core::model::{ImportCommand, SettingsCommand};
 use kapaint_core::task::Progress;
 
 /// What a worker hands back.
@@ -202,7 +203,7 @@ impl EditorState {
                 }
                 let mesh = MeshRef::from_spec(&path.display().to_string());
                 let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
-                match self.doc.apply(Command::SetMesh(attached)) {
+                match self.doc.apply(ImportCommand::SetMesh(attached)) {
                     Ok(()) => {
                         self.follow_mesh();
                         self.notices
@@ -214,7 +215,7 @@ impl EditorState {
             JobResult::Image(path, planes) => {
                 let channel = planes.channel();
                 let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
-                match self.doc.apply(Command::ImportChannel(imported)) {
+                match self.doc.apply(ImportCommand::ImportChannel(imported)) {
                     Ok(()) => self.notices.push(notice(
                         format!(
                             "{} imported into {}",
@@ -228,7 +229,7 @@ impl EditorState {
             }
             JobResult::Resized(resized) => {
                 let (w, h) = (resized.0.0.width, resized.0.0.height);
-                self.apply(Command::Resize(resized));
+                self.apply(ImportCommand::Resize(resized).into());
                 self.notices
                     .push(notice(format!("Resized the maps to {w}x{h}"), false));
             }
@@ -244,7 +245,7 @@ impl EditorState {
             JobResult::Stamp(path, stamp) => {
                 let mut brush = self.doc.settings().brush.clone();
                 brush.stamp = Some(stamp);
-                self.apply(Command::SetBrush(brush));
+                self.apply(SettingsCommand::SetBrush(brush).into());
                 self.notices
                     .push(notice(format!("stamp {}", path.display()), false));
             }
@@ -346,7 +347,7 @@ impl EditorState {
             normal: normal.map(Arc::new),
             report: Some(report.clone()),
         };
-        if let Err(e) = self.doc.apply(Command::ImportMaterial(imported)) {
+        if let Err(e) = self.doc.apply(ImportCommand::ImportMaterial(imported)) {
             self.notices.push(notice(e.to_string(), true));
             return;
         }

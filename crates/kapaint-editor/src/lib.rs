@@ -433,8 +433,8 @@ impl EditorState {
     }
 
     /// Applies a command as the panels do (an error becomes a notice).
-    pub fn apply_command(&mut self, command: Command) {
-        self.apply(command);
+    pub fn apply_command(&mut self, command: impl Into<Command>) {
+        self.apply(command.into());
     }
 
     fn apply(&mut self, command: Command) {

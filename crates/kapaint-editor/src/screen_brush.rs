@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use super::{EditorState, project};
-use kapaint_core::model::Command;
+use kapaint_core::model::SettingsCommand;
 
 /// How the brush's size is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,7 +89,7 @@ impl EditorState {
         let mut brush = self.doc.settings().brush.clone();
         if (brush.radius_px - radius).abs() > 1e-3 * radius {
             brush.radius_px = radius;
-            self.apply(Command::SetBrush(brush));
+            self.apply(SettingsCommand::SetBrush(brush).into());
         }
     }
 

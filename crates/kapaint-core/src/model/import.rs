@@ -224,7 +224,7 @@ fn triangle_taps(src: u32, dst: u32) -> Vec<(u32, Vec<f32>)> {
 
 /// One channel resampled to a map size and encoded, a plane per tile (row-major tiles):
 /// the heavy part of an import, done off the UI thread, installed by
-/// [`super::Command::ImportChannel`].
+/// [`super::ImportCommand::ImportChannel`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum ChannelPlanes {
     /// `k_d` or `k_s`.
@@ -445,7 +445,7 @@ pub fn import_into(
 ) -> Result<(), ModelError> {
     let (w, h) = (doc.maps().width(), doc.maps().height());
     let planes = resample(image, channel, w, h);
-    doc.apply(super::Command::ImportChannel(ImportedChannel(
+    doc.apply(super::ImportCommand::ImportChannel(ImportedChannel(
         std::sync::Arc::new(planes),
     )))
 }

@@ -26,8 +26,9 @@ pub mod texel;
 pub mod tile;
 
 pub use document::{
-    Command, Document, DocumentSettings, FillRegion, LayerKind, LayerMove, LayerPlace, LayerRef,
-    StrokeTool,
+    Command, Document, DocumentSettings, FillRegion, HistoryCommand, ImportCommand, LayerCommand,
+    LayerKind, LayerMove, LayerPlace, LayerRef, MaskCommand, PaintCommand, SettingsCommand,
+    StrokeCommand, StrokeTool,
 };
 pub use error::ModelError;
 pub use maps::MaterialMaps;

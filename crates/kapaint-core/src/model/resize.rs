@@ -15,7 +15,7 @@ use super::surface::Surface;
 use super::texel::{Channel, MaterialValue, decode_rgb};
 
 /// A layer stack resampled to a new size with the mesh surface baked at that size: made on a
-/// worker, installed by [`super::Command::Resize`].
+/// worker, installed by [`super::ImportCommand::Resize`].
 #[derive(Clone, Debug)]
 pub struct ResizedMaps(pub Arc<(LayerStack, Option<Arc<Surface>>)>);
 

@@ -10,11 +10,12 @@ use crate::model::paint::GradientShape;
 use crate::model::{
     Channel, Channels, Command, Document, DocumentSettings, MaterialValue, StrokeTool, import,
 };
+use crate::model::{PaintCommand, SettingsCommand, StrokeCommand};
 
 /// [`textured`] with painting on `n` alone (what the documents then paint).
 fn textured_n_only(side: u32, texture: Option<&Path>) -> Result<Document, String> {
     let mut doc = textured(side, texture)?;
-    doc.apply(Command::SetChannels(Channels {
+    doc.apply(SettingsCommand::SetChannels(Channels {
         kd: false,
         ks: false,
         n: true,
@@ -46,28 +47,30 @@ pub fn typical_document(
     let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
     apply(
         &mut doc,
-        Command::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 2000.0)),
+        SettingsCommand::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 2000.0)).into(),
     )?;
     apply(
         &mut doc,
-        Command::SetSecondary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 8.0)),
+        SettingsCommand::SetSecondary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, 8.0)).into(),
     )?;
     apply(
         &mut doc,
-        Command::Gradient {
+        PaintCommand::Gradient {
             shape: GradientShape::Radial,
             start: Vec2::splat(s / 2.0),
             end: Vec2::new(s, s / 2.0),
-        },
+        }
+        .into(),
     )?;
-    apply(&mut doc, Command::SetChannels(Channels::ALL))?;
+    apply(&mut doc, SettingsCommand::SetChannels(Channels::ALL).into())?;
     apply(
         &mut doc,
-        Command::SetBrush(BrushSettings {
+        SettingsCommand::SetBrush(BrushSettings {
             radius_px: 64.0,
             hardness: 0.6,
             ..BrushSettings::default()
-        }),
+        })
+        .into(),
     )?;
     let mut state = 0x0123_4567_89AB_CDEF_u64;
     let mut next = move || {
@@ -82,7 +85,7 @@ pub fn typical_document(
             Vec3::splat(next()),
             1.0 + 500.0 * next(),
         );
-        apply(&mut doc, Command::SetPrimary(value))?;
+        apply(&mut doc, SettingsCommand::SetPrimary(value).into())?;
         let mut pos = Vec2::new(next() * s, next() * s);
         let mut points = Vec::new();
         for _ in 0..12 {
@@ -94,10 +97,11 @@ pub fn typical_document(
         }
         apply(
             &mut doc,
-            Command::Stroke {
+            StrokeCommand::Stroke {
                 tool: StrokeTool::Brush,
                 points,
-            },
+            }
+            .into(),
         )?;
     }
     Ok(doc)
@@ -116,11 +120,12 @@ pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Documen
     let apply = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
     apply(
         &mut doc,
-        Command::SetBrush(BrushSettings {
+        SettingsCommand::SetBrush(BrushSettings {
             radius_px: 100.0 * scale,
             hardness: 0.0,
             ..BrushSettings::default()
-        }),
+        })
+        .into(),
     )?;
     for (n, from, to) in [
         (3000.0, Vec2::new(0.1, 0.3), Vec2::new(0.9, 0.7)),
@@ -128,7 +133,7 @@ pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Documen
     ] {
         apply(
             &mut doc,
-            Command::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, n)),
+            SettingsCommand::SetPrimary(MaterialValue::new(Vec3::ZERO, Vec3::ZERO, n)).into(),
         )?;
         let points = (0..=32)
             .map(|k| StrokePoint {
@@ -138,10 +143,11 @@ pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Documen
             .collect();
         apply(
             &mut doc,
-            Command::Stroke {
+            StrokeCommand::Stroke {
                 tool: StrokeTool::Brush,
                 points,
-            },
+            }
+            .into(),
         )?;
     }
     Ok(doc)

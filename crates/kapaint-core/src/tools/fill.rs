@@ -1,5 +1,6 @@
 //! The fill tool: a press fills with the primary material, as its mode says.
 
+use crate::model::PaintCommand;
 use crate::model::texel::Channel;
 use crate::model::{Command, Document, FillRegion};
 
@@ -70,7 +71,7 @@ impl Tool for Fill {
         match event {
             ToolEvent::Press { at, .. } => at
                 .texel_index(size)
-                .map(|t| Command::Fill(self.region(doc, t)))
+                .map(|t| PaintCommand::Fill(self.region(doc, t)).into())
                 .into_iter()
                 .collect(),
             ToolEvent::Drag { .. } | ToolEvent::Release | ToolEvent::Escape => Vec::new(),

@@ -5,6 +5,7 @@
 
 use glam::Vec2;
 
+use crate::model::PaintCommand;
 use crate::model::paint::GradientShape;
 use crate::model::{Command, Document};
 
@@ -56,11 +57,14 @@ impl Tool for Gradient {
                 Vec::new()
             }
             ToolEvent::Release => match self.drag.take() {
-                Some((start, end)) if start != end => vec![Command::Gradient {
-                    shape: self.shape,
-                    start,
-                    end,
-                }],
+                Some((start, end)) if start != end => vec![
+                    PaintCommand::Gradient {
+                        shape: self.shape,
+                        start,
+                        end,
+                    }
+                    .into(),
+                ],
                 _ => Vec::new(),
             },
             ToolEvent::Escape => {

@@ -1,6 +1,7 @@
 //! The picker: a press reads every channel under the pointer into the primary material, on
 //! the UV canvas or on the mesh: of the composite, or (an option) of the selected layer.
 
+use crate::model::PaintCommand;
 use crate::model::{Command, Document};
 
 use super::{Tool, ToolEvent};
@@ -20,10 +21,11 @@ impl Tool for Picker {
                 .texel_index(size)
                 .map(|(x, y)| {
                     if self.from_layer {
-                        Command::PickLayer { x, y }
+                        PaintCommand::PickLayer { x, y }
                     } else {
-                        Command::Pick { x, y }
+                        PaintCommand::Pick { x, y }
                     }
+                    .into()
                 })
                 .into_iter()
                 .collect(),

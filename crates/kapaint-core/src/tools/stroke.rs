@@ -1,6 +1,7 @@
 //! The state machine the stroke tools share: a press begins a stroke (one undo step), drags
 //! add points in the view it began in, release ends it, Escape abandons it.
 
+use crate::model::StrokeCommand;
 use crate::model::brush::StrokePoint;
 use crate::model::{Command, Document, StrokeTool};
 
@@ -43,10 +44,10 @@ impl Stroke {
     fn point(&self, at: Place, pressure: f32) -> Option<Command> {
         match (self.state, at) {
             (StrokeState::OnCanvas, Place::Canvas(pos)) => {
-                Some(Command::StrokeTo(StrokePoint { pos, pressure }))
+                Some(StrokeCommand::StrokeTo(StrokePoint { pos, pressure }).into())
             }
             (StrokeState::OnSurface, Place::Surface { pos, .. }) => {
-                Some(Command::SurfaceStrokeTo(StrokePoint { pos, pressure }))
+                Some(StrokeCommand::SurfaceStrokeTo(StrokePoint { pos, pressure }).into())
             }
             _ => None,
         }
@@ -63,7 +64,7 @@ impl Stroke {
                     Place::Canvas(_) => StrokeState::OnCanvas,
                     Place::Surface { .. } => StrokeState::OnSurface,
                 };
-                let mut out = vec![Command::BeginStroke(self.tool)];
+                let mut out = vec![StrokeCommand::BeginStroke(self.tool).into()];
                 out.extend(self.point(at, pressure));
                 out
             }
@@ -72,11 +73,11 @@ impl Stroke {
             }
             ToolEvent::Release if self.state != StrokeState::Ready => {
                 self.state = StrokeState::Ready;
-                vec![Command::EndStroke]
+                vec![StrokeCommand::EndStroke.into()]
             }
             ToolEvent::Escape if self.state != StrokeState::Ready => {
                 self.state = StrokeState::Ready;
-                vec![Command::AbortStroke]
+                vec![StrokeCommand::AbortStroke.into()]
             }
             ToolEvent::Release | ToolEvent::Escape => Vec::new(),
         }

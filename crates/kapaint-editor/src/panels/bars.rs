@@ -6,7 +6,7 @@ use std::time::Duration;
 use crate::files::FilePurpose;
 use crate::keys::{self, Action};
 use crate::{EditorState, notice};
-use kapaint_core::model::Command;
+use kapaint_core::model::HistoryCommand;
 use kapaint_core::model::texel::Channel;
 use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
 
@@ -150,10 +150,10 @@ impl EditorState {
             });
             ui.menu_button("Edit", |ui| {
                 if item(ui, "Undo", Action::Undo) {
-                    self.apply(Command::Undo);
+                    self.apply(HistoryCommand::Undo.into());
                 }
                 if item(ui, "Redo", Action::Redo) {
-                    self.apply(Command::Redo);
+                    self.apply(HistoryCommand::Redo.into());
                 }
             });
             ui.menu_button("Image", |ui| {

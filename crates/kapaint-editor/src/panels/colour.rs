@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use crate::EditorState;
-use kapaint_core::model::Command;
+use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8, srgb_to_linear};
 
 /// How many recent materials the panel keeps.
@@ -109,7 +109,7 @@ impl EditorState {
                 .on_hover_text(format!("Secondary (X swaps): {}", describe(&secondary)))
                 .clicked()
             {
-                self.apply(Command::SwapMaterials);
+                self.apply(SettingsCommand::SwapMaterials.into());
                 *primary = self.doc.settings().primary;
             }
             ui.label("Hex");
@@ -206,7 +206,7 @@ impl EditorState {
             }
         });
         if let Some(v) = chosen {
-            self.apply(Command::SetPrimary(v));
+            self.apply(SettingsCommand::SetPrimary(v).into());
         }
     }
 

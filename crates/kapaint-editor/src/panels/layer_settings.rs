@@ -6,6 +6,7 @@ use crate::EditorState;
 use kapaint_core::model::layers::{Layer, LayerBlend, LayerContent};
 use kapaint_core::model::texel::{Channel, Channels};
 use kapaint_core::model::{Command, LayerMove};
+use kapaint_core::model::{LayerCommand, MaskCommand};
 
 impl EditorState {
     /// The selected layer's name, opacity, channels and blends, fill material, mask and moves.
@@ -14,14 +15,14 @@ impl EditorState {
             ui.label("No layer is selected.");
             return;
         };
-        let mut commands = Vec::new();
+        let mut commands: Vec<Command> = Vec::new();
         if let Some(name) = &mut self.layers_panel.rename {
             let edit = ui.text_edit_singleline(name);
             edit.request_focus();
             if edit.lost_focus() {
                 let entered = ui.input(|i| !i.key_pressed(egui::Key::Escape));
                 if entered && !name.trim().is_empty() && *name != layer.props.name {
-                    commands.push(Command::RenameLayer(name.trim().to_owned()));
+                    commands.push(LayerCommand::RenameLayer(name.trim().to_owned()).into());
                 }
                 self.layers_panel.rename = None;
             }
@@ -38,18 +39,22 @@ impl EditorState {
             )
             .changed()
         {
-            commands.push(Command::SetLayerOpacity(opacity / 100.0));
+            commands.push(LayerCommand::SetLayerOpacity(opacity / 100.0).into());
         }
-        commands.extend(channels_ui(ui, &layer));
+        commands.extend(channels_ui(ui, &layer).into_iter().map(Command::from));
         if let LayerContent::Fill(value) = layer.content
             && ui
                 .button("Fill with the primary material")
                 .on_hover_text(format!("Now: n {:.0}", value.n))
                 .clicked()
         {
-            commands.push(Command::SetLayerFill(self.doc.settings().primary));
+            commands.push(LayerCommand::SetLayerFill(self.doc.settings().primary).into());
         }
-        commands.extend(mask_ui(ui, &layer, self.doc.selection().mask));
+        commands.extend(
+            mask_ui(ui, &layer, self.doc.selection().mask)
+                .into_iter()
+                .map(Command::from),
+        );
         ui.horizontal_wrapped(|ui| {
             for (text, m) in [
                 ("Up", LayerMove::Up),
@@ -58,14 +63,14 @@ impl EditorState {
                 ("Out of group", LayerMove::OutOfGroup),
             ] {
                 if ui.button(text).clicked() {
-                    commands.push(Command::MoveLayer(m));
+                    commands.push(LayerCommand::MoveLayer(m).into());
                 }
             }
             if ui.button("Group").clicked() {
-                commands.push(Command::Group);
+                commands.push(LayerCommand::Group.into());
             }
             if matches!(layer.content, LayerContent::Group(_)) && ui.button("Ungroup").clicked() {
-                commands.push(Command::Ungroup);
+                commands.push(LayerCommand::Ungroup.into());
             }
         });
         for c in commands {
@@ -75,13 +80,13 @@ impl EditorState {
 }
 
 /// Per channel: whether the layer lays it over those below, and its blend mode.
-fn channels_ui(ui: &mut egui::Ui, layer: &Layer) -> Vec<Command> {
+fn channels_ui(ui: &mut egui::Ui, layer: &Layer) -> Vec<LayerCommand> {
     let mut commands = Vec::new();
     let mut on = layer.props.channels.map(|c| c.enabled);
     egui::Grid::new("layer channels").show(ui, |ui| {
         for (k, channel) in Channel::ALL.into_iter().enumerate() {
             if ui.checkbox(&mut on[k], channel.name()).changed() {
-                commands.push(Command::SetLayerChannels(Channels {
+                commands.push(LayerCommand::SetLayerChannels(Channels {
                     kd: on[0],
                     ks: on[1],
                     n: on[2],
@@ -97,7 +102,7 @@ fn channels_ui(ui: &mut egui::Ui, layer: &Layer) -> Vec<Command> {
                         .filter(|m| m.allowed_for(channel))
                     {
                         if ui.selectable_label(m == mode, m.name(channel)).clicked() && m != mode {
-                            commands.push(Command::SetLayerBlend { channel, mode: m });
+                            commands.push(LayerCommand::SetLayerBlend { channel, mode: m });
                         }
                     }
                 });
@@ -108,7 +113,7 @@ fn channels_ui(ui: &mut egui::Ui, layer: &Layer) -> Vec<Command> {
 }
 
 /// The mask's switches, or a button adding one.
-fn mask_ui(ui: &mut egui::Ui, layer: &Layer, painting_mask: bool) -> Vec<Command> {
+fn mask_ui(ui: &mut egui::Ui, layer: &Layer, painting_mask: bool) -> Vec<MaskCommand> {
     let mut commands = Vec::new();
     ui.horizontal_wrapped(|ui| {
         let Some(mask) = &layer.mask else {
@@ -117,26 +122,26 @@ fn mask_ui(ui: &mut egui::Ui, layer: &Layer, painting_mask: bool) -> Vec<Command
                 .on_hover_text("A white mask: paint black to hide")
                 .clicked()
             {
-                commands.push(Command::AddMask);
+                commands.push(MaskCommand::AddMask);
             }
             return;
         };
         let (text, command) = if painting_mask {
-            ("Paint the layer", Command::SelectContent)
+            ("Paint the layer", MaskCommand::SelectContent)
         } else {
-            ("Paint the mask", Command::SelectMask)
+            ("Paint the mask", MaskCommand::SelectMask)
         };
         if ui.button(text).clicked() {
             commands.push(command);
         }
         let mut enabled = mask.enabled;
         if ui.checkbox(&mut enabled, "Mask on").changed() {
-            commands.push(Command::SetMaskEnabled(enabled));
+            commands.push(MaskCommand::SetMaskEnabled(enabled));
         }
         for (text, command) in [
-            ("Invert", Command::InvertMask),
-            ("Apply", Command::ApplyMask),
-            ("Delete mask", Command::DeleteMask),
+            ("Invert", MaskCommand::InvertMask),
+            ("Apply", MaskCommand::ApplyMask),
+            ("Delete mask", MaskCommand::DeleteMask),
         ] {
             if ui.button(text).clicked() {
                 commands.push(command);

@@ -12,6 +12,7 @@ use egui::{Color32, Rect, Sense, Vec2};
 use crate::EditorState;
 use kapaint_core::model::layers::{Layer, LayerContent, thumbnail};
 use kapaint_core::model::{Command, Document, LayerKind, LayerPlace};
+use kapaint_core::model::{LayerCommand, MaskCommand};
 
 /// Thumbnails' side in texels.
 const THUMB: u32 = 32;
@@ -235,16 +236,16 @@ impl EditorState {
                 self.new_layer(LayerKind::Group);
             }
             if add(ui, "Duplicate", "Duplicate the selected layer (Ctrl+J)") {
-                self.apply(Command::DuplicateLayer);
+                self.apply(LayerCommand::DuplicateLayer.into());
             }
             if add(ui, "Delete", "Delete the selected layer") {
-                self.apply(Command::DeleteLayer);
+                self.apply(LayerCommand::DeleteLayer.into());
             }
             if add(ui, "Merge down", "Merge into the layer below (Ctrl+E)") {
-                self.apply(Command::MergeDown);
+                self.apply(LayerCommand::MergeDown.into());
             }
             if add(ui, "Flatten", "Every layer into one paint layer") {
-                self.apply(Command::Flatten);
+                self.apply(LayerCommand::Flatten.into());
             }
         });
     }
@@ -257,7 +258,7 @@ impl EditorState {
             LayerKind::Fill => format!("Fill {}", count + 1),
             LayerKind::Group => format!("Group {}", count + 1),
         };
-        self.apply(Command::AddLayer { kind, name });
+        self.apply(LayerCommand::AddLayer { kind, name }.into());
     }
 
     /// Rows of `layers` (top first), groups' children indented under them.
@@ -292,7 +293,9 @@ impl EditorState {
                 ("–", "Show")
             };
             if icon_button(ui, eye, tip) {
-                action = Some(RowAction::Toggle(Command::SetLayerVisible(!p.visible)));
+                action = Some(RowAction::Toggle(
+                    LayerCommand::SetLayerVisible(!p.visible).into(),
+                ));
             }
             let (lock, tip) = if p.locked {
                 ("🔒", "Unlock")
@@ -300,7 +303,9 @@ impl EditorState {
                 ("🔓", "Lock")
             };
             if icon_button(ui, lock, tip) {
-                action = Some(RowAction::Toggle(Command::SetLayerLocked(!p.locked)));
+                action = Some(RowAction::Toggle(
+                    LayerCommand::SetLayerLocked(!p.locked).into(),
+                ));
             }
             let handle = egui::Id::new(("layer drag", path));
             ui.dnd_drag_source(handle, DraggedLayer(path.to_vec()), |ui| {
@@ -417,9 +422,9 @@ impl EditorState {
     fn row_action(&mut self, path: Vec<usize>, action: RowAction) {
         match action {
             RowAction::Select { mask, alone } => {
-                self.apply(Command::SelectPath(path));
+                self.apply(LayerCommand::SelectPath(path).into());
                 if mask {
-                    self.apply(Command::SelectMask);
+                    self.apply(MaskCommand::SelectMask.into());
                 }
                 if alone {
                     self.layer_view = LayerView::Mask;
@@ -428,17 +433,17 @@ impl EditorState {
             RowAction::Toggle(command) => {
                 // The eye and the lock act on their row's layer, leaving the selection be.
                 let before = self.doc.selection().clone();
-                self.apply(Command::SelectPath(path));
+                self.apply(LayerCommand::SelectPath(path).into());
                 self.apply(command);
                 if self.doc.stack().layer(&before.path).is_some() {
-                    self.apply(Command::SelectPath(before.path));
+                    self.apply(LayerCommand::SelectPath(before.path).into());
                     if before.mask {
-                        self.apply(Command::SelectMask);
+                        self.apply(MaskCommand::SelectMask.into());
                     }
                 }
             }
             RowAction::Rename => {
-                self.apply(Command::SelectPath(path));
+                self.apply(LayerCommand::SelectPath(path).into());
                 self.layers_panel.rename = Some(
                     self.doc
                         .stack()
@@ -448,11 +453,14 @@ impl EditorState {
                 );
             }
             RowAction::Drop(from, place) => {
-                self.apply(Command::SelectPath(from));
-                self.apply(Command::MoveLayerTo {
-                    target: path,
-                    place,
-                });
+                self.apply(LayerCommand::SelectPath(from).into());
+                self.apply(
+                    LayerCommand::MoveLayerTo {
+                        target: path,
+                        place,
+                    }
+                    .into(),
+                );
             }
         }
     }

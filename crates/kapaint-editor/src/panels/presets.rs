@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use crate::{EditorState, notice};
-use kapaint_core::model::Command;
+use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::brush::preset::{self as brush_preset, BrushPreset};
 use kapaint_core::model::texel::MaterialValue;
 
@@ -148,7 +148,7 @@ impl EditorState {
                 });
             });
         if let Some(v) = chosen {
-            self.apply(Command::SetPrimary(v));
+            self.apply(SettingsCommand::SetPrimary(v).into());
         }
     }
 
@@ -172,7 +172,7 @@ impl EditorState {
                 }
             });
         if let Some(b) = chosen {
-            self.apply(Command::SetBrush(b));
+            self.apply(SettingsCommand::SetBrush(b).into());
         }
         self.naming_ui(ui, Naming::Brush, "Save brush…");
     }

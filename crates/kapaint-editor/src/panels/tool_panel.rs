@@ -2,7 +2,7 @@
 
 use crate::files::FilePurpose;
 use crate::{EditorState, stamp_image, stamp_key};
-use kapaint_core::model::Command;
+use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::paint::GradientShape;
 use kapaint_core::model::texel::Channel;
 use kapaint_core::reflectance;
@@ -73,7 +73,7 @@ impl EditorState {
                 ui.add(egui::Slider::new(&mut brush.blur_radius_px, 1..=16).text("Blur radius"))
                     .on_hover_text("Kernel radius in texels");
                 if brush != self.doc.settings().brush {
-                    self.apply(Command::SetBrush(brush));
+                    self.apply(SettingsCommand::SetBrush(brush).into());
                 }
             }
             ToolKind::Picker => {
@@ -119,7 +119,7 @@ impl EditorState {
         self.stamp_ui(ui, &mut brush);
         stroke_options_ui(ui, &mut brush);
         if brush != self.doc.settings().brush {
-            self.apply(Command::SetBrush(brush));
+            self.apply(SettingsCommand::SetBrush(brush).into());
         }
         ui.separator();
         ui.heading("Material");
@@ -160,14 +160,14 @@ impl EditorState {
         ))
         .on_hover_text("The exponent of the other model with the closest highlight");
         if primary != self.doc.settings().primary {
-            self.apply(Command::SetPrimary(primary));
+            self.apply(SettingsCommand::SetPrimary(primary).into());
         }
         if ui
             .button("Swap primary / secondary")
             .on_hover_text("X")
             .clicked()
         {
-            self.apply(Command::SwapMaterials);
+            self.apply(SettingsCommand::SwapMaterials.into());
         }
         self.recent_materials_ui(ui);
         ui.separator();
@@ -179,7 +179,7 @@ impl EditorState {
             ui.checkbox(&mut ch.n, "n");
         });
         if ch != self.doc.settings().channels {
-            self.apply(Command::SetChannels(ch));
+            self.apply(SettingsCommand::SetChannels(ch).into());
         }
     }
 

@@ -6,8 +6,8 @@ use crate::EditorState;
 use crate::canvas::CanvasChannel;
 use crate::panels::layers::LayerView;
 use crate::viewport::Compare;
-use kapaint_core::model::Command;
 use kapaint_core::model::texel::MaterialValue;
+use kapaint_core::model::{HistoryCommand, SettingsCommand};
 use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
 use kapaint_core::render::{FrameSettings, ViewMode};
 
@@ -112,7 +112,7 @@ impl EditorState {
             });
         }
         if model != self.doc.settings().model {
-            self.apply(Command::SetModel(model));
+            self.apply(SettingsCommand::SetModel(model).into());
         }
         let mut approx = self.doc.settings().approx;
         ui.add_enabled_ui(model.has_paper_forms(), |ui| {
@@ -130,7 +130,7 @@ impl EditorState {
              kapaint's fit (within 2e-5 of the exact integral)",
         );
         if approx != self.doc.settings().approx {
-            self.apply(Command::SetApprox(approx));
+            self.apply(SettingsCommand::SetApprox(approx).into());
         }
         self.compare_ui(ui);
         ui.heading("View");
@@ -209,7 +209,7 @@ impl EditorState {
                 }
             });
         if let Some(n) = jump {
-            self.apply(Command::HistoryJump(n));
+            self.apply(HistoryCommand::HistoryJump(n).into());
         }
     }
 

@@ -54,9 +54,31 @@ pub enum FillRegion {
     },
 }
 
-/// Everything that changes a document.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// Everything that changes a document, by room: each room's commands are their own enum,
+/// and [`Document::apply`](super::Document::apply) hands each to the room that matches it
+/// exhaustively. Scripts name the commands flat, as they always have (see `script.rs`).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(from = "super::script::ScriptCommand")]
 pub enum Command {
+    /// The tool settings: brush, materials, channels, shading.
+    Settings(SettingsCommand),
+    /// Strokes of the brush, eraser and blur.
+    Stroke(StrokeCommand),
+    /// The one-click tools: fills, gradients, picks.
+    Paint(PaintCommand),
+    /// What a worker made from a file: channels, materials, normal maps, meshes, resized maps.
+    Import(ImportCommand),
+    /// Undo and redo.
+    History(HistoryCommand),
+    /// The layer stack.
+    Layer(LayerCommand),
+    /// The selected layer's mask.
+    Mask(MaskCommand),
+}
+
+/// Commands that change the tool settings (no undo step: they are not part of the material).
+#[derive(Clone, Debug, PartialEq)]
+pub enum SettingsCommand {
     /// Replaces the brush settings (sanitised).
     SetBrush(BrushSettings),
     /// Sets the primary material.
@@ -71,6 +93,11 @@ pub enum Command {
     SetModel(ShadingModel),
     /// Sets the approximation of `chi`.
     SetApprox(AmbientApprox),
+}
+
+/// Strokes: each is one undo step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StrokeCommand {
     /// Starts a stroke (one undo step).
     BeginStroke(StrokeTool),
     /// Moves the stroke to a new input point.
@@ -95,6 +122,11 @@ pub enum Command {
         /// Input points in object space.
         points: Vec<SurfacePoint>,
     },
+}
+
+/// The one-click tools.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PaintCommand {
     /// Fills with the primary material.
     Fill(FillRegion),
     /// A gradient from the primary (at `start`) to the secondary material (at `end`).
@@ -102,10 +134,8 @@ pub enum Command {
         /// Linear or radial.
         shape: GradientShape,
         /// Start point in texel units.
-        #[serde(deserialize_with = "crate::model::check::finite_vec2")]
         start: Vec2,
         /// End point in texel units.
-        #[serde(deserialize_with = "crate::model::check::finite_vec2")]
         end: Vec2,
     },
     /// Reads every channel at a texel into the primary material.
@@ -124,27 +154,30 @@ pub enum Command {
         /// Texel row.
         y: u32,
     },
-    /// Replaces a channel with an image already resampled to the map size (one undo step;
-    /// see [`crate::model::import`]). Not for scripts: its planes come from a decoder.
-    #[serde(skip)]
+}
+
+/// What a worker made from a file, each put in place as one undo step. Not for scripts: their
+/// content comes from a decoder or a worker.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ImportCommand {
+    /// Replaces a channel with an image already resampled to the map size (see
+    /// [`crate::model::import`]).
     ImportChannel(ImportedChannel),
     /// Replaces `k_d`, `k_s` and `n` of the selected paint layer with maps of the document's
-    /// size (a PBR material converted on a worker), as one undo step. Not for scripts.
-    #[serde(skip)]
+    /// size (a PBR material converted on a worker), with its normal map and report.
     ImportMaterial(ImportedMaterial),
-    /// Sets or clears the material's normal map, as one undo step. Not for scripts: its map
-    /// comes from a decoder.
-    #[serde(skip)]
+    /// Sets or clears the material's normal map.
     SetNormal(AttachedNormal),
-    /// Makes a mesh, baked at the map size on a worker, the project's mesh, as one undo step.
-    /// Not for scripts: its bake comes from a worker.
-    #[serde(skip)]
+    /// Makes a mesh, baked at the map size on a worker, the project's mesh.
     SetMesh(AttachedMesh),
     /// Installs maps resized on a worker ([`crate::model::resize::resized`]) with the mesh
-    /// surface baked at their size, as one undo step. Not for scripts: its maps come from a
-    /// worker.
-    #[serde(skip)]
+    /// surface baked at their size.
     Resize(crate::model::resize::ResizedMaps),
+}
+
+/// Moves through the undo history.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HistoryCommand {
     /// Undoes the last step.
     Undo,
     /// Redoes the last undone step.
@@ -152,27 +185,31 @@ pub enum Command {
     /// Undoes or redoes until this many steps are applied (0: the state before the oldest
     /// step kept; the history panel's click on a step).
     HistoryJump(usize),
+}
+
+/// The layer stack: selection, properties and structure; each change is one undo step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LayerCommand {
     /// Adds a layer above the selected one (in its group) and selects it.
     AddLayer {
         /// Paint, fill (the primary material) or group.
         kind: LayerKind,
         /// Its name.
-        #[serde(deserialize_with = "crate::model::check::layer_name")]
         name: String,
     },
-    /// Selects a layer by index (0: the bottom of the top level) or name (the topmost of
-    /// that name, at any depth); tools then paint its content.
+    /// Selects a layer by index (0: the bottom of the top level), name (the topmost of that
+    /// name, at any depth) or id; tools then paint its content.
     SelectLayer(LayerRef),
     /// Selects the layer at a path of indices into groups (the Layers panel).
     SelectPath(Vec<usize>),
     /// Sets the selected layer's opacity (clamped to `[0, 1]`).
-    SetLayerOpacity(#[serde(deserialize_with = "crate::model::check::layer_opacity")] f32),
+    SetLayerOpacity(f32),
     /// Shows or hides the selected layer.
     SetLayerVisible(bool),
     /// Locks or unlocks the selected layer against painting.
     SetLayerLocked(bool),
     /// Renames the selected layer.
-    RenameLayer(#[serde(deserialize_with = "crate::model::check::layer_name")] String),
+    RenameLayer(String),
     /// Sets the blend mode of one of the selected layer's channels.
     SetLayerBlend {
         /// The channel.
@@ -201,6 +238,15 @@ pub enum Command {
     MergeDown,
     /// Flattens every layer into one paint layer of the composite.
     Flatten,
+    /// Puts the selected layer into a new group in its place.
+    Group,
+    /// Replaces the selected group by its layers.
+    Ungroup,
+}
+
+/// The selected layer's mask; each change is one undo step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaskCommand {
     /// Adds a white mask to the selected layer.
     AddMask,
     /// Deletes the selected layer's mask.
@@ -221,14 +267,26 @@ pub enum Command {
         /// The channel read.
         channel: Channel,
         /// The threshold.
-        #[serde(deserialize_with = "crate::model::check::finite_f32")]
         threshold: f32,
     },
-    /// Puts the selected layer into a new group in its place.
-    Group,
-    /// Replaces the selected group by its layers.
-    Ungroup,
 }
+
+macro_rules! room {
+    ($room:ident, $ty:ty) => {
+        impl From<$ty> for Command {
+            fn from(command: $ty) -> Self {
+                Self::$room(command)
+            }
+        }
+    };
+}
+room!(Settings, SettingsCommand);
+room!(Stroke, StrokeCommand);
+room!(Paint, PaintCommand);
+room!(Import, ImportCommand);
+room!(History, HistoryCommand);
+room!(Layer, LayerCommand);
+room!(Mask, MaskCommand);
 
 /// A layer's kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -257,7 +315,7 @@ pub enum LayerRef {
     },
 }
 
-/// Where [`Command::MoveLayer`] moves a layer.
+/// Where [`LayerCommand::MoveLayer`] moves a layer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum LayerMove {
     /// One place up in its list.
@@ -274,7 +332,7 @@ pub enum LayerMove {
     OutOfGroup,
 }
 
-/// Where [`Command::MoveLayerTo`] puts a layer, relative to its target.
+/// Where [`LayerCommand::MoveLayerTo`] puts a layer, relative to its target.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum LayerPlace {
     /// Just above the target, in the target's list.
@@ -290,7 +348,7 @@ pub enum LayerPlace {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImportedChannel(pub Arc<crate::model::import::ChannelPlanes>);
 
-/// A material converted on a worker for [`Command::ImportMaterial`]: its maps, the normal map
+/// A material converted on a worker for [`ImportCommand::ImportMaterial`]: its maps, the normal map
 /// it brought and the report of its conversion, all undone together. Shared so that the
 /// command clones cheaply (equal when they are the same maps).
 #[derive(Clone, Debug)]
@@ -309,7 +367,7 @@ impl PartialEq for ImportedMaterial {
     }
 }
 
-/// A normal map for [`Command::SetNormal`] (none: cleared); equal when it is the same map.
+/// A normal map for [`ImportCommand::SetNormal`] (none: cleared); equal when it is the same map.
 #[derive(Clone, Debug)]
 pub struct AttachedNormal(pub Option<Arc<crate::model::normal::NormalMap>>);
 
@@ -322,7 +380,7 @@ impl PartialEq for AttachedNormal {
     }
 }
 
-/// A mesh for [`Command::SetMesh`]: how the project names it and its bake at the map size;
+/// A mesh for [`ImportCommand::SetMesh`]: how the project names it and its bake at the map size;
 /// equal when it is the same bake.
 #[derive(Clone, Debug)]
 pub struct AttachedMesh {
@@ -344,9 +402,10 @@ impl Command {
     pub fn needs_surface(&self) -> bool {
         matches!(
             self,
-            Self::SurfaceStrokeTo(_)
-                | Self::SurfaceStroke { .. }
-                | Self::Fill(FillRegion::Island { .. } | FillRegion::Part { .. })
+            Self::Stroke(StrokeCommand::SurfaceStrokeTo(_) | StrokeCommand::SurfaceStroke { .. })
+                | Self::Paint(PaintCommand::Fill(
+                    FillRegion::Island { .. } | FillRegion::Part { .. }
+                ))
         )
     }
 }

@@ -2,7 +2,7 @@
 //! converted material, each one undo step.
 
 use super::Document;
-use super::layers::command_error;
+use super::paths::command_error;
 use crate::model::ModelError;
 use crate::model::import::ChannelPlanes;
 use crate::model::layers::Stamped;
@@ -11,7 +11,7 @@ use crate::model::texel::Channel;
 use crate::model::tile::Plane;
 
 impl Document {
-    /// [`Command::ImportMaterial`]: every channel of the selected paint layer from `maps`.
+    /// [`ImportCommand::ImportMaterial`]: every channel of the selected paint layer from `maps`.
     pub(super) fn import_material(
         &mut self,
         imported: &super::ImportedMaterial,

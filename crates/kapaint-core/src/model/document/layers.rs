@@ -1,20 +1,12 @@
 //! The layer commands, and the editing of the selected layer's planes by fills and gradients
 //! (imports: `import.rs`). Each command that changes the stack is one undo step.
 
-use super::{Command, Document, LayerKind, LayerRef, moves};
+use super::paths::{command_error, no_layer, resolve, selected_mut};
+use super::{Document, LayerCommand, moves, structure};
 use crate::model::ModelError;
 use crate::model::layers::edit::{EditValue, LayerEdit, Planes, PrePlanes};
-use crate::model::layers::{
-    Layer, LayerContent, LayerStack, LayerStroke, Mask, State, channel_index,
-};
+use crate::model::layers::{Layer, LayerContent, LayerStroke, Mask, State, channel_index};
 use crate::model::texel::MaterialValue;
-
-/// The most layers (groups and their children included) a document holds.
-pub const MAX_LAYERS: usize = 256;
-
-pub(super) fn command_error(text: impl Into<String>) -> ModelError {
-    ModelError::Command(text.into())
-}
 
 impl Document {
     /// Whether tools can paint the selection: a layer is selected, unlocked, and has planes
@@ -151,13 +143,13 @@ impl Document {
     }
 
     /// Records `before` as one undo step and brings the composite up to date.
-    fn commit(&mut self, label: &str, before: State) {
+    pub(super) fn commit(&mut self, label: &str, before: State) {
         self.record(label, before);
         self.compositor.update(&self.state.stack, &mut self.maps);
     }
 
     /// Runs `f` on the state as one undo step; on an error nothing changes.
-    fn change(
+    pub(super) fn change(
         &mut self,
         label: &str,
         f: impl FnOnce(&mut State, &CommandContext) -> Result<(), ModelError>,
@@ -177,272 +169,72 @@ impl Document {
         Ok(())
     }
 
-    /// The layer commands.
-    pub(super) fn layer_command(&mut self, command: Command) -> Result<(), ModelError> {
+    /// The layer room.
+    pub(super) fn layer_command(
+        &mut self,
+        command: LayerCommand,
+        opacity_run: Option<&[usize]>,
+    ) -> Result<(), ModelError> {
         match command {
-            Command::SelectLayer(r) => {
+            LayerCommand::SelectLayer(r) => {
                 let path = resolve(&self.state.stack, &r)?;
                 self.select(path, false);
                 Ok(())
             }
-            Command::SelectPath(path) => {
+            LayerCommand::SelectPath(path) => {
                 if self.state.stack.layer(&path).is_none() {
                     return Err(command_error(format!("no layer is at {path:?}")));
                 }
                 self.select(path, false);
                 Ok(())
             }
-            Command::SelectMask => {
-                let layer = self.selected()?;
-                if layer.mask.is_none() {
-                    return Err(command_error(format!(
-                        "the layer \"{}\" has no mask: add one first",
-                        layer.props.name
-                    )));
-                }
-                self.select(self.state.selection.path.clone(), true);
-                Ok(())
-            }
-            Command::SelectContent => {
-                self.selected()?;
-                self.select(self.state.selection.path.clone(), false);
-                Ok(())
-            }
-            Command::SetLayerVisible(v) => {
+            LayerCommand::SetLayerOpacity(opacity) => self.set_opacity(opacity, opacity_run),
+            LayerCommand::SetLayerVisible(v) => {
                 self.props(if v { "Show layer" } else { "Hide layer" }, |l| {
                     l.props.visible = v;
                     Ok(())
                 })
             }
-            Command::SetLayerLocked(v) => {
+            LayerCommand::SetLayerLocked(v) => {
                 self.props(if v { "Lock layer" } else { "Unlock layer" }, |l| {
                     l.props.locked = v;
                     Ok(())
                 })
             }
-            Command::RenameLayer(name) => self.props("Rename layer", |l| {
+            LayerCommand::RenameLayer(name) => self.props("Rename layer", |l| {
                 l.props.name = crate::model::check::fit_name(&name, "", &l.props.name);
                 Ok(())
             }),
-            Command::SetLayerBlend { channel, mode } => self.props("Layer blend mode", |l| {
-                if !mode.allowed_for(channel) {
-                    return Err(command_error(format!(
-                        "{} does not blend {}: use one of {}",
-                        channel.name(),
-                        mode.name(channel),
-                        crate::model::layers::LayerBlend::ALL
-                            .iter()
-                            .filter(|m| m.allowed_for(channel))
-                            .map(|m| m.name(channel))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )));
-                }
-                l.props.channels[channel_index(channel)].mode = mode;
-                Ok(())
-            }),
-            Command::SetLayerChannels(c) => self.props("Layer channels", |l| {
+            LayerCommand::SetLayerBlend { channel, mode } => {
+                self.props("Layer blend mode", |l| set_blend(l, channel, mode))
+            }
+            LayerCommand::SetLayerChannels(c) => self.props("Layer channels", |l| {
                 for (ch, on) in [c.kd, c.ks, c.n].into_iter().enumerate() {
                     l.props.channels[ch].enabled = on;
                 }
                 Ok(())
             }),
-            Command::SetLayerFill(v) => self.props("Fill material", |l| match &mut l.content {
-                LayerContent::Fill(value) => {
-                    *value = v.sanitized();
-                    Ok(())
-                }
-                _ => Err(command_error(format!(
-                    "the layer \"{}\" is not a fill layer",
-                    l.props.name
-                ))),
-            }),
-            other => self.structure_command(other),
-        }
-    }
-
-    /// The layer commands that change the stack's structure or masks.
-    fn structure_command(&mut self, command: Command) -> Result<(), ModelError> {
-        match command {
-            Command::AddLayer { kind, name } => self.change("Add layer", |st, cx| {
-                if count_layers(&st.stack.layers) >= MAX_LAYERS {
-                    return Err(command_error(format!(
-                        "a document holds at most {MAX_LAYERS} layers"
-                    )));
-                }
-                let layer = match kind {
-                    LayerKind::Paint => Layer::paint(name, cx.tile_count),
-                    LayerKind::Fill => Layer::fill(name, cx.primary),
-                    LayerKind::Group => Layer::group(name, Vec::new()),
-                };
-                let (parent, at) = match st.selection.path.split_last() {
-                    Some((&i, parent)) => (parent.to_vec(), i + 1),
-                    None => (Vec::new(), st.stack.layers.len()),
-                };
-                let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                list.insert(at.min(list.len()), layer);
-                st.selection.path = [parent, vec![at]].concat();
-                st.selection.mask = false;
+            LayerCommand::SetLayerFill(v) => self.props("Fill material", |l| set_fill(l, v)),
+            LayerCommand::AddLayer { kind, name } => {
+                self.change("Add layer", |st, cx| structure::add(st, cx, kind, name))
+            }
+            LayerCommand::DeleteLayer => self.change("Delete layer", |st, _| structure::delete(st)),
+            LayerCommand::DuplicateLayer => {
+                self.change("Duplicate layer", |st, _| structure::duplicate(st))
+            }
+            LayerCommand::MergeDown => self.change("Merge down", structure::merge_down),
+            LayerCommand::Flatten => self.change("Flatten", |st, cx| {
+                structure::flatten(st, cx);
                 Ok(())
             }),
-            Command::DeleteLayer => self.change("Delete layer", |st, _| {
-                let (parent, i) = split(&st.selection.path)?;
-                let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                list.remove(i);
-                st.selection.path = if list.is_empty() {
-                    parent
-                } else {
-                    [parent, vec![i.saturating_sub(1).min(list.len() - 1)]].concat()
-                };
-                st.selection.mask = false;
-                Ok(())
-            }),
-            Command::DuplicateLayer => self.change("Duplicate layer", |st, _| {
-                if count_layers(&st.stack.layers) >= MAX_LAYERS {
-                    return Err(command_error(format!(
-                        "a document holds at most {MAX_LAYERS} layers"
-                    )));
-                }
-                let (parent, i) = split(&st.selection.path)?;
-                let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                let mut copy = list[i].clone().with_fresh_ids();
-                // Never past what a project holds: the name is cut to leave room for " copy".
-                copy.props.name = crate::model::check::fit_name(&copy.props.name, " copy", "copy");
-                list.insert(i + 1, copy);
-                st.selection.path = [parent, vec![i + 1]].concat();
-                Ok(())
-            }),
-            Command::MergeDown => self.change("Merge down", |st, cx| {
-                let (parent, i) = split(&st.selection.path)?;
-                if i == 0 {
-                    return Err(command_error(
-                        "no layer is below the selected one to merge into",
-                    ));
-                }
-                let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                let tiles = crate::model::layers::ops::merged(&list[i - 1..=i], cx.tile_count);
-                let name = list[i - 1].props.name.clone();
-                list.splice(
-                    i - 1..=i,
-                    [Layer {
-                        props: crate::model::layers::LayerProps::named(name),
-                        content: LayerContent::Paint(tiles),
-                        mask: None,
-                    }],
-                );
-                st.selection.path = [parent, vec![i - 1]].concat();
-                st.selection.mask = false;
-                Ok(())
-            }),
-            Command::Flatten => self.change("Flatten", |st, cx| {
-                st.stack = LayerStack::from_maps(cx.maps, st.stack.base, "Flattened");
-                st.selection.path = vec![0];
-                st.selection.mask = false;
-                Ok(())
-            }),
-            Command::MoveLayer(m) => self.change("Move layer", |st, _| moves::move_layer(st, m)),
-            Command::MoveLayerTo { target, place } => self.change("Move layer", |st, _| {
+            LayerCommand::MoveLayer(m) => {
+                self.change("Move layer", |st, _| moves::move_layer(st, m))
+            }
+            LayerCommand::MoveLayerTo { target, place } => self.change("Move layer", |st, _| {
                 moves::move_layer_to(st, &target, place)
             }),
-            other => self.group_command(other),
-        }
-    }
-
-    /// Grouping and ungrouping.
-    fn group_command(&mut self, command: Command) -> Result<(), ModelError> {
-        match command {
-            Command::Group => self.change("Group", |st, _| {
-                let (parent, i) = split(&st.selection.path)?;
-                let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                let layer = list.remove(i);
-                list.insert(i, Layer::group("Group", vec![layer]));
-                st.selection.mask = false;
-                moves::check_depth(&st.stack)
-            }),
-            Command::Ungroup => self.change("Ungroup", |st, _| {
-                let (parent, i) = split(&st.selection.path)?;
-                let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
-                let LayerContent::Group(children) = &list[i].content else {
-                    return Err(command_error(format!(
-                        "the layer \"{}\" is not a group",
-                        list[i].props.name
-                    )));
-                };
-                let children = children.clone();
-                let n = children.len();
-                list.splice(i..=i, children);
-                st.selection.path = if n == 0 {
-                    parent
-                } else {
-                    [parent, vec![i + n - 1]].concat()
-                };
-                st.selection.mask = false;
-                Ok(())
-            }),
-            other => self.mask_command(other),
-        }
-    }
-
-    /// The mask commands.
-    fn mask_command(&mut self, command: Command) -> Result<(), ModelError> {
-        match command {
-            Command::AddMask => self.change("Add mask", |st, cx| {
-                let layer = selected_mut(st)?;
-                if layer.mask.is_none() {
-                    layer.mask = Some(Mask::white(cx.tile_count));
-                }
-                Ok(())
-            }),
-            Command::DeleteMask => self.change("Delete mask", |st, _| {
-                selected_mut(st)?.mask = None;
-                st.selection.mask = false;
-                Ok(())
-            }),
-            Command::InvertMask => self.mask_props("Invert mask", |m| {
-                m.inverted = !m.inverted;
-            }),
-            Command::SetMaskEnabled(on) => {
-                self.mask_props(if on { "Enable mask" } else { "Disable mask" }, |m| {
-                    m.enabled = on;
-                })
-            }
-            Command::MaskFromChannel { channel, threshold } => {
-                self.change("Mask from channel", |st, cx| {
-                    let tiles =
-                        crate::model::layers::ops::mask_from_channel(cx.maps, channel, threshold);
-                    let layer = selected_mut(st)?;
-                    let mask = layer.mask.get_or_insert_with(|| Mask::white(cx.tile_count));
-                    mask.tiles = tiles;
-                    mask.inverted = false;
-                    Ok(())
-                })
-            }
-            Command::ApplyMask => self.change("Apply mask", |st, cx| {
-                let layer = selected_mut(st)?;
-                if layer.mask.is_none() {
-                    return Err(command_error(format!(
-                        "the layer \"{}\" has no mask to apply",
-                        layer.props.name
-                    )));
-                }
-                let mut bake = layer.clone();
-                bake.props.opacity = 1.0;
-                bake.props.visible = true;
-                for c in &mut bake.props.channels {
-                    *c = crate::model::layers::ChannelBlend {
-                        enabled: true,
-                        mode: crate::model::layers::LayerBlend::Normal,
-                    };
-                }
-                layer.content =
-                    LayerContent::Paint(crate::model::layers::ops::merged(&[bake], cx.tile_count));
-                layer.mask = None;
-                st.selection.mask = false;
-                Ok(())
-            }),
-            other => Err(ModelError::Internal(format!(
-                "{other:?} is not a layer command"
-            ))),
+            LayerCommand::Group => self.change("Group", |st, _| structure::group(st)),
+            LayerCommand::Ungroup => self.change("Ungroup", |st, _| structure::ungroup(st)),
         }
     }
 
@@ -471,12 +263,12 @@ impl Document {
         Ok(())
     }
 
-    fn select(&mut self, path: Vec<usize>, mask: bool) {
+    pub(super) fn select(&mut self, path: Vec<usize>, mask: bool) {
         self.end_stroke();
         self.state.selection = crate::model::layers::Selection { path, mask };
     }
 
-    fn selected(&self) -> Result<&Layer, ModelError> {
+    pub(super) fn selected(&self) -> Result<&Layer, ModelError> {
         self.state
             .stack
             .layer(&self.state.selection.path)
@@ -484,7 +276,7 @@ impl Document {
     }
 
     /// Changes the selected layer's settings as one undo step.
-    fn props(
+    pub(super) fn props(
         &mut self,
         label: &str,
         f: impl FnOnce(&mut Layer) -> Result<(), ModelError>,
@@ -493,7 +285,11 @@ impl Document {
     }
 
     /// Changes the selected layer's mask's switches as one undo step.
-    fn mask_props(&mut self, label: &str, f: impl FnOnce(&mut Mask)) -> Result<(), ModelError> {
+    pub(super) fn mask_props(
+        &mut self,
+        label: &str,
+        f: impl FnOnce(&mut Mask),
+    ) -> Result<(), ModelError> {
         self.change(label, |st, _| {
             let layer = selected_mut(st)?;
             let name = layer.props.name.clone();
@@ -514,58 +310,46 @@ pub fn mask_gray(v: MaterialValue) -> f32 {
     crate::model::texel::linear_to_srgb(kd.max_element()).clamp(0.0, 1.0)
 }
 
-pub(super) fn no_layer() -> ModelError {
-    command_error("no layer is selected")
-}
-
-fn selected_mut(st: &mut State) -> Result<&mut Layer, ModelError> {
-    st.stack.layer_mut(&st.selection.path).ok_or_else(no_layer)
-}
-
-/// The parent path and index of a layer's path.
-pub(super) fn split(path: &[usize]) -> Result<(Vec<usize>, usize), ModelError> {
-    path.split_last()
-        .map(|(&i, parent)| (parent.to_vec(), i))
-        .ok_or_else(no_layer)
-}
-
-/// Layers in `layers`, groups' children included.
-pub fn count_layers(layers: &[Layer]) -> usize {
-    layers
-        .iter()
-        .map(|l| {
-            1 + match &l.content {
-                LayerContent::Group(children) => count_layers(children),
-                _ => 0,
-            }
-        })
-        .sum()
-}
-
-/// The path of a layer named in a script.
-fn resolve(stack: &LayerStack, r: &LayerRef) -> Result<Vec<usize>, ModelError> {
-    match r {
-        LayerRef::Index(i) if *i < stack.layers.len() => Ok(vec![*i]),
-        LayerRef::Index(i) => Err(command_error(format!(
-            "no layer has index {i} (the stack has {} at the top level)",
-            stack.layers.len()
-        ))),
-        LayerRef::Name(name) => stack
-            .walk()
-            .into_iter()
-            .rev()
-            .find(|(_, l)| &l.props.name == name)
-            .map(|(p, _)| p)
-            .ok_or_else(|| command_error(format!("no layer is named \"{name}\""))),
-        LayerRef::Id { id } => stack
-            .path_of(crate::model::layers::LayerId(*id))
-            .ok_or_else(|| command_error(format!("no layer has id {id}"))),
-    }
-}
-
 /// What a layer command reads besides the state.
-struct CommandContext<'a> {
-    tile_count: usize,
-    primary: MaterialValue,
-    maps: &'a crate::model::maps::MaterialMaps,
+pub(super) struct CommandContext<'a> {
+    pub(super) tile_count: usize,
+    pub(super) primary: MaterialValue,
+    pub(super) maps: &'a crate::model::maps::MaterialMaps,
+}
+
+/// Sets the blend mode of one of a layer's channels, where the channel has that mode.
+fn set_blend(
+    l: &mut Layer,
+    channel: crate::model::texel::Channel,
+    mode: crate::model::layers::LayerBlend,
+) -> Result<(), ModelError> {
+    if !mode.allowed_for(channel) {
+        return Err(command_error(format!(
+            "{} does not blend {}: use one of {}",
+            channel.name(),
+            mode.name(channel),
+            crate::model::layers::LayerBlend::ALL
+                .iter()
+                .filter(|m| m.allowed_for(channel))
+                .map(|m| m.name(channel))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    l.props.channels[channel_index(channel)].mode = mode;
+    Ok(())
+}
+
+/// Sets a fill layer's material.
+fn set_fill(l: &mut Layer, v: MaterialValue) -> Result<(), ModelError> {
+    match &mut l.content {
+        LayerContent::Fill(value) => {
+            *value = v.sanitized();
+            Ok(())
+        }
+        _ => Err(command_error(format!(
+            "the layer \"{}\" is not a fill layer",
+            l.props.name
+        ))),
+    }
 }

@@ -10,16 +10,21 @@ mod id;
 mod import;
 mod layers;
 
+mod masks;
 mod moves;
+mod paths;
+mod script;
+mod structure;
 mod surface;
 pub use super::mesh_ref::MeshRef;
 pub use id::DocumentId;
-pub use layers::MAX_LAYERS;
+pub use paths::MAX_LAYERS;
 mod stroke;
 
 pub use command::{
-    AttachedMesh, AttachedNormal, Command, FillRegion, ImportedChannel, ImportedMaterial,
-    LayerKind, LayerMove, LayerPlace, LayerRef, StrokeTool,
+    AttachedMesh, AttachedNormal, Command, FillRegion, HistoryCommand, ImportCommand,
+    ImportedChannel, ImportedMaterial, LayerCommand, LayerKind, LayerMove, LayerPlace, LayerRef,
+    MaskCommand, PaintCommand, SettingsCommand, StrokeCommand, StrokeTool,
 };
 
 use std::sync::Arc;
@@ -356,7 +361,29 @@ impl Document {
     /// # Errors
     /// When the command cannot apply (outside the map, a mesh command with no mesh): the
     /// document is unchanged.
-    pub fn apply(&mut self, command: Command) -> Result<(), ModelError> {
+    pub fn apply(&mut self, command: impl Into<Command>) -> Result<(), ModelError> {
+        let command = command.into();
+        self.check_memory(&command)?;
+        let opacity_run = self.opacity_run.take();
+        match command {
+            Command::Settings(c) => {
+                self.settings_command(c);
+                Ok(())
+            }
+            Command::Stroke(c) => self.stroke_command(c),
+            Command::Paint(c) => self.paint_command(c),
+            Command::Import(c) => self.import_command(c),
+            Command::History(c) => {
+                self.history_command(c);
+                Ok(())
+            }
+            Command::Layer(c) => self.layer_command(c, opacity_run.as_deref()),
+            Command::Mask(c) => self.mask_command(c),
+        }
+    }
+
+    /// The settings room: no undo step, a settings version counted where a value changed.
+    fn settings_command(&mut self, command: SettingsCommand) {
         /// Sets a setting, counting a change.
         fn set<T: PartialEq>(field: &mut T, value: T, version: &mut u64) {
             if *field != value {
@@ -364,39 +391,41 @@ impl Document {
                 *version += 1;
             }
         }
-        self.check_memory(&command)?;
-        let opacity_run = self.opacity_run.take();
-        if let Command::SetLayerOpacity(opacity) = command {
-            return self.set_opacity(opacity, opacity_run.as_deref());
-        }
         let v = &mut self.settings_version;
+        let s = &mut self.settings;
         match command {
-            Command::SetBrush(b) => set(&mut self.settings.brush, b.sanitized(), v),
-            Command::SetPrimary(p) => set(&mut self.settings.primary, p.sanitized(), v),
-            Command::SetSecondary(p) => set(&mut self.settings.secondary, p.sanitized(), v),
-            Command::SwapMaterials => {
-                let primary = self.settings.primary;
-                let secondary = std::mem::replace(&mut self.settings.secondary, primary);
-                set(&mut self.settings.primary, secondary, v);
+            SettingsCommand::SetBrush(b) => set(&mut s.brush, b.sanitized(), v),
+            SettingsCommand::SetPrimary(p) => set(&mut s.primary, p.sanitized(), v),
+            SettingsCommand::SetSecondary(p) => set(&mut s.secondary, p.sanitized(), v),
+            SettingsCommand::SwapMaterials => {
+                let primary = s.primary;
+                let secondary = std::mem::replace(&mut s.secondary, primary);
+                set(&mut s.primary, secondary, v);
             }
-            Command::SetChannels(c) => set(&mut self.settings.channels, c, v),
-            Command::SetModel(m) => set(&mut self.settings.model, m, v),
-            Command::SetApprox(a) => set(&mut self.settings.approx, a, v),
-            Command::BeginStroke(tool) => self.begin_stroke(tool)?,
-            Command::StrokeTo(p) => self.stroke_to(p)?,
-            Command::EndStroke => self.end_stroke(),
-            Command::AbortStroke => self.abort_stroke(),
-            Command::Stroke { tool, points } => {
+            SettingsCommand::SetChannels(c) => set(&mut s.channels, c, v),
+            SettingsCommand::SetModel(m) => set(&mut s.model, m, v),
+            SettingsCommand::SetApprox(a) => set(&mut s.approx, a, v),
+        }
+    }
+
+    /// The stroke room.
+    fn stroke_command(&mut self, command: StrokeCommand) -> Result<(), ModelError> {
+        match command {
+            StrokeCommand::BeginStroke(tool) => self.begin_stroke(tool)?,
+            StrokeCommand::StrokeTo(p) => self.stroke_to(p)?,
+            StrokeCommand::EndStroke => self.end_stroke(),
+            StrokeCommand::AbortStroke => self.abort_stroke(),
+            StrokeCommand::Stroke { tool, points } => {
                 self.begin_stroke(tool)?;
                 let result = points.into_iter().try_for_each(|p| self.stroke_to(p));
                 self.end_stroke();
                 result?;
             }
-            Command::SurfaceStrokeTo(p) => {
+            StrokeCommand::SurfaceStrokeTo(p) => {
                 let surface = self.require_surface("a stroke on the mesh")?;
                 self.surface_stroke_to(&surface, p)?;
             }
-            Command::SurfaceStroke { tool, points } => {
+            StrokeCommand::SurfaceStroke { tool, points } => {
                 let surface = self.require_surface("a stroke on the mesh")?;
                 self.begin_stroke(tool)?;
                 let result = points
@@ -405,29 +434,41 @@ impl Document {
                 self.end_stroke();
                 result?;
             }
-            Command::Fill(region) => self.fill(region)?,
-            Command::Gradient { shape, start, end } => self.gradient(shape, start, end)?,
-            Command::Pick { x, y } => self.pick(x, y, false)?,
-            Command::PickLayer { x, y } => self.pick(x, y, true)?,
-            Command::ImportChannel(imported) => self.import_channel(&imported.0)?,
-            Command::ImportMaterial(imported) => self.import_material(&imported)?,
-            Command::SetNormal(normal) => self.set_normal(normal.0),
-            Command::SetMesh(mesh) => self.set_mesh(&mesh)?,
-            Command::Undo => {
-                self.end_stroke();
-                if self.history.undo(&mut self.state) {
-                    self.after_history();
-                }
+        }
+        Ok(())
+    }
+
+    /// The one-click tools.
+    fn paint_command(&mut self, command: PaintCommand) -> Result<(), ModelError> {
+        match command {
+            PaintCommand::Fill(region) => self.fill(region),
+            PaintCommand::Gradient { shape, start, end } => self.gradient(shape, start, end),
+            PaintCommand::Pick { x, y } => self.pick(x, y, false),
+            PaintCommand::PickLayer { x, y } => self.pick(x, y, true),
+        }
+    }
+
+    /// What workers made from files.
+    fn import_command(&mut self, command: ImportCommand) -> Result<(), ModelError> {
+        match command {
+            ImportCommand::ImportChannel(imported) => self.import_channel(&imported.0),
+            ImportCommand::ImportMaterial(imported) => self.import_material(&imported),
+            ImportCommand::SetNormal(normal) => {
+                self.set_normal(normal.0);
+                Ok(())
             }
-            Command::Redo => {
-                self.end_stroke();
-                if self.history.redo(&mut self.state) {
-                    self.after_history();
-                }
-            }
-            Command::Resize(resized) => self.install_resized(&resized)?,
-            Command::HistoryJump(applied) => {
-                self.end_stroke();
+            ImportCommand::SetMesh(mesh) => self.set_mesh(&mesh),
+            ImportCommand::Resize(resized) => self.install_resized(&resized),
+        }
+    }
+
+    /// Undo, redo and jumps through the history; a stroke in progress ends first.
+    fn history_command(&mut self, command: HistoryCommand) {
+        self.end_stroke();
+        let moved = match command {
+            HistoryCommand::Undo => self.history.undo(&mut self.state),
+            HistoryCommand::Redo => self.history.redo(&mut self.state),
+            HistoryCommand::HistoryJump(applied) => {
                 let now = self.history.undo_steps().count();
                 let mut moved = false;
                 for _ in applied..now {
@@ -439,13 +480,12 @@ impl Document {
                     }
                     moved = true;
                 }
-                if moved {
-                    self.after_history();
-                }
+                moved
             }
-            other => self.layer_command(other)?,
+        };
+        if moved {
+            self.after_history();
         }
-        Ok(())
     }
 
     /// Refuses a command that may fill a whole layer (or a mask, or a merged layer) when the
@@ -454,19 +494,21 @@ impl Document {
     fn check_memory(&self, command: &Command) -> Result<(), ModelError> {
         let writes_a_layer = matches!(
             command,
-            Command::BeginStroke(_)
-                | Command::Stroke { .. }
-                | Command::SurfaceStroke { .. }
-                | Command::Fill(_)
-                | Command::Gradient { .. }
-                | Command::ImportChannel(_)
-                | Command::ImportMaterial(_)
-                | Command::MergeDown
-                | Command::Flatten
-                | Command::AddMask
-                | Command::ApplyMask
-                | Command::InvertMask
-                | Command::MaskFromChannel { .. }
+            Command::Stroke(
+                StrokeCommand::BeginStroke(_)
+                    | StrokeCommand::Stroke { .. }
+                    | StrokeCommand::SurfaceStroke { .. }
+            ) | Command::Paint(PaintCommand::Fill(_) | PaintCommand::Gradient { .. })
+                | Command::Import(
+                    ImportCommand::ImportChannel(_) | ImportCommand::ImportMaterial(_)
+                )
+                | Command::Layer(LayerCommand::MergeDown | LayerCommand::Flatten)
+                | Command::Mask(
+                    MaskCommand::AddMask
+                        | MaskCommand::ApplyMask
+                        | MaskCommand::InvertMask
+                        | MaskCommand::MaskFromChannel { .. }
+                )
         );
         if !writes_a_layer {
             return Ok(());
@@ -478,7 +520,7 @@ impl Document {
         crate::memory::check_fits("painting a whole layer", bytes).map_err(|e| {
             ModelError::Command(format!(
                 "{e}: the document has {} layers; merge or delete some, or use a smaller map",
-                layers::count_layers(&self.state.stack.layers)
+                paths::count_layers(&self.state.stack.layers)
             ))
         })
     }

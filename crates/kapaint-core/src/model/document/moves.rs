@@ -1,6 +1,6 @@
 //! Moving layers: up and down their list, into and out of groups, and by drag and drop.
 
-use super::layers::{command_error, no_layer, split};
+use super::paths::{command_error, no_layer, split};
 use super::{LayerMove, LayerPlace};
 use crate::model::ModelError;
 use crate::model::layers::{LayerContent, LayerStack, State};

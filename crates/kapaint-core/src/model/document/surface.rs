@@ -12,7 +12,7 @@ impl Document {
     /// This document with the mesh surface that object-space strokes and island/part fills
     /// paint on (the bake of its mesh at the map size), or without one, as it is made or
     /// opened: no undo step (changing the mesh is
-    /// [`Command::SetMesh`](super::Command::SetMesh)).
+    /// [`ImportCommand::SetMesh`](super::ImportCommand::SetMesh)).
     ///
     /// # Errors
     /// When the bake's size differs from the maps'.
@@ -24,7 +24,7 @@ impl Document {
     /// Attaches the bake of the document's mesh (or another mesh a command paints on, such as
     /// `paint --mesh`), or detaches it, as a document is opened. A bake is derived data the
     /// project never stores, so this is no undo step; the project's mesh changes only through
-    /// [`Command::SetMesh`](super::Command::SetMesh).
+    /// [`ImportCommand::SetMesh`](super::ImportCommand::SetMesh).
     ///
     /// # Errors
     /// When the bake's size differs from the maps'; nothing changes then.
@@ -54,7 +54,7 @@ impl Document {
         }
     }
 
-    /// [`Command::SetMesh`](super::Command::SetMesh): the project's mesh and its bake, as one
+    /// [`ImportCommand::SetMesh`](super::ImportCommand::SetMesh): the project's mesh and its bake, as one
     /// undo step.
     pub(super) fn set_mesh(&mut self, mesh: &AttachedMesh) -> Result<(), ModelError> {
         self.check_surface(Some(&mesh.surface))?;
@@ -66,7 +66,7 @@ impl Document {
         Ok(())
     }
 
-    /// [`Command::SetNormal`](super::Command::SetNormal): the normal map set or cleared, as one
+    /// [`ImportCommand::SetNormal`](super::ImportCommand::SetNormal): the normal map set or cleared, as one
     /// undo step.
     pub(super) fn set_normal(&mut self, normal: Option<Arc<NormalMap>>) {
         self.end_stroke();

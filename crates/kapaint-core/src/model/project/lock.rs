@@ -173,7 +173,8 @@ impl Drop for ProjectLock {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Command, DocumentSettings, FillRegion};
+    use crate::model::{DocumentSettings, FillRegion};
+    use crate::model::{PaintCommand, SettingsCommand};
 
     fn temp(tag: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("kapaint-lock-{tag}-{}", std::process::id()));
@@ -191,9 +192,9 @@ mod tests {
         // Two runs read the same file; the first saves; the second finds it changed.
         let mut a = crate::model::project::load(&p).unwrap();
         let mut b = crate::model::project::load(&p).unwrap();
-        a.apply(Command::Fill(FillRegion::All)).unwrap();
-        b.apply(Command::SwapMaterials).unwrap();
-        b.apply(Command::Fill(FillRegion::All)).unwrap();
+        a.apply(PaintCommand::Fill(FillRegion::All)).unwrap();
+        b.apply(SettingsCommand::SwapMaterials).unwrap();
+        b.apply(PaintCommand::Fill(FillRegion::All)).unwrap();
         let saved = save_checked(&a, &p, Some(&first)).unwrap();
         assert_ne!(saved, first);
         let err = save_checked(&b, &p, Some(&first)).unwrap_err();

@@ -4,7 +4,10 @@ use super::folder::{generations, journal_file};
 use super::session::Owner;
 use super::*;
 use crate::model::layers::{Layer, LayerContent};
-use crate::model::{Command, DocumentSettings, FillRegion, MaterialValue};
+use crate::model::{DocumentSettings, FillRegion, MaterialValue};
+use crate::model::{
+    HistoryCommand, LayerCommand, MaskCommand, PaintCommand, SettingsCommand, StrokeCommand,
+};
 
 fn temp(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("kapaint-recovery-{tag}-{}", std::process::id()));
@@ -14,7 +17,7 @@ fn temp(tag: &str) -> PathBuf {
 }
 
 fn stroke(doc: &mut Document, y: f32) {
-    doc.apply(Command::Stroke {
+    doc.apply(StrokeCommand::Stroke {
         tool: crate::model::StrokeTool::Brush,
         points: vec![
             crate::model::brush::StrokePoint {
@@ -84,27 +87,27 @@ fn same_document(a: &Document, b: &Document) -> bool {
 /// with a painted mask, a group.
 fn layered(w: u32, h: u32) -> Document {
     let mut doc = Document::new(w, h, DocumentSettings::default()).unwrap();
-    doc.apply(Command::Gradient {
+    doc.apply(PaintCommand::Gradient {
         shape: crate::model::paint::GradientShape::Radial,
         start: glam::Vec2::ZERO,
         end: glam::Vec2::new(w as f32, h as f32),
     })
     .unwrap();
     stroke(&mut doc, 20.0);
-    doc.apply(Command::AddLayer {
+    doc.apply(LayerCommand::AddLayer {
         kind: crate::model::LayerKind::Fill,
         name: "Rust".into(),
     })
     .unwrap();
-    doc.apply(Command::AddMask).unwrap();
-    doc.apply(Command::SelectMask).unwrap();
+    doc.apply(MaskCommand::AddMask).unwrap();
+    doc.apply(MaskCommand::SelectMask).unwrap();
     stroke(&mut doc, 40.0);
-    doc.apply(Command::AddLayer {
+    doc.apply(LayerCommand::AddLayer {
         kind: crate::model::LayerKind::Group,
         name: "Folder".into(),
     })
     .unwrap();
-    doc.apply(Command::SelectLayer(crate::model::LayerRef::Name(
+    doc.apply(LayerCommand::SelectLayer(crate::model::LayerRef::Name(
         "Layer 1".into(),
     )))
     .unwrap();
@@ -130,13 +133,13 @@ fn every_autosave_after_the_first_appends_only_what_changed_layers_and_all() {
     // what changed.
     for (k, y) in [100.0, 140.0].into_iter().enumerate() {
         stroke(&mut doc, y);
-        doc.apply(Command::SetModel(if k == 0 {
+        doc.apply(SettingsCommand::SetModel(if k == 0 {
             crate::reflectance::ShadingModel::BlinnPhong
         } else {
             crate::reflectance::ShadingModel::Phong
         }))
         .unwrap();
-        doc.apply(Command::SetLayerOpacity(0.5)).unwrap();
+        doc.apply(LayerCommand::SetLayerOpacity(0.5)).unwrap();
         let before = saver.generation.as_ref().unwrap().bytes;
         saver.poll(&doc, t);
         saver.wait().unwrap().unwrap();
@@ -149,8 +152,8 @@ fn every_autosave_after_the_first_appends_only_what_changed_layers_and_all() {
     }
     assert_eq!(generations(&session).len(), 1);
     // Undo brings back tiles an earlier record held.
-    doc.apply(Command::Undo).unwrap();
-    doc.apply(Command::Undo).unwrap();
+    doc.apply(HistoryCommand::Undo).unwrap();
+    doc.apply(HistoryCommand::Undo).unwrap();
     saver.poll(&doc, t);
     saver.wait().unwrap().unwrap();
     assert!(same_document(&load(&session).unwrap(), &doc));
@@ -206,7 +209,7 @@ fn a_failed_autosave_is_retried_and_its_folder_made() {
     let project = dir.join("state/kapaint/p.kapaint");
     let mut doc = Document::new(64, 64, DocumentSettings::default()).unwrap();
     let mut saver = Autosaver::new(Duration::from_secs(20), Some(&project), &doc);
-    doc.apply(Command::Fill(FillRegion::All)).unwrap();
+    doc.apply(PaintCommand::Fill(FillRegion::All)).unwrap();
     let t = Instant::now();
     saver.poll(&doc, t + Duration::from_secs(21));
     saver.wait().unwrap().unwrap();
@@ -216,13 +219,13 @@ fn a_failed_autosave_is_retried_and_its_folder_made() {
     remove(&session);
     std::fs::create_dir_all(saver.recovery_folder()).unwrap();
     std::fs::write(&session, b"in the way").unwrap();
-    doc.apply(Command::SetPrimary(MaterialValue::new(
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
         glam::Vec3::X,
         glam::Vec3::ZERO,
         5.0,
     )))
     .unwrap();
-    doc.apply(Command::Fill(FillRegion::All)).unwrap();
+    doc.apply(PaintCommand::Fill(FillRegion::All)).unwrap();
     saver.poll(&doc, t + Duration::from_secs(42));
     assert!(saver.wait().unwrap().is_err());
     assert!(!saver.is_current(&doc));
@@ -246,7 +249,7 @@ fn the_next_poll_is_when_the_copy_falls_due() {
     let mut saver = Autosaver::new(Duration::from_secs(20), Some(&dir.join("r.kapaint")), &doc);
     let t = saver.last_time;
     assert_eq!(saver.next_poll(&doc, t), None, "nothing to save");
-    doc.apply(Command::Fill(FillRegion::All)).unwrap();
+    doc.apply(PaintCommand::Fill(FillRegion::All)).unwrap();
     assert_eq!(
         saver.next_poll(&doc, t + Duration::from_secs(5)),
         Some(Duration::from_secs(15))
