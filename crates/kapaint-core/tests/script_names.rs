@@ -24,6 +24,16 @@ fn parse(text: &str) -> Command {
 
 /// Every flat name scripts use, with the command it must mean.
 fn every_name() -> Vec<(String, Command)> {
+    [
+        settings_and_strokes(),
+        tools_and_history(),
+        layers_and_masks(),
+    ]
+    .concat()
+}
+
+/// The settings and strokes.
+fn settings_and_strokes() -> Vec<(String, Command)> {
     let point = StrokePoint {
         pos: Vec2::new(3.0, 4.0),
         pressure: 0.5,
@@ -99,7 +109,12 @@ fn every_name() -> Vec<(String, Command)> {
             }
             .into(),
         ),
-        // one-click tools
+    ]
+}
+
+/// The one-click tools and the history.
+fn tools_and_history() -> Vec<(String, Command)> {
+    vec![
         (
             "Fill(All)".into(),
             PaintCommand::Fill(FillRegion::All).into(),
@@ -132,7 +147,13 @@ fn every_name() -> Vec<(String, Command)> {
             "HistoryJump(3)".into(),
             HistoryCommand::HistoryJump(3).into(),
         ),
-        // layers
+    ]
+}
+
+/// The layer and mask rooms.
+fn layers_and_masks() -> Vec<(String, Command)> {
+    let all = Channels::ALL;
+    vec![
         (
             "AddLayer(kind: Fill, name: \"dirt\")".into(),
             LayerCommand::AddLayer {

@@ -15,7 +15,9 @@ use kapaint_core::model::surface::Surface;
 use kapaint_core::model::texel::{Channel, MaterialValue, Texel};
 use kapaint_core::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
 use kapaint_core::model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
-use kapaint_core::tools::{FillMode, Place, ToolEvent, ToolKind, Tools};
+use kapaint_core::tools::{
+    Fill, FillMode, Gradient, OptionValue, OptionWidget, Place, ToolEvent, ToolKind, Tools,
+};
 
 fn document() -> Document {
     let mut doc = Document::new(128, 64, DocumentSettings::default()).expect("doc");
@@ -117,7 +119,7 @@ fn a_brush_stroke_is_one_undo_step_from_press_to_release() {
 
 #[test]
 fn escape_abandons_a_stroke_in_every_stroke_tool_and_view() {
-    for kind in [ToolKind::Brush, ToolKind::Eraser, ToolKind::Blur] {
+    for kind in [ToolKind::BRUSH, ToolKind::ERASER, ToolKind::BLUR] {
         for on_mesh in [false, true] {
             let mut doc = with_sphere(document());
             // Something for the eraser and the blur to change.
@@ -192,7 +194,7 @@ fn a_gradient_dragged_on_the_mesh_lays_a_gradient_not_a_pick() {
     let before = texels(&doc);
     let primary = doc.settings().primary;
     let mut tools = Tools::default();
-    tools.select(ToolKind::Gradient, &doc);
+    tools.select(ToolKind::GRADIENT, &doc);
     let (a, b) = (
         on_surface(&doc, Vec3::new(0.0, 0.0, 1.0)),
         on_surface(&doc, Vec3::new(1.0, 0.0, 0.0)),
@@ -226,8 +228,8 @@ fn a_gradient_dragged_on_the_mesh_lays_a_gradient_not_a_pick() {
 fn a_gradient_can_be_radial_and_escape_drops_it() {
     let mut doc = document();
     let mut tools = Tools::default();
-    tools.select(ToolKind::Gradient, &doc);
-    tools.gradient.shape = GradientShape::Radial;
+    tools.select(ToolKind::GRADIENT, &doc);
+    tools.get_mut::<Gradient>().expect("gradient").shape = GradientShape::Radial;
     let before = texels(&doc);
     let commands = run(
         &mut tools,
@@ -269,8 +271,8 @@ fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
     })
     .expect("halves");
     let mut tools = Tools::default();
-    tools.select(ToolKind::Fill, &doc);
-    tools.fill.mode = FillMode::Similar {
+    tools.select(ToolKind::FILL, &doc);
+    tools.get_mut::<Fill>().expect("fill").mode = FillMode::Similar {
         channel: Channel::Kd,
         tolerance: 0.01,
     };
@@ -302,14 +304,14 @@ fn fill_modes_cover_islands_similar_texels_and_the_whole_map() {
         doc.maps().value(120, 10).kd.y < 0.7,
         "the right half is not"
     );
-    tools.fill.mode = FillMode::All;
+    tools.get_mut::<Fill>().expect("fill").mode = FillMode::All;
     let commands = run(&mut tools, &mut doc, &[press(10.0, 10.0)]);
     assert_eq!(
         commands,
         vec![Command::from(PaintCommand::Fill(FillRegion::All))]
     );
     // Island: on the mesh's UVs an island, off them (no mesh here) the whole map.
-    tools.fill.mode = FillMode::Island;
+    tools.get_mut::<Fill>().expect("fill").mode = FillMode::Island;
     assert_eq!(
         tools.handle(press(10.0, 10.0), &doc),
         vec![Command::from(PaintCommand::Fill(FillRegion::All))]
@@ -335,7 +337,7 @@ fn the_picker_reads_the_texel_under_the_pointer_in_either_view() {
         &[press(60.0, 30.0), ToolEvent::Release],
     );
     let mut tools = Tools::default();
-    tools.select(ToolKind::Picker, &doc);
+    tools.select(ToolKind::PICKER, &doc);
     let commands = run(&mut tools, &mut doc, &[press(60.5, 30.5)]);
     assert_eq!(
         commands,
@@ -360,14 +362,14 @@ fn switching_tools_mid_stroke_keeps_the_stroke_and_drops_a_gradient() {
     let mut doc = document();
     let mut tools = Tools::default();
     run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
-    let ended = tools.select(ToolKind::Picker, &doc);
+    let ended = tools.select(ToolKind::PICKER, &doc);
     assert_eq!(ended, vec![Command::from(StrokeCommand::EndStroke)]);
     doc.apply(StrokeCommand::EndStroke).expect("end");
     assert_eq!(doc.history().undo_steps().count(), 1, "the stroke is kept");
-    tools.select(ToolKind::Gradient, &doc);
+    tools.select(ToolKind::GRADIENT, &doc);
     run(&mut tools, &mut doc, &[press(10.0, 10.0), drag(50.0, 10.0)]);
     assert!(
-        tools.select(ToolKind::Brush, &doc).is_empty(),
+        tools.select(ToolKind::BRUSH, &doc).is_empty(),
         "no gradient laid"
     );
     assert_eq!(doc.history().undo_steps().count(), 1);
@@ -400,4 +402,102 @@ fn a_stroke_stays_in_the_view_it_began_in() {
             .any(|c| matches!(c, Command::Stroke(StrokeCommand::StrokeTo(_)))),
         "the canvas drag is not part of a mesh stroke: {commands:?}"
     );
+}
+
+/// Every tool says who it is, and its options, set the way the panel sets them, change what
+/// its next command does.
+#[test]
+fn every_tool_describes_itself_and_its_options_drive_it() {
+    let all = Tools::all();
+    assert_eq!(all.len(), 6);
+    for (i, a) in all.iter().enumerate() {
+        assert!(!a.label.is_empty() && !a.key_help.is_empty(), "{a:?}");
+        for b in &all[i + 1..] {
+            assert_ne!(a.kind, b.kind);
+            assert!(
+                a.key.is_none() || a.key != b.key,
+                "{a:?} and {b:?} share a key"
+            );
+        }
+    }
+    let mut doc = Document::new(100, 70, DocumentSettings::default()).expect("doc");
+    let mut tools = Tools::default();
+    // The fill: similar texels in n, tolerance 0.2, through the options the panel draws.
+    tools.select(ToolKind::FILL, &doc);
+    let options = tools.options(&doc);
+    assert_eq!(options.len(), 1, "island mode shows only the mode");
+    assert!(
+        tools
+            .set_option("mode", OptionValue::Choice(1), &doc)
+            .is_empty()
+    );
+    let ids: Vec<_> = tools.options(&doc).iter().map(|o| o.id).collect();
+    assert_eq!(ids, ["mode", "channel", "tolerance"]);
+    tools.set_option("channel", OptionValue::Choice(2), &doc);
+    tools.set_option("tolerance", OptionValue::Number(0.2), &doc);
+    tools.set_option("tolerance", OptionValue::Number(f32::NAN), &doc);
+    assert_eq!(
+        tools.handle(press(10.0, 10.0), &doc),
+        vec![Command::from(PaintCommand::Fill(FillRegion::Similar {
+            x: 10,
+            y: 10,
+            channel: Channel::N,
+            tolerance: 0.2,
+        }))]
+    );
+    // The blur's radius is a brush setting: the option answers with the command.
+    tools.select(ToolKind::BLUR, &doc);
+    let commands = tools.set_option("radius", OptionValue::Number(7.4), &doc);
+    for c in commands {
+        doc.apply(c).expect("radius");
+    }
+    assert_eq!(doc.settings().brush.blur_radius_px, 7);
+    let Some(OptionWidget::Slider { value, .. }) =
+        tools.options(&doc).first().map(|o| o.widget.clone())
+    else {
+        panic!("the blur radius is a slider");
+    };
+    assert!((value - 7.0).abs() < 1e-6);
+    // The gradient's shape and its overlay while dragged.
+    tools.select(ToolKind::GRADIENT, &doc);
+    tools.set_option("shape", OptionValue::Choice(1), &doc);
+    assert_eq!(tools.overlay(), None);
+    tools.handle(press(10.0, 10.0), &doc);
+    tools.handle(
+        ToolEvent::Drag {
+            at: Place::Canvas(Vec2::new(50.0, 20.0)),
+            pressure: 1.0,
+        },
+        &doc,
+    );
+    assert_eq!(
+        tools.overlay(),
+        Some(kapaint_core::tools::Overlay::Arrow {
+            from: Vec2::new(10.0, 10.0),
+            to: Vec2::new(50.0, 20.0)
+        })
+    );
+    let laid = tools.handle(ToolEvent::Release, &doc);
+    assert!(matches!(
+        laid[..],
+        [Command::Paint(PaintCommand::Gradient {
+            shape: GradientShape::Radial,
+            ..
+        })]
+    ));
+    assert!(tools.lays_material(&laid[0]));
+    // The picker reads the selected layer when asked.
+    tools.select(ToolKind::PICKER, &doc);
+    tools.set_option("from", OptionValue::Choice(1), &doc);
+    assert_eq!(
+        tools.handle(press(3.0, 4.0), &doc),
+        vec![Command::from(PaintCommand::PickLayer { x: 3, y: 4 })]
+    );
+    assert!(!tools.lays_material(&PaintCommand::PickLayer { x: 3, y: 4 }.into()));
+    // The tools' own state stays reachable by type.
+    assert!(tools.get_mut::<Gradient>().is_some());
+    assert!(matches!(
+        tools.get_mut::<Fill>().map(|f| f.mode),
+        Some(FillMode::Similar { .. })
+    ));
 }

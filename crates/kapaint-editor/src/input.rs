@@ -11,10 +11,8 @@ use glam::Vec2;
 use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
 use kapaint_core::model::brush::SurfacePos;
-use kapaint_core::model::{Command, StrokeTool};
-use kapaint_core::model::{PaintCommand, StrokeCommand};
 use kapaint_core::render::FrameSettings;
-use kapaint_core::tools::{Place, ToolEvent, ToolKind};
+use kapaint_core::tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
 
 impl EditorState {
     /// The texel under a map-space position, if inside.
@@ -48,11 +46,7 @@ impl EditorState {
     /// Hands an event to the active tool and applies its commands.
     pub(super) fn tool_event(&mut self, event: ToolEvent) {
         for command in self.tools.handle(event, &self.doc) {
-            let lays = matches!(
-                command,
-                Command::Stroke(StrokeCommand::BeginStroke(StrokeTool::Brush))
-                    | Command::Paint(PaintCommand::Fill(_) | PaintCommand::Gradient { .. })
-            );
+            let lays = self.tools.lays_material(&command);
             self.apply(command);
             if lays {
                 self.remember_material();
@@ -81,7 +75,7 @@ impl EditorState {
                         && response.ctx.layer_id_at(p) == Some(response.layer_id);
                     if self.held.is_none() && on_view && !reserved {
                         self.held = Some(tab);
-                        if self.tools.active().strokes() {
+                        if self.tools.active_meta().cursor == ToolCursor::BrushOutline {
                             self.fit_brush_to_screen();
                         }
                         if let Some(at) = at {
@@ -103,6 +97,19 @@ impl EditorState {
         // A release egui never reported (the pointer left the window): end the stroke.
         if self.held == Some(tab) && !response.ctx.input(|i| i.pointer.primary_down()) {
             self.release();
+        }
+    }
+
+    /// The active tool's cursor over a view (not while `reserved` gives the pointer to the
+    /// camera).
+    fn tool_cursor(&self, response: &egui::Response, reserved: bool) {
+        if response.hovered() && !reserved {
+            response
+                .ctx
+                .set_cursor_icon(match self.tools.active_meta().cursor {
+                    ToolCursor::BrushOutline | ToolCursor::Crosshair => egui::CursorIcon::Crosshair,
+                    ToolCursor::Cell => egui::CursorIcon::Cell,
+                });
         }
     }
 
@@ -134,10 +141,11 @@ impl EditorState {
             })
             .collect();
         self.pointer_input(Tab::Canvas, response, samples, space);
+        self.tool_cursor(response, space);
         // The brush circle: the dab's radius in texels, at the canvas's zoom.
         self.canvas_outline = None;
         if let Some(p) = response.hover_pos()
-            && self.tools.active().strokes()
+            && self.tools.active_meta().cursor == ToolCursor::BrushOutline
             && !space
         {
             let radius = if self.brush_size.on_screen {
@@ -155,15 +163,13 @@ impl EditorState {
             painter.circle_stroke(p, radius, egui::Stroke::new(1.0, egui::Color32::WHITE));
             self.canvas_outline = Some((p, radius));
         }
-        if self.tools.active() == ToolKind::Gradient
-            && let Some((start, end)) = self.tools.gradient.drag()
-        {
+        if let Some(Overlay::Arrow { from, to }) = self.tools.overlay() {
             let at = |p: Vec2| {
                 rect.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * rect.size()
             };
             response.ctx.layer_painter(response.layer_id).arrow(
-                at(start),
-                at(end) - at(start),
+                at(from),
+                at(to) - at(from),
                 egui::Stroke::new(2.0, egui::Color32::WHITE),
             );
         }
@@ -212,6 +218,7 @@ impl EditorState {
             })
             .collect();
         self.pointer_input(Tab::Viewport, response, samples, alt);
+        self.tool_cursor(response, alt);
         // Shift + right drag turns the light: across for its yaw, up and down for its height.
         if response.dragged_by(egui::PointerButton::Secondary)
             && response.ctx.input(|i| i.modifiers.shift)
@@ -222,7 +229,7 @@ impl EditorState {
         // The brush circle, projected on the surface: a circle of the dab's world radius in
         // the tangent plane under the cursor, drawn through the camera.
         if let (Some(p), Some(surface)) = (response.hover_pos(), self.doc.surface())
-            && self.tools.active().strokes()
+            && self.tools.active_meta().cursor == ToolCursor::BrushOutline
             && let Some(hit) = self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh)
         {
             let picture = self.viewport.picture_at(rect, p);

@@ -6,7 +6,7 @@ use egui::{Key, KeyboardShortcut, Modifiers};
 
 use super::{EditorState, Tab};
 use kapaint_core::model::{HistoryCommand, LayerCommand, SettingsCommand};
-use kapaint_core::tools::{ToolEvent, ToolKind};
+use kapaint_core::tools::{ToolEvent, ToolKind, Tools};
 
 /// What a key does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,9 +83,21 @@ const CTRL: Modifiers = Modifiers::COMMAND;
 const CTRL_SHIFT: Modifiers = Modifiers::COMMAND.plus(Modifiers::SHIFT);
 const NONE: Modifiers = Modifiers::NONE;
 
-/// Every binding. Where two share a key, the one with more modifiers comes first (egui
-/// matches modifiers loosely: Ctrl+Shift+Z would also match Ctrl+Z).
-pub const KEYMAP: &[Binding] = &[
+/// Every binding: the editor's own, then each tool's key as the tool gives it.
+pub fn keymap() -> &'static [Binding] {
+    static MAP: std::sync::OnceLock<Vec<Binding>> = std::sync::OnceLock::new();
+    MAP.get_or_init(|| {
+        let tools = Tools::all().into_iter().filter_map(|tool| {
+            let key = Key::from_name(&tool.key?.to_string())?;
+            Some(bind(NONE, key, Action::Tool(tool.kind), tool.summary))
+        });
+        EDITOR_KEYS.iter().copied().chain(tools).collect()
+    })
+}
+
+/// The editor's own bindings. Where two share a key, the one with more modifiers comes first
+/// (egui matches modifiers loosely: Ctrl+Shift+Z would also match Ctrl+Z).
+const EDITOR_KEYS: &[Binding] = &[
     bind(CTRL_SHIFT, Key::Z, Action::Redo, "redo"),
     bind(CTRL, Key::Y, Action::Redo, "redo"),
     bind(CTRL, Key::Z, Action::Undo, "undo"),
@@ -98,16 +110,6 @@ pub const KEYMAP: &[Binding] = &[
     bind(CTRL, Key::E, Action::MergeDown, "merge layer down"),
     bind(CTRL, Key::J, Action::DuplicateLayer, "duplicate layer"),
     bind(CTRL, Key::Q, Action::Quit, "quit"),
-    bind(NONE, Key::B, Action::Tool(ToolKind::Brush), "brush"),
-    bind(NONE, Key::E, Action::Tool(ToolKind::Eraser), "eraser"),
-    bind(NONE, Key::R, Action::Tool(ToolKind::Blur), "blur"),
-    bind(
-        NONE,
-        Key::G,
-        Action::Tool(ToolKind::Gradient),
-        "gradient (drag, on the canvas or the mesh)",
-    ),
-    bind(NONE, Key::I, Action::Tool(ToolKind::Picker), "picker"),
     bind(
         NONE,
         Key::F,
@@ -161,7 +163,7 @@ pub const KEYMAP: &[Binding] = &[
 
 /// The first binding of `action`, for menus.
 pub fn shortcut(action: Action) -> Option<KeyboardShortcut> {
-    KEYMAP
+    keymap()
         .iter()
         .find(|b| b.action == action)
         .map(|b| b.shortcut)
@@ -212,7 +214,7 @@ impl EditorState {
             return;
         }
         let actions: Vec<Action> = ctx.input_mut(|i| {
-            KEYMAP
+            keymap()
                 .iter()
                 .filter(|b| {
                     i.consume_shortcut(&b.shortcut)
@@ -238,7 +240,7 @@ impl EditorState {
                 Action::Tool(kind) => self.select_tool(kind),
                 Action::FillOrFrame => {
                     if self.hover_tab == Some(Tab::Canvas) {
-                        self.select_tool(ToolKind::Fill);
+                        self.select_tool(ToolKind::FILL);
                     } else {
                         self.viewport.frame(&self.mesh.mesh);
                     }
@@ -272,7 +274,7 @@ impl EditorState {
             .collapsible(false)
             .show(ctx, |ui| {
                 egui::Grid::new("keymap").striped(true).show(ui, |ui| {
-                    for b in KEYMAP {
+                    for b in keymap() {
                         ui.label(ctx.format_shortcut(&b.shortcut));
                         ui.label(b.description);
                         ui.end_row();
@@ -328,12 +330,13 @@ mod tests {
         for action in actions {
             assert!(shortcut(action).is_some(), "{action:?} has no key");
         }
-        for kind in ToolKind::ALL {
-            let bound = shortcut(Action::Tool(kind)).is_some() || kind == ToolKind::Fill;
-            assert!(bound, "{kind:?} has no key");
+        for tool in Tools::all() {
+            let bound = shortcut(Action::Tool(tool.kind)).is_some() || tool.kind == ToolKind::FILL;
+            assert!(bound, "{:?} has no key", tool.kind);
         }
-        for (k, a) in KEYMAP.iter().enumerate() {
-            for b in &KEYMAP[k + 1..] {
+        let map = keymap();
+        for (k, a) in map.iter().enumerate() {
+            for b in &map[k + 1..] {
                 assert_ne!(
                     (a.shortcut.modifiers, a.shortcut.logical_key),
                     (b.shortcut.modifiers, b.shortcut.logical_key),
@@ -357,7 +360,7 @@ mod tests {
             .flat_map(|c| c.split(" / "))
             .map(str::trim)
             .collect();
-        for b in KEYMAP {
+        for b in keymap() {
             let key = written(&b.shortcut);
             assert!(
                 cells.contains(&key.as_str()),

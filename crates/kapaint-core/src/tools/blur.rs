@@ -1,9 +1,11 @@
 //! The blur tool. Smooths the enabled channels under the brush, on the UV canvas or on the mesh.
 
-use crate::model::{Command, Document, StrokeTool};
+use crate::model::{Command, Document, SettingsCommand, StrokeTool};
 
 use super::stroke::{Stroke, StrokeState};
-use super::{Tool, ToolEvent};
+use super::{
+    OptionValue, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+};
 
 /// The blur tool: a stroke from press to release, one undo step, abandoned by Escape.
 #[derive(Clone, Debug)]
@@ -22,12 +24,55 @@ impl Blur {
     }
 }
 
+impl ToolKind {
+    /// The blur.
+    pub const BLUR: Self = Self("blur");
+}
+
 impl Tool for Blur {
+    fn meta(&self) -> ToolMeta {
+        ToolMeta {
+            kind: ToolKind::BLUR,
+            label: "Blur",
+            key: Some('R'),
+            key_help: "R",
+            summary: "blur",
+            cursor: ToolCursor::BrushOutline,
+        }
+    }
+
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
         self.0.handle(event, doc)
     }
 
     fn busy(&self) -> bool {
         self.0.state() != StrokeState::Ready
+    }
+
+    /// The kernel's radius, a brush setting of the document.
+    fn options(&self, doc: &Document) -> Vec<ToolOption> {
+        vec![ToolOption {
+            id: "radius",
+            label: "Blur radius",
+            hover: "Kernel radius in texels",
+            widget: OptionWidget::Slider {
+                value: doc.settings().brush.blur_radius_px as f32,
+                min: 1.0,
+                max: 16.0,
+                integer: true,
+            },
+        }]
+    }
+
+    fn set_option(&mut self, id: &str, value: OptionValue, doc: &Document) -> Vec<Command> {
+        let (&"radius", OptionValue::Number(r)) = (&id, value) else {
+            return Vec::new();
+        };
+        let mut brush = doc.settings().brush.clone();
+        brush.blur_radius_px = r.round().clamp(1.0, 16.0) as u32;
+        if brush == doc.settings().brush {
+            return Vec::new();
+        }
+        vec![SettingsCommand::SetBrush(brush).into()]
     }
 }

@@ -3,7 +3,7 @@
 use crate::model::{Command, Document, StrokeTool};
 
 use super::stroke::{Stroke, StrokeState};
-use super::{Tool, ToolEvent};
+use super::{Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta};
 
 /// The eraser tool: a stroke from press to release, one undo step, abandoned by Escape.
 #[derive(Clone, Debug)]
@@ -22,7 +22,23 @@ impl Eraser {
     }
 }
 
+impl ToolKind {
+    /// The eraser.
+    pub const ERASER: Self = Self("eraser");
+}
+
 impl Tool for Eraser {
+    fn meta(&self) -> ToolMeta {
+        ToolMeta {
+            kind: ToolKind::ERASER,
+            label: "Eraser",
+            key: Some('E'),
+            key_help: "E",
+            summary: "eraser",
+            cursor: ToolCursor::BrushOutline,
+        }
+    }
+
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
         self.0.handle(event, doc)
     }

@@ -4,7 +4,9 @@ use crate::model::PaintCommand;
 use crate::model::texel::Channel;
 use crate::model::{Command, Document, FillRegion};
 
-use super::{Tool, ToolEvent};
+use super::{
+    OptionValue, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+};
 
 /// What a fill covers.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,7 +67,101 @@ impl Fill {
     }
 }
 
+impl ToolKind {
+    /// The fill.
+    pub const FILL: Self = Self("fill");
+}
+
+/// The fill modes as the panel names them, in [`FillMode`]'s order.
+const MODES: &[&str] = &["UV island (or all)", "Similar texels", "Whole map"];
+/// The channels as the panel names them, in [`Channel::ALL`]'s order.
+const CHANNELS: &[&str] = &["k_d", "k_s", "n"];
+
 impl Tool for Fill {
+    fn meta(&self) -> ToolMeta {
+        ToolMeta {
+            kind: ToolKind::FILL,
+            label: "Fill",
+            // F is shared: the fill over the UV canvas, framing the mesh over the viewport.
+            key: None,
+            key_help: "F on the UV canvas",
+            summary: "fill (UV canvas) / frame mesh (viewport)",
+            cursor: ToolCursor::Cell,
+        }
+    }
+
+    fn lays_material(&self, command: &Command) -> bool {
+        matches!(command, Command::Paint(PaintCommand::Fill(_)))
+    }
+
+    /// The mode; for similar texels, the channel compared and the tolerance.
+    fn options(&self, _doc: &Document) -> Vec<ToolOption> {
+        let chosen = match self.mode {
+            FillMode::Island => 0,
+            FillMode::Similar { .. } => 1,
+            FillMode::All => 2,
+        };
+        let mut options = vec![ToolOption {
+            id: "mode",
+            label: "Fill",
+            hover: "",
+            widget: OptionWidget::Choice {
+                choices: MODES,
+                chosen,
+                dropdown: true,
+            },
+        }];
+        if let FillMode::Similar { channel, tolerance } = self.mode {
+            options.push(ToolOption {
+                id: "channel",
+                label: "Compared channel",
+                hover: "",
+                widget: OptionWidget::Choice {
+                    choices: CHANNELS,
+                    chosen: Channel::ALL.iter().position(|&c| c == channel).unwrap_or(0),
+                    dropdown: true,
+                },
+            });
+            options.push(ToolOption {
+                id: "tolerance",
+                label: "Tolerance",
+                hover: "The largest difference still filled, in blend space",
+                widget: OptionWidget::Slider {
+                    value: tolerance,
+                    min: 0.0,
+                    max: 1.0,
+                    integer: false,
+                },
+            });
+        }
+        options
+    }
+
+    fn set_option(&mut self, id: &str, value: OptionValue, _doc: &Document) -> Vec<Command> {
+        match (id, value, &mut self.mode) {
+            ("mode", OptionValue::Choice(0), mode) => *mode = FillMode::Island,
+            ("mode", OptionValue::Choice(1), mode @ (FillMode::Island | FillMode::All)) => {
+                *mode = FillMode::Similar {
+                    channel: Channel::Kd,
+                    tolerance: 0.05,
+                };
+            }
+            ("mode", OptionValue::Choice(2), mode) => *mode = FillMode::All,
+            ("channel", OptionValue::Choice(i), FillMode::Similar { channel, .. }) => {
+                if let Some(&c) = Channel::ALL.get(i) {
+                    *channel = c;
+                }
+            }
+            ("tolerance", OptionValue::Number(t), FillMode::Similar { tolerance, .. })
+                if t.is_finite() =>
+            {
+                *tolerance = t.clamp(0.0, 1.0);
+            }
+            _ => {}
+        }
+        Vec::new()
+    }
+
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
         let size = (doc.maps().width(), doc.maps().height());
         match event {

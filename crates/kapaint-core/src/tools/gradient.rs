@@ -9,7 +9,9 @@ use crate::model::PaintCommand;
 use crate::model::paint::GradientShape;
 use crate::model::{Command, Document};
 
-use super::{Tool, ToolEvent};
+use super::{
+    OptionValue, OptionWidget, Overlay, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+};
 
 /// The gradient tool, its shape, and the drag under way.
 #[derive(Clone, Debug)]
@@ -29,18 +31,69 @@ impl Default for Gradient {
 }
 
 impl Gradient {
-    /// The drag under way, `(start, end)` in texel units, for the editor to draw.
+    /// The drag under way, `(start, end)` in texel units.
     pub fn drag(&self) -> Option<(Vec2, Vec2)> {
         self.drag
     }
-
-    /// Drops the drag under way.
-    pub fn cancel(&mut self) {
-        self.drag = None;
-    }
 }
 
+impl ToolKind {
+    /// The gradient.
+    pub const GRADIENT: Self = Self("gradient");
+}
+
+/// The shapes as the panel names them.
+const SHAPES: &[&str] = &["Linear", "Radial"];
+
 impl Tool for Gradient {
+    fn meta(&self) -> ToolMeta {
+        ToolMeta {
+            kind: ToolKind::GRADIENT,
+            label: "Gradient",
+            key: Some('G'),
+            key_help: "G",
+            summary: "gradient (drag, on the canvas or the mesh)",
+            cursor: ToolCursor::Crosshair,
+        }
+    }
+
+    /// A gradient half dragged is dropped, not laid.
+    fn leave(&mut self, _doc: &Document) -> Vec<Command> {
+        self.drag = None;
+        Vec::new()
+    }
+
+    fn lays_material(&self, command: &Command) -> bool {
+        matches!(command, Command::Paint(PaintCommand::Gradient { .. }))
+    }
+
+    /// The drag under way, as an arrow from start to end.
+    fn overlay(&self) -> Option<Overlay> {
+        self.drag.map(|(from, to)| Overlay::Arrow { from, to })
+    }
+
+    fn options(&self, _doc: &Document) -> Vec<ToolOption> {
+        vec![ToolOption {
+            id: "shape",
+            label: "",
+            hover: "",
+            widget: OptionWidget::Choice {
+                choices: SHAPES,
+                chosen: usize::from(self.shape == GradientShape::Radial),
+                dropdown: false,
+            },
+        }]
+    }
+
+    fn set_option(&mut self, id: &str, value: OptionValue, _doc: &Document) -> Vec<Command> {
+        match (id, value) {
+            ("shape", OptionValue::Choice(0)) => self.shape = GradientShape::Linear,
+            ("shape", OptionValue::Choice(1)) => self.shape = GradientShape::Radial,
+            _ => {}
+        }
+        Vec::new()
+    }
+
     fn handle(&mut self, event: ToolEvent, _doc: &Document) -> Vec<Command> {
         match event {
             ToolEvent::Press { at, .. } => {

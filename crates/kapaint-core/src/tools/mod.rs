@@ -23,6 +23,8 @@ pub use fill::{Fill, FillMode};
 pub use gradient::Gradient;
 pub use picker::Picker;
 
+use std::any::Any;
+
 use glam::Vec2;
 
 use crate::model::brush::SurfacePos;
@@ -83,133 +85,245 @@ pub enum ToolEvent {
     Escape,
 }
 
-/// What every tool does.
-pub trait Tool {
+/// What every tool is and does. Everything the editor knows of a tool it asks here: its name
+/// and key ([`ToolMeta`]), its options ([`Tool::options`], drawn by the editor from this
+/// description), its overlay, its cursor, and which of its commands lay a material.
+pub trait Tool: Any + std::fmt::Debug {
+    /// Its name, key and cursor.
+    fn meta(&self) -> ToolMeta;
+
     /// The commands that answer one event, in the order they are to be applied.
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command>;
 
     /// Whether something is under way (a stroke, a drag).
     fn busy(&self) -> bool;
+
+    /// The commands that end what is under way when another tool is chosen: by default as if
+    /// released (a stroke is kept).
+    fn leave(&mut self, doc: &Document) -> Vec<Command> {
+        self.handle(ToolEvent::Release, doc)
+    }
+
+    /// Whether `command`, which this tool answered, lays the primary material (the editor
+    /// then keeps it among the recent materials).
+    fn lays_material(&self, _command: &Command) -> bool {
+        false
+    }
+
+    /// What the editor draws over the views while the tool works.
+    fn overlay(&self) -> Option<Overlay> {
+        None
+    }
+
+    /// The tool's options, as the panel shows them.
+    fn options(&self, _doc: &Document) -> Vec<ToolOption> {
+        Vec::new()
+    }
+
+    /// Sets the option `id` (one of [`Tool::options`]); the commands it takes, if the option
+    /// lives in the document (a brush setting).
+    fn set_option(&mut self, _id: &str, _value: OptionValue, _doc: &Document) -> Vec<Command> {
+        Vec::new()
+    }
 }
 
-/// The tools, by name.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum ToolKind {
-    /// Paints the primary material.
-    #[default]
-    Brush,
-    /// Paints the base material back.
-    Eraser,
-    /// Smooths the enabled channels.
-    Blur,
-    /// Fills a UV island, a region of similar texels, or the whole map.
-    Fill,
-    /// A gradient from the primary to the secondary material, dragged on the map.
-    Gradient,
-    /// Reads the material under the pointer into the primary.
-    Picker,
-}
+/// A tool's name: each tool's file declares its own (`ToolKind::BRUSH`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ToolKind(&'static str);
 
 impl ToolKind {
-    /// Every tool, in the order the editor lists them.
-    pub const ALL: [Self; 6] = [
-        Self::Brush,
-        Self::Eraser,
-        Self::Blur,
-        Self::Fill,
-        Self::Gradient,
-        Self::Picker,
-    ];
-
-    /// The tool's name.
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Brush => "Brush",
-            Self::Eraser => "Eraser",
-            Self::Blur => "Blur",
-            Self::Fill => "Fill",
-            Self::Gradient => "Gradient",
-            Self::Picker => "Picker",
-        }
+    /// The name, lower case (`"brush"`).
+    pub fn name(self) -> &'static str {
+        self.0
     }
+}
 
-    /// Whether the tool paints strokes (and so shows the brush outline).
-    pub fn strokes(self) -> bool {
-        matches!(self, Self::Brush | Self::Eraser | Self::Blur)
-    }
+/// What the editor shows of a tool besides its options.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ToolMeta {
+    /// Which tool.
+    pub kind: ToolKind,
+    /// Its label in the panel.
+    pub label: &'static str,
+    /// The key that chooses it (none: chosen some other way, `key_help` says how).
+    pub key: Option<char>,
+    /// The key in the tool's tooltip ("B", "F on the UV canvas").
+    pub key_help: &'static str,
+    /// What the shortcut sheet says its key does ("gradient (drag, on the canvas or the mesh)").
+    pub summary: &'static str,
+    /// What the pointer shows over the views.
+    pub cursor: ToolCursor,
+}
+
+/// The pointer over the views.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToolCursor {
+    /// A crosshair inside the brush's outline (the dab's size on the canvas or the mesh).
+    BrushOutline,
+    /// A crosshair.
+    Crosshair,
+    /// A cell: a click acts on what is under it.
+    Cell,
+}
+
+/// What a tool asks the editor to draw over the views, in texel units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Overlay {
+    /// An arrow (a gradient's drag).
+    Arrow {
+        /// Where it starts.
+        from: Vec2,
+        /// Where it points.
+        to: Vec2,
+    },
+}
+
+/// One of a tool's options, as the panel shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ToolOption {
+    /// What [`Tool::set_option`] calls it.
+    pub id: &'static str,
+    /// Its label (empty: none).
+    pub label: &'static str,
+    /// Its tooltip (empty: none).
+    pub hover: &'static str,
+    /// The control and its value.
+    pub widget: OptionWidget,
+}
+
+/// An option's control.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OptionWidget {
+    /// One of a few named choices.
+    Choice {
+        /// The choices' names.
+        choices: &'static [&'static str],
+        /// The one chosen.
+        chosen: usize,
+        /// A drop-down list (else a row of buttons).
+        dropdown: bool,
+    },
+    /// A number in a range.
+    Slider {
+        /// Its value.
+        value: f32,
+        /// The smallest value.
+        min: f32,
+        /// The largest value.
+        max: f32,
+        /// Whole numbers only.
+        integer: bool,
+    },
+}
+
+/// A value the panel sets an option to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OptionValue {
+    /// The index of a choice.
+    Choice(usize),
+    /// A number.
+    Number(f32),
+}
+
+/// Every tool, in the order the editor lists them: adding a tool is its file and one line here.
+fn registry() -> Vec<Box<dyn Tool>> {
+    vec![
+        Box::new(Brush::default()),
+        Box::new(Eraser::default()),
+        Box::new(Blur::default()),
+        Box::new(Fill::default()),
+        Box::new(Gradient::default()),
+        Box::new(Picker::default()),
+    ]
 }
 
 /// The editor's tools and which one is active. Switching tools while one is busy ends its
 /// stroke (kept) or drag (dropped).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Tools {
-    active: ToolKind,
-    brush: Brush,
-    eraser: Eraser,
-    blur: Blur,
-    /// The fill tool and its options.
-    pub fill: Fill,
-    /// The gradient tool and its options.
-    pub gradient: Gradient,
-    /// The picker and its option.
-    pub picker: Picker,
+    active: usize,
+    tools: Vec<Box<dyn Tool>>,
+}
+
+impl Default for Tools {
+    fn default() -> Self {
+        Self {
+            active: 0,
+            tools: registry(),
+        }
+    }
 }
 
 impl Tools {
+    /// Every tool's name and key, in the editor's order.
+    pub fn all() -> Vec<ToolMeta> {
+        registry().iter().map(|t| t.meta()).collect()
+    }
+
     /// The active tool.
     pub fn active(&self) -> ToolKind {
-        self.active
+        self.active_tool().meta().kind
+    }
+
+    /// The active tool's name, key and cursor.
+    pub fn active_meta(&self) -> ToolMeta {
+        self.active_tool().meta()
     }
 
     /// Makes `kind` the active tool; returns the commands that end what the old one had
-    /// under way.
+    /// under way. An unknown kind changes nothing.
     pub fn select(&mut self, kind: ToolKind, doc: &Document) -> Vec<Command> {
-        if kind == self.active {
+        let Some(i) = self.tools.iter().position(|t| t.meta().kind == kind) else {
+            return Vec::new();
+        };
+        if i == self.active {
             return Vec::new();
         }
-        let ended = match self.active {
-            // A gradient half dragged is dropped, not laid.
-            ToolKind::Gradient => {
-                self.gradient.cancel();
-                Vec::new()
-            }
-            // A stroke under way is kept: it ends as if released.
-            active => self.tool_mut(active).handle(ToolEvent::Release, doc),
-        };
-        self.active = kind;
+        let ended = self.tools[self.active].leave(doc);
+        self.active = i;
         ended
     }
 
     /// The active tool's answer to `event`.
     pub fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
-        let kind = self.active;
-        self.tool_mut(kind).handle(event, doc)
+        let active = self.active;
+        self.tools[active].handle(event, doc)
     }
 
     /// Whether the active tool has something under way.
     pub fn busy(&self) -> bool {
-        self.tool(self.active).busy()
+        self.active_tool().busy()
     }
 
-    fn tool(&self, kind: ToolKind) -> &dyn Tool {
-        match kind {
-            ToolKind::Brush => &self.brush,
-            ToolKind::Eraser => &self.eraser,
-            ToolKind::Blur => &self.blur,
-            ToolKind::Fill => &self.fill,
-            ToolKind::Gradient => &self.gradient,
-            ToolKind::Picker => &self.picker,
-        }
+    /// Whether `command`, answered by the active tool, lays the primary material.
+    pub fn lays_material(&self, command: &Command) -> bool {
+        self.active_tool().lays_material(command)
     }
 
-    fn tool_mut(&mut self, kind: ToolKind) -> &mut dyn Tool {
-        match kind {
-            ToolKind::Brush => &mut self.brush,
-            ToolKind::Eraser => &mut self.eraser,
-            ToolKind::Blur => &mut self.blur,
-            ToolKind::Fill => &mut self.fill,
-            ToolKind::Gradient => &mut self.gradient,
-            ToolKind::Picker => &mut self.picker,
-        }
+    /// What the active tool draws over the views.
+    pub fn overlay(&self) -> Option<Overlay> {
+        self.active_tool().overlay()
+    }
+
+    /// The active tool's options.
+    pub fn options(&self, doc: &Document) -> Vec<ToolOption> {
+        self.active_tool().options(doc)
+    }
+
+    /// Sets one of the active tool's options; the commands it takes.
+    pub fn set_option(&mut self, id: &str, value: OptionValue, doc: &Document) -> Vec<Command> {
+        let active = self.active;
+        self.tools[active].set_option(id, value, doc)
+    }
+
+    /// The tool of type `T`, to read or set its state directly (tests, presets).
+    pub fn get_mut<T: Tool>(&mut self) -> Option<&mut T> {
+        self.tools
+            .iter_mut()
+            .find_map(|t| (t.as_mut() as &mut dyn Any).downcast_mut::<T>())
+    }
+
+    fn active_tool(&self) -> &dyn Tool {
+        self.tools[self.active].as_ref()
     }
 }

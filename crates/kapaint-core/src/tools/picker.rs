@@ -4,7 +4,9 @@
 use crate::model::PaintCommand;
 use crate::model::{Command, Document};
 
-use super::{Tool, ToolEvent};
+use super::{
+    OptionValue, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+};
 
 /// The picker tool.
 #[derive(Clone, Copy, Debug, Default)]
@@ -13,7 +15,46 @@ pub struct Picker {
     pub from_layer: bool,
 }
 
+impl ToolKind {
+    /// The picker.
+    pub const PICKER: Self = Self("picker");
+}
+
+/// Where the picker reads, as the panel names it.
+const SOURCES: &[&str] = &["All layers", "Selected layer"];
+
 impl Tool for Picker {
+    fn meta(&self) -> ToolMeta {
+        ToolMeta {
+            kind: ToolKind::PICKER,
+            label: "Picker",
+            key: Some('I'),
+            key_help: "I",
+            summary: "picker",
+            cursor: ToolCursor::Crosshair,
+        }
+    }
+
+    fn options(&self, _doc: &Document) -> Vec<ToolOption> {
+        vec![ToolOption {
+            id: "from",
+            label: "",
+            hover: "Read the composite, or what the selected layer holds",
+            widget: OptionWidget::Choice {
+                choices: SOURCES,
+                chosen: usize::from(self.from_layer),
+                dropdown: false,
+            },
+        }]
+    }
+
+    fn set_option(&mut self, id: &str, value: OptionValue, _doc: &Document) -> Vec<Command> {
+        if let ("from", OptionValue::Choice(i @ (0 | 1))) = (id, value) {
+            self.from_layer = i == 1;
+        }
+        Vec::new()
+    }
+
     fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
         let size = (doc.maps().width(), doc.maps().height());
         match event {

@@ -3,89 +3,22 @@
 use crate::files::FilePurpose;
 use crate::{EditorState, stamp_image, stamp_key};
 use kapaint_core::model::SettingsCommand;
-use kapaint_core::model::paint::GradientShape;
-use kapaint_core::model::texel::Channel;
 use kapaint_core::reflectance;
-use kapaint_core::tools::{FillMode, ToolKind};
-
-/// The key that selects a tool.
-fn tool_key(kind: ToolKind) -> &'static str {
-    match kind {
-        ToolKind::Brush => "B",
-        ToolKind::Eraser => "E",
-        ToolKind::Blur => "R",
-        ToolKind::Fill => "F on the UV canvas",
-        ToolKind::Gradient => "G",
-        ToolKind::Picker => "I",
-    }
-}
+use kapaint_core::tools::{OptionValue, OptionWidget, ToolOption, Tools};
 
 impl EditorState {
-    /// The active tool's options: the fill's mode, the gradient's shape.
+    /// The active tool's options, drawn from what the tool says they are.
     fn tool_options_ui(&mut self, ui: &mut egui::Ui) {
-        match self.tools.active() {
-            ToolKind::Fill => {
-                let mode = &mut self.tools.fill.mode;
-                let name = match mode {
-                    FillMode::Island => "UV island (or all)",
-                    FillMode::Similar { .. } => "Similar texels",
-                    FillMode::All => "Whole map",
-                };
-                egui::ComboBox::from_label("Fill")
-                    .selected_text(name)
-                    .show_ui(ui, |ui| {
-                        ui.selectable_value(mode, FillMode::Island, "UV island (or all)");
-                        if ui
-                            .selectable_label(
-                                matches!(mode, FillMode::Similar { .. }),
-                                "Similar texels",
-                            )
-                            .clicked()
-                        {
-                            *mode = FillMode::Similar {
-                                channel: Channel::Kd,
-                                tolerance: 0.05,
-                            };
-                        }
-                        ui.selectable_value(mode, FillMode::All, "Whole map");
-                    });
-                if let FillMode::Similar { channel, tolerance } = mode {
-                    egui::ComboBox::from_label("Compared channel")
-                        .selected_text(super::bars::channel_label(*channel))
-                        .show_ui(ui, |ui| {
-                            for c in Channel::ALL {
-                                ui.selectable_value(channel, c, super::bars::channel_label(c));
-                            }
-                        });
-                    ui.add(egui::Slider::new(tolerance, 0.0..=1.0).text("Tolerance"))
-                        .on_hover_text("The largest difference still filled, in blend space");
-                }
+        let mut changed = Vec::new();
+        for option in self.tools.options(&self.doc) {
+            if let Some(value) = option_ui(ui, &option) {
+                changed.push((option.id, value));
             }
-            ToolKind::Gradient => {
-                let shape = &mut self.tools.gradient.shape;
-                ui.horizontal(|ui| {
-                    ui.selectable_value(shape, GradientShape::Linear, "Linear");
-                    ui.selectable_value(shape, GradientShape::Radial, "Radial");
-                });
+        }
+        for (id, value) in changed {
+            for command in self.tools.set_option(id, value, &self.doc) {
+                self.apply(command);
             }
-            ToolKind::Blur => {
-                let mut brush = self.doc.settings().brush.clone();
-                ui.add(egui::Slider::new(&mut brush.blur_radius_px, 1..=16).text("Blur radius"))
-                    .on_hover_text("Kernel radius in texels");
-                if brush != self.doc.settings().brush {
-                    self.apply(SettingsCommand::SetBrush(brush).into());
-                }
-            }
-            ToolKind::Picker => {
-                let from = &mut self.tools.picker.from_layer;
-                ui.horizontal(|ui| {
-                    ui.selectable_value(from, false, "All layers");
-                    ui.selectable_value(from, true, "Selected layer");
-                })
-                .response
-                .on_hover_text("Read the composite, or what the selected layer holds");
-            }
-            ToolKind::Brush | ToolKind::Eraser => {}
         }
     }
 
@@ -94,9 +27,9 @@ impl EditorState {
         ui.heading("Tools");
         let mut chosen = self.tools.active();
         ui.horizontal_wrapped(|ui| {
-            for kind in ToolKind::ALL {
-                ui.selectable_value(&mut chosen, kind, kind.label())
-                    .on_hover_text(format!("{} ({})", kind.label(), tool_key(kind)));
+            for tool in Tools::all() {
+                ui.selectable_value(&mut chosen, tool.kind, tool.label)
+                    .on_hover_text(format!("{} ({})", tool.label, tool.key_help));
             }
         });
         if chosen != self.tools.active() {
@@ -280,4 +213,57 @@ fn blend_label(mode: kapaint_core::model::brush::BlendMode) -> &'static str {
         BlendMode::Subtract => "Subtract",
         BlendMode::Multiply => "Multiply",
     }
+}
+
+/// One tool option's control; the value it was set to this frame, if it changed.
+fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionValue> {
+    let (value, response) = match &option.widget {
+        OptionWidget::Choice {
+            choices,
+            chosen,
+            dropdown,
+        } => {
+            let mut picked = *chosen;
+            let response = if *dropdown {
+                let name = choices.get(*chosen).copied().unwrap_or_default();
+                egui::ComboBox::from_label(option.label)
+                    .selected_text(name)
+                    .show_ui(ui, |ui| {
+                        for (i, choice) in choices.iter().enumerate() {
+                            ui.selectable_value(&mut picked, i, *choice);
+                        }
+                    })
+                    .response
+            } else {
+                ui.horizontal(|ui| {
+                    if !option.label.is_empty() {
+                        ui.label(option.label);
+                    }
+                    for (i, choice) in choices.iter().enumerate() {
+                        ui.selectable_value(&mut picked, i, *choice);
+                    }
+                })
+                .response
+            };
+            (
+                (picked != *chosen).then_some(OptionValue::Choice(picked)),
+                response,
+            )
+        }
+        &OptionWidget::Slider {
+            value,
+            min,
+            max,
+            integer,
+        } => {
+            let mut v = value;
+            let slider = egui::Slider::new(&mut v, min..=max).text(option.label);
+            let response = ui.add(if integer { slider.integer() } else { slider });
+            ((v != value).then_some(OptionValue::Number(v)), response)
+        }
+    };
+    if !option.hover.is_empty() {
+        response.on_hover_text(option.hover);
+    }
+    value
 }
