@@ -1170,7 +1170,7 @@ fn autosave_on_a_full_disk_is_an_error_that_leaves_nothing_half_written() {
     .expect("noise");
     let mut saver = Autosaver::new(Duration::ZERO, Some(&project), &doc);
     let path = saver.session();
-    kapaint::model::import::import_file(&mut doc, kapaint::model::Channel::Kd, &noise)
+    doc.import_file(kapaint::model::Channel::Kd, &noise)
         .expect("import");
     saver.poll(&doc, Instant::now());
     let err = saver

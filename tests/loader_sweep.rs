@@ -20,7 +20,7 @@ use glam::Vec2;
 use kapaint::cli::PaintScript;
 use kapaint::export::{preset::ExportPreset, set};
 use kapaint::model::brush::{BrushSettings, Stamp, StrokePoint};
-use kapaint::model::{Channel, Document, DocumentSettings, StrokeTool, import, project};
+use kapaint::model::{Channel, Document, DocumentSettings, StrokeTool, project};
 use kapaint::model::{SettingsCommand, StrokeCommand};
 
 /// A deterministic xorshift generator: the same cases on every run.
@@ -427,7 +427,7 @@ fn images() {
         std::fs::write(&path, &case[1..]).expect("write");
         let mut doc = Document::new(32, 32, DocumentSettings::default()).expect("doc");
         for channel in Channel::ALL {
-            if import::import_file(&mut doc, channel, &path).is_err() {
+            if doc.import_file(channel, &path).is_err() {
                 return;
             }
         }

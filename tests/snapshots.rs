@@ -23,7 +23,7 @@ use kapaint::gpu::difference::Difference;
 use kapaint::gpu::preview::COMPARED_MODELS;
 use kapaint::gpu::{Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
 use kapaint::model::texel::{MaterialValue, linear_to_srgb8};
-use kapaint::model::{Channel, Document, DocumentSettings, import};
+use kapaint::model::{Channel, Document, DocumentSettings};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
 use kapaint::render::{Camera, FrameSettings, Lighting, ViewMode};
 
@@ -135,8 +135,8 @@ fn the_main_views_match_their_snapshots() {
     )
     .expect("doc");
     let texture = testdata("spot_texture.png");
-    import::import_file(&mut doc, Channel::Kd, &texture).expect("k_d");
-    import::import_file(&mut doc, Channel::N, &texture).expect("n");
+    doc.import_file(Channel::Kd, &texture).expect("k_d");
+    doc.import_file(Channel::N, &texture).expect("n");
     let buffers = MeshBuffers::new(&gpu, &mesh).expect("mesh buffers");
     let maps = MapTextures::new(&gpu, doc.maps()).expect("map textures");
     let preview = Preview::new(&gpu);

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use super::{CliError, model_error};
-use crate::model::{Channel, import, project};
+use crate::model::{Channel, project};
 
 /// Import an image (PNG, JPEG, TGA, EXR) into one channel of a project.
 #[derive(Debug, clap::Args)]
@@ -32,7 +32,7 @@ impl ImportArgs {
         // The file as read: a save finds out if another run saved over it meanwhile.
         let on_disk = project::OnDisk::of(&self.file);
         let mut doc = project::load(&self.file).map_err(model_error)?;
-        import::import_file(&mut doc, channel, &self.image).map_err(model_error)?;
+        doc.import_file(channel, &self.image).map_err(model_error)?;
         let expected = if self.out.is_none() {
             on_disk.as_ref()
         } else {

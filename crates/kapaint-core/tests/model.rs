@@ -11,7 +11,7 @@ use kapaint_core::model::paint::GradientShape;
 use kapaint_core::model::texel::{N_MAX, Texel, srgb_to_linear};
 use kapaint_core::model::{
     Channel, Channels, Document, DocumentSettings, FillRegion, MaterialMaps, MaterialValue,
-    StrokeTool, import, project,
+    StrokeTool, project,
 };
 use kapaint_core::model::{Command, HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 
@@ -440,7 +440,7 @@ fn spot_texture() -> std::path::PathBuf {
 fn importing_the_spot_texture_converts_srgb_to_linear() {
     let path = spot_texture();
     let mut d = doc(1024, 1024);
-    import::import_file(&mut d, Channel::Kd, &path).expect("import");
+    d.import_file(Channel::Kd, &path).expect("import");
     let png = image::open(&path).expect("decodes").to_rgb8();
     for (x, y) in [(100, 100), (512, 300), (900, 950), (0, 0)] {
         let p = png.get_pixel(x, y).0;
@@ -466,7 +466,7 @@ fn importing_into_n_uses_the_log_scale() {
         .save(&gray)
         .expect("write");
     let mut d = doc(64, 64);
-    import::import_file(&mut d, Channel::N, &gray).expect("import");
+    d.import_file(Channel::N, &gray).expect("import");
     assert_eq!(d.maps().value(0, 0).n, 0.0);
     assert_eq!(d.maps().value(63, 0).n, N_MAX);
     let _ = std::fs::remove_dir_all(&dir);
@@ -497,7 +497,8 @@ fn bad_images_are_clear_errors() {
         (&not_image, "png"),
         (&bomb_path, "too large"),
     ] {
-        let err = import::import_file(&mut d, Channel::Kd, path)
+        let err = d
+            .import_file(Channel::Kd, path)
             .expect_err("must fail")
             .to_string();
         assert!(

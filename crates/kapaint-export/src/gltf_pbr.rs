@@ -15,14 +15,9 @@ use kapaint_core::pbr::round_trip::convert;
 use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::task::Progress;
 
-/// `format` of a glTF PBR set's `material.json`.
-pub const PBR_MANIFEST_FORMAT: &str = "kapaint-gltf-pbr";
+pub use crate::set::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, PBR_MANIFEST_FORMAT};
 /// Its version.
 pub const PBR_MANIFEST_VERSION: u32 = 1;
-/// The base colour image's name.
-pub const BASE_COLOR_FILE: &str = "base_color.png";
-/// The metallic-roughness image's name.
-pub const METALLIC_ROUGHNESS_FILE: &str = "metallic_roughness.png";
 /// The normal map's name (where the project has one).
 pub const NORMAL_FILE: &str = "normal.png";
 /// The `.glb`'s name.
@@ -136,52 +131,41 @@ pub fn export(
         path: out.to_path_buf(),
         reason,
     };
-    let (base_png, mr_png) = rayon::join(
-        || {
-            png_bytes(
-                converted.base.as_flattened(),
-                (w, h),
-                image::ExtendedColorType::Rgb8,
-            )
-        },
-        || {
-            png_bytes(
-                converted.metallic_roughness.as_flattened(),
-                (w, h),
-                image::ExtendedColorType::Rgb8,
-            )
-        },
+    let png =
+        |rgb: &[[u8; 3]]| png_bytes(rgb.as_flattened(), (w, h), image::ExtendedColorType::Rgb8);
+    let (base, metallic_roughness) = rayon::join(
+        || png(&converted.base),
+        || png(&converted.metallic_roughness),
     );
-    let (base_png, mr_png) = (base_png.map_err(invalid)?, mr_png.map_err(invalid)?);
+    let (base, metallic_roughness) = (base.map_err(invalid)?, metallic_roughness.map_err(invalid)?);
     progress.check().map_err(|_| SetError::Cancelled)?;
     progress.start("measure", 1);
     // The normal map passes through as stored.
-    let normal_png = doc
+    let normal = doc
         .normal()
         .map(|m| m.to_png())
         .transpose()
         .map_err(invalid)?;
-    let glb_bytes = glb
+    let name = out
+        .file_name()
+        .map_or_else(|| "kapaint".into(), |n| n.to_string_lossy().into_owned());
+    let glb = glb
         .map(|mesh| {
-            super::glb::write(
-                mesh,
-                &super::glb::Textures {
-                    base_color: &base_png,
-                    metallic_roughness: &mr_png,
-                    normal: normal_png.as_deref(),
-                },
-                out.file_name()
-                    .map_or_else(|| "kapaint".into(), |n| n.to_string_lossy().into_owned()),
-            )
+            let textures = super::glb::Textures {
+                base_color: &base,
+                metallic_roughness: &metallic_roughness,
+                normal: normal.as_deref(),
+            };
+            super::glb::write(mesh, &textures, name)
         })
         .transpose()
         .map_err(invalid)?;
-    let files = files_of(
-        base_png.len(),
-        mr_png.len(),
-        normal_png.as_ref().map(Vec::len),
-        glb_bytes.as_ref().map(Vec::len),
-    );
+    let written = PbrFiles {
+        base,
+        metallic_roughness,
+        normal,
+        glb,
+    };
     let manifest = PbrManifest {
         format: PBR_MANIFEST_FORMAT.into(),
         version: PBR_MANIFEST_VERSION,
@@ -195,30 +179,55 @@ pub fn export(
         },
         round_trip: converted.error,
         dilated,
-        files,
+        files: written.entries(),
         preset: preset.name.clone(),
     };
     commit(out, &found, |tmp| {
-        let io = |path: &Path, e: std::io::Error| SetError::Io {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        };
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| invalid(e.to_string()))?;
+        written.write(tmp, &json)?;
+        Ok(manifest)
+    })
+}
+
+/// The files of a glTF PBR set, encoded.
+struct PbrFiles {
+    base: Vec<u8>,
+    metallic_roughness: Vec<u8>,
+    normal: Option<Vec<u8>>,
+    glb: Option<Vec<u8>>,
+}
+
+impl PbrFiles {
+    /// Their manifest entries.
+    fn entries(&self) -> Vec<PbrFile> {
+        files_of(
+            self.base.len(),
+            self.metallic_roughness.len(),
+            self.normal.as_ref().map(Vec::len),
+            self.glb.as_ref().map(Vec::len),
+        )
+    }
+
+    /// Writes them and the manifest's `json` into `tmp`.
+    fn write(&self, tmp: &Path, json: &[u8]) -> Result<(), SetError> {
         let mut writes: Vec<(&str, &[u8])> = vec![
-            (BASE_COLOR_FILE, &base_png),
-            (METALLIC_ROUGHNESS_FILE, &mr_png),
-            ("material.json", &json),
+            (BASE_COLOR_FILE, &self.base),
+            (METALLIC_ROUGHNESS_FILE, &self.metallic_roughness),
+            ("material.json", json),
         ];
-        if let Some(bytes) = &normal_png {
+        if let Some(bytes) = &self.normal {
             writes.push((NORMAL_FILE, bytes));
         }
-        if let Some(bytes) = &glb_bytes {
+        if let Some(bytes) = &self.glb {
             writes.push((GLB_FILE, bytes));
         }
         for (name, bytes) in writes {
             let path = tmp.join(name);
-            kapaint_core::atomic::write_atomic(&path, bytes).map_err(|e| io(&path, e))?;
+            kapaint_core::atomic::write_atomic(&path, bytes).map_err(|e| SetError::Io {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
         }
-        Ok(manifest)
-    })
+        Ok(())
+    }
 }

@@ -4,6 +4,7 @@
 
 pub mod blocks;
 pub mod encoding;
+pub mod file_kind;
 pub mod glb;
 pub mod gltf_pbr;
 pub mod ktx;

@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 
 use super::encoding::NCurve;
-use super::set::Manifest;
+use crate::set::manifest::Manifest;
 use kapaint_core::reflectance::wgsl::{
     ShaderLanguage, ambient_glsl, ambient_wgsl_standalone, approx_constant, model_constant,
 };
@@ -56,6 +56,22 @@ fn snippet(manifest: &Manifest, lang: ShaderLanguage) -> String {
             let _ = writeln!(s, "const uint KAPAINT_APPROX = {approx};\n");
         }
     }
+    decode_n(&mut s, manifest, lang);
+    s += match lang {
+        ShaderLanguage::Wgsl => {
+            "\nfn kapaint_ka(kd: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {\n    \
+             return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n"
+        }
+        ShaderLanguage::Glsl => {
+            "\nvec3 kapaint_ka(vec3 kd, vec3 ks, float n) {\n    \
+             return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n"
+        }
+    };
+    s
+}
+
+/// `kapaint_decode_n` for the set's `n`: constant, on its encoding's curve, or as stored.
+fn decode_n(s: &mut String, manifest: &Manifest, lang: ShaderLanguage) {
     // `fn name(x: f32) -> f32` or `float name(float x)`, and `let` or `float` for locals.
     let (float_fn, local): (fn(&str, &str) -> String, &str) = match lang {
         ShaderLanguage::Wgsl => (
@@ -107,15 +123,4 @@ fn snippet(manifest: &Manifest, lang: ShaderLanguage) -> String {
             );
         }
     }
-    s += match lang {
-        ShaderLanguage::Wgsl => {
-            "\nfn kapaint_ka(kd: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {\n    \
-             return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n"
-        }
-        ShaderLanguage::Glsl => {
-            "\nvec3 kapaint_ka(vec3 kd, vec3 ks, float n) {\n    \
-             return ambient_ka(KAPAINT_MODEL, KAPAINT_APPROX, kd, ks, n);\n}\n"
-        }
-    };
-    s
 }

@@ -202,6 +202,12 @@ pub fn finite_f32<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     }
 }
 
+/// The most layers (groups and their children included) a document holds.
+pub const MAX_LAYERS: usize = 256;
+
+/// The deepest layer groups nest.
+pub const MAX_DEPTH: usize = 16;
+
 /// A layer's name ([`name`]).
 pub fn layer_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     let v = String::deserialize(d)?;
@@ -213,8 +219,8 @@ pub fn layer_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 /// under the most layers a project may hold.
 pub fn layer_path<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<usize>, D::Error> {
     let v = Vec::<usize>::deserialize(d)?;
-    let depth = crate::model::project::layers::MAX_DEPTH + 1;
-    let most = crate::model::document::MAX_LAYERS;
+    let depth = MAX_DEPTH + 1;
+    let most = MAX_LAYERS;
     if v.len() > depth || v.iter().any(|&i| i >= most) {
         return Err(D::Error::custom(format!(
             "a layer path has at most {depth} indices, each under {most}"

@@ -19,7 +19,6 @@ use image::DynamicImage;
 use rayon::prelude::*;
 
 use super::ModelError;
-use super::document::{Document, ImportedChannel};
 use super::maps::MaterialMaps;
 use super::texel::{Channel, encode_n, encode_rgb, n_from_blend, srgb_to_linear};
 use super::tile::{Plane, TILE_SIZE};
@@ -433,23 +432,6 @@ pub(super) fn write_planes(maps: &mut MaterialMaps, planes: &ChannelPlanes) {
     }
 }
 
-/// Writes `image` into `channel` of the selected paint layer as one undo step.
-///
-/// # Errors
-/// The command's: the selected layer is locked, a fill layer or a group, or its mask is
-/// selected; the document is unchanged then.
-pub fn import_into(
-    doc: &mut Document,
-    channel: Channel,
-    image: &DynamicImage,
-) -> Result<(), ModelError> {
-    let (w, h) = (doc.maps().width(), doc.maps().height());
-    let planes = resample(image, channel, w, h);
-    doc.apply(super::ImportCommand::ImportChannel(ImportedChannel(
-        std::sync::Arc::new(planes),
-    )))
-}
-
 /// Reads a grayscale brush stamp from an image file (luminance of the decoded image; an
 /// alpha channel, if present, multiplies it), at most 1024 x 1024 pixels.
 pub fn read_stamp(path: &Path) -> Result<super::brush::Stamp, ModelError> {
@@ -476,15 +458,6 @@ pub fn read_stamp(path: &Path) -> Result<super::brush::Stamp, ModelError> {
             reason,
         }
     })
-}
-
-/// Reads `path` and imports it into `channel` of the selected paint layer.
-///
-/// # Errors
-/// The image's, or the command's ([`import_into`]).
-pub fn import_file(doc: &mut Document, channel: Channel, path: &Path) -> Result<(), ModelError> {
-    let image = read_image(path)?;
-    import_into(doc, channel, &image)
 }
 
 /// A PNG of `data` (samples in the encoder's order; 16-bit words native-endian) with `color`,

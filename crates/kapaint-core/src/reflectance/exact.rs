@@ -266,9 +266,8 @@ fn blinn_g_window(n: f64, a: f64, b: f64, e: f64, sin2: impl Fn(f64) -> f64) -> 
 /// [`super::geometry`]: the mean of the lobe over `samples` uniform points of the box, with its
 /// standard error. An independent check of [`chi_exact`] that shares no code with it.
 pub fn chi_monte_carlo(model: ShadingModel, n: f64, samples: u64, seed: u64) -> (f64, f64) {
-    let [estimate] = super::geometry::box_average(samples, seed, |t, g, p| {
-        [super::geometry::rho_s(model, n, t, g, p)]
-    });
+    let [estimate] =
+        super::geometry::box_average(samples, seed, |t, g, p| [rho_s(model, n, t, g, p)]);
     estimate
 }
 
@@ -283,6 +282,18 @@ pub fn asymptotic_slope(model: ShadingModel) -> f64 {
         ShadingModel::BlinnPhong => 8.0 / (PI * PI),
         ShadingModel::CookTorrance => super::cook_torrance::SUM_LOG_SLOPE,
     }
+}
+
+/// The specular reflectance `rho_s = max(0, cos)^n`, with `0^0` taken as 0: at `n = 0` the
+/// lobe is the indicator of the set where the cosine is positive, which is the limit of
+/// `max(0, cos)^n` as `n -> 0`. For Cook-Torrance, its radiance factor with `F0 = 1`
+/// (`chi_1 + chi_0` is its average).
+pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f64 {
+    if model == ShadingModel::CookTorrance {
+        let [first, second] = super::cook_torrance::rho_s_parts(n, theta, gamma, phi);
+        return first + second;
+    }
+    super::geometry::lobe_power(super::geometry::lobe_cosine(model, theta, gamma, phi), n)
 }
 
 #[cfg(test)]
@@ -349,7 +360,7 @@ mod tests {
             let kink = FRAC_PI_2 - (t.sin() * g.cos()).atan2(t.cos());
             let peak = -(t.sin() * g.cos()).atan2(t.cos());
             let brute = rule.integrate_pieces(&break_points(-FRAC_PI_2, kink, [peak]), |p| {
-                super::super::geometry::rho_s(ShadingModel::Phong, n, t, g, p)
+                super::rho_s(ShadingModel::Phong, n, t, g, p)
             });
             assert!(rel(reduced, brute) < 1e-12, "n={n}: {reduced} vs {brute}");
         }

@@ -48,19 +48,8 @@ pub fn lobe_cosine(model: ShadingModel, theta: f64, gamma: f64, phi: f64) -> f64
     }
 }
 
-/// The specular reflectance `rho_s = max(0, cos)^n`, with `0^0` taken as 0: at `n = 0` the
-/// lobe is the indicator of the set where the cosine is positive, which is the limit of
-/// `max(0, cos)^n` as `n -> 0`. For Cook-Torrance, its radiance factor with `F0 = 1`
-/// (`chi_1 + chi_0` is its average).
-pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f64 {
-    if model == ShadingModel::CookTorrance {
-        let [first, second] = super::cook_torrance::rho_s_parts(n, theta, gamma, phi);
-        return first + second;
-    }
-    lobe_power(lobe_cosine(model, theta, gamma, phi), n)
-}
-
-/// `max(0, c)^n` with `0^0` taken as 0 (see [`rho_s`]).
+/// `max(0, c)^n` with `0^0` taken as 0: at `n = 0` the lobe is the indicator of the set
+/// where the cosine is positive, the limit of `max(0, cos)^n` as `n -> 0`.
 pub fn lobe_power(c: f64, n: f64) -> f64 {
     if c <= 0.0 {
         0.0

@@ -29,7 +29,8 @@ fn textured(side: u32, texture: Option<&Path>) -> Result<Document, String> {
     let mut doc =
         Document::new(side, side, DocumentSettings::default()).map_err(|e| e.to_string())?;
     if let Some(path) = texture {
-        import::import_file(&mut doc, Channel::Kd, path).map_err(|e| e.to_string())?;
+        doc.import_file(Channel::Kd, path)
+            .map_err(|e| e.to_string())?;
     }
     Ok(doc)
 }

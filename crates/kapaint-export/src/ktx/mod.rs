@@ -17,7 +17,7 @@ pub use self::container::{Decoded, decode};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 use super::blocks::{self, BlockKind, Coder};
 use super::preset::Bc7Quality;
-use super::set::Compression;
+use crate::file_kind::Compression;
 use kapaint_core::task::Progress;
 
 /// A texel's component in its averaging space (`value(texel, component)`, unquantised).

@@ -21,9 +21,7 @@
 
 use std::time::Instant;
 
-use glam::Vec3;
-use serde::{Deserialize, Serialize};
-
+use super::choice::{BlockChoice, BlockLayout, Trial};
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
@@ -31,119 +29,14 @@ use crate::blocks::{BlockEncoder, BlockKind, Coder, Encoder};
 use crate::encoding::{KaError, NEncoding};
 use crate::ktx::{self, Compressed};
 use crate::preset::{Bc7Quality, BlockBudget, ExportPreset, Format};
+use glam::Vec3;
 use kapaint_core::model::texel::Texel;
 use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
 use kapaint_core::task::Progress;
 
-/// Where `n` goes in a block-compressed set.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BlockLayout {
-    /// In `k_d`'s BC7 alpha (the fewest bytes).
-    Packed,
-    /// Out of the colour blocks: a BC4 plane of its own, or with grey `k_s` in a BC5 image.
-    NApart,
-    /// `n` apart, and the three-component colour images BC6H: linear half floats instead
-    /// of BC7's 8-bit sRGB (the same bytes as `n-apart`).
-    HalfColour,
-}
-
-impl BlockLayout {
-    /// Whether colour images are half floats.
-    fn half(self) -> bool {
-        self == Self::HalfColour
-    }
-}
-
 /// Whether an image of `comps` is colour that BC6H can hold: three colour components.
 fn half_image(comps: &[Comp]) -> bool {
     comps.len() == 3 && comps.iter().all(|c| is_colour(*c))
-}
-
-/// One encoding of level 0 that the export measured.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Trial {
-    /// Where `n` was.
-    pub layout: BlockLayout,
-    /// BC7's (and BC6H's) effort.
-    pub bc7_effort: Bc7Quality,
-    /// The set's `k_a` error, level 0 as a consumer decodes it.
-    pub ka_error: KaError,
-    /// The smallest PSNR of any compressed component (dB; `None` where all are exact).
-    pub min_psnr: Option<f64>,
-    /// Seconds spent encoding and measuring.
-    pub seconds: f64,
-}
-
-impl Trial {
-    /// The trial and its measures, for the manifest's reason.
-    fn describe(&self) -> String {
-        format!(
-            "{:?} at {:?}: k_a max {}, mean {}, PSNR {}",
-            self.layout,
-            self.bc7_effort,
-            pct(self.ka_error.max),
-            pct(self.ka_error.mean),
-            self.min_psnr
-                .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
-        )
-    }
-}
-
-/// How a block-compressed set's layout and effort were chosen.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BlockChoice {
-    /// The block encoder that finished the set.
-    pub encoder: Encoder,
-    /// Why the GPU encoder failed, where it began this set and a CPU encoder (`encoder`)
-    /// finished it. Absent otherwise.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gpu_failed: Option<String>,
-    /// Where `n` went.
-    pub layout: BlockLayout,
-    /// BC7's effort.
-    pub bc7_effort: Bc7Quality,
-    /// The preset's budget.
-    pub budget: BlockBudget,
-    /// Whether the chosen trial meets it.
-    pub within_budget: bool,
-    /// Why this one, in a sentence.
-    pub reason: String,
-    /// Every trial, in the order run.
-    pub trials: Vec<Trial>,
-}
-
-impl BlockChoice {
-    /// One line for people: the layout and effort chosen, the encoder, and the budget's
-    /// verdict (the manifest's `blocks` has the trials and the reason).
-    pub fn summary(&self) -> String {
-        let layout = match self.layout {
-            BlockLayout::Packed => "n packed in k_d's BC7",
-            BlockLayout::NApart => "n apart (BC4/BC5), colour BC7",
-            BlockLayout::HalfColour => "n apart (BC4/BC5), colour BC6H",
-        };
-        let encoder = match self.encoder {
-            Encoder::Ispc => "ISPC",
-            Encoder::Portable => "portable CPU",
-            Encoder::Gpu => "GPU",
-        };
-        let encoder = if self.gpu_failed.is_some() {
-            format!("{encoder} encoder (the GPU encoder failed part-way)")
-        } else {
-            format!("{encoder} encoder")
-        };
-        let verdict = if self.within_budget {
-            "within the k_a budget".to_owned()
-        } else {
-            format!(
-                "over the k_a budget (max {}, mean {}): kept the nearest of {} trials",
-                pct(self.budget.max_ka_error),
-                pct(self.budget.mean_ka_error),
-                self.trials.len()
-            )
-        };
-        format!("{layout} at {:?}, {encoder}, {verdict}", self.bc7_effort)
-    }
 }
 
 /// A set's images: file stem and components.
@@ -332,19 +225,11 @@ fn reachable(trials: &[Trial], layout: BlockLayout, budget: &BlockBudget, left: 
         && psnr_ok
 }
 
-fn pct(v: f64) -> String {
-    format!("{:.2} %", v * 100.0)
-}
-
 /// Encodes a block-compressed set: trials on level 0 from the cheapest profile up (see the
 /// module), then the chosen images with their mip chains.
 ///
 /// # Errors
 /// A failed encode, or cancelled (`"cancelled"`).
-#[expect(
-    clippy::too_many_lines,
-    reason = "one search: encode, measure, decide, in a loop"
-)]
 pub(super) fn encode_blocks(
     job: &Job<'_>,
     packed: &Images,
@@ -352,145 +237,18 @@ pub(super) fn encode_blocks(
     progress: &Progress,
 ) -> Result<(Vec<Encoded>, BlockChoice), String> {
     let encoder = Coder::best(job.brought);
-    let budget = job.preset.budget;
-    let efforts: Vec<Bc7Quality> = Bc7Quality::ALL
-        .into_iter()
-        .filter(|e| *e <= job.preset.max_bc7_effort)
-        .collect();
-    // The layouts to try at the lowest effort, in order: fewest bytes first; then, for the
-    // same bytes, BC6H colour where there is a colour image and the preset allows it (its
-    // k_d is 15 dB closer than BC7's at the same effort), else n apart in BC7.
-    let apart_images = apart.unwrap_or(packed);
-    let mut layouts = vec![BlockLayout::Packed];
-    if job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
-        layouts.push(BlockLayout::HalfColour);
-    } else if apart.is_some() {
-        layouts.push(BlockLayout::NApart);
-    }
-    let want_of = |layout: BlockLayout| match layout {
-        BlockLayout::Packed => packed,
-        BlockLayout::NApart | BlockLayout::HalfColour => apart_images,
-    };
-    let mut layout = BlockLayout::Packed;
-    let mut step = 0;
-    let mut trials: Vec<Trial> = Vec::new();
-    let mut images: Vec<TrialImage<'_>> = Vec::new();
-    let (w, h) = job.size;
-    let reason;
-    let chosen;
-    loop {
-        let effort = efforts[step];
-        prepare(&mut images, want_of(layout), layout.half(), job);
-        let started = Instant::now();
-        progress.start("encode", images.len() as u64 * u64::from(h));
-        for image in &mut images {
-            image.compress(encoder, effort, (w, h), progress);
-            if progress.is_cancelled() {
-                return Err("cancelled".into());
-            }
-        }
-        let stored: Vec<StoredImage> = images.iter().map(TrialImage::stored).collect();
-        let ka_error = job.measure(&stored);
-        let min_psnr = images
-            .iter_mut()
-            .filter_map(|i| {
-                let (_, c) = i.compressed.as_mut()?;
-                c.psnr(&i.level0, i.texels.spaces())
-                    .iter()
-                    .flatten()
-                    .copied()
-                    .reduce(f64::min)
-            })
-            .reduce(f64::min);
-        let psnr_ok = min_psnr.is_none_or(|p| p >= budget.min_psnr);
-        let ka_ok = within(&budget, ka_error);
-        trials.push(Trial {
-            layout,
-            bc7_effort: effort,
-            ka_error,
-            min_psnr,
-            seconds: started.elapsed().as_secs_f64(),
-        });
-        let here = trials.last().map(Trial::describe).unwrap_or_default();
-        if ka_ok && psnr_ok {
-            reason = format!("{here}: within the budget");
-            chosen = trials.len() - 1;
-            break;
-        }
-        // The layout failed: the next one, at the same effort.
-        if let Some(next) = layouts.iter().find(|l| !tried(&trials, **l)) {
-            layout = *next;
-            continue;
-        }
-        // Then more effort for the best layout, while it buys something.
-        if trials.len() == layouts.len() {
-            layout = trials
-                .iter()
-                .reduce(|a, b| better(a, b, &budget))
-                .map_or(layout, |t| t.layout);
-        }
-        if step + 1 < efforts.len() && reachable(&trials, layout, &budget, efforts.len() - step - 1)
-        {
-            step += 1;
-            // BC6H has no effort between ultra-fast and very-fast: skip a step that would
-            // encode the same blocks again.
-            if layout.half() && efforts[step] == Bc7Quality::VeryFast && step + 1 < efforts.len() {
-                step += 1;
-            }
-            continue;
-        }
-        // Nothing met the budget: the trial nearest it.
-        chosen = (0..trials.len())
-            .reduce(|a, b| {
-                if nearer(&trials[a], &trials[b], &budget) {
-                    b
-                } else {
-                    a
-                }
-            })
-            .unwrap_or(0);
-        let kept = trials[chosen].describe();
-        reason = if step + 1 < efforts.len() {
-            format!(
-                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept} (the last: {here})"
-            )
-        } else {
-            format!(
-                "no trial up to {:?} met the budget: kept the trial nearest it, {kept} (the last: {here})",
-                job.preset.max_bc7_effort
-            )
-        };
-        break;
-    }
-    let pick = trials[chosen].clone();
-    if pick.layout != layout || pick.bc7_effort != efforts[step] {
+    let search = Search::new(job, packed, apart);
+    let mut images = Vec::new();
+    let found = search.run(&mut images, encoder, progress)?;
+    let pick = found.trials[found.chosen].clone();
+    if (pick.layout, pick.bc7_effort) != found.last {
         // The pick is an earlier trial: encode its level 0 again.
-        prepare(&mut images, want_of(pick.layout), pick.layout.half(), job);
-        progress.start("encode", images.len() as u64 * u64::from(h));
-        for image in &mut images {
-            image.compress(encoder, pick.bc7_effort, (w, h), progress);
-        }
+        let want = search.images_of(pick.layout);
+        prepare(&mut images, want, pick.layout.half(), job);
+        compress_all(&mut images, encoder, pick.bc7_effort, job, progress);
     }
-    // The chosen images with their mips.
-    progress.start("encode", images.len() as u64 * u64::from(h));
-    let mut encoded = Vec::with_capacity(images.len());
-    for image in images {
-        let compressed = image.compressed.map(|(_, c)| c);
-        let written = ktx::encode(
-            &image.texels.source((w, h), &image.level0),
-            Some((encoder, pick.bc7_effort)),
-            compressed,
-            progress,
-        )?;
-        if progress.is_cancelled() {
-            return Err("cancelled".into());
-        }
-        encoded.push((
-            format!("{}.ktx2", image.stem),
-            image.comps,
-            ktx_image(written, image.srgb, image.half),
-        ));
-    }
+    let encoded = with_mips(images, encoder, pick.bc7_effort, job.size, progress)?;
+    let budget = job.preset.budget;
     let within_budget =
         within(&budget, pick.ka_error) && pick.min_psnr.is_none_or(|p| p >= budget.min_psnr);
     // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
@@ -508,10 +266,244 @@ pub(super) fn encode_blocks(
             bc7_effort: pick.bc7_effort,
             budget,
             within_budget,
-            reason,
-            trials,
+            reason: found.reason,
+            trials: found.trials,
         },
     ))
+}
+
+/// The search's answer: every trial, the one chosen and why, and the layout and effort the
+/// images were last compressed at.
+struct Found {
+    trials: Vec<Trial>,
+    chosen: usize,
+    reason: String,
+    last: (BlockLayout, Bc7Quality),
+}
+
+/// The layouts and efforts a block-compressed set may take.
+struct Search<'j, 'a> {
+    job: &'j Job<'a>,
+    packed: &'j Images,
+    apart: &'j Images,
+    /// The layouts to try at the lowest effort, in order.
+    layouts: Vec<BlockLayout>,
+    /// The efforts up to the preset's ceiling, lowest first.
+    efforts: Vec<Bc7Quality>,
+}
+
+impl<'j, 'a> Search<'j, 'a> {
+    fn new(job: &'j Job<'a>, packed: &'j Images, apart: Option<&'j Images>) -> Self {
+        let efforts = Bc7Quality::ALL
+            .into_iter()
+            .filter(|e| *e <= job.preset.max_bc7_effort)
+            .collect();
+        // Fewest bytes first; then, for the same bytes, BC6H colour where there is a colour
+        // image and the preset allows it (its k_d is 15 dB closer than BC7's at the same
+        // effort), else n apart in BC7.
+        let apart_images = apart.unwrap_or(packed);
+        let mut layouts = vec![BlockLayout::Packed];
+        if job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
+            layouts.push(BlockLayout::HalfColour);
+        } else if apart.is_some() {
+            layouts.push(BlockLayout::NApart);
+        }
+        Self {
+            job,
+            packed,
+            apart: apart_images,
+            layouts,
+            efforts,
+        }
+    }
+
+    /// The images of a layout.
+    fn images_of(&self, layout: BlockLayout) -> &'j Images {
+        match layout {
+            BlockLayout::Packed => self.packed,
+            BlockLayout::NApart | BlockLayout::HalfColour => self.apart,
+        }
+    }
+
+    /// Trials until one meets the budget or more effort would not: the layouts in order at
+    /// the lowest effort, then more effort for the one nearest the budget.
+    fn run(
+        &self,
+        images: &mut Vec<TrialImage<'a>>,
+        encoder: Coder<'_>,
+        progress: &Progress,
+    ) -> Result<Found, String> {
+        let budget = self.job.preset.budget;
+        let (mut layout, mut step) = (BlockLayout::Packed, 0);
+        let mut trials: Vec<Trial> = Vec::new();
+        loop {
+            let effort = self.efforts[step];
+            prepare(images, self.images_of(layout), layout.half(), self.job);
+            let trial = run_trial(images, encoder, layout, effort, self.job, progress)?;
+            let here = trial.describe();
+            let met = within(&budget, trial.ka_error)
+                && trial.min_psnr.is_none_or(|p| p >= budget.min_psnr);
+            trials.push(trial);
+            if met {
+                return Ok(Found {
+                    chosen: trials.len() - 1,
+                    trials,
+                    reason: format!("{here}: within the budget"),
+                    last: (layout, effort),
+                });
+            }
+            // The layout failed: the next one, at the same effort.
+            if let Some(next) = self.layouts.iter().find(|l| !tried(&trials, **l)) {
+                layout = *next;
+                continue;
+            }
+            // Then more effort for the best layout, while it buys something.
+            if trials.len() == self.layouts.len() {
+                layout = trials
+                    .iter()
+                    .reduce(|a, b| better(a, b, &budget))
+                    .map_or(layout, |t| t.layout);
+            }
+            if let Some(next) = self.more_effort(&trials, layout, step) {
+                step = next;
+                continue;
+            }
+            return Ok(self.nearest(trials, step, &here, (layout, effort)));
+        }
+    }
+
+    /// The next effort for `layout` after `step`, where more effort may still meet the budget.
+    fn more_effort(&self, trials: &[Trial], layout: BlockLayout, step: usize) -> Option<usize> {
+        let left = self.efforts.len() - step - 1;
+        if left == 0 || !reachable(trials, layout, &self.job.preset.budget, left) {
+            return None;
+        }
+        // BC6H has no effort between ultra-fast and very-fast: skip a step that would encode
+        // the same blocks again.
+        let skip = layout.half() && self.efforts[step + 1] == Bc7Quality::VeryFast && left > 1;
+        Some(step + 1 + usize::from(skip))
+    }
+
+    /// Nothing met the budget: the trial nearest it, and why.
+    fn nearest(
+        &self,
+        trials: Vec<Trial>,
+        step: usize,
+        here: &str,
+        last: (BlockLayout, Bc7Quality),
+    ) -> Found {
+        let budget = &self.job.preset.budget;
+        let chosen = (0..trials.len())
+            .reduce(|a, b| {
+                if nearer(&trials[a], &trials[b], budget) {
+                    b
+                } else {
+                    a
+                }
+            })
+            .unwrap_or(0);
+        let kept = trials[chosen].describe();
+        let reason = if step + 1 < self.efforts.len() {
+            format!(
+                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept} (the last: {here})"
+            )
+        } else {
+            format!(
+                "no trial up to {:?} met the budget: kept the trial nearest it, {kept} (the last: {here})",
+                self.job.preset.max_bc7_effort
+            )
+        };
+        Found {
+            trials,
+            chosen,
+            reason,
+            last,
+        }
+    }
+}
+
+/// Compresses every image's level 0 at `effort`.
+fn compress_all(
+    images: &mut [TrialImage<'_>],
+    encoder: Coder<'_>,
+    effort: Bc7Quality,
+    job: &Job<'_>,
+    progress: &Progress,
+) {
+    progress.start("encode", images.len() as u64 * u64::from(job.size.1));
+    for image in images {
+        image.compress(encoder, effort, job.size, progress);
+        if progress.is_cancelled() {
+            return;
+        }
+    }
+}
+
+/// One trial: level 0 of `images` compressed at `effort`, and the set measured as a consumer
+/// decodes it.
+fn run_trial(
+    images: &mut [TrialImage<'_>],
+    encoder: Coder<'_>,
+    layout: BlockLayout,
+    effort: Bc7Quality,
+    job: &Job<'_>,
+    progress: &Progress,
+) -> Result<Trial, String> {
+    let started = Instant::now();
+    compress_all(images, encoder, effort, job, progress);
+    if progress.is_cancelled() {
+        return Err("cancelled".into());
+    }
+    let stored: Vec<StoredImage> = images.iter().map(TrialImage::stored).collect();
+    let ka_error = job.measure(&stored);
+    let min_psnr = images
+        .iter_mut()
+        .filter_map(|i| {
+            let (_, c) = i.compressed.as_mut()?;
+            c.psnr(&i.level0, i.texels.spaces())
+                .iter()
+                .flatten()
+                .copied()
+                .reduce(f64::min)
+        })
+        .reduce(f64::min);
+    Ok(Trial {
+        layout,
+        bc7_effort: effort,
+        ka_error,
+        min_psnr,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The chosen images, level 0 as compressed, with their mip chains: the set's files.
+fn with_mips(
+    images: Vec<TrialImage<'_>>,
+    encoder: Coder<'_>,
+    effort: Bc7Quality,
+    size: (u32, u32),
+    progress: &Progress,
+) -> Result<Vec<Encoded>, String> {
+    progress.start("encode", images.len() as u64 * u64::from(size.1));
+    let mut encoded = Vec::with_capacity(images.len());
+    for image in images {
+        let compressed = image.compressed.map(|(_, c)| c);
+        let written = ktx::encode(
+            &image.texels.source(size, &image.level0),
+            Some((encoder, effort)),
+            compressed,
+            progress,
+        )?;
+        if progress.is_cancelled() {
+            return Err("cancelled".into());
+        }
+        encoded.push((
+            format!("{}.ktx2", image.stem),
+            image.comps,
+            ktx_image(written, image.srgb, image.half),
+        ));
+    }
+    Ok(encoded)
 }
 
 #[cfg(test)]

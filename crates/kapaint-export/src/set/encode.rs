@@ -146,19 +146,7 @@ pub(super) fn encode_image(
                 .collect();
             Ok(plain(png(&data, [C::L16, C::La16, C::Rgb16, C::Rgba16])?))
         }
-        Format::Exr => {
-            // RGB floats; a one-component image repeats its value in all three.
-            let data: Vec<f32> = (0..count * 3)
-                .into_par_iter()
-                .map(|j| value(j / 3, (j % 3).min(channels - 1)))
-                .collect();
-            let mut out = std::io::Cursor::new(Vec::new());
-            image::Rgb32FImage::from_raw(width, height, data)
-                .ok_or("image size")?
-                .write_to(&mut out, image::ImageFormat::OpenExr)
-                .map_err(|e| e.to_string())?;
-            Ok(plain(out.into_inner()))
-        }
+        Format::Exr => Ok(plain(exr_bytes(&value, channels, (width, height))?)),
         Format::Ktx2 | Format::Ktx2Bc => {
             let source = KtxTexels::new(texels, ka, comps, srgb, false, n_enc);
             let level0 = source.level0();
@@ -173,6 +161,26 @@ pub(super) fn encode_image(
             Ok(ktx_image(written, srgb, false))
         }
     }
+}
+
+/// An OpenEXR file of RGB floats from `value(texel, component)`; a one-component image
+/// repeats its value in all three.
+fn exr_bytes(
+    value: &(impl Fn(usize, usize) -> f32 + Sync),
+    channels: usize,
+    (width, height): (u32, u32),
+) -> Result<Vec<u8>, String> {
+    let count = width as usize * height as usize;
+    let data: Vec<f32> = (0..count * 3)
+        .into_par_iter()
+        .map(|j| value(j / 3, (j % 3).min(channels - 1)))
+        .collect();
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::Rgb32FImage::from_raw(width, height, data)
+        .ok_or("image size")?
+        .write_to(&mut out, image::ImageFormat::OpenExr)
+        .map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
 }
 
 /// An encoded image of a written KTX2 file.

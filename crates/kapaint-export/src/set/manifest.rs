@@ -8,120 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::encoding::{KaError, NEncoding};
 use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
 
-/// How a file's colour components are encoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ColourSpace {
-    /// sRGB-encoded (colour components of 8-bit images).
-    Srgb,
-    /// Linear values.
-    Linear,
-}
-
-impl ColourSpace {
-    /// The name a manifest spells.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Srgb => "srgb",
-            Self::Linear => "linear",
-        }
-    }
-
-    /// The colour space a manifest names.
-    pub fn parse(name: &str) -> Option<Self> {
-        [Self::Srgb, Self::Linear]
-            .into_iter()
-            .find(|c| c.name() == name)
-    }
-}
-
-impl std::fmt::Display for ColourSpace {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A file's container and compression.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Compression {
-    /// PNG (deflate), 8 or 16 bits.
-    #[serde(rename = "png")]
-    Png,
-    /// OpenEXR, 32-bit float.
-    #[serde(rename = "exr")]
-    Exr,
-    /// KTX2, uncompressed 8-bit texels.
-    #[serde(rename = "ktx2")]
-    Ktx2,
-    /// KTX2 with BC4 blocks (one component).
-    #[serde(rename = "ktx2-bc4")]
-    Ktx2Bc4,
-    /// KTX2 with BC5 blocks (two components).
-    #[serde(rename = "ktx2-bc5")]
-    Ktx2Bc5,
-    /// KTX2 with BC7 blocks (three or four components).
-    #[serde(rename = "ktx2-bc7")]
-    Ktx2Bc7,
-    /// KTX2 with BC6H blocks: three components, linear unsigned half floats.
-    #[serde(rename = "ktx2-bc6h")]
-    Ktx2Bc6h,
-}
-
-impl Compression {
-    /// Every compression, in the order the docs list them.
-    pub const ALL: [Self; 7] = [
-        Self::Png,
-        Self::Exr,
-        Self::Ktx2,
-        Self::Ktx2Bc4,
-        Self::Ktx2Bc5,
-        Self::Ktx2Bc7,
-        Self::Ktx2Bc6h,
-    ];
-
-    /// The name a manifest spells.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Png => "png",
-            Self::Exr => "exr",
-            Self::Ktx2 => "ktx2",
-            Self::Ktx2Bc4 => "ktx2-bc4",
-            Self::Ktx2Bc5 => "ktx2-bc5",
-            Self::Ktx2Bc7 => "ktx2-bc7",
-            Self::Ktx2Bc6h => "ktx2-bc6h",
-        }
-    }
-
-    /// The compression a manifest names.
-    pub fn parse(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|c| c.name() == name)
-    }
-
-    /// The file name's extension.
-    pub fn extension(self) -> &'static str {
-        match self {
-            Self::Png => "png",
-            Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 | Self::Ktx2Bc6h => "ktx2",
-        }
-    }
-
-    /// The bits per component a file of this kind has.
-    pub fn bit_depths(self) -> &'static [u32] {
-        match self {
-            Self::Png => &[8, 16],
-            Self::Exr => &[32],
-            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 => &[8],
-            Self::Ktx2Bc6h => &[16],
-        }
-    }
-}
-
-impl std::fmt::Display for Compression {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+pub use crate::file_kind::{ColourSpace, Compression};
 
 /// Manifest format name and version.
 pub const MANIFEST_FORMAT: &str = "kapaint-material";
@@ -390,7 +277,7 @@ pub struct Manifest {
     pub level_ka_error: Vec<KaError>,
     /// Block-compressed sets: how the layout and BC7 effort were chosen.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub blocks: Option<Box<super::choose::BlockChoice>>,
+    pub blocks: Option<Box<super::choice::BlockChoice>>,
     /// The project's tangent-space normal map, beside the maps as it stores it (it lights
     /// only: `k_a` never reads it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -427,7 +314,7 @@ struct ManifestFile {
     #[serde(default)]
     level_ka_error: Vec<KaError>,
     #[serde(default)]
-    blocks: Option<Box<super::choose::BlockChoice>>,
+    blocks: Option<Box<super::choice::BlockChoice>>,
     #[serde(default)]
     normal: Option<Box<super::normal::NormalFile>>,
 }

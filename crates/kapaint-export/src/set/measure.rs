@@ -139,71 +139,134 @@ pub(super) fn ka_error_of_set(
     approx: AmbientApprox,
 ) -> KaError {
     let lut = kapaint_core::model::maps::chi_lut(model, approx);
-    // [chi_1, chi_0] as two tables (chi_0 = 0 but for Cook-Torrance).
-    let split = |pairs: &[[f32; 2]]| -> [Vec<f32>; 2] {
-        [0, 1].map(|k| pairs.iter().map(|p| p[k]).collect())
-    };
-    let chi = split(lut);
+    let tables = SetTables::new(lut, manifest.n_encoding, model, approx);
+    let colours = ColourTables::new();
+    let reads = tables.reads(&colours, stored, manifest.constants, format);
     let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
-    let exact: Vec<f32> = (0..=u16::MAX).map(decode_unorm).collect();
-    let sixteen: Vec<f32> = exact
-        .iter()
-        .map(|v| (v * 65535.0).round() / 65535.0)
-        .collect();
-    // n: stored half-float bits -> chi of what the set decodes.
-    let chi_of_set = split(
-        &(0..=u16::MAX)
-            .map(|bits| match manifest.n_encoding {
-                Some(e) => {
-                    reflectance::chi_parts_f32(model, approx, e.decode(e.encode(decode_n(bits))))
-                }
-                None => lut[bits as usize],
-            })
-            .collect::<Vec<_>>(),
-    );
-    let tables = ColourTables::new();
-    let chi8 = split(
-        &(0..=255_u16)
-            .map(|q| {
-                manifest.n_encoding.map_or([0.0; 2], |e| {
-                    reflectance::chi_parts_f32(model, approx, e.decode(q.min((1 << e.bits) - 1)))
+    compare(texels, manifest.width, lut, &tables.exact, diffuse, &reads)
+}
+
+/// The tables a set's values are read through.
+struct SetTables {
+    /// Every 16-bit unorm code's value.
+    exact: Vec<f32>,
+    /// The same, through a 16-bit file.
+    sixteen: Vec<f32>,
+    /// `[chi_1, chi_0]` of every half-float `n` (`chi_0` = 0 but for Cook-Torrance).
+    chi: [Vec<f32>; 2],
+    /// The same, of what the set decodes of each `n`.
+    chi_of_set: [Vec<f32>; 2],
+    /// The same, of each byte of `n`'s 8-bit encoding.
+    chi8: [Vec<f32>; 2],
+}
+
+/// The three channels' reads: `k_d` and `k_s` per colour component, `[chi_1, chi_0]` of `n`.
+type Reads<'a> = ([Read<'a>; 3], [Read<'a>; 3], [Read<'a>; 2]);
+
+impl SetTables {
+    fn new(
+        lut: &[[f32; 2]],
+        n_encoding: Option<NEncoding>,
+        model: ShadingModel,
+        approx: AmbientApprox,
+    ) -> Self {
+        let split = |pairs: &[[f32; 2]]| -> [Vec<f32>; 2] {
+            [0, 1].map(|k| pairs.iter().map(|p| p[k]).collect())
+        };
+        let exact: Vec<f32> = (0..=u16::MAX).map(decode_unorm).collect();
+        let sixteen = exact
+            .iter()
+            .map(|v| (v * 65535.0).round() / 65535.0)
+            .collect();
+        // n: stored half-float bits -> chi of what the set decodes.
+        let chi_of_set = split(
+            &(0..=u16::MAX)
+                .map(|bits| match n_encoding {
+                    Some(e) => reflectance::chi_parts_f32(
+                        model,
+                        approx,
+                        e.decode(e.encode(decode_n(bits))),
+                    ),
+                    None => lut[bits as usize],
                 })
-            })
-            .collect::<Vec<_>>(),
-    );
-    // The source of each component: an 8-bit file's bytes, else a table.
-    let colour_table: &[f32] = if format == Format::Png16 {
-        &sixteen
-    } else {
-        &exact
-    };
-    let kd: [Read<'_>; 3] = std::array::from_fn(|c| {
-        if manifest.constants.kd.is_some() {
-            Read::Table(&exact)
-        } else {
-            tables
-                .read(stored, &[Comp::Kd(c)])
-                .unwrap_or(Read::Table(colour_table))
+                .collect::<Vec<_>>(),
+        );
+        let chi8 = split(
+            &(0..=255_u16)
+                .map(|q| {
+                    n_encoding.map_or([0.0; 2], |e| {
+                        reflectance::chi_parts_f32(
+                            model,
+                            approx,
+                            e.decode(q.min((1 << e.bits) - 1)),
+                        )
+                    })
+                })
+                .collect::<Vec<_>>(),
+        );
+        Self {
+            exact,
+            sixteen,
+            chi: split(lut),
+            chi_of_set,
+            chi8,
         }
-    });
-    let ks: [Read<'_>; 3] = std::array::from_fn(|c| {
-        if manifest.constants.ks.is_some() {
-            Read::Table(&exact)
+    }
+
+    /// Where each component of the set comes from: an 8-bit file's bytes, else a table.
+    fn reads<'a>(
+        &'a self,
+        colours: &'a ColourTables,
+        stored: &'a [StoredImage<'_>],
+        constants: &Constants,
+        format: Format,
+    ) -> Reads<'a> {
+        let colour_table: &[f32] = if format == Format::Png16 {
+            &self.sixteen
         } else {
-            tables
-                .read(stored, &[Comp::Ks(c), Comp::Ks(0)])
-                .unwrap_or(Read::Table(colour_table))
-        }
-    });
-    let n: [Read<'_>; 2] = std::array::from_fn(|k| {
-        if manifest.constants.n.is_some() {
-            Read::Table(&chi[k])
-        } else {
-            in_file(stored, &[Comp::N], &chi8[k], &chi8[k], None)
-                .unwrap_or(Read::Table(&chi_of_set[k]))
-        }
-    });
-    let w = manifest.width as usize;
+            &self.exact
+        };
+        let kd = std::array::from_fn(|c| {
+            if constants.kd.is_some() {
+                Read::Table(&self.exact)
+            } else {
+                colours
+                    .read(stored, &[Comp::Kd(c)])
+                    .unwrap_or(Read::Table(colour_table))
+            }
+        });
+        let ks = std::array::from_fn(|c| {
+            if constants.ks.is_some() {
+                Read::Table(&self.exact)
+            } else {
+                colours
+                    .read(stored, &[Comp::Ks(c), Comp::Ks(0)])
+                    .unwrap_or(Read::Table(colour_table))
+            }
+        });
+        let n = std::array::from_fn(|k| {
+            if constants.n.is_some() {
+                Read::Table(&self.chi[k])
+            } else {
+                in_file(stored, &[Comp::N], &self.chi8[k], &self.chi8[k], None)
+                    .unwrap_or(Read::Table(&self.chi_of_set[k]))
+            }
+        });
+        (kd, ks, n)
+    }
+}
+
+/// The relative `k_a` error of every texel's components, read through `reads`, against the
+/// exact texels: its maximum and mean.
+fn compare(
+    texels: &[Texel],
+    width: u32,
+    lut: &[[f32; 2]],
+    exact: &[f32],
+    diffuse: f32,
+    (kd, ks, n): &Reads<'_>,
+) -> KaError {
+    let w = width as usize;
     let (max, sum, count) = texels
         .par_chunks(w)
         .enumerate()

@@ -3,10 +3,11 @@
 //! A set is written into a temporary folder beside the target and renamed into place at the
 //! end, so a half-written set is never left where the target should be.
 
+mod choice;
 mod choose;
 mod encode;
 mod import;
-mod manifest;
+pub(crate) mod manifest;
 mod measure;
 mod normal;
 mod plan;
@@ -17,7 +18,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use rayon::prelude::*;
 
-pub use self::choose::{BlockChoice, BlockLayout, Trial};
+pub use self::choice::{BlockChoice, BlockLayout, Trial};
 pub(crate) use self::encode::png_bytes;
 use self::encode::{Encoded, StoredImage, encode_image, rows};
 pub use self::import::import;
@@ -29,8 +30,9 @@ use self::manifest::{Comp, approximation};
 use self::measure::ka_error_of_set;
 pub use self::normal::{NORMAL_FILE, NormalFile};
 use self::plan::plan_set;
-pub use self::plan::{PlannedFile, SetPlan, plan};
-pub use self::target::{SetKind, Target, holds, target};
+
+pub use self::plan::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, PlannedFile, SetPlan, plan};
+pub use self::target::{PBR_MANIFEST_FORMAT, SetKind, Target, holds, target};
 pub(crate) use self::target::{claim, commit};
 use super::encoding::KaError;
 use super::preset::{ExportPreset, Format};
@@ -114,10 +116,10 @@ pub fn export_replacing(
     export_into(doc, preset, out, progress, true, None)
 }
 
-#[expect(
-    clippy::too_many_lines,
-    reason = "one pass: analyse, encode in parallel, measure"
-)]
+/// The export, stage after stage: plan (what each file holds, the texels and their `k_a`),
+/// choose and encode (`choose.rs` for block-compressed sets, `encode.rs`), write the images,
+/// measure the set as a consumer decodes it (`measure.rs`), write the manifest and snippets.
+/// No stage calls back into one before it.
 pub(super) fn export_into(
     doc: &Document,
     preset: &ExportPreset,
@@ -126,38 +128,96 @@ pub(super) fn export_into(
     replace: bool,
     brought: Option<&dyn crate::blocks::BlockEncoder>,
 ) -> Result<Manifest, SetError> {
-    let cancelled = |_| SetError::Cancelled;
     progress.start("analyse", 1);
     let found = claim(out, replace, SetKind::Material)?;
     if preset.format == Format::GltfPbr {
         return Err(SetError::Invalid {
             path: out.to_path_buf(),
-            reason: "a glTF PBR set is written by crate::run (crate::gltf_pbr)".into(),
+            reason: "a glTF PBR set is written by the glTF PBR writer".into(),
         });
     }
-    let maps = doc.maps();
-    let (model, approx) = (doc.settings().model, doc.settings().approx);
-    let (w, h) = (maps.width(), maps.height());
-    let (planned, mono_ks, images) = plan_set(doc, preset);
-    let (constants, n_enc) = (planned.constants, planned.n_encoding);
-    let (texels, dilated) = padded_texels(doc);
-    let ka: Vec<Vec3> = if preset.include_ka {
-        texels
-            .par_iter()
-            .map(|t| {
-                let v = t.decode();
-                reflectance::ka(model, approx, v.kd, v.ks, v.n)
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
-
-    let ext = preset.format.extension();
-    progress.check().map_err(cancelled)?;
-    progress.start("encode", images.len() as u64 * u64::from(h));
-
+    let source = Source::plan(doc, preset);
+    progress.check().map_err(|_| SetError::Cancelled)?;
+    progress.start(
+        "encode",
+        source.images.len() as u64 * u64::from(source.size.1),
+    );
     commit(out, &found, |tmp| {
+        let (encoded, blocks) = source.encode(preset, progress, brought, tmp)?;
+        progress.start("measure", 1);
+        let written = write_images(&source, preset, tmp, encoded)?;
+        let mut manifest = source.manifest(preset, written.files, blocks);
+        source.measure(&mut manifest, &written.stored, &written.mips, preset);
+        write_manifest(&mut manifest, doc, tmp)?;
+        Ok(manifest)
+    })
+}
+
+/// What the plan stage hands on: the document's maps as the set will hold them.
+struct Source<'d> {
+    doc: &'d Document,
+    model: reflectance::ShadingModel,
+    approx: reflectance::AmbientApprox,
+    size: (u32, u32),
+    planned: SetPlan,
+    mono_ks: bool,
+    images: Vec<(&'static str, Vec<Comp>)>,
+    /// Row-major, padded past the UV islands ([`padded_texels`]).
+    texels: Vec<kapaint_core::model::texel::Texel>,
+    dilated: bool,
+    /// Per texel, where the preset writes `k_a`.
+    ka: Vec<Vec3>,
+}
+
+impl<'d> Source<'d> {
+    /// The plan stage.
+    fn plan(doc: &'d Document, preset: &ExportPreset) -> Self {
+        let maps = doc.maps();
+        let (model, approx) = (doc.settings().model, doc.settings().approx);
+        let (planned, mono_ks, images) = plan_set(doc, preset);
+        let (texels, dilated) = padded_texels(doc);
+        let ka = if preset.include_ka {
+            texels
+                .par_iter()
+                .map(|t| {
+                    let v = t.decode();
+                    reflectance::ka(model, approx, v.kd, v.ks, v.n)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Self {
+            doc,
+            model,
+            approx,
+            size: (maps.width(), maps.height()),
+            planned,
+            mono_ks,
+            images,
+            texels,
+            dilated,
+            ka,
+        }
+    }
+
+    fn shape(&self) -> measure::Shape<'_> {
+        measure::Shape {
+            width: self.size.0,
+            constants: &self.planned.constants,
+            n_encoding: self.planned.n_encoding,
+        }
+    }
+
+    /// The choose and encode stages: the images' bytes, and for block-compressed sets the
+    /// layout chosen by measurement.
+    fn encode(
+        &self,
+        preset: &ExportPreset,
+        progress: &Progress,
+        brought: Option<&dyn crate::blocks::BlockEncoder>,
+        tmp: &Path,
+    ) -> Result<(Vec<Encoded>, Option<Box<BlockChoice>>), SetError> {
         let fail = |e: String, file: &str| {
             if progress.is_cancelled() {
                 SetError::Cancelled
@@ -165,166 +225,226 @@ pub(super) fn export_into(
                 io(&tmp.join(file), e)
             }
         };
-        let shape = measure::Shape {
-            width: w,
-            constants: &constants,
-            n_encoding: n_enc,
-        };
-        let (encoded, blocks): (Vec<Result<Encoded, SetError>>, _) = if preset.format
-            == Format::Ktx2Bc
-        {
+        let n_enc = self.planned.n_encoding;
+        if preset.format == Format::Ktx2Bc {
             let job = choose::Job {
-                texels: &texels,
-                ka: &ka,
-                size: (w, h),
+                texels: &self.texels,
+                ka: &self.ka,
+                size: self.size,
                 preset,
                 n_enc,
-                shape,
-                model,
-                approx,
+                shape: self.shape(),
+                model: self.model,
+                approx: self.approx,
                 brought,
             };
-            let apart = choose::n_apart(&images, mono_ks);
-            let (encoded, choice) = choose::encode_blocks(&job, &images, apart.as_ref(), progress)
-                .map_err(|e| fail(e, "material.json"))?;
-            (
-                encoded.into_iter().map(Ok).collect(),
-                Some(Box::new(choice)),
-            )
-        } else {
-            let encoded = images
-                .par_iter()
-                .map(|(stem, comps)| {
-                    let file = format!("{stem}.{ext}");
-                    if progress.is_cancelled() {
-                        return Err(SetError::Cancelled);
-                    }
-                    let image = encode_image(&texels, &ka, (w, h), comps, preset, n_enc, progress)
-                        .map_err(|e| fail(e, &file))?;
-                    if progress.is_cancelled() {
-                        return Err(SetError::Cancelled);
-                    }
-                    Ok((file, comps.clone(), image))
-                })
-                .collect();
-            (encoded, None)
-        };
-        progress.start("measure", 1);
-        let mut files = Vec::new();
-        let mut stored = Vec::new();
-        let mut mips: Vec<Mips> = Vec::new();
-        for item in encoded {
-            let (file, comps, mut image) = item?;
-            if let Some(k) = image.ktx.as_mut() {
-                mips.push(Mips {
-                    comps: comps.clone(),
-                    levels: std::mem::take(&mut k.mips),
-                    srgb: image.srgb,
-                    half: image.half,
-                });
-            }
-            let path = tmp.join(&file);
-            kapaint_core::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
-            let (mip_levels, psnr, compression) = match image.ktx {
-                Some(k) => (Some(k.levels), k.psnr, k.compression),
-                None if preset.format == Format::Exr => (None, None, Compression::Exr),
-                None => (None, None, Compression::Png),
-            };
-            files.push(FileEntry {
-                path: file,
-                layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
-                colour_space: if image.srgb {
-                    ColourSpace::Srgb
-                } else {
-                    ColourSpace::Linear
-                },
-                bit_depth: match preset.format {
-                    _ if image.half => 16,
-                    Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 8,
-                    Format::Png16 => 16,
-                    Format::Exr => 32,
-                },
-                compression,
-                width: w,
-                height: h,
-                bytes: image.bytes.len() as u64,
-                mip_levels,
-                psnr,
-            });
-            if let Some(data) = image.stored {
-                stored.push(StoredImage {
-                    comps,
-                    data: data.into(),
-                    srgb: image.srgb,
-                    half: image.half,
-                });
-            }
+            let apart = choose::n_apart(&self.images, self.mono_ks);
+            let (encoded, choice) =
+                choose::encode_blocks(&job, &self.images, apart.as_ref(), progress)
+                    .map_err(|e| fail(e, "material.json"))?;
+            return Ok((encoded, Some(Box::new(choice))));
         }
+        let ext = preset.format.extension();
+        let encoded = self
+            .images
+            .par_iter()
+            .map(|(stem, comps)| {
+                let file = format!("{stem}.{ext}");
+                progress.check().map_err(|_| SetError::Cancelled)?;
+                let image = encode_image(
+                    &self.texels,
+                    &self.ka,
+                    self.size,
+                    comps,
+                    preset,
+                    n_enc,
+                    progress,
+                )
+                .map_err(|e| fail(e, &file))?;
+                progress.check().map_err(|_| SetError::Cancelled)?;
+                Ok((file, comps.clone(), image))
+            })
+            .collect::<Result<Vec<_>, SetError>>()?;
+        Ok((encoded, None))
+    }
+
+    /// The manifest of the written `files`, its measures still to come.
+    fn manifest(
+        &self,
+        preset: &ExportPreset,
+        files: Vec<FileEntry>,
+        blocks: Option<Box<BlockChoice>>,
+    ) -> Manifest {
         let depth = match preset.format {
             Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 1,
             Format::Png16 => 2,
             Format::Exr => 4,
         };
+        let (w, h) = self.size;
         let texel_count = u64::from(w) * u64::from(h);
-        let mut manifest = Manifest {
+        Manifest {
             format: MANIFEST_FORMAT.into(),
             version: MANIFEST_VERSION,
             width: w,
             height: h,
-            model,
-            approximation: approximation(approx, model),
-            constants,
-            n_encoding: n_enc,
+            model: self.model,
+            approximation: approximation(self.approx, self.model),
+            constants: self.planned.constants,
+            n_encoding: self.planned.n_encoding,
             files,
             ka_error: KaError::default(),
-            dilated,
+            dilated: self.dilated,
             bytes: MemoryReport {
                 exported: 0,
                 naive: texel_count * 10 * depth,
                 project: texel_count * 14,
             },
             preset: preset.name.clone(),
-            layers: u32::try_from(doc.stack().walk().len()).unwrap_or(u32::MAX),
+            layers: u32::try_from(self.doc.stack().walk().len()).unwrap_or(u32::MAX),
             level_ka_error: Vec::new(),
             blocks,
             normal: None,
-        };
-        // The k_a error, measured on the set as a consumer decodes it.
-        manifest.ka_error = ka_error_of_set(&texels, shape, &stored, preset.format, model, approx);
+        }
+    }
+
+    /// The measure stage: the `k_a` error of the set as a consumer decodes it, of level 0 and
+    /// (KTX2) of every mip level.
+    fn measure(
+        &self,
+        manifest: &mut Manifest,
+        stored: &[StoredImage<'_>],
+        mips: &[Mips],
+        preset: &ExportPreset,
+    ) {
+        let (model, approx) = (self.model, self.approx);
+        manifest.ka_error = ka_error_of_set(
+            &self.texels,
+            self.shape(),
+            stored,
+            preset.format,
+            model,
+            approx,
+        );
         if preset.format.is_ktx2() {
-            manifest.level_ka_error = level_errors(&texels, (w, h), shape, &mips, model, approx);
+            manifest.level_ka_error =
+                level_errors(&self.texels, self.size, self.shape(), mips, model, approx);
             manifest.level_ka_error.insert(0, manifest.ka_error);
         }
-        // The decode + k_a snippets for engines (WGSL and GLSL), beside the images.
-        let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
-        if let Some(normal) = doc.normal() {
-            let file = NormalFile::write(normal, tmp)?;
-            exported += file.bytes;
-            manifest.normal = Some(Box::new(file));
+    }
+}
+
+/// What writing the images leaves for the manifest and the measures.
+struct Written {
+    files: Vec<FileEntry>,
+    stored: Vec<StoredImage<'static>>,
+    mips: Vec<Mips>,
+}
+
+/// Writes the encoded images into `tmp`: their manifest entries, what a consumer decodes of
+/// level 0, and the KTX2 files' decoded mip levels.
+fn write_images(
+    source: &Source<'_>,
+    preset: &ExportPreset,
+    tmp: &Path,
+    encoded: Vec<Encoded>,
+) -> Result<Written, SetError> {
+    let mut written = Written {
+        files: Vec::new(),
+        stored: Vec::new(),
+        mips: Vec::new(),
+    };
+    for (file, comps, mut image) in encoded {
+        if let Some(k) = image.ktx.as_mut() {
+            written.mips.push(Mips {
+                comps: comps.clone(),
+                levels: std::mem::take(&mut k.mips),
+                srgb: image.srgb,
+                half: image.half,
+            });
         }
-        for (name, snippet) in [
-            ("material.wgsl", crate::snippet::wgsl(&manifest)),
-            ("material.glsl", crate::snippet::glsl(&manifest)),
-        ] {
-            let snippet_path = tmp.join(name);
-            kapaint_core::atomic::write_atomic(&snippet_path, snippet.as_bytes())
-                .map_err(|e| io(&snippet_path, e))?;
-            exported += snippet.len() as u64;
+        let path = tmp.join(&file);
+        kapaint_core::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
+        written
+            .files
+            .push(file_entry(source, preset, file, &comps, &image));
+        if let Some(data) = image.stored {
+            written.stored.push(StoredImage {
+                comps,
+                data: data.into(),
+                srgb: image.srgb,
+                half: image.half,
+            });
         }
-        // The manifest counts itself, and its length depends on the count's digits: repeat
-        // until they agree (the count only grows, so this ends, in two or three rounds).
-        let json = loop {
-            let json = serde_json::to_vec_pretty(&manifest).map_err(|e| io(tmp, e))?;
-            let total = exported + json.len() as u64;
-            if manifest.bytes.exported == total {
-                break json;
-            }
-            manifest.bytes.exported = total;
-        };
-        let path = tmp.join("material.json");
-        kapaint_core::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))?;
-        Ok(manifest)
-    })
+    }
+    Ok(written)
+}
+
+/// An image's manifest entry.
+fn file_entry(
+    source: &Source<'_>,
+    preset: &ExportPreset,
+    file: String,
+    comps: &[Comp],
+    image: &encode::EncodedImage,
+) -> FileEntry {
+    let (mip_levels, psnr, compression) = match &image.ktx {
+        Some(k) => (Some(k.levels), k.psnr.clone(), k.compression),
+        None if preset.format == Format::Exr => (None, None, Compression::Exr),
+        None => (None, None, Compression::Png),
+    };
+    FileEntry {
+        path: file,
+        layout: comps.iter().map(|c| c.name(source.mono_ks)).collect(),
+        colour_space: if image.srgb {
+            ColourSpace::Srgb
+        } else {
+            ColourSpace::Linear
+        },
+        bit_depth: match preset.format {
+            _ if image.half => 16,
+            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 8,
+            Format::Png16 => 16,
+            Format::Exr => 32,
+        },
+        compression,
+        width: source.size.0,
+        height: source.size.1,
+        bytes: image.bytes.len() as u64,
+        mip_levels,
+        psnr,
+    }
+}
+
+/// The write stage's last files: the normal map, the decode + `k_a` snippets for engines
+/// (WGSL and GLSL), and `material.json`, which counts every byte written, itself included.
+fn write_manifest(manifest: &mut Manifest, doc: &Document, tmp: &Path) -> Result<(), SetError> {
+    let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
+    if let Some(normal) = doc.normal() {
+        let file = NormalFile::write(normal, tmp)?;
+        exported += file.bytes;
+        manifest.normal = Some(Box::new(file));
+    }
+    for (name, snippet) in [
+        ("material.wgsl", crate::snippet::wgsl(manifest)),
+        ("material.glsl", crate::snippet::glsl(manifest)),
+    ] {
+        let snippet_path = tmp.join(name);
+        kapaint_core::atomic::write_atomic(&snippet_path, snippet.as_bytes())
+            .map_err(|e| io(&snippet_path, e))?;
+        exported += snippet.len() as u64;
+    }
+    // The manifest counts itself, and its length depends on the count's digits: repeat
+    // until they agree (the count only grows, so this ends, in two or three rounds).
+    let json = loop {
+        let json = serde_json::to_vec_pretty(&*manifest).map_err(|e| io(tmp, e))?;
+        let total = exported + json.len() as u64;
+        if manifest.bytes.exported == total {
+            break json;
+        }
+        manifest.bytes.exported = total;
+    };
+    let path = tmp.join("material.json");
+    kapaint_core::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))
 }
 
 /// A KTX2 file's components, its levels past 0 as decoded, and how its colour is stored.

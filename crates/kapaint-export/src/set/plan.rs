@@ -161,7 +161,6 @@ pub(super) fn plan_set(
 
 /// A glTF PBR set's plan: base colour and metallic-roughness, three 8-bit channels each.
 fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
-    use crate::gltf_pbr::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE};
     let texels = u64::from(maps.width()) * u64::from(maps.height());
     let files: Vec<PlannedFile> = [
         (BASE_COLOR_FILE, ["base.r", "base.g", "base.b"]),
@@ -191,3 +190,8 @@ fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
         ka_error: KaError::default(),
     }
 }
+
+/// A glTF PBR set's base colour image.
+pub const BASE_COLOR_FILE: &str = "base_color.png";
+/// A glTF PBR set's metallic-roughness image.
+pub const METALLIC_ROUGHNESS_FILE: &str = "metallic_roughness.png";

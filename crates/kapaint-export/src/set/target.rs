@@ -44,7 +44,7 @@ impl SetKind {
     fn format(self) -> &'static str {
         match self {
             Self::Material => MANIFEST_FORMAT,
-            Self::Pbr => crate::gltf_pbr::PBR_MANIFEST_FORMAT,
+            Self::Pbr => PBR_MANIFEST_FORMAT,
         }
     }
 
@@ -251,3 +251,6 @@ fn remove_stale_sets(dir: &Path, name: &str) {
         });
     }
 }
+
+/// `format` of a glTF PBR set's `material.json`.
+pub const PBR_MANIFEST_FORMAT: &str = "kapaint-gltf-pbr";

@@ -56,9 +56,8 @@ pub enum FillRegion {
 
 /// Everything that changes a document, by room: each room's commands are their own enum,
 /// and [`Document::apply`](super::Document::apply) hands each to the room that matches it
-/// exhaustively. Scripts name the commands flat, as they always have (see `script.rs`).
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(from = "super::script::ScriptCommand")]
+/// exhaustively. Scripts name the commands flat, as they always have: `script.rs` reads them.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// The tool settings: brush, materials, channels, shading.
     Settings(SettingsCommand),

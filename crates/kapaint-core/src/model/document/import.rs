@@ -11,6 +11,37 @@ use crate::model::texel::Channel;
 use crate::model::tile::Plane;
 
 impl Document {
+    /// Writes `image` into `channel` of the selected paint layer, resampled to the map size,
+    /// as one undo step.
+    ///
+    /// # Errors
+    /// The command's: the selected layer is locked, a fill layer or a group, or its mask is
+    /// selected; the document is unchanged then.
+    pub fn import_image(
+        &mut self,
+        channel: Channel,
+        image: &image::DynamicImage,
+    ) -> Result<(), ModelError> {
+        let (w, h) = (self.maps().width(), self.maps().height());
+        let planes = crate::model::import::resample(image, channel, w, h);
+        self.apply(super::ImportCommand::ImportChannel(super::ImportedChannel(
+            std::sync::Arc::new(planes),
+        )))
+    }
+
+    /// Reads `path` and imports it into `channel` of the selected paint layer.
+    ///
+    /// # Errors
+    /// The image's, or the command's ([`Document::import_image`]).
+    pub fn import_file(
+        &mut self,
+        channel: Channel,
+        path: &std::path::Path,
+    ) -> Result<(), ModelError> {
+        let image = crate::model::import::read_image(path)?;
+        self.import_image(channel, &image)
+    }
+
     /// [`ImportCommand::ImportMaterial`]: every channel of the selected paint layer from `maps`.
     pub(super) fn import_material(
         &mut self,

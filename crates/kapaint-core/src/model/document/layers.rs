@@ -1,7 +1,7 @@
 //! The layer commands, and the editing of the selected layer's planes by fills and gradients
 //! (imports: `import.rs`). Each command that changes the stack is one undo step.
 
-use super::paths::{command_error, no_layer, resolve, selected_mut};
+use super::paths::{CommandContext, command_error, no_layer, resolve, selected_mut};
 use super::{Document, LayerCommand, moves, structure};
 use crate::model::ModelError;
 use crate::model::layers::edit::{EditValue, LayerEdit, Planes, PrePlanes};
@@ -308,13 +308,6 @@ impl Document {
 pub fn mask_gray(v: MaterialValue) -> f32 {
     let kd = v.sanitized().kd;
     crate::model::texel::linear_to_srgb(kd.max_element()).clamp(0.0, 1.0)
-}
-
-/// What a layer command reads besides the state.
-pub(super) struct CommandContext<'a> {
-    pub(super) tile_count: usize,
-    pub(super) primary: MaterialValue,
-    pub(super) maps: &'a crate::model::maps::MaterialMaps,
 }
 
 /// Sets the blend mode of one of a layer's channels, where the channel has that mode.

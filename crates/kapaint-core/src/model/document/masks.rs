@@ -1,8 +1,7 @@
 //! The mask room: add, delete, apply, invert, enable, make from a channel, and which of the
 //! selected layer's planes tools paint.
 
-use super::layers::CommandContext;
-use super::paths::{command_error, selected_mut};
+use super::paths::{CommandContext, command_error, selected_mut};
 use super::{Document, MaskCommand};
 use crate::model::ModelError;
 use crate::model::layers::{ChannelBlend, LayerBlend, LayerContent, Mask, State, ops};

@@ -4,9 +4,9 @@
 use super::LayerRef;
 use crate::model::ModelError;
 use crate::model::layers::{Layer, LayerContent, LayerStack, State};
+use crate::model::texel::MaterialValue;
 
-/// The most layers (groups and their children included) a document holds.
-pub const MAX_LAYERS: usize = 256;
+pub use crate::model::check::MAX_LAYERS;
 
 /// A command's refusal, in the user's words.
 pub(super) fn command_error(text: impl Into<String>) -> ModelError {
@@ -62,4 +62,11 @@ pub(super) fn resolve(stack: &LayerStack, r: &LayerRef) -> Result<Vec<usize>, Mo
             .path_of(crate::model::layers::LayerId(*id))
             .ok_or_else(|| command_error(format!("no layer has id {id}"))),
     }
+}
+
+/// What a layer command reads besides the state.
+pub(super) struct CommandContext<'a> {
+    pub(super) tile_count: usize,
+    pub(super) primary: MaterialValue,
+    pub(super) maps: &'a crate::model::maps::MaterialMaps,
 }

@@ -99,6 +99,12 @@ pub(super) enum ScriptCommand {
     Ungroup,
 }
 
+impl<'de> Deserialize<'de> for Command {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        ScriptCommand::deserialize(deserializer).map(Self::from)
+    }
+}
+
 impl From<ScriptCommand> for Command {
     fn from(command: ScriptCommand) -> Self {
         use ScriptCommand as S;

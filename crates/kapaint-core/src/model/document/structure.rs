@@ -1,8 +1,7 @@
 //! The commands that change the stack's structure: add, delete, duplicate, merge, flatten,
 //! group and ungroup. Each changes the state it is given; the caller makes it one undo step.
 
-use super::layers::CommandContext;
-use super::paths::{MAX_LAYERS, command_error, count_layers, no_layer, split};
+use super::paths::{CommandContext, MAX_LAYERS, command_error, count_layers, no_layer, split};
 use super::{LayerKind, moves};
 use crate::model::ModelError;
 use crate::model::layers::{Layer, LayerContent, LayerStack, State};

@@ -23,8 +23,7 @@ use crate::model::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile};
 /// The most layers a project may hold.
 pub const MAX_LAYERS: usize = crate::model::document::MAX_LAYERS;
 
-/// The deepest nesting of groups a project may hold.
-pub const MAX_DEPTH: usize = 16;
+pub use crate::model::check::MAX_DEPTH;
 
 /// A layer's kind in the manifest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -1,0 +1,119 @@
+//! What a block-compressed export chose, as its manifest records it: the layout, the effort,
+//! every trial measured, and why. Data only: `choose.rs` makes it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::blocks::Encoder;
+use crate::encoding::KaError;
+use crate::preset::{Bc7Quality, BlockBudget};
+
+/// Where `n` goes in a block-compressed set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BlockLayout {
+    /// In `k_d`'s BC7 alpha (the fewest bytes).
+    Packed,
+    /// Out of the colour blocks: a BC4 plane of its own, or with grey `k_s` in a BC5 image.
+    NApart,
+    /// `n` apart, and the three-component colour images BC6H: linear half floats instead
+    /// of BC7's 8-bit sRGB (the same bytes as `n-apart`).
+    HalfColour,
+}
+
+impl BlockLayout {
+    /// Whether colour images are half floats.
+    pub(super) fn half(self) -> bool {
+        self == Self::HalfColour
+    }
+}
+
+/// One encoding of level 0 that the export measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Trial {
+    /// Where `n` was.
+    pub layout: BlockLayout,
+    /// BC7's (and BC6H's) effort.
+    pub bc7_effort: Bc7Quality,
+    /// The set's `k_a` error, level 0 as a consumer decodes it.
+    pub ka_error: KaError,
+    /// The smallest PSNR of any compressed component (dB; `None` where all are exact).
+    pub min_psnr: Option<f64>,
+    /// Seconds spent encoding and measuring.
+    pub seconds: f64,
+}
+
+impl Trial {
+    /// The trial and its measures, for the manifest's reason.
+    pub(super) fn describe(&self) -> String {
+        format!(
+            "{:?} at {:?}: k_a max {}, mean {}, PSNR {}",
+            self.layout,
+            self.bc7_effort,
+            pct(self.ka_error.max),
+            pct(self.ka_error.mean),
+            self.min_psnr
+                .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
+        )
+    }
+}
+
+/// How a block-compressed set's layout and effort were chosen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlockChoice {
+    /// The block encoder that finished the set.
+    pub encoder: Encoder,
+    /// Why the GPU encoder failed, where it began this set and a CPU encoder (`encoder`)
+    /// finished it. Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gpu_failed: Option<String>,
+    /// Where `n` went.
+    pub layout: BlockLayout,
+    /// BC7's effort.
+    pub bc7_effort: Bc7Quality,
+    /// The preset's budget.
+    pub budget: BlockBudget,
+    /// Whether the chosen trial meets it.
+    pub within_budget: bool,
+    /// Why this one, in a sentence.
+    pub reason: String,
+    /// Every trial, in the order run.
+    pub trials: Vec<Trial>,
+}
+
+impl BlockChoice {
+    /// One line for people: the layout and effort chosen, the encoder, and the budget's
+    /// verdict (the manifest's `blocks` has the trials and the reason).
+    pub fn summary(&self) -> String {
+        let layout = match self.layout {
+            BlockLayout::Packed => "n packed in k_d's BC7",
+            BlockLayout::NApart => "n apart (BC4/BC5), colour BC7",
+            BlockLayout::HalfColour => "n apart (BC4/BC5), colour BC6H",
+        };
+        let encoder = match self.encoder {
+            Encoder::Ispc => "ISPC",
+            Encoder::Portable => "portable CPU",
+            Encoder::Gpu => "GPU",
+        };
+        let encoder = if self.gpu_failed.is_some() {
+            format!("{encoder} encoder (the GPU encoder failed part-way)")
+        } else {
+            format!("{encoder} encoder")
+        };
+        let verdict = if self.within_budget {
+            "within the k_a budget".to_owned()
+        } else {
+            format!(
+                "over the k_a budget (max {}, mean {}): kept the nearest of {} trials",
+                pct(self.budget.max_ka_error),
+                pct(self.budget.mean_ka_error),
+                self.trials.len()
+            )
+        };
+        format!("{layout} at {:?}, {encoder}, {verdict}", self.bc7_effort)
+    }
+}
+
+/// A fraction as a percentage with two decimals.
+pub(super) fn pct(v: f64) -> String {
+    format!("{:.2} %", v * 100.0)
+}
