@@ -194,3 +194,68 @@ fn layer_ids_survive_moves_grouping_undo_and_saves_and_copies_get_their_own() {
     let unique: std::collections::BTreeSet<_> = all.iter().collect();
     assert_eq!(unique.len(), all.len());
 }
+
+/// The selection is a layer, not a place: it follows the selected layer through every move
+/// (up, into and out of groups, drag and drop), with no path to repair, and undo and redo
+/// bring back the layer that was selected in the state they restore.
+#[test]
+fn the_selection_is_a_layer_and_follows_it() {
+    use kapaint_core::model::{LayerMove, LayerPlace};
+    let mut doc = document();
+    run(
+        &mut doc,
+        r#"(commands: [
+            AddLayer(kind: Paint, name: "A"),
+            AddLayer(kind: Group, name: "G"),
+            AddLayer(kind: Paint, name: "B"),
+            SelectLayer("A"),
+        ])"#,
+    );
+    let selected = |doc: &Document| {
+        let path = doc.selection().path;
+        doc.stack().layer(&path).map(|l| l.props.name.clone())
+    };
+    assert_eq!(selected(&doc).as_deref(), Some("A"));
+    for (m, path) in [
+        (LayerMove::Top, vec![3]),
+        (LayerMove::Down, vec![2]),
+        (LayerMove::Down, vec![1]),
+        (LayerMove::IntoGroup, vec![1, 0]),
+        (LayerMove::OutOfGroup, vec![2]),
+        (LayerMove::Bottom, vec![0]),
+    ] {
+        doc.apply(LayerCommand::MoveLayer(m)).expect("move");
+        assert_eq!(doc.selection().path, path, "{m:?}");
+        assert_eq!(selected(&doc).as_deref(), Some("A"), "{m:?}");
+    }
+    // Dropped into the group from the Layers panel.
+    let group = doc
+        .stack()
+        .walk()
+        .into_iter()
+        .find(|(_, l)| l.props.name == "G")
+        .map(|(p, _)| p)
+        .expect("group");
+    doc.apply(LayerCommand::MoveLayerTo {
+        target: group,
+        place: LayerPlace::Into,
+    })
+    .expect("drop");
+    assert_eq!(selected(&doc).as_deref(), Some("A"));
+    // Select another layer, then undo the drop: the layer selected before it comes back.
+    doc.apply(LayerCommand::SelectLayer(
+        kapaint_core::model::LayerRef::Name("B".into()),
+    ))
+    .expect("select B");
+    doc.apply(HistoryCommand::Undo).expect("undo");
+    assert_eq!(selected(&doc).as_deref(), Some("A"));
+    // Redo brings back the state undo left, with B selected, and A in the group again.
+    doc.apply(HistoryCommand::Redo).expect("redo");
+    assert_eq!(selected(&doc).as_deref(), Some("B"));
+    let a = doc
+        .stack()
+        .walk()
+        .into_iter()
+        .find(|(_, l)| l.props.name == "A");
+    assert_eq!(a.map(|(p, _)| p.len()), Some(2), "inside the group again");
+}

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use super::project_jobs::OpenedProject;
 use super::{EditorState, MeshState, autosave_interval, notice};
 use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::surface::Surface;
@@ -468,6 +467,21 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
             m.round_trip.p99 * 100.0
         ),
     }
+}
+
+/// A project a worker opened or recovered.
+pub(super) struct OpenedProject {
+    /// Where it is saved (`None` for recovered untitled work).
+    pub(super) path: Option<std::path::PathBuf>,
+    pub(super) doc: kapaint_core::model::Document,
+    /// The recovery copy it came from, if it did.
+    pub(super) recovered: Option<std::path::PathBuf>,
+    /// A note for the user (its mesh could not be loaded, its recovery failed).
+    pub(super) note: Option<String>,
+    /// The project file as it was when read: what a save expects to replace.
+    pub(super) on_disk: Option<kapaint_core::model::project::OnDisk>,
+    /// Opened read-only (another kapaint has it open).
+    pub(super) read_only: bool,
 }
 
 #[cfg(test)]

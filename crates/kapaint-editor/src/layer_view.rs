@@ -2,9 +2,34 @@
 //! "mask" views, maps composited from a stack of that layer (or mask) alone, kept up to date
 //! tile by tile as it is painted.
 
-use crate::panels::layers::LayerView;
 use kapaint_core::model::layers::{Compositor, ops};
 use kapaint_core::model::{Document, MaterialMaps};
+
+/// What the viewport and canvas show of the layers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LayerView {
+    /// The composite of the stack (what export ships).
+    #[default]
+    Composite,
+    /// The selected layer alone over the base material.
+    Selected,
+    /// The selected layer's mask, in grey.
+    Mask,
+}
+
+impl LayerView {
+    /// Every view, in the order the view panel lists them.
+    pub const ALL: [Self; 3] = [Self::Composite, Self::Selected, Self::Mask];
+
+    /// Its label.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Composite => "All layers",
+            Self::Selected => "Selected layer only",
+            Self::Mask => "Mask",
+        }
+    }
+}
 
 /// The maps of the view being shown, when it is not the composite.
 #[derive(Default)]

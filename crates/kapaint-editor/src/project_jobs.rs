@@ -4,25 +4,9 @@
 use std::path::PathBuf;
 
 use super::files::FilePurpose;
-use super::jobs::{JobResult, load_project, with_fallback};
+use super::jobs::{JobResult, OpenedProject, load_project, with_fallback};
 use super::{EditorState, autosave_interval, notice};
-use kapaint_core::model::Document;
 use kapaint_core::model::{project, recovery};
-
-/// A project a worker opened or recovered.
-pub(super) struct OpenedProject {
-    /// Where it is saved (`None` for recovered untitled work).
-    pub(super) path: Option<PathBuf>,
-    pub(super) doc: Document,
-    /// The recovery copy it came from, if it did.
-    pub(super) recovered: Option<PathBuf>,
-    /// A note for the user (its mesh could not be loaded, its recovery failed).
-    pub(super) note: Option<String>,
-    /// The project file as it was when read: what a save expects to replace.
-    pub(super) on_disk: Option<project::OnDisk>,
-    /// Opened read-only (another kapaint has it open).
-    pub(super) read_only: bool,
-}
 
 impl EditorState {
     /// A save finished: the document version it holds, and the file as written.

@@ -4,6 +4,7 @@
 //! layers, and the selected layer's opacity, channel blends and mask. Every change is a
 //! [`Command`]; the panel only reads the document.
 
+pub use crate::layer_view::LayerView;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
@@ -20,32 +21,6 @@ const THUMB: u32 = 32;
 const THUMB_POINTS: f32 = 28.0;
 /// While a stroke goes on, thumbnails are made at most this often.
 const STROKE_REFRESH: Duration = Duration::from_millis(300);
-
-/// What the viewport and canvas show of the layers.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LayerView {
-    /// The composite of the stack (what export ships).
-    #[default]
-    Composite,
-    /// The selected layer alone over the base material.
-    Selected,
-    /// The selected layer's mask, in grey.
-    Mask,
-}
-
-impl LayerView {
-    /// Every view, in the order the view panel lists them.
-    pub const ALL: [Self; 3] = [Self::Composite, Self::Selected, Self::Mask];
-
-    /// Its label.
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Composite => "All layers",
-            Self::Selected => "Selected layer only",
-            Self::Mask => "Mask",
-        }
-    }
-}
 
 /// A layer being dragged in the panel: its path.
 #[derive(Clone, Debug)]
@@ -432,7 +407,7 @@ impl EditorState {
             }
             RowAction::Toggle(command) => {
                 // The eye and the lock act on their row's layer, leaving the selection be.
-                let before = self.doc.selection().clone();
+                let before = self.doc.selection();
                 self.apply(LayerCommand::SelectPath(path).into());
                 self.apply(command);
                 if self.doc.stack().layer(&before.path).is_some() {

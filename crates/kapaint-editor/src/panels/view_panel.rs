@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use crate::EditorState;
 use crate::canvas::CanvasChannel;
-use crate::panels::layers::LayerView;
+use crate::layer_view::LayerView;
 use crate::viewport::Compare;
 use kapaint_core::model::texel::MaterialValue;
 use kapaint_core::model::{HistoryCommand, SettingsCommand};

@@ -5,14 +5,14 @@ use super::paths::{CommandContext, command_error, no_layer, resolve, selected_mu
 use super::{Document, LayerCommand, moves, structure};
 use crate::model::ModelError;
 use crate::model::layers::edit::{EditValue, LayerEdit, Planes, PrePlanes};
-use crate::model::layers::{Layer, LayerContent, LayerStroke, Mask, State, channel_index};
+use crate::model::layers::{Layer, LayerContent, LayerId, LayerStroke, Mask, State, channel_index};
 use crate::model::texel::MaterialValue;
 
 impl Document {
     /// Whether tools can paint the selection: a layer is selected, unlocked, and has planes
     /// (its mask, or a paint layer's content).
     pub(super) fn check_paintable(&self) -> Result<(), ModelError> {
-        let sel = &self.state.selection;
+        let sel = self.state.selection();
         let layer = self
             .state
             .stack
@@ -67,7 +67,7 @@ impl Document {
     /// The selected layer's value at texel `(x, y)` over `under`: the channels a paint layer
     /// (or a group's merge) covers there, or a fill layer's material.
     pub(super) fn layer_value(&self, x: u32, y: u32, under: MaterialValue) -> MaterialValue {
-        let Some(layer) = self.state.stack.layer(&self.state.selection.path) else {
+        let Some(layer) = self.state.stack.layer(&self.state.selected_path()) else {
             return under;
         };
         let (id, i) = self.maps.locate(x, y);
@@ -97,7 +97,7 @@ impl Document {
         let inverted = self
             .state
             .stack
-            .layer(&self.state.selection.path)
+            .layer(&self.state.selected_path())
             .and_then(|l| l.mask.as_ref())
             .is_some_and(|m| m.inverted);
         if inverted { 1.0 - shown } else { shown }
@@ -124,7 +124,7 @@ impl Document {
         self.check_paintable()?;
         let before = self.state.clone();
         let count = self.state.stack.tile_count();
-        let sel = &self.state.selection;
+        let sel = self.state.selection();
         let pre = before
             .stack
             .layer(&sel.path)
@@ -173,19 +173,19 @@ impl Document {
     pub(super) fn layer_command(
         &mut self,
         command: LayerCommand,
-        opacity_run: Option<&[usize]>,
+        opacity_run: Option<LayerId>,
     ) -> Result<(), ModelError> {
         match command {
             LayerCommand::SelectLayer(r) => {
                 let path = resolve(&self.state.stack, &r)?;
-                self.select(path, false);
+                self.select(&path, false);
                 Ok(())
             }
             LayerCommand::SelectPath(path) => {
                 if self.state.stack.layer(&path).is_none() {
                     return Err(command_error(format!("no layer is at {path:?}")));
                 }
-                self.select(path, false);
+                self.select(&path, false);
                 Ok(())
             }
             LayerCommand::SetLayerOpacity(opacity) => self.set_opacity(opacity, opacity_run),
@@ -243,12 +243,12 @@ impl Document {
     pub(super) fn set_opacity(
         &mut self,
         opacity: f32,
-        run: Option<&[usize]>,
+        run: Option<LayerId>,
     ) -> Result<(), ModelError> {
         const LABEL: &str = "Layer opacity";
-        let path = self.state.selection.path.clone();
+        let id = self.state.selection.id;
         let opacity = opacity.clamp(0.0, 1.0);
-        let joined = run == Some(path.as_slice()) && !self.stroking();
+        let joined = id.is_some() && run == id && !self.stroking();
         match self.history.take_last(LABEL).filter(|_| joined) {
             Some(before) => {
                 selected_mut(&mut self.state)?.props.opacity = opacity;
@@ -259,19 +259,20 @@ impl Document {
                 Ok(())
             })?,
         }
-        self.opacity_run = Some(path);
+        self.opacity_run = id;
         Ok(())
     }
 
-    pub(super) fn select(&mut self, path: Vec<usize>, mask: bool) {
+    pub(super) fn select(&mut self, path: &[usize], mask: bool) {
         self.end_stroke();
-        self.state.selection = crate::model::layers::Selection { path, mask };
+        self.state.select_path(path);
+        self.state.selection.mask = mask;
     }
 
     pub(super) fn selected(&self) -> Result<&Layer, ModelError> {
         self.state
             .stack
-            .layer(&self.state.selection.path)
+            .layer(&self.state.selected_path())
             .ok_or_else(no_layer)
     }
 

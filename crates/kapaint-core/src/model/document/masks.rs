@@ -18,12 +18,12 @@ impl Document {
                         layer.props.name
                     )));
                 }
-                self.select(self.state.selection.path.clone(), true);
+                self.select(&self.state.selected_path(), true);
                 Ok(())
             }
             MaskCommand::SelectContent => {
                 self.selected()?;
-                self.select(self.state.selection.path.clone(), false);
+                self.select(&self.state.selected_path(), false);
                 Ok(())
             }
             MaskCommand::AddMask => self.change("Add mask", |st, cx| {

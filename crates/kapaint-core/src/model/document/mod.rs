@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use super::ModelError;
 use super::brush::BrushSettings;
-use super::layers::{Compositor, LayerStack, Selection, StackHistory, State};
+use super::layers::{Compositor, LayerId, LayerStack, Selected, Selection, StackHistory, State};
 use super::maps::MaterialMaps;
 use super::normal::NormalMap;
 use super::surface::Surface;
@@ -119,7 +119,7 @@ pub struct Document {
     revisions: u64,
     /// The layer whose opacity the last command set: the next opacity change of that layer
     /// joins its undo step (a slider's drag is one step).
-    opacity_run: Option<Vec<usize>>,
+    opacity_run: Option<LayerId>,
     /// Which document this is: kept in its project file and its recovery journal, so a
     /// journal is only ever recovered into the project it was written for.
     id: DocumentId,
@@ -184,11 +184,11 @@ impl Document {
     /// project or recovery copy restoring what was selected); otherwise as it was.
     #[must_use]
     pub fn with_selection(mut self, selection: Selection) -> Self {
-        if let Some(layer) = self.state.stack.layer(&selection.path) {
-            let mask = selection.mask && layer.mask.is_some();
-            self.state.selection = Selection {
-                path: selection.path,
-                mask,
+        let Selection { path, mask } = selection;
+        if let Some(layer) = self.state.stack.layer(&path) {
+            self.state.selection = Selected {
+                id: Some(layer.props.id),
+                mask: mask && layer.mask.is_some(),
             };
         }
         self
@@ -226,12 +226,12 @@ impl Document {
     fn assemble(mut maps: MaterialMaps, stack: LayerStack, settings: DocumentSettings) -> Self {
         let mut compositor = Compositor::new();
         compositor.update(&stack, &mut maps);
-        let path = topmost_paintable(&stack);
+        let id = stack.layer(&topmost_paintable(&stack)).map(|l| l.props.id);
         Self {
             maps,
             state: State {
                 stack,
-                selection: Selection { path, mask: false },
+                selection: Selected { id, mask: false },
                 surface: None,
                 mesh: settings.mesh.clone(),
                 normal: None,
@@ -276,8 +276,8 @@ impl Document {
     }
 
     /// The selected layer and whether tools paint its mask.
-    pub fn selection(&self) -> &Selection {
-        &self.state.selection
+    pub fn selection(&self) -> Selection {
+        self.state.selection()
     }
 
     /// The maps: read them freely; they change only through [`Document::apply`].
@@ -377,7 +377,7 @@ impl Document {
                 self.history_command(c);
                 Ok(())
             }
-            Command::Layer(c) => self.layer_command(c, opacity_run.as_deref()),
+            Command::Layer(c) => self.layer_command(c, opacity_run),
             Command::Mask(c) => self.mask_command(c),
         }
     }

@@ -1,4 +1,5 @@
-//! Moving layers: up and down their list, into and out of groups, and by drag and drop.
+//! Moving layers: up and down their list, into and out of groups, and by drag and drop. The
+//! selection is the layer's id, so it follows the layer without repair.
 
 use super::paths::{command_error, no_layer, split};
 use super::{LayerMove, LayerPlace};
@@ -8,7 +9,7 @@ use crate::model::project::layers::MAX_DEPTH;
 
 /// Moves the selected layer within its list, or into or out of a group.
 pub(super) fn move_layer(st: &mut State, m: LayerMove) -> Result<(), ModelError> {
-    let (parent, i) = split(&st.selection.path)?;
+    let (parent, i) = split(&st.selected_path())?;
     let list = st.stack.list_mut(&parent).ok_or_else(no_layer)?;
     let last = list.len() - 1;
     let to = match m {
@@ -24,7 +25,6 @@ pub(super) fn move_layer(st: &mut State, m: LayerMove) -> Result<(), ModelError>
             if let LayerContent::Group(children) = &mut list[i].content {
                 children.insert(0, layer);
             }
-            st.selection.path = [parent, vec![i, 0]].concat();
             return check_depth(&st.stack);
         }
         LayerMove::OutOfGroup => {
@@ -33,13 +33,11 @@ pub(super) fn move_layer(st: &mut State, m: LayerMove) -> Result<(), ModelError>
             let layer = list.remove(i);
             let outer = st.stack.list_mut(&grand).ok_or_else(no_layer)?;
             outer.insert(g + 1, layer);
-            st.selection.path = [grand, vec![g + 1]].concat();
             return Ok(());
         }
     };
     let layer = list.remove(i);
     list.insert(to, layer);
-    st.selection.path = [parent, vec![to]].concat();
     Ok(())
 }
 
@@ -50,7 +48,7 @@ pub(super) fn move_layer_to(
     target: &[usize],
     place: LayerPlace,
 ) -> Result<(), ModelError> {
-    let from = st.selection.path.clone();
+    let from = st.selected_path();
     let target_layer = st
         .stack
         .layer(target)
@@ -90,7 +88,6 @@ pub(super) fn move_layer_to(
     let list = st.stack.list_mut(&list_path).ok_or_else(no_layer)?;
     let at = at.min(list.len());
     list.insert(at, layer);
-    st.selection.path = [list_path, vec![at]].concat();
     check_depth(&st.stack)
 }
 

@@ -20,7 +20,8 @@ pub(super) fn no_layer() -> ModelError {
 
 /// The selected layer.
 pub(super) fn selected_mut(st: &mut State) -> Result<&mut Layer, ModelError> {
-    st.stack.layer_mut(&st.selection.path).ok_or_else(no_layer)
+    let path = st.selected_path();
+    st.stack.layer_mut(&path).ok_or_else(no_layer)
 }
 
 /// The parent path and index of a layer's path.

@@ -244,7 +244,7 @@ impl Document {
         }
         // Tiles composited up to date before the dab need recompositing only where it writes.
         let current = to.compositor.current(&to.state.stack, &ids);
-        let selection = &to.state.selection;
+        let selection = to.state.selection();
         let Some(layer) = to.state.stack.layer_mut(&selection.path) else {
             return;
         };

@@ -9,7 +9,7 @@
 use std::collections::{HashSet, VecDeque};
 use std::sync::Arc;
 
-use super::{Layer, LayerContent, LayerStack};
+use super::{Layer, LayerContent, LayerId, LayerStack};
 use crate::model::mesh_ref::MeshRef;
 use crate::model::normal::NormalMap;
 use crate::model::provenance::ImportReport;
@@ -18,11 +18,22 @@ use crate::model::surface::Surface;
 /// Default cap on the memory history may hold: 1 GiB.
 pub const DEFAULT_UNDO_CAP_BYTES: usize = 1 << 30;
 
-/// Which layer tools act on, and whether on its mask.
+/// Which layer tools act on, as a path (what the Layers panel, projects and scripts show),
+/// and whether on its mask. The document keeps a [`Selected`] layer by id; this is where that
+/// layer is now.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Selection {
     /// Indices from the top-level list down into groups; empty when the stack has no layers.
     pub path: Vec<usize>,
+    /// Tools paint the layer's mask rather than its content.
+    pub mask: bool,
+}
+
+/// The selected layer, by id: the same layer whatever moves around it, and after undo.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Selected {
+    /// The layer (none when the stack has no layers).
+    pub id: Option<LayerId>,
     /// Tools paint the layer's mask rather than its content.
     pub mask: bool,
 }
@@ -34,7 +45,7 @@ pub struct State {
     /// The layer stack.
     pub stack: LayerStack,
     /// The selected layer.
-    pub selection: Selection,
+    pub selection: Selected,
     /// The mesh surface baked at the stack's size.
     pub surface: Option<Arc<Surface>>,
     /// The mesh the project is painted on.
@@ -46,6 +57,29 @@ pub struct State {
     /// Which revision of the content this is: a new number for every step, so that undo back to
     /// a state brings its number back (what "unsaved changes" compares).
     pub revision: u64,
+}
+
+impl State {
+    /// Where the selected layer is in the stack (empty: none is selected).
+    pub fn selected_path(&self) -> Vec<usize> {
+        self.selection
+            .id
+            .and_then(|id| self.stack.path_of(id))
+            .unwrap_or_default()
+    }
+
+    /// Selects the layer at `path` (none where no layer is there).
+    pub fn select_path(&mut self, path: &[usize]) {
+        self.selection.id = self.stack.layer(path).map(|l| l.props.id);
+    }
+
+    /// The selection as a path.
+    pub fn selection(&self) -> Selection {
+        Selection {
+            path: self.selected_path(),
+            mask: self.selection.mask,
+        }
+    }
 }
 
 /// One undoable step.

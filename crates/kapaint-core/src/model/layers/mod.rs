@@ -21,7 +21,7 @@ pub mod thumbnail;
 
 pub use blend::{Covered, LayerBlend};
 pub use composite::{Compositor, composite_tile, merge_tile};
-pub use history::{Selection, StackHistory, State};
+pub use history::{Selected, Selection, StackHistory, State};
 pub use paint::{LayerStroke, LayerValue};
 
 use std::sync::Arc;
@@ -439,10 +439,23 @@ impl LayerStack {
 
     /// The path of the layer with `id`, at any depth.
     pub fn path_of(&self, id: LayerId) -> Option<Vec<usize>> {
-        self.walk()
-            .into_iter()
-            .find(|(_, l)| l.props.id == id)
-            .map(|(p, _)| p)
+        fn find(list: &[Layer], id: LayerId, path: &mut Vec<usize>) -> bool {
+            for (i, layer) in list.iter().enumerate() {
+                path.push(i);
+                if layer.props.id == id {
+                    return true;
+                }
+                if let LayerContent::Group(children) = &layer.content
+                    && find(children, id, path)
+                {
+                    return true;
+                }
+                path.pop();
+            }
+            false
+        }
+        let mut path = Vec::new();
+        find(&self.layers, id, &mut path).then_some(path)
     }
 
     /// Every layer, depth first, bottom first within each list, with its path.

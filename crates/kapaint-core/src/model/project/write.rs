@@ -220,7 +220,7 @@ pub(super) fn write_project(
             height: m.height(),
         }),
         id: Some(doc.id().to_hex()),
-        selection: Some(super::SelectionEntry::of(doc.selection())),
+        selection: Some(super::SelectionEntry::of(&doc.selection())),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
     // Never write what the loader would refuse: the manifest goes through the loader's own

@@ -44,7 +44,7 @@ impl Snapshot {
         Self {
             id: doc.id(),
             settings: doc.settings().clone(),
-            selection: doc.selection().clone(),
+            selection: doc.selection(),
             stack: doc.stack().clone(),
             normal: doc.normal().cloned(),
         }
