@@ -146,41 +146,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             | KtxFormat::BC7_UNORM_BLOCK
             | KtxFormat::BC7_SRGB_BLOCK
             | KtxFormat::BC6H_UFLOAT_BLOCK),
-        ) => {
-            let kind = match f {
-                KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
-                KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
-                KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
-                    effort: Bc7Quality::UltraFast,
-                },
-                _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
-            };
-            let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
-            let size = (padded.0 as usize / 4) * (padded.1 as usize / 4) * kind.block_bytes();
-            if data.len() < size {
-                return Err("level 0 is truncated".into());
-            }
-            let per = kind.texel_bytes();
-            let texels = blocks::decode(kind, &data[..size], padded);
-            let tight = crop(&texels, padded.0, (w, h), per, per);
-            if per == 8 {
-                let rgba = tight
-                    .chunks_exact(2)
-                    .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
-                    .collect();
-                return Ok(Decoded {
-                    width: w,
-                    height: h,
-                    channels: 3,
-                    rgba,
-                });
-            }
-            let mut rgba = vec![255_u8; w as usize * h as usize * 4];
-            for (px, t) in rgba.chunks_exact_mut(4).zip(tight.chunks_exact(per)) {
-                px[..per].copy_from_slice(t);
-            }
-            (per, rgba)
-        }
+        ) => return decode_blocks(f, data, (w, h)),
         other => return Err(format!("KTX2 format {other:?} is not one kapaint writes")),
     };
     let rgba = rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
@@ -189,5 +155,47 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         height: h,
         channels,
         rgba,
+    })
+}
+
+/// Level 0 of a block-compressed file of `format`, as RGBA (BC6H: three linear floats).
+fn decode_blocks(format: KtxFormat, data: &[u8], (w, h): (u32, u32)) -> Result<Decoded, String> {
+    let kind = match format {
+        KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
+        KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
+        KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
+            effort: Bc7Quality::UltraFast,
+        },
+        _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
+    };
+    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+    let size = (padded.0 as usize / 4) * (padded.1 as usize / 4) * kind.block_bytes();
+    if data.len() < size {
+        return Err("level 0 is truncated".into());
+    }
+    let per = kind.texel_bytes();
+    let texels = blocks::decode(kind, &data[..size], padded);
+    let tight = crop(&texels, padded.0, (w, h), per, per);
+    if per == 8 {
+        let rgba = tight
+            .chunks_exact(2)
+            .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+            .collect();
+        return Ok(Decoded {
+            width: w,
+            height: h,
+            channels: 3,
+            rgba,
+        });
+    }
+    let mut rgba = vec![255_u8; w as usize * h as usize * 4];
+    for (px, t) in rgba.chunks_exact_mut(4).zip(tight.chunks_exact(per)) {
+        px[..per].copy_from_slice(t);
+    }
+    Ok(Decoded {
+        width: w,
+        height: h,
+        channels: per,
+        rgba: rgba.iter().map(|b| f32::from(*b) / 255.0).collect(),
     })
 }

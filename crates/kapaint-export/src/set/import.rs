@@ -49,10 +49,6 @@ fn read_pixels(path: &Path) -> Result<Pixels, SetError> {
 
 /// Reads a set's maps back as a consumer would (no settings).
 fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> {
-    let invalid = |path: &Path, reason: String| SetError::Invalid {
-        path: path.to_path_buf(),
-        reason,
-    };
     let (w, h) = (manifest.width, manifest.height);
     let mut values = vec![
         MaterialValue::new(
@@ -63,72 +59,7 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
         (w as usize) * (h as usize)
     ];
     for file in &manifest.files {
-        let path = dir.join(&file.path);
-        if file.path.contains(['/', '\\']) || file.path.starts_with('.') {
-            return Err(invalid(&path, "file names must stay inside the set".into()));
-        }
-        let (ktx, size, pixels) = read_pixels(&path)?;
-        if size != (w, h) {
-            return Err(invalid(
-                &path,
-                format!("is {}x{}, the manifest says {w}x{h}", size.0, size.1),
-            ));
-        }
-        let comps: Vec<Comp> = file
-            .layout
-            .iter()
-            .map(|c| {
-                Comp::parse(c).ok_or_else(|| invalid(&path, format!("unknown component {c:?}")))
-            })
-            .collect::<Result<_, _>>()?;
-        let srgb = file.colour_space == ColourSpace::Srgb;
-        let exr = file.compression == Compression::Exr;
-        let n_enc = manifest.n_encoding;
-        let n_codes: Vec<f32> = n_enc.map_or_else(Vec::new, |e| {
-            (0..=((1_u32 << e.bits) - 1) as u16)
-                .map(|q| e.decode(q))
-                .collect()
-        });
-        let srgb8: Vec<f32> = (0..=255_u8)
-            .map(|v| srgb_to_linear(f32::from(v) / 255.0))
-            .collect();
-        values
-            .par_iter_mut()
-            .zip(pixels.par_chunks(4))
-            .for_each(|(v, px)| {
-                for (k, comp) in comps.iter().enumerate() {
-                    // EXR one-component images repeat the value, grey + alpha PNGs read as
-                    // (L, L, L, A); others hold components in order.
-                    let raw = match (comps.len(), k) {
-                        (1, _) if exr => px[0],
-                        (2, 1) if !ktx && !exr => px[3],
-                        _ => px[k.min(3)],
-                    };
-                    let colour = |x: f32| {
-                        if srgb {
-                            srgb8[(x.clamp(0.0, 1.0) * 255.0).round() as usize]
-                        } else {
-                            x
-                        }
-                    };
-                    match *comp {
-                        Comp::Kd(c) => v.kd[c] = colour(raw),
-                        Comp::Ks(3) => v.ks = Vec3::splat(colour(raw)),
-                        Comp::Ks(c) => v.ks[c] = colour(raw),
-                        Comp::N => {
-                            v.n = match n_enc {
-                                Some(e) => {
-                                    let q = (raw.clamp(0.0, 1.0) * ((1_u32 << e.bits) - 1) as f32)
-                                        .round();
-                                    n_codes[q as usize]
-                                }
-                                None => raw,
-                            };
-                        }
-                        Comp::Ka(_) => {}
-                    }
-                }
-            });
+        read_file(&mut values, manifest, dir, file)?;
     }
     let mut maps = MaterialMaps::new(w, h, MaterialValue::default())
         .map_err(|e| invalid(dir, e.to_string()))?;
@@ -141,6 +72,88 @@ fn read_maps(manifest: &Manifest, dir: &Path) -> Result<MaterialMaps, SetError> 
         maps.tile_mut(id).compact();
     }
     Ok(maps)
+}
+
+fn invalid(path: &Path, reason: String) -> SetError {
+    SetError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    }
+}
+
+/// Reads one image of the set into the components of `values` it holds.
+fn read_file(
+    values: &mut [MaterialValue],
+    manifest: &Manifest,
+    dir: &Path,
+    file: &super::FileEntry,
+) -> Result<(), SetError> {
+    let (w, h) = (manifest.width, manifest.height);
+    let path = dir.join(&file.path);
+    if file.path.contains(['/', '\\']) || file.path.starts_with('.') {
+        return Err(invalid(&path, "file names must stay inside the set".into()));
+    }
+    let (ktx, size, pixels) = read_pixels(&path)?;
+    if size != (w, h) {
+        return Err(invalid(
+            &path,
+            format!("is {}x{}, the manifest says {w}x{h}", size.0, size.1),
+        ));
+    }
+    let comps: Vec<Comp> = file
+        .layout
+        .iter()
+        .map(|c| Comp::parse(c).ok_or_else(|| invalid(&path, format!("unknown component {c:?}"))))
+        .collect::<Result<_, _>>()?;
+    let srgb = file.colour_space == ColourSpace::Srgb;
+    let exr = file.compression == Compression::Exr;
+    let n_enc = manifest.n_encoding;
+    let n_codes: Vec<f32> = n_enc.map_or_else(Vec::new, |e| {
+        (0..=((1_u32 << e.bits) - 1) as u16)
+            .map(|q| e.decode(q))
+            .collect()
+    });
+    let srgb8: Vec<f32> = (0..=255_u8)
+        .map(|v| srgb_to_linear(f32::from(v) / 255.0))
+        .collect();
+    let colour = |x: f32| {
+        if srgb {
+            srgb8[(x.clamp(0.0, 1.0) * 255.0).round() as usize]
+        } else {
+            x
+        }
+    };
+    values
+        .par_iter_mut()
+        .zip(pixels.par_chunks(4))
+        .for_each(|(v, px)| {
+            for (k, comp) in comps.iter().enumerate() {
+                // EXR one-component images repeat the value, grey + alpha PNGs read as
+                // (L, L, L, A); others hold components in order.
+                let raw = match (comps.len(), k) {
+                    (1, _) if exr => px[0],
+                    (2, 1) if !ktx && !exr => px[3],
+                    _ => px[k.min(3)],
+                };
+                match *comp {
+                    Comp::Kd(c) => v.kd[c] = colour(raw),
+                    Comp::Ks(3) => v.ks = Vec3::splat(colour(raw)),
+                    Comp::Ks(c) => v.ks[c] = colour(raw),
+                    Comp::N => {
+                        v.n = match n_enc {
+                            Some(e) => {
+                                let q =
+                                    (raw.clamp(0.0, 1.0) * ((1_u32 << e.bits) - 1) as f32).round();
+                                n_codes[q as usize]
+                            }
+                            None => raw,
+                        };
+                    }
+                    Comp::Ka(_) => {}
+                }
+            }
+        });
+    Ok(())
 }
 
 /// Reads a set (`material.json` and its images) back into a document.

@@ -339,33 +339,7 @@ impl TryFrom<ManifestFile> for Manifest {
             &f.preset,
             kapaint_core::model::check::MAX_NAME_BYTES,
         )?;
-        let mut names: Vec<&str> = Vec::new();
-        let mut comps: Vec<Comp> = Vec::new();
-        for file in &f.files {
-            if (file.width, file.height) != (w, h) {
-                return Err(format!(
-                    "{} is listed as {}x{}, the set is {w}x{h}",
-                    file.path, file.width, file.height
-                ));
-            }
-            if names.iter().any(|n| n.eq_ignore_ascii_case(&file.path)) {
-                return Err(format!("{} is listed twice", file.path));
-            }
-            names.push(&file.path);
-            for c in file.layout.iter().filter_map(|c| Comp::parse(c)) {
-                if c == Comp::N
-                    && file.compression != Compression::Exr
-                    && f.n_encoding
-                        .is_none_or(|e| u32::from(e.bits) > file.bit_depth)
-                {
-                    return Err(format!(
-                        "{} holds n in {}-bit codes, but n_encoding does not say how to decode them",
-                        file.path, file.bit_depth
-                    ));
-                }
-                comps.push(c);
-            }
-        }
+        let comps = stored_components(&f, (w, h))?;
         if let Some(n) = &f.normal {
             n.check()?;
         }
@@ -403,6 +377,39 @@ impl TryFrom<ManifestFile> for Manifest {
             normal: f.normal,
         })
     }
+}
+
+/// Every component the manifest's files hold, each file checked against the set: its size,
+/// its name once, and `n` in integer codes only with an encoding that decodes them.
+fn stored_components(f: &ManifestFile, (w, h): (u32, u32)) -> Result<Vec<Comp>, String> {
+    let mut names: Vec<&str> = Vec::new();
+    let mut comps: Vec<Comp> = Vec::new();
+    for file in &f.files {
+        if (file.width, file.height) != (w, h) {
+            return Err(format!(
+                "{} is listed as {}x{}, the set is {w}x{h}",
+                file.path, file.width, file.height
+            ));
+        }
+        if names.iter().any(|n| n.eq_ignore_ascii_case(&file.path)) {
+            return Err(format!("{} is listed twice", file.path));
+        }
+        names.push(&file.path);
+        for c in file.layout.iter().filter_map(|c| Comp::parse(c)) {
+            if c == Comp::N
+                && file.compression != Compression::Exr
+                && f.n_encoding
+                    .is_none_or(|e| u32::from(e.bits) > file.bit_depth)
+            {
+                return Err(format!(
+                    "{} holds n in {}-bit codes, but n_encoding does not say how to decode them",
+                    file.path, file.bit_depth
+                ));
+            }
+            comps.push(c);
+        }
+    }
+    Ok(comps)
 }
 
 /// A component source: which channel component of a texel.
