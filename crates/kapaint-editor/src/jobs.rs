@@ -228,7 +228,7 @@ impl EditorState {
             }
             JobResult::Resized(resized) => {
                 let (w, h) = (resized.0.0.width, resized.0.0.height);
-                self.apply(ImportCommand::Resize(resized).into());
+                self.apply(ImportCommand::Resize(resized));
                 self.notices
                     .push(notice(format!("Resized the maps to {w}x{h}"), false));
             }
@@ -244,7 +244,7 @@ impl EditorState {
             JobResult::Stamp(path, stamp) => {
                 let mut brush = self.doc.settings().brush.clone();
                 brush.stamp = Some(stamp);
-                self.apply(SettingsCommand::SetBrush(brush).into());
+                self.apply(SettingsCommand::SetBrush(brush));
                 self.notices
                     .push(notice(format!("stamp {}", path.display()), false));
             }

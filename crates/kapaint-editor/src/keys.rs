@@ -226,16 +226,16 @@ impl EditorState {
         let mut brush = self.doc.settings().brush.clone();
         for action in actions {
             match action {
-                Action::Undo => self.apply(HistoryCommand::Undo.into()),
-                Action::Redo => self.apply(HistoryCommand::Redo.into()),
+                Action::Undo => self.apply(HistoryCommand::Undo),
+                Action::Redo => self.apply(HistoryCommand::Redo),
                 Action::Save => self.save(),
                 Action::SaveAs => self.save_as(),
                 Action::Open => self.open_dialog(),
                 Action::New => self.new_project(),
                 Action::Export => self.open_export(),
                 Action::NewLayer => self.new_layer(kapaint_core::model::LayerKind::Paint),
-                Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer.into()),
-                Action::MergeDown => self.apply(LayerCommand::MergeDown.into()),
+                Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer),
+                Action::MergeDown => self.apply(LayerCommand::MergeDown),
                 Action::Quit => self.quit.asked = true,
                 Action::Tool(kind) => self.select_tool(kind),
                 Action::FillOrFrame => {
@@ -247,7 +247,7 @@ impl EditorState {
                 }
                 Action::FitCanvas => self.canvas.fit(),
                 Action::Shortcuts => self.shortcuts_open = !self.shortcuts_open,
-                Action::SwapMaterials => self.apply(SettingsCommand::SwapMaterials.into()),
+                Action::SwapMaterials => self.apply(SettingsCommand::SwapMaterials),
                 Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
                 Action::SmallerBrush => self.scale_brush(&mut brush, 1.0 / 1.25),
@@ -262,7 +262,7 @@ impl EditorState {
             }
         }
         if brush != self.doc.settings().brush {
-            self.apply(SettingsCommand::SetBrush(brush).into());
+            self.apply(SettingsCommand::SetBrush(brush));
         }
     }
 

@@ -385,7 +385,7 @@ impl EditorState {
     /// tools paint shows alone, in grey, while the chosen view is the whole stack.
     pub fn shown_layer_view(&self) -> panels::layers::LayerView {
         use panels::layers::LayerView;
-        if self.doc.selection().mask && self.layer_view == LayerView::Composite {
+        if self.doc.painting_mask() && self.layer_view == LayerView::Composite {
             LayerView::Mask
         } else {
             self.layer_view
@@ -434,10 +434,10 @@ impl EditorState {
 
     /// Applies a command as the panels do (an error becomes a notice).
     pub fn apply_command(&mut self, command: impl Into<Command>) {
-        self.apply(command.into());
+        self.apply(command);
     }
 
-    fn apply(&mut self, command: Command) {
+    fn apply(&mut self, command: impl Into<Command>) {
         if let Err(e) = self.doc.apply(command) {
             self.notices.push(notice(e.to_string(), true));
         }

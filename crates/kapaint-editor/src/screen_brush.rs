@@ -89,7 +89,7 @@ impl EditorState {
         let mut brush = self.doc.settings().brush.clone();
         if (brush.radius_px - radius).abs() > 1e-3 * radius {
             brush.radius_px = radius;
-            self.apply(SettingsCommand::SetBrush(brush).into());
+            self.apply(SettingsCommand::SetBrush(brush));
         }
     }
 

@@ -255,9 +255,15 @@ impl Default for Tools {
 }
 
 impl Tools {
-    /// Every tool's name and key, in the editor's order.
+    /// Every tool's name and key, in the editor's order (before any [`Tools`] is made: the
+    /// keymap).
     pub fn all() -> Vec<ToolMeta> {
         registry().iter().map(|t| t.meta()).collect()
+    }
+
+    /// These tools' names and keys, in the editor's order.
+    pub fn metas(&self) -> impl Iterator<Item = ToolMeta> + '_ {
+        self.tools.iter().map(|t| t.meta())
     }
 
     /// The active tool.

@@ -150,10 +150,10 @@ impl EditorState {
             });
             ui.menu_button("Edit", |ui| {
                 if item(ui, "Undo", Action::Undo) {
-                    self.apply(HistoryCommand::Undo.into());
+                    self.apply(HistoryCommand::Undo);
                 }
                 if item(ui, "Redo", Action::Redo) {
-                    self.apply(HistoryCommand::Redo.into());
+                    self.apply(HistoryCommand::Redo);
                 }
             });
             ui.menu_button("Image", |ui| {

@@ -109,7 +109,7 @@ impl EditorState {
                 .on_hover_text(format!("Secondary (X swaps): {}", describe(&secondary)))
                 .clicked()
             {
-                self.apply(SettingsCommand::SwapMaterials.into());
+                self.apply(SettingsCommand::SwapMaterials);
                 *primary = self.doc.settings().primary;
             }
             ui.label("Hex");
@@ -206,7 +206,7 @@ impl EditorState {
             }
         });
         if let Some(v) = chosen {
-            self.apply(SettingsCommand::SetPrimary(v).into());
+            self.apply(SettingsCommand::SetPrimary(v));
         }
     }
 

@@ -11,7 +11,7 @@ use kapaint_core::model::{LayerCommand, MaskCommand};
 impl EditorState {
     /// The selected layer's name, opacity, channels and blends, fill material, mask and moves.
     pub(super) fn selected_layer_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(layer) = self.doc.stack().layer(&self.doc.selection().path).cloned() else {
+        let Some(layer) = self.doc.selected_layer().cloned() else {
             ui.label("No layer is selected.");
             return;
         };
@@ -51,7 +51,7 @@ impl EditorState {
             commands.push(LayerCommand::SetLayerFill(self.doc.settings().primary).into());
         }
         commands.extend(
-            mask_ui(ui, &layer, self.doc.selection().mask)
+            mask_ui(ui, &layer, self.doc.painting_mask())
                 .into_iter()
                 .map(Command::from),
         );

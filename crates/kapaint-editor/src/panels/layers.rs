@@ -111,9 +111,8 @@ impl EditorState {
     /// What tools paint (a layer or its mask) and which layer view is shown, as the viewport
     /// and canvas say it.
     pub fn painting_text(&self) -> Option<String> {
-        let selection = self.doc.selection();
-        let layer = self.doc.stack().layer(&selection.path)?;
-        let mut text = if selection.mask {
+        let layer = self.doc.selected_layer()?;
+        let mut text = if self.doc.painting_mask() {
             format!("Painting the mask of \"{}\"", layer.props.name)
         } else {
             format!("Painting \"{}\"", layer.props.name)
@@ -131,7 +130,7 @@ impl EditorState {
         let Some(text) = self.painting_text() else {
             return;
         };
-        let colour = if self.doc.selection().mask {
+        let colour = if self.doc.painting_mask() {
             Color32::from_rgb(255, 200, 120)
         } else {
             Color32::from_gray(220)
@@ -211,16 +210,16 @@ impl EditorState {
                 self.new_layer(LayerKind::Group);
             }
             if add(ui, "Duplicate", "Duplicate the selected layer (Ctrl+J)") {
-                self.apply(LayerCommand::DuplicateLayer.into());
+                self.apply(LayerCommand::DuplicateLayer);
             }
             if add(ui, "Delete", "Delete the selected layer") {
-                self.apply(LayerCommand::DeleteLayer.into());
+                self.apply(LayerCommand::DeleteLayer);
             }
             if add(ui, "Merge down", "Merge into the layer below (Ctrl+E)") {
-                self.apply(LayerCommand::MergeDown.into());
+                self.apply(LayerCommand::MergeDown);
             }
             if add(ui, "Flatten", "Every layer into one paint layer") {
-                self.apply(LayerCommand::Flatten.into());
+                self.apply(LayerCommand::Flatten);
             }
         });
     }
@@ -233,7 +232,7 @@ impl EditorState {
             LayerKind::Fill => format!("Fill {}", count + 1),
             LayerKind::Group => format!("Group {}", count + 1),
         };
-        self.apply(LayerCommand::AddLayer { kind, name }.into());
+        self.apply(LayerCommand::AddLayer { kind, name });
     }
 
     /// Rows of `layers` (top first), groups' children indented under them.
@@ -256,8 +255,7 @@ impl EditorState {
     }
 
     fn row_ui(&self, ui: &mut egui::Ui, layer: &Layer, path: &[usize]) -> Option<RowAction> {
-        let selection = self.doc.selection();
-        let selected = selection.path == path;
+        let selected = self.doc.selected_id() == Some(layer.props.id);
         let mut action = None;
         let row = ui.horizontal(|ui| {
             ui.add_space(14.0 * (path.len() - 1) as f32);
@@ -289,7 +287,7 @@ impl EditorState {
             let content = Self::thumb_ui(
                 ui,
                 self.layers_panel.thumbs.content.get(path),
-                selected && !selection.mask,
+                selected && !self.doc.painting_mask(),
                 &format!("Content of {}", p.name),
             );
             if content.clicked() {
@@ -302,7 +300,7 @@ impl EditorState {
                 let r = Self::thumb_ui(
                     ui,
                     self.layers_panel.thumbs.masks.get(path),
-                    selected && selection.mask,
+                    selected && self.doc.painting_mask(),
                     &format!("Mask of {}", p.name),
                 )
                 .on_hover_text("Paint the mask (Alt + click: show it alone)");
@@ -397,9 +395,9 @@ impl EditorState {
     fn row_action(&mut self, path: Vec<usize>, action: RowAction) {
         match action {
             RowAction::Select { mask, alone } => {
-                self.apply(LayerCommand::SelectPath(path).into());
+                self.apply(LayerCommand::SelectPath(path));
                 if mask {
-                    self.apply(MaskCommand::SelectMask.into());
+                    self.apply(MaskCommand::SelectMask);
                 }
                 if alone {
                     self.layer_view = LayerView::Mask;
@@ -408,34 +406,30 @@ impl EditorState {
             RowAction::Toggle(command) => {
                 // The eye and the lock act on their row's layer, leaving the selection be.
                 let before = self.doc.selection();
-                self.apply(LayerCommand::SelectPath(path).into());
+                self.apply(LayerCommand::SelectPath(path));
                 self.apply(command);
                 if self.doc.stack().layer(&before.path).is_some() {
-                    self.apply(LayerCommand::SelectPath(before.path).into());
+                    self.apply(LayerCommand::SelectPath(before.path));
                     if before.mask {
-                        self.apply(MaskCommand::SelectMask.into());
+                        self.apply(MaskCommand::SelectMask);
                     }
                 }
             }
             RowAction::Rename => {
-                self.apply(LayerCommand::SelectPath(path).into());
+                self.apply(LayerCommand::SelectPath(path));
                 self.layers_panel.rename = Some(
                     self.doc
-                        .stack()
-                        .layer(&self.doc.selection().path)
+                        .selected_layer()
                         .map(|l| l.props.name.clone())
                         .unwrap_or_default(),
                 );
             }
             RowAction::Drop(from, place) => {
-                self.apply(LayerCommand::SelectPath(from).into());
-                self.apply(
-                    LayerCommand::MoveLayerTo {
-                        target: path,
-                        place,
-                    }
-                    .into(),
-                );
+                self.apply(LayerCommand::SelectPath(from));
+                self.apply(LayerCommand::MoveLayerTo {
+                    target: path,
+                    place,
+                });
             }
         }
     }

@@ -148,7 +148,7 @@ impl EditorState {
                 });
             });
         if let Some(v) = chosen {
-            self.apply(SettingsCommand::SetPrimary(v).into());
+            self.apply(SettingsCommand::SetPrimary(v));
         }
     }
 
@@ -172,7 +172,7 @@ impl EditorState {
                 }
             });
         if let Some(b) = chosen {
-            self.apply(SettingsCommand::SetBrush(b).into());
+            self.apply(SettingsCommand::SetBrush(b));
         }
         self.naming_ui(ui, Naming::Brush, "Save brush…");
     }

@@ -4,7 +4,7 @@ use crate::files::FilePurpose;
 use crate::{EditorState, stamp_image, stamp_key};
 use kapaint_core::model::SettingsCommand;
 use kapaint_core::reflectance;
-use kapaint_core::tools::{OptionValue, OptionWidget, ToolOption, Tools};
+use kapaint_core::tools::{OptionValue, OptionWidget, ToolOption};
 
 impl EditorState {
     /// The active tool's options, drawn from what the tool says they are.
@@ -26,8 +26,9 @@ impl EditorState {
     pub(crate) fn tools_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Tools");
         let mut chosen = self.tools.active();
+        let tools: Vec<_> = self.tools.metas().collect();
         ui.horizontal_wrapped(|ui| {
-            for tool in Tools::all() {
+            for tool in tools {
                 ui.selectable_value(&mut chosen, tool.kind, tool.label)
                     .on_hover_text(format!("{} ({})", tool.label, tool.key_help));
             }
@@ -52,7 +53,7 @@ impl EditorState {
         self.stamp_ui(ui, &mut brush);
         stroke_options_ui(ui, &mut brush);
         if brush != self.doc.settings().brush {
-            self.apply(SettingsCommand::SetBrush(brush).into());
+            self.apply(SettingsCommand::SetBrush(brush));
         }
         ui.separator();
         ui.heading("Material");
@@ -93,14 +94,14 @@ impl EditorState {
         ))
         .on_hover_text("The exponent of the other model with the closest highlight");
         if primary != self.doc.settings().primary {
-            self.apply(SettingsCommand::SetPrimary(primary).into());
+            self.apply(SettingsCommand::SetPrimary(primary));
         }
         if ui
             .button("Swap primary / secondary")
             .on_hover_text("X")
             .clicked()
         {
-            self.apply(SettingsCommand::SwapMaterials.into());
+            self.apply(SettingsCommand::SwapMaterials);
         }
         self.recent_materials_ui(ui);
         ui.separator();
@@ -112,7 +113,7 @@ impl EditorState {
             ui.checkbox(&mut ch.n, "n");
         });
         if ch != self.doc.settings().channels {
-            self.apply(SettingsCommand::SetChannels(ch).into());
+            self.apply(SettingsCommand::SetChannels(ch));
         }
     }
 

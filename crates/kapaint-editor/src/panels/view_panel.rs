@@ -112,7 +112,7 @@ impl EditorState {
             });
         }
         if model != self.doc.settings().model {
-            self.apply(SettingsCommand::SetModel(model).into());
+            self.apply(SettingsCommand::SetModel(model));
         }
         let mut approx = self.doc.settings().approx;
         ui.add_enabled_ui(model.has_paper_forms(), |ui| {
@@ -130,7 +130,7 @@ impl EditorState {
              kapaint's fit (within 2e-5 of the exact integral)",
         );
         if approx != self.doc.settings().approx {
-            self.apply(SettingsCommand::SetApprox(approx).into());
+            self.apply(SettingsCommand::SetApprox(approx));
         }
         self.compare_ui(ui);
         ui.heading("View");
@@ -209,7 +209,7 @@ impl EditorState {
                 }
             });
         if let Some(n) = jump {
-            self.apply(HistoryCommand::HistoryJump(n).into());
+            self.apply(HistoryCommand::HistoryJump(n));
         }
     }
 

@@ -270,10 +270,7 @@ impl Document {
     }
 
     pub(super) fn selected(&self) -> Result<&Layer, ModelError> {
-        self.state
-            .stack
-            .layer(&self.state.selected_path())
-            .ok_or_else(no_layer)
+        self.selected_layer().ok_or_else(no_layer)
     }
 
     /// Changes the selected layer's settings as one undo step.

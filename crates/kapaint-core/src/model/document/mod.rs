@@ -275,9 +275,24 @@ impl Document {
         &self.state.stack
     }
 
-    /// The selected layer and whether tools paint its mask.
+    /// The selected layer's path and whether tools paint its mask.
     pub fn selection(&self) -> Selection {
         self.state.selection()
+    }
+
+    /// The selected layer's id (none: the stack has no layers), without finding its path.
+    pub fn selected_id(&self) -> Option<LayerId> {
+        self.state.selection.id
+    }
+
+    /// The selected layer.
+    pub fn selected_layer(&self) -> Option<&crate::model::layers::Layer> {
+        self.state.stack.layer(&self.state.selected_path())
+    }
+
+    /// Whether tools paint the selected layer's mask.
+    pub fn painting_mask(&self) -> bool {
+        self.state.selection.mask
     }
 
     /// The maps: read them freely; they change only through [`Document::apply`].
