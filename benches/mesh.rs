@@ -1,7 +1,7 @@
 //! Criterion benches for the mesh targets (issue 4): a 4096^2 UV bake of a ~100k-triangle
 //! mesh (target <= 1 s) and of the spot mesh; BVH build and pick on 1M triangles; the
 //! object-space index and a 128 px-equivalent dab on 4096^2 maps (target <= 1 ms); MikkTSpace
-//! tangents for normal maps.
+//! tangents for normal maps; automatic UVs for meshes that have none.
 
 #![expect(
     clippy::expect_used,
@@ -172,5 +172,36 @@ fn tangents(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bakes, picking, surface_dabs, tangents);
+/// Automatic UVs for a 2048^2 map: teapot and suzanne (no UVs of their own; targets 0.5 s and
+/// 0.2 s), and spot's own UVs replaced on request (1 s for a mesh re-unwrapped on request).
+fn unwraps(c: &mut Criterion) {
+    use kapaint::mesh::unwrap::{UnwrapOptions, unwrap};
+    let mut group = c.benchmark_group("unwrap_2048");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(5));
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (name, path) in [
+        (
+            "teapot_6320_triangles",
+            root.join("tests/data/meshes/teapot.obj"),
+        ),
+        (
+            "suzanne_968_triangles",
+            root.join("tests/data/meshes/suzanne.obj"),
+        ),
+        (
+            "spot_5856_triangles_rewrapped",
+            root.join("../shared/testdata/spot/spot_triangulated.obj"),
+        ),
+    ] {
+        let mesh = mesh::load(&path).expect("mesh loads");
+        group.bench_function(name, |b| {
+            b.iter(|| unwrap(&mesh, UnwrapOptions::for_size(2048), None).expect("unwraps"));
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bakes, picking, surface_dabs, tangents, unwraps);
 criterion_main!(benches);

@@ -1,7 +1,7 @@
-//! Regenerates `crates/kapaint-core/src/reflectance/fast_coeffs.rs` from the exact integrator, after exploring
+//! Regenerates `crates/kapaint-reflectance/src/fast_coeffs.rs` from the exact integrator, after exploring
 //! which polynomial degree per octave is needed (printed to stderr).
 //!
-//! Usage: `cargo run --release --example fit_fast [DEGREE] > crates/kapaint-core/src/reflectance/fast_coeffs.rs`
+//! Usage: `cargo run --release --example fit_fast [DEGREE] > crates/kapaint-reflectance/src/fast_coeffs.rs`
 //! (with no DEGREE, the smallest degree whose worst error is <= 2e-5 is chosen).
 
 use kapaint::reflectance::ShadingModel;

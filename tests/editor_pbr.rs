@@ -201,3 +201,94 @@ fn a_texture_set_imports_from_any_one_of_its_images() {
     assert!((v.ks.x - 0.04).abs() < 1e-3, "{v:?}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+fn teapot(request: &FileRequest) -> Option<std::path::PathBuf> {
+    matches!(request.purpose, FilePurpose::ImportMesh).then(|| {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/teapot.obj")
+    })
+}
+
+/// Steps the editor until a button labelled `label` shows.
+fn wait_for_button(harness: &mut egui_kittest::Harness<'_, Editor>, label: &str) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness
+        .query_by_role_and_label(Role::Button, label)
+        .is_none()
+    {
+        assert!(std::time::Instant::now() < deadline, "no {label:?} button");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+}
+
+/// File > Import mesh with a mesh that has no UVs (the teapot) asks whether to unwrap it;
+/// Cancel leaves the project as it was, "Unwrap automatically" gives it an atlas the project
+/// keeps (saved inside it, there again when it reopens), and Undo takes it back.
+#[test]
+fn a_mesh_without_uvs_is_unwrapped_on_request_and_kept() {
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(teapot);
+    let import = |harness: &mut egui_kittest::Harness<'_, Editor>| {
+        harness.get_by_label("File").click();
+        harness.run_steps(2);
+        harness.get_by_label("Import mesh…").click();
+        harness.run_steps(2);
+        wait_for_button(harness, "Unwrap automatically");
+    };
+    import(&mut harness);
+    assert!(
+        harness
+            .query_by_role_and_label(Role::Button, "Keep its UVs")
+            .is_none(),
+        "the teapot has no UVs to keep"
+    );
+    harness
+        .get_by_role_and_label(Role::Button, "Cancel")
+        .click();
+    harness.run_steps(2);
+    assert_eq!(
+        harness.state().state.doc().settings().mesh,
+        kapaint::model::MeshRef::Sphere
+    );
+    assert!(!harness.state().state.dirty(), "Cancel changed nothing");
+
+    import(&mut harness);
+    harness
+        .get_by_role_and_label(Role::Button, "Unwrap automatically")
+        .click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "mesh unwrapped", notice("unwrapped: "));
+    harness.run_steps(2);
+    let doc = harness.state().state.doc();
+    assert_eq!(
+        doc.settings().mesh,
+        kapaint::model::MeshRef::Embedded("teapot.obj, unwrapped".into())
+    );
+    let surface = doc.surface().expect("baked");
+    assert_eq!(surface.mesh.triangles.len(), 6320);
+    assert_eq!(kapaint::mesh::unwrap::uv_overlap(&surface.mesh, 1024), 0.0);
+    assert!(harness.state().state.dirty());
+
+    // Saved and reopened, the project paints on the same unwrapped teapot.
+    let dir = kit::scratch("editor-unwrap");
+    let path = dir.join("teapot.kapaint");
+    kapaint::model::project::save(doc, &path).expect("saves");
+    let kept = doc.embedded_mesh().expect("kept").clone();
+    let reopened = kit::editor_on(&path);
+    let doc = reopened.state().state.doc();
+    assert!(**doc.embedded_mesh().expect("kept") == *kept);
+    assert_eq!(
+        doc.surface().expect("baked").mesh.triangles.len(),
+        6320,
+        "the teapot, not the sphere"
+    );
+
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    let doc = harness.state().state.doc();
+    assert_eq!(doc.settings().mesh, kapaint::model::MeshRef::Sphere);
+    assert!(doc.embedded_mesh().is_none());
+    let _ = std::fs::remove_dir_all(&dir);
+}

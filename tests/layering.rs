@@ -1,11 +1,11 @@
 //! The layering, as far as Cargo cannot see it.
 //!
-//! Cargo already enforces that no crate imports one above it: `kapaint-core` has no kapaint
-//! crate to import, `kapaint-export` only the core, `kapaint-gpu` the core and the export,
-//! `kapaint-editor` those three, and a crate cannot name a module of a crate it does not
-//! depend on. What Cargo does not stop is a dependency added to a crate's manifest that pulls a
-//! GUI or GPU crate into a room that must build and test without a window or a device. This
-//! test asks `cargo tree` (features resolved for that crate alone) what each crate links.
+//! Cargo already enforces that no crate imports one above it (a dependency back down would be
+//! a cycle, which Cargo refuses) and that a crate cannot name a module of a crate it does not
+//! depend on. What Cargo does not stop is a new edge that still makes no cycle (the maths
+//! taking the mesh crate, say) or a dependency that pulls a GUI or GPU crate into a room that
+//! must build and test without a window or a device. This test pins the graph and asks
+//! `cargo tree` (features resolved for that crate alone) what each crate links.
 #![expect(
     clippy::expect_used,
     reason = "test helpers: a failed expectation is a failed test"
@@ -54,42 +54,100 @@ fn kapaint_deps(krate: &str) -> BTreeSet<String> {
         .collect()
 }
 
+/// Each crate with the kapaint crates under it (its whole tree, not only what it names).
+const LAYERS: [(&str, &[&str]); 9] = [
+    ("kapaint-base", &[]),
+    ("kapaint-reflectance", &[]),
+    ("kapaint-mesh", &["kapaint-base"]),
+    (
+        "kapaint-model",
+        &["kapaint-base", "kapaint-mesh", "kapaint-reflectance"],
+    ),
+    ("kapaint-core", &BELOW_CORE),
+    (
+        "kapaint-export",
+        &[
+            BELOW_CORE[0],
+            BELOW_CORE[1],
+            BELOW_CORE[2],
+            BELOW_CORE[3],
+            "kapaint-core",
+        ],
+    ),
+    (
+        "kapaint-gpu",
+        &[
+            BELOW_CORE[0],
+            BELOW_CORE[1],
+            BELOW_CORE[2],
+            BELOW_CORE[3],
+            "kapaint-core",
+            "kapaint-export",
+        ],
+    ),
+    (
+        "kapaint-editor",
+        &[
+            BELOW_CORE[0],
+            BELOW_CORE[1],
+            BELOW_CORE[2],
+            BELOW_CORE[3],
+            "kapaint-core",
+            "kapaint-export",
+            "kapaint-gpu",
+        ],
+    ),
+    (
+        "kapaint",
+        &[
+            BELOW_CORE[0],
+            BELOW_CORE[1],
+            BELOW_CORE[2],
+            BELOW_CORE[3],
+            "kapaint-core",
+            "kapaint-editor",
+            "kapaint-export",
+            "kapaint-gpu",
+        ],
+    ),
+];
+
+const BELOW_CORE: [&str; 4] = [
+    "kapaint-base",
+    "kapaint-mesh",
+    "kapaint-model",
+    "kapaint-reflectance",
+];
+
 #[test]
-fn the_core_links_no_gui_or_gpu_crate() {
-    let mut forbidden = GUI.to_vec();
-    forbidden.push("wgpu");
-    assert_free_of("kapaint-core", &forbidden);
-    assert!(kapaint_deps("kapaint-core").is_empty());
+fn every_crate_stands_only_on_the_crates_below_it() {
+    for (krate, below) in LAYERS {
+        let want: BTreeSet<String> = below.iter().map(|s| (*s).to_owned()).collect();
+        assert_eq!(
+            kapaint_deps(krate),
+            want,
+            "the kapaint crates under {krate}"
+        );
+    }
 }
 
 #[test]
-fn the_export_links_no_gui_or_gpu_crate_and_only_the_core() {
+fn the_core_and_everything_under_it_link_no_gui_or_gpu_crate() {
     let mut forbidden = GUI.to_vec();
     forbidden.push("wgpu");
-    assert_free_of("kapaint-export", &forbidden);
-    assert_eq!(
-        kapaint_deps("kapaint-export"),
-        BTreeSet::from(["kapaint-core".to_owned()])
-    );
+    for krate in [
+        "kapaint-base",
+        "kapaint-reflectance",
+        "kapaint-mesh",
+        "kapaint-model",
+        "kapaint-core",
+        "kapaint-export",
+    ] {
+        assert_free_of(krate, &forbidden);
+    }
 }
 
 #[test]
-fn the_gpu_crate_links_no_gui_crate_and_nothing_above_it() {
+fn the_gpu_crate_links_no_gui_crate() {
     assert_free_of("kapaint-gpu", &GUI);
-    assert_eq!(
-        kapaint_deps("kapaint-gpu"),
-        BTreeSet::from(["kapaint-core".to_owned(), "kapaint-export".to_owned()])
-    );
-}
-
-#[test]
-fn the_editor_sits_below_the_command_line() {
-    assert_eq!(
-        kapaint_deps("kapaint-editor"),
-        BTreeSet::from([
-            "kapaint-core".to_owned(),
-            "kapaint-export".to_owned(),
-            "kapaint-gpu".to_owned()
-        ])
-    );
 }

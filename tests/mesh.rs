@@ -305,3 +305,193 @@ fn picking_agrees_with_brute_force_on_random_rays() {
         assert!(hits > 500, "only {hits} rays hit");
     }
 }
+
+fn data_mesh(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/meshes")
+        .join(name)
+}
+
+fn kapaint(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(args)
+        .output()
+        .expect("kapaint runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-unwrap-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// The percentage of the map covered, from `kapaint unwrap`'s first line.
+fn covered(line: &str) -> f64 {
+    let (before, _) = line.split_once(" % of a").expect("coverage in the line");
+    before
+        .rsplit(' ')
+        .next()
+        .and_then(|t| t.parse().ok())
+        .expect("a number")
+}
+
+/// Teapot and suzanne have no UVs: each unwraps into an atlas that covers at least 60 % of
+/// the map with no texel claimed twice, written as OBJ and as GLB, and read back with UVs.
+#[test]
+fn meshes_without_uvs_unwrap_into_a_clean_atlas() {
+    let dir = temp_dir("atlas");
+    for (name, triangles) in [("teapot.obj", 6320), ("suzanne.obj", 968)] {
+        let source = mesh::load(&data_mesh(name)).expect("loads");
+        assert!(source.uvs.is_none(), "{name} comes without UVs");
+        assert_eq!(source.triangles.len(), triangles);
+        for ext in ["obj", "glb"] {
+            let out = dir.join(format!("{name}.{ext}"));
+            let o = kapaint(&[
+                "unwrap",
+                data_mesh(name).to_str().expect("path"),
+                "--out",
+                out.to_str().expect("path"),
+            ]);
+            assert!(o.status.success(), "{o:?}");
+            let text = String::from_utf8(o.stdout).expect("utf-8");
+            let first = text.lines().next().expect("a line");
+            assert!(first.starts_with("unwrapped "), "{text}");
+            assert!(covered(first) >= 60.0, "{first}");
+            let back = mesh::load(&out).expect("the unwrapped mesh loads");
+            assert_eq!(back.triangles.len(), triangles);
+            assert!(back.paintable().is_ok());
+            assert_eq!(mesh::unwrap::uv_overlap(&back, 2048), 0.0, "{name}.{ext}");
+            assert!(mesh::unwrap::uv_area(&back) >= 0.6, "{name}.{ext}");
+            // Every triangle keeps its corners where they were.
+            for (a, b) in back.triangles.iter().zip(&source.triangles) {
+                for k in 0..3 {
+                    let (p, q) = (
+                        back.positions[a[k] as usize],
+                        source.positions[b[k] as usize],
+                    );
+                    assert!((p - q).length() < 1e-5, "{name}.{ext}: {p} vs {q}");
+                }
+            }
+        }
+    }
+}
+
+/// What cannot be unwrapped, or written, is one line and exit 2, and nothing is written.
+#[test]
+fn unwrap_refuses_what_it_cannot_do() {
+    let dir = temp_dir("refused");
+    let degenerate = dir.join("line.obj");
+    std::fs::write(&degenerate, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").expect("write");
+    let nan = dir.join("nan.obj");
+    std::fs::write(&nan, "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").expect("write");
+    let teapot = data_mesh("teapot.obj");
+    let teapot = teapot.to_str().expect("path");
+    let out = dir.join("out.obj");
+    let out_s = out.to_str().expect("path");
+    let existing = dir.join("existing.obj");
+    std::fs::write(&existing, "keep me").expect("write");
+    for (args, mentions) in [
+        (
+            vec![degenerate.to_str().expect("path"), "--out", out_s],
+            "degenerate",
+        ),
+        (
+            vec![nan.to_str().expect("path"), "--out", out_s],
+            "non-finite",
+        ),
+        (
+            vec![teapot, "--out", out_s, "--size", "10"],
+            "outside 64 to 16384",
+        ),
+        (
+            vec![teapot, "--out", dir.join("t.png").to_str().expect("path")],
+            ".obj or .glb",
+        ),
+        (
+            vec![teapot, "--out", existing.to_str().expect("path")],
+            "--force",
+        ),
+    ] {
+        let mut all = vec!["unwrap"];
+        all.extend(args);
+        let o = kapaint(&all);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {o:?}");
+        assert!(o.stdout.is_empty());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(mentions), "{err} should mention {mentions}");
+        assert!(!out.exists() && !dir.join("t.png").exists());
+    }
+    assert_eq!(std::fs::read(&existing).expect("read"), b"keep me");
+    let o = kapaint(&[
+        "import-pbr",
+        "--base-color",
+        "0.5",
+        "--unwrap",
+        "--out",
+        out_s,
+    ]);
+    assert_eq!(o.status.code(), Some(2), "--unwrap needs --mesh: {o:?}");
+}
+
+/// `new --unwrap` keeps the unwrapped mesh inside the project: the project paints on it after
+/// it moves away from the mesh file, and saves it again unchanged.
+#[test]
+fn a_project_keeps_its_unwrapped_mesh() {
+    let dir = temp_dir("kept");
+    let project = dir.join("teapot.kapaint");
+    let project_s = project.to_str().expect("path");
+    let o = kapaint(&[
+        "new",
+        "--size",
+        "512",
+        "--mesh",
+        data_mesh("teapot.obj").to_str().expect("path"),
+        "--unwrap",
+        "--out",
+        project_s,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let text = String::from_utf8(o.stdout).expect("utf-8");
+    assert!(
+        text.starts_with("unwrapped ") && text.contains("created "),
+        "{text}"
+    );
+    let info = String::from_utf8(kapaint(&["info", project_s]).stdout).expect("utf-8");
+    assert!(info.contains("teapot.obj, unwrapped"), "{info}");
+    // Moved elsewhere, the project still has its mesh.
+    let moved_dir = temp_dir("kept-moved");
+    let moved = moved_dir.join("moved.kapaint");
+    std::fs::rename(&project, &moved).expect("move");
+    let moved_s = moved.to_str().expect("path");
+    let (doc, failed) =
+        kapaint::model::project::open_with_mesh(&moved, None).expect("the project opens");
+    assert!(failed.is_none(), "{failed:?}");
+    let surface = doc.surface().expect("the kept mesh is attached");
+    assert_eq!(surface.mesh.triangles.len(), 6320);
+    let kept = doc.embedded_mesh().expect("held").clone();
+    // A stroke on the teapot's lid and a fill of one chart paint through the kept UVs.
+    let script = moved_dir.join("s.ron");
+    std::fs::write(
+        &script,
+        "(commands: [SetPrimary((kd: (0.0, 0.0, 1.0), ks: (0.1, 0.1, 0.1), n: 9.0)), \
+         SetBrush((radius_px: 12.0)), \
+         SurfaceStroke(tool: Brush, points: [(pos: (point: (0.0, 3.1, 0.0)), pressure: 1.0), \
+         (pos: (point: (0.3, 3.0, 0.0)), pressure: 1.0)])])",
+    )
+    .expect("write script");
+    let o = kapaint(&["paint", moved_s, "--script", script.to_str().expect("path")]);
+    assert!(o.status.success(), "{o:?}");
+    let info = String::from_utf8(kapaint(&["info", moved_s]).stdout).expect("utf-8");
+    assert!(
+        info.contains("kd.r 0.000000"),
+        "the stroke painted blue: {info}"
+    );
+    let (again, failed) = kapaint::model::project::open_with_mesh(&moved, None).expect("opens");
+    assert!(failed.is_none());
+    assert!(
+        **again.embedded_mesh().expect("held") == *kept,
+        "saved unchanged"
+    );
+}

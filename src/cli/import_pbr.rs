@@ -62,6 +62,10 @@ pub struct ImportPbrArgs {
     /// A mesh to paint on (.obj, .gltf, .glb, or sphere, plane, cube, torus).
     #[arg(long, conflicts_with = "gltf")]
     mesh: Option<String>,
+    /// Give the --mesh a new UV atlas for the map size and keep the unwrapped mesh inside the
+    /// project (the material's images are taken as they are, not moved to the new charts).
+    #[arg(long, requires = "mesh")]
+    unwrap: bool,
     /// Overwrite an existing file.
     #[arg(long)]
     force: bool,
@@ -214,15 +218,25 @@ impl ImportPbrArgs {
         imported.report.notes.extend(notes);
         let mut settings = imported.doc.settings().clone();
         settings.import = Some(imported.report.clone());
-        if let Some(mesh) = mesh {
-            settings.mesh = MeshRef::from_spec(&mesh);
+        if let Some(mesh) = &mesh {
+            settings.mesh = MeshRef::from_spec(mesh);
         }
         let doc = imported
             .doc
             .with_normal(normal.map(std::sync::Arc::new))
             .with_settings(settings);
+        let (doc, unwrapped) = match (&self.mesh, self.unwrap) {
+            (Some(m), true) => {
+                let (doc, line) = super::unwrap::keep_unwrapped(doc, m)?;
+                (doc, format!("{line}\n"))
+            }
+            _ => (doc, String::new()),
+        };
         project::save(&doc, &self.out).map_err(model_error)?;
-        Ok(report_text(&self.out, &doc, &imported.report))
+        Ok(format!(
+            "{unwrapped}{}",
+            report_text(&self.out, &doc, &imported.report)
+        ))
     }
 }
 

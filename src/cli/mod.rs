@@ -31,6 +31,7 @@ mod mesh_info;
 mod new;
 mod paint;
 mod render;
+mod unwrap;
 
 pub use accuracy::MAX_ACCURACY_POINTS;
 pub use args::{MethodArg, ModelArg, fmt17};
@@ -137,6 +138,9 @@ pub enum Command {
     /// Print a mesh's vertices, triangles, UV islands, bounds, and whether normals and UVs
     /// were present (FILE is an .obj, .gltf or .glb file, or sphere, plane, cube, torus).
     MeshInfo(mesh_info::MeshInfoArgs),
+    /// Give a mesh a new UV atlas (charts packed and padded for a map size, no overlap) and
+    /// write it as .obj or .glb.
+    Unwrap(unwrap::UnwrapArgs),
     /// Panics on purpose, to check what a crash looks like (one line, a report file, exit
     /// code 70).
     #[command(hide = true)]
@@ -223,6 +227,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
         Command::EquivalentN(a) => a.run(),
         Command::Render(a) => a.run(),
         Command::MeshInfo(a) => a.run(),
+        Command::Unwrap(a) => a.run(),
         Command::DebugPanic(a) => a.run(),
         Command::Bench(a) => a.run(),
     }

@@ -21,6 +21,10 @@ pub struct NewArgs {
     /// Mesh the material is painted on: sphere, plane, cube, torus or a mesh file.
     #[arg(long, default_value = "sphere")]
     mesh: String,
+    /// Give the mesh a new UV atlas for the map size and keep the unwrapped mesh inside the
+    /// project (for a mesh without UVs, or whose UVs overlap).
+    #[arg(long)]
+    unwrap: bool,
     /// Overwrite an existing file.
     #[arg(long)]
     force: bool,
@@ -50,9 +54,15 @@ impl NewArgs {
             ..DocumentSettings::default()
         };
         let doc = Document::new(w, h, settings).map_err(model_error)?;
+        let (doc, unwrapped) = if self.unwrap {
+            let (doc, line) = super::unwrap::keep_unwrapped(doc, &self.mesh)?;
+            (doc, format!("{line}\n"))
+        } else {
+            (doc, String::new())
+        };
         project::save(&doc, &self.out).map_err(model_error)?;
         Ok(format!(
-            "created {} ({w}x{h}, {})\n",
+            "{unwrapped}created {} ({w}x{h}, {})\n",
             self.out.display(),
             preset.name
         ))

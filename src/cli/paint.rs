@@ -36,10 +36,11 @@ impl PaintArgs {
         let on_disk = project::OnDisk::of(&self.file);
         let mut doc = project::load(&self.file).map_err(model_error)?;
         if commands.iter().any(model::Command::needs_surface) {
-            let spec = self
-                .mesh
-                .unwrap_or_else(|| doc.settings().mesh.spec().to_string());
-            project::attach_mesh(&mut doc, Path::new(&spec)).map_err(model_error)?;
+            match &self.mesh {
+                Some(spec) => project::attach_mesh(&mut doc, Path::new(spec)),
+                None => project::attach_own_mesh(&mut doc),
+            }
+            .map_err(model_error)?;
         }
         let count = commands.len();
         for (i, command) in commands.into_iter().enumerate() {

@@ -1,6 +1,6 @@
 //! `kapaint render`: the preview renderer, headless, into a PNG or EXR.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
@@ -128,17 +128,27 @@ impl From<ApproxArg> for AmbientApprox {
 type Material = (
     model::MaterialMaps,
     Option<std::sync::Arc<model::normal::NormalMap>>,
-    std::path::PathBuf,
+    OwnMesh,
 );
+
+/// The mesh a project names: a built-in name or a file, or the mesh it keeps inside itself.
+enum OwnMesh {
+    Spec(PathBuf),
+    Kept(mesh::Mesh),
+}
 
 /// The maps to render (a project's, or one uniform material), the project's normal map and
 /// the mesh they come with.
 fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
     if let Some(file) = &a.project {
         let doc = project::load(file).map_err(model_error)?;
-        let spec = PathBuf::from(doc.settings().mesh.spec());
+        let own = if doc.settings().mesh.is_embedded() {
+            OwnMesh::Kept(project::own_mesh(&doc).map_err(model_error)?)
+        } else {
+            OwnMesh::Spec(PathBuf::from(doc.settings().mesh.spec()))
+        };
         let normal = doc.normal().cloned();
-        return Ok((doc.into_parts().0, normal, spec));
+        return Ok((doc.into_parts().0, normal, own));
     }
     let d = model::MaterialValue::default();
     let kd =
@@ -159,7 +169,7 @@ fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
         n.map_or(d.n, |v| v as f32),
     );
     let maps = model::MaterialMaps::new(16, 16, value).map_err(model_error)?;
-    Ok((maps, None, std::path::PathBuf::from("sphere")))
+    Ok((maps, None, OwnMesh::Spec(PathBuf::from("sphere"))))
 }
 
 /// `--sides LEFT,RIGHT`: exactly two models.
@@ -199,8 +209,11 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
         )));
     }
     let (maps, normal, own_mesh) = render_material(&a)?;
-    let mesh_spec = a.mesh.map_or(own_mesh, std::path::PathBuf::from);
-    let mesh = mesh::open(&mesh_spec).map_err(super::mesh_error)?;
+    let mesh = match (a.mesh, own_mesh) {
+        (Some(spec), _) => mesh::open(Path::new(&spec)).map_err(super::mesh_error)?,
+        (None, OwnMesh::Spec(spec)) => mesh::open(&spec).map_err(super::mesh_error)?,
+        (None, OwnMesh::Kept(kept)) => kept,
+    };
     let light = match &a.light {
         Some(text) => parse_light(text)?,
         None => Lighting::default().light,

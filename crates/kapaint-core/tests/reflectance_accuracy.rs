@@ -139,7 +139,7 @@ fn committed_fast_constants_are_what_the_fit_produces() {
     let phong = fit::fit_exact(ShadingModel::Phong, 5);
     let blinn = fit::fit_exact(ShadingModel::BlinnPhong, 5);
     let fresh = fit::render_rust(&phong, &blinn);
-    let committed = include_str!("../src/reflectance/fast_coeffs.rs");
+    let committed = include_str!("../../kapaint-reflectance/src/fast_coeffs.rs");
     // Compare numerically: libm differences across machines may move a last digit.
     let numbers = |text: &str| -> Vec<f64> {
         text.split(|c: char| !(c.is_ascii_digit() || "eE.-+".contains(c)))

@@ -104,6 +104,7 @@ impl Editor {
                 resize_dialog: None,
                 pending_open: None,
                 material_prompt: None,
+                unwrap_prompt: None,
                 recent: load_recent(),
                 stamp_preview: None,
                 pressure: 1.0,
@@ -273,6 +274,7 @@ impl Editor {
         s.open_prompt(&ctx);
         s.claim_prompt(&ctx);
         s.material_prompt_window(&ctx);
+        s.unwrap_prompt_window(&ctx);
         s.modal_job_ui(&ctx);
         s.files_ui(&ctx);
         if s.job.is_some() {

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use super::{EditorState, MeshState, autosave_interval, notice};
+use kapaint_core::mesh::unwrap;
 use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::surface::Surface;
 use kapaint_core::model::texel::Channel;
@@ -34,6 +35,11 @@ pub(super) enum JobResult {
     /// A mesh loaded and baked at the map size, and whether its file has a textured material
     /// (the editor then offers to bring it in).
     Mesh(PathBuf, Arc<Surface>, bool),
+    /// A mesh that cannot be painted as it is (no UVs) or would paint two places at once
+    /// (overlapping UVs): the editor asks whether to unwrap it.
+    NeedsUnwrap(UnwrapPrompt),
+    /// A mesh unwrapped and baked at the map size: the project keeps it.
+    Unwrapped(PathBuf, Arc<Surface>, String),
     /// A PBR material converted at the map size for the document's model.
     Material(PathBuf, Box<PbrMaterial>),
     /// An image decoded and resampled into a channel's planes.
@@ -46,6 +52,20 @@ pub(super) enum JobResult {
     Stamp(PathBuf, kapaint_core::model::brush::Stamp),
     Failed(String),
 }
+
+/// A mesh whose UVs cannot be painted as they are, and why.
+#[derive(Clone)]
+pub(super) struct UnwrapPrompt {
+    pub(super) path: PathBuf,
+    pub(super) mesh: Arc<kapaint_core::mesh::Mesh>,
+    /// What is wrong with its UVs, for the question.
+    pub(super) why: String,
+    /// Whether it has UVs of its own to keep.
+    pub(super) has_uvs: bool,
+}
+
+/// Fraction of a mesh's texels claimed twice above which the editor offers to unwrap it.
+const OVERLAP_OFFER: f64 = 0.01;
 
 /// A glTF material converted on a worker (File > Import PBR material).
 pub(super) struct PbrMaterial {
@@ -77,8 +97,7 @@ pub(super) fn new_document(size: u32) -> Result<(Document, MeshState), String> {
 /// name it) attached and baked.
 pub(super) fn new_document_with(size: u32, settings: DocumentSettings) -> Result<Document, String> {
     let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
-    let spec = PathBuf::from(doc.settings().mesh.spec());
-    project::attach_mesh(&mut doc, &spec).map_err(|e| e.to_string())?;
+    project::attach_own_mesh(&mut doc).map_err(|e| e.to_string())?;
     Ok(doc)
 }
 
@@ -211,6 +230,22 @@ impl EditorState {
                     Err(e) => self.notices.push(notice(e.to_string(), true)),
                 }
             }
+            JobResult::NeedsUnwrap(prompt) => self.unwrap_prompt = Some(prompt),
+            JobResult::Unwrapped(path, surface, summary) => {
+                let attached = kapaint_core::model::document::AttachedMesh {
+                    mesh: MeshRef::Embedded(surface.mesh.name.clone()),
+                    surface,
+                };
+                match self.doc.apply(ImportCommand::SetMesh(attached)) {
+                    Ok(()) => {
+                        self.follow_mesh();
+                        self.notices.push(notice(summary, false));
+                    }
+                    Err(e) => self
+                        .notices
+                        .push(notice(format!("{}: {e}", path.display()), true)),
+                }
+            }
             JobResult::Image(path, planes) => {
                 let channel = planes.channel();
                 let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
@@ -272,7 +307,8 @@ impl EditorState {
         }
     }
 
-    /// Loads and bakes a mesh on a worker; it becomes the project's mesh.
+    /// Loads and bakes a mesh on a worker; it becomes the project's mesh. A mesh without UVs,
+    /// or whose UVs overlap, comes back as a question: unwrap it, keep its UVs, or cancel.
     pub fn import_mesh(&mut self, path: PathBuf) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
         self.start_job("Mesh", move |progress| {
@@ -281,13 +317,75 @@ impl EditorState {
                 Ok(m) => m,
                 Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
             };
+            progress.start("check UVs", 1);
+            let why = if mesh.uvs.is_none() {
+                Some("has no UVs, so no texel knows where on the surface it is".to_string())
+            } else {
+                let overlap = unwrap::uv_overlap(&mesh, w.min(h).min(2048));
+                (overlap > OVERLAP_OFFER).then(|| {
+                    format!(
+                        "has UVs that overlap: {:.0} % of its texels are shared by two places                          of the surface, so painting one paints the other",
+                        100.0 * overlap
+                    )
+                })
+            };
+            if let Some(why) = why {
+                return JobResult::NeedsUnwrap(UnwrapPrompt {
+                    has_uvs: mesh.uvs.is_some(),
+                    path,
+                    mesh: Arc::new(mesh),
+                    why,
+                });
+            }
+            Self::bake_mesh(path, mesh, (w, h), progress)
+        });
+    }
+
+    /// Bakes a mesh whose UVs are kept as they are (the answer "Keep its UVs").
+    pub(super) fn keep_mesh_uvs(&mut self, prompt: UnwrapPrompt) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Mesh", move |progress| {
+            Self::bake_mesh(prompt.path, (*prompt.mesh).clone(), (w, h), progress)
+        });
+    }
+
+    fn bake_mesh(
+        path: PathBuf,
+        mesh: kapaint_core::mesh::Mesh,
+        (w, h): (u32, u32),
+        progress: &Progress,
+    ) -> JobResult {
+        progress.start("bake", 1);
+        match Surface::new(mesh, w, h) {
+            Ok(s) => {
+                let textured = kapaint_core::pbr::gltf::has_textured_material(&path);
+                JobResult::Mesh(path, Arc::new(s), textured)
+            }
+            Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+        }
+    }
+
+    /// Unwraps a mesh on a worker (progress and Cancel in the status bar) and bakes it; the
+    /// project keeps the unwrapped mesh (the answer "Unwrap automatically").
+    pub(super) fn unwrap_mesh(&mut self, prompt: UnwrapPrompt) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Unwrap", move |progress| {
+            let options = unwrap::UnwrapOptions::for_size(w.min(h).max(64));
+            let mut done = match unwrap::unwrap(&prompt.mesh, options, Some(progress)) {
+                Ok(done) => done,
+                Err(e) => return JobResult::Failed(format!("{}: {e}", prompt.path.display())),
+            };
+            let summary = format!(
+                "{} unwrapped: {} charts, {:.0} % of the map covered",
+                prompt.path.display(),
+                done.charts,
+                100.0 * done.coverage
+            );
+            done.mesh.name = format!("{}, unwrapped", done.mesh.name);
             progress.start("bake", 1);
-            match Surface::new(mesh, w, h) {
-                Ok(s) => {
-                    let textured = kapaint_core::pbr::gltf::has_textured_material(&path);
-                    JobResult::Mesh(path, Arc::new(s), textured)
-                }
-                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            match Surface::new(done.mesh, w, h) {
+                Ok(s) => JobResult::Unwrapped(prompt.path, Arc::new(s), summary),
+                Err(e) => JobResult::Failed(format!("{}: {e}", prompt.path.display())),
             }
         });
     }

@@ -201,6 +201,8 @@ pub struct EditorState {
     pending_open: Option<PathBuf>,
     /// An imported glTF mesh whose material has textures: asking whether to bring them in.
     material_prompt: Option<PathBuf>,
+    /// A mesh import waiting on whether to unwrap the mesh.
+    unwrap_prompt: Option<jobs::UnwrapPrompt>,
     /// Recently opened or saved projects, newest first.
     recent: Vec<PathBuf>,
     /// The pen's last pressure in the current stroke (1 with a mouse).

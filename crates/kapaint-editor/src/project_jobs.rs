@@ -163,8 +163,7 @@ impl EditorState {
             let recovered = recovery::load(&from)
                 .map_err(|e| e.to_string())
                 .and_then(|mut doc| {
-                    let own = PathBuf::from(doc.settings().mesh.spec());
-                    let failed = project::attach_mesh(&mut doc, &own).err();
+                    let failed = project::attach_own_mesh(&mut doc).err();
                     with_fallback(doc, failed)
                 });
             let e = match recovered {

@@ -1,5 +1,6 @@
 //! The editor's questions before it goes on: unsaved changes before another project opens or
-//! the window closes, and whether a glTF mesh's material comes in with it.
+//! the window closes, whether a glTF mesh's material comes in with it, and whether a mesh
+//! whose UVs cannot be painted is unwrapped.
 
 use super::EditorState;
 use super::dialogs::centred;
@@ -32,6 +33,43 @@ impl EditorState {
             self.import_pbr(path);
         } else if skip {
             self.material_prompt = None;
+        }
+    }
+
+    /// After a mesh import whose UVs cannot be painted as they are: unwrap automatically, keep
+    /// its UVs (when it has some), or cancel the import.
+    pub(super) fn unwrap_prompt_window(&mut self, ctx: &egui::Context) {
+        let Some(prompt) = self.unwrap_prompt.clone() else {
+            return;
+        };
+        let (mut unwrap, mut keep, mut cancel) = (false, false, false);
+        centred(egui::Window::new("Unwrap the mesh?"), ctx)
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "{} {}. kapaint can give it a new UV atlas: charts packed for this map \
+                     ({}x{}), padded, none overlapping. The project keeps the unwrapped mesh.",
+                    prompt.path.display(),
+                    prompt.why,
+                    self.doc.maps().width(),
+                    self.doc.maps().height()
+                ));
+                ui.horizontal(|ui| {
+                    unwrap = ui.button("Unwrap automatically").clicked();
+                    if prompt.has_uvs {
+                        keep = ui.button("Keep its UVs").clicked();
+                    }
+                    cancel = ui.button("Cancel").clicked();
+                });
+            });
+        if unwrap || keep || cancel {
+            self.unwrap_prompt = None;
+        }
+        if unwrap {
+            self.unwrap_mesh(prompt);
+        } else if keep {
+            self.keep_mesh_uvs(prompt);
         }
     }
 

@@ -222,10 +222,27 @@ fn push_material(
 /// # Errors
 /// A mesh without UVs, or one too large for a GLB (4 GiB).
 pub fn write(mesh: &Mesh, textures: &Textures<'_>, name: String) -> Result<Vec<u8>, String> {
+    write_glb(mesh, Some(textures), name)
+}
+
+/// The `.glb` of `mesh` alone: positions, normals and UVs, no material (what `kapaint unwrap`
+/// writes).
+///
+/// # Errors
+/// A mesh without UVs, or one too large for a GLB (4 GiB).
+pub fn write_mesh(mesh: &Mesh) -> Result<Vec<u8>, String> {
+    write_glb(mesh, None, mesh.name.clone())
+}
+
+fn write_glb(
+    mesh: &Mesh,
+    textures: Option<&Textures<'_>>,
+    name: String,
+) -> Result<Vec<u8>, String> {
     // A normal map is read in MikkTSpace tangents: they go in the file (vertices split where
     // a seam needs two), so every reader uses the frame it was made for.
     let with_tangents = textures
-        .normal
+        .and_then(|t| t.normal)
         .and_then(|_| kapaint_core::mesh::tangents::generate(mesh));
     let (mesh, tangents) = match &with_tangents {
         Some(t) => (&t.mesh, Some(t.tangents.as_slice())),
@@ -239,7 +256,7 @@ pub fn write(mesh: &Mesh, textures: &Textures<'_>, name: String) -> Result<Vec<u
     root.asset.generator = Some(format!("kapaint {}", env!("CARGO_PKG_VERSION")));
     let mut bin = Bin { bytes: Vec::new() };
     let (attributes, indices) = push_geometry(&mut root, &mut bin, mesh, uvs, tangents);
-    let material = push_material(&mut root, &mut bin, textures, name);
+    let material = textures.map(|t| push_material(&mut root, &mut bin, t, name));
     let m = root.push(json::Mesh {
         extensions: None,
         extras: json::Extras::default(),
@@ -249,7 +266,7 @@ pub fn write(mesh: &Mesh, textures: &Textures<'_>, name: String) -> Result<Vec<u
             extensions: None,
             extras: json::Extras::default(),
             indices: Some(indices),
-            material: Some(material),
+            material,
             mode: Valid(json::mesh::Mode::Triangles),
             targets: None,
         }],

@@ -1,0 +1,525 @@
+//! glTF 2.0 import (`.gltf` with its buffers, or `.glb`) through the `gltf` crate.
+//!
+//! Every mesh and primitive the scene instantiates, with node transforms applied (normals by
+//! the inverse transpose; mirrored nodes keep their triangles facing out). Triangle strips
+//! and fans are unrolled; points and lines are skipped. A primitive without normals gets
+//! smooth normals over the vertices it shares, so the vertices the file splits stay hard
+//! edges (a fully split primitive comes out flat, as the glTF specification describes). Accessors are checked against their buffers
+//! before anything is read, so a hostile file is an error, never a panic.
+
+use std::path::Path;
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::Semantic;
+use gltf::accessor::{DataType as T, Dimensions as D};
+use gltf::mesh::Mode;
+
+use super::{MAX_TRIANGLES, Mesh, MeshError};
+
+/// Deepest node hierarchy followed (deeper means a cycle or an absurd file).
+const MAX_DEPTH: usize = 64;
+
+/// A glTF file opened and checked: its document, its buffers' bytes and its folder.
+pub struct Opened {
+    /// The document, validated.
+    pub document: gltf::Document,
+    /// Every buffer's bytes, by index.
+    pub buffers: Vec<Vec<u8>>,
+    /// The folder that relative URIs are taken from.
+    pub dir: std::path::PathBuf,
+    /// The file's JSON as written (the `gltf` crate reads some fields lossily: an index past
+    /// `u32` wraps), for checks that need the numbers as they are.
+    pub json: Vec<u8>,
+}
+
+/// Opens a `.gltf` or `.glb` file: its references checked and its buffers loaded (from the
+/// GLB blob, data: URIs, or files beside it). Errors are one line.
+pub fn open_gltf(path: &Path) -> Result<Opened, MeshError> {
+    let invalid = |reason: String| MeshError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let bytes = super::read_mesh_file(path)?;
+    let not_gltf = |e: gltf::Error| invalid(format!("not a valid glTF file: {e}"));
+    let json = if bytes.starts_with(b"glTF") {
+        gltf::binary::Glb::from_slice(&bytes)
+            .map_err(not_gltf)?
+            .json
+            .into_owned()
+    } else {
+        bytes.clone()
+    };
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(&bytes).map_err(not_gltf)?;
+    // gltf-json 1.4.1's own validation indexes the accessor list with the POSITION
+    // attribute unchecked (and panics on a dangling one): check references first.
+    check_references(document.as_json()).map_err(&invalid)?;
+    let document = gltf::Document::from_json(document.into_json()).map_err(not_gltf)?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let buffers = load_buffers(&document, &dir, blob).map_err(&invalid)?;
+    Ok(Opened {
+        document,
+        buffers,
+        dir,
+        json,
+    })
+}
+
+/// Loads a `.gltf` or `.glb` file.
+pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
+    let invalid = |reason: String| MeshError::Invalid {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let Opened {
+        document, buffers, ..
+    } = open_gltf(path)?;
+    let buffers: Vec<&[u8]> = buffers.iter().map(Vec::as_slice).collect();
+
+    // The default scene (else the first; else every mesh once, untransformed). A node graph
+    // can reuse a node many times (2^40 instances from 40 nodes), so what the scene would
+    // instantiate is counted before anything is expanded.
+    let mut instances: Vec<(gltf::Mesh<'_>, Mat4)> = Vec::new();
+    match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => {
+            let mut counts = vec![None; document.nodes().len()];
+            let total = scene
+                .nodes()
+                .try_fold(Count::default(), |sum, node| {
+                    Ok::<_, String>(sum.add(count(&node, 0, &mut counts)?))
+                })
+                .map_err(&invalid)?;
+            if total.triangles > MAX_TRIANGLES as u64 || total.instances > MAX_INSTANCES {
+                return Err(invalid(format!(
+                    "the scene instantiates {} meshes with {} triangles (nodes are reused), more than the {MAX_INSTANCES} instances and {MAX_TRIANGLES} triangles supported",
+                    total.instances, total.triangles
+                )));
+            }
+            for node in scene.nodes() {
+                collect(&node, Mat4::IDENTITY, 0, &mut instances).map_err(&invalid)?;
+            }
+        }
+        None => instances.extend(document.meshes().map(|m| (m, Mat4::IDENTITY))),
+    }
+
+    let mut out = Builder::default();
+    for (mesh, transform) in &instances {
+        for (k, primitive) in mesh.primitives().enumerate() {
+            let what = format!("mesh {:?} primitive {k}", mesh.name().unwrap_or("unnamed"));
+            out.add(&primitive, *transform, &buffers)
+                .map_err(|e| invalid(format!("{what}: {e}")))?;
+        }
+    }
+    let name = path
+        .file_name()
+        .map_or_else(|| "mesh".into(), |n| n.to_string_lossy().into_owned());
+    let mesh = out.finish(name);
+    mesh.validate().map_err(invalid)?;
+    Ok(mesh)
+}
+
+/// Every accessor a primitive names exists.
+fn check_references(root: &gltf::json::Root) -> Result<(), String> {
+    let count = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (k, primitive) in mesh.primitives.iter().enumerate() {
+            let named = primitive
+                .attributes
+                .values()
+                .chain(primitive.indices.as_ref());
+            if let Some(bad) = named.map(gltf::json::Index::value).find(|&i| i >= count) {
+                return Err(format!(
+                    "mesh {m} primitive {k} uses accessor {bad}, but there are {count}"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Most mesh instances a scene may create.
+const MAX_INSTANCES: u64 = 1_000_000;
+
+/// What a node and its subtree instantiate (saturating: a hostile graph overflows `u64`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Count {
+    instances: u64,
+    triangles: u64,
+}
+
+impl Count {
+    fn add(self, other: Self) -> Self {
+        Self {
+            instances: self.instances.saturating_add(other.instances),
+            triangles: self.triangles.saturating_add(other.triangles),
+        }
+    }
+}
+
+/// Triangles one instance of `mesh` adds, from its accessors' counts (nothing is read).
+fn mesh_triangles(mesh: &gltf::Mesh<'_>) -> u64 {
+    mesh.primitives()
+        .map(|p| {
+            let corners = p
+                .indices()
+                .map(|a| a.count())
+                .or_else(|| p.get(&Semantic::Positions).map(|a| a.count()))
+                .unwrap_or(0) as u64;
+            match p.mode() {
+                Mode::Triangles => corners / 3,
+                Mode::TriangleStrip | Mode::TriangleFan => corners.saturating_sub(2),
+                _ => 0,
+            }
+        })
+        .fold(0, u64::saturating_add)
+}
+
+/// What `node` instantiates, memoised per node (so a node reused a billion times is counted
+/// once); the depth bound catches cycles.
+fn count(node: &gltf::Node<'_>, depth: usize, memo: &mut [Option<Count>]) -> Result<Count, String> {
+    if depth > MAX_DEPTH {
+        return Err(format!(
+            "the node hierarchy is deeper than {MAX_DEPTH} (a cycle?)"
+        ));
+    }
+    if let Some(Some(c)) = memo.get(node.index()) {
+        return Ok(*c);
+    }
+    let own = node.mesh().map_or(Count::default(), |m| Count {
+        instances: 1,
+        triangles: mesh_triangles(&m),
+    });
+    let total = node.children().try_fold(own, |sum, child| {
+        Ok::<_, String>(sum.add(count(&child, depth + 1, memo)?))
+    })?;
+    if let Some(slot) = memo.get_mut(node.index()) {
+        *slot = Some(total);
+    }
+    Ok(total)
+}
+
+/// Reads every buffer: the GLB's binary chunk, `data:` URIs, and files beside the glTF. A file
+/// must be a regular file inside the glTF's folder (no absolute paths, no `..`, no other URI
+/// schemes), and at least as long as the buffer's declared `byteLength`, of which no more is
+/// read.
+fn load_buffers(
+    document: &gltf::Document,
+    dir: &Path,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>, String> {
+    use gltf::buffer::{Data, Source};
+    let mut total: u64 = 0;
+    let mut out = Vec::new();
+    for buffer in document.buffers() {
+        let declared = buffer.length() as u64;
+        total = total.saturating_add(declared);
+        if total > super::MAX_FILE_BYTES {
+            return Err(format!(
+                "the buffers declare more than the {} bytes supported",
+                super::MAX_FILE_BYTES
+            ));
+        }
+        let what = format!("buffer {}", buffer.index());
+        let data = match buffer.source() {
+            Source::Uri(uri) if !uri.starts_with("data:") => {
+                read_buffer_file(dir, uri, declared).map_err(|e| format!("{what}: {e}"))?
+            }
+            source => {
+                Data::from_source_and_blob(source, None, &mut blob)
+                    .map_err(|e| format!("{what}: {e}"))?
+                    .0
+            }
+        };
+        if (data.len() as u64) < declared {
+            return Err(format!(
+                "{what} holds {} bytes but its byteLength is {declared} (truncated?)",
+                data.len()
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// A buffer file named by a relative `uri`, confined to `dir`; at most `declared` bytes.
+fn read_buffer_file(dir: &Path, uri: &str, declared: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read as _;
+    let file = file_beside(dir, uri)?;
+    let len = kapaint_base::file_check::regular_file(&file, super::MAX_FILE_BYTES)
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    if len < declared {
+        return Err(format!(
+            "{} holds {len} bytes but the buffer's byteLength is {declared} (truncated?)",
+            file.display()
+        ));
+    }
+    let mut data = Vec::with_capacity(declared as usize);
+    std::fs::File::open(&file)
+        .and_then(|f| f.take(declared).read_to_end(&mut data))
+        .map_err(|e| format!("{}: {e}", file.display()))?;
+    Ok(data)
+}
+
+/// The file a relative `uri` names, confined to `dir` (no URI schemes, no absolute paths,
+/// no `..`, no links out of it).
+pub fn file_beside(dir: &Path, uri: &str) -> Result<std::path::PathBuf, String> {
+    use std::path::Component;
+    if uri.contains(':') {
+        return Err(format!(
+            "{uri:?}: only files beside the glTF are read (no URI schemes)"
+        ));
+    }
+    let decoded = urlencoding::decode(uri).map_err(|_| format!("{uri:?} is not a valid URI"))?;
+    let relative = Path::new(decoded.as_ref());
+    if relative
+        .components()
+        .any(|c| !matches!(c, Component::Normal(_) | Component::CurDir))
+    {
+        return Err(format!(
+            "{uri:?} leaves the glTF's folder (absolute paths and .. are not followed)"
+        ));
+    }
+    let file = dir.join(relative);
+    let inside = match (file.canonicalize(), dir.canonicalize()) {
+        (Ok(f), Ok(d)) => f.starts_with(d),
+        (Err(e), _) | (_, Err(e)) => return Err(format!("{}: {e}", file.display())),
+    };
+    if !inside {
+        return Err(format!(
+            "{uri:?} links outside the glTF's folder, which is not followed"
+        ));
+    }
+    Ok(file)
+}
+
+/// Walks the node tree, accumulating transforms.
+fn collect<'a>(
+    node: &gltf::Node<'a>,
+    parent: Mat4,
+    depth: usize,
+    out: &mut Vec<(gltf::Mesh<'a>, Mat4)>,
+) -> Result<(), String> {
+    if depth > MAX_DEPTH {
+        return Err(format!(
+            "the node hierarchy is deeper than {MAX_DEPTH} (a cycle?)"
+        ));
+    }
+    let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+    let world = parent * local;
+    if !world.is_finite() {
+        return Err(format!("node {} has a non-finite transform", node.index()));
+    }
+    if let Some(mesh) = node.mesh() {
+        out.push((mesh, world));
+    }
+    for child in node.children() {
+        collect(&child, world, depth + 1, out)?;
+    }
+    Ok(())
+}
+
+/// Checks that an accessor has a type `allowed` and that its elements lie inside its buffer view and the view inside its
+/// buffer, with overflow-free arithmetic, before the reader touches them.
+fn check_accessor(
+    accessor: &gltf::Accessor<'_>,
+    buffers: &[&[u8]],
+    allowed: &[(T, D)],
+) -> Result<(), String> {
+    let name = format!("accessor {}", accessor.index());
+    let kind = (accessor.data_type(), accessor.dimensions());
+    if !allowed.contains(&kind) {
+        return Err(format!(
+            "{name} holds {:?} {:?}, which this attribute cannot be",
+            kind.0, kind.1
+        ));
+    }
+    if accessor.sparse().is_some() {
+        return Err(format!(
+            "{name} is sparse, which is not supported for geometry"
+        ));
+    }
+    let view = accessor
+        .view()
+        .ok_or_else(|| format!("{name} has no buffer view (no data)"))?;
+    let count = accessor.count();
+    if count == 0 {
+        return Err(format!("{name} is empty"));
+    }
+    let size = accessor.size();
+    let stride = view.stride().unwrap_or(size);
+    let end = stride
+        .checked_mul(count - 1)
+        .and_then(|v| v.checked_add(size))
+        .and_then(|v| v.checked_add(accessor.offset()))
+        .ok_or_else(|| format!("{name} claims an absurd size ({count} elements)"))?;
+    if end > view.length() {
+        return Err(format!(
+            "{name} needs {end} bytes but its buffer view holds {}",
+            view.length()
+        ));
+    }
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("{name} refers to a missing buffer"))?;
+    let view_end = view
+        .offset()
+        .checked_add(view.length())
+        .ok_or_else(|| format!("buffer view {} claims an absurd size", view.index()))?;
+    if view_end > buffer.len() {
+        return Err(format!(
+            "buffer view {} ends at byte {view_end} but its buffer holds {} (truncated?)",
+            view.index(),
+            buffer.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Merges primitives into one mesh.
+#[derive(Default)]
+struct Builder {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    triangles: Vec<[u32; 3]>,
+    any_uv: bool,
+    missing_normals: bool,
+}
+
+impl Builder {
+    fn add(
+        &mut self,
+        primitive: &gltf::Primitive<'_>,
+        transform: Mat4,
+        buffers: &[&[u8]],
+    ) -> Result<(), String> {
+        let mode = primitive.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            return Ok(()); // points and lines have no surface
+        }
+        // The reader hits `unreachable!` on a type the specification does not allow, so the
+        // types of what is read are checked here as well as the bounds.
+        for (semantic, accessor) in primitive.attributes() {
+            let allowed: &[(T, D)] = match semantic {
+                Semantic::Positions | Semantic::Normals => &[(T::F32, D::Vec3)],
+                Semantic::TexCoords(0) => &[(T::F32, D::Vec2), (T::U8, D::Vec2), (T::U16, D::Vec2)],
+                _ => continue, // not read
+            };
+            check_accessor(&accessor, buffers, allowed)?;
+        }
+        if let Some(indices) = primitive.indices() {
+            check_accessor(
+                &indices,
+                buffers,
+                &[(T::U8, D::Scalar), (T::U16, D::Scalar), (T::U32, D::Scalar)],
+            )?;
+        }
+        let reader = primitive.reader(|b| buffers.get(b.index()).copied());
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or("has no POSITION attribute")?
+            .map(Vec3::from)
+            .collect();
+        let count = positions.len();
+        let normals: Option<Vec<Vec3>> = reader.read_normals().map(|n| n.map(Vec3::from).collect());
+        let uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
+        if normals.as_ref().is_some_and(|n| n.len() != count)
+            || uvs.as_ref().is_some_and(|t| t.len() != count)
+        {
+            return Err("attribute counts differ".into());
+        }
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..u32::try_from(count).map_err(|_| "too many vertices")?).collect(),
+        };
+        if let Some(bad) = indices.iter().find(|&&i| i as usize >= count) {
+            return Err(format!("index {bad} is out of range for {count} vertices"));
+        }
+        let corners = unroll(mode, &indices);
+        if self.triangles.len() + corners.len() > MAX_TRIANGLES {
+            return Err(format!("more than the {MAX_TRIANGLES} triangles supported"));
+        }
+        let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+        let flip = transform.determinant() < 0.0;
+        let base = u32::try_from(self.positions.len()).map_err(|_| "too many vertices")?;
+        let world: Vec<Vec3> = positions
+            .iter()
+            .map(|&p| transform.transform_point3(p))
+            .collect();
+        self.missing_normals |= normals.is_none();
+        self.any_uv |= uvs.is_some();
+        // A missing UV set reads as (0, 0): those triangles have no texels to paint.
+        let uv_of = |i: usize| uvs.as_ref().map_or(Vec2::ZERO, |t| t[i]);
+        let triangles: Vec<[u32; 3]> = corners
+            .iter()
+            .map(|&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
+            .collect();
+        let vertex_normals: Vec<Vec3> = if let Some(n) = &normals {
+            n.iter()
+                .map(|&v| (normal_matrix * v).try_normalize().unwrap_or(Vec3::Y))
+                .collect()
+        } else {
+            // Smooth normals over the vertices the file shares; where it splits a vertex
+            // (a hard edge, a UV seam) the copies keep their own side's normal.
+            let identity: Vec<usize> = (0..count).collect();
+            super::smooth_normals(&world, &triangles, &identity, count)
+        };
+        for i in 0..count {
+            self.positions.push(world[i]);
+            self.normals.push(vertex_normals[i]);
+            self.uvs.push(uv_of(i));
+        }
+        self.triangles
+            .extend(triangles.iter().map(|t| t.map(|i| base + i)));
+        Ok(())
+    }
+
+    fn finish(self, name: String) -> Mesh {
+        Mesh {
+            name,
+            positions: self.positions,
+            normals: self.normals,
+            uvs: self.any_uv.then_some(self.uvs),
+            triangles: self.triangles,
+            had_normals: !self.missing_normals,
+        }
+    }
+}
+
+/// Triangles of a triangle list, strip or fan.
+fn unroll(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => indices
+            .windows(3)
+            .enumerate()
+            .map(|(k, w)| {
+                if k % 2 == 0 {
+                    [w[0], w[1], w[2]]
+                } else {
+                    [w[1], w[0], w[2]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => indices
+            .windows(2)
+            .skip(1)
+            .map(|w| [indices[0], w[0], w[1]])
+            .collect(),
+        _ => indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    }
+}

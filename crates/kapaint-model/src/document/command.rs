@@ -1,0 +1,410 @@
+//! The commands that change a document, and the stroke tools and fill regions they name.
+
+use std::sync::Arc;
+
+use glam::Vec2;
+use serde::{Deserialize, Serialize};
+
+use crate::brush::{BrushSettings, StrokePoint, SurfacePoint};
+use crate::paint::GradientShape;
+use crate::texel::{Channel, Channels, MaterialValue};
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
+
+/// Tools that work as strokes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StrokeTool {
+    /// Paints the primary material.
+    Brush,
+    /// Paints the base material back.
+    Eraser,
+    /// Smooths the enabled channels.
+    Blur,
+}
+
+/// Which texels a fill writes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum FillRegion {
+    /// The whole map.
+    All,
+    /// The connected region around a texel whose channel is within `tolerance` (blend space).
+    Similar {
+        /// Seed texel column.
+        x: u32,
+        /// Seed texel row.
+        y: u32,
+        /// Channel compared.
+        channel: Channel,
+        /// Largest difference still filled, in `[0, 1]`.
+        #[serde(deserialize_with = "crate::check::tolerance")]
+        tolerance: f32,
+    },
+    /// The UV island under a texel (needs the document's mesh surface).
+    Island {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+    /// The mesh part (connected piece of surface, across UV seams) under a texel.
+    Part {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+}
+
+/// Everything that changes a document, by room: each room's commands are their own enum,
+/// and [`Document::apply`](super::Document::apply) hands each to the room that matches it
+/// exhaustively. Scripts name the commands flat, as they always have: `script.rs` reads them.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// The tool settings: brush, materials, channels, shading.
+    Settings(SettingsCommand),
+    /// Strokes of the brush, eraser and blur.
+    Stroke(StrokeCommand),
+    /// The one-click tools: fills, gradients, picks.
+    Paint(PaintCommand),
+    /// What a worker made from a file: channels, materials, normal maps, meshes, resized maps.
+    Import(ImportCommand),
+    /// Undo and redo.
+    History(HistoryCommand),
+    /// The layer stack.
+    Layer(LayerCommand),
+    /// The selected layer's mask.
+    Mask(MaskCommand),
+}
+
+/// Commands that change the tool settings (no undo step: they are not part of the material).
+#[derive(Clone, Debug, PartialEq)]
+pub enum SettingsCommand {
+    /// Replaces the brush settings (sanitised).
+    SetBrush(BrushSettings),
+    /// Sets the primary material.
+    SetPrimary(MaterialValue),
+    /// Sets the secondary material.
+    SetSecondary(MaterialValue),
+    /// Swaps primary and secondary.
+    SwapMaterials,
+    /// Sets the channels tools write.
+    SetChannels(Channels),
+    /// Sets the shading model.
+    SetModel(ShadingModel),
+    /// Sets the approximation of `chi`.
+    SetApprox(AmbientApprox),
+}
+
+/// Strokes: each is one undo step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StrokeCommand {
+    /// Starts a stroke (one undo step).
+    BeginStroke(StrokeTool),
+    /// Moves the stroke to a new input point.
+    StrokeTo(StrokePoint),
+    /// Ends the stroke.
+    EndStroke,
+    /// Abandons the stroke, restoring the maps.
+    AbortStroke,
+    /// A whole stroke at once (scripts): begin, every point, end.
+    Stroke {
+        /// The tool.
+        tool: StrokeTool,
+        /// Input points in texel units.
+        points: Vec<StrokePoint>,
+    },
+    /// Moves the stroke to a new point on the mesh (object-space brush; needs a surface).
+    SurfaceStrokeTo(SurfacePoint),
+    /// A whole stroke on the mesh at once (scripts).
+    SurfaceStroke {
+        /// The tool.
+        tool: StrokeTool,
+        /// Input points in object space.
+        points: Vec<SurfacePoint>,
+    },
+}
+
+/// The one-click tools.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PaintCommand {
+    /// Fills with the primary material.
+    Fill(FillRegion),
+    /// A gradient from the primary (at `start`) to the secondary material (at `end`).
+    Gradient {
+        /// Linear or radial.
+        shape: GradientShape,
+        /// Start point in texel units.
+        start: Vec2,
+        /// End point in texel units.
+        end: Vec2,
+    },
+    /// Reads every channel at a texel into the primary material.
+    Pick {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+    /// Reads the selected layer at a texel into the primary material: the channels it covers
+    /// there (a paint layer), its material (a fill layer) or what its children merge to (a
+    /// group); the other channels stay as they were.
+    PickLayer {
+        /// Texel column.
+        x: u32,
+        /// Texel row.
+        y: u32,
+    },
+}
+
+/// What a worker made from a file, each put in place as one undo step. Not for scripts: their
+/// content comes from a decoder or a worker.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ImportCommand {
+    /// Replaces a channel with an image already resampled to the map size (see
+    /// [`crate::import`]).
+    ImportChannel(ImportedChannel),
+    /// Replaces `k_d`, `k_s` and `n` of the selected paint layer with maps of the document's
+    /// size (a PBR material converted on a worker), with its normal map and report.
+    ImportMaterial(ImportedMaterial),
+    /// Sets or clears the material's normal map.
+    SetNormal(AttachedNormal),
+    /// Makes a mesh, baked at the map size on a worker, the project's mesh.
+    SetMesh(AttachedMesh),
+    /// Installs maps resized on a worker ([`crate::resize::resized`]) with the mesh
+    /// surface baked at their size.
+    Resize(crate::resize::ResizedMaps),
+}
+
+/// Moves through the undo history.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HistoryCommand {
+    /// Undoes the last step.
+    Undo,
+    /// Redoes the last undone step.
+    Redo,
+    /// Undoes or redoes until this many steps are applied (0: the state before the oldest
+    /// step kept; the history panel's click on a step).
+    HistoryJump(usize),
+}
+
+/// The layer stack: selection, properties and structure; each change is one undo step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LayerCommand {
+    /// Adds a layer above the selected one (in its group) and selects it.
+    AddLayer {
+        /// Paint, fill (the primary material) or group.
+        kind: LayerKind,
+        /// Its name.
+        name: String,
+    },
+    /// Selects a layer by index (0: the bottom of the top level), name (the topmost of that
+    /// name, at any depth) or id; tools then paint its content.
+    SelectLayer(LayerRef),
+    /// Selects the layer at a path of indices into groups (the Layers panel).
+    SelectPath(Vec<usize>),
+    /// Sets the selected layer's opacity (clamped to `[0, 1]`).
+    SetLayerOpacity(f32),
+    /// Shows or hides the selected layer.
+    SetLayerVisible(bool),
+    /// Locks or unlocks the selected layer against painting.
+    SetLayerLocked(bool),
+    /// Renames the selected layer.
+    RenameLayer(String),
+    /// Sets the blend mode of one of the selected layer's channels.
+    SetLayerBlend {
+        /// The channel.
+        channel: Channel,
+        /// Its mode (for `n`: Normal, Multiply, Add, Min, Max).
+        mode: crate::layers::LayerBlend,
+    },
+    /// Which of its channels the selected layer lays over the layers below.
+    SetLayerChannels(Channels),
+    /// Sets a fill layer's material.
+    SetLayerFill(MaterialValue),
+    /// Moves the selected layer.
+    MoveLayer(LayerMove),
+    /// Moves the selected layer next to or into another (the Layers panel's drag and drop).
+    MoveLayerTo {
+        /// The path of the layer it lands by (as the stack is before the move).
+        target: Vec<usize>,
+        /// Above or below that layer in its list, or at the top of that group.
+        place: LayerPlace,
+    },
+    /// Deletes the selected layer.
+    DeleteLayer,
+    /// Duplicates the selected layer above itself and selects the copy.
+    DuplicateLayer,
+    /// Merges the selected layer into the one below it (a paint layer of what both showed).
+    MergeDown,
+    /// Flattens every layer into one paint layer of the composite.
+    Flatten,
+    /// Puts the selected layer into a new group in its place.
+    Group,
+    /// Replaces the selected group by its layers.
+    Ungroup,
+}
+
+/// The selected layer's mask; each change is one undo step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaskCommand {
+    /// Adds a white mask to the selected layer.
+    AddMask,
+    /// Deletes the selected layer's mask.
+    DeleteMask,
+    /// Bakes the selected layer's mask into it (a paint layer) and deletes the mask.
+    ApplyMask,
+    /// Tools paint the selected layer's mask.
+    SelectMask,
+    /// Tools paint the selected layer's content.
+    SelectContent,
+    /// Inverts the selected layer's mask.
+    InvertMask,
+    /// Enables or disables the selected layer's mask.
+    SetMaskEnabled(bool),
+    /// Makes the selected layer's mask white where a channel of the composite is above a
+    /// threshold (`k_d`, `k_s`: their mean; `n`: the exponent), black elsewhere.
+    MaskFromChannel {
+        /// The channel read.
+        channel: Channel,
+        /// The threshold.
+        threshold: f32,
+    },
+}
+
+macro_rules! room {
+    ($room:ident, $ty:ty) => {
+        impl From<$ty> for Command {
+            fn from(command: $ty) -> Self {
+                Self::$room(command)
+            }
+        }
+    };
+}
+room!(Settings, SettingsCommand);
+room!(Stroke, StrokeCommand);
+room!(Paint, PaintCommand);
+room!(Import, ImportCommand);
+room!(History, HistoryCommand);
+room!(Layer, LayerCommand);
+room!(Mask, MaskCommand);
+
+/// A layer's kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerKind {
+    /// Painted planes.
+    Paint,
+    /// One material over the whole map, shaped by its mask.
+    Fill,
+    /// A folder of layers.
+    Group,
+}
+
+/// A layer named in a script: its index in the top-level list, its name, or its id
+/// (`(id: 7)`, as `kapaint layers` prints it: the same layer whatever moved).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum LayerRef {
+    /// Index from the bottom of the top-level list.
+    Index(usize),
+    /// Name (the topmost layer of that name, at any depth).
+    Name(String),
+    /// Id, at any depth.
+    Id {
+        /// The layer's id.
+        id: u64,
+    },
+}
+
+/// Where [`LayerCommand::MoveLayer`] moves a layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerMove {
+    /// One place up in its list.
+    Up,
+    /// One place down in its list.
+    Down,
+    /// The top of its list.
+    Top,
+    /// The bottom of its list.
+    Bottom,
+    /// Into the group just above it, at that group's bottom.
+    IntoGroup,
+    /// Out of its group, just above it.
+    OutOfGroup,
+}
+
+/// Where [`LayerCommand::MoveLayerTo`] puts a layer, relative to its target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LayerPlace {
+    /// Just above the target, in the target's list.
+    Above,
+    /// Just below the target, in the target's list.
+    Below,
+    /// At the top of the target group's children.
+    Into,
+}
+
+/// A channel's planes made by [`crate::import::resample`], shared so that the command
+/// clones cheaply.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportedChannel(pub Arc<crate::import::ChannelPlanes>);
+
+/// A material converted on a worker for [`ImportCommand::ImportMaterial`]: its maps, the normal map
+/// it brought and the report of its conversion, all undone together. Shared so that the
+/// command clones cheaply (equal when they are the same maps).
+#[derive(Clone, Debug)]
+pub struct ImportedMaterial {
+    /// The maps, at the document's size.
+    pub maps: Arc<crate::MaterialMaps>,
+    /// Its normal map (none: the document keeps no normal map).
+    pub normal: Option<Arc<crate::normal::NormalMap>>,
+    /// How it was converted, with the measured error.
+    pub report: Option<crate::provenance::ImportReport>,
+}
+
+impl PartialEq for ImportedMaterial {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.maps, &other.maps)
+    }
+}
+
+/// A normal map for [`ImportCommand::SetNormal`] (none: cleared); equal when it is the same map.
+#[derive(Clone, Debug)]
+pub struct AttachedNormal(pub Option<Arc<crate::normal::NormalMap>>);
+
+impl PartialEq for AttachedNormal {
+    fn eq(&self, other: &Self) -> bool {
+        match (&self.0, &other.0) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (a, b) => a.is_none() && b.is_none(),
+        }
+    }
+}
+
+/// A mesh for [`ImportCommand::SetMesh`]: how the project names it and its bake at the map size;
+/// equal when it is the same bake.
+#[derive(Clone, Debug)]
+pub struct AttachedMesh {
+    /// The mesh as the project stores it.
+    pub mesh: crate::MeshRef,
+    /// Its bake at the map size.
+    pub surface: Arc<crate::surface::Surface>,
+}
+
+impl PartialEq for AttachedMesh {
+    fn eq(&self, other: &Self) -> bool {
+        self.mesh == other.mesh && Arc::ptr_eq(&self.surface, &other.surface)
+    }
+}
+
+impl Command {
+    /// Whether the command paints on the mesh (and so needs
+    /// [`Document::with_surface`](super::Document::with_surface)).
+    pub fn needs_surface(&self) -> bool {
+        matches!(
+            self,
+            Self::Stroke(StrokeCommand::SurfaceStrokeTo(_) | StrokeCommand::SurfaceStroke { .. })
+                | Self::Paint(PaintCommand::Fill(
+                    FillRegion::Island { .. } | FillRegion::Part { .. }
+                ))
+        )
+    }
+}

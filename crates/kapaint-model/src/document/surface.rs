@@ -1,0 +1,87 @@
+//! What a document is painted on and with: its mesh and the mesh's bake (`SetMesh`), the
+//! bake a loader attaches, and the normal map (`SetNormal`); each change one undo step.
+
+use std::sync::Arc;
+
+use super::{AttachedMesh, Document};
+use crate::ModelError;
+use crate::normal::NormalMap;
+use crate::surface::Surface;
+
+impl Document {
+    /// This document with the mesh surface that object-space strokes and island/part fills
+    /// paint on (the bake of its mesh at the map size), or without one, as it is made or
+    /// opened: no undo step (changing the mesh is
+    /// [`ImportCommand::SetMesh`](super::ImportCommand::SetMesh)).
+    ///
+    /// # Errors
+    /// When the bake's size differs from the maps'.
+    pub fn with_surface(mut self, surface: Option<Arc<Surface>>) -> Result<Self, ModelError> {
+        self.attach_surface(surface)?;
+        Ok(self)
+    }
+
+    /// Attaches the bake of the document's mesh (or another mesh a command paints on, such as
+    /// `paint --mesh`), or detaches it, as a document is opened. A bake is derived data the
+    /// project never stores, so this is no undo step; the project's mesh changes only through
+    /// [`ImportCommand::SetMesh`](super::ImportCommand::SetMesh).
+    ///
+    /// # Errors
+    /// When the bake's size differs from the maps'; nothing changes then.
+    pub(crate) fn attach_surface(
+        &mut self,
+        surface: Option<Arc<Surface>>,
+    ) -> Result<(), ModelError> {
+        self.check_surface(surface.as_deref())?;
+        self.end_stroke();
+        self.state.surface = surface;
+        Ok(())
+    }
+
+    /// An error when a bake's size differs from the maps'.
+    fn check_surface(&self, surface: Option<&Surface>) -> Result<(), ModelError> {
+        match surface {
+            Some(s) if (s.width(), s.height()) != (self.maps.width(), self.maps.height()) => {
+                Err(ModelError::Internal(format!(
+                    "the mesh is baked at {}x{} but the maps are {}x{}",
+                    s.width(),
+                    s.height(),
+                    self.maps.width(),
+                    self.maps.height()
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// [`ImportCommand::SetMesh`](super::ImportCommand::SetMesh): the project's mesh and its bake, as one
+    /// undo step.
+    pub(super) fn set_mesh(&mut self, mesh: &AttachedMesh) -> Result<(), ModelError> {
+        self.check_surface(Some(&mesh.surface))?;
+        self.end_stroke();
+        let before = self.state.clone();
+        self.state.surface = Some(Arc::clone(&mesh.surface));
+        self.state.mesh = mesh.mesh.clone();
+        // A mesh the project keeps is the one just baked.
+        self.state.embedded_mesh = mesh
+            .mesh
+            .is_embedded()
+            .then(|| Arc::new(mesh.surface.mesh.clone()));
+        self.record("Mesh", before);
+        Ok(())
+    }
+
+    /// [`ImportCommand::SetNormal`](super::ImportCommand::SetNormal): the normal map set or cleared, as one
+    /// undo step.
+    pub(super) fn set_normal(&mut self, normal: Option<Arc<NormalMap>>) {
+        self.end_stroke();
+        let label = if normal.is_some() {
+            "Normal map"
+        } else {
+            "Clear normal map"
+        };
+        let before = self.state.clone();
+        self.state.normal = normal;
+        self.record(label, before);
+    }
+}

@@ -1,0 +1,277 @@
+//! Brush and eraser dabs on a paint layer or mask: the stroke's coverage raised, then the
+//! texels it rose at written, a row at a time (the loops run through
+//! [`vectorized`](crate::simd::vectorized)).
+#![expect(
+    clippy::inline_always,
+    reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+)]
+
+use rayon::prelude::*;
+
+use super::{LayerEdit, Planes, PrePlanes, Slot, slots};
+use crate::layers::{LayerStroke, LayerValue, PaintTile};
+use crate::paint::n_bits_from_blend_in;
+use crate::texel::{decode_unorm, encode_unorm};
+use crate::tile::{Plane, TILE_SIZE, TileSpans};
+
+/// Writes dabs into tiles `ids` (sorted, unique) in parallel, each with the stroke's coverage
+/// so far (`covers`, one value a texel of the tile): [`Raise::raise`] raises a tile's
+/// coverage and returns the texels where it rose, and each of those becomes its
+/// pre-operation value at that coverage, a row at a time. Returns, per tile, those texels.
+pub fn edit_cover(
+    (planes, pre): (Planes<'_>, PrePlanes<'_>),
+    edit: &LayerEdit,
+    ids: &[usize],
+    covers: Vec<&mut [f32]>,
+    raise: &impl Raise,
+) -> Vec<TileSpans> {
+    slots(planes, pre, ids)
+        .into_par_iter()
+        .zip(covers)
+        .zip(ids)
+        .map(|((slot, cover), &id)| {
+            crate::simd::vectorized(CoverTile {
+                slot,
+                edit,
+                id,
+                cover,
+                raise,
+            })
+        })
+        .collect()
+}
+
+/// What a dab does to the stroke's coverage, for [`edit_cover`].
+pub trait Raise: Sync {
+    /// Raises the coverage `cover` of tile `id`; returns the texels where it rose. Mark it
+    /// `#[inline(always)]`: it runs inside [`vectorized`](crate::simd::vectorized).
+    fn raise(&self, id: usize, cover: &mut [f32]) -> TileSpans;
+}
+
+/// One tile of [`edit_cover`]: its coverage raised, then the texels it rose at written.
+struct CoverTile<'a, 'b, R> {
+    slot: Slot<'a>,
+    edit: &'b LayerEdit,
+    id: usize,
+    cover: &'b mut [f32],
+    raise: &'b R,
+}
+
+impl<R: Raise> crate::simd::Kernel for CoverTile<'_, '_, R> {
+    type Output = TileSpans;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> TileSpans {
+        let Self {
+            mut slot,
+            edit,
+            id,
+            cover,
+            raise,
+        } = self;
+        let spans = raise.raise(id, cover);
+        if !spans.is_empty() {
+            slot.write_cover(edit, &spans, cover);
+            slot.compact();
+        }
+        spans
+    }
+}
+
+/// Decodes `len` texels of `plane` from texel `start` into `out` through `f`.
+#[inline(always)]
+fn decode_run<T: Copy + PartialEq>(
+    plane: &Plane<T>,
+    start: usize,
+    out: &mut [f32],
+    f: impl Fn(T) -> f32,
+) {
+    match plane {
+        Plane::Uniform(v) => out.fill(f(*v)),
+        Plane::Data(d) => {
+            let len = out.len();
+            for (o, &v) in out.iter_mut().zip(&d[start..start + len]) {
+                *o = f(v);
+            }
+        }
+    }
+}
+
+/// The coverage of a transparent texel after a brush at `cover`, at texels `spans` of a
+/// channel's coverage plane (the value is the target's: see [`Slot::write_cover`]).
+#[inline(always)]
+pub(super) fn cover_alpha(alpha: &mut Plane<u16>, spans: &TileSpans, cover: &[f32]) {
+    let mut row = [0_u16; TILE_SIZE];
+    for (y, x0, x1) in spans.rows() {
+        let (start, end) = (y * TILE_SIZE + x0, y * TILE_SIZE + x1);
+        let cov = &cover[start..end];
+        for (p, &a) in row.iter_mut().zip(cov) {
+            *p = encode_unorm(a.min(1.0));
+        }
+        write_row(alpha, start, &row[..end - start], cov, all_reached(cov));
+    }
+}
+
+/// Channel `ch` of a paint tile's texels `spans` after a brush of `target` (its components)
+/// whose mode gives `value` ([`LayerStroke::value`]) at coverage `cover`, from the pre-operation tile (none: transparent), a row at a
+/// time: the coverage and the pre-stroke value's weight once per texel, then each component
+/// in a plain loop over the row ([`LayerStroke::apply`], term for term).
+#[inline(always)]
+pub(super) fn cover_channel(
+    (tile, pre, ch, target, spans, cover): (
+        &mut PaintTile,
+        Option<&PaintTile>,
+        usize,
+        &[f32],
+        &TileSpans,
+        &[f32],
+    ),
+    value: impl Fn((f32, f32), f32, f32) -> f32,
+) {
+    let table = crate::paint::n_blend_table();
+    let n_bits = crate::paint::n_bits_table();
+    let mut pre_alpha = [0.0_f32; TILE_SIZE];
+    let mut pre_value = [0.0_f32; TILE_SIZE];
+    let (mut a, mut w) = ([0.0_f32; TILE_SIZE], [0.0_f32; TILE_SIZE]);
+    let mut alpha = [0_u16; TILE_SIZE];
+    let mut out = [[0_u16; TILE_SIZE]; 3];
+    for (y, x0, x1) in spans.rows() {
+        let (start, width) = (y * TILE_SIZE + x0, x1 - x0);
+        let cov = &cover[start..start + width];
+        if let Some(p) = pre {
+            decode_run(&p.alpha[ch], start, &mut pre_alpha[..width], decode_unorm);
+        }
+        for j in 0..width {
+            let aj = cov[j].clamp(0.0, 1.0);
+            let (coverage, weight) = LayerStroke::cover(pre_alpha[j], aj);
+            (a[j], w[j], alpha[j]) = (aj, weight, encode_unorm(coverage.min(1.0)));
+        }
+        for (c, &t) in target.iter().enumerate() {
+            if let Some(p) = pre {
+                let out = &mut pre_value[..width];
+                match ch {
+                    0 => decode_run(&p.value.kd, start, out, |v| decode_unorm(v[c])),
+                    1 => decode_run(&p.value.ks, start, out, |v| decode_unorm(v[c])),
+                    _ => decode_run(&p.value.n, start, out, |bits| table[bits as usize]),
+                }
+            }
+            let encoded = &mut out[c][..width];
+            if ch == 2 {
+                for j in 0..width {
+                    let v = value((w[j], a[j]), pre_value[j], t);
+                    encoded[j] = n_bits_from_blend_in(n_bits, v);
+                }
+            } else {
+                for j in 0..width {
+                    encoded[j] = encode_unorm(value((w[j], a[j]), pre_value[j], t));
+                }
+            }
+        }
+        // Only texels the stroke reached change.
+        let all = all_reached(cov);
+        write_row(&mut tile.alpha[ch], start, &alpha[..width], cov, all);
+        match ch {
+            0 | 1 => {
+                let [r, g, b] = &out;
+                let mut rgb = [[0_u16; 3]; TILE_SIZE];
+                for (j, p) in rgb[..width].iter_mut().enumerate() {
+                    *p = [r[j], g[j], b[j]];
+                }
+                let plane = if ch == 0 {
+                    &mut tile.value.kd
+                } else {
+                    &mut tile.value.ks
+                };
+                write_row(plane, start, &rgb[..width], cov, all);
+            }
+            _ => write_row(&mut tile.value.n, start, &out[0][..width], cov, all),
+        }
+    }
+}
+
+/// Whether a dab reached every texel of a row's run (as a disc does).
+#[inline(always)]
+fn all_reached(cov: &[f32]) -> bool {
+    cov.iter().all(|&c| c > 0.0)
+}
+
+/// Writes `new` into `plane` from texel `start` where `cov` reached (`all`: everywhere, a
+/// plain copy; else chosen texel by texel, without a branch). A uniform plane those values
+/// leave as it is stays uniform: where a stroke has saturated, its dabs do not expand a tile
+/// only for it to be compacted again.
+#[inline(always)]
+fn write_row<T: Copy + PartialEq>(
+    plane: &mut Plane<T>,
+    start: usize,
+    new: &[T],
+    cov: &[f32],
+    all: bool,
+) {
+    if let Plane::Uniform(u) = plane
+        && new.iter().zip(cov).all(|(v, &c)| v == u || c <= 0.0)
+    {
+        return;
+    }
+    let plane = &mut plane.data_mut()[start..start + new.len()];
+    if all {
+        plane.copy_from_slice(new);
+    } else {
+        for ((p, &new), &c) in plane.iter_mut().zip(new).zip(cov) {
+            *p = if c > 0.0 { new } else { *p };
+        }
+    }
+}
+
+/// The eraser on channel `ch` of a paint tile's texels `spans` at coverage `cover`, from the
+/// pre-operation tile: the coverage falls ([`LayerStroke::apply`]); values stay.
+#[inline(always)]
+pub(super) fn erase_channel(
+    (tile, pre, ch, spans, cover): (
+        &mut PaintTile,
+        Option<&PaintTile>,
+        usize,
+        &TileSpans,
+        &[f32],
+    ),
+) {
+    let Some(pre) = pre else {
+        // Nothing to erase: the tile is as transparent as before the stroke.
+        return;
+    };
+    let plane = tile.alpha[ch].data_mut();
+    for i in spans.indices() {
+        let a = cover[i];
+        let out = LayerStroke::Erase.apply(
+            LayerValue {
+                value: 0.0,
+                alpha: decode_unorm(pre.alpha[ch].get(i)),
+            },
+            0.0,
+            a,
+        );
+        plane[i] = if a > 0.0 {
+            encode_unorm(out.alpha)
+        } else {
+            plane[i]
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_row_that_leaves_a_uniform_plane_as_it_is_does_not_expand_it() {
+        let cov = [1.0, 0.0, 0.5];
+        let mut plane = Plane::Uniform(7_u16);
+        // Where the dab reached, the values are the plane's; where it did not, they are not read.
+        write_row(&mut plane, 10, &[7, 9, 7], &cov, false);
+        assert_eq!(plane, Plane::Uniform(7));
+        write_row(&mut plane, 10, &[7, 9, 8], &cov, false);
+        let Plane::Data(d) = &plane else {
+            panic!("a new value expands the plane");
+        };
+        assert_eq!((d[9], d[10], d[11], d[12], d[13]), (7, 7, 7, 8, 7));
+    }
+}

@@ -1,0 +1,167 @@
+//! A mesh the project keeps inside itself (an unwrapped mesh): saved and read back as the same
+//! mesh, an undo step when set, and refused when the file says one thing and holds another.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::io::{Cursor, Read, Write};
+use std::sync::Arc;
+
+use kapaint_mesh::unwrap::{UnwrapOptions, unwrap};
+use kapaint_model::document::AttachedMesh;
+use kapaint_model::project::{self, from_reader, to_bytes};
+use kapaint_model::surface::Surface;
+use kapaint_model::{Document, DocumentSettings, HistoryCommand, ImportCommand, MeshRef};
+
+/// A torus without UVs, unwrapped.
+fn unwrapped() -> kapaint_mesh::Mesh {
+    let mut torus = kapaint_mesh::torus(1.0, 0.35, 32, 16);
+    torus.uvs = None;
+    let mut mesh = unwrap(&torus, UnwrapOptions::for_size(256), None)
+        .expect("unwraps")
+        .mesh;
+    mesh.name = "torus, unwrapped".into();
+    mesh
+}
+
+fn kept_document() -> Document {
+    let mesh = unwrapped();
+    let settings = DocumentSettings {
+        mesh: MeshRef::Embedded(mesh.name.clone()),
+        ..DocumentSettings::default()
+    };
+    Document::new(256, 256, settings)
+        .expect("document")
+        .with_embedded_mesh(Some(Arc::new(mesh)))
+}
+
+/// The archive's entries, by name.
+fn entries(bytes: &[u8]) -> Vec<(String, Vec<u8>)> {
+    let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).expect("zip");
+    (0..zip.len())
+        .map(|i| {
+            let mut e = zip.by_index(i).expect("entry");
+            let mut data = Vec::new();
+            e.read_to_end(&mut data).expect("read");
+            (e.name().expect("name").to_string(), data)
+        })
+        .collect()
+}
+
+/// The archive with `edit` applied to its manifest (JSON).
+fn with_manifest(bytes: &[u8], edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+    let mut out = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    for (name, data) in entries(bytes) {
+        out.start_file(name.as_str(), zip::write::SimpleFileOptions::default())
+            .expect("start");
+        if name == "manifest.json" {
+            let mut json: serde_json::Value = serde_json::from_slice(&data).expect("json");
+            edit(&mut json);
+            out.write_all(&serde_json::to_vec(&json).expect("json"))
+                .expect("write");
+        } else {
+            out.write_all(&data).expect("write");
+        }
+    }
+    out.finish().expect("finish").into_inner()
+}
+
+fn version(bytes: &[u8]) -> u64 {
+    let manifest = entries(bytes)
+        .into_iter()
+        .find(|(n, _)| n == "manifest.json")
+        .expect("manifest")
+        .1;
+    serde_json::from_slice::<serde_json::Value>(&manifest).expect("json")["version"]
+        .as_u64()
+        .expect("version")
+}
+
+#[test]
+fn a_kept_mesh_reads_back_as_the_same_mesh_and_attaches() {
+    let doc = kept_document();
+    let bytes = to_bytes(&doc).expect("saves");
+    assert_eq!(version(&bytes), 3, "a kept mesh is version 3");
+    let mut back = from_reader(Cursor::new(&bytes)).expect("reads");
+    assert!(
+        **back.embedded_mesh().expect("held") == **doc.embedded_mesh().expect("held"),
+        "the same mesh"
+    );
+    assert_eq!(
+        back.settings().mesh,
+        MeshRef::Embedded("torus, unwrapped".into())
+    );
+    project::attach_own_mesh(&mut back).expect("the kept mesh attaches");
+    assert!(back.surface().is_some());
+    // Saved again, byte for byte the same mesh entry.
+    let again = to_bytes(&back).expect("saves");
+    let mesh_of = |b: &[u8]| {
+        entries(b)
+            .into_iter()
+            .find(|(n, _)| n == project::MESH_FILE)
+            .expect("mesh.obj")
+            .1
+    };
+    assert_eq!(mesh_of(&bytes), mesh_of(&again));
+    // A project without a kept mesh is still written as version 2, as before.
+    let plain = Document::new(64, 64, DocumentSettings::default()).expect("document");
+    assert_eq!(version(&to_bytes(&plain).expect("saves")), 2);
+}
+
+/// A change to a manifest.
+type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+
+#[test]
+fn a_file_that_says_one_thing_and_holds_another_is_refused() {
+    let bytes = to_bytes(&kept_document()).expect("saves");
+    let cases: [(&str, Edit); 4] = [
+        (
+            "manifest lists none",
+            Box::new(|m| {
+                m.as_object_mut().expect("object").remove("mesh");
+            }),
+        ),
+        (
+            "the manifest says 1",
+            Box::new(|m| m["mesh"]["triangles"] = 1.into()),
+        ),
+        ("keeps no mesh", Box::new(|m| m["version"] = 2.into())),
+        (
+            "settings name another mesh",
+            Box::new(|m| m["settings"]["mesh"] = "Sphere".into()),
+        ),
+    ];
+    for (says, edit) in cases {
+        let edited = with_manifest(&bytes, edit);
+        let e = from_reader(Cursor::new(&edited)).expect_err(says);
+        assert!(e.contains(says), "{says}: {e}");
+    }
+    // A document whose settings name a kept mesh it does not hold is never written.
+    let settings = DocumentSettings {
+        mesh: MeshRef::Embedded("gone".into()),
+        ..DocumentSettings::default()
+    };
+    let orphan = Document::new(64, 64, settings).expect("document");
+    assert!(to_bytes(&orphan).is_err());
+}
+
+#[test]
+fn setting_a_kept_mesh_is_one_undo_step() {
+    let mut doc = Document::new(256, 256, DocumentSettings::default()).expect("document");
+    let mesh = unwrapped();
+    let surface = Arc::new(Surface::new(mesh.clone(), 256, 256).expect("bakes"));
+    doc.apply(ImportCommand::SetMesh(AttachedMesh {
+        mesh: MeshRef::Embedded(mesh.name.clone()),
+        surface,
+    }))
+    .expect("sets");
+    assert!(**doc.embedded_mesh().expect("kept") == mesh);
+    assert!(to_bytes(&doc).is_ok());
+    doc.apply(HistoryCommand::Undo).expect("undo");
+    assert!(doc.embedded_mesh().is_none());
+    assert_eq!(doc.settings().mesh, MeshRef::Sphere);
+    assert_eq!(version(&to_bytes(&doc).expect("saves")), 2);
+    doc.apply(HistoryCommand::Redo).expect("redo");
+    assert!(doc.embedded_mesh().is_some());
+}
