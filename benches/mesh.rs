@@ -203,5 +203,37 @@ fn unwraps(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bakes, picking, surface_dabs, tangents, unwraps);
+/// An AO bake of spot at 1024^2 with 64 rays a texel (the 2048^2 figures of docs/performance.md
+/// come from `kapaint bake`, a run each: one sample is 20 s).
+fn ao_bakes(c: &mut Criterion) {
+    use kapaint::mesh::bakes::{BakeMap, BakeOptions, bake_map};
+    let mut group = c.benchmark_group("ao_1024_64_rays");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(40));
+    let spot = mesh::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/testdata/spot/spot_triangulated.obj"),
+    )
+    .expect("spot loads");
+    let uv = bake(&spot, 1024, 1024, 4).expect("bakes");
+    let options = BakeOptions {
+        rays: 64,
+        max_distance: None,
+    };
+    group.bench_function("spot_5856_triangles", |b| {
+        b.iter(|| bake_map(&spot, &uv, BakeMap::Ao, options, None).expect("bakes"));
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bakes,
+    picking,
+    surface_dabs,
+    tangents,
+    unwraps,
+    ao_bakes
+);
 criterion_main!(benches);

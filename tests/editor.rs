@@ -32,7 +32,7 @@ fn a_scripted_editing_session() {
     );
     harness.get_by_label("Resolution");
     harness.get_by_label("Base preset");
-    harness.get_by_label("Mesh");
+    harness.get_by_role_and_label(Role::ComboBox, "Mesh");
     harness
         .state_mut()
         .state

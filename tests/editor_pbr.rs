@@ -292,3 +292,33 @@ fn a_mesh_without_uvs_is_unwrapped_on_request_and_kept() {
     assert!(doc.embedded_mesh().is_none());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Mesh > Bake bakes a map of the mesh on a worker and keeps it in the project as one undo
+/// step.
+#[test]
+fn mesh_bake_keeps_a_map_of_the_mesh_as_one_undo_step() {
+    use kapaint::mesh::bakes::BakeMap;
+    let mut harness = editor();
+    harness.get_by_role_and_label(Role::Button, "Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake…").click();
+    harness.run_steps(2);
+    harness.get_by_label("Map").click();
+    harness.run_steps(2);
+    harness.get_by_label("curvature").click();
+    harness.run_steps(2);
+    harness.get_by_role_and_label(Role::Button, "Bake").click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "curvature baked", notice("baked curvature"));
+    let doc = harness.state().state.doc();
+    let bake = doc.bake_of(BakeMap::Curvature).expect("kept");
+    assert_eq!(
+        (bake.width, bake.height),
+        (doc.maps().width(), doc.maps().height())
+    );
+    assert!(harness.state().state.dirty());
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert!(harness.state().state.doc().bakes().is_empty());
+    assert!(!harness.state().state.dirty());
+}

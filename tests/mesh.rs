@@ -495,3 +495,146 @@ fn a_project_keeps_its_unwrapped_mesh() {
         "saved unchanged"
     );
 }
+
+/// `kapaint bake` keeps a map of the mesh in the project (a cache, version 3), or with --out
+/// writes a 16-bit PNG and leaves the project as it is; bad values are one line and exit 2.
+#[test]
+fn bakes_are_kept_in_the_project_or_written_out() {
+    let dir = temp_dir("bake");
+    let project = teapot_project(&dir);
+    let p = project.to_str().expect("path");
+    let o = kapaint(&["bake", p, "--map", "ao", "--rays", "16"]);
+    assert!(o.status.success(), "{o:?}");
+    let text = String::from_utf8(o.stdout).expect("utf-8");
+    assert!(
+        text.starts_with("baked ao of ") && text.contains("kept in "),
+        "{text}"
+    );
+    let doc = kapaint::model::project::load(&project).expect("loads");
+    let ao = doc
+        .bake_of(kapaint::mesh::bakes::BakeMap::Ao)
+        .expect("the AO bake is kept");
+    assert_eq!((ao.width, ao.height, ao.options.rays), (256, 256, 16));
+    let mesh = doc.embedded_mesh().expect("kept mesh");
+    assert_eq!(ao.mesh_hash, mesh.content_hash());
+    // Written out instead: a 16-bit grey PNG of the map's size; the project is untouched.
+    let before = std::fs::read(&project).expect("read");
+    let png = dir.join("curvature.png");
+    let o = kapaint(&[
+        "bake",
+        p,
+        "--map",
+        "curvature",
+        "--out",
+        png.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let image = image::open(&png).expect("a PNG");
+    assert_eq!((image.width(), image.height()), (256, 256));
+    assert!(matches!(image, image::DynamicImage::ImageLuma16(_)));
+    let normal = dir.join("normal.png");
+    let o = kapaint(&[
+        "bake",
+        p,
+        "--map",
+        "normal",
+        "--out",
+        normal.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    assert!(matches!(
+        image::open(&normal).expect("a PNG"),
+        image::DynamicImage::ImageRgb16(_)
+    ));
+    assert_eq!(std::fs::read(&project).expect("read"), before);
+}
+
+/// A 256^2 project on the unwrapped teapot, in `dir`.
+fn teapot_project(dir: &Path) -> PathBuf {
+    let project = dir.join("teapot.kapaint");
+    let o = kapaint(&[
+        "new",
+        "--size",
+        "256",
+        "--mesh",
+        data_mesh("teapot.obj").to_str().expect("path"),
+        "--unwrap",
+        "--out",
+        project.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    project
+}
+
+/// A bake with bad values, or of a mesh that is gone, is one line and exit 2, and the project
+/// is untouched.
+#[test]
+fn a_bake_refuses_bad_values_and_a_missing_mesh() {
+    let dir = temp_dir("bake-refused");
+    let project = teapot_project(&dir);
+    let p = project.to_str().expect("path");
+    let png = dir.join("taken.png");
+    std::fs::write(&png, b"keep").expect("write");
+    let before = std::fs::read(&project).expect("read");
+    // Bad values: exit 2, one line, nothing written.
+    let bad = dir.join("bad.png");
+    for args in [
+        vec!["bake", p, "--map", "ao", "--rays", "0"],
+        vec!["bake", p, "--map", "ao", "--rays", "65537"],
+        vec!["bake", p, "--map", "ao", "--max-distance", "nan"],
+        vec!["bake", p, "--map", "ao", "--max-distance", "-1"],
+        vec!["bake", p, "--map", "shadow"],
+        vec![
+            "bake",
+            p,
+            "--map",
+            "ao",
+            "--out",
+            dir.join("x.jpg").to_str().expect("path"),
+        ],
+        vec![
+            "bake",
+            p,
+            "--map",
+            "ao",
+            "--out",
+            png.to_str().expect("path"),
+        ],
+    ] {
+        let o = kapaint(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {o:?}");
+        assert_eq!(
+            String::from_utf8_lossy(&o.stderr)
+                .trim_end()
+                .lines()
+                .count(),
+            1
+        );
+        assert!(o.stdout.is_empty() && !bad.exists(), "{args:?}");
+    }
+    assert_eq!(std::fs::read(&project).expect("read"), before);
+    // A project whose mesh file is gone: one line, exit 2, untouched.
+    let obj = dir.join("tri.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+    )
+    .expect("write");
+    let gone = dir.join("gone.kapaint");
+    let g = gone.to_str().expect("path");
+    let o = kapaint(&[
+        "new",
+        "--size",
+        "64",
+        "--mesh",
+        obj.to_str().expect("path"),
+        "--out",
+        g,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    std::fs::remove_file(&obj).expect("remove");
+    let before = std::fs::read(&gone).expect("read");
+    let o = kapaint(&["bake", g, "--map", "ao"]);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert_eq!(std::fs::read(&gone).expect("read"), before);
+}

@@ -15,6 +15,7 @@ use crate::model::ModelError;
 
 mod accuracy;
 mod args;
+mod bake;
 mod bench;
 mod chi;
 mod debug_panic;
@@ -138,6 +139,9 @@ pub enum Command {
     /// Print a mesh's vertices, triangles, UV islands, bounds, and whether normals and UVs
     /// were present (FILE is an .obj, .gltf or .glb file, or sphere, plane, cube, torus).
     MeshInfo(mesh_info::MeshInfoArgs),
+    /// Bake a map of a project's mesh (ao, curvature, thickness, position, normal) at the
+    /// project's size into a 16-bit PNG.
+    Bake(bake::BakeArgs),
     /// Give a mesh a new UV atlas (charts packed and padded for a map size, no overlap) and
     /// write it as .obj or .glb.
     Unwrap(unwrap::UnwrapArgs),
@@ -228,6 +232,7 @@ pub fn run(command: Command, stdin: &mut dyn BufRead) -> Result<String, CliError
         Command::Render(a) => a.run(),
         Command::MeshInfo(a) => a.run(),
         Command::Unwrap(a) => a.run(),
+        Command::Bake(a) => a.run(),
         Command::DebugPanic(a) => a.run(),
         Command::Bench(a) => a.run(),
     }

@@ -102,6 +102,7 @@ impl Editor {
                 export_choice: None,
                 new_dialog: None,
                 resize_dialog: None,
+                bake_dialog: None,
                 pending_open: None,
                 material_prompt: None,
                 unwrap_prompt: None,
@@ -267,6 +268,7 @@ impl Editor {
         s.export_window(&ctx);
         s.new_window(&ctx);
         s.resize_window(&ctx);
+        s.bake_window(&ctx);
         s.recovery_window(&ctx);
         s.shortcuts_window(&ctx);
         s.notices_ui(&ctx);

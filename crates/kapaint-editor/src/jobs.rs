@@ -38,6 +38,11 @@ pub(super) enum JobResult {
     /// A mesh that cannot be painted as it is (no UVs) or would paint two places at once
     /// (overlapping UVs): the editor asks whether to unwrap it.
     NeedsUnwrap(UnwrapPrompt),
+    /// A map baked from the mesh, and what it holds.
+    Baked(
+        Arc<kapaint_core::mesh::bakes::Baked>,
+        kapaint_core::mesh::bakes::BakeStats,
+    ),
     /// A mesh unwrapped and baked at the map size: the project keeps it.
     Unwrapped(PathBuf, Arc<Surface>, String),
     /// A PBR material converted at the map size for the document's model.
@@ -215,37 +220,10 @@ impl EditorState {
             JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
             JobResult::Exported(dir, m) => self.notices.push(exported_notice(&dir, *m)),
             JobResult::Material(path, m) => self.take_material(&path, *m),
-            JobResult::Mesh(path, surface, textured) => {
-                if textured {
-                    self.material_prompt = Some(path.clone());
-                }
-                let mesh = MeshRef::from_spec(&path.display().to_string());
-                let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
-                match self.doc.apply(ImportCommand::SetMesh(attached)) {
-                    Ok(()) => {
-                        self.follow_mesh();
-                        self.notices
-                            .push(notice(format!("mesh {}", path.display()), false));
-                    }
-                    Err(e) => self.notices.push(notice(e.to_string(), true)),
-                }
-            }
-            JobResult::NeedsUnwrap(prompt) => self.unwrap_prompt = Some(prompt),
-            JobResult::Unwrapped(path, surface, summary) => {
-                let attached = kapaint_core::model::document::AttachedMesh {
-                    mesh: MeshRef::Embedded(surface.mesh.name.clone()),
-                    surface,
-                };
-                match self.doc.apply(ImportCommand::SetMesh(attached)) {
-                    Ok(()) => {
-                        self.follow_mesh();
-                        self.notices.push(notice(summary, false));
-                    }
-                    Err(e) => self
-                        .notices
-                        .push(notice(format!("{}: {e}", path.display()), true)),
-                }
-            }
+            result @ (JobResult::Mesh(..)
+            | JobResult::NeedsUnwrap(_)
+            | JobResult::Baked(..)
+            | JobResult::Unwrapped(..)) => self.mesh_arrived(result),
             JobResult::Image(path, planes) => {
                 let channel = planes.channel();
                 let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
@@ -287,6 +265,58 @@ impl EditorState {
                 self.quit.after_save = false;
                 self.notices.push(notice(e, true));
             }
+        }
+    }
+
+    /// What a mesh job made: a mesh to bake, a question, a bake, an unwrapped mesh.
+    fn mesh_arrived(&mut self, result: JobResult) {
+        match result {
+            JobResult::Mesh(path, surface, textured) => {
+                if textured {
+                    self.material_prompt = Some(path.clone());
+                }
+                let mesh = MeshRef::from_spec(&path.display().to_string());
+                let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
+                match self.doc.apply(ImportCommand::SetMesh(attached)) {
+                    Ok(()) => {
+                        self.follow_mesh();
+                        self.notices
+                            .push(notice(format!("mesh {}", path.display()), false));
+                    }
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::NeedsUnwrap(prompt) => self.unwrap_prompt = Some(prompt),
+            JobResult::Baked(baked, stats) => {
+                let name = baked.map.name();
+                let bake = kapaint_core::model::document::AttachedBake(baked);
+                match self.doc.apply(ImportCommand::SetBake(bake)) {
+                    Ok(()) => self.notices.push(notice(
+                        format!(
+                            "baked {name}: {} texels, mean {:.3}, min {:.3}",
+                            stats.texels, stats.mean, stats.min
+                        ),
+                        false,
+                    )),
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Unwrapped(path, surface, summary) => {
+                let attached = kapaint_core::model::document::AttachedMesh {
+                    mesh: MeshRef::Embedded(surface.mesh.name.clone()),
+                    surface,
+                };
+                match self.doc.apply(ImportCommand::SetMesh(attached)) {
+                    Ok(()) => {
+                        self.follow_mesh();
+                        self.notices.push(notice(summary, false));
+                    }
+                    Err(e) => self
+                        .notices
+                        .push(notice(format!("{}: {e}", path.display()), true)),
+                }
+            }
+            _ => {}
         }
     }
 

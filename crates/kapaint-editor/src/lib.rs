@@ -6,6 +6,7 @@
 //! (open, save, export) runs on named worker threads with a progress bar and cancel.
 
 mod app;
+pub mod bake;
 pub mod canvas;
 mod claim;
 mod dialogs;
@@ -195,6 +196,8 @@ pub struct EditorState {
     export_choice: Option<(String, String)>,
     /// The Resize dialog, while open.
     resize_dialog: Option<resize::ResizeDialog>,
+    /// Mesh > Bake, while open.
+    bake_dialog: Option<bake::BakeDialog>,
     /// The New dialog, while open.
     new_dialog: Option<NewDialog>,
     /// A project to open once the user has decided about the unsaved changes.

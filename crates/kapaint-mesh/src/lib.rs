@@ -6,6 +6,7 @@
 //! so a UV seam is two vertices at one position.
 
 pub mod bake;
+pub mod bakes;
 mod builtin;
 pub mod gltf_import;
 mod obj;
@@ -124,6 +125,28 @@ impl Mesh {
             (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
             |(lo, hi), &p| (lo.min(p), hi.max(p)),
         )
+    }
+
+    /// A hash of what the mesh is (positions, UVs, triangles), stable across runs and
+    /// builds: the key its bakes are kept under, so a changed mesh is baked again.
+    pub fn content_hash(&self) -> u64 {
+        use std::hash::Hasher as _;
+        let mut h = fnv::FnvHasher::default();
+        // Little-endian whatever the machine, so a project's key is the same everywhere.
+        let mut word = |w: u32| h.write(&w.to_le_bytes());
+        for p in &self.positions {
+            p.to_array().into_iter().for_each(|c| word(c.to_bits()));
+        }
+        if let Some(uvs) = &self.uvs {
+            word(u32::MAX);
+            for t in uvs {
+                t.to_array().into_iter().for_each(|c| word(c.to_bits()));
+            }
+        }
+        for &i in self.triangles.iter().flatten() {
+            word(i);
+        }
+        h.finish()
     }
 
     /// Per-triangle part labels: pieces of surface connected through shared positions (so a

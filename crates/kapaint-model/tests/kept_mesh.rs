@@ -1,5 +1,6 @@
-//! A mesh the project keeps inside itself (an unwrapped mesh): saved and read back as the same
-//! mesh, an undo step when set, and refused when the file says one thing and holds another.
+//! A mesh the project keeps inside itself (an unwrapped mesh), and maps baked from a mesh:
+//! saved and read back as they were, an undo step when set, dropped when the mesh changes,
+//! and refused when the file says one thing and holds another.
 #![expect(
     clippy::expect_used,
     reason = "test helpers: a failed expectation is a failed test"
@@ -164,4 +165,68 @@ fn setting_a_kept_mesh_is_one_undo_step() {
     assert_eq!(version(&to_bytes(&doc).expect("saves")), 2);
     doc.apply(HistoryCommand::Redo).expect("redo");
     assert!(doc.embedded_mesh().is_some());
+}
+
+fn ao_of(doc: &Document) -> Arc<kapaint_mesh::bakes::Baked> {
+    let surface = doc.surface().expect("attached");
+    Arc::new(
+        kapaint_mesh::bakes::bake_map(
+            &surface.mesh,
+            &surface.bake,
+            kapaint_mesh::bakes::BakeMap::Ao,
+            kapaint_mesh::bakes::BakeOptions {
+                rays: 8,
+                max_distance: Some(2.0),
+            },
+            None,
+        )
+        .expect("bakes"),
+    )
+}
+
+#[test]
+fn a_bake_is_kept_read_back_and_dropped_with_its_mesh() {
+    use kapaint_mesh::bakes::BakeMap;
+    use kapaint_model::document::AttachedBake;
+    let mut doc = kept_document();
+    project::attach_own_mesh(&mut doc).expect("attaches");
+    let ao = ao_of(&doc);
+    doc.apply(ImportCommand::SetBake(AttachedBake(Arc::clone(&ao))))
+        .expect("kept");
+    assert!(doc.bake_of(BakeMap::Ao).is_some());
+    let bytes = to_bytes(&doc).expect("saves");
+    assert_eq!(version(&bytes), 3);
+    let back = from_reader(Cursor::new(&bytes)).expect("reads");
+    assert_eq!(**back.bake_of(BakeMap::Ao).expect("read back"), *ao);
+    // Listed twice, or of another size: refused.
+    let twice = with_manifest(&bytes, |m| {
+        let entry = m["bakes"][0].clone();
+        m["bakes"].as_array_mut().expect("list").push(entry);
+    });
+    let e = from_reader(Cursor::new(&twice)).expect_err("twice");
+    assert!(e.contains("listed twice"), "{e}");
+    let unknown = with_manifest(&bytes, |m| m["bakes"][0]["map"] = "shadow".into());
+    assert!(from_reader(Cursor::new(&unknown)).is_err());
+    let no_rays = with_manifest(&bytes, |m| m["bakes"][0]["rays"] = 0.into());
+    assert!(from_reader(Cursor::new(&no_rays)).is_err());
+    // Another mesh: the bake goes with the old one; undo brings both back.
+    let sphere = kapaint_mesh::uv_sphere(32, 16);
+    let surface = Arc::new(Surface::new(sphere, 256, 256).expect("bakes"));
+    doc.apply(ImportCommand::SetMesh(AttachedMesh {
+        mesh: MeshRef::Sphere,
+        surface,
+    }))
+    .expect("sets");
+    assert!(doc.bakes().is_empty(), "a bake of another mesh is stale");
+    doc.apply(HistoryCommand::Undo).expect("undo");
+    assert!(doc.bake_of(BakeMap::Ao).is_some());
+    doc.apply(HistoryCommand::Undo).expect("undo");
+    assert!(doc.bakes().is_empty(), "undo takes the bake back");
+    // A bake of another mesh is refused.
+    let mut other = Document::new(256, 256, DocumentSettings::default()).expect("document");
+    project::attach_own_mesh(&mut other).expect("the sphere");
+    let e = other
+        .apply(ImportCommand::SetBake(AttachedBake(ao)))
+        .expect_err("another mesh");
+    assert!(e.to_string().contains("another mesh"), "{e}");
 }

@@ -156,20 +156,37 @@ impl EditorState {
                     self.apply(HistoryCommand::Redo);
                 }
             });
-            ui.menu_button("Image", |ui| {
-                if ui
-                    .button("Resize…")
-                    .on_hover_text("Resample the maps to another size (one undo step)")
-                    .clicked()
-                {
-                    self.open_resize();
-                }
-            });
+            self.image_and_mesh_menus(ui);
             ui.menu_button("Help", |ui| {
                 if ui.button("Keyboard shortcuts").clicked() {
                     self.shortcuts_open = true;
                 }
             });
+        });
+    }
+
+    /// The Image menu (resize) and the Mesh menu (bake).
+    fn image_and_mesh_menus(&mut self, ui: &mut egui::Ui) {
+        ui.menu_button("Image", |ui| {
+            if ui
+                .button("Resize…")
+                .on_hover_text("Resample the maps to another size (one undo step)")
+                .clicked()
+            {
+                self.open_resize();
+            }
+        });
+        ui.menu_button("Mesh", |ui| {
+            if ui
+                .button("Bake…")
+                .on_hover_text(
+                    "Bake ambient occlusion, curvature, thickness, position or normal from \
+                     the mesh into the project (one undo step)",
+                )
+                .clicked()
+            {
+                self.open_bake();
+            }
         });
     }
 

@@ -169,6 +169,9 @@ pub enum ImportCommand {
     SetNormal(AttachedNormal),
     /// Makes a mesh, baked at the map size on a worker, the project's mesh.
     SetMesh(AttachedMesh),
+    /// Keeps a map baked from the mesh on a worker (AO, curvature, ...), replacing the bake of
+    /// the same map.
+    SetBake(AttachedBake),
     /// Installs maps resized on a worker ([`crate::resize::resized`]) with the mesh
     /// surface baked at their size.
     Resize(crate::resize::ResizedMaps),
@@ -376,6 +379,16 @@ impl PartialEq for AttachedNormal {
             (Some(a), Some(b)) => Arc::ptr_eq(a, b),
             (a, b) => a.is_none() && b.is_none(),
         }
+    }
+}
+
+/// A map baked from the mesh for [`ImportCommand::SetBake`]; equal when it is the same bake.
+#[derive(Clone, Debug)]
+pub struct AttachedBake(pub Arc<kapaint_mesh::bakes::Baked>);
+
+impl PartialEq for AttachedBake {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
     }
 }
 

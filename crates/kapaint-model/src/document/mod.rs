@@ -22,7 +22,7 @@ pub use paths::MAX_LAYERS;
 mod stroke;
 
 pub use command::{
-    AttachedMesh, AttachedNormal, Command, FillRegion, HistoryCommand, ImportCommand,
+    AttachedBake, AttachedMesh, AttachedNormal, Command, FillRegion, HistoryCommand, ImportCommand,
     ImportedChannel, ImportedMaterial, LayerCommand, LayerKind, LayerMove, LayerPlace, LayerRef,
     MaskCommand, PaintCommand, SettingsCommand, StrokeCommand, StrokeTool,
 };
@@ -202,6 +202,27 @@ impl Document {
         self
     }
 
+    /// The maps baked from the mesh (at most one of each), in the order
+    /// [`BakeMap::ALL`](kapaint_mesh::bakes::BakeMap::ALL) lists them.
+    pub fn bakes(&self) -> &[Arc<kapaint_mesh::bakes::Baked>] {
+        &self.state.bakes
+    }
+
+    /// The bake of `map`, if the document keeps one.
+    pub fn bake_of(
+        &self,
+        map: kapaint_mesh::bakes::BakeMap,
+    ) -> Option<&Arc<kapaint_mesh::bakes::Baked>> {
+        self.state.bakes.iter().find(|b| b.map == map)
+    }
+
+    /// This document with the bakes its project keeps (a loader making it).
+    #[must_use]
+    pub fn with_bakes(mut self, bakes: Vec<Arc<kapaint_mesh::bakes::Baked>>) -> Self {
+        self.state.bakes = bakes;
+        self
+    }
+
     /// The mesh the project keeps inside itself, if it keeps one.
     pub fn embedded_mesh(&self) -> Option<&Arc<kapaint_mesh::Mesh>> {
         self.state.embedded_mesh.as_ref()
@@ -248,6 +269,7 @@ impl Document {
                 surface: None,
                 mesh: settings.mesh.clone(),
                 embedded_mesh: None,
+                bakes: Vec::new(),
                 normal: None,
                 import: settings.import.clone(),
                 revision: 0,
@@ -487,6 +509,7 @@ impl Document {
                 Ok(())
             }
             ImportCommand::SetMesh(mesh) => self.set_mesh(&mesh),
+            ImportCommand::SetBake(bake) => self.set_bake(bake.0),
             ImportCommand::Resize(resized) => self.install_resized(&resized),
         }
     }

@@ -34,6 +34,11 @@ impl Document {
     ) -> Result<(), ModelError> {
         self.check_surface(surface.as_deref())?;
         self.end_stroke();
+        // Bakes of another mesh (a mesh file changed since they were made) are stale.
+        if let Some(s) = &surface {
+            let hash = s.mesh.content_hash();
+            self.state.bakes.retain(|b| b.mesh_hash == hash);
+        }
         self.state.surface = surface;
         Ok(())
     }
@@ -67,7 +72,52 @@ impl Document {
             .mesh
             .is_embedded()
             .then(|| Arc::new(mesh.surface.mesh.clone()));
+        // Bakes belong to the mesh they were made from.
+        let hash = mesh.surface.mesh.content_hash();
+        self.state.bakes.retain(|b| b.mesh_hash == hash);
         self.record("Mesh", before);
+        Ok(())
+    }
+
+    /// [`ImportCommand::SetBake`](super::ImportCommand::SetBake): a map baked from the mesh
+    /// kept, replacing the bake of the same map, as one undo step.
+    ///
+    /// # Errors
+    /// A bake of another size than the maps, or of another mesh than the attached one.
+    pub(super) fn set_bake(
+        &mut self,
+        bake: Arc<kapaint_mesh::bakes::Baked>,
+    ) -> Result<(), ModelError> {
+        if (bake.width, bake.height) != (self.maps.width(), self.maps.height()) {
+            return Err(ModelError::Command(format!(
+                "the {} bake is {}x{} but the maps are {}x{}",
+                bake.map.name(),
+                bake.width,
+                bake.height,
+                self.maps.width(),
+                self.maps.height()
+            )));
+        }
+        if let Some(s) = &self.state.surface
+            && s.mesh.content_hash() != bake.mesh_hash
+        {
+            return Err(ModelError::Command(format!(
+                "the {} bake was made from another mesh than the project's",
+                bake.map.name()
+            )));
+        }
+        self.end_stroke();
+        let before = self.state.clone();
+        let order = |m| {
+            kapaint_mesh::bakes::BakeMap::ALL
+                .iter()
+                .position(|(_, x)| *x == m)
+        };
+        self.state.bakes.retain(|b| b.map != bake.map);
+        let label = format!("Bake {}", bake.map.name());
+        self.state.bakes.push(bake);
+        self.state.bakes.sort_by_key(|b| order(b.map));
+        self.record(&label, before);
         Ok(())
     }
 

@@ -52,6 +52,9 @@ pub struct State {
     pub mesh: MeshRef,
     /// The mesh itself when the project keeps it ([`MeshRef::Embedded`]).
     pub embedded_mesh: Option<Arc<kapaint_mesh::Mesh>>,
+    /// Maps baked from the mesh, at most one of each: caches, never painted or exported as
+    /// material, dropped when the mesh changes.
+    pub bakes: Vec<Arc<kapaint_mesh::bakes::Baked>>,
     /// The tangent-space normal map an imported material brought.
     pub normal: Option<Arc<NormalMap>>,
     /// The PBR import the maps were made by.

@@ -10,6 +10,7 @@
 //! everything (zip and PNG checksums, sizes, colour types, every stored value) and reports
 //! the first problem as one error; it never panics on any input.
 
+mod bakes;
 pub mod layers;
 pub mod lock;
 mod read;
@@ -100,6 +101,27 @@ pub struct Manifest {
     /// The mesh the project keeps inside itself (version 3), as an OBJ file in the archive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mesh: Option<MeshEntry>,
+    /// Maps baked from the mesh (version 3), each a 16-bit PNG in the archive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bakes: Option<Vec<BakeEntry>>,
+}
+
+/// Where a project keeps a map baked from its mesh.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BakeEntry {
+    /// Which map: `ao`, `curvature`, `thickness`, `position`, `normal`.
+    pub map: String,
+    /// Entry name in the archive (`bake_MAP.png`): 16-bit grey, or RGB for position and
+    /// normal.
+    pub file: String,
+    /// The hash of the mesh it was baked from (16 hex digits).
+    pub mesh_hash: String,
+    /// Rays per texel.
+    pub rays: u32,
+    /// How far its rays looked, if bounded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_distance: Option<f32>,
 }
 
 /// Where a project keeps its mesh.
@@ -425,6 +447,12 @@ fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
     if manifest.mesh.is_some() && manifest.version < VERSION {
         return Err(format!(
             "a version {} project keeps no mesh (a kept mesh is version {VERSION})",
+            manifest.version
+        ));
+    }
+    if manifest.bakes.is_some() && manifest.version < VERSION {
+        return Err(format!(
+            "a version {} project keeps no bakes (bakes are version {VERSION})",
             manifest.version
         ));
     }

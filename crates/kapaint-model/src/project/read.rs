@@ -47,8 +47,9 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             base: manifest.base.unwrap_or(manifest.settings.base).sanitized(),
             layers,
         };
-        // The kept mesh is read before the settings move into the document.
+        // The kept mesh and bakes are read before the settings move into the document.
         let mesh = read_mesh(&mut zip, &manifest)?;
+        let bakes = super::bakes::read(&mut zip, &manifest)?;
         let doc = Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string())?;
         // The stored composite is read too: every entry's checksum is checked, and it must
         // be what the layers composite to.
@@ -76,6 +77,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         let doc = doc
             .with_normal(normal)
             .with_embedded_mesh(mesh)
+            .with_bakes(bakes)
             .with_selection(
                 manifest
                     .selection

@@ -205,7 +205,7 @@ pub(super) fn write_project(
     let kept_mesh = kept_mesh(doc, &settings)?;
     let manifest = Manifest {
         format: FORMAT.into(),
-        version: if kept_mesh.is_some() {
+        version: if kept_mesh.is_some() || !doc.bakes().is_empty() {
             VERSION
         } else {
             super::LAYERS_VERSION
@@ -229,6 +229,18 @@ pub(super) fn write_project(
         mesh: kept_mesh.as_ref().map(|(_, triangles)| super::MeshEntry {
             file: super::MESH_FILE.into(),
             triangles: *triangles,
+        }),
+        bakes: (!doc.bakes().is_empty()).then(|| {
+            doc.bakes()
+                .iter()
+                .map(|b| super::BakeEntry {
+                    map: b.map.name().into(),
+                    file: super::bakes::file_of(b.map),
+                    mesh_hash: format!("{:016x}", b.mesh_hash),
+                    rays: b.options.rays,
+                    max_distance: b.options.max_distance,
+                })
+                .collect()
         }),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
@@ -282,6 +294,12 @@ fn write_archive(
         zip.start_file(super::MESH_FILE, deflated)
             .map_err(|e| e.to_string())?;
         zip.write_all(obj.as_bytes()).map_err(|e| e.to_string())?;
+    }
+    for bake in doc.bakes() {
+        let png = super::bakes::to_png(bake)?;
+        zip.start_file(super::bakes::file_of(bake.map), stored_file)
+            .map_err(|e| e.to_string())?;
+        zip.write_all(&png).map_err(|e| e.to_string())?;
     }
     zip.finish().map_err(|e| e.to_string())?;
     Ok(())

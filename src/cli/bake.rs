@@ -1,0 +1,179 @@
+//! `kapaint bake`: a map of the project's mesh (AO, curvature, thickness, position, normal)
+//! at the project's size, kept in the project (a cache tied to the mesh) or written out as a
+//! 16-bit PNG.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::{CliError, model_error};
+use crate::mesh::bakes::{BakeMap, BakeOptions, BakeStats, Baked, RAYS, bake_map};
+use crate::model::project;
+
+/// A map baked from a project's mesh.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum MapArg {
+    /// Ambient occlusion: the share of the hemisphere that sees open sky (1 = open).
+    Ao,
+    /// Curvature: 0.5 flat, above convex, below concave.
+    Curvature,
+    /// Thickness: the mean distance to the mesh inwards, over the maximum distance.
+    Thickness,
+    /// Object-space position, normalised to the bounding box (RGB).
+    Position,
+    /// Object-space normal, 0.5 + 0.5 n (RGB).
+    Normal,
+}
+
+impl From<MapArg> for BakeMap {
+    fn from(m: MapArg) -> Self {
+        match m {
+            MapArg::Ao => Self::Ao,
+            MapArg::Curvature => Self::Curvature,
+            MapArg::Thickness => Self::Thickness,
+            MapArg::Position => Self::Position,
+            MapArg::Normal => Self::Normal,
+        }
+    }
+}
+
+/// Bake a map of the project's mesh at the project's size (every texel the mesh's UVs give a
+/// surface point, seams padded like the maps): kept in the project, or with --out written as
+/// a 16-bit PNG (grey, or RGB for position and normal) and the project left as it is.
+#[derive(Debug, clap::Args)]
+pub struct BakeArgs {
+    /// The project.
+    project: PathBuf,
+    /// The map to bake.
+    #[arg(long, value_enum)]
+    map: MapArg,
+    /// Rays per texel (ao, thickness), 1 to 65536.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(i64::from(*RAYS.start())..=i64::from(*RAYS.end())))]
+    rays: u32,
+    /// How far a ray looks, in object units (default: unbounded for ao, the bounding box's
+    /// diagonal for thickness).
+    #[arg(long)]
+    max_distance: Option<f32>,
+    /// The PNG to write instead of keeping the bake in the project.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Overwrite an existing file.
+    #[arg(long)]
+    force: bool,
+}
+
+impl BakeArgs {
+    /// Runs the command; returns what it prints.
+    ///
+    /// # Errors
+    /// A project or mesh that does not load, a mesh without UVs, bad values, an existing file
+    /// without `--force`, a failed write. Nothing is written then.
+    pub fn run(self) -> Result<String, CliError> {
+        if let Some(out) = &self.out {
+            let ext = out
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
+            if ext.as_deref() != Some("png") {
+                return Err(CliError::usage(format!(
+                    "{}: --out must end in .png",
+                    out.display()
+                )));
+            }
+            if out.exists() && !self.force {
+                return Err(CliError::usage(format!(
+                    "{} exists; pass --force to overwrite it",
+                    out.display()
+                )));
+            }
+        }
+        if let Some(d) = self.max_distance
+            && !(d.is_finite() && d > 0.0)
+        {
+            return Err(CliError::usage(format!(
+                "--max-distance {d} is not a positive number"
+            )));
+        }
+        // The file as read: a save finds out if another run saved over it meanwhile.
+        let on_disk = project::OnDisk::of(&self.project);
+        let (mut doc, failed) =
+            project::open_with_mesh(&self.project, None).map_err(model_error)?;
+        if let Some(e) = failed {
+            return Err(CliError::usage(format!(
+                "{}: its mesh cannot be baked: {e}",
+                self.project.display()
+            )));
+        }
+        let surface = doc.surface().cloned().ok_or_else(|| {
+            CliError::usage(format!("{}: no mesh to bake", self.project.display()))
+        })?;
+        let options = BakeOptions {
+            rays: self.rays,
+            max_distance: self.max_distance,
+        };
+        let start = Instant::now();
+        let baked = bake_map(&surface.mesh, &surface.bake, self.map.into(), options, None)
+            .map_err(CliError::usage)?;
+        let seconds = start.elapsed().as_secs_f64();
+        let stats = baked.stats(&surface.bake);
+        let line = summary(&self.project, &surface.mesh.name, &baked, &stats, seconds);
+        if let Some(out) = &self.out {
+            let png = encode_png(&baked).map_err(CliError::io)?;
+            crate::atomic::write_atomic(out, &png)
+                .map_err(|e| CliError::of_io(format!("{}: {e}", out.display()), &e))?;
+            return Ok(format!("{line}\nwrote {}\n", out.display()));
+        }
+        let bake = crate::model::document::AttachedBake(std::sync::Arc::new(baked));
+        doc.apply(crate::model::ImportCommand::SetBake(bake))
+            .map_err(model_error)?;
+        project::save_checked(&doc, &self.project, on_disk.as_ref()).map_err(model_error)?;
+        Ok(format!("{line}\nkept in {}\n", self.project.display()))
+    }
+}
+
+/// One line on what was baked.
+fn summary(
+    project: &std::path::Path,
+    mesh: &str,
+    baked: &Baked,
+    stats: &BakeStats,
+    seconds: f64,
+) -> String {
+    let mut line = format!(
+        "baked {} of {} ({mesh}): {}x{}, {} texels, mean {:.4}, min {:.4}, {seconds:.2} s",
+        baked.map.name(),
+        project.display(),
+        baked.width,
+        baked.height,
+        stats.texels,
+        stats.mean,
+        stats.min,
+    );
+    if stats.rays_cast > 0 {
+        use std::fmt::Write as _;
+        let _ = write!(
+            line,
+            ", {} rays ({:.1} M rays/s)",
+            stats.rays_cast,
+            stats.rays_cast as f64 / seconds.max(1e-9) / 1e6
+        );
+    }
+    line
+}
+
+/// A 16-bit PNG of the bake: grey, or RGB.
+fn encode_png(baked: &Baked) -> Result<Vec<u8>, String> {
+    use image::{ImageBuffer, Luma, Rgb};
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let (w, h) = (baked.width, baked.height);
+    let result = if baked.map.channels() == 3 {
+        ImageBuffer::<Rgb<u16>, &[u16]>::from_raw(w, h, &baked.data)
+            .ok_or("bake size mismatch")?
+            .write_to(&mut bytes, image::ImageFormat::Png)
+    } else {
+        ImageBuffer::<Luma<u16>, &[u16]>::from_raw(w, h, &baked.data)
+            .ok_or("bake size mismatch")?
+            .write_to(&mut bytes, image::ImageFormat::Png)
+    };
+    result.map_err(|e| e.to_string())?;
+    Ok(bytes.into_inner())
+}
