@@ -340,6 +340,39 @@ fn the_first_save_of_untitled_work_takes_its_recovery_copy_along() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A save makes the work safe: the recovery copy written before it goes, and no copy is
+/// written after it until the work changes again, so a kill after Ctrl+S offers nothing (an
+/// autosave falling due after the save used to leave a copy newer than the project, offered
+/// at the next start as unsaved work).
+#[test]
+fn a_saved_project_leaves_no_recovery_copy_to_offer() {
+    use kapaint::model::recovery;
+    let dir = scratch("saved-no-offer");
+    let path = dir.join("saved.kapaint");
+    let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+        .expect("document");
+    kapaint::model::project::save(&doc, &path).expect("saved");
+    let mut harness = editor_on(&path);
+    wait_until(&mut harness, "opened", |e| {
+        e.state.opening().is_none() && e.state.doc().maps().width() == 64
+    });
+    let centre = harness.get_by_label(CANVAS_LABEL).rect().center();
+    drag(&mut harness, centre, centre + Vec2::new(40.0, 10.0));
+    harness.state_mut().state.autosave_now().expect("autosaved");
+    let copy = harness.state().state.recovery_copy();
+    assert!(copy.exists(), "the stroke's copy");
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    wait_until(&mut harness, "saved", |e| !e.state.dirty());
+    assert!(!copy.exists(), "the copy of saved work was kept");
+    // The autosave that falls due next finds nothing to protect.
+    harness.state_mut().state.autosave_now().expect("autosaved");
+    assert!(!harness.state().state.recovery_copy().exists());
+    drop(harness);
+    assert_eq!(recovery::offer(Some(&path)), None);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn save_as_moves_the_recovery_copy_to_the_new_project() {
     use kapaint::model::recovery;

@@ -20,6 +20,8 @@ impl EditorState {
             // Save As (or the first save): the recovery copy follows the work.
             self.autosaver.relocate(Some(&path));
         }
+        // What was saved needs no recovery copy (unless it changed while saving).
+        self.autosaver.saved(&self.doc, version);
         self.path = Some(path);
         if std::mem::take(&mut self.quit.after_save) && !self.dirty() {
             // The quit prompt's Save: the work is safe, so the window closes.
@@ -40,6 +42,7 @@ impl EditorState {
         self.notices.push(notice(message, true));
         self.remember(&written);
         self.autosaver.relocate(Some(&written));
+        self.autosaver.saved(&self.doc, version);
         self.claim
             .hold(Some(&written), project::OnDisk::of(&written), false);
         self.path = Some(written);

@@ -7,6 +7,7 @@ pub mod brush;
 pub mod check;
 pub mod document;
 mod error;
+pub mod generator;
 pub mod import;
 pub mod layers;
 pub mod maps;

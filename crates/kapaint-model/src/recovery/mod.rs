@@ -166,6 +166,18 @@ impl Autosaver {
         }
     }
 
+    /// The project was saved holding the document at `version`. When that is the document as
+    /// it is now, the work is safe in the project: the copy goes (after an autosave in flight)
+    /// and the next change starts a new one, so a copy written after the save is never offered
+    /// as unsaved work. Changes made while the save ran keep their copy.
+    pub fn saved(&mut self, doc: &Document, version: u64) {
+        if doc.version() == version {
+            self.discard();
+            self.saved_version = version;
+            self.last_time = Instant::now();
+        }
+    }
+
     /// Removes this process's recovery copy (and any it replaces), after waiting for an
     /// autosave in flight: the work was saved, or the user discarded it.
     pub fn discard(&mut self) {
