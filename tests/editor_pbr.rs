@@ -317,8 +317,22 @@ fn mesh_bake_keeps_a_map_of_the_mesh_as_one_undo_step() {
         (doc.maps().width(), doc.maps().height())
     );
     assert!(harness.state().state.dirty());
+    // The canvas offers the bake to look at.
+    harness.get_by_label("Canvas shows").click();
+    harness.run_steps(2);
+    harness.get_by_label("curvature bake").click();
+    harness.run_steps(2);
+    assert_eq!(
+        harness.state().state.canvas_channel(),
+        kapaint::ui::canvas::CanvasChannel::Bake(BakeMap::Curvature)
+    );
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
     harness.run_steps(2);
     assert!(harness.state().state.doc().bakes().is_empty());
     assert!(!harness.state().state.dirty());
+    // With the bake gone, the canvas shows k_d again.
+    assert_eq!(
+        harness.state().state.canvas_channel(),
+        kapaint::ui::canvas::CanvasChannel::Kd
+    );
 }

@@ -198,6 +198,12 @@ impl TabViewer for Tabs<'_> {
             }
             Tab::Canvas => {
                 let lines = std::mem::take(&mut s.mesh.uv_lines);
+                // A bake the project no longer keeps (undone, or its mesh replaced): k_d again.
+                if let CanvasChannel::Bake(map) = s.canvas.channel
+                    && s.doc.bake_of(map).is_none()
+                {
+                    s.canvas.channel = CanvasChannel::Kd;
+                }
                 let channel = s.canvas.channel;
                 if s.shown_layer_view() == LayerView::Mask {
                     s.canvas.channel = CanvasChannel::Kd;

@@ -3,6 +3,7 @@
 
 use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
 
+use kapaint_core::mesh::bakes::BakeMap;
 use kapaint_core::model::texel::{MaterialValue, linear_to_srgb};
 use kapaint_core::model::{Document, MaterialMaps};
 use kapaint_core::reflectance;
@@ -25,6 +26,9 @@ pub enum CanvasChannel {
     /// What each texel loses as a glTF PBR material: its round-trip error against the
     /// Cook-Torrance shading of its PBR reading, as a heatmap (0 to 100 %).
     PbrError,
+    /// A map baked from the mesh (grey, or RGB for position and normal), when the project
+    /// keeps one: offered after the channels above.
+    Bake(BakeMap),
 }
 
 impl CanvasChannel {
@@ -39,6 +43,11 @@ impl CanvasChannel {
             Self::N => "n",
             Self::Ka => "k_a",
             Self::PbrError => "PBR error",
+            Self::Bake(BakeMap::Ao) => "AO bake",
+            Self::Bake(BakeMap::Curvature) => "curvature bake",
+            Self::Bake(BakeMap::Thickness) => "thickness bake",
+            Self::Bake(BakeMap::Position) => "position bake",
+            Self::Bake(BakeMap::Normal) => "normal bake",
         }
     }
 }
@@ -110,6 +119,8 @@ fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
             kapaint_core::pbr::round_trip::RoundTrip::for_model(doc.settings().model).error(v)
                 / PBR_ERROR_TOP,
         ),
+        // Read per texel from the bake (see `tile_image`); mid grey where there is none.
+        CanvasChannel::Bake(_) => glam::Vec3::splat(0.5),
     };
     let c = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0).round() as u8;
     Color32::from_rgb(c(rgb.x), c(rgb.y), c(rgb.z))
@@ -125,9 +136,28 @@ fn tile_image(
     let kapaint_core::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
     let (w, h) = (x1 - x0, y1 - y0);
     let mut pixels = Vec::with_capacity((w * h) as usize);
+    let bake = match channel {
+        CanvasChannel::Bake(map) => doc
+            .bake_of(map)
+            .filter(|b| (b.width, b.height) == (maps.width(), maps.height())),
+        _ => None,
+    };
     for y in y0..y1 {
         for x in x0..x1 {
-            pixels.push(colour(doc, channel, maps.value(x, y)));
+            pixels.push(match bake {
+                // A bake holds data values (AO, position, ...): shown as they are, not as
+                // linear colour.
+                Some(b) => {
+                    let i = (y * maps.width() + x) as usize;
+                    let c = |k: usize| (b.value(i, k) * 255.0).round() as u8;
+                    if b.map.channels() == 3 {
+                        Color32::from_rgb(c(0), c(1), c(2))
+                    } else {
+                        Color32::from_gray(c(0))
+                    }
+                }
+                None => colour(doc, channel, maps.value(x, y)),
+            });
         }
     }
     ColorImage::new([w as usize, h as usize], pixels)
@@ -152,8 +182,13 @@ impl Canvas {
             version: maps.version(),
             channel: self.channel,
             size: (maps.width(), maps.height()),
-            // k_a depends on the model and approximation too.
-            shading: u64::from(doc.settings().model as u8) << 8 | doc.settings().approx as u64,
+            // k_a depends on the model and approximation too, a bake on which one is kept.
+            shading: match self.channel {
+                CanvasChannel::Bake(map) => doc
+                    .bake_of(map)
+                    .map_or(0, |b| std::sync::Arc::as_ptr(b) as u64),
+                _ => u64::from(doc.settings().model as u8) << 8 | doc.settings().approx as u64,
+            },
             uniform: false,
         };
         let options = TextureOptions::NEAREST;
@@ -186,7 +221,9 @@ impl Canvas {
             self.zoom *= was.size.0 as f32 / now.size.0 as f32;
         }
         let (w, h) = now.size;
-        let image = if maps.uniform_texel().is_some() {
+        let image = if maps.uniform_texel().is_some()
+            && !matches!(self.channel, CanvasChannel::Bake(_))
+        {
             ColorImage::new([1, 1], vec![colour(doc, self.channel, maps.value(0, 0))])
         } else {
             let mut image = ColorImage::filled([w as usize, h as usize], Color32::BLACK);

@@ -403,6 +403,11 @@ impl EditorState {
         self.doc.version() != self.saved_version
     }
 
+    /// What the UV canvas shows.
+    pub fn canvas_channel(&self) -> CanvasChannel {
+        self.canvas.channel
+    }
+
     /// The UV canvas's zoom, in screen points per texel (0 until it is fitted to its
     /// panel).
     pub fn canvas_zoom(&self) -> f32 {
@@ -476,7 +481,10 @@ impl EditorState {
         match self.canvas.channel {
             CanvasChannel::Ks => Channel::Ks,
             CanvasChannel::N => Channel::N,
-            CanvasChannel::Kd | CanvasChannel::Ka | CanvasChannel::PbrError => Channel::Kd,
+            CanvasChannel::Kd
+            | CanvasChannel::Ka
+            | CanvasChannel::PbrError
+            | CanvasChannel::Bake(_) => Channel::Kd,
         }
     }
 

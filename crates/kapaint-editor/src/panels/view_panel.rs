@@ -158,6 +158,10 @@ impl EditorState {
                 for c in CanvasChannel::ALL {
                     ui.selectable_value(&mut self.canvas.channel, c, c.label());
                 }
+                for b in self.doc.bakes() {
+                    let c = CanvasChannel::Bake(b.map);
+                    ui.selectable_value(&mut self.canvas.channel, c, c.label());
+                }
             });
         ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
         self.light_ui(ui);
