@@ -336,3 +336,37 @@ fn mesh_bake_keeps_a_map_of_the_mesh_as_one_undo_step() {
         kapaint::ui::canvas::CanvasChannel::Kd
     );
 }
+
+/// Mesh > Unwrap automatically replaces the project's mesh's UVs on request (the built-in
+/// sphere here), after saying what happens to what is painted; the project keeps the result.
+#[test]
+fn mesh_unwrap_on_request_replaces_the_uvs() {
+    let mut harness = editor();
+    harness.get_by_role_and_label(Role::Button, "Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Unwrap automatically…").click();
+    harness.run_steps(2);
+    wait_for_button(&mut harness, "Unwrap automatically");
+    assert!(
+        harness
+            .query_by_label_contains("no longer sits on the same places")
+            .is_some(),
+        "the question says what happens to the paint"
+    );
+    harness
+        .get_by_role_and_label(Role::Button, "Unwrap automatically")
+        .click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "sphere unwrapped", notice("unwrapped: "));
+    harness.run_steps(2);
+    let doc = harness.state().state.doc();
+    let sphere = kapaint::mesh::builtin("sphere").expect("sphere");
+    assert_eq!(
+        doc.settings().mesh,
+        kapaint::model::MeshRef::Embedded(format!("{}, unwrapped", sphere.name))
+    );
+    let mesh = &doc.surface().expect("baked").mesh;
+    assert_eq!(mesh.triangles.len(), sphere.triangles.len());
+    assert_ne!(mesh.uvs, sphere.uvs, "new UVs");
+    assert_eq!(kapaint::mesh::unwrap::uv_overlap(mesh, 1024), 0.0);
+}

@@ -371,6 +371,29 @@ impl EditorState {
         });
     }
 
+    /// Mesh > Unwrap automatically: asks, for the project's mesh, whether to replace its UVs
+    /// with a new atlas.
+    pub fn ask_unwrap(&mut self) {
+        let Some(surface) = self.doc.surface() else {
+            self.notices
+                .push(notice("there is no mesh to unwrap", true));
+            return;
+        };
+        let mesh = Arc::new(surface.mesh.clone());
+        let why = if mesh.uvs.is_some() {
+            "is painted on its own UVs: a new atlas replaces them, and what is painted stays \
+             where it is on the map, so it no longer sits on the same places of the surface"
+        } else {
+            "has no UVs"
+        };
+        self.unwrap_prompt = Some(UnwrapPrompt {
+            path: PathBuf::from(self.doc.settings().mesh.spec()),
+            mesh,
+            why: why.to_string(),
+            has_uvs: false,
+        });
+    }
+
     /// Bakes a mesh whose UVs are kept as they are (the answer "Keep its UVs").
     pub(super) fn keep_mesh_uvs(&mut self, prompt: UnwrapPrompt) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
@@ -411,7 +434,8 @@ impl EditorState {
                 done.charts,
                 100.0 * done.coverage
             );
-            done.mesh.name = format!("{}, unwrapped", done.mesh.name);
+            let base = done.mesh.name.trim_end_matches(", unwrapped").to_string();
+            done.mesh.name = format!("{base}, unwrapped");
             progress.start("bake", 1);
             match Surface::new(done.mesh, w, h) {
                 Ok(s) => JobResult::Unwrapped(prompt.path, Arc::new(s), summary),

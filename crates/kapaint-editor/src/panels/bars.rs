@@ -187,6 +187,16 @@ impl EditorState {
             {
                 self.open_bake();
             }
+            if ui
+                .button("Unwrap automatically…")
+                .on_hover_text(
+                    "Give the mesh a new UV atlas, kept in the project (what is painted stays \
+                     where it is on the map)",
+                )
+                .clicked()
+            {
+                self.ask_unwrap();
+            }
         });
     }
 
