@@ -117,7 +117,7 @@ impl BakeArgs {
         let stats = baked.stats(&surface.bake);
         let line = summary(&self.project, &surface.mesh.name, &baked, &stats, seconds);
         if let Some(out) = &self.out {
-            let png = encode_png(&baked).map_err(CliError::io)?;
+            let png = project::bake_png(&baked).map_err(CliError::io)?;
             crate::atomic::write_atomic(out, &png)
                 .map_err(|e| CliError::of_io(format!("{}: {e}", out.display()), &e))?;
             return Ok(format!("{line}\nwrote {}\n", out.display()));
@@ -158,22 +158,4 @@ fn summary(
         );
     }
     line
-}
-
-/// A 16-bit PNG of the bake: grey, or RGB.
-fn encode_png(baked: &Baked) -> Result<Vec<u8>, String> {
-    use image::{ImageBuffer, Luma, Rgb};
-    let mut bytes = std::io::Cursor::new(Vec::new());
-    let (w, h) = (baked.width, baked.height);
-    let result = if baked.map.channels() == 3 {
-        ImageBuffer::<Rgb<u16>, &[u16]>::from_raw(w, h, &baked.data)
-            .ok_or("bake size mismatch")?
-            .write_to(&mut bytes, image::ImageFormat::Png)
-    } else {
-        ImageBuffer::<Luma<u16>, &[u16]>::from_raw(w, h, &baked.data)
-            .ok_or("bake size mismatch")?
-            .write_to(&mut bytes, image::ImageFormat::Png)
-    };
-    result.map_err(|e| e.to_string())?;
-    Ok(bytes.into_inner())
 }

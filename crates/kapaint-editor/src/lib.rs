@@ -16,6 +16,7 @@ mod jobs;
 pub mod keys;
 mod layer_view;
 mod layout;
+mod mesh_jobs;
 pub mod notices;
 pub use notices::{Notice, NoticeLevel, Notices};
 mod panels;

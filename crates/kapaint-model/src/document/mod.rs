@@ -35,7 +35,6 @@ use super::ModelError;
 use super::brush::BrushSettings;
 use super::layers::{Compositor, LayerId, LayerStack, Selected, Selection, StackHistory, State};
 use super::maps::MaterialMaps;
-use super::normal::NormalMap;
 use super::surface::Surface;
 use super::texel::{Channels, MaterialValue};
 use kapaint_reflectance::{AmbientApprox, ShadingModel};
@@ -194,47 +193,6 @@ impl Document {
         self
     }
 
-    /// This document with the mesh its project keeps (a loader or `kapaint new --unwrap`
-    /// making it; [`MeshRef::Embedded`] names it).
-    #[must_use]
-    pub fn with_embedded_mesh(mut self, mesh: Option<Arc<kapaint_mesh::Mesh>>) -> Self {
-        self.state.embedded_mesh = mesh;
-        self
-    }
-
-    /// The maps baked from the mesh (at most one of each), in the order
-    /// [`BakeMap::ALL`](kapaint_mesh::bakes::BakeMap::ALL) lists them.
-    pub fn bakes(&self) -> &[Arc<kapaint_mesh::bakes::Baked>] {
-        &self.state.bakes
-    }
-
-    /// The bake of `map`, if the document keeps one.
-    pub fn bake_of(
-        &self,
-        map: kapaint_mesh::bakes::BakeMap,
-    ) -> Option<&Arc<kapaint_mesh::bakes::Baked>> {
-        self.state.bakes.iter().find(|b| b.map == map)
-    }
-
-    /// This document with the bakes its project keeps (a loader making it).
-    #[must_use]
-    pub fn with_bakes(mut self, bakes: Vec<Arc<kapaint_mesh::bakes::Baked>>) -> Self {
-        self.state.bakes = bakes;
-        self
-    }
-
-    /// The mesh the project keeps inside itself, if it keeps one.
-    pub fn embedded_mesh(&self) -> Option<&Arc<kapaint_mesh::Mesh>> {
-        self.state.embedded_mesh.as_ref()
-    }
-
-    /// This document with `normal` as its normal map (a loader making it).
-    #[must_use]
-    pub fn with_normal(mut self, normal: Option<Arc<NormalMap>>) -> Self {
-        self.state.normal = normal;
-        self
-    }
-
     /// This document with `settings` (a loader adjusting paths, an importer recording its
     /// report and mesh), as it is made: no undo step.
     #[must_use]
@@ -299,11 +257,6 @@ impl Document {
             self.settings_version += 1;
         }
         Ok(())
-    }
-
-    /// The tangent-space normal map, if the material has one (not painted; never in `k_a`).
-    pub fn normal(&self) -> Option<&Arc<NormalMap>> {
-        self.state.normal.as_ref()
     }
 
     /// The layer stack: read it freely; it changes only through [`Document::apply`].

@@ -1,5 +1,6 @@
 //! What a document is painted on and with: its mesh and the mesh's bake (`SetMesh`), the
-//! bake a loader attaches, and the normal map (`SetNormal`); each change one undo step.
+//! mesh its project keeps, the maps baked from the mesh (`SetBake`), the bake a loader
+//! attaches, and the normal map (`SetNormal`); each change one undo step.
 
 use std::sync::Arc;
 
@@ -9,6 +10,52 @@ use crate::normal::NormalMap;
 use crate::surface::Surface;
 
 impl Document {
+    /// This document with `normal` as its normal map (a loader making it).
+    #[must_use]
+    pub fn with_normal(mut self, normal: Option<Arc<NormalMap>>) -> Self {
+        self.state.normal = normal;
+        self
+    }
+
+    /// The tangent-space normal map, if the material has one (not painted; never in `k_a`).
+    pub fn normal(&self) -> Option<&Arc<NormalMap>> {
+        self.state.normal.as_ref()
+    }
+
+    /// This document with the mesh its project keeps (a loader or `kapaint new --unwrap`
+    /// making it; [`MeshRef::Embedded`](crate::MeshRef::Embedded) names it).
+    #[must_use]
+    pub fn with_embedded_mesh(mut self, mesh: Option<Arc<kapaint_mesh::Mesh>>) -> Self {
+        self.state.embedded_mesh = mesh;
+        self
+    }
+
+    /// The maps baked from the mesh (at most one of each), in the order
+    /// [`BakeMap::ALL`](kapaint_mesh::bakes::BakeMap::ALL) lists them.
+    pub fn bakes(&self) -> &[Arc<kapaint_mesh::bakes::Baked>] {
+        &self.state.bakes
+    }
+
+    /// The bake of `map`, if the document keeps one.
+    pub fn bake_of(
+        &self,
+        map: kapaint_mesh::bakes::BakeMap,
+    ) -> Option<&Arc<kapaint_mesh::bakes::Baked>> {
+        self.state.bakes.iter().find(|b| b.map == map)
+    }
+
+    /// This document with the bakes its project keeps (a loader making it).
+    #[must_use]
+    pub fn with_bakes(mut self, bakes: Vec<Arc<kapaint_mesh::bakes::Baked>>) -> Self {
+        self.state.bakes = bakes;
+        self
+    }
+
+    /// The mesh the project keeps inside itself, if it keeps one.
+    pub fn embedded_mesh(&self) -> Option<&Arc<kapaint_mesh::Mesh>> {
+        self.state.embedded_mesh.as_ref()
+    }
+
     /// This document with the mesh surface that object-space strokes and island/part fills
     /// paint on (the bake of its mesh at the map size), or without one, as it is made or
     /// opened: no undo step (changing the mesh is

@@ -15,8 +15,9 @@ pub(super) fn file_of(map: BakeMap) -> String {
     format!("bake_{}.png", map.name())
 }
 
-/// The bake as a 16-bit PNG.
-pub(super) fn to_png(bake: &Baked) -> Result<Vec<u8>, String> {
+/// The bake as a 16-bit PNG (grey, or RGB for position and normal): as the project keeps it,
+/// and as `kapaint bake --out` writes it.
+pub fn to_png(bake: &Baked) -> Result<Vec<u8>, String> {
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     let mut bytes = Vec::new();
     let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Up);

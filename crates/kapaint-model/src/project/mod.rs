@@ -11,6 +11,7 @@
 //! the first problem as one error; it never panics on any input.
 
 mod bakes;
+pub use bakes::to_png as bake_png;
 pub mod layers;
 pub mod lock;
 mod read;

@@ -13,6 +13,9 @@ use glam::Vec3;
 use kapaint_mesh::bakes::{BakeMap, Baked};
 use serde::{Deserialize, Serialize};
 
+mod file;
+use file::GeneratorFile;
+
 /// Deepest nesting of blends.
 pub const MAX_DEPTH: usize = 4;
 /// Largest noise scale (features per unit of its space).
@@ -66,10 +69,6 @@ pub struct Levels {
     pub invert: bool,
 }
 
-fn one() -> f32 {
-    1.0
-}
-
 /// Noise parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Noise {
@@ -83,10 +82,6 @@ pub struct Noise {
     pub seed: u32,
     /// Where it is laid.
     pub space: Space,
-}
-
-fn one_octave() -> u32 {
-    1
 }
 
 /// Which noise.
@@ -134,141 +129,6 @@ pub enum BlendOp {
     Max,
     /// `min(a + b, 1)`.
     Add,
-}
-
-/// A generator as a file or script spells it (fields in the variant: `Ao(black: 0.2, white:
-/// 0.9)`), before it is checked.
-#[derive(Clone, Serialize, Deserialize)]
-enum GeneratorFile {
-    Ao {
-        black: f32,
-        white: f32,
-        #[serde(default = "one")]
-        gamma: f32,
-        #[serde(default)]
-        invert: bool,
-    },
-    Curvature {
-        black: f32,
-        white: f32,
-        #[serde(default = "one")]
-        gamma: f32,
-        #[serde(default)]
-        invert: bool,
-    },
-    Thickness {
-        black: f32,
-        white: f32,
-        #[serde(default = "one")]
-        gamma: f32,
-        #[serde(default)]
-        invert: bool,
-    },
-    Noise {
-        kind: NoiseKind,
-        scale: f32,
-        #[serde(default = "one_octave")]
-        octaves: u32,
-        #[serde(default)]
-        seed: u32,
-        #[serde(default)]
-        space: Space,
-    },
-    Gradient {
-        axis: Axis,
-        from: f32,
-        to: f32,
-    },
-    Blend {
-        op: BlendOp,
-        a: Box<Generator>,
-        b: Box<Generator>,
-    },
-}
-
-impl TryFrom<GeneratorFile> for Generator {
-    type Error = String;
-
-    fn try_from(f: GeneratorFile) -> Result<Self, String> {
-        use GeneratorFile as F;
-        let levels = |black, white, gamma, invert| Levels {
-            black,
-            white,
-            gamma,
-            invert,
-        };
-        let g = match f {
-            F::Ao {
-                black,
-                white,
-                gamma,
-                invert,
-            } => Self::Ao(levels(black, white, gamma, invert)),
-            F::Curvature {
-                black,
-                white,
-                gamma,
-                invert,
-            } => Self::Curvature(levels(black, white, gamma, invert)),
-            F::Thickness {
-                black,
-                white,
-                gamma,
-                invert,
-            } => Self::Thickness(levels(black, white, gamma, invert)),
-            F::Noise {
-                kind,
-                scale,
-                octaves,
-                seed,
-                space,
-            } => Self::Noise(Noise {
-                kind,
-                scale,
-                octaves,
-                seed,
-                space,
-            }),
-            F::Gradient { axis, from, to } => Self::Gradient { axis, from, to },
-            F::Blend { op, a, b } => Self::Blend { op, a, b },
-        };
-        g.check()?;
-        Ok(g)
-    }
-}
-
-impl From<Generator> for GeneratorFile {
-    fn from(g: Generator) -> Self {
-        match g {
-            Generator::Ao(l) => Self::Ao {
-                black: l.black,
-                white: l.white,
-                gamma: l.gamma,
-                invert: l.invert,
-            },
-            Generator::Curvature(l) => Self::Curvature {
-                black: l.black,
-                white: l.white,
-                gamma: l.gamma,
-                invert: l.invert,
-            },
-            Generator::Thickness(l) => Self::Thickness {
-                black: l.black,
-                white: l.white,
-                gamma: l.gamma,
-                invert: l.invert,
-            },
-            Generator::Noise(n) => Self::Noise {
-                kind: n.kind,
-                scale: n.scale,
-                octaves: n.octaves,
-                seed: n.seed,
-                space: n.space,
-            },
-            Generator::Gradient { axis, from, to } => Self::Gradient { axis, from, to },
-            Generator::Blend { op, a, b } => Self::Blend { op, a, b },
-        }
-    }
 }
 
 impl Levels {
@@ -497,117 +357,4 @@ impl<'a> Node<'a> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn parse(text: &str) -> Result<Generator, String> {
-        ron::from_str(text).map_err(|e| e.to_string())
-    }
-
-    fn texel(p: Vec3) -> Texel {
-        Texel {
-            uv: glam::Vec2::new(p.x, p.z),
-            position: p,
-            normal: Vec3::Y,
-            index: 0,
-        }
-    }
-
-    #[test]
-    fn the_script_spellings_read_and_bad_values_are_refused() {
-        let ao = parse("Ao(black: 0.2, white: 0.9, invert: false)").expect("ao");
-        assert_eq!(ao.bakes_needed(), vec![BakeMap::Ao]);
-        parse("Curvature(black: 0.5, white: 0.7, invert: true)").expect("curvature");
-        parse("Noise(kind: Perlin, scale: 8.0, octaves: 4, seed: 1, space: Object)")
-            .expect("noise");
-        parse("Noise(kind: Worley, scale: 3.0)").expect("defaults");
-        let blend = parse(
-            "Blend(op: Multiply, a: Curvature(black: 0.5, white: 0.7), \
-             b: Noise(kind: Simplex, scale: 4.0, space: Triplanar))",
-        )
-        .expect("blend");
-        assert_eq!(blend.bakes_needed(), vec![BakeMap::Curvature]);
-        for bad in [
-            "Ao(black: NaN, white: 0.9)",
-            "Ao(black: 0.9, white: 0.2)",
-            "Ao(black: 0.1, white: 1.5)",
-            "Ao(black: 0.1, white: 0.5, gamma: 0.0)",
-            "Noise(kind: Perlin, scale: inf)",
-            "Noise(kind: Perlin, scale: -1.0)",
-            "Noise(kind: Perlin, scale: 2.0, octaves: 0)",
-            "Noise(kind: Perlin, scale: 2.0, octaves: 9)",
-            "Gradient(axis: Y, from: 0.5, to: 0.5)",
-            "Gradient(axis: Y, from: NaN, to: 0.5)",
-            "Shadow(black: 0.1, white: 0.2)",
-        ] {
-            assert!(parse(bad).is_err(), "{bad} was accepted");
-        }
-        // Blends nest at most MAX_DEPTH deep.
-        let mut deep = "Noise(kind: Perlin, scale: 1.0)".to_string();
-        for _ in 0..=MAX_DEPTH {
-            deep = format!("Blend(op: Max, a: {deep}, b: Noise(kind: Perlin, scale: 1.0))");
-        }
-        assert!(parse(&deep).is_err());
-    }
-
-    #[test]
-    fn a_generator_writes_as_it_reads() {
-        let g = parse(
-            "Blend(op: Add, a: Thickness(black: 0.1, white: 0.4, gamma: 2.0, invert: true), \
-             b: Gradient(axis: Z, from: 1.0, to: 0.0))",
-        )
-        .expect("reads");
-        let text = ron::to_string(&g).expect("writes");
-        assert_eq!(parse(&text).expect("reads back"), g);
-        let json = serde_json::to_string(&g).expect("json");
-        assert_eq!(
-            serde_json::from_str::<Generator>(&json).expect("json back"),
-            g
-        );
-    }
-
-    #[test]
-    fn values_stay_in_range_and_follow_their_parameters() {
-        let no_bakes: Vec<std::sync::Arc<Baked>> = Vec::new();
-        for kind in [NoiseKind::Perlin, NoiseKind::Simplex, NoiseKind::Worley] {
-            for space in [Space::Uv, Space::Object, Space::Triplanar] {
-                let g = Generator::Noise(Noise {
-                    kind,
-                    scale: 6.0,
-                    octaves: 3,
-                    seed: 7,
-                    space,
-                });
-                let e = Evaluator::new(&g, &no_bakes);
-                let values: Vec<f32> = (0..400)
-                    .map(|i| {
-                        let p = Vec3::new((i % 20) as f32 / 20.0, 0.3, (i / 20) as f32 / 20.0);
-                        e.value(&texel(p))
-                    })
-                    .collect();
-                assert!(values.iter().all(|v| (0.0..=1.0).contains(v)));
-                let spread = values.iter().copied().fold(f32::MIN, f32::max)
-                    - values.iter().copied().fold(f32::MAX, f32::min);
-                assert!(spread > 0.2, "{kind:?} {space:?} is flat: {spread}");
-            }
-        }
-        let ramp = Generator::Gradient {
-            axis: Axis::Y,
-            from: 0.25,
-            to: 0.75,
-        };
-        let e = Evaluator::new(&ramp, &no_bakes);
-        assert_eq!(e.value(&texel(Vec3::new(0.0, 0.0, 0.0))), 0.0);
-        assert_eq!(e.value(&texel(Vec3::new(0.0, 0.5, 0.0))), 0.5);
-        assert_eq!(e.value(&texel(Vec3::new(0.0, 1.0, 0.0))), 1.0);
-        let levels = Levels {
-            black: 0.2,
-            white: 0.6,
-            gamma: 1.0,
-            invert: true,
-        };
-        assert_eq!(levels.apply(0.1), 1.0);
-        assert!((levels.apply(0.4) - 0.5).abs() < 1e-6);
-        assert_eq!(levels.apply(0.9), 0.0);
-    }
-}
+mod tests;

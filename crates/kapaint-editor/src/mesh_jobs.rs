@@ -1,0 +1,177 @@
+//! Mesh jobs: a mesh imported (and the question when its UVs cannot be painted as they are),
+//! unwrapped on request, or baked, each on a worker; and what the editor does when one ends.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use super::jobs::{JobResult, UnwrapPrompt};
+use super::{EditorState, notice};
+use kapaint_core::mesh::unwrap;
+use kapaint_core::model::ImportCommand;
+use kapaint_core::model::document::MeshRef;
+use kapaint_core::model::surface::Surface;
+use kapaint_core::task::Progress;
+
+/// Fraction of a mesh's texels claimed twice above which the editor offers to unwrap it.
+const OVERLAP_OFFER: f64 = 0.01;
+
+impl EditorState {
+    /// What a mesh job made: a mesh to bake, a question, a bake, an unwrapped mesh.
+    pub(super) fn mesh_arrived(&mut self, result: JobResult) {
+        match result {
+            JobResult::Mesh(path, surface, textured) => {
+                if textured {
+                    self.material_prompt = Some(path.clone());
+                }
+                let mesh = MeshRef::from_spec(&path.display().to_string());
+                let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
+                match self.doc.apply(ImportCommand::SetMesh(attached)) {
+                    Ok(()) => {
+                        self.follow_mesh();
+                        self.notices
+                            .push(notice(format!("mesh {}", path.display()), false));
+                    }
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::NeedsUnwrap(prompt) => self.unwrap_prompt = Some(prompt),
+            JobResult::Baked(baked, stats) => {
+                let name = baked.map.name();
+                let bake = kapaint_core::model::document::AttachedBake(baked);
+                match self.doc.apply(ImportCommand::SetBake(bake)) {
+                    Ok(()) => self.notices.push(notice(
+                        format!(
+                            "baked {name}: {} texels, mean {:.3}, min {:.3}",
+                            stats.texels, stats.mean, stats.min
+                        ),
+                        false,
+                    )),
+                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                }
+            }
+            JobResult::Unwrapped(path, surface, summary) => {
+                let attached = kapaint_core::model::document::AttachedMesh {
+                    mesh: MeshRef::Embedded(surface.mesh.name.clone()),
+                    surface,
+                };
+                match self.doc.apply(ImportCommand::SetMesh(attached)) {
+                    Ok(()) => {
+                        self.follow_mesh();
+                        self.notices.push(notice(summary, false));
+                    }
+                    Err(e) => self
+                        .notices
+                        .push(notice(format!("{}: {e}", path.display()), true)),
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Loads and bakes a mesh on a worker; it becomes the project's mesh. A mesh without UVs,
+    /// or whose UVs overlap, comes back as a question: unwrap it, keep its UVs, or cancel.
+    pub fn import_mesh(&mut self, path: PathBuf) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Mesh", move |progress| {
+            progress.start("load", 1);
+            let mesh = match kapaint_core::mesh::open(&path) {
+                Ok(m) => m,
+                Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
+            };
+            progress.start("check UVs", 1);
+            let why = if mesh.uvs.is_none() {
+                Some("has no UVs, so no texel knows where on the surface it is".to_string())
+            } else {
+                let overlap = unwrap::uv_overlap(&mesh, w.min(h).min(2048));
+                (overlap > OVERLAP_OFFER).then(|| {
+                    format!(
+                        "has UVs that overlap: {:.0} % of its texels are shared by two places                          of the surface, so painting one paints the other",
+                        100.0 * overlap
+                    )
+                })
+            };
+            if let Some(why) = why {
+                return JobResult::NeedsUnwrap(UnwrapPrompt {
+                    has_uvs: mesh.uvs.is_some(),
+                    path,
+                    mesh: Arc::new(mesh),
+                    why,
+                });
+            }
+            Self::bake_mesh(path, mesh, (w, h), progress)
+        });
+    }
+
+    /// Mesh > Unwrap automatically: asks, for the project's mesh, whether to replace its UVs
+    /// with a new atlas.
+    pub fn ask_unwrap(&mut self) {
+        let Some(surface) = self.doc.surface() else {
+            self.notices
+                .push(notice("there is no mesh to unwrap", true));
+            return;
+        };
+        let mesh = Arc::new(surface.mesh.clone());
+        let why = if mesh.uvs.is_some() {
+            "is painted on its own UVs: a new atlas replaces them, and what is painted stays \
+             where it is on the map, so it no longer sits on the same places of the surface"
+        } else {
+            "has no UVs"
+        };
+        self.unwrap_prompt = Some(UnwrapPrompt {
+            path: PathBuf::from(self.doc.settings().mesh.spec()),
+            mesh,
+            why: why.to_string(),
+            has_uvs: false,
+        });
+    }
+
+    /// Bakes a mesh whose UVs are kept as they are (the answer "Keep its UVs").
+    pub(super) fn keep_mesh_uvs(&mut self, prompt: UnwrapPrompt) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Mesh", move |progress| {
+            Self::bake_mesh(prompt.path, (*prompt.mesh).clone(), (w, h), progress)
+        });
+    }
+
+    fn bake_mesh(
+        path: PathBuf,
+        mesh: kapaint_core::mesh::Mesh,
+        (w, h): (u32, u32),
+        progress: &Progress,
+    ) -> JobResult {
+        progress.start("bake", 1);
+        match Surface::new(mesh, w, h) {
+            Ok(s) => {
+                let textured = kapaint_core::pbr::gltf::has_textured_material(&path);
+                JobResult::Mesh(path, Arc::new(s), textured)
+            }
+            Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+        }
+    }
+
+    /// Unwraps a mesh on a worker (progress and Cancel in the status bar) and bakes it; the
+    /// project keeps the unwrapped mesh (the answer "Unwrap automatically").
+    pub(super) fn unwrap_mesh(&mut self, prompt: UnwrapPrompt) {
+        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
+        self.start_job("Unwrap", move |progress| {
+            let options = unwrap::UnwrapOptions::for_size(w.min(h).max(64));
+            let mut done = match unwrap::unwrap(&prompt.mesh, options, Some(progress)) {
+                Ok(done) => done,
+                Err(e) => return JobResult::Failed(format!("{}: {e}", prompt.path.display())),
+            };
+            let summary = format!(
+                "{} unwrapped: {} charts, {:.0} % of the map covered",
+                prompt.path.display(),
+                done.charts,
+                100.0 * done.coverage
+            );
+            let base = done.mesh.name.trim_end_matches(", unwrapped").to_string();
+            done.mesh.name = format!("{base}, unwrapped");
+            progress.start("bake", 1);
+            match Surface::new(done.mesh, w, h) {
+                Ok(s) => JobResult::Unwrapped(prompt.path, Arc::new(s), summary),
+                Err(e) => JobResult::Failed(format!("{}: {e}", prompt.path.display())),
+            }
+        });
+    }
+}

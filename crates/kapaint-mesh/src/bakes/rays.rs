@@ -1,0 +1,158 @@
+//! Rays against the mesh: a BVH for occlusion and distance, and the direction set a bake
+//! casts about each texel's normal.
+
+use glam::{Vec3, Vec3A};
+use obvhs::cwbvh::CwBvh;
+use obvhs::ray::Ray;
+use obvhs::triangle::Triangle;
+
+use crate::Mesh;
+
+/// A BVH of the mesh for occlusion and distance rays.
+pub struct RayMesh {
+    bvh: CwBvh,
+    /// The triangles in the BVH's order (no lookup through its primitive indices per test).
+    triangles: Vec<Triangle>,
+    /// The bounding box's diagonal.
+    pub diagonal: f32,
+}
+
+impl RayMesh {
+    /// Builds the BVH of `mesh`'s triangles.
+    pub fn new(mesh: &Mesh) -> Self {
+        let triangles: Vec<Triangle> = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [v0, v1, v2] = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
+                Triangle { v0, v1, v2 }
+            })
+            .collect();
+        // A slower build for fewer node visits: a mesh is built once and cast millions of
+        // rays at.
+        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &triangles,
+            obvhs::BvhBuildParams::slow_build(),
+            &mut std::time::Duration::default(),
+        );
+        let triangles = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| triangles[i as usize])
+            .collect();
+        let (lo, hi) = mesh.bounds();
+        Self {
+            bvh,
+            triangles,
+            diagonal: (hi - lo).length(),
+        }
+    }
+
+    /// Whether a ray from `origin` along unit `dir` meets the mesh before `far`.
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
+        let ray = Ray::new(origin.into(), dir.into(), 0.0, far);
+        !self
+            .bvh
+            .ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
+    }
+
+    /// The distance along a ray from `origin` along unit `dir` to the mesh, if it meets it
+    /// before `far`.
+    pub fn distance(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
+        let ray = Ray::new(origin.into(), dir.into(), 0.0, far);
+        let mut hit = obvhs::ray::RayHit::none();
+        self.bvh
+            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
+            .then_some(hit.t)
+    }
+
+    /// The cosine-weighted fraction of the `set`'s directions around unit `normal` from
+    /// `point` that meet nothing before `far`; the set is turned by `turn` about the normal.
+    pub fn open_fraction(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        set: &Directions,
+        far: f32,
+        turn: f32,
+    ) -> f32 {
+        let origin = point + normal * self.offset();
+        let open = set
+            .around(normal, turn)
+            .filter(|&dir| !self.occluded(origin, dir, far))
+            .count();
+        open as f32 / set.len() as f32
+    }
+
+    /// The mean of `min(distance, far) / far` over the `set`'s directions around unit
+    /// `normal` from `point`, turned by `turn`.
+    pub fn mean_distance(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        set: &Directions,
+        far: f32,
+        turn: f32,
+    ) -> f32 {
+        let origin = point + normal * self.offset();
+        let sum: f32 = set
+            .around(normal, turn)
+            .map(|dir| self.distance(origin, dir, far).map_or(1.0, |t| t / far))
+            .sum();
+        sum / set.len() as f32
+    }
+
+    /// How far a ray starts off the surface: clear of the triangle it leaves, close enough to
+    /// see a neighbour.
+    fn offset(&self) -> f32 {
+        self.diagonal * 1e-5
+    }
+}
+
+/// A cosine-weighted Hammersley set of directions about `+z`, made once per bake; each texel
+/// turns it about its own normal.
+pub struct Directions(Vec<Vec3>);
+
+impl Directions {
+    /// `n` directions.
+    pub fn new(n: u32) -> Self {
+        Self(
+            (0..n)
+                .map(|k| {
+                    let u = (k as f32 + 0.5) / n as f32;
+                    let v = k.reverse_bits() as f32 / 4_294_967_296.0;
+                    let r = u.sqrt();
+                    let phi = std::f32::consts::TAU * v;
+                    Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u).max(0.0).sqrt())
+                })
+                .collect(),
+        )
+    }
+
+    /// How many.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// The set about unit `normal`, turned by `turn` (a fraction of a full turn).
+    pub(super) fn around(&self, normal: Vec3, turn: f32) -> impl Iterator<Item = Vec3> + '_ {
+        let (t, b) = normal.any_orthonormal_pair();
+        let (sin, cos) = (std::f32::consts::TAU * turn).sin_cos();
+        let (t, b) = (t * cos + b * sin, b * cos - t * sin);
+        self.0.iter().map(move |d| t * d.x + b * d.y + normal * d.z)
+    }
+}
+
+/// A per-texel turn in `[0, 1)` from a hash of its index.
+pub(super) fn turn_of(i: usize) -> f32 {
+    let mut h = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    h ^= h >> 29;
+    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    h ^= h >> 32;
+    (h & 0x00FF_FFFF) as f32 / 16_777_216.0
+}

@@ -1,0 +1,151 @@
+//! A generator as scripts and project files spell it: the fields in the variant (`Ao(black:
+//! 0.2, white: 0.9)`), read and checked into a [`Generator`], and written back the same way.
+
+use serde::{Deserialize, Serialize};
+
+use super::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
+
+/// A generator as a file or script spells it (fields in the variant: `Ao(black: 0.2, white:
+/// 0.9)`), before it is checked.
+#[derive(Clone, Serialize, Deserialize)]
+pub(super) enum GeneratorFile {
+    Ao {
+        black: f32,
+        white: f32,
+        #[serde(default = "one")]
+        gamma: f32,
+        #[serde(default)]
+        invert: bool,
+    },
+    Curvature {
+        black: f32,
+        white: f32,
+        #[serde(default = "one")]
+        gamma: f32,
+        #[serde(default)]
+        invert: bool,
+    },
+    Thickness {
+        black: f32,
+        white: f32,
+        #[serde(default = "one")]
+        gamma: f32,
+        #[serde(default)]
+        invert: bool,
+    },
+    Noise {
+        kind: NoiseKind,
+        scale: f32,
+        #[serde(default = "one_octave")]
+        octaves: u32,
+        #[serde(default)]
+        seed: u32,
+        #[serde(default)]
+        space: Space,
+    },
+    Gradient {
+        axis: Axis,
+        from: f32,
+        to: f32,
+    },
+    Blend {
+        op: BlendOp,
+        a: Box<Generator>,
+        b: Box<Generator>,
+    },
+}
+
+impl TryFrom<GeneratorFile> for Generator {
+    type Error = String;
+
+    fn try_from(f: GeneratorFile) -> Result<Self, String> {
+        use GeneratorFile as F;
+        let levels = |black, white, gamma, invert| Levels {
+            black,
+            white,
+            gamma,
+            invert,
+        };
+        let g = match f {
+            F::Ao {
+                black,
+                white,
+                gamma,
+                invert,
+            } => Self::Ao(levels(black, white, gamma, invert)),
+            F::Curvature {
+                black,
+                white,
+                gamma,
+                invert,
+            } => Self::Curvature(levels(black, white, gamma, invert)),
+            F::Thickness {
+                black,
+                white,
+                gamma,
+                invert,
+            } => Self::Thickness(levels(black, white, gamma, invert)),
+            F::Noise {
+                kind,
+                scale,
+                octaves,
+                seed,
+                space,
+            } => Self::Noise(Noise {
+                kind,
+                scale,
+                octaves,
+                seed,
+                space,
+            }),
+            F::Gradient { axis, from, to } => Self::Gradient { axis, from, to },
+            F::Blend { op, a, b } => Self::Blend { op, a, b },
+        };
+        g.check()?;
+        Ok(g)
+    }
+}
+
+impl From<Generator> for GeneratorFile {
+    fn from(g: Generator) -> Self {
+        match g {
+            Generator::Ao(l) => Self::Ao {
+                black: l.black,
+                white: l.white,
+                gamma: l.gamma,
+                invert: l.invert,
+            },
+            Generator::Curvature(l) => Self::Curvature {
+                black: l.black,
+                white: l.white,
+                gamma: l.gamma,
+                invert: l.invert,
+            },
+            Generator::Thickness(l) => Self::Thickness {
+                black: l.black,
+                white: l.white,
+                gamma: l.gamma,
+                invert: l.invert,
+            },
+            Generator::Noise(n) => Self::Noise {
+                kind: n.kind,
+                scale: n.scale,
+                octaves: n.octaves,
+                seed: n.seed,
+                space: n.space,
+            },
+            Generator::Gradient { axis, from, to } => Self::Gradient { axis, from, to },
+            Generator::Blend { op, a, b } => Self::Blend { op, a, b },
+        }
+    }
+}
+
+/// A straight levels curve, the default.
+fn one() -> f32 {
+    1.0
+}
+
+/// One octave, the default.
+fn one_octave() -> u32 {
+    1
+}
