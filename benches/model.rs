@@ -443,6 +443,93 @@ fn layered_project_io(c: &mut Criterion) {
     group.finish();
 }
 
+/// A `side x side` document of `masks` fill layers over the base, each masked by a noise
+/// generator (`generated`) or by a painted mask holding the same values as pixels.
+fn masked_document(side: u32, masks: usize, generated: bool) -> Document {
+    use kapaint::model::MaskCommand;
+    let mut doc = Document::new(side, side, DocumentSettings::default()).expect("size");
+    for k in 0..masks {
+        doc.apply(LayerCommand::AddLayer {
+            kind: kapaint::model::LayerKind::Fill,
+            name: format!("Dirt {k}"),
+        })
+        .expect("layer");
+        doc.apply(MaskCommand::SetMaskGenerator(Some(noise(8.0, k as u32))))
+            .expect("generator");
+        if !generated {
+            doc.apply(MaskCommand::SetMaskGenerator(None))
+                .expect("pixels");
+        }
+    }
+    doc
+}
+
+/// Perlin fBm, 4 octaves, in object space.
+fn noise(scale: f32, seed: u32) -> kapaint::model::generator::Generator {
+    use kapaint::model::generator::{Generator, Noise, NoiseKind, Space};
+    Generator::Noise(Noise {
+        kind: NoiseKind::Perlin,
+        scale,
+        octaves: 4,
+        seed,
+        space: Space::Object,
+    })
+}
+
+/// Generator masks (issue 41): a drag's coarse preview at 2048^2 (<= 150 ms), the full
+/// result at 4096^2 (<= 1 s), and saving and opening 8 generator masks against 8 painted
+/// masks of the same values at 4096^2 (no slower).
+fn generators(c: &mut Criterion) {
+    use kapaint::model::MaskCommand;
+    let mut group = c.benchmark_group("generators");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    let mut doc = masked_document(2048, 1, true);
+    let mut s = 8.0;
+    group.bench_function("drag_noise_2048_coarse", |b| {
+        b.iter(|| {
+            s += 0.01;
+            doc.apply(MaskCommand::PreviewMaskGenerator(noise(s, 0)))
+                .expect("preview");
+        });
+    });
+    group.bench_function("drag_noise_2048_full", |b| {
+        b.iter(|| {
+            s += 0.01;
+            doc.apply(MaskCommand::SetMaskGenerator(Some(noise(s, 0))))
+                .expect("set");
+        });
+    });
+    let mut doc = masked_document(SIDE, 1, true);
+    group.bench_function("settle_noise_4096", |b| {
+        b.iter(|| {
+            s += 0.01;
+            doc.apply(MaskCommand::SetMaskGenerator(Some(noise(s, 0))))
+                .expect("set");
+        });
+    });
+    drop(doc);
+    let dir = std::env::temp_dir().join(format!("kapaint-bench-gen-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    for (name, generated) in [("painted", false), ("generated", true)] {
+        let doc = masked_document(SIDE, 8, generated);
+        let path = dir.join(format!("{name}.kapaint"));
+        group.bench_function(format!("save_8_{name}_masks_4096"), |b| {
+            b.iter(|| project::save(&doc, &path).expect("save"));
+        });
+        eprintln!(
+            "8 {name} masks: {} MB",
+            std::fs::metadata(&path).map_or(0, |m| m.len() / 1_000_000)
+        );
+        group.bench_function(format!("open_8_{name}_masks_4096"), |b| {
+            b.iter(|| black_box(project::load(&path).expect("load")));
+        });
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    group.finish();
+}
+
 criterion_group!(
     benches,
     dabs,
@@ -451,6 +538,7 @@ criterion_group!(
     autosave,
     resize,
     layers,
-    layered_project_io
+    layered_project_io,
+    generators
 );
 criterion_main!(benches);

@@ -81,6 +81,8 @@ impl Editor {
             super::panels::presets::load_material_presets(preset_dir.as_deref(), &mut notices);
         let brush_presets =
             super::panels::presets::load_brush_presets(preset_dir.as_deref(), &mut notices);
+        let mask_presets =
+            super::panels::generator::load_mask_presets(preset_dir.as_deref(), &mut notices);
         let dock = load_layout().unwrap_or_else(default_layout);
         let saved_version = doc.version();
         let mut editor = Self {
@@ -125,6 +127,7 @@ impl Editor {
                 recovery_offer,
                 presets,
                 brush_presets,
+                mask_presets,
                 naming: None,
                 preset_dir,
                 autosaver,

@@ -246,6 +246,8 @@ pub struct EditorState {
     presets: Vec<panels::presets::PresetEntry>,
     /// Brush presets, shipped and the user's.
     brush_presets: Vec<kapaint_core::model::brush::preset::BrushPreset>,
+    /// Smart masks, shipped and the user's.
+    mask_presets: Vec<kapaint_core::model::generator::preset::MaskPreset>,
     /// The user preset folder presets are saved to.
     preset_dir: Option<PathBuf>,
     /// A preset's name being typed, what it names, and whether its field opened this frame.

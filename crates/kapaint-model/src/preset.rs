@@ -86,7 +86,7 @@ impl MaterialPreset {
 }
 
 /// The text of a preset file: a regular file of at most `max_bytes`, UTF-8; errors name it.
-pub(super) fn read_text(path: &Path, max_bytes: u64) -> Result<String, ModelError> {
+pub(crate) fn read_text(path: &Path, max_bytes: u64) -> Result<String, ModelError> {
     let bytes = kapaint_base::file_check::read_limited(path, max_bytes).map_err(|e| match e {
         kapaint_base::file_check::FileCheck::Io(source) => ModelError::io(path, source),
         other => ModelError::Preset {
@@ -218,7 +218,7 @@ pub fn save_user(
 }
 
 /// The `.ron` files in `dir`, sorted by name (none where it cannot be read).
-pub(super) fn ron_files(dir: &Path) -> Vec<PathBuf> {
+pub(crate) fn ron_files(dir: &Path) -> Vec<PathBuf> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Vec::new();
     };

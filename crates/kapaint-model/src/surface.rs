@@ -63,6 +63,8 @@ pub struct Surface {
     pub mesh: Mesh,
     /// Its UV bake at the map resolution.
     pub bake: UvBake,
+    /// [`Mesh::content_hash`] of the mesh (what generators and bakes know it by).
+    pub mesh_hash: u64,
     /// Object units per texel (square root of the mesh's surface area over its UV area in
     /// texels): converts brush radius and spacing from texels to object units.
     pub units_per_texel: f32,
@@ -113,6 +115,7 @@ impl Surface {
             .collect();
         let units_per_texel = units_per_texel(&mesh, width, height);
         Ok(Self {
+            mesh_hash: mesh.content_hash(),
             mesh,
             bake,
             units_per_texel,

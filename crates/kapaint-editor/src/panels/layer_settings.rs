@@ -55,6 +55,7 @@ impl EditorState {
                 .into_iter()
                 .map(Command::from),
         );
+        self.generator_ui(ui, &layer);
         ui.horizontal_wrapped(|ui| {
             for (text, m) in [
                 ("Up", LayerMove::Up),

@@ -97,6 +97,8 @@ pub struct PanelState {
     pub(super) rename: Option<String>,
     /// The maps a layer view shows.
     pub(crate) view_maps: crate::layer_view::ViewMaps,
+    /// The mask generator's live thumbnail and the document version it shows.
+    pub(super) generator_thumb: Option<(u64, egui::TextureHandle)>,
 }
 
 /// What a row asked for this frame.

@@ -4,6 +4,7 @@
 
 mod bars;
 pub mod colour;
+pub(super) mod generator;
 mod layer_settings;
 pub mod layers;
 pub(super) mod presets;

@@ -28,6 +28,8 @@ pub(crate) enum Naming {
     Material,
     /// The brush settings, as a brush preset.
     Brush,
+    /// The selected layer's mask generator, as a smart mask.
+    Mask,
 }
 
 /// The shipped material presets, then the user's (a malformed user file is a notice, not a
@@ -178,7 +180,7 @@ impl EditorState {
     }
 
     /// A button that opens a name field, then saves what `kind` names under that name.
-    fn naming_ui(&mut self, ui: &mut egui::Ui, kind: Naming, button: &str) {
+    pub(super) fn naming_ui(&mut self, ui: &mut egui::Ui, kind: Naming, button: &str) {
         match &mut self.naming {
             Some((k, name, just_opened)) if *k == kind => {
                 let mut save = false;
@@ -248,6 +250,28 @@ impl EditorState {
                     self.brush_presets.push(preset);
                     Ok(path)
                 }),
+            Naming::Mask => self
+                .preset_dir
+                .as_ref()
+                .map(|d| d.join("masks"))
+                .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
+                .and_then(|dir| {
+                    let mask = self
+                        .doc
+                        .selected_layer()
+                        .and_then(|l| l.mask.as_ref())
+                        .and_then(|m| m.generator())
+                        .cloned()
+                        .ok_or("the selected layer's mask is not made by a generator")?;
+                    let preset = kapaint_core::model::generator::preset::MaskPreset {
+                        name: name.trim().to_string(),
+                        mask,
+                    };
+                    let path = preset.save(&dir).map_err(|e| e.to_string())?;
+                    self.mask_presets.retain(|p| p.name != preset.name);
+                    self.mask_presets.push(preset);
+                    Ok(path)
+                }),
         };
         match saved {
             Ok(path) => {
@@ -274,6 +298,7 @@ impl EditorState {
         let dir = self.preset_dir.clone();
         self.presets = load_material_presets(dir.as_deref(), &mut self.notices);
         self.brush_presets = load_brush_presets(dir.as_deref(), &mut self.notices);
+        self.mask_presets = super::generator::load_mask_presets(dir.as_deref(), &mut self.notices);
     }
 
     /// The names of the material presets, as the browser shows them.

@@ -247,7 +247,7 @@ pub enum LayerCommand {
 }
 
 /// The selected layer's mask; each change is one undo step.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum MaskCommand {
     /// Adds a white mask to the selected layer.
     AddMask,
@@ -271,6 +271,14 @@ pub enum MaskCommand {
         /// The threshold.
         threshold: f32,
     },
+    /// Makes the selected layer's mask by a generator (a mask is added if the layer has
+    /// none), keeping what is painted over the generator it had; `None` turns the mask back
+    /// into pixels, keeping what it showed.
+    SetMaskGenerator(Option<crate::generator::Generator>),
+    /// The editor's drag of a generator parameter: the mask made coarsely by `generator`
+    /// (one value per 4 x 4 texels), joining the step of the previews before it; the
+    /// `SetMaskGenerator` that ends the drag joins it too.
+    PreviewMaskGenerator(crate::generator::Generator),
 }
 
 macro_rules! room {

@@ -249,7 +249,7 @@ impl Document {
         let id = self.state.selection.id;
         let opacity = opacity.clamp(0.0, 1.0);
         let joined = id.is_some() && run == id && !self.stroking();
-        match self.history.take_last(LABEL).filter(|_| joined) {
+        match joined.then(|| self.history.take_last(LABEL)).flatten() {
             Some(before) => {
                 selected_mut(&mut self.state)?.props.opacity = opacity;
                 self.commit(LABEL, before);

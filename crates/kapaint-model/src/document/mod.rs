@@ -119,6 +119,9 @@ pub struct Document {
     /// The layer whose opacity the last command set: the next opacity change of that layer
     /// joins its undo step (a slider's drag is one step).
     opacity_run: Option<LayerId>,
+    /// The layer whose mask generator the last command previewed (a drag in progress): the
+    /// next change of it joins that step.
+    generator_run: Option<LayerId>,
     /// Which document this is: kept in its project file and its recovery journal, so a
     /// journal is only ever recovered into the project it was written for.
     id: DocumentId,
@@ -167,10 +170,11 @@ impl Document {
     /// same content, mesh surface and version.
     #[must_use]
     pub fn snapshot(&self) -> Self {
-        let mut doc = Self::assemble(
+        let mut doc = Self::assemble_with(
             self.maps.clone(),
             self.state.stack.clone(),
             self.settings.clone(),
+            self.compositor.clone(),
         );
         doc.state = self.state.clone();
         doc.settings_version = self.settings_version;
@@ -218,6 +222,40 @@ impl Document {
     fn assemble(mut maps: MaterialMaps, stack: LayerStack, settings: DocumentSettings) -> Self {
         let mut compositor = Compositor::new();
         compositor.update(&stack, &mut maps);
+        Self::assemble_with(maps, stack, settings, compositor)
+    }
+
+    /// A document around a layer stack and `maps`, its composite as a project stored it (a
+    /// version 4 project with generator masks: what they made is not computed again until
+    /// something they read or shape changes).
+    ///
+    /// # Errors
+    /// Maps of another size than the stack.
+    pub fn from_stack_and_composite(
+        mut stack: LayerStack,
+        maps: MaterialMaps,
+        settings: DocumentSettings,
+    ) -> Result<Self, ModelError> {
+        if (maps.width(), maps.height()) != (stack.width, stack.height) {
+            return Err(ModelError::Internal(format!(
+                "the composite is {}x{} but the layers are {}x{}",
+                maps.width(),
+                maps.height(),
+                stack.width,
+                stack.height
+            )));
+        }
+        stack.make_ids_unique();
+        let compositor = Compositor::primed(&stack);
+        Ok(Self::assemble_with(maps, stack, settings, compositor))
+    }
+
+    fn assemble_with(
+        maps: MaterialMaps,
+        stack: LayerStack,
+        settings: DocumentSettings,
+        compositor: Compositor,
+    ) -> Self {
         let id = stack.layer(&topmost_paintable(&stack)).map(|l| l.props.id);
         Self {
             maps,
@@ -239,6 +277,7 @@ impl Document {
             settings_version: 0,
             revisions: 0,
             opacity_run: None,
+            generator_run: None,
             id: DocumentId::random(),
         }
     }
@@ -307,6 +346,12 @@ impl Document {
 
     /// Records `before` as one undo step, the state now as a new revision.
     fn record(&mut self, label: &str, before: State) {
+        let stack = &self.state.stack;
+        let same_size = (stack.width, stack.height) == (self.maps.width(), self.maps.height());
+        // A resize composites anew after it is recorded.
+        if masks::lay_generators(&mut self.state) && same_size {
+            self.compositor.update(&self.state.stack, &mut self.maps);
+        }
         self.revisions += 1;
         self.state.revision = self.revisions;
         self.history.push(label, before, &self.state);
@@ -369,6 +414,7 @@ impl Document {
         let command = command.into();
         self.check_memory(&command)?;
         let opacity_run = self.opacity_run.take();
+        let generator_run = self.generator_run.take();
         match command {
             Command::Settings(c) => {
                 self.settings_command(c);
@@ -382,7 +428,7 @@ impl Document {
                 Ok(())
             }
             Command::Layer(c) => self.layer_command(c, opacity_run),
-            Command::Mask(c) => self.mask_command(c),
+            Command::Mask(c) => self.mask_command(c, generator_run),
         }
     }
 

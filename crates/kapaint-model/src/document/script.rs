@@ -95,6 +95,7 @@ pub(super) enum ScriptCommand {
         #[serde(deserialize_with = "crate::check::finite_f32")]
         threshold: f32,
     },
+    SetMaskGenerator(crate::generator::MaskGenerator),
     Group,
     Ungroup,
 }
@@ -164,6 +165,7 @@ impl From<ScriptCommand> for Command {
             S::MaskFromChannel { channel, threshold } => {
                 MaskCommand::MaskFromChannel { channel, threshold }.into()
             }
+            S::SetMaskGenerator(g) => MaskCommand::SetMaskGenerator(g.0).into(),
         }
     }
 }

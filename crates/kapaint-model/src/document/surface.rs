@@ -48,7 +48,15 @@ impl Document {
     #[must_use]
     pub fn with_bakes(mut self, bakes: Vec<Arc<kapaint_mesh::bakes::Baked>>) -> Self {
         self.state.bakes = bakes;
+        self.lay_generators();
         self
+    }
+
+    /// Lays the generator masks again on what they read now, and composites what changed.
+    fn lay_generators(&mut self) {
+        if super::masks::lay_generators(&mut self.state) {
+            self.compositor.update(&self.state.stack, &mut self.maps);
+        }
     }
 
     /// The mesh the project keeps inside itself, if it keeps one.
@@ -87,6 +95,7 @@ impl Document {
             self.state.bakes.retain(|b| b.mesh_hash == hash);
         }
         self.state.surface = surface;
+        self.lay_generators();
         Ok(())
     }
 

@@ -9,6 +9,8 @@ use super::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
 /// 0.9)`), before it is checked.
 #[derive(Clone, Serialize, Deserialize)]
 pub(super) enum GeneratorFile {
+    /// No generator (only where one may be absent: `SetMaskGenerator(None)`).
+    None,
     Ao {
         black: f32,
         white: f32,
@@ -48,6 +50,24 @@ pub(super) enum GeneratorFile {
         from: f32,
         to: f32,
     },
+    Facing {
+        axis: Axis,
+        black: f32,
+        white: f32,
+        #[serde(default = "one")]
+        gamma: f32,
+        #[serde(default)]
+        invert: bool,
+    },
+    Remap {
+        black: f32,
+        white: f32,
+        #[serde(default = "one")]
+        gamma: f32,
+        #[serde(default)]
+        invert: bool,
+        of: Box<Generator>,
+    },
     Blend {
         op: BlendOp,
         a: Box<Generator>,
@@ -67,6 +87,7 @@ impl TryFrom<GeneratorFile> for Generator {
             invert,
         };
         let g = match f {
+            F::None => return Err("None is not a generator here".into()),
             F::Ao {
                 black,
                 white,
@@ -99,6 +120,26 @@ impl TryFrom<GeneratorFile> for Generator {
                 space,
             }),
             F::Gradient { axis, from, to } => Self::Gradient { axis, from, to },
+            F::Facing {
+                axis,
+                black,
+                white,
+                gamma,
+                invert,
+            } => Self::Facing {
+                axis,
+                levels: levels(black, white, gamma, invert),
+            },
+            F::Remap {
+                black,
+                white,
+                gamma,
+                invert,
+                of,
+            } => Self::Remap {
+                levels: levels(black, white, gamma, invert),
+                of,
+            },
             F::Blend { op, a, b } => Self::Blend { op, a, b },
         };
         g.check()?;
@@ -135,6 +176,20 @@ impl From<Generator> for GeneratorFile {
                 space: n.space,
             },
             Generator::Gradient { axis, from, to } => Self::Gradient { axis, from, to },
+            Generator::Facing { axis, levels: l } => Self::Facing {
+                axis,
+                black: l.black,
+                white: l.white,
+                gamma: l.gamma,
+                invert: l.invert,
+            },
+            Generator::Remap { levels: l, of } => Self::Remap {
+                black: l.black,
+                white: l.white,
+                gamma: l.gamma,
+                invert: l.invert,
+                of,
+            },
             Generator::Blend { op, a, b } => Self::Blend { op, a, b },
         }
     }
@@ -148,4 +203,27 @@ fn one() -> f32 {
 /// One octave, the default.
 fn one_octave() -> u32 {
     1
+}
+
+/// A mask's generator or none, as `SetMaskGenerator(...)` spells it: `None`, or a generator
+/// (`Ao(black: 0.2, white: 0.9, invert: false)`), checked as it is read.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "GeneratorFile", into = "GeneratorFile")]
+pub struct MaskGenerator(pub Option<Generator>);
+
+impl TryFrom<GeneratorFile> for MaskGenerator {
+    type Error = String;
+
+    fn try_from(f: GeneratorFile) -> Result<Self, String> {
+        match f {
+            GeneratorFile::None => Ok(Self(None)),
+            f => Generator::try_from(f).map(|g| Self(Some(g))),
+        }
+    }
+}
+
+impl From<MaskGenerator> for GeneratorFile {
+    fn from(g: MaskGenerator) -> Self {
+        g.0.map_or(Self::None, Self::from)
+    }
 }

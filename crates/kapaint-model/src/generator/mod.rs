@@ -6,7 +6,8 @@
 //!
 //! In scripts: `Ao(black: 0.2, white: 0.9, invert: false)`, `Curvature(black: 0.5, white:
 //! 0.7, invert: false)`, `Noise(kind: Perlin, scale: 8.0, octaves: 4, seed: 1, space:
-//! Object)`, `Gradient(axis: Y, from: 0.0, to: 1.0)`, `Blend(op: Multiply, a: ..., b: ...)`.
+//! Object)`, `Gradient(axis: Y, from: 0.0, to: 1.0)`, `Facing(axis: Y, black: 0.7, white:
+//! 0.95)`, `Remap(black: 0.45, white: 0.55, of: ...)`, `Blend(op: Multiply, a: ..., b: ...)`.
 
 use fastnoise_lite::{CellularReturnType, FastNoiseLite, FractalType, NoiseType};
 use glam::Vec3;
@@ -14,7 +15,10 @@ use kapaint_mesh::bakes::{BakeMap, Baked};
 use serde::{Deserialize, Serialize};
 
 mod file;
+pub mod preset;
+pub mod tiles;
 use file::GeneratorFile;
+pub use file::MaskGenerator;
 
 /// Deepest nesting of blends.
 pub const MAX_DEPTH: usize = 4;
@@ -43,6 +47,21 @@ pub enum Generator {
         from: f32,
         /// Where it reaches 1.
         to: f32,
+    },
+    /// How much the surface faces along an object-space axis (`0.5 + 0.5 n.axis` of the
+    /// surface normal) through levels: dust settles on what faces up.
+    Facing {
+        /// The axis.
+        axis: Axis,
+        /// The levels.
+        levels: Levels,
+    },
+    /// Another generator through levels (noise made into patches, say).
+    Remap {
+        /// The levels.
+        levels: Levels,
+        /// The generator.
+        of: Box<Generator>,
     },
     /// Two generators combined.
     Blend {
@@ -197,9 +216,17 @@ impl Generator {
                 }
                 Ok(())
             }
+            Self::Facing { levels, .. } => levels.check(),
+            Self::Remap { levels, of } => {
+                if depth >= MAX_DEPTH {
+                    return Err(format!("generators nest more than {MAX_DEPTH} deep"));
+                }
+                levels.check()?;
+                of.check_at(depth + 1)
+            }
             Self::Blend { a, b, .. } => {
                 if depth >= MAX_DEPTH {
-                    return Err(format!("blends nest more than {MAX_DEPTH} deep"));
+                    return Err(format!("generators nest more than {MAX_DEPTH} deep"));
                 }
                 a.check_at(depth + 1)?;
                 b.check_at(depth + 1)
@@ -219,7 +246,11 @@ impl Generator {
             Self::Ao(_) => Some(BakeMap::Ao),
             Self::Curvature(_) => Some(BakeMap::Curvature),
             Self::Thickness(_) => Some(BakeMap::Thickness),
-            Self::Noise(_) | Self::Gradient { .. } => None,
+            Self::Noise(_) | Self::Gradient { .. } | Self::Facing { .. } => None,
+            Self::Remap { of, .. } => {
+                of.collect_bakes(out);
+                None
+            }
             Self::Blend { a, b, .. } => {
                 a.collect_bakes(out);
                 b.collect_bakes(out);
@@ -256,6 +287,8 @@ enum Node<'a> {
     Bake(Levels, Option<&'a Baked>),
     Noise(Box<FastNoiseLite>, Noise),
     Gradient(Axis, f32, f32),
+    Facing(Axis, Levels),
+    Remap(Levels, Box<Node<'a>>),
     Blend(BlendOp, Box<Node<'a>>, Box<Node<'a>>),
 }
 
@@ -274,7 +307,70 @@ impl<'a> Evaluator<'a> {
     }
 }
 
+/// A tile's texels as a generator reads them: `side x side`, row-major, `None` where no
+/// surface is.
+pub struct Grid {
+    /// Texels a side.
+    pub side: usize,
+    /// The texels.
+    pub texels: Vec<Option<Texel>>,
+}
+
+/// Largest span, in cells of a noise's finest octave, over which a value between two exact
+/// samples is interpolated instead of computed: linear interpolation of fBm over an eighth
+/// of its finest cell stays within half an 8-bit level (measured in the tests: at most 87
+/// of 65535 on the builtin sphere at 4096^2, one octave of Perlin at scale 30).
+pub const SMOOTH_SPAN: f32 = 0.125;
+
+impl Evaluator<'_> {
+    /// The values at every texel of `grid` into `out` (0 where no surface is). With
+    /// `interpolate`, noise whose finest octave is smooth over two texels is computed on
+    /// every second texel and interpolated between (see [`SMOOTH_SPAN`]).
+    pub fn grid_values(&self, grid: &Grid, interpolate: bool, out: &mut [f32]) {
+        self.node.values(grid, interpolate, out);
+        for (o, t) in out.iter_mut().zip(&grid.texels) {
+            *o = if t.is_some() { o.clamp(0.0, 1.0) } else { 0.0 };
+        }
+    }
+}
+
 impl<'a> Node<'a> {
+    /// [`Evaluator::grid_values`] of this node.
+    fn values(&self, grid: &Grid, interpolate: bool, out: &mut [f32]) {
+        match self {
+            // Only Perlin is interpolated: Worley's distance has creases, which interpolation
+            // would round off, and OpenSimplex2 bends too sharply to gain.
+            Self::Noise(noise, n) if interpolate && n.kind == NoiseKind::Perlin => {
+                noise_values(noise, n, grid, out);
+            }
+            Self::Remap(levels, of) => {
+                of.values(grid, interpolate, out);
+                for o in out.iter_mut() {
+                    *o = levels.apply(o.clamp(0.0, 1.0));
+                }
+            }
+            Self::Blend(op, a, b) => {
+                let mut other = vec![0.0; out.len()];
+                a.values(grid, interpolate, out);
+                b.values(grid, interpolate, &mut other);
+                for (a, b) in out.iter_mut().zip(other) {
+                    let (x, y) = (a.clamp(0.0, 1.0), b.clamp(0.0, 1.0));
+                    *a = match op {
+                        BlendOp::Multiply => x * y,
+                        BlendOp::Min => x.min(y),
+                        BlendOp::Max => x.max(y),
+                        BlendOp::Add => (x + y).min(1.0),
+                    };
+                }
+            }
+            _ => {
+                for (o, t) in out.iter_mut().zip(&grid.texels) {
+                    *o = t.as_ref().map_or(0.0, |t| self.value(t));
+                }
+            }
+        }
+    }
+
     fn of(g: &Generator, bakes: &'a [std::sync::Arc<Baked>]) -> Self {
         let bake = |map| bakes.iter().find(|b| b.map == map).map(AsRef::as_ref);
         match g {
@@ -299,6 +395,8 @@ impl<'a> Node<'a> {
                 Self::Noise(Box::new(noise), *n)
             }
             Generator::Gradient { axis, from, to } => Self::Gradient(*axis, *from, *to),
+            Generator::Facing { axis, levels } => Self::Facing(*axis, *levels),
+            Generator::Remap { levels, of } => Self::Remap(*levels, Box::new(Self::of(of, bakes))),
             Generator::Blend { op, a, b } => Self::Blend(
                 *op,
                 Box::new(Self::of(a, bakes)),
@@ -309,31 +407,22 @@ impl<'a> Node<'a> {
 
     fn value(&self, t: &Texel) -> f32 {
         match self {
+            Self::Noise(noise, n) => noise_at(noise, n, t),
             Self::Bake(l, bake) => {
                 let v = bake
                     .filter(|b| t.index < b.data.len() / b.map.channels())
                     .map_or(0.5, |b| b.value(t.index, 0));
                 l.apply(v)
             }
-            Self::Noise(noise, n) => {
-                // FastNoiseLite returns about [-1, 1].
-                let raw = match n.space {
-                    Space::Uv => noise.get_noise_2d(t.uv.x, t.uv.y),
-                    Space::Object => {
-                        let p = t.position;
-                        noise.get_noise_3d(p.x, p.y, p.z)
-                    }
-                    Space::Triplanar => {
-                        let p = t.position;
-                        let w = t.normal.abs().powf(4.0);
-                        let w = w / w.element_sum().max(1e-6);
-                        w.x * noise.get_noise_2d(p.y, p.z)
-                            + w.y * noise.get_noise_2d(p.z, p.x)
-                            + w.z * noise.get_noise_2d(p.x, p.y)
-                    }
+            Self::Facing(axis, levels) => {
+                let n = match axis {
+                    Axis::X => t.normal.x,
+                    Axis::Y => t.normal.y,
+                    Axis::Z => t.normal.z,
                 };
-                0.5 + 0.5 * raw
+                levels.apply(0.5 + 0.5 * n)
             }
+            Self::Remap(levels, of) => levels.apply(of.value(t)),
             Self::Gradient(axis, from, to) => {
                 let v = match axis {
                     Axis::X => t.position.x,
@@ -353,6 +442,79 @@ impl<'a> Node<'a> {
             }
         }
         .clamp(0.0, 1.0)
+    }
+}
+
+/// Noise `n` at texel `t`, in `[0, 1]`.
+fn noise_at(noise: &FastNoiseLite, n: &Noise, t: &Texel) -> f32 {
+    // FastNoiseLite returns about [-1, 1].
+    let raw = match n.space {
+        Space::Uv => noise.get_noise_2d(t.uv.x, t.uv.y),
+        Space::Object => {
+            let p = t.position;
+            noise.get_noise_3d(p.x, p.y, p.z)
+        }
+        Space::Triplanar => {
+            let p = t.position;
+            let w = t.normal.abs().powf(4.0);
+            let w = w / w.element_sum().max(1e-6);
+            w.x * noise.get_noise_2d(p.y, p.z)
+                + w.y * noise.get_noise_2d(p.z, p.x)
+                + w.z * noise.get_noise_2d(p.x, p.y)
+        }
+    };
+    0.5 + 0.5 * raw
+}
+
+/// Noise over a grid: exact on even rows' even texels, then each other texel interpolated
+/// between its two computed neighbours (left and right on even rows, above and below on odd
+/// ones) where both have a surface and lie within [`SMOOTH_SPAN`] of the finest octave's
+/// cell of each other (with normals alike, for triplanar noise), else computed.
+fn noise_values(noise: &FastNoiseLite, n: &Noise, grid: &Grid, out: &mut [f32]) {
+    let side = grid.side;
+    let finest = n.scale * (1_u32 << (n.octaves - 1)) as f32;
+    let at = |i: usize| grid.texels[i].as_ref();
+    let close = |a: &Texel, b: &Texel| {
+        let d = match n.space {
+            Space::Uv => a.uv.distance(b.uv),
+            Space::Object => a.position.distance(b.position),
+            Space::Triplanar => {
+                if a.normal.dot(b.normal) < 0.999 {
+                    return false;
+                }
+                a.position.distance(b.position)
+            }
+        };
+        d * finest <= SMOOTH_SPAN
+    };
+    let exact = |i: usize| at(i).map_or(0.0, |t| noise_at(noise, n, t));
+    // Between `a` and `b` (indices), at `i`.
+    let between = |out: &[f32], i: usize, a: usize, b: usize| match (at(i), at(a), at(b)) {
+        (Some(_), Some(ta), Some(tb)) if close(ta, tb) => 0.5 * (out[a] + out[b]),
+        _ => exact(i),
+    };
+    for y in (0..side).step_by(2) {
+        for x in (0..side).step_by(2) {
+            out[y * side + x] = exact(y * side + x);
+        }
+        for x in (1..side).step_by(2) {
+            let i = y * side + x;
+            out[i] = if x + 1 < side {
+                between(out, i, i - 1, i + 1)
+            } else {
+                exact(i)
+            };
+        }
+    }
+    for y in (1..side).step_by(2) {
+        for x in 0..side {
+            let i = y * side + x;
+            out[i] = if y + 1 < side {
+                between(out, i, i - side, i + side)
+            } else {
+                exact(i)
+            };
+        }
     }
 }
 

@@ -111,3 +111,50 @@ fn values_stay_in_range_and_follow_their_parameters() {
     assert!((levels.apply(0.4) - 0.5).abs() < 1e-6);
     assert_eq!(levels.apply(0.9), 0.0);
 }
+
+/// Interpolated noise against noise computed at every texel, on the builtin sphere's map:
+/// the largest difference in 16-bit levels.
+fn interpolation_error(g: &Generator, side: u32) -> u16 {
+    use crate::generator::tiles::{Generated, Source};
+    let made = Generated::new(g.clone(), Source::new(None, &[], side, side), false);
+    let tiles = (side as usize / 64).pow(2);
+    let mut worst = 0;
+    for id in (0..tiles).step_by(23) {
+        let fast = made.tile(id);
+        let exact = made.tile_exact(id);
+        for i in 0..64 * 64 {
+            let d = fast.get(i).abs_diff(exact.get(i));
+            worst = worst.max(d);
+        }
+    }
+    worst
+}
+
+#[test]
+fn interpolated_noise_stays_within_half_an_8_bit_level() {
+    for (kind, space) in [
+        (NoiseKind::Perlin, Space::Object),
+        (NoiseKind::Simplex, Space::Object),
+        (NoiseKind::Perlin, Space::Uv),
+        (NoiseKind::Perlin, Space::Triplanar),
+        (NoiseKind::Worley, Space::Object),
+    ] {
+        for (scale, octaves) in [(8.0, 4), (2.0, 8), (30.0, 1)] {
+            let g = Generator::Noise(Noise {
+                kind,
+                scale,
+                octaves,
+                seed: 3,
+                space,
+            });
+            let worst = interpolation_error(&g, 4096);
+            eprintln!(
+                "{kind:?} {space:?} scale {scale} octaves {octaves}: {worst} levels of 65535"
+            );
+            assert!(
+                worst <= 128,
+                "{kind:?} {space:?} {scale} {octaves}: {worst}"
+            );
+        }
+    }
+}

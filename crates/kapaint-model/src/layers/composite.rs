@@ -67,15 +67,21 @@ impl Active<'_> {
 
 /// The layers of `layers` that take part at tile `id`, bottom first.
 fn active(layers: &[Layer], id: usize) -> Vec<Active<'_>> {
+    active_at(layers, id, true)
+}
+
+/// [`active`], where `generated` says whether a generator's values may be computed to find
+/// a layer its mask hides at the tile (without, such a layer counts as taking part: what the
+/// compositor's signatures read, so that they cost no generator a value).
+fn active_at(layers: &[Layer], id: usize, generated: bool) -> Vec<Active<'_>> {
     layers
         .iter()
         .filter(|l| {
             let p = &l.props;
             let hidden_by_mask = l.mask.as_ref().is_some_and(|m| {
                 m.enabled
-                    && m.tiles[id]
-                        .get()
-                        .uniform()
+                    && (generated || m.generator.is_none())
+                    && m.uniform(id)
                         .is_some_and(|v| if m.inverted { v == u16::MAX } else { v == 0 })
             });
             p.visible && p.opacity > 0.0 && p.channels.iter().any(|c| c.enabled) && !hidden_by_mask
@@ -84,7 +90,7 @@ fn active(layers: &[Layer], id: usize) -> Vec<Active<'_>> {
             LayerContent::Paint(tiles) => tiles[id].as_ref().map(|t| Active::Paint(l, t)),
             LayerContent::Fill(v) => Some(Active::Fill(l, values(Texel::encode(*v)))),
             LayerContent::Group(children) => {
-                let inner = active(children, id);
+                let inner = active_at(children, id, generated);
                 (!inner.is_empty()).then_some(Active::Group(l, inner))
             }
         })
@@ -272,11 +278,11 @@ fn cover_of(layer: &Layer, id: usize, runs: &[(usize, usize, usize)], out: &mut 
     let opacity = layer.props.opacity.clamp(0.0, 1.0);
     match &layer.mask {
         Some(mask) if mask.enabled => {
-            let plane = mask.tiles[id].get();
+            let plane = mask.plane(id);
             if mask.inverted {
-                decode_runs(plane, runs, out, |m| opacity * (1.0 - decode_unorm(m)));
+                decode_runs(&plane, runs, out, |m| opacity * (1.0 - decode_unorm(m)));
             } else {
-                decode_runs(plane, runs, out, |m| opacity * decode_unorm(m));
+                decode_runs(&plane, runs, out, |m| opacity * decode_unorm(m));
             }
         }
         _ => out.fill(opacity),
@@ -415,7 +421,7 @@ fn uniform_inputs(layers: &[Active<'_>], id: usize) -> bool {
             .layer()
             .mask
             .as_ref()
-            .is_none_or(|m| !m.enabled || m.tiles[id].get().uniform().is_some());
+            .is_none_or(|m| !m.enabled || m.uniform(id).is_some());
         mask && match a {
             Active::Paint(_, t) => {
                 let t = t.get();

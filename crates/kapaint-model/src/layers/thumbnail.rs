@@ -50,7 +50,11 @@ pub fn content(stack: &LayerStack, layer: &Layer, size: u32) -> Option<Vec<[u8; 
 pub fn mask(stack: &LayerStack, layer: &Layer, size: u32) -> Option<Vec<[u8; 4]>> {
     let mask = layer.mask.as_ref()?;
     Some(sample(stack, size, |id, i| {
-        let v = mask.tiles.get(id).map_or(0, |t| t.get().get(i));
+        let v = if id < mask.tiles.len() {
+            mask.sample(id, i)
+        } else {
+            0
+        };
         let v = if mask.inverted { u16::MAX - v } else { v };
         let g = u8::try_from(v >> 8).unwrap_or(u8::MAX);
         [g, g, g, 255]

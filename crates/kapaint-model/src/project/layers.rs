@@ -83,6 +83,10 @@ pub struct MaskEntry {
     /// The gray of the tiles not stored.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fill: Option<u16>,
+    /// The generator that makes it (version 4): its parameters, checked as they are read;
+    /// `gray` is then the paint over it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generator: Option<crate::generator::Generator>,
 }
 
 /// One layer in the manifest.
@@ -315,6 +319,7 @@ pub fn entries(
                     .map(|(m, stored)| MaskEntry {
                         enabled: m.enabled,
                         inverted: m.inverted,
+                        generator: m.generator().cloned(),
                         ..stored
                     }),
                 children: match &layer.content {
@@ -324,6 +329,13 @@ pub fn entries(
             }
         })
         .collect()
+}
+
+/// Whether a mask among `entries` (at any depth) is made by a generator.
+pub fn any_generator(entries: &[LayerEntry]) -> bool {
+    entries.iter().any(|e| {
+        e.mask.as_ref().is_some_and(|m| m.generator.is_some()) || any_generator(&e.children)
+    })
 }
 
 /// Counts the layers and the deepest nesting of `entries`, refusing more than the limits.
@@ -380,7 +392,7 @@ pub fn check_shape(entries: &[LayerEntry], depth: usize, count: &mut usize) -> R
 pub fn build(
     entries: &[LayerEntry],
     next: &mut usize,
-    tile_count: usize,
+    (tile_count, size): (usize, (u32, u32)),
     read: &mut impl FnMut(usize, &LayerEntry) -> Result<LayerMaps, String>,
 ) -> Result<Vec<Layer>, String> {
     entries
@@ -404,7 +416,7 @@ pub fn build(
                 KindEntry::Paint => LayerContent::Paint(paint_tiles(&stored, tile_count)),
                 KindEntry::Fill => LayerContent::Fill(e.fill.unwrap_or_default().sanitized()),
                 KindEntry::Group => {
-                    LayerContent::Group(build(&e.children, next, tile_count, read)?)
+                    LayerContent::Group(build(&e.children, next, (tile_count, size), read)?)
                 }
             };
             let mask = e.mask.as_ref().map(|m| {
@@ -419,6 +431,15 @@ pub fn build(
                     tiles,
                     enabled: m.enabled,
                     inverted: m.inverted,
+                    // Laid on the map alone for now: the document lays it again on its mesh
+                    // and bakes as they are attached.
+                    generator: m.generator.clone().map(|g| {
+                        Arc::new(crate::generator::tiles::Generated::new(
+                            g,
+                            crate::generator::tiles::Source::new(None, &[], size.0, size.1),
+                            false,
+                        ))
+                    }),
                 }
             });
             Ok(Layer {

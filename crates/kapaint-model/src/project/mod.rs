@@ -37,7 +37,10 @@ pub const FORMAT: &str = "kapaint-project";
 
 /// The newest manifest version this build writes: 3 for a project that keeps its mesh inside
 /// itself, else 2, which every build since layers reads. It reads 1, 2 and 3.
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
+
+/// The version that first kept a mesh and bakes.
+const MESH_VERSION: u32 = 3;
 
 /// The version of a project that keeps nothing version 3 added.
 const LAYERS_VERSION: u32 = 2;
@@ -445,22 +448,30 @@ fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
             manifest.format
         ));
     }
-    if manifest.mesh.is_some() && manifest.version < VERSION {
+    if manifest.mesh.is_some() && manifest.version < MESH_VERSION {
         return Err(format!(
-            "a version {} project keeps no mesh (a kept mesh is version {VERSION})",
+            "a version {} project keeps no mesh (a kept mesh is version {MESH_VERSION})",
             manifest.version
         ));
     }
-    if manifest.bakes.is_some() && manifest.version < VERSION {
+    if manifest.bakes.is_some() && manifest.version < MESH_VERSION {
         return Err(format!(
-            "a version {} project keeps no bakes (bakes are version {VERSION})",
+            "a version {} project keeps no bakes (bakes are version {MESH_VERSION})",
             manifest.version
         ));
     }
     match (manifest.version, &manifest.layers) {
         (1, None) => {}
-        (2 | 3, Some(entries)) => layers::check_shape(entries, 0, &mut 0)?,
-        (1..=3, _) => {
+        (2..=4, Some(entries)) => {
+            layers::check_shape(entries, 0, &mut 0)?;
+            if manifest.version < VERSION && layers::any_generator(entries) {
+                return Err(format!(
+                    "a version {} project has no generator masks (they are version {VERSION})",
+                    manifest.version
+                ));
+            }
+        }
+        (1..=4, _) => {
             return Err(format!(
                 "a version {} project {} layers",
                 manifest.version,

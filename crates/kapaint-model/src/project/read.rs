@@ -40,7 +40,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             .map_err(|e| e.to_string())?
             .tile_count();
         let mut read = |k: usize, e: &super::layers::LayerEntry| read_layer(&mut zip, k, e, w, h);
-        let layers = super::layers::build(entries, &mut 0, tile_count, &mut read)?;
+        let layers = super::layers::build(entries, &mut 0, (tile_count, (w, h)), &mut read)?;
         let stack = crate::layers::LayerStack {
             width: w,
             height: h,
@@ -50,9 +50,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         // The kept mesh and bakes are read before the settings move into the document.
         let mesh = read_mesh(&mut zip, &manifest)?;
         let bakes = super::bakes::read(&mut zip, &manifest)?;
-        let doc = Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string())?;
-        // The stored composite is read too: every entry's checksum is checked, and it must
-        // be what the layers composite to.
+        // The stored composite is read too: every entry's checksum is checked.
         let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
         let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
         let n = read_channel(&mut zip, &manifest.n, "n", w, h, 1)?;
@@ -60,19 +58,43 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         let mut stored =
             MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
         fill_maps(&mut stored, &kd, &ks, &n);
-        let differs = |id: usize| {
-            let (a, b) = (stored.tile(id), doc.maps().tile(id));
-            let r = stored.tile_rect(id);
-            (r.y0..r.y1).any(|y| {
-                (r.x0..r.x1).any(|x| {
-                    let i = (y - r.y0) as usize * TILE_SIZE + (x - r.x0) as usize;
-                    a.texel(i) != b.texel(i)
+        let doc = if super::layers::any_generator(entries) {
+            // Generator masks are laid on the mesh the project names, and the stored
+            // composite is taken as what they made: nothing is computed until something
+            // they read or shape changes (their values need the mesh's surface, which the
+            // caller attaches; a project on another mesh file computes them then).
+            let hash = match (&mesh, &manifest.settings.mesh) {
+                (Some(m), _) => Some(m.content_hash()),
+                (None, crate::MeshRef::Sphere | crate::MeshRef::Builtin(_)) => {
+                    kapaint_mesh::builtin(manifest.settings.mesh.spec()).map(|m| m.content_hash())
+                }
+                _ => bakes.first().map(|b| b.mesh_hash),
+            };
+            let mut stack = stack;
+            let source = crate::generator::tiles::Source::expecting(hash, &bakes, w, h);
+            crate::generator::tiles::lay_all(&mut stack.layers, &source);
+            Document::from_stack_and_composite(stack, stored, manifest.settings)
+                .map_err(|e| e.to_string())?
+        } else {
+            let doc = Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string())?;
+            // Without generators, the stored composite must be what the layers composite to.
+            let differs = |id: usize| {
+                let (a, b) = (stored.tile(id), doc.maps().tile(id));
+                let r = stored.tile_rect(id);
+                (r.y0..r.y1).any(|y| {
+                    (r.x0..r.x1).any(|x| {
+                        let i = (y - r.y0) as usize * TILE_SIZE + (x - r.x0) as usize;
+                        a.texel(i) != b.texel(i)
+                    })
                 })
-            })
+            };
+            if (0..stored.tile_count()).into_par_iter().any(differs) {
+                return Err(
+                    "the stored composite differs from what the layers composite to".into(),
+                );
+            }
+            doc
         };
-        if (0..stored.tile_count()).into_par_iter().any(differs) {
-            return Err("the stored composite differs from what the layers composite to".into());
-        }
         let normal = read_normal(&mut zip, manifest.normal.as_ref())?;
         let doc = doc
             .with_normal(normal)

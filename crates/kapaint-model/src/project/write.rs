@@ -192,6 +192,7 @@ pub(super) fn write_project(
                 gray: e,
                 tiles: Some(l.mask_tiles.clone()),
                 fill: Some(l.mask_fill),
+                generator: None,
             }
         });
         stored.push((planes, mask));
@@ -205,8 +206,10 @@ pub(super) fn write_project(
     let kept_mesh = kept_mesh(doc, &settings)?;
     let manifest = Manifest {
         format: FORMAT.into(),
-        version: if kept_mesh.is_some() || !doc.bakes().is_empty() {
+        version: if has_generator(&doc.stack().layers) {
             VERSION
+        } else if kept_mesh.is_some() || !doc.bakes().is_empty() {
+            super::MESH_VERSION
         } else {
             super::LAYERS_VERSION
         },
@@ -335,4 +338,12 @@ fn invalid_n_in(maps: &MaterialMaps) -> Option<u16> {
             Plane::Uniform(bits) => (!valid_n_bits(*bits)).then_some(*bits),
             Plane::Data(d) => d.iter().copied().find(|&bits| !valid_n_bits(bits)),
         })
+}
+
+/// Whether a mask in `layers` (at any depth) is made by a generator.
+fn has_generator(layers: &[crate::layers::Layer]) -> bool {
+    layers.iter().any(|l| {
+        l.mask.as_ref().is_some_and(|m| m.generator.is_some())
+            || matches!(&l.content, crate::layers::LayerContent::Group(c) if has_generator(c))
+    })
 }

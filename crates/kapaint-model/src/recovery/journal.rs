@@ -109,6 +109,10 @@ pub(super) struct MaskMeta {
     pub(super) enabled: bool,
     pub(super) inverted: bool,
     pub(super) tiles: u64,
+    /// The generator that makes it (absent from records of painted masks, whose bytes stay
+    /// as they were).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) generator: Option<crate::generator::Generator>,
 }
 
 /// The key of a list of stamps (what a record refers to it by).
@@ -185,6 +189,7 @@ impl<'a> Gathered<'a> {
                 enabled: m.enabled,
                 inverted: m.inverted,
                 tiles: self.list(known, stamps),
+                generator: m.generator().cloned(),
             }
         });
         LayerMeta {

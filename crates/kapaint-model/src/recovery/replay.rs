@@ -236,6 +236,7 @@ impl Replay {
         };
         let mut take = Taken {
             tile_count,
+            size: (d.width, d.height),
             old: self,
             lists: &mut lists,
             paint: &mut paint,
@@ -273,6 +274,7 @@ impl Replay {
 /// Resolving a record's references: from what it carried, else from what the journal held.
 struct Taken<'a> {
     tile_count: usize,
+    size: (u32, u32),
     old: &'a Replay,
     lists: &'a mut HashMap<u64, Vec<u64>>,
     paint: &'a mut HashMap<u64, SharedPaintTile>,
@@ -342,6 +344,18 @@ impl Taken<'_> {
                     tiles,
                     enabled: mm.enabled,
                     inverted: mm.inverted,
+                    generator: mm.generator.clone().map(|g| {
+                        Arc::new(crate::generator::tiles::Generated::new(
+                            g,
+                            crate::generator::tiles::Source::new(
+                                None,
+                                &[],
+                                self.size.0,
+                                self.size.1,
+                            ),
+                            false,
+                        ))
+                    }),
                 })
             }
         };

@@ -10,7 +10,7 @@ use std::hash::{Hash, Hasher};
 
 use rayon::prelude::*;
 
-use super::{Active, CompositeTile, active, composite_spans, runs};
+use super::{Active, CompositeTile, active_at, composite_spans, runs};
 use crate::layers::LayerStack;
 use crate::maps::MaterialMaps;
 use crate::simd::{Kernel, vectorized};
@@ -27,7 +27,7 @@ fn hash_active(layers: &[Active<'_>], id: usize, h: &mut impl Hasher) {
         (l.props.opacity.to_bits(), l.props.channels).hash(h);
         l.mask
             .as_ref()
-            .map(|m| (m.enabled, m.inverted, m.tiles[id].stamp()))
+            .map(|m| (m.enabled, m.inverted, m.stamps(id)))
             .hash(h);
         match a {
             Active::Paint(_, tile) => (0u8, tile.stamp()).hash(h),
@@ -44,7 +44,7 @@ fn hash_active(layers: &[Active<'_>], id: usize, h: &mut impl Hasher) {
 fn signature(stack: &LayerStack, id: usize) -> u64 {
     let mut h = std::hash::DefaultHasher::new();
     (stack.width, stack.height, Texel::encode(stack.base)).hash(&mut h);
-    hash_active(&active(&stack.layers, id), id, &mut h);
+    hash_active(&active_at(&stack.layers, id, false), id, &mut h);
     h.finish().max(1)
 }
 
@@ -60,6 +60,17 @@ impl Compositor {
     /// A compositor that has composited nothing yet (its first update does every tile).
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A compositor that takes `maps` to be the composite of `stack` as it is (a project's
+    /// stored composite): only tiles whose inputs change from now on are recomposited.
+    pub fn primed(stack: &LayerStack) -> Self {
+        Self {
+            signatures: (0..stack.tile_count())
+                .into_par_iter()
+                .map(|id| signature(stack, id))
+                .collect(),
+        }
     }
 
     /// Brings `maps` up to date with `stack` (of the same size): recomposites the tiles whose
