@@ -263,6 +263,8 @@ impl EditorState {
         if let Some(g) = &current {
             let mut edited = g.clone();
             let mut edit = Edit::default();
+            // Room to drag a parameter finely.
+            ui.spacing_mut().slider_width = ui.spacing().slider_width.max(160.0);
             parameters_ui(ui, &mut edited, &mut edit);
             if edit.released || (edit.changed && !edit.dragging) {
                 commands.push(MaskCommand::SetMaskGenerator(Some(edited)));

@@ -60,6 +60,7 @@ fn same_document(a: &Document, b: &Document) -> bool {
             (Some(x), Some(y)) => {
                 x.enabled == y.enabled
                     && x.inverted == y.inverted
+                    && x.generator() == y.generator()
                     && x.tiles
                         .iter()
                         .zip(&y.tiles)
@@ -199,6 +200,33 @@ fn a_normal_map_and_a_new_generation_are_kept() {
     let back = load(&saver.session()).unwrap();
     assert!(same_document(&back, &doc));
     assert!(back.normal().is_some());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_generator_mask_is_recovered_as_its_parameters() {
+    let dir = temp("generator");
+    let mut doc = layered(128, 128);
+    let mut saver = Autosaver::new(Duration::ZERO, Some(&dir.join("g.kapaint")), &doc);
+    doc.apply(LayerCommand::SelectLayer(crate::LayerRef::Name(
+        "Rust".into(),
+    )))
+    .unwrap();
+    let noise = crate::generator::Generator::Noise(crate::generator::Noise {
+        kind: crate::generator::NoiseKind::Perlin,
+        scale: 6.0,
+        octaves: 3,
+        seed: 4,
+        space: crate::generator::Space::Object,
+    });
+    doc.apply(MaskCommand::SetMaskGenerator(Some(noise.clone())))
+        .unwrap();
+    saver.poll(&doc, Instant::now());
+    saver.wait().unwrap().unwrap();
+    let back = load(&saver.session()).unwrap();
+    assert!(same_document(&back, &doc));
+    let mask = back.stack().layers[1].mask.clone().unwrap();
+    assert_eq!(mask.generator(), Some(&noise));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
