@@ -41,6 +41,41 @@ fn chi(c: &mut Criterion) {
     group.finish();
 }
 
+/// `chi_view` from the per-view table (issue 42) beside `chi`'s fit, in the same run: one
+/// evaluation per (n, view) pair, 4096 pairs.
+fn chi_view(c: &mut Criterion) {
+    let pairs: Vec<(f32, f32)> = (0..4096)
+        .map(|i| {
+            let n = (i as f32 * 0.0023).exp() - 1.0;
+            let phi = (i as f32 * 0.618_034).fract() * 1.56;
+            (n, phi)
+        })
+        .collect();
+    let mut group = c.benchmark_group("chi_view_f32");
+    group.throughput(Throughput::Elements(pairs.len() as u64));
+    for model in ShadingModel::ALL {
+        group.bench_function(BenchmarkId::new(model.name(), "chi_fast"), |b| {
+            b.iter(|| {
+                pairs
+                    .iter()
+                    .map(|&(n, _)| chi_parts_f32(model, AmbientApprox::Fast, black_box(n)))
+                    .fold(0.0, |acc, [a, b]| acc + a + b)
+            });
+        });
+        group.bench_function(BenchmarkId::new(model.name(), "chi_view_fast"), |b| {
+            b.iter(|| {
+                pairs
+                    .iter()
+                    .filter_map(|&(n, phi)| {
+                        kapaint::reflectance::view::chi_view_fast(model, black_box(n), phi)
+                    })
+                    .fold(0.0, |acc, [a, b]| acc + a + b)
+            });
+        });
+    }
+    group.finish();
+}
+
 fn derive(c: &mut Criterion) {
     let texels = SIDE * SIDE;
     let maps = BenchMaps::new(texels);
@@ -77,5 +112,5 @@ fn derive(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, chi, derive);
+criterion_group!(benches, chi, chi_view, derive);
 criterion_main!(benches);

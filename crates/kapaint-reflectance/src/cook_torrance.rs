@@ -187,7 +187,7 @@ pub fn chi_exact_at_level(n: f64, level: u32) -> [f64; 2] {
 }
 
 /// The `(t, g)` integral at fixed `p`.
-fn over_t(rule: &TanhSinh, a: f64, p: f64) -> [f64; 2] {
+pub(crate) fn over_t(rule: &TanhSinh, a: f64, p: f64) -> [f64; 2] {
     let (sp, cp) = p.sin_cos();
     let cp = cp.max(0.0);
     // The lobe's peak in t: the mirror direction t = -p, or the pole for p >= 0.

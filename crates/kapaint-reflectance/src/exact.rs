@@ -105,7 +105,7 @@ pub fn chi_parts_exact(model: ShadingModel, n: f64) -> [f64; 2] {
 
 /// `n` within the Cook-Torrance model's limit [`super::cook_torrance::fast::N_MAX`] (the
 /// integrator itself reaches a little further, to the end of the fit's last octave); NaN is 0.
-fn cook_torrance_n(n: f64) -> f64 {
+pub(crate) fn cook_torrance_n(n: f64) -> f64 {
     if n.is_nan() {
         0.0
     } else {
@@ -114,13 +114,13 @@ fn cook_torrance_n(n: f64) -> f64 {
 }
 
 /// `exp(n * ln_1p(y))`, i.e. `(1 + y)^n` for `y in [-1, 0]`, with `0^0 = 1`.
-fn pow1p(n: f64, y: f64) -> f64 {
+pub(crate) fn pow1p(n: f64, y: f64) -> f64 {
     if n == 0.0 { 1.0 } else { (n * y.ln_1p()).exp() }
 }
 
 /// `1 - e^(-2 WINDOW_LOG / n)`: the largest `sin^2` of a lobe `(1 - sin^2)^(n/2)` that still
 /// counts.
-fn window_sin2(n: f64) -> f64 {
+pub(crate) fn window_sin2(n: f64) -> f64 {
     if n == 0.0 {
         1.0
     } else {
@@ -129,12 +129,12 @@ fn window_sin2(n: f64) -> f64 {
 }
 
 /// Largest angle `u` with `cos^n u >= e^-WINDOW_LOG`.
-fn window_angle(n: f64) -> f64 {
+pub(crate) fn window_angle(n: f64) -> f64 {
     window_sin2(n).sqrt().min(1.0).asin()
 }
 
 /// Feature width `1/sqrt(n)` of the peak, used to grade the outer intervals.
-fn peak_scale(n: f64) -> f64 {
+pub(crate) fn peak_scale(n: f64) -> f64 {
     if n > 0.0 {
         n.sqrt().recip()
     } else {
@@ -184,7 +184,6 @@ fn phong(outer_rule: &TanhSinh, rule: &TanhSinh, n: f64) -> f64 {
 
 fn blinn(rule: &TanhSinh, n: f64) -> f64 {
     let window = window_sin2(n);
-    let spread = window_angle(n);
     let scale = peak_scale(n);
     let p_max = (2.0 * window.sqrt()).min(1.0).asin();
     let p_breaks = break_points(
@@ -194,41 +193,48 @@ fn blinn(rule: &TanhSinh, n: f64) -> f64 {
             .chain(graded_from(-FRAC_PI_2, 1.0, scale, FRAC_PI_2 / 2.0))
             .chain([0.0]),
     );
-    let outer = rule.integrate_pieces_par(&p_breaks, |p| {
-        let (sp, cp) = p.sin_cos();
-        let t_breaks = if p < 0.0 {
-            // The lobe is at most cos^n((t + p)/2), so t stays within 2*spread of -p.
-            break_points(
-                (-p - 2.0 * spread).max(0.0),
-                (-p + 2.0 * spread).min(FRAC_PI_2),
-                [-p],
-            )
-        } else {
-            // sin^2(beta) >= st^2/4 when p >= 0.
-            break_points(0.0, (2.0 * window.sqrt()).min(1.0).asin(), [])
-        };
-        rule.integrate_pieces(&t_breaks, |t| {
-            let (st, ct) = t.sin_cos();
-            let sum_half = 2.0 * (0.5 * (t + p)).sin() * (0.5 * (t - p)).cos(); // st + sp
-            let a = st * st + sp * sp;
-            let b = 2.0 * st * sp;
-            let e = 2.0 + 2.0 * ct * cp;
-            let sin2 = |g: f64| {
-                let h = (0.5 * g).sin();
-                let num = sum_half * sum_half - 2.0 * b * h * h;
-                let den = e + b * g.cos();
-                if den > 0.0 {
-                    (num / den).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                }
-            };
-            let lobe = |g: f64| pow1p(0.5 * n, -sin2(g));
-            let (g_lo, g_hi) = blinn_g_window(n, a, b, e, sin2);
-            rule.integrate(g_lo, g_hi, lobe)
-        })
-    });
+    let outer = rule.integrate_pieces_par(&p_breaks, |p| blinn_at_p(rule, n, p));
     4.0 / (PI * PI * PI) * outer
+}
+
+/// The Blinn lobe's integral over `t in [0, pi/2]` and `g in [0, pi/2]` at the view angle
+/// `p` (signed): what [`chi_exact`] integrates over `p`, and what the per-view average
+/// ([`super::view`]) takes at `p` and `-p`.
+pub(crate) fn blinn_at_p(rule: &TanhSinh, n: f64, p: f64) -> f64 {
+    let window = window_sin2(n);
+    let spread = window_angle(n);
+    let (sp, cp) = p.sin_cos();
+    let t_breaks = if p < 0.0 {
+        // The lobe is at most cos^n((t + p)/2), so t stays within 2*spread of -p.
+        break_points(
+            (-p - 2.0 * spread).max(0.0),
+            (-p + 2.0 * spread).min(FRAC_PI_2),
+            [-p],
+        )
+    } else {
+        // sin^2(beta) >= st^2/4 when p >= 0.
+        break_points(0.0, (2.0 * window.sqrt()).min(1.0).asin(), [])
+    };
+    rule.integrate_pieces(&t_breaks, |t| {
+        let (st, ct) = t.sin_cos();
+        let sum_half = 2.0 * (0.5 * (t + p)).sin() * (0.5 * (t - p)).cos(); // st + sp
+        let a = st * st + sp * sp;
+        let b = 2.0 * st * sp;
+        let e = 2.0 + 2.0 * ct * cp;
+        let sin2 = |g: f64| {
+            let h = (0.5 * g).sin();
+            let num = sum_half * sum_half - 2.0 * b * h * h;
+            let den = e + b * g.cos();
+            if den > 0.0 {
+                (num / den).clamp(0.0, 1.0)
+            } else {
+                1.0
+            }
+        };
+        let lobe = |g: f64| pow1p(0.5 * n, -sin2(g));
+        let (g_lo, g_hi) = blinn_g_window(n, a, b, e, sin2);
+        rule.integrate(g_lo, g_hi, lobe)
+    })
 }
 
 /// The `g` range where the Blinn lobe is above `e^-WINDOW_LOG` of its peak, for fixed `(p, t)`.

@@ -25,6 +25,8 @@ mod fast_coeffs;
 pub mod fit;
 pub mod geometry;
 pub mod quadrature;
+pub mod view;
+mod view_table;
 pub mod wgsl;
 
 use glam::Vec3;

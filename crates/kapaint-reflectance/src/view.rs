@@ -1,0 +1,378 @@
+//! The specular part of the ambient term at one view angle, before eq. (6) averages over it:
+//! `chi_view(n, phi)`, the mean of `rho_s` over `theta in [0, pi/2]` and the light's full
+//! azimuth `gamma in [-pi, pi]`, in the paper's plain angle measure, with
+//! `phi = acos(N.V) in [0, pi/2]`:
+//!
+//! ```text
+//! chi_view(n, phi) = (1/pi^2) Int_0^{pi/2} dt Int_{-pi}^{pi} dg rho_s(n, t, g, phi)
+//! ```
+//!
+//! Its mean over the view, `(2/pi) Int_0^{pi/2} chi_view dphi`, is `chi(n)`: mirroring `V`
+//! across the normal maps the paper's half-range azimuth box at `-phi` onto the other half of
+//! the full azimuth at `phi` (`rho_s(t, g, -phi) = rho_s(t, pi - g, phi)`).
+//!
+//! # Method
+//!
+//! The same mirror folds the full azimuth onto the paper's quarter: with `F(p)` the lobe's
+//! integral over `t in [0, pi/2], g in [0, pi/2]` at the signed view angle `p`,
+//! `chi_view(n, phi) = (2/pi^2) (F(phi) + F(-phi))`. `F` is the inner integral of the exact
+//! `chi(n)` for Blinn-Phong and Cook-Torrance ([`super::exact`], [`super::cook_torrance`]),
+//! which integrate it over `p`. For original Phong, whose exact `chi` integrates `p` in closed
+//! form instead, `F` integrates `t` in closed form: at fixed `g`,
+//! `R.V = ct cp - st sp cg = M cos(t + d)` with `M^2 = 1 - sp^2 sg^2` and
+//! `d = atan2(sp cg, cp)`, so the `t` integral of the positive part is `M^n` times an integral
+//! of `cos^n` over `[d, d + pi/2]` cut at `pi/2`: for `d >= 0` the span `[d, pi/2]` (its peak
+//! at the lower end), for `d < 0` the two spans `[0, -d]` and `[0, pi/2 + d]` (the peak inside,
+//! at `t = -d`, which is the mirror direction). The `g` integral is graded towards `g = 0`,
+//! where `M^n` peaks with width `1/(sqrt(n) |sp|)`, and cut where `M^n` falls below `e^-40`.
+//!
+//! **Grazing views.** At `phi -> pi/2` nothing is singular: `cp -> 0` only moves `d` towards
+//! `+-pi/2` and the mirror direction to the horizon. The integrators take `phi` up to `pi/2`;
+//! the CLI accepts views in `[0, 90)` degrees.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use super::ShadingModel;
+use super::exact::{
+    DEFAULT_LEVEL, EXACT_N_MAX, blinn_at_p, cook_torrance_n, peak_scale, pow1p, window_angle,
+    window_sin2,
+};
+use super::quadrature::{TanhSinh, break_points, graded_from};
+
+/// `[chi_view_1(n, phi), chi_view_0(n, phi)]`: for Phong and Blinn-Phong `[chi_view, 0]`; for
+/// Cook-Torrance the per-view forms of its two parts (`k_s chi_1 + chi_0`). `n` is clamped as
+/// [`super::exact::chi_exact`] clamps it, `phi` (radians) into `[0, pi/2]`; NaN is 0.
+pub fn chi_view_exact(model: ShadingModel, n: f64, phi: f64) -> [f64; 2] {
+    chi_view_exact_at_level(model, n, phi, DEFAULT_LEVEL)
+}
+
+/// [`chi_view_exact`] with an explicit tanh-sinh level, for convergence studies.
+pub fn chi_view_exact_at_level(model: ShadingModel, n: f64, phi: f64, level: u32) -> [f64; 2] {
+    let n = if n.is_nan() {
+        0.0
+    } else {
+        n.clamp(0.0, EXACT_N_MAX)
+    };
+    let phi = if phi.is_nan() {
+        0.0
+    } else {
+        phi.clamp(0.0, FRAC_PI_2)
+    };
+    let rule = TanhSinh::new(level);
+    let k = 2.0 / (PI * PI);
+    match model {
+        ShadingModel::Phong => [
+            k * (phong_at_p(&rule, n, phi) + phong_at_p(&rule, n, -phi)),
+            0.0,
+        ],
+        ShadingModel::BlinnPhong => [
+            k * (blinn_at_p(&rule, n, phi) + blinn_at_p(&rule, n, -phi)),
+            0.0,
+        ],
+        ShadingModel::CookTorrance => {
+            let a = super::cook_torrance::alpha(cook_torrance_n(n));
+            let (up, down) = (
+                super::cook_torrance::over_t(&rule, a, phi),
+                super::cook_torrance::over_t(&rule, a, -phi),
+            );
+            [k * (up[0] + down[0]), k * (up[1] + down[1])]
+        }
+    }
+}
+
+/// Head-on Phong in closed form: `chi_view(n, 0) = (2/pi) Int_0^{pi/2} cos^n t dt
+/// = Gamma((n+1)/2) / (sqrt(pi) Gamma(n/2 + 1))`, by the log-gamma ratio.
+pub fn phong_head_on(n: f64) -> f64 {
+    // (2/pi) * (sqrt(pi)/2) Gamma((n+1)/2) / Gamma(n/2 + 1).
+    (ln_gamma(0.5 * (n + 1.0)) - ln_gamma(0.5 * n + 1.0)).exp() / PI.sqrt()
+}
+
+/// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7, 9 terms: about 1e-15 relative).
+fn ln_gamma(x: f64) -> f64 {
+    const G: f64 = 7.0;
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        // Reflection.
+        return (PI / (PI * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let t = x + G + 0.5;
+    let sum = C
+        .iter()
+        .enumerate()
+        .skip(1)
+        .fold(C[0], |s, (i, c)| s + c / (x + i as f64));
+    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + sum.ln()
+}
+
+/// Phong's lobe integrated over `t in [0, pi/2]` (in closed form per `g`) and `g in [0, pi/2]`
+/// at the signed view angle `p`.
+fn phong_at_p(rule: &TanhSinh, n: f64, p: f64) -> f64 {
+    let (sp, cp) = p.sin_cos();
+    let s = sp.abs();
+    // M^n = (1 - sp^2 sg^2)^(n/2) falls below the window at sg = sqrt(window) / |sp|.
+    let g_max = if s > 0.0 {
+        (window_sin2(n).sqrt() / s).min(1.0).asin()
+    } else {
+        FRAC_PI_2
+    };
+    let scale = if s > 0.0 {
+        peak_scale(n) / s
+    } else {
+        f64::INFINITY
+    };
+    let breaks = break_points(0.0, g_max, graded_from(0.0, 1.0, scale, g_max / 2.0));
+    let spread = window_angle(n);
+    // Int_a^b cos^n u du for 0 <= a <= b <= pi/2, its peak at `a`: cut where cos^n(u) falls
+    // below the window of cos^n(a) (cos u <= cos a cos(u - a) there).
+    let from = |a: f64, b: f64| {
+        let b = b.min(a + spread);
+        if b <= a {
+            return 0.0;
+        }
+        rule.integrate(a, b, |u| {
+            let h = (0.5 * u).sin();
+            pow1p(n, -2.0 * h * h)
+        })
+    };
+    rule.integrate_pieces(&breaks, |g| {
+        let (sg, cg) = g.sin_cos();
+        let m_pow = pow1p(0.5 * n, -(s * sg) * (s * sg));
+        let d = (sp * cg).atan2(cp);
+        let t_part = if d >= 0.0 {
+            from(d, FRAC_PI_2)
+        } else {
+            from(0.0, -d) + from(0.0, FRAC_PI_2 + d)
+        };
+        m_pow * t_part
+    })
+}
+
+/// Largest `n` the per-view table covers.
+pub const VIEW_N_MAX: f32 = 16384.0;
+
+/// Where `(n, phi)` falls in the table, in `[0, 1]^2`: `u` along
+/// `log2(1 + n) / log2(1 + VIEW_N_MAX)`; `v` along the view angle measured in units of the
+/// lobe's width `1/sqrt(1 + n)` from both ends, logarithmically,
+/// `v = 1/2 + (ln(1 + tau_0) - ln(1 + tau_90)) / (2 ln(1 + tau_max))` with
+/// `tau_0 = sqrt(1 + n) phi`, `tau_90 = sqrt(1 + n) (pi/2 - phi)`: a sharp lobe's head-on peak
+/// and its cut by the horizon at grazing views are as many nodes wide as a broad lobe's, and
+/// between them `chi_view` falls as a power of `phi`, a straight line in `ln`.
+fn table_coords(n: f64, phi: f64) -> (f64, f64) {
+    let width = (1.0 + n).sqrt();
+    let u = (1.0 + n).log2() / (1.0 + f64::from(VIEW_N_MAX)).log2();
+    let span = (width * FRAC_PI_2).ln_1p();
+    let v = 0.5 + ((width * phi).ln_1p() - (width * (FRAC_PI_2 - phi)).ln_1p()) / (2.0 * span);
+    (u, v)
+}
+
+/// [`table_coords`] in `f32`, as the renderer computes it.
+fn table_coords_f32(n: f32, phi: f32) -> (f32, f32) {
+    let width = (1.0 + n).sqrt();
+    let u = (1.0 + n).log2() / (1.0 + VIEW_N_MAX).log2();
+    let span = (width * std::f32::consts::FRAC_PI_2).ln_1p();
+    let v = 0.5
+        + ((width * phi).ln_1p() - (width * (std::f32::consts::FRAC_PI_2 - phi)).ln_1p())
+            / (2.0 * span);
+    (u, v)
+}
+
+/// The inverse of [`table_coords`]: `(n, phi)` at table position `(u, v)` in `[0, 1]^2`.
+fn table_point(u: f64, v: f64) -> (f64, f64) {
+    let n = ((u * (1.0 + f64::from(VIEW_N_MAX)).log2()).exp2() - 1.0).max(0.0);
+    // v is increasing in phi: bisection.
+    let (mut lo, mut hi) = (0.0, FRAC_PI_2);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if table_coords(n, mid).1 < v {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (n, 0.5 * (lo + hi))
+}
+
+/// `ln chi_view` of `model`'s parts at every node of a `nodes x nodes` table, row by row in
+/// `u`: what [`view_table_source`] prints. Runs the exact integrator at every node.
+pub fn view_table(model: ShadingModel, nodes: usize) -> Vec<[f64; 2]> {
+    use rayon::prelude::*;
+    let last = (nodes - 1) as f64;
+    (0..nodes * nodes)
+        .into_par_iter()
+        .map(|k| {
+            let (n, phi) = table_point((k / nodes) as f64 / last, (k % nodes) as f64 / last);
+            chi_view_exact(model, n, phi).map(|c| if c > 0.0 { c.ln() } else { -745.0 })
+        })
+        .collect()
+}
+
+/// The worst relative error of `table` (a part of [`view_table`] as `f32`) against the exact
+/// integrator at the centres of its cells (where interpolation is furthest from the nodes),
+/// and where it is: `(error, n, phi)`.
+pub fn table_error(
+    model: ShadingModel,
+    part: usize,
+    nodes: usize,
+    table: &[f32],
+) -> (f64, f64, f64) {
+    use rayon::prelude::*;
+    let last = (nodes - 1) as f64;
+    let cells = nodes - 1;
+    (0..cells * cells)
+        .into_par_iter()
+        .map(|k| {
+            let (u, v) = (
+                ((k / cells) as f64 + 0.5) / last,
+                ((k % cells) as f64 + 0.5) / last,
+            );
+            let (n, phi) = table_point(u, v);
+            let exact = chi_view_exact(model, n, phi)[part];
+            let (tu, tv) = table_coords(n, phi);
+            let fast = f64::from(bicubic(table, nodes, tu, tv).exp());
+            ((fast / exact - 1.0).abs(), n, phi)
+        })
+        .reduce(|| (0.0, 0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a })
+}
+
+/// The generated Rust source of `view_table.rs`: the three models' tables of `nodes^2` nodes,
+/// with each table's worst error between the nodes (see [`table_error`]) on stderr.
+pub fn view_table_source(nodes: usize) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::from(
+        "//! Generated by `cargo run --release --example fit_view`: do not edit by hand.\n\
+         //! `ln chi_view` at the nodes of the per-view table (see `view.rs`).\n\n\
+         #![expect(\n    clippy::unreadable_literal,\n    \
+         reason = \"generated table, printed in full\"\n)]\n\n",
+    );
+    let _ = writeln!(
+        out,
+        "/// Nodes per side.\npub const NODES: usize = {nodes};\n"
+    );
+    for (name, model) in [
+        ("PHONG", ShadingModel::Phong),
+        ("BLINN", ShadingModel::BlinnPhong),
+        ("COOK_TORRANCE", ShadingModel::CookTorrance),
+    ] {
+        let table = view_table(model, nodes);
+        let parts = if model == ShadingModel::CookTorrance {
+            2
+        } else {
+            1
+        };
+        for part in 0..parts {
+            let values: Vec<f32> = table.iter().map(|v| v[part] as f32).collect();
+            let (e, n, phi) = table_error(model, part, nodes, &values);
+            eprintln!(
+                "{name} part {part}: worst {e:.2e} at n {n:.1}, view {:.2} deg",
+                phi.to_degrees()
+            );
+            let suffix = if parts == 2 {
+                format!("_{}", 1 - part)
+            } else {
+                String::new()
+            };
+            let _ = writeln!(
+                out,
+                "/// `ln chi_view` ({name}{suffix}), `NODES` rows of `NODES`.\n\
+                 pub const {name}{suffix}: [f32; NODES * NODES] = ["
+            );
+            for v in &table {
+                let _ = writeln!(out, "    {:e},", v[part] as f32);
+            }
+            let _ = writeln!(out, "];\n");
+        }
+    }
+    out
+}
+
+/// `chi_view` from the table in `f32`, as a renderer evaluates it: `[chi_view, 0]` for Phong
+/// and Blinn-Phong, both parts for Cook-Torrance. Bicubic (Catmull-Rom) interpolation of
+/// `ln chi_view` over [`table_coords`]. `None` for an `n` beyond [`VIEW_N_MAX`] or NaN; `phi`
+/// is clamped into `[0, pi/2]`.
+pub fn chi_view_fast(model: ShadingModel, n: f32, phi: f32) -> Option<[f32; 2]> {
+    use super::view_table as t;
+    if n.is_nan() || !(0.0..=VIEW_N_MAX).contains(&n) {
+        return None;
+    }
+    let phi = if phi.is_nan() {
+        0.0
+    } else {
+        phi.clamp(0.0, std::f32::consts::FRAC_PI_2)
+    };
+    let (u, v) = table_coords_f32(n, phi);
+    let at = |table: &[f32]| bicubic(table, t::NODES, f64::from(u), f64::from(v)).exp();
+    Some(match model {
+        ShadingModel::Phong => [at(&t::PHONG), 0.0],
+        ShadingModel::BlinnPhong => [at(&t::BLINN), 0.0],
+        ShadingModel::CookTorrance => [at(&t::COOK_TORRANCE_1), at(&t::COOK_TORRANCE_0)],
+    })
+}
+
+/// Catmull-Rom interpolation of a `nodes x nodes` table at `(u, v)` in `[0, 1]^2`, ends
+/// extended linearly.
+fn bicubic(table: &[f32], nodes: usize, u: f64, v: f64) -> f32 {
+    let last = (nodes - 1) as f64;
+    let (x, y) = (u.clamp(0.0, 1.0) * last, v.clamp(0.0, 1.0) * last);
+    let (i, j) = ((x as usize).min(nodes - 2), (y as usize).min(nodes - 2));
+    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
+    let get = |a: isize, b: isize| -> f32 {
+        // Linear extension past the edges keeps the end intervals third-order.
+        let clampi = |k: isize| k.clamp(0, nodes as isize - 1) as usize;
+        let value = |a: usize, b: usize| table[a * nodes + b];
+        let (ca, cb) = (clampi(a), clampi(b));
+        let mut v = value(ca, cb);
+        if a < 0 {
+            v = 2.0 * v - value(1, cb);
+        } else if a as usize >= nodes {
+            v = 2.0 * v - value(nodes - 2, cb);
+        }
+        if b < 0 {
+            v += value(ca, 0) - value(ca, 1);
+        } else if b as usize >= nodes {
+            v += value(ca, nodes - 1) - value(ca, nodes - 2);
+        }
+        v
+    };
+    let weights = |f: f32| {
+        let (f2, f3) = (f * f, f * f * f);
+        [
+            -0.5 * f3 + f2 - 0.5 * f,
+            1.5 * f3 - 2.5 * f2 + 1.0,
+            -1.5 * f3 + 2.0 * f2 + 0.5 * f,
+            0.5 * f3 - 0.5 * f2,
+        ]
+    };
+    let (wx, wy) = (weights(fx), weights(fy));
+    if (1..nodes - 2).contains(&i) && (1..nodes - 2).contains(&j) {
+        // Inside: the 4 x 4 nodes around the point, read directly.
+        let mut sum = 0.0;
+        for (a, wa) in wx.iter().enumerate() {
+            let row = &table[(i - 1 + a) * nodes + j - 1..][..4];
+            sum += wa * (row[0] * wy[0] + row[1] * wy[1] + row[2] * wy[2] + row[3] * wy[3]);
+        }
+        return sum;
+    }
+    let mut sum = 0.0;
+    for (a, wa) in wx.iter().enumerate() {
+        let mut row = 0.0;
+        for (b, wb) in wy.iter().enumerate() {
+            row += wb * get(i as isize - 1 + a as isize, j as isize - 1 + b as isize);
+        }
+        sum += wa * row;
+    }
+    sum
+}
+
+#[cfg(test)]
+mod tests;
