@@ -82,7 +82,7 @@ impl Editor {
         let brush_presets =
             super::panels::presets::load_brush_presets(preset_dir.as_deref(), &mut notices);
         let mask_presets =
-            super::panels::generator::load_mask_presets(preset_dir.as_deref(), &mut notices);
+            super::panels::presets::load_mask_presets(preset_dir.as_deref(), &mut notices);
         let dock = load_layout().unwrap_or_else(default_layout);
         let saved_version = doc.version();
         let mut editor = Self {

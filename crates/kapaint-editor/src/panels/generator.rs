@@ -4,9 +4,7 @@
 //! (`PreviewMaskGenerator`); letting go sets it (`SetMaskGenerator`), the drag one undo step.
 
 use kapaint_core::model::MaskCommand;
-use kapaint_core::model::generator::{
-    Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space, preset::MaskPreset,
-};
+use kapaint_core::model::generator::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
 use kapaint_core::model::layers::{Layer, thumbnail};
 
 use super::presets::Naming;
@@ -322,26 +320,4 @@ impl EditorState {
     pub fn mask_preset_names(&self) -> Vec<&str> {
         self.mask_presets.iter().map(|p| p.name.as_str()).collect()
     }
-}
-
-/// The shipped smart masks, then the user's from the `masks` folder of `dir` (a malformed file
-/// is a notice).
-pub(crate) fn load_mask_presets(
-    dir: Option<&std::path::Path>,
-    notices: &mut crate::Notices,
-) -> Vec<MaskPreset> {
-    use kapaint_core::model::generator::preset;
-    let mut list = preset::builtin();
-    if let Some(dir) = dir {
-        for found in preset::load_dir(&dir.join("masks")) {
-            match found {
-                Ok(p) => {
-                    list.retain(|q| q.name != p.name);
-                    list.push(p);
-                }
-                Err(e) => notices.push(crate::notice(format!("skipped {e}"), true)),
-            }
-        }
-    }
-    list
 }

@@ -298,7 +298,7 @@ impl EditorState {
         let dir = self.preset_dir.clone();
         self.presets = load_material_presets(dir.as_deref(), &mut self.notices);
         self.brush_presets = load_brush_presets(dir.as_deref(), &mut self.notices);
-        self.mask_presets = super::generator::load_mask_presets(dir.as_deref(), &mut self.notices);
+        self.mask_presets = load_mask_presets(dir.as_deref(), &mut self.notices);
     }
 
     /// The names of the material presets, as the browser shows them.
@@ -310,4 +310,26 @@ impl EditorState {
     pub fn brush_preset_names(&self) -> Vec<&str> {
         self.brush_presets.iter().map(|p| p.name.as_str()).collect()
     }
+}
+
+/// The shipped smart masks, then the user's from the `masks` folder of `dir` (a malformed file
+/// is a notice).
+pub(crate) fn load_mask_presets(
+    dir: Option<&std::path::Path>,
+    notices: &mut crate::Notices,
+) -> Vec<kapaint_core::model::generator::preset::MaskPreset> {
+    use kapaint_core::model::generator::preset;
+    let mut list = preset::builtin();
+    if let Some(dir) = dir {
+        for found in preset::load_dir(&dir.join("masks")) {
+            match found {
+                Ok(p) => {
+                    list.retain(|q| q.name != p.name);
+                    list.push(p);
+                }
+                Err(e) => notices.push(crate::notice(format!("skipped {e}"), true)),
+            }
+        }
+    }
+    list
 }

@@ -175,7 +175,7 @@ fn lay(
 /// bakes, the map size): whether any was. Paint over them stays.
 pub(super) fn lay_generators(st: &mut State) -> bool {
     let source = source_of(st);
-    crate::generator::tiles::lay_all(&mut st.stack.layers, &source)
+    crate::layers::lay_generators(&mut st.stack.layers, &source)
 }
 
 /// Bakes the selected layer's mask into its content (a paint layer) and deletes the mask.

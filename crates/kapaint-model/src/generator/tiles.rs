@@ -17,6 +17,12 @@ use super::{Evaluator, Generator, Grid, Texel};
 use crate::surface::Surface;
 use crate::tile::{Plane, TILE_SIZE, TILE_TEXELS};
 
+/// The next stamp of a laid generator (0 stands for none).
+fn next_stamp() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Texels a side of one coarse sample.
 pub const COARSE: usize = 4;
 
@@ -126,7 +132,7 @@ impl Generated {
             "a source's surface is of its mesh"
         );
         Self {
-            stamp: crate::layers::next_stamp(),
+            stamp: next_stamp(),
             generator,
             coarse,
             source,
@@ -343,38 +349,4 @@ pub fn with_paint(g: u16, p: u16) -> u16 {
         g - (n - p) * 65535 / n
     };
     u16::try_from(v.clamp(0, 65535)).unwrap_or(u16::MAX)
-}
-
-/// Lays every generator mask in `layers` (at any depth) on `source` where it was laid on
-/// other inputs (a new stamp: recomposited), or gives it `source`'s surface where it was laid
-/// on the same mesh before the surface was attached (the same stamp); whether any changed. A
-/// `source` without a surface keeps the mesh each generator was laid on.
-pub fn lay_all(layers: &mut [crate::layers::Layer], source: &Source) -> bool {
-    let mut changed = false;
-    for layer in layers {
-        if let Some(mask) = &mut layer.mask
-            && let Some(g) = &mask.generator
-        {
-            // No surface attached (yet, or for a while) does not change the mesh a
-            // generator was laid on.
-            let source = match (&source.surface, g.source().mesh) {
-                (None, Some(mesh)) => &Source {
-                    mesh: Some(mesh),
-                    ..source.clone()
-                },
-                _ => source,
-            };
-            if !g.source().same(source) {
-                let made = Generated::new(g.generator().clone(), source.clone(), g.is_coarse());
-                mask.generator = Some(Arc::new(made));
-                changed = true;
-            } else if let (None, Some(s)) = (&g.source().surface, &source.surface) {
-                mask.generator = Some(Arc::new(g.with_surface(Arc::clone(s))));
-            }
-        }
-        if let crate::layers::LayerContent::Group(children) = &mut layer.content {
-            changed |= lay_all(children, source);
-        }
-    }
-    changed
 }

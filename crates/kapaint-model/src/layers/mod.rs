@@ -628,3 +628,41 @@ impl Layer {
         }
     }
 }
+
+/// Lays every generator mask in `layers` (at any depth) on `source` where it was laid on
+/// other inputs (a new stamp: recomposited), or gives it `source`'s surface where it was laid
+/// on the same mesh before the surface was attached (the same stamp); whether any changed. A
+/// `source` without a surface keeps the mesh each generator was laid on.
+pub fn lay_generators(layers: &mut [Layer], source: &crate::generator::tiles::Source) -> bool {
+    let mut changed = false;
+    for layer in layers {
+        if let Some(mask) = &mut layer.mask
+            && let Some(g) = &mask.generator
+        {
+            // No surface attached (yet, or for a while) does not change the mesh a
+            // generator was laid on.
+            let source = match (&source.surface, g.source().mesh) {
+                (None, Some(mesh)) => &crate::generator::tiles::Source {
+                    mesh: Some(mesh),
+                    ..source.clone()
+                },
+                _ => source,
+            };
+            if !g.source().same(source) {
+                let made = crate::generator::tiles::Generated::new(
+                    g.generator().clone(),
+                    source.clone(),
+                    g.is_coarse(),
+                );
+                mask.generator = Some(Arc::new(made));
+                changed = true;
+            } else if let (None, Some(s)) = (&g.source().surface, &source.surface) {
+                mask.generator = Some(Arc::new(g.with_surface(Arc::clone(s))));
+            }
+        }
+        if let LayerContent::Group(children) = &mut layer.content {
+            changed |= lay_generators(children, source);
+        }
+    }
+    changed
+}

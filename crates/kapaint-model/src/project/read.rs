@@ -72,7 +72,7 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
             };
             let mut stack = stack;
             let source = crate::generator::tiles::Source::expecting(hash, &bakes, w, h);
-            crate::generator::tiles::lay_all(&mut stack.layers, &source);
+            crate::layers::lay_generators(&mut stack.layers, &source);
             Document::from_stack_and_composite(stack, stored, manifest.settings)
                 .map_err(|e| e.to_string())?
         } else {
