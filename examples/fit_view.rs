@@ -10,7 +10,7 @@ fn main() {
     let nodes: usize = std::env::args()
         .nth(1)
         .and_then(|a| a.parse().ok())
-        .unwrap_or(48);
+        .unwrap_or(128);
     let start = std::time::Instant::now();
     print!("{}", view_table_source(nodes));
     eprintln!("{nodes}^2 nodes in {:.1} s", start.elapsed().as_secs_f64());

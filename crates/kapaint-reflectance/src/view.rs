@@ -162,30 +162,36 @@ fn phong_at_p(rule: &TanhSinh, n: f64, p: f64) -> f64 {
 pub const VIEW_N_MAX: f32 = 16384.0;
 
 /// Where `(n, phi)` falls in the table, in `[0, 1]^2`: `u` along
-/// `log2(1 + n) / log2(1 + VIEW_N_MAX)`; `v` along the view angle measured in units of the
-/// lobe's width `1/sqrt(1 + n)` from both ends, logarithmically,
-/// `v = 1/2 + (ln(1 + tau_0) - ln(1 + tau_90)) / (2 ln(1 + tau_max))` with
-/// `tau_0 = sqrt(1 + n) phi`, `tau_90 = sqrt(1 + n) (pi/2 - phi)`: a sharp lobe's head-on peak
-/// and its cut by the horizon at grazing views are as many nodes wide as a broad lobe's, and
-/// between them `chi_view` falls as a power of `phi`, a straight line in `ln`.
+/// `log2(1 + n) / log2(1 + VIEW_N_MAX)`; `v` along the view angle, logarithmically from both
+/// ends, `v = 1/2 + (ln(1 + w phi) / ln(1 + w pi/2) - ln(1 + g x) / ln(1 + g pi/2)) / 2` with
+/// `x = pi/2 - phi`, `w = sqrt(1 + n)` (the inverse of the lobe's width) and
+/// `g = hypot(w, GRAZE)` (a smooth max): a sharp lobe's head-on peak and its cut by the horizon are as many
+/// nodes wide as a broad lobe's, between them `chi_view` falls as a power of `phi` (a straight
+/// line in `ln`), and the last degree before grazing is resolved whatever `n`.
 fn table_coords(n: f64, phi: f64) -> (f64, f64) {
     let width = (1.0 + n).sqrt();
+    let graze = width.hypot(GRAZE);
     let u = (1.0 + n).log2() / (1.0 + f64::from(VIEW_N_MAX)).log2();
-    let span = (width * FRAC_PI_2).ln_1p();
-    let v = 0.5 + ((width * phi).ln_1p() - (width * (FRAC_PI_2 - phi)).ln_1p()) / (2.0 * span);
-    (u, v)
+    let head_on = (width * phi).ln_1p() / (width * FRAC_PI_2).ln_1p();
+    let grazing = (graze * (FRAC_PI_2 - phi)).ln_1p() / (graze * FRAC_PI_2).ln_1p();
+    (u, 0.5 + 0.5 * (head_on - grazing))
 }
 
 /// [`table_coords`] in `f32`, as the renderer computes it.
 fn table_coords_f32(n: f32, phi: f32) -> (f32, f32) {
+    use std::f32::consts::FRAC_PI_2;
     let width = (1.0 + n).sqrt();
+    let graze = width.hypot(GRAZE as f32);
     let u = (1.0 + n).log2() / (1.0 + VIEW_N_MAX).log2();
-    let span = (width * std::f32::consts::FRAC_PI_2).ln_1p();
-    let v = 0.5
-        + ((width * phi).ln_1p() - (width * (std::f32::consts::FRAC_PI_2 - phi)).ln_1p())
-            / (2.0 * span);
-    (u, v)
+    let head_on = (width * phi).ln_1p() / (width * FRAC_PI_2).ln_1p();
+    let grazing = (graze * (FRAC_PI_2 - phi)).ln_1p() / (graze * FRAC_PI_2).ln_1p();
+    (u, 0.5 + 0.5 * (head_on - grazing))
 }
+
+/// The finest angle (its inverse, per radian) the table resolves at grazing views whatever
+/// `n`: Cook-Torrance's and Phong's `chi_view` meet 90 degrees like `x ln x` in the angle `x`
+/// left to the horizon, which is smooth in `ln x`.
+const GRAZE: f64 = 64.0;
 
 /// The inverse of [`table_coords`]: `(n, phi)` at table position `(u, v)` in `[0, 1]^2`.
 fn table_point(u: f64, v: f64) -> (f64, f64) {
@@ -285,7 +291,7 @@ pub fn view_table_source(nodes: usize) -> String {
             let _ = writeln!(
                 out,
                 "/// `ln chi_view` ({name}{suffix}), `NODES` rows of `NODES`.\n\
-                 pub const {name}{suffix}: [f32; NODES * NODES] = ["
+                 pub static {name}{suffix}: [f32; NODES * NODES] = ["
             );
             for v in &table {
                 let _ = writeln!(out, "    {:e},", v[part] as f32);
@@ -326,23 +332,28 @@ fn bicubic(table: &[f32], nodes: usize, u: f64, v: f64) -> f32 {
     let (x, y) = (u.clamp(0.0, 1.0) * last, v.clamp(0.0, 1.0) * last);
     let (i, j) = ((x as usize).min(nodes - 2), (y as usize).min(nodes - 2));
     let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
-    let get = |a: isize, b: isize| -> f32 {
-        // Linear extension past the edges keeps the end intervals third-order.
-        let clampi = |k: isize| k.clamp(0, nodes as isize - 1) as usize;
-        let value = |a: usize, b: usize| table[a * nodes + b];
-        let (ca, cb) = (clampi(a), clampi(b));
-        let mut v = value(ca, cb);
+    // Past the edges, the quadratic through the last three nodes: the end intervals stay
+    // third-order.
+    let column = |a: isize, b: usize| -> f32 {
+        let value = |a: usize| table[a * nodes + b];
+        let last = nodes - 1;
         if a < 0 {
-            v = 2.0 * v - value(1, cb);
-        } else if a as usize >= nodes {
-            v = 2.0 * v - value(nodes - 2, cb);
+            3.0 * value(0) - 3.0 * value(1) + value(2)
+        } else if a as usize > last {
+            3.0 * value(last) - 3.0 * value(last - 1) + value(last - 2)
+        } else {
+            value(a as usize)
         }
+    };
+    let get = |a: isize, b: isize| -> f32 {
+        let last = nodes - 1;
         if b < 0 {
-            v += value(ca, 0) - value(ca, 1);
-        } else if b as usize >= nodes {
-            v += value(ca, nodes - 1) - value(ca, nodes - 2);
+            3.0 * column(a, 0) - 3.0 * column(a, 1) + column(a, 2)
+        } else if b as usize > last {
+            3.0 * column(a, last) - 3.0 * column(a, last - 1) + column(a, last - 2)
+        } else {
+            column(a, b as usize)
         }
-        v
     };
     let weights = |f: f32| {
         let (f2, f3) = (f * f, f * f * f);

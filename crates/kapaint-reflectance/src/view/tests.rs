@@ -152,7 +152,7 @@ fn the_fast_table_follows_the_exact_integral() {
     // Between the nodes, over n in [0, 16384] and views in [0, 89.9] degrees (a fixed
     // low-discrepancy set of points): the table's measured accuracy (docs/reflectance.md).
     let mut worst = [0.0_f64; 3];
-    for k in 0..400_u32 {
+    for k in 0..800_u32 {
         let a = (f64::from(k) * 0.618_033_988_749_895).fract();
         let b = (f64::from(k) * 0.754_877_666_246_692_7).fract();
         let n = (a * 14.0).exp2() - 1.0;
@@ -168,8 +168,10 @@ fn the_fast_table_follows_the_exact_integral() {
         }
     }
     eprintln!("worst relative error: {worst:?}");
+    // The 1e-4 contract holds for Phong and Blinn-Phong; Cook-Torrance's parts reach 1.7e-4
+    // within a degree of grazing at small n (docs/reflectance.md).
     assert!(
-        worst[0] < 2e-3 && worst[1] < 1e-3 && worst[2] < 1e-2,
+        worst[0] < 1e-4 && worst[1] < 1e-4 && worst[2] < 2e-4,
         "{worst:?}"
     );
     assert_eq!(chi_view_fast(ShadingModel::Phong, 16385.0, 0.0), None);
