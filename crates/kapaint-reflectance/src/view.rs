@@ -304,8 +304,9 @@ pub fn view_table_source(nodes: usize) -> String {
 
 /// `chi_view` from the table in `f32`, as a renderer evaluates it: `[chi_view, 0]` for Phong
 /// and Blinn-Phong, both parts for Cook-Torrance. Bicubic (Catmull-Rom) interpolation of
-/// `ln chi_view` over [`table_coords`]. `None` for an `n` beyond [`VIEW_N_MAX`] or NaN; `phi`
-/// is clamped into `[0, pi/2]`.
+/// `ln chi_view` over `log2(1 + n)` and the view angle in lobe widths from both ends (see
+/// docs/reflectance.md). `None` for an `n` beyond [`VIEW_N_MAX`] or NaN; `phi` is clamped
+/// into `[0, pi/2]`.
 pub fn chi_view_fast(model: ShadingModel, n: f32, phi: f32) -> Option<[f32; 2]> {
     use super::view_table as t;
     if n.is_nan() || !(0.0..=VIEW_N_MAX).contains(&n) {
