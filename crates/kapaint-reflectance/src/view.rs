@@ -191,7 +191,7 @@ fn table_coords_f32(n: f32, phi: f32) -> (f32, f32) {
 /// The finest angle (its inverse, per radian) the table resolves at grazing views whatever
 /// `n`: Cook-Torrance's and Phong's `chi_view` meet 90 degrees like `x ln x` in the angle `x`
 /// left to the horizon, which is smooth in `ln x`.
-const GRAZE: f64 = 64.0;
+const GRAZE: f64 = 256.0;
 
 /// The inverse of [`table_coords`]: `(n, phi)` at table position `(u, v)` in `[0, 1]^2`.
 fn table_point(u: f64, v: f64) -> (f64, f64) {
@@ -294,12 +294,44 @@ pub fn view_table_source(nodes: usize) -> String {
                  pub static {name}{suffix}: [f32; NODES * NODES] = ["
             );
             for v in &table {
-                let _ = writeln!(out, "    {:e},", v[part] as f32);
+                let _ = writeln!(out, "    {},", literal(v[part] as f32));
             }
             let _ = writeln!(out, "];\n");
         }
     }
     out
+}
+
+/// `v` as a Rust literal: its shortest exponent form, or its bits where that would read as
+/// one of the mathematical constants (which clippy asks to name instead).
+fn literal(v: f32) -> String {
+    use std::f32::consts as c;
+    let constants = [
+        c::E,
+        c::FRAC_1_PI,
+        c::FRAC_1_SQRT_2,
+        c::FRAC_2_PI,
+        c::FRAC_2_SQRT_PI,
+        c::FRAC_PI_2,
+        c::FRAC_PI_3,
+        c::FRAC_PI_4,
+        c::FRAC_PI_6,
+        c::FRAC_PI_8,
+        c::LN_10,
+        c::LN_2,
+        c::LOG10_E,
+        c::LOG2_E,
+        c::LOG2_10,
+        c::LOG10_2,
+        c::PI,
+        c::SQRT_2,
+        c::TAU,
+    ];
+    if constants.iter().any(|k| (v.abs() - k).abs() <= 1e-3 * k) {
+        format!("f32::from_bits({:#010x})", v.to_bits())
+    } else {
+        format!("{v:e}")
+    }
 }
 
 /// `chi_view` from the table in `f32`, as a renderer evaluates it: `[chi_view, 0]` for Phong

@@ -168,8 +168,8 @@ fn the_fast_table_follows_the_exact_integral() {
         }
     }
     eprintln!("worst relative error: {worst:?}");
-    // The 1e-4 contract holds for Phong and Blinn-Phong; Cook-Torrance's parts reach 1.7e-4
-    // within a degree of grazing at small n (docs/reflectance.md).
+    // The 1e-4 contract holds for Phong and Blinn-Phong; Cook-Torrance's chi_0 reaches 1.6e-4
+    // at large n (docs/reflectance.md).
     assert!(
         worst[0] < 1e-4 && worst[1] < 1e-4 && worst[2] < 2e-4,
         "{worst:?}"
