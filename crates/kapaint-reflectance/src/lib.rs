@@ -26,7 +26,6 @@ pub mod fit;
 pub mod geometry;
 pub mod quadrature;
 pub mod view;
-mod view_table;
 pub mod wgsl;
 
 use glam::Vec3;
