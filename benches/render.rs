@@ -119,6 +119,17 @@ fn documents() -> (Document, Document) {
     (painted, matte)
 }
 
+/// A Blinn-Phong frame of `view` framing `points`.
+fn blinn_phong(view: ViewMode, points: &[glam::Vec3]) -> FrameSettings {
+    FrameSettings {
+        model: ShadingModel::BlinnPhong,
+        approx: AmbientApprox::Fast,
+        view,
+        lighting: Lighting::default(),
+        camera: Camera::default().framing(points),
+    }
+}
+
 fn frames(c: &mut Criterion) {
     let Ok(gpu) = Gpu::headless() else {
         eprintln!("SKIPPED: no GPU adapter");
@@ -138,13 +149,7 @@ fn frames(c: &mut Criterion) {
     let (w, h) = (1920, 1080);
     let color = target(&gpu, w, h, wgpu::TextureFormat::Rgba8UnormSrgb);
     let depth = target(&gpu, w, h, wgpu::TextureFormat::Depth32Float);
-    let settings = |view| FrameSettings {
-        model: ShadingModel::BlinnPhong,
-        approx: AmbientApprox::Fast,
-        view,
-        lighting: Lighting::default(),
-        camera: Camera::default().framing(&sphere.positions),
-    };
+    let settings = |view| blinn_phong(view, &sphere.positions);
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let cases = [
         (
@@ -167,6 +172,18 @@ fn frames(c: &mut Criterion) {
         ),
         ("view_ka_painted_maps", &painted_maps, ViewMode::Ka, false),
         ("view_kd_painted_maps", &painted_maps, ViewMode::Kd, false),
+        (
+            "view_ka_per_view_painted",
+            &painted_maps,
+            ViewMode::KaView,
+            false,
+        ),
+        (
+            "view_average_error_painted",
+            &painted_maps,
+            ViewMode::KaViewError,
+            false,
+        ),
     ];
     for (name, maps, view, full) in cases {
         let s = settings(view);

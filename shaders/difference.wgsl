@@ -2,6 +2,8 @@
 // colour components) as a heatmap, black -> red -> yellow -> white from 0 to `max`. The ramp
 // is `render::heat_ramp`'s; a test renders both and compares them.
 
+#include "heat.wgsl"
+
 struct Heat {
     // 1 / max (0 when max is 0): the difference shown white.
     inv_max: f32,
@@ -19,11 +21,6 @@ struct Heat {
 fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     let corner = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
     return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
-}
-
-fn heat_ramp(t_raw: f32) -> vec3<f32> {
-    let t = clamp(t_raw, 0.0, 1.0);
-    return vec3<f32>(min(t * 3.0, 1.0), clamp(t * 3.0 - 1.0, 0.0, 1.0), clamp(t * 3.0 - 2.0, 0.0, 1.0));
 }
 
 @fragment

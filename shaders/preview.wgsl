@@ -15,6 +15,8 @@
 #include "ambient.wgsl"
 #include "preview_bindings.wgsl"
 #include "preview_functions.wgsl"
+#include "ambient_view.wgsl"
+#include "heat.wgsl"
 
 override MODEL: u32 = 0u;          // MODEL_*
 override APPROX: u32 = 2u;         // APPROX_*
@@ -80,6 +82,16 @@ fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
     }
     if VIEW == VIEW_KA {
         return vec4<f32>(finite_or_zero(ka), 1.0);
+    }
+    if VIEW == VIEW_KA_VIEW || VIEW == VIEW_KA_VIEW_ERROR {
+        // The geometric normal's view angle: like k_a, never the normal map's.
+        let to_eye = normalize(frame.eye - f.position);
+        let phi = acos(clamp(dot(normalize(f.normal), to_eye), 0.0, 1.0));
+        let per_view = finite_or_zero(ambient_ka_view(MODEL, kd, ks, n, phi));
+        if VIEW == VIEW_KA_VIEW {
+            return vec4<f32>(per_view, 1.0);
+        }
+        return vec4<f32>(heat_ramp(relative_error(finite_or_zero(ka), per_view) / VIEW_ERROR_TOP), 1.0);
     }
     let ambient = frame.ambient_intensity * ka;
     if VIEW == VIEW_AMBIENT {

@@ -130,9 +130,8 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
         }
     };
     let mut pixels = pixels;
-    if req.settings.view == ViewMode::NFalseColour {
-        draw_n_legend(&mut pixels);
-        note = ", legend: n = 0 (left) to 16384 (right), log scale".into();
+    if let Some(legend) = draw_view_legend(req.settings.view, &mut pixels) {
+        note = legend;
     }
     if req.settings.view == ViewMode::N
         && kind == Kind::Png
@@ -170,8 +169,31 @@ fn describe(req: &Request<'_>) -> String {
     }
 }
 
-/// Draws the false-colour scale of `n` along the bottom rows (n = 0 left, 16384 right, log).
-fn draw_n_legend(image: &mut RenderedImage) {
+/// Draws the scale of a false-colour or heatmap view along the bottom rows; what the report
+/// says about it.
+fn draw_view_legend(view: ViewMode, pixels: &mut RenderedImage) -> Option<String> {
+    match view {
+        ViewMode::NFalseColour => {
+            draw_legend(pixels, |t| {
+                let span = (1.0 + kapaint_core::model::texel::N_MAX).ln();
+                kapaint_core::render::n_false_colour((span * t).exp() - 1.0)
+            });
+            Some(", legend: n = 0 (left) to 16384 (right), log scale".into())
+        }
+        ViewMode::KaViewError => {
+            draw_legend(pixels, kapaint_core::render::heat_ramp);
+            Some(format!(
+                ", legend: relative error 0 (left) to {:.0} % (right)",
+                kapaint_core::render::VIEW_ERROR_TOP * 100.0
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// Draws a scale along the bottom rows: `ramp(t)` (linear RGB) for `t` from 0 at the left to
+/// 1 at the right.
+fn draw_legend(image: &mut RenderedImage, ramp: impl Fn(f32) -> glam::Vec3) {
     let (width, height) = match image {
         RenderedImage::Srgb8 { width, height, .. }
         | RenderedImage::Linear { width, height, .. } => (*width, *height),
@@ -179,9 +201,7 @@ fn draw_n_legend(image: &mut RenderedImage) {
     let bar = (height / 24).max(2).min(height);
     for y in height - bar..height {
         for x in 0..width {
-            let t = x as f32 / (width.max(2) - 1) as f32;
-            let n = ((1.0 + kapaint_core::model::texel::N_MAX).ln() * t).exp() - 1.0;
-            let c = kapaint_core::render::n_false_colour(n);
+            let c = ramp(x as f32 / (width.max(2) - 1) as f32);
             let i = (y * width + x) as usize * 4;
             match image {
                 RenderedImage::Srgb8 { pixels, .. } => {

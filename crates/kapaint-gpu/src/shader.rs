@@ -9,10 +9,14 @@ use kapaint_core::reflectance::wgsl::{IDS_FILE, model_and_approx_ids, screaming_
 use kapaint_core::render::ViewMode;
 
 /// Every file in `shaders/`, by name.
-pub const FILES: [(&str, &str); 7] = [
+pub const FILES: [(&str, &str); 9] = [
     (
         "ambient.wgsl",
         include_str!("../../../shaders/ambient.wgsl"),
+    ),
+    (
+        "ambient_view.wgsl",
+        include_str!("../../../shaders/ambient_view.wgsl"),
     ),
     (
         "chi_check.wgsl",
@@ -22,6 +26,7 @@ pub const FILES: [(&str, &str); 7] = [
         "difference.wgsl",
         include_str!("../../../shaders/difference.wgsl"),
     ),
+    ("heat.wgsl", include_str!("../../../shaders/heat.wgsl")),
     (
         "preview.wgsl",
         include_str!("../../../shaders/preview.wgsl"),
@@ -258,6 +263,29 @@ mod tests {
         for (name, text) in FILES {
             let disk = std::fs::read_to_string(dir.join(name)).expect("readable");
             assert_eq!(disk, text, "{name}");
+        }
+    }
+
+    #[test]
+    fn the_per_view_shader_holds_the_tables_constants() {
+        use kapaint_core::reflectance::view::{
+            VIEW_COEFFICIENTS, VIEW_GRAZE, VIEW_N_MAX, VIEW_NODES,
+        };
+        let wgsl = file("ambient_view.wgsl").expect("embedded");
+        for line in [
+            format!("const VIEW_NODES: i32 = {VIEW_NODES};"),
+            format!("const VIEW_COEFFICIENTS: i32 = {VIEW_COEFFICIENTS};"),
+            format!("const VIEW_N_MAX: f32 = {VIEW_N_MAX:?};"),
+            format!("const VIEW_GRAZE: f32 = {VIEW_GRAZE:?};"),
+            format!(
+                "const VIEW_ERROR_TOP: f32 = {:?};",
+                kapaint_core::render::VIEW_ERROR_TOP
+            ),
+        ] {
+            assert!(
+                wgsl.contains(&line),
+                "{line} missing from ambient_view.wgsl"
+            );
         }
     }
 

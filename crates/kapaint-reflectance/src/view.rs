@@ -165,12 +165,12 @@ pub const VIEW_N_MAX: f32 = 16384.0;
 /// `log2(1 + n) / log2(1 + VIEW_N_MAX)`; `v` along the view angle, logarithmically from both
 /// ends, `v = 1/2 + (ln(1 + w phi) / ln(1 + w pi/2) - ln(1 + g x) / ln(1 + g pi/2)) / 2` with
 /// `x = pi/2 - phi`, `w = sqrt(1 + n)` (the inverse of the lobe's width) and
-/// `g = hypot(w, GRAZE)` (a smooth max): a sharp lobe's head-on peak and its cut by the horizon are as many
+/// `g = hypot(w, VIEW_GRAZE)` (a smooth max): a sharp lobe's head-on peak and its cut by the horizon are as many
 /// nodes wide as a broad lobe's, between them `chi_view` falls as a power of `phi` (a straight
 /// line in `ln`), and the last degree before grazing is resolved whatever `n`.
 fn table_coords(n: f64, phi: f64) -> (f64, f64) {
     let width = (1.0 + n).sqrt();
-    let graze = width.hypot(GRAZE);
+    let graze = width.hypot(VIEW_GRAZE);
     let u = (1.0 + n).log2() / (1.0 + f64::from(VIEW_N_MAX)).log2();
     let head_on = (width * phi).ln_1p() / (width * FRAC_PI_2).ln_1p();
     let grazing = (graze * (FRAC_PI_2 - phi)).ln_1p() / (graze * FRAC_PI_2).ln_1p();
@@ -181,7 +181,7 @@ fn table_coords(n: f64, phi: f64) -> (f64, f64) {
 fn table_coords_f32(n: f32, phi: f32) -> (f32, f32) {
     use std::f32::consts::FRAC_PI_2;
     let width = (1.0 + n).sqrt();
-    let graze = width.hypot(GRAZE as f32);
+    let graze = width.hypot(VIEW_GRAZE as f32);
     let u = (1.0 + n).log2() / (1.0 + VIEW_N_MAX).log2();
     let head_on = (width * phi).ln_1p() / (width * FRAC_PI_2).ln_1p();
     let grazing = (graze * (FRAC_PI_2 - phi)).ln_1p() / (graze * FRAC_PI_2).ln_1p();
@@ -191,7 +191,7 @@ fn table_coords_f32(n: f32, phi: f32) -> (f32, f32) {
 /// The finest angle (its inverse, per radian) the table resolves at grazing views whatever
 /// `n`: Cook-Torrance's and Phong's `chi_view` meet 90 degrees like `x ln x` in the angle `x`
 /// left to the horizon, which is smooth in `ln x`.
-const GRAZE: f64 = 256.0;
+pub const VIEW_GRAZE: f64 = 256.0;
 
 /// The inverse of [`table_coords`]: `(n, phi)` at table position `(u, v)` in `[0, 1]^2`.
 fn table_point(u: f64, v: f64) -> (f64, f64) {
@@ -233,6 +233,7 @@ pub fn table_error(
     table: &[f32],
 ) -> (f64, f64, f64) {
     use rayon::prelude::*;
+    let coefficients = spline::coefficients(table, nodes);
     let last = (nodes - 1) as f64;
     let cells = nodes - 1;
     (0..cells * cells)
@@ -245,7 +246,7 @@ pub fn table_error(
             let (n, phi) = table_point(u, v);
             let exact = chi_view_exact(model, n, phi)[part];
             let (tu, tv) = table_coords(n, phi);
-            let fast = f64::from(bicubic(table, nodes, tu, tv).exp());
+            let fast = f64::from(spline::eval(&coefficients, nodes, tu, tv).exp());
             ((fast / exact - 1.0).abs(), n, phi)
         })
         .reduce(|| (0.0, 0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a })
@@ -287,8 +288,14 @@ pub fn view_table_bytes(nodes: usize) -> Vec<u8> {
     out
 }
 
-/// The shipped tables, decoded once from `view_table.bin`.
-fn shipped() -> &'static [Vec<f32>; 4] {
+/// Coefficients per side of a shipped table's spline: a ring of one around the nodes.
+pub const VIEW_COEFFICIENTS: usize = VIEW_NODES + 2;
+
+/// The shipped tables' spline coefficients (`VIEW_COEFFICIENTS^2` each, rows in `u`), in the
+/// order Phong, Blinn-Phong, Cook-Torrance's `chi_1`, its `chi_0`: decoded once from
+/// `view_table.bin` (the nodes' `ln chi_view`) and made into the not-a-knot cubic B-spline
+/// through them. What the shaders read (see `shaders/ambient_view.wgsl`).
+pub fn view_coefficients() -> &'static [Vec<f32>; 4] {
     static TABLE: std::sync::LazyLock<[Vec<f32>; 4]> = std::sync::LazyLock::new(|| {
         let bytes = include_bytes!("view_table.bin");
         let size = VIEW_NODES * VIEW_NODES;
@@ -296,14 +303,15 @@ fn shipped() -> &'static [Vec<f32>; 4] {
             bytes[k * size * 4..(k + 1) * size * 4]
                 .chunks_exact(4)
                 .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .collect()
+                .collect::<Vec<f32>>()
         })
+        .map(|nodes| spline::coefficients(&nodes, VIEW_NODES))
     });
     &TABLE
 }
 
 /// `chi_view` from the table in `f32`, as a renderer evaluates it: `[chi_view, 0]` for Phong
-/// and Blinn-Phong, both parts for Cook-Torrance. Bicubic (Catmull-Rom) interpolation of
+/// and Blinn-Phong, both parts for Cook-Torrance. The cubic B-spline through the nodes of
 /// `ln chi_view` over `log2(1 + n)` and the view angle in lobe widths from both ends (see
 /// docs/reflectance.md). `None` for an `n` beyond [`VIEW_N_MAX`] or NaN; `phi` is clamped
 /// into `[0, pi/2]`.
@@ -317,8 +325,8 @@ pub fn chi_view_fast(model: ShadingModel, n: f32, phi: f32) -> Option<[f32; 2]> 
         phi.clamp(0.0, std::f32::consts::FRAC_PI_2)
     };
     let (u, v) = table_coords_f32(n, phi);
-    let t = shipped();
-    let at = |table: &[f32]| bicubic(table, VIEW_NODES, f64::from(u), f64::from(v)).exp();
+    let t = view_coefficients();
+    let at = |c: &[f32]| spline::eval(c, VIEW_NODES, f64::from(u), f64::from(v)).exp();
     Some(match model {
         ShadingModel::Phong => [at(&t[0]), 0.0],
         ShadingModel::BlinnPhong => [at(&t[1]), 0.0],
@@ -326,65 +334,27 @@ pub fn chi_view_fast(model: ShadingModel, n: f32, phi: f32) -> Option<[f32; 2]> 
     })
 }
 
-/// Catmull-Rom interpolation of a `nodes x nodes` table at `(u, v)` in `[0, 1]^2`, ends
-/// extended linearly.
-fn bicubic(table: &[f32], nodes: usize, u: f64, v: f64) -> f32 {
-    let last = (nodes - 1) as f64;
-    let (x, y) = (u.clamp(0.0, 1.0) * last, v.clamp(0.0, 1.0) * last);
-    let (i, j) = ((x as usize).min(nodes - 2), (y as usize).min(nodes - 2));
-    let (fx, fy) = ((x - i as f64) as f32, (y - j as f64) as f32);
-    // Past the edges, the quadratic through the last three nodes: the end intervals stay
-    // third-order.
-    let column = |a: isize, b: usize| -> f32 {
-        let value = |a: usize| table[a * nodes + b];
-        let last = nodes - 1;
-        if a < 0 {
-            3.0 * value(0) - 3.0 * value(1) + value(2)
-        } else if a as usize > last {
-            3.0 * value(last) - 3.0 * value(last - 1) + value(last - 2)
-        } else {
-            value(a as usize)
-        }
-    };
-    let get = |a: isize, b: isize| -> f32 {
-        let last = nodes - 1;
-        if b < 0 {
-            3.0 * column(a, 0) - 3.0 * column(a, 1) + column(a, 2)
-        } else if b as usize > last {
-            3.0 * column(a, last) - 3.0 * column(a, last - 1) + column(a, last - 2)
-        } else {
-            column(a, b as usize)
-        }
-    };
-    let weights = |f: f32| {
-        let (f2, f3) = (f * f, f * f * f);
-        [
-            -0.5 * f3 + f2 - 0.5 * f,
-            1.5 * f3 - 2.5 * f2 + 1.0,
-            -1.5 * f3 + 2.0 * f2 + 0.5 * f,
-            0.5 * f3 - 0.5 * f2,
-        ]
-    };
-    let (wx, wy) = (weights(fx), weights(fy));
-    if (1..nodes - 2).contains(&i) && (1..nodes - 2).contains(&j) {
-        // Inside: the 4 x 4 nodes around the point, read directly.
-        let mut sum = 0.0;
-        for (a, wa) in wx.iter().enumerate() {
-            let row = &table[(i - 1 + a) * nodes + j - 1..][..4];
-            sum += wa * (row[0] * wy[0] + row[1] * wy[1] + row[2] * wy[2] + row[3] * wy[3]);
-        }
-        return sum;
-    }
-    let mut sum = 0.0;
-    for (a, wa) in wx.iter().enumerate() {
-        let mut row = 0.0;
-        for (b, wb) in wy.iter().enumerate() {
-            row += wb * get(i as isize - 1 + a as isize, j as isize - 1 + b as isize);
-        }
-        sum += wa * row;
-    }
-    sum
+/// `k_a` per view: the paper's ambient coefficient with `chi_view` at the view angle `phi`
+/// (radians, between the eye and the normal) instead of its mean over the view:
+/// `(2/pi) k_d + k_s chi_view(n, phi)`, and `(2/pi) k_d + k_s chi_view_1 + chi_view_0` for
+/// Cook-Torrance. Inputs are sanitized as [`super::ka`] sanitizes them (an `n` beyond the table
+/// is the table's last, `16384`, which is also the largest `n` a texel holds).
+#[inline]
+pub fn ka_view(
+    model: ShadingModel,
+    kd: glam::Vec3,
+    ks: glam::Vec3,
+    n: f32,
+    phi: f32,
+) -> glam::Vec3 {
+    let kd = kd.map(super::sanitize_coefficient);
+    let ks = ks.map(super::sanitize_coefficient);
+    let n = super::sanitize_n_f32(n).min(VIEW_N_MAX);
+    let [slope, offset] = chi_view_fast(model, n, phi).unwrap_or([0.0, 0.0]);
+    super::TWO_OVER_PI as f32 * kd + ks * slope + glam::Vec3::splat(offset)
 }
+
+mod spline;
 
 #[cfg(test)]
 mod tests;

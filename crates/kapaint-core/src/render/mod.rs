@@ -32,6 +32,36 @@ pub enum ViewMode {
     Checker,
     /// `n` in false colour on the log scale [`N_RAMP`] (a picture, not data).
     NFalseColour,
+    /// `k_a` per view (linear data): the ambient coefficient with `chi_view` at the pixel's own
+    /// view angle instead of its mean over the view (see [`reflectance::view::ka_view`]).
+    KaView,
+    /// The view-average error: `k_a`'s relative difference from `k_a` per view
+    /// ([`relative_error`]) as a heatmap, 0 to [`VIEW_ERROR_TOP`] (a picture, not data).
+    KaViewError,
+}
+
+/// The top of the view-average error's heatmap scale (relative error; 1 = 100 %).
+pub const VIEW_ERROR_TOP: f32 = 1.0;
+
+/// The relative difference of `live` from `reference`: the largest over the colour channels
+/// of `|live - reference| / reference`, 0 where both are 0 and [`f32::MAX`] where only the
+/// reference is (never NaN). `shaders/preview_functions.wgsl` holds the same.
+pub fn relative_error(live: Vec3, reference: Vec3) -> f32 {
+    let mut worst = 0.0_f32;
+    for (a, b) in live.to_array().into_iter().zip(reference.to_array()) {
+        let d = (a - b).abs();
+        let e = if b > 0.0 {
+            d / b
+        } else if d > 0.0 {
+            f32::MAX
+        } else {
+            0.0
+        };
+        if e > worst {
+            worst = e;
+        }
+    }
+    worst
 }
 
 /// The false-colour scale of `n`: `ln(1 + n) / ln(1 + 16384)` through these linear-RGB
@@ -103,7 +133,7 @@ pub fn n_false_colour(n: f32) -> Vec3 {
 
 impl ViewMode {
     /// Every view, in the order the shader numbers them (`gpu::shader::view_id`).
-    pub const ALL: [Self; 10] = [
+    pub const ALL: [Self; 12] = [
         Self::Shaded,
         Self::Ka,
         Self::Kd,
@@ -114,6 +144,8 @@ impl ViewMode {
         Self::Ambient,
         Self::Checker,
         Self::NFalseColour,
+        Self::KaView,
+        Self::KaViewError,
     ];
 
     /// The name the editor shows: the CLI's, with `k_a`, `k_d`, `k_s` spelt as everywhere
@@ -130,6 +162,8 @@ impl ViewMode {
             Self::Ambient => "ambient",
             Self::Checker => "checker",
             Self::NFalseColour => "n false colour",
+            Self::KaView => "k_a per view",
+            Self::KaViewError => "view-average error",
         }
     }
 
@@ -146,6 +180,8 @@ impl ViewMode {
             Self::Ambient => "ambient",
             Self::Checker => "checker",
             Self::NFalseColour => "n-false-colour",
+            Self::KaView => "ka-view",
+            Self::KaViewError => "ka-view-error",
         }
     }
 
@@ -156,7 +192,10 @@ impl ViewMode {
 
     /// Whether the view is linear data (written raw) rather than a picture (sRGB).
     pub fn is_data(self) -> bool {
-        !matches!(self, Self::Shaded | Self::Checker | Self::NFalseColour)
+        !matches!(
+            self,
+            Self::Shaded | Self::Checker | Self::NFalseColour | Self::KaViewError
+        )
     }
 }
 
@@ -442,6 +481,15 @@ pub fn shade(s: &FrameSettings, m: Sample, normal: Vec3, to_eye: Vec3, uv: glam:
     let ka = reflectance::ka(s.model, s.approx, kd, ks, n);
     if s.view == ViewMode::Ka {
         return finite(ka);
+    }
+    if matches!(s.view, ViewMode::KaView | ViewMode::KaViewError) {
+        // The geometric normal's view angle: like k_a, never the normal map's.
+        let phi = normal.dot(to_eye).clamp(0.0, 1.0).acos();
+        let per_view = finite(reflectance::view::ka_view(s.model, kd, ks, n, phi));
+        if s.view == ViewMode::KaView {
+            return per_view;
+        }
+        return heat_ramp(relative_error(finite(ka), per_view) / VIEW_ERROR_TOP);
     }
     let ambient = s.lighting.ia * ka;
     if s.view == ViewMode::Ambient {

@@ -49,6 +49,21 @@ impl EditorState {
                         }
                     });
                 ui.end_row();
+                ui.label("");
+                egui::ComboBox::from_id_salt(("compare view", name))
+                    .selected_text(side.view.map_or("viewport's view", ViewMode::label))
+                    .width(COMBO_WIDTH)
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(&mut side.view, None, "viewport's view");
+                        for v in ViewMode::ALL {
+                            ui.selectable_value(&mut side.view, Some(v), v.label());
+                        }
+                    })
+                    .response
+                    .on_hover_text(
+                        "What this side shows: k_a on one side and k_a per view on the other, say",
+                    );
+                ui.end_row();
             }
         });
         match c.mode {

@@ -17,7 +17,7 @@ use kapaint_core::mesh::Mesh;
 use kapaint_core::mesh::pick::{Bvh, Hit};
 use kapaint_core::model::MaterialMaps;
 use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
-use kapaint_core::render::{Camera, FrameSettings};
+use kapaint_core::render::{Camera, FrameSettings, ViewMode};
 
 /// The viewport's accessible name.
 pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
@@ -39,6 +39,9 @@ pub struct Side {
     pub model: ShadingModel,
     /// Approximation of `chi`.
     pub approx: AmbientApprox,
+    /// The side's own view (`k_a` on one side, `k_a` per view on the other, say); `None`
+    /// shows the viewport's.
+    pub view: Option<ViewMode>,
 }
 
 impl Side {
@@ -48,9 +51,20 @@ impl Side {
             ShadingModel::Phong => "Phong (eq. 8)",
             ShadingModel::BlinnPhong => "Blinn-Phong (eq. 11)",
             // The paper printed no form for it: the method is always kapaint's fit.
-            ShadingModel::CookTorrance => return "Cook-Torrance (GGX), fast".to_owned(),
+            ShadingModel::CookTorrance => {
+                return self.with_view("Cook-Torrance (GGX), fast".to_owned());
+            }
         };
-        format!("{model}, {}", self.approx.name())
+        let label = format!("{model}, {}", self.approx.name());
+        self.with_view(label)
+    }
+
+    /// `label` followed by the side's own view, if it has one.
+    fn with_view(self, label: String) -> String {
+        match self.view {
+            Some(view) => format!("{label} · {}", view.label()),
+            None => label,
+        }
     }
 }
 
@@ -69,6 +83,21 @@ pub struct Comparison {
     pub diff_max: f32,
 }
 
+impl Comparison {
+    /// The views the frame shows when the viewport's is `view` (each side may have its own).
+    pub fn views(&self, view: ViewMode) -> Vec<ViewMode> {
+        match self.mode {
+            Compare::Single => vec![view],
+            // The three models, each with the left side's method and view.
+            Compare::ThreeWay => vec![self.left.view.unwrap_or(view)],
+            Compare::Split | Compare::SideBySide | Compare::Difference => vec![
+                self.left.view.unwrap_or(view),
+                self.right.view.unwrap_or(view),
+            ],
+        }
+    }
+}
+
 impl Default for Comparison {
     fn default() -> Self {
         Self {
@@ -76,10 +105,12 @@ impl Default for Comparison {
             left: Side {
                 model: ShadingModel::Phong,
                 approx: AmbientApprox::Fast,
+                view: None,
             },
             right: Side {
                 model: ShadingModel::BlinnPhong,
                 approx: AmbientApprox::Fast,
+                view: None,
             },
             split_at: 0.5,
             diff_max: 0.1,
@@ -250,10 +281,13 @@ impl Viewport {
             }
         }
         self.labels_ui(&painter, rect);
-        if settings.view == kapaint_core::render::ViewMode::NFalseColour
-            && self.comparison.mode != Compare::Difference
-        {
-            overlay::n_legend_ui(ui, &painter, rect);
+        let views = self.comparison.views(settings.view);
+        if self.comparison.mode != Compare::Difference {
+            if views.contains(&ViewMode::NFalseColour) {
+                overlay::n_legend_ui(ui, &painter, rect);
+            } else if views.contains(&ViewMode::KaViewError) {
+                overlay::view_error_legend_ui(ui, &painter, rect);
+            }
         }
         (response, rect)
     }

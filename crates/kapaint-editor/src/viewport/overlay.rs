@@ -113,6 +113,25 @@ pub(super) fn n_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect: Rect) {
         .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Other, true, N_LEGEND_LABEL));
 }
 
+/// The accessible name of the view-average error's scale bar.
+pub const VIEW_ERROR_LEGEND_LABEL: &str =
+    "view-average error scale, relative difference of k_a from k_a per view, 0 to 100 %";
+
+/// The view-average error's scale along the bottom of `rect`: the heat ramp from no
+/// difference to [`kapaint_core::render::VIEW_ERROR_TOP`].
+pub(super) fn view_error_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect: Rect) {
+    let top = kapaint_core::render::VIEW_ERROR_TOP * 100.0;
+    heat_bar(painter, rect, "0 %", &format!("{top:.0} % or more"));
+    ui.interact(
+        scale_bar(rect),
+        ui.id().with("view error legend"),
+        Sense::hover(),
+    )
+    .widget_info(|| {
+        egui::WidgetInfo::labeled(egui::WidgetType::Other, true, VIEW_ERROR_LEGEND_LABEL)
+    });
+}
+
 /// Where a scale bar goes: along the bottom of `rect`.
 pub(crate) fn scale_bar(rect: Rect) -> Rect {
     Rect::from_min_size(

@@ -220,6 +220,7 @@ impl ViewportGpu {
             let settings = FrameSettings {
                 model: s.model,
                 approx: s.approx,
+                view: s.view.unwrap_or(settings.view),
                 ..*settings
             };
             PipelineKey::for_frame(&settings, &maps.uniform, format)

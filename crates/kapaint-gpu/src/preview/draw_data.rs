@@ -162,6 +162,10 @@ fn bind_group(
                 binding: 5,
                 resource: wgpu::BindingResource::TextureView(&normal),
             },
+            wgpu::BindGroupEntry {
+                binding: 6,
+                resource: wgpu::BindingResource::TextureView(&preview.view_table),
+            },
         ],
     })
 }

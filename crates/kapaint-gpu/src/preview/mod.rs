@@ -36,6 +36,7 @@ pub struct Preview {
     layout: wgpu::PipelineLayout,
     bind_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+    view_table: wgpu::TextureView,
     pipelines: PipelineCache<PipelineKey>,
 }
 
@@ -79,6 +80,7 @@ impl Preview {
                     count: None,
                 },
                 texture_entry(5),
+                super::texture_entry(6, false),
             ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -100,6 +102,7 @@ impl Preview {
             layout,
             bind_layout,
             sampler,
+            view_table: view_table(gpu),
             pipelines: PipelineCache::default(),
         }
     }
@@ -121,6 +124,36 @@ impl Preview {
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, data: &PreviewDrawData) {
         data.record(pass);
     }
+}
+
+/// The per-view table's spline coefficients as one `R32Float` texture, the four tables
+/// stacked in rows (`shaders/ambient_view.wgsl` reads it): 270 KB, made once per renderer.
+fn view_table(gpu: &Gpu) -> wgpu::TextureView {
+    use kapaint_core::reflectance::view::{VIEW_COEFFICIENTS, view_coefficients};
+    use wgpu::util::DeviceExt as _;
+    let tables = view_coefficients();
+    let texels: Vec<f32> = tables.iter().flatten().copied().collect();
+    let side = VIEW_COEFFICIENTS as u32;
+    let texture = gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("per-view table"),
+            size: wgpu::Extent3d {
+                width: side,
+                height: side * tables.len() as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&texels),
+    );
+    texture.create_view(&wgpu::TextureViewDescriptor::default())
 }
 
 /// A render pass over `target` and `depth`, both cleared: what a preview frame is drawn in.
