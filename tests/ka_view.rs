@@ -278,3 +278,129 @@ fn the_render_cli_draws_the_view_average_error_with_its_scale() {
     assert_eq!(image.get_pixel(w - 1, h - 1).0, [255, 255, 255, 255]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `kapaint render --view ka-traced`: the traced `k_a` on the CPU (no GPU needed), a 16-bit
+/// linear PNG whose centre pixel of a uniform sphere seen head-on converges to `k_a` per view
+/// there (nothing on a sphere shadows itself); its error view with the scale; the report names
+/// the samples, the standard error and the CPU.
+#[test]
+fn the_render_cli_traces_on_the_cpu() {
+    let dir = temp_dir("ka-traced");
+    let out = dir.join("traced.png");
+    let o = run(&[
+        "render",
+        "--model",
+        "phong",
+        "--view",
+        "ka-traced",
+        "--samples",
+        "512",
+        "--size",
+        "33",
+        "--kd",
+        "0.5,0.4,0.3",
+        "--ks",
+        "0.6",
+        "--n",
+        "100",
+        "--out",
+        out.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let line = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        line.contains("view ka-traced")
+            && line.contains("512 samples per pixel")
+            && line.contains("std. error")
+            && line.contains("on the CPU"),
+        "{line}"
+    );
+    let image = image::open(&out).expect("PNG decodes");
+    assert_eq!(
+        image.color(),
+        image::ColorType::Rgba16,
+        "a 16-bit data view"
+    );
+    let p = image.to_rgba16().get_pixel(16, 16).0;
+    let [chi, _] = chi_view_exact(ShadingModel::Phong, 100.0, 0.0);
+    for (c, kd) in [0.5, 0.4, 0.3].into_iter().enumerate() {
+        let want = reflectance::TWO_OVER_PI * kd + 0.6 * chi;
+        let got = f64::from(p[c]) / 65535.0;
+        assert!((got / want - 1.0).abs() < 0.02, "{got} vs {want}");
+    }
+    let out = dir.join("traced-error.png");
+    let o = run(&[
+        "render",
+        "--model",
+        "blinn",
+        "--view",
+        "ka-traced-error",
+        "--samples",
+        "16",
+        "--mesh",
+        "torus",
+        "--size",
+        "48",
+        "--out",
+        out.to_str().expect("path"),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("0 (left) to 100 % (right)"));
+    let image = image::open(&out).expect("PNG decodes");
+    assert_eq!(image.color(), image::ColorType::Rgba8, "a picture");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Bad input: `--samples` 0 or above 1,048,576, `--samples` on an untraced view, a traced
+/// comparison, and a trace that does not fit in memory each exit 2 with one line and write
+/// nothing; the last names the untraced view.
+#[test]
+fn the_traced_render_refuses_bad_input() {
+    let dir = temp_dir("ka-traced-bad");
+    let out = dir.join("x.png");
+    let path = out.to_str().expect("path");
+    for args in [
+        &["--model", "phong", "--view", "ka-traced", "--samples", "0"][..],
+        &[
+            "--model",
+            "phong",
+            "--view",
+            "ka-traced",
+            "--samples",
+            "1048577",
+        ],
+        &["--model", "phong", "--view", "ka-traced", "--samples", "-3"],
+        &["--model", "phong", "--view", "ka", "--samples", "4"],
+        &["--model", "compare-split", "--view", "ka-traced"],
+    ] {
+        let mut all = vec!["render"];
+        all.extend(args);
+        all.extend(["--out", path]);
+        let o = run(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {o:?}");
+        assert_eq!(
+            String::from_utf8_lossy(&o.stderr).lines().count(),
+            1,
+            "{o:?}"
+        );
+        assert!(!out.exists());
+    }
+    // A 8192^2 trace under a 2 GB address-space limit: refused before anything is built.
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 2000000; exec '{}' render --model blinn --view ka-traced --size 8192 \
+             --out '{path}'",
+            env!("CARGO_BIN_EXE_kapaint")
+        ))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(
+        err.contains("memory") && err.contains("--view ka-view"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

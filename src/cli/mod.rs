@@ -32,6 +32,7 @@ mod mesh_info;
 mod new;
 mod paint;
 mod render;
+mod render_traced;
 mod unwrap;
 
 pub use accuracy::MAX_ACCURACY_POINTS;

@@ -62,6 +62,10 @@ pub struct RenderArgs {
     /// Camera angle above the horizon, degrees.
     #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
     pitch: f32,
+    /// Samples per pixel of a traced view (ka-traced, ka-traced-error): 1 to 1048576
+    /// (default 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(crate::render::traced::MAX_SAMPLES)))]
+    samples: Option<u32>,
     /// Output image: .png or .exr.
     #[arg(long)]
     out: PathBuf,
@@ -260,6 +264,13 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
         },
         camera,
     };
+    let single = compare == Compare::Single;
+    let size = (width, height);
+    if let Some(report) =
+        super::render_traced::route(a.samples, single, (&mesh, &maps), &settings, size, &a.out)?
+    {
+        return Ok(report);
+    }
     let gpu = crate::gpu::Gpu::headless().map_err(|e| CliError {
         message: e.to_string(),
         code: 1,

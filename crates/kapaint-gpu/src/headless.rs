@@ -129,11 +129,31 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
             heatmap(&diff, width, height, max)
         }
     };
-    let mut pixels = pixels;
-    if let Some(legend) = draw_view_legend(req.settings.view, &mut pixels) {
-        note = legend;
-    }
-    if req.settings.view == ViewMode::N
+    note += &write_image(pixels, req.settings.view, &req.out)?;
+    Ok(format!(
+        "wrote {} ({width}x{height}, view {}, {}{note}, adapter {} ({:?}))\n",
+        req.out.display(),
+        req.settings.view.name(),
+        describe(req),
+        gpu.info.name,
+        gpu.info.backend,
+    ))
+}
+
+/// Writes a rendered `image` of `view` to `out` (`.png` or `.exr`) atomically: the view's scale
+/// along the bottom rows of a false-colour or heatmap view, `n` on the painting engine's log
+/// scale in a PNG. Returns what the report says of the scale (empty for none).
+///
+/// # Errors
+/// A bad output name, or a failed encode or write.
+pub fn write_image(
+    mut pixels: RenderedImage,
+    view: ViewMode,
+    out: &Path,
+) -> Result<String, GpuError> {
+    let kind = kind_of(out)?;
+    let note = draw_view_legend(view, &mut pixels).unwrap_or_default();
+    if view == ViewMode::N
         && kind == Kind::Png
         && let RenderedImage::Linear { pixels: p, .. } = &mut pixels
     {
@@ -145,16 +165,9 @@ pub fn run(gpu: &Gpu, req: &Request<'_>) -> Result<String, GpuError> {
         }
     }
     let bytes = encode(&pixels, kind)?;
-    kapaint_core::atomic::write_atomic(&req.out, &bytes)
-        .map_err(|e| GpuError(format!("cannot write {}: {e}", req.out.display())))?;
-    Ok(format!(
-        "wrote {} ({width}x{height}, view {}, {}{note}, adapter {} ({:?}))\n",
-        req.out.display(),
-        req.settings.view.name(),
-        describe(req),
-        gpu.info.name,
-        gpu.info.backend,
-    ))
+    kapaint_core::atomic::write_atomic(out, &bytes)
+        .map_err(|e| GpuError(format!("cannot write {}: {e}", out.display())))?;
+    Ok(note)
 }
 
 /// What the image shows: the model, or the models compared and how.
@@ -180,7 +193,7 @@ fn draw_view_legend(view: ViewMode, pixels: &mut RenderedImage) -> Option<String
             });
             Some(", legend: n = 0 (left) to 16384 (right), log scale".into())
         }
-        ViewMode::KaViewError => {
+        ViewMode::KaViewError | ViewMode::TracedError => {
             draw_legend(pixels, kapaint_core::render::heat_ramp);
             Some(format!(
                 ", legend: relative error 0 (left) to {:.0} % (right)",

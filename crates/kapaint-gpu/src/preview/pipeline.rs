@@ -68,7 +68,7 @@ impl PipelineKey {
         Self {
             model: settings.model,
             approx: settings.approx.for_model(settings.model),
-            view: settings.view,
+            view: settings.view.untraced(),
             kd_uniform: u.kd.is_some(),
             ks_uniform: u.ks.is_some(),
             n_uniform: u.n.is_some(),
