@@ -196,6 +196,9 @@ impl TabViewer for Tabs<'_> {
                 let (response, rect) =
                     s.viewport
                         .show(ui, (maps.0, maps.1, normal.as_ref()), &mesh, &settings);
+                if std::mem::take(&mut s.viewport.untraced_requested) {
+                    s.view = s.view.untraced();
+                }
                 s.painting_label(ui, rect);
                 s.viewport_input(&response, rect);
             }

@@ -332,6 +332,11 @@ impl EditorState {
         self.viewport.comparison
     }
 
+    /// The traced view's samples per pixel and standard error, while one is shown.
+    pub fn traced_status(&self) -> Option<(u32, Option<f32>)> {
+        self.viewport.traced.status()
+    }
+
     /// The New dialog's choices, while it is open.
     pub fn new_dialog(&self) -> Option<&NewDialog> {
         self.new_dialog.as_ref()

@@ -53,6 +53,7 @@ impl EditorState {
                 egui::ComboBox::from_id_salt(("compare view", name))
                     .selected_text(side.view.map_or("viewport's view", ViewMode::label))
                     .width(COMBO_WIDTH)
+                    .height(f32::INFINITY)
                     .show_ui(ui, |ui| {
                         ui.selectable_value(&mut side.view, None, "viewport's view");
                         for v in ViewMode::ALL {
@@ -152,6 +153,8 @@ impl EditorState {
         egui::ComboBox::from_label("View mode")
             .selected_text(self.view.label())
             .width(COMBO_WIDTH)
+            // Every view in sight at once, no scrolling to the last ones.
+            .height(f32::INFINITY)
             .show_ui(ui, |ui| {
                 for v in ViewMode::ALL {
                     ui.selectable_value(&mut self.view, v, v.label());

@@ -4,6 +4,7 @@
 
 pub(crate) mod overlay;
 mod renderer;
+pub(crate) mod traced;
 
 pub use overlay::{DIVIDER_LABEL, N_LEGEND_LABEL};
 pub use renderer::ViewportGpu;
@@ -135,6 +136,11 @@ pub struct Viewport {
     frame_pending: bool,
     /// How many pictures side by side the camera was last framed for.
     framed_columns: usize,
+    /// The traced views' worker and picture.
+    pub traced: traced::TracedView,
+    /// Set when the user asked for the untraced view instead of a trace that does not fit;
+    /// the editor switches the view and clears it.
+    pub untraced_requested: bool,
 }
 
 impl Viewport {
@@ -149,6 +155,8 @@ impl Viewport {
             gpu_error: None,
             frame_pending: true,
             framed_columns: 1,
+            traced: traced::TracedView::default(),
+            untraced_requested: false,
         }
     }
 
@@ -280,15 +288,32 @@ impl Viewport {
                 );
             }
         }
-        self.labels_ui(&painter, rect);
-        let views = self.comparison.views(settings.view);
-        if self.comparison.mode != Compare::Difference {
-            if views.contains(&ViewMode::NFalseColour) {
-                overlay::n_legend_ui(ui, &painter, rect);
-            } else if views.contains(&ViewMode::KaViewError) {
-                overlay::view_error_legend_ui(ui, &painter, rect);
+        if settings.view.is_traced() && self.comparison.mode == Compare::Single {
+            self.traced
+                .update(ui.ctx(), (maps.0, maps.1), mesh, &frame, size);
+            self.traced.paint(&painter, rect);
+            if self.traced_ui(ui, &painter, rect, settings.view) {
+                self.untraced_requested = true;
             }
+        } else {
+            self.traced.stop();
         }
+        self.labels_ui(&painter, rect);
+        self.legends_ui(ui, &painter, rect, settings.view);
         (response, rect)
+    }
+
+    /// The scale of a false-colour or heatmap view the frame shows (the viewport's `view`, or
+    /// a side's own).
+    fn legends_ui(&self, ui: &egui::Ui, painter: &egui::Painter, rect: Rect, view: ViewMode) {
+        let views = self.comparison.views(view);
+        if self.comparison.mode == Compare::Difference {
+            return;
+        }
+        if views.contains(&ViewMode::NFalseColour) {
+            overlay::n_legend_ui(ui, painter, rect);
+        } else if views.iter().any(|v| v.is_error_heatmap()) {
+            overlay::view_error_legend_ui(ui, painter, rect);
+        }
     }
 }

@@ -113,6 +113,53 @@ pub(super) fn n_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect: Rect) {
         .widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Other, true, N_LEGEND_LABEL));
 }
 
+impl super::Viewport {
+    /// The traced view's status over `rect`: its samples and standard error, or why it does
+    /// not fit with a button for the untraced view. Returns whether that button was clicked.
+    pub(super) fn traced_ui(
+        &self,
+        ui: &mut egui::Ui,
+        painter: &egui::Painter,
+        rect: Rect,
+        view: kapaint_core::render::ViewMode,
+    ) -> bool {
+        let font = egui::FontId::proportional(13.0);
+        let at = Pos2::new(rect.min.x + 8.0, rect.max.y - 56.0);
+        if let Some(why) = self.traced.refused() {
+            let untraced = view.untraced().label();
+            painter.text(
+                rect.center() - egui::vec2(0.0, 24.0),
+                egui::Align2::CENTER_CENTER,
+                format!("{why}: showing {untraced} instead"),
+                font,
+                Color32::from_rgb(230, 120, 110),
+            );
+            let button = Rect::from_center_size(rect.center(), egui::vec2(200.0, 24.0));
+            return ui
+                .put(button, egui::Button::new(format!("Show {untraced}")))
+                .clicked();
+        }
+        let text = match self.traced.status() {
+            Some((samples, error)) => {
+                let error =
+                    error.map_or_else(String::new, |e| format!(" · std. error {:.2} %", e * 100.0));
+                let state = if self.traced.running() && samples < super::traced::SAMPLES {
+                    "tracing"
+                } else {
+                    "done"
+                };
+                format!(
+                    "{} · {samples} samples per pixel{error} · {state}",
+                    view.label()
+                )
+            }
+            None => format!("{} · tracing the first samples…", view.label()),
+        };
+        painter.text(at, egui::Align2::LEFT_BOTTOM, text, font, Color32::WHITE);
+        false
+    }
+}
+
 /// The accessible name of the view-average error's scale bar.
 pub const VIEW_ERROR_LEGEND_LABEL: &str =
     "view-average error scale, relative difference of k_a from k_a per view, 0 to 100 %";
