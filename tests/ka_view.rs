@@ -404,3 +404,61 @@ fn the_traced_render_refuses_bad_input() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `kapaint accuracy` adds what the view average hides: the view-average table (every model
+/// and exponent) and the traced table per mesh, where on a sphere (nothing shadows) the AO
+/// stand-in changes nothing and on a torus it brings `k_a` closer to the trace.
+#[test]
+fn accuracy_reports_the_view_average_and_the_traced_error() {
+    let o = run(&[
+        "accuracy",
+        "--points",
+        "2",
+        "--model",
+        "blinn",
+        "--samples",
+        "32",
+        "--mesh",
+        "sphere",
+        "--mesh",
+        "torus",
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let text = String::from_utf8_lossy(&o.stdout);
+    let view_rows = text.lines().filter(|l| l.starts_with("| blinn | ")).count();
+    // The approximations' rows (3 methods, 2 ranges) and the view-average rows (8 exponents).
+    assert_eq!(view_rows, 3 * 2 + 8, "{text}");
+    let cell = |line: &str, k: usize| -> f64 {
+        line.split('|')
+            .nth(k)
+            .and_then(|c| c.trim().trim_end_matches('%').trim().parse().ok())
+            .unwrap_or(f64::NAN)
+    };
+    let row = |mesh: &str| {
+        text.lines()
+            .find(|l| l.starts_with(&format!("| {mesh} | blinn |")))
+            .unwrap_or_else(|| panic!("no {mesh} row in {text}"))
+            .to_owned()
+    };
+    let (sphere, torus) = (row("sphere"), row("torus"));
+    assert!(
+        (cell(&sphere, 3) - cell(&sphere, 5)).abs() < 0.05,
+        "AO is 1 on a sphere: {sphere}"
+    );
+    assert!(
+        cell(&torus, 5) < cell(&torus, 3),
+        "AO helps on a torus: {torus}"
+    );
+    for bad in [
+        &["accuracy", "--samples", "0"][..],
+        &["accuracy", "--mesh", "nowhere.obj"],
+    ] {
+        let o = run(bad);
+        assert_ne!(o.status.code(), Some(0), "{bad:?}: {o:?}");
+        assert_eq!(
+            String::from_utf8_lossy(&o.stderr).lines().count(),
+            1,
+            "{o:?}"
+        );
+    }
+}

@@ -57,6 +57,8 @@ pub fn ray_mesh_bytes(triangles: usize) -> u64 {
 struct Point {
     /// Where the shadow rays start: the hit, a little off the surface.
     origin: Vec3,
+    /// The triangle's own normal (what the AO bake casts about).
+    face: Vec3,
     normal: Vec3,
     to_eye: Vec3,
     kd: Vec3,
@@ -147,6 +149,7 @@ impl Traced {
                 };
                 Some(Point {
                     origin: hit.position + face * offset,
+                    face,
                     normal: hit.normal,
                     to_eye,
                     kd,
@@ -252,6 +255,44 @@ impl Traced {
             ViewMode::TracedError => Some(self.error(settings)),
             _ => None,
         }
+    }
+
+    /// The AO stand-in at every pixel (`None` where no surface): what the AO bake holds at the
+    /// pixel's surface point, the cosine-weighted fraction of `rays` directions about the
+    /// triangle's normal that escape the mesh.
+    pub fn ambient_occlusion(&self, mesh: &RayMesh, rays: u32) -> Vec<Option<f32>> {
+        let set = crate::mesh::bakes::Directions::new(rays);
+        let far = self.far;
+        self.points
+            .par_iter()
+            .map(|p| {
+                p.map(|p| {
+                    let turn = p.shift[0] * std::f32::consts::TAU;
+                    mesh.open_fraction(p.origin, p.face, &set, far, turn)
+                })
+            })
+            .collect()
+    }
+
+    /// The relative difference of the live `k_a` of `settings` (times `ao` where given, the
+    /// stand-in of [`Traced::ambient_occlusion`]) from the traced one, at every covered pixel
+    /// that has samples.
+    pub fn relative_errors(
+        &self,
+        settings: &FrameSettings,
+        ao: Option<&[Option<f32>]>,
+    ) -> Vec<f32> {
+        self.points
+            .iter()
+            .zip(&self.sums)
+            .enumerate()
+            .filter_map(|(i, (p, s))| {
+                let p = p.as_ref().filter(|_| s.count > 0)?;
+                let live = reflectance::ka(settings.model, settings.approx, p.kd, p.ks, p.n);
+                let scale = ao.map_or(Some(1.0), |ao| ao.get(i).copied().flatten())?;
+                Some(relative_error(live * scale, s.sum / s.count as f32))
+            })
+            .collect()
     }
 
     /// The standard error of the traced `k_a` relative to its value, the mean over the covered
