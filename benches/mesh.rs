@@ -227,8 +227,60 @@ fn ao_bakes(c: &mut Criterion) {
     group.finish();
 }
 
+/// The traced view (issue 42): the spot cow at 1024^2, 64 samples per pixel on the CPU path
+/// (target under 10 s), primary rays and BVH included; and one pass of one sample, what the
+/// editor's worker adds between pictures.
+fn traced(c: &mut Criterion) {
+    use kapaint::mesh::{bakes::RayMesh, pick::Bvh};
+    use kapaint::reflectance::{AmbientApprox, ShadingModel};
+    use kapaint::render::reference::Material;
+    use kapaint::render::traced::Traced;
+    use kapaint::render::{Camera, FrameSettings, Lighting, Sample, ViewMode};
+    let spot = mesh::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/testdata/spot/spot_triangulated.obj"),
+    )
+    .expect("spot loads");
+    let settings = FrameSettings {
+        model: ShadingModel::BlinnPhong,
+        approx: AmbientApprox::Fast,
+        view: ViewMode::KaTraced,
+        lighting: Lighting::default(),
+        camera: Camera {
+            yaw: 30f32.to_radians(),
+            pitch: 20f32.to_radians(),
+            ..Camera::default()
+        }
+        .framing(&spot.positions),
+    };
+    let material = Material::Uniform(Sample {
+        kd: glam::Vec3::new(0.6, 0.5, 0.4),
+        ks: glam::Vec3::splat(0.4),
+        n: 80.0,
+    });
+    let mut group = c.benchmark_group("traced_spot");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    group.bench_function("1024x1024_64_samples", |b| {
+        b.iter(|| {
+            let (bvh, rays) = (Bvh::build(&spot), RayMesh::new(&spot));
+            let mut t = Traced::new((&spot, &bvh, &rays), &material, &settings, 1024, 1024);
+            t.pass(&rays, 64, &|| false);
+            t.samples()
+        });
+    });
+    let (bvh, rays) = (Bvh::build(&spot), RayMesh::new(&spot));
+    let mut t = Traced::new((&spot, &bvh, &rays), &material, &settings, 1024, 1024);
+    group.bench_function("1024x1024_one_pass_of_one_sample", |b| {
+        b.iter(|| t.pass(&rays, 1, &|| false));
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    traced,
     bakes,
     picking,
     surface_dabs,

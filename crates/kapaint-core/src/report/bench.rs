@@ -330,11 +330,11 @@ fn draw_plot(rows: &[BenchRow], rgb: &mut [u8]) -> Result<(), Box<dyn std::error
 }
 
 /// The font family name the plot registers.
-const FONT: &str = "kapaint-mono";
+pub(crate) const FONT: &str = "kapaint-mono";
 
 /// Registers egui's bundled monospace font with plotters (no system fonts needed; plotters
 /// lays proportional fonts out with collapsed spaces, a monospace font reads cleanly).
-fn register_font() -> Result<(), String> {
+pub(crate) fn register_font() -> Result<(), String> {
     use std::sync::OnceLock;
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED

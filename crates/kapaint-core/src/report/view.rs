@@ -240,3 +240,94 @@ pub fn traced_markdown(rows: &[TracedRow], setup: &TracedSetup) -> String {
     );
     out
 }
+
+/// The exponents the figure of `chi_view` draws.
+const PLOT_N: [f64; 4] = [1.0, 10.0, 100.0, 1000.0];
+
+/// Draws `chi_view(n, phi) / chi(n)` against the view angle for Phong (solid) and Blinn-Phong
+/// (dashed) at [`PLOT_N`], exact integrals at 90 views each, and writes it as a PNG: the
+/// figure of docs/reflectance.md.
+///
+/// # Errors
+/// A failed draw, encode or write.
+pub fn plot_chi_view(path: &std::path::Path) -> Result<(), String> {
+    const SIZE: (u32, u32) = (960, 560);
+    let mut rgb = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    draw_chi_view(&mut rgb, SIZE).map_err(|e| format!("cannot draw the plot: {e}"))?;
+    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).ok_or("wrong buffer size")?;
+    let mut png = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
+    crate::atomic::write_atomic(path, &png)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+fn draw_chi_view(rgb: &mut [u8], size: (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    use rayon::prelude::*;
+    let font = super::bench::FONT;
+    super::bench::register_font()?;
+    let root = BitMapBackend::with_buffer(rgb, size).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "chi_view(n, phi) / chi(n): the view average hides a factor of ten",
+            (font, 22),
+        )
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..90.0_f64, -2.0..1.0_f64)?;
+    chart
+        .configure_mesh()
+        .x_desc("view angle phi (degrees)")
+        .y_desc("chi_view / chi, log scale")
+        .y_label_formatter(&|y| {
+            // Decades only: 0.01, 0.1, 1, 10.
+            if (y - y.round()).abs() < 1e-9 {
+                format!("{}", 10f64.powi(y.round() as i32))
+            } else {
+                String::new()
+            }
+        })
+        .label_style((font, 14))
+        .axis_desc_style((font, 15))
+        .draw()?;
+    for (i, n) in PLOT_N.into_iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+            let chi = chi_parts_exact(model, n)[0];
+            let points: Vec<(f64, f64)> = (0..90)
+                .into_par_iter()
+                .map(|k| {
+                    let deg = f64::from(k) + 0.5;
+                    let v = crate::reflectance::view::chi_view_exact(model, n, deg.to_radians());
+                    (deg, (v[0] / chi).max(1e-2).log10())
+                })
+                .collect();
+            let style = ShapeStyle::from(colour).stroke_width(2);
+            if model == ShadingModel::Phong {
+                chart
+                    .draw_series(LineSeries::new(points, style))?
+                    .label(format!("n = {n} (Phong solid, Blinn-Phong dashed)"))
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
+            } else {
+                chart.draw_series(DashedLineSeries::new(points, 8, 6, style))?;
+            }
+        }
+    }
+    chart
+        .draw_series(LineSeries::new([(0.0, 0.0), (90.0, 0.0)], BLACK.mix(0.5)))?
+        .label("1: the view average")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.mix(0.5)));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font((font, 14))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
