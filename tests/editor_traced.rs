@@ -73,3 +73,21 @@ fn the_traced_view_accumulates_beside_a_light_ui_thread_and_restarts_on_a_move()
     harness.run();
     assert_eq!(harness.state().state.traced_status(), None);
 }
+
+/// The AO stand-in's error view on a project without an AO bake says what it needs and offers
+/// the untraced view; a click there switches to it.
+#[test]
+fn the_ao_view_without_a_bake_offers_the_untraced_view() {
+    let mut harness = editor();
+    harness.get_by_label("View mode").click();
+    harness.run();
+    harness.get_by_label("k_a × AO error").click();
+    harness.run_steps(3);
+    assert_eq!(harness.state().state.traced_status(), None);
+    harness.get_by_label("Show view-average error").click();
+    harness.run_steps(3);
+    assert_eq!(
+        harness.state().state.frame_settings().view,
+        ViewMode::KaViewError
+    );
+}

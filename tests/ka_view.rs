@@ -462,3 +462,83 @@ fn accuracy_reports_the_view_average_and_the_traced_error() {
         );
     }
 }
+
+/// The AO stand-in's error view: on the spot cow with its AO baked, `k_a` times AO is nearer
+/// the trace than `k_a` where the mesh shadows itself (the mean heat is lower); without an AO
+/// bake, or with another mesh than the bake's, the view exits 2 and names what to do.
+#[test]
+fn the_ao_stand_in_view_needs_the_bake_and_beats_k_a() {
+    let dir = temp_dir("ka-ao");
+    let project = dir.join("spot.kapaint");
+    let p = project.to_str().expect("path");
+    let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot/spot_triangulated.obj");
+    let o = run(&[
+        "new",
+        "--size",
+        "256",
+        "--mesh",
+        spot.to_str().expect("path"),
+        "--out",
+        p,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let no_bake = dir.join("none.png");
+    let args = |view: &'static str, out: &std::path::Path| -> Vec<String> {
+        [
+            "render",
+            "--project",
+            p,
+            "--model",
+            "blinn",
+            "--view",
+            view,
+            "--samples",
+            "64",
+            "--size",
+            "96",
+            "--out",
+        ]
+        .iter()
+        .map(|s| (*s).to_owned())
+        .chain([out.to_string_lossy().into_owned()])
+        .collect()
+    };
+    let run_owned = |a: Vec<String>| {
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        run(&refs)
+    };
+    let o = run_owned(args("ka-ao-traced-error", &no_bake));
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--map ao"),
+        "{o:?}"
+    );
+    assert!(!no_bake.exists());
+    let o = run(&["bake", p, "--map", "ao", "--rays", "64"]);
+    assert!(o.status.success(), "{o:?}");
+    let mean_heat = |view: &'static str| {
+        let out = dir.join(format!("{view}.png"));
+        let o = run_owned(args(view, &out));
+        assert!(o.status.success(), "{o:?}");
+        let image = image::open(&out).expect("PNG decodes").to_rgba8();
+        let covered: Vec<_> = image
+            .pixels()
+            .take((96 - 4) * 96)
+            .filter(|p| p[3] > 0)
+            .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+            .collect();
+        assert!(covered.len() > 500, "{view}: {} pixels", covered.len());
+        covered.iter().sum::<f64>() / covered.len() as f64
+    };
+    let (k_a, k_a_ao) = (
+        mean_heat("ka-traced-error"),
+        mean_heat("ka-ao-traced-error"),
+    );
+    assert!(k_a_ao < k_a, "k_a x AO {k_a_ao} vs k_a {k_a}");
+    let mut other = args("ka-ao-traced-error", &dir.join("other.png"));
+    other.extend(["--mesh".to_owned(), "torus".to_owned()]);
+    let o = run_owned(other);
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

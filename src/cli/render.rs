@@ -128,11 +128,13 @@ impl From<ApproxArg> for AmbientApprox {
     }
 }
 
-/// What `render` draws: maps, the normal map, and the mesh they come with.
+/// What `render` draws: maps, the normal map, the mesh they come with, and the project's AO
+/// bake (for the AO stand-in's view).
 type Material = (
     model::MaterialMaps,
     Option<std::sync::Arc<model::normal::NormalMap>>,
     OwnMesh,
+    Option<std::sync::Arc<mesh::bakes::Baked>>,
 );
 
 /// The mesh a project names: a built-in name or a file, or the mesh it keeps inside itself.
@@ -152,7 +154,8 @@ fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
             OwnMesh::Spec(PathBuf::from(doc.settings().mesh.spec()))
         };
         let normal = doc.normal().cloned();
-        return Ok((doc.into_parts().0, normal, own));
+        let ao = doc.bake_of(mesh::bakes::BakeMap::Ao).cloned();
+        return Ok((doc.into_parts().0, normal, own, ao));
     }
     let d = model::MaterialValue::default();
     let kd =
@@ -173,7 +176,7 @@ fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
         n.map_or(d.n, |v| v as f32),
     );
     let maps = model::MaterialMaps::new(16, 16, value).map_err(model_error)?;
-    Ok((maps, None, OwnMesh::Spec(PathBuf::from("sphere"))))
+    Ok((maps, None, OwnMesh::Spec(PathBuf::from("sphere")), None))
 }
 
 /// `--sides LEFT,RIGHT`: exactly two models.
@@ -212,7 +215,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
             a.out.display()
         )));
     }
-    let (maps, normal, own_mesh) = render_material(&a)?;
+    let (maps, normal, own_mesh, ao) = render_material(&a)?;
     let mesh = match (a.mesh, own_mesh) {
         (Some(spec), _) => mesh::open(Path::new(&spec)).map_err(super::mesh_error)?,
         (None, OwnMesh::Spec(spec)) => mesh::open(&spec).map_err(super::mesh_error)?,
@@ -266,9 +269,14 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
     };
     let single = compare == Compare::Single;
     let size = (width, height);
-    if let Some(report) =
-        super::render_traced::route(a.samples, single, (&mesh, &maps), &settings, size, &a.out)?
-    {
+    if let Some(report) = super::render_traced::route(
+        a.samples,
+        single,
+        (&mesh, &maps, ao.as_deref()),
+        &settings,
+        size,
+        &a.out,
+    )? {
         return Ok(report);
     }
     let gpu = crate::gpu::Gpu::headless().map_err(|e| CliError {

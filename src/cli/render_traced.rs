@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use super::CliError;
 use crate::gpu::RenderedImage;
-use crate::mesh::{self, bakes::RayMesh, pick::Bvh};
+use crate::mesh::{self, bakes::Baked, bakes::RayMesh, pick::Bvh};
 use crate::render::reference::Material;
 use crate::render::traced::{self, Traced};
 use crate::render::{FrameSettings, ViewMode};
@@ -22,7 +22,7 @@ pub const DEFAULT_SAMPLES: u32 = 64;
 pub fn route(
     samples: Option<u32>,
     single: bool,
-    (mesh, maps): (&mesh::Mesh, &crate::model::MaterialMaps),
+    (mesh, maps, ao): (&mesh::Mesh, &crate::model::MaterialMaps, Option<&Baked>),
     settings: &FrameSettings,
     size: (u32, u32),
     out: &Path,
@@ -43,7 +43,23 @@ pub fn route(
         )));
     }
     let samples = samples.unwrap_or(DEFAULT_SAMPLES);
-    render((mesh, maps), settings, size, samples, out).map(Some)
+    let ao = match ao {
+        _ if !view.needs_ao_bake() => None,
+        Some(bake) if bake.mesh_hash == mesh.content_hash() => Some(bake),
+        Some(_) => {
+            return Err(CliError::usage(format!(
+                "--view {}: the project's AO bake is of its own mesh, not of --mesh",
+                view.name()
+            )));
+        }
+        None => {
+            return Err(CliError::usage(format!(
+                "--view {} needs the project's AO bake: kapaint bake PROJECT --map ao",
+                view.name()
+            )));
+        }
+    };
+    render((mesh, maps, ao), settings, size, samples, out).map(Some)
 }
 
 /// Renders the traced view of `settings` over `maps` on `mesh` and writes it to `out`; returns
@@ -53,7 +69,7 @@ pub fn route(
 /// A mesh whose tracing does not fit in memory (exit 2, pointing at the untraced view), or a
 /// failed write.
 pub fn render(
-    (mesh, maps): (&mesh::Mesh, &crate::model::MaterialMaps),
+    (mesh, maps, ao): (&mesh::Mesh, &crate::model::MaterialMaps, Option<&Baked>),
     settings: &FrameSettings,
     (width, height): (u32, u32),
     samples: u32,
@@ -76,6 +92,9 @@ pub fn render(
         width,
         height,
     );
+    if let Some(bake) = ao {
+        traced.set_ao_bake(bake);
+    }
     traced.pass(&rays, samples, &|| false);
     let seconds = start.elapsed().as_secs_f64();
     let image = traced

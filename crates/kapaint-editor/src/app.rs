@@ -193,6 +193,10 @@ impl TabViewer for Tabs<'_> {
                 let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
                 let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
                 let normal = s.doc.normal().cloned();
+                s.viewport.ao_bake = s
+                    .doc
+                    .bake_of(kapaint_core::mesh::bakes::BakeMap::Ao)
+                    .cloned();
                 let (response, rect) =
                     s.viewport
                         .show(ui, (maps.0, maps.1, normal.as_ref()), &mesh, &settings);

@@ -193,7 +193,7 @@ fn draw_view_legend(view: ViewMode, pixels: &mut RenderedImage) -> Option<String
             });
             Some(", legend: n = 0 (left) to 16384 (right), log scale".into())
         }
-        ViewMode::KaViewError | ViewMode::TracedError => {
+        v if v.is_error_heatmap() => {
             draw_legend(pixels, kapaint_core::render::heat_ramp);
             Some(format!(
                 ", legend: relative error 0 (left) to {:.0} % (right)",

@@ -68,6 +68,8 @@ struct Point {
     shares: [f32; 2],
     /// Per-pixel shift of the sequence.
     shift: [f32; 3],
+    /// The texture coordinate (mesh convention: v up).
+    uv: Vec2,
 }
 
 /// A pixel's running sums: the estimates, the squares of their channel means, and how many.
@@ -86,6 +88,8 @@ pub struct Traced {
     points: Vec<Option<Point>>,
     sums: Vec<Sums>,
     far: f32,
+    /// The AO bake at every pixel, once [`Traced::set_ao_bake`] has read it.
+    ao: Option<Vec<Option<f32>>>,
 }
 
 impl std::fmt::Debug for Traced {
@@ -157,6 +161,7 @@ impl Traced {
                     n,
                     shares,
                     shift: shift(i),
+                    uv: hit.uv.unwrap_or(Vec2::ZERO),
                 })
             })
             .collect::<Vec<_>>();
@@ -168,7 +173,26 @@ impl Traced {
             points,
             sums,
             far: rays.diagonal * 2.0,
+            ao: None,
         }
+    }
+
+    /// Reads the AO bake at every pixel's texture coordinate (its nearest texel), for the AO
+    /// stand-in's error view ([`ViewMode::KaAoTracedError`]).
+    pub fn set_ao_bake(&mut self, bake: &crate::mesh::bakes::Baked) {
+        let (w, h) = (bake.width, bake.height);
+        self.ao = Some(
+            self.points
+                .iter()
+                .map(|p| {
+                    let p = p.as_ref()?;
+                    let x = ((p.uv.x.clamp(0.0, 1.0) * w as f32) as u32).min(w.max(1) - 1);
+                    let y = (((1.0 - p.uv.y).clamp(0.0, 1.0) * h as f32) as u32).min(h.max(1) - 1);
+                    let i = (y * w + x) as usize;
+                    (i * bake.map.channels() < bake.data.len()).then(|| bake.value(i, 0))
+                })
+                .collect(),
+        );
     }
 
     /// The image size.
@@ -233,14 +257,21 @@ impl Traced {
     /// and approximation) from the traced one, as the heatmap of the view-average error (0 to
     /// [`VIEW_ERROR_TOP`]), linear RGBA.
     pub fn error(&self, settings: &FrameSettings) -> Vec<Vec4> {
+        self.error_with(settings, None)
+    }
+
+    /// [`Traced::error`] of the live `k_a` times `ao` (per pixel) where given.
+    fn error_with(&self, settings: &FrameSettings, ao: Option<&[Option<f32>]>) -> Vec<Vec4> {
         self.points
             .iter()
             .zip(&self.sums)
-            .map(|(p, s)| match p {
+            .enumerate()
+            .map(|(i, (p, s))| match p {
                 Some(p) => {
                     let live = reflectance::ka(settings.model, settings.approx, p.kd, p.ks, p.n);
+                    let scale = ao.map_or(1.0, |ao| ao.get(i).copied().flatten().unwrap_or(1.0));
                     let traced = s.sum / s.count.max(1) as f32;
-                    heat_ramp(relative_error(live, traced) / VIEW_ERROR_TOP).extend(1.0)
+                    heat_ramp(relative_error(live * scale, traced) / VIEW_ERROR_TOP).extend(1.0)
                 }
                 None => Vec4::ZERO,
             })
@@ -253,6 +284,10 @@ impl Traced {
         match view {
             ViewMode::KaTraced => Some(self.ka()),
             ViewMode::TracedError => Some(self.error(settings)),
+            ViewMode::KaAoTracedError => self
+                .ao
+                .as_ref()
+                .map(|ao| self.error_with(settings, Some(ao))),
             _ => None,
         }
     }

@@ -39,6 +39,9 @@ pub enum ViewMode {
     /// The traced error: the live `k_a`'s relative difference from the traced one, as a
     /// heatmap 0 to [`VIEW_ERROR_TOP`] (a picture, not data).
     TracedError,
+    /// The AO stand-in's error: `k_a` times the AO bake against the traced `k_a`, on the same
+    /// heat scale (a picture; needs an AO bake).
+    KaAoTracedError,
 }
 
 /// The top of the view-average error's heatmap scale (relative error; 1 = 100 %).
@@ -96,7 +99,7 @@ pub fn n_false_colour(n: f32) -> Vec3 {
 
 impl ViewMode {
     /// Every view, in the order the shader numbers them (`gpu::shader::view_id`).
-    pub const ALL: [Self; 14] = [
+    pub const ALL: [Self; 15] = [
         Self::Shaded,
         Self::Ka,
         Self::Kd,
@@ -111,6 +114,7 @@ impl ViewMode {
         Self::KaViewError,
         Self::KaTraced,
         Self::TracedError,
+        Self::KaAoTracedError,
     ];
 
     /// The name the editor shows: the CLI's, with `k_a`, `k_d`, `k_s` spelt as everywhere
@@ -131,6 +135,7 @@ impl ViewMode {
             Self::KaViewError => "view-average error",
             Self::KaTraced => "k_a traced",
             Self::TracedError => "traced error",
+            Self::KaAoTracedError => "k_a × AO error",
         }
     }
 
@@ -151,6 +156,7 @@ impl ViewMode {
             Self::KaViewError => "ka-view-error",
             Self::KaTraced => "ka-traced",
             Self::TracedError => "ka-traced-error",
+            Self::KaAoTracedError => "ka-ao-traced-error",
         }
     }
 
@@ -168,12 +174,21 @@ impl ViewMode {
                 | Self::NFalseColour
                 | Self::KaViewError
                 | Self::TracedError
+                | Self::KaAoTracedError
         )
     }
 
     /// Whether the view is traced on the CPU ([`traced`]) rather than shaded per fragment.
     pub fn is_traced(self) -> bool {
-        matches!(self, Self::KaTraced | Self::TracedError)
+        matches!(
+            self,
+            Self::KaTraced | Self::TracedError | Self::KaAoTracedError
+        )
+    }
+
+    /// Whether the view needs the project's AO bake.
+    pub fn needs_ao_bake(self) -> bool {
+        self == Self::KaAoTracedError
     }
 
     /// What a shader draws for the view: a traced view's untraced counterpart (`k_a` per view,
@@ -183,7 +198,7 @@ impl ViewMode {
     pub fn untraced(self) -> Self {
         match self {
             Self::KaTraced => Self::KaView,
-            Self::TracedError => Self::KaViewError,
+            Self::TracedError | Self::KaAoTracedError => Self::KaViewError,
             other => other,
         }
     }
@@ -191,6 +206,9 @@ impl ViewMode {
     /// Whether the view is a heatmap of a relative error on the scale 0 to
     /// [`VIEW_ERROR_TOP`].
     pub fn is_error_heatmap(self) -> bool {
-        matches!(self, Self::KaViewError | Self::TracedError)
+        matches!(
+            self,
+            Self::KaViewError | Self::TracedError | Self::KaAoTracedError
+        )
     }
 }

@@ -138,6 +138,8 @@ pub struct Viewport {
     framed_columns: usize,
     /// The traced views' worker and picture.
     pub traced: traced::TracedView,
+    /// The project's AO bake, for the AO stand-in's view (the editor sets it each frame).
+    pub ao_bake: Option<Arc<kapaint_core::mesh::bakes::Baked>>,
     /// Set when the user asked for the untraced view instead of a trace that does not fit;
     /// the editor switches the view and clears it.
     pub untraced_requested: bool,
@@ -156,6 +158,7 @@ impl Viewport {
             frame_pending: true,
             framed_columns: 1,
             traced: traced::TracedView::default(),
+            ao_bake: None,
             untraced_requested: false,
         }
     }
@@ -288,19 +291,33 @@ impl Viewport {
                 );
             }
         }
-        if settings.view.is_traced() && self.comparison.mode == Compare::Single {
-            self.traced
-                .update(ui.ctx(), (maps.0, maps.1), mesh, &frame, size);
-            self.traced.paint(&painter, rect);
-            if self.traced_ui(ui, &painter, rect, settings.view) {
-                self.untraced_requested = true;
-            }
-        } else {
-            self.traced.stop();
-        }
+        self.traced_frame(ui, (&painter, rect), (maps.0, maps.1), mesh, (&frame, size));
         self.labels_ui(&painter, rect);
         self.legends_ui(ui, &painter, rect, settings.view);
         (response, rect)
+    }
+
+    /// A traced view's picture and status over `rect` while one is shown (in the single
+    /// view), its trace kept going; else the trace stopped.
+    fn traced_frame(
+        &mut self,
+        ui: &mut egui::Ui,
+        (painter, rect): (&egui::Painter, Rect),
+        maps: (&MaterialMaps, u64),
+        mesh: &(u64, Arc<Mesh>),
+        (frame, size): (&FrameSettings, (u32, u32)),
+    ) {
+        if !(frame.view.is_traced() && self.comparison.mode == Compare::Single) {
+            self.traced.stop();
+            return;
+        }
+        let ao = self.ao_bake.clone();
+        self.traced
+            .update(ui.ctx(), maps, (mesh, ao.as_ref()), frame, size);
+        self.traced.paint(painter, rect);
+        if self.traced_ui(ui, painter, rect, frame.view) {
+            self.untraced_requested = true;
+        }
     }
 
     /// The scale of a false-colour or heatmap view the frame shows (the viewport's `view`, or

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use egui::{Color32, ColorImage, Pos2, Rect, TextureHandle};
-use kapaint_core::mesh::bakes::RayMesh;
+use kapaint_core::mesh::bakes::{Baked, RayMesh};
 use kapaint_core::mesh::{Mesh, pick::Bvh};
 use kapaint_core::model::MaterialMaps;
 use kapaint_core::render::FrameSettings;
@@ -31,6 +31,8 @@ struct Key {
     maps: (u64, u64),
     mesh: u64,
     size: (u32, u32),
+    /// Which AO bake (its address), for the AO stand-in's view.
+    ao: usize,
 }
 
 /// What the worker last published.
@@ -122,20 +124,32 @@ impl TracedView {
         &mut self,
         ctx: &egui::Context,
         (maps, maps_id): (&MaterialMaps, u64),
-        mesh: &(u64, Arc<Mesh>),
+        (mesh, ao): (&(u64, Arc<Mesh>), Option<&Arc<Baked>>),
         settings: &FrameSettings,
         size: (u32, u32),
     ) {
+        let ao = ao.filter(|_| settings.view.needs_ao_bake());
         let key = Key {
             settings: *settings,
             maps: (maps_id, maps.version()),
             mesh: mesh.0,
             size: picture_size(size),
+            ao: ao.map_or(0, |a| Arc::as_ptr(a) as usize),
         };
+        if settings.view.needs_ao_bake() && ao.is_none() {
+            self.job = None;
+            self.status = None;
+            self.refused = Some(format!(
+                "{} needs an AO bake (Mesh > Bake)",
+                settings.view.label()
+            ));
+            return;
+        }
         if self.job.as_ref().is_none_or(|j| j.key != key) {
             self.status = None;
             self.refused = None;
-            self.job = Some(start(key, maps.clone(), Arc::clone(&mesh.1), &self.rays));
+            let inputs = (maps.clone(), Arc::clone(&mesh.1), ao.cloned());
+            self.job = Some(start(key, inputs, &self.rays));
         }
         let published = self.job.as_ref().and_then(|j| {
             j.latest
@@ -180,7 +194,11 @@ impl TracedView {
 }
 
 /// Starts a worker tracing `key`'s picture.
-fn start(key: Key, maps: MaterialMaps, mesh: Arc<Mesh>, rays: &Rays) -> Job {
+fn start(
+    key: Key,
+    (maps, mesh, ao): (MaterialMaps, Arc<Mesh>, Option<Arc<Baked>>),
+    rays: &Rays,
+) -> Job {
     let stop = Arc::new(AtomicBool::new(false));
     let latest = Arc::new(Mutex::new(None));
     let job = Job {
@@ -194,7 +212,7 @@ fn start(key: Key, maps: MaterialMaps, mesh: Arc<Mesh>, rays: &Rays) -> Job {
     };
     let spawned = std::thread::Builder::new()
         .name("traced view".into())
-        .spawn(move || work(key, &maps, &mesh, &rays, &stop, &publish));
+        .spawn(move || work(key, (&maps, &mesh, ao.as_deref()), &rays, &stop, &publish));
     if let Err(e) = spawned {
         // No thread: say so where the picture would be.
         *job.latest.lock().unwrap_or_else(PoisonError::into_inner) =
@@ -207,8 +225,7 @@ fn start(key: Key, maps: MaterialMaps, mesh: Arc<Mesh>, rays: &Rays) -> Job {
 /// publishing a picture after each, until stopped or done.
 fn work(
     key: Key,
-    maps: &MaterialMaps,
-    mesh: &Mesh,
+    (maps, mesh, ao): (&MaterialMaps, &Mesh, Option<&Baked>),
     rays: &Rays,
     stop: &AtomicBool,
     publish: &(dyn Fn(Published) + Sync),
@@ -250,6 +267,9 @@ fn work(
         }
         let s = &key.settings;
         let mut trace = Traced::new((mesh, bvh, ray_mesh), &Material::Maps(maps), s, w, h);
+        if let Some(bake) = ao {
+            trace.set_ao_bake(bake);
+        }
         let mut per_pass = 1;
         while trace.samples() < SAMPLES {
             let started = std::time::Instant::now();
