@@ -124,7 +124,7 @@ impl super::Viewport {
         view: kapaint_core::render::ViewMode,
     ) -> bool {
         let font = egui::FontId::proportional(13.0);
-        let at = Pos2::new(rect.min.x + 8.0, rect.max.y - 56.0);
+        let at = Pos2::new(rect.min.x + 8.0, rect.max.y - 76.0);
         if let Some(why) = self.traced.refused() {
             let untraced = view.untraced().label();
             painter.text(
@@ -182,7 +182,7 @@ pub(super) fn view_error_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect:
 /// Where a scale bar goes: along the bottom of `rect`.
 pub(crate) fn scale_bar(rect: Rect) -> Rect {
     Rect::from_min_size(
-        Pos2::new(rect.min.x + 16.0, rect.max.y - 34.0),
+        Pos2::new(rect.min.x + 16.0, rect.max.y - 56.0),
         egui::vec2((rect.width() - 32.0).clamp(40.0, 320.0), 12.0),
     )
 }
