@@ -28,13 +28,13 @@ pub enum ViewMode {
     /// `n` in false colour on the log scale [`N_RAMP`] (a picture, not data).
     NFalseColour,
     /// `k_a` per view (linear data): the ambient coefficient with `chi_view` at the pixel's own
-    /// view angle instead of its mean over the view (see [`reflectance::view::ka_view`]).
+    /// view angle instead of its mean over the view (see [`crate::reflectance::view::ka_view`]).
     KaView,
     /// The view-average error: `k_a`'s relative difference from `k_a` per view
     /// ([`relative_error`]) as a heatmap, 0 to [`VIEW_ERROR_TOP`] (a picture, not data).
     KaViewError,
     /// `k_a` traced (linear data): the per-view integral with each light direction masked by
-    /// a ray against the mesh, by progressive Monte Carlo on the CPU ([`traced`]).
+    /// a ray against the mesh, by progressive Monte Carlo on the CPU ([`super::traced`]).
     KaTraced,
     /// The traced error: the live `k_a`'s relative difference from the traced one, as a
     /// heatmap 0 to [`VIEW_ERROR_TOP`] (a picture, not data).
@@ -178,7 +178,7 @@ impl ViewMode {
         )
     }
 
-    /// Whether the view is traced on the CPU ([`traced`]) rather than shaded per fragment.
+    /// Whether the view is traced on the CPU ([`super::traced`]) rather than shaded per fragment.
     pub fn is_traced(self) -> bool {
         matches!(
             self,

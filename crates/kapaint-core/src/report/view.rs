@@ -242,7 +242,7 @@ pub fn traced_markdown(rows: &[TracedRow], setup: &TracedSetup) -> String {
 }
 
 /// The exponents the figure of `chi_view` draws.
-const PLOT_N: [f64; 4] = [1.0, 10.0, 100.0, 1000.0];
+pub const PLOT_N: [f64; 4] = [1.0, 10.0, 100.0, 1000.0];
 
 /// Draws `chi_view(n, phi) / chi(n)` against the view angle for Phong (solid) and Blinn-Phong
 /// (dashed) at [`PLOT_N`], exact integrals at 90 views each, and writes it as a PNG: the
