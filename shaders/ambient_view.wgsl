@@ -5,6 +5,10 @@
 // from `view_table` (four tables stacked in rows: Phong, Blinn-Phong, Cook-Torrance's chi_1,
 // its chi_0; columns run along v, rows along u). `reflectance::view::ka_view` is the CPU twin.
 
+#include "ids.wgsl"
+#include "ambient.wgsl"
+#include "preview_bindings.wgsl"
+
 const VIEW_NODES: i32 = 128;
 const VIEW_COEFFICIENTS: i32 = 130;
 const VIEW_N_MAX: f32 = 16384.0;

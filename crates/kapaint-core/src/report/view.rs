@@ -75,13 +75,13 @@ pub fn view_average_rows(models: &[ShadingModel]) -> Vec<ViewAverageRow> {
 /// The view-average table as markdown.
 pub fn view_average_markdown(rows: &[ViewAverageRow]) -> String {
     let mut out = String::from(
-        "| view average | n | max rel error | at view (deg) | mean over the disc | head-on |\n\
-         |---|---|---|---|---|---|\n",
+        "| view average | model | n | max rel error | at view (deg) | mean over the disc | head-on |\n\
+         |---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {:.3e} | {:.1} | {:.3e} | {:.3e} |",
+            "| view average | {} | {} | {:.3e} | {:.1} | {:.3e} | {:.3e} |",
             r.model.name(),
             super::accuracy::format_n(r.n),
             r.max.0,
