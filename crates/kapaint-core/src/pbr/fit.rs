@@ -249,6 +249,66 @@ impl LobeSamples {
         (0.5 * (lo + hi)).exp_m1()
     }
 
+    /// The lobe height `s` that minimises the box average of `|rho_GGX - s c^n|` for the
+    /// target's lobe of exponent `n` (Phong or Blinn-Phong), and that distance: the weighted
+    /// median of `rho_GGX / c^n` with weights `w c^n` (where `c^n > 0`), since
+    /// `|g - s t| = t |g / t - s|`.
+    pub fn height_for(&self, target: ShadingModel, n: f64) -> (f64, f64) {
+        let k = usize::from(target != ShadingModel::Phong);
+        let mut ratios: Vec<(f64, f64)> = Vec::with_capacity(self.len());
+        let mut total = 0.0;
+        for i in 0..self.len() {
+            let t = lobe(self.cosines[i][k], n);
+            let wt = self.weight[i] * t;
+            if wt > 0.0 {
+                let [g1, g0] = self.ggx[i];
+                ratios.push(((g1 + g0) / t, wt));
+                total += wt;
+            }
+        }
+        ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut seen = 0.0;
+        let s = ratios
+            .iter()
+            .find(|(_, w)| {
+                seen += w;
+                seen >= 0.5 * total
+            })
+            .map_or(0.0, |(r, _)| *r);
+        let distance = (0..self.len())
+            .map(|i| {
+                let [g1, g0] = self.ggx[i];
+                self.weight[i] * (g1 + g0 - s * lobe(self.cosines[i][k], n)).abs()
+            })
+            .sum();
+        (s, distance)
+    }
+
+    /// The exponent in `[0, cap]` and the lobe height that together minimise the box L1
+    /// distance to the GGX lobe ([`Self::height_for`] at each exponent): a scan of
+    /// `u = ln(1 + n)` and golden-section search around its best point, as [`Self::fit_n`].
+    pub fn fit_n_and_height(&self, target: ShadingModel, cap: f64) -> (f64, f64) {
+        const SCAN: usize = 24;
+        let u_max = cap
+            .clamp(0.0, f64::from(crate::model::texel::N_MAX))
+            .ln_1p();
+        let f = |u: f64| self.height_for(target, u.exp_m1()).1;
+        let du = u_max / SCAN as f64;
+        let best = (0..=SCAN)
+            .map(|i| (i, f(i as f64 * du)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |(i, _)| i);
+        let (lo, hi) = (
+            (best as f64 - 1.0).max(0.0) * du,
+            (best as f64 + 1.0).min(SCAN as f64) * du,
+        );
+        let shrink = 2.0 / (5.0_f64.sqrt() - 1.0);
+        let steps = ((hi - lo) / 1e-4).ln() / shrink.ln();
+        let (lo, hi) = golden_section(f, (lo, hi), steps.ceil().max(0.0) as usize);
+        let n = (0.5 * (lo + hi)).exp_m1();
+        (n, self.height_for(target, n).0)
+    }
+
     /// The L1 distance between the two lobes each divided by its mean (their shapes).
     pub fn shape_distance(&self, target: ShadingModel, n: f64) -> f64 {
         let chi = self.target_mean(target, n);
