@@ -12,11 +12,12 @@ fn main() {
     }
     let started = std::time::Instant::now();
     eprintln!(
-        "roughness  n (Phong, Blinn-Phong, Cook-Torrance)  lobe distance / mean (fitted; unconstrained)"
+        "roughness  n (Phong, Blinn-Phong, Cook-Torrance)  lobe distance / mean (fitted; unconstrained)  \
+         height fit: n, height, distance (Phong; Blinn-Phong)"
     );
     let rows = fit_curve(&table_roughness(), LEVEL, |row| {
         eprintln!(
-            "{:.4}  {:9.3} {:9.3} {:9.3}  {:.3} {:.3} {:.3}; {:.3} {:.3}",
+            "{:.4}  {:9.3} {:9.3} {:9.3}  {:.3} {:.3} {:.3}; {:.3} {:.3}  {:.4} {:.4} {:.3}; {:.4} {:.4} {:.3}",
             row.roughness,
             row.n[0],
             row.n[1],
@@ -26,6 +27,12 @@ fn main() {
             row.distance[2],
             row.free_distance[0],
             row.free_distance[1],
+            row.height_fit[0].0,
+            row.height_fit[0].1,
+            row.height_distance[0],
+            row.height_fit[1].0,
+            row.height_fit[1].1,
+            row.height_distance[1],
         );
     });
     eprintln!(

@@ -38,6 +38,11 @@ pub const KS_NODES: usize = 17;
 /// GGX `alpha < 0.001`, beyond the integrators' range).
 pub const ROUGHNESS_MIN: f64 = 1.0 / 32.0;
 
+/// The largest lobe height the fit gives (`k_s = F0 height`): the converted `k_s` never
+/// exceeds `F0`, so the conversion adds no energy; the height only lowers the lobe where GGX's
+/// sinks below `F0` (the rough end), and the smooth end keeps today's `k_s = F0`.
+pub const MAX_HEIGHT: f64 = 1.0;
+
 /// The tanh-sinh level of the box rule the tables are made with.
 pub const LEVEL: u32 = 2;
 
@@ -249,39 +254,58 @@ impl LobeSamples {
         (0.5 * (lo + hi)).exp_m1()
     }
 
-    /// The lobe height `s` that minimises the box average of `|rho_GGX - s c^n|` for the
-    /// target's lobe of exponent `n` (Phong or Blinn-Phong), and that distance: the weighted
-    /// median of `rho_GGX / c^n` with weights `w c^n` (where `c^n > 0`), since
-    /// `|g - s t| = t |g / t - s|`.
+    /// The lobe height `s` in `[0, MAX_HEIGHT]` that minimises the box average of
+    /// `|rho_GGX - s c^n|` for the target's lobe of exponent `n` (Phong or Blinn-Phong), and
+    /// that distance. Since `|g - s t| = t |g / t - s|`, the unbounded minimum is the weighted
+    /// median of `rho_GGX / c^n` with weights `w c^n` (where `c^n > 0`); the distance is convex
+    /// in `s`, so the bounded one is that median clamped (found without sorting when at least
+    /// half the weight lies at or above the bound).
     pub fn height_for(&self, target: ShadingModel, n: f64) -> (f64, f64) {
         let k = usize::from(target != ShadingModel::Phong);
-        let mut ratios: Vec<(f64, f64)> = Vec::with_capacity(self.len());
-        let mut total = 0.0;
-        for i in 0..self.len() {
-            let t = lobe(self.cosines[i][k], n);
-            let wt = self.weight[i] * t;
-            if wt > 0.0 {
+        let ratios: Vec<(f64, f64)> = (0..self.len())
+            .into_par_iter()
+            .filter_map(|i| {
+                let t = lobe(self.cosines[i][k], n);
+                let wt = self.weight[i] * t;
                 let [g1, g0] = self.ggx[i];
-                ratios.push(((g1 + g0) / t, wt));
-                total += wt;
-            }
-        }
-        ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut seen = 0.0;
-        let s = ratios
+                (wt > 0.0).then(|| ((g1 + g0) / t, wt))
+            })
+            .collect();
+        let total: f64 = ratios.iter().map(|r| r.1).sum();
+        let above: f64 = ratios
             .iter()
-            .find(|(_, w)| {
-                seen += w;
-                seen >= 0.5 * total
-            })
-            .map_or(0.0, |(r, _)| *r);
-        let distance = (0..self.len())
-            .map(|i| {
-                let [g1, g0] = self.ggx[i];
-                self.weight[i] * (g1 + g0 - s * lobe(self.cosines[i][k], n)).abs()
-            })
+            .filter(|r| r.0 >= MAX_HEIGHT)
+            .map(|r| r.1)
             .sum();
-        (s, distance)
+        let s = if above >= 0.5 * total {
+            MAX_HEIGHT
+        } else {
+            let mut ratios = ratios;
+            ratios.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let mut seen = 0.0;
+            ratios
+                .iter()
+                .find(|(_, w)| {
+                    seen += w;
+                    seen >= 0.5 * total
+                })
+                .map_or(0.0, |(r, _)| *r)
+        };
+        // Summed in fixed chunks, in order: the result does not depend on the thread count.
+        let chunks: Vec<f64> = (0..self.len())
+            .collect::<Vec<_>>()
+            .par_chunks(1 << 16)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|&i| {
+                        let [g1, g0] = self.ggx[i];
+                        self.weight[i] * (g1 + g0 - s * lobe(self.cosines[i][k], n)).abs()
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        (s, chunks.iter().sum())
     }
 
     /// The exponent in `[0, cap]` and the lobe height that together minimise the box L1
@@ -322,15 +346,15 @@ impl LobeSamples {
             .sum()
     }
 
-    /// `[weight, rho_1 - t_1, rho_0 - t_0]` at every node for the target's lobe of exponent
-    /// `n`.
-    fn differences(&self, target: ShadingModel, n: f64) -> Vec<[f64; 3]> {
+    /// `[weight, rho_1 - h t_1, rho_0 - h t_0]` at every node for the target's lobe of
+    /// exponent `n` and height `h`.
+    fn differences(&self, target: ShadingModel, n: f64, h: f64) -> Vec<[f64; 3]> {
         (0..self.len())
             .into_par_iter()
             .map(|i| {
                 let [g1, g0] = self.ggx[i];
                 let [t1, t0] = self.target_parts(target, n, i);
-                [self.weight[i], g1 - t1, g0 - t0]
+                [self.weight[i], g1 - h * t1, g0 - h * t0]
             })
             .collect()
     }
@@ -338,7 +362,7 @@ impl LobeSamples {
     /// The numerator of the conversion error at `k_s`: the box average of
     /// `|k_s (rho_1 - t_1) + (rho_0 - t_0)|` for the target's lobe of exponent `n`.
     pub fn error_at(&self, target: ShadingModel, n: f64, ks: f64) -> f64 {
-        self.differences(target, n)
+        self.differences(target, n, 1.0)
             .iter()
             .map(|[w, a, b]| w * (ks * a + b).abs())
             .sum()
@@ -346,7 +370,13 @@ impl LobeSamples {
 
     /// [`Self::error_at`] at every `k_s` node.
     pub fn error_table(&self, target: ShadingModel, n: f64) -> [f64; KS_NODES] {
-        let diffs = self.differences(target, n);
+        self.error_table_at_height(target, n, 1.0)
+    }
+
+    /// [`Self::error_table`] for the target's lobe scaled to height `h` (`k_s` becomes
+    /// `h k_s`, unclamped): the box average of `|k_s (rho_1 - h t_1) + rho_0|` per node.
+    pub fn error_table_at_height(&self, target: ShadingModel, n: f64, h: f64) -> [f64; KS_NODES] {
+        let diffs = self.differences(target, n, h);
         std::array::from_fn(|k| {
             let ks = ks_node(k);
             diffs.iter().map(|[w, a, b]| w * (ks * a + b).abs()).sum()
@@ -370,6 +400,12 @@ pub struct Node {
     pub distance: [f64; 3],
     /// The same without the cap (the unconstrained minimum), per target.
     pub free_distance: [f64; 3],
+    /// Phong's and Blinn-Phong's exponent and lobe height fitted together (`k_s = F0 h`).
+    pub height_fit: [(f64, f64); 2],
+    /// Their lobe distance over the GGX mean.
+    pub height_distance: [f64; 2],
+    /// Their error numerator at every `k_s` node (unclamped `h k_s`).
+    pub height_error: [[f64; KS_NODES]; 2],
 }
 
 /// The tables' rows for `roughness` values sorted from smooth to rough, with a rule of
@@ -401,6 +437,29 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
             distance[k] = samples.lobe_distance(target, n[k]) / mean;
             free_distance[k] = samples.lobe_distance(target, free) / mean;
         }
+        let mut height_fit = [(0.0, 0.0); 2];
+        let mut height_distance = [0.0; 2];
+        let mut height_error = [[0.0; KS_NODES]; 2];
+        for (k, target) in [ShadingModel::Phong, ShadingModel::BlinnPhong]
+            .into_iter()
+            .enumerate()
+        {
+            // Strictly falling: a row's exponent stays below the smoother row's.
+            let cap = rows
+                .last()
+                .map_or(f64::from(crate::model::texel::N_MAX), |row| {
+                    row.height_fit[k].0 * (1.0 - 1e-4)
+                });
+            let (hn, h) = samples.fit_n_and_height(target, f64::from(crate::model::texel::N_MAX));
+            let (hn, h) = if hn < cap {
+                (hn, h)
+            } else {
+                samples.fit_n_and_height(target, cap)
+            };
+            height_fit[k] = (hn, h);
+            height_distance[k] = samples.height_for(target, hn).1 / mean;
+            height_error[k] = samples.error_table_at_height(target, hn, h);
+        }
         let row = Node {
             roughness: r,
             means,
@@ -408,6 +467,9 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
             error,
             distance,
             free_distance,
+            height_fit,
+            height_distance,
+            height_error,
         };
         progress(&row);
         rows.push(row);
@@ -467,6 +529,44 @@ pub fn render_rust(rows: &[Node], level: u32) -> String {
     for row in rows {
         let _ = writeln!(out, "    [");
         for e in &row.error {
+            let cells: Vec<String> = e.iter().map(|v| format!("{:?}", *v as f32)).collect();
+            let _ = writeln!(out, "        [{}],", cells.join(", "));
+        }
+        let _ = writeln!(out, "    ],");
+    }
+    let _ = writeln!(out, "];\n");
+    let _ = writeln!(
+        out,
+        "/// Phong's and Blinn-Phong's `[n, height]` per row, fitted together (`k_s = F0 height`)."
+    );
+    let _ = writeln!(out, "#[rustfmt::skip]");
+    let _ = writeln!(out, "pub static HEIGHT_FIT: [[[f32; 2]; 2]; ROWS] = [");
+    for row in rows {
+        let [(n0, h0), (n1, h1)] = row.height_fit;
+        let _ = writeln!(
+            out,
+            "    [[{:?}, {:?}], [{:?}, {:?}]],",
+            n0 as f32, h0 as f32, n1 as f32, h1 as f32
+        );
+    }
+    let _ = writeln!(out, "];\n");
+    let _ = writeln!(
+        out,
+        "/// Their error numerator per row at `k_s = (k / {})^2` (the lobe at `height k_s`).",
+        KS_NODES - 1
+    );
+    let _ = writeln!(out, "#[rustfmt::skip]");
+    let _ = writeln!(
+        out,
+        "#[expect(dead_code, reason = \"the height mapping's conversion error comes next (issue 43)\")]"
+    );
+    let _ = writeln!(
+        out,
+        "pub static HEIGHT_ERROR: [[[f32; {KS_NODES}]; 2]; ROWS] = ["
+    );
+    for row in rows {
+        let _ = writeln!(out, "    [");
+        for e in &row.height_error {
             let cells: Vec<String> = e.iter().map(|v| format!("{:?}", *v as f32)).collect();
             let _ = writeln!(out, "        [{}],", cells.join(", "));
         }

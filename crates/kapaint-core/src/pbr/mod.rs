@@ -30,6 +30,7 @@ pub mod round_trip;
 mod table;
 
 use crate::model::texel::{MaterialValue, N_MAX};
+use crate::reflectance::ShadingModel;
 
 /// The dielectric `F0` of the metallic-roughness model.
 pub const DIELECTRIC_F0: f32 = 0.04;
@@ -129,9 +130,67 @@ pub fn from_material(v: MaterialValue) -> Pbr {
     }
 }
 
+/// The height mapping's exponent and lobe height for `roughness` (`k_s = F0 height`; issue
+/// 43, not yet what the conversion uses): linear in `ln(1 + n)` and in the height between the
+/// table's rows, the first row's below them; NaN is roughness 1. `None` for Cook-Torrance,
+/// which needs no fit.
+pub fn height_fit(model: ShadingModel, roughness: f32) -> Option<(f32, f32)> {
+    let k = match model {
+        ShadingModel::Phong => 0,
+        ShadingModel::BlinnPhong => 1,
+        ShadingModel::CookTorrance => return None,
+    };
+    let r = if roughness.is_nan() {
+        1.0
+    } else {
+        roughness.clamp(0.0, 1.0)
+    };
+    let x = (r * 64.0 - 2.0).max(0.0);
+    let row = (x as usize).min(table::ROWS - 2);
+    let t = (x - row as f32).min(1.0);
+    let (a, b) = (table::HEIGHT_FIT[row][k], table::HEIGHT_FIT[row + 1][k]);
+    let n = (a[0].ln_1p() + (b[0].ln_1p() - a[0].ln_1p()) * t).exp_m1();
+    Some((n, a[1] + (b[1] - a[1]) * t))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_height_fit_falls_strictly_over_the_whole_table() {
+        use super::table::{HEIGHT_FIT, ROWS};
+        for (k, target) in [ShadingModel::Phong, ShadingModel::BlinnPhong]
+            .into_iter()
+            .enumerate()
+        {
+            for i in 1..ROWS {
+                let (n, h) = (HEIGHT_FIT[i][k][0], HEIGHT_FIT[i][k][1]);
+                assert!(n < HEIGHT_FIT[i - 1][k][0], "{target:?}, row {i}: n {n}");
+                assert!(h > 0.0 && h <= 1.0, "{target:?}, row {i}: height {h}");
+            }
+            // The issue's target: roughness 0.5, 0.75 and 1.0 each at least 1.25 times the next.
+            let n = |r: f32| HEIGHT_FIT[(r * 64.0).round() as usize - 2][k][0];
+            assert!(
+                n(0.5) >= 1.25 * n(0.75) && n(0.75) >= 1.25 * n(1.0),
+                "{target:?}: {} {} {}",
+                n(0.5),
+                n(0.75),
+                n(1.0)
+            );
+        }
+        // The lookup: the rows at their roughness, between them in between, none for
+        // Cook-Torrance.
+        let at = |r| height_fit(ShadingModel::Phong, r).unwrap_or((f32::NAN, f32::NAN));
+        assert_eq!(at(0.75), (HEIGHT_FIT[46][0][0], HEIGHT_FIT[46][0][1]));
+        let mid = at(0.75 + 0.5 / 64.0);
+        assert!(
+            mid.0 < at(0.75).0 && mid.0 > at(0.75 + 1.0 / 64.0).0,
+            "{mid:?}"
+        );
+        assert_eq!(at(f32::NAN), at(1.0));
+        assert_eq!(height_fit(ShadingModel::CookTorrance, 0.5), None);
+    }
 
     #[test]
     fn the_inverse_gives_back_the_material_and_pure_dielectrics_and_metals() {
