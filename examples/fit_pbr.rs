@@ -1,15 +1,24 @@
-//! Regenerates `crates/kapaint-core/src/pbr/table.rs`: the fitted exponent per roughness for each target model and
-//! the conversion-error tables (see `kapaint::pbr::fit`), printing each row's fit to stderr.
+//! Regenerates `crates/kapaint-core/src/pbr/table.rs` (the fitted exponent per roughness for
+//! each target model and the conversion-error tables) and `table_height.rs` beside it (the
+//! height mapping's columns), see `kapaint::pbr::fit`, printing each row's fit to stderr.
 //!
-//! Usage: `cargo run --release --example fit_pbr > crates/kapaint-core/src/pbr/table.rs`
+//! Usage: `cargo run --release --example fit_pbr -- crates/kapaint-core/src/pbr`
+//! (`fit_pbr LEVEL` checks a box rule's level against the exact integrals instead).
 
-use kapaint::pbr::fit::{LEVEL, LobeSamples, ct_n, fit_curve, render_rust, table_roughness};
+use kapaint::pbr::fit::{
+    LEVEL, LobeSamples, ct_n, fit_curve, render_height_rust, render_rust, table_roughness,
+};
 
 fn main() {
-    if let Some(level) = std::env::args().nth(1).and_then(|a| a.parse::<u32>().ok()) {
+    let Some(arg) = std::env::args().nth(1) else {
+        eprintln!("usage: fit_pbr DIR (where table.rs goes) | fit_pbr LEVEL");
+        std::process::exit(2);
+    };
+    if let Ok(level) = arg.parse::<u32>() {
         check(level);
         return;
     }
+    let dir = std::path::PathBuf::from(arg);
     let started = std::time::Instant::now();
     eprintln!(
         "roughness  n (Phong, Blinn-Phong, Cook-Torrance)  lobe distance / mean (fitted; unconstrained)  \
@@ -40,7 +49,15 @@ fn main() {
         rows.len(),
         started.elapsed().as_secs_f64()
     );
-    print!("{}", render_rust(&rows, LEVEL));
+    for (name, text) in [
+        ("table.rs", render_rust(&rows, LEVEL)),
+        ("table_height.rs", render_height_rust(&rows, LEVEL)),
+    ] {
+        if let Err(e) = kapaint::atomic::write_atomic(&dir.join(name), text.as_bytes()) {
+            eprintln!("fit_pbr: {}: {e}", dir.join(name).display());
+            std::process::exit(1);
+        }
+    }
 }
 
 /// The box rule of `level` against the exact integrals: GGX's mean and Phong's `chi`.

@@ -28,6 +28,7 @@ pub mod import;
 pub mod names;
 pub mod round_trip;
 mod table;
+mod table_height;
 
 use crate::model::texel::{MaterialValue, N_MAX};
 use crate::reflectance::ShadingModel;
@@ -148,7 +149,10 @@ pub fn height_fit(model: ShadingModel, roughness: f32) -> Option<(f32, f32)> {
     let x = (r * 64.0 - 2.0).max(0.0);
     let row = (x as usize).min(table::ROWS - 2);
     let t = (x - row as f32).min(1.0);
-    let (a, b) = (table::HEIGHT_FIT[row][k], table::HEIGHT_FIT[row + 1][k]);
+    let (a, b) = (
+        table_height::HEIGHT_FIT[row][k],
+        table_height::HEIGHT_FIT[row + 1][k],
+    );
     let n = (a[0].ln_1p() + (b[0].ln_1p() - a[0].ln_1p()) * t).exp_m1();
     Some((n, a[1] + (b[1] - a[1]) * t))
 }
@@ -159,7 +163,8 @@ mod tests {
 
     #[test]
     fn the_height_fit_falls_strictly_over_the_whole_table() {
-        use super::table::{HEIGHT_FIT, ROWS};
+        use super::table::ROWS;
+        use super::table_height::HEIGHT_FIT;
         for (k, target) in [ShadingModel::Phong, ShadingModel::BlinnPhong]
             .into_iter()
             .enumerate()

@@ -259,6 +259,11 @@ pub fn plot(rows: &[BenchRow], path: &Path) -> Result<(), String> {
     let (w, h) = PLOT_SIZE;
     let mut rgb = vec![255u8; (w * h * 3) as usize];
     draw_plot(rows, &mut rgb).map_err(|e| format!("cannot draw the plot: {e}"))?;
+    write_png(rgb, PLOT_SIZE, path)
+}
+
+/// Writes a plot's RGB buffer of `(w, h)` pixels as a PNG at `path`, atomically.
+pub(crate) fn write_png(rgb: Vec<u8>, (w, h): (u32, u32), path: &Path) -> Result<(), String> {
     let image = image::RgbImage::from_raw(w, h, rgb).ok_or("plot buffer has the wrong size")?;
     let mut png = Vec::new();
     image

@@ -254,13 +254,7 @@ pub fn plot_chi_view(path: &std::path::Path) -> Result<(), String> {
     const SIZE: (u32, u32) = (960, 560);
     let mut rgb = vec![255u8; (SIZE.0 * SIZE.1 * 3) as usize];
     draw_chi_view(&mut rgb, SIZE).map_err(|e| format!("cannot draw the plot: {e}"))?;
-    let image = image::RgbImage::from_raw(SIZE.0, SIZE.1, rgb).ok_or("wrong buffer size")?;
-    let mut png = Vec::new();
-    image
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
-    crate::atomic::write_atomic(path, &png)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    super::bench::write_png(rgb, SIZE, path)
 }
 
 fn draw_chi_view(rgb: &mut [u8], size: (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
