@@ -12,6 +12,7 @@
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use kapaint::pbr::NMapping;
 use kapaint::pbr::import::{PbrSet, Source, import};
 use kapaint::reflectance::ShadingModel;
 
@@ -41,20 +42,21 @@ fn imports(c: &mut Criterion) {
         ShadingModel::CookTorrance,
     ] {
         group.bench_function(model.name(), |b| {
-            b.iter(|| import(&set, None, model).expect("import"));
+            b.iter(|| import(&set, None, model, NMapping::default()).expect("import"));
         });
     }
     let out = dir.join("out.kapaint");
     group.bench_function("phong_and_save", |b| {
         b.iter(|| {
-            let imported = import(&set, None, ShadingModel::Phong).expect("import");
+            let imported =
+                import(&set, None, ShadingModel::Phong, NMapping::default()).expect("import");
             kapaint::model::project::save(&imported.doc, &out).expect("save");
         });
     });
     group.finish();
     // The way back: the imported project to glTF textures (convert with the round-trip error,
     // encode both PNGs, write the set), and the conversion alone.
-    let imported = import(&set, None, ShadingModel::Phong).expect("import");
+    let imported = import(&set, None, ShadingModel::Phong, NMapping::default()).expect("import");
     let preset = kapaint::export::preset::find("gltf-pbr").expect("preset");
     let mut group = c.benchmark_group("pbr_export_4096");
     group
@@ -68,7 +70,9 @@ fn imports(c: &mut Criterion) {
             .collect()
     };
     group.bench_function("convert_phong", |b| {
-        b.iter(|| kapaint::pbr::round_trip::convert(&texels, ShadingModel::Phong));
+        b.iter(|| {
+            kapaint::pbr::round_trip::convert(&texels, ShadingModel::Phong, NMapping::default())
+        });
     });
     let progress = kapaint::task::Progress::default();
     group.bench_function("gltf_pbr_set", |b| {

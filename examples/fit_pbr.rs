@@ -1,12 +1,14 @@
 //! Regenerates `crates/kapaint-core/src/pbr/table.rs` (the fitted exponent per roughness for
 //! each target model and the conversion-error tables) and `table_height.rs` beside it (the
-//! height mapping's columns), see `kapaint::pbr::fit`, printing each row's fit to stderr.
+//! height mapping's fit) and `table_height_error.bin` (its error numerator), see
+//! `kapaint::pbr::fit`, printing each row's fit to stderr.
 //!
 //! Usage: `cargo run --release --example fit_pbr -- crates/kapaint-core/src/pbr`
 //! (`fit_pbr LEVEL` checks a box rule's level against the exact integrals instead).
 
 use kapaint::pbr::fit::{
-    LEVEL, LobeSamples, ct_n, fit_curve, render_height_rust, render_rust, table_roughness,
+    LEVEL, LobeSamples, ct_n, fit_curve, height_error_bytes, render_height_rust, render_rust,
+    table_roughness,
 };
 
 fn main() {
@@ -49,11 +51,15 @@ fn main() {
         rows.len(),
         started.elapsed().as_secs_f64()
     );
-    for (name, text) in [
-        ("table.rs", render_rust(&rows, LEVEL)),
-        ("table_height.rs", render_height_rust(&rows, LEVEL)),
+    for (name, bytes) in [
+        ("table.rs", render_rust(&rows, LEVEL).into_bytes()),
+        (
+            "table_height.rs",
+            render_height_rust(&rows, LEVEL).into_bytes(),
+        ),
+        ("table_height_error.bin", height_error_bytes(&rows)),
     ] {
-        if let Err(e) = kapaint::atomic::write_atomic(&dir.join(name), text.as_bytes()) {
+        if let Err(e) = kapaint::atomic::write_atomic(&dir.join(name), &bytes) {
             eprintln!("fit_pbr: {}: {e}", dir.join(name).display());
             std::process::exit(1);
         }

@@ -83,7 +83,7 @@ fn a_gltf_material_round_trips_through_a_project_within_one_code() {
             .expect("mr")
             .to_rgb8();
         assert_eq!(base.dimensions(), original.dimensions());
-        let c = Conversion::for_model(model);
+        let c = Conversion::for_model(model, kapaint::pbr::NMapping::default());
         let (mut base_off, mut rough_off) = (0_i32, 0_i32);
         for (x, y, want) in original.enumerate_pixels() {
             let got = base.get_pixel(x, y);
@@ -441,7 +441,14 @@ fn a_texture_set_is_found_by_its_names_from_any_one_of_its_images() {
     // Metallic from B: the right half is a metal (k_d black), the left a dielectric.
     let (left, right) = (doc.maps().value(10, 10), doc.maps().value(50, 10));
     assert!(left.kd.max_element() > 0.01 && right.kd.max_element() < 1e-3);
-    assert!((left.ks.x - 0.04).abs() < 1e-3);
+    // The dielectric's F0 at the roughness' lobe height, within the energy guard per channel
+    // (spot's red is white: k_d 1 leaves no k_s there).
+    let height = Conversion::for_model(ShadingModel::Phong, kapaint::pbr::NMapping::default())
+        .height(128.0 / 255.0);
+    for c in 0..3 {
+        let want = (0.04 * height).min(1.0 - left.kd[c]);
+        assert!((left.ks[c] - want).abs() < 1e-3, "{left:?}");
+    }
     // The DirectX green is flipped: the stored normal tilts to +Y in glTF's convention.
     let normal = doc.normal().expect("normal map").normal(5, 5);
     assert!(normal.y > 0.5, "{normal}");

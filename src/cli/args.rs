@@ -32,6 +32,26 @@ impl From<ModelArg> for ShadingModel {
     }
 }
 
+/// `--n-mapping` values: how PBR roughness and `F0` become Phong's `n` and `k_s`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum NMappingArg {
+    /// `n` and the lobe's height fitted together (`k_s = F0 height(r)`): every roughness its
+    /// own exponent.
+    HeightFitted,
+    /// `k_s = F0`, `n` fitted alone (the mapping before the height fit; `n` stops falling at
+    /// roughness 0.48).
+    HeightFixed,
+}
+
+impl From<NMappingArg> for crate::pbr::NMapping {
+    fn from(m: NMappingArg) -> Self {
+        match m {
+            NMappingArg::HeightFitted => Self::HeightFitted,
+            NMappingArg::HeightFixed => Self::HeightFixed,
+        }
+    }
+}
+
 /// Refuses a `--method` the model does not have: the paper printed no form for Cook-Torrance.
 pub(super) fn check_method(model: ShadingModel, method: MethodArg) -> Result<(), CliError> {
     if !model.has_paper_forms() && matches!(method, MethodArg::Paper | MethodArg::PaperCorrected) {

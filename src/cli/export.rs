@@ -184,6 +184,11 @@ pub struct ExportArgs {
     /// embedded.
     #[arg(long)]
     glb: bool,
+    /// With --preset gltf-pbr: how n and k_s become roughness and F0 for Phong and
+    /// Blinn-Phong projects (default: the mapping the project was imported with, else
+    /// height-fitted).
+    #[arg(long, value_enum)]
+    n_mapping: Option<super::args::NMappingArg>,
 }
 
 impl ExportArgs {
@@ -261,8 +266,24 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
             preset.name
         )));
     }
+    if args.n_mapping.is_some() && preset.format != crate::export::preset::Format::GltfPbr {
+        return Err(CliError::usage(format!(
+            "--n-mapping chooses how n becomes roughness: use it with --preset gltf-pbr, not {}",
+            preset.name
+        )));
+    }
     let mut text = String::new();
-    let docs = load_projects(files, !args.no_padding, glb, &mut text)?;
+    let mut docs = load_projects(files, !args.no_padding, glb, &mut text)?;
+    if let Some(mapping) = args.n_mapping {
+        docs = docs
+            .into_iter()
+            .map(|(doc, mesh)| {
+                let mut settings = doc.settings().clone();
+                settings.n_mapping = Some(mapping.into());
+                (doc.with_settings(settings), mesh)
+            })
+            .collect();
+    }
     let targets: Vec<PathBuf> = if files.len() == 1 {
         vec![out.clone()]
     } else {

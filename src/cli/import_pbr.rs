@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::args::{ModelArg, parse_size};
+use super::args::{ModelArg, NMappingArg, parse_size};
 use super::{CliError, mesh_error, model_error};
 use crate::model::document::MeshRef;
 use crate::model::normal::NormalMap;
@@ -24,6 +24,10 @@ pub struct ImportPbrArgs {
     /// The target model the set is converted for.
     #[arg(long, value_enum, default_value = "phong")]
     model: ModelArg,
+    /// How roughness and F0 become n and k_s for Phong and Blinn-Phong (kept with the
+    /// project; its gltf-pbr export inverts the same).
+    #[arg(long, value_enum, default_value = "height-fitted")]
+    n_mapping: NMappingArg,
     /// A glTF file (.glb or .gltf): its mesh and its material's textures and factors.
     #[arg(long, conflicts_with_all = ["base_color", "metallic", "roughness", "metallic_roughness", "specular", "glossiness"])]
     gltf: Option<PathBuf>,
@@ -214,7 +218,8 @@ impl ImportPbrArgs {
             (None, Some(m)) => Some(m.clone()),
             (None, None) => None,
         };
-        let mut imported = crate::pbr::import::import(&set, size, model).map_err(model_error)?;
+        let mut imported = crate::pbr::import::import(&set, size, model, self.n_mapping.into())
+            .map_err(model_error)?;
         imported.report.notes.extend(notes);
         let mut settings = imported.doc.settings().clone();
         settings.import = Some(imported.report.clone());
@@ -259,6 +264,7 @@ fn report_text(out: &Path, doc: &crate::model::Document, report: &ImportReport) 
         100.0 * e.mean,
         100.0 * e.p99
     );
+    let _ = writeln!(text, "n mapping: {}", report.n_mapping);
     if let Some(normal) = doc.normal() {
         let _ = writeln!(
             text,

@@ -116,7 +116,11 @@ fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
             reflectance::ka(doc.settings().model, doc.settings().approx, v.kd, v.ks, v.n)
         }
         CanvasChannel::PbrError => kapaint_core::render::heat_ramp(
-            kapaint_core::pbr::round_trip::RoundTrip::for_model(doc.settings().model).error(v)
+            kapaint_core::pbr::round_trip::RoundTrip::for_model(
+                doc.settings().model,
+                doc.settings().n_mapping(),
+            )
+            .error(v)
                 / PBR_ERROR_TOP,
         ),
         // Read per texel from the bake (see `tile_image`); mid grey where there is none.

@@ -285,7 +285,7 @@ impl EditorState {
     /// replaces the selected layer's channels (one undo step) when it arrives.
     pub fn import_pbr(&mut self, path: PathBuf) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
-        let model = self.doc.settings().model;
+        let (model, mapping) = (self.doc.settings().model, self.doc.settings().n_mapping());
         self.start_job("Material", move |progress| {
             progress.start("decode", 1);
             let gltf = path
@@ -304,7 +304,8 @@ impl EditorState {
             };
             let converted = set.and_then(|(set, normal, notes)| {
                 progress.start("convert", 1);
-                let imported = kapaint_core::pbr::import::import(&set, Some((w, h)), model)?;
+                let imported =
+                    kapaint_core::pbr::import::import(&set, Some((w, h)), model, mapping)?;
                 let mut report = imported.report;
                 report.notes.extend(notes);
                 let (maps, _) = imported.doc.into_parts();

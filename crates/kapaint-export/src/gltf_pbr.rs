@@ -50,7 +50,9 @@ pub struct PbrManifest {
     pub height: u32,
     /// The project's shading model, whose `n` was read back into roughness.
     pub model: ShadingModel,
-    /// `fitted` (Phong, Blinn-Phong: the inverse of the fitted table) or `cook-torrance`.
+    /// `height-fitted` or `height-fixed` (Phong, Blinn-Phong: the inverse of that mapping;
+    /// manifests written before the height fit say `fitted`, the height-fixed one) or
+    /// `cook-torrance`.
     pub n_mapping: String,
     /// The round-trip error (relative, box average; see the module docs).
     pub round_trip: ErrorSummary,
@@ -125,7 +127,8 @@ pub fn export(
     let (texels, dilated) = padded_texels(doc);
     progress.check().map_err(|_| SetError::Cancelled)?;
     progress.start("encode", 2);
-    let converted = convert(&texels, model);
+    let mapping = doc.settings().n_mapping();
+    let converted = convert(&texels, model, mapping);
     drop(texels);
     let invalid = |reason: String| SetError::Invalid {
         path: out.to_path_buf(),
@@ -172,11 +175,7 @@ pub fn export(
         width: w,
         height: h,
         model,
-        n_mapping: if model == ShadingModel::CookTorrance {
-            "cook-torrance".into()
-        } else {
-            "fitted".into()
-        },
+        n_mapping: mapping.report_name(model).into(),
         round_trip: converted.error,
         dilated,
         files: written.entries(),

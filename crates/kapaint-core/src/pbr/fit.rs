@@ -46,6 +46,19 @@ pub const MAX_HEIGHT: f64 = 1.0;
 /// The tanh-sinh level of the box rule the tables are made with.
 pub const LEVEL: u32 = 2;
 
+/// The least the height mapping's exponent falls from one row to the next (relative): 2 %
+/// a row is 0.5 % an 8-bit roughness level, five steps of the half float that stores `n`,
+/// so the export reads every level back. Unconstrained, Phong's fit stalls at roughness 0.48
+/// to 0.52 (the height still 1, the exponent still wanting the height-fixed value).
+pub const MIN_FALL: f64 = 0.02;
+
+/// Number of clamp factors of the height mapping's error table: the converted `k_s` is
+/// `q F0 height` with `q = l / (CLAMP_NODES - 1)` (1 where the energy guard leaves it whole).
+pub const CLAMP_NODES: usize = 9;
+
+mod render;
+pub use render::{height_error_bytes, render_height_rust, render_rust};
+
 /// `k_s` at error-table node `i`.
 pub fn ks_node(i: usize) -> f64 {
     let u = i as f64 / (KS_NODES - 1) as f64;
@@ -335,18 +348,74 @@ impl LobeSamples {
 
     /// [`Self::error_at`] at every `k_s` node.
     pub fn error_table(&self, target: ShadingModel, n: f64) -> [f64; KS_NODES] {
-        self.error_table_at_height(target, n, 1.0)
-    }
-
-    /// [`Self::error_table`] for the target's lobe scaled to height `h` (`k_s` becomes
-    /// `h k_s`, unclamped): the box average of `|k_s (rho_1 - h t_1) + rho_0|` per node.
-    pub fn error_table_at_height(&self, target: ShadingModel, n: f64, h: f64) -> [f64; KS_NODES] {
-        let diffs = self.differences(target, n, h);
+        let diffs = self.differences(target, n, 1.0);
         std::array::from_fn(|k| {
             let ks = ks_node(k);
             diffs.iter().map(|[w, a, b]| w * (ks * a + b).abs()).sum()
         })
     }
+
+    /// The error numerator of a texel of `F0` converted to `k_s` (any height, clamped or not)
+    /// for the target's lobe of exponent `n`: the box average of `|F0 rho_1 + rho_0 - k_s c^n|`
+    /// (what [`Self::error_table_clamped`] tabulates).
+    pub fn error_at_height(&self, target: ShadingModel, n: f64, f0: f64, ks: f64) -> f64 {
+        (0..self.len())
+            .into_par_iter()
+            .map(|i| {
+                let [g1, g0] = self.ggx[i];
+                let t = self.target_parts(target, n, i)[0];
+                self.weight[i] * (f0 * g1 + g0 - ks * t).abs()
+            })
+            .sum()
+    }
+
+    /// The error numerator of the height mapping at every `F0` node `j` and clamp factor `q`
+    /// (node `l`): the box average of `|F0 rho_1 + rho_0 - q F0 h c^n|`, the GGX shading
+    /// against the target's lobe of exponent `n` at the height the energy guard leaves
+    /// (`q = 1` where it leaves `k_s = F0 h` whole).
+    pub fn error_table_clamped(
+        &self,
+        target: ShadingModel,
+        n: f64,
+        h: f64,
+    ) -> [[f64; CLAMP_NODES]; KS_NODES] {
+        // Summed in fixed chunks, in order: the result does not depend on the thread count.
+        let chunks: Vec<[[f64; CLAMP_NODES]; KS_NODES]> = (0..self.len())
+            .collect::<Vec<_>>()
+            .par_chunks(1 << 14)
+            .map(|chunk| {
+                let mut sum = [[0.0; CLAMP_NODES]; KS_NODES];
+                for &i in chunk {
+                    let [g1, g0] = self.ggx[i];
+                    let t = h * self.target_parts(target, n, i)[0];
+                    let w = self.weight[i];
+                    for (j, row) in sum.iter_mut().enumerate() {
+                        let f0 = ks_node(j);
+                        let g = f0 * g1 + g0;
+                        for (l, cell) in row.iter_mut().enumerate() {
+                            *cell += w * (g - clamp_node(l) * f0 * t).abs();
+                        }
+                    }
+                }
+                sum
+            })
+            .collect();
+        chunks
+            .iter()
+            .fold([[0.0; CLAMP_NODES]; KS_NODES], |mut acc, c| {
+                for (a, b) in acc.iter_mut().zip(c) {
+                    for (x, y) in a.iter_mut().zip(b) {
+                        *x += y;
+                    }
+                }
+                acc
+            })
+    }
+}
+
+/// `q` at clamp node `l` of the height mapping's error table.
+pub fn clamp_node(l: usize) -> f64 {
+    l as f64 / (CLAMP_NODES - 1) as f64
 }
 
 /// The exponent in `[0, cap]` (`cap` at most `N_MAX`) that minimises `distance`: a scan of
@@ -393,8 +462,9 @@ pub struct Node {
     pub height_fit: [(f64, f64); 2],
     /// Their lobe distance over the GGX mean.
     pub height_distance: [f64; 2],
-    /// Their error numerator at every `k_s` node (unclamped `h k_s`).
-    pub height_error: [[f64; KS_NODES]; 2],
+    /// Their error numerator at every `F0` node ([`ks_node`]) and clamp factor
+    /// ([`CLAMP_NODES`]): the converted `k_s` is `q F0 h`.
+    pub height_error: [[[f64; CLAMP_NODES]; KS_NODES]; 2],
 }
 
 /// The tables' rows for `roughness` values sorted from smooth to rough, with a rule of
@@ -428,16 +498,17 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
         }
         let mut height_fit = [(0.0, 0.0); 2];
         let mut height_distance = [0.0; 2];
-        let mut height_error = [[0.0; KS_NODES]; 2];
+        let mut height_error = [[[0.0; CLAMP_NODES]; KS_NODES]; 2];
         for (k, target) in [ShadingModel::Phong, ShadingModel::BlinnPhong]
             .into_iter()
             .enumerate()
         {
-            // Strictly falling: a row's exponent stays below the smoother row's.
+            // Falling by at least MIN_FALL a row, so a stored exponent tells every 8-bit
+            // roughness apart.
             let cap = rows
                 .last()
                 .map_or(f64::from(crate::model::texel::N_MAX), |row| {
-                    row.height_fit[k].0 * (1.0 - 1e-4)
+                    row.height_fit[k].0 * (1.0 - MIN_FALL)
                 });
             let (hn, h) = samples.fit_n_and_height(target, f64::from(crate::model::texel::N_MAX));
             let (hn, h) = if hn < cap {
@@ -447,7 +518,7 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
             };
             height_fit[k] = (hn, h);
             height_distance[k] = samples.height_for(target, hn).1 / mean;
-            height_error[k] = samples.error_table_at_height(target, hn, h);
+            height_error[k] = samples.error_table_clamped(target, hn, h);
         }
         let row = Node {
             roughness: r,
@@ -469,113 +540,4 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
 /// The tables' roughness rows: `ROUGHNESS_MIN` to 1 in steps of 1/64.
 pub fn table_roughness() -> Vec<f64> {
     (2..=64).map(|i| f64::from(i) / 64.0).collect()
-}
-
-/// The Rust source of `table_height.rs` for `rows`: the height mapping's columns (made by
-/// [`fit_curve`] at [`table_roughness`]; the row count is `table.rs`'s).
-pub fn render_height_rust(rows: &[Node], level: u32) -> String {
-    use std::fmt::Write as _;
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "//! Generated by `cargo run --release --example fit_pbr -- src/pbr` from [`super::fit`]\n\
-         //! (box rule level {level}), beside `table.rs`: the height mapping's columns; do not edit.\n\n\
-         #![expect(\n    clippy::unreadable_literal,\n    reason = \"generated fit constants, printed in full\"\n)]\n\n\
-         use super::table::ROWS;\n"
-    );
-    let _ = writeln!(
-        out,
-        "/// Phong's and Blinn-Phong's `[n, height]` per row, fitted together (`k_s = F0 height`)."
-    );
-    let _ = writeln!(out, "#[rustfmt::skip]");
-    let _ = writeln!(out, "pub static HEIGHT_FIT: [[[f32; 2]; 2]; ROWS] = [");
-    for row in rows {
-        let [(n0, h0), (n1, h1)] = row.height_fit;
-        let _ = writeln!(
-            out,
-            "    [[{:?}, {:?}], [{:?}, {:?}]],",
-            n0 as f32, h0 as f32, n1 as f32, h1 as f32
-        );
-    }
-    let _ = writeln!(out, "];\n");
-    let _ = writeln!(
-        out,
-        "/// Their error numerator per row at `k_s = (k / {})^2` (the lobe at `height k_s`).",
-        KS_NODES - 1
-    );
-    let _ = writeln!(out, "#[rustfmt::skip]");
-    let _ = writeln!(
-        out,
-        "#[expect(dead_code, reason = \"the height mapping's conversion error comes next (issue 43)\")]"
-    );
-    let _ = writeln!(
-        out,
-        "pub static HEIGHT_ERROR: [[[f32; {KS_NODES}]; 2]; ROWS] = ["
-    );
-    for row in rows {
-        let _ = writeln!(out, "    [");
-        for e in &row.height_error {
-            let cells: Vec<String> = e.iter().map(|v| format!("{:?}", *v as f32)).collect();
-            let _ = writeln!(out, "        [{}],", cells.join(", "));
-        }
-        let _ = writeln!(out, "    ],");
-    }
-    let _ = writeln!(out, "];");
-    out
-}
-
-/// The Rust source of `table.rs` for `rows` (made by [`fit_curve`] at [`table_roughness`]).
-pub fn render_rust(rows: &[Node], level: u32) -> String {
-    use std::fmt::Write as _;
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "//! Generated by `cargo run --release --example fit_pbr -- src/pbr` from\n\
-         //! [`super::fit`] (box rule level {level}); do not edit.\n\n\
-         #![expect(\n    clippy::unreadable_literal,\n    reason = \"generated fit constants, printed in full\"\n)]\n"
-    );
-    let _ = writeln!(out, "/// Rows: roughness `(i + 2) / 64` for row `i`.");
-    let _ = writeln!(out, "pub const ROWS: usize = {};\n", rows.len());
-    let _ = writeln!(
-        out,
-        "/// The fitted exponent per row, for Phong, Blinn-Phong and Cook-Torrance."
-    );
-    let _ = writeln!(out, "#[rustfmt::skip]");
-    let _ = writeln!(out, "pub static FITTED_N: [[f32; 3]; ROWS] = [");
-    for row in rows {
-        let _ = writeln!(
-            out,
-            "    [{:?}, {:?}, {:?}],",
-            row.n[0] as f32, row.n[1] as f32, row.n[2] as f32
-        );
-    }
-    let _ = writeln!(out, "];\n");
-    let _ = writeln!(out, "/// GGX's `[avg rho_1, avg rho_0]` per row.");
-    let _ = writeln!(out, "#[rustfmt::skip]");
-    let _ = writeln!(out, "pub static GGX_MEANS: [[f32; 2]; ROWS] = [");
-    for row in rows {
-        let _ = writeln!(
-            out,
-            "    [{:?}, {:?}],",
-            row.means[0] as f32, row.means[1] as f32
-        );
-    }
-    let _ = writeln!(out, "];\n");
-    let _ = writeln!(
-        out,
-        "/// The error numerator per row and target at `k_s = (k / {})^2`.",
-        KS_NODES - 1
-    );
-    let _ = writeln!(out, "#[rustfmt::skip]");
-    let _ = writeln!(out, "pub static ERROR: [[[f32; {KS_NODES}]; 3]; ROWS] = [");
-    for row in rows {
-        let _ = writeln!(out, "    [");
-        for e in &row.error {
-            let cells: Vec<String> = e.iter().map(|v| format!("{:?}", *v as f32)).collect();
-            let _ = writeln!(out, "        [{}],", cells.join(", "));
-        }
-        let _ = writeln!(out, "    ],");
-    }
-    let _ = writeln!(out, "];");
-    out
 }

@@ -13,6 +13,7 @@ use glam::{Vec2, Vec3};
 use image::DynamicImage;
 use rayon::prelude::*;
 
+use super::NMapping;
 use super::convert::{Conversion, ErrorStats};
 use crate::model::ModelError;
 use crate::model::document::{Document, DocumentSettings};
@@ -165,7 +166,7 @@ impl PbrSet {
         }
     }
 
-    /// A texel's `k_d`, `k_s` and roughness from the three quantities' values.
+    /// A texel's `k_d`, `F0` and roughness from the three quantities' values.
     fn texel(&self, [a, b, c]: [Vec3; 3]) -> (Vec3, Vec3, f32) {
         let unit = |v: Vec3| v.map(crate::model::texel::unit);
         match self {
@@ -220,7 +221,8 @@ fn load(input: &Input) -> Result<Loaded, ModelError> {
     })
 }
 
-/// Imports `set` at `size` (or the largest input image's size) for `model`.
+/// Imports `set` at `size` (or the largest input image's size) for `model` under `mapping`
+/// (which the document keeps: its glTF export inverts the same one).
 ///
 /// # Errors
 /// An input that does not read (missing, corrupt, too large), or maps too large to make.
@@ -228,6 +230,7 @@ pub fn import(
     set: &PbrSet,
     size: Option<(u32, u32)>,
     model: ShadingModel,
+    mapping: NMapping,
 ) -> Result<Imported, ModelError> {
     let sources = set.sources();
     let loaded = sources
@@ -266,7 +269,7 @@ pub fn import(
         .zip(&sources)
         .map(|(l, s)| Sampler::new(l, s, width, height))
         .collect();
-    let conversion = Conversion::for_model(model);
+    let conversion = Conversion::for_model(model, mapping);
     let tiles_x = maps.tiles_x() as usize;
     let tiles_y = maps.tiles_y() as usize;
     let bands: Vec<(Vec<Tile>, ErrorStats)> = (0..tiles_y)
@@ -302,17 +305,14 @@ pub fn import(
     let report = ImportReport {
         source: names.join(", "),
         model: model.name().to_string(),
-        n_mapping: if model == ShadingModel::CookTorrance {
-            "cook-torrance".into()
-        } else {
-            "fitted".into()
-        },
+        n_mapping: mapping.report_name(model).into(),
         error: stats.summary(),
         notes,
     };
     let settings = DocumentSettings {
         model,
         import: Some(report.clone()),
+        n_mapping: Some(mapping),
         ..DocumentSettings::default()
     };
     Ok(Imported {
@@ -477,12 +477,13 @@ fn convert_band(
             for r in 0..rows {
                 for c in 0..cols {
                     let at = r * width + x0 + c;
-                    let (d, s, rough) = set.texel([values[0][at], values[1][at], values[2][at]]);
+                    let (d, f0, rough) = set.texel([values[0][at], values[1][at], values[2][at]]);
+                    let v = conversion.convert(d, f0, rough);
                     let i = r * TILE_SIZE + c;
-                    kd[i] = encode_rgb(d);
-                    ks[i] = encode_rgb(s);
-                    n[i] = encode_n(conversion.n(rough));
-                    stats.add(conversion.error_of(d, s, rough));
+                    kd[i] = encode_rgb(v.kd);
+                    ks[i] = encode_rgb(v.ks);
+                    n[i] = encode_n(v.n);
+                    stats.add(conversion.error_of(d, f0, rough));
                 }
             }
             fill_outside(kd, (cols, rows));

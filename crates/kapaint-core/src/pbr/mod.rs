@@ -30,8 +30,8 @@ pub mod round_trip;
 mod table;
 mod table_height;
 
+pub use crate::model::provenance::NMapping;
 use crate::model::texel::{MaterialValue, N_MAX};
-use crate::reflectance::ShadingModel;
 
 /// The dielectric `F0` of the metallic-roughness model.
 pub const DIELECTRIC_F0: f32 = 0.04;
@@ -94,6 +94,12 @@ pub fn to_material(p: Pbr) -> MaterialValue {
 /// base, less metal): the larger is taken, so a metal comes back a metal. Values no texel of
 /// the model has (no real root) take the `m` nearest to one, the vertex.
 pub fn metallic_of(kd: Vec3, ks: Vec3) -> f32 {
+    metallic_within(kd, ks, F0_TOLERANCE)
+}
+
+/// [`metallic_of`] with `tolerance` for how far from the dielectric `F0` a grey `F0` still
+/// reads as a dielectric.
+fn metallic_within(kd: Vec3, ks: Vec3, tolerance: f32) -> f32 {
     let f0 = DIELECTRIC_F0;
     let (d, s) = (
         kd.map(unit).element_sum() / 3.0,
@@ -102,14 +108,24 @@ pub fn metallic_of(kd: Vec3, ks: Vec3) -> f32 {
     let b = d + s - 2.0 * f0;
     let c = s - f0;
     let disc = b * b + 4.0 * f0 * c;
-    // Within storage precision of the dielectric F0 (unorm16 rounds 0.04 to 0.039994) is a
-    // dielectric: the dark-metal reading below is for values clearly under it.
-    let m = if c >= -F0_TOLERANCE {
-        // The positive root without cancellation: 2c / (b + sqrt(b^2 + 0.16 c)); 0 at c = 0.
-        if c <= 0.0 {
-            0.0
-        } else {
+    // F0 within storage precision of the dielectric 0.04 in every channel (unorm16 rounds 0.04
+    // to 0.039994; a height-fitted k_s divided by its height lands either side) is a
+    // dielectric: on a dark base a mean just above 0.04 would otherwise read as a metal (only
+    // a metal reaches it there), and the dark-metal reading below is for values clearly under
+    // it. A coloured F0 whose mean is near 0.04 is a metal's: the roots below say so.
+    let grey = ks
+        .map(unit)
+        .to_array()
+        .iter()
+        .all(|k| (k - f0).abs() <= tolerance);
+    let m = if c.abs() <= tolerance && grey {
+        0.0
+    } else if c > 0.0 {
+        // The one positive root, in the form without cancellation for the sign of b.
+        if b >= 0.0 {
             2.0 * c / (b + disc.sqrt())
+        } else {
+            (-b + disc.sqrt()) / (2.0 * f0)
         }
     } else if disc >= 0.0 {
         (-b + disc.sqrt()) / (2.0 * f0)
@@ -122,44 +138,26 @@ pub fn metallic_of(kd: Vec3, ks: Vec3) -> f32 {
 /// kapaint's material as a PBR texel: the inverse of [`to_material`] (exact where
 /// `to_material` made the values; elsewhere the nearest metallic-roughness reading).
 pub fn from_material(v: MaterialValue) -> Pbr {
-    let (kd, ks) = (v.kd.map(unit), v.ks.map(unit));
-    let m = metallic_of(kd, ks);
-    Pbr {
-        base: (kd + ks - Vec3::splat(DIELECTRIC_F0 * (1.0 - m))).map(unit),
-        metallic: m,
-        roughness: roughness_of_n(v.n),
-    }
+    pbr_of(v.kd, v.ks, roughness_of_n(v.n), F0_TOLERANCE)
 }
 
-/// The height mapping's exponent and lobe height for `roughness` (`k_s = F0 height`; issue
-/// 43, not yet what the conversion uses): linear in `ln(1 + n)` and in the height between the
-/// table's rows, the first row's below them; NaN is roughness 1. `None` for Cook-Torrance,
-/// which needs no fit.
-pub fn height_fit(model: ShadingModel, roughness: f32) -> Option<(f32, f32)> {
-    let k = match model {
-        ShadingModel::Phong => 0,
-        ShadingModel::BlinnPhong => 1,
-        ShadingModel::CookTorrance => return None,
-    };
-    let r = if roughness.is_nan() {
-        1.0
-    } else {
-        roughness.clamp(0.0, 1.0)
-    };
-    let x = (r * 64.0 - 2.0).max(0.0);
-    let row = (x as usize).min(table::ROWS - 2);
-    let t = (x - row as f32).min(1.0);
-    let (a, b) = (
-        table_height::HEIGHT_FIT[row][k],
-        table_height::HEIGHT_FIT[row + 1][k],
-    );
-    let n = (a[0].ln_1p() + (b[0].ln_1p() - a[0].ln_1p()) * t).exp_m1();
-    Some((n, a[1] + (b[1] - a[1]) * t))
+/// The PBR texel of `k_d`, `F0` and roughness: metallic by [`metallic_within`] (`tolerance`
+/// below the dielectric `F0` still a dielectric), then `base = k_d + F0 - 0.04 (1 - m)`.
+fn pbr_of(kd: Vec3, f0: Vec3, roughness: f32, tolerance: f32) -> Pbr {
+    let (kd, f0) = (kd.map(unit), f0.map(unit));
+    let m = metallic_within(kd, f0, tolerance);
+    Pbr {
+        base: (kd + f0 - Vec3::splat(DIELECTRIC_F0 * (1.0 - m))).map(unit),
+        metallic: m,
+        roughness,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use crate::reflectance::ShadingModel;
 
     #[test]
     fn the_height_fit_falls_strictly_over_the_whole_table() {
@@ -171,7 +169,10 @@ mod tests {
         {
             for i in 1..ROWS {
                 let (n, h) = (HEIGHT_FIT[i][k][0], HEIGHT_FIT[i][k][1]);
-                assert!(n < HEIGHT_FIT[i - 1][k][0], "{target:?}, row {i}: n {n}");
+                // Falling at least MIN_FALL a row: the stored exponent tells every 8-bit
+                // roughness apart.
+                let cap = HEIGHT_FIT[i - 1][k][0] * (1.0 - fit::MIN_FALL as f32);
+                assert!(n <= cap * (1.0 + 1e-6), "{target:?}, row {i}: n {n}");
                 assert!(h > 0.0 && h <= 1.0, "{target:?}, row {i}: height {h}");
             }
             // The issue's target: roughness 0.5, 0.75 and 1.0 each at least 1.25 times the next.
@@ -184,17 +185,21 @@ mod tests {
                 n(1.0)
             );
         }
-        // The lookup: the rows at their roughness, between them in between, none for
-        // Cook-Torrance.
-        let at = |r| height_fit(ShadingModel::Phong, r).unwrap_or((f32::NAN, f32::NAN));
-        assert_eq!(at(0.75), (HEIGHT_FIT[46][0][0], HEIGHT_FIT[46][0][1]));
-        let mid = at(0.75 + 0.5 / 64.0);
-        assert!(
-            mid.0 < at(0.75).0 && mid.0 > at(0.75 + 1.0 / 64.0).0,
-            "{mid:?}"
-        );
-        assert_eq!(at(f32::NAN), at(1.0));
-        assert_eq!(height_fit(ShadingModel::CookTorrance, 0.5), None);
+        // The conversion's lookup: the rows at their roughness, between them in between, and
+        // strictly falling over the whole dense table.
+        let c = convert::Conversion::for_model(ShadingModel::Phong, NMapping::HeightFitted);
+        assert!((c.n(0.75) / HEIGHT_FIT[46][0][0] - 1.0).abs() < 1e-5);
+        assert!((c.height(0.75) - HEIGHT_FIT[46][0][1]).abs() < 1e-6);
+        let mid = c.n(0.75 + 0.5 / 64.0);
+        assert!(mid < c.n(0.75) && mid > c.n(0.75 + 1.0 / 64.0), "{mid}");
+        assert_eq!(c.n(f32::NAN), c.n(0.0));
+        for target in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+            let c = convert::Conversion::for_model(target, NMapping::HeightFitted);
+            for i in 1..=4096 {
+                let (a, b) = (c.n((i - 1) as f32 / 4096.0), c.n(i as f32 / 4096.0));
+                assert!(b < a, "{target:?} at {i}: {a} then {b}");
+            }
+        }
     }
 
     #[test]

@@ -2,24 +2,24 @@
 //! error: what the `gltf-pbr` export writes (`crate::pbr` converts, the export crate writes) and
 //! what the canvas's PBR error view shows.
 //!
-//! Per texel: metallic and base colour by [`super::from_material`], roughness by the inverse
-//! of the project model's roughness-to-`n` mapping ([`Conversion::roughness`]), all stored in
-//! 8 bits (base colour sRGB-encoded).
+//! Per texel: the inverse of the project's conversion ([`Conversion::pbr`]: roughness from
+//! `n`, `F0 = k_s / height`, metallic and base colour from `k_d` and `F0`), all stored in 8
+//! bits (base colour sRGB-encoded).
 //!
 //! The round-trip error is the import's measure ([`Conversion::error`]) taken against the
 //! project's own values: per channel, the box average of the difference between the
 //! Cook-Torrance shading of the exported (8-bit) PBR values and the project model's shading
 //! of the texel's `k_d`, `k_s`, `n`, over the Cook-Torrance mean. It is the import's error of
 //! the exported values plus what the texel drifted on the way (`k_d`, `k_s` and `n` against
-//! what the exported values convert back to), added by the triangle inequality: exact where
-//! the texel survives the round trip, an upper bound elsewhere.
+//! what the exported values convert back to by the same mapping), added by the triangle
+//! inequality: exact where the texel survives the round trip, an upper bound elsewhere.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::DIELECTRIC_F0;
 use super::convert::{Conversion, ErrorStats};
-use super::from_material;
-use crate::model::provenance::ErrorSummary;
+use crate::model::provenance::{ErrorSummary, NMapping};
 use crate::model::texel::{Texel, decode_n, linear_to_srgb8, srgb_to_linear};
 use crate::reflectance::{AmbientApprox, ShadingModel, chi_parts_f32};
 
@@ -33,12 +33,14 @@ pub struct Converted {
     pub error: ErrorSummary,
 }
 
-/// One model's round trip, texel by texel: the tables that turn a stored texel into its
-/// 8-bit PBR values and their round-trip error (built once per process and model).
+/// One model's round trip under one mapping, texel by texel: the tables that turn a stored
+/// texel into its 8-bit PBR values and their round-trip error (built once per process, model
+/// and mapping).
 pub struct RoundTrip {
     conversion: &'static Conversion,
-    /// Per stored `n` code: its roughness byte and the model's `[chi_1, chi_0]`.
-    n_table: Vec<(u8, [f32; 2])>,
+    /// Per stored `n` code: its roughness, that roughness' byte and the model's
+    /// `[chi_1, chi_0]`.
+    n_table: Vec<(f32, u8, [f32; 2])>,
     /// A stored sRGB byte in linear light.
     srgb: [f32; 256],
     /// Per roughness byte, the `[chi_1, chi_0]` of the exponent it reads back as.
@@ -46,9 +48,12 @@ pub struct RoundTrip {
 }
 
 impl RoundTrip {
-    /// The tables for `model` (built on first use, about 10 ms).
-    pub fn for_model(model: ShadingModel) -> &'static Self {
-        static TABLES: [std::sync::OnceLock<RoundTrip>; 3] = [
+    /// The tables for `model` under `mapping` (built on first use, about 10 ms).
+    pub fn for_model(model: ShadingModel, mapping: NMapping) -> &'static Self {
+        static TABLES: [std::sync::OnceLock<RoundTrip>; 6] = [
+            std::sync::OnceLock::new(),
+            std::sync::OnceLock::new(),
+            std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
@@ -57,12 +62,12 @@ impl RoundTrip {
             ShadingModel::Phong => 0,
             ShadingModel::BlinnPhong => 1,
             ShadingModel::CookTorrance => 2,
-        };
-        TABLES[k].get_or_init(|| Self::build(model))
+        } + 3 * usize::from(mapping == NMapping::HeightFixed);
+        TABLES[k].get_or_init(|| Self::build(model, mapping))
     }
 
-    fn build(model: ShadingModel) -> Self {
-        let conversion = Conversion::for_model(model);
+    fn build(model: ShadingModel, mapping: NMapping) -> Self {
+        let conversion = Conversion::for_model(model, mapping);
         let approx = AmbientApprox::Fast;
         Self {
             conversion,
@@ -70,8 +75,8 @@ impl RoundTrip {
                 .into_par_iter()
                 .map(|bits| {
                     let n = decode_n(bits);
-                    let r = (conversion.roughness(n) * 255.0 + 0.5) as u8;
-                    (r, chi_parts_f32(model, approx, n))
+                    let r = conversion.roughness(n);
+                    (r, (r * 255.0 + 0.5) as u8, chi_parts_f32(model, approx, n))
                 })
                 .collect(),
             srgb: std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0)),
@@ -85,21 +90,21 @@ impl RoundTrip {
     /// metallic) and round-trip error (see the module docs).
     pub fn texel(&self, t: &Texel) -> ([u8; 3], [u8; 3], f32) {
         let v = t.decode();
-        let p = from_material(v);
+        let (rough, r, chi) = self.n_table[usize::from(t.n)];
+        let p = self.conversion.pbr_at(v.kd, v.ks, rough);
         let base = p.base.to_array().map(linear_to_srgb8);
-        let (r, chi) = self.n_table[usize::from(t.n)];
         let mr = [255, r, (p.metallic * 255.0 + 0.5) as u8];
-        // The texel as a consumer reads the files, in the model's terms.
+        // The texel as a consumer reads the files, and as this mapping converts that back.
         let (back_base, m) = (
             Vec3::from_array(base.map(|c| self.srgb[usize::from(c)])),
             f32::from(mr[2]) / 255.0,
         );
         let back_kd = back_base * (1.0 - m);
-        let back_ks = Vec3::splat(super::DIELECTRIC_F0).lerp(back_base, m);
+        let back_f0 = Vec3::splat(DIELECTRIC_F0).lerp(back_base, m);
+        let rough_back = f32::from(r) / 255.0;
+        let back_ks = self.conversion.convert(back_kd, back_f0, rough_back).ks;
         let chi_back = self.chi_of_byte[usize::from(r)];
-        let parts = self
-            .conversion
-            .error_parts(back_kd, back_ks, f32::from(r) / 255.0);
+        let parts = self.conversion.error_parts(back_kd, back_f0, rough_back);
         let mut worst = 0.0_f32;
         for (c, [numerator, mean]) in parts.into_iter().enumerate() {
             let drift = std::f32::consts::FRAC_2_PI * (v.kd[c] - back_kd[c]).abs()
@@ -123,10 +128,10 @@ impl RoundTrip {
 /// One chunk's base colours, metallic-roughness texels and error statistics.
 type Chunk = (Vec<[u8; 3]>, Vec<[u8; 3]>, ErrorStats);
 
-/// Converts texels (row-major) read in `model`'s terms to 8-bit PBR values, with the
-/// round-trip error (see the module docs).
-pub fn convert(texels: &[Texel], model: ShadingModel) -> Converted {
-    let round_trip = RoundTrip::for_model(model);
+/// Converts texels (row-major) read in `model`'s terms under `mapping` to 8-bit PBR values,
+/// with the round-trip error (see the module docs).
+pub fn convert(texels: &[Texel], model: ShadingModel, mapping: NMapping) -> Converted {
+    let round_trip = RoundTrip::for_model(model, mapping);
     let texel = |t: &Texel| round_trip.texel(t);
     let chunks: Vec<Chunk> = texels
         .par_chunks(1 << 16)
@@ -168,30 +173,33 @@ mod tests {
 
     #[test]
     fn the_round_trip_error_is_the_imports_where_the_texel_survives_and_more_where_not() {
-        for model in crate::pbr::fit::TARGETS {
-            let c = Conversion::for_model(model);
+        for (model, mapping) in crate::pbr::fit::TARGETS
+            .into_iter()
+            .flat_map(|m| NMapping::ALL.map(|n| (m, n)))
+        {
+            let c = Conversion::for_model(model, mapping);
             let p = Pbr {
                 base: Vec3::new(0.6, 0.3, 0.1),
                 metallic: 0.0,
                 roughness: 0.3,
             };
             let made = Texel::encode(c.material(p));
-            let out = convert(&[made], model);
+            let out = convert(&[made], model, mapping);
             let import = c.error(p);
             // The 8-bit roughness moves the exponent a little (0.5 % for Cook-Torrance here).
             assert!(
                 (out.error.max - import).abs() <= 0.01 + 0.02 * import,
-                "{model:?}: {} vs the import's {import}",
+                "{model:?} {mapping:?}: {} vs the import's {import}",
                 out.error.max
             );
             // An exponent no roughness gives (a mirror for Phong's flat end, or far off the
             // curve) drifts, and the drift is counted.
             let off = Texel::encode(MaterialValue::new(p.base, Vec3::splat(0.04), 0.5));
-            let drifted = convert(&[off], model);
+            let drifted = convert(&[off], model, mapping);
             let honest = c.error_of(p.base, Vec3::splat(0.04), c.roughness(0.5));
             assert!(
                 drifted.error.max > honest,
-                "{model:?}: {} vs {honest}",
+                "{model:?} {mapping:?}: {} vs {honest}",
                 drifted.error.max
             );
         }

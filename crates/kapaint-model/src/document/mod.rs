@@ -67,6 +67,25 @@ pub struct DocumentSettings {
     /// The PBR import the maps were made by, with its measured conversion error.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub import: Option<super::provenance::ImportReport>,
+    /// The PBR mapping imports and the glTF export use, where one was chosen (see
+    /// [`Self::n_mapping`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub n_mapping: Option<super::provenance::NMapping>,
+}
+
+impl DocumentSettings {
+    /// The PBR mapping the document's maps are in: the one chosen, else the one its import
+    /// recorded (a project imported before the height fit records the height-fixed one), else
+    /// the default.
+    pub fn n_mapping(&self) -> super::provenance::NMapping {
+        self.n_mapping
+            .or_else(|| {
+                self.import
+                    .as_ref()
+                    .and_then(|r| super::provenance::NMapping::from_name(&r.n_mapping))
+            })
+            .unwrap_or_default()
+    }
 }
 
 impl Default for DocumentSettings {
@@ -87,6 +106,7 @@ impl Default for DocumentSettings {
             mesh: MeshRef::Sphere,
             preset: None,
             import: None,
+            n_mapping: None,
         }
     }
 }
