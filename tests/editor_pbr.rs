@@ -196,9 +196,17 @@ fn a_texture_set_imports_from_any_one_of_its_images() {
         "{}",
         report.source
     );
-    // A dielectric everywhere: k_s is the dielectric F0.
+    // A dielectric everywhere: k_s is the dielectric F0 at the roughness' lobe height (the
+    // document's mapping, height-fitted), and the export reads F0 back.
     let v = doc.maps().value(3, 3);
-    assert!((v.ks.x - 0.04).abs() < 1e-3, "{v:?}");
+    let c = kapaint::pbr::convert::Conversion::for_model(
+        doc.settings().model,
+        doc.settings().n_mapping(),
+    );
+    let height = c.height(200.0 / 255.0);
+    assert!(height < 0.5, "a rough texel's lobe is lowered: {height}");
+    assert!((v.ks.x - 0.04 * height).abs() < 1e-3, "{v:?}");
+    assert!(c.pbr(v).metallic < 1e-3, "{:?}", c.pbr(v));
     let _ = std::fs::remove_dir_all(&d);
 }
 
