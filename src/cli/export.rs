@@ -9,6 +9,9 @@ use crate::model::project;
 /// The `--report` lines of one exported set.
 fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
     let _ = writeln!(text, "  preset: {}", m.preset);
+    if let Some(e) = m.ka_error_srgb {
+        let _ = writeln!(text, "  {}", e.describe());
+    }
     if m.dilated {
         let _ = writeln!(
             text,
@@ -79,9 +82,11 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
         for t in &b.trials {
             let _ = writeln!(
                 text,
-                "    trial {:?} {:?}: k_a max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
+                "    trial {:?} {:?}: k_a p99.9 {:.2} mean {:.3} levels, relative max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
                 t.layout,
                 t.bc7_effort,
+                t.ka_error_srgb.map_or(f64::NAN, |e| e.p999),
+                t.ka_error_srgb.map_or(f64::NAN, |e| e.mean),
                 t.ka_error.max,
                 t.ka_error.mean,
                 t.min_psnr
@@ -97,6 +102,18 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
             .map(|e| format!("{:.2e}", e.max))
             .collect();
         let _ = writeln!(text, "  k_a error max per mip level: {}", levels.join(" "));
+    }
+    if !m.level_ka_error_srgb.is_empty() {
+        let levels: Vec<String> = m
+            .level_ka_error_srgb
+            .iter()
+            .map(|e| format!("{:.2}", e.p999))
+            .collect();
+        let _ = writeln!(
+            text,
+            "  k_a error p99.9 per mip level, levels of 8-bit sRGB: {}",
+            levels.join(" ")
+        );
     }
     let b = m.bytes;
     let _ = writeln!(

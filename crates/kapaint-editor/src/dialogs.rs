@@ -163,7 +163,6 @@ fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
     if preset.format != kapaint_export::preset::Format::Ktx2Bc {
         return;
     }
-    let b = &preset.budget;
     let then = if preset.bc6h {
         "n apart with colour as BC6H"
     } else {
@@ -171,11 +170,9 @@ fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
     };
     ui.label(format!(
         "Blocks: the layout and effort are chosen at export by the measured k_a error \
-         (budget max {:.2} %, mean {:.2} %, PSNR {:.0} dB or more): this layout first, then \
-         {then}, then more effort up to {:?}. The notice and material.json say what was kept.",
-        b.max_ka_error * 100.0,
-        b.mean_ka_error * 100.0,
-        b.min_psnr,
+         (budget: {}): this layout first, then {then}, then more effort up to {:?}. The \
+         notice and material.json say what was kept.",
+        preset.budget.describe(),
         preset.max_bc7_effort
     ));
 }

@@ -441,6 +441,10 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
                 m.ka_error.max * 100.0,
                 m.ka_error.mean * 100.0
             );
+            if let Some(e) = m.ka_error_srgb {
+                text.push_str("; ");
+                text.push_str(&e.describe());
+            }
             if let Some(blocks) = &m.blocks {
                 text.push_str("; blocks: ");
                 text.push_str(&blocks.summary());
@@ -491,7 +495,14 @@ mod tests {
         // numbers it missed, never a green notice.
         assert!(!blocks.within_budget, "{text}");
         assert_eq!(n.level, crate::NoticeLevel::Warning, "{text}");
-        assert!(text.contains("over the k_a budget (max"), "{text}");
+        assert!(
+            text.contains("over the k_a budget (k_a within 2 levels of the displayed colour for 99.9 % of texels"),
+            "{text}"
+        );
+        assert!(
+            text.contains("levels of the displayed colour for 99.9 % of texels (mean"),
+            "{text}"
+        );
         assert!(text.contains("; blocks: "), "{text}");
         assert!(
             text.contains(&format!("at {:?}", blocks.bc7_effort)),

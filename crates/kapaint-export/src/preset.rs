@@ -75,27 +75,70 @@ impl Bc7Quality {
     ];
 }
 
-/// What a block-compressed set may lose. The export encodes with the cheapest layout and
-/// effort first and spends more only while one of these is not met (`k_a` errors relative,
-/// per texel and colour channel; PSNR per component, in dB, of level 0 against the
-/// uncompressed 8-bit values).
+/// What a block-compressed set may lose, in what the eye sees: the `k_a` error in levels of
+/// 8-bit sRGB of the ambient-lit colour ([`crate::set::perceptual`]), its 99.9th percentile and
+/// mean over texels. The export encodes with the cheapest layout and effort first and spends
+/// more only while one of these is not met. A user preset may add the older limits (`k_a`
+/// errors relative, per texel and colour channel; PSNR per component, in dB, of level 0
+/// against the uncompressed 8-bit values); the built-in ones do not.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BlockBudget {
-    /// Largest `k_a` error allowed.
-    pub max_ka_error: f64,
-    /// Mean `k_a` error allowed.
-    pub mean_ka_error: f64,
-    /// Smallest PSNR allowed of any component.
-    pub min_psnr: f64,
+    /// The 99.9th percentile of the sRGB-level error allowed.
+    #[serde(default = "default_srgb_p999")]
+    pub ka_error_srgb_p999: f64,
+    /// The mean sRGB-level error allowed.
+    #[serde(default = "default_srgb_mean")]
+    pub ka_error_srgb_mean: f64,
+    /// Largest relative `k_a` error allowed, where the preset sets one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_ka_error: Option<f64>,
+    /// Mean relative `k_a` error allowed, where the preset sets one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mean_ka_error: Option<f64>,
+    /// Smallest PSNR allowed of any component, where the preset sets one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_psnr: Option<f64>,
+}
+
+fn default_srgb_p999() -> f64 {
+    2.0
+}
+
+fn default_srgb_mean() -> f64 {
+    0.3
 }
 
 impl Default for BlockBudget {
     fn default() -> Self {
         Self {
-            max_ka_error: 0.02,
-            mean_ka_error: 0.002,
-            min_psnr: 45.0,
+            ka_error_srgb_p999: default_srgb_p999(),
+            ka_error_srgb_mean: default_srgb_mean(),
+            max_ka_error: None,
+            mean_ka_error: None,
+            min_psnr: None,
         }
+    }
+}
+
+impl BlockBudget {
+    /// The budget in words: "k_a within 2 levels of the displayed colour for 99.9 % of texels,
+    /// mean 0.3 levels" (and the optional limits where set).
+    pub fn describe(&self) -> String {
+        let mut text = format!(
+            "k_a within {} levels of the displayed colour for 99.9 % of texels, mean {} levels",
+            self.ka_error_srgb_p999, self.ka_error_srgb_mean
+        );
+        use std::fmt::Write as _;
+        if let Some(m) = self.max_ka_error {
+            let _ = write!(text, ", relative max {:.2} %", m * 100.0);
+        }
+        if let Some(m) = self.mean_ka_error {
+            let _ = write!(text, ", relative mean {:.2} %", m * 100.0);
+        }
+        if let Some(p) = self.min_psnr {
+            let _ = write!(text, ", PSNR {p:.0} dB or more");
+        }
+        text
     }
 }
 
@@ -153,30 +196,28 @@ struct ExportPresetFile {
     /// Older presets name the ceiling `bc7_quality`.
     #[serde(default, alias = "bc7_quality")]
     max_bc7_effort: Bc7Quality,
-    #[serde(default = "default_max_ka_error")]
-    max_ka_error: f64,
-    #[serde(default = "default_mean_ka_error")]
-    mean_ka_error: f64,
-    #[serde(default = "default_min_psnr")]
-    min_psnr: f64,
+    #[serde(default = "default_srgb_p999")]
+    ka_error_srgb_p999: f64,
+    #[serde(default = "default_srgb_mean")]
+    ka_error_srgb_mean: f64,
+    #[serde(default, deserialize_with = "some_number")]
+    max_ka_error: Option<f64>,
+    #[serde(default, deserialize_with = "some_number")]
+    mean_ka_error: Option<f64>,
+    #[serde(default, deserialize_with = "some_number")]
+    min_psnr: Option<f64>,
     #[serde(default = "default_bc6h")]
     bc6h: bool,
 }
 
+/// An optional limit as a preset spells it: a bare number (as before the limits became
+/// optional), present means set.
+fn some_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+    f64::deserialize(d).map(Some)
+}
+
 fn default_bc6h() -> bool {
     true
-}
-
-fn default_max_ka_error() -> f64 {
-    BlockBudget::default().max_ka_error
-}
-
-fn default_mean_ka_error() -> f64 {
-    BlockBudget::default().mean_ka_error
-}
-
-fn default_min_psnr() -> f64 {
-    BlockBudget::default().min_psnr
 }
 
 impl TryFrom<ExportPresetFile> for ExportPreset {
@@ -202,15 +243,28 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
         }
         let budget = BlockBudget {
+            ka_error_srgb_p999: f.ka_error_srgb_p999,
+            ka_error_srgb_mean: f.ka_error_srgb_mean,
             max_ka_error: f.max_ka_error,
             mean_ka_error: f.mean_ka_error,
             min_psnr: f.min_psnr,
         };
         for (field, value, range) in [
+            (
+                "ka_error_srgb_p999",
+                Some(budget.ka_error_srgb_p999),
+                0.0..=255.0,
+            ),
+            (
+                "ka_error_srgb_mean",
+                Some(budget.ka_error_srgb_mean),
+                0.0..=255.0,
+            ),
             ("max_ka_error", budget.max_ka_error, 0.0..=100.0),
             ("mean_ka_error", budget.mean_ka_error, 0.0..=100.0),
             ("min_psnr", budget.min_psnr, 0.0..=200.0),
         ] {
+            let Some(value) = value else { continue };
             if !range.contains(&value) {
                 return Err(format!(
                     "{field} must be in {}..={}, got {value}",

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::perceptual::SrgbError;
 use crate::blocks::Encoder;
 use crate::encoding::KaError;
 use crate::preset::{Bc7Quality, BlockBudget};
@@ -34,8 +35,12 @@ pub struct Trial {
     pub layout: BlockLayout,
     /// BC7's (and BC6H's) effort.
     pub bc7_effort: Bc7Quality,
-    /// The set's `k_a` error, level 0 as a consumer decodes it.
+    /// The set's `k_a` error, level 0 as a consumer decodes it (relative).
     pub ka_error: KaError,
+    /// The same in levels of 8-bit sRGB of the ambient-lit colour (absent in sets written
+    /// before the perceptual budget).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ka_error_srgb: Option<SrgbError>,
     /// The smallest PSNR of any compressed component (dB; `None` where all are exact).
     pub min_psnr: Option<f64>,
     /// Seconds spent encoding and measuring.
@@ -45,8 +50,14 @@ pub struct Trial {
 impl Trial {
     /// The trial and its measures, for the manifest's reason.
     pub(super) fn describe(&self) -> String {
+        let srgb = self.ka_error_srgb.map_or_else(String::new, |e| {
+            format!(
+                "k_a within {:.2} levels for 99.9 % of texels (mean {:.3}, max {:.2}), ",
+                e.p999, e.mean, e.max
+            )
+        });
         format!(
-            "{:?} at {:?}: k_a max {}, mean {}, PSNR {}",
+            "{:?} at {:?}: {srgb}relative max {}, mean {}, PSNR {}",
             self.layout,
             self.bc7_effort,
             pct(self.ka_error.max),
@@ -54,6 +65,11 @@ impl Trial {
             self.min_psnr
                 .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
         )
+    }
+
+    /// The trial's sRGB-level error (zero for a trial recorded before it was measured).
+    pub(super) fn srgb(&self) -> SrgbError {
+        self.ka_error_srgb.unwrap_or_default()
     }
 }
 
@@ -100,12 +116,11 @@ impl BlockChoice {
             format!("{encoder} encoder")
         };
         let verdict = if self.within_budget {
-            "within the k_a budget".to_owned()
+            format!("within the k_a budget ({})", self.budget.describe())
         } else {
             format!(
-                "over the k_a budget (max {}, mean {}): kept the nearest of {} trials",
-                pct(self.budget.max_ka_error),
-                pct(self.budget.mean_ka_error),
+                "over the k_a budget ({}): kept the nearest of {} trials",
+                self.budget.describe(),
                 self.trials.len()
             )
         };

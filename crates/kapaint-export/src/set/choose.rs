@@ -1,8 +1,9 @@
 //! Block-compressed sets: the layout and BC7 effort, chosen by measurement.
 //!
 //! The export encodes level 0 with the cheapest profile first (the packed layout, `n` in
-//! `k_d`'s BC7 alpha, at BC7's lowest effort), measures the set's `k_a` error and PSNR as a
-//! consumer decodes them, and spends more only while the preset's budget is not met:
+//! `k_d`'s BC7 alpha, at BC7's lowest effort), measures the set's `k_a` error as a consumer
+//! decodes it (in levels of 8-bit sRGB of the ambient-lit colour, and relative) and PSNR, and
+//! spends more only while the preset's budget is not met:
 //! - where the packed layout fails, `n` moves out of the colour blocks (its own BC4 plane,
 //!   or beside a grey `k_s` in a BC5 image) at the same effort: `n`'s endpoints no longer
 //!   shared with `k_d`'s, both come out better;
@@ -25,6 +26,7 @@ use super::choice::{BlockChoice, BlockLayout, Trial};
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
+use super::perceptual::SrgbError;
 use crate::blocks::{BlockEncoder, BlockKind, Coder, Encoder};
 use crate::encoding::{KaError, NEncoding};
 use crate::ktx::{self, Compressed};
@@ -143,7 +145,7 @@ fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, half: bool, job:
 }
 
 impl Job<'_> {
-    fn measure(&self, stored: &[StoredImage<'_>]) -> KaError {
+    fn measure(&self, stored: &[StoredImage<'_>]) -> (KaError, SrgbError) {
         ka_error_of_set(
             self.texels,
             self.shape,
@@ -155,8 +157,9 @@ impl Job<'_> {
     }
 }
 
-fn within(budget: &BlockBudget, ka: KaError) -> bool {
-    ka.max <= budget.max_ka_error && ka.mean <= budget.mean_ka_error
+/// Whether a trial meets the budget: its sRGB-level error, and the optional limits.
+fn within(budget: &BlockBudget, t: &Trial) -> bool {
+    shortfall(t, budget).0 == 0
 }
 
 /// How much better one trial must be than another to count as better (relative).
@@ -166,16 +169,38 @@ fn tried(trials: &[Trial], layout: BlockLayout) -> bool {
     trials.iter().any(|t| t.layout == layout)
 }
 
-/// How far a trial falls short of the budget: how many of its three measures fail, and the
-/// worst measure over its limit (each as a ratio: the `k_a` errors to theirs, PSNR as the
-/// ratio of squared errors).
-fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
-    let ratios = [
-        t.ka_error.max / budget.max_ka_error,
-        t.ka_error.mean / budget.mean_ka_error,
-        t.min_psnr
-            .map_or(0.0, |p| 10_f64.powf((budget.min_psnr - p) / 10.0)),
+/// Each of the budget's measures of a trial as a ratio to its limit (above 1 fails): the
+/// sRGB-level p99.9 and mean, then the optional relative errors, and PSNR as the ratio of
+/// squared errors.
+fn ratios(t: &Trial, budget: &BlockBudget) -> Vec<f64> {
+    let srgb = t.srgb();
+    let ratio = |v: f64, limit: f64| {
+        if limit > 0.0 {
+            v / limit
+        } else if v > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        }
+    };
+    let mut out = vec![
+        ratio(srgb.p999, budget.ka_error_srgb_p999),
+        ratio(srgb.mean, budget.ka_error_srgb_mean),
     ];
+    out.extend(budget.max_ka_error.map(|m| ratio(t.ka_error.max, m)));
+    out.extend(budget.mean_ka_error.map(|m| ratio(t.ka_error.mean, m)));
+    out.extend(
+        budget
+            .min_psnr
+            .map(|m| t.min_psnr.map_or(0.0, |p| 10_f64.powf((m - p) / 10.0))),
+    );
+    out
+}
+
+/// How far a trial falls short of the budget: how many of its measures fail, and the worst
+/// measure over its limit (see [`ratios`]).
+fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
+    let ratios = ratios(t, budget);
     let failing = ratios.iter().filter(|r| **r > 1.0).count();
     (failing, ratios.into_iter().fold(0.0, f64::max))
 }
@@ -195,9 +220,9 @@ fn nearer(a: &Trial, b: &Trial, budget: &BlockBudget) -> bool {
 }
 
 /// Whether more effort in `layout` may still meet the budget: the first step is always
-/// taken; after that, each failing measure, improving at the rate the last step improved it
-/// (a factor for the `k_a` errors, dB for PSNR), must reach its budget within the `left`
-/// steps there are. A step that bought nothing ends the search.
+/// taken; after that, each failing measure (its ratio to the limit, [`ratios`]), improving by
+/// the factor the last step improved it, must reach its limit within the `left` steps there
+/// are. A step that bought nothing ends the search.
 fn reachable(trials: &[Trial], layout: BlockLayout, budget: &BlockBudget, left: usize) -> bool {
     let mut same = trials.iter().rev().filter(|t| t.layout == layout);
     let Some(now) = same.next() else {
@@ -207,22 +232,12 @@ fn reachable(trials: &[Trial], layout: BlockLayout, budget: &BlockBudget, left: 
         return true;
     };
     let steps = i32::try_from(left).unwrap_or(i32::MAX);
-    let error_ok = |now: f64, before: f64, limit: f64| {
-        now <= limit || (before > 0.0 && now < before && now * (now / before).powi(steps) <= limit)
-    };
-    let psnr_ok = match (now.min_psnr, before.min_psnr) {
-        (None, _) => true,
-        (Some(p), _) if p >= budget.min_psnr => true,
-        (Some(p), Some(q)) => p > q && p + (p - q) * f64::from(steps) >= budget.min_psnr,
-        (Some(_), None) => false,
-    };
-    error_ok(now.ka_error.max, before.ka_error.max, budget.max_ka_error)
-        && error_ok(
-            now.ka_error.mean,
-            before.ka_error.mean,
-            budget.mean_ka_error,
-        )
-        && psnr_ok
+    ratios(now, budget)
+        .into_iter()
+        .zip(ratios(before, budget))
+        .all(|(now, before)| {
+            now <= 1.0 || (before > 0.0 && now < before && now * (now / before).powi(steps) <= 1.0)
+        })
 }
 
 /// Encodes a block-compressed set: trials on level 0 from the cheapest profile up (see the
@@ -249,8 +264,7 @@ pub(super) fn encode_blocks(
     }
     let encoded = with_mips(images, encoder, pick.bc7_effort, job.size, progress)?;
     let budget = job.preset.budget;
-    let within_budget =
-        within(&budget, pick.ka_error) && pick.min_psnr.is_none_or(|p| p >= budget.min_psnr);
+    let within_budget = within(&budget, &pick);
     // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
     let gpu_failed = encoder.failure();
     Ok((
@@ -341,8 +355,7 @@ impl<'j, 'a> Search<'j, 'a> {
             prepare(images, self.images_of(layout), layout.half(), self.job);
             let trial = run_trial(images, encoder, layout, effort, self.job, progress)?;
             let here = trial.describe();
-            let met = within(&budget, trial.ka_error)
-                && trial.min_psnr.is_none_or(|p| p >= budget.min_psnr);
+            let met = within(&budget, &trial);
             trials.push(trial);
             if met {
                 return Ok(Found {
@@ -455,7 +468,7 @@ fn run_trial(
         return Err("cancelled".into());
     }
     let stored: Vec<StoredImage> = images.iter().map(TrialImage::stored).collect();
-    let ka_error = job.measure(&stored);
+    let (ka_error, ka_error_srgb) = job.measure(&stored);
     let min_psnr = images
         .iter_mut()
         .filter_map(|i| {
@@ -471,6 +484,7 @@ fn run_trial(
         layout,
         bc7_effort: effort,
         ka_error,
+        ka_error_srgb: Some(ka_error_srgb),
         min_psnr,
         seconds: started.elapsed().as_secs_f64(),
     })

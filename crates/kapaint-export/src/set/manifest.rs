@@ -5,6 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::perceptual::SrgbError;
 use crate::encoding::{KaError, NEncoding};
 use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
 
@@ -260,6 +261,10 @@ pub struct Manifest {
     pub files: Vec<FileEntry>,
     /// Relative `k_a` error of the set (decoded as a consumer would) against the project.
     pub ka_error: KaError,
+    /// The same in levels of 8-bit sRGB of the ambient-lit colour (`k_a` under unit ambient,
+    /// sRGB-encoded; [`super::perceptual`]). Absent in sets written before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ka_error_srgb: Option<SrgbError>,
     /// Texels outside the mesh's UV islands were filled from the nearest island.
     #[serde(default)]
     pub dilated: bool,
@@ -275,6 +280,10 @@ pub struct Manifest {
     /// each further level against the mean of the exact level 0's `k_a` over its footprint).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub level_ka_error: Vec<KaError>,
+    /// KTX2 sets: the sRGB-level error of every mip level, finest first (level 0 is
+    /// `ka_error_srgb`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub level_ka_error_srgb: Vec<SrgbError>,
     /// Block-compressed sets: how the layout and BC7 effort were chosen.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blocks: Option<Box<super::choice::BlockChoice>>,
@@ -306,6 +315,8 @@ struct ManifestFile {
     files: Vec<FileEntry>,
     ka_error: KaError,
     #[serde(default)]
+    ka_error_srgb: Option<SrgbError>,
+    #[serde(default)]
     dilated: bool,
     bytes: MemoryReport,
     preset: String,
@@ -313,6 +324,8 @@ struct ManifestFile {
     layers: u32,
     #[serde(default)]
     level_ka_error: Vec<KaError>,
+    #[serde(default)]
+    level_ka_error_srgb: Vec<SrgbError>,
     #[serde(default)]
     blocks: Option<Box<super::choice::BlockChoice>>,
     #[serde(default)]
@@ -368,11 +381,13 @@ impl TryFrom<ManifestFile> for Manifest {
             n_encoding: f.n_encoding,
             files: f.files,
             ka_error: f.ka_error,
+            ka_error_srgb: f.ka_error_srgb,
             dilated: f.dilated,
             bytes: f.bytes,
             preset: f.preset,
             layers: f.layers,
             level_ka_error: f.level_ka_error,
+            level_ka_error_srgb: f.level_ka_error_srgb,
             blocks: f.blocks,
             normal: f.normal,
         })

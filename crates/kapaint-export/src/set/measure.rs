@@ -4,6 +4,7 @@ use rayon::prelude::*;
 
 use super::encode::StoredImage;
 use super::manifest::{Comp, Constants};
+use super::perceptual::{SrgbError, SrgbLevels, SrgbStats};
 use crate::encoding::KaError;
 use crate::encoding::NEncoding;
 use crate::preset::Format;
@@ -127,9 +128,10 @@ pub(super) struct Shape<'a> {
     pub n_encoding: Option<NEncoding>,
 }
 
-/// Relative `k_a` error of the set described by `manifest` against the texels it was made
-/// from, per texel and colour channel: every value goes through what a consumer reads (the
-/// bytes an 8-bit file holds after compression, or 16-bit and float codes by table) and back.
+/// The `k_a` error of the set described by `manifest` against the texels it was made from,
+/// relative per texel and colour channel and in sRGB levels per texel
+/// ([`super::perceptual`]): every value goes through what a consumer reads (the bytes an 8-bit
+/// file holds after compression, or 16-bit and float codes by table) and back.
 pub(super) fn ka_error_of_set(
     texels: &[Texel],
     manifest: Shape<'_>,
@@ -137,7 +139,7 @@ pub(super) fn ka_error_of_set(
     format: Format,
     model: ShadingModel,
     approx: AmbientApprox,
-) -> KaError {
+) -> (KaError, SrgbError) {
     let lut = kapaint_core::model::maps::chi_lut(model, approx);
     let tables = SetTables::new(lut, manifest.n_encoding, model, approx);
     let colours = ColourTables::new();
@@ -256,8 +258,66 @@ impl SetTables {
     }
 }
 
-/// The relative `k_a` error of every texel's components, read through `reads`, against the
-/// exact texels: its maximum and mean.
+/// What the measures add up as they go: the relative error's max, sum and count (per
+/// channel), and the texels' sRGB-level errors.
+struct Acc {
+    max: f64,
+    sum: f64,
+    count: u64,
+    srgb: SrgbStats,
+}
+
+impl Acc {
+    fn new() -> Self {
+        Self {
+            max: 0.0,
+            sum: 0.0,
+            count: 0,
+            srgb: SrgbStats::new(),
+        }
+    }
+
+    /// One texel: its exact `k_a` and the one read back.
+    #[inline]
+    fn add(&mut self, levels: &SrgbLevels, want: [f32; 3], got: [f32; 3]) {
+        for c in 0..3 {
+            let err = if want[c] > 0.0 {
+                f64::from((got[c] - want[c]).abs() / want[c])
+            } else {
+                0.0
+            };
+            self.max = self.max.max(err);
+            self.sum += err;
+        }
+        self.count += 3;
+        self.srgb.add(levels.distance(want, got));
+    }
+
+    fn merge(mut self, other: Self) -> Self {
+        self.max = self.max.max(other.max);
+        self.sum += other.sum;
+        self.count += other.count;
+        self.srgb = self.srgb.merge(&other.srgb);
+        self
+    }
+
+    fn finish(self) -> (KaError, SrgbError) {
+        (
+            KaError {
+                max: self.max,
+                mean: if self.count > 0 {
+                    self.sum / self.count as f64
+                } else {
+                    0.0
+                },
+            },
+            self.srgb.summary(),
+        )
+    }
+}
+
+/// The `k_a` error of every texel's components, read through `reads`, against the exact
+/// texels: relative (max and mean per channel) and in sRGB levels.
 fn compare(
     texels: &[Texel],
     width: u32,
@@ -265,54 +325,41 @@ fn compare(
     exact: &[f32],
     diffuse: f32,
     (kd, ks, n): &Reads<'_>,
-) -> KaError {
+) -> (KaError, SrgbError) {
     let w = width as usize;
-    let (max, sum, count) = texels
+    let levels = SrgbLevels::new();
+    texels
         .par_chunks(w)
         .enumerate()
-        .map(|(y, row)| {
-            let (mut max, mut sum) = (0.0_f64, 0.0_f64);
+        .fold(Acc::new, |mut acc, (y, row)| {
             for (x, t) in row.iter().enumerate() {
                 let i = y * w + x;
                 let [chi_t, offset_t] = lut[t.n as usize];
                 let (chi_b, offset_b) = (n[0].get(i, t.n), n[1].get(i, t.n));
-                for c in 0..3 {
-                    let ka = diffuse * exact[t.kd[c] as usize]
-                        + exact[t.ks[c] as usize] * chi_t
-                        + offset_t;
-                    let kb =
-                        diffuse * kd[c].get(i, t.kd[c]) + ks[c].get(i, t.ks[c]) * chi_b + offset_b;
-                    let err = if ka > 0.0 {
-                        f64::from((kb - ka).abs() / ka)
-                    } else {
-                        0.0
-                    };
-                    max = max.max(err);
-                    sum += err;
-                }
+                let want = std::array::from_fn(|c| {
+                    diffuse * exact[t.kd[c] as usize] + exact[t.ks[c] as usize] * chi_t + offset_t
+                });
+                let got = std::array::from_fn(|c| {
+                    diffuse * kd[c].get(i, t.kd[c]) + ks[c].get(i, t.ks[c]) * chi_b + offset_b
+                });
+                acc.add(&levels, want, got);
             }
-            (max, sum, row.len() as u64 * 3)
+            acc
         })
-        .reduce(
-            || (0.0, 0.0, 0),
-            |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2),
-        );
-    KaError {
-        max,
-        mean: if count > 0 { sum / count as f64 } else { 0.0 },
-    }
+        .reduce(Acc::new, Acc::merge)
+        .finish()
 }
 
-/// Relative `k_a` error of one mip level as a consumer decodes it (`stored`: the level's
-/// images, decoded) against `reference` ([`reference_levels`]). Per texel and colour
-/// channel.
+/// The `k_a` error of one mip level as a consumer decodes it (`stored`: the level's images,
+/// decoded) against `reference` ([`reference_levels`]): relative per texel and colour
+/// channel, and in sRGB levels per texel.
 pub(super) fn ka_error_of_level(
     shape: Shape<'_>,
     stored: &[StoredImage<'_>],
     reference: &[[f32; 3]],
     model: ShadingModel,
     approx: AmbientApprox,
-) -> KaError {
+) -> (KaError, SrgbError) {
     let diffuse = reflectance::diffuse_factor(approx.for_model(model)) as f32;
     let tables = ColourTables::new();
     let chi_of = |n: f32| reflectance::chi_parts_f32(model, approx, n);
@@ -341,34 +388,19 @@ pub(super) fn ka_error_of_level(
         Some(v) => Read::Table(&v[k]),
         None => in_file(stored, &[Comp::N], &chi8[k], &chi8[k], None).unwrap_or(Read::Table(&zero)),
     });
-    let (max, sum) = reference
+    let levels = SrgbLevels::new();
+    reference
         .par_iter()
         .enumerate()
-        .map(|(i, want)| {
+        .fold(Acc::new, |mut acc, (i, want)| {
             let (chi, offset) = (n[0].get(i, 0), n[1].get(i, 0));
-            let mut max = 0.0_f64;
-            let mut sum = 0.0_f64;
-            for c in 0..3 {
-                let got = diffuse * kd[c].get(i, 0) + ks[c].get(i, 0) * chi + offset;
-                let err = if want[c] > 0.0 {
-                    f64::from((got - want[c]).abs() / want[c])
-                } else {
-                    0.0
-                };
-                max = max.max(err);
-                sum += err;
-            }
-            (max, sum)
+            let got =
+                std::array::from_fn(|c| diffuse * kd[c].get(i, 0) + ks[c].get(i, 0) * chi + offset);
+            acc.add(&levels, *want, got);
+            acc
         })
-        .reduce(|| (0.0, 0.0), |x, y| (x.0.max(y.0), x.1 + y.1));
-    KaError {
-        max,
-        mean: if reference.is_empty() {
-            0.0
-        } else {
-            sum / (reference.len() * 3) as f64
-        },
-    }
+        .reduce(Acc::new, Acc::merge)
+        .finish()
 }
 
 /// The reference of every mip level past 0 (see [`ka_error_of_level`]): the `k_a` of what

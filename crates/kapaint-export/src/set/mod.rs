@@ -10,6 +10,7 @@ mod import;
 pub(crate) mod manifest;
 mod measure;
 mod normal;
+pub mod perceptual;
 mod plan;
 mod target;
 
@@ -293,6 +294,7 @@ impl<'d> Source<'d> {
             n_encoding: self.planned.n_encoding,
             files,
             ka_error: KaError::default(),
+            ka_error_srgb: None,
             dilated: self.dilated,
             bytes: MemoryReport {
                 exported: 0,
@@ -302,6 +304,7 @@ impl<'d> Source<'d> {
             preset: preset.name.clone(),
             layers: u32::try_from(self.doc.stack().walk().len()).unwrap_or(u32::MAX),
             level_ka_error: Vec::new(),
+            level_ka_error_srgb: Vec::new(),
             blocks,
             normal: None,
         }
@@ -317,7 +320,7 @@ impl<'d> Source<'d> {
         preset: &ExportPreset,
     ) {
         let (model, approx) = (self.model, self.approx);
-        manifest.ka_error = ka_error_of_set(
+        let (relative, srgb) = ka_error_of_set(
             &self.texels,
             self.shape(),
             stored,
@@ -325,10 +328,16 @@ impl<'d> Source<'d> {
             model,
             approx,
         );
+        manifest.ka_error = relative;
+        manifest.ka_error_srgb = Some(srgb);
         if preset.format.is_ktx2() {
-            manifest.level_ka_error =
-                level_errors(&self.texels, self.size, self.shape(), mips, model, approx);
-            manifest.level_ka_error.insert(0, manifest.ka_error);
+            let levels = level_errors(&self.texels, self.size, self.shape(), mips, model, approx);
+            manifest.level_ka_error = std::iter::once(relative)
+                .chain(levels.iter().map(|l| l.0))
+                .collect();
+            manifest.level_ka_error_srgb = std::iter::once(srgb)
+                .chain(levels.iter().map(|l| l.1))
+                .collect();
         }
     }
 }
@@ -455,9 +464,9 @@ struct Mips {
     half: bool,
 }
 
-/// The `k_a` error of every mip level past 0 of a KTX2 set (`mips`: per file, its
-/// components and levels 1 and on as decoded), against the exact level 0 averaged over each
-/// texel's footprint.
+/// The `k_a` error (relative, and in sRGB levels) of every mip level past 0 of a KTX2 set
+/// (`mips`: per file, its components and levels 1 and on as decoded), against the exact level
+/// 0 averaged over each texel's footprint.
 fn level_errors(
     texels: &[kapaint_core::model::texel::Texel],
     size: (u32, u32),
@@ -465,7 +474,7 @@ fn level_errors(
     mips: &[Mips],
     model: reflectance::ShadingModel,
     approx: reflectance::AmbientApprox,
-) -> Vec<KaError> {
+) -> Vec<(KaError, perceptual::SrgbError)> {
     let reference = measure::reference_levels(texels, size, model, approx);
     reference
         .iter()
