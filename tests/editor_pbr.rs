@@ -168,6 +168,18 @@ fn answer_set(request: &FileRequest) -> Option<std::path::PathBuf> {
     (request.purpose == FilePurpose::ImportPbr).then(|| set_dir().join("Bricks_ORM.png"))
 }
 
+/// File > Import PBR material, until the editor asks about the material's size.
+fn import(harness: &mut egui_kittest::Harness<'static, Editor>) {
+    harness.get_by_label("File").click();
+    harness.run_steps(2);
+    harness.get_by_label("Import PBR material…").click();
+    harness.run_steps(2);
+    wait_until(harness, "the size question", |e| {
+        e.state.size_prompt().is_some()
+    });
+    harness.run_steps(2);
+}
+
 #[test]
 fn a_texture_set_imports_from_any_one_of_its_images() {
     let d = set_dir();
@@ -183,11 +195,27 @@ fn a_texture_set_imports_from_any_one_of_its_images() {
     let files = harness.state_mut().state.files_mut();
     files.force(FileDialogBackend::System);
     files.set_system_dialog(answer_set);
-    harness.get_by_label("File").click();
-    harness.run_steps(2);
-    harness.get_by_label("Import PBR material…").click();
+    // The set is 32x32, the new project 1024x1024 and unpainted: the editor asks, adopting
+    // first (regression: it resampled the material to the maps without a word).
+    import(&mut harness);
+    let prompt = harness.state().state.size_prompt().expect("asked");
+    assert_eq!((prompt.size, prompt.project), ((32, 32), (1024, 1024)));
+    assert!(prompt.adopt_by_default);
+    harness.get_by_label_contains("the project's maps are 1024x1024");
+    harness.get_by_label("Resample to 1024x1024");
+    harness.get_by_label("Adopt 32x32").click();
     harness.run_steps(2);
     wait_until(&mut harness, "set imported", notice("conversion error max"));
+    let doc = harness.state().state.doc();
+    assert_eq!((doc.maps().width(), doc.maps().height()), (32, 32));
+    assert!(
+        doc.settings()
+            .import
+            .as_ref()
+            .is_some_and(|r| r.notes.iter().all(|n| !n.contains("resampled"))),
+        "nothing resampled: {:?}",
+        doc.settings().import
+    );
     let doc = harness.state().state.doc();
     assert!(doc.normal().is_none(), "the set has no normal map");
     let report = doc.settings().import.clone().expect("report");
@@ -207,6 +235,50 @@ fn a_texture_set_imports_from_any_one_of_its_images() {
     assert!(height < 0.5, "a rough texel's lobe is lowered: {height}");
     assert!((v.ks.x - 0.04 * height).abs() < 1e-3, "{v:?}");
     assert!(c.pbr(v).metallic < 1e-3, "{:?}", c.pbr(v));
+    // Two undo steps: the material, then the maps' size.
+    for _ in 0..2 {
+        harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+        harness.run_steps(2);
+    }
+    let doc = harness.state().state.doc();
+    assert_eq!((doc.maps().width(), doc.maps().height()), (1024, 1024));
+    assert!(doc.settings().import.is_none());
+    // A project that holds paint: resampling is the default, and Enter takes it.
+    harness
+        .state_mut()
+        .state
+        .apply_command(kapaint::model::document::PaintCommand::Fill(
+            kapaint::model::document::FillRegion::All,
+        ));
+    harness.run_steps(2);
+    import(&mut harness);
+    assert!(
+        !harness
+            .state()
+            .state
+            .size_prompt()
+            .expect("asked")
+            .adopt_by_default
+    );
+    harness.key_press(egui::Key::Enter);
+    harness.run_steps(2);
+    wait_until(&mut harness, "set resampled", |e| {
+        e.state
+            .doc()
+            .settings()
+            .import
+            .as_ref()
+            .is_some_and(|r| r.notes.iter().any(|n| n.contains("resampled")))
+    });
+    let doc = harness.state().state.doc();
+    assert_eq!((doc.maps().width(), doc.maps().height()), (1024, 1024));
+    // Cancel imports nothing.
+    let before = texels(harness.state());
+    import(&mut harness);
+    harness.get_by_label("Cancel").click();
+    harness.run_steps(4);
+    assert!(harness.state().state.size_prompt().is_none());
+    assert_eq!(kit::changed(&before, &texels(harness.state())), 0);
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -60,40 +60,7 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
         text.push('\n');
     }
     if let Some(b) = &m.blocks {
-        let _ = writeln!(
-            text,
-            "  blocks: {:?} at {:?} ({:?} encoder), {}: {}",
-            b.layout,
-            b.bc7_effort,
-            b.encoder,
-            if b.within_budget {
-                "within the budget"
-            } else {
-                "over the budget"
-            },
-            b.reason
-        );
-        if let Some(why) = &b.gpu_failed {
-            let _ = writeln!(
-                text,
-                "  the GPU encoder failed part-way ({why}): the CPU finished"
-            );
-        }
-        for t in &b.trials {
-            let _ = writeln!(
-                text,
-                "    trial {:?} {:?}: k_a p99.9 {:.2} mean {:.3} levels, relative max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
-                t.layout,
-                t.bc7_effort,
-                t.ka_error_srgb.map_or(f64::NAN, |e| e.p999),
-                t.ka_error_srgb.map_or(f64::NAN, |e| e.mean),
-                t.ka_error.max,
-                t.ka_error.mean,
-                t.min_psnr
-                    .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB")),
-                t.seconds
-            );
-        }
+        write_blocks(text, b);
     }
     if !m.level_ka_error.is_empty() {
         let levels: Vec<String> = m
@@ -125,6 +92,45 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
         b.project,
         b.project as f64 / b.exported.max(1) as f64
     );
+}
+
+/// The `--report` lines of a block-compressed set's choice: the layout, effort and encoder,
+/// the verdict, and every trial.
+fn write_blocks(text: &mut String, b: &crate::export::set::BlockChoice) {
+    let _ = writeln!(
+        text,
+        "  blocks: {:?} at {:?} ({:?} encoder), {}: {}",
+        b.layout,
+        b.bc7_effort,
+        b.encoder,
+        if b.within_budget {
+            "within the budget"
+        } else {
+            "over the budget"
+        },
+        b.reason
+    );
+    if let Some(why) = &b.gpu_failed {
+        let _ = writeln!(
+            text,
+            "  the GPU encoder failed part-way ({why}): the CPU finished"
+        );
+    }
+    for t in &b.trials {
+        let _ = writeln!(
+            text,
+            "    trial {:?} {:?}: k_a p99.9 {:.2} mean {:.3} levels, relative max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
+            t.layout,
+            t.bc7_effort,
+            t.ka_error_srgb.map_or(f64::NAN, |e| e.p999),
+            t.ka_error_srgb.map_or(f64::NAN, |e| e.mean),
+            t.ka_error.max,
+            t.ka_error.mean,
+            t.min_psnr
+                .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB")),
+            t.seconds
+        );
+    }
 }
 
 /// The lines of one exported glTF PBR set.

@@ -107,6 +107,7 @@ impl Editor {
                 bake_dialog: None,
                 pending_open: None,
                 material_prompt: None,
+                size_prompt: None,
                 unwrap_prompt: None,
                 recent: load_recent(),
                 stamp_preview: None,
@@ -292,6 +293,7 @@ impl Editor {
         s.open_prompt(&ctx);
         s.claim_prompt(&ctx);
         s.material_prompt_window(&ctx);
+        s.size_prompt_window(&ctx);
         s.unwrap_prompt_window(&ctx);
         s.modal_job_ui(&ctx);
         s.files_ui(&ctx);

@@ -45,6 +45,14 @@ pub(super) enum JobResult {
     Unwrapped(PathBuf, Arc<Surface>, String),
     /// A PBR material converted at the map size for the document's model.
     Material(PathBuf, Box<PbrMaterial>),
+    /// A PBR material of another size than the maps: the editor asks whether to adopt it.
+    MaterialSize(Box<crate::material_size::SizePrompt>),
+    /// The maps resized to a material's size, and the material converted at it.
+    Adopted(
+        kapaint_core::model::resize::ResizedMaps,
+        PathBuf,
+        Box<PbrMaterial>,
+    ),
     /// An image decoded and resampled into a channel's planes.
     Image(PathBuf, Box<kapaint_core::model::import::ChannelPlanes>),
     /// The maps resized, with the mesh baked at their size.
@@ -69,9 +77,9 @@ pub(super) struct UnwrapPrompt {
 
 /// A glTF material converted on a worker (File > Import PBR material).
 pub(super) struct PbrMaterial {
-    maps: kapaint_core::model::MaterialMaps,
-    normal: Option<kapaint_core::model::normal::NormalMap>,
-    report: kapaint_core::model::provenance::ImportReport,
+    pub(super) maps: kapaint_core::model::MaterialMaps,
+    pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
+    pub(super) report: kapaint_core::model::provenance::ImportReport,
 }
 
 /// Long work on a worker thread.
@@ -215,6 +223,16 @@ impl EditorState {
             JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
             JobResult::Exported(dir, m) => self.notices.push(exported_notice(&dir, *m)),
             JobResult::Material(path, m) => self.take_material(&path, *m),
+            JobResult::MaterialSize(prompt) => self.size_prompt = Some(*prompt),
+            JobResult::Adopted(resized, path, m) => {
+                let (w, h) = (resized.0.0.width, resized.0.0.height);
+                self.apply(ImportCommand::Resize(resized));
+                self.notices.push(notice(
+                    format!("Resized the maps to the material's {w}x{h}"),
+                    false,
+                ));
+                self.take_material(&path, *m);
+            }
             result @ (JobResult::Mesh(..)
             | JobResult::NeedsUnwrap(_)
             | JobResult::Baked(..)
@@ -280,51 +298,9 @@ impl EditorState {
         }
     }
 
-    /// Converts the material of the glTF at `path`, or the texture set `path` is one image of
-    /// ([`kapaint_core::pbr::names`]), for the document's model at the map size, on a worker; it
-    /// replaces the selected layer's channels (one undo step) when it arrives.
-    pub fn import_pbr(&mut self, path: PathBuf) {
-        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
-        let (model, mapping) = (self.doc.settings().model, self.doc.settings().n_mapping());
-        self.start_job("Material", move |progress| {
-            progress.start("decode", 1);
-            let gltf = path
-                .extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
-            let set = if gltf {
-                kapaint_core::pbr::gltf::material_set(&path, None)
-                    .map(|m| (m.set, m.normal, m.notes))
-            } else {
-                kapaint_core::pbr::names::set_of(&path).and_then(|named| {
-                    let mut notes = named.notes.clone();
-                    let normal = named.load_normal(&mut notes)?;
-                    Ok((named.set, normal, notes))
-                })
-            };
-            let converted = set.and_then(|(set, normal, notes)| {
-                progress.start("convert", 1);
-                let imported =
-                    kapaint_core::pbr::import::import(&set, Some((w, h)), model, mapping)?;
-                let mut report = imported.report;
-                report.notes.extend(notes);
-                let (maps, _) = imported.doc.into_parts();
-                Ok(PbrMaterial {
-                    maps,
-                    normal,
-                    report,
-                })
-            });
-            match converted {
-                Ok(m) => JobResult::Material(path, Box::new(m)),
-                Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
-            }
-        });
-    }
-
     /// Takes a converted PBR material: its maps into the selected layer (one undo step), its
     /// normal map and its report into the document.
-    fn take_material(&mut self, path: &Path, m: PbrMaterial) {
+    pub(super) fn take_material(&mut self, path: &Path, m: PbrMaterial) {
         let PbrMaterial {
             maps,
             normal,

@@ -16,6 +16,7 @@ mod jobs;
 pub mod keys;
 mod layer_view;
 mod layout;
+pub mod material_size;
 mod mesh_jobs;
 pub mod notices;
 pub use notices::{Notice, NoticeLevel, Notices};
@@ -205,6 +206,8 @@ pub struct EditorState {
     pending_open: Option<PathBuf>,
     /// An imported glTF mesh whose material has textures: asking whether to bring them in.
     material_prompt: Option<PathBuf>,
+    /// A PBR material of another size than the maps: asking whether to adopt its size.
+    size_prompt: Option<material_size::SizePrompt>,
     /// A mesh import waiting on whether to unwrap the mesh.
     unwrap_prompt: Option<jobs::UnwrapPrompt>,
     /// Recently opened or saved projects, newest first.

@@ -124,11 +124,11 @@ impl BlockBudget {
     /// The budget in words: "k_a within 2 levels of the displayed colour for 99.9 % of texels,
     /// mean 0.3 levels" (and the optional limits where set).
     pub fn describe(&self) -> String {
+        use std::fmt::Write as _;
         let mut text = format!(
             "k_a within {} levels of the displayed colour for 99.9 % of texels, mean {} levels",
             self.ka_error_srgb_p999, self.ka_error_srgb_mean
         );
-        use std::fmt::Write as _;
         if let Some(m) = self.max_ka_error {
             let _ = write!(text, ", relative max {:.2} %", m * 100.0);
         }

@@ -221,6 +221,31 @@ fn load(input: &Input) -> Result<Loaded, ModelError> {
     })
 }
 
+/// The size an import of `set` takes when none is asked for: the largest input image's (by
+/// area), `None` when every input is a constant. Image files are read for their header only.
+///
+/// # Errors
+/// An image file whose header does not read.
+pub fn native_size(set: &PbrSet) -> Result<Option<(u32, u32)>, ModelError> {
+    let mut sizes = Vec::new();
+    for s in set.sources() {
+        match &s.input {
+            Input::File(path) => {
+                let size = image::image_dimensions(path).map_err(|e| ModelError::Image {
+                    path: path.clone(),
+                    reason: e.to_string(),
+                })?;
+                sizes.push(size);
+            }
+            Input::Decoded(image, _) => sizes.push((image.width(), image.height())),
+            Input::Constant(_) => {}
+        }
+    }
+    Ok(sizes
+        .into_iter()
+        .max_by_key(|(w, h)| u64::from(*w) * u64::from(*h)))
+}
+
 /// Imports `set` at `size` (or the largest input image's size) for `model` under `mapping`
 /// (which the document keeps: its glTF export inverts the same one).
 ///

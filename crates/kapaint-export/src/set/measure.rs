@@ -293,7 +293,7 @@ impl Acc {
         self.srgb.add(levels.distance(want, got));
     }
 
-    fn merge(mut self, other: Self) -> Self {
+    fn merge(mut self, other: &Self) -> Self {
         self.max = self.max.max(other.max);
         self.sum += other.sum;
         self.count += other.count;
@@ -346,7 +346,7 @@ fn compare(
             }
             acc
         })
-        .reduce(Acc::new, Acc::merge)
+        .reduce(Acc::new, |a, b| a.merge(&b))
         .finish()
 }
 
@@ -399,7 +399,7 @@ pub(super) fn ka_error_of_level(
             acc.add(&levels, *want, got);
             acc
         })
-        .reduce(Acc::new, Acc::merge)
+        .reduce(Acc::new, |a, b| a.merge(&b))
         .finish()
 }
 

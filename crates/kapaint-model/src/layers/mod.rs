@@ -432,6 +432,16 @@ impl LayerStack {
         find(&self.layers, id, &mut path).then_some(path)
     }
 
+    /// Whether anything is painted over the base: a fill layer, or a painted tile in any paint
+    /// layer (groups included). A new document's stack holds none.
+    pub fn holds_paint(&self) -> bool {
+        self.walk().iter().any(|(_, l)| match &l.content {
+            LayerContent::Paint(tiles) => tiles.iter().any(Option::is_some),
+            LayerContent::Fill(_) => true,
+            LayerContent::Group(_) => false,
+        })
+    }
+
     /// Every layer, depth first, bottom first within each list, with its path.
     pub fn walk(&self) -> Vec<(Vec<usize>, &Layer)> {
         fn go<'a>(

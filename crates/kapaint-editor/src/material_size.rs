@@ -1,0 +1,269 @@
+//! File > Import PBR material when the material is not the project's size: the editor asks
+//! whether to adopt the material's size (the maps resized to it, one undo step, then the
+//! material at its own resolution) or to resample the material to the maps, instead of
+//! resampling without a word. Adopting is the default while the project holds no paint.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use super::EditorState;
+use super::dialogs::centred;
+use super::jobs::{JobResult, PbrMaterial};
+use kapaint_core::model::ModelError;
+use kapaint_core::model::normal::NormalMap;
+use kapaint_core::model::resize::{ResizedMaps, resized_stack};
+use kapaint_core::model::surface::Surface;
+use kapaint_core::pbr::NMapping;
+use kapaint_core::pbr::import::PbrSet;
+use kapaint_core::reflectance::ShadingModel;
+use kapaint_core::task::Progress;
+
+/// A material read from its files, before conversion.
+pub struct LoadedMaterial {
+    set: PbrSet,
+    normal: Option<NormalMap>,
+    notes: Vec<String>,
+}
+
+/// The question while it is open: the material, its size, and which answer is the default.
+pub struct SizePrompt {
+    /// The glTF file or the set's image the import came from.
+    pub path: PathBuf,
+    loaded: Arc<LoadedMaterial>,
+    /// The material's own size (its largest image).
+    pub size: (u32, u32),
+    /// The project's size when asked.
+    pub project: (u32, u32),
+    /// Adopting is the default (the project holds no paint yet).
+    pub adopt_by_default: bool,
+}
+
+/// The answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SizeAnswer {
+    /// Resize the maps to the material's size, then import it there.
+    Adopt,
+    /// Import the material resampled to the maps' size.
+    Resample,
+    /// Import nothing.
+    Cancel,
+}
+
+/// Reads the material of the glTF at `path`, or the texture set `path` is one image of.
+fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
+    let gltf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+    if gltf {
+        let m = kapaint_core::pbr::gltf::material_set(path, None)?;
+        return Ok(LoadedMaterial {
+            set: m.set,
+            normal: m.normal,
+            notes: m.notes,
+        });
+    }
+    let named = kapaint_core::pbr::names::set_of(path)?;
+    let mut notes = named.notes.clone();
+    let normal = named.load_normal(&mut notes)?;
+    Ok(LoadedMaterial {
+        set: named.set,
+        normal,
+        notes,
+    })
+}
+
+/// Converts `loaded` at `size` for `model` under `mapping`.
+fn convert(
+    loaded: &LoadedMaterial,
+    size: (u32, u32),
+    model: ShadingModel,
+    mapping: NMapping,
+    progress: &Progress,
+) -> Result<PbrMaterial, ModelError> {
+    progress.start("convert", 1);
+    let imported = kapaint_core::pbr::import::import(&loaded.set, Some(size), model, mapping)?;
+    let mut report = imported.report;
+    report.notes.extend(loaded.notes.iter().cloned());
+    let (maps, _) = imported.doc.into_parts();
+    Ok(PbrMaterial {
+        maps,
+        normal: loaded.normal.clone(),
+        report,
+    })
+}
+
+impl EditorState {
+    /// Converts the material of the glTF at `path`, or the texture set `path` is one image of
+    /// ([`kapaint_core::pbr::names`]), for the document's model, on a worker; it replaces the
+    /// selected layer's channels (one undo step) when it arrives. A material of another size
+    /// than the maps is not resampled silently: the editor asks first ([`SizePrompt`]).
+    pub fn import_pbr(&mut self, path: PathBuf) {
+        let project = (self.doc.maps().width(), self.doc.maps().height());
+        let (model, mapping) = (self.doc.settings().model, self.doc.settings().n_mapping());
+        let adopt_by_default = !self.doc.stack().holds_paint();
+        self.start_job("Material", move |progress| {
+            progress.start("decode", 1);
+            let fail = |e: ModelError| JobResult::Failed(format!("{}: {e}", path.display()));
+            let loaded = match load(&path) {
+                Ok(l) => l,
+                Err(e) => return fail(e),
+            };
+            match kapaint_core::pbr::import::native_size(&loaded.set) {
+                Ok(Some(size)) if size != project => {
+                    JobResult::MaterialSize(Box::new(SizePrompt {
+                        path,
+                        loaded: Arc::new(loaded),
+                        size,
+                        project,
+                        adopt_by_default,
+                    }))
+                }
+                Ok(_) => match convert(&loaded, project, model, mapping, progress) {
+                    Ok(m) => JobResult::Material(path, Box::new(m)),
+                    Err(e) => fail(e),
+                },
+                Err(e) => fail(e),
+            }
+        });
+    }
+
+    /// The size question, while it is open.
+    pub fn size_prompt(&self) -> Option<&SizePrompt> {
+        self.size_prompt.as_ref()
+    }
+
+    /// Answers the size question: adopt the material's size (the maps resized on a worker with
+    /// the mesh baked again, then the material converted there: two undo steps), resample the
+    /// material to the maps, or import nothing.
+    pub fn answer_size_prompt(&mut self, answer: SizeAnswer) {
+        let Some(prompt) = self.size_prompt.take() else {
+            return;
+        };
+        let (model, mapping) = (self.doc.settings().model, self.doc.settings().n_mapping());
+        let SizePrompt {
+            path,
+            loaded,
+            size,
+            project,
+            ..
+        } = prompt;
+        match answer {
+            SizeAnswer::Cancel => {}
+            SizeAnswer::Resample => self.start_job("Material", move |progress| {
+                match convert(&loaded, project, model, mapping, progress) {
+                    Ok(m) => JobResult::Material(path, Box::new(m)),
+                    Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+                }
+            }),
+            SizeAnswer::Adopt => {
+                let stack = self.doc.stack().clone();
+                let mesh = self.doc.surface().map(|s| s.mesh.clone());
+                let (w, h) = size;
+                self.start_job_modal(
+                    "Material",
+                    format!("Resizing the maps to {w}x{h} and converting the material…"),
+                    move |progress| {
+                        let fail =
+                            |e: String| JobResult::Failed(format!("{}: {e}", path.display()));
+                        progress.start("resample", 1);
+                        let stack = match resized_stack(&stack, w, h) {
+                            Ok(s) => s,
+                            Err(e) => return fail(format!("resize: {e}")),
+                        };
+                        progress.start("bake", 1);
+                        let surface = match mesh.map(|m| Surface::new(m, w, h)).transpose() {
+                            Ok(s) => s.map(Arc::new),
+                            Err(e) => return fail(format!("resize: the mesh: {e}")),
+                        };
+                        match convert(&loaded, size, model, mapping, progress) {
+                            Ok(m) => JobResult::Adopted(
+                                ResizedMaps(Arc::new((stack, surface))),
+                                path.clone(),
+                                Box::new(m),
+                            ),
+                            Err(e) => fail(e.to_string()),
+                        }
+                    },
+                );
+            }
+        }
+    }
+
+    /// The size question: the two sizes, Adopt / Resample / Cancel, the default first and
+    /// taken by Enter.
+    pub(super) fn size_prompt_window(&mut self, ctx: &egui::Context) {
+        let Some(prompt) = &self.size_prompt else {
+            return;
+        };
+        let ((w, h), (pw, ph)) = (prompt.size, prompt.project);
+        let name = prompt.path.file_name().map_or_else(
+            || prompt.path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        let adopt_label = format!("Adopt {w}x{h}");
+        let resample_label = format!("Resample to {pw}x{ph}");
+        let adopt_first = prompt.adopt_by_default;
+        let mut answer = None;
+        centred(egui::Window::new("Material size"), ctx)
+            .collapsible(false)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "{name} is {w}x{h}; the project's maps are {pw}x{ph}. Adopt the material's \
+                     size (the maps are resized to it, one undo step, and the material comes in \
+                     at its own resolution), or resample the material to the maps?"
+                ));
+                if adopt_first {
+                    ui.label("The project holds no paint yet: adopting loses nothing.");
+                }
+                ui.horizontal(|ui| {
+                    let order = if adopt_first {
+                        [
+                            (SizeAnswer::Adopt, &adopt_label),
+                            (SizeAnswer::Resample, &resample_label),
+                        ]
+                    } else {
+                        [
+                            (SizeAnswer::Resample, &resample_label),
+                            (SizeAnswer::Adopt, &adopt_label),
+                        ]
+                    };
+                    for (k, (a, label)) in order.into_iter().enumerate() {
+                        let button = egui::Button::new(label.as_str());
+                        let button = if k == 0 {
+                            button.fill(ui.visuals().selection.bg_fill)
+                        } else {
+                            button
+                        };
+                        if ui.add(button).clicked() {
+                            answer = Some(a);
+                        }
+                    }
+                    if ui.button("Cancel").clicked() {
+                        answer = Some(SizeAnswer::Cancel);
+                    }
+                });
+            });
+        if answer.is_none() {
+            let (enter, escape) = ctx.input(|i| {
+                (
+                    i.key_pressed(egui::Key::Enter),
+                    i.key_pressed(egui::Key::Escape),
+                )
+            });
+            if enter {
+                answer = Some(if adopt_first {
+                    SizeAnswer::Adopt
+                } else {
+                    SizeAnswer::Resample
+                });
+            } else if escape {
+                answer = Some(SizeAnswer::Cancel);
+            }
+        }
+        if let Some(a) = answer {
+            self.answer_size_prompt(a);
+        }
+    }
+}
