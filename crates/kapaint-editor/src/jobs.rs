@@ -46,7 +46,7 @@ pub(super) enum JobResult {
     /// A PBR material converted at the map size for the document's model.
     Material(PathBuf, Box<PbrMaterial>),
     /// A PBR material of another size than the maps: the editor asks whether to adopt it.
-    MaterialSize(Box<crate::material_size::SizePrompt>),
+    MaterialSize(Box<SizePrompt>),
     /// The maps resized to a material's size, and the material converted at it.
     Adopted(
         kapaint_core::model::resize::ResizedMaps,
@@ -73,6 +73,27 @@ pub(super) struct UnwrapPrompt {
     pub(super) why: String,
     /// Whether it has UVs of its own to keep.
     pub(super) has_uvs: bool,
+}
+
+/// A material read from its files, before conversion.
+pub struct LoadedMaterial {
+    pub(super) set: kapaint_core::pbr::import::PbrSet,
+    pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
+    pub(super) notes: Vec<String>,
+}
+
+/// File > Import PBR material's question while it is open ([`crate::material_size`]): the
+/// material, its size, and which answer is the default.
+pub struct SizePrompt {
+    /// The glTF file or the set's image the import came from.
+    pub path: PathBuf,
+    pub(super) loaded: Arc<LoadedMaterial>,
+    /// The material's own size (its largest image).
+    pub size: (u32, u32),
+    /// The project's size when asked.
+    pub project: (u32, u32),
+    /// Adopting is the default (the project holds no paint yet).
+    pub adopt_by_default: bool,
 }
 
 /// A glTF material converted on a worker (File > Import PBR material).

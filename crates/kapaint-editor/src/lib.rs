@@ -207,7 +207,7 @@ pub struct EditorState {
     /// An imported glTF mesh whose material has textures: asking whether to bring them in.
     material_prompt: Option<PathBuf>,
     /// A PBR material of another size than the maps: asking whether to adopt its size.
-    size_prompt: Option<material_size::SizePrompt>,
+    size_prompt: Option<jobs::SizePrompt>,
     /// A mesh import waiting on whether to unwrap the mesh.
     unwrap_prompt: Option<jobs::UnwrapPrompt>,
     /// Recently opened or saved projects, newest first.

@@ -1,42 +1,22 @@
 //! File > Import PBR material when the material is not the project's size: the editor asks
 //! whether to adopt the material's size (the maps resized to it, one undo step, then the
 //! material at its own resolution) or to resample the material to the maps, instead of
-//! resampling without a word. Adopting is the default while the project holds no paint.
+//! resampling without a word. Adopting is the default while the project holds no paint. The
+//! question's data ([`SizePrompt`]) lives with the jobs that make it.
 
 use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::EditorState;
 use super::dialogs::centred;
-use super::jobs::{JobResult, PbrMaterial};
+pub use super::jobs::SizePrompt;
+use super::jobs::{JobResult, LoadedMaterial, PbrMaterial};
 use kapaint_core::model::ModelError;
-use kapaint_core::model::normal::NormalMap;
 use kapaint_core::model::resize::{ResizedMaps, resized_stack};
 use kapaint_core::model::surface::Surface;
 use kapaint_core::pbr::NMapping;
-use kapaint_core::pbr::import::PbrSet;
 use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::task::Progress;
-
-/// A material read from its files, before conversion.
-pub struct LoadedMaterial {
-    set: PbrSet,
-    normal: Option<NormalMap>,
-    notes: Vec<String>,
-}
-
-/// The question while it is open: the material, its size, and which answer is the default.
-pub struct SizePrompt {
-    /// The glTF file or the set's image the import came from.
-    pub path: PathBuf,
-    loaded: Arc<LoadedMaterial>,
-    /// The material's own size (its largest image).
-    pub size: (u32, u32),
-    /// The project's size when asked.
-    pub project: (u32, u32),
-    /// Adopting is the default (the project holds no paint yet).
-    pub adopt_by_default: bool,
-}
 
 /// The answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
