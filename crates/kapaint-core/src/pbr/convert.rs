@@ -222,13 +222,23 @@ impl Conversion {
     /// `k_d` as it is, `k_s = F0 height(r)` (per channel at most `1 - k_d` when the height is
     /// fitted), `n` from the table.
     pub fn convert(&self, kd: Vec3, f0: Vec3, roughness: f32) -> MaterialValue {
-        let (kd, f0) = (kd.map(unit), f0.map(unit));
-        let ks = if self.fitted {
-            (f0 * self.height(roughness)).min(Vec3::ONE - kd)
+        let kd = kd.map(unit);
+        MaterialValue::new(
+            kd,
+            self.ks_at(kd, f0, self.height(roughness)),
+            self.n(roughness),
+        )
+    }
+
+    /// The converted `k_s` of `k_d` and `F0` where the lobe height is `height` (see
+    /// [`Self::convert`]).
+    pub fn ks_at(&self, kd: Vec3, f0: Vec3, height: f32) -> Vec3 {
+        let f0 = f0.map(unit);
+        if self.fitted {
+            (f0 * height).min(Vec3::ONE - kd.map(unit))
         } else {
             f0
-        };
-        MaterialValue::new(kd, ks, self.n(roughness))
+        }
     }
 
     /// A PBR texel as the target's material ([`Self::convert`] of `k_d = base (1 - metallic)`
@@ -269,8 +279,20 @@ impl Conversion {
     /// clamped (`k_d + k_s = 1`: a near-white dielectric, whose `F0` the clamp took) reads as
     /// the dielectric `F0` where less would be left, so such a dielectric comes back whole.
     pub fn pbr_at(&self, kd: Vec3, ks: Vec3, roughness: f32) -> Pbr {
+        self.pbr_with(
+            kd,
+            ks,
+            roughness,
+            self.height(roughness),
+            self.f0_tolerance(roughness),
+        )
+    }
+
+    /// [`Self::pbr_at`] with the roughness' height and [`Self::f0_tolerance`] already looked
+    /// up (the export's tables hold them per stored `n`).
+    pub fn pbr_with(&self, kd: Vec3, ks: Vec3, roughness: f32, height: f32, tolerance: f32) -> Pbr {
         let (kd, ks) = (kd.map(unit), ks.map(unit));
-        let height = self.height(roughness).max(f32::MIN_POSITIVE);
+        let height = height.max(f32::MIN_POSITIVE);
         let mut f0 = (ks / height).map(unit);
         if self.fitted {
             for c in 0..3 {
@@ -279,7 +301,7 @@ impl Conversion {
                 }
             }
         }
-        super::pbr_of(kd, f0, roughness, self.f0_tolerance(roughness))
+        super::pbr_of(kd, f0, roughness, tolerance)
     }
 
     /// The texel's conversion error: per channel, the box average of the absolute difference

@@ -38,9 +38,11 @@ pub struct Converted {
 /// and mapping).
 pub struct RoundTrip {
     conversion: &'static Conversion,
-    /// Per stored `n` code: its roughness, that roughness' byte and the model's
-    /// `[chi_1, chi_0]`.
-    n_table: Vec<(f32, u8, [f32; 2])>,
+    /// Per stored `n` code: its roughness, that roughness' byte, the model's
+    /// `[chi_1, chi_0]`, the lobe height and the dielectric's tolerance there.
+    n_table: Vec<(f32, u8, [f32; 2], f32, f32)>,
+    /// Per roughness byte, the lobe height it converts back with.
+    height_of_byte: [f32; 256],
     /// A stored sRGB byte in linear light.
     srgb: [f32; 256],
     /// Per roughness byte, the `[chi_1, chi_0]` of the exponent it reads back as.
@@ -76,9 +78,16 @@ impl RoundTrip {
                 .map(|bits| {
                     let n = decode_n(bits);
                     let r = conversion.roughness(n);
-                    (r, (r * 255.0 + 0.5) as u8, chi_parts_f32(model, approx, n))
+                    (
+                        r,
+                        (r * 255.0 + 0.5) as u8,
+                        chi_parts_f32(model, approx, n),
+                        conversion.height(r),
+                        conversion.f0_tolerance(r),
+                    )
                 })
                 .collect(),
+            height_of_byte: std::array::from_fn(|r| conversion.height(r as f32 / 255.0)),
             srgb: std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0)),
             chi_of_byte: std::array::from_fn(|r| {
                 chi_parts_f32(model, approx, conversion.n(r as f32 / 255.0))
@@ -90,8 +99,10 @@ impl RoundTrip {
     /// metallic) and round-trip error (see the module docs).
     pub fn texel(&self, t: &Texel) -> ([u8; 3], [u8; 3], f32) {
         let v = t.decode();
-        let (rough, r, chi) = self.n_table[usize::from(t.n)];
-        let p = self.conversion.pbr_at(v.kd, v.ks, rough);
+        let (rough, r, chi, height, tolerance) = self.n_table[usize::from(t.n)];
+        let p = self
+            .conversion
+            .pbr_with(v.kd, v.ks, rough, height, tolerance);
         let base = p.base.to_array().map(linear_to_srgb8);
         let mr = [255, r, (p.metallic * 255.0 + 0.5) as u8];
         // The texel as a consumer reads the files, and as this mapping converts that back.
@@ -102,7 +113,9 @@ impl RoundTrip {
         let back_kd = back_base * (1.0 - m);
         let back_f0 = Vec3::splat(DIELECTRIC_F0).lerp(back_base, m);
         let rough_back = f32::from(r) / 255.0;
-        let back_ks = self.conversion.convert(back_kd, back_f0, rough_back).ks;
+        let back_ks = self
+            .conversion
+            .ks_at(back_kd, back_f0, self.height_of_byte[usize::from(r)]);
         let chi_back = self.chi_of_byte[usize::from(r)];
         let parts = self.conversion.error_parts(back_kd, back_f0, rough_back);
         let mut worst = 0.0_f32;
