@@ -163,7 +163,7 @@ mod tests {
         let levels = SrgbLevels::new();
         for i in 0..=100_000 {
             // Dense near black, where the curve bends most.
-            let x = (i as f64 / 100_000.0).powi(3);
+            let x = (f64::from(i) / 100_000.0).powi(3);
             let exact = 255.0 * srgb_f64(x);
             let got = f64::from(levels.levels(x as f32));
             assert!((got - exact).abs() < 1e-3, "{x}: {got} vs {exact}");
