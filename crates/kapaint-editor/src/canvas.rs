@@ -6,6 +6,7 @@ use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions
 use kapaint_core::mesh::bakes::BakeMap;
 use kapaint_core::model::texel::{MaterialValue, linear_to_srgb};
 use kapaint_core::model::{Document, MaterialMaps};
+use kapaint_core::pbr::round_trip::RoundTrip;
 use kapaint_core::reflectance;
 use kapaint_core::render::n_false_colour;
 
@@ -106,8 +107,19 @@ impl Default for Canvas {
     }
 }
 
-/// Display colour of one texel for `channel`.
-fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
+/// The document's PBR round trip (its model and mapping), for the "PBR error" canvas.
+fn round_trip_of(doc: &Document) -> &'static RoundTrip {
+    RoundTrip::for_model(doc.settings().model, doc.settings().n_mapping())
+}
+
+/// Display colour of one texel for `channel` (`round_trip`: the document's PBR round trip
+/// where the caller looked it up once for many texels).
+fn colour(
+    doc: &Document,
+    channel: CanvasChannel,
+    round_trip: Option<&RoundTrip>,
+    v: MaterialValue,
+) -> Color32 {
     let rgb = match channel {
         CanvasChannel::Kd => v.kd,
         CanvasChannel::Ks => v.ks,
@@ -115,14 +127,10 @@ fn colour(doc: &Document, channel: CanvasChannel, v: MaterialValue) -> Color32 {
         CanvasChannel::Ka => {
             reflectance::ka(doc.settings().model, doc.settings().approx, v.kd, v.ks, v.n)
         }
-        CanvasChannel::PbrError => kapaint_core::render::heat_ramp(
-            kapaint_core::pbr::round_trip::RoundTrip::for_model(
-                doc.settings().model,
-                doc.settings().n_mapping(),
-            )
-            .error(v)
-                / PBR_ERROR_TOP,
-        ),
+        CanvasChannel::PbrError => {
+            let round_trip = round_trip.unwrap_or_else(|| round_trip_of(doc));
+            kapaint_core::render::heat_ramp(round_trip.error(v) / PBR_ERROR_TOP)
+        }
         // Read per texel from the bake (see `tile_image`); mid grey where there is none.
         CanvasChannel::Bake(_) => glam::Vec3::splat(0.5),
     };
@@ -146,6 +154,7 @@ fn tile_image(
             .filter(|b| (b.width, b.height) == (maps.width(), maps.height())),
         _ => None,
     };
+    let round_trip = (channel == CanvasChannel::PbrError).then(|| round_trip_of(doc));
     for y in y0..y1 {
         for x in x0..x1 {
             pixels.push(match bake {
@@ -160,7 +169,7 @@ fn tile_image(
                         Color32::from_gray(c(0))
                     }
                 }
-                None => colour(doc, channel, maps.value(x, y)),
+                None => colour(doc, channel, round_trip, maps.value(x, y)),
             });
         }
     }
@@ -191,7 +200,11 @@ impl Canvas {
                 CanvasChannel::Bake(map) => doc
                     .bake_of(map)
                     .map_or(0, |b| std::sync::Arc::as_ptr(b) as u64),
-                _ => u64::from(doc.settings().model as u8) << 8 | doc.settings().approx as u64,
+                _ => {
+                    u64::from(doc.settings().n_mapping() as u8) << 16
+                        | u64::from(doc.settings().model as u8) << 8
+                        | doc.settings().approx as u64
+                }
             },
             uniform: false,
         };
@@ -228,7 +241,10 @@ impl Canvas {
         let image = if maps.uniform_texel().is_some()
             && !matches!(self.channel, CanvasChannel::Bake(_))
         {
-            ColorImage::new([1, 1], vec![colour(doc, self.channel, maps.value(0, 0))])
+            ColorImage::new(
+                [1, 1],
+                vec![colour(doc, self.channel, None, maps.value(0, 0))],
+            )
         } else {
             let mut image = ColorImage::filled([w as usize, h as usize], Color32::BLACK);
             for id in 0..maps.tile_count() {

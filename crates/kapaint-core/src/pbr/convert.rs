@@ -166,16 +166,6 @@ impl Conversion {
         self.model
     }
 
-    /// The mapping the tables follow (height-fixed for the Cook-Torrance model, whose lobe
-    /// is GGX's own).
-    pub fn mapping(&self) -> NMapping {
-        if self.fitted {
-            NMapping::HeightFitted
-        } else {
-            NMapping::HeightFixed
-        }
-    }
-
     /// The dense table's position of a roughness: `(index, fraction)`.
     fn locate(roughness: f32) -> (usize, f32) {
         let x = unit(roughness) * LUT_SIZE as f32;
@@ -257,7 +247,14 @@ impl Conversion {
     /// energy guard left `k_s` whole: roughness by [`Self::roughness`], `F0 = k_s / height`,
     /// then metallic and base colour as [`super::from_material`].
     pub fn pbr(&self, v: MaterialValue) -> Pbr {
-        self.pbr_at(v.kd, v.ks, self.roughness(v.n))
+        let roughness = self.roughness(v.n);
+        self.pbr_with(
+            v.kd,
+            v.ks,
+            roughness,
+            self.height(roughness),
+            self.f0_tolerance(roughness),
+        )
     }
 
     /// How far from the dielectric `F0` a mean `F0` read back at `roughness` may lie and still
@@ -274,22 +271,12 @@ impl Conversion {
         (super::F0_TOLERANCE + DIELECTRIC_F0 * dh) / height
     }
 
-    /// [`Self::pbr`] of `k_d` and `k_s` at a roughness already found. `F0 = k_s / height`, at
-    /// most 1; a dielectric's `F0` is read within [`Self::f0_tolerance`]. A channel the energy guard
-    /// clamped (`k_d + k_s = 1`: a near-white dielectric, whose `F0` the clamp took) reads as
-    /// the dielectric `F0` where less would be left, so such a dielectric comes back whole.
-    pub fn pbr_at(&self, kd: Vec3, ks: Vec3, roughness: f32) -> Pbr {
-        self.pbr_with(
-            kd,
-            ks,
-            roughness,
-            self.height(roughness),
-            self.f0_tolerance(roughness),
-        )
-    }
-
-    /// [`Self::pbr_at`] with the roughness' height and [`Self::f0_tolerance`] already looked
-    /// up (the export's tables hold them per stored `n`).
+    /// [`Self::pbr`] of `k_d` and `k_s` at a roughness already found, with its lobe height and
+    /// [`Self::f0_tolerance`] (the export's tables hold them per stored `n`). `F0 = k_s /
+    /// height`, at most 1; a dielectric's `F0` is read within the tolerance. A channel the
+    /// energy guard clamped (`k_d + k_s = 1`: a near-white dielectric, whose `F0` the clamp
+    /// took) reads as the dielectric `F0` where less would be left, so such a dielectric comes
+    /// back whole.
     pub fn pbr_with(&self, kd: Vec3, ks: Vec3, roughness: f32, height: f32, tolerance: f32) -> Pbr {
         let (kd, ks) = (kd.map(unit), ks.map(unit));
         let height = height.max(f32::MIN_POSITIVE);

@@ -221,20 +221,21 @@ impl LobeSamples {
     /// The L1 distance over the box between the GGX lobe (`F = 1`) and the target's lobe of
     /// exponent `n`.
     pub fn lobe_distance(&self, target: ShadingModel, n: f64) -> f64 {
-        // Summed in fixed chunks, in order: the result does not depend on the thread count.
-        let chunks: Vec<f64> = (0..self.len())
-            .collect::<Vec<_>>()
-            .par_chunks(1 << 16)
-            .map(|chunk| {
-                chunk
-                    .iter()
-                    .map(|&i| {
-                        let [g1, g0] = self.ggx[i];
-                        let [t1, t0] = self.target_parts(target, n, i);
-                        self.weight[i] * (g1 + g0 - t1 - t0).abs()
-                    })
-                    .sum::<f64>()
-            })
+        self.box_sum(|i| {
+            let [g1, g0] = self.ggx[i];
+            let [t1, t0] = self.target_parts(target, n, i);
+            self.weight[i] * (g1 + g0 - t1 - t0).abs()
+        })
+    }
+
+    /// `sum f(i)` over the nodes, in fixed chunks summed in order: the result does not depend
+    /// on the thread count.
+    fn box_sum(&self, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+        const CHUNK: usize = 1 << 16;
+        let len = self.len();
+        let chunks: Vec<f64> = (0..len.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(len)).map(&f).sum::<f64>())
             .collect();
         chunks.iter().sum()
     }
@@ -286,21 +287,11 @@ impl LobeSamples {
                 })
                 .map_or(0.0, |(r, _)| *r)
         };
-        // Summed in fixed chunks, in order: the result does not depend on the thread count.
-        let chunks: Vec<f64> = (0..self.len())
-            .collect::<Vec<_>>()
-            .par_chunks(1 << 16)
-            .map(|chunk| {
-                chunk
-                    .iter()
-                    .map(|&i| {
-                        let [g1, g0] = self.ggx[i];
-                        self.weight[i] * (g1 + g0 - s * lobe(self.cosines[i][k], n)).abs()
-                    })
-                    .sum::<f64>()
-            })
-            .collect();
-        (s, chunks.iter().sum())
+        let distance = self.box_sum(|i| {
+            let [g1, g0] = self.ggx[i];
+            self.weight[i] * (g1 + g0 - s * lobe(self.cosines[i][k], n)).abs()
+        });
+        (s, distance)
     }
 
     /// The exponent in `[0, cap]` and the lobe height that together minimise the box L1
@@ -359,14 +350,11 @@ impl LobeSamples {
     /// for the target's lobe of exponent `n`: the box average of `|F0 rho_1 + rho_0 - k_s c^n|`
     /// (what [`Self::error_table_clamped`] tabulates).
     pub fn error_at_height(&self, target: ShadingModel, n: f64, f0: f64, ks: f64) -> f64 {
-        (0..self.len())
-            .into_par_iter()
-            .map(|i| {
-                let [g1, g0] = self.ggx[i];
-                let t = self.target_parts(target, n, i)[0];
-                self.weight[i] * (f0 * g1 + g0 - ks * t).abs()
-            })
-            .sum()
+        self.box_sum(|i| {
+            let [g1, g0] = self.ggx[i];
+            let t = self.target_parts(target, n, i)[0];
+            self.weight[i] * (f0 * g1 + g0 - ks * t).abs()
+        })
     }
 
     /// The error numerator of the height mapping at every `F0` node `j` and clamp factor `q`

@@ -52,19 +52,21 @@ pub struct RoundTrip {
 impl RoundTrip {
     /// The tables for `model` under `mapping` (built on first use, about 10 ms).
     pub fn for_model(model: ShadingModel, mapping: NMapping) -> &'static Self {
-        static TABLES: [std::sync::OnceLock<RoundTrip>; 6] = [
-            std::sync::OnceLock::new(),
+        static TABLES: [std::sync::OnceLock<RoundTrip>; 5] = [
             std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
             std::sync::OnceLock::new(),
         ];
-        let k = match model {
-            ShadingModel::Phong => 0,
-            ShadingModel::BlinnPhong => 1,
-            ShadingModel::CookTorrance => 2,
-        } + 3 * usize::from(mapping == NMapping::HeightFixed);
+        // The Cook-Torrance model has one mapping: one table, whichever is asked for.
+        let k = match (model, mapping) {
+            (ShadingModel::Phong, NMapping::HeightFitted) => 0,
+            (ShadingModel::BlinnPhong, NMapping::HeightFitted) => 1,
+            (ShadingModel::CookTorrance, _) => 2,
+            (ShadingModel::Phong, NMapping::HeightFixed) => 3,
+            (ShadingModel::BlinnPhong, NMapping::HeightFixed) => 4,
+        };
         TABLES[k].get_or_init(|| Self::build(model, mapping))
     }
 
