@@ -1,7 +1,7 @@
 //! Criterion benches for the exporter (issue 6): a 4096^2 typical project (the spot texture in
 //! k_d, a log gradient of n, 50 strokes) exported with each preset (target: compact <= 2 s;
-//! KTX2 with mips, uncompressed and BC7/BC4 at the default effort, measured),
-//! and the choice of n's encoding alone.
+//! KTX2 with mips, uncompressed, BC and ASTC, each block preset at most 2x `ktx2-raw`), and
+//! the choice of n's encoding alone.
 
 #![expect(
     clippy::expect_used,
@@ -28,7 +28,14 @@ fn exports(c: &mut Criterion) {
     group
         .sample_size(10)
         .measurement_time(Duration::from_secs(20));
-    for name in ["compact", "16-bit", "with-ka", "ktx2-raw", "ktx2"] {
+    for name in [
+        "compact",
+        "16-bit",
+        "with-ka",
+        "ktx2-raw",
+        "ktx2",
+        "ktx2-astc",
+    ] {
         let p = preset::find(name).expect("preset");
         let out = dir.join(name);
         group.bench_function(name, |b| {
@@ -50,7 +57,9 @@ fn exports(c: &mut Criterion) {
 /// Issue 21's project (the spot texture in k_d, soft strokes of n = 3000 and n = 2): the
 /// `ktx2` export with its effort search and full mip chains (target <= 5 s on 2 cores), and,
 /// side by side in the same run, the BC7 encoders alone on one thread on the packed level 0:
-/// Intel's ISPC kernels and `block_compression`'s port.
+/// Intel's ISPC kernels and `block_compression`'s port; and ASTC 4x4 (astcenc) on the same
+/// texels at its fastest and thorough searches (ISPC's own ASTC encoder beside it:
+/// `benches/peers/astc_side_by_side.sh`).
 fn block_compression(c: &mut Criterion) {
     use kapaint::export::blocks::{self, BlockKind, Coder};
     use kapaint::export::preset::Bc7Quality;
@@ -98,6 +107,17 @@ fn block_compression(c: &mut Criterion) {
         };
         group.bench_function(format!("bc7_one_thread_{encoder:?}_{effort:?}"), |b| {
             b.iter(|| one.install(|| blocks::encode(encoder, kind, &rgba, (w, h), None)));
+        });
+    }
+    for effort in [Bc7Quality::UltraFast, Bc7Quality::Basic] {
+        let kind = BlockKind::Astc {
+            block: kapaint::export::astc_block::AstcBlock::DEFAULT,
+            channels: 4,
+            srgb: true,
+            effort,
+        };
+        group.bench_function(format!("astc4x4_one_thread_{effort:?}"), |b| {
+            b.iter(|| one.install(|| blocks::encode(Coder::Ispc, kind, &rgba, (w, h), None)));
         });
     }
     group.finish();

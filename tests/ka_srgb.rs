@@ -47,7 +47,7 @@ fn levels(a: &Document, b: &Document, x: u32, y: u32) -> f64 {
 #[test]
 fn every_sets_manifest_reports_the_ka_error_in_srgb_levels_and_it_is_the_files() {
     let doc = project(128);
-    for name in ["compact", "16-bit", "exr", "ktx2-raw", "ktx2"] {
+    for name in ["compact", "16-bit", "exr", "ktx2-raw", "ktx2", "ktx2-astc"] {
         let out = dir(name);
         let m = set::export(&doc, &preset::find(name).expect("preset"), &out).expect("export");
         let e = m.ka_error_srgb.expect("ka_error_srgb");

@@ -275,10 +275,12 @@ fn psnr(a: &[u8], b: &[u8]) -> f64 {
 fn every_level_of_every_file_decodes_independently_close_to_the_uncompressed_levels() {
     let doc = project(256);
     let (raw_dir, raw) = export(&doc, &preset::find("ktx2-raw").expect("preset"), "raw");
-    // A budget the cheapest trial meets (BC7 k_d with n in its alpha), and one only BC6H
-    // k_d comes near.
+    // A budget the cheapest trial meets (BC7 k_d with n in its alpha), and a mean only BC6H
+    // k_d meets. (This once asked for a maximum nothing meets, at a ceiling that ended the
+    // search on the BC6H trial; the files were that trial's while the manifest named the
+    // nearest, packed BC7: `tests/ktx2_astc.rs` checks the files are the kept trial's.)
     let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Bc7Quality::UltraFast);
-    let strict = with_budget(relative_budget(1e-6, 0.002, 50.0), Bc7Quality::UltraFast);
+    let strict = with_budget(relative_budget(10.0, 0.002, 20.0), Bc7Quality::UltraFast);
     let mut half_files = 0;
     for (bc_preset, tag) in [(loose, "bc"), (strict, "bc6h")] {
         half_files += compare_with_raw(&doc, &raw_dir, &raw, &bc_preset, tag);

@@ -471,7 +471,14 @@ fn every_set_preset_carries_the_normal_map_and_help_lists_every_preset() {
     ]);
     assert!(o.status.success(), "{o:?}");
     for preset in [
-        "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw",
+        "compact",
+        "16-bit",
+        "separate",
+        "exr",
+        "with-ka",
+        "ktx2",
+        "ktx2-astc",
+        "ktx2-raw",
     ] {
         let out = dir.join(preset);
         let o = kapaint(&["export", s(&project), "--preset", preset, "--out", s(&out)]);

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use super::export_plan::{block_search_ui, export_plan_ui};
 use super::files::FilePurpose;
 use super::jobs::new_document_with;
 use super::layout::layout_path;
@@ -14,81 +15,6 @@ use super::{EditorState, JobResult};
 use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::{Document, DocumentSettings};
 use kapaint_export::preset::ExportPreset;
-
-/// The export dialog's preview: the packed layout of each file, the constants, the memory
-/// report and the `k_a` error that `n`'s quantisation costs.
-pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetPlan, pbr: bool) {
-    let mb = |b: u64| b as f64 / 1e6;
-    ui.label(
-        egui::RichText::new(if pbr {
-            "glTF metallic-roughness textures"
-        } else {
-            "Packed layout"
-        })
-        .strong(),
-    );
-    egui::Grid::new("export layout")
-        .striped(true)
-        .show(ui, |ui| {
-            for f in &plan.files {
-                ui.monospace(&f.path);
-                ui.monospace(f.layout.join(" | "));
-                ui.label(format!("{:.1} MB raw", mb(f.raw_bytes)));
-                ui.end_row();
-            }
-        });
-    let c = &plan.constants;
-    let mut constants = Vec::new();
-    if let Some([r, g, b]) = c.kd {
-        constants.push(format!("k_d = ({r:.3}, {g:.3}, {b:.3})"));
-    }
-    if let Some([r, g, b]) = c.ks {
-        constants.push(format!("k_s = ({r:.3}, {g:.3}, {b:.3})"));
-    }
-    if let Some(n) = c.n {
-        constants.push(format!("n = {n:.2}"));
-    }
-    if let Some((w, h)) = plan.normal {
-        ui.label(format!(
-            "normal.png: the project's normal map ({w}x{h}, 8-bit tangent space, as stored); \
-             it lights only, k_a never reads it"
-        ));
-    }
-    if plan.files.is_empty() && plan.normal.is_none() {
-        ui.label("Every channel is constant: the set is a manifest alone.");
-    }
-    if !constants.is_empty() {
-        ui.label(format!(
-            "Constants in the manifest: {}",
-            constants.join(", ")
-        ));
-    }
-    if let Some(e) = plan.n_encoding {
-        ui.label(format!(
-            "n: {:?} curve over [{:.2}, {:.1}], {} bits",
-            e.curve, e.lo, e.hi, e.bits
-        ));
-    }
-    if pbr {
-        ui.label(
-            "Base colour, metallic and roughness are converted back from k_d, k_s and n; \
-             the round-trip error is measured as the set is written (material.json).",
-        );
-    } else {
-        ui.label(format!(
-            "Estimated k_a error (n quantisation): max {:.3} %, mean {:.4} %",
-            plan.ka_error.max * 100.0,
-            plan.ka_error.mean * 100.0
-        ));
-    }
-    let b = &plan.bytes;
-    ui.label(format!(
-        "Memory: set {:.1} MB uncompressed (files are smaller), naive k_a + k_d + k_s + n {:.1} MB, project {:.1} MB",
-        mb(b.exported),
-        mb(b.naive),
-        mb(b.project)
-    ));
-}
 
 /// The New dialog's choices.
 #[derive(Clone, Debug, PartialEq)]
@@ -155,26 +81,6 @@ pub(super) fn save_recent(list: &[PathBuf]) {
         }
         let _ = kapaint_core::atomic::write_atomic(&path, &json);
     }
-}
-
-/// For a block-compressed preset: the layout above is the search's first trial; the export
-/// measures and may move `n` out and colour to BC6H (the notice says what it chose).
-fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
-    if preset.format != kapaint_export::preset::Format::Ktx2Bc {
-        return;
-    }
-    let then = if preset.bc6h {
-        "n apart with colour as BC6H"
-    } else {
-        "n apart"
-    };
-    ui.label(format!(
-        "Blocks: the layout and effort are chosen at export by the measured k_a error \
-         (budget: {}): this layout first, then {then}, then more effort up to {:?}. The \
-         notice and material.json say what was kept.",
-        preset.budget.describe(),
-        preset.max_bc7_effort
-    ));
 }
 
 /// The export dialog's state.

@@ -10,6 +10,7 @@ pub mod bake;
 pub mod canvas;
 mod claim;
 mod dialogs;
+mod export_plan;
 pub mod files;
 mod input;
 mod jobs;

@@ -60,11 +60,15 @@ pub enum Compression {
     /// KTX2 with BC6H blocks: three components, linear unsigned half floats.
     #[serde(rename = "ktx2-bc6h")]
     Ktx2Bc6h,
+    /// KTX2 with ASTC LDR blocks (one to four components; the footprint is the file's
+    /// `vkFormat` and the manifest's `astc_block`).
+    #[serde(rename = "ktx2-astc")]
+    Ktx2Astc,
 }
 
 impl Compression {
     /// Every compression, in the order the docs list them.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
         Self::Png,
         Self::Exr,
         Self::Ktx2,
@@ -72,6 +76,7 @@ impl Compression {
         Self::Ktx2Bc5,
         Self::Ktx2Bc7,
         Self::Ktx2Bc6h,
+        Self::Ktx2Astc,
     ];
 
     /// The name a manifest spells.
@@ -84,6 +89,7 @@ impl Compression {
             Self::Ktx2Bc5 => "ktx2-bc5",
             Self::Ktx2Bc7 => "ktx2-bc7",
             Self::Ktx2Bc6h => "ktx2-bc6h",
+            Self::Ktx2Astc => "ktx2-astc",
         }
     }
 
@@ -97,7 +103,12 @@ impl Compression {
         match self {
             Self::Png => "png",
             Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 | Self::Ktx2Bc6h => "ktx2",
+            Self::Ktx2
+            | Self::Ktx2Bc4
+            | Self::Ktx2Bc5
+            | Self::Ktx2Bc7
+            | Self::Ktx2Bc6h
+            | Self::Ktx2Astc => "ktx2",
         }
     }
 
@@ -106,7 +117,7 @@ impl Compression {
         match self {
             Self::Png => &[8, 16],
             Self::Exr => &[32],
-            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 => &[8],
+            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 | Self::Ktx2Astc => &[8],
             Self::Ktx2Bc6h => &[16],
         }
     }

@@ -2,6 +2,7 @@
 //! encoding by the `k_a` error it causes ([`encoding`]), and sets of images with a
 //! `material.json` manifest written atomically and read back ([`set`]).
 
+pub mod astc_block;
 pub mod blocks;
 pub mod encoding;
 pub mod file_kind;

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::astc_block::AstcBlock;
+
 /// Image format of the exported files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Format {
@@ -19,6 +21,9 @@ pub enum Format {
     /// KTX2 block-compressed with a full mip chain: BC7 for three or four components, BC5
     /// for two, BC4 for one.
     Ktx2Bc,
+    /// KTX2 with ASTC LDR blocks and a full mip chain (phones, standalone headsets): one
+    /// footprint for every image (`astc_block`, 4x4 by default), `k_d` sRGB.
+    Ktx2Astc,
     /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
     /// roughness, B metallic), and the normal map where the project has one; converted back
     /// from `k_d`, `k_s`, `n` ([`crate::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
@@ -29,12 +34,21 @@ pub enum Format {
 impl Format {
     /// Whether files hold 8-bit components (PNG8 and both KTX2 kinds).
     pub fn is_8bit(self) -> bool {
-        matches!(self, Self::Png8 | Self::Ktx2 | Self::Ktx2Bc | Self::GltfPbr)
+        matches!(
+            self,
+            Self::Png8 | Self::Ktx2 | Self::Ktx2Bc | Self::Ktx2Astc | Self::GltfPbr
+        )
     }
 
     /// Whether files are KTX2 containers.
     pub fn is_ktx2(self) -> bool {
-        matches!(self, Self::Ktx2 | Self::Ktx2Bc)
+        matches!(self, Self::Ktx2 | Self::Ktx2Bc | Self::Ktx2Astc)
+    }
+
+    /// Whether files are block-compressed (BC or ASTC), their layout and effort chosen
+    /// against the preset's budget.
+    pub fn is_blocks(self) -> bool {
+        matches!(self, Self::Ktx2Bc | Self::Ktx2Astc)
     }
 
     /// The files' extension.
@@ -42,7 +56,7 @@ impl Format {
         match self {
             Self::Png8 | Self::Png16 | Self::GltfPbr => "png",
             Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc => "ktx2",
+            Self::Ktx2 | Self::Ktx2Bc | Self::Ktx2Astc => "ktx2",
         }
     }
 }
@@ -179,6 +193,9 @@ pub struct ExportPreset {
     /// Whether a `Ktx2Bc` export may store colour as BC6H (linear half floats) when BC7
     /// misses the budget; off for consumers that sample only BC7 (RON `bc6h`, default on).
     pub bc6h: bool,
+    /// A `Ktx2Astc` set's footprint (RON `astc_block: "6x6"`, default 4x4); the loader
+    /// refuses one ASTC does not define.
+    pub astc_block: AstcBlock,
 }
 
 /// An export preset as its file spells it, before it is checked.
@@ -208,6 +225,13 @@ struct ExportPresetFile {
     min_psnr: Option<f64>,
     #[serde(default = "default_bc6h")]
     bc6h: bool,
+    #[serde(default, deserialize_with = "some_block")]
+    astc_block: Option<AstcBlock>,
+}
+
+/// An ASTC footprint as a preset spells it: a bare `"WxH"`, present means set.
+fn some_block<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<AstcBlock>, D::Error> {
+    AstcBlock::deserialize(d).map(Some)
 }
 
 /// An optional limit as a preset spells it: a bare number (as before the limits became
@@ -238,6 +262,12 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
         }
         if f.format == Format::GltfPbr && f.include_ka {
             return Err("a glTF PBR set has no k_a map (include_ka: false)".into());
+        }
+        if f.astc_block.is_some() && f.format != Format::Ktx2Astc {
+            return Err(format!(
+                "astc_block applies to Ktx2Astc presets, not {:?}",
+                f.format
+            ));
         }
         if f.format == Format::Png16 && f.n_bits != 16 {
             return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
@@ -283,6 +313,7 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             max_bc7_effort: f.max_bc7_effort,
             budget,
             bc6h: f.bc6h,
+            astc_block: f.astc_block.unwrap_or_default(),
         })
     }
 }
@@ -320,6 +351,10 @@ const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../../presets/export/gltf-pbr.ron"),
     ),
     ("ktx2", include_str!("../../../presets/export/ktx2.ron")),
+    (
+        "ktx2-astc",
+        include_str!("../../../presets/export/ktx2-astc.ron"),
+    ),
     (
         "ktx2-raw",
         include_str!("../../../presets/export/ktx2-raw.ron"),
@@ -412,7 +447,15 @@ mod tests {
     fn every_builtin_parses_and_is_found() {
         assert_eq!(builtin().len(), BUILTIN.len());
         for name in [
-            "compact", "16-bit", "separate", "exr", "with-ka", "ktx2", "ktx2-raw", "gltf-pbr",
+            "compact",
+            "16-bit",
+            "separate",
+            "exr",
+            "with-ka",
+            "ktx2",
+            "ktx2-astc",
+            "ktx2-raw",
+            "gltf-pbr",
         ] {
             assert_eq!(find(name).unwrap().name, name);
         }
@@ -430,6 +473,10 @@ mod tests {
             "(name: \"a\", format: Png8, layout: Packed, n_bits: 8, extra: 1)",
             "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, max_ka_error: -1.0)",
             "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, min_psnr: NaN)",
+            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"7x7\")",
+            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"4x4x4\")",
+            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: 4)",
+            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, astc_block: \"4x4\")",
         ] {
             let err = ExportPreset::parse(path, text).unwrap_err().to_string();
             assert!(err.starts_with("x.ron: "), "{err}");

@@ -151,7 +151,7 @@ fn source_format(kind: BlockKind) -> wgpu::TextureFormat {
     match kind {
         BlockKind::Bc4 => wgpu::TextureFormat::R8Unorm,
         BlockKind::Bc5 => wgpu::TextureFormat::Rg8Unorm,
-        BlockKind::Bc7 { .. } => wgpu::TextureFormat::Rgba8Unorm,
+        BlockKind::Bc7 { .. } | BlockKind::Astc { .. } => wgpu::TextureFormat::Rgba8Unorm,
         BlockKind::Bc6h { .. } => wgpu::TextureFormat::Rgba16Float,
     }
 }
@@ -211,6 +211,11 @@ impl GpuBlockEncoder {
             error,
             rows_done: 0,
         };
+        if kind.variant().is_none() {
+            return Err(at_start(GpuError(format!(
+                "{kind:?} is not a block kind the GPU encodes"
+            ))));
+        }
         let row_bytes = width as usize * kind.texel_bytes();
         let fit = u32::try_from(STRIP_BYTES / row_bytes.max(1)).unwrap_or(u32::MAX);
         let strip_rows = (fit.min(self.strip_rows) / 4 * 4).clamp(4, height);
@@ -300,6 +305,9 @@ impl Strip {
         rows: u32,
         dst: &mut [u8],
     ) -> Result<(), GpuError> {
+        let variant = kind
+            .variant()
+            .ok_or_else(|| GpuError(format!("{kind:?} is not a block kind the GPU encodes")))?;
         let width = self.texture.width();
         let scope = gpu.scope()?;
         gpu.queue.write_texture(
@@ -324,15 +332,8 @@ impl Strip {
                 label: Some("block encoding"),
                 timestamp_writes: None,
             });
-            compressor.add_compression_task(
-                kind.variant(),
-                &self.view,
-                width,
-                rows,
-                &self.out,
-                None,
-                None,
-            );
+            compressor
+                .add_compression_task(variant, &self.view, width, rows, &self.out, None, None);
             compressor.compress(&mut pass);
         }
         let bytes = dst.len() as u64;

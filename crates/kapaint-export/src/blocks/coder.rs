@@ -17,6 +17,8 @@ pub enum Encoder {
     /// An encoder the caller brought ([`BlockEncoder`]: a GPU's compute shaders); the CPU's
     /// best encoder wherever it fails.
     Gpu,
+    /// ARM's ASTC encoder (`astcenc`), for ASTC blocks.
+    Astcenc,
 }
 
 impl Encoder {

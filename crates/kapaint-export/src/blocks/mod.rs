@@ -1,5 +1,5 @@
 //! Block encoders for the KTX2 export: BC7 (three or four components), BC6H (three linear
-//! half floats), BC5 (two), BC4 (one).
+//! half floats), BC5 (two), BC4 (one), and ASTC LDR (one to four, any footprint: [`astc`]).
 //!
 //! On `x86_64` the blocks come from Intel's ISPC texture compressor kernels (`intel_tex_2`,
 //! which ships them precompiled); elsewhere from `block_compression`'s port of the same
@@ -7,18 +7,31 @@
 //! encoder behind [`BlockEncoder`] (the GPU crate's compute shaders): an export uses it only
 //! when handed one ([`Coder::best`]); nothing here reaches for a device of its own. Decoding
 //! (to measure what a consumer sees) is `block_compression`'s CPU decoder, also in strips.
+//! ASTC is encoded and decoded on the CPU by ARM's `astcenc`, whatever encoder is handed in.
 
 use block_compression::decode::{decode_block_bc6h, decompress_blocks_as_rgba8};
 use block_compression::{BC6HSettings, BC7Settings, CompressionVariant};
 use half::f16;
 use rayon::prelude::*;
 
+pub mod astc;
 mod coder;
 
 pub use coder::{BlockEncoder, Coder, Encoder, Interrupted};
 
 use super::preset::Bc7Quality;
+use crate::astc_block::AstcBlock;
 use kapaint_core::task::Progress;
+
+/// Which blocks a block-compressed image holds: BC (BC7, BC6H, BC5 or BC4 by what it
+/// stores), or ASTC LDR of one footprint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockFamily {
+    /// Desktop GPUs' BC formats.
+    Bc,
+    /// ASTC LDR (phones, standalone headsets).
+    Astc(AstcBlock),
+}
 
 /// What blocks hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,6 +53,19 @@ pub enum BlockKind {
         /// How hard the encoder searches.
         effort: Bc7Quality,
     },
+    /// ASTC LDR: 16 bytes per block of any footprint ASTC defines, `channels` components
+    /// (one as luminance, two as luminance and alpha), colour sRGB where `srgb`, at an effort
+    /// (BC7's scale, [`astc::preset_of`]).
+    Astc {
+        /// The footprint.
+        block: AstcBlock,
+        /// Meaningful components, 1 to 4.
+        channels: u8,
+        /// RGB is sRGB-encoded (the sRGB profile).
+        srgb: bool,
+        /// How hard the encoder searches.
+        effort: Bc7Quality,
+    },
 }
 
 impl BlockKind {
@@ -55,17 +81,27 @@ impl BlockKind {
         }
     }
 
-    /// Bytes per 4x4 block.
+    /// Bytes per block.
     pub fn block_bytes(self) -> usize {
         match self {
             Self::Bc4 => 8,
-            Self::Bc5 | Self::Bc7 { .. } | Self::Bc6h { .. } => 16,
+            Self::Bc5 | Self::Bc7 { .. } | Self::Bc6h { .. } | Self::Astc { .. } => 16,
         }
     }
 
-    /// Bytes of the blocks covering a `(width, height)` image (sides multiples of 4).
+    /// A block's footprint, texels across and down: 4x4, or ASTC's.
+    pub fn dims(self) -> (u32, u32) {
+        match self {
+            Self::Astc { block, .. } => block.dims(),
+            _ => (4, 4),
+        }
+    }
+
+    /// Bytes of the blocks covering a `(width, height)` image (sides multiples of
+    /// [`BlockKind::dims`]).
     pub fn blocks_len(self, (width, height): (u32, u32)) -> usize {
-        (width as usize / 4) * (height as usize / 4) * self.block_bytes()
+        let (bw, bh) = self.dims();
+        (width / bw) as usize * (height / bh) as usize * self.block_bytes()
     }
 
     /// Bytes per texel of the input (and of [`decode`]'s output): 1, 2 or 4 bytes, or four
@@ -74,7 +110,7 @@ impl BlockKind {
         match self {
             Self::Bc4 => 1,
             Self::Bc5 => 2,
-            Self::Bc7 { .. } => 4,
+            Self::Bc7 { .. } | Self::Astc { .. } => 4,
             Self::Bc6h { .. } => 8,
         }
     }
@@ -91,9 +127,10 @@ impl BlockKind {
         }
     }
 
-    /// `block_compression`'s name and settings for the kind.
-    pub fn variant(self) -> CompressionVariant {
-        match self {
+    /// `block_compression`'s name and settings for the kind (`None` for ASTC, which it does
+    /// not encode).
+    pub fn variant(self) -> Option<CompressionVariant> {
+        Some(match self {
             Self::Bc4 => CompressionVariant::BC4,
             Self::Bc5 => CompressionVariant::BC5,
             Self::Bc7 { alpha, effort } => CompressionVariant::BC7(portable_bc7(effort, alpha)),
@@ -103,7 +140,8 @@ impl BlockKind {
                 Bc7Quality::Basic => BC6HSettings::basic(),
                 Bc7Quality::Slow => BC6HSettings::slow(),
             }),
-        }
+            Self::Astc { .. } => return None,
+        })
     }
 }
 
@@ -187,6 +225,8 @@ mod ispc {
             BlockKind::Bc6h { effort } => {
                 bc6h::compress_blocks_into(&bc6h_settings(effort), &rgba, out);
             }
+            // astcenc's, in `encode_strip`.
+            BlockKind::Astc { .. } => {}
         }
     }
 }
@@ -214,27 +254,48 @@ fn widen(kind: BlockKind, src: &[u8], stored: usize, to: usize) -> std::borrow::
 /// Encodes one strip with the portable encoder (which reads RGBA8 whatever the kind, RGBA16F
 /// for BC6H).
 fn encode_portable(kind: BlockKind, data: &[u8], width: u32, rows: u32, out: &mut [u8]) {
+    let Some(variant) = kind.variant() else {
+        return;
+    };
     if let BlockKind::Bc6h { .. } = kind {
         let halves: Vec<f16> = bytemuck::pod_collect_to_vec(data);
-        block_compression::encode::compress_rgba16(
-            kind.variant(),
-            &halves,
-            out,
-            width,
-            rows,
-            width * 4,
-        );
+        block_compression::encode::compress_rgba16(variant, &halves, out, width, rows, width * 4);
         return;
     }
     let rgba = widen(kind, data, kind.texel_bytes(), 4);
-    block_compression::encode::compress_rgba8(kind.variant(), &rgba, out, width, rows, width * 4);
+    block_compression::encode::compress_rgba8(variant, &rgba, out, width, rows, width * 4);
+}
+
+/// Encodes one strip of whole texels: ASTC with `astcenc`, BC with `encoder`.
+fn encode_strip(
+    encoder: Coder<'_>,
+    kind: BlockKind,
+    data: &[u8],
+    width: u32,
+    rows: u32,
+    out: &mut [u8],
+) {
+    match (kind, encoder) {
+        (
+            BlockKind::Astc {
+                block,
+                channels,
+                srgb,
+                effort,
+            },
+            _,
+        ) => astc::encode(block, channels, srgb, effort, data, (width, rows), out),
+        #[cfg(target_arch = "x86_64")]
+        (_, Coder::Ispc) => ispc::encode(kind, data, width, rows, out),
+        _ => encode_portable(kind, data, width, rows, out),
+    }
 }
 
 /// Block rows per parallel task.
 const STRIP: usize = 8;
 
-/// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
-/// bytes per texel, in parallel strips of block rows. Each strip advances `progress` by its
+/// Encodes a `(width, height)` image (sides multiples of [`BlockKind::dims`]) of
+/// [`BlockKind::texel_bytes`] bytes per texel, in parallel strips of block rows. Each strip advances `progress` by its
 /// texel rows; once it is cancelled the remaining strips are skipped (the result is then
 /// garbage: check [`Progress::is_cancelled`]).
 pub fn encode(
@@ -258,10 +319,13 @@ pub fn encode_stored(
     (width, height): (u32, u32),
     progress: Option<&Progress>,
 ) -> Vec<u8> {
-    debug_assert!(width % 4 == 0 && height % 4 == 0);
+    let (bw, bh) = kind.dims();
+    debug_assert!(width % bw == 0 && height % bh == 0);
     let per = kind.texel_bytes();
     let mut blocks = vec![0_u8; kind.blocks_len((width, height))];
     let (encoder, from_row) = match encoder {
+        // A brought encoder (a GPU's) encodes BC only.
+        Coder::Brought(_) if matches!(kind, BlockKind::Astc { .. }) => (Coder::best_cpu(), 0),
         Coder::Brought(b) => {
             let done = encode_brought(
                 b,
@@ -280,10 +344,10 @@ pub fn encode_stored(
         cpu => (cpu, 0),
     };
     // The rows the GPU did not encode (all of them, mostly).
-    let row_bytes = (width as usize / 4) * kind.block_bytes();
-    let first_block = row_bytes * from_row as usize / 4;
+    let row_bytes = (width / bw) as usize * kind.block_bytes();
+    let first_block = row_bytes * (from_row / bh) as usize;
     let first_texel = from_row as usize * width as usize * stored;
-    let strip_texels = STRIP * 4 * width as usize * stored;
+    let strip_texels = STRIP * bh as usize * width as usize * stored;
     blocks[first_block..]
         .par_chunks_mut(row_bytes * STRIP)
         .zip(texels[first_texel..].par_chunks(strip_texels))
@@ -291,13 +355,9 @@ pub fn encode_stored(
             if progress.is_some_and(Progress::is_cancelled) {
                 return;
             }
-            let rows = (out.len() / row_bytes * 4) as u32;
+            let rows = (out.len() / row_bytes) as u32 * bh;
             let wide = widen(kind, src, stored, per);
-            match encoder {
-                #[cfg(target_arch = "x86_64")]
-                Coder::Ispc => ispc::encode(kind, &wide, width, rows, out),
-                _ => encode_portable(kind, &wide, width, rows, out),
-            }
+            encode_strip(encoder, kind, &wide, width, rows, out);
             if let Some(p) = progress {
                 p.advance(u64::from(rows));
             }
@@ -365,7 +425,8 @@ fn decode_bc6h(blocks: &[u8], width: usize, dst: &mut [u8]) {
     }
 }
 
-/// Decodes blocks of `kind` covering `(width, height)` (sides multiples of 4) into
+/// Decodes blocks of `kind` covering `(width, height)` (sides multiples of
+/// [`BlockKind::dims`]) into
 /// [`BlockKind::texel_bytes`] bytes per texel, in parallel strips.
 pub fn decode(kind: BlockKind, blocks: &[u8], size: (u32, u32)) -> Vec<u8> {
     decode_stored(kind, blocks, size, kind.texel_bytes())
@@ -373,19 +434,23 @@ pub fn decode(kind: BlockKind, blocks: &[u8], size: (u32, u32)) -> Vec<u8> {
 
 /// [`decode`] keeping the leading `stored` bytes of each texel (as [`encode_stored`] took
 /// them), strip by strip.
+///
+/// # Panics
+/// Where `astcenc` cannot build an ASTC decoder (out of memory).
 pub fn decode_stored(
     kind: BlockKind,
     blocks: &[u8],
     (width, height): (u32, u32),
     stored: usize,
 ) -> Vec<u8> {
-    let row_bytes = (width as usize / 4) * kind.block_bytes();
+    let (bw, bh) = kind.dims();
+    let row_bytes = (width / bw) as usize * kind.block_bytes();
     let mut out = vec![0_u8; width as usize * height as usize * stored];
     let variant = kind.variant();
-    out.par_chunks_mut(STRIP * 4 * width as usize * stored)
+    out.par_chunks_mut(STRIP * bh as usize * width as usize * stored)
         .zip(blocks.par_chunks(row_bytes * STRIP))
         .for_each(|(dst, src)| {
-            let rows = (src.len() / row_bytes * 4) as u32;
+            let rows = (src.len() / row_bytes) as u32 * bh;
             // Whole texels as the decoder writes them (BC6H's halves, else RGBA8): into `dst`
             // where it holds them whole, else into a strip narrowed into it.
             let whole = if let BlockKind::Bc6h { .. } = kind {
@@ -400,10 +465,24 @@ pub fn decode_stored(
                 strip.resize(width as usize * rows as usize * whole, 0);
                 &mut strip
             };
-            if whole == 8 {
-                decode_bc6h(src, width as usize, texels);
-            } else {
-                decompress_blocks_as_rgba8(variant, width, rows, src, texels);
+            match (kind, variant) {
+                (
+                    BlockKind::Astc {
+                        block,
+                        channels,
+                        srgb,
+                        ..
+                    },
+                    _,
+                ) => {
+                    if let Err(e) = astc::decode(block, channels, srgb, src, (width, rows), texels)
+                    {
+                        panic!("{e}");
+                    }
+                }
+                _ if whole == 8 => decode_bc6h(src, width as usize, texels),
+                (_, Some(variant)) => decompress_blocks_as_rgba8(variant, width, rows, src, texels),
+                (_, None) => {}
             }
             if stored != whole {
                 for (d, s) in dst.chunks_exact_mut(stored).zip(strip.chunks_exact(whole)) {

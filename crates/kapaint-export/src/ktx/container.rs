@@ -4,6 +4,7 @@
 use ktx2::{Format as KtxFormat, Header, Index, LevelIndex, dfd};
 
 use super::crop;
+use crate::astc_block::AstcBlock;
 use crate::blocks::{self, BlockKind};
 use crate::preset::Bc7Quality;
 
@@ -45,6 +46,7 @@ pub(super) fn container(
         | KtxFormat::BC7_SRGB_BLOCK
         | KtxFormat::BC7_UNORM_BLOCK
         | KtxFormat::BC6H_UFLOAT_BLOCK => 16,
+        f if AstcBlock::of_vk_format(f.value()).is_some() => 16,
         _ => 4,
     };
     let index_at = Header::LENGTH;
@@ -102,6 +104,7 @@ pub(super) fn container(
 }
 
 /// Reads level 0 of a KTX2 file kapaint writes (the formats above, no supercompression).
+/// ASTC files come back as RGBA, luminance in RGB and the second of two components in alpha.
 ///
 /// # Errors
 /// A malformed file or a format kapaint does not write.
@@ -147,6 +150,9 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             | KtxFormat::BC7_SRGB_BLOCK
             | KtxFormat::BC6H_UFLOAT_BLOCK),
         ) => return decode_blocks(f, data, (w, h)),
+        Some(f) if AstcBlock::of_vk_format(f.value()).is_some() => {
+            return decode_blocks(f, data, (w, h));
+        }
         other => return Err(format!("KTX2 format {other:?} is not one kapaint writes")),
     };
     let rgba = rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
@@ -160,16 +166,26 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
 
 /// Level 0 of a block-compressed file of `format`, as RGBA (BC6H: three linear floats).
 fn decode_blocks(format: KtxFormat, data: &[u8], (w, h): (u32, u32)) -> Result<Decoded, String> {
-    let kind = match format {
-        KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
-        KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
-        KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
+    let kind = if let Some((block, srgb)) = AstcBlock::of_vk_format(format.value()) {
+        BlockKind::Astc {
+            block,
+            channels: 4,
+            srgb,
             effort: Bc7Quality::UltraFast,
-        },
-        _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
+        }
+    } else {
+        match format {
+            KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
+            KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
+            KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
+                effort: Bc7Quality::UltraFast,
+            },
+            _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
+        }
     };
-    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
-    let size = (padded.0 as usize / 4) * (padded.1 as usize / 4) * kind.block_bytes();
+    let (bw, bh) = kind.dims();
+    let padded = (w.div_ceil(bw) * bw, h.div_ceil(bh) * bh);
+    let size = kind.blocks_len(padded);
     if data.len() < size {
         return Err("level 0 is truncated".into());
     }

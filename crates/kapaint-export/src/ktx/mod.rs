@@ -1,6 +1,6 @@
 //! KTX2 files with a full mip chain: 8-bit components uncompressed, or block-compressed
 //! (BC7 for three or four components, BC5 for two, BC4 for one, BC6H for three linear half
-//! floats).
+//! floats; or ASTC LDR of any footprint for one to four).
 //!
 //! The container is assembled from the `ktx2` crate's header, level index and data format
 //! descriptor types (`container.rs`); blocks come from [`super::blocks`]; mips
@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use self::container::container;
 pub use self::container::{Decoded, decode};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
-use super::blocks::{self, BlockKind, Coder};
+use super::blocks::{self, BlockFamily, BlockKind, Coder};
 use super::preset::Bc7Quality;
 use crate::file_kind::Compression;
 use kapaint_core::task::Progress;
@@ -136,13 +136,19 @@ impl Compressed {
     }
 }
 
-/// The block kind of an image of `spaces` at `effort` (BC7 and BC6H only): BC6H for half
-/// floats, else by the component count.
-pub fn block_kind(spaces: &[Space], effort: Bc7Quality) -> BlockKind {
-    if spaces.first() == Some(&Space::Half) {
-        BlockKind::Bc6h { effort }
-    } else {
-        BlockKind::for_channels(spaces.len(), effort)
+/// The block kind of an image of `spaces` in `family` at `effort` (BC4 and BC5 have one):
+/// ASTC of the family's footprint (sRGB where colour leads three or four components); else
+/// BC6H for half floats, else BC by the component count.
+pub fn block_kind(spaces: &[Space], family: BlockFamily, effort: Bc7Quality) -> BlockKind {
+    match family {
+        BlockFamily::Astc(block) => BlockKind::Astc {
+            block,
+            channels: spaces.len() as u8,
+            srgb: spaces.len() >= 3 && spaces[0].is_colour(),
+            effort,
+        },
+        BlockFamily::Bc if spaces.first() == Some(&Space::Half) => BlockKind::Bc6h { effort },
+        BlockFamily::Bc => BlockKind::for_channels(spaces.len(), effort),
     }
 }
 
@@ -156,7 +162,8 @@ pub fn compress_level(
     channels: usize,
     progress: Option<&Progress>,
 ) -> Compressed {
-    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+    let (bw, bh) = kind.dims();
+    let padded = (w.div_ceil(bw) * bw, h.div_ceil(bh) * bh);
     let input: std::borrow::Cow<'_, [u8]> = if padded == (w, h) {
         bytes.into()
     } else {
@@ -248,12 +255,22 @@ pub struct Written {
     pub psnr: Option<Vec<Option<f64>>>,
     /// Mip levels in the file.
     pub levels: u32,
-    /// The file's compression: plain KTX2, or BC4, BC5, BC7 or BC6H blocks.
+    /// The file's compression: plain KTX2, or BC4, BC5, BC7, BC6H or ASTC blocks.
     pub compression: Compression,
 }
 
-/// The KTX2 format and compression name of `channels` components, block-compressed or not.
-fn format_of(spaces: &[Space], srgb: bool, compressed: bool) -> (KtxFormat, Compression) {
+/// The KTX2 format and compression name of `channels` components, uncompressed or
+/// block-compressed in `family`.
+fn format_of(
+    spaces: &[Space],
+    srgb: bool,
+    family: Option<BlockFamily>,
+) -> (KtxFormat, Compression) {
+    if let Some(BlockFamily::Astc(block)) = family {
+        let format = KtxFormat::new(block.vk_format(srgb)).unwrap_or(KtxFormat::R8_UNORM);
+        return (format, Compression::Ktx2Astc);
+    }
+    let compressed = family.is_some();
     if spaces.first() == Some(&Space::Half) {
         return (KtxFormat::BC6H_UFLOAT_BLOCK, Compression::Ktx2Bc6h);
     }
@@ -270,7 +287,7 @@ fn format_of(spaces: &[Space], srgb: bool, compressed: bool) -> (KtxFormat, Comp
 }
 
 /// Writes `source` as a KTX2 file with a full mip chain: uncompressed, or with
-/// `compressed = Some((encoder, effort))` block-compressed. `level0`, when given, is level 0
+/// `compressed = Some((encoder, family, effort))` block-compressed. `level0`, when given, is level 0
 /// already compressed (the export's effort search keeps the one it chose). Level 0's rows
 /// advance `progress`; a cancel stops the block encoder between strips.
 ///
@@ -279,7 +296,7 @@ fn format_of(spaces: &[Space], srgb: bool, compressed: bool) -> (KtxFormat, Comp
 /// three components, or cancelled.
 pub fn encode(
     source: &Source<'_>,
-    compressed: Option<(Coder<'_>, Bc7Quality)>,
+    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
     level0: Option<Compressed>,
     progress: &Progress,
 ) -> Result<Written, String> {
@@ -290,7 +307,7 @@ pub fn encode(
     if compressed.is_none() && per != ch {
         return Err("half floats are written only as BC6H blocks".into());
     }
-    let (format, compression) = format_of(source.spaces, srgb, compressed.is_some());
+    let (format, compression) = format_of(source.spaces, srgb, compressed.map(|c| c.1));
     let chain = mips(source);
     let mut level_bytes = Vec::with_capacity(chain.len() + 1);
     let mut decoded = Vec::with_capacity(chain.len() + 1);
@@ -315,8 +332,8 @@ pub fn encode(
                 decoded.push(bytes.clone());
             }
         }
-        Some((encoder, effort)) => {
-            let kind = block_kind(source.spaces, effort);
+        Some((encoder, family, effort)) => {
+            let kind = block_kind(source.spaces, family, effort);
             let mut first = match level0 {
                 Some(c) => {
                     progress.advance(u64::from(h));
@@ -386,7 +403,7 @@ mod tests {
         };
         encode(
             &source,
-            compressed.map(|q| (Coder::best_cpu(), q)),
+            compressed.map(|q| (Coder::best_cpu(), BlockFamily::Bc, q)),
             None,
             &Progress::default(),
         )

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::perceptual::SrgbError;
+use crate::astc_block::AstcBlock;
 use crate::blocks::Encoder;
 use crate::encoding::KaError;
 use crate::preset::{Bc7Quality, BlockBudget};
@@ -84,12 +85,20 @@ pub struct BlockChoice {
     pub gpu_failed: Option<String>,
     /// Where `n` went.
     pub layout: BlockLayout,
-    /// BC7's effort.
+    /// BC7's effort (or ASTC's on the same scale: `blocks::astc::preset_of`).
     pub bc7_effort: Bc7Quality,
+    /// An ASTC set's footprint (`"4x4"`); absent for BC sets.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub astc_block: Option<AstcBlock>,
     /// The preset's budget.
     pub budget: BlockBudget,
     /// Whether the chosen trial meets it.
     pub within_budget: bool,
+    /// Where a trial missed the budget: the `k_a` error of the first layout's files
+    /// uncompressed (8-bit, as `ktx2-raw` writes them), what storage alone costs before any
+    /// block does. Absent where the first trial met the budget (it is not measured then).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncompressed_ka_error_srgb: Option<SrgbError>,
     /// Why this one, in a sentence.
     pub reason: String,
     /// Every trial, in the order run.
@@ -100,15 +109,18 @@ impl BlockChoice {
     /// One line for people: the layout and effort chosen, the encoder, and the budget's
     /// verdict (the manifest's `blocks` has the trials and the reason).
     pub fn summary(&self) -> String {
-        let layout = match self.layout {
-            BlockLayout::Packed => "n packed in k_d's BC7",
-            BlockLayout::NApart => "n apart (BC4/BC5), colour BC7",
-            BlockLayout::HalfColour => "n apart (BC4/BC5), colour BC6H",
+        let layout = match (self.layout, self.astc_block) {
+            (BlockLayout::Packed, None) => "n packed in k_d's BC7".to_string(),
+            (BlockLayout::NApart, None) => "n apart (BC4/BC5), colour BC7".into(),
+            (BlockLayout::HalfColour, _) => "n apart (BC4/BC5), colour BC6H".into(),
+            (BlockLayout::Packed, Some(b)) => format!("ASTC {b}, n packed in k_d's alpha"),
+            (BlockLayout::NApart, Some(b)) => format!("ASTC {b}, n apart"),
         };
         let encoder = match self.encoder {
             Encoder::Ispc => "ISPC",
             Encoder::Portable => "portable CPU",
             Encoder::Gpu => "GPU",
+            Encoder::Astcenc => "astcenc",
         };
         let encoder = if self.gpu_failed.is_some() {
             format!("{encoder} encoder (the GPU encoder failed part-way)")
@@ -118,8 +130,20 @@ impl BlockChoice {
         let verdict = if self.within_budget {
             format!("within the k_a budget ({})", self.budget.describe())
         } else {
+            let floor = self
+                .uncompressed_ka_error_srgb
+                .filter(|f| {
+                    f.p999 > self.budget.ka_error_srgb_p999
+                        || f.mean > self.budget.ka_error_srgb_mean
+                })
+                .map_or_else(String::new, |f| {
+                    format!(
+                        "; the same files uncompressed are over it too (k_a within {:.2} levels for 99.9 % of texels, mean {:.3}): 8-bit storage alone misses it",
+                        f.p999, f.mean
+                    )
+                });
             format!(
-                "over the k_a budget ({}): kept the nearest of {} trials",
+                "over the k_a budget ({}): kept the nearest of {} trials{floor}",
                 self.budget.describe(),
                 self.trials.len()
             )

@@ -22,15 +22,16 @@
 
 use std::time::Instant;
 
+use super::budget::{better, nearer, reachable, shortfall, within};
 use super::choice::{BlockChoice, BlockLayout, Trial};
-use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, srgb_image};
+use super::encode::{Encoded, KtxTexels, StoredImage, block_family, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
 use super::perceptual::SrgbError;
-use crate::blocks::{BlockEncoder, BlockKind, Coder, Encoder};
+use crate::blocks::{BlockEncoder, BlockFamily, BlockKind, Coder, Encoder};
 use crate::encoding::{KaError, NEncoding};
 use crate::ktx::{self, Compressed};
-use crate::preset::{Bc7Quality, BlockBudget, ExportPreset, Format};
+use crate::preset::{Bc7Quality, ExportPreset};
 use glam::Vec3;
 use kapaint_core::model::texel::Texel;
 use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
@@ -86,12 +87,11 @@ struct TrialImage<'a> {
 
 impl TrialImage<'_> {
     /// Compresses level 0 at `effort`, unless it already is (BC4 and BC5 have one effort).
-    fn compress(&mut self, encoder: Coder<'_>, effort: Bc7Quality, size: (u32, u32), p: &Progress) {
-        let kind = ktx::block_kind(self.texels.spaces(), effort);
+    fn compress(&mut self, encoder: Coder<'_>, effort: Bc7Quality, job: &Job<'_>, p: &Progress) {
+        let size = job.size;
+        let kind = ktx::block_kind(self.texels.spaces(), job.family(), effort);
         let fresh = match &self.compressed {
-            Some((e, _)) => {
-                matches!(kind, BlockKind::Bc7 { .. } | BlockKind::Bc6h { .. }) && *e != effort
-            }
+            Some((e, _)) => !matches!(kind, BlockKind::Bc4 | BlockKind::Bc5) && *e != effort,
             None => true,
         };
         if fresh {
@@ -100,6 +100,16 @@ impl TrialImage<'_> {
             self.compressed = Some((effort, c));
         } else {
             p.advance(u64::from(size.1));
+        }
+    }
+
+    /// Level 0 as stored before any block: what the uncompressed files would hold.
+    fn uncompressed(&self) -> StoredImage<'_> {
+        StoredImage {
+            comps: self.comps.clone(),
+            data: self.level0[..].into(),
+            srgb: self.srgb,
+            half: self.half,
         }
     }
 
@@ -127,7 +137,7 @@ fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, half: bool, job:
     for (stem, comps) in want {
         if !images.iter().any(|i| i.stem == *stem) {
             let half = half_of(comps);
-            let srgb = !half && srgb_image(Format::Ktx2Bc, comps);
+            let srgb = !half && srgb_image(job.preset.format, comps);
             let texels = KtxTexels::new(job.texels, job.ka, comps, srgb, half, job.n_enc);
             let level0 = texels.level0();
             images.push(TrialImage {
@@ -145,99 +155,25 @@ fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, half: bool, job:
 }
 
 impl Job<'_> {
+    /// The blocks the preset writes.
+    fn family(&self) -> BlockFamily {
+        block_family(self.preset).unwrap_or(BlockFamily::Bc)
+    }
+
     fn measure(&self, stored: &[StoredImage<'_>]) -> (KaError, SrgbError) {
         ka_error_of_set(
             self.texels,
             self.shape,
             stored,
-            Format::Ktx2Bc,
+            self.preset.format,
             self.model,
             self.approx,
         )
     }
 }
 
-/// Whether a trial meets the budget: its sRGB-level error, and the optional limits.
-fn within(budget: &BlockBudget, t: &Trial) -> bool {
-    shortfall(t, budget).0 == 0
-}
-
-/// How much better one trial must be than another to count as better (relative).
-const MIN_GAIN: f64 = 0.05;
-
 fn tried(trials: &[Trial], layout: BlockLayout) -> bool {
     trials.iter().any(|t| t.layout == layout)
-}
-
-/// Each of the budget's measures of a trial as a ratio to its limit (above 1 fails): the
-/// sRGB-level p99.9 and mean, then the optional relative errors, and PSNR as the ratio of
-/// squared errors.
-fn ratios(t: &Trial, budget: &BlockBudget) -> Vec<f64> {
-    let srgb = t.srgb();
-    let ratio = |v: f64, limit: f64| {
-        if limit > 0.0 {
-            v / limit
-        } else if v > 0.0 {
-            f64::INFINITY
-        } else {
-            0.0
-        }
-    };
-    let mut out = vec![
-        ratio(srgb.p999, budget.ka_error_srgb_p999),
-        ratio(srgb.mean, budget.ka_error_srgb_mean),
-    ];
-    out.extend(budget.max_ka_error.map(|m| ratio(t.ka_error.max, m)));
-    out.extend(budget.mean_ka_error.map(|m| ratio(t.ka_error.mean, m)));
-    out.extend(
-        budget
-            .min_psnr
-            .map(|m| t.min_psnr.map_or(0.0, |p| 10_f64.powf((m - p) / 10.0))),
-    );
-    out
-}
-
-/// How far a trial falls short of the budget: how many of its measures fail, and the worst
-/// measure over its limit (see [`ratios`]).
-fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
-    let ratios = ratios(t, budget);
-    let failing = ratios.iter().filter(|r| **r > 1.0).count();
-    (failing, ratios.into_iter().fold(0.0, f64::max))
-}
-
-/// The better of two trials against `budget`: the one that fails fewer measures, then the one
-/// whose worst measure is nearer its limit (the earlier on a tie: fewer bytes, or the more
-/// common format).
-fn better<'t>(a: &'t Trial, b: &'t Trial, budget: &BlockBudget) -> &'t Trial {
-    if nearer(a, b, budget) { b } else { a }
-}
-
-/// Whether `b` is nearer `budget` than `a` (see [`better`]).
-fn nearer(a: &Trial, b: &Trial, budget: &BlockBudget) -> bool {
-    let (fa, wa) = shortfall(a, budget);
-    let (fb, wb) = shortfall(b, budget);
-    fb < fa || (fb == fa && wb < wa * (1.0 - MIN_GAIN))
-}
-
-/// Whether more effort in `layout` may still meet the budget: the first step is always
-/// taken; after that, each failing measure (its ratio to the limit, [`ratios`]), improving by
-/// the factor the last step improved it, must reach its limit within the `left` steps there
-/// are. A step that bought nothing ends the search.
-fn reachable(trials: &[Trial], layout: BlockLayout, budget: &BlockBudget, left: usize) -> bool {
-    let mut same = trials.iter().rev().filter(|t| t.layout == layout);
-    let Some(now) = same.next() else {
-        return true;
-    };
-    let Some(before) = same.next() else {
-        return true;
-    };
-    let steps = i32::try_from(left).unwrap_or(i32::MAX);
-    ratios(now, budget)
-        .into_iter()
-        .zip(ratios(before, budget))
-        .all(|(now, before)| {
-            now <= 1.0 || (before > 0.0 && now < before && now * (now / before).powi(steps) <= 1.0)
-        })
 }
 
 /// Encodes a block-compressed set: trials on level 0 from the cheapest profile up (see the
@@ -251,7 +187,12 @@ pub(super) fn encode_blocks(
     apart: Option<&Images>,
     progress: &Progress,
 ) -> Result<(Vec<Encoded>, BlockChoice), String> {
-    let encoder = Coder::best(job.brought);
+    let family = job.family();
+    // ASTC is astcenc's, on the CPU.
+    let encoder = match family {
+        BlockFamily::Bc => Coder::best(job.brought),
+        BlockFamily::Astc(_) => Coder::best_cpu(),
+    };
     let search = Search::new(job, packed, apart);
     let mut images = Vec::new();
     let found = search.run(&mut images, encoder, progress)?;
@@ -262,24 +203,35 @@ pub(super) fn encode_blocks(
         prepare(&mut images, want, pick.layout.half(), job);
         compress_all(&mut images, encoder, pick.bc7_effort, job, progress);
     }
-    let encoded = with_mips(images, encoder, pick.bc7_effort, job.size, progress)?;
+    let encoded = with_mips(
+        images,
+        (encoder, family, pick.bc7_effort),
+        job.size,
+        progress,
+    )?;
     let budget = job.preset.budget;
     let within_budget = within(&budget, &pick);
+    let uncompressed_ka_error_srgb = found.floor;
     // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
     let gpu_failed = encoder.failure();
     Ok((
         encoded,
         BlockChoice {
-            encoder: if gpu_failed.is_some() {
-                Encoder::best_cpu()
-            } else {
-                encoder.name()
+            encoder: match family {
+                BlockFamily::Astc(_) => Encoder::Astcenc,
+                BlockFamily::Bc if gpu_failed.is_some() => Encoder::best_cpu(),
+                BlockFamily::Bc => encoder.name(),
             },
             gpu_failed,
             layout: pick.layout,
             bc7_effort: pick.bc7_effort,
+            astc_block: match family {
+                BlockFamily::Astc(b) => Some(b),
+                BlockFamily::Bc => None,
+            },
             budget,
             within_budget,
+            uncompressed_ka_error_srgb,
             reason: found.reason,
             trials: found.trials,
         },
@@ -293,6 +245,8 @@ struct Found {
     chosen: usize,
     reason: String,
     last: (BlockLayout, Bc7Quality),
+    /// The first layout's files uncompressed, measured once a trial missed the budget.
+    floor: Option<SrgbError>,
 }
 
 /// The layouts and efforts a block-compressed set may take.
@@ -314,13 +268,20 @@ impl<'j, 'a> Search<'j, 'a> {
             .collect();
         // Fewest bytes first; then, for the same bytes, BC6H colour where there is a colour
         // image and the preset allows it (its k_d is 15 dB closer than BC7's at the same
-        // effort), else n apart in BC7.
+        // effort), else n apart in BC7 (ASTC: always; it has no LDR half floats).
         let apart_images = apart.unwrap_or(packed);
         let mut layouts = vec![BlockLayout::Packed];
-        if job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
+        let bc = job.family() == BlockFamily::Bc;
+        if bc && job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
             layouts.push(BlockLayout::HalfColour);
         } else if apart.is_some() {
             layouts.push(BlockLayout::NApart);
+        }
+        // Every ASTC block is 16 bytes whatever it holds: where both layouts have as many
+        // images (a grey k_s: kd_n + ks, or kd + ks_n), they cost the same, and n apart, on
+        // endpoints of its own, goes first.
+        if !bc && apart.is_some_and(|a| a.len() == packed.len()) {
+            layouts.reverse();
         }
         Self {
             job,
@@ -348,10 +309,13 @@ impl<'j, 'a> Search<'j, 'a> {
         progress: &Progress,
     ) -> Result<Found, String> {
         let budget = self.job.preset.budget;
-        let (mut layout, mut step) = (BlockLayout::Packed, 0);
+        let (mut layout, mut step) = (self.layouts[0], 0);
         let mut trials: Vec<Trial> = Vec::new();
+        let mut floor = None;
         loop {
             let effort = self.efforts[step];
+            // What the images hold once this trial ran (`layout` may move on below).
+            let ran = (layout, effort);
             prepare(images, self.images_of(layout), layout.half(), self.job);
             let trial = run_trial(images, encoder, layout, effort, self.job, progress)?;
             let here = trial.describe();
@@ -362,8 +326,14 @@ impl<'j, 'a> Search<'j, 'a> {
                     chosen: trials.len() - 1,
                     trials,
                     reason: format!("{here}: within the budget"),
-                    last: (layout, effort),
+                    last: ran,
+                    floor,
                 });
+            }
+            if trials.len() == 1 {
+                // What the same files cost uncompressed: no block does better than that.
+                let plain: Vec<StoredImage> = images.iter().map(TrialImage::uncompressed).collect();
+                floor = Some(self.job.measure(&plain).1);
             }
             // The layout failed: the next one, at the same effort.
             if let Some(next) = self.layouts.iter().find(|l| !tried(&trials, **l)) {
@@ -377,12 +347,42 @@ impl<'j, 'a> Search<'j, 'a> {
                     .reduce(|a, b| better(a, b, &budget))
                     .map_or(layout, |t| t.layout);
             }
-            if let Some(next) = self.more_effort(&trials, layout, step) {
+            let stored_misses = self.storage_misses(floor, &trials, layout);
+            if !stored_misses && let Some(next) = self.more_effort(&trials, layout, step) {
                 step = next;
                 continue;
             }
-            return Ok(self.nearest(trials, step, &here, (layout, effort)));
+            let mut found = self.nearest(trials, step, &here, ran, stored_misses);
+            found.floor = floor;
+            return Ok(found);
         }
+    }
+
+    /// Whether `layout`'s last trial misses the budget only by measures that its files miss
+    /// uncompressed too (`floor`, the first layout's 8-bit files: not a half-float layout's),
+    /// so that no effort can meet it.
+    fn storage_misses(
+        &self,
+        floor: Option<SrgbError>,
+        trials: &[Trial],
+        layout: BlockLayout,
+    ) -> bool {
+        let (Some(f), false) = (floor, layout.half()) else {
+            return false;
+        };
+        let Some(t) = trials.iter().rev().find(|t| t.layout == layout) else {
+            return false;
+        };
+        let budget = &self.job.preset.budget;
+        let (p999, mean) = (
+            t.srgb().p999 > budget.ka_error_srgb_p999,
+            t.srgb().mean > budget.ka_error_srgb_mean,
+        );
+        let failing = shortfall(t, budget).0;
+        failing > 0
+            && failing == usize::from(p999) + usize::from(mean)
+            && (!p999 || f.p999 > budget.ka_error_srgb_p999)
+            && (!mean || f.mean > budget.ka_error_srgb_mean)
     }
 
     /// The next effort for `layout` after `step`, where more effort may still meet the budget.
@@ -404,6 +404,7 @@ impl<'j, 'a> Search<'j, 'a> {
         step: usize,
         here: &str,
         last: (BlockLayout, Bc7Quality),
+        stored_misses: bool,
     ) -> Found {
         let budget = &self.job.preset.budget;
         let chosen = (0..trials.len())
@@ -416,7 +417,11 @@ impl<'j, 'a> Search<'j, 'a> {
             })
             .unwrap_or(0);
         let kept = trials[chosen].describe();
-        let reason = if step + 1 < self.efforts.len() {
+        let reason = if stored_misses {
+            format!(
+                "no trial met the budget, and no effort can: the same files uncompressed miss it too; kept the trial nearest it, {kept} (the last: {here})"
+            )
+        } else if step + 1 < self.efforts.len() {
             format!(
                 "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept} (the last: {here})"
             )
@@ -431,6 +436,7 @@ impl<'j, 'a> Search<'j, 'a> {
             chosen,
             reason,
             last,
+            floor: None,
         }
     }
 }
@@ -445,7 +451,7 @@ fn compress_all(
 ) {
     progress.start("encode", images.len() as u64 * u64::from(job.size.1));
     for image in images {
-        image.compress(encoder, effort, job.size, progress);
+        image.compress(encoder, effort, job, progress);
         if progress.is_cancelled() {
             return;
         }
@@ -493,8 +499,7 @@ fn run_trial(
 /// The chosen images, level 0 as compressed, with their mip chains: the set's files.
 fn with_mips(
     images: Vec<TrialImage<'_>>,
-    encoder: Coder<'_>,
-    effort: Bc7Quality,
+    blocks: (Coder<'_>, BlockFamily, Bc7Quality),
     size: (u32, u32),
     progress: &Progress,
 ) -> Result<Vec<Encoded>, String> {
@@ -504,7 +509,7 @@ fn with_mips(
         let compressed = image.compressed.map(|(_, c)| c);
         let written = ktx::encode(
             &image.texels.source(size, &image.level0),
-            Some((encoder, effort)),
+            Some(blocks),
             compressed,
             progress,
         )?;

@@ -5,6 +5,7 @@ use image::ExtendedColorType as C;
 use rayon::prelude::*;
 
 use super::manifest::{Comp, Compression, is_colour};
+use crate::blocks::BlockFamily;
 use crate::encoding::NEncoding;
 use crate::ktx::{Space, texel_layout};
 use crate::preset::{ExportPreset, Format};
@@ -47,6 +48,15 @@ pub(super) struct KtxInfo {
     pub compression: Compression,
     /// Levels 1 and on as a consumer decodes them.
     pub mips: Vec<Vec<u8>>,
+}
+
+/// The blocks a block-compressed preset writes (`None` for the others).
+pub(super) fn block_family(preset: &ExportPreset) -> Option<BlockFamily> {
+    match preset.format {
+        Format::Ktx2Bc => Some(BlockFamily::Bc),
+        Format::Ktx2Astc => Some(BlockFamily::Astc(preset.astc_block)),
+        _ => None,
+    }
 }
 
 /// Whether an image's colour components are sRGB-encoded: in 8-bit PNGs always, in KTX2
@@ -147,11 +157,11 @@ pub(super) fn encode_image(
             Ok(plain(png(&data, [C::L16, C::La16, C::Rgb16, C::Rgba16])?))
         }
         Format::Exr => Ok(plain(exr_bytes(&value, channels, (width, height))?)),
-        Format::Ktx2 | Format::Ktx2Bc => {
+        Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc => {
             let source = KtxTexels::new(texels, ka, comps, srgb, false, n_enc);
             let level0 = source.level0();
-            let compressed = (format == Format::Ktx2Bc)
-                .then_some((crate::blocks::Coder::best_cpu(), preset.max_bc7_effort));
+            let compressed = block_family(preset)
+                .map(|f| (crate::blocks::Coder::best_cpu(), f, preset.max_bc7_effort));
             let written = crate::ktx::encode(
                 &source.source((width, height), &level0),
                 compressed,

@@ -107,6 +107,8 @@ fn read_file(
         .collect::<Result<_, _>>()?;
     let srgb = file.colour_space == ColourSpace::Srgb;
     let exr = file.compression == Compression::Exr;
+    // Two-component ASTC images are luminance + alpha, as grey + alpha PNGs.
+    let second_in_alpha = !exr && (!ktx || file.compression == Compression::Ktx2Astc);
     let n_enc = manifest.n_encoding;
     let n_codes: Vec<f32> = n_enc.map_or_else(Vec::new, |e| {
         (0..=((1_u32 << e.bits) - 1) as u16)
@@ -128,11 +130,11 @@ fn read_file(
         .zip(pixels.par_chunks(4))
         .for_each(|(v, px)| {
             for (k, comp) in comps.iter().enumerate() {
-                // EXR one-component images repeat the value, grey + alpha PNGs read as
-                // (L, L, L, A); others hold components in order.
+                // EXR one-component images repeat the value, grey + alpha PNGs and ASTC
+                // read as (L, L, L, A); others hold components in order.
                 let raw = match (comps.len(), k) {
                     (1, _) if exr => px[0],
-                    (2, 1) if !ktx && !exr => px[3],
+                    (2, 1) if second_in_alpha => px[3],
                     _ => px[k.min(3)],
                 };
                 match *comp {

@@ -6,6 +6,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::perceptual::SrgbError;
+use crate::astc_block::AstcBlock;
 use crate::encoding::{KaError, NEncoding};
 use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
 
@@ -48,6 +49,9 @@ pub struct FileEntry {
     /// the same components uncompressed; `null` where a component is exact.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub psnr: Option<Vec<Option<f64>>>,
+    /// For ASTC files: the block footprint (`"4x4"`; the file's `vkFormat` says it too).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub astc_block: Option<AstcBlock>,
 }
 
 /// A file entry as a manifest spells it, before it is checked.
@@ -65,6 +69,8 @@ struct FileEntryFile {
     mip_levels: Option<u32>,
     #[serde(default)]
     psnr: Option<Vec<Option<f64>>>,
+    #[serde(default)]
+    astc_block: Option<AstcBlock>,
 }
 
 impl TryFrom<FileEntryFile> for FileEntry {
@@ -98,6 +104,11 @@ impl TryFrom<FileEntryFile> for FileEntry {
                 f.bit_depth
             ));
         }
+        if f.astc_block.is_some() && compression != Compression::Ktx2Astc {
+            return Err(format!(
+                "{name}: astc_block names an ASTC file's footprint, not a {compression} file's"
+            ));
+        }
         let colour_space = ColourSpace::parse(&f.colour_space).ok_or_else(|| {
             format!(
                 "{name}: colour_space must be srgb or linear, got {:?}",
@@ -129,6 +140,7 @@ impl TryFrom<FileEntryFile> for FileEntry {
             bytes: f.bytes,
             mip_levels: f.mip_levels,
             psnr: f.psnr,
+            astc_block: f.astc_block,
         })
     }
 }

@@ -3,6 +3,7 @@
 //! A set is written into a temporary folder beside the target and renamed into place at the
 //! end, so a half-written set is never left where the target should be.
 
+mod budget;
 mod choice;
 mod choose;
 mod encode;
@@ -227,7 +228,7 @@ impl<'d> Source<'d> {
             }
         };
         let n_enc = self.planned.n_encoding;
-        if preset.format == Format::Ktx2Bc {
+        if preset.format.is_blocks() {
             let job = choose::Job {
                 texels: &self.texels,
                 ka: &self.ka,
@@ -277,7 +278,7 @@ impl<'d> Source<'d> {
         blocks: Option<Box<BlockChoice>>,
     ) -> Manifest {
         let depth = match preset.format {
-            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 1,
+            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc | Format::GltfPbr => 1,
             Format::Png16 => 2,
             Format::Exr => 4,
         };
@@ -411,7 +412,7 @@ fn file_entry(
         },
         bit_depth: match preset.format {
             _ if image.half => 16,
-            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 8,
+            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc | Format::GltfPbr => 8,
             Format::Png16 => 16,
             Format::Exr => 32,
         },
@@ -421,6 +422,7 @@ fn file_entry(
         bytes: image.bytes.len() as u64,
         mip_levels,
         psnr,
+        astc_block: (compression == Compression::Ktx2Astc).then_some(preset.astc_block),
     }
 }
 

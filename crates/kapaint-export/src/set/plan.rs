@@ -126,7 +126,7 @@ pub(super) fn plan_set(
     };
     let images = plan_images(preset, &constants, mono_ks);
     let depth: u64 = match preset.format {
-        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::GltfPbr => 1,
+        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc | Format::GltfPbr => 1,
         Format::Png16 => 2,
         Format::Exr => 4,
     };

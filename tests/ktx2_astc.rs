@@ -1,0 +1,448 @@
+//! Issue 43, item 3: the `ktx2-astc` preset, checked independently of kapaint's own code.
+//! Every file is parsed with the `ktx2` crate's reader and held to the KTX2 specification's
+//! rules for an ASTC file (vkFormat of the footprint, sRGB for colour, the DFD's ASTC colour
+//! model and texel block), every level is decoded with `texture2ddecoder` (not astcenc, which
+//! encoded it) and compared with the same project's uncompressed levels and with what
+//! kapaint's own decode (the export's measure, the import) reads.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::path::{Path, PathBuf};
+
+use kapaint::export::astc_block::AstcBlock;
+use kapaint::export::blocks::{self, BlockKind, Coder};
+use kapaint::export::preset::{self, Bc7Quality, ExportPreset};
+use kapaint::export::set::{self, BlockLayout, ColourSpace, Compression, Manifest};
+use kapaint::model::Document;
+use kapaint::report::typical::typical_document;
+
+fn temp(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kapaint-astc-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn project(side: u32) -> Document {
+    let texture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_texture.png");
+    typical_document(side, texture.exists().then_some(texture.as_path()), 12).expect("project")
+}
+
+fn astc_preset(block: &str, extra: &str) -> ExportPreset {
+    let text = format!(
+        "(name: \"astc-{block}\", format: Ktx2Astc, layout: Packed, n_bits: 8, \
+         astc_block: \"{block}\"{extra})"
+    );
+    ExportPreset::parse(Path::new("astc.ron"), &text).expect("preset")
+}
+
+/// A level's texels by `texture2ddecoder`, as RGBA8.
+fn decode(data: &[u8], (w, h): (u32, u32), block: AstcBlock) -> Vec<u8> {
+    let (bw, bh) = block.dims();
+    let mut image = vec![0_u32; w as usize * h as usize];
+    texture2ddecoder::decode_astc(
+        data,
+        w as usize,
+        h as usize,
+        bw as usize,
+        bh as usize,
+        &mut image,
+    )
+    .expect("texture2ddecoder decodes the level");
+    // Packed as little-endian BGRA.
+    image
+        .iter()
+        .flat_map(|p| {
+            let [b, g, r, a] = p.to_le_bytes();
+            [r, g, b, a]
+        })
+        .collect()
+}
+
+/// Checks an ASTC KTX2 file against the specification; returns its levels decoded by
+/// `texture2ddecoder`, finest first, RGBA8.
+fn check_and_decode(path: &Path, block: AstcBlock, srgb: bool) -> Vec<Vec<u8>> {
+    let bytes = std::fs::read(path).expect("read");
+    let what = path.display();
+    let reader = ktx2::Reader::new(&bytes[..]).expect("a KTX2 file");
+    let header = reader.header();
+    let format = header.format.expect("a vkFormat");
+    // VK_FORMAT_ASTC_{w}x{h}_{UNORM,SRGB}_BLOCK.
+    assert_eq!(format.value(), block.vk_format(srgb), "{what}: vkFormat");
+    let (w, h) = (header.pixel_width, header.pixel_height);
+    assert_eq!(header.type_size, 1, "{what}: typeSize");
+    assert_eq!(header.level_count, 32 - w.max(h).leading_zeros(), "{what}");
+    let (bw, bh) = block.dims();
+    let mut levels = Vec::new();
+    for (i, level) in reader.levels().enumerate() {
+        let (lw, lh) = ((w >> i).max(1), (h >> i).max(1));
+        let blocks = lw.div_ceil(bw) as usize * lh.div_ceil(bh) as usize;
+        assert_eq!(level.data.len(), blocks * 16, "{what}: level {i}");
+        let at = 80 + i * 24;
+        let entry = ktx2::LevelIndex::from_bytes(bytes[at..at + 24].try_into().expect("24"));
+        assert_eq!(entry.byte_offset % 16, 0, "{what}: level {i} alignment");
+        levels.push(decode(level.data, (lw, lh), block));
+    }
+    let basic = reader.basic_dfd().expect("a basic descriptor block");
+    assert_eq!(basic.color_model, Some(ktx2::ColorModel::ASTC), "{what}");
+    assert_eq!(
+        basic.transfer_function,
+        Some(if srgb {
+            ktx2::TransferFunction::SRGB
+        } else {
+            ktx2::TransferFunction::Linear
+        }),
+        "{what}: transferFunction"
+    );
+    let dims: Vec<u8> = basic
+        .texel_block_dimensions
+        .iter()
+        .map(|d| d.get())
+        .collect();
+    assert_eq!(
+        dims,
+        [bw as u8, bh as u8, 1, 1],
+        "{what}: texelBlockDimension"
+    );
+    assert_eq!(basic.bytes_planes[0], 16, "{what}: bytesPlane0");
+    levels
+}
+
+/// Where component `k` of an image of `count` components sits in a decoded RGBA texel: in
+/// order, but the second of two in alpha (luminance + alpha).
+fn channel(count: usize, k: usize) -> usize {
+    if count == 2 && k == 1 { 3 } else { k }
+}
+
+/// PSNR of two byte sequences.
+fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (f64::from(*x) - f64::from(*y)).powi(2))
+        .sum::<f64>()
+        / a.len() as f64;
+    10.0 * (255.0 * 255.0 / mse.max(1e-12)).log10()
+}
+
+/// Every component of every file of an ASTC set against the same project's `ktx2-raw` set,
+/// level by level, decoded independently; and level 0 as kapaint's import decodes it.
+fn compare_with_raw(doc: &Document, dir: &Path, m: &Manifest, block: AstcBlock, tag: &str) {
+    // 8 bits per texel at 4x4 keeps every level within 36 dB of the project; 3.56 at 6x6
+    // loses more on the small levels, where one block spans much of the texture's detail.
+    let floor = if block == AstcBlock::DEFAULT {
+        36.0
+    } else {
+        25.0
+    };
+    let raw_dir = temp(&format!("{tag}-raw"));
+    let raw = set::export(doc, &preset::find("ktx2-raw").expect("raw"), &raw_dir).expect("raw");
+    for file in &m.files {
+        assert_eq!(file.compression, Compression::Ktx2Astc, "{}", file.path);
+        assert_eq!(file.astc_block, Some(block), "{}", file.path);
+        let srgb = file.colour_space == ColourSpace::Srgb;
+        let levels = check_and_decode(&dir.join(&file.path), block, srgb);
+        let ours =
+            kapaint::export::ktx::decode(&std::fs::read(dir.join(&file.path)).expect("read"))
+                .expect("kapaint decodes");
+        // kapaint's decode (the export's measure and the import) and an independent decoder
+        // agree to within a level.
+        let worst = ours
+            .rgba
+            .iter()
+            .zip(&levels[0])
+            .map(|(a, b)| ((a * 255.0).round() - f32::from(*b)).abs())
+            .fold(0.0_f32, f32::max);
+        assert!(worst <= 1.0, "{}: decoders differ by {worst}", file.path);
+        for (k, comp) in file.layout.iter().enumerate() {
+            let (raw_file, at) = raw
+                .files
+                .iter()
+                .find_map(|f| f.layout.iter().position(|c| c == comp).map(|i| (f, i)))
+                .expect("the raw set holds every component");
+            let raw_levels = check_raw(&raw_dir.join(&raw_file.path));
+            for (i, (got, want)) in levels.iter().zip(&raw_levels).enumerate().take(4) {
+                let c = channel(file.layout.len(), k);
+                // Uncompressed files hold components in order.
+                let rc = at;
+                let a: Vec<u8> = got.chunks_exact(4).map(|t| t[c]).collect();
+                let b: Vec<u8> = want.chunks_exact(4).map(|t| t[rc]).collect();
+                let p = psnr(&a, &b);
+                eprintln!("{tag} {}: {comp} level {i}: {p:.1} dB", file.path);
+                assert!(
+                    p > floor,
+                    "{tag} {}: {comp} level {i}: {p:.1} dB",
+                    file.path
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&raw_dir);
+}
+
+/// An uncompressed KTX2 file's levels, RGBA8 (components in order).
+fn check_raw(path: &Path) -> Vec<Vec<u8>> {
+    let bytes = std::fs::read(path).expect("read");
+    let reader = ktx2::Reader::new(&bytes[..]).expect("KTX2");
+    let per = match reader.header().format {
+        Some(ktx2::Format::R8_UNORM) => 1,
+        Some(ktx2::Format::R8G8_UNORM) => 2,
+        _ => 4,
+    };
+    reader
+        .levels()
+        .map(|l| {
+            l.data
+                .chunks_exact(per)
+                .flat_map(|t| {
+                    let mut px = [255_u8; 4];
+                    px[..per].copy_from_slice(t);
+                    px
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn astc_sets_are_valid_ktx2_that_an_independent_decoder_reads_close_to_the_project() {
+    let doc = project(128);
+    let p = preset::find("ktx2-astc").expect("the built-in preset");
+    assert_eq!(p.astc_block, AstcBlock::DEFAULT);
+    let out = temp("4x4");
+    let m = set::export(&doc, &p, &out).expect("export");
+    let blocks = m.blocks.as_ref().expect("the search's record");
+    assert_eq!(blocks.astc_block, Some(AstcBlock::DEFAULT));
+    assert_eq!(blocks.encoder, kapaint::export::blocks::Encoder::Astcenc);
+    let text = std::fs::read_to_string(out.join("material.json")).expect("manifest");
+    assert!(text.contains("\"astc_block\": \"4x4\""), "{text}");
+    assert!(text.contains("\"ktx2-astc\""), "{text}");
+    compare_with_raw(&doc, &out, &m, AstcBlock::DEFAULT, "4x4");
+    // The set imports (the blocks decoded as a consumer does).
+    let back = set::import(&out.join("material.json")).expect("import");
+    assert_eq!((back.maps().width(), back.maps().height()), (128, 128));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_larger_footprint_is_a_preset_field_and_pads_partial_blocks() {
+    // 6x6 on a 128^2 project: 22 blocks across, the last one two texels past the edge.
+    let doc = project(128);
+    let block = AstcBlock::parse("6x6").expect("6x6");
+    let p = astc_preset("6x6", "");
+    assert_eq!(p.astc_block, block);
+    let out = temp("6x6");
+    let m = set::export(&doc, &p, &out).expect("export");
+    assert_eq!(m.blocks.as_ref().and_then(|b| b.astc_block), Some(block));
+    compare_with_raw(&doc, &out, &m, block, "6x6");
+    // Fewer bytes than 4x4: 16 bytes per 36 texels against per 16.
+    let kd = m.files.iter().find(|f| f.layout[0] == "kd.r").expect("kd");
+    assert!(kd.bytes < 128 * 128 * 16 / 36 * 2, "{}", kd.bytes);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn footprints_astc_does_not_define_are_refused_by_the_preset_loader() {
+    for bad in ["7x7", "4x5", "16x16", "4x4x4", "big"] {
+        let text = format!(
+            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"{bad}\")"
+        );
+        let err = ExportPreset::parse(Path::new("bad.ron"), &text)
+            .expect_err(bad)
+            .to_string();
+        assert!(
+            err.starts_with("bad.ron: ") && err.contains("12x12"),
+            "{bad}: {err}"
+        );
+    }
+    // A footprint belongs to ASTC presets only.
+    let text = "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, astc_block: \"4x4\")";
+    assert!(ExportPreset::parse(Path::new("x.ron"), text).is_err());
+    for good in AstcBlock::ALL {
+        let p = astc_preset(&good.name(), "");
+        assert_eq!(p.astc_block, good);
+    }
+}
+
+#[test]
+fn two_components_are_luminance_and_alpha() {
+    // A grey k_s beside n, as the n-apart layout stores them: one in RGB, the other in alpha.
+    let (w, h) = (64_u32, 32_u32);
+    let src: Vec<u8> = (0..w * h)
+        .flat_map(|i| {
+            let (x, y) = (i % w, i / w);
+            [(x * 4) as u8, (255 - y * 6) as u8]
+        })
+        .collect();
+    let kind = BlockKind::Astc {
+        block: AstcBlock::DEFAULT,
+        channels: 2,
+        srgb: false,
+        effort: Bc7Quality::Fast,
+    };
+    let encoded = blocks::encode_stored(Coder::best_cpu(), kind, &src, 2, (w, h), None);
+    let theirs = decode(&encoded, (w, h), AstcBlock::DEFAULT);
+    let ours = blocks::decode_stored(kind, &encoded, (w, h), 2);
+    for (i, (t, s)) in theirs.chunks_exact(4).zip(src.chunks_exact(2)).enumerate() {
+        assert!(t[0] == t[1] && t[1] == t[2], "texel {i}: luminance {t:?}");
+        assert!(
+            t[0].abs_diff(s[0]) <= 2 && t[3].abs_diff(s[1]) <= 2,
+            "texel {i}: {t:?} {s:?}"
+        );
+        // The two decoders round unorm8 differently by at most one level.
+        let mine = &ours[2 * i..2 * i + 2];
+        assert!(
+            mine[0].abs_diff(t[0]) <= 1 && mine[1].abs_diff(t[3]) <= 1,
+            "texel {i}: {mine:?} against {t:?}"
+        );
+    }
+}
+
+#[test]
+fn the_search_tries_both_layouts_then_more_effort_against_the_perceptual_budget() {
+    // A budget no encoding meets: every layout is tried, then more effort while it pays.
+    let doc = project(64);
+    let p = astc_preset(
+        "4x4",
+        ", ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0, max_bc7_effort: Fast",
+    );
+    let out = temp("search");
+    let m = set::export(&doc, &p, &out).expect("export");
+    let b = m.blocks.as_ref().expect("blocks");
+    let tried: Vec<(BlockLayout, Bc7Quality)> =
+        b.trials.iter().map(|t| (t.layout, t.bc7_effort)).collect();
+    // The project's k_s is grey: packed (kd_n + ks) and n apart (kd + ks_n) are two images of
+    // 16-byte blocks each, the same bytes, and n apart goes first.
+    assert_eq!(m.files.len(), 2, "{:?}", m.files);
+    assert!(m.files.iter().any(|f| f.layout.contains(&"ks".to_string())));
+    assert_eq!(
+        tried[0],
+        (BlockLayout::NApart, Bc7Quality::UltraFast),
+        "{tried:?}"
+    );
+    assert_eq!(
+        tried[1],
+        (BlockLayout::Packed, Bc7Quality::UltraFast),
+        "{tried:?}"
+    );
+    assert!(
+        !b.within_budget && b.reason.contains("no trial"),
+        "{}",
+        b.reason
+    );
+    assert!(
+        tried.iter().all(|(l, _)| *l != BlockLayout::HalfColour),
+        "ASTC has no BC6H: {tried:?}"
+    );
+    // What was kept is on disk, and imports.
+    set::import(&out.join("material.json")).expect("import");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Whether a set's files are the packed layout's: `n` beside `k_d` in one image.
+fn packed_files(m: &Manifest) -> bool {
+    m.files
+        .iter()
+        .any(|f| f.layout.first().is_some_and(|c| c == "kd.r") && f.layout.contains(&"n".into()))
+}
+
+#[test]
+fn the_files_written_are_the_kept_trials_when_the_search_ends_on_another() {
+    // A ceiling of the cheapest effort and a budget nothing meets: both layouts are tried at
+    // it, and the nearest is kept. Where that is not the last one tried, its level 0 must be
+    // encoded again: the files once held the last trial's layout under the kept one's name.
+    let doc = project(64);
+    for (preset, tag) in [
+        (
+            astc_preset(
+                "4x4",
+                ", ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0, max_bc7_effort: UltraFast",
+            ),
+            "kept-astc",
+        ),
+        (
+            ExportPreset::parse(
+                Path::new("bc.ron"),
+                "(name: \"bc\", format: Ktx2Bc, layout: Packed, n_bits: 8, \
+                 ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0, max_bc7_effort: UltraFast, \
+                 bc6h: false)",
+            )
+            .expect("preset"),
+            "kept-bc",
+        ),
+    ] {
+        let out = temp(tag);
+        let m = set::export(&doc, &preset, &out).expect("export");
+        let b = m.blocks.as_ref().expect("blocks");
+        assert_eq!(b.trials.len(), 2, "{tag}: {:?}", b.trials);
+        assert_eq!(
+            packed_files(&m),
+            b.layout == BlockLayout::Packed,
+            "{tag}: kept {:?}, files {:?}",
+            b.layout,
+            m.files.iter().map(|f| &f.layout).collect::<Vec<_>>()
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
+
+#[test]
+fn a_budget_that_8_bit_storage_misses_is_said_and_costs_no_more_effort() {
+    // A mid-grey k_d (0.5 linear) is 187.5 in 8-bit sRGB: stored in 8 bits it is half a level
+    // off everywhere, and k_a with it, so no 8-bit file meets a mean of 0.3 levels, however
+    // its blocks are encoded. The search says so and stops after the layouts.
+    use glam::{Vec2, Vec3};
+    use kapaint::model::brush::StrokePoint;
+    use kapaint::model::texel::MaterialValue;
+    use kapaint::model::{DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
+    let mut doc = Document::new(
+        256,
+        256,
+        DocumentSettings {
+            base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.25), 32.0),
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("doc");
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
+        Vec3::new(0.8, 0.1, 0.1),
+        Vec3::splat(0.5),
+        200.0,
+    )))
+    .expect("primary");
+    doc.apply(StrokeCommand::Stroke {
+        tool: StrokeTool::Brush,
+        points: [100.0, 140.0]
+            .map(|x| StrokePoint {
+                pos: Vec2::new(x, 128.0),
+                pressure: 1.0,
+            })
+            .to_vec(),
+    })
+    .expect("stroke");
+    let p = preset::find("ktx2-astc").expect("preset");
+    let out = temp("floor");
+    let m = set::export(&doc, &p, &out).expect("export");
+    let b = m.blocks.as_ref().expect("blocks");
+    let floor = b
+        .uncompressed_ka_error_srgb
+        .expect("measured once a trial missed");
+    assert!(floor.mean > 0.3, "{floor:?}");
+    assert!(!b.within_budget);
+    assert_eq!(
+        b.trials.len(),
+        2,
+        "both layouts, no more effort: {:?}",
+        b.trials
+    );
+    assert!(b.reason.contains("uncompressed"), "{}", b.reason);
+    assert!(
+        b.summary().contains("8-bit storage alone misses it"),
+        "{}",
+        b.summary()
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
