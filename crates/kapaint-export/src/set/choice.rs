@@ -94,9 +94,10 @@ pub struct BlockChoice {
     pub budget: BlockBudget,
     /// Whether the chosen trial meets it.
     pub within_budget: bool,
-    /// Where a trial missed the budget: the `k_a` error of the first layout's files
-    /// uncompressed (8-bit, as `ktx2-raw` writes them), what storage alone costs before any
-    /// block does. Absent where the first trial met the budget (it is not measured then).
+    /// Where the search weighed more effort in an 8-bit layout: the `k_a` error of the same
+    /// files uncompressed (as `ktx2-raw` writes them), what storage alone costs before any
+    /// block does. Absent otherwise (a trial met the budget first, or the layout in question
+    /// was BC6H's half floats).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uncompressed_ka_error_srgb: Option<SrgbError>,
     /// Why this one, in a sentence.

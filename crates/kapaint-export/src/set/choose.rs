@@ -245,7 +245,7 @@ struct Found {
     chosen: usize,
     reason: String,
     last: (BlockLayout, Bc7Quality),
-    /// The first layout's files uncompressed, measured once a trial missed the budget.
+    /// The same files uncompressed, where more effort in an 8-bit layout was weighed.
     floor: Option<SrgbError>,
 }
 
@@ -330,11 +330,6 @@ impl<'j, 'a> Search<'j, 'a> {
                     floor,
                 });
             }
-            if trials.len() == 1 {
-                // What the same files cost uncompressed: no block does better than that.
-                let plain: Vec<StoredImage> = images.iter().map(TrialImage::uncompressed).collect();
-                floor = Some(self.job.measure(&plain).1);
-            }
             // The layout failed: the next one, at the same effort.
             if let Some(next) = self.layouts.iter().find(|l| !tried(&trials, **l)) {
                 layout = *next;
@@ -346,6 +341,13 @@ impl<'j, 'a> Search<'j, 'a> {
                     .iter()
                     .reduce(|a, b| better(a, b, &budget))
                     .map_or(layout, |t| t.layout);
+            }
+            // What 8-bit files cost uncompressed, where more effort in an 8-bit layout is in
+            // question (measured once, from images that are not half floats: every 8-bit
+            // layout stores the same values): no block does better than that.
+            if floor.is_none() && !layout.half() && images.iter().all(|i| !i.half) {
+                let plain: Vec<StoredImage> = images.iter().map(TrialImage::uncompressed).collect();
+                floor = Some(self.job.measure(&plain).1);
             }
             let stored_misses = self.storage_misses(floor, &trials, layout);
             if !stored_misses && let Some(next) = self.more_effort(&trials, layout, step) {
