@@ -446,3 +446,42 @@ fn a_budget_that_8_bit_storage_misses_is_said_and_costs_no_more_effort() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn an_astc_file_of_garbage_blocks_reads_without_a_crash() {
+    // A hostile or corrupt file: the header and index of a real set, level 0's blocks
+    // replaced by noise (reserved modes, void extents out of range, illegal weight counts),
+    // for the smallest and the largest footprints. ASTC decodes every 128-bit pattern: the
+    // import reads colours (an illegal block is the error colour), never crashes; and a file
+    // cut short is an error.
+    let doc = project(64);
+    for block in ["4x4", "12x12"] {
+        let out = temp(&format!("garbage-{block}"));
+        let m = set::export(&doc, &astc_preset(block, ""), &out).expect("export");
+        let path = out.join(&m.files[0].path);
+        let mut bytes = std::fs::read(&path).expect("read");
+        let reader = ktx2::Reader::new(&bytes[..]).expect("KTX2");
+        let level0 = bytes.len() - reader.levels().next().expect("level 0").data.len();
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        for b in &mut bytes[level0..] {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            *b = state as u8;
+        }
+        let decoded = kapaint::export::ktx::decode(&bytes).expect("garbage blocks decode");
+        assert_eq!((decoded.width, decoded.height), (64, 64));
+        assert!(
+            decoded
+                .rgba
+                .iter()
+                .all(|v| v.is_finite() && (0.0..=1.0).contains(v))
+        );
+        bytes.truncate(bytes.len() - 7);
+        assert!(
+            kapaint::export::ktx::decode(&bytes).is_err(),
+            "{block}: cut short"
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}
