@@ -202,6 +202,9 @@ fn a_texture_set_imports_from_any_one_of_its_images() {
     assert_eq!((prompt.size, prompt.project), ((32, 32), (1024, 1024)));
     assert!(prompt.adopt_by_default);
     harness.get_by_label_contains("the project's maps are 1024x1024");
+    // The set by its name, not the image clicked (regression: "Bricks_BaseColor.png is
+    // 32x32").
+    harness.get_by_label_contains("The texture set Bricks is 32x32");
     harness.get_by_label("Resample to 1024x1024");
     harness.get_by_label("Adopt 32x32").click();
     harness.run_steps(2);

@@ -77,6 +77,8 @@ pub(super) struct UnwrapPrompt {
 
 /// A material read from its files, before conversion.
 pub struct LoadedMaterial {
+    /// What the size question calls it: "The texture set Bricks", "cow.glb's material".
+    pub(super) name: String,
     pub(super) set: kapaint_core::pbr::import::PbrSet,
     pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
     pub(super) notes: Vec<String>,

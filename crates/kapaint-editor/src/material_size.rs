@@ -37,7 +37,12 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
         .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
     if gltf {
         let m = kapaint_core::pbr::gltf::material_set(path, None)?;
+        let file = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
         return Ok(LoadedMaterial {
+            name: format!("{file}'s material"),
             set: m.set,
             normal: m.normal,
             notes: m.notes,
@@ -47,6 +52,7 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
     let mut notes = named.notes.clone();
     let normal = named.load_normal(&mut notes)?;
     Ok(LoadedMaterial {
+        name: format!("The texture set {}", named.name),
         set: named.set,
         normal,
         notes,
@@ -177,10 +183,7 @@ impl EditorState {
             return;
         };
         let ((w, h), (pw, ph)) = (prompt.size, prompt.project);
-        let name = prompt.path.file_name().map_or_else(
-            || prompt.path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
+        let name = &prompt.loaded.name;
         let adopt_label = format!("Adopt {w}x{h}");
         let resample_label = format!("Resample to {pw}x{ph}");
         let adopt_first = prompt.adopt_by_default;
