@@ -485,3 +485,49 @@ fn an_astc_file_of_garbage_blocks_reads_without_a_crash() {
         let _ = std::fs::remove_dir_all(&out);
     }
 }
+
+#[test]
+fn the_cli_report_names_the_footprint() {
+    let dir = temp("cli");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let project = dir.join("p.kapaint");
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+            .args(args)
+            .output()
+            .expect("kapaint runs")
+    };
+    let s = |p: &Path| p.to_str().expect("UTF-8 path").to_owned();
+    let o = run(&["new", "--size", "64", "--out", &s(&project)]);
+    assert!(o.status.success(), "{o:?}");
+    // A k_d that varies, so the set holds block-compressed images.
+    let image = dir.join("kd.png");
+    image::RgbImage::from_fn(64, 64, |x, y| {
+        image::Rgb([(x * 4) as u8, (y * 4) as u8, 90])
+    })
+    .save(&image)
+    .expect("png");
+    let o = run(&[
+        "import",
+        &s(&project),
+        "--channel",
+        "kd",
+        "--image",
+        &s(&image),
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let out = dir.join("set");
+    let o = run(&[
+        "export",
+        &s(&project),
+        "--preset",
+        "ktx2-astc",
+        "--out",
+        &s(&out),
+        "--report",
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("  blocks: ASTC 4x4, "), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

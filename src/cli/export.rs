@@ -97,9 +97,12 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
 /// The `--report` lines of a block-compressed set's choice: the layout, effort and encoder,
 /// the verdict, and every trial.
 fn write_blocks(text: &mut String, b: &crate::export::set::BlockChoice) {
+    let footprint = b
+        .astc_block
+        .map_or_else(String::new, |f| format!("ASTC {f}, "));
     let _ = writeln!(
         text,
-        "  blocks: {:?} at {:?} ({:?} encoder), {}: {}",
+        "  blocks: {footprint}{:?} at {:?} ({:?} encoder), {}: {}",
         b.layout,
         b.bc7_effort,
         b.encoder,
@@ -110,6 +113,13 @@ fn write_blocks(text: &mut String, b: &crate::export::set::BlockChoice) {
         },
         b.reason
     );
+    if let Some(f) = &b.uncompressed_ka_error_srgb {
+        let _ = writeln!(
+            text,
+            "  the same files uncompressed: k_a within {:.2} levels for 99.9 % of texels (mean {:.3})",
+            f.p999, f.mean
+        );
+    }
     if let Some(why) = &b.gpu_failed {
         let _ = writeln!(
             text,

@@ -11,7 +11,7 @@
 
 use std::sync::{Mutex, OnceLock};
 
-use block_compression::GpuBlockCompressor;
+use block_compression::{CompressionVariant, GpuBlockCompressor};
 
 use super::{Gpu, GpuError};
 use kapaint_export::blocks::{BlockEncoder, BlockKind};
@@ -211,11 +211,11 @@ impl GpuBlockEncoder {
             error,
             rows_done: 0,
         };
-        if kind.variant().is_none() {
+        let Some(variant) = kind.variant() else {
             return Err(at_start(GpuError(format!(
                 "{kind:?} is not a block kind the GPU encodes"
             ))));
-        }
+        };
         let row_bytes = width as usize * kind.texel_bytes();
         let fit = u32::try_from(STRIP_BYTES / row_bytes.max(1)).unwrap_or(u32::MAX);
         let strip_rows = (fit.min(self.strip_rows) / 4 * 4).clamp(4, height);
@@ -230,7 +230,7 @@ impl GpuBlockEncoder {
         let strip = self
             .gpu
             .checked("block encoding", || {
-                Strip::new(&self.gpu, kind, (width, strip_rows))
+                Strip::new(&self.gpu, kind, variant, (width, strip_rows))
             })
             .map_err(at_start)?;
         let mut texels = vec![0_u8; row_bytes * strip_rows as usize];
@@ -242,7 +242,7 @@ impl GpuBlockEncoder {
             let at = blocks_row * row as usize / 4;
             let dst = &mut blocks[at..at + blocks_row * rows as usize / 4];
             strip
-                .encode(&self.gpu, &mut compressor, kind, src, rows, dst)
+                .encode(&self.gpu, &mut compressor, src, rows, dst)
                 .map_err(|error| Interrupted {
                     error,
                     rows_done: row,
@@ -256,8 +256,11 @@ impl GpuBlockEncoder {
     }
 }
 
-/// The device side of one strip: its source texture, its blocks, and their read-back.
+/// The device side of one strip: what it encodes, its source texture, its blocks, and their
+/// read-back.
 struct Strip {
+    kind: BlockKind,
+    variant: CompressionVariant,
     texture: wgpu::Texture,
     view: wgpu::TextureView,
     out: wgpu::Buffer,
@@ -265,7 +268,12 @@ struct Strip {
 }
 
 impl Strip {
-    fn new(gpu: &Gpu, kind: BlockKind, (width, rows): (u32, u32)) -> Self {
+    fn new(
+        gpu: &Gpu,
+        kind: BlockKind,
+        variant: CompressionVariant,
+        (width, rows): (u32, u32),
+    ) -> Self {
         let texture = gpu.texture_2d(
             "blocks source strip",
             (width, rows),
@@ -282,6 +290,8 @@ impl Strip {
             })
         };
         Self {
+            kind,
+            variant,
             view: texture.create_view(&wgpu::TextureViewDescriptor::default()),
             texture,
             out: buffer(
@@ -300,14 +310,10 @@ impl Strip {
         &self,
         gpu: &Gpu,
         compressor: &mut GpuBlockCompressor,
-        kind: BlockKind,
         texels: &[u8],
         rows: u32,
         dst: &mut [u8],
     ) -> Result<(), GpuError> {
-        let variant = kind
-            .variant()
-            .ok_or_else(|| GpuError(format!("{kind:?} is not a block kind the GPU encodes")))?;
         let width = self.texture.width();
         let scope = gpu.scope()?;
         gpu.queue.write_texture(
@@ -315,7 +321,7 @@ impl Strip {
             texels,
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: Some(width * kind.texel_bytes() as u32),
+                bytes_per_row: Some(width * self.kind.texel_bytes() as u32),
                 rows_per_image: Some(rows),
             },
             wgpu::Extent3d {
@@ -332,8 +338,15 @@ impl Strip {
                 label: Some("block encoding"),
                 timestamp_writes: None,
             });
-            compressor
-                .add_compression_task(variant, &self.view, width, rows, &self.out, None, None);
+            compressor.add_compression_task(
+                self.variant,
+                &self.view,
+                width,
+                rows,
+                &self.out,
+                None,
+                None,
+            );
             compressor.compress(&mut pass);
         }
         let bytes = dst.len() as u64;

@@ -295,9 +295,9 @@ fn encode_strip(
 const STRIP: usize = 8;
 
 /// Encodes a `(width, height)` image (sides multiples of [`BlockKind::dims`]) of
-/// [`BlockKind::texel_bytes`] bytes per texel, in parallel strips of block rows. Each strip advances `progress` by its
-/// texel rows; once it is cancelled the remaining strips are skipped (the result is then
-/// garbage: check [`Progress::is_cancelled`]).
+/// [`BlockKind::texel_bytes`] bytes per texel, in parallel strips of block rows. Each strip
+/// advances `progress` by its texel rows; once it is cancelled the remaining strips are
+/// skipped (the result is then garbage: check [`Progress::is_cancelled`]).
 pub fn encode(
     encoder: Coder<'_>,
     kind: BlockKind,

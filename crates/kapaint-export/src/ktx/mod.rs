@@ -287,9 +287,9 @@ fn format_of(
 }
 
 /// Writes `source` as a KTX2 file with a full mip chain: uncompressed, or with
-/// `compressed = Some((encoder, family, effort))` block-compressed. `level0`, when given, is level 0
-/// already compressed (the export's effort search keeps the one it chose). Level 0's rows
-/// advance `progress`; a cancel stops the block encoder between strips.
+/// `compressed = Some((encoder, family, effort))` block-compressed. `level0`, when given, is
+/// level 0 already compressed (the export's effort search keeps the one it chose). Level 0's
+/// rows advance `progress`; a cancel stops the block encoder between strips.
 ///
 /// # Errors
 /// An empty image, a component count outside 1..=4, half floats uncompressed or not as

@@ -3,6 +3,7 @@
 //! it at the rate the last step bought.
 
 use super::choice::{BlockLayout, Trial};
+use super::perceptual::SrgbError;
 use crate::preset::BlockBudget;
 
 /// Whether a trial meets the budget: its sRGB-level error, and the optional limits.
@@ -43,7 +44,7 @@ pub(super) fn ratios(t: &Trial, budget: &BlockBudget) -> Vec<f64> {
 
 /// How far a trial falls short of the budget: how many of its measures fail, and the worst
 /// measure over its limit (see [`ratios`]).
-pub(super) fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
+fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
     let ratios = ratios(t, budget);
     let failing = ratios.iter().filter(|r| **r > 1.0).count();
     (failing, ratios.into_iter().fold(0.0, f64::max))
@@ -87,4 +88,17 @@ pub(super) fn reachable(
         .all(|(now, before)| {
             now <= 1.0 || (before > 0.0 && now < before && now * (now / before).powi(steps) <= 1.0)
         })
+}
+
+/// Whether `t` misses the budget only by sRGB-level measures that `floor` (the same files
+/// uncompressed) misses too: then no encoding of those files can meet it.
+pub(super) fn storage_misses(t: &Trial, floor: &SrgbError, budget: &BlockBudget) -> bool {
+    let srgb = t.srgb();
+    let p999 = srgb.p999 > budget.ka_error_srgb_p999;
+    let mean = srgb.mean > budget.ka_error_srgb_mean;
+    let failing = shortfall(t, budget).0;
+    failing > 0
+        && failing == usize::from(p999) + usize::from(mean)
+        && (!p999 || floor.p999 > budget.ka_error_srgb_p999)
+        && (!mean || floor.mean > budget.ka_error_srgb_mean)
 }

@@ -22,7 +22,7 @@
 
 use std::time::Instant;
 
-use super::budget::{better, nearer, reachable, shortfall, within};
+use super::budget::{better, nearer, reachable, storage_misses, within};
 use super::choice::{BlockChoice, BlockLayout, Trial};
 use super::encode::{Encoded, KtxTexels, StoredImage, block_family, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
@@ -354,37 +354,26 @@ impl<'j, 'a> Search<'j, 'a> {
                 step = next;
                 continue;
             }
-            let mut found = self.nearest(trials, step, &here, ran, stored_misses);
-            found.floor = floor;
-            return Ok(found);
+            return Ok(self.nearest(trials, step, &here, ran, (stored_misses, floor)));
         }
     }
 
-    /// Whether `layout`'s last trial misses the budget only by measures that its files miss
-    /// uncompressed too (`floor`, the first layout's 8-bit files: not a half-float layout's),
-    /// so that no effort can meet it.
+    /// Whether no effort can bring 8-bit `layout` within the budget: its last trial misses it
+    /// only where the same files uncompressed (`floor`) miss it too.
     fn storage_misses(
         &self,
         floor: Option<SrgbError>,
         trials: &[Trial],
         layout: BlockLayout,
     ) -> bool {
-        let (Some(f), false) = (floor, layout.half()) else {
+        let (Some(floor), false) = (floor, layout.half()) else {
             return false;
         };
-        let Some(t) = trials.iter().rev().find(|t| t.layout == layout) else {
-            return false;
-        };
-        let budget = &self.job.preset.budget;
-        let (p999, mean) = (
-            t.srgb().p999 > budget.ka_error_srgb_p999,
-            t.srgb().mean > budget.ka_error_srgb_mean,
-        );
-        let failing = shortfall(t, budget).0;
-        failing > 0
-            && failing == usize::from(p999) + usize::from(mean)
-            && (!p999 || f.p999 > budget.ka_error_srgb_p999)
-            && (!mean || f.mean > budget.ka_error_srgb_mean)
+        trials
+            .iter()
+            .rev()
+            .find(|t| t.layout == layout)
+            .is_some_and(|t| storage_misses(t, &floor, &self.job.preset.budget))
     }
 
     /// The next effort for `layout` after `step`, where more effort may still meet the budget.
@@ -406,7 +395,7 @@ impl<'j, 'a> Search<'j, 'a> {
         step: usize,
         here: &str,
         last: (BlockLayout, Bc7Quality),
-        stored_misses: bool,
+        (stored_misses, floor): (bool, Option<SrgbError>),
     ) -> Found {
         let budget = &self.job.preset.budget;
         let chosen = (0..trials.len())
@@ -438,7 +427,7 @@ impl<'j, 'a> Search<'j, 'a> {
             chosen,
             reason,
             last,
-            floor: None,
+            floor,
         }
     }
 }
