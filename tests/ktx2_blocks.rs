@@ -405,11 +405,23 @@ fn failing(t: &kapaint::export::set::Trial, budget: &BlockBudget) -> usize {
 #[test]
 fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
     // Regression: n in k_d's BC7 alpha shares endpoints with k_d, which ruins both at the
-    // strokes' edges, and BC7's shared p-bit puts flat k_d a level off; the export kept that
-    // layout whatever it cost.
+    // strokes' edges; the export kept that layout whatever it cost.
     let doc = project(256);
-    // A k_a mean that BC6H k_d meets on this project and BC7 does not.
-    let budget = relative_budget(1e-6, 0.004, 50.0);
+    // First the two layouts' relative k_a means at the lowest effort, against a budget
+    // nothing meets; then a mean between them, which BC6H k_d meets on this project and BC7
+    // does not.
+    let none = with_budget(relative_budget(1e-6, 1e-9, 40.0), Bc7Quality::UltraFast);
+    let (dir, manifest) = export(&doc, &none, "strict-first");
+    let _ = std::fs::remove_dir_all(dir);
+    let means: Vec<f64> = manifest
+        .blocks
+        .expect("a block choice")
+        .trials
+        .iter()
+        .map(|t| t.ka_error.mean)
+        .collect();
+    assert!(means.len() == 2 && means[1] < means[0], "{means:?}");
+    let budget = relative_budget(1e-6, (means[0] * means[1]).sqrt(), 40.0);
     let strict = with_budget(budget, Bc7Quality::Fast);
     let (dir, manifest) = export(&doc, &strict, "strict");
     let blocks = manifest.blocks.expect("a block choice");
@@ -426,7 +438,7 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
         "then n apart and k_d as BC6H, at the same effort"
     );
     assert!(
-        apart.ka_error.mean < packed.ka_error.mean / 2.0,
+        apart.ka_error.mean < packed.ka_error.mean,
         "n apart, k_d as half floats: {apart:?} vs {packed:?}"
     );
     assert!(
@@ -522,5 +534,46 @@ fn presets_name_their_budget_and_bad_budgets_are_refused() {
             ExportPreset::parse(Path::new("b.ron"), &text).is_err(),
             "{bad}"
         );
+    }
+}
+
+/// A block of one colour decodes to that colour exactly (decoded by `bcdec_rs`), from every
+/// CPU encoder at every effort, opaque or with alpha. ISPC's BC7 missed the typical project's
+/// background `(255, 238, 230)` by a level in red at every effort (mode 6's p-bits), about
+/// three quarters of a level on average over that project.
+#[test]
+fn blocks_of_one_colour_decode_exactly() {
+    use kapaint::export::blocks::{BlockKind, Coder, encode};
+    let colours: [[u8; 4]; 8] = [
+        [255, 238, 230, 255],
+        [255, 198, 167, 255],
+        [64, 64, 64, 255],
+        [0, 1, 2, 255],
+        [128, 127, 129, 200],
+        [7, 200, 99, 0],
+        [254, 255, 253, 17],
+        [31, 32, 33, 128],
+    ];
+    let (w, h) = (16_u32, 8_u32);
+    // Block i (of 4 across, 2 down) holds colour i.
+    let texels: Vec<u8> = (0..w * h)
+        .flat_map(|t| colours[((t / w / 4) * 4 + (t % w) / 4) as usize])
+        .collect();
+    for coder in [Coder::best_cpu(), Coder::Portable] {
+        for effort in Bc7Quality::ALL {
+            for alpha in [false, true] {
+                let kind = BlockKind::Bc7 { alpha, effort };
+                let blocks = encode(coder, kind, &texels, (w, h), None);
+                for (i, block) in blocks.chunks_exact(16).enumerate() {
+                    let mut decoded = [0_u8; 64];
+                    bcdec_rs::bc7(block, &mut decoded, 16);
+                    let want = colours[i];
+                    let keep = if alpha { 4 } else { 3 };
+                    for texel in decoded.chunks_exact(4) {
+                        assert_eq!(texel[..keep], want[..keep], "{coder:?} {kind:?}, block {i}");
+                    }
+                }
+            }
+        }
     }
 }

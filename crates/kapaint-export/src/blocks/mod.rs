@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 pub mod astc;
 mod coder;
+mod solid;
 
 pub use coder::{BlockEncoder, Coder, Encoder, Interrupted};
 
@@ -336,9 +337,6 @@ pub fn encode_stored(
                 progress,
                 &mut blocks,
             );
-            if done == height {
-                return blocks;
-            }
             (Coder::best_cpu(), done)
         }
         cpu => (cpu, 0),
@@ -362,6 +360,17 @@ pub fn encode_stored(
                 p.advance(u64::from(rows));
             }
         });
+    if let BlockKind::Bc7 { alpha, .. } = kind
+        && !progress.is_some_and(Progress::is_cancelled)
+    {
+        let channels = if alpha { 4 } else { 3 };
+        blocks
+            .par_chunks_mut(row_bytes * STRIP)
+            .zip(texels.par_chunks(STRIP * 4 * width as usize * stored))
+            .for_each(|(out, src)| {
+                solid::refine(out, &widen(kind, src, stored, 4), width as usize, channels);
+            });
+    }
     blocks
 }
 
