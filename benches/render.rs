@@ -261,6 +261,16 @@ fn uploads(c: &mut Criterion) {
                 k += 1;
                 let x0 = f32::from((k % 15) as u16) * 256.0;
                 let y = 128.0 + 256.0 * (k % 7) as f32;
+                // Another colour every dab: the squares repeat every 105 dabs (an odd
+                // count), and a dab that changes nothing uploads nothing (a fast GPU runs
+                // that many).
+                let shade = if k % 2 == 0 { 0.25 } else { 0.75 };
+                doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
+                    Vec3::splat(shade),
+                    Vec3::splat(shade / 2.0),
+                    16.0 / shade,
+                )))
+                .expect("colour");
                 brush_stroke(&mut doc, &[Vec2::new(x0 + 128.0, y)]);
                 let start = std::time::Instant::now();
                 let n = maps.sync(&gpu, doc.maps()).expect("sync");
