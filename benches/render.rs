@@ -264,7 +264,7 @@ fn uploads(c: &mut Criterion) {
                 // Another colour every dab: the squares repeat every 105 dabs (an odd
                 // count), and a dab that changes nothing uploads nothing (a fast GPU runs
                 // that many).
-                let shade = if k % 2 == 0 { 0.25 } else { 0.75 };
+                let shade = if k.is_multiple_of(2) { 0.25 } else { 0.75 };
                 doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
                     Vec3::splat(shade),
                     Vec3::splat(shade / 2.0),
