@@ -18,7 +18,7 @@ use std::sync::LazyLock;
 
 use block_compression::decode::decode_block_bc7;
 
-/// BC7's 2-bit interpolation weights, in 64ths.
+/// BC7's 2-bit interpolation weights, out of 64.
 const WEIGHTS: [u32; 4] = [0, 21, 43, 64];
 
 /// A mode 5 colour endpoint (7 bits) as the decoder widens it to 8.
@@ -26,7 +26,7 @@ fn widen7(v: u8) -> u32 {
     u32::from(v) << 1 | u32::from(v) >> 6
 }
 
-/// BC7's interpolation of two 8-bit endpoints at `weight` 64ths.
+/// BC7's interpolation of two 8-bit endpoints at `weight` (out of 64).
 fn mix(a: u32, b: u32, weight: u32) -> u32 {
     ((64 - weight) * a + weight * b + 32) >> 6
 }
