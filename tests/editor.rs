@@ -736,5 +736,5 @@ fn the_export_dialog_says_a_block_compressed_layout_is_chosen_at_export() {
         std::thread::sleep(std::time::Duration::from_millis(50));
         harness.step();
     }
-    harness.get_by_label_contains("then n apart with colour as BC6H");
+    harness.get_by_label_contains("then n apart, then n apart with colour as BC6H");
 }

@@ -34,6 +34,43 @@ fn project(side: u32) -> Document {
     stroke_edge_document(side, spot().as_deref()).expect("project")
 }
 
+/// A mid-grey k_d (0.5 linear, 187.5 in 8-bit sRGB: stored in 8 bits, half a level off
+/// everywhere) with one red stroke: a k_a mean of 0.3 levels that no 8-bit file meets and BC6H's
+/// half floats do.
+fn grey_project(side: u32) -> Document {
+    use glam::{Vec2, Vec3};
+    use kapaint::model::brush::StrokePoint;
+    use kapaint::model::texel::MaterialValue;
+    use kapaint::model::{DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
+    let mut doc = Document::new(
+        side,
+        side,
+        DocumentSettings {
+            base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.25), 32.0),
+            ..DocumentSettings::default()
+        },
+    )
+    .expect("doc");
+    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
+        Vec3::new(0.8, 0.1, 0.1),
+        Vec3::splat(0.5),
+        200.0,
+    )))
+    .expect("primary");
+    let y = side as f32 / 2.0;
+    doc.apply(StrokeCommand::Stroke {
+        tool: StrokeTool::Brush,
+        points: [0.4, 0.55]
+            .map(|x| StrokePoint {
+                pos: Vec2::new(x * side as f32, y),
+                pressure: 1.0,
+            })
+            .to_vec(),
+    })
+    .expect("stroke");
+    doc
+}
+
 fn export(doc: &Document, preset: &ExportPreset, tag: &str) -> (PathBuf, Manifest) {
     let out = temp(tag);
     let manifest = set::export(doc, preset, &out).expect("export");
@@ -273,20 +310,25 @@ fn psnr(a: &[u8], b: &[u8]) -> f64 {
 
 #[test]
 fn every_level_of_every_file_decodes_independently_close_to_the_uncompressed_levels() {
-    let doc = project(256);
-    let (raw_dir, raw) = export(&doc, &preset::find("ktx2-raw").expect("preset"), "raw");
-    // A budget the cheapest trial meets (BC7 k_d with n in its alpha), and a mean only BC6H
-    // k_d meets. (This once asked for a maximum nothing meets, at a ceiling that ended the
-    // search on the BC6H trial; the files were that trial's while the manifest named the
-    // nearest, packed BC7: `tests/ktx2_astc.rs` checks the files are the kept trial's.)
+    let raw_preset = preset::find("ktx2-raw").expect("preset");
+    // The stroke-edge project at a budget the cheapest trial meets (BC7 k_d with n in its
+    // alpha); the grey project at the shipped budget, whose mean only BC6H k_d meets. (This
+    // once asked for a maximum nothing meets, at a ceiling that ended the search on the BC6H
+    // trial; the files were that trial's while the manifest named the nearest, packed BC7:
+    // `tests/ktx2_astc.rs` checks the files are the kept trial's.)
     let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Bc7Quality::UltraFast);
-    let strict = with_budget(relative_budget(10.0, 0.002, 20.0), Bc7Quality::UltraFast);
-    let mut half_files = 0;
-    for (bc_preset, tag) in [(loose, "bc"), (strict, "bc6h")] {
-        half_files += compare_with_raw(&doc, &raw_dir, &raw, &bc_preset, tag);
+    let mut shipped = preset::find("ktx2").expect("preset");
+    shipped.max_bc7_effort = Bc7Quality::UltraFast;
+    let mut half_files = Vec::new();
+    for (doc, bc_preset, tag) in [
+        (project(256), loose, "bc"),
+        (grey_project(256), shipped, "bc6h"),
+    ] {
+        let (raw_dir, raw) = export(&doc, &raw_preset, &format!("raw-{tag}"));
+        half_files.push(compare_with_raw(&doc, &raw_dir, &raw, &bc_preset, tag));
+        let _ = std::fs::remove_dir_all(raw_dir);
     }
-    assert_eq!(half_files, 1, "k_d as BC6H once");
-    let _ = std::fs::remove_dir_all(raw_dir);
+    assert_eq!(half_files, [0, 1], "k_d as BC6H once");
 }
 
 /// Exports `doc` with `bc_preset`, checks every file and level against the `ktx2-raw` set
@@ -335,7 +377,13 @@ fn compare_with_raw(
                 Some(listed) if bc6h => {
                     assert!(p < listed + 0.5 && p > 45.0, "{name}: {p} vs {listed}");
                 }
-                Some(listed) => assert!((p - listed).abs() < 0.5, "{name}: {p} vs {listed}"),
+                // Above 55 dB (an RMS error under half a level) decoders' rounding moves
+                // the PSNR by more than that (the grey project's near-flat k_s: 64.1 dB
+                // against 63.1).
+                Some(listed) => assert!(
+                    (p - listed).abs() < 0.5 || p.min(listed) > 55.0,
+                    "{name}: {p} vs {listed}"
+                ),
                 None => {}
             }
         }
@@ -407,40 +455,36 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
     // Regression: n in k_d's BC7 alpha shares endpoints with k_d, which ruins both at the
     // strokes' edges; the export kept that layout whatever it cost.
     let doc = project(256);
-    // First the two layouts' relative k_a means at the lowest effort, against a budget
-    // nothing meets; then a mean between them, which BC6H k_d meets on this project and BC7
-    // does not.
+    // First the three layouts at the lowest effort, against a budget nothing meets: the
+    // cheapest first, then n apart in BC7, then k_d as BC6H too (the grey project's budget,
+    // which only BC6H meets, is in `every_level_...`). Then a relative mean between n
+    // apart's and packed's.
     let none = with_budget(relative_budget(1e-6, 1e-9, 40.0), Bc7Quality::UltraFast);
     let (dir, manifest) = export(&doc, &none, "strict-first");
     let _ = std::fs::remove_dir_all(dir);
-    let means: Vec<f64> = manifest
-        .blocks
-        .expect("a block choice")
-        .trials
-        .iter()
-        .map(|t| t.ka_error.mean)
-        .collect();
-    assert!(means.len() == 2 && means[1] < means[0], "{means:?}");
-    let budget = relative_budget(1e-6, (means[0] * means[1]).sqrt(), 40.0);
+    let first = manifest.blocks.expect("a block choice").trials;
+    let order: Vec<_> = first.iter().map(|t| (t.layout, t.bc7_effort)).collect();
+    assert_eq!(
+        order,
+        [
+            (BlockLayout::Packed, Bc7Quality::UltraFast),
+            (BlockLayout::NApart, Bc7Quality::UltraFast),
+            (BlockLayout::HalfColour, Bc7Quality::UltraFast)
+        ],
+        "the cheapest first, then n apart, then k_d as BC6H, at the same effort"
+    );
+    let (packed, apart) = (first[0].ka_error.mean, first[1].ka_error.mean);
+    assert!(apart < packed, "n out of k_d's blocks: {first:?}");
+    let budget = relative_budget(1e-6, (packed * apart).sqrt(), 40.0);
     let strict = with_budget(budget, Bc7Quality::Fast);
     let (dir, manifest) = export(&doc, &strict, "strict");
     let blocks = manifest.blocks.expect("a block choice");
-    let packed = &blocks.trials[0];
-    let apart = &blocks.trials[1];
-    assert_eq!(
-        (packed.layout, packed.bc7_effort),
-        (BlockLayout::Packed, Bc7Quality::UltraFast),
-        "the cheapest first"
-    );
-    assert_eq!(
-        (apart.layout, apart.bc7_effort),
-        (BlockLayout::HalfColour, Bc7Quality::UltraFast),
-        "then n apart and k_d as BC6H, at the same effort"
-    );
-    assert!(
-        apart.ka_error.mean < packed.ka_error.mean,
-        "n apart, k_d as half floats: {apart:?} vs {packed:?}"
-    );
+    let tried: Vec<_> = blocks
+        .trials
+        .iter()
+        .map(|t| (t.layout, t.bc7_effort))
+        .collect();
+    assert_eq!(tried[..3], order, "{blocks:?}");
     assert!(
         !blocks.within_budget && blocks.reason.contains("no trial"),
         "{}",
@@ -452,13 +496,15 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
         blocks.layout, blocks.bc7_effort
     );
     assert!(blocks.reason.contains(&kept), "{}", blocks.reason);
-    // BC6H has no very-fast step of its own: ultra-fast, then fast, at most.
+    // Effort stops at the ceiling, and BC6H has no very-fast step of its own.
     assert!(
-        blocks.trials.len() <= 3
+        blocks.trials.len() <= 5
             && blocks
                 .trials
                 .iter()
-                .all(|t| t.layout == BlockLayout::Packed || t.bc7_effort != Bc7Quality::VeryFast),
+                .all(|t| t.bc7_effort <= Bc7Quality::Fast
+                    && (t.layout != BlockLayout::HalfColour
+                        || t.bc7_effort != Bc7Quality::VeryFast)),
         "effort stops at the ceiling: {blocks:?}"
     );
     // The chosen trial misses the fewest measures, and the files are its layout.
@@ -476,10 +522,9 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
     assert_eq!(failing(chosen, &budget), fewest, "{blocks:?}");
     assert!((manifest.ka_error.max - chosen.ka_error.max).abs() < 1e-12);
     let names: Vec<&str> = manifest.files.iter().map(|f| f.path.as_str()).collect();
-    assert_eq!(blocks.layout, BlockLayout::HalfColour);
+    assert_eq!(blocks.layout, BlockLayout::NApart);
     assert_eq!(names, ["kd.ktx2", "n.ktx2"]);
-    assert_eq!(manifest.files[0].bit_depth, 16);
-    // The set imports, k_d read back from the half floats.
+    assert_eq!(manifest.files[0].bit_depth, 8);
     set::import(&dir.join("material.json")).expect("import");
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -97,7 +97,7 @@ pub(super) fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
         "this layout and n apart (alone, or beside a grey k_s), the one with fewer bytes \
          first (n apart where k_s is grey: both cost the same)"
     } else if preset.bc6h {
-        "this layout first, then n apart with colour as BC6H"
+        "this layout first, then n apart, then n apart with colour as BC6H"
     } else {
         "this layout first, then n apart"
     };

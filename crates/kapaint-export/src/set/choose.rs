@@ -266,16 +266,19 @@ impl<'j, 'a> Search<'j, 'a> {
             .into_iter()
             .filter(|e| *e <= job.preset.max_bc7_effort)
             .collect();
-        // Fewest bytes first; then, for the same bytes, BC6H colour where there is a colour
-        // image and the preset allows it (its k_d is 15 dB closer than BC7's at the same
-        // effort), else n apart in BC7 (ASTC: always; it has no LDR half floats).
+        // Fewest bytes first; then, for the same bytes, n apart in BC7 (the more common
+        // format: with blocks of one colour exact, its stroke edges come nearer the budget
+        // than BC6H's), then BC6H colour where there is a colour image and the preset allows
+        // it (half floats meet a mean that 8-bit storage itself misses). ASTC has no LDR half
+        // floats.
         let apart_images = apart.unwrap_or(packed);
         let mut layouts = vec![BlockLayout::Packed];
         let bc = job.family() == BlockFamily::Bc;
+        if apart.is_some() {
+            layouts.push(BlockLayout::NApart);
+        }
         if bc && job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
             layouts.push(BlockLayout::HalfColour);
-        } else if apart.is_some() {
-            layouts.push(BlockLayout::NApart);
         }
         // Every ASTC block is 16 bytes whatever it holds: where both layouts have as many
         // images (a grey k_s: kd_n + ks, or kd + ks_n), they cost the same, and n apart, on
