@@ -19,6 +19,10 @@ use kapaint::export::set::{self, BlockLayout, ColourSpace, Compression, Manifest
 use kapaint::model::Document;
 use kapaint::report::typical::typical_document;
 
+#[path = "common/grey.rs"]
+mod grey;
+use grey::grey_project;
+
 fn temp(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("kapaint-astc-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -394,35 +398,7 @@ fn a_budget_that_8_bit_storage_misses_is_said_and_costs_no_more_effort() {
     // A mid-grey k_d (0.5 linear) is 187.5 in 8-bit sRGB: stored in 8 bits it is half a level
     // off everywhere, and k_a with it, so no 8-bit file meets a mean of 0.3 levels, however
     // its blocks are encoded. The search says so and stops after the layouts.
-    use glam::{Vec2, Vec3};
-    use kapaint::model::brush::StrokePoint;
-    use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
-    let mut doc = Document::new(
-        256,
-        256,
-        DocumentSettings {
-            base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.25), 32.0),
-            ..DocumentSettings::default()
-        },
-    )
-    .expect("doc");
-    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
-        Vec3::new(0.8, 0.1, 0.1),
-        Vec3::splat(0.5),
-        200.0,
-    )))
-    .expect("primary");
-    doc.apply(StrokeCommand::Stroke {
-        tool: StrokeTool::Brush,
-        points: [100.0, 140.0]
-            .map(|x| StrokePoint {
-                pos: Vec2::new(x, 128.0),
-                pressure: 1.0,
-            })
-            .to_vec(),
-    })
-    .expect("stroke");
+    let doc = grey_project(256);
     let p = preset::find("ktx2-astc").expect("preset");
     let out = temp("floor");
     let m = set::export(&doc, &p, &out).expect("export");

@@ -17,6 +17,10 @@ use kapaint::export::set::{self, BlockLayout, Manifest};
 use kapaint::model::Document;
 use kapaint::report::typical::stroke_edge_document;
 
+#[path = "common/grey.rs"]
+mod grey;
+use grey::grey_project;
+
 fn temp(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("kapaint-ktx2-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -32,43 +36,6 @@ fn spot() -> Option<PathBuf> {
 /// The stroke-edge project at `side`: the spot texture in k_d, soft strokes of n = 3000 and 2.
 fn project(side: u32) -> Document {
     stroke_edge_document(side, spot().as_deref()).expect("project")
-}
-
-/// A mid-grey k_d (0.5 linear, 187.5 in 8-bit sRGB: stored in 8 bits, half a level off
-/// everywhere) with one red stroke: a k_a mean of 0.3 levels that no 8-bit file meets and BC6H's
-/// half floats do.
-fn grey_project(side: u32) -> Document {
-    use glam::{Vec2, Vec3};
-    use kapaint::model::brush::StrokePoint;
-    use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
-    let mut doc = Document::new(
-        side,
-        side,
-        DocumentSettings {
-            base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.25), 32.0),
-            ..DocumentSettings::default()
-        },
-    )
-    .expect("doc");
-    doc.apply(SettingsCommand::SetPrimary(MaterialValue::new(
-        Vec3::new(0.8, 0.1, 0.1),
-        Vec3::splat(0.5),
-        200.0,
-    )))
-    .expect("primary");
-    let y = side as f32 / 2.0;
-    doc.apply(StrokeCommand::Stroke {
-        tool: StrokeTool::Brush,
-        points: [0.4, 0.55]
-            .map(|x| StrokePoint {
-                pos: Vec2::new(x * side as f32, y),
-                pressure: 1.0,
-            })
-            .to_vec(),
-    })
-    .expect("stroke");
-    doc
 }
 
 fn export(doc: &Document, preset: &ExportPreset, tag: &str) -> (PathBuf, Manifest) {

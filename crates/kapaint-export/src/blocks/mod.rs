@@ -356,19 +356,18 @@ pub fn encode_stored(
             let rows = (out.len() / row_bytes) as u32 * bh;
             let wide = widen(kind, src, stored, per);
             encode_strip(encoder, kind, &wide, width, rows, out);
+            solid::refine(kind, out, &wide, width as usize);
             if let Some(p) = progress {
                 p.advance(u64::from(rows));
             }
         });
-    if let BlockKind::Bc7 { alpha, .. } = kind
-        && !progress.is_some_and(Progress::is_cancelled)
-    {
-        let channels = if alpha { 4 } else { 3 };
-        blocks
+    // The rows a brought encoder did: their blocks of one colour made exact as the CPU's are.
+    if first_block > 0 && !progress.is_some_and(Progress::is_cancelled) {
+        blocks[..first_block]
             .par_chunks_mut(row_bytes * STRIP)
-            .zip(texels.par_chunks(STRIP * 4 * width as usize * stored))
+            .zip(texels[..first_texel].par_chunks(strip_texels))
             .for_each(|(out, src)| {
-                solid::refine(out, &widen(kind, src, stored, 4), width as usize, channels);
+                solid::refine(kind, out, &widen(kind, src, stored, per), width as usize);
             });
     }
     blocks
