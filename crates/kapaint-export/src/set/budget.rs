@@ -90,19 +90,11 @@ pub(super) fn reachable(
         })
 }
 
-/// Which of the budget's sRGB-level measures `e` misses: its p99.9, its mean.
-pub(super) fn srgb_over(e: &SrgbError, budget: &BlockBudget) -> (bool, bool) {
-    (
-        e.p999 > budget.ka_error_srgb_p999,
-        e.mean > budget.ka_error_srgb_mean,
-    )
-}
-
 /// Whether `t` misses the budget only by sRGB-level measures that `floor` (the same files
 /// uncompressed) misses too: then no encoding of those files can meet it.
 pub(super) fn storage_misses(t: &Trial, floor: &SrgbError, budget: &BlockBudget) -> bool {
-    let (p999, mean) = srgb_over(&t.srgb(), budget);
-    let (floor_p999, floor_mean) = srgb_over(floor, budget);
+    let (p999, mean) = t.srgb().over(budget);
+    let (floor_p999, floor_mean) = floor.over(budget);
     let failing = shortfall(t, budget).0;
     failing > 0
         && failing == usize::from(p999) + usize::from(mean)

@@ -3,7 +3,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::budget::srgb_over;
 use super::perceptual::SrgbError;
 use crate::astc_block::AstcBlock;
 use crate::blocks::Encoder;
@@ -134,7 +133,7 @@ impl BlockChoice {
         } else {
             let floor = self
                 .uncompressed_ka_error_srgb
-                .filter(|f| srgb_over(f, &self.budget) != (false, false))
+                .filter(|f| f.over(&self.budget) != (false, false))
                 .map_or_else(String::new, |f| {
                     format!(
                         "; the same files uncompressed are over it too (k_a within {:.2} levels for 99.9 % of texels, mean {:.3}): 8-bit storage alone misses it",

@@ -8,6 +8,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::preset::BlockBudget;
+
 /// Statistics of the error in levels of 8-bit sRGB (see the module).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SrgbError {
@@ -20,6 +22,14 @@ pub struct SrgbError {
 }
 
 impl SrgbError {
+    /// Which of `budget`'s sRGB-level limits this misses: the p99.9, the mean.
+    pub fn over(&self, budget: &BlockBudget) -> (bool, bool) {
+        (
+            self.p999 > budget.ka_error_srgb_p999,
+            self.mean > budget.ka_error_srgb_mean,
+        )
+    }
+
     /// In the words the editor and the CLI use: "k_a within 1.4 levels of the displayed colour
     /// for 99.9 % of texels (mean 0.12, max 6.0)".
     pub fn describe(&self) -> String {
