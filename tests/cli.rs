@@ -797,3 +797,48 @@ fn render_refuses_unknown_models_views_methods_and_sides_with_the_valid_ones() {
         assert!(!std::path::Path::new(out).exists(), "{args:?} drew nothing");
     }
 }
+
+/// `chi --method exact -` writes its rows as it computes them: the first arrives while the
+/// run is still integrating the rest (it printed nothing until the end: 10^6 values showed
+/// nothing for hours), and the whole output is the same as computed at once.
+#[test]
+fn chi_streams_its_rows_as_they_are_computed() {
+    use std::io::{BufRead, BufReader};
+    let values: String = (0..64).map(|k| (1 + 7 * k).to_string() + "\n").collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(["chi", "--model", "phong", "--method", "exact", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("kapaint starts");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(values.as_bytes())
+        .expect("values written");
+    let mut out = BufReader::new(child.stdout.take().expect("stdout"));
+    let mut header = String::new();
+    out.read_line(&mut header).expect("header");
+    assert_eq!(header, "n,chi\n");
+    let mut first = String::new();
+    out.read_line(&mut first).expect("a row");
+    assert!(first.starts_with("1,"), "{first}");
+    assert!(
+        child.try_wait().expect("status").is_none(),
+        "the first row came only when everything was done"
+    );
+    let rows: Vec<String> = std::iter::once(first.trim_end().to_owned())
+        .chain(out.lines().map(|l| l.expect("row")))
+        .collect();
+    assert!(child.wait().expect("ends").success());
+    assert_eq!(rows.len(), 64);
+    let all_at_once = kapaint(&["chi", "--model", "phong", "--method", "exact", "1", "8"]);
+    let expected: Vec<&str> = std::str::from_utf8(&all_at_once.stdout)
+        .expect("utf-8")
+        .lines()
+        .skip(1)
+        .collect();
+    assert_eq!(&rows[..2], &expected[..]);
+}

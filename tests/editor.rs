@@ -30,14 +30,16 @@ fn a_scripted_editing_session() {
         harness.state().state.new_dialog().is_some(),
         "Ctrl+N opens the New dialog"
     );
-    harness.get_by_label("Resolution");
+    harness.get_by_label("Width");
+    harness.get_by_label("× Height");
     harness.get_by_label("Base preset");
     harness.get_by_role_and_label(Role::ComboBox, "Mesh");
     harness
         .state_mut()
         .state
         .set_new_dialog(kapaint::ui::NewDialog {
-            size: 512,
+            width: 512,
+            height: 512,
             preset: 0,
             mesh: "torus".into(),
         });

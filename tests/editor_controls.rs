@@ -468,7 +468,8 @@ fn image_resize_shows_its_memory_first_and_is_one_undo_step() {
     harness
         .get_by_role_and_label(Role::Button, "Resize")
         .click();
-    harness.run();
+    // Frames are cheap (the viewport is not drawn again unchanged): wait on the job itself,
+    // not on a count of frames.
     wait_until(&mut harness, "resized", |e| {
         e.state.doc().maps().width() == 512
     });

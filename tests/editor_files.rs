@@ -497,3 +497,48 @@ fn a_project_another_kapaint_has_open_asks_and_opens_read_only() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// File > New with unsaved changes offers "Save, then create": the work is saved to its
+/// project, then the new project (of any width and height, not only square) replaces it.
+#[test]
+fn new_offers_save_then_create_and_any_width_and_height() {
+    let dir = scratch("save-then-new");
+    let path = dir.join("work.kapaint");
+    let doc = kapaint::model::Document::new(64, 64, kapaint::model::DocumentSettings::default())
+        .expect("doc");
+    kapaint::model::project::save(&doc, &path).expect("saved");
+    let mut harness = editor_on(&path);
+    wait_until(&mut harness, "opened", |e| {
+        e.state.path() == Some(path.as_path())
+    });
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::N);
+    harness.run();
+    assert!(harness.state().state.dirty(), "a layer added");
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::N);
+    harness.run();
+    harness
+        .state_mut()
+        .state
+        .set_new_dialog(kapaint::ui::NewDialog {
+            width: 512,
+            height: 256,
+            preset: 0,
+            mesh: "sphere".into(),
+        });
+    harness.run();
+    harness
+        .get_by_role_and_label(Role::Button, "Save, then create")
+        .click();
+    harness.run();
+    wait_until(&mut harness, "saved and created", |e| {
+        let maps = e.state.doc().maps();
+        (maps.width(), maps.height()) == (512, 256)
+    });
+    let saved = kapaint::model::project::load(&path).expect("loads");
+    assert_eq!(
+        saved.stack().layers.len(),
+        2,
+        "the added layer was saved first"
+    );
+    assert!(!harness.state().state.dirty());
+}

@@ -244,3 +244,126 @@ fn a_mask_being_painted_shows_alone_in_grey() {
     state.apply_command(MaskCommand::SelectContent);
     assert_eq!(state.shown_layer_view(), LayerView::Composite);
 }
+
+/// Two clicks of the primary button at `at`: a double click. The harness gives each pointer
+/// event a frame of a quarter second, more than egui's 0.3 s between the clicks of a double
+/// click, so that limit is raised for the test.
+fn double_click(harness: &mut Harness<'_, Editor>, at: Pos2) {
+    harness
+        .ctx
+        .options_mut(|o| o.input_options.max_double_click_delay = 2.0);
+    harness.hover_at(at);
+    harness.run();
+    for _ in 0..2 {
+        for pressed in [true, false] {
+            harness.event(egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: Modifiers::NONE,
+            });
+        }
+    }
+    harness.run();
+}
+
+/// Double-clicks the row of `name`, selects what is there and types `text` (nothing sent
+/// yet that ends the edit).
+fn start_rename(harness: &mut Harness<'_, Editor>, name: &str, text: &str) {
+    let at = row(harness, name);
+    double_click(harness, at);
+    assert!(
+        harness.ctx.egui_wants_keyboard_input(),
+        "the name field has the keyboard"
+    );
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.event(egui::Event::Text(text.into()));
+    harness.run();
+}
+
+/// Whether the layer hotkeys work: Ctrl+Shift+N adds a layer (undone again).
+fn keyboard_is_live(harness: &mut Harness<'_, Editor>) -> bool {
+    let before = names(harness).len();
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::N);
+    harness.run();
+    let added = names(harness).len() == before + 1;
+    if added {
+        harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+        harness.run();
+    }
+    added
+}
+
+/// A rename in the list commits on Enter, Tab and a click elsewhere, cancels on Escape, and
+/// gives the keyboard back every time (it kept it, and every shortcut, until a restart).
+#[test]
+fn renaming_a_layer_commits_or_cancels_and_never_traps_the_keyboard() {
+    let mut harness = editor();
+    start_rename(&mut harness, "Layer 1", "Rust");
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    assert_eq!(names(&harness), ["Rust"], "Enter commits");
+    assert!(keyboard_is_live(&mut harness), "shortcuts work after Enter");
+
+    start_rename(&mut harness, "Rust", "Dirt");
+    harness.key_press(egui::Key::Tab);
+    harness.run();
+    assert_eq!(names(&harness), ["Dirt"], "Tab commits");
+    assert!(keyboard_is_live(&mut harness), "shortcuts work after Tab");
+
+    start_rename(&mut harness, "Dirt", "Never");
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert_eq!(names(&harness), ["Dirt"], "Escape cancels");
+    assert!(
+        keyboard_is_live(&mut harness),
+        "shortcuts work after Escape"
+    );
+
+    start_rename(&mut harness, "Dirt", "Wear");
+    let away = harness.get_by_label(CANVAS_LABEL).rect().center();
+    harness.hover_at(away);
+    harness.run();
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: away,
+            button: egui::PointerButton::Secondary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+    }
+    harness.run();
+    assert_eq!(names(&harness), ["Wear"], "a click elsewhere commits");
+    assert!(
+        keyboard_is_live(&mut harness),
+        "shortcuts work after a click away"
+    );
+    // One undo step a rename.
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(names(&harness), ["Dirt"]);
+}
+
+/// Every key press of a frame runs, however many it holds (a held key's repeats, or presses
+/// while a slow frame was drawn): eight Ctrl+Z in one frame undo eight steps.
+#[test]
+fn every_key_press_of_a_slow_frame_is_applied() {
+    let mut harness = editor();
+    for _ in 0..8 {
+        harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::N);
+        harness.run();
+    }
+    assert_eq!(names(&harness).len(), 9);
+    for k in 0..8 {
+        harness.event(egui::Event::Key {
+            key: egui::Key::Z,
+            pressed: true,
+            modifiers: Modifiers::COMMAND,
+            repeat: k > 0,
+            physical_key: None,
+        });
+    }
+    harness.step();
+    harness.run();
+    assert_eq!(names(&harness), ["Layer 1"], "eight presses, eight undos");
+}

@@ -388,7 +388,10 @@ fn mesh_bake_keeps_a_map_of_the_mesh_as_one_undo_step() {
     harness.run_steps(2);
     harness.get_by_label("Map").click();
     harness.run_steps(2);
-    harness.get_by_label("curvature").click();
+    // The map list's entry, not the "Bake all checked" checkbox of the same name.
+    harness
+        .get_by(|n| n.label().as_deref() == Some("curvature") && n.role() != Role::CheckBox)
+        .click();
     harness.run_steps(2);
     harness.get_by_role_and_label(Role::Button, "Bake").click();
     harness.run_steps(2);

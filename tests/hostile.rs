@@ -6,6 +6,7 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
+use std::fmt::Write as _;
 use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -1191,4 +1192,189 @@ fn autosave_on_a_full_disk_is_an_error_that_leaves_nothing_half_written() {
     assert_eq!(recovery::offer(Some(&project)), None);
     drop(mount);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A project whose kept mesh (`mesh.obj`) inflates to far more than the triangles its
+/// manifest declares can need is refused by that size, before the entry is read whole or
+/// parsed (a 3.9 MB project inflating to 1.4 GB ran out of memory with exit 134).
+#[test]
+fn a_kept_mesh_that_inflates_past_its_declared_size_is_refused() {
+    let dir = temp("inflated-mesh");
+    let mesh = dir.join("tri.obj");
+    std::fs::write(&mesh, TRIANGLE_OBJ).expect("obj");
+    let project = dir.join("p.kapaint");
+    assert_ok(&kapaint_in(
+        &dir,
+        &[
+            "new",
+            "--size",
+            "64",
+            "--mesh",
+            "tri.obj",
+            "--unwrap",
+            "--out",
+            "p.kapaint",
+        ],
+    ));
+    // The same entries, `mesh.obj` padded with 40 MB of comment lines (a few hundred KB
+    // compressed) after its real triangles.
+    let bytes = std::fs::read(&project).expect("read project");
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).expect("zip");
+    let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for i in 0..zip.len() {
+        let mut entry = zip.by_index(i).expect("entry");
+        let name = entry.name().expect("entry name").to_string();
+        let mut data = Vec::new();
+        entry.read_to_end(&mut data).expect("entry bytes");
+        if name == "mesh.obj" {
+            let line = format!("# {}\n", "x".repeat(1021));
+            for _ in 0..40 << 10 {
+                data.extend_from_slice(line.as_bytes());
+            }
+        }
+        let deflated = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated);
+        out.start_file(name, deflated).expect("start");
+        out.write_all(&data).expect("write");
+    }
+    std::fs::write(&project, out.finish().expect("finish").into_inner()).expect("write");
+    assert!(std::fs::metadata(&project).expect("size").len() < 4 << 20);
+    let before = std::fs::read(&project).expect("project");
+    let o = kapaint_in(&dir, &["info", "p.kapaint"]);
+    assert_fails(&o, 2, "mesh.obj");
+    assert!(stderr(&o).contains("declares"), "{}", stderr(&o));
+    assert_unchanged(&project, &before);
+}
+
+/// An octahedron with its own UV triangles, every coordinate times `scale`, as an OBJ.
+fn octahedron_obj(scale: f64) -> String {
+    let v = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let faces = [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let mut out = String::new();
+    for p in v {
+        let _ = writeln!(
+            out,
+            "v {:e} {:e} {:e}",
+            p[0] * scale,
+            p[1] * scale,
+            p[2] * scale
+        );
+    }
+    // Each face its own triangle in a 4 x 2 grid of cells.
+    for k in 0..8 {
+        let (u0, v0) = (f64::from(k % 4) * 0.25, f64::from(k / 4) * 0.5);
+        for (du, dv) in [(0.02, 0.02), (0.23, 0.02), (0.02, 0.48)] {
+            let _ = writeln!(out, "vt {} {}", u0 + du, v0 + dv);
+        }
+    }
+    for (k, f) in faces.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "f {}/{} {}/{} {}/{}",
+            f[0] + 1,
+            3 * k + 1,
+            f[1] + 1,
+            3 * k + 2,
+            f[2] + 1,
+            3 * k + 3
+        );
+    }
+    out
+}
+
+/// The mean `kapaint bake` prints for `map` of `project`, written to a PNG (the project is
+/// left as it is).
+fn baked_mean(dir: &Path, project: &str, map: &str) -> f64 {
+    let out = format!("{map}.png");
+    let o = kapaint_in(
+        dir,
+        &[
+            "bake", project, "--map", map, "--rays", "16", "--out", &out, "--force",
+        ],
+    );
+    assert_ok(&o);
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    text.split(", mean ")
+        .nth(1)
+        .and_then(|rest| rest.split(',').next())
+        .and_then(|m| m.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no mean in {text}"))
+}
+
+/// A mesh of coordinates like 1e30 (or 1e-20) bakes, renders traced and is measured as at
+/// scale 1: the BVH build panicked (exit 70), curvature read 0, and a traced view drew
+/// nothing.
+#[test]
+fn meshes_at_any_scale_bake_and_trace_as_at_scale_one() {
+    let dir = temp("any-scale");
+    let mut seen: Vec<(f64, [f64; 3], usize)> = Vec::new();
+    for scale in [1.0, 1e30, 1e-20] {
+        std::fs::write(dir.join("oct.obj"), octahedron_obj(scale)).expect("obj");
+        assert_ok(&kapaint_in(
+            &dir,
+            &[
+                "new",
+                "--size",
+                "64",
+                "--mesh",
+                "oct.obj",
+                "--out",
+                "p.kapaint",
+                "--force",
+            ],
+        ));
+        let means = ["ao", "thickness", "curvature"].map(|m| baked_mean(&dir, "p.kapaint", m));
+        let o = kapaint_in(
+            &dir,
+            &[
+                "render",
+                "--project",
+                "p.kapaint",
+                "--model",
+                "phong",
+                "--view",
+                "ka-traced",
+                "--samples",
+                "2",
+                "--size",
+                "48",
+                "--out",
+                "r.png",
+            ],
+        );
+        assert_ok(&o);
+        let image = image::open(dir.join("r.png")).expect("render").to_rgba16();
+        let covered = image.pixels().filter(|p| p.0[3] > 0).count();
+        seen.push((scale, means, covered));
+    }
+    let (_, at_one, covered_at_one) = seen[0];
+    assert!(covered_at_one > 100, "the octahedron is drawn: {seen:?}");
+    for (scale, means, covered) in &seen[1..] {
+        for (a, b) in means.iter().zip(at_one) {
+            assert!(
+                (a - b).abs() < 0.01,
+                "scale {scale}: {means:?} vs {at_one:?}"
+            );
+        }
+        assert!(
+            covered.abs_diff(covered_at_one) <= covered_at_one / 50,
+            "scale {scale}: {covered} pixels drawn, {covered_at_one} at scale 1"
+        );
+    }
 }

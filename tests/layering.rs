@@ -151,3 +151,44 @@ fn the_core_and_everything_under_it_link_no_gui_or_gpu_crate() {
 fn the_gpu_crate_links_no_gui_crate() {
     assert_free_of("kapaint-gpu", &GUI);
 }
+
+/// The build needs a Rust toolchain and a C/C++ compiler, nothing else: no crate in any tree
+/// (normal, build or dev) runs bindgen, which needs
+/// libclang installed (ARM's ASTC encoder comes with hand-written bindings).
+#[test]
+fn nothing_in_the_build_needs_libclang() {
+    let out = Command::new(env!("CARGO"))
+        .args([
+            "tree",
+            "--locked",
+            "--workspace",
+            "-e",
+            "all",
+            "--prefix",
+            "none",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let tree: BTreeSet<String> = String::from_utf8(out.stdout)
+        .expect("utf-8")
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_owned)
+        .collect();
+    assert!(
+        tree.contains("ctt-astcenc"),
+        "the ASTC encoder is in the tree"
+    );
+    for needs_libclang in ["bindgen", "clang-sys"] {
+        assert!(
+            !tree.contains(needs_libclang),
+            "{needs_libclang} is in the build"
+        );
+    }
+}

@@ -223,6 +223,39 @@ fn the_glb_is_valid_gltf_with_the_material_embedded_and_imports_back() {
     }
 }
 
+/// A double-sided glTF material (a leaf, a cloth, a sheet) comes back double-sided in the
+/// `.glb`, through the project (it was dropped: the `.glb` lost `doubleSided`), from the
+/// command line and from the editor's import alike (both record it in the import report); a
+/// one-sided one stays one-sided.
+#[test]
+fn a_double_sided_material_stays_double_sided_in_the_glb() {
+    let d = dir("double-sided");
+    for double_sided in [true, false] {
+        let tag = if double_sided { "two" } else { "one" };
+        let sub = d.join(tag);
+        std::fs::create_dir_all(&sub).expect("dir");
+        let asset = write_asset(
+            &sub,
+            &Asset {
+                double_sided,
+                ..Asset::default()
+            },
+        );
+        let project = sub.join("leaf.kapaint");
+        import_gltf(&asset, ShadingModel::Phong, &project);
+        let doc = kapaint::model::project::load(&project).expect("load");
+        let report = doc.settings().import.clone().expect("import report");
+        assert_eq!(report.double_sided, double_sided);
+        let set = sub.join("set");
+        let o = export_gltf_pbr(&project, &set, &["--glb"]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let bytes = std::fs::read(set.join("model.glb")).expect("glb");
+        let gltf = gltf::Gltf::from_slice(&bytes).expect("a valid glTF");
+        let material = gltf.materials().next().expect("a material");
+        assert_eq!(material.double_sided(), double_sided, "{tag}");
+    }
+}
+
 #[test]
 fn glb_without_the_preset_or_a_mesh_is_one_clear_error_and_nothing_written() {
     let d = dir("bad");

@@ -240,6 +240,7 @@ fn the_height_fixed_mapping_is_the_old_one() {
             p99: 0.0,
         },
         notes: Vec::new(),
+        double_sided: false,
     });
     assert_eq!(settings.n_mapping(), NMapping::HeightFixed);
     settings.n_mapping = Some(NMapping::HeightFitted);

@@ -52,8 +52,10 @@ impl AccuracyArgs {
         let meshes = specs
             .iter()
             .map(|spec| {
-                let mesh =
-                    crate::mesh::open(std::path::Path::new(spec)).map_err(super::mesh_error)?;
+                // Traced where a camera's arithmetic holds it, whatever its scale.
+                let mesh = crate::mesh::open(std::path::Path::new(spec))
+                    .map_err(super::mesh_error)?
+                    .viewable();
                 let name = std::path::Path::new(spec)
                     .file_name()
                     .map_or_else(|| spec.clone(), |n| n.to_string_lossy().into_owned());

@@ -46,7 +46,9 @@ pub struct BakeArgs {
     /// The map to bake.
     #[arg(long, value_enum)]
     map: MapArg,
-    /// Rays per texel (ao, thickness), 1 to 65536.
+    /// Rays per texel (ao, thickness), 1 to 65536. Time grows with rays times texels: on 2
+    /// cores about 18 minutes at 65536 rays and 256^2 (a bar with an estimate shows on a
+    /// terminal).
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(i64::from(*RAYS.start())..=i64::from(*RAYS.end())))]
     rays: u32,
     /// How far a ray looks, in object units (default: unbounded for ao, the bounding box's
@@ -111,8 +113,17 @@ impl BakeArgs {
             max_distance: self.max_distance,
         };
         let start = Instant::now();
-        let baked = bake_map(&surface.mesh, &surface.bake, self.map.into(), options, None)
-            .map_err(CliError::usage)?;
+        let progress = crate::task::Progress::default();
+        let baked = super::progress::with_bar("bake", &progress, || {
+            bake_map(
+                &surface.mesh,
+                &surface.bake,
+                self.map.into(),
+                options,
+                Some(&progress),
+            )
+        })
+        .map_err(CliError::usage)?;
         let seconds = start.elapsed().as_secs_f64();
         let stats = baked.stats(&surface.bake);
         let line = summary(&self.project, &surface.mesh.name, &baked, &stats, seconds);

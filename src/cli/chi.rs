@@ -2,7 +2,7 @@
 //! Cook-Torrance both parts of `k_s chi1(n) + chi0(n)`, as CSV `n,chi1,chi0`.
 
 use std::fmt::Write as _;
-use std::io::BufRead;
+use std::io::{BufRead, Write};
 
 use super::CliError;
 use super::args::{MethodArg, ModelArg, check_method, fmt17, parse_n, read_stdin_values};
@@ -22,7 +22,10 @@ pub struct ChiArgs {
     /// specular part at that angle between the normal and the eye, one row per pair.
     #[arg(long = "view", allow_hyphen_values = true)]
     views: Vec<String>,
-    /// Exponents (n >= 0); a single `-` reads one value per line from stdin.
+    /// Exponents (n >= 0); a single `-` reads one value per line from stdin (all of them are
+    /// read and checked before the first row). The exact method integrates each value, about
+    /// 0.04 s of one core: rows stream out as they are computed, with a bar and an estimate
+    /// on a terminal.
     #[arg(required = true, allow_hyphen_values = true)]
     n: Vec<String>,
 }
@@ -49,6 +52,62 @@ impl ChiArgs {
     /// # Errors
     /// An exponent that is not a number, negative, or beyond the method's range.
     pub fn run(self, stdin: &mut dyn BufRead) -> Result<String, CliError> {
+        let mut out = Vec::new();
+        self.stream(stdin, &mut out)?;
+        String::from_utf8(out).map_err(|_| CliError::io("chi wrote text that is not UTF-8"))
+    }
+
+    /// Runs the command, writing its rows to `out` as they are computed (a block at a time,
+    /// in order): every value is read and checked first, so a bad one stops the run before a
+    /// row is written; a terminal shows a bar with an estimate meanwhile.
+    ///
+    /// # Errors
+    /// As [`Self::run`]; a failed write (exit 1).
+    pub fn stream(self, stdin: &mut dyn BufRead, out: &mut dyn Write) -> Result<(), CliError> {
+        let (model, method, values, views) = self.checked(stdin)?;
+        let two_parts = model == ShadingModel::CookTorrance;
+        let header = match (views.is_empty(), two_parts) {
+            (true, false) => "n,chi\n",
+            (true, true) => "n,chi1,chi0\n",
+            (false, false) => "n,view,chi\n",
+            (false, true) => "n,view,chi1,chi0\n",
+        };
+        let write_error = |e: std::io::Error| CliError::io(format!("writing the rows: {e}"));
+        out.write_all(header.as_bytes()).map_err(write_error)?;
+        let rows = values.len() * views.len().max(1);
+        let progress = crate::task::Progress::default();
+        progress.start("chi", rows as u64);
+        let write_block = |block: &[f64], out: &mut dyn Write| -> Result<(), CliError> {
+            let text = if views.is_empty() {
+                chi_csv(model, method, block)
+            } else {
+                chi_view_csv(model, method, block, &views)?
+            };
+            out.write_all(text.as_bytes()).map_err(write_error)?;
+            out.flush().map_err(write_error)?;
+            progress.advance((block.len() * views.len().max(1)) as u64);
+            Ok(())
+        };
+        super::progress::with_bar("chi", &progress, || {
+            // Exact integrals (tens of milliseconds each) in blocks of a few per core, so the
+            // first rows come within a second; the approximations in large blocks.
+            let rows_per_block = if method.approx().is_none() {
+                8 * rayon::current_num_threads()
+            } else {
+                STREAM_BLOCK
+            };
+            let block = (rows_per_block / views.len().max(1)).max(1);
+            values
+                .chunks(block)
+                .try_for_each(|b| write_block(b, &mut *out))
+        })
+    }
+
+    /// The model, method, exponents and view angles, every one checked.
+    fn checked(
+        self,
+        stdin: &mut dyn BufRead,
+    ) -> Result<(ShadingModel, MethodArg, Vec<f64>, Vec<f64>), CliError> {
         check_method(self.model.into(), self.method)?;
         if self.views.len() > MAX_VIEWS {
             return Err(CliError::usage(format!(
@@ -74,14 +133,27 @@ impl ChiArgs {
                 .map(|s| parse_n(s, self.method))
                 .collect::<Result<Vec<_>, _>>()?
         };
-        if views.is_empty() {
-            return Ok(chi_csv(self.model.into(), self.method, &values));
+        // The per-view table's reach, before any row is written.
+        if !views.is_empty()
+            && matches!(self.method, MethodArg::Fast)
+            && let Some(n) = values
+                .iter()
+                .find(|&&n| !(0.0..=reflectance::view::VIEW_N_MAX).contains(&(n as f32)))
+        {
+            return Err(CliError::usage(format!(
+                "n = {n} is beyond the per-view table (n <= {})",
+                reflectance::view::VIEW_N_MAX
+            )));
         }
-        chi_view_csv(self.model.into(), self.method, &values, &views)
+        Ok((self.model.into(), self.method, values, views))
     }
 }
 
-/// One row per `(n, view)` pair, `n` by `n`: `n,view,chi` (Cook-Torrance `n,view,chi1,chi0`).
+/// Rows of an approximation computed and written together while streaming.
+const STREAM_BLOCK: usize = 4096;
+
+/// One row per `(n, view)` pair, `n` by `n`: `n,view,chi` (Cook-Torrance `n,view,chi1,chi0`),
+/// no header.
 fn chi_view_csv(
     model: ShadingModel,
     method: MethodArg,
@@ -98,11 +170,7 @@ fn chi_view_csv(
         .map(|&(n, v)| chi_view_value(model, method, n, v))
         .collect::<Result<Vec<[f64; 2]>, CliError>>()?;
     let two_parts = model == ShadingModel::CookTorrance;
-    let mut out = String::from(if two_parts {
-        "n,view,chi1,chi0\n"
-    } else {
-        "n,view,chi\n"
-    });
+    let mut out = String::new();
     for ((n, v), [chi1, chi0]) in pairs.iter().zip(parts) {
         if two_parts {
             let _ = writeln!(out, "{n},{v},{},{}", fmt17(chi1), fmt17(chi0));
@@ -134,6 +202,7 @@ fn chi_view_value(
     }
 }
 
+/// One row per `n`: `n,chi` (Cook-Torrance `n,chi1,chi0`), no header.
 fn chi_csv(model: ShadingModel, method: MethodArg, values: &[f64]) -> String {
     use rayon::prelude::*;
     let chis: Vec<[f64; 2]> = values
@@ -141,11 +210,7 @@ fn chi_csv(model: ShadingModel, method: MethodArg, values: &[f64]) -> String {
         .map(|&n| chi_parts_value(model, method, n))
         .collect();
     let two_parts = model == ShadingModel::CookTorrance;
-    let mut out = String::from(if two_parts {
-        "n,chi1,chi0\n"
-    } else {
-        "n,chi\n"
-    });
+    let mut out = String::new();
     for (n, [chi1, chi0]) in values.iter().zip(chis) {
         if two_parts {
             let _ = writeln!(out, "{n},{},{}", fmt17(chi1), fmt17(chi0));

@@ -9,7 +9,8 @@ use crate::model::project;
 /// The `--report` lines of one exported set.
 fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
     let _ = writeln!(text, "  preset: {}", m.preset);
-    if let Some(e) = m.ka_error_srgb {
+    // A block-compressed set's level 0 numbers are in its verdict line.
+    if let Some(e) = m.ka_error_srgb.filter(|_| m.blocks.is_none()) {
         let _ = writeln!(text, "  {}", e.describe());
     }
     if m.dilated {
@@ -62,13 +63,23 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
     if let Some(b) = &m.blocks {
         write_blocks(text, b);
     }
+    // The budget judges level 0 alone: the levels' lines say so where there is a budget.
+    let judged = if m.blocks.is_some() {
+        " (not judged: the budget judges level 0 only)"
+    } else {
+        ""
+    };
     if !m.level_ka_error.is_empty() {
         let levels: Vec<String> = m
             .level_ka_error
             .iter()
             .map(|e| format!("{:.2e}", e.max))
             .collect();
-        let _ = writeln!(text, "  k_a error max per mip level: {}", levels.join(" "));
+        let _ = writeln!(
+            text,
+            "  k_a error max per mip level: {}{judged}",
+            levels.join(" ")
+        );
     }
     if !m.level_ka_error_srgb.is_empty() {
         let levels: Vec<String> = m
@@ -78,7 +89,7 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
             .collect();
         let _ = writeln!(
             text,
-            "  k_a error p99.9 per mip level, levels of 8-bit sRGB: {}",
+            "  k_a error p99.9 per mip level, levels of 8-bit sRGB: {}{judged}",
             levels.join(" ")
         );
     }
@@ -94,24 +105,16 @@ fn write_report(text: &mut String, m: &crate::export::set::Manifest) {
     );
 }
 
-/// The `--report` lines of a block-compressed set's choice: the layout, effort and encoder,
-/// the verdict, and every trial.
+/// The `--report` lines of a block-compressed set's choice beyond its verdict (printed with
+/// the set's first line): what was kept and why, and every trial.
 fn write_blocks(text: &mut String, b: &crate::export::set::BlockChoice) {
     let footprint = b
         .astc_block
         .map_or_else(String::new, |f| format!("ASTC {f}, "));
     let _ = writeln!(
         text,
-        "  blocks: {footprint}{:?} at {:?} ({:?} encoder), {}: {}",
-        b.layout,
-        b.bc7_effort,
-        b.encoder,
-        if b.within_budget {
-            "within the budget"
-        } else {
-            "over the budget"
-        },
-        b.reason
+        "  kept: {footprint}{:?} at {:?} ({:?} encoder); why: {}",
+        b.layout, b.bc7_effort, b.encoder, b.reason
     );
     if let Some(f) = &b.uncompressed_ka_error_srgb {
         let _ = writeln!(
@@ -127,13 +130,19 @@ fn write_blocks(text: &mut String, b: &crate::export::set::BlockChoice) {
         );
     }
     for t in &b.trials {
+        let kept = if (t.layout, t.bc7_effort) == (b.layout, b.bc7_effort) {
+            " (kept)"
+        } else {
+            ""
+        };
         let _ = writeln!(
             text,
-            "    trial {:?} {:?}: k_a p99.9 {:.2} mean {:.3} levels, relative max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
+            "    trial {:?} {:?}{kept}: k_a p99.9 {:.2} mean {:.3} max {:.2} levels, relative max {:.3e} mean {:.3e}, PSNR {}, {:.2} s",
             t.layout,
             t.bc7_effort,
             t.ka_error_srgb.map_or(f64::NAN, |e| e.p999),
             t.ka_error_srgb.map_or(f64::NAN, |e| e.mean),
+            t.ka_error_srgb.map_or(f64::NAN, |e| e.max),
             t.ka_error.max,
             t.ka_error.mean,
             t.min_psnr
@@ -252,9 +261,19 @@ fn load_projects(
         .iter()
         .map(|f| {
             if !padding && !glb {
-                return project::load(f).map(|d| (d, None)).map_err(model_error);
+                return super::open_project(f).map(|d| (d, None));
             }
             let (doc, failed) = project::open_with_mesh(f, None).map_err(model_error)?;
+            if let Some(e) = &failed
+                && doc.needs_mesh()
+            {
+                return Err(CliError::usage(format!(
+                    "{}: its generator masks are laid on its mesh {}, which does not load ({e})",
+                    f.display(),
+                    doc.settings().mesh.spec()
+                )));
+            }
+            super::require_bakes(f, &doc)?;
             if let Some(e) = failed {
                 if glb {
                     return Err(CliError::usage(format!(
@@ -288,7 +307,6 @@ fn preset_help() -> String {
 /// `kapaint export`: every project into its set; one line each, plus the report.
 fn export_command(args: &ExportArgs) -> Result<String, CliError> {
     use crate::export::set::SetKind;
-    use std::io::IsTerminal as _;
     let (files, out, report, replace, glb) =
         (&args.files, &args.out, args.report, args.replace, args.glb);
     let preset =
@@ -326,55 +344,42 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
             .collect()
     };
     check_targets(files, &targets, replace, SetKind::of(&preset))?;
-    let terminal = std::io::stderr().is_terminal();
     let gpu = crate::gpu::blocks::for_export(&preset);
     for (i, ((file, (doc, mesh)), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
         let mesh = mesh.as_ref().map(|s| &s.mesh);
         let progress = crate::task::Progress::default();
-        // The export runs on a worker; this thread draws the bar while it works.
-        let m = std::thread::scope(|scope| {
-            let worker = std::thread::Builder::new()
-                .name("kapaint-export".into())
-                .spawn_scoped(scope, || {
-                    crate::export::run(doc, &preset, target, &progress, replace, mesh, gpu)
-                })
-                .map_err(|e| CliError::io(format!("cannot start the export: {e}")))?;
-            while terminal && !worker.is_finished() {
-                let done = (progress.fraction() * 30.0) as usize;
-                eprint!(
-                    "\r[{}{}] {}/{} {} {:<8}",
-                    "#".repeat(done),
-                    " ".repeat(30 - done),
-                    i + 1,
-                    files.len(),
-                    file.display(),
-                    progress.stage()
-                );
-                std::thread::sleep(std::time::Duration::from_millis(100));
-            }
-            if terminal {
-                eprint!("\r{}\r", " ".repeat(60 + file.display().to_string().len()));
-            }
-            worker
-                .join()
-                .map_err(|_| CliError {
-                    message: "the export worker stopped unexpectedly".into(),
-                    code: crate::crash::EXIT_INTERNAL,
-                })?
-                .map_err(super::set_error)
-        })?;
+        // A bar with the stage and an estimate on a terminal while it works.
+        let what = format!("export {}/{} {}", i + 1, files.len(), file.display());
+        let m = super::progress::with_bar(&what, &progress, || {
+            crate::export::run(doc, &preset, target, &progress, replace, mesh, gpu)
+        })
+        .map_err(super::set_error)?;
         match m {
             crate::export::Exported::Set(m) => {
-                let _ = writeln!(
+                let _ = write!(
                     text,
-                    "exported {} to {} ({} files, {} bytes, k_a error max {:.3e} mean {:.3e})",
+                    "exported {} to {} ({} files, {} bytes",
                     file.display(),
                     target.display(),
                     m.files.len(),
                     m.bytes.exported,
-                    m.ka_error.max,
-                    m.ka_error.mean
                 );
+                // A block-compressed set: its numbers with the budget's verdict on them.
+                match &m.blocks {
+                    Some(b) => {
+                        let _ = writeln!(text, ")\n  blocks: {}", b.summary());
+                    }
+                    None => {
+                        let _ = writeln!(
+                            text,
+                            ", k_a error max {:.3e} mean {:.3e})",
+                            m.ka_error.max, m.ka_error.mean
+                        );
+                    }
+                }
+                if let Some(normal) = m.normal.as_ref().and_then(|n| n.summary()) {
+                    let _ = writeln!(text, "  normal map: {normal}");
+                }
                 if report {
                     write_report(&mut text, &m);
                 }

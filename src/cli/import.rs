@@ -31,7 +31,7 @@ impl ImportArgs {
             .ok_or_else(|| CliError::usage(format!("unknown channel {:?}", self.channel)))?;
         // The file as read: a save finds out if another run saved over it meanwhile.
         let on_disk = project::OnDisk::of(&self.file);
-        let mut doc = project::load(&self.file).map_err(model_error)?;
+        let mut doc = super::open_project(&self.file)?;
         doc.import_file(channel, &self.image).map_err(model_error)?;
         let expected = if self.out.is_none() {
             on_disk.as_ref()

@@ -101,12 +101,13 @@ fn source(
 }
 
 impl ImportPbrArgs {
-    /// The set, its normal map and the notes on them.
-    fn set(&self) -> Result<(PbrSet, Option<NormalMap>, Vec<String>), CliError> {
+    /// The set, its normal map and the notes on them, and whether it is seen from both
+    /// sides.
+    fn set(&self) -> Result<(PbrSet, Option<NormalMap>, Vec<String>, bool), CliError> {
         if let Some(gltf) = &self.gltf {
             let m = crate::pbr::gltf::material_set(gltf, self.material.as_deref())
                 .map_err(model_error)?;
-            return Ok((m.set, m.normal, m.notes));
+            return Ok((m.set, m.normal, m.notes, m.double_sided));
         }
         if let Some(file) = &self.set {
             if !file.exists() {
@@ -118,7 +119,7 @@ impl ImportPbrArgs {
             let named = crate::pbr::names::set_of(file).map_err(model_error)?;
             let mut notes = named.notes.clone();
             let normal = named.load_normal(&mut notes).map_err(model_error)?;
-            return Ok((named.set, normal, notes));
+            return Ok((named.set, normal, notes, false));
         }
         let mut notes = Vec::new();
         if let Some(p) = self.normal.as_deref().filter(|p| !p.exists()) {
@@ -156,6 +157,7 @@ impl ImportPbrArgs {
                 },
                 normal,
                 notes,
+                false,
             ));
         }
         let (metallic, roughness) = match &self.metallic_roughness {
@@ -189,6 +191,7 @@ impl ImportPbrArgs {
             },
             normal,
             notes,
+            false,
         ))
     }
 
@@ -212,7 +215,7 @@ impl ImportPbrArgs {
         if let Some(g) = &self.gltf {
             crate::mesh::open(g).map_err(mesh_error)?;
         }
-        let (set, normal, notes) = self.set()?;
+        let (set, normal, notes, double_sided) = self.set()?;
         let mesh = match (&self.gltf, &self.mesh) {
             (Some(gltf), _) => Some(gltf.to_string_lossy().into_owned()),
             (None, Some(m)) => Some(m.clone()),
@@ -221,6 +224,7 @@ impl ImportPbrArgs {
         let mut imported = crate::pbr::import::import(&set, size, model, self.n_mapping.into())
             .map_err(model_error)?;
         imported.report.notes.extend(notes);
+        imported.report.double_sided = double_sided;
         let mut settings = imported.doc.settings().clone();
         settings.import = Some(imported.report.clone());
         if let Some(mesh) = &mesh {

@@ -3,8 +3,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::{CliError, model_error};
-use crate::model::{self, Document, project};
+use super::CliError;
+use crate::model::{self, Document};
 
 /// Print a project's resolution, per-channel min/mean/max and memory.
 #[derive(Debug, clap::Args)]
@@ -19,7 +19,7 @@ impl InfoArgs {
     /// # Errors
     /// A project that does not load.
     pub fn run(self) -> Result<String, CliError> {
-        let doc = project::load(&self.file).map_err(model_error)?;
+        let doc = super::open_project(&self.file)?;
         let bytes = std::fs::metadata(&self.file).map_or(0, |m| m.len());
         Ok(info_text(&self.file, &doc, bytes))
     }

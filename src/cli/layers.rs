@@ -3,9 +3,8 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use super::{CliError, model_error};
+use super::CliError;
 use crate::model::layers::LayerStack;
-use crate::model::project;
 use crate::model::texel::Channel;
 
 /// List a project's layers as CSV (index 0 the bottom layer).
@@ -21,7 +20,7 @@ impl LayersArgs {
     /// # Errors
     /// A project that does not load.
     pub fn run(self) -> Result<String, CliError> {
-        let doc = project::load(&self.file).map_err(model_error)?;
+        let doc = super::open_project(&self.file)?;
         Ok(layers_csv(doc.stack()))
     }
 }

@@ -31,6 +31,7 @@ mod layers;
 mod mesh_info;
 mod new;
 mod paint;
+mod progress;
 mod render;
 mod render_traced;
 mod unwrap;
@@ -174,6 +175,17 @@ pub fn main() -> i32 {
     };
     crate::crash::install(crate::crash::OnPanic::Exit);
     let stdin = std::io::stdin();
+    if let Command::Chi(chi) = command {
+        // Rows as they are computed: a long run (an exact integral per value) shows its
+        // first rows at once, not all of them hours later.
+        return match chi.stream(&mut stdin.lock(), &mut std::io::stdout().lock()) {
+            Ok(()) => 0,
+            Err(e) => {
+                eprintln!("kapaint: {}", one_line(&e.message));
+                e.code
+            }
+        };
+    }
     match run(command, &mut stdin.lock()) {
         Ok(text) => {
             let mut stdout = std::io::stdout().lock();
@@ -261,6 +273,42 @@ pub(super) fn model_error(e: ModelError) -> CliError {
         | ModelError::Script { .. }
         | ModelError::Unsaveable { .. }
         | ModelError::Command(_) => CliError::usage(e.to_string()),
+    }
+}
+
+/// Opens a project the way every command that reads one does ([`project::load`]: its
+/// composite made from its layers, on its own mesh where a generator mask needs it) and
+/// refuses one whose generator masks read a bake it lacks.
+///
+/// # Errors
+/// A project that does not load (exit 1 or 2, as [`model_error`]); a missing bake (exit 2,
+/// naming the `kapaint bake` that makes it).
+///
+/// [`project::load`]: crate::model::project::load
+pub(super) fn open_project(path: &std::path::Path) -> Result<crate::model::Document, CliError> {
+    let doc = crate::model::project::load(path).map_err(model_error)?;
+    require_bakes(path, &doc)?;
+    Ok(doc)
+}
+
+/// An error when a generator mask of `doc` (the project at `path`) reads a bake the project
+/// does not keep: the masks would be made of a flat stand-in.
+///
+/// # Errors
+/// The first missing bake, naming the command that makes it.
+pub(super) fn require_bakes(
+    path: &std::path::Path,
+    doc: &crate::model::Document,
+) -> Result<(), CliError> {
+    match doc.missing_bakes().first() {
+        Some((map, layer)) => Err(CliError::usage(format!(
+            "{}: the mask of the layer {layer:?} reads the {name} bake, which the project does \
+             not have: run `kapaint bake {} --map {name}` first",
+            path.display(),
+            path.display(),
+            name = map.name()
+        ))),
+        None => Ok(()),
     }
 }
 

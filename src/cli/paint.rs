@@ -34,8 +34,23 @@ impl PaintArgs {
         let commands = read_script(&self.script)?;
         // The file as read: a save finds out if another run saved over it meanwhile.
         let on_disk = project::OnDisk::of(&self.file);
-        let mut doc = project::load(&self.file).map_err(model_error)?;
-        if commands.iter().any(model::Command::needs_surface) {
+        let mut doc = super::open_project(&self.file)?;
+        // The layers are composited on the mesh they are painted on whenever they need it: a
+        // stroke on the surface, a fill of an island, or a generator mask (one already in
+        // the project, or laid by the script).
+        let lays_generator = |c: &model::Command| {
+            matches!(
+                c,
+                model::Command::Mask(
+                    model::MaskCommand::SetMaskGenerator(Some(_))
+                        | model::MaskCommand::PreviewMaskGenerator(_)
+                )
+            )
+        };
+        let needs_mesh = commands
+            .iter()
+            .any(|c| c.needs_surface() || lays_generator(c));
+        if self.mesh.is_some() || (needs_mesh && doc.surface().is_none()) {
             match &self.mesh {
                 Some(spec) => project::attach_mesh(&mut doc, Path::new(spec)),
                 None => project::attach_own_mesh(&mut doc),

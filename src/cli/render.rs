@@ -147,7 +147,7 @@ enum OwnMesh {
 /// the mesh they come with.
 fn render_material(a: &RenderArgs) -> Result<Material, CliError> {
     if let Some(file) = &a.project {
-        let doc = project::load(file).map_err(model_error)?;
+        let doc = super::open_project(file)?;
         let own = if doc.settings().mesh.is_embedded() {
             OwnMesh::Kept(project::own_mesh(&doc).map_err(model_error)?)
         } else {
@@ -221,6 +221,10 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
         (None, OwnMesh::Spec(spec)) => mesh::open(&spec).map_err(super::mesh_error)?,
         (None, OwnMesh::Kept(kept)) => kept,
     };
+    // The AO bake is of the mesh as it is (its hash); the picture is of the mesh where a
+    // camera's arithmetic holds it (one of coordinates like 1e30, moved into its unit frame).
+    let mesh_hash = mesh.content_hash();
+    let mesh = mesh.viewable();
     let light = match &a.light {
         Some(text) => parse_light(text)?,
         None => Lighting::default().light,
@@ -272,7 +276,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
     if let Some(report) = super::render_traced::route(
         a.samples,
         single,
-        (&mesh, &maps, ao.as_deref()),
+        (&mesh, mesh_hash, &maps, ao.as_deref()),
         &settings,
         size,
         &a.out,

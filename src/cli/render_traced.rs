@@ -15,14 +15,20 @@ use crate::render::{FrameSettings, ViewMode};
 pub const DEFAULT_SAMPLES: u32 = 64;
 
 /// Renders a traced view (`settings.view`) of one model (`single`) with `samples` (or
-/// [`DEFAULT_SAMPLES`]); `None` for another view, which takes no `--samples`.
+/// [`DEFAULT_SAMPLES`]); `None` for another view, which takes no `--samples`. `mesh_hash` is
+/// the mesh's as loaded (its AO bake's), before [`mesh::Mesh::viewable`] moved it.
 ///
 /// # Errors
 /// As [`render`]; `--samples` with another view, or a traced view of a comparison.
 pub fn route(
     samples: Option<u32>,
     single: bool,
-    (mesh, maps, ao): (&mesh::Mesh, &crate::model::MaterialMaps, Option<&Baked>),
+    (mesh, mesh_hash, maps, ao): (
+        &mesh::Mesh,
+        u64,
+        &crate::model::MaterialMaps,
+        Option<&Baked>,
+    ),
     settings: &FrameSettings,
     size: (u32, u32),
     out: &Path,
@@ -45,7 +51,7 @@ pub fn route(
     let samples = samples.unwrap_or(DEFAULT_SAMPLES);
     let ao = match ao {
         _ if !view.needs_ao_bake() => None,
-        Some(bake) if bake.mesh_hash == mesh.content_hash() => Some(bake),
+        Some(bake) if bake.mesh_hash == mesh_hash => Some(bake),
         Some(_) => {
             return Err(CliError::usage(format!(
                 "--view {}: the project's AO bake is of its own mesh, not of --mesh",
@@ -95,7 +101,20 @@ pub fn render(
     if let Some(bake) = ao {
         traced.set_ao_bake(bake);
     }
-    traced.pass(&rays, samples, &|| false);
+    // Passes of a hundredth of the samples each (they accumulate), so a terminal shows how
+    // far the trace is and how long it has left.
+    let progress = crate::task::Progress::default();
+    progress.start("trace", u64::from(samples));
+    super::progress::with_bar("render", &progress, || {
+        let step = samples.div_ceil(100);
+        let mut done = 0;
+        while done < samples {
+            let now = step.min(samples - done);
+            traced.pass(&rays, now, &|| false);
+            done += now;
+            progress.advance(u64::from(now));
+        }
+    });
     let seconds = start.elapsed().as_secs_f64();
     let image = traced
         .image(settings.view, settings)

@@ -84,8 +84,11 @@ pub(super) fn unwrap_for(
             "--size {size} is outside 64 to 16384"
         )));
     }
-    unwrap(mesh, UnwrapOptions::for_size(size), None)
-        .map_err(|e| CliError::usage(format!("{}: {e}", path.display())))
+    let progress = crate::task::Progress::default();
+    super::progress::with_bar("unwrap", &progress, || {
+        unwrap(mesh, UnwrapOptions::for_size(size), Some(&progress))
+    })
+    .map_err(|e| CliError::usage(format!("{}: {e}", path.display())))
 }
 
 /// One line on what the unwrap made.

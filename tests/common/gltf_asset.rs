@@ -41,6 +41,8 @@ pub struct Asset {
     pub tex_coord: u32,
     /// A normal map (`normal.png`, made by [`bumps`]) with this scale.
     pub normal_scale: Option<f32>,
+    /// The material is seen from both sides (`doubleSided`).
+    pub double_sided: bool,
 }
 
 /// A bumpy tangent-space normal map of `w x h` (8-bit RGB, +Y up).
@@ -60,6 +62,7 @@ impl Default for Asset {
             transform: None,
             tex_coord: 0,
             normal_scale: None,
+            double_sided: false,
         }
     }
 }
@@ -231,6 +234,7 @@ pub fn write_asset(d: &Path, asset: &Asset) -> PathBuf {
             metallic_roughness_texture: Some(info(t_mr, 0, None)),
             ..Default::default()
         },
+        double_sided: asset.double_sided,
         ..Default::default()
     });
     if asset.transform.is_some() {

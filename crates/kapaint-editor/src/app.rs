@@ -15,8 +15,7 @@ use super::layout::{load_layout, save_layout};
 use super::panels::layers::LayerView;
 use super::viewport::{Viewport, ViewportGpu};
 use super::{
-    DEFAULT_SIZE, EditorState, MeshState, Quit, Tab, autosave_interval, default_layout, files,
-    notice, readout,
+    DEFAULT_SIZE, EditorState, MeshState, Quit, Tab, default_layout, files, notice, readout,
 };
 use kapaint_core::model::texel::MaterialValue;
 use kapaint_core::model::{Document, DocumentSettings, recovery};
@@ -36,6 +35,20 @@ pub struct Editor {
     started: Option<Instant>,
     /// The window title last sent.
     title: String,
+}
+
+/// The document the editor starts on: a new `size`^2 one on the sphere, or, where that cannot
+/// be made, a tiny one on the plane (with a notice saying why).
+fn first_document(size: u32, notices: &mut super::Notices) -> (Document, MeshState) {
+    match new_document(size) {
+        Ok(x) => x,
+        Err(e) => {
+            notices.push(notice(e, true));
+            let doc = Document::new(16, 16, DocumentSettings::default())
+                .unwrap_or_else(|_| unreachable_doc());
+            (doc, MeshState::new(kapaint_core::mesh::plane(), 1))
+        }
+    }
 }
 
 impl Editor {
@@ -61,28 +74,20 @@ impl Editor {
         } else {
             DEFAULT_SIZE
         };
-        let (doc, mesh) = match new_document(size) {
-            Ok(x) => x,
-            Err(e) => {
-                notices.push(notice(e, true));
-                let doc = Document::new(16, 16, DocumentSettings::default())
-                    .unwrap_or_else(|_| unreachable_doc());
-                (doc, MeshState::new(kapaint_core::mesh::plane(), 1))
-            }
-        };
+        let (doc, mesh) = first_document(size, &mut notices);
         let path = existing.as_deref().or(untitled_until_open.as_deref());
         let mut viewport = Viewport::new(gpu);
         viewport.frame(&mesh.mesh);
         let recovery_offer = recovery::offer(path);
-        let autosaver =
-            recovery::Autosaver::new(autosave_interval(), untitled_until_open.as_deref(), &doc);
+        let preferences = crate::preferences::Preferences::load();
+        let autosaver = recovery::Autosaver::new(
+            preferences.autosave_interval(),
+            untitled_until_open.as_deref(),
+            &doc,
+        );
         let preset_dir = kapaint_core::model::preset::user_dir();
-        let presets =
-            super::panels::presets::load_material_presets(preset_dir.as_deref(), &mut notices);
-        let brush_presets =
-            super::panels::presets::load_brush_presets(preset_dir.as_deref(), &mut notices);
-        let mask_presets =
-            super::panels::presets::load_mask_presets(preset_dir.as_deref(), &mut notices);
+        let (presets, brush_presets, mask_presets) =
+            super::panels::presets::load_all(preset_dir.as_deref(), &mut notices);
         let dock = load_layout().unwrap_or_else(default_layout);
         let saved_version = doc.version();
         let mut editor = Self {
@@ -103,8 +108,13 @@ impl Editor {
                 export: None,
                 export_choice: None,
                 new_dialog: None,
+                pending_new: None,
                 resize_dialog: None,
                 bake_dialog: None,
+                preferences,
+                preferences_open: false,
+                equivalent_n: None,
+                bake_on_demand: crate::bake::OnDemand::default(),
                 pending_open: None,
                 material_prompt: None,
                 size_prompt: None,
@@ -246,6 +256,7 @@ impl Editor {
         let ctx = ui.ctx().clone();
         let s = &mut self.state;
         s.poll_job();
+        s.bake_missing();
         s.track_pressure(&ctx);
         s.hotkeys(&ctx);
         s.follow_mesh();
@@ -288,6 +299,7 @@ impl Editor {
         s.bake_window(&ctx);
         s.recovery_window(&ctx);
         s.shortcuts_window(&ctx);
+        s.preferences_window(&ctx);
         s.notices_ui(&ctx);
         s.close_prompt(&ctx);
         s.open_prompt(&ctx);
@@ -298,7 +310,9 @@ impl Editor {
         s.modal_job_ui(&ctx);
         s.files_ui(&ctx);
         if s.job.is_some() {
-            ctx.request_repaint_after(Duration::from_millis(100));
+            // Four progress updates a second: each frame takes the CPU the job runs on (a
+            // software renderer draws the window), so a bake or an export is not slowed.
+            ctx.request_repaint_after(Duration::from_millis(250));
         }
         let title = s.window_title();
         if title != self.title {

@@ -19,8 +19,10 @@ use kapaint_export::preset::ExportPreset;
 /// The New dialog's choices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewDialog {
-    /// Map size (square), texels.
-    pub size: u32,
+    /// Map width, texels.
+    pub width: u32,
+    /// Map height, texels.
+    pub height: u32,
     /// Index into the material presets: the base material.
     pub preset: usize,
     /// A built-in mesh name, or a mesh file's path.
@@ -159,7 +161,8 @@ impl EditorState {
             .or_else(|| self.presets.iter().position(|p| p.stem == "default"))
             .unwrap_or(0);
         self.new_dialog = Some(NewDialog {
-            size: self.doc.maps().width(),
+            width: self.doc.maps().width(),
+            height: self.doc.maps().height(),
             preset,
             mesh: "sphere".into(),
         });
@@ -177,7 +180,7 @@ impl EditorState {
             settings.secondary = p.value;
             settings.preset = Some(p.stem.clone());
         }
-        let size = dialog.size;
+        let size = (dialog.width, dialog.height);
         // Loading and baking the mesh at up to 8192^2 takes seconds: a worker does it.
         self.start_job("New", move |progress| {
             progress.start("bake", 1);
@@ -188,23 +191,31 @@ impl EditorState {
         });
     }
 
-    /// The New dialog: resolution, base preset, mesh.
+    /// The New dialog: width and height, base preset, mesh; with unsaved changes, save them
+    /// first or discard them.
     pub(super) fn new_window(&mut self, ctx: &egui::Context) {
         let Some(mut dialog) = self.new_dialog.take() else {
             return;
         };
-        let (mut open, mut create, mut choose) = (true, false, false);
+        let (mut open, mut create, mut choose, mut save_first) = (true, false, false, false);
         centred(egui::Window::new("New project"), ctx)
             .open(&mut open)
             .collapsible(false)
             .show(ctx, |ui| {
-                egui::ComboBox::from_label("Resolution")
-                    .selected_text(format!("{0}x{0}", dialog.size))
-                    .show_ui(ui, |ui| {
-                        for size in NEW_SIZES {
-                            ui.selectable_value(&mut dialog.size, size, format!("{size}x{size}"));
-                        }
-                    });
+                ui.horizontal(|ui| {
+                    for (side, label) in [
+                        (&mut dialog.width, "Width"),
+                        (&mut dialog.height, "× Height"),
+                    ] {
+                        egui::ComboBox::from_label(label)
+                            .selected_text(side.to_string())
+                            .show_ui(ui, |ui| {
+                                for size in NEW_SIZES {
+                                    ui.selectable_value(side, size, size.to_string());
+                                }
+                            });
+                    }
+                });
                 egui::ComboBox::from_label("Base preset")
                     .selected_text(
                         self.presets
@@ -228,21 +239,28 @@ impl EditorState {
                         choose = true;
                     }
                 });
-                let bytes = u64::from(dialog.size).pow(2) * 14;
+                let bytes = u64::from(dialog.width) * u64::from(dialog.height) * 14;
                 ui.label(format!("Maps: {:.0} MB", bytes as f64 / 1e6));
-                let label = if self.dirty() {
+                if self.dirty() {
                     ui.colored_label(
                         ui.visuals().warn_fg_color,
                         "The current project has unsaved changes.",
                     );
-                    "Discard changes and create"
+                    ui.horizontal(|ui| {
+                        save_first = ui.button("Save, then create").clicked();
+                        create = ui.button("Discard changes and create").clicked();
+                    });
                 } else {
-                    "Create"
-                };
-                create = ui.button(label).clicked();
+                    create = ui.button("Create").clicked();
+                }
             });
         if create {
             self.create_project(&dialog);
+        } else if save_first {
+            // Created once the save is done (untitled work asks where first); a save that
+            // fails or is cancelled creates nothing.
+            self.pending_new = Some(dialog);
+            self.save();
         } else if open {
             self.new_dialog = Some(dialog);
             if choose {

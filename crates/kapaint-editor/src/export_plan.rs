@@ -37,10 +37,10 @@ pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetP
     if let Some(n) = c.n {
         constants.push(format!("n = {n:.2}"));
     }
-    if let Some((w, h)) = plan.normal {
+    if let Some(n) = &plan.normal {
         ui.label(format!(
-            "normal.png: the project's normal map ({w}x{h}, 8-bit tangent space, as stored); \
-             it lights only, k_a never reads it"
+            "{}: the project's normal map ({}x{}, {}); it lights only, k_a never reads it",
+            n.path, n.width, n.height, n.storage
         ));
     }
     if plan.files.is_empty() && plan.normal.is_none() {

@@ -473,6 +473,7 @@ impl super::EditorState {
             Some(ChooserEvent::FellBack(text)) => self.notices.push(super::notice(text, false)),
             Some(ChooserEvent::Cancelled(FilePurpose::SaveProject)) => {
                 self.quit.after_save = false;
+                self.pending_new = None;
             }
             None | Some(ChooserEvent::Cancelled(_)) => {}
             Some(ChooserEvent::Picked(Picked { purpose, path })) => match purpose {

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use super::{EditorState, MeshState, autosave_interval, notice};
+use super::{EditorState, MeshState, notice};
 use kapaint_core::model::surface::Surface;
 use kapaint_core::model::texel::Channel;
 use kapaint_core::model::{Document, DocumentSettings, ModelError, project, recovery};
@@ -36,10 +36,14 @@ pub(super) enum JobResult {
     /// A mesh that cannot be painted as it is (no UVs) or would paint two places at once
     /// (overlapping UVs): the editor asks whether to unwrap it.
     NeedsUnwrap(UnwrapPrompt),
-    /// A map baked from the mesh, and what it holds.
+    /// Maps baked from the mesh (one, or "Bake all"'s), what each holds and how many seconds
+    /// it took.
     Baked(
-        Arc<kapaint_core::mesh::bakes::Baked>,
-        kapaint_core::mesh::bakes::BakeStats,
+        Vec<(
+            Arc<kapaint_core::mesh::bakes::Baked>,
+            kapaint_core::mesh::bakes::BakeStats,
+            f64,
+        )>,
     ),
     /// A mesh unwrapped and baked at the map size: the project keeps it.
     Unwrapped(PathBuf, Arc<Surface>, String),
@@ -82,6 +86,8 @@ pub struct LoadedMaterial {
     pub(super) set: kapaint_core::pbr::import::PbrSet,
     pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
     pub(super) notes: Vec<String>,
+    /// The material is seen from both sides (glTF's `doubleSided`).
+    pub(super) double_sided: bool,
 }
 
 /// File > Import PBR material's question while it is open ([`crate::material_size`]): the
@@ -119,15 +125,18 @@ pub(super) struct Job {
 
 /// A new `size`^2 document on the default settings, with its mesh.
 pub(super) fn new_document(size: u32) -> Result<(Document, MeshState), String> {
-    let doc = new_document_with(size, DocumentSettings::default())?;
+    let doc = new_document_with((size, size), DocumentSettings::default())?;
     let mesh = doc.surface().map(|s| s.mesh.clone()).ok_or("no mesh")?;
     Ok((doc, MeshState::new(mesh, 1)))
 }
 
-/// A new `size`^2 document with `settings`, its mesh (built in or a file, as the settings
+/// A new `width x height` document with `settings`, its mesh (built in or a file, as the settings
 /// name it) attached and baked.
-pub(super) fn new_document_with(size: u32, settings: DocumentSettings) -> Result<Document, String> {
-    let mut doc = Document::new(size, size, settings).map_err(|e| e.to_string())?;
+pub(super) fn new_document_with(
+    (width, height): (u32, u32),
+    settings: DocumentSettings,
+) -> Result<Document, String> {
+    let mut doc = Document::new(width, height, settings).map_err(|e| e.to_string())?;
     project::attach_own_mesh(&mut doc).map_err(|e| e.to_string())?;
     Ok(doc)
 }
@@ -288,7 +297,8 @@ impl EditorState {
                 self.claim.hold(None, None, false);
                 // The old document was saved or its changes discarded (asked before).
                 self.autosaver.discard();
-                self.autosaver = recovery::Autosaver::new(autosave_interval(), None, &self.doc);
+                self.autosaver =
+                    recovery::Autosaver::new(self.preferences.autosave_interval(), None, &self.doc);
             }
             JobResult::Stamp(path, stamp) => {
                 let mut brush = self.doc.settings().brush.clone();
@@ -299,6 +309,8 @@ impl EditorState {
             }
             JobResult::Failed(e) => {
                 self.quit.after_save = false;
+                self.pending_new = None;
+                self.bake_failed();
                 self.notices.push(notice(e, true));
             }
         }
@@ -314,6 +326,7 @@ impl EditorState {
         // The texel under the cursor was found on the old maps.
         self.hover = None;
         self.shown_hover = None;
+        self.layers_panel.document_replaced();
         self.doc = doc;
         if let Some(mesh) = mesh {
             self.mesh = MeshState::new(mesh, self.mesh.id + 1);
@@ -432,21 +445,31 @@ fn exported_notice(dir: &std::path::Path, m: kapaint_export::Exported) -> super:
 fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
     match m {
         kapaint_export::Exported::Set(m) => {
-            let mut text = format!(
-                "exported {} ({} files, {} bytes, k_a error max {:.2}% mean {:.3}%)",
+            let head = format!(
+                "exported {} ({} files, {} bytes",
                 dir.display(),
                 m.file_count(),
-                m.bytes.exported,
-                m.ka_error.max * 100.0,
-                m.ka_error.mean * 100.0
+                m.bytes.exported
             );
-            if let Some(e) = m.ka_error_srgb {
-                text.push_str("; ");
-                text.push_str(&e.describe());
-            }
-            if let Some(blocks) = &m.blocks {
-                text.push_str("; blocks: ");
-                text.push_str(&blocks.summary());
+            // A block-compressed set's numbers come with the budget's verdict on them, in
+            // the summary; no number stands beside it unjudged.
+            let mut text = if let Some(blocks) = &m.blocks {
+                format!("{head}); blocks: {}", blocks.summary())
+            } else {
+                let mut text = format!(
+                    "{head}, k_a error max {:.2}% mean {:.3}%)",
+                    m.ka_error.max * 100.0,
+                    m.ka_error.mean * 100.0
+                );
+                if let Some(e) = m.ka_error_srgb {
+                    text.push_str("; ");
+                    text.push_str(&e.describe());
+                }
+                text
+            };
+            if let Some(normal) = m.normal.as_ref().and_then(|n| n.summary()) {
+                text.push_str("; normal map: ");
+                text.push_str(&normal);
             }
             text
         }
@@ -498,10 +521,10 @@ mod tests {
             text.contains("over the k_a budget (k_a within 2 levels of the displayed colour for 99.9 % of texels"),
             "{text}"
         );
-        assert!(
-            text.contains("levels of the displayed colour for 99.9 % of texels (mean"),
-            "{text}"
-        );
+        // One verdict: the numbers it judges, and the max beside it said not to be judged.
+        assert!(text.contains("which judges level 0: p99.9 "), "{text}");
+        assert!(text.contains("not judged: max "), "{text}");
+        assert!(!text.contains("k_a error max"), "{text}");
         assert!(text.contains("; blocks: "), "{text}");
         assert!(
             text.contains(&format!("at {:?}", blocks.bc7_effort)),

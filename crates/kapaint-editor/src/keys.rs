@@ -183,6 +183,53 @@ fn shifted(shortcut: KeyboardShortcut) -> Option<KeyboardShortcut> {
         .then(|| KeyboardShortcut::new(shortcut.modifiers, key))
 }
 
+/// The actions of the key presses among `events`, one per press (repeats of a held key
+/// included) in the order they came, however many a frame holds; the presses are taken out.
+/// A press runs the first binding in the keymap it matches (the more specific come first:
+/// `Ctrl+Shift+Z` before `Ctrl+Z`).
+pub fn pressed_actions(events: &mut Vec<egui::Event>) -> Vec<Action> {
+    let matches = |shortcut: &KeyboardShortcut, key: Key, modifiers: egui::Modifiers| {
+        key == shortcut.logical_key && modifiers.matches_logically(shortcut.modifiers)
+    };
+    let mut actions = Vec::new();
+    events.retain(|event| {
+        let egui::Event::Key {
+            key,
+            modifiers,
+            pressed: true,
+            ..
+        } = event
+        else {
+            return true;
+        };
+        let found = keymap().iter().find(|b| {
+            matches(&b.shortcut, *key, *modifiers)
+                || shifted(b.shortcut).is_some_and(|s| matches(&s, *key, *modifiers))
+        });
+        match found {
+            Some(b) => {
+                actions.push(b.action);
+                false
+            }
+            None => true,
+        }
+    });
+    actions
+}
+
+/// A binding as the editor shows it (the shortcut sheet, the menus): the platform's modifier
+/// names (`Ctrl+`, or `Cmd` on a Mac) and the key as it is printed on the keyboard (`[`, not
+/// `OpenBracket`).
+pub fn printed(ctx: &egui::Context, shortcut: &KeyboardShortcut) -> String {
+    let names = egui::ModifierNames::NAMES;
+    let mut out = names.format(&shortcut.modifiers, ctx.os().is_mac());
+    if !out.is_empty() {
+        out.push_str(names.concat);
+    }
+    out.push_str(shortcut.logical_key.symbol_or_name());
+    out
+}
+
 /// A binding as people write it (`Ctrl+Shift+Z`, `Shift+[`, `B`), independent of the platform
 /// (the README and the tests use it; the editor shows egui's own formatting).
 pub fn written(shortcut: &KeyboardShortcut) -> String {
@@ -213,16 +260,7 @@ impl EditorState {
         {
             return;
         }
-        let actions: Vec<Action> = ctx.input_mut(|i| {
-            keymap()
-                .iter()
-                .filter(|b| {
-                    i.consume_shortcut(&b.shortcut)
-                        || shifted(b.shortcut).is_some_and(|s| i.consume_shortcut(&s))
-                })
-                .map(|b| b.action)
-                .collect()
-        });
+        let actions: Vec<Action> = ctx.input_mut(|i| pressed_actions(&mut i.events));
         let mut brush = self.doc.settings().brush.clone();
         for action in actions {
             match action {
@@ -275,7 +313,7 @@ impl EditorState {
             .show(ctx, |ui| {
                 egui::Grid::new("keymap").striped(true).show(ui, |ui| {
                     for b in keymap() {
-                        ui.label(ctx.format_shortcut(&b.shortcut));
+                        ui.label(printed(ctx, &b.shortcut));
                         ui.label(b.description);
                         ui.end_row();
                     }

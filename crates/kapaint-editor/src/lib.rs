@@ -22,6 +22,7 @@ mod mesh_jobs;
 pub mod notices;
 pub use notices::{Notice, NoticeLevel, Notices};
 mod panels;
+pub mod preferences;
 mod project_jobs;
 mod prompts;
 pub use panels::layers::LayerView;
@@ -38,7 +39,6 @@ pub use layout::{default_layout, layout_json, parse_layout};
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Duration;
 
 use egui::Color32;
 use glam::Vec2;
@@ -201,8 +201,22 @@ pub struct EditorState {
     resize_dialog: Option<resize::ResizeDialog>,
     /// Mesh > Bake, while open.
     bake_dialog: Option<bake::BakeDialog>,
+    /// The editor's settings that outlive a run (Edit > Preferences).
+    preferences: preferences::Preferences,
+    /// Whether the Preferences window is open.
+    preferences_open: bool,
+    /// The other model's exponent matching the primary's `n` (the tools panel shows it), for
+    /// the model and `n` (its bits) it was found for.
+    equivalent_n: Option<((kapaint_core::reflectance::ShadingModel, u32), f64)>,
+    /// The bakes the editor makes on its own: a generator mask set while a bake it reads was
+    /// missing (laid once they arrive), and the document version last looked at for bakes its
+    /// masks read and lack.
+    bake_on_demand: bake::OnDemand,
     /// The New dialog, while open.
     new_dialog: Option<NewDialog>,
+    /// The New dialog's project, created once the save its "Save, then create" started is
+    /// done.
+    pending_new: Option<NewDialog>,
     /// A project to open once the user has decided about the unsaved changes.
     pending_open: Option<PathBuf>,
     /// An imported glTF mesh whose material has textures: asking whether to bring them in.
@@ -287,16 +301,6 @@ enum QuitAllowed {
 
 /// A preset's thumbnail: the id of the mesh it shows, and its texture.
 type Thumbnail = (u64, egui::TextureHandle);
-
-/// How often the editor autosaves: [`recovery::AUTOSAVE_INTERVAL`], or
-/// `KAPAINT_AUTOSAVE_SECONDS` (the crash test uses a short one).
-fn autosave_interval() -> Duration {
-    std::env::var("KAPAINT_AUTOSAVE_SECONDS")
-        .ok()
-        .and_then(|s| s.parse::<f64>().ok())
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .map_or(recovery::AUTOSAVE_INTERVAL, Duration::from_secs_f64)
-}
 
 /// Information, or an error.
 fn notice(text: impl Into<String>, error: bool) -> Notice {

@@ -46,6 +46,7 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
             set: m.set,
             normal: m.normal,
             notes: m.notes,
+            double_sided: m.double_sided,
         });
     }
     let named = kapaint_core::pbr::names::set_of(path)?;
@@ -56,6 +57,7 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
         set: named.set,
         normal,
         notes,
+        double_sided: false,
     })
 }
 
@@ -71,6 +73,7 @@ fn convert(
     let imported = kapaint_core::pbr::import::import(&loaded.set, Some(size), model, mapping)?;
     let mut report = imported.report;
     report.notes.extend(loaded.notes.iter().cloned());
+    report.double_sided = loaded.double_sided;
     let (maps, _) = imported.doc.into_parts();
     Ok(PbrMaterial {
         maps,

@@ -35,18 +35,34 @@ impl EditorState {
                 }
             }
             JobResult::NeedsUnwrap(prompt) => self.unwrap_prompt = Some(prompt),
-            JobResult::Baked(baked, stats) => {
-                let name = baked.map.name();
-                let bake = kapaint_core::model::document::AttachedBake(baked);
-                match self.doc.apply(ImportCommand::SetBake(bake)) {
-                    Ok(()) => self.notices.push(notice(
+            JobResult::Baked(baked) => {
+                let lines: Vec<String> = baked
+                    .iter()
+                    .map(|(b, stats, seconds)| {
                         format!(
-                            "baked {name}: {} texels, mean {:.3}, min {:.3}",
-                            stats.texels, stats.mean, stats.min
-                        ),
-                        false,
-                    )),
-                    Err(e) => self.notices.push(notice(e.to_string(), true)),
+                            "baked {}: {} texels, mean {:.3}, min {:.3}, {seconds:.1} s",
+                            b.map.name(),
+                            stats.texels,
+                            stats.mean,
+                            stats.min
+                        )
+                    })
+                    .collect();
+                let bakes = baked
+                    .into_iter()
+                    .map(|(b, _, _)| kapaint_core::model::document::AttachedBake(b))
+                    .collect();
+                match self.doc.apply(ImportCommand::SetBakes(bakes)) {
+                    Ok(()) => {
+                        for line in lines {
+                            self.notices.push(notice(line, false));
+                        }
+                        self.baked_on_demand();
+                    }
+                    Err(e) => {
+                        self.bake_failed();
+                        self.notices.push(notice(e.to_string(), true));
+                    }
                 }
             }
             JobResult::Unwrapped(path, surface, summary) => {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use super::files::FilePurpose;
 use super::jobs::{JobResult, OpenedProject, load_project, with_fallback};
-use super::{EditorState, autosave_interval, notice};
+use super::{EditorState, notice};
 use kapaint_core::model::{project, recovery};
 
 impl EditorState {
@@ -33,6 +33,11 @@ impl EditorState {
         {
             self.open_now(next);
         }
+        if !self.dirty()
+            && let Some(dialog) = self.pending_new.take()
+        {
+            self.create_project(&dialog);
+        }
     }
 
     /// A save found its project changed on disk: the work went to `written` instead.
@@ -47,6 +52,7 @@ impl EditorState {
             .hold(Some(&written), project::OnDisk::of(&written), false);
         self.path = Some(written);
         self.quit.after_save = false;
+        self.pending_new = None;
     }
 
     /// Makes `doc` the document, with its mesh shown and framed.
@@ -64,7 +70,7 @@ impl EditorState {
         self.replace_document(doc);
         // The old document was saved or its changes discarded (asked before).
         self.autosaver.discard();
-        let interval = autosave_interval();
+        let interval = self.preferences.autosave_interval();
         // Recovered work is unsaved work, and its copy stays until this editor has its own.
         (self.saved_version, self.autosaver) = match recovered.clone() {
             Some(from) => (

@@ -21,6 +21,8 @@ pub struct Textures<'a> {
     pub metallic_roughness: &'a [u8],
     /// The tangent-space normal map, if any.
     pub normal: Option<&'a [u8]>,
+    /// The material is seen from both sides (glTF's `doubleSided`).
+    pub double_sided: bool,
 }
 
 /// The binary chunk being built, and the views into it.
@@ -213,6 +215,7 @@ fn push_material(
             metallic_roughness_texture: Some(mr),
             ..Default::default()
         },
+        double_sided: textures.double_sided,
         ..Default::default()
     })
 }

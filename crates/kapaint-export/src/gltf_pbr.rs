@@ -158,6 +158,11 @@ pub fn export(
                 base_color: &base,
                 metallic_roughness: &metallic_roughness,
                 normal: normal.as_deref(),
+                double_sided: doc
+                    .settings()
+                    .import
+                    .as_ref()
+                    .is_some_and(|r| r.double_sided),
             };
             super::glb::write(mesh, &textures, name)
         })

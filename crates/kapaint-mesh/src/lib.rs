@@ -8,9 +8,12 @@
 pub mod bake;
 pub mod bakes;
 mod builtin;
+mod fans;
+pub mod frame;
 pub mod gltf_import;
 mod obj;
 pub mod pick;
+mod polygon;
 pub mod tangents;
 pub mod unwrap;
 
@@ -84,7 +87,23 @@ impl Mesh {
         Ok(())
     }
 
-    /// Checks the invariants every consumer relies on.
+    /// The mesh as a camera and a tracer can see it: itself, or, where its scale is extreme
+    /// ([`frame::UnitFrame::is_extreme`]: coordinates of 1e30, or of 1e-20), moved into its
+    /// unit frame. The same shape, so a picture framed on it is the same picture.
+    #[must_use]
+    pub fn viewable(self) -> Self {
+        let frame = frame::UnitFrame::of(&self.positions);
+        if !frame.is_extreme() {
+            return self;
+        }
+        Self {
+            positions: frame.local_positions(&self.positions),
+            ..self
+        }
+    }
+
+    /// Checks the invariants every consumer relies on: among them, finite positions whose
+    /// bounding box has a diagonal f32 can measure ([`frame::MAX_DIAGONAL`]).
     pub fn validate(&self) -> Result<(), String> {
         if self.triangles.is_empty() {
             return Err("the mesh has no triangles".into());
@@ -99,9 +118,7 @@ impl Mesh {
         if self.normals.len() != n || self.uvs.as_ref().is_some_and(|u| u.len() != n) {
             return Err("attribute counts differ".into());
         }
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!("vertex {i} has a non-finite position"));
-        }
+        frame::UnitFrame::checked(&self.positions)?;
         if let Some(uvs) = &self.uvs
             && let Some(i) = uvs.iter().position(|t| !t.is_finite())
         {
@@ -219,9 +236,11 @@ pub fn smooth_normals(
     group: &[usize],
     groups: usize,
 ) -> Vec<Vec3> {
-    let mut sums = vec![Vec3::ZERO; groups];
+    // In f64: a product of two f32 coordinates always fits (1e30 squared overflows f32, 1e-20
+    // squared is below its least value), so normals are the same at any scale.
+    let mut sums = vec![glam::DVec3::ZERO; groups];
     for t in triangles {
-        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
         let face = (b - a).cross(c - a); // length = twice the area: area weighting
         for &i in t {
             sums[group[i as usize]] += face;
@@ -229,7 +248,11 @@ pub fn smooth_normals(
     }
     group
         .iter()
-        .map(|&g| sums[g].try_normalize().unwrap_or(Vec3::Y))
+        .map(|&g| {
+            sums[g]
+                .try_normalize()
+                .map_or(Vec3::Y, glam::DVec3::as_vec3)
+        })
         .collect()
 }
 
@@ -314,4 +337,25 @@ pub fn info_text(path: &Path, mesh: &Mesh) -> String {
             "missing"
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn computed_normals_are_the_same_at_every_scale() {
+        let torus = torus(1.0, 0.35, 24, 12);
+        let group: Vec<usize> = (0..torus.vertex_count()).collect();
+        let at = |scale: f32| {
+            let positions: Vec<Vec3> = torus.positions.iter().map(|&p| p * scale).collect();
+            smooth_normals(&positions, &torus.triangles, &group, group.len())
+        };
+        let unit = at(1.0);
+        for scale in [1e-20_f32, 1e30] {
+            for (a, b) in unit.iter().zip(at(scale)) {
+                assert!((*a - b).length() < 1e-5, "at {scale}: {a} against {b}");
+            }
+        }
+    }
 }

@@ -1,4 +1,5 @@
-//! Wavefront OBJ import (through `tobj`): every object and group, polygons triangulated.
+//! Wavefront OBJ import (through `tobj`): every object and group, polygons triangulated
+//! ([`crate::polygon`]).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -28,8 +29,9 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
         path: path.to_path_buf(),
         reason,
     };
+    // Faces come as polygons and are triangulated here: tobj fans them from their first corner.
     let options = tobj::LoadOptions {
-        triangulate: true,
+        triangulate: false,
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
@@ -52,9 +54,15 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
     for model in &models {
         let m = &model.mesh;
         let count = m.positions.len() / 3;
-        if m.indices.len() % 3 != 0 {
+        // No arities: every face is a triangle.
+        let arities: Vec<usize> = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        if arities.iter().sum::<usize>() != m.indices.len() {
             return Err(invalid(format!(
-                "object {:?} has a face that did not triangulate",
+                "object {:?} has faces whose corners do not add up",
                 model.name
             )));
         }
@@ -127,8 +135,38 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
             map.insert((p, t, nn), v);
             Ok(v)
         };
-        for k in (0..m.indices.len()).step_by(3) {
-            triangles.push([corner(k)?, corner(k + 1)?, corner(k + 2)?]);
+        let mut first = 0;
+        for arity in arities {
+            let face = first..first + arity;
+            first += arity;
+            if arity <= 4 {
+                // Split as tobj split them (the meshes that always loaded load the same).
+                if arity >= 3 {
+                    let k = face.start;
+                    triangles.push([corner(k)?, corner(k + 1)?, corner(k + 2)?]);
+                }
+                if arity == 4 {
+                    let k = face.start;
+                    triangles.push([corner(k)?, corner(k + 2)?, corner(k + 3)?]);
+                }
+                continue;
+            }
+            let positions_of: Vec<Vec3> = m.indices[face.clone()]
+                .iter()
+                .map(|&p| {
+                    let pi = p as usize * 3;
+                    m.positions
+                        .get(pi..pi + 3)
+                        .map(|c| Vec3::new(c[0], c[1], c[2]))
+                        .ok_or_else(|| {
+                            invalid(format!("a face refers to vertex {} of {count}", p + 1))
+                        })
+                })
+                .collect::<Result<_, _>>()?;
+            for t in crate::polygon::triangulate(&positions_of) {
+                let [a, b, c] = t.map(|i| face.start + i as usize);
+                triangles.push([corner(a)?, corner(b)?, corner(c)?]);
+            }
         }
         position_base += count;
     }

@@ -3,10 +3,15 @@
 //! A bounding volume hierarchy over the triangles, built by splitting at the median centroid
 //! along the longest axis (`select_nth_unstable`, so the build is O(n log n)), flattened into
 //! an array. A pick walks it near child first and tests triangles with Moller-Trumbore.
+//!
+//! The hierarchy holds the mesh in its [`UnitFrame`] (centred, scaled into `[-1, 1]` by a power
+//! of two), so boxes, centroids and intersections see the same numbers at any scale; rays come
+//! in and hits go out in object units.
 
 use glam::{Vec2, Vec3};
 
 use super::Mesh;
+use crate::frame::UnitFrame;
 
 /// Triangles per leaf at most.
 const LEAF_SIZE: usize = 4;
@@ -26,6 +31,12 @@ struct Node {
 pub struct Bvh {
     nodes: Vec<Node>,
     order: Vec<u32>,
+    /// Where the boxes and `positions` are.
+    frame: UnitFrame,
+    /// The mesh's positions in `frame`.
+    positions: Vec<Vec3>,
+    /// The mesh's triangles.
+    triangles: Vec<[u32; 3]>,
 }
 
 /// A ray hit on the surface.
@@ -45,32 +56,45 @@ pub struct Hit {
     pub uv: Option<Vec2>,
 }
 
-fn bounds(mesh: &Mesh, tris: &[u32]) -> (Vec3, Vec3) {
+/// The box around the triangles `tris` (indices into `triangles`, corners in `positions`).
+fn bounds(positions: &[Vec3], triangles: &[[u32; 3]], tris: &[u32]) -> (Vec3, Vec3) {
     tris.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), &t| {
-            mesh.triangles[t as usize]
-                .iter()
-                .fold((lo, hi), |(lo, hi), &v| {
-                    (
-                        lo.min(mesh.positions[v as usize]),
-                        hi.max(mesh.positions[v as usize]),
-                    )
-                })
+            triangles[t as usize].iter().fold((lo, hi), |(lo, hi), &v| {
+                (lo.min(positions[v as usize]), hi.max(positions[v as usize]))
+            })
         },
     )
 }
 
 impl Bvh {
-    /// Builds the hierarchy.
+    /// Builds the hierarchy. A mesh that fails [`Mesh::validate`] is built all the same:
+    /// triangles with a non-finite corner, or a corner that is not a vertex, are left out (no
+    /// ray meets them).
     pub fn build(mesh: &Mesh) -> Self {
+        let frame = UnitFrame::of(&mesh.positions);
+        let positions = frame.local_positions(&mesh.positions);
+        let corner = |v: u32| positions.get(v as usize).copied().filter(|p| p.is_finite());
+        let mut order: Vec<u32> = (0..mesh.triangles.len() as u32)
+            .filter(|&t| {
+                mesh.triangles[t as usize]
+                    .iter()
+                    .all(|&v| corner(v).is_some())
+            })
+            .collect();
         let centroids: Vec<Vec3> = mesh
             .triangles
             .iter()
-            .map(|t| t.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / 3.0)
+            .map(|t| {
+                t.map(|v| corner(v).unwrap_or(Vec3::ZERO))
+                    .iter()
+                    .sum::<Vec3>()
+                    / 3.0
+            })
             .collect();
-        let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * mesh.triangles.len() / LEAF_SIZE + 1);
+        let triangles = mesh.triangles.clone();
+        let mut nodes = Vec::with_capacity(2 * order.len() / LEAF_SIZE + 1);
         // (node index, start, end) still to split.
         let mut stack = vec![(0usize, 0usize, order.len())];
         nodes.push(Node {
@@ -80,7 +104,7 @@ impl Bvh {
             count: 0,
         });
         while let Some((index, start, end)) = stack.pop() {
-            let (lo, hi) = bounds(mesh, &order[start..end]);
+            let (lo, hi) = bounds(&positions, &triangles, &order[start..end]);
             if end - start <= LEAF_SIZE {
                 nodes[index] = Node {
                     lo,
@@ -131,19 +155,32 @@ impl Bvh {
             stack.push((right, mid, end));
             stack.push((left, start, mid));
         }
-        Self { nodes, order }
+        Self {
+            nodes,
+            order,
+            frame,
+            positions,
+            triangles,
+        }
     }
 
-    /// The nearest hit of the ray `origin + t * dir`, `t > 0`, if any.
+    /// The nearest hit of the ray `origin + t * dir`, `t > 0`, if any. `mesh` is the mesh the
+    /// hierarchy was built from (it gives the hit's position, normal and UV).
     pub fn pick(&self, mesh: &Mesh, origin: Vec3, dir: Vec3) -> Option<Hit> {
-        if self.nodes.is_empty()
-            || mesh.triangles.is_empty()
+        // In f64: a direction of 1e30 has no f32 length.
+        let length = dir.as_dvec3().length();
+        if self.order.is_empty()
+            || mesh.triangles.len() != self.triangles.len()
             || !origin.is_finite()
-            || !dir.is_finite()
-            || dir == Vec3::ZERO
+            || !(length.is_finite() && length > 0.0)
         {
             return None;
         }
+        // The same ray in the local frame, with a unit direction: a local distance is
+        // `length / local_per_object` of the ray's `t`.
+        let t_per_local = 1.0 / (length * self.frame.local_per_object());
+        let dir = (dir.as_dvec3() / length).as_vec3();
+        let origin = self.frame.local_from_object(origin);
         let inv = dir.recip();
         let mut best: Option<(f32, u32, f32, f32)> = None;
         let mut stack = [0u32; 64];
@@ -157,7 +194,8 @@ impl Bvh {
             }
             if node.count > 0 {
                 for &t in &self.order[node.start as usize..(node.start + node.count) as usize] {
-                    if let Some((d, u, v)) = intersect(mesh, t, origin, dir)
+                    let corners = self.triangles[t as usize].map(|v| self.positions[v as usize]);
+                    if let Some((d, u, v)) = moller_trumbore(corners, origin, dir)
                         && best.is_none_or(|b| d < b.0)
                     {
                         best = Some((d, t, u, v));
@@ -183,6 +221,7 @@ impl Bvh {
             }
         }
         let (t, tri, u, v) = best?;
+        let t = (f64::from(t) * t_per_local) as f32;
         let [a, b, c] = mesh.triangles[tri as usize];
         let bary = Vec3::new(1.0 - u - v, u, v);
         let lerp3 = |p: [Vec3; 3]| p[0] * bary.x + p[1] * bary.y + p[2] * bary.z;
@@ -211,9 +250,20 @@ fn slab(lo: Vec3, hi: Vec3, origin: Vec3, inv: Vec3) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
-/// Moller-Trumbore: `(t, u, v)` of the ray's hit on triangle `tri`, two-sided.
+/// Moller-Trumbore in object space: `(t, u, v)` of the ray's hit on triangle `tri`,
+/// two-sided. A reference to check [`Bvh::pick`] against on meshes of moderate scale (f32
+/// products of coordinates overflow beyond about 1e19); the hierarchy tests the same way in the
+/// mesh's unit frame.
 pub fn intersect(mesh: &Mesh, tri: u32, origin: Vec3, dir: Vec3) -> Option<(f32, f32, f32)> {
-    let [a, b, c] = mesh.triangles[tri as usize].map(|v| mesh.positions[v as usize]);
+    moller_trumbore(
+        mesh.triangles[tri as usize].map(|v| mesh.positions[v as usize]),
+        origin,
+        dir,
+    )
+}
+
+/// Moller-Trumbore: `(t, u, v)` of the ray's hit on the triangle `[a, b, c]`, two-sided.
+fn moller_trumbore([a, b, c]: [Vec3; 3], origin: Vec3, dir: Vec3) -> Option<(f32, f32, f32)> {
     let (e1, e2) = (b - a, c - a);
     let p = dir.cross(e2);
     let det = e1.dot(p);
@@ -233,4 +283,55 @@ pub fn intersect(mesh: &Mesh, tri: u32, origin: Vec3, dir: Vec3) -> Option<(f32,
     }
     let t = e2.dot(q) * inv;
     (t > 0.0).then_some((t, u, v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn picks_are_the_same_at_every_scale() {
+        let torus = crate::torus(1.0, 0.35, 40, 20);
+        let offset = Vec3::new(-2.0, 0.5, 1.0);
+        // Rays from a ring around the torus towards points on and off it.
+        let rays: Vec<(Vec3, Vec3)> = (0..400)
+            .map(|i| {
+                let a = i as f32 * 2.399;
+                let origin = Vec3::new(3.0 * a.cos(), 1.0 + (i % 7) as f32 * 0.1, 3.0 * a.sin());
+                let aim = Vec3::new(0.9 * (a * 1.7).sin(), 0.3 * (a * 0.3).cos(), 0.9 * a.cos());
+                (origin + offset, aim - origin)
+            })
+            .collect();
+        let picks = |scale: f32| {
+            let mut mesh = torus.clone();
+            mesh.positions
+                .iter_mut()
+                .for_each(|p| *p = (*p + offset) * scale);
+            let bvh = Bvh::build(&mesh);
+            rays.iter()
+                .map(|&(o, d)| bvh.pick(&mesh, o * scale, d * scale))
+                .collect::<Vec<_>>()
+        };
+        let unit = picks(1.0);
+        assert!(unit.iter().flatten().count() > 100, "enough rays hit");
+        for scale in [1e-20_f32, 1e30, 2.0_f32.powi(-100), 2.0_f32.powi(120)] {
+            for (k, (a, b)) in unit.iter().zip(picks(scale)).enumerate() {
+                let (Some(a), Some(b)) = (a, b) else {
+                    assert!(
+                        a.is_none() && b.is_none(),
+                        "ray {k} at {scale}: {a:?} {b:?}"
+                    );
+                    continue;
+                };
+                assert_eq!(a.triangle, b.triangle, "ray {k} at {scale}");
+                assert!((a.t - b.t).abs() <= 1e-5 * a.t, "ray {k} at {scale}");
+                assert!((a.barycentric - b.barycentric).abs().max_element() < 1e-4);
+                let back = b.position / scale - offset;
+                assert!(
+                    (a.position - offset - back).length() < 1e-4,
+                    "ray {k} at {scale}"
+                );
+            }
+        }
+    }
 }

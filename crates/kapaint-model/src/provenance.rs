@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// The conversion error over a set's texels (relative, see `kapaint_core::pbr::convert::Conversion::error`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ErrorSummary {
     /// Largest.
     pub max: f32,
@@ -15,6 +16,7 @@ pub struct ErrorSummary {
 
 /// What an import did, kept with the project.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ImportReport {
     /// Where the set came from (file names, or "constant").
     pub source: String,
@@ -27,6 +29,10 @@ pub struct ImportReport {
     /// What was done to fit the inputs together (resampling), one line each.
     #[serde(default)]
     pub notes: Vec<String>,
+    /// The source material is seen from both sides (glTF's `doubleSided`): the `.glb` the
+    /// `gltf-pbr` export writes says so too.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub double_sided: bool,
 }
 
 /// How a PBR texel's roughness and `F0` become a Phong or Blinn-Phong `n` and `k_s` (the

@@ -42,6 +42,7 @@ pub struct MaterialValue {
 
 /// A material value as a file spells it, before its ranges are checked.
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MaterialValueFile {
     kd: [f32; 3],
     ks: [f32; 3],
@@ -97,6 +98,7 @@ impl Default for MaterialValue {
 
 /// Which channels an operation writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Channels {
     /// Write `k_d`.
     pub kd: bool,

@@ -24,6 +24,9 @@ use layer_doc::{document, run, texels};
 /// A rust layer over the base, selected: what a generator mask shapes.
 fn rust_layer() -> Document {
     let mut doc = document();
+    // Its mesh attached, as every path that lays a generator has it (the editor, `paint`,
+    // opening a project).
+    kapaint_model::project::attach_own_mesh(&mut doc).expect("the sphere");
     run(
         &mut doc,
         r#"(commands: [AddLayer(kind: Fill, name: "Rust"), SetPrimary((kd: (0.4, 0.15, 0.05), ks: (0.02, 0.02, 0.02), n: 3.0)), SetLayerFill((kd: (0.4, 0.15, 0.05), ks: (0.02, 0.02, 0.02), n: 3.0))])"#,
@@ -273,10 +276,20 @@ fn the_ao_generator_reads_the_ao_bake_through_its_levels() {
     .expect("mesh");
     run(
         &mut doc,
-        r#"(commands: [AddLayer(kind: Fill, name: "Dirt"), SetMaskGenerator(Ao(black: 0.2, white: 0.9, invert: true))])"#,
+        r#"(commands: [AddLayer(kind: Fill, name: "Dirt")])"#,
     );
-    // No bake yet: the generator reads 0.5 through its levels.
-    let unbaked = mask_values(&doc);
+    // No bake yet: the generator is refused, naming the bake that makes what it reads (it read
+    // a flat 0.5 through its levels before).
+    let ao_mask = MaskCommand::SetMaskGenerator(Some(Generator::Ao(Levels {
+        black: 0.2,
+        white: 0.9,
+        gamma: 1.0,
+        invert: true,
+        relative: false,
+    })));
+    let e = doc.apply(ao_mask.clone()).expect_err("no AO bake");
+    assert!(e.to_string().contains("kapaint bake"), "{e}");
+    let unmasked = texels(&doc);
     let ao = Arc::new(
         bake_map(
             &surface.mesh,
@@ -294,13 +307,14 @@ fn the_ao_generator_reads_the_ao_bake_through_its_levels() {
         Arc::clone(&ao),
     )))
     .expect("kept");
+    doc.apply(ao_mask.clone()).expect("the bake is there");
     let baked = mask_values(&doc);
-    assert_ne!(baked, unbaked, "the bake is read once it is there");
     let levels = Levels {
         black: 0.2,
         white: 0.9,
         gamma: 1.0,
         invert: true,
+        relative: false,
     };
     for i in (0..baked.len()).step_by(131) {
         if surface.bake.triangle(i).is_none() {
@@ -310,9 +324,11 @@ fn the_ao_generator_reads_the_ao_bake_through_its_levels() {
         let got = f32::from(baked[i]) / 65535.0;
         assert!((got - expect).abs() < 1e-4, "texel {i}: {got} vs {expect}");
     }
-    // Undo of the bake: the generator reads no bake again.
+    // Undo of the mask, then of the bake: as it was, and the generator refused again.
     doc.apply(HistoryCommand::Undo).expect("undo");
-    assert_eq!(mask_values(&doc), unbaked);
+    assert_eq!(texels(&doc), unmasked);
+    doc.apply(HistoryCommand::Undo).expect("undo");
+    assert!(doc.apply(ao_mask).is_err());
 }
 
 /// The archive's manifest, edited by `edit`.
@@ -381,8 +397,10 @@ fn generators_save_as_parameters_in_version_4_and_read_back_bit_exact() {
     }
 }
 
+/// Opening lays a project's generator masks on its mesh and makes its composite from the
+/// layers there: what was saved, computed again, not read from the stored composite.
 #[test]
-fn a_project_with_generator_masks_opens_without_computing_them_and_meets_its_mesh() {
+fn a_project_with_generator_masks_opens_with_them_made_on_its_mesh() {
     use kapaint_model::project;
     let settings = kapaint_model::DocumentSettings {
         mesh: kapaint_model::MeshRef::Builtin("torus".into()),
@@ -397,17 +415,20 @@ fn a_project_with_generator_masks_opens_without_computing_them_and_meets_its_mes
     let bytes = to_bytes(&doc).expect("saves");
     let mut back = from_reader(Cursor::new(&bytes)).expect("reads");
     let computed = |d: &Document| d.stack().heap_bytes();
-    assert_eq!(computed(&back), 0, "nothing computed on opening");
-    assert_eq!(texels(&back), texels(&doc), "the stored composite");
-    project::attach_own_mesh(&mut back).expect("torus");
-    assert_eq!(computed(&back), 0, "nor on meeting its mesh");
+    assert!(back.surface().is_some(), "the torus is attached");
+    assert!(computed(&back) > 0, "the masks were made on opening");
     assert_eq!(texels(&back), texels(&doc));
+    // The stored composite is not what opens: a `kd` made white in the file changes nothing.
+    let white = with_manifest(&bytes, |m| {
+        m["kd"] = serde_json::json!({"kind": "uniform", "value": [65535, 65535, 65535]});
+    });
+    let opened = from_reader(Cursor::new(&white)).expect("reads");
+    assert_eq!(texels(&opened), texels(&doc));
     // A change computes them on the mesh, as in the document saved.
     for d in [&mut doc, &mut back] {
         d.apply(MaskCommand::SetMaskGenerator(Some(noise(3.0))))
             .expect("set");
     }
-    assert!(computed(&back) > 0);
     assert_eq!(texels(&back), texels(&doc));
 }
 
@@ -427,4 +448,79 @@ fn the_dust_smart_mask_settles_on_what_faces_up() {
     let bottom = values[w * h / 2..].iter().filter(|&&v| v > 0).count();
     assert!(top > w * h / 64, "dust on top: {top} texels");
     assert_eq!(bottom, 0, "no dust underneath");
+}
+
+/// The fraction of `mesh`'s surface texels (at 256^2, unwrapped first where it has no UVs)
+/// that the curvature part of the shipped Edge wear smart mask marks (above one half).
+fn edge_wear_fraction(mesh: kapaint_mesh::Mesh) -> f64 {
+    use kapaint_mesh::bakes::{BakeMap, BakeOptions, bake_map};
+    let size = 256;
+    let mesh = if mesh.uvs.is_some() {
+        mesh
+    } else {
+        kapaint_mesh::unwrap::unwrap(
+            &mesh,
+            kapaint_mesh::unwrap::UnwrapOptions::for_size(size),
+            None,
+        )
+        .expect("unwraps")
+        .mesh
+    };
+    let surface = kapaint_model::surface::Surface::new(mesh, size, size).expect("bakes");
+    let baked = bake_map(
+        &surface.mesh,
+        &surface.bake,
+        BakeMap::Curvature,
+        BakeOptions::default(),
+        None,
+    )
+    .expect("curvature");
+    let edge = kapaint_model::generator::preset::builtin()
+        .into_iter()
+        .find(|p| p.name == "Edge wear")
+        .expect("shipped");
+    let Generator::Blend { a, .. } = edge.mask else {
+        panic!("Edge wear is a blend: {:?}", edge.mask);
+    };
+    let Generator::Curvature(levels) = a.resolved(&[Arc::new(baked.clone())]) else {
+        panic!("its first part reads curvature: {a:?}");
+    };
+    let (mut on, mut all) = (0_u64, 0_u64);
+    for i in 0..surface.bake.len() {
+        if surface.bake.coverage(i) == kapaint_mesh::bake::Coverage::Empty {
+            continue;
+        }
+        all += 1;
+        on += u64::from(levels.apply(baked.value(i, 0)) > 0.5);
+    }
+    on as f64 / all as f64
+}
+
+/// Edge wear marks a mesh's edges, not its body: its levels sit in each mesh's own spread of
+/// curvature (fixed levels sat at the smooth teapot's and cow's mean and covered them whole).
+#[test]
+fn edge_wear_finds_the_edges_of_smooth_and_sharp_meshes_alike() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/meshes");
+    let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/testdata/spot/spot_triangulated.obj");
+    let meshes = [
+        (
+            "teapot",
+            kapaint_mesh::open(&data.join("teapot.obj")).expect("teapot"),
+        ),
+        ("spot", kapaint_mesh::open(&spot).expect("spot")),
+        (
+            "suzanne",
+            kapaint_mesh::open(&data.join("suzanne.obj")).expect("suzanne"),
+        ),
+    ];
+    for (name, mesh) in meshes {
+        let f = edge_wear_fraction(mesh);
+        eprintln!("Edge wear marks {:.2} % of the {name}", 100.0 * f);
+        assert!(
+            (0.002..=0.2).contains(&f),
+            "Edge wear marks {:.1} % of the {name}",
+            100.0 * f
+        );
+    }
 }

@@ -28,6 +28,8 @@ pub struct MaterialSet {
     pub normal: Option<NormalMap>,
     /// What was left out, one line each.
     pub notes: Vec<String>,
+    /// The material is seen from both sides (`doubleSided`).
+    pub double_sided: bool,
 }
 
 fn fail(path: &Path, reason: impl Into<String>) -> ModelError {
@@ -125,6 +127,7 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
         name,
         normal,
         notes,
+        double_sided: material.double_sided(),
     })
 }
 

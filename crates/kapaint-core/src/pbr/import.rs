@@ -333,6 +333,7 @@ pub fn import(
         n_mapping: mapping.report_name(model).into(),
         error: stats.summary(),
         notes,
+        double_sided: false,
     };
     let settings = DocumentSettings {
         model,

@@ -13,6 +13,19 @@ use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
 impl EditorState {
     pub(crate) fn status_bar_ui(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
+            // A job's progress and Cancel first: the readouts after them may run past the
+            // window's edge, the job's controls never do.
+            if let Some(job) = &self.job {
+                ui.add(
+                    egui::ProgressBar::new(job.progress.fraction())
+                        .desired_width(160.0)
+                        .text(job_text(&job.label, &job.progress.stage())),
+                );
+                if ui.button("Cancel").clicked() {
+                    job.progress.cancel();
+                }
+                ui.separator();
+            }
             let maps = self.doc.maps();
             ui.label(format!("{}x{}", maps.width(), maps.height()));
             ui.separator();
@@ -59,17 +72,6 @@ impl EditorState {
                 ))
                 .on_hover_text("k_a of the red channel: Phong by eq. (8), Blinn-Phong by eq. (11), Cook-Torrance (GGX) by kapaint's fit, and the exact integral for the current model");
             }
-            if let Some(job) = &self.job {
-                ui.separator();
-                ui.add(
-                    egui::ProgressBar::new(job.progress.fraction())
-                        .desired_width(160.0)
-                        .text(job_text(&job.label, &job.progress.stage())),
-                );
-                if ui.button("Cancel").clicked() {
-                    job.progress.cancel();
-                }
-            }
         });
     }
 
@@ -77,7 +79,7 @@ impl EditorState {
         // A menu entry showing its shortcut; whether it was clicked.
         let item = |ui: &mut egui::Ui, label: &str, action: Action| {
             let text =
-                keys::shortcut(action).map_or_else(String::new, |k| ui.ctx().format_shortcut(&k));
+                keys::shortcut(action).map_or_else(String::new, |k| keys::printed(ui.ctx(), &k));
             ui.add(egui::Button::new(label).shortcut_text(text))
                 .clicked()
         };
@@ -154,6 +156,10 @@ impl EditorState {
                 }
                 if item(ui, "Redo", Action::Redo) {
                     self.apply(HistoryCommand::Redo);
+                }
+                ui.separator();
+                if ui.button("Preferences…").clicked() {
+                    self.open_preferences();
                 }
             });
             self.image_and_mesh_menus(ui);

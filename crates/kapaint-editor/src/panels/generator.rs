@@ -20,6 +20,7 @@ fn kinds() -> [(&'static str, Option<Generator>); 7] {
         white,
         gamma: 1.0,
         invert,
+        relative: false,
     };
     [
         ("Paint only", None),
@@ -91,8 +92,9 @@ impl Edit {
     }
 }
 
-/// Sliders for `l`'s black and white points, gamma and invert.
-fn levels_ui(ui: &mut egui::Ui, l: &mut Levels, edit: &mut Edit) {
+/// Black, white, gamma and invert; for a bake (`bake`), whether they are relative to the
+/// mesh.
+fn levels_ui(ui: &mut egui::Ui, l: &mut Levels, bake: bool, edit: &mut Edit) {
     edit.read(&ui.add(egui::Slider::new(&mut l.black, 0.0..=0.999).text("Black")));
     edit.read(&ui.add(egui::Slider::new(&mut l.white, 0.001..=1.0).text("White")));
     edit.read(
@@ -103,6 +105,12 @@ fn levels_ui(ui: &mut egui::Ui, l: &mut Levels, edit: &mut Edit) {
         ),
     );
     edit.read(&ui.checkbox(&mut l.invert, "Invert"));
+    if bake {
+        edit.read(&ui.checkbox(&mut l.relative, "Relative to this mesh").on_hover_text(
+            "Black and white are places in the mesh's own spread of the bake (0.9: the value \
+             90 % of the surface lies below), so the same levels fit any mesh",
+        ));
+    }
     // Black stays below white, whichever moved.
     if l.black >= l.white {
         if l.white >= 0.999 {
@@ -143,7 +151,7 @@ const AXES: [(Axis, &str); 3] = [(Axis::X, "X"), (Axis::Y, "Y (up)"), (Axis::Z, 
 fn parameters_ui(ui: &mut egui::Ui, g: &mut Generator, edit: &mut Edit) {
     match g {
         Generator::Ao(l) | Generator::Curvature(l) | Generator::Thickness(l) => {
-            levels_ui(ui, l, edit);
+            levels_ui(ui, l, true, edit);
         }
         Generator::Noise(n) => {
             choice(
@@ -191,10 +199,10 @@ fn parameters_ui(ui: &mut egui::Ui, g: &mut Generator, edit: &mut Edit) {
         }
         Generator::Facing { axis, levels } => {
             choice(ui, "Faces along", axis, &AXES, edit);
-            levels_ui(ui, levels, edit);
+            levels_ui(ui, levels, false, edit);
         }
         Generator::Remap { levels, of } => {
-            levels_ui(ui, levels, edit);
+            levels_ui(ui, levels, false, edit);
             ui.collapsing("Of", |ui| parameters_ui(ui, of, edit));
         }
         Generator::Blend { op, a, b } => {
@@ -225,6 +233,8 @@ impl EditorState {
     pub(super) fn generator_ui(&mut self, ui: &mut egui::Ui, layer: &Layer) {
         let current = layer.mask.as_ref().and_then(|m| m.generator()).cloned();
         let mut commands = Vec::new();
+        // A generator to lay, baking first what it reads and the project lacks.
+        let mut baking: Option<Generator> = None;
         ui.separator();
         ui.horizontal(|ui| {
             egui::ComboBox::from_label("Mask made by")
@@ -233,7 +243,10 @@ impl EditorState {
                     for (name, g) in kinds() {
                         let on = name == kind_name(current.as_ref());
                         if ui.selectable_label(on, name).clicked() && !on {
-                            commands.push(MaskCommand::SetMaskGenerator(g));
+                            match g {
+                                Some(g) => baking = Some(g),
+                                None => commands.push(MaskCommand::SetMaskGenerator(None)),
+                            }
                         }
                     }
                 });
@@ -255,7 +268,7 @@ impl EditorState {
                     }
                 });
             if let Some(g) = chosen {
-                commands.push(MaskCommand::SetMaskGenerator(Some(g)));
+                baking = Some(g);
             }
         });
         if let Some(g) = &current {
@@ -264,27 +277,34 @@ impl EditorState {
             // Room to drag a parameter finely.
             ui.spacing_mut().slider_width = ui.spacing().slider_width.max(160.0);
             parameters_ui(ui, &mut edited, &mut edit);
-            if edit.released || (edit.changed && !edit.dragging) {
-                commands.push(MaskCommand::SetMaskGenerator(Some(edited)));
+            let missing: Vec<&str> = edited
+                .bakes_needed()
+                .into_iter()
+                .filter(|&m| self.doc.bake_of(m).is_none())
+                .map(kapaint_core::mesh::bakes::BakeMap::name)
+                .collect();
+            if edit.released || (edit.changed && (!edit.dragging || !missing.is_empty())) {
+                baking = Some(edited);
             } else if edit.changed {
                 commands.push(MaskCommand::PreviewMaskGenerator(edited));
             }
-            for map in g.bakes_needed() {
-                if self.doc.bake_of(map).is_none() {
-                    ui.label(
-                        egui::RichText::new(format!(
-                            "No {} bake yet: Mesh > Bake… (it reads 0.5 until then)",
-                            map.name()
-                        ))
-                        .weak(),
-                    );
-                }
+            if !missing.is_empty() {
+                ui.label(
+                    egui::RichText::new(format!(
+                        "No {} bake yet: it is baked before the mask is laid",
+                        missing.join(" or ")
+                    ))
+                    .weak(),
+                );
             }
             self.generator_thumb_ui(ui, layer);
             self.naming_ui(ui, Naming::Mask, "Save as smart mask…");
         }
         for c in commands {
             self.apply(c);
+        }
+        if let Some(g) = baking {
+            self.set_generator_baking(g);
         }
     }
 

@@ -16,20 +16,8 @@ impl EditorState {
             return;
         };
         let mut commands: Vec<Command> = Vec::new();
-        if let Some(name) = &mut self.layers_panel.rename {
-            let edit = ui.text_edit_singleline(name);
-            edit.request_focus();
-            if edit.lost_focus() {
-                let entered = ui.input(|i| !i.key_pressed(egui::Key::Escape));
-                if entered && !name.trim().is_empty() && *name != layer.props.name {
-                    commands.push(LayerCommand::RenameLayer(name.trim().to_owned()).into());
-                }
-                self.layers_panel.rename = None;
-            }
-        } else {
-            ui.label(egui::RichText::new(&layer.props.name).strong())
-                .on_hover_text("Double-click the name in the list to rename");
-        }
+        ui.label(egui::RichText::new(&layer.props.name).strong())
+            .on_hover_text("Double-click the name in the list to rename");
         let mut opacity = layer.props.opacity * 100.0;
         if ui
             .add(

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use egui::{Color32, Rect, Sense, Vec2};
 
 use crate::EditorState;
-use kapaint_core::model::layers::{Layer, LayerContent, thumbnail};
+use kapaint_core::model::layers::{Layer, LayerContent, LayerId, thumbnail};
 use kapaint_core::model::{Command, Document, LayerKind, LayerPlace};
 use kapaint_core::model::{LayerCommand, MaskCommand};
 
@@ -93,19 +93,51 @@ impl LayerThumbs {
 #[derive(Default)]
 pub struct PanelState {
     thumbs: LayerThumbs,
-    /// The selected layer's new name being typed.
-    pub(super) rename: Option<String>,
+    /// A layer's new name being typed in its row.
+    pub(super) rename: Option<Rename>,
+    /// Whether the next frame takes the keyboard from whichever field has it (a rename that
+    /// Tab ended).
+    release_keyboard: bool,
     /// The maps a layer view shows.
     pub(crate) view_maps: crate::layer_view::ViewMaps,
     /// The mask generator's live thumbnail and the document version it shows.
     pub(super) generator_thumb: Option<(u64, egui::TextureHandle)>,
 }
 
+/// A layer's name being typed in place of its label in the list: Enter, Tab or a click
+/// elsewhere commits it, Escape cancels, and the keyboard is the editor's again either way.
+pub(super) struct Rename {
+    /// The layer renamed.
+    id: LayerId,
+    /// What is typed so far.
+    text: String,
+    /// Whether the field has had the keyboard (it is given it once, on the first frame).
+    focused: bool,
+}
+
+impl PanelState {
+    /// Forgets what was made from the document replaced (thumbnails, memory, a rename under
+    /// way): a new document's version numbers start again, and may equal the old one's.
+    pub(crate) fn document_replaced(&mut self) {
+        self.thumbs = LayerThumbs::default();
+        self.rename = None;
+        self.generator_thumb = None;
+    }
+}
+
 /// What a row asked for this frame.
 enum RowAction {
-    Select { mask: bool, alone: bool },
+    Select {
+        mask: bool,
+        alone: bool,
+    },
     Toggle(Command),
     Rename,
+    /// The name typed is done: committed (`Some`) or cancelled; `tabbed` when Tab ended it.
+    Renamed {
+        name: Option<String>,
+        tabbed: bool,
+    },
     Drop(Vec<usize>, LayerPlace),
 }
 
@@ -150,16 +182,25 @@ impl EditorState {
 
     /// The Layers tab.
     pub(crate) fn layers_ui(&mut self, ui: &mut egui::Ui) {
+        if std::mem::take(&mut self.layers_panel.release_keyboard) {
+            ui.memory_mut(egui::Memory::stop_text_input);
+        }
         self.layers_panel.thumbs.refresh(ui.ctx(), &self.doc);
         self.layer_buttons_ui(ui);
         ui.separator();
         let mut actions = Vec::new();
+        // A rename of a layer that is gone (deleted, undone) ends with it.
+        let mut rename = self
+            .layers_panel
+            .rename
+            .take()
+            .filter(|r| self.doc.stack().path_of(r.id).is_some());
         egui::ScrollArea::vertical()
             .id_salt("layers")
             .max_height((ui.available_height() - 230.0).max(120.0))
             .show(ui, |ui| {
                 let layers = &self.doc.stack().layers;
-                self.rows_ui(ui, layers, &[], &mut actions);
+                self.rows_ui(ui, layers, &[], &mut rename, &mut actions);
                 ui.label(
                     egui::RichText::new(format!(
                         "Base material (n {:.0})",
@@ -182,6 +223,7 @@ impl EditorState {
                     );
                 }
             });
+        self.layers_panel.rename = rename;
         for (path, action) in actions {
             self.row_action(path, action);
         }
@@ -243,20 +285,27 @@ impl EditorState {
         ui: &mut egui::Ui,
         layers: &[Layer],
         parent: &[usize],
+        rename: &mut Option<Rename>,
         actions: &mut Vec<(Vec<usize>, RowAction)>,
     ) {
         for (i, layer) in layers.iter().enumerate().rev() {
             let path = [parent, &[i]].concat();
-            if let Some(action) = self.row_ui(ui, layer, &path) {
+            if let Some(action) = self.row_ui(ui, layer, &path, rename) {
                 actions.push((path.clone(), action));
             }
             if let LayerContent::Group(children) = &layer.content {
-                self.rows_ui(ui, children, &path, actions);
+                self.rows_ui(ui, children, &path, rename, actions);
             }
         }
     }
 
-    fn row_ui(&self, ui: &mut egui::Ui, layer: &Layer, path: &[usize]) -> Option<RowAction> {
+    fn row_ui(
+        &self,
+        ui: &mut egui::Ui,
+        layer: &Layer,
+        path: &[usize],
+        rename: &mut Option<Rename>,
+    ) -> Option<RowAction> {
         let selected = self.doc.selected_id() == Some(layer.props.id);
         let mut action = None;
         let row = ui.horizontal(|ui| {
@@ -317,14 +366,8 @@ impl EditorState {
                     action = Some(RowAction::Select { mask: true, alone });
                 }
             }
-            let name = ui.selectable_label(selected, &p.name);
-            if name.double_clicked() {
-                action = Some(RowAction::Rename);
-            } else if name.clicked() {
-                action = Some(RowAction::Select {
-                    mask: false,
-                    alone: false,
-                });
+            if let Some(a) = Self::name_ui(ui, layer, selected, rename) {
+                action = Some(a);
             }
             let bytes = self
                 .layers_panel
@@ -341,6 +384,59 @@ impl EditorState {
             .on_hover_text("Memory this layer's tiles and mask hold");
         });
         drop_target(ui, row.response.rect, path, &layer.content).or(action)
+    }
+
+    /// The layer's name in its row: a label to select (double-click renames), or the field
+    /// of a rename under way.
+    fn name_ui(
+        ui: &mut egui::Ui,
+        layer: &Layer,
+        selected: bool,
+        rename: &mut Option<Rename>,
+    ) -> Option<RowAction> {
+        let p = &layer.props;
+        let mut action = None;
+        if let Some(r) = rename.as_mut().filter(|r| r.id == p.id) {
+            let edit = ui.add(
+                egui::TextEdit::singleline(&mut r.text)
+                    .desired_width(140.0)
+                    .id_salt(("rename layer", p.id)),
+            );
+            if !r.focused {
+                edit.request_focus();
+                r.focused = true;
+            } else if !edit.has_focus() {
+                // Enter, Tab and a click elsewhere take the keyboard from the field:
+                // the name is done. Escape cancels it.
+                // Read from the frame's raw input: egui takes the keyboard from the field
+                // on Escape before any widget runs, and the editor's own Escape (abandon
+                // the stroke) may have taken the key press by now.
+                let pressed = |key| {
+                    ui.input(|i| {
+                        i.raw.events.iter().any(|e| {
+                            matches!(e, egui::Event::Key { key: k, pressed: true, .. } if *k == key)
+                        })
+                    })
+                };
+                let (cancelled, tabbed) = (pressed(egui::Key::Escape), pressed(egui::Key::Tab));
+                let text = r.text.trim().to_owned();
+                action = Some(RowAction::Renamed {
+                    name: (!cancelled && !text.is_empty() && text != p.name).then_some(text),
+                    tabbed,
+                });
+            }
+        } else {
+            let name = ui.selectable_label(selected, &p.name);
+            if name.double_clicked() {
+                action = Some(RowAction::Rename);
+            } else if name.clicked() {
+                action = Some(RowAction::Select {
+                    mask: false,
+                    alone: false,
+                });
+            }
+        }
+        action
     }
 
     /// A thumbnail over a checkerboard (transparent is unpainted), framed when selected.
@@ -419,12 +515,21 @@ impl EditorState {
             }
             RowAction::Rename => {
                 self.apply(LayerCommand::SelectPath(path));
-                self.layers_panel.rename = Some(
-                    self.doc
-                        .selected_layer()
-                        .map(|l| l.props.name.clone())
-                        .unwrap_or_default(),
-                );
+                self.layers_panel.rename = self.doc.selected_layer().map(|l| Rename {
+                    id: l.props.id,
+                    text: l.props.name.clone(),
+                    focused: false,
+                });
+            }
+            RowAction::Renamed { name, tabbed } => {
+                self.layers_panel.rename = None;
+                // Tab handed the keyboard to the next field: the next frame gives it back to
+                // the editor instead, so the shortcuts are live again.
+                self.layers_panel.release_keyboard = tabbed;
+                if let Some(name) = name {
+                    self.apply(LayerCommand::SelectPath(path));
+                    self.apply(LayerCommand::RenameLayer(name));
+                }
             }
             RowAction::Drop(from, place) => {
                 self.apply(LayerCommand::SelectPath(from));

@@ -34,6 +34,22 @@ pub(crate) enum Naming {
 
 /// The shipped material presets, then the user's (a malformed user file is a notice, not a
 /// preset).
+/// The material, brush and mask presets: shipped, then the user's in `dir`.
+pub(crate) fn load_all(
+    dir: Option<&Path>,
+    notices: &mut crate::Notices,
+) -> (
+    Vec<PresetEntry>,
+    Vec<BrushPreset>,
+    Vec<kapaint_core::model::generator::preset::MaskPreset>,
+) {
+    (
+        load_material_presets(dir, notices),
+        load_brush_presets(dir, notices),
+        load_mask_presets(dir, notices),
+    )
+}
+
 pub(crate) fn load_material_presets(
     dir: Option<&Path>,
     notices: &mut crate::Notices,

@@ -83,11 +83,19 @@ impl EditorState {
                 .logarithmic(true)
                 .text("n"),
         );
-        let other = reflectance::equivalent::counterpart(self.doc.settings().model);
-        let eq = reflectance::equivalent::equivalent_exponent(
-            self.doc.settings().model,
-            f64::from(primary.n),
-        );
+        let model = self.doc.settings().model;
+        let other = reflectance::equivalent::counterpart(model);
+        // A root search over the lobes' integrals (about 4 ms): made again only when the
+        // exponent or the model changes, not every frame.
+        let key = (model, primary.n.to_bits());
+        let eq = match self.equivalent_n {
+            Some((k, eq)) if k == key => eq,
+            _ => {
+                let eq = reflectance::equivalent::equivalent_exponent(model, f64::from(primary.n));
+                self.equivalent_n = Some((key, eq));
+                eq
+            }
+        };
         ui.label(format!(
             "≈ n {eq:.1} in {}",
             super::view_panel::model_label(other)

@@ -10,7 +10,6 @@ pub use overlay::{DIVIDER_LABEL, N_LEGEND_LABEL};
 pub use renderer::ViewportGpu;
 
 use std::sync::Arc;
-use std::time::Instant;
 
 use egui::{Color32, Pos2, Rect, Sense};
 
@@ -254,21 +253,19 @@ impl Viewport {
         let mut frame = *settings;
         frame.camera = self.camera;
         match &mut self.gpu {
-            Some(gpu) => {
-                let start = Instant::now();
-                match gpu.render(maps, mesh, &frame, &self.comparison, size) {
-                    Ok(id) => {
-                        self.frame_ms = start.elapsed().as_secs_f32() * 1000.0;
-                        self.gpu_error = None;
-                        painter.image(
-                            id,
-                            rect,
-                            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
-                            Color32::WHITE,
-                        );
-                    }
-                    Err(e) => {
-                        painter.text(
+            Some(gpu) => match gpu.render(maps, mesh, &frame, &self.comparison, size) {
+                Ok(id) => {
+                    self.frame_ms = gpu.draw_ms();
+                    self.gpu_error = None;
+                    painter.image(
+                        id,
+                        rect,
+                        Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+                        Color32::WHITE,
+                    );
+                }
+                Err(e) => {
+                    painter.text(
                             rect.center(),
                             egui::Align2::CENTER_CENTER,
                             format!(
@@ -277,10 +274,9 @@ impl Viewport {
                             egui::FontId::proportional(14.0),
                             Color32::from_rgb(230, 120, 110),
                         );
-                        self.gpu_error = Some(e.to_string());
-                    }
+                    self.gpu_error = Some(e.to_string());
                 }
-            }
+            },
             None => {
                 painter.text(
                     rect.center(),

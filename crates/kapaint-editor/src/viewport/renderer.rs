@@ -35,6 +35,22 @@ pub struct ViewportGpu {
     bindings: FrameBindings,
     /// The heatmap's.
     difference_bindings: DifferenceBindings,
+    /// What the target holds now: a frame asked for again unchanged (a job's progress
+    /// redrawing the window, a notice fading) is shown as it is, not drawn again.
+    drawn: Option<Drawn>,
+    /// How long the last frame drawn took to record and submit, in milliseconds.
+    draw_ms: f32,
+}
+
+/// Everything a viewport picture is made from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Drawn {
+    mesh: u64,
+    maps: (u64, u64),
+    normal: Option<usize>,
+    settings: FrameSettings,
+    comparison: Comparison,
+    size: (u32, u32),
 }
 
 /// The viewport's renderers, immutable once made: kept in egui_wgpu's callback resources.
@@ -82,7 +98,14 @@ impl ViewportGpu {
             target: None,
             bindings: FrameBindings::default(),
             difference_bindings: DifferenceBindings::default(),
+            drawn: None,
+            draw_ms: 0.0,
         }
+    }
+
+    /// How long the last picture actually drawn took (one shown again costs nothing).
+    pub fn draw_ms(&self) -> f32 {
+        self.draw_ms
     }
 
     /// A `size`-pixel picture of `value` on the mesh, for the preset browser.
@@ -188,9 +211,26 @@ impl ViewportGpu {
                 (side_texture(gpu, size), side_texture(gpu, size))
             })?);
         }
+        let drawn = Drawn {
+            mesh: mesh.0,
+            maps: (source, maps.version()),
+            normal: normal.map(|n| Arc::as_ptr(n) as usize),
+            settings: *settings,
+            comparison: *comparison,
+            size,
+        };
+        if let Some(target) = &self.target
+            && self.drawn == Some(drawn)
+        {
+            return Ok(target.id);
+        }
+        self.drawn = None;
+        let start = std::time::Instant::now();
         let scope = self.gpu.scope()?;
         let id = self.draw(settings, comparison, size);
         scope.finish("drawing the viewport")?;
+        self.draw_ms = start.elapsed().as_secs_f32() * 1000.0;
+        self.drawn = Some(drawn);
         Ok(id)
     }
 

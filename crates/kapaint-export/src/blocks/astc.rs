@@ -1,4 +1,4 @@
-//! ASTC LDR blocks with ARM's own encoder and decoder (`astcenc`, through `astcenc-rs`).
+//! ASTC LDR blocks with ARM's own encoder and decoder (`astcenc`, through `ctt-astcenc`).
 //!
 //! Strips of block rows run in parallel, each on a single-threaded `astcenc` context taken
 //! from a small pool (a context holds the footprint's partition and weight tables, which cost
@@ -9,12 +9,11 @@
 //! texels come back with the stored components first (luminance and alpha as its first two
 //! bytes), so the export measures what a consumer sampling `.r`/`.ra`/`.rgb`/`.rgba` gets.
 
+use std::ffi::c_void;
 use std::sync::Mutex;
 
-use astcenc_rs::{
-    ConfigBuilder, Context, Extents, Flags, Image, PRESET_FAST, PRESET_FASTEST, PRESET_MEDIUM,
-    PRESET_THOROUGH, PRESET_VERY_THOROUGH, Preset, Profile, Selector, Swizzle,
-};
+use ctt_astcenc::bindings::{astcenc_image, astcenc_type_ASTCENC_TYPE_U8};
+use ctt_astcenc::{Context, Flags, Preset, Profile, Swizzle, SwizzleChannel, config_init};
 
 use super::Bc7Quality;
 use crate::astc_block::AstcBlock;
@@ -22,11 +21,11 @@ use crate::astc_block::AstcBlock;
 /// `astcenc`'s search preset for an effort on BC7's scale.
 pub fn preset_of(effort: Bc7Quality) -> (&'static str, Preset) {
     match effort {
-        Bc7Quality::UltraFast => ("fastest", PRESET_FASTEST),
-        Bc7Quality::VeryFast => ("fast", PRESET_FAST),
-        Bc7Quality::Fast => ("medium", PRESET_MEDIUM),
-        Bc7Quality::Basic => ("thorough", PRESET_THOROUGH),
-        Bc7Quality::Slow => ("very thorough", PRESET_VERY_THOROUGH),
+        Bc7Quality::UltraFast => ("fastest", Preset::Fastest),
+        Bc7Quality::VeryFast => ("fast", Preset::Fast),
+        Bc7Quality::Fast => ("medium", Preset::Medium),
+        Bc7Quality::Basic => ("thorough", Preset::Thorough),
+        Bc7Quality::Slow => ("very thorough", Preset::VeryThorough),
     }
 }
 
@@ -46,26 +45,23 @@ static POOL: Mutex<Vec<(Key, Context)>> = Mutex::new(Vec::new());
 const POOL_MAX: usize = 16;
 
 fn context(key: Key) -> Result<Context, String> {
-    let mut config = ConfigBuilder::new()
-        .with_profile(if key.srgb {
-            Profile::LdrSrgb
-        } else {
-            Profile::LdrRgba
-        })
-        .with_block_size(Extents::new(key.block.dims().0, key.block.dims().1));
-    // Consumers decode LDR blocks to 8 bits: the encoder rounds as they do.
-    let mut flags = Flags::DECODE_UNORM8;
-    if let Some(effort) = key.effort {
-        config = config.with_preset(preset_of(effort).1);
+    let profile = if key.srgb {
+        Profile::LdrSrgb
     } else {
-        config = config.with_preset(PRESET_FASTEST);
+        Profile::Ldr
+    };
+    // Consumers decode LDR blocks to 8 bits: the encoder rounds as they do.
+    let mut flags = Flags::USE_DECODE_UNORM8;
+    let preset = if let Some(effort) = key.effort {
+        preset_of(effort).1
+    } else {
         flags |= Flags::DECOMPRESS_ONLY;
-    }
-    let config = config
-        .with_flags(flags)
-        .build()
-        .map_err(|e| format!("astcenc configuration for {}: {e:?}", key.block))?;
-    Context::with_threads(1, config).map_err(|e| format!("astcenc context: {e:?}"))
+        Preset::Fastest
+    };
+    let (bx, by) = key.block.dims();
+    let config = config_init(profile, bx, by, 1, preset, flags)
+        .map_err(|e| format!("astcenc configuration for {}: {e}", key.block))?;
+    Context::new(&config).map_err(|e| format!("astcenc context: {e}"))
 }
 
 /// Runs `f` on a context for `key`: a pooled one where there is one, else a new one, put
@@ -96,10 +92,22 @@ fn with_context<R>(key: Key, f: impl FnOnce(&mut Context) -> R) -> Result<R, Str
 
 fn swizzle(channels: u8) -> Swizzle {
     match channels {
-        1 => Swizzle::rrr1(),
-        2 => Swizzle::rrrg(),
-        3 => Swizzle::rgb1(),
-        _ => Swizzle::rgba(),
+        1 => Swizzle::RRR1,
+        2 => Swizzle::RRRG,
+        3 => Swizzle::RGB1,
+        _ => Swizzle::IDENTITY,
+    }
+}
+
+/// `astcenc`'s description of a tightly packed RGBA8 image of `width` x `rows` texels whose
+/// one plane starts at `plane` (which must outlive the description's use).
+fn image(plane: &mut *mut c_void, (width, rows): (u32, u32)) -> astcenc_image {
+    astcenc_image {
+        dim_x: width,
+        dim_y: rows,
+        dim_z: 1,
+        data_type: astcenc_type_ASTCENC_TYPE_U8,
+        data: std::ptr::from_mut(plane),
     }
 }
 
@@ -122,15 +130,17 @@ pub(super) fn encode(
         srgb,
         effort: Some(effort),
     };
-    let image = Image {
-        extents: Extents::new(width, rows),
-        data: vec![rgba],
+    let blocks = if rgba.len() == width as usize * rows as usize * 4 {
+        // astcenc only reads the plane, and only while compressing; its size is checked.
+        let mut plane = rgba.as_ptr().cast_mut().cast::<c_void>();
+        let mut image = image(&mut plane, (width, rows));
+        with_context(key, |ctx| ctx.compress(&mut image, swizzle(channels), out))
+            .and_then(|r| r.map_err(|e| format!("astcenc: {e}")))
+    } else {
+        Err(format!("{} bytes of texels", rgba.len()))
     };
-    let blocks = with_context(key, |ctx| ctx.compress(&image, swizzle(channels)))
-        .and_then(|r| r.map_err(|e| format!("astcenc: {e:?}")));
-    match blocks {
-        Ok(blocks) => out.copy_from_slice(&blocks),
-        Err(e) => panic!("ASTC {block} encode of {width}x{rows}: {e}"),
+    if let Err(e) = blocks {
+        panic!("ASTC {block} encode of {width}x{rows}: {e}");
     }
 }
 
@@ -153,21 +163,25 @@ pub(super) fn decode(
         srgb,
         effort: None,
     };
-    let mut image = Image {
-        extents: Extents::new(width, rows),
-        data: vec![&mut out[..]],
-    };
+    if out.len() != width as usize * rows as usize * 4 {
+        return Err(format!(
+            "astcenc decode of {width}x{rows}: {} bytes of texels",
+            out.len()
+        ));
+    }
+    let mut plane = out.as_mut_ptr().cast::<c_void>();
+    let mut image = image(&mut plane, (width, rows));
     // Luminance and alpha: alpha into the second byte.
     let swz = if channels == 2 {
         Swizzle {
-            r: Selector::Red,
-            g: Selector::Alpha,
-            b: Selector::Blue,
-            a: Selector::Green,
+            r: SwizzleChannel::R,
+            g: SwizzleChannel::A,
+            b: SwizzleChannel::B,
+            a: SwizzleChannel::G,
         }
     } else {
-        Swizzle::rgba()
+        Swizzle::IDENTITY
     };
-    with_context(key, |ctx| ctx.decompress_into(blocks, &mut image, swz))?
-        .map_err(|e| format!("astcenc decode: {e:?}"))
+    with_context(key, |ctx| ctx.decompress(blocks, &mut image, swz))?
+        .map_err(|e| format!("astcenc decode: {e}"))
 }

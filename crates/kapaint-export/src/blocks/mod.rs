@@ -6,7 +6,8 @@
 //! encoder. Either runs in parallel over strips of block rows. A caller may bring another
 //! encoder behind [`BlockEncoder`] (the GPU crate's compute shaders): an export uses it only
 //! when handed one ([`Coder::best`]); nothing here reaches for a device of its own. Decoding
-//! (to measure what a consumer sees) is `block_compression`'s CPU decoder, also in strips.
+//! (to measure what a consumer sees) is `block_compression`'s CPU decoder for BC7 and BC6H,
+//! and kapaint's own for BC4 and BC5 (rounded as the specification says), also in strips.
 //! ASTC is encoded and decoded on the CPU by ARM's `astcenc`, whatever encoder is handed in.
 
 use block_compression::decode::{decode_block_bc6h, decompress_blocks_as_rgba8};
@@ -15,6 +16,7 @@ use half::f16;
 use rayon::prelude::*;
 
 pub mod astc;
+mod bc45;
 mod coder;
 mod solid;
 
@@ -489,6 +491,8 @@ pub fn decode_stored(
                     }
                 }
                 _ if whole == 8 => decode_bc6h(src, width as usize, texels),
+                (BlockKind::Bc4, _) => bc45::decode(src, 1, width as usize, texels),
+                (BlockKind::Bc5, _) => bc45::decode(src, 2, width as usize, texels),
                 (_, Some(variant)) => decompress_blocks_as_rgba8(variant, width, rows, src, texels),
                 (_, None) => {}
             }

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use self::container::container;
 pub use self::container::{Decoded, decode};
+use self::levels::half;
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 use super::blocks::{self, BlockFamily, BlockKind, Coder};
 use super::preset::Bc7Quality;
@@ -301,14 +302,80 @@ pub fn encode(
     progress: &Progress,
 ) -> Result<Written, String> {
     source.check()?;
-    let (w, h, ch) = (source.width, source.height, source.channels());
-    let per = source.texel_bytes();
-    let srgb = source.srgb();
+    let chain = mips(source);
+    let image = Image {
+        spaces: source.spaces,
+        size: (source.width, source.height),
+        level0: source.level0,
+        chain: &chain,
+    };
+    write_levels(&image, compressed, level0, progress)
+}
+
+/// Writes an image whose levels the caller made (finest first, a full chain: `levels[k]` of
+/// the size [`level_count`]'s level `k` has) of `channels` linear bytes per texel, as a KTX2
+/// file: uncompressed, or block-compressed as [`encode`] does. A normal map's levels are its
+/// box-filtered normals made unit again, which no per-component average gives.
+///
+/// # Errors
+/// No levels, levels that are not a full chain of `channels` bytes per texel, or a component
+/// count outside 1..=4.
+pub fn encode_levels(
+    levels: &[((u32, u32), Vec<u8>)],
+    channels: usize,
+    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
+) -> Result<Written, String> {
+    let spaces = vec![Space::Linear; channels];
+    let Some(((w, h), level0)) = levels.first() else {
+        return Err("no levels".into());
+    };
+    let mut size = (*w, *h);
+    let whole = levels.len() == level_count(size.0, size.1) as usize
+        && levels.iter().enumerate().all(|(k, (s, bytes))| {
+            if k > 0 {
+                size = half(size);
+            }
+            *s == size && bytes.len() == s.0 as usize * s.1 as usize * channels
+        });
+    if !whole || !(1..=4).contains(&channels) || *w == 0 || *h == 0 {
+        return Err(format!(
+            "cannot write {} levels of a {w}x{h} image of {channels} components",
+            levels.len()
+        ));
+    }
+    let image = Image {
+        spaces: &spaces,
+        size: (*w, *h),
+        level0,
+        chain: &levels[1..],
+    };
+    write_levels(&image, compressed, None, &Progress::default())
+}
+
+/// An image's levels as stored bytes: level 0 and the chain after it.
+struct Image<'a> {
+    spaces: &'a [Space],
+    size: (u32, u32),
+    level0: &'a [u8],
+    chain: &'a [((u32, u32), Vec<u8>)],
+}
+
+/// The KTX2 file of `image`'s levels, uncompressed or block-compressed (`level0`: level 0
+/// already compressed).
+fn write_levels(
+    image: &Image<'_>,
+    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
+    level0: Option<Compressed>,
+    progress: &Progress,
+) -> Result<Written, String> {
+    let ((w, h), spaces, chain) = (image.size, image.spaces, image.chain);
+    let ch = spaces.len();
+    let per = texel_layout(spaces).0;
+    let srgb = ch >= 3 && spaces[0].is_colour();
     if compressed.is_none() && per != ch {
         return Err("half floats are written only as BC6H blocks".into());
     }
-    let (format, compression) = format_of(source.spaces, srgb, compressed.map(|c| c.1));
-    let chain = mips(source);
+    let (format, compression) = format_of(spaces, srgb, compressed.map(|c| c.1));
     let mut level_bytes = Vec::with_capacity(chain.len() + 1);
     let mut decoded = Vec::with_capacity(chain.len() + 1);
     let mut psnr_values = None;
@@ -325,29 +392,29 @@ pub fn encode(
                 }
             };
             progress.advance(u64::from(h));
-            level_bytes.push(widen(source.level0));
-            decoded.push(source.level0.to_vec());
-            for (_, bytes) in &chain {
+            level_bytes.push(widen(image.level0));
+            decoded.push(image.level0.to_vec());
+            for (_, bytes) in chain {
                 level_bytes.push(widen(bytes));
                 decoded.push(bytes.clone());
             }
         }
         Some((encoder, family, effort)) => {
-            let kind = block_kind(source.spaces, family, effort);
+            let kind = block_kind(spaces, family, effort);
             let mut first = match level0 {
                 Some(c) => {
                     progress.advance(u64::from(h));
                     c
                 }
-                None => compress_level(encoder, kind, source.level0, (w, h), per, Some(progress)),
+                None => compress_level(encoder, kind, image.level0, (w, h), per, Some(progress)),
             };
             if progress.is_cancelled() {
                 return Err("cancelled".into());
             }
-            psnr_values = Some(first.psnr(source.level0, source.spaces).to_vec());
+            psnr_values = Some(first.psnr(image.level0, spaces).to_vec());
             level_bytes.push(first.blocks);
             decoded.push(first.decoded);
-            for (size, bytes) in &chain {
+            for (size, bytes) in chain {
                 let c = compress_level(encoder, kind, bytes, *size, per, None);
                 level_bytes.push(c.blocks);
                 decoded.push(c.decoded);

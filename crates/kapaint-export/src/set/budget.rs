@@ -1,67 +1,89 @@
 //! A block-compressed set's trials judged against the preset's budget: whether one meets it,
-//! how far each falls short, which of two is nearer, and whether more effort may still reach
-//! it at the rate the last step bought.
+//! how far each falls short, which of two is nearer (the rule the notices name,
+//! [`super::choice::NEAREST_RULE`]), and whether more effort may still reach it at the rate
+//! the last step bought.
 
-use super::choice::{BlockLayout, Trial};
+use std::cmp::Ordering;
+
+use super::choice::{BlockLayout, Measure, Trial};
 use super::perceptual::SrgbError;
 use crate::preset::BlockBudget;
 
 /// Whether a trial meets the budget: its sRGB-level error, and the optional limits.
 pub(super) fn within(budget: &BlockBudget, t: &Trial) -> bool {
-    shortfall(t, budget).0 == 0
+    failing(t, budget) == 0
 }
 
-/// How much better one trial must be than another to count as better (relative).
-pub(super) const MIN_GAIN: f64 = 0.05;
-
-/// Each of the budget's measures of a trial as a ratio to its limit (above 1 fails): the
-/// sRGB-level p99.9 and mean, then the optional relative errors, and PSNR as the ratio of
-/// squared errors.
+/// Each measure the budget judges of a trial as a ratio to its limit (above 1 fails), in
+/// [`Measure::ALL`]'s order: the sRGB-level p99.9 and mean, then the optional relative errors,
+/// and PSNR as the ratio of squared errors.
 pub(super) fn ratios(t: &Trial, budget: &BlockBudget) -> Vec<f64> {
-    let srgb = t.srgb();
-    let ratio = |v: f64, limit: f64| {
-        if limit > 0.0 {
-            v / limit
-        } else if v > 0.0 {
-            f64::INFINITY
-        } else {
-            0.0
-        }
-    };
-    let mut out = vec![
-        ratio(srgb.p999, budget.ka_error_srgb_p999),
-        ratio(srgb.mean, budget.ka_error_srgb_mean),
-    ];
-    out.extend(budget.max_ka_error.map(|m| ratio(t.ka_error.max, m)));
-    out.extend(budget.mean_ka_error.map(|m| ratio(t.ka_error.mean, m)));
-    out.extend(
-        budget
-            .min_psnr
-            .map(|m| t.min_psnr.map_or(0.0, |p| 10_f64.powf((m - p) / 10.0))),
-    );
-    out
+    Measure::ALL
+        .into_iter()
+        .filter_map(|m| {
+            let limit = m.limit(budget)?;
+            let v = m.of(t);
+            Some(match (m, v) {
+                (Measure::Psnr, p) => p.map_or(0.0, |p| 10_f64.powf((limit - p) / 10.0)),
+                (_, v) => {
+                    let v = v.unwrap_or(0.0);
+                    if limit > 0.0 {
+                        v / limit
+                    } else if v > 0.0 {
+                        f64::INFINITY
+                    } else {
+                        0.0
+                    }
+                }
+            })
+        })
+        .collect()
 }
 
-/// How far a trial falls short of the budget: how many of its measures fail, and the worst
-/// measure over its limit (see [`ratios`]).
-fn shortfall(t: &Trial, budget: &BlockBudget) -> (usize, f64) {
-    let ratios = ratios(t, budget);
+/// How many of a trial's judged measures fail (see [`ratios`]).
+fn failing(t: &Trial, budget: &BlockBudget) -> usize {
+    ratios(t, budget).iter().filter(|r| **r > 1.0).count()
+}
+
+/// Where a trial stands by [`super::choice::NEAREST_RULE`], to compare in order: how many
+/// judged measures fail; their ratios to their limits, the worst first; then every measure's
+/// badness ([`Measure::badness`]), judged or not.
+fn standing(t: &Trial, budget: &BlockBudget) -> (usize, Vec<f64>, Vec<f64>) {
+    let mut ratios = ratios(t, budget);
     let failing = ratios.iter().filter(|r| **r > 1.0).count();
-    (failing, ratios.into_iter().fold(0.0, f64::max))
+    ratios.sort_by(|a, b| b.total_cmp(a));
+    let badness = Measure::ALL.map(|m| m.badness(m.of(t))).to_vec();
+    (failing, ratios, badness)
 }
 
-/// The better of two trials against `budget`: the one that fails fewer measures, then the one
-/// whose worst measure is nearer its limit (the earlier on a tie: fewer bytes, or the more
-/// common format).
+/// `a` against `b` by [`super::choice::NEAREST_RULE`] (`Less`: `a` is nearer the budget). A
+/// trial at least as good as another on every number and better on one comes first: its
+/// failing count is no more, its ratios sorted are each no more, and a badness is less.
+fn order(a: &Trial, b: &Trial, budget: &BlockBudget) -> Ordering {
+    let lexical = |x: &[f64], y: &[f64]| {
+        x.iter()
+            .zip(y)
+            .map(|(x, y)| x.total_cmp(y))
+            .find(|o| o.is_ne())
+            .unwrap_or(Ordering::Equal)
+    };
+    let (fails_a, ratios_a, badness_a) = standing(a, budget);
+    let (fails_b, ratios_b, badness_b) = standing(b, budget);
+    fails_a
+        .cmp(&fails_b)
+        .then_with(|| lexical(&ratios_a, &ratios_b))
+        .then_with(|| lexical(&badness_a, &badness_b))
+}
+
+/// The better of two trials against `budget` by [`super::choice::NEAREST_RULE`] (the earlier
+/// on a tie: fewer bytes, or the more common format).
 pub(super) fn better<'t>(a: &'t Trial, b: &'t Trial, budget: &BlockBudget) -> &'t Trial {
     if nearer(a, b, budget) { b } else { a }
 }
 
-/// Whether `b` is nearer `budget` than `a` (see [`better`]).
+/// Whether `b` is nearer `budget` than `a` by [`super::choice::NEAREST_RULE`].
 pub(super) fn nearer(a: &Trial, b: &Trial, budget: &BlockBudget) -> bool {
-    let (fa, wa) = shortfall(a, budget);
-    let (fb, wb) = shortfall(b, budget);
-    fb < fa || (fb == fa && wb < wa * (1.0 - MIN_GAIN))
+    order(b, a, budget) == Ordering::Less
 }
 
 /// Whether more effort in `layout` may still meet the budget: the first step is always
@@ -95,7 +117,7 @@ pub(super) fn reachable(
 pub(super) fn storage_misses(t: &Trial, floor: &SrgbError, budget: &BlockBudget) -> bool {
     let (p999, mean) = t.srgb().over(budget);
     let (floor_p999, floor_mean) = floor.over(budget);
-    let failing = shortfall(t, budget).0;
+    let failing = failing(t, budget);
     failing > 0
         && failing == usize::from(p999) + usize::from(mean)
         && (!p999 || floor_p999)

@@ -49,28 +49,135 @@ pub struct Trial {
 }
 
 impl Trial {
-    /// The trial and its measures, for the manifest's reason.
-    pub(super) fn describe(&self) -> String {
-        let srgb = self.ka_error_srgb.map_or_else(String::new, |e| {
-            format!(
-                "k_a within {:.2} levels for 99.9 % of texels (mean {:.3}, max {:.2}), ",
-                e.p999, e.mean, e.max
-            )
-        });
+    /// The trial and its measures, for the manifest's reason: what `budget` judges, then
+    /// what it does not.
+    pub(super) fn describe(&self, budget: &BlockBudget) -> String {
+        let (judged, rest) = Measure::split(budget);
+        let list = |measures: &[Measure]| -> Vec<String> {
+            measures.iter().map(|m| m.show(m.of(self))).collect()
+        };
         format!(
-            "{:?} at {:?}: {srgb}relative max {}, mean {}, PSNR {}",
+            "{:?} at {:?} (judged: {}; not judged: {})",
             self.layout,
             self.bc7_effort,
-            pct(self.ka_error.max),
-            pct(self.ka_error.mean),
-            self.min_psnr
-                .map_or_else(|| "exact".into(), |p| format!("{p:.1} dB"))
+            list(&judged).join(", "),
+            list(&rest).join(", ")
         )
     }
 
     /// The trial's sRGB-level error (zero for a trial recorded before it was measured).
     pub(super) fn srgb(&self) -> SrgbError {
         self.ka_error_srgb.unwrap_or_default()
+    }
+}
+
+/// The rule that keeps a trial where none meets the budget, in the words the notices use. Its
+/// last steps cover every number a trial shows, so a kept trial is never beaten on all of them.
+pub(super) const NEAREST_RULE: &str = "fewest measures over their limits, then the smallest worst ratio to a limit, the next, and so on, then the lowest max, relative max and mean, and the highest PSNR";
+
+/// A number the notices show of a trial. The budget judges the sRGB-level p99.9 and mean, and
+/// the relative ones and PSNR where a preset sets limits for them; never the max, which a few
+/// texels at stroke edges set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Measure {
+    /// The sRGB-level error's 99.9th percentile (levels).
+    P999,
+    /// The sRGB-level error's mean (levels).
+    Mean,
+    /// The sRGB-level error's largest (levels).
+    Max,
+    /// The relative error's largest, per texel and colour channel.
+    RelativeMax,
+    /// The relative error's mean.
+    RelativeMean,
+    /// The smallest PSNR of any compressed component (dB; none where every one is exact).
+    Psnr,
+}
+
+impl Measure {
+    /// Every measure, in the order the notices list them.
+    pub(super) const ALL: [Self; 6] = [
+        Self::P999,
+        Self::Mean,
+        Self::Max,
+        Self::RelativeMax,
+        Self::RelativeMean,
+        Self::Psnr,
+    ];
+
+    /// `budget`'s limit of this measure, where it judges it.
+    pub(super) fn limit(self, budget: &BlockBudget) -> Option<f64> {
+        match self {
+            Self::P999 => Some(budget.ka_error_srgb_p999),
+            Self::Mean => Some(budget.ka_error_srgb_mean),
+            Self::Max => None,
+            Self::RelativeMax => budget.max_ka_error,
+            Self::RelativeMean => budget.mean_ka_error,
+            Self::Psnr => budget.min_psnr,
+        }
+    }
+
+    /// The measures `budget` judges, and the others, each in [`Measure::ALL`]'s order.
+    pub(super) fn split(budget: &BlockBudget) -> (Vec<Self>, Vec<Self>) {
+        Self::ALL
+            .into_iter()
+            .partition(|m| m.limit(budget).is_some())
+    }
+
+    /// This measure of `t` (`None`: the PSNR where every component is exact).
+    pub(super) fn of(self, t: &Trial) -> Option<f64> {
+        let srgb = t.srgb();
+        match self {
+            Self::P999 => Some(srgb.p999),
+            Self::Mean => Some(srgb.mean),
+            Self::Max => Some(srgb.max),
+            Self::RelativeMax => Some(t.ka_error.max),
+            Self::RelativeMean => Some(t.ka_error.mean),
+            Self::Psnr => t.min_psnr,
+        }
+    }
+
+    /// How bad `value` is, the lower the better: the value, or the PSNR negated (exact the
+    /// best).
+    pub(super) fn badness(self, value: Option<f64>) -> f64 {
+        match (self, value) {
+            (Self::Psnr, Some(p)) => -p,
+            (Self::Psnr, None) => f64::NEG_INFINITY,
+            (_, v) => v.unwrap_or(0.0),
+        }
+    }
+
+    /// `value` as the notices write it: "p99.9 1.88 levels", "relative max 4.10 %".
+    pub(super) fn show(self, value: Option<f64>) -> String {
+        let v = value.unwrap_or(0.0);
+        match self {
+            Self::P999 => format!("p99.9 {v:.2} levels"),
+            Self::Mean => format!("mean {v:.3} levels"),
+            Self::Max => format!("max {v:.2} levels"),
+            Self::RelativeMax => format!("relative max {}", pct(v)),
+            Self::RelativeMean => format!("relative mean {}", pct(v)),
+            Self::Psnr => value.map_or_else(|| "PSNR exact".into(), |p| format!("PSNR {p:.1} dB")),
+        }
+    }
+
+    /// Whether `value` misses `limit` (a PSNR under it, anything else over it).
+    pub(super) fn misses(self, value: Option<f64>, limit: f64) -> bool {
+        match (self, value) {
+            (Self::Psnr, p) => p.is_some_and(|p| p < limit),
+            (_, v) => v.unwrap_or(0.0) > limit,
+        }
+    }
+
+    /// The judgement of `value` against `budget`, where it judges this measure: "p99.9 4.06
+    /// levels (over)".
+    fn judge(self, value: Option<f64>, budget: &BlockBudget) -> Option<String> {
+        let limit = self.limit(budget)?;
+        let side = if self.misses(value, limit) {
+            "over"
+        } else {
+            "within"
+        };
+        Some(format!("{} ({side})", self.show(value)))
     }
 }
 
@@ -107,8 +214,17 @@ pub struct BlockChoice {
 }
 
 impl BlockChoice {
+    /// The trial kept (the one whose layout and effort the set has).
+    pub fn kept(&self) -> Option<&Trial> {
+        self.trials
+            .iter()
+            .rev()
+            .find(|t| t.layout == self.layout && t.bc7_effort == self.bc7_effort)
+    }
+
     /// One line for people: the layout and effort chosen, the encoder, and the budget's
-    /// verdict (the manifest's `blocks` has the trials and the reason).
+    /// verdict with every number it rests on, beside the numbers it does not judge (the
+    /// manifest's `blocks` has the trials and the reason).
     pub fn summary(&self) -> String {
         let layout = match (self.layout, self.astc_block) {
             (BlockLayout::Packed, None) => "n packed in k_d's BC7".to_string(),
@@ -128,9 +244,21 @@ impl BlockChoice {
         } else {
             format!("{encoder} encoder")
         };
-        let verdict = if self.within_budget {
-            format!("within the k_a budget ({})", self.budget.describe())
-        } else {
+        let (judged, rest) = Measure::split(&self.budget);
+        let kept = self.kept();
+        let value = |m: Measure| kept.and_then(|t| m.of(t));
+        let judged: Vec<String> = judged
+            .iter()
+            .filter_map(|m| m.judge(value(*m), &self.budget))
+            .collect();
+        let rest: Vec<String> = rest.iter().map(|m| m.show(value(*m))).collect();
+        let side = if self.within_budget { "within" } else { "over" };
+        let mut verdict = format!(
+            "{side} the k_a budget ({}), which judges level 0: {}",
+            self.budget.describe(),
+            judged.join(", ")
+        );
+        if !self.within_budget {
             let floor = self
                 .uncompressed_ka_error_srgb
                 .filter(|f| f.over(&self.budget) != (false, false))
@@ -140,13 +268,16 @@ impl BlockChoice {
                         f.p999, f.mean
                     )
                 });
-            format!(
-                "over the k_a budget ({}): kept the nearest of {} trials{floor}",
-                self.budget.describe(),
+            verdict = format!(
+                "{verdict}; kept the nearest of {} trials by {NEAREST_RULE}{floor}",
                 self.trials.len()
-            )
-        };
-        format!("{layout} at {:?}, {encoder}, {verdict}", self.bc7_effort)
+            );
+        }
+        format!(
+            "{layout} at {:?}, {encoder}: {verdict}; not judged: {}, nor the mip levels past 0",
+            self.bc7_effort,
+            rest.join(", ")
+        )
     }
 }
 

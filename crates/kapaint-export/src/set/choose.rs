@@ -11,19 +11,23 @@
 //!   bytes as BC7): BC7 keeps 8-bit sRGB and its mode 6 shares one p-bit across channels,
 //!   so flat blocks come out a level off, a large relative error in dark texels where `k_s`
 //!   adds little;
-//! - then the layout nearest the budget (fewest failing measures, then the worst measure
-//!   nearest its limit) takes more effort, a step at a time up
-//!   to the preset's ceiling, while the rate at which the last step improved each failing
-//!   measure could still meet the budget;
+//! - then the layout nearest the budget takes more effort, a step at a time up to the
+//!   preset's ceiling, while the rate at which the last step improved each failing measure
+//!   could still meet the budget;
 //! - at the ceiling, the trial nearest the budget is kept, and the manifest says
 //!   the budget was not met.
+//!
+//! "Nearest" is one rule ([`super::choice::NEAREST_RULE`], in the notices' words): fewest
+//! failing measures, then the worst measure's ratio to its limit, the next, and so on, then
+//! every number a trial shows. So no trial is kept while another is as good on every number
+//! and better on one.
 //!
 //! The manifest records every trial and why the chosen one was chosen.
 
 use std::time::Instant;
 
 use super::budget::{better, nearer, reachable, storage_misses, within};
-use super::choice::{BlockChoice, BlockLayout, Trial};
+use super::choice::{BlockChoice, BlockLayout, NEAREST_RULE, Trial};
 use super::encode::{Encoded, KtxTexels, StoredImage, block_family, ktx_image, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
@@ -321,7 +325,7 @@ impl<'j, 'a> Search<'j, 'a> {
             let ran = (layout, effort);
             prepare(images, self.images_of(layout), layout.half(), self.job);
             let trial = run_trial(images, encoder, layout, effort, self.job, progress)?;
-            let here = trial.describe();
+            let here = trial.describe(&budget);
             let met = within(&budget, &trial);
             trials.push(trial);
             if met {
@@ -410,18 +414,24 @@ impl<'j, 'a> Search<'j, 'a> {
                 }
             })
             .unwrap_or(0);
-        let kept = trials[chosen].describe();
+        let kept = trials[chosen].describe(budget);
+        // The last trial where it is not the one kept.
+        let last_tried = if chosen + 1 == trials.len() {
+            String::new()
+        } else {
+            format!(" (the last: {here})")
+        };
         let reason = if stored_misses {
             format!(
-                "no trial met the budget, and no effort can: the same files uncompressed miss it too; kept the trial nearest it, {kept} (the last: {here})"
+                "no trial met the budget, and no effort can: the same files uncompressed miss it too; kept the trial nearest it, {kept}, by {NEAREST_RULE}{last_tried}"
             )
         } else if step + 1 < self.efforts.len() {
             format!(
-                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept} (the last: {here})"
+                "no trial met the budget, and more effort, at the rate the last step bought, would not: kept the trial nearest it, {kept}, by {NEAREST_RULE}{last_tried}"
             )
         } else {
             format!(
-                "no trial up to {:?} met the budget: kept the trial nearest it, {kept} (the last: {here})",
+                "no trial up to {:?} met the budget: kept the trial nearest it, {kept}, by {NEAREST_RULE}{last_tried}",
                 self.job.preset.max_bc7_effort
             )
         };

@@ -30,10 +30,15 @@ pub use self::manifest::{
 };
 use self::manifest::{Comp, approximation};
 use self::measure::ka_error_of_set;
-pub use self::normal::{NORMAL_FILE, NormalFile};
+pub use self::normal::{
+    AngularError, NORMAL_FILE, NORMAL_KTX2_FILE, NORMAL_XY_ENCODING, NORMAL_Z, NormalFile,
+    NormalStorage,
+};
 use self::plan::plan_set;
 
-pub use self::plan::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, PlannedFile, SetPlan, plan};
+pub use self::plan::{
+    BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, PlannedFile, PlannedNormal, SetPlan, plan,
+};
 pub use self::target::{PBR_MANIFEST_FORMAT, SetKind, Target, holds, target};
 pub(crate) use self::target::{claim, commit};
 use super::encoding::KaError;
@@ -150,7 +155,7 @@ pub(super) fn export_into(
         let written = write_images(&source, preset, tmp, encoded)?;
         let mut manifest = source.manifest(preset, written.files, blocks);
         source.measure(&mut manifest, &written.stored, &written.mips, preset);
-        write_manifest(&mut manifest, doc, tmp)?;
+        write_manifest(&mut manifest, doc, NormalStorage::of(preset), tmp)?;
         Ok(manifest)
     })
 }
@@ -426,12 +431,18 @@ fn file_entry(
     }
 }
 
-/// The write stage's last files: the normal map, the decode + `k_a` snippets for engines
-/// (WGSL and GLSL), and `material.json`, which counts every byte written, itself included.
-fn write_manifest(manifest: &mut Manifest, doc: &Document, tmp: &Path) -> Result<(), SetError> {
+/// The write stage's last files: the normal map (as `normal` says), the decode + `k_a`
+/// snippets for engines (WGSL and GLSL), and `material.json`, which counts every byte
+/// written, itself included.
+fn write_manifest(
+    manifest: &mut Manifest,
+    doc: &Document,
+    normal: NormalStorage,
+    tmp: &Path,
+) -> Result<(), SetError> {
     let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
-    if let Some(normal) = doc.normal() {
-        let file = NormalFile::write(normal, tmp)?;
+    if let Some(map) = doc.normal() {
+        let file = NormalFile::write(map, tmp, normal)?;
         exported += file.bytes;
         manifest.normal = Some(Box::new(file));
     }

@@ -88,15 +88,33 @@ pub struct SetPlan {
     pub ka_error: KaError,
     /// Bytes: the images uncompressed, the naive maps, the project's maps.
     pub bytes: MemoryReport,
-    /// The size of the project's normal map, written beside the maps as `normal.png` (as the
-    /// project stores it), when it has one.
-    pub normal: Option<(u32, u32)>,
+    /// The project's normal map, written beside the maps, when it has one.
+    pub normal: Option<PlannedNormal>,
+}
+
+/// The normal map a set will hold: its file, its size, and how it is stored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedNormal {
+    /// File name (`normal.png`, or `normal.ktx2` in KTX2 sets).
+    pub path: &'static str,
+    /// Size in texels (the normal map's own).
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+    /// How it is stored, in words ("x and y as BC5, z rebuilt by the consumer").
+    pub storage: String,
 }
 
 /// The plan of exporting `doc` with `preset` (see [`SetPlan`]).
 pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
     let (mut plan, _, _) = plan_set(doc, preset);
-    plan.normal = doc.normal().map(|n| (n.width(), n.height()));
+    let storage = super::NormalStorage::of(preset);
+    plan.normal = doc.normal().map(|n| PlannedNormal {
+        path: storage.file(),
+        width: n.width(),
+        height: n.height(),
+        storage: storage.describe(),
+    });
     plan
 }
 

@@ -66,6 +66,11 @@ impl UvBake {
         self.cells.len()
     }
 
+    /// Triangles of the mesh it was made from.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
     /// Whether the bake has no texels.
     pub fn is_empty(&self) -> bool {
         self.cells.is_empty()

@@ -7,6 +7,10 @@
 //! (AO) or its opposite (thickness), turned about the normal by a hashed angle per texel so
 //! neighbouring texels do not share their errors. A bake holds 2 bytes a texel
 //! per channel and nothing per ray.
+//!
+//! Every bake computes in the mesh's [`UnitFrame`] (centred, scaled into `[-1, 1]` by a power of
+//! two), so the same shape bakes to the same map at any scale: `1e-20` and `1e30` alike, with a
+//! maximum distance given in object units scaled with it.
 
 use glam::Vec3;
 use kapaint_base::task::Progress;
@@ -18,6 +22,7 @@ pub use rays::{Directions, RayMesh};
 
 use crate::Mesh;
 use crate::bake::{Coverage, UvBake};
+use crate::frame::UnitFrame;
 
 /// What is baked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -157,11 +162,9 @@ impl Baked {
     }
 }
 
-/// The unit geometric normal of texel `i`'s triangle, turned to the side its shading normal
-/// faces. A triangle with no area (a sphere's pole) gives the shading normal.
-fn geometric_normal(uv: &UvBake, i: usize, t: u32) -> Vec3 {
-    let [a, b, c] = uv.corners(t);
-    let shading = uv.normal(i);
+/// The unit geometric normal of a triangle with `corners`, turned to the side the `shading`
+/// normal faces. A triangle with no area (a sphere's pole) gives the shading normal.
+fn geometric_normal([a, b, c]: [Vec3; 3], shading: Vec3) -> Vec3 {
     match (b - a).cross(c - a).try_normalize() {
         Some(n) if n.dot(shading) < 0.0 => -n,
         Some(n) => n,
@@ -172,7 +175,8 @@ fn geometric_normal(uv: &UvBake, i: usize, t: u32) -> Vec3 {
 /// Rows baked between progress reports and cancel checks.
 const BAND_ROWS: usize = 8;
 
-/// What one bake needs at every texel.
+/// What one bake needs at every texel. Positions, distances and bounds are in the mesh's
+/// [`UnitFrame`].
 struct Baker<'a> {
     mesh: &'a Mesh,
     uv: &'a UvBake,
@@ -181,6 +185,7 @@ struct Baker<'a> {
     ray_mesh: Option<RayMesh>,
     directions: Directions,
     curvature: Option<Vec<f32>>,
+    local: Vec<Vec3>,
     bounds: (Vec3, Vec3),
 }
 
@@ -192,16 +197,21 @@ impl Baker<'_> {
         };
         let unorm = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
         let uv = self.uv;
+        let corners = || self.mesh.triangles[t as usize].map(|v| self.local[v as usize]);
+        let position = || {
+            let ([a, b, c], w) = (corners(), uv.barycentric(i));
+            a * w.x + b * w.y + c * w.z
+        };
         match self.map {
             BakeMap::Ao | BakeMap::Thickness => {
                 let value = self.ray_mesh.as_ref().map_or(1.0, |r| {
-                    let n = geometric_normal(uv, i, t);
-                    let p = uv.position(i);
+                    let n = geometric_normal(corners(), uv.normal(i));
+                    let p = position();
                     let set = &self.directions;
                     if self.map == BakeMap::Ao {
-                        r.open_fraction(p, n, set, self.far, turn_of(i))
+                        r.open_fraction_local(p, n, set, self.far, turn_of(i))
                     } else {
-                        r.mean_distance(p, -n, set, self.far, turn_of(i))
+                        r.mean_distance_local(p, -n, set, self.far, turn_of(i))
                     }
                 });
                 out[0] = unorm(value);
@@ -216,7 +226,7 @@ impl Baker<'_> {
             }
             BakeMap::Position => {
                 let (lo, hi) = self.bounds;
-                let p = (uv.position(i) - lo) / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+                let p = (position() - lo) / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
                 out.copy_from_slice(&p.to_array().map(unorm));
             }
             BakeMap::Normal => {
@@ -249,7 +259,9 @@ fn check(map: BakeMap, options: BakeOptions) -> Result<(), String> {
 /// are padded like the maps). `progress` counts rows and cancels.
 ///
 /// # Errors
-/// Rays out of range, a maximum distance that is not a positive number, or cancelled.
+/// Rays out of range, a maximum distance that is not a positive number, a mesh whose positions
+/// are not finite or whose bounding box is too large to measure
+/// ([`MAX_DIAGONAL`](crate::frame::MAX_DIAGONAL)), or cancelled.
 pub fn bake_map(
     mesh: &Mesh,
     uv: &UvBake,
@@ -258,14 +270,23 @@ pub fn bake_map(
     progress: Option<&Progress>,
 ) -> Result<Baked, String> {
     check(map, options)?;
+    if uv.triangle_count() != mesh.triangles.len() {
+        return Err("the UV bake was made from another mesh".into());
+    }
+    let frame = UnitFrame::checked(&mesh.positions)?;
     let (w, h) = (uv.width as usize, uv.height as usize);
     let channels = map.channels();
     let ray_mesh = map.casts_rays().then(|| RayMesh::new(mesh));
     let far = match (map, options.max_distance) {
-        (_, Some(d)) => d,
-        (BakeMap::Thickness, None) => ray_mesh.as_ref().map_or(1.0, |r| r.diagonal),
+        (_, Some(d)) => frame.local_length(d),
+        (BakeMap::Thickness, None) => frame.local_diagonal(),
         _ => f32::INFINITY,
     };
+    let local = frame.local_positions(&mesh.positions);
+    let bounds = local.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
     let baker = Baker {
         mesh,
         uv,
@@ -273,8 +294,9 @@ pub fn bake_map(
         far,
         ray_mesh,
         directions: Directions::new(if map.casts_rays() { options.rays } else { 0 }),
-        curvature: (map == BakeMap::Curvature).then(|| vertex_curvature(mesh)),
-        bounds: mesh.bounds(),
+        curvature: (map == BakeMap::Curvature).then(|| curvature_in(mesh, &local)),
+        local,
+        bounds,
     };
     if let Some(p) = progress {
         p.start(&format!("bake {}", map.name()), h as u64);
@@ -316,8 +338,17 @@ pub const CURVATURE_SCALE: f32 = 32.0;
 /// Signed mean curvature per vertex, in units of [`CURVATURE_SCALE`] over the mesh's
 /// diagonal, clamped to `[-1, 1]`: positive convex, negative concave, 0 flat. Vertices at one
 /// position count as one (a UV seam does not cut the surface); per edge, the normals' spread
-/// along it over its length squared, averaged around the vertex.
+/// along it over its length squared, averaged around the vertex. Computed in the mesh's
+/// [`UnitFrame`], so it is the same at any scale.
 pub fn vertex_curvature(mesh: &Mesh) -> Vec<f32> {
+    curvature_in(
+        mesh,
+        &UnitFrame::of(&mesh.positions).local_positions(&mesh.positions),
+    )
+}
+
+/// [`vertex_curvature`] with the mesh's positions in its unit frame (`local`, one a vertex).
+fn curvature_in(mesh: &Mesh, local: &[Vec3]) -> Vec<f32> {
     // Weld by position, with each welded vertex's normal the mean of its copies'.
     let mut ids = std::collections::HashMap::new();
     let weld: Vec<usize> = mesh
@@ -332,7 +363,7 @@ pub fn vertex_curvature(mesh: &Mesh) -> Vec<f32> {
     let mut position = vec![Vec3::ZERO; ids.len()];
     for (v, &g) in weld.iter().enumerate() {
         normal[g] += mesh.normals[v];
-        position[g] = mesh.positions[v];
+        position[g] = local[v];
     }
     for n in &mut normal {
         *n = n.normalize_or_zero();
@@ -344,7 +375,7 @@ pub fn vertex_curvature(mesh: &Mesh) -> Vec<f32> {
             let (a, b) = (weld[t[k] as usize], weld[t[(k + 1) % 3] as usize]);
             let d = position[b] - position[a];
             let len2 = d.length_squared();
-            if a == b || len2 <= 0.0 {
+            if a == b || len2.is_nan() || len2 <= 0.0 {
                 continue;
             }
             let k_edge = (normal[b] - normal[a]).dot(d) / len2;
@@ -354,7 +385,10 @@ pub fn vertex_curvature(mesh: &Mesh) -> Vec<f32> {
             }
         }
     }
-    let (lo, hi) = mesh.bounds();
+    let (lo, hi) = position.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
     let scale = (hi - lo).length() / CURVATURE_SCALE;
     weld.iter()
         .map(|&g| {

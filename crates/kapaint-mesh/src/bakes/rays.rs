@@ -1,5 +1,9 @@
 //! Rays against the mesh: a BVH for occlusion and distance, and the direction set a bake
 //! casts about each texel's normal.
+//!
+//! The BVH holds the mesh in its [`UnitFrame`] (centred, scaled into `[-1, 1]` by a power of
+//! two), so its build and every ray see the same numbers at any scale; rays are given and
+//! distances handed back in object units.
 
 use glam::{Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
@@ -7,25 +11,38 @@ use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 
 use crate::Mesh;
+use crate::frame::UnitFrame;
 
 /// A BVH of the mesh for occlusion and distance rays.
 pub struct RayMesh {
     bvh: CwBvh,
-    /// The triangles in the BVH's order (no lookup through its primitive indices per test).
+    /// The triangles in the BVH's order (no lookup through its primitive indices per test), in
+    /// local coordinates.
     triangles: Vec<Triangle>,
-    /// The bounding box's diagonal.
+    /// Where the triangles are.
+    frame: UnitFrame,
+    /// The bounding box's diagonal (object units; saturated at `f32::MAX`).
     pub diagonal: f32,
 }
 
 impl RayMesh {
-    /// Builds the BVH of `mesh`'s triangles.
+    /// Builds the BVH of `mesh`'s triangles. A mesh that fails [`Mesh::validate`] is built all
+    /// the same: triangles with a non-finite corner are left out (no ray meets them), and
+    /// lengths saturate where its box is too large to measure.
     pub fn new(mesh: &Mesh) -> Self {
+        let frame = UnitFrame::of(&mesh.positions);
+        let local = frame.local_positions(&mesh.positions);
         let triangles: Vec<Triangle> = mesh
             .triangles
             .iter()
-            .map(|t| {
-                let [v0, v1, v2] = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
-                Triangle { v0, v1, v2 }
+            .filter_map(|t| {
+                let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
+                let (v0, v1, v2) = (v0?, v1?, v2?);
+                (v0.is_finite() && v1.is_finite() && v2.is_finite()).then_some(Triangle {
+                    v0,
+                    v1,
+                    v2,
+                })
             })
             .collect();
         // A slower build for fewer node visits: a mesh is built once and cast millions of
@@ -40,25 +57,89 @@ impl RayMesh {
             .iter()
             .map(|&i| triangles[i as usize])
             .collect();
-        let (lo, hi) = mesh.bounds();
         Self {
             bvh,
             triangles,
-            diagonal: (hi - lo).length(),
+            diagonal: frame.diagonal(),
+            frame,
         }
     }
 
-    /// Whether a ray from `origin` along unit `dir` meets the mesh before `far`.
+    /// The frame the BVH is built in.
+    pub fn frame(&self) -> &UnitFrame {
+        &self.frame
+    }
+
+    /// Whether a ray from `origin` along unit `dir` meets the mesh before `far` (object
+    /// units).
     pub fn occluded(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
+        self.occluded_local(
+            self.frame.local_from_object(origin),
+            dir,
+            self.frame.local_length(far),
+        )
+    }
+
+    /// The distance along a ray from `origin` along unit `dir` to the mesh, if it meets it
+    /// before `far` (object units).
+    pub fn distance(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
+        self.distance_local(
+            self.frame.local_from_object(origin),
+            dir,
+            self.frame.local_length(far),
+        )
+        .map(|t| self.frame.object_length(t))
+    }
+
+    /// The cosine-weighted fraction of the `set`'s directions around unit `normal` from
+    /// `point` that meet nothing before `far` (object units); the set is turned by `turn`
+    /// about the normal.
+    pub fn open_fraction(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        set: &Directions,
+        far: f32,
+        turn: f32,
+    ) -> f32 {
+        self.open_fraction_local(
+            self.frame.local_from_object(point),
+            normal,
+            set,
+            self.frame.local_length(far),
+            turn,
+        )
+    }
+
+    /// The mean of `min(distance, far) / far` over the `set`'s directions around unit
+    /// `normal` from `point`, turned by `turn` (object units).
+    pub fn mean_distance(
+        &self,
+        point: Vec3,
+        normal: Vec3,
+        set: &Directions,
+        far: f32,
+        turn: f32,
+    ) -> f32 {
+        self.mean_distance_local(
+            self.frame.local_from_object(point),
+            normal,
+            set,
+            self.frame.local_length(far),
+            turn,
+        )
+    }
+
+    /// [`RayMesh::occluded`] in local units.
+    fn occluded_local(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, far);
         !self
             .bvh
             .ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
     }
 
-    /// The distance along a ray from `origin` along unit `dir` to the mesh, if it meets it
-    /// before `far`.
-    pub fn distance(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
+    /// [`RayMesh::distance`] in local units.
+    fn distance_local(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
         let ray = Ray::new(origin.into(), dir.into(), 0.0, far);
         let mut hit = obvhs::ray::RayHit::none();
         self.bvh
@@ -66,9 +147,8 @@ impl RayMesh {
             .then_some(hit.t)
     }
 
-    /// The cosine-weighted fraction of the `set`'s directions around unit `normal` from
-    /// `point` that meet nothing before `far`; the set is turned by `turn` about the normal.
-    pub fn open_fraction(
+    /// [`RayMesh::open_fraction`] from a point and to a distance in local units.
+    pub(super) fn open_fraction_local(
         &self,
         point: Vec3,
         normal: Vec3,
@@ -79,14 +159,13 @@ impl RayMesh {
         let origin = point + normal * self.offset();
         let open = set
             .around(normal, turn)
-            .filter(|&dir| !self.occluded(origin, dir, far))
+            .filter(|&dir| !self.occluded_local(origin, dir, far))
             .count();
         open as f32 / set.len() as f32
     }
 
-    /// The mean of `min(distance, far) / far` over the `set`'s directions around unit
-    /// `normal` from `point`, turned by `turn`.
-    pub fn mean_distance(
+    /// [`RayMesh::mean_distance`] from a point and to a distance in local units.
+    pub(super) fn mean_distance_local(
         &self,
         point: Vec3,
         normal: Vec3,
@@ -97,15 +176,18 @@ impl RayMesh {
         let origin = point + normal * self.offset();
         let sum: f32 = set
             .around(normal, turn)
-            .map(|dir| self.distance(origin, dir, far).map_or(1.0, |t| t / far))
+            .map(|dir| {
+                self.distance_local(origin, dir, far)
+                    .map_or(1.0, |t| t / far)
+            })
             .sum();
         sum / set.len() as f32
     }
 
-    /// How far a ray starts off the surface: clear of the triangle it leaves, close enough to
-    /// see a neighbour.
+    /// How far a ray starts off the surface (local units): clear of the triangle it leaves,
+    /// close enough to see a neighbour.
     fn offset(&self) -> f32 {
-        self.diagonal * 1e-5
+        self.frame.local_diagonal() * 1e-5
     }
 }
 

@@ -194,3 +194,84 @@ fn bad_values_and_cancel_are_errors() {
     .expect_err("cancelled");
     assert_eq!(e, "cancelled");
 }
+
+/// `mesh` with its positions moved by `offset` and scaled by `scale`.
+fn scaled(mesh: &Mesh, offset: Vec3, scale: f32) -> Mesh {
+    let mut out = mesh.clone();
+    for p in &mut out.positions {
+        *p = (*p + offset) * scale;
+    }
+    out
+}
+
+/// The largest and the mean difference between two bakes' samples (unorm16 steps).
+fn difference(a: &Baked, b: &Baked) -> (u16, f64) {
+    let diffs = a.data.iter().zip(&b.data).map(|(&x, &y)| x.abs_diff(y));
+    let max = diffs.clone().max().unwrap_or(0);
+    let mean = diffs.map(f64::from).sum::<f64>() / a.data.len().max(1) as f64;
+    (max, mean)
+}
+
+#[test]
+fn bakes_are_the_same_at_every_scale() {
+    // A torus (occluded inside its ring, curved both ways) away from the origin.
+    let torus = crate::torus(1.0, 0.35, 48, 24);
+    let offset = Vec3::new(3.0, -1.0, 0.5);
+    let bake_at = |scale: f32, map: BakeMap| {
+        let mesh = scaled(&torus, offset, scale);
+        let uv = bake(&mesh, 96, 96, 2).expect("bakes");
+        let options = BakeOptions {
+            rays: 32,
+            // Object units, scaled with the mesh.
+            max_distance: (map == BakeMap::Ao).then_some(1.5 * scale),
+        };
+        bake_map(&mesh, &uv, map, options, None).expect("a bake")
+    };
+    for map in [
+        BakeMap::Ao,
+        BakeMap::Thickness,
+        BakeMap::Curvature,
+        BakeMap::Position,
+    ] {
+        let unit = bake_at(1.0, map);
+        let stats = unit.stats(&bake(&torus, 96, 96, 2).expect("bakes"));
+        assert!(stats.min < stats.mean, "{map:?} has something to compare");
+        // A power of two scales exactly: the same bits.
+        for scale in [2.0_f32.powi(-70), 2.0_f32.powi(100)] {
+            assert!(bake_at(scale, map).data == unit.data, "{map:?} at {scale}");
+        }
+        // Any other scale rounds the positions once: a sample may move by a step, and a ray
+        // that grazes an edge may turn (one ray of 32); almost every sample is the same.
+        for scale in [1e-20_f32, 3.0, 1e30] {
+            let (max, mean) = difference(&bake_at(scale, map), &unit);
+            assert!(
+                u32::from(max) <= 65535 / 32 && mean < 0.05,
+                "{map:?} at {scale}: largest difference {max}, mean {mean}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_mesh_too_large_to_measure_is_refused_not_baked() {
+    // The box from -1e38 to 1e38 on every axis: its diagonal is more than f32 holds.
+    let huge = scaled(&crate::uv_sphere(16, 8), Vec3::ZERO, 1e38);
+    let e = huge.validate().expect_err("refused");
+    assert!(e.contains("too large to measure"), "{e}");
+    let uv = bake(&huge, 32, 32, 2).expect("the UV bake needs no positions");
+    for map in [BakeMap::Ao, BakeMap::Thickness, BakeMap::Curvature] {
+        let e = bake_map(&huge, &uv, map, BakeOptions::default(), None).expect_err("refused");
+        assert!(e.contains("too large to measure"), "{map:?}: {e}");
+    }
+    // Long on one axis only, it is measured and baked.
+    let mut long = crate::uv_sphere(16, 8);
+    long.positions.iter_mut().for_each(|p| p.x *= 1e38);
+    assert!(long.validate().is_ok());
+    let uv = bake(&long, 32, 32, 2).expect("bakes");
+    let ao = bake_map(&long, &uv, BakeMap::Ao, BakeOptions::default(), None).expect("ao");
+    assert!(
+        ao.stats(&uv).min >= 0.99,
+        "a convex shape is open: {:?}",
+        ao.stats(&uv)
+    );
+}

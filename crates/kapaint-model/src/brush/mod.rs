@@ -72,6 +72,7 @@ impl BlendMode {
     clippy::struct_excessive_bools,
     reason = "independent switches, as a brush panel shows them"
 )]
+#[serde(deny_unknown_fields)]
 pub struct BrushSettings {
     /// Radius in texels (2D) at full pressure, `[0.5, 4096]`.
     #[serde(deserialize_with = "check::radius_px")]

@@ -39,6 +39,7 @@ impl StrokePos for Vec2 {
 
 /// A point on a mesh surface in object space, with the direction the brush faces.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SurfacePos {
     /// Object-space point (on or very near the surface).
     #[serde(deserialize_with = "check::finite_vec3")]
@@ -74,6 +75,7 @@ impl StrokePos for SurfacePos {
 /// One input sample of a stroke.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(bound(deserialize = "P: StrokePos + Deserialize<'de>"))]
+#[serde(deny_unknown_fields)]
 pub struct StrokePoint<P = Vec2> {
     /// Position: in texel units on the canvas (texel `(i, j)` has its centre at
     /// `(i + 0.5, j + 0.5)`), or a [`SurfacePos`] on a mesh.

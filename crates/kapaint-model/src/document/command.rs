@@ -23,6 +23,7 @@ pub enum StrokeTool {
 
 /// Which texels a fill writes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum FillRegion {
     /// The whole map.
     All,
@@ -172,6 +173,8 @@ pub enum ImportCommand {
     /// Keeps a map baked from the mesh on a worker (AO, curvature, ...), replacing the bake of
     /// the same map.
     SetBake(AttachedBake),
+    /// Keeps several maps baked together ("Bake all"), as one step.
+    SetBakes(Vec<AttachedBake>),
     /// Installs maps resized on a worker ([`crate::resize::resized`]) with the mesh
     /// surface baked at their size.
     Resize(crate::resize::ResizedMaps),

@@ -94,31 +94,6 @@ impl Document {
         Self::assemble_with(maps, stack, settings, compositor)
     }
 
-    /// A document around a layer stack and `maps`, its composite as a project stored it (a
-    /// version 4 project with generator masks: what they made is not computed again until
-    /// something they read or shape changes).
-    ///
-    /// # Errors
-    /// Maps of another size than the stack.
-    pub fn from_stack_and_composite(
-        mut stack: LayerStack,
-        maps: MaterialMaps,
-        settings: DocumentSettings,
-    ) -> Result<Self, ModelError> {
-        if (maps.width(), maps.height()) != (stack.width, stack.height) {
-            return Err(ModelError::Internal(format!(
-                "the composite is {}x{} but the layers are {}x{}",
-                maps.width(),
-                maps.height(),
-                stack.width,
-                stack.height
-            )));
-        }
-        stack.make_ids_unique();
-        let compositor = Compositor::primed(&stack);
-        Ok(Self::assemble_with(maps, stack, settings, compositor))
-    }
-
     fn assemble_with(
         maps: MaterialMaps,
         stack: LayerStack,

@@ -90,6 +90,14 @@ impl Document {
         const LABEL: &str = "Mask generator";
         if let Some(g) = &generator {
             g.check().map_err(command_error)?;
+            // A bake the generator reads must be there: never a flat default in its place.
+            if let Some(map) = g
+                .bakes_needed()
+                .into_iter()
+                .find(|&m| self.bake_of(m).is_none())
+            {
+                return Err(command_error(missing_bake(map)));
+            }
         }
         let id = self.state.selection.id;
         let joined = id.is_some() && run == id && !self.stroking();
@@ -115,6 +123,15 @@ impl Document {
             }
         }
     }
+}
+
+/// Why a generator that reads the `map` bake cannot be laid on a document without one.
+fn missing_bake(map: kapaint_mesh::bakes::BakeMap) -> String {
+    format!(
+        "the mask generator reads the {name} bake, which the project does not have yet: bake \
+         it first (`kapaint bake PROJECT --map {name}`, or Mesh > Bake in the editor)",
+        name = map.name()
+    )
 }
 
 /// What a generator reads in `st`: its surface, bakes and map size.

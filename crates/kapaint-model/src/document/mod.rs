@@ -44,6 +44,7 @@ use stroke::ActiveStroke;
 /// Everything about a document that is not the maps; saved with the project.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
+#[serde(deny_unknown_fields)]
 pub struct DocumentSettings {
     /// Shading model of the preview and of derived `k_a`.
     pub model: ShadingModel,
@@ -385,7 +386,10 @@ impl Document {
                 Ok(())
             }
             ImportCommand::SetMesh(mesh) => self.set_mesh(&mesh),
-            ImportCommand::SetBake(bake) => self.set_bake(bake.0),
+            ImportCommand::SetBake(bake) => self.set_bakes(vec![bake.0]),
+            ImportCommand::SetBakes(bakes) => {
+                self.set_bakes(bakes.into_iter().map(|b| b.0).collect())
+            }
             ImportCommand::Resize(resized) => self.install_resized(&resized),
         }
     }

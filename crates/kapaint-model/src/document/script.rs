@@ -17,6 +17,7 @@ use kapaint_reflectance::{AmbientApprox, ShadingModel};
 /// A command as a script names it (see [`Command`] for what each does; the commands made by
 /// workers from files have no script name).
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 pub(super) enum ScriptCommand {
     SetBrush(BrushSettings),
     SetPrimary(MaterialValue),

@@ -52,6 +52,39 @@ impl Document {
         self
     }
 
+    /// Whether a layer's mask is made by a generator, which is laid on the mesh: the
+    /// composite is only right with the mesh's surface attached.
+    pub fn needs_mesh(&self) -> bool {
+        self.state
+            .stack
+            .walk()
+            .iter()
+            .any(|(_, l)| l.mask.as_ref().is_some_and(|m| m.generator.is_some()))
+    }
+
+    /// The bakes a generator mask reads that the document does not keep, each with the name
+    /// of the first layer whose mask reads it, in [`BakeMap::ALL`](kapaint_mesh::bakes::BakeMap::ALL)
+    /// order.
+    pub fn missing_bakes(&self) -> Vec<(kapaint_mesh::bakes::BakeMap, String)> {
+        let mut out: Vec<(kapaint_mesh::bakes::BakeMap, String)> = Vec::new();
+        for (_, layer) in self.state.stack.walk() {
+            let Some(g) = layer.mask.as_ref().and_then(|m| m.generator()) else {
+                continue;
+            };
+            for map in g.bakes_needed() {
+                if self.bake_of(map).is_none() && out.iter().all(|(m, _)| *m != map) {
+                    out.push((map, layer.props.name.clone()));
+                }
+            }
+        }
+        out.sort_by_key(|(m, _)| {
+            kapaint_mesh::bakes::BakeMap::ALL
+                .iter()
+                .position(|(_, x)| x == m)
+        });
+        out
+    }
+
     /// Lays the generator masks again on what they read now, and composites what changed.
     fn lay_generators(&mut self) {
         if super::masks::lay_generators(&mut self.state) {
@@ -135,32 +168,39 @@ impl Document {
         Ok(())
     }
 
-    /// [`ImportCommand::SetBake`](super::ImportCommand::SetBake): a map baked from the mesh
-    /// kept, replacing the bake of the same map, as one undo step.
+    /// [`ImportCommand::SetBake`](super::ImportCommand::SetBake) and
+    /// [`SetBakes`](super::ImportCommand::SetBakes): maps baked from the mesh kept, each
+    /// replacing the bake of the same map, as one undo step.
     ///
     /// # Errors
-    /// A bake of another size than the maps, or of another mesh than the attached one.
-    pub(super) fn set_bake(
+    /// A bake of another size than the maps, or of another mesh than the attached one;
+    /// nothing is kept then.
+    pub(super) fn set_bakes(
         &mut self,
-        bake: Arc<kapaint_mesh::bakes::Baked>,
+        bakes: Vec<Arc<kapaint_mesh::bakes::Baked>>,
     ) -> Result<(), ModelError> {
-        if (bake.width, bake.height) != (self.maps.width(), self.maps.height()) {
-            return Err(ModelError::Command(format!(
-                "the {} bake is {}x{} but the maps are {}x{}",
-                bake.map.name(),
-                bake.width,
-                bake.height,
-                self.maps.width(),
-                self.maps.height()
-            )));
+        for bake in &bakes {
+            if (bake.width, bake.height) != (self.maps.width(), self.maps.height()) {
+                return Err(ModelError::Command(format!(
+                    "the {} bake is {}x{} but the maps are {}x{}",
+                    bake.map.name(),
+                    bake.width,
+                    bake.height,
+                    self.maps.width(),
+                    self.maps.height()
+                )));
+            }
+            if let Some(s) = &self.state.surface
+                && s.mesh.content_hash() != bake.mesh_hash
+            {
+                return Err(ModelError::Command(format!(
+                    "the {} bake was made from another mesh than the project's",
+                    bake.map.name()
+                )));
+            }
         }
-        if let Some(s) = &self.state.surface
-            && s.mesh.content_hash() != bake.mesh_hash
-        {
-            return Err(ModelError::Command(format!(
-                "the {} bake was made from another mesh than the project's",
-                bake.map.name()
-            )));
+        if bakes.is_empty() {
+            return Ok(());
         }
         self.end_stroke();
         let before = self.state.clone();
@@ -169,9 +209,12 @@ impl Document {
                 .iter()
                 .position(|(_, x)| *x == m)
         };
-        self.state.bakes.retain(|b| b.map != bake.map);
-        let label = format!("Bake {}", bake.map.name());
-        self.state.bakes.push(bake);
+        let names: Vec<&str> = bakes.iter().map(|b| b.map.name()).collect();
+        let label = format!("Bake {}", names.join(", "));
+        for bake in bakes {
+            self.state.bakes.retain(|b| b.map != bake.map);
+            self.state.bakes.push(bake);
+        }
         self.state.bakes.sort_by_key(|b| order(b.map));
         self.record(&label, before);
         Ok(())

@@ -8,6 +8,7 @@ use super::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
 /// A generator as a file or script spells it (fields in the variant: `Ao(black: 0.2, white:
 /// 0.9)`), before it is checked.
 #[derive(Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub(super) enum GeneratorFile {
     /// No generator (only where one may be absent: `SetMaskGenerator(None)`).
     None,
@@ -18,6 +19,8 @@ pub(super) enum GeneratorFile {
         gamma: f32,
         #[serde(default)]
         invert: bool,
+        #[serde(default, skip_serializing_if = "is_false")]
+        relative: bool,
     },
     Curvature {
         black: f32,
@@ -26,6 +29,8 @@ pub(super) enum GeneratorFile {
         gamma: f32,
         #[serde(default)]
         invert: bool,
+        #[serde(default, skip_serializing_if = "is_false")]
+        relative: bool,
     },
     Thickness {
         black: f32,
@@ -34,6 +39,8 @@ pub(super) enum GeneratorFile {
         gamma: f32,
         #[serde(default)]
         invert: bool,
+        #[serde(default, skip_serializing_if = "is_false")]
+        relative: bool,
     },
     Noise {
         kind: NoiseKind,
@@ -85,6 +92,11 @@ impl TryFrom<GeneratorFile> for Generator {
             white,
             gamma,
             invert,
+            relative: false,
+        };
+        let bake_levels = |black, white, gamma, invert, relative| Levels {
+            relative,
+            ..levels(black, white, gamma, invert)
         };
         let g = match f {
             F::None => return Err("None is not a generator here".into()),
@@ -93,19 +105,22 @@ impl TryFrom<GeneratorFile> for Generator {
                 white,
                 gamma,
                 invert,
-            } => Self::Ao(levels(black, white, gamma, invert)),
+                relative,
+            } => Self::Ao(bake_levels(black, white, gamma, invert, relative)),
             F::Curvature {
                 black,
                 white,
                 gamma,
                 invert,
-            } => Self::Curvature(levels(black, white, gamma, invert)),
+                relative,
+            } => Self::Curvature(bake_levels(black, white, gamma, invert, relative)),
             F::Thickness {
                 black,
                 white,
                 gamma,
                 invert,
-            } => Self::Thickness(levels(black, white, gamma, invert)),
+                relative,
+            } => Self::Thickness(bake_levels(black, white, gamma, invert, relative)),
             F::Noise {
                 kind,
                 scale,
@@ -155,18 +170,21 @@ impl From<Generator> for GeneratorFile {
                 white: l.white,
                 gamma: l.gamma,
                 invert: l.invert,
+                relative: l.relative,
             },
             Generator::Curvature(l) => Self::Curvature {
                 black: l.black,
                 white: l.white,
                 gamma: l.gamma,
                 invert: l.invert,
+                relative: l.relative,
             },
             Generator::Thickness(l) => Self::Thickness {
                 black: l.black,
                 white: l.white,
                 gamma: l.gamma,
                 invert: l.invert,
+                relative: l.relative,
             },
             Generator::Noise(n) => Self::Noise {
                 kind: n.kind,
@@ -198,6 +216,15 @@ impl From<Generator> for GeneratorFile {
 /// A straight levels curve, the default.
 fn one() -> f32 {
     1.0
+}
+
+/// Whether a switch is off (then it is left out of what is written).
+#[expect(
+    clippy::trivially_copy_pass_by_ref,
+    reason = "serde's skip_serializing_if"
+)]
+fn is_false(b: &bool) -> bool {
+    !b
 }
 
 /// One octave, the default.

@@ -106,6 +106,7 @@ fn values_stay_in_range_and_follow_their_parameters() {
         white: 0.6,
         gamma: 1.0,
         invert: true,
+        relative: false,
     };
     assert_eq!(levels.apply(0.1), 1.0);
     assert!((levels.apply(0.4) - 0.5).abs() < 1e-6);

@@ -91,6 +91,8 @@ impl Source {
 pub struct Generated {
     stamp: u64,
     generator: Generator,
+    /// The generator as evaluated: its relative levels made absolute on the source's bakes.
+    evaluated: Generator,
     coarse: bool,
     source: Source,
     bounds: (Vec3, Vec3),
@@ -133,6 +135,7 @@ impl Generated {
         );
         Self {
             stamp: next_stamp(),
+            evaluated: generator.resolved(&source.bakes),
             generator,
             coarse,
             source,
@@ -146,19 +149,6 @@ impl Generated {
         Source {
             mesh: source.mesh,
             ..Source::new(source.surface, &source.bakes, source.width, source.height)
-        }
-    }
-
-    /// The same generator, with the same stamp (the compositor takes what it made to be
-    /// unchanged), given the surface of the mesh it was laid on (`surface` must be of that
-    /// mesh): how a project's generators meet the mesh attached after it is read.
-    #[must_use]
-    pub fn with_surface(&self, surface: Arc<Surface>) -> Self {
-        let mut source = self.source.clone();
-        source.surface = Some(surface);
-        Self {
-            stamp: self.stamp,
-            ..Self::new(self.generator.clone(), source, self.coarse)
         }
     }
 
@@ -203,7 +193,7 @@ impl Generated {
             texels: self.texels((x, y), 1, 1),
         };
         let mut v = [0.0];
-        Evaluator::new(&self.generator, &self.source.bakes).grid_values(&grid, false, &mut v);
+        Evaluator::new(&self.evaluated, &self.source.bakes).grid_values(&grid, false, &mut v);
         unorm(v[0])
     }
 
@@ -310,7 +300,7 @@ impl Generated {
         }
         let grid = Grid { side, texels };
         let mut values = vec![0.0; side * side];
-        Evaluator::new(&self.generator, &self.source.bakes).grid_values(
+        Evaluator::new(&self.evaluated, &self.source.bakes).grid_values(
             &grid,
             interpolate,
             &mut values,

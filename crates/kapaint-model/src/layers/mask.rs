@@ -146,7 +146,11 @@ pub fn lay_generators(layers: &mut [Layer], source: &crate::generator::tiles::So
                 },
                 _ => source,
             };
-            if !g.source().same(source) {
+            // A generator laid before its mesh was attached is laid again on the mesh: its
+            // values (and the composite made from them) are computed there, never taken from
+            // a file.
+            let meets_surface = g.source().surface.is_none() && source.surface.is_some();
+            if !g.source().same(source) || meets_surface {
                 let made = crate::generator::tiles::Generated::new(
                     g.generator().clone(),
                     source.clone(),
@@ -154,8 +158,6 @@ pub fn lay_generators(layers: &mut [Layer], source: &crate::generator::tiles::So
                 );
                 mask.generator = Some(Arc::new(made));
                 changed = true;
-            } else if let (None, Some(s)) = (&g.source().surface, &source.surface) {
-                mask.generator = Some(Arc::new(g.with_surface(Arc::clone(s))));
             }
         }
         if let LayerContent::Group(children) = &mut layer.content {

@@ -51,6 +51,7 @@ const MAX_MANIFEST_BYTES: u64 = 4 << 20;
 /// How one channel is stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
+#[serde(deny_unknown_fields)]
 pub enum ChannelEntry {
     /// The same stored value at every texel (unorm16 RGB, or half-float bits for `n`).
     Uniform {
@@ -68,6 +69,7 @@ pub enum ChannelEntry {
 
 /// `manifest.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Manifest {
     /// Always [`FORMAT`].
     pub format: String,
@@ -172,6 +174,7 @@ impl SelectionEntry {
 
 /// Where a project keeps its normal map.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct NormalEntry {
     /// Entry name in the archive ([`NORMAL_FILE`]).
     pub file: String,
@@ -372,7 +375,8 @@ fn attach_loaded(
 /// Opens a project with its mesh attached (`mesh` instead of the project's own, when given):
 /// the document, and why the mesh could not be attached when it could not (the document
 /// then has no surface, and the caller decides: the editor shows the sphere, `export` skips
-/// padding, `paint` refuses strokes on the mesh).
+/// padding, `paint` refuses strokes on the mesh; a document whose generator masks
+/// [need the mesh](Document::needs_mesh) has them made on nothing until a mesh is attached).
 ///
 /// # Errors
 /// A project that does not load.
@@ -380,7 +384,7 @@ pub fn open_with_mesh(
     path: &Path,
     mesh: Option<&Path>,
 ) -> Result<(Document, Option<ModelError>), ModelError> {
-    let mut doc = load(path)?;
+    let mut doc = read_file(path)?.doc;
     let failed = match mesh {
         Some(mesh) => attach_mesh(&mut doc, mesh),
         None => attach_own_mesh(&mut doc),
@@ -393,8 +397,28 @@ pub fn open_with_mesh(
 pub const MAX_PROJECT_BYTES: u64 = 4 << 30;
 
 /// Loads and validates a project file (a regular file: a FIFO or a device is refused before
-/// it is opened).
+/// it is opened). Its composite is made from its layers; where a generator mask needs the
+/// mesh, the project's own mesh is attached first.
+///
+/// # Errors
+/// A project that does not load, or whose generator masks need a mesh that does not.
 pub fn load(path: &Path) -> Result<Document, ModelError> {
+    let read = read_file(path)?;
+    let mut doc = read.doc;
+    if read.needs_mesh {
+        attach_own_mesh(&mut doc).map_err(|e| ModelError::Project {
+            path: path.to_path_buf(),
+            reason: format!(
+                "its generator masks are laid on its mesh {}, which does not load ({e})",
+                doc.settings().mesh.spec()
+            ),
+        })?;
+    }
+    Ok(doc)
+}
+
+/// Reads a project file, its settings' paths taken from its folder; the mesh not attached.
+fn read_file(path: &Path) -> Result<read::ReadProject, ModelError> {
     kapaint_base::file_check::regular_file(path, MAX_PROJECT_BYTES).map_err(|e| match e {
         kapaint_base::file_check::FileCheck::Io(source) => ModelError::io(path, source),
         other => ModelError::Project {
@@ -403,12 +427,13 @@ pub fn load(path: &Path) -> Result<Document, ModelError> {
         },
     })?;
     let file = File::open(path).map_err(|e| ModelError::io(path, e))?;
-    let doc = from_reader(file).map_err(|reason| ModelError::Project {
+    let mut read = read::read(file).map_err(|reason| ModelError::Project {
         path: path.to_path_buf(),
         reason,
     })?;
-    let settings = settings_from_file(doc.settings().clone(), path);
-    Ok(doc.with_settings(settings))
+    let settings = settings_from_file(read.doc.settings().clone(), path);
+    read.doc = read.doc.with_settings(settings);
+    Ok(read)
 }
 
 /// The identity of the project at `path` (from its manifest alone), if it is a project that

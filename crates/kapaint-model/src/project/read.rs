@@ -14,7 +14,63 @@ use crate::texel::MaterialValue;
 use crate::tile::{Plane, TILE_SIZE, Tile};
 
 /// Loads and validates a project from any seekable reader; the error is a reason text.
+///
+/// A project with generator masks has them laid on the mesh it keeps or names built in, and
+/// its composite made from the layers there; one on a mesh file needs [`super::load`], which
+/// finds the file beside the project.
 pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
+    let read = read(reader)?;
+    let mut doc = read.doc;
+    if read.needs_mesh {
+        let mesh = match doc.settings().mesh.clone() {
+            crate::MeshRef::Embedded(_) => doc.embedded_mesh().map(|m| (**m).clone()),
+            crate::MeshRef::Sphere => kapaint_mesh::builtin("sphere"),
+            crate::MeshRef::Builtin(name) => kapaint_mesh::builtin(&name),
+            crate::MeshRef::File(path) => {
+                return Err(format!(
+                    "its generator masks are laid on the mesh file {path}, which only opening \
+                     the project from its folder finds"
+                ));
+            }
+        };
+        let mesh = mesh.ok_or("its generator masks need its mesh, which it does not hold")?;
+        let name = doc.settings().mesh.spec().to_string();
+        super::attach_loaded(&mut doc, mesh, &name).map_err(|e| e.to_string())?;
+    }
+    Ok(doc)
+}
+
+/// A project as read, before its mesh is attached.
+pub(super) struct ReadProject {
+    /// The document, its composite made from the layers (generator masks not yet on their
+    /// mesh).
+    pub(super) doc: Document,
+    /// Whether its layers need its mesh (generator masks): its composite is only right once
+    /// the mesh is attached.
+    pub(super) needs_mesh: bool,
+}
+
+/// The first texel (column, row) where `a` and `b` differ, if any.
+fn first_difference(a: &MaterialMaps, b: &MaterialMaps) -> Option<(u32, u32)> {
+    let differs = |id: usize| -> Option<(u32, u32)> {
+        let (ta, tb) = (a.tile(id), b.tile(id));
+        let r = a.tile_rect(id);
+        (r.y0..r.y1).find_map(|y| {
+            (r.x0..r.x1).find_map(|x| {
+                let i = (y - r.y0) as usize * TILE_SIZE + (x - r.x0) as usize;
+                (ta.texel(i) != tb.texel(i)).then_some((x, y))
+            })
+        })
+    };
+    (0..a.tile_count())
+        .into_par_iter()
+        .filter_map(differs)
+        .min_by_key(|&(x, y)| (y, x))
+}
+
+/// Reads a project: its document composited from the layers, and the composite it stored
+/// where that can only be checked once its mesh is attached.
+pub(super) fn read(reader: impl Read + Seek) -> Result<ReadProject, String> {
     let mut zip = zip::ZipArchive::new(reader).map_err(|e| format!("not a zip archive ({e})"))?;
     let manifest = {
         let entry = zip
@@ -58,43 +114,35 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
         let mut stored =
             MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
         fill_maps(&mut stored, &kd, &ks, &n);
-        let doc = if super::layers::any_generator(entries) {
-            // Generator masks are laid on the mesh the project names, and the stored
-            // composite is taken as what they made: nothing is computed until something
-            // they read or shape changes (their values need the mesh's surface, which the
-            // caller attaches; a project on another mesh file computes them then).
+        let needs_mesh = super::layers::any_generator(entries);
+        let mut stack = stack;
+        if needs_mesh {
+            // Generator masks wait for the mesh the project names (nothing is computed for
+            // them until it is attached): its hash where the project says, else one no mesh
+            // has.
             let hash = match (&mesh, &manifest.settings.mesh) {
-                (Some(m), _) => Some(m.content_hash()),
+                (Some(m), _) => m.content_hash(),
                 (None, crate::MeshRef::Sphere | crate::MeshRef::Builtin(_)) => {
-                    kapaint_mesh::builtin(manifest.settings.mesh.spec()).map(|m| m.content_hash())
+                    kapaint_mesh::builtin(manifest.settings.mesh.spec())
+                        .map_or(0, |m| m.content_hash())
                 }
-                _ => bakes.first().map(|b| b.mesh_hash),
+                _ => bakes.first().map_or(0, |b| b.mesh_hash),
             };
-            let mut stack = stack;
-            let source = crate::generator::tiles::Source::expecting(hash, &bakes, w, h);
+            let source = crate::generator::tiles::Source::expecting(Some(hash), &bakes, w, h);
             crate::layers::lay_generators(&mut stack.layers, &source);
-            Document::from_stack_and_composite(stack, stored, manifest.settings)
-                .map_err(|e| e.to_string())?
-        } else {
-            let doc = Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string())?;
-            // Without generators, the stored composite must be what the layers composite to.
-            let differs = |id: usize| {
-                let (a, b) = (stored.tile(id), doc.maps().tile(id));
-                let r = stored.tile_rect(id);
-                (r.y0..r.y1).any(|y| {
-                    (r.x0..r.x1).any(|x| {
-                        let i = (y - r.y0) as usize * TILE_SIZE + (x - r.x0) as usize;
-                        a.texel(i) != b.texel(i)
-                    })
-                })
-            };
-            if (0..stored.tile_count()).into_par_iter().any(differs) {
-                return Err(
-                    "the stored composite differs from what the layers composite to".into(),
-                );
-            }
-            doc
-        };
+        }
+        let doc = Document::from_stack(stack, manifest.settings).map_err(|e| e.to_string())?;
+        // The stored composite is a cache, never taken as it is: the document's is made from
+        // the layers. Without generator masks the two must agree (a difference is a damaged
+        // or edited file); with them, the masks are laid on the mesh once it is attached, and
+        // what they make there stands (a project an older build saved may hold a composite
+        // its masks made on another surface).
+        if !needs_mesh && let Some((x, y)) = first_difference(&stored, doc.maps()) {
+            return Err(format!(
+                "the stored composite differs from what the layers composite to (first at \
+                 texel {x}, {y})"
+            ));
+        }
         let normal = read_normal(&mut zip, manifest.normal.as_ref())?;
         let doc = doc
             .with_normal(normal)
@@ -107,7 +155,10 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
                     .map(super::SelectionEntry::selection)
                     .unwrap_or_default(),
             );
-        return Ok(with_id(doc, manifest.id.as_deref()));
+        return Ok(ReadProject {
+            doc: with_id(doc, manifest.id.as_deref()),
+            needs_mesh,
+        });
     }
     let kd = read_channel(&mut zip, &manifest.kd, "kd", w, h, 3)?;
     let ks = read_channel(&mut zip, &manifest.ks, "ks", w, h, 3)?;
@@ -118,7 +169,10 @@ pub fn from_reader(reader: impl Read + Seek) -> Result<Document, String> {
     fill_maps(&mut maps, &kd, &ks, &n);
     let doc = Document::from_parts(maps, settings)
         .with_normal(read_normal(&mut zip, manifest.normal.as_ref())?);
-    Ok(with_id(doc, manifest.id.as_deref()))
+    Ok(ReadProject {
+        doc: with_id(doc, manifest.id.as_deref()),
+        needs_mesh: false,
+    })
 }
 
 /// `doc` with the identity the manifest names (`id`) (a project written before projects had one
@@ -175,7 +229,14 @@ fn check_declared(manifest: &super::Manifest) -> Result<(), String> {
     kapaint_base::memory::check_fits("opening it", texel_bytes)
 }
 
-/// The normal map of the manifest's entry, checked against it.
+/// The most bytes of OBJ text a triangle of a kept mesh takes: three vertices (`v`, `vt` and
+/// `vn` lines of at most about 60 bytes each, numbers in full precision) and a face line.
+const MAX_OBJ_BYTES_PER_TRIANGLE: u64 = 3 * 180 + 80;
+
+/// Bytes a parsed triangle of a kept mesh takes while it is read, measured high (the reader's
+/// vectors and the mesh made from them).
+const MESH_BYTES_PER_TRIANGLE: u64 = 400;
+
 /// The mesh the project keeps, if its settings name one (and then the archive must hold it).
 fn read_mesh<R: Read + Seek>(
     zip: &mut zip::ZipArchive<R>,
@@ -206,20 +267,43 @@ fn read_mesh<R: Read + Seek>(
             super::MESH_FILE
         ));
     }
+    if e.triangles == 0 || e.triangles > kapaint_mesh::MAX_TRIANGLES as u64 {
+        return Err(format!(
+            "the kept mesh declares {} triangles, outside 1 to {}",
+            e.triangles,
+            kapaint_mesh::MAX_TRIANGLES
+        ));
+    }
+    // An OBJ written by kapaint holds at most three new vertices (position, UV, normal lines)
+    // and a face line per triangle: an entry larger than that, declared or as it inflates,
+    // is refused before it is read, and what it will take once parsed must fit in memory.
+    let limit =
+        (e.triangles * MAX_OBJ_BYTES_PER_TRIANGLE + (1 << 20)).min(kapaint_mesh::MAX_FILE_BYTES);
+    kapaint_base::memory::check_fits(
+        &format!("reading the kept mesh of {} triangles", e.triangles),
+        limit + e.triangles * MESH_BYTES_PER_TRIANGLE,
+    )?;
     let file = zip
         .by_name(&e.file)
         .map_err(|err| format!("{}: {err}", e.file))?;
-    if file.size() > kapaint_mesh::MAX_FILE_BYTES {
-        return Err(format!(
-            "{} is {} bytes, more than a mesh may be",
-            e.file,
-            file.size()
-        ));
+    let too_large = |size: u64| {
+        format!(
+            "{} is {size} bytes or more, more than an OBJ of the {} triangles the manifest \
+             declares can be ({limit} bytes)",
+            e.file, e.triangles
+        )
+    };
+    if file.size() > limit {
+        return Err(too_large(file.size()));
     }
     let mut bytes = Vec::new();
-    file.take(kapaint_mesh::MAX_FILE_BYTES)
+    file.take(limit + 1)
         .read_to_end(&mut bytes)
         .map_err(|err| format!("{}: {err}", e.file))?;
+    if bytes.len() as u64 > limit {
+        // The entry declared less than it inflates to.
+        return Err(too_large(bytes.len() as u64));
+    }
     let mesh = kapaint_mesh::parse_obj(&bytes, name.clone(), std::path::Path::new(&e.file))
         .map_err(|err| err.to_string())?;
     if mesh.triangles.len() as u64 != e.triangles {

@@ -115,6 +115,12 @@ impl Autosaver {
         saver
     }
 
+    /// Autosaves every `interval` from now on (the next copy falls due `interval` after the
+    /// last).
+    pub fn set_interval(&mut self, interval: Duration) {
+        self.interval = interval;
+    }
+
     /// This process's recovery copy: its session folder.
     pub fn session(&self) -> PathBuf {
         session_dir(&self.recovery)

@@ -90,12 +90,22 @@ fn host_name() -> String {
     }
 }
 
-/// When process `pid` started (field 22 of `/proc/PID/stat`), if it runs.
+/// When process `pid` started (field 22 of `/proc/PID/stat`), if it runs. A process that has
+/// ended but not yet been waited for (a zombie, state `Z`, or `X` while it goes) runs no more:
+/// a killed editor whose parent has not reaped it holds nothing.
 fn start_time(pid: u32) -> Option<u64> {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    start_time_of(&stat)
+}
+
+/// [`start_time`] from the text of a `/proc/PID/stat`.
+fn start_time_of(stat: &str) -> Option<u64> {
     // The command name, in parentheses, may hold spaces: count fields after its end.
-    let rest = &stat[stat.rfind(')')? + 1..];
-    rest.split_whitespace().nth(19)?.parse().ok()
+    let mut rest = stat[stat.rfind(')')? + 1..].split_whitespace();
+    if matches!(rest.next()?, "Z" | "X" | "x") {
+        return None;
+    }
+    rest.nth(18)?.parse().ok()
 }
 
 #[cfg(test)]
@@ -114,6 +124,49 @@ mod tests {
             ("my-host", 12, 34)
         );
         assert!(Owner::from_file_name("nonsense").is_none());
+    }
+
+    /// A killed process that its parent has not yet waited for (a killed editor under a
+    /// launcher that does not reap it) runs no more: its locks and copies are free.
+    #[test]
+    fn a_killed_process_not_yet_reaped_has_ended() {
+        if !Path::new("/proc/self").exists() {
+            eprintln!("SKIPPED: this system has no /proc");
+            return;
+        }
+        let Ok(mut child) = std::process::Command::new("sleep").arg("60").spawn() else {
+            eprintln!("SKIPPED: no sleep to run");
+            return;
+        };
+        let owner = Owner {
+            pid: child.id(),
+            start: start_time(child.id()).unwrap_or(0),
+            ..Owner::this_process().clone()
+        };
+        assert_eq!(owner.running(), Some(true));
+        child.kill().unwrap();
+        // Not waited for: a zombie until the wait below.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        while owner.running() != Some(false) && std::time::Instant::now() < deadline {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        assert_eq!(owner.running(), Some(false), "a zombie runs no more");
+        child.wait().unwrap();
+    }
+
+    #[test]
+    fn a_zombie_has_ended() {
+        let stat = |state: &str| {
+            format!(
+                "4242 (kapaint (edit)) {state} 1 4242 4242 0 -1 4194560 100 0 0 0 5 2 0 0 20 0 \
+                 9 0 123456 1000 100"
+            )
+        };
+        assert_eq!(start_time_of(&stat("S")), Some(123_456));
+        assert_eq!(start_time_of(&stat("R")), Some(123_456));
+        for ended in ["Z", "X"] {
+            assert_eq!(start_time_of(&stat(ended)), None, "{ended}");
+        }
     }
 
     #[test]

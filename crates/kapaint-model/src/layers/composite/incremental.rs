@@ -62,17 +62,6 @@ impl Compositor {
         Self::default()
     }
 
-    /// A compositor that takes `maps` to be the composite of `stack` as it is (a project's
-    /// stored composite): only tiles whose inputs change from now on are recomposited.
-    pub fn primed(stack: &LayerStack) -> Self {
-        Self {
-            signatures: (0..stack.tile_count())
-                .into_par_iter()
-                .map(|id| signature(stack, id))
-                .collect(),
-        }
-    }
-
     /// Brings `maps` up to date with `stack` (of the same size): recomposites the tiles whose
     /// inputs changed since the last update, in parallel, and writes those that came out
     /// different. Returns the tiles written, ascending.
