@@ -376,6 +376,44 @@ fn a_mesh_without_uvs_is_unwrapped_on_request_and_kept() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// While a bake runs the window redraws once a second for its progress, and not between: on a
+/// software renderer each frame takes about 0.1 s of the CPU the bake runs on (four frames a
+/// second, and the notices' two, made an AO bake in the editor take 1.4 times the CLI's).
+#[test]
+fn a_running_bake_redraws_the_window_once_a_second() {
+    use kapaint::mesh::bakes::BakeMap;
+    let mut harness = editor();
+    harness
+        .state_mut()
+        .state
+        .bake(kapaint::ui::bake::BakeDialog {
+            map: BakeMap::Ao,
+            rays: 1024,
+            ..Default::default()
+        });
+    let mut delays = Vec::new();
+    for _ in 0..6 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+        let delay = harness.output().viewport_output[&egui::ViewportId::ROOT].repaint_delay;
+        delays.push(delay);
+    }
+    let running = harness.state().state.busy();
+    harness
+        .get_by_role_and_label(Role::Button, "Cancel")
+        .click();
+    harness.step();
+    assert!(running, "the bake ended before the test looked");
+    // egui asks for the frame one predicted frame time early (kittest predicts 0.25 s): 1 s
+    // reads 0.75 s here, and the 0.25 s it was before reads 0.
+    let last = *delays.last().expect("steps");
+    assert!(
+        last >= std::time::Duration::from_millis(700),
+        "the next frame is asked for in {last:?} ({delays:?})"
+    );
+    wait_until(&mut harness, "cancelled", |e| !e.state.busy());
+}
+
 /// Mesh > Bake bakes a map of the mesh on a worker and keeps it in the project as one undo
 /// step.
 #[test]

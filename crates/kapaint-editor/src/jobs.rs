@@ -211,10 +211,16 @@ impl EditorState {
         }
         let progress = Arc::new(Progress::default());
         let shared = Arc::clone(&progress);
+        let waker = self.waker.clone();
         match std::thread::Builder::new()
             .name(format!("kapaint-{}", label.to_lowercase()))
-            .spawn(move || work(&shared))
-        {
+            .spawn(move || {
+                let result = work(&shared);
+                if let Some(ctx) = waker {
+                    ctx.request_repaint();
+                }
+                result
+            }) {
             Ok(handle) => {
                 self.job = Some(Job {
                     label: label.into(),

@@ -194,6 +194,9 @@ pub struct EditorState {
     /// Messages.
     notices: Notices,
     job: Option<Job>,
+    /// The window's context, for a worker to wake the window when its job is done (a frame
+    /// is drawn then, not at the next progress tick).
+    waker: Option<egui::Context>,
     export: Option<ExportDialog>,
     /// The last export's preset and folder, offered again by the next.
     export_choice: Option<(String, String)>,
@@ -504,7 +507,8 @@ impl EditorState {
         }
     }
 
-    fn busy(&self) -> bool {
+    /// Whether a job runs (a bake, an export, an open, ...).
+    pub fn busy(&self) -> bool {
         self.job.is_some()
     }
 

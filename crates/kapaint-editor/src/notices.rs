@@ -104,6 +104,14 @@ impl Notices {
     pub fn expire(&mut self) {
         self.0.retain(|n| n.at.elapsed() < n.level.shown_for());
     }
+
+    /// How long until the next notice is due to go (none without notices).
+    pub fn next_expiry(&self) -> Option<std::time::Duration> {
+        self.0
+            .iter()
+            .map(|n| n.level.shown_for().saturating_sub(n.at.elapsed()))
+            .min()
+    }
 }
 
 impl std::ops::Deref for Notices {
