@@ -203,6 +203,91 @@ fn unwraps(c: &mut Criterion) {
     group.finish();
 }
 
+/// The OBJ text of one polygon of `corners` corners round the unit circle, its radius (`flat`)
+/// or its height (else) waving 200 times: a 3 MB file at 100,000 corners.
+fn polygon_obj(corners: usize, flat: bool) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    for i in 0..corners {
+        let t = std::f64::consts::TAU * i as f64 / corners as f64;
+        let wave = (200.0 * t).sin();
+        let (r, z) = if flat {
+            (1.0 + 0.3 * wave, 0.0)
+        } else {
+            (1.0, 0.3 * wave)
+        };
+        let _ = writeln!(out, "v {:.7} {:.7} {z:.7}", r * t.cos(), r * t.sin());
+    }
+    out.push('f');
+    for i in 1..=corners {
+        let _ = write!(out, " {i}");
+    }
+    out.push('\n');
+    out
+}
+
+/// The OBJ text of a bumpy `n x n` latitude-longitude sphere (2 n (n - 1) triangles: 1,998,000
+/// at 1000), no UVs: the radius `1 + 0.02 sin(20 theta) sin(20 phi)`.
+fn bumpy_sphere_obj(n: usize) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::with_capacity(n * n * 40);
+    for i in 0..=n {
+        let theta = std::f64::consts::PI * i as f64 / n as f64;
+        for j in 0..n {
+            let phi = std::f64::consts::TAU * j as f64 / n as f64;
+            let r = 1.0 + 0.02 * (20.0 * theta).sin() * (20.0 * phi).sin();
+            let (x, y, z) = (
+                r * theta.sin() * phi.cos(),
+                r * theta.cos(),
+                r * theta.sin() * phi.sin(),
+            );
+            let _ = writeln!(out, "v {x:.7} {y:.7} {z:.7}");
+        }
+    }
+    let at = |i: usize, j: usize| i * n + j % n + 1;
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (at(i, j), at(i, j + 1), at(i + 1, j), at(i + 1, j + 1));
+            if i > 0 {
+                let _ = writeln!(out, "f {a} {b} {c}");
+            }
+            if i + 1 < n {
+                let _ = writeln!(out, "f {b} {d} {c}");
+            }
+        }
+    }
+    out
+}
+
+/// Meshes as they come (issue 54, target: the 2M-triangle sphere within 60 s on 2 cores):
+/// loading and unwrapping one polygon of 100,000 corners, flat and waving in height, and a
+/// bumpy sphere of 1,998,000 triangles, each made here and read from an OBJ file.
+fn unwraps_big(c: &mut Criterion) {
+    use kapaint::mesh::unwrap::{UnwrapOptions, unwrap};
+    let dir = std::env::temp_dir().join(format!("kapaint-bench-unwrap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("folder");
+    let mut group = c.benchmark_group("unwrap_big");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    for (name, text) in [
+        ("polygon_100000_corners_flat", polygon_obj(100_000, true)),
+        ("polygon_100000_corners_waving", polygon_obj(100_000, false)),
+        ("bumpy_sphere_1998000_triangles", bumpy_sphere_obj(1000)),
+    ] {
+        let path = dir.join(format!("{name}.obj"));
+        std::fs::write(&path, text).expect("written");
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mesh = mesh::load(&path).expect("mesh loads");
+                unwrap(&mesh, UnwrapOptions::for_size(1024), None).expect("unwraps")
+            });
+        });
+    }
+    group.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// An AO bake of spot at 1024^2 with 64 rays a texel (the 2048^2 figures of docs/performance.md
 /// come from `kapaint bake`, a run each: one sample is 20 s).
 fn ao_bakes(c: &mut Criterion) {
@@ -286,6 +371,7 @@ criterion_group!(
     surface_dabs,
     tangents,
     unwraps,
+    unwraps_big,
     ao_bakes
 );
 criterion_main!(benches);

@@ -438,6 +438,15 @@ fn f1_opens_the_shortcut_sheet() {
     harness.run();
     harness.get_by_label("Keyboard shortcuts");
     harness.get_by_label("keyboard shortcuts (this sheet)");
+    // Keys as the keyboard prints them: `[` and `]` for the brush size, never egui's names.
+    harness.get_by_label("[");
+    harness.get_by_label("]");
+    for name in ["OpenBracket", "CloseBracket"] {
+        assert!(
+            harness.query_all_by_label_contains(name).next().is_none(),
+            "the sheet says {name}"
+        );
+    }
 }
 
 #[test]

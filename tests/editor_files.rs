@@ -456,6 +456,54 @@ fn a_layered_project_opens_clean_on_its_saved_selection() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The Layers list is right from the first frame after an open: each paint layer shows the
+/// memory its tiles hold (it showed 0.0 MB, a blank thumbnail and a group icon until the layer
+/// was edited: the opened document's version equalled the one before, so the list kept what it
+/// had made of that one).
+#[test]
+fn the_layers_list_is_right_from_the_first_frame_after_an_open() {
+    use kapaint::model::{LayerCommand, LayerKind, PaintCommand};
+    let dir = scratch("layers-after-open");
+    let project = dir.join("painted.kapaint");
+    let mut doc =
+        kapaint::model::Document::new(512, 512, kapaint::model::DocumentSettings::default())
+            .expect("document");
+    doc.apply(LayerCommand::AddLayer {
+        kind: LayerKind::Paint,
+        name: "Rust".into(),
+    })
+    .expect("layer");
+    // A gradient: every tile of its own (a flat fill is kept as uniform tiles of no size).
+    doc.apply(PaintCommand::Gradient {
+        shape: kapaint::model::paint::GradientShape::Linear,
+        start: glam::Vec2::ZERO,
+        end: glam::Vec2::splat(512.0),
+    })
+    .expect("gradient");
+    kapaint::model::project::save(&doc, &project).expect("saved");
+    let opened = kapaint::model::project::load(&project).expect("loads");
+    let rust = opened
+        .stack()
+        .walk()
+        .into_iter()
+        .find(|(_, l)| l.props.name == "Rust")
+        .map(|(_, l)| l.heap_bytes())
+        .expect("the layer");
+    let shown = format!("{:.1} MB", rust as f64 / 1e6);
+    assert_ne!(shown, "0.0 MB", "the layer holds paint");
+
+    let mut harness = editor_on(&project);
+    wait_until(&mut harness, "opened", |e| {
+        e.state.opening().is_none() && e.state.doc().maps().width() == 512
+    });
+    harness.step();
+    assert!(
+        harness.query_all_by_label(&shown).next().is_some(),
+        "the Layers list shows {shown} for the painted layer"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn a_project_another_kapaint_has_open_asks_and_opens_read_only() {
     use kapaint::model::recovery::session::Owner;

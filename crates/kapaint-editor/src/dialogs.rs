@@ -422,7 +422,11 @@ impl EditorState {
                 ui.separator();
                 ui.horizontal(|ui| {
                     ui.label("Folder");
-                    if ui.text_edit_singleline(&mut dialog.folder).changed() {
+                    // A fixed id: the measurement arriving above it must not take the
+                    // keyboard from a folder being typed.
+                    let field =
+                        egui::TextEdit::singleline(&mut dialog.folder).id_salt("export folder");
+                    if ui.add(field).changed() {
                         (dialog.confirm_replace, dialog.problem) = (false, None);
                     }
                     if ui.button("…").clicked() {
