@@ -1246,8 +1246,8 @@ fn steady_frames_reuse_their_buffers_and_bind_groups() {
     use kapaint::gpu::difference::{Difference, DifferenceBindings};
     use kapaint::gpu::preview::{
         DEPTH_FORMAT, DrawPart, FrameBindings, PipelineKey, PreviewDrawData, begin_pass,
-        read_texture,
     };
+    use kapaint::gpu::readback::read_texture;
     let Some(gpu) = gpu() else { return };
     let sphere = mesh::uv_sphere(32, 16);
     let buffers = MeshBuffers::new(&gpu, &sphere).expect("mesh buffers");

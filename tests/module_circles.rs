@@ -66,9 +66,115 @@ fn code(path: &Path) -> String {
     out
 }
 
+/// What each module re-exports: a name its `pub use` (or `pub(crate) use`) brings in, and the
+/// module that name comes from (the deepest module of the path), for paths that start at
+/// `crate::`, `self::`, `super::` or a child module.
+type Reexports = BTreeMap<String, BTreeMap<String, String>>;
+
+/// The deepest module of `all` along `segments` from `base`, and the segment after it.
+fn deepest(
+    base: &[String],
+    segments: &[String],
+    all: &BTreeMap<String, PathBuf>,
+) -> (Vec<String>, Option<String>) {
+    let mut target = base.to_vec();
+    for seg in segments {
+        let candidate = [target.as_slice(), std::slice::from_ref(seg)].concat();
+        if !all.contains_key(&candidate.join("::")) {
+            return (target, Some(seg.clone()));
+        }
+        target = candidate;
+    }
+    (target, None)
+}
+
+/// [`Reexports`] of one module.
+fn reexports_of(
+    module: &str,
+    path: &Path,
+    all: &BTreeMap<String, PathBuf>,
+) -> BTreeMap<String, String> {
+    let here: Vec<String> = module
+        .split("::")
+        .filter(|s| !s.is_empty())
+        .map(str::to_owned)
+        .collect();
+    let mut out = BTreeMap::new();
+    for statement in code(path).split(';') {
+        let Some(at) = statement
+            .find("pub use ")
+            .map(|i| i + "pub use ".len())
+            .or_else(|| {
+                statement
+                    .find("pub(crate) use ")
+                    .map(|i| i + "pub(crate) use ".len())
+            })
+        else {
+            continue;
+        };
+        let body: String = statement[at..]
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        let (prefix, items) = match body.split_once('{') {
+            Some((p, list)) => (
+                p.trim_end_matches("::").to_string(),
+                list.trim_end_matches('}')
+                    .split(',')
+                    .map(|i| i.trim().to_string())
+                    .filter(|i| !i.is_empty())
+                    .collect::<Vec<_>>(),
+            ),
+            None => match body.rsplit_once("::") {
+                Some((p, item)) => (p.to_string(), vec![item.to_string()]),
+                None => continue,
+            },
+        };
+        let mut segments: Vec<String> = prefix.split("::").map(|s| s.trim().to_owned()).collect();
+        let base: Vec<String> = match segments.first().map(String::as_str) {
+            Some("crate") => Vec::new(),
+            Some("self") => here.clone(),
+            Some("super") => here[..here.len().saturating_sub(1)].to_vec(),
+            Some(child)
+                if all
+                    .contains_key(&[here.as_slice(), &[child.to_owned()]].concat().join("::")) =>
+            {
+                segments.insert(0, "self".into());
+                here.clone()
+            }
+            _ => continue,
+        };
+        for item in items {
+            let (path, alias) = match item.split_once(" as ") {
+                Some((p, a)) => (p.trim().to_string(), a.trim().to_string()),
+                None => (
+                    item.clone(),
+                    item.rsplit("::").next().unwrap_or_default().to_string(),
+                ),
+            };
+            let full: Vec<String> = segments[1..]
+                .iter()
+                .cloned()
+                .chain(path.split("::").map(|s| s.trim().to_owned()))
+                .collect();
+            let (target, _) = deepest(&base, &full, all);
+            let target = target.join("::");
+            if target != module {
+                out.insert(alias, target);
+            }
+        }
+    }
+    out
+}
+
 /// The modules `module`'s code names, by `crate::`, `super::` and `self::` paths (brace
-/// groups included).
-fn edges(module: &str, path: &Path, all: &BTreeMap<String, PathBuf>) -> BTreeSet<String> {
+/// groups included); a name a module re-exports counts as the module it comes from.
+fn edges(
+    module: &str,
+    path: &Path,
+    all: &BTreeMap<String, PathBuf>,
+    reexports: &Reexports,
+) -> BTreeSet<String> {
     let here: Vec<String> = module
         .split("::")
         .filter(|s| !s.is_empty())
@@ -103,16 +209,23 @@ fn edges(module: &str, path: &Path, all: &BTreeMap<String, PathBuf>) -> BTreeSet
             None => vec![rest],
         };
         for head in heads {
-            let mut target = base.clone();
-            for seg in head.split("::") {
-                let seg: String = seg.chars().take_while(|c| ident(*c)).collect();
-                let candidate = [target.as_slice(), &[seg]].concat();
-                if !all.contains_key(&candidate.join("::")) {
-                    break;
+            let segments: Vec<String> = head
+                .split("::")
+                .map(|seg| seg.trim().chars().take_while(|c| ident(*c)).collect())
+                .collect();
+            let (target, item) = deepest(&base, &segments, all);
+            let mut name = target.join("::");
+            // An item the module re-exports is a use of the module it comes from (followed
+            // through a few re-exports).
+            for _ in 0..4 {
+                match item
+                    .as_ref()
+                    .and_then(|i| reexports.get(&name).and_then(|r| r.get(i)))
+                {
+                    Some(from) if *from != name => name.clone_from(from),
+                    _ => break,
                 }
-                target = candidate;
             }
-            let name = target.join("::");
             let related = name.is_empty()
                 || name == module
                 || module.starts_with(&format!("{name}::"))
@@ -170,9 +283,13 @@ fn no_crate_has_a_circle_of_modules() {
     for src in &sources {
         let all = modules(src);
         assert!(all.len() > 3, "{} has modules", src.display());
+        let reexports: Reexports = all
+            .iter()
+            .map(|(m, path)| (m.clone(), reexports_of(m, path, &all)))
+            .collect();
         let graph: BTreeMap<String, BTreeSet<String>> = all
             .iter()
-            .map(|(m, path)| (m.clone(), edges(m, path, &all)))
+            .map(|(m, path)| (m.clone(), edges(m, path, &all, &reexports)))
             .collect();
         for circle in circles(&graph) {
             found.push(format!("{}: {}", src.display(), circle.join(" <-> ")));

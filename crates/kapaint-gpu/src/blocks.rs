@@ -352,7 +352,7 @@ impl Strip {
         let bytes = dst.len() as u64;
         commands.copy_buffer_to_buffer(&self.out, 0, &self.staging, 0, bytes);
         gpu.queue.submit([commands.finish()]);
-        let blocks = super::preview::read_buffer_prefix(gpu, &self.staging, bytes);
+        let blocks = super::readback::read_buffer_prefix(gpu, &self.staging, bytes);
         scope.finish("block encoding")?;
         dst.copy_from_slice(&blocks?);
         Ok(())

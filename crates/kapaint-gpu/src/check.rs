@@ -99,6 +99,6 @@ pub fn run_kernel(
     }
     encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
     gpu.queue.submit([encoder.finish()]);
-    let out = super::preview::read_buffer(gpu, &readback)?;
+    let out = super::readback::read_buffer(gpu, &readback)?;
     Ok(bytemuck::pod_collect_to_vec(&out))
 }

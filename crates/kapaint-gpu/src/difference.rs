@@ -296,7 +296,7 @@ impl Difference {
             let mut pass = Self::begin_pass(&mut encoder, &target);
             self.draw(&mut pass, &data);
         }
-        let pixels = super::preview::read_texture(gpu, encoder, &out, 4, 0)?;
+        let pixels = super::readback::read_texture(gpu, encoder, &out, 4, 0)?;
         Ok(RenderedImage::Srgb8 {
             width,
             height,

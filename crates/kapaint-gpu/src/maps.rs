@@ -268,7 +268,7 @@ impl MapTextures {
         let encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        let bytes = super::preview::read_texture(gpu, encoder, texture, texel, level)?;
+        let bytes = super::readback::read_texture(gpu, encoder, texture, texel, level)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 

@@ -20,9 +20,7 @@ mod pipeline;
 pub use draw_data::{FrameBindings, FrameUniforms, PreviewDrawData};
 pub use layout::{DrawPart, Layout, Scissor};
 pub use mesh::MeshBuffers;
-pub use offscreen::{
-    COMPARED_MODELS, Offscreen, RenderedImage, read_buffer, read_buffer_prefix, read_texture,
-};
+pub use offscreen::{COMPARED_MODELS, Offscreen, RenderedImage};
 pub use pipeline::PipelineKey;
 
 use super::{Gpu, PipelineCache};
