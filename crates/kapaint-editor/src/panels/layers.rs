@@ -5,13 +5,16 @@
 //! [`Command`]; the panel only reads the document.
 
 pub use crate::layer_view::LayerView;
+
+mod rename;
+use rename::Rename;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use egui::{Color32, Rect, Sense, Vec2};
 
 use crate::EditorState;
-use kapaint_core::model::layers::{Layer, LayerContent, LayerId, thumbnail};
+use kapaint_core::model::layers::{Layer, LayerContent, thumbnail};
 use kapaint_core::model::{Command, Document, LayerKind, LayerPlace};
 use kapaint_core::model::{LayerCommand, MaskCommand};
 
@@ -102,17 +105,6 @@ pub struct PanelState {
     pub(crate) view_maps: crate::layer_view::ViewMaps,
     /// The mask generator's live thumbnail and the document version it shows.
     pub(super) generator_thumb: Option<(u64, egui::TextureHandle)>,
-}
-
-/// A layer's name being typed in place of its label in the list: Enter, Tab or a click
-/// elsewhere commits it, Escape cancels, and the keyboard is the editor's again either way.
-pub(super) struct Rename {
-    /// The layer renamed.
-    id: LayerId,
-    /// What is typed so far.
-    text: String,
-    /// Whether the field has had the keyboard (it is given it once, on the first frame).
-    focused: bool,
 }
 
 impl PanelState {
@@ -384,59 +376,6 @@ impl EditorState {
             .on_hover_text("Memory this layer's tiles and mask hold");
         });
         drop_target(ui, row.response.rect, path, &layer.content).or(action)
-    }
-
-    /// The layer's name in its row: a label to select (double-click renames), or the field
-    /// of a rename under way.
-    fn name_ui(
-        ui: &mut egui::Ui,
-        layer: &Layer,
-        selected: bool,
-        rename: &mut Option<Rename>,
-    ) -> Option<RowAction> {
-        let p = &layer.props;
-        let mut action = None;
-        if let Some(r) = rename.as_mut().filter(|r| r.id == p.id) {
-            let edit = ui.add(
-                egui::TextEdit::singleline(&mut r.text)
-                    .desired_width(140.0)
-                    .id_salt(("rename layer", p.id)),
-            );
-            if !r.focused {
-                edit.request_focus();
-                r.focused = true;
-            } else if !edit.has_focus() {
-                // Enter, Tab and a click elsewhere take the keyboard from the field:
-                // the name is done. Escape cancels it.
-                // Read from the frame's raw input: egui takes the keyboard from the field
-                // on Escape before any widget runs, and the editor's own Escape (abandon
-                // the stroke) may have taken the key press by now.
-                let pressed = |key| {
-                    ui.input(|i| {
-                        i.raw.events.iter().any(|e| {
-                            matches!(e, egui::Event::Key { key: k, pressed: true, .. } if *k == key)
-                        })
-                    })
-                };
-                let (cancelled, tabbed) = (pressed(egui::Key::Escape), pressed(egui::Key::Tab));
-                let text = r.text.trim().to_owned();
-                action = Some(RowAction::Renamed {
-                    name: (!cancelled && !text.is_empty() && text != p.name).then_some(text),
-                    tabbed,
-                });
-            }
-        } else {
-            let name = ui.selectable_label(selected, &p.name);
-            if name.double_clicked() {
-                action = Some(RowAction::Rename);
-            } else if name.clicked() {
-                action = Some(RowAction::Select {
-                    mask: false,
-                    alone: false,
-                });
-            }
-        }
-        action
     }
 
     /// A thumbnail over a checkerboard (transparent is unpainted), framed when selected.

@@ -8,14 +8,15 @@
 
 mod container;
 mod levels;
+mod own_levels;
 
 use ktx2::Format as KtxFormat;
 use rayon::prelude::*;
 
 use self::container::container;
 pub use self::container::{Decoded, decode};
-use self::levels::half;
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
+pub use self::own_levels::encode_levels;
 use super::blocks::{self, BlockFamily, BlockKind, Coder};
 use super::preset::Bc7Quality;
 use crate::file_kind::Compression;
@@ -310,46 +311,6 @@ pub fn encode(
         chain: &chain,
     };
     write_levels(&image, compressed, level0, progress)
-}
-
-/// Writes an image whose levels the caller made (finest first, a full chain: `levels[k]` of
-/// the size [`level_count`]'s level `k` has) of `channels` linear bytes per texel, as a KTX2
-/// file: uncompressed, or block-compressed as [`encode`] does. A normal map's levels are its
-/// box-filtered normals made unit again, which no per-component average gives.
-///
-/// # Errors
-/// No levels, levels that are not a full chain of `channels` bytes per texel, or a component
-/// count outside 1..=4.
-pub fn encode_levels(
-    levels: &[((u32, u32), Vec<u8>)],
-    channels: usize,
-    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
-) -> Result<Written, String> {
-    let spaces = vec![Space::Linear; channels];
-    let Some(((w, h), level0)) = levels.first() else {
-        return Err("no levels".into());
-    };
-    let mut size = (*w, *h);
-    let whole = levels.len() == level_count(size.0, size.1) as usize
-        && levels.iter().enumerate().all(|(k, (s, bytes))| {
-            if k > 0 {
-                size = half(size);
-            }
-            *s == size && bytes.len() == s.0 as usize * s.1 as usize * channels
-        });
-    if !whole || !(1..=4).contains(&channels) || *w == 0 || *h == 0 {
-        return Err(format!(
-            "cannot write {} levels of a {w}x{h} image of {channels} components",
-            levels.len()
-        ));
-    }
-    let image = Image {
-        spaces: &spaces,
-        size: (*w, *h),
-        level0,
-        chain: &levels[1..],
-    };
-    write_levels(&image, compressed, None, &Progress::default())
 }
 
 /// An image's levels as stored bytes: level 0 and the chain after it.
