@@ -8,7 +8,7 @@ use crate::preset::Bc7Quality;
 
 /// Writes an image whose levels the caller made (finest first, a full chain: `levels[k]` of
 /// the size [`level_count`]'s level `k` has) of `channels` linear bytes per texel, as a KTX2
-/// file: uncompressed, or block-compressed as [`encode`] does. A normal map's levels are its
+/// file: uncompressed, or block-compressed as [`encode`](super::encode) does. A normal map's levels are its
 /// box-filtered normals made unit again, which no per-component average gives.
 ///
 /// # Errors
