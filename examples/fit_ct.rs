@@ -1,7 +1,7 @@
-//! Regenerates `crates/kapaint-reflectance/src/cook_torrance/fast_coeffs.rs` from the exact integrator, after
+//! Regenerates `crates/kapaint-reflectance/src/model/cook_torrance/fast_coeffs.rs` from the exact integrator, after
 //! exploring which polynomial degree per octave is needed (printed to stderr).
 //!
-//! Usage: `cargo run --release --example fit_ct [DEGREE] > crates/kapaint-reflectance/src/cook_torrance/fast_coeffs.rs`
+//! Usage: `cargo run --release --example fit_ct [DEGREE] > crates/kapaint-reflectance/src/model/cook_torrance/fast_coeffs.rs`
 //! (with no DEGREE, the smallest degree whose worst error on `n in [0, 16384]` is <= 5e-6, a
 //! quarter of the contract of 2e-5, is chosen). Exact values are cached by `x`, so the
 //! reference's nodes (degree 10) are reused by degrees 2 and 5.

@@ -111,17 +111,9 @@ fn fs_main(f: VertexOut) -> @location(0) vec4<f32> {
         return vec4<f32>(finite_or_zero(diffuse), 1.0);
     }
     var specular = vec3<f32>(0.0);
-    if MODEL == MODEL_COOK_TORRANCE {
-        specular = frame.light_intensity * cook_torrance_specular(normal, l, v, ks, n);
-    } else if HAS_SPECULAR && n_dot_l > 0.0 {
-        var cosine = 0.0;
-        if MODEL == MODEL_PHONG {
-            let r = 2.0 * n_dot_l * normal - l;
-            cosine = dot(r, v);
-        } else {
-            cosine = dot(normal, normalize(l + v));
-        }
-        specular = frame.light_intensity * ks * spec_pow(cosine, n);
+    if HAS_SPECULAR {
+        let lobe = specular_lobe(MODEL, normal, l, v, n);
+        specular = frame.light_intensity * (ks * lobe.x + vec3<f32>(lobe.y));
     }
     if VIEW == VIEW_SPECULAR {
         return vec4<f32>(finite_or_zero(specular), 1.0);

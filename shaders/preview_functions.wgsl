@@ -1,7 +1,7 @@
-// The preview's functions that need no bindings: the false-colour scale of n, the specular
-// power, Cook-Torrance's specular term and the guard against non-finite results.
+// The preview's functions that need no bindings: the false-colour scale of n, the guard
+// against non-finite results and the normal map (the lobes are in lobes.wgsl).
 
-#include "ambient.wgsl"
+#include "lobes.wgsl"
 
 // n's false-colour scale: ln(1 + n) / ln(1 + 16384) through five colours (dark blue, blue,
 // teal, green, yellow; linear RGB), as `render::N_RAMP`.
@@ -18,41 +18,6 @@ fn n_false_colour(n: f32) -> vec3<f32> {
     let t = clamp(log(1.0 + n) / N_LOG_SPAN, 0.0, 1.0) * 4.0;
     let i = min(u32(t), 3u);
     return mix(N_RAMP[i], N_RAMP[i + 1u], t - f32(i));
-}
-
-// x^n for x in [0, 1] without pow's undefined cases: 0 for x <= 0, 1 for n == 0.
-fn spec_pow(x: f32, n: f32) -> f32 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    return exp2(n * log2(min(x, 1.0)));
-}
-
-const PI: f32 = 3.14159265f;
-
-// Cook-Torrance's radiance factor rho_s = D G2 F / (4 N.V) per colour channel, k_s as F0 and
-// alpha^2 = 2 / (n + 2) (n clamped to CT_N_MAX, as for k_a); zero where N.L <= 0 or N.V <= 0.
-// Written without cancellation: 1 - (N.H)^2 as |N x H|^2, and G2 / (4 N.L N.V) in the form
-// that stays finite at grazing angles. `render::cook_torrance_specular` is its CPU twin.
-fn cook_torrance_specular(normal: vec3<f32>, l: vec3<f32>, v: vec3<f32>, ks: vec3<f32>, n: f32) -> vec3<f32> {
-    let nl = dot(normal, l);
-    let nv = dot(normal, v);
-    let sum = l + v;
-    let len2 = dot(sum, sum);
-    if nl <= 0.0 || nv <= 0.0 || len2 <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    let h = sum * inverseSqrt(len2);
-    let a2 = 2.0 / (min(n, CT_N_MAX) + 2.0);
-    let c = cross(normal, h);
-    let q = a2 + (1.0 - a2) * dot(c, c);
-    let d = a2 / (PI * q * q);
-    let smith = nv * sqrt(nl * nl * (1.0 - a2) + a2) + nl * sqrt(nv * nv * (1.0 - a2) + a2);
-    let base = d * nl / (2.0 * smith);
-    let m = 1.0 - clamp(dot(v, h), 0.0, 1.0);
-    let m2 = m * m;
-    let s = m2 * m2 * m;
-    return base * (ks * (1.0 - s) + vec3<f32>(s));
 }
 
 // Replaces a non-finite result by 0 (on the bits: compilers may assume finite floats).

@@ -11,24 +11,34 @@ use crate::model;
 use crate::reflectance::exact::EXACT_N_MAX;
 use crate::reflectance::{AmbientApprox, ShadingModel};
 
-/// `--model` values.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum ModelArg {
-    /// Original Phong, eq. (8).
-    Phong,
-    /// Blinn-Phong, eq. (11).
-    Blinn,
-    /// Cook-Torrance (GGX), k_a = (2/pi) k_d + k_s chi1(n) + chi0(n).
-    CookTorrance,
+/// `--model` values: every shading model by its name ([`ShadingModel::name`]), the list made
+/// from [`ShadingModel::ALL`] so that it cannot drift from the models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ModelArg(pub ShadingModel);
+
+impl ValueEnum for ModelArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: std::sync::LazyLock<Vec<ModelArg>> =
+            std::sync::LazyLock::new(|| ShadingModel::ALL.into_iter().map(ModelArg).collect());
+        &VARIANTS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(model_help(self.0)))
+    }
+}
+
+/// A model as `--help` describes it: "Original Phong, eq. (8)".
+pub fn model_help(model: ShadingModel) -> String {
+    match model.paper_equation() {
+        Some(eq) => format!("{}, eq. ({eq})", model.label()),
+        None => model.full_label().to_owned(),
+    }
 }
 
 impl From<ModelArg> for ShadingModel {
     fn from(m: ModelArg) -> Self {
-        match m {
-            ModelArg::Phong => Self::Phong,
-            ModelArg::Blinn => Self::BlinnPhong,
-            ModelArg::CookTorrance => Self::CookTorrance,
-        }
+        m.0
     }
 }
 

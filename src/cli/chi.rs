@@ -65,7 +65,7 @@ impl ChiArgs {
     /// As [`Self::run`]; a failed write (exit 1).
     pub fn stream(self, stdin: &mut dyn BufRead, out: &mut dyn Write) -> Result<(), CliError> {
         let (model, method, values, views) = self.checked(stdin)?;
-        let two_parts = model == ShadingModel::CookTorrance;
+        let two_parts = model.has_second_part();
         let header = match (views.is_empty(), two_parts) {
             (true, false) => "n,chi\n",
             (true, true) => "n,chi1,chi0\n",
@@ -169,7 +169,7 @@ fn chi_view_csv(
         .par_iter()
         .map(|&(n, v)| chi_view_value(model, method, n, v))
         .collect::<Result<Vec<[f64; 2]>, CliError>>()?;
-    let two_parts = model == ShadingModel::CookTorrance;
+    let two_parts = model.has_second_part();
     let mut out = String::new();
     for ((n, v), [chi1, chi0]) in pairs.iter().zip(parts) {
         if two_parts {
@@ -209,7 +209,7 @@ fn chi_csv(model: ShadingModel, method: MethodArg, values: &[f64]) -> String {
         .par_iter()
         .map(|&n| chi_parts_value(model, method, n))
         .collect();
-    let two_parts = model == ShadingModel::CookTorrance;
+    let two_parts = model.has_second_part();
     let mut out = String::new();
     for (n, [chi1, chi0]) in values.iter().zip(chis) {
         if two_parts {

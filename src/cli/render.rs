@@ -71,15 +71,11 @@ pub struct RenderArgs {
     out: PathBuf,
 }
 
-/// `kapaint render --model`: one model, or a comparison.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+/// `kapaint render --model`: one model (by its name), or a comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RenderModel {
-    /// Original Phong, eq. (8).
-    Phong,
-    /// Blinn-Phong, eq. (11).
-    Blinn,
-    /// Cook-Torrance (GGX).
-    CookTorrance,
+    /// One model.
+    Single(ShadingModel),
     /// The --sides models left and right of a divider.
     CompareSplit,
     /// The --sides models side by side, one camera.
@@ -88,6 +84,42 @@ pub enum RenderModel {
     CompareDiff,
     /// Phong, Blinn-Phong and Cook-Torrance side by side.
     CompareThree,
+}
+
+impl ValueEnum for RenderModel {
+    fn value_variants<'a>() -> &'a [Self] {
+        static VARIANTS: std::sync::LazyLock<Vec<RenderModel>> = std::sync::LazyLock::new(|| {
+            let compare = [
+                RenderModel::CompareSplit,
+                RenderModel::CompareSide,
+                RenderModel::CompareDiff,
+                RenderModel::CompareThree,
+            ];
+            ShadingModel::ALL
+                .into_iter()
+                .map(RenderModel::Single)
+                .chain(compare)
+                .collect()
+        });
+        &VARIANTS
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        use clap::builder::PossibleValue;
+        Some(match self {
+            Self::Single(model) => {
+                PossibleValue::new(model.name()).help(super::args::model_help(*model))
+            }
+            Self::CompareSplit => PossibleValue::new("compare-split")
+                .help("The --sides models left and right of a divider"),
+            Self::CompareSide => PossibleValue::new("compare-side")
+                .help("The --sides models side by side, one camera"),
+            Self::CompareDiff => PossibleValue::new("compare-diff")
+                .help("|left - right| of the --sides models, as a heatmap"),
+            Self::CompareThree => PossibleValue::new("compare-three")
+                .help("Phong, Blinn-Phong and Cook-Torrance side by side"),
+        })
+    }
 }
 
 /// `kapaint render --view`: a view mode by its name ([`ViewMode::name`]), the list of valid
@@ -239,9 +271,7 @@ fn render_command(a: RenderArgs) -> Result<String, CliError> {
     }
     let sides = sides(&a.sides)?;
     let (model, compare) = match a.model {
-        RenderModel::Phong => (ShadingModel::Phong, Compare::Single),
-        RenderModel::Blinn => (ShadingModel::BlinnPhong, Compare::Single),
-        RenderModel::CookTorrance => (ShadingModel::CookTorrance, Compare::Single),
+        RenderModel::Single(model) => (model, Compare::Single),
         RenderModel::CompareSplit => (sides[0], Compare::Split),
         RenderModel::CompareSide => (sides[0], Compare::SideBySide),
         RenderModel::CompareDiff => (sides[0], Compare::Difference),

@@ -1,4 +1,5 @@
-//! Small compute kernels on the GPU: the shader's `chi` (`shaders/chi_check.wgsl`) checked
+//! Small compute kernels on the GPU: the shader's `chi` (`shaders/chi_check.wgsl`), the
+//! models' lobes and the per-view table's coordinates (`shaders/model_check.wgsl`) checked
 //! against the Rust core, and any WGSL function over a list of values ([`run_kernel`]).
 
 use kapaint_core::reflectance::wgsl::shader_id;
@@ -22,6 +23,63 @@ pub fn chi_on_gpu(
     ];
     let source = shader_source("chi_check.wgsl");
     run_kernel(gpu, &source, &constants, n, n.len())
+}
+
+/// One point at which a lobe is evaluated: unit normal, unit direction to the light, unit
+/// direction to the eye, and the painted exponent (sanitized by the shader as by the preview).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LobePoint {
+    /// The unit normal.
+    pub normal: [f32; 3],
+    /// The unit direction to the light.
+    pub l: [f32; 3],
+    /// The unit direction to the eye.
+    pub v: [f32; 3],
+    /// The exponent.
+    pub n: f32,
+}
+
+/// `specular_lobe(model, ...)` of `shaders/lobes.wgsl` (`[rho_1, rho_0]`) at every point.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn lobes_on_gpu(
+    gpu: &Gpu,
+    model: ShadingModel,
+    points: &[LobePoint],
+) -> Result<Vec<[f32; 2]>, GpuError> {
+    let input: Vec<f32> = points
+        .iter()
+        .flat_map(|p| p.normal.into_iter().chain(p.l).chain(p.v).chain([p.n]))
+        .collect();
+    let constants = [
+        ("MODEL", f64::from(shader_id(&ShadingModel::ALL, &model))),
+        ("CHECK", 0.0),
+    ];
+    let out = run_kernel(
+        gpu,
+        &shader_source("model_check.wgsl"),
+        &constants,
+        &input,
+        2 * points.len(),
+    )?;
+    Ok(out.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+}
+
+/// `view_table_coords(n, phi)` of `shaders/view_coords.wgsl` at every `(n, phi)`.
+///
+/// # Errors
+/// When the read-back fails.
+pub fn view_coords_on_gpu(gpu: &Gpu, points: &[[f32; 2]]) -> Result<Vec<[f32; 2]>, GpuError> {
+    let input: Vec<f32> = points.iter().flatten().copied().collect();
+    let out = run_kernel(
+        gpu,
+        &shader_source("model_check.wgsl"),
+        &[("CHECK", 1.0)],
+        &input,
+        input.len(),
+    )?;
+    Ok(out.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
 }
 
 /// Runs the compute entry `cs_main` of `source` (binding 0: `array<f32>` input, binding 1:

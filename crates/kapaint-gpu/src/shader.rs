@@ -9,7 +9,7 @@ use kapaint_core::reflectance::wgsl::{IDS_FILE, model_and_approx_ids, screaming_
 use kapaint_core::render::ViewMode;
 
 /// Every file in `shaders/`, by name.
-pub const FILES: [(&str, &str); 9] = [
+pub const FILES: [(&str, &str); 12] = [
     (
         "ambient.wgsl",
         include_str!("../../../shaders/ambient.wgsl"),
@@ -27,6 +27,11 @@ pub const FILES: [(&str, &str); 9] = [
         include_str!("../../../shaders/difference.wgsl"),
     ),
     ("heat.wgsl", include_str!("../../../shaders/heat.wgsl")),
+    ("lobes.wgsl", include_str!("../../../shaders/lobes.wgsl")),
+    (
+        "model_check.wgsl",
+        include_str!("../../../shaders/model_check.wgsl"),
+    ),
     (
         "preview.wgsl",
         include_str!("../../../shaders/preview.wgsl"),
@@ -42,6 +47,10 @@ pub const FILES: [(&str, &str); 9] = [
     (
         "preview_types.wgsl",
         include_str!("../../../shaders/preview_types.wgsl"),
+    ),
+    (
+        "view_coords.wgsl",
+        include_str!("../../../shaders/view_coords.wgsl"),
     ),
 ];
 
@@ -271,7 +280,8 @@ mod tests {
         use kapaint_core::reflectance::view::{
             VIEW_COEFFICIENTS, VIEW_GRAZE, VIEW_N_MAX, VIEW_NODES,
         };
-        let wgsl = file("ambient_view.wgsl").expect("embedded");
+        // With its includes: the table's coordinates are in view_coords.wgsl.
+        let wgsl = resolve("ambient_view.wgsl").expect("embedded");
         for line in [
             format!("const VIEW_NODES: i32 = {VIEW_NODES};"),
             format!("const VIEW_COEFFICIENTS: i32 = {VIEW_COEFFICIENTS};"),

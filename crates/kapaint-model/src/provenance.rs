@@ -73,7 +73,7 @@ impl NMapping {
     /// The name a report records for an import or export to `model`: the mapping's, or
     /// `cook-torrance` for that model, which maps roughness by its own `alpha`.
     pub fn report_name(self, model: kapaint_reflectance::ShadingModel) -> &'static str {
-        if model == kapaint_reflectance::ShadingModel::CookTorrance {
+        if model.is_microfacet() {
             "cook-torrance"
         } else {
             self.name()

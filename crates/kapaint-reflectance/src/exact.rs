@@ -34,13 +34,10 @@
 //! relative size. Halving the step of every rule doubles the node count; the tests show the
 //! change falling below 1e-12 relative from one level to the next across `n in [0, 1e5]`.
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 use super::ShadingModel;
-use super::quadrature::{TanhSinh, break_points, graded_from};
-
-/// The lobe is neglected where it is below `e^-WINDOW_LOG` of its local maximum.
-const WINDOW_LOG: f64 = 40.0;
+use super::quadrature::TanhSinh;
 
 /// Largest exponent the exact integrator accepts; larger values are clamped to it.
 pub const EXACT_N_MAX: f64 = 1.0e6;
@@ -83,8 +80,10 @@ pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
     match model {
         // Phong's outer integrand is smooth enough for one level less (measured: no change in
         // the 13th digit), which saves a third of its time.
-        ShadingModel::Phong => phong(&TanhSinh::new(level.saturating_sub(1)), &rule, n),
-        ShadingModel::BlinnPhong => blinn(&rule, n),
+        ShadingModel::Phong => {
+            crate::model::phong::exact::chi(&TanhSinh::new(level.saturating_sub(1)), &rule, n)
+        }
+        ShadingModel::BlinnPhong => crate::model::blinn::exact::chi(&rule, n),
         // chi_1, the part that scales with k_s; see `super::cook_torrance` for both parts.
         ShadingModel::CookTorrance => {
             super::cook_torrance::chi_exact_at_level(cook_torrance_n(n), level)[0]
@@ -95,11 +94,12 @@ pub fn chi_exact_at_level(model: ShadingModel, n: f64, level: u32) -> f64 {
 /// `[chi_1(n), chi_0(n)]` by the exact integrators: `[chi(n), 0]` for Phong and Blinn-Phong,
 /// both parts of [`super::cook_torrance::chi_exact`] for Cook-Torrance.
 pub fn chi_parts_exact(model: ShadingModel, n: f64) -> [f64; 2] {
-    if model == ShadingModel::CookTorrance {
-        count_call();
-        super::cook_torrance::chi_exact(cook_torrance_n(n))
-    } else {
-        [chi_exact(model, n), 0.0]
+    match model {
+        ShadingModel::CookTorrance => {
+            count_call();
+            super::cook_torrance::chi_exact(cook_torrance_n(n))
+        }
+        ShadingModel::Phong | ShadingModel::BlinnPhong => [chi_exact(model, n), 0.0],
     }
 }
 
@@ -110,161 +110,6 @@ pub(crate) fn cook_torrance_n(n: f64) -> f64 {
         0.0
     } else {
         n.min(f64::from(super::cook_torrance::fast::N_MAX))
-    }
-}
-
-/// `exp(n * ln_1p(y))`, i.e. `(1 + y)^n` for `y in [-1, 0]`, with `0^0 = 1`.
-pub(crate) fn pow1p(n: f64, y: f64) -> f64 {
-    if n == 0.0 { 1.0 } else { (n * y.ln_1p()).exp() }
-}
-
-/// `1 - e^(-2 WINDOW_LOG / n)`: the largest `sin^2` of a lobe `(1 - sin^2)^(n/2)` that still
-/// counts.
-pub(crate) fn window_sin2(n: f64) -> f64 {
-    if n == 0.0 {
-        1.0
-    } else {
-        -(-2.0 * WINDOW_LOG / n).exp_m1()
-    }
-}
-
-/// Largest angle `u` with `cos^n u >= e^-WINDOW_LOG`.
-pub(crate) fn window_angle(n: f64) -> f64 {
-    window_sin2(n).sqrt().min(1.0).asin()
-}
-
-/// Feature width `1/sqrt(n)` of the peak, used to grade the outer intervals.
-pub(crate) fn peak_scale(n: f64) -> f64 {
-    if n > 0.0 {
-        n.sqrt().recip()
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// `C_n(x) = Int_0^x cos^n u du` for `x in [0, pi/2]`.
-fn cos_power_integral(rule: &TanhSinh, n: f64, x: f64) -> f64 {
-    let upper = x.min(window_angle(n));
-    rule.integrate(0.0, upper, |u| {
-        let s = (0.5 * u).sin();
-        // cos u = 1 - 2 sin^2(u/2), exact in relative terms next to the peak at u = 0.
-        pow1p(n, -2.0 * s * s)
-    })
-}
-
-fn phong(outer_rule: &TanhSinh, rule: &TanhSinh, n: f64) -> f64 {
-    let half_full = cos_power_integral(rule, n, FRAC_PI_2);
-    let g_window = window_sin2(n);
-    let scale = peak_scale(n);
-    let breaks = break_points(
-        0.0,
-        FRAC_PI_2,
-        graded_from(0.0, 1.0, scale, FRAC_PI_2 / 2.0).chain(graded_from(
-            FRAC_PI_2,
-            -1.0,
-            scale,
-            FRAC_PI_2 / 2.0,
-        )),
-    );
-    let outer = outer_rule.integrate_pieces_par(&breaks, |t| {
-        let (st, ct) = t.sin_cos();
-        // M^n = (1 - st^2 sg^2)^(n/2) drops below the window at sg = sqrt(window)/st.
-        let sg_max = if st > 0.0 { g_window.sqrt() / st } else { 1.0 };
-        let g_max = sg_max.min(1.0).asin();
-        rule.integrate(0.0, g_max, |g| {
-            let (sg, cg) = g.sin_cos();
-            let m_pow = pow1p(0.5 * n, -(st * sg) * (st * sg));
-            let to_kink = ct.atan2(st * cg); // pi/2 - d
-            m_pow * (half_full + cos_power_integral(rule, n, to_kink))
-        })
-    });
-    // Factor 2 for the folded g range; 2/pi^3 for the average.
-    4.0 / (PI * PI * PI) * outer
-}
-
-fn blinn(rule: &TanhSinh, n: f64) -> f64 {
-    let window = window_sin2(n);
-    let scale = peak_scale(n);
-    let p_max = (2.0 * window.sqrt()).min(1.0).asin();
-    let p_breaks = break_points(
-        -FRAC_PI_2,
-        p_max,
-        graded_from(0.0, -1.0, scale, FRAC_PI_2 / 2.0)
-            .chain(graded_from(-FRAC_PI_2, 1.0, scale, FRAC_PI_2 / 2.0))
-            .chain([0.0]),
-    );
-    let outer = rule.integrate_pieces_par(&p_breaks, |p| blinn_at_p(rule, n, p));
-    4.0 / (PI * PI * PI) * outer
-}
-
-/// The Blinn lobe's integral over `t in [0, pi/2]` and `g in [0, pi/2]` at the view angle
-/// `p` (signed): what [`chi_exact`] integrates over `p`, and what the per-view average
-/// ([`super::view`]) takes at `p` and `-p`.
-pub(crate) fn blinn_at_p(rule: &TanhSinh, n: f64, p: f64) -> f64 {
-    let window = window_sin2(n);
-    let spread = window_angle(n);
-    let (sp, cp) = p.sin_cos();
-    let t_breaks = if p < 0.0 {
-        // The lobe is at most cos^n((t + p)/2), so t stays within 2*spread of -p.
-        break_points(
-            (-p - 2.0 * spread).max(0.0),
-            (-p + 2.0 * spread).min(FRAC_PI_2),
-            [-p],
-        )
-    } else {
-        // sin^2(beta) >= st^2/4 when p >= 0.
-        break_points(0.0, (2.0 * window.sqrt()).min(1.0).asin(), [])
-    };
-    rule.integrate_pieces(&t_breaks, |t| {
-        let (st, ct) = t.sin_cos();
-        let sum_half = 2.0 * (0.5 * (t + p)).sin() * (0.5 * (t - p)).cos(); // st + sp
-        let a = st * st + sp * sp;
-        let b = 2.0 * st * sp;
-        let e = 2.0 + 2.0 * ct * cp;
-        let sin2 = |g: f64| {
-            let h = (0.5 * g).sin();
-            let num = sum_half * sum_half - 2.0 * b * h * h;
-            let den = e + b * g.cos();
-            if den > 0.0 {
-                (num / den).clamp(0.0, 1.0)
-            } else {
-                1.0
-            }
-        };
-        let lobe = |g: f64| pow1p(0.5 * n, -sin2(g));
-        let (g_lo, g_hi) = blinn_g_window(n, a, b, e, sin2);
-        rule.integrate(g_lo, g_hi, lobe)
-    })
-}
-
-/// The `g` range where the Blinn lobe is above `e^-WINDOW_LOG` of its peak, for fixed `(p, t)`.
-///
-/// With `c = cos g`, `sin^2 beta = (a + b c) / (e + b c)` is monotone in `c`, so the window
-/// edge solves a linear equation.
-fn blinn_g_window(n: f64, a: f64, b: f64, e: f64, sin2: impl Fn(f64) -> f64) -> (f64, f64) {
-    if n == 0.0 || b.abs() < 1e-300 {
-        return (0.0, FRAC_PI_2);
-    }
-    let peak_g = if b < 0.0 { 0.0 } else { FRAC_PI_2 };
-    let s_peak = sin2(peak_g);
-    // (1 - s)^(n/2) = e^-W (1 - s_peak)^(n/2)  =>  1 - s = e^(-2W/n) (1 - s_peak).
-    let s_edge = 1.0 - (1.0 - window_sin2(n)) * (1.0 - s_peak);
-    let denom = b * (1.0 - s_edge);
-    if denom == 0.0 {
-        return (0.0, FRAC_PI_2);
-    }
-    let c_edge = (s_edge * e - a) / denom;
-    if b < 0.0 {
-        // Peak at g = 0; the lobe falls as c falls.
-        if c_edge <= 0.0 {
-            (0.0, FRAC_PI_2)
-        } else {
-            (0.0, c_edge.min(1.0).acos())
-        }
-    } else if c_edge >= 1.0 {
-        (0.0, FRAC_PI_2)
-    } else {
-        (c_edge.max(0.0).acos(), FRAC_PI_2)
     }
 }
 
@@ -295,16 +140,16 @@ pub fn asymptotic_slope(model: ShadingModel) -> f64 {
 /// `max(0, cos)^n` as `n -> 0`. For Cook-Torrance, its radiance factor with `F0 = 1`
 /// (`chi_1 + chi_0` is its average).
 pub fn rho_s(model: ShadingModel, n: f64, theta: f64, gamma: f64, phi: f64) -> f64 {
-    if model == ShadingModel::CookTorrance {
-        let [first, second] = super::cook_torrance::rho_s_parts(n, theta, gamma, phi);
-        return first + second;
-    }
-    super::geometry::lobe_power(super::geometry::lobe_cosine(model, theta, gamma, phi), n)
+    let [first, second] = model.lobe_in_box(super::sanitize_n_f64(n), theta, gamma, phi);
+    first + second
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::phong::exact::cos_power_integral;
+    use crate::quadrature::break_points;
+    use std::f64::consts::FRAC_PI_2;
 
     fn rel(a: f64, b: f64) -> f64 {
         ((a - b) / b).abs()

@@ -8,12 +8,11 @@
 //! V = (sin p, cos p, 0),                  p in [-pi/2, pi/2]
 //! ```
 //!
-//! This module states the integrand literally, with vectors. It is the definition that the
-//! fast reduced integrals of [`super::exact`] are checked against.
+//! This module states the box with vectors; each model's lobe over it is in
+//! [`crate::model`] ([`crate::model::Cosines::of_box`]), the definition that the fast reduced
+//! integrals of [`super::exact`] are checked against.
 
 use glam::DVec3;
-
-use super::ShadingModel;
 
 /// Light direction for polar angle `theta` and azimuth `gamma` (radians).
 pub fn light_dir(theta: f64, gamma: f64) -> DVec3 {
@@ -27,37 +26,6 @@ pub fn light_dir(theta: f64, gamma: f64) -> DVec3 {
 /// View direction for the signed angle `phi` from the normal (radians).
 pub fn view_dir(phi: f64) -> DVec3 {
     DVec3::new(phi.sin(), phi.cos(), 0.0)
-}
-
-/// The cosine that the specular lobe raises to the power `n`: `R.V` for original Phong
-/// (eq. 4, `R` the mirror of `L` about `N`) and `N.H` for Blinn-Phong (eq. 9); `N.H` too for
-/// Cook-Torrance, the cosine its GGX distribution is a function of.
-pub fn lobe_cosine(model: ShadingModel, theta: f64, gamma: f64, phi: f64) -> f64 {
-    let l = light_dir(theta, gamma);
-    let v = view_dir(phi);
-    match model {
-        ShadingModel::Phong => {
-            let r = DVec3::new(-l.x, l.y, -l.z);
-            r.dot(v)
-        }
-        ShadingModel::BlinnPhong | ShadingModel::CookTorrance => {
-            let sum = l + v;
-            let len = sum.length();
-            if len > 0.0 { sum.y / len } else { 0.0 }
-        }
-    }
-}
-
-/// `max(0, c)^n` with `0^0` taken as 0: at `n = 0` the lobe is the indicator of the set
-/// where the cosine is positive, the limit of `max(0, cos)^n` as `n -> 0`.
-pub fn lobe_power(c: f64, n: f64) -> f64 {
-    if c <= 0.0 {
-        0.0
-    } else if n == 0.0 {
-        1.0
-    } else {
-        c.powf(n)
-    }
 }
 
 /// Golden-section search for the minimum of a unimodal `f` on `[lo, hi]`: `iterations`
@@ -129,6 +97,7 @@ pub fn box_average<const K: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Cosines;
     use std::f64::consts::FRAC_PI_2;
 
     #[test]
@@ -139,7 +108,7 @@ mod tests {
             (FRAC_PI_2, 0.0, 1.0),
         ] {
             let closed = t.cos() * p.cos() - t.sin() * p.sin() * g.cos();
-            let c = lobe_cosine(ShadingModel::Phong, t, g, p);
+            let c = Cosines::of_box(t, g, p).rv;
             assert!((c - closed).abs() < 1e-15);
         }
     }
@@ -150,7 +119,7 @@ mod tests {
             let l = light_dir(t, g);
             let v = view_dir(p);
             let closed = (t.cos() + p.cos()) / (l + v).length();
-            let c = lobe_cosine(ShadingModel::BlinnPhong, t, g, p);
+            let c = Cosines::of_box(t, g, p).nh;
             assert!((c - closed).abs() < 1e-15);
         }
     }
@@ -158,9 +127,9 @@ mod tests {
     #[test]
     fn the_lobe_peaks_on_the_mirror_direction() {
         // g = 0, p = -t puts V on the mirror of L: both cosines are 1.
-        for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
-            let c = lobe_cosine(model, 0.6, 0.0, -0.6);
-            assert!((c - 1.0).abs() < 1e-15, "{model:?}: {c}");
+        let c = Cosines::of_box(0.6, 0.0, -0.6);
+        for (name, c) in [("R.V", c.rv), ("N.H", c.nh)] {
+            assert!((c - 1.0).abs() < 1e-15, "{name}: {c}");
         }
     }
 }

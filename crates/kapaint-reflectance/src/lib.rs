@@ -17,16 +17,18 @@
 //! (Cook-Torrance also clamps `n` to [`cook_torrance::fast::N_MAX`], the limit of its roughness
 //! mapping; there `chi_1 + chi_0 <= 0.52`.)
 
-pub mod cook_torrance;
 pub mod equivalent;
 pub mod exact;
 pub mod fast;
 mod fast_coeffs;
 pub mod fit;
 pub mod geometry;
+pub mod model;
 pub mod quadrature;
 pub mod view;
 pub mod wgsl;
+
+pub use model::{ShadingModel, cook_torrance};
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -36,63 +38,6 @@ pub const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
 
 /// The paper's printed rounding of `2/pi` in eq. (8) and (11).
 pub const PAPER_TWO_OVER_PI: f64 = 0.637;
-
-/// Which specular lobe the surface uses.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum ShadingModel {
-    /// Original Phong, `rho_s = max(0, R.V)^n` (eq. 4); its ambient is eq. (8).
-    #[default]
-    #[serde(alias = "Phong")]
-    Phong,
-    /// Modified (Blinn-)Phong, `rho_s = max(0, N.H)^n` (eq. 9); its ambient is eq. (11).
-    /// Files say `blinn`; scripts may say `BlinnPhong` as the type does.
-    #[serde(rename = "blinn", alias = "BlinnPhong", alias = "blinn-phong")]
-    BlinnPhong,
-    /// Cook-Torrance with GGX, height-correlated Smith and Schlick's Fresnel (`k_s` as `F0`),
-    /// roughness from `n` by `alpha = sqrt(2 / (n + 2))`; its ambient is
-    /// `(2/pi) k_d + k_s chi_1(n) + chi_0(n)` (see [`cook_torrance`]).
-    #[serde(rename = "cook-torrance", alias = "CookTorrance")]
-    CookTorrance,
-}
-
-impl ShadingModel {
-    /// Every model, in a fixed order for reports (and the shader ids).
-    pub const ALL: [Self; 3] = [Self::Phong, Self::BlinnPhong, Self::CookTorrance];
-
-    /// The two models of the paper, whose ambient has the printed forms.
-    pub const PAPER: [Self; 2] = [Self::Phong, Self::BlinnPhong];
-
-    /// The name used on the command line and in files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Phong => "phong",
-            Self::BlinnPhong => "blinn",
-            Self::CookTorrance => "cook-torrance",
-        }
-    }
-
-    /// The model [`ShadingModel::name`] names.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|m| m.name() == name)
-    }
-
-    /// The name people read in reports and the editor.
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Phong => "Phong",
-            Self::BlinnPhong => "Blinn-Phong",
-            Self::CookTorrance => "Cook-Torrance",
-        }
-    }
-
-    /// Whether the paper printed an approximation of this model's ambient (eq. 8 and 11).
-    pub fn has_paper_forms(self) -> bool {
-        self != Self::CookTorrance
-    }
-}
 
 /// How `chi(n)` is approximated when `k_a` is derived per texel.
 #[derive(
@@ -211,19 +156,17 @@ pub fn sanitize_coefficient(k: f32) -> f32 {
 /// (`chi_1 = chi`, `chi_0 = 0` for Phong and Blinn-Phong).
 #[inline]
 pub fn chi_parts_f32(model: ShadingModel, approx: AmbientApprox, n: f32) -> [f32; 2] {
-    if model == ShadingModel::CookTorrance {
-        cook_torrance::fast::chi_f32(sanitize_n_f32(n))
-    } else {
-        [chi_f32(model, approx, n), 0.0]
+    match model {
+        ShadingModel::CookTorrance => cook_torrance::fast::chi_f32(sanitize_n_f32(n)),
+        ShadingModel::Phong | ShadingModel::BlinnPhong => [chi_f32(model, approx, n), 0.0],
     }
 }
 
 /// [`chi_parts_f32`] in `f64`.
 pub fn chi_parts_f64(model: ShadingModel, approx: AmbientApprox, n: f64) -> [f64; 2] {
-    if model == ShadingModel::CookTorrance {
-        cook_torrance::fast::chi_f64(sanitize_n_f64(n))
-    } else {
-        [chi_f64(model, approx, n), 0.0]
+    match model {
+        ShadingModel::CookTorrance => cook_torrance::fast::chi_f64(sanitize_n_f64(n)),
+        ShadingModel::Phong | ShadingModel::BlinnPhong => [chi_f64(model, approx, n), 0.0],
     }
 }
 
@@ -232,8 +175,8 @@ pub fn chi_parts_f64(model: ShadingModel, approx: AmbientApprox, n: f64) -> [f64
 #[inline]
 pub fn chi_f32(model: ShadingModel, approx: AmbientApprox, n: f32) -> f32 {
     let n = sanitize_n_f32(n);
-    if model == ShadingModel::CookTorrance {
-        return cook_torrance::fast::chi_f32(n)[0];
+    if model.has_second_part() {
+        return chi_parts_f32(model, approx, n)[0];
     }
     match paper_constants(model, approx) {
         None => fast::chi_f32(model, n),
@@ -245,8 +188,8 @@ pub fn chi_f32(model: ShadingModel, approx: AmbientApprox, n: f32) -> f32 {
 /// `chi(n)` in `f64`; agrees with [`chi_f32`] to `f32` rounding.
 pub fn chi_f64(model: ShadingModel, approx: AmbientApprox, n: f64) -> f64 {
     let n = sanitize_n_f64(n);
-    if model == ShadingModel::CookTorrance {
-        return cook_torrance::fast::chi_f64(n)[0];
+    if model.has_second_part() {
+        return chi_parts_f64(model, approx, n)[0];
     }
     match paper_constants(model, approx) {
         None => fast::chi_f64(model, n),
@@ -287,7 +230,7 @@ pub fn derive_ka(
     out: &mut [Vec3],
 ) {
     assert_same_lengths(kd, ks, n, out);
-    if model == ShadingModel::CookTorrance {
+    if model.has_second_part() {
         derive_with::<true>(kd, ks, n, out, TWO_OVER_PI as f32, |n| {
             cook_torrance::fast::chi_f32(sanitize_n_f32(n))
         });

@@ -221,6 +221,38 @@ pub fn graded_from(start: f64, sign: f64, scale: f64, span: f64) -> impl Iterato
     })
 }
 
+/// The lobe is neglected where it is below `e^-WINDOW_LOG` of its local maximum.
+const WINDOW_LOG: f64 = 40.0;
+
+/// `exp(n * ln_1p(y))`, i.e. `(1 + y)^n` for `y in [-1, 0]`, with `0^0 = 1`.
+pub(crate) fn pow1p(n: f64, y: f64) -> f64 {
+    if n == 0.0 { 1.0 } else { (n * y.ln_1p()).exp() }
+}
+
+/// `1 - e^(-2 WINDOW_LOG / n)`: the largest `sin^2` of a lobe `(1 - sin^2)^(n/2)` that still
+/// counts.
+pub(crate) fn window_sin2(n: f64) -> f64 {
+    if n == 0.0 {
+        1.0
+    } else {
+        -(-2.0 * WINDOW_LOG / n).exp_m1()
+    }
+}
+
+/// Largest angle `u` with `cos^n u >= e^-WINDOW_LOG`.
+pub(crate) fn window_angle(n: f64) -> f64 {
+    window_sin2(n).sqrt().min(1.0).asin()
+}
+
+/// Feature width `1/sqrt(n)` of the peak, used to grade the outer intervals.
+pub(crate) fn peak_scale(n: f64) -> f64 {
+    if n > 0.0 {
+        n.sqrt().recip()
+    } else {
+        f64::INFINITY
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

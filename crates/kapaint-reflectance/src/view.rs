@@ -33,11 +33,12 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use super::ShadingModel;
-use super::exact::{
-    DEFAULT_LEVEL, EXACT_N_MAX, blinn_at_p, cook_torrance_n, peak_scale, pow1p, window_angle,
-    window_sin2,
-};
-use super::quadrature::{TanhSinh, break_points, graded_from};
+use num_traits::Float;
+
+use super::exact::{DEFAULT_LEVEL, EXACT_N_MAX, cook_torrance_n};
+use super::model::lobe::lit;
+use super::model::{blinn, phong};
+use super::quadrature::TanhSinh;
 
 /// `[chi_view_1(n, phi), chi_view_0(n, phi)]`: for Phong and Blinn-Phong `[chi_view, 0]`; for
 /// Cook-Torrance the per-view forms of its two parts (`k_s chi_1 + chi_0`). `n` is clamped as
@@ -62,11 +63,11 @@ pub fn chi_view_exact_at_level(model: ShadingModel, n: f64, phi: f64, level: u32
     let k = 2.0 / (PI * PI);
     match model {
         ShadingModel::Phong => [
-            k * (phong_at_p(&rule, n, phi) + phong_at_p(&rule, n, -phi)),
+            k * (phong::exact::at_p(&rule, n, phi) + phong::exact::at_p(&rule, n, -phi)),
             0.0,
         ],
         ShadingModel::BlinnPhong => [
-            k * (blinn_at_p(&rule, n, phi) + blinn_at_p(&rule, n, -phi)),
+            k * (blinn::exact::at_p(&rule, n, phi) + blinn::exact::at_p(&rule, n, -phi)),
             0.0,
         ],
         ShadingModel::CookTorrance => {
@@ -80,84 +81,6 @@ pub fn chi_view_exact_at_level(model: ShadingModel, n: f64, phi: f64, level: u32
     }
 }
 
-/// Head-on Phong in closed form: `chi_view(n, 0) = (2/pi) Int_0^{pi/2} cos^n t dt
-/// = Gamma((n+1)/2) / (sqrt(pi) Gamma(n/2 + 1))`, by the log-gamma ratio.
-pub fn phong_head_on(n: f64) -> f64 {
-    // (2/pi) * (sqrt(pi)/2) Gamma((n+1)/2) / Gamma(n/2 + 1).
-    (ln_gamma(0.5 * (n + 1.0)) - ln_gamma(0.5 * n + 1.0)).exp() / PI.sqrt()
-}
-
-/// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7, 9 terms: about 1e-15 relative).
-fn ln_gamma(x: f64) -> f64 {
-    const G: f64 = 7.0;
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        // Reflection.
-        return (PI / (PI * x).sin()).ln() - ln_gamma(1.0 - x);
-    }
-    let x = x - 1.0;
-    let t = x + G + 0.5;
-    let sum = C
-        .iter()
-        .enumerate()
-        .skip(1)
-        .fold(C[0], |s, (i, c)| s + c / (x + i as f64));
-    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + sum.ln()
-}
-
-/// Phong's lobe integrated over `t in [0, pi/2]` (in closed form per `g`) and `g in [0, pi/2]`
-/// at the signed view angle `p`.
-fn phong_at_p(rule: &TanhSinh, n: f64, p: f64) -> f64 {
-    let (sp, cp) = p.sin_cos();
-    let s = sp.abs();
-    // M^n = (1 - sp^2 sg^2)^(n/2) falls below the window at sg = sqrt(window) / |sp|.
-    let g_max = if s > 0.0 {
-        (window_sin2(n).sqrt() / s).min(1.0).asin()
-    } else {
-        FRAC_PI_2
-    };
-    let scale = if s > 0.0 {
-        peak_scale(n) / s
-    } else {
-        f64::INFINITY
-    };
-    let breaks = break_points(0.0, g_max, graded_from(0.0, 1.0, scale, g_max / 2.0));
-    let spread = window_angle(n);
-    // Int_a^b cos^n u du for 0 <= a <= b <= pi/2, its peak at `a`: cut where cos^n(u) falls
-    // below the window of cos^n(a) (cos u <= cos a cos(u - a) there).
-    let from = |a: f64, b: f64| {
-        let b = b.min(a + spread);
-        if b <= a {
-            return 0.0;
-        }
-        rule.integrate(a, b, |u| {
-            let h = (0.5 * u).sin();
-            pow1p(n, -2.0 * h * h)
-        })
-    };
-    rule.integrate_pieces(&breaks, |g| {
-        let (sg, cg) = g.sin_cos();
-        let m_pow = pow1p(0.5 * n, -(s * sg) * (s * sg));
-        let d = (sp * cg).atan2(cp);
-        let t_part = if d >= 0.0 {
-            from(d, FRAC_PI_2)
-        } else {
-            from(0.0, -d) + from(0.0, FRAC_PI_2 + d)
-        };
-        m_pow * t_part
-    })
-}
-
 /// Largest `n` the per-view table covers.
 pub const VIEW_N_MAX: f32 = 16384.0;
 
@@ -168,24 +91,20 @@ pub const VIEW_N_MAX: f32 = 16384.0;
 /// `g = hypot(w, VIEW_GRAZE)` (a smooth max): a sharp lobe's head-on peak and its cut by the horizon are as many
 /// nodes wide as a broad lobe's, between them `chi_view` falls as a power of `phi` (a straight
 /// line in `ln`), and the last degree before grazing is resolved whatever `n`.
-fn table_coords(n: f64, phi: f64) -> (f64, f64) {
-    let width = (1.0 + n).sqrt();
-    let graze = width.hypot(VIEW_GRAZE);
-    let u = (1.0 + n).log2() / (1.0 + f64::from(VIEW_N_MAX)).log2();
-    let head_on = (width * phi).ln_1p() / (width * FRAC_PI_2).ln_1p();
-    let grazing = (graze * (FRAC_PI_2 - phi)).ln_1p() / (graze * FRAC_PI_2).ln_1p();
-    (u, 0.5 + 0.5 * (head_on - grazing))
-}
-
-/// [`table_coords`] in `f32`, as the renderer computes it.
-fn table_coords_f32(n: f32, phi: f32) -> (f32, f32) {
-    use std::f32::consts::FRAC_PI_2;
-    let width = (1.0 + n).sqrt();
-    let graze = width.hypot(VIEW_GRAZE as f32);
-    let u = (1.0 + n).log2() / (1.0 + VIEW_N_MAX).log2();
-    let head_on = (width * phi).ln_1p() / (width * FRAC_PI_2).ln_1p();
-    let grazing = (graze * (FRAC_PI_2 - phi)).ln_1p() / (graze * FRAC_PI_2).ln_1p();
-    (u, 0.5 + 0.5 * (head_on - grazing))
+///
+/// Generic in the float type: the table's nodes are placed in `f64`, the renderer looks up in
+/// `f32`, and `shaders/view_coords.wgsl`'s `view_table_coords` is checked against the `f32`
+/// form by the GPU tests.
+pub fn table_coords<F: Float>(n: F, phi: F) -> (F, F) {
+    let one = F::one();
+    let half_pi = lit::<F>(FRAC_PI_2);
+    let width = (one + n).sqrt();
+    let graze = width.hypot(lit(VIEW_GRAZE));
+    let u = (one + n).log2() / (one + lit(f64::from(VIEW_N_MAX))).log2();
+    let head_on = (width * phi).ln_1p() / (width * half_pi).ln_1p();
+    let grazing = (graze * (half_pi - phi)).ln_1p() / (graze * half_pi).ln_1p();
+    let half = lit::<F>(0.5);
+    (u, half + half * (head_on - grazing))
 }
 
 /// The finest angle (its inverse, per radian) the table resolves at grazing views whatever
@@ -324,7 +243,7 @@ pub fn chi_view_fast(model: ShadingModel, n: f32, phi: f32) -> Option<[f32; 2]> 
     } else {
         phi.clamp(0.0, std::f32::consts::FRAC_PI_2)
     };
-    let (u, v) = table_coords_f32(n, phi);
+    let (u, v) = table_coords(n, phi);
     let t = view_coefficients();
     let at = |c: &[f32]| spline::eval(c, VIEW_NODES, f64::from(u), f64::from(v)).exp();
     Some(match model {

@@ -73,11 +73,7 @@ pub struct Conversion {
 
 /// The target's index in the tables.
 fn column(model: ShadingModel) -> usize {
-    match model {
-        ShadingModel::Phong => 0,
-        ShadingModel::BlinnPhong => 1,
-        ShadingModel::CookTorrance => 2,
-    }
+    model.index()
 }
 
 /// A roughness' place among the fitted rows: `(row, fraction)`, the first row below them.
@@ -98,15 +94,10 @@ impl Conversion {
     /// The tables for `model` under `mapping` (built once per process; the Cook-Torrance
     /// model's are the same for every mapping).
     pub fn for_model(model: ShadingModel, mapping: NMapping) -> &'static Self {
-        static TABLES: [OnceLock<Conversion>; 5] = [
-            OnceLock::new(),
-            OnceLock::new(),
-            OnceLock::new(),
-            OnceLock::new(),
-            OnceLock::new(),
-        ];
-        let fitted = mapping == NMapping::HeightFitted && model != ShadingModel::CookTorrance;
-        let slot = column(model) + if fitted { 3 } else { 0 };
+        const MODELS: usize = ShadingModel::ALL.len();
+        static TABLES: [OnceLock<Conversion>; 2 * MODELS] = [const { OnceLock::new() }; 2 * MODELS];
+        let fitted = mapping == NMapping::HeightFitted && !model.is_microfacet();
+        let slot = column(model) + if fitted { MODELS } else { 0 };
         TABLES[slot].get_or_init(|| Self::build(model, fitted))
     }
 
@@ -130,7 +121,7 @@ impl Conversion {
             let r = i as f32 / LUT_SIZE as f32;
             let x = r * ROWS_PER_UNIT - FIRST_ROW;
             let (row, t) = row_of(r);
-            n.push(if model == ShadingModel::CookTorrance {
+            n.push(if model.is_microfacet() {
                 n_of_roughness(r)
             } else if x < 0.0 {
                 // To a mirror at r = 0.
@@ -192,7 +183,7 @@ impl Conversion {
     /// back as the flat part's smoothest roughness). For Cook-Torrance, its mapping's inverse.
     pub fn roughness(&self, n: f32) -> f32 {
         let n = crate::reflectance::sanitize_n_f32(n);
-        if self.model == ShadingModel::CookTorrance {
+        if self.model.is_microfacet() {
             return super::roughness_of_n(n);
         }
         // The first entry at most n (entries are non-increasing).

@@ -22,14 +22,15 @@
 //! lobes' common peak (the mirror direction), as the exact integrators do, at a low level:
 //! the rule's own integrals of each lobe alone are checked against the exact `chi` values.
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
 use crate::reflectance::ShadingModel;
 use crate::reflectance::cook_torrance;
-use crate::reflectance::geometry::{golden_section, lobe_cosine, lobe_power as lobe};
-use crate::reflectance::quadrature::{TanhSinh, break_points, graded_from};
+use crate::reflectance::geometry::golden_section;
+use crate::reflectance::model::Cosines;
+use crate::reflectance::quadrature::TanhSinh;
 
 /// Number of `k_s` values of the error tables: `k_s = (i / (KS_NODES - 1))^2`.
 pub const KS_NODES: usize = 17;
@@ -66,11 +67,7 @@ pub fn ks_node(i: usize) -> f64 {
 }
 
 /// The targets, in table order.
-pub const TARGETS: [ShadingModel; 3] = [
-    ShadingModel::Phong,
-    ShadingModel::BlinnPhong,
-    ShadingModel::CookTorrance,
-];
+pub const TARGETS: [ShadingModel; ShadingModel::ALL.len()] = ShadingModel::ALL;
 
 /// The exponent the Cook-Torrance model gives `alpha = r^2` (`2 / alpha^2 - 2`), unclamped.
 pub fn ct_n(roughness: f64) -> f64 {
@@ -78,8 +75,8 @@ pub fn ct_n(roughness: f64) -> f64 {
     (2.0 / a2 - 2.0).max(0.0)
 }
 
-/// One node's weight, GGX parts, painted GGX parts and the two cosines.
-type NodeValues = (f64, [f64; 2], [f64; 2], [f64; 2]);
+/// One node's weight, GGX parts and cosines.
+type NodeValues = (f64, [f64; 2], Cosines<f64>);
 
 /// The lobes sampled at the nodes of a box rule fitted to one roughness.
 pub struct LobeSamples {
@@ -89,11 +86,8 @@ pub struct LobeSamples {
     weight: Vec<f64>,
     /// GGX `[rho_1, rho_0]` at the roughness.
     ggx: Vec<[f64; 2]>,
-    /// The Cook-Torrance model's own `[rho_1, rho_0]` at its painted exponent (clamped to
-    /// `N_MAX`): the Cook-Torrance target.
-    ggx_painted: Vec<[f64; 2]>,
-    /// `max(0, R.V)` and `max(0, N.H)`.
-    cosines: Vec<[f64; 2]>,
+    /// The geometry at each node, where every target evaluates its own lobe.
+    cosines: Vec<Cosines<f64>>,
 }
 
 impl LobeSamples {
@@ -108,56 +102,21 @@ impl LobeSamples {
         // resolves both.
         let scale = 0.5 * alpha;
         let rule = TanhSinh::new(level);
-        let quarter = FRAC_PI_2 / 2.0;
-        let p_breaks = break_points(
-            -FRAC_PI_2,
-            FRAC_PI_2,
-            graded_from(0.0, -1.0, scale, quarter)
-                .chain(graded_from(0.0, 1.0, scale, quarter))
-                .chain(graded_from(-FRAC_PI_2, 1.0, scale, quarter))
-                .chain([0.0]),
-        );
+        let p_breaks = cook_torrance::p_pieces(scale);
         // 2 for g folded onto [0, pi/2], 2/pi^3 for the average.
         let norm = 4.0 / (PI * PI * PI);
-        let clamped = n_painted < n_ggx;
         let per_phi: Vec<Vec<NodeValues>> = rule
             .points(&p_breaks)
             .into_par_iter()
             .map(|(p, wp)| {
                 let mut out = Vec::new();
-                let peak = (-p).max(0.0);
-                let t_breaks = break_points(
-                    0.0,
-                    FRAC_PI_2,
-                    graded_from(peak, -1.0, scale, FRAC_PI_2)
-                        .chain(graded_from(peak, 1.0, scale, FRAC_PI_2))
-                        .chain([peak]),
-                );
-                let (g_peak, g_sign) = if p < 0.0 {
-                    (0.0, 1.0)
-                } else {
-                    (FRAC_PI_2, -1.0)
-                };
+                let t_breaks = cook_torrance::t_pieces(scale, p);
                 for (t, wt) in rule.points(&t_breaks) {
-                    let st = t.sin();
-                    let g_scale = if st > 0.0 { scale / st } else { f64::INFINITY };
-                    let g_breaks = break_points(
-                        0.0,
-                        FRAC_PI_2,
-                        graded_from(g_peak, g_sign, g_scale, FRAC_PI_2),
-                    );
+                    let g_breaks = cook_torrance::g_pieces(scale, p, t.sin());
                     for (g, wg) in rule.points(&g_breaks) {
-                        let ggx = cook_torrance::rho_s_parts(n_ggx, t, g, p);
-                        let painted = if clamped {
-                            cook_torrance::rho_s_parts(n_painted, t, g, p)
-                        } else {
-                            ggx
-                        };
-                        let cosines = [
-                            lobe_cosine(ShadingModel::Phong, t, g, p),
-                            lobe_cosine(ShadingModel::BlinnPhong, t, g, p),
-                        ];
-                        out.push((norm * wp * wt * wg, ggx, painted, cosines));
+                        let cosines = Cosines::of_box(t, g, p);
+                        let ggx = ShadingModel::CookTorrance.lobe(&cosines, n_ggx);
+                        out.push((norm * wp * wt * wg, ggx, cosines));
                     }
                 }
                 out
@@ -167,13 +126,11 @@ impl LobeSamples {
             n_painted,
             weight: Vec::new(),
             ggx: Vec::new(),
-            ggx_painted: Vec::new(),
             cosines: Vec::new(),
         };
-        for (w, ggx, painted, cosines) in per_phi.into_iter().flatten() {
+        for (w, ggx, cosines) in per_phi.into_iter().flatten() {
             out.weight.push(w);
             out.ggx.push(ggx);
-            out.ggx_painted.push(painted);
             out.cosines.push(cosines);
         }
         out
@@ -200,22 +157,26 @@ impl LobeSamples {
     /// The box average of `max(0, c)^n` for a Phong or Blinn-Phong target: the rule's
     /// `chi(n)`, to check it against the exact integral.
     pub fn target_mean(&self, target: ShadingModel, n: f64) -> f64 {
-        let k = usize::from(target != ShadingModel::Phong);
-        self.weight
-            .iter()
-            .zip(&self.cosines)
-            .map(|(w, c)| w * lobe(c[k], n))
+        (0..self.len())
+            .map(|i| self.weight[i] * self.target_at(target, n, i))
             .sum()
     }
 
     /// The target's `[rho_1, rho_0]` at node `i` for exponent `n` (Cook-Torrance: its painted
     /// exponent, whatever `n`).
     fn target_parts(&self, target: ShadingModel, n: f64, i: usize) -> [f64; 2] {
-        match target {
-            ShadingModel::Phong => [lobe(self.cosines[i][0], n), 0.0],
-            ShadingModel::BlinnPhong => [lobe(self.cosines[i][1], n), 0.0],
-            ShadingModel::CookTorrance => self.ggx_painted[i],
-        }
+        let n = if target.is_microfacet() {
+            self.n_painted
+        } else {
+            n
+        };
+        target.lobe(&self.cosines[i], n)
+    }
+
+    /// The target's whole lobe `rho_1 + rho_0` (`F = 1`) at node `i` (as [`Self::target_parts`]).
+    fn target_at(&self, target: ShadingModel, n: f64, i: usize) -> f64 {
+        let [first, second] = self.target_parts(target, n, i);
+        first + second
     }
 
     /// The L1 distance over the box between the GGX lobe (`F = 1`) and the target's lobe of
@@ -244,7 +205,7 @@ impl LobeSamples {
     /// [`Self::lobe_distance`]: a scan of `u = ln(1 + n)` followed by golden-section search
     /// around the best point. For the Cook-Torrance target, its own painted exponent.
     pub fn fit_n(&self, target: ShadingModel, cap: f64) -> f64 {
-        if target == ShadingModel::CookTorrance {
+        if target.is_microfacet() {
             return self.n_painted;
         }
         minimise_exponent(cap, |n| self.lobe_distance(target, n))
@@ -257,11 +218,10 @@ impl LobeSamples {
     /// in `s`, so the bounded one is that median clamped (found without sorting when at least
     /// half the weight lies at or above the bound).
     pub fn height_for(&self, target: ShadingModel, n: f64) -> (f64, f64) {
-        let k = usize::from(target != ShadingModel::Phong);
         let ratios: Vec<(f64, f64)> = (0..self.len())
             .into_par_iter()
             .filter_map(|i| {
-                let t = lobe(self.cosines[i][k], n);
+                let t = self.target_at(target, n, i);
                 let wt = self.weight[i] * t;
                 let [g1, g0] = self.ggx[i];
                 (wt > 0.0).then(|| ((g1 + g0) / t, wt))
@@ -289,7 +249,7 @@ impl LobeSamples {
         };
         let distance = self.box_sum(|i| {
             let [g1, g0] = self.ggx[i];
-            self.weight[i] * (g1 + g0 - s * lobe(self.cosines[i][k], n)).abs()
+            self.weight[i] * (g1 + g0 - s * self.target_at(target, n, i)).abs()
         });
         (s, distance)
     }
@@ -306,11 +266,10 @@ impl LobeSamples {
     pub fn shape_distance(&self, target: ShadingModel, n: f64) -> f64 {
         let chi = self.target_mean(target, n);
         let [m1, m0] = self.ggx_means();
-        let k = usize::from(target != ShadingModel::Phong);
         (0..self.len())
             .map(|i| {
                 let [g1, g0] = self.ggx[i];
-                self.weight[i] * ((g1 + g0) / (m1 + m0) - lobe(self.cosines[i][k], n) / chi).abs()
+                self.weight[i] * ((g1 + g0) / (m1 + m0) - self.target_at(target, n, i) / chi).abs()
             })
             .sum()
     }

@@ -52,21 +52,12 @@ pub struct RoundTrip {
 impl RoundTrip {
     /// The tables for `model` under `mapping` (built on first use, about 10 ms).
     pub fn for_model(model: ShadingModel, mapping: NMapping) -> &'static Self {
-        static TABLES: [std::sync::OnceLock<RoundTrip>; 5] = [
-            std::sync::OnceLock::new(),
-            std::sync::OnceLock::new(),
-            std::sync::OnceLock::new(),
-            std::sync::OnceLock::new(),
-            std::sync::OnceLock::new(),
-        ];
-        // The Cook-Torrance model has one mapping: one table, whichever is asked for.
-        let k = match (model, mapping) {
-            (ShadingModel::Phong, NMapping::HeightFitted) => 0,
-            (ShadingModel::BlinnPhong, NMapping::HeightFitted) => 1,
-            (ShadingModel::CookTorrance, _) => 2,
-            (ShadingModel::Phong, NMapping::HeightFixed) => 3,
-            (ShadingModel::BlinnPhong, NMapping::HeightFixed) => 4,
-        };
+        const MODELS: usize = ShadingModel::ALL.len();
+        static TABLES: [std::sync::OnceLock<RoundTrip>; 2 * MODELS] =
+            [const { std::sync::OnceLock::new() }; 2 * MODELS];
+        // A microfacet model has one mapping: one table, whichever is asked for.
+        let fixed = mapping == NMapping::HeightFixed && !model.is_microfacet();
+        let k = model.index() + if fixed { MODELS } else { 0 };
         TABLES[k].get_or_init(|| Self::build(model, mapping))
     }
 

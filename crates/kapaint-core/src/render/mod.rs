@@ -279,38 +279,6 @@ pub struct Sample {
     pub n: f32,
 }
 
-/// `x^n` for `x` in `[0, 1]` as the shader computes it: 0 for `x <= 0`, 1 for `n == 0`.
-pub fn spec_pow(x: f32, n: f32) -> f32 {
-    if x.is_nan() || x <= 0.0 {
-        return 0.0;
-    }
-    (n * x.min(1.0).log2()).exp2()
-}
-
-/// Cook-Torrance's radiance factor `D G2 F / (4 N.V)` per colour channel (`k_s` as `F0`), for
-/// unit `normal`, `l` (towards the light) and `v` (towards the eye): the twin of the preview
-/// shader's `cook_torrance_specular`, operation for operation (see
-/// [`reflectance::cook_torrance`] for the model).
-pub fn cook_torrance_specular(normal: Vec3, l: Vec3, v: Vec3, ks: Vec3, n: f32) -> Vec3 {
-    let (nl, nv) = (normal.dot(l), normal.dot(v));
-    let sum = l + v;
-    let len2 = sum.dot(sum);
-    // `!(x > 0)` also turns NaN away.
-    if !(nl > 0.0 && nv > 0.0 && len2 > 0.0) {
-        return Vec3::ZERO;
-    }
-    let h = sum / len2.sqrt();
-    let a2 = 2.0 / (n.min(reflectance::cook_torrance::fast::N_MAX) + 2.0);
-    let c = normal.cross(h);
-    let q = a2 + (1.0 - a2) * c.dot(c);
-    let d = a2 / (std::f32::consts::PI * q * q);
-    let smith = nv * (nl * nl * (1.0 - a2) + a2).sqrt() + nl * (nv * nv * (1.0 - a2) + a2).sqrt();
-    let base = d * nl / (2.0 * smith);
-    let m = 1.0 - v.dot(h).clamp(0.0, 1.0);
-    let s = m * m * m * m * m;
-    base * (ks * (1.0 - s) + Vec3::splat(s))
-}
-
 /// The value a view shows at a surface point with unit `normal`, seen along unit `to_eye`:
 /// the equation of `shaders/preview.wgsl`, in linear light (not yet sRGB-encoded).
 pub fn shade(s: &FrameSettings, m: Sample, normal: Vec3, to_eye: Vec3, uv: glam::Vec2) -> Vec3 {
@@ -354,17 +322,7 @@ pub fn shade(s: &FrameSettings, m: Sample, normal: Vec3, to_eye: Vec3, uv: glam:
     if view == ViewMode::Diffuse {
         return finite(diffuse);
     }
-    let mut specular = Vec3::ZERO;
-    if s.model == ShadingModel::CookTorrance {
-        specular = s.lighting.il * cook_torrance_specular(normal, l, to_eye, ks, n);
-    } else if n_dot_l > 0.0 {
-        let cosine = if s.model == ShadingModel::Phong {
-            (2.0 * n_dot_l * normal - l).dot(to_eye)
-        } else {
-            normal.dot((l + to_eye).normalize())
-        };
-        specular = s.lighting.il * ks * spec_pow(cosine, n);
-    }
+    let specular = s.lighting.il * s.model.specular(normal, l, to_eye, ks, n);
     if view == ViewMode::Specular {
         return finite(specular);
     }

@@ -25,10 +25,7 @@ use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::reference::Material;
-use super::{
-    FrameSettings, VIEW_ERROR_TOP, ViewMode, cook_torrance_specular, heat_ramp, relative_error,
-    spec_pow,
-};
+use super::{FrameSettings, VIEW_ERROR_TOP, ViewMode, heat_ramp, relative_error};
 use crate::mesh::Mesh;
 use crate::mesh::bakes::RayMesh;
 use crate::mesh::pick::Bvh;
@@ -402,33 +399,11 @@ impl Cauchy {
     }
 }
 
-/// The lobe's angular width in the light direction: about `1/sqrt(n)` for Phong, twice that
-/// for Blinn-Phong (the half vector turns half as fast), and GGX's `2 alpha` for Cook-Torrance.
-fn lobe_width(model: ShadingModel, n: f32) -> f32 {
-    let n = n.max(1e-6);
-    let w = match model {
-        ShadingModel::Phong => n.sqrt().recip(),
-        ShadingModel::BlinnPhong => 2.0 * n.sqrt().recip(),
-        ShadingModel::CookTorrance => 2.0 * (2.0 / (n + 2.0)).sqrt(),
-    };
-    w.min(8.0)
-}
-
 /// The box integrand at unit light direction `l`: `k_d cos theta + k_s rho_s` (+ the second
 /// part for Cook-Torrance), as the preview shades it.
 fn integrand(model: ShadingModel, p: &Point, l: Vec3) -> Vec3 {
     let n_dot_l = p.normal.dot(l).max(0.0);
-    let specular = match model {
-        ShadingModel::Phong => {
-            let r = 2.0 * n_dot_l * p.normal - l;
-            p.ks * spec_pow(r.dot(p.to_eye), p.n)
-        }
-        ShadingModel::BlinnPhong => {
-            let h = (l + p.to_eye).normalize_or_zero();
-            p.ks * spec_pow(p.normal.dot(h), p.n)
-        }
-        ShadingModel::CookTorrance => cook_torrance_specular(p.normal, l, p.to_eye, p.ks, p.n),
-    };
+    let specular = model.specular(p.normal, l, p.to_eye, p.ks, p.n);
     p.kd * n_dot_l + specular
 }
 
@@ -443,17 +418,11 @@ fn estimate(model: ShadingModel, p: &Point, k: u32, rays: &RayMesh, far: f32) ->
         .unwrap_or_else(|| p.normal.any_orthonormal_vector());
     let z = p.normal.cross(x);
     let phi = p.normal.dot(p.to_eye).clamp(0.0, 1.0).acos();
-    let width = lobe_width(model, p.n);
+    let width = model.lobe_width(p.n);
     let theta_lobe = Cauchy::new(phi, width, 0.0, FRAC_PI_2);
-    // Across the mirror direction the lobe narrows with the light's distance from the normal:
-    // Phong's R.V falls like sin theta sin phi (1 + cos gamma); the half vector turns by
-    // sin theta / (2 cos phi) per radian of gamma.
+    // Across the mirror direction the lobe narrows with the light's distance from the normal.
     let gamma_lobe = |theta: f32| {
-        let scale = if model == ShadingModel::Phong {
-            width / (theta.sin() * phi.sin()).max(1e-12).sqrt()
-        } else {
-            width * phi.cos() / theta.sin().max(1e-6)
-        };
+        let scale = model.across_width(width, theta, phi);
         Cauchy::new(PI, scale.min(1e3), 0.0, TAU)
     };
     let [diffuse, specular] = p.shares;

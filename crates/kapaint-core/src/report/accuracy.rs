@@ -204,6 +204,14 @@ pub struct AccuracyReport {
     pub cook_torrance: Vec<CtAccuracyRow>,
 }
 
+/// Whether the paper's printed exponent for `model` was a misprint kapaint corrects (eq. 11's
+/// Blinn-Phong exponent): the model whose exponent the report checks.
+fn has_corrected_exponent(model: ShadingModel) -> bool {
+    let [printed, corrected] = [AmbientApprox::PaperPrinted, AmbientApprox::PaperCorrected]
+        .map(|approx| crate::reflectance::paper_constants(model, approx));
+    printed.is_some() && printed != corrected
+}
+
 /// Measures every approximation of `models` on every grid (at least one), evaluating the
 /// exact integrator once per model and grid.
 pub fn accuracy_report(grids: &[Grid], models: &[ShadingModel]) -> AccuracyReport {
@@ -223,12 +231,12 @@ pub fn accuracy_report(grids: &[Grid], models: &[ShadingModel]) -> AccuracyRepor
                     stats: error_stats(approx, &exact),
                 });
             }
-            if model == ShadingModel::BlinnPhong && i == 0 {
+            if i == 0 && has_corrected_exponent(model) {
                 exponent = Some(exponent_check(&exact));
             }
         }
     }
-    let exponent = models.contains(&ShadingModel::BlinnPhong).then(|| {
+    let exponent = models.iter().any(|&m| has_corrected_exponent(m)).then(|| {
         exponent.unwrap_or_else(|| {
             exponent_check(&ExactSamples::compute(
                 ShadingModel::BlinnPhong,

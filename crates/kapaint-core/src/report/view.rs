@@ -290,7 +290,10 @@ fn draw_chi_view(rgb: &mut [u8], size: (u32, u32)) -> Result<(), Box<dyn std::er
         .draw()?;
     for (i, n) in PLOT_N.into_iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();
-        for model in [ShadingModel::Phong, ShadingModel::BlinnPhong] {
+        for (solid, model) in [
+            (true, ShadingModel::Phong),
+            (false, ShadingModel::BlinnPhong),
+        ] {
             let chi = chi_parts_exact(model, n)[0];
             let points: Vec<(f64, f64)> = (0..90)
                 .into_par_iter()
@@ -301,7 +304,7 @@ fn draw_chi_view(rgb: &mut [u8], size: (u32, u32)) -> Result<(), Box<dyn std::er
                 })
                 .collect();
             let style = ShapeStyle::from(colour).stroke_width(2);
-            if model == ShadingModel::Phong {
+            if solid {
                 chart
                     .draw_series(LineSeries::new(points, style))?
                     .label(format!("n = {n} (Phong solid, Blinn-Phong dashed)"))

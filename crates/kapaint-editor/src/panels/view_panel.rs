@@ -118,11 +118,14 @@ impl EditorState {
     pub(crate) fn view_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Shading");
         let mut model = self.doc.settings().model;
-        // The paper's two models on one row, Cook-Torrance below: rows of fixed content keep
-        // the panel's width the same from the first frame on.
-        for row in [&ShadingModel::PAPER[..], &[ShadingModel::CookTorrance]] {
+        // The paper's models on one row, the others below: rows of fixed content keep the
+        // panel's width the same from the first frame on.
+        let (paper, others): (Vec<_>, Vec<_>) = ShadingModel::ALL
+            .into_iter()
+            .partition(|m| m.has_paper_forms());
+        for row in [paper, others] {
             ui.horizontal(|ui| {
-                for &m in row {
+                for m in row {
                     ui.selectable_value(&mut model, m, model_label(m));
                 }
             });
@@ -285,11 +288,10 @@ impl EditorState {
 const COMBO_WIDTH: f32 = 130.0;
 
 /// A shading model as the editor names it: with the paper's equation of its `k_a`.
-pub(crate) fn model_label(model: ShadingModel) -> &'static str {
-    match model {
-        ShadingModel::Phong => "Phong (8)",
-        ShadingModel::BlinnPhong => "Blinn-Phong (11)",
-        ShadingModel::CookTorrance => "Cook-Torrance",
+pub(crate) fn model_label(model: ShadingModel) -> String {
+    match model.paper_equation() {
+        Some(eq) => format!("{} ({eq})", model.label()),
+        None => model.label().to_owned(),
     }
 }
 

@@ -47,15 +47,12 @@ pub struct Side {
 impl Side {
     /// The label drawn over this side of the viewport.
     pub fn label(self) -> String {
-        let model = match self.model {
-            ShadingModel::Phong => "Phong (eq. 8)",
-            ShadingModel::BlinnPhong => "Blinn-Phong (eq. 11)",
-            // The paper printed no form for it: the method is always kapaint's fit.
-            ShadingModel::CookTorrance => {
-                return self.with_view("Cook-Torrance (GGX), fast".to_owned());
-            }
+        // The paper printed no form for Cook-Torrance: there the method is always kapaint's fit.
+        let approx = self.approx.for_model(self.model);
+        let label = match self.model.paper_equation() {
+            Some(eq) => format!("{} (eq. {eq}), {}", self.model.label(), approx.name()),
+            None => format!("{}, {}", self.model.full_label(), approx.name()),
         };
-        let label = format!("{model}, {}", self.approx.name());
         self.with_view(label)
     }
 

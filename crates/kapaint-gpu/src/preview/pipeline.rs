@@ -73,7 +73,7 @@ impl PipelineKey {
             ks_uniform: u.ks.is_some(),
             n_uniform: u.n.is_some(),
             // Cook-Torrance's Fresnel term reflects even where k_s (its F0) is zero.
-            has_specular: u.ks != Some([0.0; 3]) || settings.model == ShadingModel::CookTorrance,
+            has_specular: u.ks != Some([0.0; 3]) || settings.model.has_second_part(),
             normal_map: u.normal_map,
             format,
         }

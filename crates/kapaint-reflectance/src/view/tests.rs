@@ -3,6 +3,8 @@
 
 use super::*;
 use crate::exact::{chi_exact, chi_parts_exact, rho_s};
+use crate::model::phong::exact::phong_head_on;
+use crate::quadrature::{break_points, graded_from};
 
 fn rel(a: f64, b: f64) -> f64 {
     if a == b {
