@@ -12,6 +12,7 @@ mod layers;
 
 mod make;
 mod masks;
+mod memory_need;
 mod moves;
 mod paths;
 mod script;
@@ -424,24 +425,7 @@ impl Document {
     /// memory available could not hold one more layer and its composite: a clear error instead
     /// of an out-of-memory abort part-way through a script.
     fn check_memory(&self, command: &Command) -> Result<(), ModelError> {
-        let writes_a_layer = matches!(
-            command,
-            Command::Stroke(
-                StrokeCommand::BeginStroke(_)
-                    | StrokeCommand::Stroke { .. }
-                    | StrokeCommand::SurfaceStroke { .. }
-            ) | Command::Paint(PaintCommand::Fill(_) | PaintCommand::Gradient { .. })
-                | Command::Import(
-                    ImportCommand::ImportChannel(_) | ImportCommand::ImportMaterial(_)
-                )
-                | Command::Layer(LayerCommand::MergeDown | LayerCommand::Flatten)
-                | Command::Mask(
-                    MaskCommand::AddMask
-                        | MaskCommand::ApplyMask
-                        | MaskCommand::InvertMask
-                        | MaskCommand::MaskFromChannel { .. }
-                )
-        );
+        let writes_a_layer = command.may_write_a_whole_layer();
         if !writes_a_layer {
             return Ok(());
         }
