@@ -400,22 +400,35 @@ pub fn builtin_sets() -> Vec<ExportPreset> {
         .collect()
 }
 
-/// Finds a preset by name or file stem: a user file (`$KAPAINT_EXPORT_PRESET_DIR/NAME.ron`)
-/// first, then the built-in ones.
+/// The folder of the user's export presets: `$KAPAINT_EXPORT_PRESET_DIR` where it is set,
+/// else the `export` folder of the user preset folder every kind of preset shares
+/// ([`kapaint_core::model::preset::user_dir`]).
+pub fn user_dir() -> Option<PathBuf> {
+    std::env::var_os("KAPAINT_EXPORT_PRESET_DIR")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| kapaint_core::model::preset::user_dir().map(|d| d.join("export")))
+}
+
+/// Finds a preset by name or file stem: a user file (`NAME.ron` in [`user_dir`]) first,
+/// then the built-in ones.
 ///
 /// # Errors
 /// A malformed user preset, or no preset of that name.
 pub fn find(name: &str) -> Result<ExportPreset, PresetError> {
-    if let Some(dir) = std::env::var_os("KAPAINT_EXPORT_PRESET_DIR").map(PathBuf::from) {
+    if let Some(dir) = user_dir() {
         let path = dir.join(format!("{name}.ron"));
         if path.exists() {
-            let malformed = |reason: String| PresetError::Malformed {
-                path: path.clone(),
-                reason,
-            };
-            let bytes = kapaint_core::file_check::read_limited(&path, 1 << 20)
-                .map_err(|e| malformed(format!("the file {e}")))?;
-            let text = String::from_utf8(bytes).map_err(|_| malformed("not UTF-8 text".into()))?;
+            // The one reader every preset file goes through (size, regular file, UTF-8).
+            let text = kapaint_core::model::preset::read_text(&path, 1 << 20).map_err(|e| {
+                PresetError::Malformed {
+                    path: path.clone(),
+                    reason: match e {
+                        kapaint_core::model::ModelError::Preset { reason, .. } => reason,
+                        other => other.to_string(),
+                    },
+                }
+            })?;
             return ExportPreset::parse(&path, &text);
         }
     }

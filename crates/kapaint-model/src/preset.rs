@@ -68,15 +68,12 @@ const MAX_PRESET_BYTES: u64 = 1 << 20;
 impl MaterialPreset {
     /// Parses and validates preset text; errors name `path`.
     pub fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
-        ron::from_str(text).map_err(|e| ModelError::Preset {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })
+        <Self as PresetKind>::parse(path, text)
     }
 
     /// Reads and parses a preset file (a regular file of at most 1 MiB).
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        Self::parse(path, &read_text(path, MAX_PRESET_BYTES)?)
+        load::<Self>(path)
     }
 
     /// The preset's material value.
@@ -86,7 +83,7 @@ impl MaterialPreset {
 }
 
 /// The text of a preset file: a regular file of at most `max_bytes`, UTF-8; errors name it.
-pub(crate) fn read_text(path: &Path, max_bytes: u64) -> Result<String, ModelError> {
+pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, ModelError> {
     let bytes = kapaint_base::file_check::read_limited(path, max_bytes).map_err(|e| match e {
         kapaint_base::file_check::FileCheck::Io(source) => ModelError::io(path, source),
         other => ModelError::Preset {
@@ -98,6 +95,84 @@ pub(crate) fn read_text(path: &Path, max_bytes: u64) -> Result<String, ModelErro
         path: path.to_path_buf(),
         reason: "not UTF-8 text".into(),
     })
+}
+
+/// A kind of preset file: RON text of at most [`Self::MAX_BYTES`], parsed and checked by
+/// [`Self::parse`], shipped as `presets/FOLDER/*.ron` and kept by the user in
+/// `FOLDER` of [`user_dir`]. The one loader every kind goes through ([`load`],
+/// [`load_dir`], [`builtin_of`], [`user_folder`]).
+pub trait PresetKind: Sized {
+    /// The largest file read (bytes).
+    const MAX_BYTES: u64;
+    /// The folder under `presets/` that ships the kind, and under [`user_dir`] that keeps the
+    /// user's (`""`: the user folder itself, for materials).
+    const FOLDER: &'static str;
+    /// The shipped folder's name when it differs from [`Self::FOLDER`].
+    const SHIPPED_FOLDER: &'static str = Self::FOLDER;
+
+    /// Parses and checks preset text; errors name `path`.
+    ///
+    /// # Errors
+    /// Malformed RON, unknown fields or values a check refuses.
+    fn parse(path: &Path, text: &str) -> Result<Self, ModelError>;
+}
+
+/// Reads and parses a preset file of kind `T` (a regular file of at most `T::MAX_BYTES`).
+///
+/// # Errors
+/// The file cannot be read, is too large or not UTF-8, or does not parse.
+pub fn load<T: PresetKind>(path: &Path) -> Result<T, ModelError> {
+    T::parse(path, &read_text(path, T::MAX_BYTES)?)
+}
+
+/// Every `.ron` file of kind `T` in `dir`, sorted by name, with its file stem, each read or
+/// with its error.
+pub fn load_dir_of<T: PresetKind>(dir: &Path) -> Vec<Result<(String, T), ModelError>> {
+    ron_files(dir)
+        .into_iter()
+        .map(|p| {
+            let stem = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            load::<T>(&p).map(|preset| (stem, preset))
+        })
+        .collect()
+}
+
+/// The shipped presets of kind `T` (file stems and texts), parsed, by stem.
+pub fn builtin_of<T: PresetKind>(files: &[(&str, &str)]) -> Vec<(String, T)> {
+    files
+        .iter()
+        .filter_map(|(stem, text)| {
+            let path = PathBuf::from(format!("presets/{}/{stem}.ron", T::SHIPPED_FOLDER));
+            T::parse(&path, text).ok().map(|p| ((*stem).to_string(), p))
+        })
+        .collect()
+}
+
+/// Where the user keeps presets of kind `T`: its folder in [`user_dir`].
+pub fn user_folder<T: PresetKind>() -> Option<PathBuf> {
+    user_dir().map(|d| {
+        if T::FOLDER.is_empty() {
+            d
+        } else {
+            d.join(T::FOLDER)
+        }
+    })
+}
+
+impl PresetKind for MaterialPreset {
+    const MAX_BYTES: u64 = MAX_PRESET_BYTES;
+    const FOLDER: &'static str = "";
+    const SHIPPED_FOLDER: &'static str = "materials";
+
+    fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
+        ron::from_str(text).map_err(|e| ModelError::Preset {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })
+    }
 }
 
 macro_rules! builtin {
@@ -141,20 +216,13 @@ builtin!(
 
 /// The built-in presets by file stem, sorted.
 pub fn builtin() -> Vec<(String, MaterialPreset)> {
-    BUILTIN_FILES
-        .iter()
-        .filter_map(|(stem, text)| {
-            let path = PathBuf::from(format!("presets/materials/{stem}.ron"));
-            MaterialPreset::parse(&path, text)
-                .ok()
-                .map(|p| ((*stem).to_string(), p))
-        })
-        .collect()
+    builtin_of(BUILTIN_FILES)
 }
 
 /// The user's preset folder: `$KAPAINT_PRESET_DIR`, else `$XDG_CONFIG_HOME/kapaint/presets`,
-/// else `~/.config/kapaint/presets`. Material presets are its `.ron` files; brush presets
-/// live in its `brushes` folder. It may not exist yet: saving a preset creates it.
+/// else `~/.config/kapaint/presets`. Material presets are its `.ron` files; every other kind
+/// lives in its own folder in it ([`PresetKind::FOLDER`]: `brushes`, `masks`, and `export`
+/// for export presets). It may not exist yet: saving a preset creates it.
 pub fn user_dir() -> Option<PathBuf> {
     std::env::var_os("KAPAINT_PRESET_DIR")
         .filter(|v| !v.is_empty())
@@ -233,16 +301,7 @@ pub(crate) fn ron_files(dir: &Path) -> Vec<PathBuf> {
 
 /// Every `.ron` file in `dir`, sorted by name, each parsed or with its error.
 pub fn load_dir(dir: &Path) -> Vec<Result<(String, MaterialPreset), ModelError>> {
-    ron_files(dir)
-        .into_iter()
-        .map(|p| {
-            let stem = p
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            MaterialPreset::load(&p).map(|preset| (stem, preset))
-        })
-        .collect()
+    load_dir_of(dir)
 }
 
 /// Finds a preset by file stem or display name (case-insensitive): user presets first, then

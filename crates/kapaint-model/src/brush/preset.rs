@@ -21,6 +21,26 @@ pub struct BrushPreset {
 /// Largest brush preset file read (bytes): room for the largest stamp.
 const MAX_BRUSH_PRESET_BYTES: u64 = 8 << 20;
 
+impl crate::preset::PresetKind for BrushPreset {
+    const MAX_BYTES: u64 = MAX_BRUSH_PRESET_BYTES;
+    const FOLDER: &'static str = "brushes";
+
+    fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
+        let preset: Self = ron::from_str(text).map_err(|e| ModelError::Preset {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+        crate::check::name("name", &preset.name).map_err(|reason| ModelError::Preset {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+        Ok(Self {
+            brush: preset.brush.sanitized(),
+            ..preset
+        })
+    }
+}
+
 /// The shipped brush presets, by file stem.
 const BUILTIN: &[(&str, &str)] = &[
     (
@@ -44,26 +64,12 @@ const BUILTIN: &[(&str, &str)] = &[
 impl BrushPreset {
     /// Parses and checks preset text; errors name `path`.
     pub fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
-        let preset: Self = ron::from_str(text).map_err(|e| ModelError::Preset {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
-        crate::check::name("name", &preset.name).map_err(|reason| ModelError::Preset {
-            path: path.to_path_buf(),
-            reason,
-        })?;
-        Ok(Self {
-            brush: preset.brush.sanitized(),
-            ..preset
-        })
+        <Self as crate::preset::PresetKind>::parse(path, text)
     }
 
     /// Reads a preset file (a regular file of at most 8 MiB).
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        Self::parse(
-            path,
-            &crate::preset::read_text(path, MAX_BRUSH_PRESET_BYTES)?,
-        )
+        crate::preset::load::<Self>(path)
     }
 
     /// Saves the preset into `dir` (created if missing) as `STEM.ron`, atomically, replacing
@@ -91,19 +97,17 @@ impl BrushPreset {
 
 /// The shipped brush presets, sorted by file stem.
 pub fn builtin() -> Vec<BrushPreset> {
-    BUILTIN
-        .iter()
-        .filter_map(|(stem, text)| {
-            BrushPreset::parse(Path::new(&format!("presets/brushes/{stem}.ron")), text).ok()
-        })
+    crate::preset::builtin_of(BUILTIN)
+        .into_iter()
+        .map(|(_, p)| p)
         .collect()
 }
 
 /// Every `.ron` file in `dir`, sorted by name, each read or with its error.
 pub fn load_dir(dir: &Path) -> Vec<Result<BrushPreset, ModelError>> {
-    crate::preset::ron_files(dir)
-        .iter()
-        .map(|p| BrushPreset::load(p))
+    crate::preset::load_dir_of(dir)
+        .into_iter()
+        .map(|r| r.map(|(_, p)| p))
         .collect()
 }
 

@@ -22,6 +22,21 @@ pub struct MaskPreset {
 /// Largest smart mask file read (bytes).
 const MAX_MASK_PRESET_BYTES: u64 = 64 << 10;
 
+impl crate::preset::PresetKind for MaskPreset {
+    const MAX_BYTES: u64 = MAX_MASK_PRESET_BYTES;
+    const FOLDER: &'static str = "masks";
+
+    fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
+        let error = |reason: String| ModelError::Preset {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let preset: Self = ron::from_str(text).map_err(|e| error(e.to_string()))?;
+        crate::check::name("name", &preset.name).map_err(error)?;
+        Ok(preset)
+    }
+}
+
 /// The shipped smart masks, by file stem.
 const BUILTIN: &[(&str, &str)] = &[
     (
@@ -42,21 +57,12 @@ const BUILTIN: &[(&str, &str)] = &[
 impl MaskPreset {
     /// Parses and checks preset text; errors name `path`.
     pub fn parse(path: &Path, text: &str) -> Result<Self, ModelError> {
-        let error = |reason: String| ModelError::Preset {
-            path: path.to_path_buf(),
-            reason,
-        };
-        let preset: Self = ron::from_str(text).map_err(|e| error(e.to_string()))?;
-        crate::check::name("name", &preset.name).map_err(error)?;
-        Ok(preset)
+        <Self as crate::preset::PresetKind>::parse(path, text)
     }
 
     /// Reads a preset file (a regular file of at most 64 KiB).
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        Self::parse(
-            path,
-            &crate::preset::read_text(path, MAX_MASK_PRESET_BYTES)?,
-        )
+        crate::preset::load::<Self>(path)
     }
 
     /// Saves the preset into `dir` (created if missing) as `STEM.ron`, atomically, replacing
@@ -85,19 +91,17 @@ impl MaskPreset {
 
 /// The shipped smart masks, sorted by file stem.
 pub fn builtin() -> Vec<MaskPreset> {
-    BUILTIN
-        .iter()
-        .filter_map(|(stem, text)| {
-            MaskPreset::parse(Path::new(&format!("presets/masks/{stem}.ron")), text).ok()
-        })
+    crate::preset::builtin_of(BUILTIN)
+        .into_iter()
+        .map(|(_, p)| p)
         .collect()
 }
 
 /// Every `.ron` file in `dir`, sorted by name, each read or with its error.
 pub fn load_dir(dir: &Path) -> Vec<Result<MaskPreset, ModelError>> {
-    crate::preset::ron_files(dir)
-        .iter()
-        .map(|p| MaskPreset::load(p))
+    crate::preset::load_dir_of(dir)
+        .into_iter()
+        .map(|r| r.map(|(_, p)| p))
         .collect()
 }
 
