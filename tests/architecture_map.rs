@@ -7,6 +7,8 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
+mod source_tree;
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -70,35 +72,10 @@ fn public_modules(src: &Path) -> (BTreeSet<String>, BTreeSet<String>) {
 
 /// Every module of a crate by its path from the root (`set`, `set::plan`), public or not.
 fn module_paths(src: &Path) -> BTreeSet<String> {
-    fn walk(dir: &Path, src: &Path, out: &mut BTreeSet<String>) {
-        for entry in std::fs::read_dir(dir).expect("source folder") {
-            let path = entry.expect("entry").path();
-            if path.is_dir() {
-                walk(&path, src, out);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                let rel = path
-                    .strip_prefix(src)
-                    .expect("under src")
-                    .with_extension("");
-                let mut parts: Vec<String> = rel
-                    .components()
-                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
-                    .collect();
-                if matches!(
-                    parts.last().map(String::as_str),
-                    Some("mod" | "lib" | "main")
-                ) {
-                    parts.pop();
-                }
-                if !parts.is_empty() {
-                    out.insert(parts.join("::"));
-                }
-            }
-        }
-    }
-    let mut out = BTreeSet::new();
-    walk(src, src, &mut out);
-    out
+    source_tree::modules(src)
+        .into_keys()
+        .filter(|m| !m.is_empty())
+        .collect()
 }
 
 /// The text between backticks in `text`.

@@ -11,39 +11,11 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
+mod source_tree;
+
+use source_tree::modules;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-
-/// A crate's modules (`a::b`, the root `""`) and the file of each.
-fn modules(src: &Path) -> BTreeMap<String, PathBuf> {
-    fn walk(dir: &Path, src: &Path, out: &mut BTreeMap<String, PathBuf>) {
-        for entry in std::fs::read_dir(dir).expect("source folder") {
-            let path = entry.expect("entry").path();
-            if path.is_dir() {
-                walk(&path, src, out);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                let rel = path
-                    .strip_prefix(src)
-                    .expect("under src")
-                    .with_extension("");
-                let mut parts: Vec<String> = rel
-                    .components()
-                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
-                    .collect();
-                if matches!(
-                    parts.last().map(String::as_str),
-                    Some("mod" | "lib" | "main")
-                ) {
-                    parts.pop();
-                }
-                out.insert(parts.join("::"), path);
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(src, src, &mut out);
-    out
-}
 
 /// The code of a file without comments, string literals and its test module.
 fn code(path: &Path) -> String {

@@ -71,11 +71,6 @@ pub struct Conversion {
     error: Vec<[f32; KS_NODES]>,
 }
 
-/// The target's index in the tables.
-fn column(model: ShadingModel) -> usize {
-    model.index()
-}
-
 /// A roughness' place among the fitted rows: `(row, fraction)`, the first row below them.
 fn row_of(roughness: f32) -> (usize, f32) {
     let x = unit(roughness) * ROWS_PER_UNIT - FIRST_ROW;
@@ -97,12 +92,12 @@ impl Conversion {
         const MODELS: usize = ShadingModel::ALL.len();
         static TABLES: [OnceLock<Conversion>; 2 * MODELS] = [const { OnceLock::new() }; 2 * MODELS];
         let fitted = mapping == NMapping::HeightFitted && !model.is_microfacet();
-        let slot = column(model) + if fitted { MODELS } else { 0 };
+        let slot = model.index() + if fitted { MODELS } else { 0 };
         TABLES[slot].get_or_init(|| Self::build(model, fitted))
     }
 
     fn build(model: ShadingModel, fitted: bool) -> Self {
-        let k = column(model);
+        let k = model.index();
         let size = LUT_SIZE + 1;
         let (mut n, mut height, mut means, mut error) = (
             Vec::with_capacity(size),
@@ -344,7 +339,7 @@ impl Conversion {
         let y = q.clamp(0.0, 1.0) * (CLAMP_NODES - 1) as f32;
         let l = (y as usize).min(CLAMP_NODES - 2);
         let v = (y - l as f32).min(1.0);
-        let k = column(self.model);
+        let k = self.model.index();
         let at = |row: usize, j: usize| {
             let base = ((row * 2 + k) * KS_NODES + j) * CLAMP_NODES + l;
             lerp(table[base], table[base + 1], v)
