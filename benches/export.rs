@@ -61,8 +61,8 @@ fn exports(c: &mut Criterion) {
 /// texels at its fastest and thorough searches (ISPC's own ASTC encoder beside it:
 /// `benches/peers/astc_side_by_side.sh`).
 fn block_compression(c: &mut Criterion) {
-    use kapaint::export::blocks::{self, BlockKind, Coder};
-    use kapaint::export::preset::Bc7Quality;
+    use kapaint::export::blocks::{self, Coder};
+    use kapaint::export::codec::{Astc, AstcBlock, Bc7, Effort};
     let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/testdata/spot/spot_texture.png");
     let doc = kapaint::report::typical::stroke_edge_document(
@@ -97,27 +97,23 @@ fn block_compression(c: &mut Criterion) {
         .build()
         .expect("pool");
     for (encoder, effort) in [
-        (Coder::Ispc, Bc7Quality::UltraFast),
-        (Coder::Portable, Bc7Quality::UltraFast),
-        (Coder::Ispc, Bc7Quality::VeryFast),
+        (Coder::Ispc, Effort::UltraFast),
+        (Coder::Portable, Effort::UltraFast),
+        (Coder::Ispc, Effort::VeryFast),
     ] {
-        let kind = BlockKind::Bc7 {
-            alpha: true,
-            effort,
-        };
+        let bc7 = Bc7::new(true, true);
         group.bench_function(format!("bc7_one_thread_{encoder:?}_{effort:?}"), |b| {
-            b.iter(|| one.install(|| blocks::encode(encoder, kind, &rgba, (w, h), None)));
+            b.iter(|| one.install(|| blocks::encode(encoder, &bc7, effort, &rgba, (w, h), None)));
         });
     }
-    for effort in [Bc7Quality::UltraFast, Bc7Quality::Basic] {
-        let kind = BlockKind::Astc {
-            block: kapaint::export::astc_block::AstcBlock::DEFAULT,
-            channels: 4,
-            srgb: true,
-            effort,
-        };
+    // One codec value for every iteration: its astcenc contexts are built once, as an
+    // export's image builds them once for its trials and mips.
+    let astc = Astc::new(AstcBlock::DEFAULT, 4, true);
+    for effort in [Effort::UltraFast, Effort::Basic] {
         group.bench_function(format!("astc4x4_one_thread_{effort:?}"), |b| {
-            b.iter(|| one.install(|| blocks::encode(Coder::Ispc, kind, &rgba, (w, h), None)));
+            b.iter(|| {
+                one.install(|| blocks::encode(Coder::Ispc, &astc, effort, &rgba, (w, h), None))
+            });
         });
     }
     group.finish();

@@ -10,9 +10,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use kapaint::export::astc_block::AstcBlock;
-use kapaint::export::blocks::{self, BlockKind, Coder};
-use kapaint::export::preset::{self, Bc7Quality};
+use kapaint::export::blocks::{self, Coder};
+use kapaint::export::codec::{Astc, AstcBlock, Effort, astc};
+use kapaint::export::preset;
 use kapaint::export::{ktx, set};
 use kapaint::report::typical::typical_document;
 
@@ -51,24 +51,15 @@ fn main() -> Result<(), String> {
         std::fs::write(out.join(format!("{name}.rgba")), rgba).map_err(|e| e.to_string())?;
         std::fs::write(out.join(format!("{name}.size")), format!("{w} {h}"))
             .map_err(|e| e.to_string())?;
-        for effort in [
-            Bc7Quality::UltraFast,
-            Bc7Quality::VeryFast,
-            Bc7Quality::Fast,
-            Bc7Quality::Basic,
-            Bc7Quality::Slow,
-        ] {
-            let kind = BlockKind::Astc {
-                block: AstcBlock::DEFAULT,
-                channels: 4,
-                srgb: false,
-                effort,
-            };
-            let preset = blocks::astc::preset_of(effort).0.replace(' ', "-");
-            // Once to build the pooled contexts, then timed.
-            blocks::encode(Coder::best_cpu(), kind, rgba, (*w, *h), None);
+        let codec = Astc::new(AstcBlock::DEFAULT, 4, false);
+        for effort in Effort::ALL {
+            let preset = astc::preset_of(effort).0.replace(' ', "-");
+            // Once to build the codec's contexts, then timed.
+            blocks::encode(Coder::best_cpu(), &codec, effort, rgba, (*w, *h), None)
+                .map_err(|e| e.to_string())?;
             let start = Instant::now();
-            let encoded = blocks::encode(Coder::best_cpu(), kind, rgba, (*w, *h), None);
+            let encoded = blocks::encode(Coder::best_cpu(), &codec, effort, rgba, (*w, *h), None)
+                .map_err(|e| e.to_string())?;
             let seconds = start.elapsed().as_secs_f64();
             std::fs::write(out.join(format!("{name}_{preset}.astc")), &encoded)
                 .map_err(|e| e.to_string())?;

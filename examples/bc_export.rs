@@ -10,8 +10,9 @@
 use std::path::Path;
 use std::time::Instant;
 
-use kapaint::export::blocks::{self, BlockKind, Coder};
-use kapaint::export::preset::{self, Bc7Quality};
+use kapaint::export::blocks::{self, Coder};
+use kapaint::export::codec::{Bc7, Effort};
+use kapaint::export::preset;
 use kapaint::export::set;
 use kapaint::report::typical::stroke_edge_document;
 
@@ -102,16 +103,15 @@ fn main() -> Result<(), String> {
         .build()
         .map_err(|e| e.to_string())?;
     println!("one thread, BC7 RGBA {w}x{h} level 0:");
-    for effort in [Bc7Quality::UltraFast, Bc7Quality::VeryFast] {
+    let bc7 = Bc7::new(true, false);
+    for effort in [Effort::UltraFast, Effort::VeryFast] {
         for encoder in [Coder::Ispc, Coder::Portable] {
-            let kind = BlockKind::Bc7 {
-                alpha: true,
-                effort,
-            };
             let start = Instant::now();
-            let blocks = one.install(|| blocks::encode(encoder, kind, &rgba, (w, h), None));
+            let blocks = one
+                .install(|| blocks::encode(encoder, &bc7, effort, &rgba, (w, h), None))
+                .map_err(|e| e.to_string())?;
             let secs = start.elapsed().as_secs_f64();
-            let back = blocks::decode(kind, &blocks, (w, h));
+            let back = blocks::decode(&bc7, &blocks, (w, h)).map_err(|e| e.to_string())?;
             println!(
                 "  {encoder:?} {effort:?}: {secs:.2} s, PSNR {:.1} / {:.1} / {:.1} / {:.1} dB",
                 psnr(&rgba, &back, 0),

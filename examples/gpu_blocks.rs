@@ -8,9 +8,9 @@
 
 use std::time::Instant;
 
-use kapaint::export::blocks::{self, BlockKind, Coder};
+use kapaint::export::blocks::{self, Coder};
+use kapaint::export::codec::{Bc7, Effort};
 use kapaint::export::ktx::{Space, psnr};
-use kapaint::export::preset::Bc7Quality;
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
@@ -18,16 +18,16 @@ fn main() -> Result<(), String> {
         .next()
         .map_or(Ok(4096), |s| s.parse())
         .map_err(|e| format!("SIDE: {e}"))?;
-    let efforts: Vec<Bc7Quality> = args
+    let efforts: Vec<Effort> = args
         .map(|a| {
-            Bc7Quality::ALL
+            Effort::ALL
                 .into_iter()
                 .find(|q| format!("{q:?}").to_lowercase() == a.replace('-', ""))
                 .ok_or(format!("unknown effort {a}"))
         })
         .collect::<Result<_, _>>()?;
     let efforts = if efforts.is_empty() {
-        vec![Bc7Quality::UltraFast]
+        vec![Effort::UltraFast]
     } else {
         efforts
     };
@@ -53,16 +53,14 @@ fn main() -> Result<(), String> {
     );
     let size = (side, side);
     let spaces = [Space::Srgb, Space::Srgb, Space::Srgb, Space::Linear];
+    let bc7 = Bc7::new(false, true);
     for effort in efforts {
-        let kind = BlockKind::Bc7 {
-            alpha: false,
-            effort,
-        };
         for encoder in [Coder::Brought(&encoder), Coder::best_cpu()] {
             let t = Instant::now();
-            let out = blocks::encode(encoder, kind, &texels, size, None);
+            let out = blocks::encode(encoder, &bc7, effort, &texels, size, None)
+                .map_err(|e| e.to_string())?;
             let seconds = t.elapsed().as_secs_f64();
-            let back = blocks::decode(kind, &out, size);
+            let back = blocks::decode(&bc7, &out, size).map_err(|e| e.to_string())?;
             let db: Vec<String> = psnr(&texels, &back, &spaces)
                 .iter()
                 .map(|p| p.map_or("exact".into(), |p| format!("{p:.2}")))

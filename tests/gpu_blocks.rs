@@ -17,9 +17,10 @@ use std::process::Command;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use kapaint::export::blocks::{self, BlockEncoder, BlockKind, Coder, Encoder};
+use kapaint::export::blocks::{self, BlockEncoder, Coder, Encoder};
+use kapaint::export::codec::{Bc4, Bc5, Bc6h, Bc7, Codec, Effort};
 use kapaint::export::ktx::{Space, psnr};
-use kapaint::export::preset::{self, Bc7Quality};
+use kapaint::export::preset;
 use kapaint::export::set;
 use kapaint::gpu::blocks::GpuBlockEncoder;
 use kapaint::report::typical::stroke_edge_document;
@@ -58,9 +59,9 @@ fn halves(bytes: &[u8]) -> Vec<u8> {
         .collect()
 }
 
-fn quality(kind: BlockKind, src: &[u8], blocks: &[u8], size: (u32, u32)) -> Vec<Option<f64>> {
-    let back = blocks::decode(kind, blocks, size);
-    if let BlockKind::Bc6h { .. } = kind {
+fn quality(codec: &dyn Codec, src: &[u8], blocks: &[u8], size: (u32, u32)) -> Vec<Option<f64>> {
+    let back = blocks::decode(codec, blocks, size).expect("decoded");
+    if codec.texel_bytes() == 8 {
         // Compare as 8-bit values: the halves' relative error shows as dB like the rest.
         let bytes = |d: &[u8]| -> Vec<u8> {
             d.chunks_exact(2)
@@ -70,7 +71,7 @@ fn quality(kind: BlockKind, src: &[u8], blocks: &[u8], size: (u32, u32)) -> Vec<
         let spaces = vec![Space::Linear; 4];
         return psnr(&bytes(src), &bytes(&back), &spaces);
     }
-    psnr(src, &back, &vec![Space::Linear; kind.texel_bytes()])
+    psnr(src, &back, &vec![Space::Linear; codec.texel_bytes()])
 }
 
 #[test]
@@ -85,33 +86,27 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
     assert_eq!(Coder::best(Some(encoder)).name(), Encoder::Gpu);
     assert_eq!(Coder::best(None).name(), Encoder::best_cpu());
     let size = (64, 44);
-    let kinds = [
-        BlockKind::Bc4,
-        BlockKind::Bc5,
-        BlockKind::Bc7 {
-            alpha: false,
-            effort: Bc7Quality::UltraFast,
-        },
-        BlockKind::Bc7 {
-            alpha: true,
-            effort: Bc7Quality::VeryFast,
-        },
-        BlockKind::Bc6h {
-            effort: Bc7Quality::UltraFast,
-        },
+    let codecs: [(Box<dyn Codec>, Effort); 5] = [
+        (Box::new(Bc4), Effort::UltraFast),
+        (Box::new(Bc5), Effort::UltraFast),
+        (Box::new(Bc7::new(false, true)), Effort::UltraFast),
+        (Box::new(Bc7::new(true, false)), Effort::VeryFast),
+        (Box::new(Bc6h), Effort::UltraFast),
     ];
-    for kind in kinds {
-        let src = if let BlockKind::Bc6h { .. } = kind {
+    for (codec, effort) in codecs {
+        let (codec, kind) = (&*codec, format!("{codec:?} {effort:?}"));
+        assert!(encoder.encodes(codec), "{kind}");
+        let src = if codec.texel_bytes() == 8 {
             halves(&pattern(size, 4))
         } else {
-            pattern(size, kind.texel_bytes())
+            pattern(size, codec.texel_bytes())
         };
-        let row = size.0 as usize * kind.texel_bytes();
+        let row = size.0 as usize * codec.texel_bytes();
         let mut strips = Vec::new();
-        let mut gpu_blocks = vec![0; (size.0 * size.1) as usize / 16 * kind.block_bytes()];
+        let mut gpu_blocks = vec![0; (size.0 * size.1) as usize / 16 * codec.block_bytes()];
         encoder
             .encode(
-                kind,
+                (codec, effort),
                 size,
                 &mut |y, rows, out: &mut [u8]| {
                     out.copy_from_slice(&src[y as usize * row..(y + rows) as usize * row]);
@@ -123,17 +118,15 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
                 &mut gpu_blocks,
             )
             .expect("GPU encode");
-        assert_eq!(strips, [8, 8, 8, 8, 8, 4], "{kind:?}");
+        assert_eq!(strips, [8, 8, 8, 8, 8, 4], "{kind}");
         // Through the exporter's entry point too (texels widened strip by strip).
-        assert_eq!(
-            blocks::encode(Coder::Brought(encoder), kind, &src, size, None),
-            gpu_blocks,
-            "{kind:?}"
-        );
-        let cpu_blocks = blocks::encode(Coder::best_cpu(), kind, &src, size, None);
+        let brought = blocks::encode(Coder::Brought(encoder), codec, effort, &src, size, None);
+        assert_eq!(brought.expect("blocks"), gpu_blocks, "{kind}");
+        let cpu_blocks =
+            blocks::encode(Coder::best_cpu(), codec, effort, &src, size, None).expect("blocks");
         let (on_gpu, on_cpu) = (
-            quality(kind, &src, &gpu_blocks, size),
-            quality(kind, &src, &cpu_blocks, size),
+            quality(codec, &src, &gpu_blocks, size),
+            quality(codec, &src, &cpu_blocks, size),
         );
         for (g, c) in on_gpu.iter().zip(&on_cpu) {
             let (g, c) = (g.unwrap_or(99.0), c.unwrap_or(99.0));
@@ -141,7 +134,7 @@ fn gpu_blocks_decode_as_close_as_the_cpu_encoders_and_a_ktx2_export_records_them
             // strip written to the wrong rows or a wrong source format falls below 20 dB.
             assert!(
                 g > 30.0 && g > c - 1.0,
-                "{kind:?} on {adapter}: GPU {on_gpu:?} dB, CPU {on_cpu:?} dB"
+                "{kind} on {adapter}: GPU {on_gpu:?} dB, CPU {on_cpu:?} dB"
             );
         }
     }

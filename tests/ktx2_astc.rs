@@ -12,9 +12,9 @@
 
 use std::path::{Path, PathBuf};
 
-use kapaint::export::astc_block::AstcBlock;
-use kapaint::export::blocks::{self, BlockKind, Coder};
-use kapaint::export::preset::{self, Bc7Quality, ExportPreset};
+use kapaint::export::blocks::{self, Coder};
+use kapaint::export::codec::{Astc, AstcBlock, Effort};
+use kapaint::export::preset::{self, ExportPreset};
 use kapaint::export::set::{self, BlockLayout, ColourSpace, Compression, Manifest};
 use kapaint::model::Document;
 use kapaint::report::typical::typical_document;
@@ -35,10 +35,10 @@ fn project(side: u32) -> Document {
     typical_document(side, texture.exists().then_some(texture.as_path()), 12).expect("project")
 }
 
-fn astc_preset(block: &str, extra: &str) -> ExportPreset {
+fn astc_preset(block: &str, max_effort: &str, extra: &str) -> ExportPreset {
     let text = format!(
-        "(name: \"astc-{block}\", format: Ktx2Astc, layout: Packed, n_bits: 8, \
-         astc_block: \"{block}\"{extra})"
+        "(version: 2, name: \"astc-{block}\", format: Ktx2Astc(block: \"{block}\", \
+         max_effort: {max_effort}), layout: Packed, n_bits: 8{extra})"
     );
     ExportPreset::parse(Path::new("astc.ron"), &text).expect("preset")
 }
@@ -215,7 +215,7 @@ fn check_raw(path: &Path) -> Vec<Vec<u8>> {
 fn astc_sets_are_valid_ktx2_that_an_independent_decoder_reads_close_to_the_project() {
     let doc = project(128);
     let p = preset::find("ktx2-astc").expect("the built-in preset");
-    assert_eq!(p.astc_block, AstcBlock::DEFAULT);
+    assert_eq!(p.format.astc_block(), Some(AstcBlock::DEFAULT));
     let out = temp("4x4");
     let m = set::export(&doc, &p, &out).expect("export");
     let blocks = m.blocks.as_ref().expect("the search's record");
@@ -236,8 +236,8 @@ fn a_larger_footprint_is_a_preset_field_and_pads_partial_blocks() {
     // 6x6 on a 128^2 project: 22 blocks across, the last one two texels past the edge.
     let doc = project(128);
     let block = AstcBlock::parse("6x6").expect("6x6");
-    let p = astc_preset("6x6", "");
-    assert_eq!(p.astc_block, block);
+    let p = astc_preset("6x6", "Basic", "");
+    assert_eq!(p.format.astc_block(), Some(block));
     let out = temp("6x6");
     let m = set::export(&doc, &p, &out).expect("export");
     assert_eq!(m.blocks.as_ref().and_then(|b| b.astc_block), Some(block));
@@ -252,7 +252,7 @@ fn a_larger_footprint_is_a_preset_field_and_pads_partial_blocks() {
 fn footprints_astc_does_not_define_are_refused_by_the_preset_loader() {
     for bad in ["7x7", "4x5", "16x16", "4x4x4", "big"] {
         let text = format!(
-            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"{bad}\")"
+            "(version: 2, name: \"a\", format: Ktx2Astc(block: \"{bad}\"), layout: Packed, n_bits: 8)"
         );
         let err = ExportPreset::parse(Path::new("bad.ron"), &text)
             .expect_err(bad)
@@ -263,11 +263,12 @@ fn footprints_astc_does_not_define_are_refused_by_the_preset_loader() {
         );
     }
     // A footprint belongs to ASTC presets only.
-    let text = "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, astc_block: \"4x4\")";
+    let text =
+        "(version: 2, name: \"a\", format: Ktx2Bc(block: \"4x4\"), layout: Packed, n_bits: 8)";
     assert!(ExportPreset::parse(Path::new("x.ron"), text).is_err());
     for good in AstcBlock::ALL {
-        let p = astc_preset(&good.name(), "");
-        assert_eq!(p.astc_block, good);
+        let p = astc_preset(&good.name(), "Basic", "");
+        assert_eq!(p.format.astc_block(), Some(good));
     }
 }
 
@@ -281,15 +282,19 @@ fn two_components_are_luminance_and_alpha() {
             [(x * 4) as u8, (255 - y * 6) as u8]
         })
         .collect();
-    let kind = BlockKind::Astc {
-        block: AstcBlock::DEFAULT,
-        channels: 2,
-        srgb: false,
-        effort: Bc7Quality::Fast,
-    };
-    let encoded = blocks::encode_stored(Coder::best_cpu(), kind, &src, 2, (w, h), None);
+    let astc = Astc::new(AstcBlock::DEFAULT, 2, false);
+    let encoded = blocks::encode_stored(
+        Coder::best_cpu(),
+        &astc,
+        Effort::Fast,
+        &src,
+        2,
+        (w, h),
+        None,
+    )
+    .expect("blocks");
     let theirs = decode(&encoded, (w, h), AstcBlock::DEFAULT);
-    let ours = blocks::decode_stored(kind, &encoded, (w, h), 2);
+    let ours = blocks::decode_stored(&astc, &encoded, (w, h), 2).expect("decoded");
     for (i, (t, s)) in theirs.chunks_exact(4).zip(src.chunks_exact(2)).enumerate() {
         assert!(t[0] == t[1] && t[1] == t[2], "texel {i}: luminance {t:?}");
         assert!(
@@ -311,12 +316,13 @@ fn the_search_tries_both_layouts_then_more_effort_against_the_perceptual_budget(
     let doc = project(64);
     let p = astc_preset(
         "4x4",
-        ", ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0, max_bc7_effort: Fast",
+        "Fast",
+        ", ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0",
     );
     let out = temp("search");
     let m = set::export(&doc, &p, &out).expect("export");
     let b = m.blocks.as_ref().expect("blocks");
-    let tried: Vec<(BlockLayout, Bc7Quality)> =
+    let tried: Vec<(BlockLayout, Effort)> =
         b.trials.iter().map(|t| (t.layout, t.bc7_effort)).collect();
     // The project's k_s is grey: packed (kd_n + ks) and n apart (kd + ks_n) are two images of
     // 16-byte blocks each, the same bytes, and n apart goes first.
@@ -324,12 +330,12 @@ fn the_search_tries_both_layouts_then_more_effort_against_the_perceptual_budget(
     assert!(m.files.iter().any(|f| f.layout.contains(&"ks".to_string())));
     assert_eq!(
         tried[0],
-        (BlockLayout::NApart, Bc7Quality::UltraFast),
+        (BlockLayout::NApart, Effort::UltraFast),
         "{tried:?}"
     );
     assert_eq!(
         tried[1],
-        (BlockLayout::Packed, Bc7Quality::UltraFast),
+        (BlockLayout::Packed, Effort::UltraFast),
         "{tried:?}"
     );
     assert!(
@@ -363,16 +369,16 @@ fn the_files_written_are_the_kept_trials_when_the_search_ends_on_another() {
         (
             astc_preset(
                 "4x4",
-                ", ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0, max_bc7_effort: UltraFast",
+                "UltraFast",
+                ", ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0",
             ),
             "kept-astc",
         ),
         (
             ExportPreset::parse(
                 Path::new("bc.ron"),
-                "(name: \"bc\", format: Ktx2Bc, layout: Packed, n_bits: 8, \
-                 ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0, max_bc7_effort: UltraFast, \
-                 bc6h: false)",
+                "(version: 2, name: \"bc\", format: Ktx2Bc(max_effort: UltraFast, bc6h: false), \
+                 layout: Packed, n_bits: 8, ka_error_srgb_p999: 0.0, ka_error_srgb_mean: 0.0)",
             )
             .expect("preset"),
             "kept-bc",
@@ -433,7 +439,7 @@ fn an_astc_file_of_garbage_blocks_reads_without_a_crash() {
     let doc = project(64);
     for block in ["4x4", "12x12"] {
         let out = temp(&format!("garbage-{block}"));
-        let m = set::export(&doc, &astc_preset(block, ""), &out).expect("export");
+        let m = set::export(&doc, &astc_preset(block, "Basic", ""), &out).expect("export");
         let path = out.join(&m.files[0].path);
         let mut bytes = std::fs::read(&path).expect("read");
         let reader = ktx2::Reader::new(&bytes[..]).expect("KTX2");

@@ -12,7 +12,8 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use kapaint::export::preset::{self, Bc7Quality, BlockBudget, ExportPreset};
+use kapaint::export::codec::Effort;
+use kapaint::export::preset::{self, BlockBudget, ExportPreset, Format};
 use kapaint::export::set::{self, BlockLayout, Manifest};
 use kapaint::model::Document;
 use kapaint::report::typical::stroke_edge_document;
@@ -283,9 +284,12 @@ fn every_level_of_every_file_decodes_independently_close_to_the_uncompressed_lev
     // once asked for a maximum nothing meets, at a ceiling that ended the search on the BC6H
     // trial; the files were that trial's while the manifest named the nearest, packed BC7:
     // `tests/ktx2_astc.rs` checks the files are the kept trial's.)
-    let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Bc7Quality::UltraFast);
+    let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Effort::UltraFast);
     let mut shipped = preset::find("ktx2").expect("preset");
-    shipped.max_bc7_effort = Bc7Quality::UltraFast;
+    shipped.format = Format::Ktx2Bc {
+        max_effort: Effort::UltraFast,
+        bc6h: true,
+    };
     let mut half_files = Vec::new();
     for (doc, bc_preset, tag) in [
         (project(256), loose, "bc"),
@@ -371,22 +375,25 @@ fn relative_budget(max: f64, mean: f64, psnr: f64) -> BlockBudget {
     }
 }
 
-fn with_budget(budget: BlockBudget, ceiling: Bc7Quality) -> ExportPreset {
+fn with_budget(budget: BlockBudget, ceiling: Effort) -> ExportPreset {
     let mut p = preset::find("ktx2").expect("preset");
     p.budget = budget;
-    p.max_bc7_effort = ceiling;
+    p.format = Format::Ktx2Bc {
+        max_effort: ceiling,
+        bc6h: true,
+    };
     p
 }
 
 #[test]
 fn the_cheapest_encoding_that_meets_the_budget_is_kept_and_no_more_is_spent() {
     let doc = project(128);
-    let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Bc7Quality::Basic);
+    let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Effort::Basic);
     let (dir, manifest) = export(&doc, &loose, "loose");
     let blocks = manifest.blocks.expect("a block choice");
     assert_eq!(blocks.trials.len(), 1, "{blocks:?}");
     assert_eq!(blocks.layout, BlockLayout::Packed);
-    assert_eq!(blocks.bc7_effort, Bc7Quality::UltraFast);
+    assert_eq!(blocks.bc7_effort, Effort::UltraFast);
     assert!(blocks.within_budget && blocks.reason.contains("within the budget"));
     assert!(
         cfg!(not(target_arch = "x86_64"))
@@ -426,7 +433,7 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
     // cheapest first, then n apart in BC7, then k_d as BC6H too (the grey project's budget,
     // which only BC6H meets, is in `every_level_...`). Then a relative mean between n
     // apart's and packed's.
-    let none = with_budget(relative_budget(1e-6, 1e-9, 40.0), Bc7Quality::UltraFast);
+    let none = with_budget(relative_budget(1e-6, 1e-9, 40.0), Effort::UltraFast);
     let (dir, manifest) = export(&doc, &none, "strict-first");
     let _ = std::fs::remove_dir_all(dir);
     let first = manifest.blocks.expect("a block choice").trials;
@@ -434,16 +441,16 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
     assert_eq!(
         order,
         [
-            (BlockLayout::Packed, Bc7Quality::UltraFast),
-            (BlockLayout::NApart, Bc7Quality::UltraFast),
-            (BlockLayout::HalfColour, Bc7Quality::UltraFast)
+            (BlockLayout::Packed, Effort::UltraFast),
+            (BlockLayout::NApart, Effort::UltraFast),
+            (BlockLayout::HalfColour, Effort::UltraFast)
         ],
         "the cheapest first, then n apart, then k_d as BC6H, at the same effort"
     );
     let (packed, apart) = (first[0].ka_error.mean, first[1].ka_error.mean);
     assert!(apart < packed, "n out of k_d's blocks: {first:?}");
     let budget = relative_budget(1e-6, (packed * apart).sqrt(), 40.0);
-    let strict = with_budget(budget, Bc7Quality::Fast);
+    let strict = with_budget(budget, Effort::Fast);
     let (dir, manifest) = export(&doc, &strict, "strict");
     let blocks = manifest.blocks.expect("a block choice");
     let tried: Vec<_> = blocks
@@ -466,12 +473,8 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
     // Effort stops at the ceiling, and BC6H has no very-fast step of its own.
     assert!(
         blocks.trials.len() <= 5
-            && blocks
-                .trials
-                .iter()
-                .all(|t| t.bc7_effort <= Bc7Quality::Fast
-                    && (t.layout != BlockLayout::HalfColour
-                        || t.bc7_effort != Bc7Quality::VeryFast)),
+            && blocks.trials.iter().all(|t| t.bc7_effort <= Effort::Fast
+                && (t.layout != BlockLayout::HalfColour || t.bc7_effort != Effort::VeryFast)),
         "effort stops at the ceiling: {blocks:?}"
     );
     // The chosen trial misses the fewest measures, and the files are its layout.
@@ -499,8 +502,11 @@ fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
 #[test]
 fn without_bc6h_n_moves_apart_in_bc7() {
     let doc = project(128);
-    let mut strict = with_budget(relative_budget(1e-6, 1e-7, 90.0), Bc7Quality::UltraFast);
-    strict.bc6h = false;
+    let mut strict = with_budget(relative_budget(1e-6, 1e-7, 90.0), Effort::UltraFast);
+    strict.format = Format::Ktx2Bc {
+        max_effort: Effort::UltraFast,
+        bc6h: false,
+    };
     let (dir, manifest) = export(&doc, &strict, "no-bc6h");
     let blocks = manifest.blocks.expect("a block choice");
     let layouts: Vec<BlockLayout> = blocks.trials.iter().map(|t| t.layout).collect();
@@ -517,18 +523,23 @@ fn without_bc6h_n_moves_apart_in_bc7() {
 fn presets_name_their_budget_and_bad_budgets_are_refused() {
     let p = preset::find("ktx2").expect("preset");
     assert_eq!(p.budget, BlockBudget::default());
-    assert_eq!(p.max_bc7_effort, Bc7Quality::Basic);
-    // Older presets named the ceiling bc7_quality.
+    assert_eq!(p.format.max_effort(), Some(Effort::Basic));
+    // Version-1 presets named the ceiling bc7_quality, then max_bc7_effort, beside the
+    // format: refused, with the spelling to write instead.
     let old = ExportPreset::parse(
         Path::new("old.ron"),
         "(name: \"old\", format: Ktx2Bc, layout: Packed, n_bits: 8, bc7_quality: Fast)",
     )
-    .expect("an older preset");
-    assert_eq!(old.max_bc7_effort, Bc7Quality::Fast);
-    // Older presets' relative limits stay limits, beside the perceptual ones.
+    .expect_err("a version-1 preset")
+    .to_string();
+    assert!(
+        old.ends_with("write version: 2 and format: Ktx2Bc(max_effort: Fast, bc6h: true)"),
+        "{old}"
+    );
+    // The relative limits stay limits, beside the perceptual ones.
     let relative = ExportPreset::parse(
         Path::new("old.ron"),
-        "(name: \"old\", format: Ktx2Bc, layout: Packed, n_bits: 8, max_ka_error: 0.02, mean_ka_error: 0.002, min_psnr: 45.0)",
+        "(version: 2, name: \"old\", format: Ktx2Bc(), layout: Packed, n_bits: 8, max_ka_error: 0.02, mean_ka_error: 0.002, min_psnr: 45.0)",
     )
     .expect("an older preset with relative limits");
     assert_eq!(relative.budget.max_ka_error, Some(0.02));
@@ -541,7 +552,9 @@ fn presets_name_their_budget_and_bad_budgets_are_refused() {
         "ka_error_srgb_p999: -1.0",
         "ka_error_srgb_mean: NaN",
     ] {
-        let text = format!("(name: \"b\", format: Ktx2Bc, layout: Packed, n_bits: 8, {bad})");
+        let text = format!(
+            "(version: 2, name: \"b\", format: Ktx2Bc(), layout: Packed, n_bits: 8, {bad})"
+        );
         assert!(
             ExportPreset::parse(Path::new("b.ron"), &text).is_err(),
             "{bad}"
@@ -555,7 +568,8 @@ fn presets_name_their_budget_and_bad_budgets_are_refused() {
 /// three quarters of a level on average over that project.
 #[test]
 fn blocks_of_one_colour_decode_exactly() {
-    use kapaint::export::blocks::{BlockKind, Coder, encode};
+    use kapaint::export::blocks::{Coder, encode};
+    use kapaint::export::codec::Bc7;
     let colours: [[u8; 4]; 8] = [
         [255, 238, 230, 255],
         [255, 198, 167, 255],
@@ -572,17 +586,21 @@ fn blocks_of_one_colour_decode_exactly() {
         .flat_map(|t| colours[((t / w / 4) * 4 + (t % w) / 4) as usize])
         .collect();
     for coder in [Coder::best_cpu(), Coder::Portable] {
-        for effort in Bc7Quality::ALL {
+        for effort in Effort::ALL {
             for alpha in [false, true] {
-                let kind = BlockKind::Bc7 { alpha, effort };
-                let blocks = encode(coder, kind, &texels, (w, h), None);
+                let bc7 = Bc7::new(alpha, false);
+                let blocks = encode(coder, &bc7, effort, &texels, (w, h), None).expect("blocks");
                 for (i, block) in blocks.chunks_exact(16).enumerate() {
                     let mut decoded = [0_u8; 64];
                     bcdec_rs::bc7(block, &mut decoded, 16);
                     let want = colours[i];
                     let keep = if alpha { 4 } else { 3 };
                     for texel in decoded.chunks_exact(4) {
-                        assert_eq!(texel[..keep], want[..keep], "{coder:?} {kind:?}, block {i}");
+                        assert_eq!(
+                            texel[..keep],
+                            want[..keep],
+                            "{coder:?} {bc7:?} {effort:?}, block {i}"
+                        );
                     }
                 }
             }

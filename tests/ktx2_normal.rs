@@ -119,8 +119,8 @@ fn decode_xy(format: ktx2::Format, data: &[u8], (w, h): (u32, u32)) -> Vec<[u8; 
         }
         return out;
     }
-    let (block, srgb) = kapaint::export::astc_block::AstcBlock::of_vk_format(format.value())
-        .expect("an ASTC format");
+    let (block, srgb) =
+        kapaint::export::codec::AstcBlock::of_vk_format(format.value()).expect("an ASTC format");
     assert!(!srgb, "a normal map is not colour");
     let (bw, bh) = block.dims();
     let mut image = vec![0_u32; w * h];

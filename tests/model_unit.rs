@@ -7,58 +7,10 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
-use std::path::{Path, PathBuf};
+mod product_sources;
 
 use kapaint::reflectance::ShadingModel;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Every file under `dir` whose name ends with `ext`, recursively.
-fn files(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            files(&path, ext, out);
-        } else if path.to_string_lossy().ends_with(ext) {
-            out.push(path);
-        }
-    }
-}
-
-/// The product's Rust sources, each with its text up to its first `#[cfg(test)]`: test
-/// files and test modules are left out.
-fn product_sources() -> Vec<(String, String)> {
-    let root = root();
-    let mut paths = Vec::new();
-    files(&root.join("src"), ".rs", &mut paths);
-    files(&root.join("crates"), ".rs", &mut paths);
-    let mut out: Vec<(String, String)> = paths
-        .into_iter()
-        .filter_map(|p| {
-            let relative = p
-                .strip_prefix(&root)
-                .ok()?
-                .to_string_lossy()
-                .replace('\\', "/");
-            let is_test = relative.contains("/tests/")
-                || relative.ends_with("/tests.rs")
-                || relative.contains("/benches/");
-            if is_test {
-                return None;
-            }
-            let text = std::fs::read_to_string(&p).ok()?;
-            let code = text.split("#[cfg(test)]").next().unwrap_or("").to_owned();
-            Some((relative, code))
-        })
-        .collect();
-    out.sort();
-    out
-}
+use product_sources::{files, product_sources, root};
 
 /// The variants' paths as code names them.
 fn variant_paths() -> Vec<String> {
@@ -135,27 +87,9 @@ fn the_detectors_see_what_they_look_for() {
     ));
 }
 
-/// The files ARCHITECTURE.md lists between its `model-files` markers.
-fn listed_files() -> Vec<String> {
-    let text = std::fs::read_to_string(root().join("ARCHITECTURE.md")).expect("ARCHITECTURE.md");
-    let start = text
-        .find("<!-- model-files -->")
-        .expect("ARCHITECTURE.md marks the files a new model touches");
-    let end = text
-        .find("<!-- /model-files -->")
-        .expect("the list's end marker");
-    text[start..end]
-        .lines()
-        .filter_map(|line| {
-            let line = line.trim().strip_prefix("- `")?;
-            Some(line[..line.find('`')?].to_owned())
-        })
-        .collect()
-}
-
 #[test]
 fn architecture_lists_every_file_a_new_model_touches_and_they_are_at_most_ten() {
-    let listed = listed_files();
+    let listed = product_sources::listed_files("model-files");
     assert!(
         !listed.is_empty() && listed.len() <= 10,
         "a new model touches {} files outside its folder: {listed:?}",

@@ -311,13 +311,13 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
         (&args.files, &args.out, args.report, args.replace, args.glb);
     let preset =
         crate::export::preset::find(&args.preset).map_err(|e| CliError::usage(e.to_string()))?;
-    if glb && preset.format != crate::export::preset::Format::GltfPbr {
+    if glb && !preset.format.is_gltf_pbr() {
         return Err(CliError::usage(format!(
             "--glb writes the mesh with a glTF material: use it with --preset gltf-pbr, not {}",
             preset.name
         )));
     }
-    if args.n_mapping.is_some() && preset.format != crate::export::preset::Format::GltfPbr {
+    if args.n_mapping.is_some() && !preset.format.is_gltf_pbr() {
         return Err(CliError::usage(format!(
             "--n-mapping chooses how n becomes roughness: use it with --preset gltf-pbr, not {}",
             preset.name

@@ -284,7 +284,7 @@ impl EditorState {
         };
         let out = PathBuf::from(dialog.folder.trim());
         self.export_choice = Some((preset.name.clone(), dialog.folder.clone()));
-        let pbr = preset.format == kapaint_export::preset::Format::GltfPbr;
+        let pbr = preset.format.is_gltf_pbr();
         let mesh = self
             .doc
             .surface()
@@ -404,7 +404,7 @@ impl EditorState {
                 let pbr = dialog
                     .presets
                     .get(dialog.chosen)
-                    .is_some_and(|p| p.format == kapaint_export::preset::Format::GltfPbr);
+                    .is_some_and(|p| p.format.is_gltf_pbr());
                 match &dialog.plan {
                     Some((p, _, plan)) if *p == dialog.chosen => {
                         export_plan_ui(ui, plan, pbr);

@@ -82,21 +82,17 @@ pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetP
 /// For a block-compressed preset: the layout above is the search's first trial; the export
 /// measures and may move `n` out and colour to BC6H (the notice says what it chose).
 pub(super) fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
-    use kapaint_export::preset::Format;
-    if !preset.format.is_blocks() {
+    let Some(max_effort) = preset.format.max_effort() else {
         return;
-    }
-    let astc = (preset.format == Format::Ktx2Astc).then(|| {
-        format!(
-            "ASTC {} ({:.2} bits per texel). ",
-            preset.astc_block,
-            preset.astc_block.bits_per_texel()
-        )
-    });
+    };
+    let astc = preset
+        .format
+        .astc_block()
+        .map(|b| format!("ASTC {b} ({:.2} bits per texel). ", b.bits_per_texel()));
     let order = if astc.is_some() {
         "this layout and n apart (alone, or beside a grey k_s), the one with fewer bytes \
          first (n apart where k_s is grey: both cost the same)"
-    } else if preset.bc6h {
+    } else if preset.format.half_colour() {
         "this layout first, then n apart, then n apart with colour as BC6H"
     } else {
         "this layout first, then n apart"
@@ -107,6 +103,6 @@ pub(super) fn block_search_ui(ui: &mut egui::Ui, preset: &ExportPreset) {
          say what was kept.",
         astc.unwrap_or_default(),
         preset.budget.describe(),
-        preset.max_bc7_effort
+        max_effort
     ));
 }

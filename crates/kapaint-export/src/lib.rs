@@ -1,9 +1,9 @@
-//! Exporting compact texture sets: presets ([`preset`]), the choice of `n`'s
+//! Exporting compact texture sets: presets ([`preset`]), block codecs ([`codec`]), the choice of `n`'s
 //! encoding by the `k_a` error it causes ([`encoding`]), and sets of images with a
 //! `material.json` manifest written atomically and read back ([`set`]).
 
-pub mod astc_block;
 pub mod blocks;
+pub mod codec;
 pub mod encoding;
 pub mod file_kind;
 pub mod glb;
@@ -40,7 +40,7 @@ pub fn run(
     glb: Option<&kapaint_core::mesh::Mesh>,
     brought: Option<&dyn blocks::BlockEncoder>,
 ) -> Result<Exported, set::SetError> {
-    if preset.format == preset::Format::GltfPbr {
+    if preset.format.is_gltf_pbr() {
         return gltf_pbr::export(doc, preset, out, progress, replace, glb).map(Exported::Pbr);
     }
     if glb.is_some() {

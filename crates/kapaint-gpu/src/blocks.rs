@@ -18,7 +18,8 @@ use std::sync::{Mutex, OnceLock};
 use block_compression::{CompressionVariant, GpuBlockCompressor};
 
 use super::{Gpu, GpuError};
-use kapaint_export::blocks::{BlockEncoder, BlockKind};
+use kapaint_export::blocks::BlockEncoder;
+use kapaint_export::codec::{Codec, Effort};
 
 /// The most texel bytes one strip uploads.
 pub const STRIP_BYTES: usize = 32 << 20;
@@ -100,28 +101,35 @@ pub fn shared() -> Option<&'static GpuBlockEncoder> {
 pub fn for_export(
     preset: &kapaint_export::preset::ExportPreset,
 ) -> Option<&'static dyn BlockEncoder> {
-    if preset.format != kapaint_export::preset::Format::Ktx2Bc {
-        return None;
-    }
+    // Only a format whose colour codec the shaders encode (`block_compression`'s: BC).
+    let colour = [kapaint_export::ktx::Space::Srgb; 3];
+    let codec = preset.format.codec(&colour)?;
+    codec.portable(Effort::default())?;
     let encoder = shared()?;
     Some(encoder)
 }
 
 impl BlockEncoder for GpuBlockEncoder {
+    /// The codecs `block_compression` has shaders for (BC4, BC5, BC6H, BC7).
+    fn encodes(&self, codec: &dyn Codec) -> bool {
+        codec.portable(Effort::UltraFast).is_some()
+    }
+
     fn encode(
         &self,
-        kind: BlockKind,
+        codec: &dyn Codec,
+        effort: Effort,
         size: (u32, u32),
         fill: &mut dyn FnMut(u32, u32, &mut [u8]),
         strip_done: &mut dyn FnMut(u32) -> bool,
         blocks: &mut [u8],
     ) -> Result<(), kapaint_export::blocks::Interrupted> {
-        GpuBlockEncoder::encode(self, kind, size, fill, strip_done, blocks).map_err(|stopped| {
-            kapaint_export::blocks::Interrupted {
+        GpuBlockEncoder::encode(self, (codec, effort), size, fill, strip_done, blocks).map_err(
+            |stopped| kapaint_export::blocks::Interrupted {
                 error: stopped.error.to_string(),
                 rows_done: stopped.rows_done,
-            }
-        })
+            },
+        )
     }
 
     fn failure(&self) -> Option<String> {
@@ -146,13 +154,14 @@ pub struct Interrupted {
     pub rows_done: u32,
 }
 
-/// The texture format the shaders read a kind's texels from.
-fn source_format(kind: BlockKind) -> wgpu::TextureFormat {
-    match kind {
-        BlockKind::Bc4 => wgpu::TextureFormat::R8Unorm,
-        BlockKind::Bc5 => wgpu::TextureFormat::Rg8Unorm,
-        BlockKind::Bc7 { .. } | BlockKind::Astc { .. } => wgpu::TextureFormat::Rgba8Unorm,
-        BlockKind::Bc6h { .. } => wgpu::TextureFormat::Rgba16Float,
+/// The texture format the shaders read texels of `bytes` each from (one, two or four bytes,
+/// or four half floats).
+fn source_format(bytes: usize) -> wgpu::TextureFormat {
+    match bytes {
+        1 => wgpu::TextureFormat::R8Unorm,
+        2 => wgpu::TextureFormat::Rg8Unorm,
+        8 => wgpu::TextureFormat::Rgba16Float,
+        _ => wgpu::TextureFormat::Rgba8Unorm,
     }
 }
 
@@ -188,8 +197,9 @@ impl GpuBlockEncoder {
         &self.gpu.info
     }
 
-    /// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
-    /// bytes per texel into `blocks` ([`BlockKind::blocks_len`] bytes), strip by strip:
+    /// Encodes a `(width, height)` image (sides multiples of 4) of [`Codec::texel_bytes`]
+    /// bytes per texel as the codec at the effort into `blocks` ([`Codec::blocks_len`]
+    /// bytes), strip by strip:
     /// `fill(row, rows, texels)` writes texel rows `row..row + rows` into `texels` (exactly
     /// `rows` rows). `strip_done(rows)` follows each strip; it answers `false` to stop (the
     /// rest is then left as it was).
@@ -199,30 +209,32 @@ impl GpuBlockEncoder {
     /// lost), with the texel rows from the top whose blocks are in place.
     pub fn encode(
         &self,
-        kind: BlockKind,
+        (codec, effort): (&dyn Codec, Effort),
         (width, height): (u32, u32),
         fill: &mut dyn FnMut(u32, u32, &mut [u8]),
         strip_done: &mut dyn FnMut(u32) -> bool,
         blocks: &mut [u8],
     ) -> Result<(), Interrupted> {
         debug_assert!(width % 4 == 0 && height % 4 == 0);
-        debug_assert_eq!(blocks.len(), kind.blocks_len((width, height)));
+        debug_assert_eq!(blocks.len(), codec.blocks_len((width, height)));
         let at_start = |error| Interrupted {
             error,
             rows_done: 0,
         };
-        let Some(variant) = kind.variant() else {
+        let Some(variant) = codec.portable(effort) else {
             return Err(at_start(GpuError(format!(
-                "{kind:?} is not a block kind the GPU encodes"
+                "{} is not a codec the GPU encodes",
+                codec.name()
             ))));
         };
-        let row_bytes = width as usize * kind.texel_bytes();
+        let texel_bytes = codec.texel_bytes();
+        let row_bytes = width as usize * texel_bytes;
         let fit = u32::try_from(STRIP_BYTES / row_bytes.max(1)).unwrap_or(u32::MAX);
         let strip_rows = (fit.min(self.strip_rows) / 4 * 4).clamp(4, height);
         self.gpu
             .check_texture_size("a level to block-encode", (width, strip_rows))
             .map_err(at_start)?;
-        let blocks_row = (width as usize / 4) * kind.block_bytes();
+        let blocks_row = (width as usize / 4) * codec.block_bytes();
         let mut compressor = self
             .compressor
             .lock()
@@ -230,7 +242,12 @@ impl GpuBlockEncoder {
         let strip = self
             .gpu
             .checked("block encoding", || {
-                Strip::new(&self.gpu, kind, variant, (width, strip_rows))
+                Strip::new(
+                    &self.gpu,
+                    (texel_bytes, codec.block_bytes()),
+                    variant,
+                    (width, strip_rows),
+                )
             })
             .map_err(at_start)?;
         let mut texels = vec![0_u8; row_bytes * strip_rows as usize];
@@ -259,7 +276,8 @@ impl GpuBlockEncoder {
 /// The device side of one strip: what it encodes, its source texture, its blocks, and their
 /// read-back.
 struct Strip {
-    kind: BlockKind,
+    /// Bytes per source texel.
+    texel_bytes: usize,
     variant: CompressionVariant,
     texture: wgpu::Texture,
     view: wgpu::TextureView,
@@ -270,17 +288,17 @@ struct Strip {
 impl Strip {
     fn new(
         gpu: &Gpu,
-        kind: BlockKind,
+        (texel_bytes, block_bytes): (usize, usize),
         variant: CompressionVariant,
         (width, rows): (u32, u32),
     ) -> Self {
         let texture = gpu.texture_2d(
             "blocks source strip",
             (width, rows),
-            source_format(kind),
+            source_format(texel_bytes),
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );
-        let size = ((width as usize / 4) * kind.block_bytes() * rows as usize / 4) as u64;
+        let size = ((width as usize / 4) * block_bytes * rows as usize / 4) as u64;
         let buffer = |label, usage| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -290,7 +308,7 @@ impl Strip {
             })
         };
         Self {
-            kind,
+            texel_bytes,
             variant,
             view: texture.create_view(&wgpu::TextureViewDescriptor::default()),
             texture,
@@ -321,7 +339,7 @@ impl Strip {
             texels,
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: Some(width * self.kind.texel_bytes() as u32),
+                bytes_per_row: Some(width * self.texel_bytes as u32),
                 rows_per_image: Some(rows),
             },
             wgpu::Extent3d {

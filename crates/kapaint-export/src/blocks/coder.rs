@@ -2,35 +2,8 @@
 //! GPU crate's compute shaders), chosen per export ([`Coder::best`]) and named in manifests
 //! ([`Encoder`]).
 
-use serde::{Deserialize, Serialize};
-
-use super::BlockKind;
-
-/// Which code encoded the blocks, as a manifest names it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Encoder {
-    /// Intel's ISPC kernels (`x86_64`).
-    Ispc,
-    /// `block_compression`'s CPU port.
-    Portable,
-    /// An encoder the caller brought ([`BlockEncoder`]: a GPU's compute shaders); the CPU's
-    /// best encoder wherever it fails.
-    Gpu,
-    /// ARM's ASTC encoder (`astcenc`), for ASTC blocks.
-    Astcenc,
-}
-
-impl Encoder {
-    /// The fastest encoder this CPU has.
-    pub fn best_cpu() -> Self {
-        if cfg!(target_arch = "x86_64") {
-            Self::Ispc
-        } else {
-            Self::Portable
-        }
-    }
-}
+pub use crate::codec::Encoder;
+use crate::codec::{Codec, Cpu, Effort};
 
 /// An encode that a [`BlockEncoder`] stopped part-way: why, and the texel rows from the top
 /// whose blocks are in place.
@@ -43,18 +16,22 @@ pub struct Interrupted {
 }
 
 /// A block encoder a caller brings beside the CPU's (the GPU crate's compute shaders), handed
-/// to an export rather than found by it.
+/// to an export rather than found by it; the CPU's encode the codecs it does not.
 pub trait BlockEncoder: Send + Sync {
-    /// Encodes a `(width, height)` image (sides multiples of 4) of [`BlockKind::texel_bytes`]
-    /// bytes per texel into `blocks` ([`BlockKind::blocks_len`] bytes), strip by strip:
-    /// `fill(row, rows, texels)` writes texel rows `row..row + rows` into `texels`;
-    /// `strip_done(rows)` follows each strip and answers `false` to stop.
+    /// Whether it encodes `codec`'s blocks.
+    fn encodes(&self, codec: &dyn Codec) -> bool;
+
+    /// Encodes a `(width, height)` image (sides multiples of 4) of [`Codec::texel_bytes`]
+    /// bytes per texel as `codec` at `effort` into `blocks` ([`Codec::blocks_len`] bytes),
+    /// strip by strip: `fill(row, rows, texels)` writes texel rows `row..row + rows` into
+    /// `texels`; `strip_done(rows)` follows each strip and answers `false` to stop.
     ///
     /// # Errors
     /// A failure part-way, with the rows whose blocks are in place.
     fn encode(
         &self,
-        kind: BlockKind,
+        codec: &dyn Codec,
+        effort: Effort,
         size: (u32, u32),
         fill: &mut dyn FnMut(u32, u32, &mut [u8]),
         strip_done: &mut dyn FnMut(u32) -> bool,
@@ -108,6 +85,18 @@ impl<'a> Coder<'a> {
             Self::Ispc => Encoder::Ispc,
             Self::Portable => Encoder::Portable,
             Self::Brought(_) => Encoder::Gpu,
+        }
+    }
+
+    /// The CPU encoder it runs strips on: its own, or for a brought one the CPU's best.
+    pub fn cpu(self) -> Cpu {
+        match self {
+            Self::Ispc => Cpu::Ispc,
+            Self::Portable => Cpu::Portable,
+            Self::Brought(_) => match Self::best_cpu() {
+                Self::Ispc => Cpu::Ispc,
+                _ => Cpu::Portable,
+            },
         }
     }
 

@@ -4,9 +4,8 @@
 use ktx2::{Format as KtxFormat, Header, Index, LevelIndex, dfd};
 
 use super::crop;
-use crate::astc_block::AstcBlock;
-use crate::blocks::{self, BlockKind};
-use crate::preset::Bc7Quality;
+use crate::blocks;
+use crate::codec::{self, Codec};
 
 /// Level 0 of a KTX2 file as decoded texels.
 #[derive(Clone, Debug)]
@@ -40,15 +39,7 @@ pub(super) fn container(
     kvd.extend_from_slice(entry.as_bytes());
     kvd.resize(kvd.len().div_ceil(4) * 4, 0);
     // Level data alignment: lcm(texel block size, 4).
-    let block_bytes = match format {
-        KtxFormat::BC4_UNORM_BLOCK => 8,
-        KtxFormat::BC5_UNORM_BLOCK
-        | KtxFormat::BC7_SRGB_BLOCK
-        | KtxFormat::BC7_UNORM_BLOCK
-        | KtxFormat::BC6H_UFLOAT_BLOCK => 16,
-        f if AstcBlock::of_vk_format(f.value()).is_some() => 16,
-        _ => 4,
-    };
+    let block_bytes = codec::from_vk_format(format).map_or(4, |c| c.block_bytes());
     let index_at = Header::LENGTH;
     let dfd_at = index_at + levels.len() * LevelIndex::LENGTH;
     let kvd_at = dfd_at + dfd_bytes.len();
@@ -143,17 +134,12 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             }
             (4, data[..texels * 4].to_vec())
         }
-        Some(
-            f @ (KtxFormat::BC4_UNORM_BLOCK
-            | KtxFormat::BC5_UNORM_BLOCK
-            | KtxFormat::BC7_UNORM_BLOCK
-            | KtxFormat::BC7_SRGB_BLOCK
-            | KtxFormat::BC6H_UFLOAT_BLOCK),
-        ) => return decode_blocks(f, data, (w, h)),
-        Some(f) if AstcBlock::of_vk_format(f.value()).is_some() => {
-            return decode_blocks(f, data, (w, h));
+        other => {
+            let Some(codec) = other.and_then(codec::from_vk_format) else {
+                return Err(format!("KTX2 format {other:?} is not one kapaint writes"));
+            };
+            return decode_blocks(&*codec, data, (w, h));
         }
-        other => return Err(format!("KTX2 format {other:?} is not one kapaint writes")),
     };
     let rgba = rgba.iter().map(|b| f32::from(*b) / 255.0).collect();
     Ok(Decoded {
@@ -164,33 +150,16 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
     })
 }
 
-/// Level 0 of a block-compressed file of `format`, as RGBA (BC6H: three linear floats).
-fn decode_blocks(format: KtxFormat, data: &[u8], (w, h): (u32, u32)) -> Result<Decoded, String> {
-    let kind = if let Some((block, srgb)) = AstcBlock::of_vk_format(format.value()) {
-        BlockKind::Astc {
-            block,
-            channels: 4,
-            srgb,
-            effort: Bc7Quality::UltraFast,
-        }
-    } else {
-        match format {
-            KtxFormat::BC4_UNORM_BLOCK => BlockKind::Bc4,
-            KtxFormat::BC5_UNORM_BLOCK => BlockKind::Bc5,
-            KtxFormat::BC6H_UFLOAT_BLOCK => BlockKind::Bc6h {
-                effort: Bc7Quality::UltraFast,
-            },
-            _ => BlockKind::for_channels(4, Bc7Quality::UltraFast),
-        }
-    };
-    let (bw, bh) = kind.dims();
+/// Level 0 of a block-compressed file of `codec`, as RGBA (BC6H: three linear floats).
+fn decode_blocks(codec: &dyn Codec, data: &[u8], (w, h): (u32, u32)) -> Result<Decoded, String> {
+    let (bw, bh) = codec.block_dims();
     let padded = (w.div_ceil(bw) * bw, h.div_ceil(bh) * bh);
-    let size = kind.blocks_len(padded);
+    let size = codec.blocks_len(padded);
     if data.len() < size {
         return Err("level 0 is truncated".into());
     }
-    let per = kind.texel_bytes();
-    let texels = blocks::decode(kind, &data[..size], padded);
+    let per = codec.texel_bytes();
+    let texels = blocks::decode(codec, &data[..size], padded).map_err(|e| e.to_string())?;
     let tight = crop(&texels, padded.0, (w, h), per, per);
     if per == 8 {
         let rgba = tight

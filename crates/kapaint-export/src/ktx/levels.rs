@@ -72,7 +72,7 @@ impl Space {
         }
     }
 
-    pub(super) fn is_colour(self) -> bool {
+    pub(crate) fn is_colour(self) -> bool {
         self == Self::Srgb
     }
 }

@@ -17,8 +17,8 @@ use self::container::container;
 pub use self::container::{Decoded, decode};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 pub use self::own_levels::encode_levels;
-use super::blocks::{self, BlockFamily, BlockKind, Coder};
-use super::preset::Bc7Quality;
+use super::blocks::{self, Coder};
+use super::codec::{Codec, CodecError, Effort};
 use crate::file_kind::Compression;
 use kapaint_core::task::Progress;
 
@@ -138,51 +138,38 @@ impl Compressed {
     }
 }
 
-/// The block kind of an image of `spaces` in `family` at `effort` (BC4 and BC5 have one):
-/// ASTC of the family's footprint (sRGB where colour leads three or four components); else
-/// BC6H for half floats, else BC by the component count.
-pub fn block_kind(spaces: &[Space], family: BlockFamily, effort: Bc7Quality) -> BlockKind {
-    match family {
-        BlockFamily::Astc(block) => BlockKind::Astc {
-            block,
-            channels: spaces.len() as u8,
-            srgb: spaces.len() >= 3 && spaces[0].is_colour(),
-            effort,
-        },
-        BlockFamily::Bc if spaces.first() == Some(&Space::Half) => BlockKind::Bc6h { effort },
-        BlockFamily::Bc => BlockKind::for_channels(spaces.len(), effort),
-    }
-}
-
-/// Compresses one level (`channels` bytes per stored texel) as `kind` with `encoder`. Rows
-/// advance `progress`.
+/// Compresses one level (`channels` bytes per stored texel) as `codec` at `effort` with
+/// `encoder`. Rows advance `progress`.
+///
+/// # Errors
+/// The codec failed.
 pub fn compress_level(
     encoder: Coder<'_>,
-    kind: BlockKind,
+    (codec, effort): (&dyn Codec, Effort),
     bytes: &[u8],
     (w, h): (u32, u32),
     channels: usize,
     progress: Option<&Progress>,
-) -> Compressed {
-    let (bw, bh) = kind.dims();
+) -> Result<Compressed, CodecError> {
+    let (bw, bh) = codec.block_dims();
     let padded = (w.div_ceil(bw) * bw, h.div_ceil(bh) * bh);
     let input: std::borrow::Cow<'_, [u8]> = if padded == (w, h) {
         bytes.into()
     } else {
         pad(bytes, (w, h), channels, padded).into()
     };
-    let blocks = blocks::encode_stored(encoder, kind, &input, channels, padded, progress);
-    let decoded = blocks::decode_stored(kind, &blocks, padded, channels);
+    let blocks = blocks::encode_stored(encoder, codec, effort, &input, channels, padded, progress)?;
+    let decoded = blocks::decode_stored(codec, &blocks, padded, channels)?;
     let decoded = if padded == (w, h) {
         decoded
     } else {
         crop(&decoded, padded.0, (w, h), channels, channels)
     };
-    Compressed {
+    Ok(Compressed {
         blocks,
         decoded,
         psnr: None,
-    }
+    })
 }
 
 /// Per component, PSNR (dB) of `decoded` against `reference` (texels of components in
@@ -261,35 +248,25 @@ pub struct Written {
     pub compression: Compression,
 }
 
-/// The KTX2 format and compression name of `channels` components, uncompressed or
-/// block-compressed in `family`.
-fn format_of(
-    spaces: &[Space],
-    srgb: bool,
-    family: Option<BlockFamily>,
-) -> (KtxFormat, Compression) {
-    if let Some(BlockFamily::Astc(block)) = family {
-        let format = KtxFormat::new(block.vk_format(srgb)).unwrap_or(KtxFormat::R8_UNORM);
-        return (format, Compression::Ktx2Astc);
+/// The KTX2 format and compression name of `channels` components: the codec's where
+/// block-compressed, else 8-bit components.
+fn format_of(spaces: &[Space], srgb: bool, codec: Option<&dyn Codec>) -> (KtxFormat, Compression) {
+    if let Some(codec) = codec {
+        return (codec.vk_format(), codec.compression());
     }
-    let compressed = family.is_some();
-    if spaces.first() == Some(&Space::Half) {
-        return (KtxFormat::BC6H_UFLOAT_BLOCK, Compression::Ktx2Bc6h);
-    }
-    match (compressed, spaces.len()) {
-        (false, 1) => (KtxFormat::R8_UNORM, Compression::Ktx2),
-        (false, 2) => (KtxFormat::R8G8_UNORM, Compression::Ktx2),
-        (false, _) if srgb => (KtxFormat::R8G8B8A8_SRGB, Compression::Ktx2),
-        (false, _) => (KtxFormat::R8G8B8A8_UNORM, Compression::Ktx2),
-        (true, 1) => (KtxFormat::BC4_UNORM_BLOCK, Compression::Ktx2Bc4),
-        (true, 2) => (KtxFormat::BC5_UNORM_BLOCK, Compression::Ktx2Bc5),
-        (true, _) if srgb => (KtxFormat::BC7_SRGB_BLOCK, Compression::Ktx2Bc7),
-        (true, _) => (KtxFormat::BC7_UNORM_BLOCK, Compression::Ktx2Bc7),
+    match spaces.len() {
+        1 => (KtxFormat::R8_UNORM, Compression::Ktx2),
+        2 => (KtxFormat::R8G8_UNORM, Compression::Ktx2),
+        _ if srgb => (KtxFormat::R8G8B8A8_SRGB, Compression::Ktx2),
+        _ => (KtxFormat::R8G8B8A8_UNORM, Compression::Ktx2),
     }
 }
 
+/// How an image's blocks are made: the encoder, the codec and its effort.
+pub type Blocks<'a> = (Coder<'a>, &'a dyn Codec, Effort);
+
 /// Writes `source` as a KTX2 file with a full mip chain: uncompressed, or with
-/// `compressed = Some((encoder, family, effort))` block-compressed. `level0`, when given, is
+/// `compressed = Some((encoder, codec, effort))` block-compressed. `level0`, when given, is
 /// level 0 already compressed (the export's effort search keeps the one it chose). Level 0's
 /// rows advance `progress`; a cancel stops the block encoder between strips.
 ///
@@ -298,7 +275,7 @@ fn format_of(
 /// three components, or cancelled.
 pub fn encode(
     source: &Source<'_>,
-    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
+    compressed: Option<Blocks<'_>>,
     level0: Option<Compressed>,
     progress: &Progress,
 ) -> Result<Written, String> {
@@ -325,7 +302,7 @@ struct Image<'a> {
 /// already compressed).
 fn write_levels(
     image: &Image<'_>,
-    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
+    compressed: Option<Blocks<'_>>,
     level0: Option<Compressed>,
     progress: &Progress,
 ) -> Result<Written, String> {
@@ -337,6 +314,7 @@ fn write_levels(
         return Err("half floats are written only as BC6H blocks".into());
     }
     let (format, compression) = format_of(spaces, srgb, compressed.map(|c| c.1));
+    let failed = |e: CodecError| e.to_string();
     let mut level_bytes = Vec::with_capacity(chain.len() + 1);
     let mut decoded = Vec::with_capacity(chain.len() + 1);
     let mut psnr_values = None;
@@ -360,14 +338,15 @@ fn write_levels(
                 decoded.push(bytes.clone());
             }
         }
-        Some((encoder, family, effort)) => {
-            let kind = block_kind(spaces, family, effort);
+        Some((encoder, codec, effort)) => {
+            let blocks = (codec, effort);
             let mut first = match level0 {
                 Some(c) => {
                     progress.advance(u64::from(h));
                     c
                 }
-                None => compress_level(encoder, kind, image.level0, (w, h), per, Some(progress)),
+                None => compress_level(encoder, blocks, image.level0, (w, h), per, Some(progress))
+                    .map_err(failed)?,
             };
             if progress.is_cancelled() {
                 return Err("cancelled".into());
@@ -376,7 +355,7 @@ fn write_levels(
             level_bytes.push(first.blocks);
             decoded.push(first.decoded);
             for (size, bytes) in chain {
-                let c = compress_level(encoder, kind, bytes, *size, per, None);
+                let c = compress_level(encoder, blocks, bytes, *size, per, None).map_err(failed)?;
                 level_bytes.push(c.blocks);
                 decoded.push(c.decoded);
             }
@@ -410,7 +389,7 @@ mod tests {
         (w, h): (u32, u32),
         spaces: &[Space],
         values: &[f32],
-        compressed: Option<Bc7Quality>,
+        compressed: Option<Effort>,
     ) -> Written {
         let ch = spaces.len();
         let bounds: Vec<Vec<f32>> = spaces.iter().map(|s| s.boundaries()).collect();
@@ -429,9 +408,14 @@ mod tests {
             level0: &level0,
             value: &value,
         };
+        let bc = crate::preset::Format::Ktx2Bc {
+            max_effort: Effort::Slow,
+            bc6h: true,
+        };
+        let codec = bc.codec(spaces).unwrap();
         encode(
             &source,
-            compressed.map(|q| (Coder::best_cpu(), BlockFamily::Bc, q)),
+            compressed.map(|q| (Coder::best_cpu(), &*codec, q)),
             None,
             &Progress::default(),
         )
@@ -445,10 +429,10 @@ mod tests {
             (2, None),
             (3, None),
             (4, None),
-            (1, Some(Bc7Quality::VeryFast)),
-            (2, Some(Bc7Quality::VeryFast)),
-            (4, Some(Bc7Quality::UltraFast)),
-            (5, Some(Bc7Quality::UltraFast)),
+            (1, Some(Effort::VeryFast)),
+            (2, Some(Effort::VeryFast)),
+            (4, Some(Effort::UltraFast)),
+            (5, Some(Effort::UltraFast)),
         ] {
             // 5: three half floats, as BC6H.
             let half = ch == 5;

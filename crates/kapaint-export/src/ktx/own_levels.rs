@@ -2,9 +2,7 @@
 //! which no per-component average of its bytes gives).
 
 use super::levels::half;
-use super::{Image, Progress, Space, Written, level_count, write_levels};
-use crate::blocks::{BlockFamily, Coder};
-use crate::preset::Bc7Quality;
+use super::{Blocks, Image, Progress, Space, Written, level_count, write_levels};
 
 /// Writes an image whose levels the caller made (finest first, a full chain: `levels[k]` of
 /// the size [`level_count`]'s level `k` has) of `channels` linear bytes per texel, as a KTX2
@@ -17,7 +15,7 @@ use crate::preset::Bc7Quality;
 pub fn encode_levels(
     levels: &[((u32, u32), Vec<u8>)],
     channels: usize,
-    compressed: Option<(Coder<'_>, BlockFamily, Bc7Quality)>,
+    compressed: Option<Blocks<'_>>,
 ) -> Result<Written, String> {
     let spaces = vec![Space::Linear; channels];
     let Some(((w, h), level0)) = levels.first() else {

@@ -4,10 +4,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::perceptual::SrgbError;
-use crate::astc_block::AstcBlock;
 use crate::blocks::Encoder;
+use crate::codec::{AstcBlock, Effort};
 use crate::encoding::KaError;
-use crate::preset::{Bc7Quality, BlockBudget};
+use crate::preset::BlockBudget;
 
 /// Where `n` goes in a block-compressed set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -35,7 +35,7 @@ pub struct Trial {
     /// Where `n` was.
     pub layout: BlockLayout,
     /// BC7's (and BC6H's) effort.
-    pub bc7_effort: Bc7Quality,
+    pub bc7_effort: Effort,
     /// The set's `k_a` error, level 0 as a consumer decodes it (relative).
     pub ka_error: KaError,
     /// The same in levels of 8-bit sRGB of the ambient-lit colour (absent in sets written
@@ -192,8 +192,8 @@ pub struct BlockChoice {
     pub gpu_failed: Option<String>,
     /// Where `n` went.
     pub layout: BlockLayout,
-    /// BC7's effort (or ASTC's on the same scale: `blocks::astc::preset_of`).
-    pub bc7_effort: Bc7Quality,
+    /// The effort, on the one scale every codec maps to its own (`Codec::effort_name`).
+    pub bc7_effort: Effort,
     /// An ASTC set's footprint (`"4x4"`); absent for BC sets.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub astc_block: Option<AstcBlock>,

@@ -28,14 +28,16 @@ use std::time::Instant;
 
 use super::budget::{better, nearer, reachable, storage_misses, within};
 use super::choice::{BlockChoice, BlockLayout, NEAREST_RULE, Trial};
-use super::encode::{Encoded, KtxTexels, StoredImage, block_family, ktx_image, srgb_image};
+use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, spaces_of, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
 use super::perceptual::SrgbError;
-use crate::blocks::{BlockEncoder, BlockFamily, BlockKind, Coder, Encoder};
+use super::role::{Images, Role};
+use crate::blocks::{self, BlockEncoder, Coder};
+use crate::codec::{Codec, Effort};
 use crate::encoding::{KaError, NEncoding};
 use crate::ktx::{self, Compressed};
-use crate::preset::{Bc7Quality, ExportPreset};
+use crate::preset::ExportPreset;
 use glam::Vec3;
 use kapaint_core::model::texel::Texel;
 use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
@@ -46,9 +48,6 @@ fn half_image(comps: &[Comp]) -> bool {
     comps.len() == 3 && comps.iter().all(|c| is_colour(*c))
 }
 
-/// A set's images: file stem and components.
-pub(super) type Images = Vec<(&'static str, Vec<Comp>)>;
-
 /// The images of the n-apart layout for the packed `images`, or `None` where `n` is not in a
 /// colour image (constant, or already beside `k_s`).
 pub(super) fn n_apart(images: &Images, mono_ks: bool) -> Option<Images> {
@@ -56,10 +55,10 @@ pub(super) fn n_apart(images: &Images, mono_ks: bool) -> Option<Images> {
         .iter()
         .position(|(_, c)| c.len() == 4 && c[3] == Comp::N)?;
     let mut out = images.clone();
-    out[packed] = ("kd", out[packed].1[..3].to_vec());
-    match out.iter().position(|(stem, _)| *stem == "ks") {
-        Some(ks) if mono_ks => out[ks] = ("ks_n", vec![Comp::Ks(0), Comp::N]),
-        _ => out.insert(packed + 1, ("n", vec![Comp::N])),
+    out[packed] = (Role::Kd, out[packed].1[..3].to_vec());
+    match out.iter().position(|(role, _)| *role == Role::Ks) {
+        Some(ks) if mono_ks => out[ks] = (Role::KsN, vec![Comp::Ks(0), Comp::N]),
+        _ => out.insert(packed + 1, (Role::N, vec![Comp::N])),
     }
     Some(out)
 }
@@ -78,33 +77,42 @@ pub(super) struct Job<'a> {
     pub brought: Option<&'a dyn BlockEncoder>,
 }
 
-/// One image of a trial: its texels, level 0 as stored, and level 0 compressed.
+/// One image of a trial: its texels and codec, level 0 as stored, and level 0 compressed.
 struct TrialImage<'a> {
-    stem: &'static str,
+    role: Role,
     comps: Vec<Comp>,
     srgb: bool,
     half: bool,
     texels: KtxTexels<'a>,
+    /// The image's codec (its contexts serve every trial and the mips).
+    codec: Box<dyn Codec>,
     level0: Vec<u8>,
-    compressed: Option<(Bc7Quality, Compressed)>,
+    /// Level 0's blocks, and the effort the codec ran for them.
+    compressed: Option<(Effort, Compressed)>,
 }
 
 impl TrialImage<'_> {
-    /// Compresses level 0 at `effort`, unless it already is (BC4 and BC5 have one effort).
-    fn compress(&mut self, encoder: Coder<'_>, effort: Bc7Quality, job: &Job<'_>, p: &Progress) {
+    /// Compresses level 0 at `effort`, unless it already is at an effort the codec does not
+    /// tell apart from it.
+    fn compress(
+        &mut self,
+        encoder: Coder<'_>,
+        effort: Effort,
+        job: &Job<'_>,
+        p: &Progress,
+    ) -> Result<(), String> {
         let size = job.size;
-        let kind = ktx::block_kind(self.texels.spaces(), job.family(), effort);
-        let fresh = match &self.compressed {
-            Some((e, _)) => !matches!(kind, BlockKind::Bc4 | BlockKind::Bc5) && *e != effort,
-            None => true,
-        };
-        if fresh {
-            let per = ktx::texel_layout(self.texels.spaces()).0;
-            let c = ktx::compress_level(encoder, kind, &self.level0, size, per, Some(p));
-            self.compressed = Some((effort, c));
-        } else {
+        let runs = self.codec.effort(effort);
+        if self.compressed.as_ref().is_some_and(|(e, _)| *e == runs) {
             p.advance(u64::from(size.1));
+            return Ok(());
         }
+        let per = ktx::texel_layout(self.texels.spaces()).0;
+        let blocks = (&*self.codec, effort);
+        let c = ktx::compress_level(encoder, blocks, &self.level0, size, per, Some(p))
+            .map_err(|e| e.to_string())?;
+        self.compressed = Some((runs, c));
+        Ok(())
     }
 
     /// Level 0 as stored before any block: what the uncompressed files would hold.
@@ -132,38 +140,48 @@ impl TrialImage<'_> {
 
 /// The images of `want` (three-component colour as half floats where `half`): what the
 /// last trial shares with it is kept (with its blocks), what it lacks is made.
-fn prepare<'a>(images: &mut Vec<TrialImage<'a>>, want: &Images, half: bool, job: &Job<'a>) {
+///
+/// # Errors
+/// The preset has no blocks.
+fn prepare<'a>(
+    images: &mut Vec<TrialImage<'a>>,
+    want: &Images,
+    half: bool,
+    job: &Job<'a>,
+) -> Result<(), String> {
     let half_of = |comps: &[Comp]| half && half_image(comps);
     images.retain(|i| {
         want.iter()
-            .any(|(s, c)| *s == i.stem && *c == i.comps && half_of(c) == i.half)
+            .any(|(r, c)| *r == i.role && *c == i.comps && half_of(c) == i.half)
     });
-    for (stem, comps) in want {
-        if !images.iter().any(|i| i.stem == *stem) {
+    for (role, comps) in want {
+        if !images.iter().any(|i| i.role == *role) {
             let half = half_of(comps);
             let srgb = !half && srgb_image(job.preset.format, comps);
             let texels = KtxTexels::new(job.texels, job.ka, comps, srgb, half, job.n_enc);
+            let codec = job
+                .preset
+                .format
+                .codec(texels.spaces())
+                .ok_or_else(|| format!("{} has no blocks", job.preset.format.name()))?;
             let level0 = texels.level0();
             images.push(TrialImage {
-                stem,
+                role: *role,
                 comps: comps.clone(),
                 srgb,
                 half,
                 texels,
+                codec,
                 level0,
                 compressed: None,
             });
         }
     }
-    images.sort_by_key(|i| want.iter().position(|(s, _)| *s == i.stem));
+    images.sort_by_key(|i| want.iter().position(|(r, _)| *r == i.role));
+    Ok(())
 }
 
 impl Job<'_> {
-    /// The blocks the preset writes.
-    fn family(&self) -> BlockFamily {
-        block_family(self.preset).unwrap_or(BlockFamily::Bc)
-    }
-
     fn measure(&self, stored: &[StoredImage<'_>]) -> (KaError, SrgbError) {
         ka_error_of_set(
             self.texels,
@@ -191,12 +209,8 @@ pub(super) fn encode_blocks(
     apart: Option<&Images>,
     progress: &Progress,
 ) -> Result<(Vec<Encoded>, BlockChoice), String> {
-    let family = job.family();
-    // ASTC is astcenc's, on the CPU.
-    let encoder = match family {
-        BlockFamily::Bc => Coder::best(job.brought),
-        BlockFamily::Astc(_) => Coder::best_cpu(),
-    };
+    // The brought encoder encodes what it can; the CPU the rest ([`blocks::encode`]).
+    let encoder = Coder::best(job.brought);
     let search = Search::new(job, packed, apart);
     let mut images = Vec::new();
     let found = search.run(&mut images, encoder, progress)?;
@@ -204,35 +218,26 @@ pub(super) fn encode_blocks(
     if (pick.layout, pick.bc7_effort) != found.last {
         // The pick is an earlier trial: encode its level 0 again.
         let want = search.images_of(pick.layout);
-        prepare(&mut images, want, pick.layout.half(), job);
-        compress_all(&mut images, encoder, pick.bc7_effort, job, progress);
+        prepare(&mut images, want, pick.layout.half(), job)?;
+        compress_all(&mut images, encoder, pick.bc7_effort, job, progress)?;
     }
-    let encoded = with_mips(
-        images,
-        (encoder, family, pick.bc7_effort),
-        job.size,
-        progress,
-    )?;
+    let encoded = with_mips(&mut images, (encoder, pick.bc7_effort), job.size, progress)?;
+    // What the manifest names: the encoder of the first image's blocks (a GPU that failed on
+    // the way handed the rest to the CPU, for the rest of the process).
+    let names = images
+        .first()
+        .map_or(encoder.name(), |i| blocks::encoder_name(encoder, &*i.codec));
     let budget = job.preset.budget;
     let within_budget = within(&budget, &pick);
     let uncompressed_ka_error_srgb = found.floor;
-    // A GPU that failed on the way handed the rest to the CPU (for the rest of the process).
-    let gpu_failed = encoder.failure();
     Ok((
         encoded,
         BlockChoice {
-            encoder: match family {
-                BlockFamily::Astc(_) => Encoder::Astcenc,
-                BlockFamily::Bc if gpu_failed.is_some() => Encoder::best_cpu(),
-                BlockFamily::Bc => encoder.name(),
-            },
-            gpu_failed,
+            encoder: names,
+            gpu_failed: encoder.failure(),
             layout: pick.layout,
             bc7_effort: pick.bc7_effort,
-            astc_block: match family {
-                BlockFamily::Astc(b) => Some(b),
-                BlockFamily::Bc => None,
-            },
+            astc_block: job.preset.format.astc_block(),
             budget,
             within_budget,
             uncompressed_ka_error_srgb,
@@ -248,7 +253,7 @@ struct Found {
     trials: Vec<Trial>,
     chosen: usize,
     reason: String,
-    last: (BlockLayout, Bc7Quality),
+    last: (BlockLayout, Effort),
     /// The same files uncompressed, where more effort in an 8-bit layout was weighed.
     floor: Option<SrgbError>,
 }
@@ -261,33 +266,31 @@ struct Search<'j, 'a> {
     /// The layouts to try at the lowest effort, in order.
     layouts: Vec<BlockLayout>,
     /// The efforts up to the preset's ceiling, lowest first.
-    efforts: Vec<Bc7Quality>,
+    efforts: Vec<Effort>,
 }
 
 impl<'j, 'a> Search<'j, 'a> {
     fn new(job: &'j Job<'a>, packed: &'j Images, apart: Option<&'j Images>) -> Self {
-        let efforts = Bc7Quality::ALL
-            .into_iter()
-            .filter(|e| *e <= job.preset.max_bc7_effort)
-            .collect();
+        let ceiling = job.preset.format.max_effort().unwrap_or_default();
+        let efforts = Effort::ALL.into_iter().filter(|e| *e <= ceiling).collect();
         // Fewest bytes first; then, for the same bytes, n apart in BC7 (the more common
         // format: with blocks of one colour exact, its stroke edges come nearer the budget
-        // than BC6H's), then BC6H colour where there is a colour image and the preset allows
-        // it (half floats meet a mean that 8-bit storage itself misses). ASTC has no LDR half
-        // floats.
+        // than BC6H's), then BC6H colour where there is a colour image and the format allows
+        // it (half floats meet a mean that 8-bit storage itself misses; ASTC has no LDR half
+        // floats).
+        let format = job.preset.format;
         let apart_images = apart.unwrap_or(packed);
         let mut layouts = vec![BlockLayout::Packed];
-        let bc = job.family() == BlockFamily::Bc;
         if apart.is_some() {
             layouts.push(BlockLayout::NApart);
         }
-        if bc && job.preset.bc6h && apart_images.iter().any(|(_, c)| half_image(c)) {
+        if format.half_colour() && apart_images.iter().any(|(_, c)| half_image(c)) {
             layouts.push(BlockLayout::HalfColour);
         }
-        // Every ASTC block is 16 bytes whatever it holds: where both layouts have as many
-        // images (a grey k_s: kd_n + ks, or kd + ks_n), they cost the same, and n apart, on
-        // endpoints of its own, goes first.
-        if !bc && apart.is_some_and(|a| a.len() == packed.len()) {
+        // Where every block costs the same whatever it holds (ASTC's 16 bytes) and both
+        // layouts have as many images (a grey k_s: kd_n + ks, or kd + ks_n), they cost the
+        // same, and n apart, on endpoints of its own, goes first.
+        if format.same_bytes_per_block() && apart.is_some_and(|a| a.len() == packed.len()) {
             layouts.reverse();
         }
         Self {
@@ -323,7 +326,7 @@ impl<'j, 'a> Search<'j, 'a> {
             let effort = self.efforts[step];
             // What the images hold once this trial ran (`layout` may move on below).
             let ran = (layout, effort);
-            prepare(images, self.images_of(layout), layout.half(), self.job);
+            prepare(images, self.images_of(layout), layout.half(), self.job)?;
             let trial = run_trial(images, encoder, layout, effort, self.job, progress)?;
             let here = trial.describe(&budget);
             let met = within(&budget, &trial);
@@ -389,10 +392,29 @@ impl<'j, 'a> Search<'j, 'a> {
         if left == 0 || !reachable(trials, layout, &self.job.preset.budget, left) {
             return None;
         }
-        // BC6H has no effort between ultra-fast and very-fast: skip a step that would encode
-        // the same blocks again.
-        let skip = layout.half() && self.efforts[step + 1] == Bc7Quality::VeryFast && left > 1;
-        Some(step + 1 + usize::from(skip))
+        // Skip the steps that would encode the same blocks again (BC6H has no effort between
+        // ultra-fast and very-fast; BC4 and BC5 have one), while a step is left after them.
+        let mut next = step + 1;
+        while next + 1 < self.efforts.len()
+            && self.same_blocks(layout, self.efforts[step], self.efforts[next])
+        {
+            next += 1;
+        }
+        Some(next)
+    }
+
+    /// Whether every image of `layout` is encoded alike at efforts `a` and `b` (its codec
+    /// does not tell them apart).
+    fn same_blocks(&self, layout: BlockLayout, a: Effort, b: Effort) -> bool {
+        let (job, format) = (self.job, self.job.preset.format);
+        self.images_of(layout).iter().all(|(_, comps)| {
+            let half = layout.half() && half_image(comps);
+            let srgb = !half && srgb_image(format, comps);
+            let spaces = spaces_of(comps, srgb, half, job.n_enc);
+            format
+                .codec(&spaces)
+                .is_none_or(|c| c.effort(a) == c.effort(b))
+        })
     }
 
     /// Nothing met the budget: the trial nearest it, and why.
@@ -401,7 +423,7 @@ impl<'j, 'a> Search<'j, 'a> {
         trials: Vec<Trial>,
         step: usize,
         here: &str,
-        last: (BlockLayout, Bc7Quality),
+        last: (BlockLayout, Effort),
         (stored_misses, floor): (bool, Option<SrgbError>),
     ) -> Found {
         let budget = &self.job.preset.budget;
@@ -432,7 +454,7 @@ impl<'j, 'a> Search<'j, 'a> {
         } else {
             format!(
                 "no trial up to {:?} met the budget: kept the trial nearest it, {kept}, by {NEAREST_RULE}{last_tried}",
-                self.job.preset.max_bc7_effort
+                self.efforts[self.efforts.len() - 1]
             )
         };
         Found {
@@ -449,17 +471,18 @@ impl<'j, 'a> Search<'j, 'a> {
 fn compress_all(
     images: &mut [TrialImage<'_>],
     encoder: Coder<'_>,
-    effort: Bc7Quality,
+    effort: Effort,
     job: &Job<'_>,
     progress: &Progress,
-) {
+) -> Result<(), String> {
     progress.start("encode", images.len() as u64 * u64::from(job.size.1));
     for image in images {
-        image.compress(encoder, effort, job, progress);
+        image.compress(encoder, effort, job, progress)?;
         if progress.is_cancelled() {
-            return;
+            break;
         }
     }
+    Ok(())
 }
 
 /// One trial: level 0 of `images` compressed at `effort`, and the set measured as a consumer
@@ -468,12 +491,12 @@ fn run_trial(
     images: &mut [TrialImage<'_>],
     encoder: Coder<'_>,
     layout: BlockLayout,
-    effort: Bc7Quality,
+    effort: Effort,
     job: &Job<'_>,
     progress: &Progress,
 ) -> Result<Trial, String> {
     let started = Instant::now();
-    compress_all(images, encoder, effort, job, progress);
+    compress_all(images, encoder, effort, job, progress)?;
     if progress.is_cancelled() {
         return Err("cancelled".into());
     }
@@ -502,18 +525,18 @@ fn run_trial(
 
 /// The chosen images, level 0 as compressed, with their mip chains: the set's files.
 fn with_mips(
-    images: Vec<TrialImage<'_>>,
-    blocks: (Coder<'_>, BlockFamily, Bc7Quality),
+    images: &mut [TrialImage<'_>],
+    (encoder, effort): (Coder<'_>, Effort),
     size: (u32, u32),
     progress: &Progress,
 ) -> Result<Vec<Encoded>, String> {
     progress.start("encode", images.len() as u64 * u64::from(size.1));
     let mut encoded = Vec::with_capacity(images.len());
     for image in images {
-        let compressed = image.compressed.map(|(_, c)| c);
+        let compressed = image.compressed.take().map(|(_, c)| c);
         let written = ktx::encode(
             &image.texels.source(size, &image.level0),
-            Some(blocks),
+            Some((encoder, &*image.codec, effort)),
             compressed,
             progress,
         )?;
@@ -521,8 +544,8 @@ fn with_mips(
             return Err("cancelled".into());
         }
         encoded.push((
-            format!("{}.ktx2", image.stem),
-            image.comps,
+            image.role.file("ktx2"),
+            image.comps.clone(),
             ktx_image(written, image.srgb, image.half),
         ));
     }
@@ -535,25 +558,31 @@ mod tests {
 
     #[test]
     fn n_apart_takes_n_out_of_the_colour_image() {
-        let kd_n = ("kd_n", vec![Comp::Kd(0), Comp::Kd(1), Comp::Kd(2), Comp::N]);
-        let kd = ("kd", vec![Comp::Kd(0), Comp::Kd(1), Comp::Kd(2)]);
+        let kd_n = (
+            Role::KdN,
+            vec![Comp::Kd(0), Comp::Kd(1), Comp::Kd(2), Comp::N],
+        );
+        let kd = (Role::Kd, vec![Comp::Kd(0), Comp::Kd(1), Comp::Kd(2)]);
         // Grey k_s: n joins it in a BC5 image.
-        let grey = vec![kd_n.clone(), ("ks", vec![Comp::Ks(0)])];
+        let grey = vec![kd_n.clone(), (Role::Ks, vec![Comp::Ks(0)])];
         assert_eq!(
             n_apart(&grey, true).unwrap(),
-            vec![kd.clone(), ("ks_n", vec![Comp::Ks(0), Comp::N])]
+            vec![kd.clone(), (Role::KsN, vec![Comp::Ks(0), Comp::N])]
         );
         // Colour k_s, or k_s constant: n alone, as BC4.
         let colour = vec![
             kd_n.clone(),
-            ("ks", vec![Comp::Ks(0), Comp::Ks(1), Comp::Ks(2)]),
+            (Role::Ks, vec![Comp::Ks(0), Comp::Ks(1), Comp::Ks(2)]),
         ];
-        assert_eq!(n_apart(&colour, false).unwrap()[1], ("n", vec![Comp::N]));
+        assert_eq!(
+            n_apart(&colour, false).unwrap()[1],
+            (Role::N, vec![Comp::N])
+        );
         assert_eq!(
             n_apart(&vec![kd_n], true).unwrap(),
-            vec![kd, ("n", vec![Comp::N])]
+            vec![kd, (Role::N, vec![Comp::N])]
         );
         // n already apart from colour: nothing to move.
-        assert!(n_apart(&vec![("ks_n", vec![Comp::Ks(0), Comp::N])], true).is_none());
+        assert!(n_apart(&vec![(Role::KsN, vec![Comp::Ks(0), Comp::N])], true).is_none());
     }
 }

@@ -5,7 +5,6 @@ use image::ExtendedColorType as C;
 use rayon::prelude::*;
 
 use super::manifest::{Comp, Compression, is_colour};
-use crate::blocks::BlockFamily;
 use crate::encoding::NEncoding;
 use crate::ktx::{Space, texel_layout};
 use crate::preset::{ExportPreset, Format};
@@ -50,20 +49,11 @@ pub(super) struct KtxInfo {
     pub mips: Vec<Vec<u8>>,
 }
 
-/// The blocks a block-compressed preset writes (`None` for the others).
-pub(super) fn block_family(preset: &ExportPreset) -> Option<BlockFamily> {
-    match preset.format {
-        Format::Ktx2Bc => Some(BlockFamily::Bc),
-        Format::Ktx2Astc => Some(BlockFamily::Astc(preset.astc_block)),
-        _ => None,
-    }
-}
-
 /// Whether an image's colour components are sRGB-encoded: in 8-bit PNGs always, in KTX2
 /// where the format has an sRGB variant (three or four components).
 pub(super) fn srgb_image(format: Format, comps: &[Comp]) -> bool {
     let colour = comps.iter().any(|c| is_colour(*c));
-    colour && (format == Format::Png8 || (format.is_ktx2() && comps.len() >= 3))
+    colour && (matches!(format, Format::Png8) || (format.is_ktx2() && comps.len() >= 3))
 }
 
 /// Per stored 16-bit code, what a file holds: colour components (sRGB-encoded where `srgb`),
@@ -157,14 +147,14 @@ pub(super) fn encode_image(
             Ok(plain(png(&data, [C::L16, C::La16, C::Rgb16, C::Rgba16])?))
         }
         Format::Exr => Ok(plain(exr_bytes(&value, channels, (width, height))?)),
-        Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc => {
+        Format::Ktx2 | Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. } => {
             let source = KtxTexels::new(texels, ka, comps, srgb, false, n_enc);
             let level0 = source.level0();
-            let compressed = block_family(preset)
-                .map(|f| (crate::blocks::Coder::best_cpu(), f, preset.max_bc7_effort));
+            let codec = preset.format.codec(source.spaces());
+            let compressed = codec.as_deref().zip(preset.format.max_effort());
             let written = crate::ktx::encode(
                 &source.source((width, height), &level0),
-                compressed,
+                compressed.map(|(c, e)| (crate::blocks::Coder::best_cpu(), c, e)),
                 None,
                 progress,
             )?;
@@ -238,6 +228,26 @@ pub(super) struct KtxTexels<'a> {
     sources: Vec<CompSource>,
 }
 
+/// The spaces of an image of `comps` (colour sRGB-encoded where `srgb`, linear half floats
+/// where `half`; `n` by `n_enc`).
+pub(super) fn spaces_of(
+    comps: &[Comp],
+    srgb: bool,
+    half: bool,
+    n_enc: Option<NEncoding>,
+) -> Vec<Space> {
+    comps
+        .iter()
+        .map(|c| match (c, n_enc) {
+            (Comp::N, Some(e)) => Space::N(e),
+            (Comp::N, None) => Space::Linear,
+            _ if half => Space::Half,
+            _ if srgb => Space::Srgb,
+            _ => Space::Linear,
+        })
+        .collect()
+}
+
 impl<'a> KtxTexels<'a> {
     /// The image of `comps` (colour sRGB-encoded where `srgb`, linear half floats where
     /// `half`; `n` by `n_enc`).
@@ -249,16 +259,7 @@ impl<'a> KtxTexels<'a> {
         half: bool,
         n_enc: Option<NEncoding>,
     ) -> Self {
-        let spaces: Vec<Space> = comps
-            .iter()
-            .map(|c| match (c, n_enc) {
-                (Comp::N, Some(e)) => Space::N(e),
-                (Comp::N, None) => Space::Linear,
-                _ if half => Space::Half,
-                _ if srgb => Space::Srgb,
-                _ => Space::Linear,
-            })
-            .collect();
+        let spaces = spaces_of(comps, srgb, half, n_enc);
         let sources = comps
             .iter()
             .zip(&spaces)

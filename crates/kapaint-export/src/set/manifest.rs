@@ -6,7 +6,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::perceptual::SrgbError;
-use crate::astc_block::AstcBlock;
+use crate::codec::AstcBlock;
 use crate::encoding::{KaError, NEncoding};
 use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
 

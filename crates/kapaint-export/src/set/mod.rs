@@ -13,6 +13,7 @@ mod measure;
 mod normal;
 pub mod perceptual;
 mod plan;
+mod role;
 mod target;
 
 use std::path::{Path, PathBuf};
@@ -137,7 +138,7 @@ pub(super) fn export_into(
 ) -> Result<Manifest, SetError> {
     progress.start("analyse", 1);
     let found = claim(out, replace, SetKind::Material)?;
-    if preset.format == Format::GltfPbr {
+    if preset.format.is_gltf_pbr() {
         return Err(SetError::Invalid {
             path: out.to_path_buf(),
             reason: "a glTF PBR set is written by the glTF PBR writer".into(),
@@ -168,7 +169,7 @@ struct Source<'d> {
     size: (u32, u32),
     planned: SetPlan,
     mono_ks: bool,
-    images: Vec<(&'static str, Vec<Comp>)>,
+    images: role::Images,
     /// Row-major, padded past the UV islands ([`padded_texels`]).
     texels: Vec<kapaint_core::model::texel::Texel>,
     dilated: bool,
@@ -255,8 +256,8 @@ impl<'d> Source<'d> {
         let encoded = self
             .images
             .par_iter()
-            .map(|(stem, comps)| {
-                let file = format!("{stem}.{ext}");
+            .map(|(role, comps)| {
+                let file = role.file(ext);
                 progress.check().map_err(|_| SetError::Cancelled)?;
                 let image = encode_image(
                     &self.texels,
@@ -282,11 +283,7 @@ impl<'d> Source<'d> {
         files: Vec<FileEntry>,
         blocks: Option<Box<BlockChoice>>,
     ) -> Manifest {
-        let depth = match preset.format {
-            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc | Format::GltfPbr => 1,
-            Format::Png16 => 2,
-            Format::Exr => 4,
-        };
+        let depth = u64::from(preset.format.component_bytes());
         let (w, h) = self.size;
         let texel_count = u64::from(w) * u64::from(h);
         Manifest {
@@ -404,7 +401,7 @@ fn file_entry(
 ) -> FileEntry {
     let (mip_levels, psnr, compression) = match &image.ktx {
         Some(k) => (Some(k.levels), k.psnr.clone(), k.compression),
-        None if preset.format == Format::Exr => (None, None, Compression::Exr),
+        None if matches!(preset.format, Format::Exr) => (None, None, Compression::Exr),
         None => (None, None, Compression::Png),
     };
     FileEntry {
@@ -415,11 +412,10 @@ fn file_entry(
         } else {
             ColourSpace::Linear
         },
-        bit_depth: match preset.format {
-            _ if image.half => 16,
-            Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc | Format::GltfPbr => 8,
-            Format::Png16 => 16,
-            Format::Exr => 32,
+        bit_depth: if image.half {
+            16
+        } else {
+            u32::from(preset.format.component_bytes()) * 8
         },
         compression,
         width: source.size.0,
@@ -427,7 +423,10 @@ fn file_entry(
         bytes: image.bytes.len() as u64,
         mip_levels,
         psnr,
-        astc_block: (compression == Compression::Ktx2Astc).then_some(preset.astc_block),
+        astc_block: preset
+            .format
+            .astc_block()
+            .filter(|_| compression == Compression::Ktx2Astc),
     }
 }
 

@@ -14,10 +14,11 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{SetError, io};
-use crate::astc_block::AstcBlock;
-use crate::blocks::{BlockFamily, Coder};
+use crate::blocks::Coder;
+use crate::codec::{AstcBlock, Codec, Effort};
 use crate::file_kind::Compression;
-use crate::preset::{Bc7Quality, ExportPreset, Format};
+use crate::ktx::Space;
+use crate::preset::{ExportPreset, Format};
 use kapaint_core::model::normal::NormalMap;
 use kapaint_core::model::project::NORMAL_ENCODING;
 
@@ -37,9 +38,9 @@ pub const NORMAL_Z: &str = "sqrt(max(0, 1 - x^2 - y^2))";
 pub enum NormalStorage {
     /// [`NORMAL_FILE`], as the project stores it.
     Png,
-    /// [`NORMAL_KTX2_FILE`], x and y: 8-bit RG uncompressed, or in blocks of a family (BC5,
-    /// or ASTC with two components as luminance and alpha) at an effort (ASTC's).
-    Ktx2(Option<(BlockFamily, Bc7Quality)>),
+    /// [`NORMAL_KTX2_FILE`], x and y: 8-bit RG uncompressed, or in the blocks a block format
+    /// gives two components (BC5, or ASTC as luminance and alpha) at an effort.
+    Ktx2(Option<(Format, Effort)>),
 }
 
 impl NormalStorage {
@@ -48,11 +49,17 @@ impl NormalStorage {
         match preset.format {
             Format::Png8 | Format::Png16 | Format::Exr | Format::GltfPbr => Self::Png,
             Format::Ktx2 => Self::Ktx2(None),
-            Format::Ktx2Bc => Self::Ktx2(Some((BlockFamily::Bc, Bc7Quality::UltraFast))),
-            Format::Ktx2Astc => Self::Ktx2(Some((
-                BlockFamily::Astc(preset.astc_block),
-                NORMAL_ASTC_EFFORT,
-            ))),
+            blocks @ (Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. }) => {
+                Self::Ktx2(Some((blocks, NORMAL_EFFORT)))
+            }
+        }
+    }
+
+    /// The codec of its blocks, where it has blocks.
+    fn codec(self) -> Option<Box<dyn Codec>> {
+        match self {
+            Self::Ktx2(Some((format, _))) => format.codec(&[Space::Linear; 2]),
+            Self::Png | Self::Ktx2(None) => None,
         }
     }
 
@@ -68,21 +75,19 @@ impl NormalStorage {
     pub fn describe(self) -> String {
         match self {
             Self::Png => "8-bit RGB tangent space, as the project stores it".into(),
-            Self::Ktx2(None) => "x and y as 8-bit RG, z rebuilt by the consumer".into(),
-            Self::Ktx2(Some((BlockFamily::Bc, _))) => {
-                "x and y as BC5, z rebuilt by the consumer".into()
-            }
-            Self::Ktx2(Some((BlockFamily::Astc(b), _))) => {
-                format!("x and y as ASTC {b} (luminance and alpha), z rebuilt by the consumer")
-            }
+            Self::Ktx2(_) => format!(
+                "x and y as {}, z rebuilt by the consumer",
+                self.codec()
+                    .map_or_else(|| "8-bit RG".to_string(), |c| c.describe())
+            ),
         }
     }
 }
 
-/// The ASTC search for normal maps: astcenc's fastest, as the set's first trial. Its medium
-/// search halves the angular error of bumpy maps but takes three to seven times as long, more
-/// than the rest of the set (docs/export.md).
-const NORMAL_ASTC_EFFORT: Bc7Quality = Bc7Quality::UltraFast;
+/// The effort for normal maps' blocks: the cheapest, as the set's first trial. BC5 has one;
+/// astcenc's medium search halves the angular error of bumpy maps but takes three to seven
+/// times as long as its fastest, more than the rest of the set (docs/export.md).
+const NORMAL_EFFORT: Effort = Effort::UltraFast;
 
 /// The angle between a normal as a consumer decodes it and the project's, in degrees.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -185,10 +190,14 @@ impl NormalFile {
         let unit = unit_normals(normal);
         let size = (normal.width(), normal.height());
         let levels = xy_levels(&unit, size);
+        let codec = storage.codec();
         let written = crate::ktx::encode_levels(
             &levels,
             2,
-            blocks.map(|(family, effort)| (Coder::best_cpu(), family, effort)),
+            codec
+                .as_deref()
+                .zip(blocks)
+                .map(|(codec, (_, effort))| (Coder::best_cpu(), codec, effort)),
         )
         .map_err(|e| io(&path, e))?;
         let decoded = written.decoded.first().map_or(&[][..], |d| &d[..]);
@@ -201,10 +210,7 @@ impl NormalFile {
             height: size.1,
             bytes: written.bytes.len() as u64,
             compression: Some(written.compression),
-            astc_block: match blocks {
-                Some((BlockFamily::Astc(b), _)) => Some(b),
-                _ => None,
-            },
+            astc_block: blocks.and_then(|(format, _)| format.astc_block()),
             mip_levels: Some(written.levels),
             xy: Some(xy_of(written.compression).into()),
             z: Some(NORMAL_Z.into()),

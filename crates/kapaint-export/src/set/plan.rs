@@ -4,6 +4,7 @@
 use rayon::prelude::*;
 
 use super::manifest::{Comp, Constants, MemoryReport};
+use super::role::{Images, Role};
 use crate::encoding::{KaError, NEncoding, rank_encodings};
 use crate::preset::{ExportPreset, Format, Layout};
 use kapaint_core::model::texel::{decode_n, decode_unorm};
@@ -22,11 +23,7 @@ fn ks_monochrome(maps: &MaterialMaps) -> bool {
 
 /// Which images a set holds, with which components: what is constant is left out, `k_s` is
 /// one channel when grey, and the packed layout puts `n` in `k_d`'s alpha.
-fn plan_images(
-    preset: &ExportPreset,
-    constants: &Constants,
-    mono_ks: bool,
-) -> Vec<(&'static str, Vec<Comp>)> {
+fn plan_images(preset: &ExportPreset, constants: &Constants, mono_ks: bool) -> Images {
     let kd: Vec<Comp> = (0..3).map(Comp::Kd).collect();
     let ks: Vec<Comp> = if mono_ks {
         vec![Comp::Ks(0)]
@@ -34,30 +31,30 @@ fn plan_images(
         (0..3).map(Comp::Ks).collect()
     };
     let (with_kd, with_n) = (constants.kd.is_none(), constants.n.is_none());
-    let mut images: Vec<(&'static str, Vec<Comp>)> = Vec::new();
+    let mut images: Images = Vec::new();
     let with_ks = constants.ks.is_none();
     if preset.layout == Layout::Packed && with_kd && with_n {
-        images.push(("kd_n", [kd, vec![Comp::N]].concat()));
+        images.push((Role::KdN, [kd, vec![Comp::N]].concat()));
     } else if preset.layout == Layout::Packed && with_n && with_ks && mono_ks {
         // k_d constant: grey k_s and n share a two-component image.
-        images.push(("ks_n", vec![Comp::Ks(0), Comp::N]));
+        images.push((Role::KsN, vec![Comp::Ks(0), Comp::N]));
         if preset.include_ka {
-            images.push(("ka", (0..3).map(Comp::Ka).collect()));
+            images.push((Role::Ka, (0..3).map(Comp::Ka).collect()));
         }
         return images;
     } else {
         if with_kd {
-            images.push(("kd", kd));
+            images.push((Role::Kd, kd));
         }
         if with_n {
-            images.push(("n", vec![Comp::N]));
+            images.push((Role::N, vec![Comp::N]));
         }
     }
     if constants.ks.is_none() {
-        images.push(("ks", ks));
+        images.push((Role::Ks, ks));
     }
     if preset.include_ka {
-        images.push(("ka", (0..3).map(Comp::Ka).collect()));
+        images.push((Role::Ka, (0..3).map(Comp::Ka).collect()));
     }
     images
 }
@@ -120,12 +117,9 @@ pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
 
 /// [`plan`], with the two facts the writer needs besides: whether `k_s` is grey, and the
 /// planned images' components.
-pub(super) fn plan_set(
-    doc: &Document,
-    preset: &ExportPreset,
-) -> (SetPlan, bool, Vec<(&'static str, Vec<Comp>)>) {
+pub(super) fn plan_set(doc: &Document, preset: &ExportPreset) -> (SetPlan, bool, Images) {
     let maps = doc.maps();
-    if preset.format == Format::GltfPbr {
+    if preset.format.is_gltf_pbr() {
         return (gltf_pbr_plan(maps), false, Vec::new());
     }
     let (model, approx) = (doc.settings().model, doc.settings().approx);
@@ -143,17 +137,13 @@ pub(super) fn plan_set(
             .map_or((None, KaError::default()), |(e, err)| (Some(*e), *err)),
     };
     let images = plan_images(preset, &constants, mono_ks);
-    let depth: u64 = match preset.format {
-        Format::Png8 | Format::Ktx2 | Format::Ktx2Bc | Format::Ktx2Astc | Format::GltfPbr => 1,
-        Format::Png16 => 2,
-        Format::Exr => 4,
-    };
+    let depth = u64::from(preset.format.component_bytes());
     let texels = u64::from(maps.width()) * u64::from(maps.height());
     let ext = preset.format.extension();
     let files: Vec<PlannedFile> = images
         .iter()
-        .map(|(stem, comps)| PlannedFile {
-            path: format!("{stem}.{ext}"),
+        .map(|(role, comps)| PlannedFile {
+            path: role.file(ext),
             layout: comps.iter().map(|c| c.name(mono_ks)).collect(),
             raw_bytes: texels * depth * comps.len() as u64,
         })

@@ -5,89 +5,16 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::astc_block::AstcBlock;
+mod format;
+mod version_one;
 
-/// Image format of the exported files.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Format {
-    /// 8-bit PNG (colour in sRGB).
-    Png8,
-    /// 16-bit PNG (linear).
-    Png16,
-    /// Float OpenEXR (linear; `n` as is).
-    Exr,
-    /// KTX2, 8 bits per component, uncompressed, with a full mip chain.
-    Ktx2,
-    /// KTX2 block-compressed with a full mip chain: BC7 for three or four components, BC5
-    /// for two, BC4 for one.
-    Ktx2Bc,
-    /// KTX2 with ASTC LDR blocks and a full mip chain (phones, standalone headsets): one
-    /// footprint for every image (`astc_block`, 4x4 by default), `k_d` sRGB.
-    Ktx2Astc,
-    /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
-    /// roughness, B metallic), and the normal map where the project has one; converted back
-    /// from `k_d`, `k_s`, `n` ([`crate::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
-    /// not apply.
-    GltfPbr,
-}
+pub use self::format::Format;
+use self::version_one::VersionOne;
+pub use crate::codec::{AstcBlock, Effort};
 
-impl Format {
-    /// Whether files hold 8-bit components (PNG8 and both KTX2 kinds).
-    pub fn is_8bit(self) -> bool {
-        matches!(
-            self,
-            Self::Png8 | Self::Ktx2 | Self::Ktx2Bc | Self::Ktx2Astc | Self::GltfPbr
-        )
-    }
-
-    /// Whether files are KTX2 containers.
-    pub fn is_ktx2(self) -> bool {
-        matches!(self, Self::Ktx2 | Self::Ktx2Bc | Self::Ktx2Astc)
-    }
-
-    /// Whether files are block-compressed (BC or ASTC), their layout and effort chosen
-    /// against the preset's budget.
-    pub fn is_blocks(self) -> bool {
-        matches!(self, Self::Ktx2Bc | Self::Ktx2Astc)
-    }
-
-    /// The files' extension.
-    pub fn extension(self) -> &'static str {
-        match self {
-            Self::Png8 | Self::Png16 | Self::GltfPbr => "png",
-            Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc | Self::Ktx2Astc => "ktx2",
-        }
-    }
-}
-
-/// BC7 encoder effort (BC4 and BC5 have one speed): slower finds better endpoints. Ordered
-/// from the cheapest.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum Bc7Quality {
-    /// Fewest partitions and modes tried.
-    UltraFast,
-    /// About 1 dB under `Basic` at a fraction of the time.
-    VeryFast,
-    /// More modes.
-    Fast,
-    /// The reference encoder's basic profile: the most a preset spends by default.
-    #[default]
-    Basic,
-    /// Exhaustive.
-    Slow,
-}
-
-impl Bc7Quality {
-    /// Every effort, cheapest first.
-    pub const ALL: [Self; 5] = [
-        Self::UltraFast,
-        Self::VeryFast,
-        Self::Fast,
-        Self::Basic,
-        Self::Slow,
-    ];
-}
+/// The version of the preset files this kapaint writes and reads: 2 gave each block format
+/// its own parameters (`Ktx2Bc(max_effort:, bc6h:)`, `Ktx2Astc(block:, max_effort:)`).
+pub const PRESET_VERSION: u32 = 2;
 
 /// What a block-compressed set may lose, in what the eye sees: the `k_a` error in levels of
 /// 8-bit sRGB of the ambient-lit colour ([`crate::set::perceptual`]), its 99.9th percentile and
@@ -177,7 +104,7 @@ pub struct ExportPreset {
     /// One line for menus.
     #[serde(default)]
     pub description: String,
-    /// Image format.
+    /// Image format, with its parameters.
     pub format: Format,
     /// Channel packing.
     pub layout: Layout,
@@ -186,22 +113,17 @@ pub struct ExportPreset {
     /// Also write a baked `k_a` map.
     #[serde(default)]
     pub include_ka: bool,
-    /// The most BC7 effort a `Ktx2Bc` export may spend meeting its budget.
-    pub max_bc7_effort: Bc7Quality,
-    /// What a `Ktx2Bc` set may lose.
+    /// What a block-compressed set may lose.
     pub budget: BlockBudget,
-    /// Whether a `Ktx2Bc` export may store colour as BC6H (linear half floats) when BC7
-    /// misses the budget; off for consumers that sample only BC7 (RON `bc6h`, default on).
-    pub bc6h: bool,
-    /// A `Ktx2Astc` set's footprint (RON `astc_block: "6x6"`, default 4x4); the loader
-    /// refuses one ASTC does not define.
-    pub astc_block: AstcBlock,
 }
 
 /// An export preset as its file spells it, before it is checked.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ExportPresetFile {
+    /// [`PRESET_VERSION`] (files before version 2 have none).
+    #[serde(default = "version_one")]
+    version: u32,
     name: String,
     #[serde(default)]
     description: String,
@@ -210,37 +132,31 @@ struct ExportPresetFile {
     n_bits: u8,
     #[serde(default)]
     include_ka: bool,
-    /// Older presets name the ceiling `bc7_quality`.
-    #[serde(default, alias = "bc7_quality")]
-    max_bc7_effort: Bc7Quality,
     #[serde(default = "default_srgb_p999")]
     ka_error_srgb_p999: f64,
     #[serde(default = "default_srgb_mean")]
     ka_error_srgb_mean: f64,
-    #[serde(default, deserialize_with = "some_number")]
+    #[serde(default, deserialize_with = "some")]
     max_ka_error: Option<f64>,
-    #[serde(default, deserialize_with = "some_number")]
+    #[serde(default, deserialize_with = "some")]
     mean_ka_error: Option<f64>,
-    #[serde(default, deserialize_with = "some_number")]
+    #[serde(default, deserialize_with = "some")]
     min_psnr: Option<f64>,
-    #[serde(default = "default_bc6h")]
-    bc6h: bool,
-    #[serde(default, deserialize_with = "some_block")]
-    astc_block: Option<AstcBlock>,
 }
 
-/// An ASTC footprint as a preset spells it: a bare `"WxH"`, present means set.
-fn some_block<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<AstcBlock>, D::Error> {
-    AstcBlock::deserialize(d).map(Some)
+fn version_one() -> u32 {
+    1
 }
 
-/// An optional limit as a preset spells it: a bare number (as before the limits became
+/// An optional value as a preset spells it: bare (a limit as before the limits became
 /// optional), present means set.
-fn some_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
-    f64::deserialize(d).map(Some)
+pub(super) fn some<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(
+    d: D,
+) -> Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
 }
 
-fn default_bc6h() -> bool {
+pub(super) fn default_bc6h() -> bool {
     true
 }
 
@@ -249,6 +165,18 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
 
     fn try_from(f: ExportPresetFile) -> Result<Self, String> {
         use kapaint_core::model::check::{MAX_PATH_BYTES, bounded_text, name};
+        if f.version > PRESET_VERSION {
+            return Err(format!(
+                "version {} is newer than this kapaint reads ({PRESET_VERSION})",
+                f.version
+            ));
+        }
+        if f.version < PRESET_VERSION && f.format.is_blocks() {
+            return Err(format!(
+                "a {} preset needs version: {PRESET_VERSION} (block parameters live in the format)",
+                f.format.name()
+            ));
+        }
         name("name", &f.name)?;
         bounded_text("description", &f.description, MAX_PATH_BYTES)?;
         if !matches!(f.n_bits, 8 | 16) {
@@ -256,20 +184,14 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
         }
         if f.format.is_8bit() && f.n_bits != 8 {
             return Err(format!(
-                "{:?} stores 8-bit components (n_bits: 8)",
-                f.format
+                "{} stores 8-bit components (n_bits: 8)",
+                f.format.name()
             ));
         }
-        if f.format == Format::GltfPbr && f.include_ka {
+        if f.format.is_gltf_pbr() && f.include_ka {
             return Err("a glTF PBR set has no k_a map (include_ka: false)".into());
         }
-        if f.astc_block.is_some() && f.format != Format::Ktx2Astc {
-            return Err(format!(
-                "astc_block applies to Ktx2Astc presets, not {:?}",
-                f.format
-            ));
-        }
-        if f.format == Format::Png16 && f.n_bits != 16 {
+        if matches!(f.format, Format::Png16) && f.n_bits != 16 {
             return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
         }
         let budget = BlockBudget {
@@ -310,10 +232,7 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             layout: f.layout,
             n_bits: f.n_bits,
             include_ka: f.include_ka,
-            max_bc7_effort: f.max_bc7_effort,
             budget,
-            bc6h: f.bc6h,
-            astc_block: f.astc_block.unwrap_or_default(),
         })
     }
 }
@@ -340,32 +259,35 @@ pub enum PresetError {
 }
 
 const BUILTIN: &[(&str, &str)] = &[
-    ("16-bit", include_str!("../../../presets/export/16-bit.ron")),
+    (
+        "16-bit",
+        include_str!("../../../../presets/export/16-bit.ron"),
+    ),
     (
         "compact",
-        include_str!("../../../presets/export/compact.ron"),
+        include_str!("../../../../presets/export/compact.ron"),
     ),
-    ("exr", include_str!("../../../presets/export/exr.ron")),
+    ("exr", include_str!("../../../../presets/export/exr.ron")),
     (
         "gltf-pbr",
-        include_str!("../../../presets/export/gltf-pbr.ron"),
+        include_str!("../../../../presets/export/gltf-pbr.ron"),
     ),
-    ("ktx2", include_str!("../../../presets/export/ktx2.ron")),
+    ("ktx2", include_str!("../../../../presets/export/ktx2.ron")),
     (
         "ktx2-astc",
-        include_str!("../../../presets/export/ktx2-astc.ron"),
+        include_str!("../../../../presets/export/ktx2-astc.ron"),
     ),
     (
         "ktx2-raw",
-        include_str!("../../../presets/export/ktx2-raw.ron"),
+        include_str!("../../../../presets/export/ktx2-raw.ron"),
     ),
     (
         "separate",
-        include_str!("../../../presets/export/separate.ron"),
+        include_str!("../../../../presets/export/separate.ron"),
     ),
     (
         "with-ka",
-        include_str!("../../../presets/export/with-ka.ron"),
+        include_str!("../../../../presets/export/with-ka.ron"),
     ),
 ];
 
@@ -375,9 +297,20 @@ impl ExportPreset {
     /// # Errors
     /// Malformed RON, unknown fields, or values out of range.
     pub fn parse(path: &Path, text: &str) -> Result<Self, PresetError> {
-        ron::from_str(text).map_err(|e| PresetError::Malformed {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
+        ron::from_str(text).map_err(|e| {
+            // The version-1 spelling: say what it is spelled as now.
+            let old = ron::from_str::<VersionOne>(text)
+                .ok()
+                .and_then(|v| v.instead());
+            PresetError::Malformed {
+                path: path.to_path_buf(),
+                reason: match old {
+                    Some(instead) => format!(
+                        "the version-1 spelling of a block format: since preset version {PRESET_VERSION}, max_bc7_effort, bc6h and astc_block live in the format; {instead}"
+                    ),
+                    None => e.to_string(),
+                },
+            }
         })
     }
 }
@@ -396,7 +329,7 @@ pub fn builtin() -> Vec<ExportPreset> {
 pub fn builtin_sets() -> Vec<ExportPreset> {
     builtin()
         .into_iter()
-        .filter(|p| p.format != Format::GltfPbr)
+        .filter(|p| !p.format.is_gltf_pbr())
         .collect()
 }
 
@@ -484,15 +417,53 @@ mod tests {
             "(name: \"a\", format: Png16, layout: Packed, n_bits: 8)",
             "(name: \"a\", format: Gif, layout: Packed, n_bits: 8)",
             "(name: \"a\", format: Png8, layout: Packed, n_bits: 8, extra: 1)",
-            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, max_ka_error: -1.0)",
-            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, min_psnr: NaN)",
-            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"7x7\")",
-            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"4x4x4\")",
-            "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: 4)",
-            "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, astc_block: \"4x4\")",
+            "(version: 2, name: \"a\", format: Ktx2Bc(), layout: Packed, n_bits: 8, max_ka_error: -1.0)",
+            "(version: 2, name: \"a\", format: Ktx2Bc(), layout: Packed, n_bits: 8, min_psnr: NaN)",
+            "(version: 2, name: \"a\", format: Ktx2Astc(block: \"7x7\"), layout: Packed, n_bits: 8)",
+            "(version: 2, name: \"a\", format: Ktx2Astc(block: \"4x4x4\"), layout: Packed, n_bits: 8)",
+            "(version: 2, name: \"a\", format: Ktx2Astc(block: 4), layout: Packed, n_bits: 8)",
+            "(version: 2, name: \"a\", format: Ktx2Bc(block: \"4x4\"), layout: Packed, n_bits: 8)",
+            "(version: 2, name: \"a\", format: Ktx2Bc(max_effort: Hard), layout: Packed, n_bits: 8)",
+            "(version: 3, name: \"a\", format: Png8, layout: Packed, n_bits: 8)",
+            "(name: \"a\", format: Ktx2Bc(), layout: Packed, n_bits: 8)",
         ] {
             let err = ExportPreset::parse(path, text).unwrap_err().to_string();
             assert!(err.starts_with("x.ron: "), "{err}");
         }
+    }
+
+    #[test]
+    fn the_version_one_spelling_is_refused_with_the_new_one() {
+        let path = Path::new("old.ron");
+        for (text, instead) in [
+            (
+                "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, max_bc7_effort: Fast, bc6h: false)",
+                "write version: 2 and format: Ktx2Bc(max_effort: Fast, bc6h: false)",
+            ),
+            (
+                "(name: \"a\", format: Ktx2Bc, layout: Packed, n_bits: 8, bc7_quality: Slow)",
+                "write version: 2 and format: Ktx2Bc(max_effort: Slow, bc6h: true)",
+            ),
+            (
+                "(name: \"a\", format: Ktx2Astc, layout: Packed, n_bits: 8, astc_block: \"6x6\")",
+                "write version: 2 and format: Ktx2Astc(block: \"6x6\", max_effort: Basic)",
+            ),
+            (
+                "(name: \"a\", format: Png8, layout: Packed, n_bits: 8, bc6h: true)",
+                "remove them: Png8 has no blocks",
+            ),
+        ] {
+            let err = ExportPreset::parse(path, text).unwrap_err().to_string();
+            assert!(err.starts_with("old.ron: the version-1 spelling"), "{err}");
+            assert!(err.ends_with(instead), "{err}");
+            // What it says to write reads as it says.
+            if let Some(format) = instead.strip_prefix("write version: 2 and ") {
+                let new = format!("(version: 2, name: \"a\", {format}, layout: Packed, n_bits: 8)");
+                ExportPreset::parse(path, &new).unwrap();
+            }
+        }
+        // A version-1 preset without blocks still reads as it did.
+        let png = "(name: \"a\", format: Png8, layout: Packed, n_bits: 8)";
+        assert_eq!(ExportPreset::parse(path, png).unwrap().format, Format::Png8);
     }
 }

@@ -18,8 +18,6 @@ use std::sync::LazyLock;
 
 use block_compression::decode::decode_block_bc7;
 
-use super::BlockKind;
-
 /// BC7's 2-bit interpolation weights, out of 64.
 const WEIGHTS: [u32; 4] = [0, 21, 43, 64];
 
@@ -114,14 +112,10 @@ fn error(texels: &[[u8; 4]; 16], decoded: &[u8], channels: usize) -> u32 {
         .sum()
 }
 
-/// Replaces, in `blocks` of `kind` (`width` texels across, as many rows as they cover), each
+/// Replaces, in BC7 `blocks` (`width` texels across, as many rows as they cover), each
 /// block of one RGB colour in `texels` (RGBA8, `width` across) with its exact mode 5 block
-/// where that decodes closer over the components the file stores. Other kinds than BC7 are
-/// left as they are.
-pub(super) fn refine(kind: BlockKind, blocks: &mut [u8], texels: &[u8], width: usize) {
-    let BlockKind::Bc7 { alpha, .. } = kind else {
-        return;
-    };
+/// where that decodes closer over the components the file stores (alpha where `alpha`).
+pub(super) fn refine(alpha: bool, blocks: &mut [u8], texels: &[u8], width: usize) {
     let channels = if alpha { 4 } else { 3 };
     let across = width / 4;
     for (n, block) in blocks.chunks_exact_mut(16).enumerate() {

@@ -75,14 +75,14 @@ impl AstcBlock {
         };
         let (w, h) = name
             .split_once(['x', 'X'])
-            .ok_or_else(|| format!("astc_block {name:?} is not WxH (ASTC's: {})", known()))?;
+            .ok_or_else(|| format!("ASTC block {name:?} is not WxH (ASTC's: {})", known()))?;
         let side = |s: &str| s.trim().parse::<u32>().ok();
         side(w)
             .zip(side(h))
             .and_then(|(w, h)| Self::of(w, h))
             .ok_or_else(|| {
                 format!(
-                    "astc_block {name:?} is not a footprint ASTC defines ({})",
+                    "ASTC block {name:?} is not a footprint ASTC defines ({})",
                     known()
                 )
             })
