@@ -1,9 +1,9 @@
-//! Regenerates `crates/kapaint-core/src/pbr/table.rs` (the fitted exponent per roughness for
+//! Regenerates `crates/kapaint-pbr/src/table.rs` (the fitted exponent per roughness for
 //! each target model and the conversion-error tables) and `table_height.rs` beside it (the
 //! height mapping's fit) and `table_height_error.bin` (its error numerator), see
 //! `kapaint::pbr::fit`, printing each row's fit to stderr.
 //!
-//! Usage: `cargo run --release --example fit_pbr -- crates/kapaint-core/src/pbr`
+//! Usage: `cargo run --release --example fit_pbr -- crates/kapaint-pbr/src`
 //! (`fit_pbr LEVEL` checks a box rule's level against the exact integrals instead).
 
 use kapaint::pbr::fit::{

@@ -55,7 +55,7 @@ fn kapaint_deps(krate: &str) -> BTreeSet<String> {
 }
 
 /// Each crate with the kapaint crates under it (its whole tree, not only what it names).
-const LAYERS: [(&str, &[&str]); 9] = [
+const LAYERS: [(&str, &[&str]); 10] = [
     ("kapaint-base", &[]),
     ("kapaint-reflectance", &[]),
     ("kapaint-mesh", &["kapaint-base"]),
@@ -63,6 +63,7 @@ const LAYERS: [(&str, &[&str]); 9] = [
         "kapaint-model",
         &["kapaint-base", "kapaint-mesh", "kapaint-reflectance"],
     ),
+    ("kapaint-pbr", &BELOW_CORE),
     ("kapaint-core", &BELOW_CORE),
     (
         "kapaint-export",
@@ -71,7 +72,7 @@ const LAYERS: [(&str, &[&str]); 9] = [
             BELOW_CORE[1],
             BELOW_CORE[2],
             BELOW_CORE[3],
-            "kapaint-core",
+            "kapaint-pbr",
         ],
     ),
     (
@@ -83,6 +84,7 @@ const LAYERS: [(&str, &[&str]); 9] = [
             BELOW_CORE[3],
             "kapaint-core",
             "kapaint-export",
+            "kapaint-pbr",
         ],
     ),
     (
@@ -95,6 +97,7 @@ const LAYERS: [(&str, &[&str]); 9] = [
             "kapaint-core",
             "kapaint-export",
             "kapaint-gpu",
+            "kapaint-pbr",
         ],
     ),
     (
@@ -108,6 +111,7 @@ const LAYERS: [(&str, &[&str]); 9] = [
             "kapaint-editor",
             "kapaint-export",
             "kapaint-gpu",
+            "kapaint-pbr",
         ],
     ),
 ];
@@ -140,11 +144,20 @@ fn the_core_and_everything_under_it_link_no_gui_or_gpu_crate() {
         "kapaint-reflectance",
         "kapaint-mesh",
         "kapaint-model",
+        "kapaint-pbr",
         "kapaint-core",
         "kapaint-export",
     ] {
         assert_free_of(krate, &forbidden);
     }
+}
+
+/// The export needs the model and the PBR conversion, never the tools nor the reports'
+/// charts (issue 55: every crate above the core linked `plotters`).
+#[test]
+fn the_export_links_neither_the_core_nor_its_charts() {
+    assert_free_of("kapaint-export", &["kapaint-core", "plotters"]);
+    assert_free_of("kapaint-pbr", &["kapaint-core", "plotters"]);
 }
 
 #[test]

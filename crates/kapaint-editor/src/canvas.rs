@@ -6,9 +6,9 @@ use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions
 use kapaint_core::mesh::bakes::BakeMap;
 use kapaint_core::model::texel::{MaterialValue, linear_to_srgb};
 use kapaint_core::model::{Document, MaterialMaps};
-use kapaint_core::pbr::round_trip::RoundTrip;
 use kapaint_core::reflectance;
 use kapaint_core::render::n_false_colour;
+use kapaint_pbr::round_trip::RoundTrip;
 
 /// The canvas's accessible name (tests and screen readers find it by this).
 pub const CANVAS_LABEL: &str = "UV canvas painting area";

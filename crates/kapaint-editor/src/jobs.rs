@@ -83,7 +83,7 @@ pub(super) struct UnwrapPrompt {
 pub struct LoadedMaterial {
     /// What the size question calls it: "The texture set Bricks", "cow.glb's material".
     pub(super) name: String,
-    pub(super) set: kapaint_core::pbr::import::PbrSet,
+    pub(super) set: kapaint_pbr::import::PbrSet,
     pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
     pub(super) notes: Vec<String>,
     /// The material is seen from both sides (glTF's `doubleSided`).

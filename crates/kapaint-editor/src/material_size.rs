@@ -14,9 +14,9 @@ use super::jobs::{JobResult, LoadedMaterial, PbrMaterial};
 use kapaint_core::model::ModelError;
 use kapaint_core::model::resize::{ResizedMaps, resized_stack};
 use kapaint_core::model::surface::Surface;
-use kapaint_core::pbr::NMapping;
 use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::task::Progress;
+use kapaint_pbr::NMapping;
 
 /// The answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +36,7 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
     if gltf {
-        let m = kapaint_core::pbr::gltf::material_set(path, None)?;
+        let m = kapaint_pbr::gltf::material_set(path, None)?;
         let file = path.file_name().map_or_else(
             || path.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
@@ -49,7 +49,7 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
             double_sided: m.double_sided,
         });
     }
-    let named = kapaint_core::pbr::names::set_of(path)?;
+    let named = kapaint_pbr::names::set_of(path)?;
     let mut notes = named.notes.clone();
     let normal = named.load_normal(&mut notes)?;
     Ok(LoadedMaterial {
@@ -70,7 +70,7 @@ fn convert(
     progress: &Progress,
 ) -> Result<PbrMaterial, ModelError> {
     progress.start("convert", 1);
-    let imported = kapaint_core::pbr::import::import(&loaded.set, Some(size), model, mapping)?;
+    let imported = kapaint_pbr::import::import(&loaded.set, Some(size), model, mapping)?;
     let mut report = imported.report;
     report.notes.extend(loaded.notes.iter().cloned());
     report.double_sided = loaded.double_sided;
@@ -84,7 +84,7 @@ fn convert(
 
 impl EditorState {
     /// Converts the material of the glTF at `path`, or the texture set `path` is one image of
-    /// ([`kapaint_core::pbr::names`]), for the document's model, on a worker; it replaces the
+    /// ([`kapaint_pbr::names`]), for the document's model, on a worker; it replaces the
     /// selected layer's channels (one undo step) when it arrives. A material of another size
     /// than the maps is not resampled silently: the editor asks first ([`SizePrompt`]).
     pub fn import_pbr(&mut self, path: PathBuf) {
@@ -98,7 +98,7 @@ impl EditorState {
                 Ok(l) => l,
                 Err(e) => return fail(e),
             };
-            match kapaint_core::pbr::import::native_size(&loaded.set) {
+            match kapaint_pbr::import::native_size(&loaded.set) {
                 Ok(Some(size)) if size != project => {
                     JobResult::MaterialSize(Box::new(SizePrompt {
                         path,

@@ -158,7 +158,7 @@ impl EditorState {
         progress.start("bake", 1);
         match Surface::new(mesh, w, h) {
             Ok(s) => {
-                let textured = kapaint_core::pbr::gltf::has_textured_material(&path);
+                let textured = kapaint_pbr::gltf::has_textured_material(&path);
                 JobResult::Mesh(path, Arc::new(s), textured)
             }
             Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),

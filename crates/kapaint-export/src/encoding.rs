@@ -9,11 +9,11 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use kapaint_core::model::MaterialMaps;
-use kapaint_core::model::maps::chi_lut;
-use kapaint_core::model::texel::{N_MAX, decode_n};
-use kapaint_core::model::tile::TILE_TEXELS;
-use kapaint_core::reflectance::{AmbientApprox, ShadingModel, diffuse_factor};
+use kapaint_model::MaterialMaps;
+use kapaint_model::maps::chi_lut;
+use kapaint_model::texel::{N_MAX, decode_n};
+use kapaint_model::tile::TILE_TEXELS;
+use kapaint_reflectance::{AmbientApprox, ShadingModel, diffuse_factor};
 
 /// The curve `n` is quantised along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -80,7 +80,7 @@ impl TryFrom<NEncodingFile> for NEncoding {
     type Error = String;
 
     fn try_from(f: NEncodingFile) -> Result<Self, String> {
-        use kapaint_core::model::check::in_range;
+        use kapaint_model::check::in_range;
         if !matches!(f.bits, 8 | 16) {
             return Err(format!(
                 "n_encoding.bits must be 8 or 16 (what kapaint writes), got {}",
@@ -153,8 +153,8 @@ pub fn n_range(maps: &MaterialMaps) -> (f32, f32) {
     let mut used = vec![false; 1 << 16];
     for id in 0..maps.tile_count() {
         match &maps.tile(id).n {
-            kapaint_core::model::tile::Plane::Uniform(v) => used[*v as usize] = true,
-            kapaint_core::model::tile::Plane::Data(d) => {
+            kapaint_model::tile::Plane::Uniform(v) => used[*v as usize] = true,
+            kapaint_model::tile::Plane::Data(d) => {
                 for &v in d {
                     used[v as usize] = true;
                 }
@@ -184,18 +184,14 @@ pub fn ka_error(
     let quantised: Vec<[f32; 2]> = (0..=u16::MAX)
         .map(|bits| {
             let n = decode_n(bits);
-            kapaint_core::reflectance::chi_parts_f32(
-                model,
-                approx,
-                encoding.decode(encoding.encode(n)),
-            )
+            kapaint_reflectance::chi_parts_f32(model, approx, encoding.decode(encoding.encode(n)))
         })
         .collect();
     let diffuse = diffuse_factor(approx.for_model(model)) as f32;
     let (max, sum, count) = (0..maps.tile_count())
         .into_par_iter()
         .map(|id| {
-            let kapaint_core::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
+            let kapaint_model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
             let tile = maps.tile(id);
             let (mut max, mut sum, mut count) = (0.0_f64, 0.0_f64, 0_u64);
             for i in 0..TILE_TEXELS {
@@ -206,8 +202,8 @@ pub fn ka_error(
                 let t = tile.texel(i);
                 let ([c0, z0], [c1, z1]) = (chi[t.n as usize], quantised[t.n as usize]);
                 for c in 0..3 {
-                    let kd = kapaint_core::model::texel::decode_unorm(t.kd[c]);
-                    let ks = kapaint_core::model::texel::decode_unorm(t.ks[c]);
+                    let kd = kapaint_model::texel::decode_unorm(t.kd[c]);
+                    let ks = kapaint_model::texel::decode_unorm(t.ks[c]);
                     let ka = diffuse * kd + ks * c0 + z0;
                     let err = if ka > 0.0 {
                         f64::from((ks * (c1 - c0) + (z1 - z0)).abs() / ka)
@@ -264,7 +260,7 @@ pub fn rank_encodings(
 mod tests {
     use super::*;
     use glam::Vec3;
-    use kapaint_core::model::texel::MaterialValue;
+    use kapaint_model::texel::MaterialValue;
 
     #[test]
     fn codes_round_trip_at_the_ends_and_stay_monotone() {
@@ -307,7 +303,7 @@ mod tests {
             let (id, i) = maps.locate(x, 0);
             maps.tile_mut(id).set_texel(
                 i,
-                kapaint_core::model::texel::Texel::encode(MaterialValue::new(
+                kapaint_model::texel::Texel::encode(MaterialValue::new(
                     Vec3::splat(0.2),
                     Vec3::splat(0.8),
                     n,

@@ -2,8 +2,8 @@
 //! are embedded, built with the `gltf` crate's JSON types.
 //!
 //! kapaint's meshes keep OBJ's UV convention (`v` up); glTF's `v` runs down, so the file
-//! stores `1 - v`, as [`kapaint_core::mesh::gltf_import`] undoes on the way in. With a normal map the
-//! file carries MikkTSpace tangents ([`kapaint_core::mesh::tangents`]). Node transforms are
+//! stores `1 - v`, as [`kapaint_mesh::gltf_import`] undoes on the way in. With a normal map the
+//! file carries MikkTSpace tangents ([`kapaint_mesh::tangents`]). Node transforms are
 //! baked into the positions on import, so the one node here has none.
 
 use std::collections::BTreeMap;
@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use gltf::json;
 use gltf::json::validation::{Checked::Valid, USize64};
 
-use kapaint_core::mesh::Mesh;
+use kapaint_mesh::Mesh;
 
 /// The material's textures, PNG-encoded.
 pub struct Textures<'a> {
@@ -246,7 +246,7 @@ fn write_glb(
     // a seam needs two), so every reader uses the frame it was made for.
     let with_tangents = textures
         .and_then(|t| t.normal)
-        .and_then(|_| kapaint_core::mesh::tangents::generate(mesh));
+        .and_then(|_| kapaint_mesh::tangents::generate(mesh));
     let (mesh, tangents) = match &with_tangents {
         Some(t) => (&t.mesh, Some(t.tangents.as_slice())),
         None => (mesh, None),

@@ -1,5 +1,5 @@
 //! The `gltf-pbr` export: a project's `k_d`, `k_s`, `n` back to glTF's metallic-roughness
-//! textures ([`kapaint_core::pbr::round_trip`]), with the round-trip error in the manifest, and
+//! textures ([`kapaint_pbr::round_trip`]), with the round-trip error in the manifest, and
 //! optionally a `.glb` of the project's mesh with the material embedded ([`super::glb`]).
 
 use std::path::Path;
@@ -8,12 +8,12 @@ use serde::{Deserialize, Serialize};
 
 use super::preset::ExportPreset;
 use super::set::{ColourSpace, SetError, claim, commit, padded_texels, png_bytes};
-use kapaint_core::mesh::Mesh;
-use kapaint_core::model::Document;
-use kapaint_core::model::provenance::ErrorSummary;
-use kapaint_core::pbr::round_trip::convert;
-use kapaint_core::reflectance::ShadingModel;
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
+use kapaint_mesh::Mesh;
+use kapaint_model::Document;
+use kapaint_model::provenance::ErrorSummary;
+use kapaint_pbr::round_trip::convert;
+use kapaint_reflectance::ShadingModel;
 
 pub use crate::set::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, PBR_MANIFEST_FORMAT};
 /// Its version.
@@ -227,7 +227,7 @@ impl PbrFiles {
         }
         for (name, bytes) in writes {
             let path = tmp.join(name);
-            kapaint_core::atomic::write_atomic(&path, bytes).map_err(|e| SetError::Io {
+            kapaint_base::atomic::write_atomic(&path, bytes).map_err(|e| SetError::Io {
                 path: path.clone(),
                 reason: e.to_string(),
             })?;

@@ -32,12 +32,12 @@ pub enum Exported {
 /// # Errors
 /// As the exports; `glb` with a preset that is not glTF PBR.
 pub fn run(
-    doc: &kapaint_core::model::Document,
+    doc: &kapaint_model::Document,
     preset: &preset::ExportPreset,
     out: &Path,
-    progress: &kapaint_core::task::Progress,
+    progress: &kapaint_base::task::Progress,
     replace: bool,
-    glb: Option<&kapaint_core::mesh::Mesh>,
+    glb: Option<&kapaint_mesh::Mesh>,
     brought: Option<&dyn blocks::BlockEncoder>,
 ) -> Result<Exported, set::SetError> {
     if preset.format.is_gltf_pbr() {

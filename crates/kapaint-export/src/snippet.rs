@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 
 use super::encoding::NCurve;
 use crate::set::manifest::Manifest;
-use kapaint_core::reflectance::wgsl::{
+use kapaint_reflectance::wgsl::{
     ShaderLanguage, ambient_glsl, ambient_wgsl_standalone, approx_constant, model_constant,
 };
 

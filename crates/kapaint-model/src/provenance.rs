@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The conversion error over a set's texels (relative, see `kapaint_core::pbr::convert::Conversion::error`).
+/// The conversion error over a set's texels (relative, see `kapaint_pbr::convert::Conversion::error`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ErrorSummary {

@@ -13,7 +13,7 @@ mod coder;
 pub use coder::{BlockEncoder, Coder, Encoder, Interrupted};
 
 use crate::codec::{Codec, CodecError, Effort};
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
 
 /// `src`'s texels of `stored` bytes widened to `codec`'s whole texels (`to` bytes, at most
 /// [`Codec::texel_bytes`]) with its [`Codec::filler`], into `out`.

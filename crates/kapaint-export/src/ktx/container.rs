@@ -106,7 +106,7 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         return Err("supercompressed KTX2 is not supported".into());
     }
     let (w, h) = (header.pixel_width, header.pixel_height.max(1));
-    if w > kapaint_core::model::maps::MAX_SIDE || h > kapaint_core::model::maps::MAX_SIDE {
+    if w > kapaint_model::maps::MAX_SIDE || h > kapaint_model::maps::MAX_SIDE {
         return Err(format!("{w}x{h} is larger than kapaint's maps"));
     }
     let level = reader.levels().next().ok_or("the file has no levels")?;

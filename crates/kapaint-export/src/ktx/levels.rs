@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use super::{Source, Values};
 use crate::encoding::NEncoding;
-use kapaint_core::model::texel::{n_to_blend, srgb_to_linear};
+use kapaint_model::texel::{n_to_blend, srgb_to_linear};
 
 /// How a component is averaged into the next mip level, and stored as a byte.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -194,7 +194,7 @@ pub fn mips(source: &Source<'_>) -> Vec<((u32, u32), Vec<u8>)> {
 mod tests {
     use super::*;
     use crate::encoding::NCurve;
-    use kapaint_core::model::texel::n_from_blend;
+    use kapaint_model::texel::n_from_blend;
 
     #[test]
     fn quantising_by_boundaries_rounds_to_the_nearest_stored_value() {

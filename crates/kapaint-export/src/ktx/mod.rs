@@ -20,7 +20,7 @@ pub use self::own_levels::encode_levels;
 use super::blocks::{self, Coder};
 use super::codec::{Codec, CodecError, Effort};
 use crate::file_kind::Compression;
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
 
 /// A texel's component in its averaging space (`value(texel, component)`, unquantised).
 pub trait Values: Sync {
@@ -227,7 +227,7 @@ static HALF_LEVELS: std::sync::LazyLock<Vec<f32>> = std::sync::LazyLock::new(|| 
         .map(|b| {
             let v = half::f16::from_bits(b).to_f32();
             let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-            kapaint_core::model::texel::linear_to_srgb(v) * 255.0
+            kapaint_model::texel::linear_to_srgb(v) * 255.0
         })
         .collect()
 });
@@ -521,7 +521,7 @@ mod tests {
             let v = half::f16::from_le_bytes([t[1], t[2]])
                 .to_f32()
                 .clamp(0.0, 1.0);
-            f64::from(kapaint_core::model::texel::linear_to_srgb(v) * 255.0)
+            f64::from(kapaint_model::texel::linear_to_srgb(v) * 255.0)
         };
         let naive = |k: usize| {
             let sum: f64 = a

@@ -164,7 +164,7 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
     type Error = String;
 
     fn try_from(f: ExportPresetFile) -> Result<Self, String> {
-        use kapaint_core::model::check::{MAX_PATH_BYTES, bounded_text, name};
+        use kapaint_model::check::{MAX_PATH_BYTES, bounded_text, name};
         if f.version > PRESET_VERSION {
             return Err(format!(
                 "version {} is newer than this kapaint reads ({PRESET_VERSION})",
@@ -335,12 +335,12 @@ pub fn builtin_sets() -> Vec<ExportPreset> {
 
 /// The folder of the user's export presets: `$KAPAINT_EXPORT_PRESET_DIR` where it is set,
 /// else the `export` folder of the user preset folder every kind of preset shares
-/// ([`kapaint_core::model::preset::user_dir`]).
+/// ([`kapaint_model::preset::user_dir`]).
 pub fn user_dir() -> Option<PathBuf> {
     std::env::var_os("KAPAINT_EXPORT_PRESET_DIR")
         .filter(|v| !v.is_empty())
         .map(PathBuf::from)
-        .or_else(|| kapaint_core::model::preset::user_dir().map(|d| d.join("export")))
+        .or_else(|| kapaint_model::preset::user_dir().map(|d| d.join("export")))
 }
 
 /// Finds a preset by name or file stem: a user file (`NAME.ron` in [`user_dir`]) first,
@@ -353,11 +353,11 @@ pub fn find(name: &str) -> Result<ExportPreset, PresetError> {
         let path = dir.join(format!("{name}.ron"));
         if path.exists() {
             // The one reader every preset file goes through (size, regular file, UTF-8).
-            let text = kapaint_core::model::preset::read_text(&path, 1 << 20).map_err(|e| {
+            let text = kapaint_model::preset::read_text(&path, 1 << 20).map_err(|e| {
                 PresetError::Malformed {
                     path: path.clone(),
                     reason: match e {
-                        kapaint_core::model::ModelError::Preset { reason, .. } => reason,
+                        kapaint_model::ModelError::Preset { reason, .. } => reason,
                         other => other.to_string(),
                     },
                 }

@@ -39,9 +39,9 @@ use crate::encoding::{KaError, NEncoding};
 use crate::ktx::{self, Compressed};
 use crate::preset::ExportPreset;
 use glam::Vec3;
-use kapaint_core::model::texel::Texel;
-use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
+use kapaint_model::texel::Texel;
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
 /// Whether an image of `comps` is colour that BC6H can hold: three colour components.
 fn half_image(comps: &[Comp]) -> bool {

@@ -8,11 +8,11 @@ use super::manifest::{Comp, Compression, is_colour};
 use crate::encoding::NEncoding;
 use crate::ktx::{Space, texel_layout};
 use crate::preset::{ExportPreset, Format};
-use kapaint_core::model::MaterialMaps;
-use kapaint_core::model::texel::{
+use kapaint_base::task::Progress;
+use kapaint_model::MaterialMaps;
+use kapaint_model::texel::{
     MaterialValue, Texel, decode_n, decode_unorm, linear_to_srgb, n_to_blend,
 };
-use kapaint_core::task::Progress;
 
 /// Texels of the map in row-major order, read in parallel by rows.
 pub(super) fn rows(maps: &MaterialMaps) -> Vec<Texel> {
@@ -80,7 +80,7 @@ fn file_tables(srgb: bool, n_enc: Option<NEncoding>) -> (Vec<f32>, Vec<f32>) {
 
 /// A PNG of `data` (16-bit words native-endian) with `color`.
 pub(crate) fn png_bytes(data: &[u8], size: (u32, u32), color: C) -> Result<Vec<u8>, String> {
-    kapaint_core::model::import::encode_png(data, size, color)
+    kapaint_model::import::encode_png(data, size, color)
 }
 
 /// Encodes one image of `comps` components from the texels.

@@ -7,8 +7,8 @@ use rayon::prelude::*;
 
 use super::manifest::{ColourSpace, Comp, Compression, Manifest};
 use super::{SetError, io};
-use kapaint_core::model::texel::{MaterialValue, Texel, srgb_to_linear};
-use kapaint_core::model::{Document, DocumentSettings, MaterialMaps};
+use kapaint_model::texel::{MaterialValue, Texel, srgb_to_linear};
+use kapaint_model::{Document, DocumentSettings, MaterialMaps};
 
 /// An image of a set as RGBA floats: whether it is KTX2, its size, the texels.
 type Pixels = (bool, (u32, u32), Vec<f32>);
@@ -23,22 +23,19 @@ fn read_pixels(path: &Path) -> Result<Pixels, SetError> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("ktx2"));
     if ktx {
-        let bytes = kapaint_core::file_check::read_limited(
-            path,
-            kapaint_core::model::import::MAX_DECODED_BYTES,
-        )
-        .map_err(|e| {
-            if e.is_io() {
-                io(path, e)
-            } else {
-                invalid(format!("the file {e}"))
-            }
-        })?;
+        let bytes =
+            kapaint_base::file_check::read_limited(path, kapaint_model::import::MAX_DECODED_BYTES)
+                .map_err(|e| {
+                    if e.is_io() {
+                        io(path, e)
+                    } else {
+                        invalid(format!("the file {e}"))
+                    }
+                })?;
         let decoded = crate::ktx::decode(&bytes).map_err(invalid)?;
         Ok((true, (decoded.width, decoded.height), decoded.rgba))
     } else {
-        let image =
-            kapaint_core::model::import::read_image(path).map_err(|e| invalid(e.to_string()))?;
+        let image = kapaint_model::import::read_image(path).map_err(|e| invalid(e.to_string()))?;
         Ok((
             false,
             (image.width(), image.height()),
@@ -188,7 +185,7 @@ const MAX_MANIFEST_BYTES: u64 = 4 << 20;
 
 /// The manifest's bytes: a regular file of at most [`MAX_MANIFEST_BYTES`].
 fn read_manifest_bytes(path: &Path) -> Result<Vec<u8>, SetError> {
-    kapaint_core::file_check::read_limited(path, MAX_MANIFEST_BYTES).map_err(|e| {
+    kapaint_base::file_check::read_limited(path, MAX_MANIFEST_BYTES).map_err(|e| {
         if e.is_io() {
             io(path, e)
         } else {

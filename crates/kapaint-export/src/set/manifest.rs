@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::perceptual::SrgbError;
 use crate::codec::AstcBlock;
 use crate::encoding::{KaError, NEncoding};
-use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
+use kapaint_reflectance::{self as reflectance, AmbientApprox, ShadingModel};
 
 pub use crate::file_kind::{ColourSpace, Compression};
 
@@ -78,7 +78,7 @@ impl TryFrom<FileEntryFile> for FileEntry {
 
     fn try_from(f: FileEntryFile) -> Result<Self, String> {
         let name = &f.path;
-        kapaint_core::model::check::bounded_text("a file name", name, 255)?;
+        kapaint_model::check::bounded_text("a file name", name, 255)?;
         if name.is_empty() || name.contains(['/', '\\', ':']) || name.starts_with('.') {
             return Err(format!(
                 "file name {name:?} must be a plain name inside the set's folder"
@@ -170,7 +170,7 @@ impl TryFrom<ConstantsFile> for Constants {
     type Error = String;
 
     fn try_from(f: ConstantsFile) -> Result<Self, String> {
-        use kapaint_core::model::check::{all_in_range, in_range};
+        use kapaint_model::check::{all_in_range, in_range};
         Ok(Self {
             kd: f
                 .kd
@@ -181,7 +181,7 @@ impl TryFrom<ConstantsFile> for Constants {
                 .map(|v| all_in_range("constants.ks", v, 0.0, 1.0))
                 .transpose()?,
             n: f.n
-                .map(|v| in_range("constants.n", v, 0.0, kapaint_core::model::texel::N_MAX))
+                .map(|v| in_range("constants.n", v, 0.0, kapaint_model::texel::N_MAX))
                 .transpose()?,
         })
     }
@@ -355,14 +355,14 @@ impl TryFrom<ManifestFile> for Manifest {
             ));
         }
         let (w, h) = (f.width, f.height);
-        let max = kapaint_core::model::maps::MAX_SIDE;
+        let max = kapaint_model::maps::MAX_SIDE;
         if w == 0 || h == 0 || w > max || h > max {
             return Err(format!("size {w}x{h} is outside 1..={max}"));
         }
-        kapaint_core::model::check::bounded_text(
+        kapaint_model::check::bounded_text(
             "preset",
             &f.preset,
-            kapaint_core::model::check::MAX_NAME_BYTES,
+            kapaint_model::check::MAX_NAME_BYTES,
         )?;
         let comps = stored_components(&f, (w, h))?;
         if let Some(n) = &f.normal {

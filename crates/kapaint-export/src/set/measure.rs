@@ -8,10 +8,10 @@ use super::perceptual::{SrgbError, SrgbLevels, SrgbStats};
 use crate::encoding::KaError;
 use crate::encoding::NEncoding;
 use crate::preset::Format;
-use kapaint_core::model::texel::{
+use kapaint_model::texel::{
     Texel, decode_n, decode_unorm, n_from_blend, n_to_blend, srgb_to_linear,
 };
-use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
+use kapaint_reflectance::{self as reflectance, AmbientApprox, ShadingModel};
 
 /// Where a consumer's value of one component comes from.
 #[derive(Clone, Copy)]
@@ -140,7 +140,7 @@ pub(super) fn ka_error_of_set(
     model: ShadingModel,
     approx: AmbientApprox,
 ) -> (KaError, SrgbError) {
-    let lut = kapaint_core::model::maps::chi_lut(model, approx);
+    let lut = kapaint_model::maps::chi_lut(model, approx);
     let tables = SetTables::new(lut, manifest.n_encoding, model, approx);
     let colours = ColourTables::new();
     let reads = tables.reads(&colours, stored, manifest.constants, format);

@@ -44,10 +44,10 @@ pub use self::target::{PBR_MANIFEST_FORMAT, SetKind, Target, holds, target};
 pub(crate) use self::target::{claim, commit};
 use super::encoding::KaError;
 use super::preset::{ExportPreset, Format};
-use kapaint_core::mesh::bake::Coverage;
-use kapaint_core::model::Document;
-use kapaint_core::reflectance;
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
+use kapaint_mesh::bake::Coverage;
+use kapaint_model::Document;
+use kapaint_reflectance as reflectance;
 /// Why an export or import failed.
 #[derive(Debug, thiserror::Error)]
 pub enum SetError {
@@ -171,7 +171,7 @@ struct Source<'d> {
     mono_ks: bool,
     images: role::Images,
     /// Row-major, padded past the UV islands ([`padded_texels`]).
-    texels: Vec<kapaint_core::model::texel::Texel>,
+    texels: Vec<kapaint_model::texel::Texel>,
     dilated: bool,
     /// Per texel, where the preset writes `k_a`.
     ka: Vec<Vec3>,
@@ -375,7 +375,7 @@ fn write_images(
             });
         }
         let path = tmp.join(&file);
-        kapaint_core::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
+        kapaint_base::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
         written
             .files
             .push(file_entry(source, preset, file, &comps, &image));
@@ -450,7 +450,7 @@ fn write_manifest(
         ("material.glsl", crate::snippet::glsl(manifest)),
     ] {
         let snippet_path = tmp.join(name);
-        kapaint_core::atomic::write_atomic(&snippet_path, snippet.as_bytes())
+        kapaint_base::atomic::write_atomic(&snippet_path, snippet.as_bytes())
             .map_err(|e| io(&snippet_path, e))?;
         exported += snippet.len() as u64;
     }
@@ -465,7 +465,7 @@ fn write_manifest(
         manifest.bytes.exported = total;
     };
     let path = tmp.join("material.json");
-    kapaint_core::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))
+    kapaint_base::atomic::write_atomic(&path, &json).map_err(|e| io(&path, e))
 }
 
 /// A KTX2 file's components, its levels past 0 as decoded, and how its colour is stored.
@@ -480,7 +480,7 @@ struct Mips {
 /// (`mips`: per file, its components and levels 1 and on as decoded), against the exact level
 /// 0 averaged over each texel's footprint.
 fn level_errors(
-    texels: &[kapaint_core::model::texel::Texel],
+    texels: &[kapaint_model::texel::Texel],
     size: (u32, u32),
     shape: measure::Shape<'_>,
     mips: &[Mips],
@@ -511,7 +511,7 @@ fn level_errors(
 /// The document's texels, row-major; outside the mesh's UV islands they copy the nearest
 /// island's, so mips and filtering do not pull the background into the edges (`true` when
 /// that was done: the document has a surface with UVs).
-pub(crate) fn padded_texels(doc: &Document) -> (Vec<kapaint_core::model::texel::Texel>, bool) {
+pub(crate) fn padded_texels(doc: &Document) -> (Vec<kapaint_model::texel::Texel>, bool) {
     let maps = doc.maps();
     let (w, h) = (maps.width(), maps.height());
     let mut texels = rows(maps);
@@ -521,7 +521,7 @@ pub(crate) fn padded_texels(doc: &Document) -> (Vec<kapaint_core::model::texel::
             .collect();
         let any = filled.iter().any(|f| *f);
         if any {
-            kapaint_core::mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
+            kapaint_mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
                 texels[k] = texels[src];
             });
         }

@@ -19,8 +19,8 @@ use crate::codec::{AstcBlock, Codec, Effort};
 use crate::file_kind::Compression;
 use crate::ktx::Space;
 use crate::preset::{ExportPreset, Format};
-use kapaint_core::model::normal::NormalMap;
-use kapaint_core::model::project::NORMAL_ENCODING;
+use kapaint_model::normal::NormalMap;
+use kapaint_model::project::NORMAL_ENCODING;
 
 /// The normal map's file in a set of PNG or EXR images.
 pub const NORMAL_FILE: &str = "normal.png";
@@ -170,7 +170,7 @@ impl NormalFile {
         let blocks = match storage {
             NormalStorage::Png => {
                 let png = normal.to_png().map_err(|e| io(&path, e))?;
-                kapaint_core::atomic::write_atomic(&path, &png).map_err(|e| io(&path, e))?;
+                kapaint_base::atomic::write_atomic(&path, &png).map_err(|e| io(&path, e))?;
                 return Ok(Self {
                     path: NORMAL_FILE.into(),
                     encoding: NORMAL_ENCODING.into(),
@@ -202,7 +202,7 @@ impl NormalFile {
         .map_err(|e| io(&path, e))?;
         let decoded = written.decoded.first().map_or(&[][..], |d| &d[..]);
         let angular_error = angular_error(&unit, decoded);
-        kapaint_core::atomic::write_atomic(&path, &written.bytes).map_err(|e| io(&path, e))?;
+        kapaint_base::atomic::write_atomic(&path, &written.bytes).map_err(|e| io(&path, e))?;
         Ok(Self {
             path: NORMAL_KTX2_FILE.into(),
             encoding: NORMAL_XY_ENCODING.into(),
@@ -241,7 +241,7 @@ impl NormalFile {
     /// # Errors
     /// Anything else, in a sentence.
     pub(super) fn check(&self) -> Result<(), String> {
-        let max = kapaint_core::model::maps::MAX_SIDE;
+        let max = kapaint_model::maps::MAX_SIDE;
         let sized = (1..=max).contains(&self.width) && (1..=max).contains(&self.height);
         let png = self.path == NORMAL_FILE
             && self.encoding == NORMAL_ENCODING
@@ -280,17 +280,15 @@ impl NormalFile {
             path: path.clone(),
             reason,
         };
-        let bytes = kapaint_core::file_check::read_limited(
-            &path,
-            kapaint_core::model::import::MAX_DECODED_BYTES,
-        )
-        .map_err(|e| {
-            if e.is_io() {
-                io(&path, e)
-            } else {
-                invalid(format!("the file {e}"))
-            }
-        })?;
+        let bytes =
+            kapaint_base::file_check::read_limited(&path, kapaint_model::import::MAX_DECODED_BYTES)
+                .map_err(|e| {
+                    if e.is_io() {
+                        io(&path, e)
+                    } else {
+                        invalid(format!("the file {e}"))
+                    }
+                })?;
         let map = if self.path == NORMAL_KTX2_FILE {
             let decoded = crate::ktx::decode(&bytes).map_err(&invalid)?;
             let second = if self.xy.as_deref() == Some("ra") {

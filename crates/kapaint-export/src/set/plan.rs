@@ -7,9 +7,9 @@ use super::manifest::{Comp, Constants, MemoryReport};
 use super::role::{Images, Role};
 use crate::encoding::{KaError, NEncoding, rank_encodings};
 use crate::preset::{ExportPreset, Format, Layout};
-use kapaint_core::model::texel::{decode_n, decode_unorm};
-use kapaint_core::model::tile::Plane;
-use kapaint_core::model::{Document, MaterialMaps};
+use kapaint_model::texel::{decode_n, decode_unorm};
+use kapaint_model::tile::Plane;
+use kapaint_model::{Document, MaterialMaps};
 
 /// Whether `k_s` is grey everywhere.
 fn ks_monochrome(maps: &MaterialMaps) -> bool {

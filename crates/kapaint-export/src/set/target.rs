@@ -74,7 +74,7 @@ fn listed_files(dir: &Path, kind: SetKind) -> Option<Vec<String>> {
         normal: Option<Listed>,
     }
     let bytes =
-        kapaint_core::file_check::read_limited(&dir.join("material.json"), MAX_LISTING_BYTES)
+        kapaint_base::file_check::read_limited(&dir.join("material.json"), MAX_LISTING_BYTES)
             .ok()?;
     let listing: Listing = serde_json::from_slice(&bytes).ok()?;
     (listing.format == kind.format()).then(|| {
@@ -93,7 +93,7 @@ fn listed_files(dir: &Path, kind: SetKind) -> Option<Vec<String>> {
 /// # Errors
 /// A folder that cannot be read.
 pub fn target(out: &Path, kind: SetKind) -> Result<Target, SetError> {
-    let linked = kapaint_core::atomic::through_links(out);
+    let linked = kapaint_base::atomic::through_links(out);
     if linked.as_path() != out && std::fs::symlink_metadata(&linked).is_err() {
         return Ok(Target::Taken(format!(
             "is a link to {}, which does not exist",
@@ -204,7 +204,7 @@ pub(crate) fn commit<T>(
 ) -> Result<T, SetError> {
     // Through a link to the folder: the set is swapped in where the link points, and the
     // link stays a link.
-    let out = &kapaint_core::atomic::through_links(out);
+    let out = &kapaint_base::atomic::through_links(out);
     let parent = out
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -216,14 +216,14 @@ pub(crate) fn commit<T>(
     remove_stale_sets(parent, &name);
     // Removed on every way out but the last rename; made new, so never a planted link.
     let guard =
-        kapaint_core::atomic::temporary_dir(parent, &name, "tmp").map_err(|e| io(parent, e))?;
+        kapaint_base::atomic::temporary_dir(parent, &name, "tmp").map_err(|e| io(parent, e))?;
     let tmp = guard.path().to_path_buf();
     let manifest = write(&tmp)?;
     if *found == Target::Set {
         // Swap: the old set moves aside, the new one takes its name, the old one goes. Should
         // the second rename fail, the old set is put back.
         let old =
-            kapaint_core::atomic::temporary_dir(parent, &name, "old").map_err(|e| io(parent, e))?;
+            kapaint_base::atomic::temporary_dir(parent, &name, "old").map_err(|e| io(parent, e))?;
         // Onto the empty folder just made: the name was never free for anyone else to take.
         std::fs::rename(out, old.path()).map_err(|e| io(out, e))?;
         if let Err(e) = std::fs::rename(&tmp, out) {
@@ -246,7 +246,7 @@ pub(crate) fn commit<T>(
 /// Removes the temporary folders of earlier exports to `name` in `dir` whose process is gone.
 fn remove_stale_sets(dir: &Path, name: &str) {
     for tag in ["tmp", "old"] {
-        kapaint_core::atomic::remove_stale_with(dir, &format!(".{name}.{tag}-"), "", |path| {
+        kapaint_base::atomic::remove_stale_with(dir, &format!(".{name}.{tag}-"), "", |path| {
             let _ = std::fs::remove_dir_all(path);
         });
     }

@@ -1,7 +1,7 @@
 //! A PBR texture set into a document: every texel converted for the target model, with the
 //! conversion error measured at every texel ([`super::convert`]).
 //!
-//! Images are read with the import limits ([`crate::model::import`]) and resampled to the
+//! Images are read with the import limits ([`kapaint_model::import`]) and resampled to the
 //! map size by its triangle filter, a band of tile rows at a time: the set is never held as
 //! floats, only as the decoded images and one band. A texture under a glTF texture transform
 //! is sampled bilinearly at the transformed coordinates instead, with the sampler's wrap.
@@ -15,15 +15,15 @@ use rayon::prelude::*;
 
 use super::NMapping;
 use super::convert::{Conversion, ErrorStats};
-use crate::model::ModelError;
-use crate::model::document::{Document, DocumentSettings};
-use crate::model::import::{Resampler, fill_outside, is_float, read_image};
-use crate::model::maps::MaterialMaps;
-use crate::model::normal::NormalMap;
-pub use crate::model::provenance::{ErrorSummary, ImportReport};
-use crate::model::texel::{MaterialValue, encode_n, encode_rgb, srgb_to_linear};
-use crate::model::tile::{Plane, TILE_SIZE, Tile};
-use crate::reflectance::ShadingModel;
+use kapaint_model::ModelError;
+use kapaint_model::document::{Document, DocumentSettings};
+use kapaint_model::import::{Resampler, fill_outside, is_float, read_image};
+use kapaint_model::maps::MaterialMaps;
+use kapaint_model::normal::NormalMap;
+pub use kapaint_model::provenance::{ErrorSummary, ImportReport};
+use kapaint_model::texel::{MaterialValue, encode_n, encode_rgb, srgb_to_linear};
+use kapaint_model::tile::{Plane, TILE_SIZE, Tile};
+use kapaint_reflectance::ShadingModel;
 
 /// Map side used when every input is a constant.
 pub const CONSTANT_SIZE: u32 = 256;
@@ -168,10 +168,10 @@ impl PbrSet {
 
     /// A texel's `k_d`, `F0` and roughness from the three quantities' values.
     fn texel(&self, [a, b, c]: [Vec3; 3]) -> (Vec3, Vec3, f32) {
-        let unit = |v: Vec3| v.map(crate::model::texel::unit);
+        let unit = |v: Vec3| v.map(kapaint_model::texel::unit);
         match self {
             Self::MetallicRoughness { .. } => {
-                let (base, m) = (unit(a), crate::model::texel::unit(b.x));
+                let (base, m) = (unit(a), kapaint_model::texel::unit(b.x));
                 (
                     base * (1.0 - m),
                     Vec3::splat(super::DIELECTRIC_F0).lerp(base, m),
@@ -183,7 +183,7 @@ impl PbrSet {
                 (
                     diffuse * (1.0 - specular.max_element()),
                     specular,
-                    1.0 - crate::model::texel::unit(c.x),
+                    1.0 - kapaint_model::texel::unit(c.x),
                 )
             }
         }

@@ -4,7 +4,7 @@
 //!
 //! For a glTF roughness `r` (GGX `alpha = r^2`), the radiance factor of the Cook-Torrance
 //! model is `k_d cos t + k_s rho_1 + rho_0` per colour channel (Schlick's `F` split as in
-//! [`crate::reflectance::cook_torrance`]); a Phong or Blinn-Phong target shades the converted
+//! [`kapaint_reflectance::cook_torrance`]); a Phong or Blinn-Phong target shades the converted
 //! texel as `k_d cos t + k_s c^n` with `c = max(0, R.V)` or `max(0, N.H)`. `k_d` converts
 //! unchanged, so the difference at one direction is `k_s (rho_1 - c^n) + rho_0`.
 //!
@@ -26,11 +26,11 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 
-use crate::reflectance::ShadingModel;
-use crate::reflectance::cook_torrance;
-use crate::reflectance::geometry::golden_section;
-use crate::reflectance::model::Cosines;
-use crate::reflectance::quadrature::TanhSinh;
+use kapaint_reflectance::ShadingModel;
+use kapaint_reflectance::cook_torrance;
+use kapaint_reflectance::geometry::golden_section;
+use kapaint_reflectance::model::Cosines;
+use kapaint_reflectance::quadrature::TanhSinh;
 
 /// Number of `k_s` values of the error tables: `k_s = (i / (KS_NODES - 1))^2`.
 pub const KS_NODES: usize = 17;
@@ -97,7 +97,7 @@ impl LobeSamples {
         let r = roughness.clamp(ROUGHNESS_MIN, 1.0);
         let alpha = r * r;
         let n_ggx = ct_n(r);
-        let n_painted = n_ggx.min(f64::from(crate::model::texel::N_MAX));
+        let n_painted = n_ggx.min(f64::from(kapaint_model::texel::N_MAX));
         // The target lobes are about as wide as GGX's (the fit makes them so); half of alpha
         // resolves both.
         let scale = 0.5 * alpha;
@@ -371,7 +371,7 @@ pub fn clamp_node(l: usize) -> f64 {
 fn minimise_exponent(cap: f64, distance: impl Fn(f64) -> f64) -> f64 {
     const SCAN: usize = 24;
     let u_max = cap
-        .clamp(0.0, f64::from(crate::model::texel::N_MAX))
+        .clamp(0.0, f64::from(kapaint_model::texel::N_MAX))
         .ln_1p();
     let f = |u: f64| distance(u.exp_m1());
     let du = u_max / SCAN as f64;
@@ -426,14 +426,14 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
         let samples = LobeSamples::new(r, level);
         let cap = rows
             .last()
-            .map_or([f64::from(crate::model::texel::N_MAX); 3], |row| row.n);
+            .map_or([f64::from(kapaint_model::texel::N_MAX); 3], |row| row.n);
         let mut n = [0.0; 3];
         let mut error = [[0.0; KS_NODES]; 3];
         let (mut distance, mut free_distance) = ([0.0; 3], [0.0; 3]);
         let means = samples.ggx_means();
         let mean = means[0] + means[1];
         for (k, target) in TARGETS.into_iter().enumerate() {
-            let free = samples.fit_n(target, f64::from(crate::model::texel::N_MAX));
+            let free = samples.fit_n(target, f64::from(kapaint_model::texel::N_MAX));
             n[k] = if free <= cap[k] {
                 free
             } else {
@@ -454,10 +454,10 @@ pub fn fit_curve(roughness: &[f64], level: u32, mut progress: impl FnMut(&Node))
             // roughness apart.
             let cap = rows
                 .last()
-                .map_or(f64::from(crate::model::texel::N_MAX), |row| {
+                .map_or(f64::from(kapaint_model::texel::N_MAX), |row| {
                     row.height_fit[k].0 * (1.0 - MIN_FALL)
                 });
-            let (hn, h) = samples.fit_n_and_height(target, f64::from(crate::model::texel::N_MAX));
+            let (hn, h) = samples.fit_n_and_height(target, f64::from(kapaint_model::texel::N_MAX));
             let (hn, h) = if hn < cap {
                 (hn, h)
             } else {

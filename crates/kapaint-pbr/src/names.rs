@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use super::import::{PbrSet, Source};
-use crate::model::ModelError;
+use kapaint_model::ModelError;
 
 /// What a file of a set holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -230,7 +230,7 @@ impl NamedSet {
     pub fn load_normal(
         &self,
         notes: &mut Vec<String>,
-    ) -> Result<Option<crate::model::normal::NormalMap>, ModelError> {
+    ) -> Result<Option<kapaint_model::normal::NormalMap>, ModelError> {
         let Some((path, dx)) = &self.normal else {
             return Ok(None);
         };
@@ -246,7 +246,7 @@ impl NamedSet {
         for p in image.pixels_mut() {
             p[1] = 255 - p[1];
         }
-        crate::model::normal::NormalMap::new(image)
+        kapaint_model::normal::NormalMap::new(image)
             .map(Some)
             .map_err(|reason| ModelError::Image {
                 path: path.clone(),

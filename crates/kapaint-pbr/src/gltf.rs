@@ -13,10 +13,10 @@ use glam::{Vec2, Vec3};
 use image::DynamicImage;
 
 use super::import::{Input, PbrSet, Source, UvTransform, Wrap};
-use crate::mesh::gltf_import::{Opened, file_beside, open_gltf};
-use crate::model::ModelError;
-use crate::model::import::{decode_bytes, read_image};
-use crate::model::normal::NormalMap;
+use kapaint_mesh::gltf_import::{Opened, file_beside, open_gltf};
+use kapaint_model::ModelError;
+use kapaint_model::import::{decode_bytes, read_image};
+use kapaint_model::normal::NormalMap;
 
 /// A material's set, and what to say about it.
 pub struct MaterialSet {
@@ -64,8 +64,8 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
             fail(path, basis_reason())
         } else {
             match e {
-                crate::mesh::MeshError::Io { source, .. } => ModelError::io(path, source),
-                crate::mesh::MeshError::Invalid { reason, .. } => fail(path, reason),
+                kapaint_mesh::MeshError::Io { source, .. } => ModelError::io(path, source),
+                kapaint_mesh::MeshError::Invalid { reason, .. } => fail(path, reason),
             }
         }
     })?;
@@ -135,7 +135,8 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
 /// normal texture (what the editor offers to bring in with the mesh). Reads the JSON only; a
 /// file that does not parse has none.
 pub fn has_textured_material(path: &Path) -> bool {
-    let Ok(bytes) = crate::file_check::read_limited(path, crate::mesh::MAX_FILE_BYTES) else {
+    let Ok(bytes) = kapaint_base::file_check::read_limited(path, kapaint_mesh::MAX_FILE_BYTES)
+    else {
         return false;
     };
     let Ok(gltf) = gltf::Gltf::from_slice_without_validation(&bytes) else {

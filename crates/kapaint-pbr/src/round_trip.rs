@@ -1,5 +1,5 @@
 //! The round trip of a stored texel to glTF's 8-bit metallic-roughness values and back, with its
-//! error: what the `gltf-pbr` export writes (`crate::pbr` converts, the export crate writes) and
+//! error: what the `gltf-pbr` export writes (`kapaint_pbr` converts, the export crate writes) and
 //! what the canvas's PBR error view shows.
 //!
 //! Per texel: the inverse of the project's conversion ([`Conversion::pbr`]: roughness from
@@ -19,9 +19,9 @@ use rayon::prelude::*;
 
 use super::DIELECTRIC_F0;
 use super::convert::{Conversion, ErrorStats};
-use crate::model::provenance::{ErrorSummary, NMapping};
-use crate::model::texel::{Texel, decode_n, linear_to_srgb8, srgb_to_linear};
-use crate::reflectance::{AmbientApprox, ShadingModel, chi_parts_f32};
+use kapaint_model::provenance::{ErrorSummary, NMapping};
+use kapaint_model::texel::{Texel, decode_n, linear_to_srgb8, srgb_to_linear};
+use kapaint_reflectance::{AmbientApprox, ShadingModel, chi_parts_f32};
 
 /// The exported images' texels and the round-trip error.
 pub struct Converted {
@@ -126,7 +126,7 @@ impl RoundTrip {
 
     /// The round-trip error of one material value: what the texel loses as a glTF PBR
     /// material (the editor's "PBR error" canvas).
-    pub fn error(&self, v: crate::model::texel::MaterialValue) -> f32 {
+    pub fn error(&self, v: kapaint_model::texel::MaterialValue) -> f32 {
         self.texel(&Texel::encode(v)).2
     }
 }
@@ -174,12 +174,12 @@ pub fn convert(texels: &[Texel], model: ShadingModel, mapping: NMapping) -> Conv
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::texel::MaterialValue;
-    use crate::pbr::Pbr;
+    use crate::Pbr;
+    use kapaint_model::texel::MaterialValue;
 
     #[test]
     fn the_round_trip_error_is_the_imports_where_the_texel_survives_and_more_where_not() {
-        for (model, mapping) in crate::pbr::fit::TARGETS
+        for (model, mapping) in crate::fit::TARGETS
             .into_iter()
             .flat_map(|m| NMapping::ALL.map(|n| (m, n)))
         {

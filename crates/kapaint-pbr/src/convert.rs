@@ -21,9 +21,9 @@ use super::fit::{CLAMP_NODES, KS_NODES};
 use super::table::{ERROR, FITTED_N, GGX_MEANS, ROWS};
 use super::table_height::HEIGHT_FIT;
 use super::{DIELECTRIC_F0, Pbr, n_of_roughness, unit};
-use crate::model::provenance::{ErrorSummary, NMapping};
-use crate::model::texel::{MaterialValue, N_MAX};
-use crate::reflectance::ShadingModel;
+use kapaint_model::provenance::{ErrorSummary, NMapping};
+use kapaint_model::texel::{MaterialValue, N_MAX};
+use kapaint_reflectance::ShadingModel;
 
 /// Intervals of the dense roughness table.
 const LUT_SIZE: usize = 4096;
@@ -177,7 +177,7 @@ impl Conversion {
     /// inverse; the height-fixed ones are constant over the rough end (a value there comes
     /// back as the flat part's smoothest roughness). For Cook-Torrance, its mapping's inverse.
     pub fn roughness(&self, n: f32) -> f32 {
-        let n = crate::reflectance::sanitize_n_f32(n);
+        let n = kapaint_reflectance::sanitize_n_f32(n);
         if self.model.is_microfacet() {
             return super::roughness_of_n(n);
         }

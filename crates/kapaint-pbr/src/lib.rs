@@ -10,7 +10,7 @@
 //! n = 2 / alpha^2 - 2                            the inverse of alpha = sqrt(2 / (n + 2))
 //! ```
 //!
-//! The last line is the Cook-Torrance model's own mapping ([`crate::reflectance::cook_torrance`]),
+//! The last line is the Cook-Torrance model's own mapping ([`kapaint_reflectance::cook_torrance`]),
 //! so a PBR material shaded by that model needs no conversion at all. `n` is clamped to the
 //! painted range `[0, 16384]` (roughness below 0.105 is a mirror there).
 //!
@@ -30,8 +30,8 @@ pub mod round_trip;
 mod table;
 mod table_height;
 
-pub use crate::model::provenance::NMapping;
-use crate::model::texel::{MaterialValue, N_MAX};
+pub use kapaint_model::provenance::NMapping;
+use kapaint_model::texel::{MaterialValue, N_MAX};
 
 /// The dielectric `F0` of the metallic-roughness model.
 pub const DIELECTRIC_F0: f32 = 0.04;
@@ -53,7 +53,7 @@ pub struct Pbr {
 
 /// `x` clamped into `[0, 1]`, NaN to 0.
 fn unit(x: f32) -> f32 {
-    crate::reflectance::sanitize_coefficient(x)
+    kapaint_reflectance::sanitize_coefficient(x)
 }
 
 /// The Phong exponent of a glTF roughness under the Cook-Torrance mapping: `2 / r^4 - 2`,
@@ -70,7 +70,7 @@ pub fn n_of_roughness(roughness: f32) -> f32 {
 /// The glTF roughness of a Phong exponent: `(2 / (n + 2))^(1/4)`, the inverse of
 /// [`n_of_roughness`] on its range.
 pub fn roughness_of_n(n: f32) -> f32 {
-    let n = crate::reflectance::sanitize_n_f32(n);
+    let n = kapaint_reflectance::sanitize_n_f32(n);
     (2.0 / (n + 2.0)).sqrt().sqrt()
 }
 
@@ -157,7 +157,7 @@ fn pbr_of(kd: Vec3, f0: Vec3, roughness: f32, tolerance: f32) -> Pbr {
 mod tests {
     use super::*;
 
-    use crate::reflectance::ShadingModel;
+    use kapaint_reflectance::ShadingModel;
 
     #[test]
     fn the_height_fit_falls_strictly_over_the_whole_table() {
@@ -243,7 +243,7 @@ mod tests {
     /// texture).
     #[test]
     fn a_stored_dark_dielectric_stays_a_dielectric() {
-        use crate::model::texel::{decode_rgb, encode_rgb};
+        use kapaint_model::texel::{decode_rgb, encode_rgb};
         for base in [
             Vec3::splat(0.0),
             Vec3::splat(0.004),
@@ -272,7 +272,7 @@ mod tests {
     fn roughness_maps_onto_the_cook_torrance_alpha() {
         for r in [0.2_f32, 0.5, 0.9, 1.0] {
             let n = n_of_roughness(r);
-            let alpha = crate::reflectance::cook_torrance::alpha(f64::from(n));
+            let alpha = kapaint_reflectance::cook_torrance::alpha(f64::from(n));
             assert!(
                 (alpha - f64::from(r * r)).abs() < 1e-5,
                 "r = {r}: alpha {alpha}"
