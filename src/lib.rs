@@ -7,7 +7,7 @@
 //! `kapaint` binary is a thin shell around [`cli::main`].
 
 pub use kapaint_core::{
-    atomic, crash, file_check, memory, mesh, model, reflectance, render, report, task, tools,
+    atomic, crash, file_check, memory, mesh, model, reflectance, render, task, tools,
 };
 pub use kapaint_editor as ui;
 pub use kapaint_export as export;
@@ -15,3 +15,4 @@ pub use kapaint_gpu as gpu;
 pub use kapaint_pbr as pbr;
 
 pub mod cli;
+pub mod report;

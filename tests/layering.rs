@@ -160,6 +160,15 @@ fn the_export_links_neither_the_core_nor_its_charts() {
     assert_free_of("kapaint-pbr", &["kapaint-core", "plotters"]);
 }
 
+/// The reports' charts are the command line's: no crate of the workspace links `plotters`
+/// but the root package.
+#[test]
+fn only_the_command_line_links_the_charts() {
+    for krate in ["kapaint-core", "kapaint-gpu", "kapaint-editor"] {
+        assert_free_of(krate, &["plotters"]);
+    }
+}
+
 #[test]
 fn the_gpu_crate_links_no_gui_crate() {
     assert_free_of("kapaint-gpu", &GUI);
