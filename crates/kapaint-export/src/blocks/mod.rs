@@ -12,32 +12,18 @@ mod coder;
 
 pub use coder::{BlockEncoder, Coder, Encoder, Interrupted};
 
-use crate::codec::{Codec, CodecError, Effort};
+use crate::codec::{self, Codec, CodecError, Effort};
 use kapaint_base::task::Progress;
 
-/// `src`'s texels of `stored` bytes widened to `codec`'s whole texels (`to` bytes, at most
-/// [`Codec::texel_bytes`]) with its [`Codec::filler`], into `out`.
-fn widen_into(codec: &dyn Codec, src: &[u8], stored: usize, to: usize, out: &mut [u8]) {
-    let filler = codec.filler();
-    for (d, s) in out.chunks_exact_mut(to).zip(src.chunks_exact(stored)) {
-        d.copy_from_slice(&filler[..to]);
-        d[..stored].copy_from_slice(s);
-    }
-}
-
-/// `src` as [`widen_into`] widens it: borrowed where it already has `to` bytes per texel.
+/// `src`'s texels of `stored` bytes widened to `to` bytes (at most [`Codec::texel_bytes`])
+/// with `codec`'s [`Codec::filler`].
 fn widen<'a>(
     codec: &dyn Codec,
     src: &'a [u8],
     stored: usize,
     to: usize,
 ) -> std::borrow::Cow<'a, [u8]> {
-    if stored == to {
-        return src.into();
-    }
-    let mut out = vec![0; src.len() / stored * to];
-    widen_into(codec, src, stored, to, &mut out);
-    out.into()
+    codec::widen(src, stored, to, codec.filler())
 }
 
 /// Block rows per parallel task.
@@ -171,7 +157,7 @@ fn encode_brought(
     let row_texels = width as usize * stored;
     let mut fill = |row: u32, rows: u32, out: &mut [u8]| {
         let src = &texels[row as usize * row_texels..(row + rows) as usize * row_texels];
-        widen_into(codec, src, stored, per, out);
+        codec::widen_into(src, stored, per, codec.filler(), out);
     };
     let mut strip_done = |rows: u32| {
         progress.is_none_or(|p| {

@@ -9,7 +9,7 @@
 
 use block_compression::CompressionVariant;
 
-use super::{Codec, CodecError, Cpu, Effort, check_len, encode_portable, rgba8};
+use super::{Codec, CodecError, Cpu, Effort, check_strip, encode_portable, widen};
 use crate::file_kind::Compression;
 
 /// The eight values a BC4 block's 3-bit indices select: the two endpoints, then six means
@@ -105,18 +105,7 @@ impl Codec for Bc4 {
         (width, rows): (u32, u32),
         out: &mut [u8],
     ) -> Result<(), CodecError> {
-        check_len(
-            self.name(),
-            (width, rows),
-            texels.len(),
-            width as usize * rows as usize,
-        )?;
-        check_len(
-            self.name(),
-            (width, rows),
-            out.len(),
-            self.blocks_len((width, rows)),
-        )?;
+        check_strip(self, (width, rows), texels.len(), out.len())?;
         match cpu {
             #[cfg(target_arch = "x86_64")]
             Cpu::Ispc => {
@@ -130,7 +119,7 @@ impl Codec for Bc4 {
             }
             _ => encode_portable(
                 CompressionVariant::BC4,
-                &rgba8(texels, 1, self.filler()),
+                &widen(texels, 1, 4, self.filler()),
                 (width, rows),
                 out,
             ),
@@ -144,18 +133,7 @@ impl Codec for Bc4 {
         (width, rows): (u32, u32),
         out: &mut [u8],
     ) -> Result<(), CodecError> {
-        check_len(
-            self.name(),
-            (width, rows),
-            out.len(),
-            width as usize * rows as usize,
-        )?;
-        check_len(
-            self.name(),
-            (width, rows),
-            blocks.len(),
-            self.blocks_len((width, rows)),
-        )?;
+        check_strip(self, (width, rows), out.len(), blocks.len())?;
         decode(blocks, 1, width as usize, out);
         Ok(())
     }

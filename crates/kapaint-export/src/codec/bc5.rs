@@ -4,7 +4,7 @@
 
 use block_compression::CompressionVariant;
 
-use super::{Codec, CodecError, Cpu, Effort, check_len, encode_portable, rgba8};
+use super::{Codec, CodecError, Cpu, Effort, check_strip, encode_portable, widen};
 use crate::file_kind::Compression;
 
 /// BC5: two components.
@@ -50,13 +50,7 @@ impl Codec for Bc5 {
         out: &mut [u8],
     ) -> Result<(), CodecError> {
         let size = (width, rows);
-        check_len(
-            self.name(),
-            size,
-            texels.len(),
-            width as usize * rows as usize * 2,
-        )?;
-        check_len(self.name(), size, out.len(), self.blocks_len(size))?;
+        check_strip(self, size, texels.len(), out.len())?;
         match cpu {
             #[cfg(target_arch = "x86_64")]
             Cpu::Ispc => {
@@ -70,7 +64,7 @@ impl Codec for Bc5 {
             }
             _ => encode_portable(
                 CompressionVariant::BC5,
-                &rgba8(texels, 2, self.filler()),
+                &widen(texels, 2, 4, self.filler()),
                 size,
                 out,
             ),
@@ -85,13 +79,7 @@ impl Codec for Bc5 {
         out: &mut [u8],
     ) -> Result<(), CodecError> {
         let size = (width, rows);
-        check_len(
-            self.name(),
-            size,
-            out.len(),
-            width as usize * rows as usize * 2,
-        )?;
-        check_len(self.name(), size, blocks.len(), self.blocks_len(size))?;
+        check_strip(self, size, out.len(), blocks.len())?;
         super::bc4::decode(blocks, 2, width as usize, out);
         Ok(())
     }

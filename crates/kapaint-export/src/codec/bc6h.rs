@@ -5,7 +5,7 @@ use block_compression::decode::decode_block_bc6h;
 use block_compression::{BC6HSettings, CompressionVariant};
 use half::f16;
 
-use super::{Codec, CodecError, Cpu, Effort, check_len};
+use super::{Codec, CodecError, Cpu, Effort, check_strip};
 use crate::file_kind::Compression;
 
 /// BC6H: RGB as unsigned half floats (linear); its input and decoded texels are RGBA half
@@ -59,13 +59,7 @@ impl Codec for Bc6h {
         out: &mut [u8],
     ) -> Result<(), CodecError> {
         let size = (width, rows);
-        check_len(
-            self.name(),
-            size,
-            texels.len(),
-            width as usize * rows as usize * 8,
-        )?;
-        check_len(self.name(), size, out.len(), self.blocks_len(size))?;
+        check_strip(self, size, texels.len(), out.len())?;
         match cpu {
             #[cfg(target_arch = "x86_64")]
             Cpu::Ispc => {
@@ -111,8 +105,7 @@ impl Codec for Bc6h {
     ) -> Result<(), CodecError> {
         let size = (width, rows);
         let width = width as usize;
-        check_len(self.name(), size, out.len(), width * rows as usize * 8)?;
-        check_len(self.name(), size, blocks.len(), self.blocks_len(size))?;
+        check_strip(self, size, out.len(), blocks.len())?;
         let across = width / 4;
         let one = f16::ONE.to_le_bytes();
         for (b, block) in blocks.chunks_exact(16).enumerate() {

@@ -222,24 +222,30 @@ pub trait Codec: Send + Sync + std::fmt::Debug {
     }
 }
 
-/// Checks that `got` bytes hold `want` for `codec`'s strip of `(width, rows)`.
-pub(crate) fn check_len(
-    codec: &'static str,
+/// Checks a strip of `(width, rows)` texels as `codec` takes them: `texels` bytes of its
+/// whole texels and `blocks` bytes of its blocks.
+pub(crate) fn check_strip(
+    codec: &dyn Codec,
     (width, rows): (u32, u32),
-    got: usize,
-    want: usize,
+    texels: usize,
+    blocks: usize,
 ) -> Result<(), CodecError> {
-    if got == want {
-        Ok(())
-    } else {
-        Err(CodecError::Size {
-            codec,
-            width,
-            rows,
-            got,
-            want,
-        })
+    let size_error = |got, want| CodecError::Size {
+        codec: codec.name(),
+        width,
+        rows,
+        got,
+        want,
+    };
+    let want = width as usize * rows as usize * codec.texel_bytes();
+    if texels != want {
+        return Err(size_error(texels, want));
     }
+    let want = codec.blocks_len((width, rows));
+    if blocks != want {
+        return Err(size_error(blocks, want));
+    }
+    Ok(())
 }
 
 /// The codec of a KTX2 file's blocks, to read them back (ASTC as four components), where
@@ -258,16 +264,27 @@ pub fn from_vk_format(format: ktx2::Format) -> Option<Box<dyn Codec>> {
     })
 }
 
-/// `src`'s texels widened to four bytes (RGBA8) with `filler`, borrowed where they already are.
-pub(crate) fn rgba8(src: &[u8], per: usize, filler: [u8; 8]) -> std::borrow::Cow<'_, [u8]> {
-    if per == 4 {
+/// `src`'s texels of `stored` bytes widened to `to` bytes each (at most eight), the rest of
+/// each taken from `filler`, into `out`.
+pub(crate) fn widen_into(src: &[u8], stored: usize, to: usize, filler: [u8; 8], out: &mut [u8]) {
+    for (d, s) in out.chunks_exact_mut(to).zip(src.chunks_exact(stored)) {
+        d.copy_from_slice(&filler[..to]);
+        d[..stored].copy_from_slice(s);
+    }
+}
+
+/// `src` as [`widen_into`] widens it: borrowed where it already has `to` bytes per texel.
+pub(crate) fn widen(
+    src: &[u8],
+    stored: usize,
+    to: usize,
+    filler: [u8; 8],
+) -> std::borrow::Cow<'_, [u8]> {
+    if stored == to {
         return src.into();
     }
-    let mut out = vec![0; src.len() / per * 4];
-    for (d, s) in out.chunks_exact_mut(4).zip(src.chunks_exact(per)) {
-        d.copy_from_slice(&filler[..4]);
-        d[..per].copy_from_slice(s);
-    }
+    let mut out = vec![0; src.len() / stored * to];
+    widen_into(src, stored, to, filler, &mut out);
     out.into()
 }
 

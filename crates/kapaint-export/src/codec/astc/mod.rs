@@ -21,7 +21,7 @@ use ctt_astcenc::bindings::{astcenc_image, astcenc_type_ASTCENC_TYPE_U8};
 use ctt_astcenc::{Context, Flags, Preset, Profile, Swizzle, SwizzleChannel, config_init};
 
 pub use self::block::AstcBlock;
-use super::{Codec, CodecError, Cpu, Effort, Encoder, check_len};
+use super::{Codec, CodecError, Cpu, Effort, Encoder, check_strip};
 use crate::file_kind::Compression;
 
 /// `astcenc`'s name and search preset for an effort.
@@ -191,13 +191,7 @@ impl Codec for Astc {
         size: (u32, u32),
         out: &mut [u8],
     ) -> Result<(), CodecError> {
-        check_len(
-            self.name(),
-            size,
-            texels.len(),
-            size.0 as usize * size.1 as usize * 4,
-        )?;
-        check_len(self.name(), size, out.len(), self.blocks_len(size))?;
+        check_strip(self, size, texels.len(), out.len())?;
         // astcenc only reads the plane, and only while compressing; its size is checked.
         let mut plane = texels.as_ptr().cast_mut().cast::<c_void>();
         let mut image = image(&mut plane, size);
@@ -215,13 +209,7 @@ impl Codec for Astc {
         size: (u32, u32),
         out: &mut [u8],
     ) -> Result<(), CodecError> {
-        check_len(
-            self.name(),
-            size,
-            out.len(),
-            size.0 as usize * size.1 as usize * 4,
-        )?;
-        check_len(self.name(), size, blocks.len(), self.blocks_len(size))?;
+        check_strip(self, size, out.len(), blocks.len())?;
         let mut plane = out.as_mut_ptr().cast::<c_void>();
         let mut image = image(&mut plane, size);
         // Luminance and alpha: alpha into the second byte.

@@ -7,7 +7,7 @@ mod solid;
 use block_compression::decode::decompress_blocks_as_rgba8;
 use block_compression::{BC7Settings, CompressionVariant};
 
-use super::{Codec, CodecError, Cpu, Effort, check_len, encode_portable};
+use super::{Codec, CodecError, Cpu, Effort, check_strip, encode_portable};
 use crate::file_kind::Compression;
 
 /// BC7 of three components (`alpha` false: the encoder may ignore the fourth) or four.
@@ -69,13 +69,7 @@ impl Codec for Bc7 {
         out: &mut [u8],
     ) -> Result<(), CodecError> {
         let size = (width, rows);
-        check_len(
-            self.name(),
-            size,
-            texels.len(),
-            width as usize * rows as usize * 4,
-        )?;
-        check_len(self.name(), size, out.len(), self.blocks_len(size))?;
+        check_strip(self, size, texels.len(), out.len())?;
         match (cpu, self.portable(effort)) {
             #[cfg(target_arch = "x86_64")]
             (Cpu::Ispc, _) => {
@@ -113,13 +107,7 @@ impl Codec for Bc7 {
         out: &mut [u8],
     ) -> Result<(), CodecError> {
         let size = (width, rows);
-        check_len(
-            self.name(),
-            size,
-            out.len(),
-            width as usize * rows as usize * 4,
-        )?;
-        check_len(self.name(), size, blocks.len(), self.blocks_len(size))?;
+        check_strip(self, size, out.len(), blocks.len())?;
         if let Some(variant) = self.portable(Effort::UltraFast) {
             decompress_blocks_as_rgba8(variant, width, rows, blocks, out);
         }
