@@ -221,7 +221,7 @@ fn alt_click_on_a_mask_shows_it_alone_and_the_viewport_says_what_is_painted() {
     harness.run();
     let state = &harness.state().state;
     assert!(state.doc().selection().mask, "tools paint the mask");
-    assert_eq!(state.layer_view, LayerView::Mask);
+    assert_eq!(state.layer_view(), LayerView::Mask);
     assert_eq!(
         state.painting_text().as_deref(),
         Some("Painting the mask of \"Layer 1\" · showing mask")

@@ -14,9 +14,7 @@ use super::jobs::new_document;
 use super::layout::{load_layout, save_layout};
 use super::panels::layers::LayerView;
 use super::viewport::{Viewport, ViewportGpu};
-use super::{
-    DEFAULT_SIZE, EditorState, MeshState, Quit, Tab, default_layout, files, notice, readout,
-};
+use super::{DEFAULT_SIZE, EditorState, MeshState, Tab, default_layout, notice, readout};
 use kapaint_core::model::texel::MaterialValue;
 use kapaint_core::model::{Document, DocumentSettings, recovery};
 use kapaint_core::render::{Lighting, ViewMode};
@@ -96,59 +94,46 @@ impl Editor {
         let mut editor = Self {
             state: EditorState {
                 doc,
-                path: untitled_until_open,
-                starting: None,
-                saved_version,
+                project: super::project_jobs::Project {
+                    path: untitled_until_open,
+                    starting: None,
+                    saved_version,
+                    recent: load_recent(),
+                    autosaver,
+                    claim: super::claim::Claim::default(),
+                },
                 tools: Tools::default(),
-                view: ViewMode::Shaded,
-                lighting: Lighting::default(),
-                light_follows_camera: false,
+                look: super::Look {
+                    mode: ViewMode::Shaded,
+                    lighting: Lighting::default(),
+                    light_follows_camera: false,
+                },
                 viewport,
                 canvas: Canvas::default(),
                 mesh,
                 notices,
-                job: None,
-                waker: None,
-                export: None,
-                export_choice: None,
-                new_dialog: None,
-                pending_new: None,
-                resize_dialog: None,
-                bake_dialog: None,
-                preferences,
-                preferences_open: false,
-                equivalent_n: None,
-                bake_on_demand: crate::bake::OnDemand::default(),
-                pending_open: None,
-                material_prompt: None,
-                size_prompt: None,
-                unwrap_prompt: None,
-                recent: load_recent(),
-                stamp_preview: None,
-                pressure: 1.0,
-                held: None,
-                hover: None,
-                hover_tab: None,
-                canvas_outline: None,
-                brush_size: super::screen_brush::BrushSize::default(),
-                texels_per_point: None,
-                hex_text: None,
-                recent_materials: Vec::new(),
-                shown_hover: None,
-                exact_chi: readout::ExactChi::new(),
-                quit: Quit::default(),
-                files: files::FileChooser::new(),
-                shortcuts_open: false,
-                recovery_offer,
-                presets,
-                brush_presets,
-                mask_presets,
-                naming: None,
-                preset_dir,
-                autosaver,
-                claim: super::claim::Claim::default(),
+                jobs: super::jobs::Jobs {
+                    current: None,
+                    waker: None,
+                    exact_chi: readout::ExactChi::new(),
+                    bake_on_demand: crate::bake::OnDemand::default(),
+                },
+                dialogs: super::dialogs::Dialogs::default(),
+                prompts: super::prompts::Prompts {
+                    recovery_offer,
+                    ..Default::default()
+                },
+                pointer: super::input::Pointer::default(),
+                tool_panel: super::panels::tool_panel::ToolPanel::default(),
+                presets: super::panels::presets::Presets {
+                    materials: presets,
+                    brushes: brush_presets,
+                    masks: mask_presets,
+                    dir: preset_dir,
+                    naming: None,
+                },
                 layers_panel: super::panels::layers::PanelState::default(),
-                layer_view: LayerView::Composite,
+                preferences,
             },
             dock,
             started: None,
@@ -156,9 +141,9 @@ impl Editor {
         };
         if let Some(p) = existing {
             let s = &mut editor.state;
-            if s.recovery_offer.is_some() {
+            if s.prompts.recovery_offer.is_some() {
                 // Recover or Discard decides what opens.
-                s.starting = Some(p);
+                s.project.starting = Some(p);
             } else {
                 s.open_now(p);
             }
@@ -216,7 +201,7 @@ impl TabViewer for Tabs<'_> {
                     s.viewport
                         .show(ui, (maps.0, maps.1, normal.as_ref()), &mesh, &settings);
                 if std::mem::take(&mut s.viewport.untraced_requested) {
-                    s.view = s.view.untraced();
+                    s.look.mode = s.look.mode.untraced();
                 }
                 s.painting_label(ui, rect);
                 s.viewport_input(&response, rect);
@@ -259,7 +244,7 @@ impl Editor {
     pub fn frame(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         let s = &mut self.state;
-        s.waker = Some(ctx.clone());
+        s.jobs.waker = Some(ctx.clone());
         s.poll_job();
         s.bake_missing();
         s.track_pressure(&ctx);
@@ -267,16 +252,16 @@ impl Editor {
         s.follow_mesh();
         s.dropped_files(&ctx);
         let now = Instant::now();
-        if let Some(Err(e)) = s.autosaver.poll(&s.doc, now) {
+        if let Some(Err(e)) = s.project.autosaver.poll(&s.doc, now) {
             s.notices
                 .push(notice(format!("autosave failed: {e}"), true));
         }
         // An idle window draws no frames: wake up when the recovery copy falls due.
-        if let Some(wait) = s.autosaver.next_poll(&s.doc, now) {
+        if let Some(wait) = s.project.autosaver.next_poll(&s.doc, now) {
             ctx.request_repaint_after(wait);
         }
-        s.shown_hover = s.hover.take();
-        s.hover_tab = None;
+        s.pointer.shown_hover = s.pointer.hover.take();
+        s.pointer.hover_tab = None;
         egui::Panel::top("menu").show(ui, |ui| s.menu_ui(ui));
         egui::Panel::bottom("status").show(ui, |ui| s.status_bar_ui(ui));
         egui::Panel::left("tools")
@@ -314,7 +299,7 @@ impl Editor {
         s.unwrap_prompt_window(&ctx);
         s.modal_job_ui(&ctx);
         s.files_ui(&ctx);
-        if s.job.is_some() {
+        if s.jobs.current.is_some() {
             // One progress update a second: on a software renderer each frame of the window
             // takes about 0.1 s of the CPU the job runs on (four a second slowed an AO bake
             // by a third). The worker wakes the window when it is done.
@@ -344,10 +329,12 @@ impl eframe::App for Editor {
     fn on_exit(&mut self) {
         save_layout(&self.dock);
         // A clean exit, or one whose changes the user discarded, leaves no recovery copy.
-        if !self.state.dirty() || self.state.quit.allowed == Some(super::QuitAllowed::Discarded) {
-            self.state.autosaver.discard();
+        if !self.state.dirty()
+            || self.state.prompts.quit.allowed == Some(super::QuitAllowed::Discarded)
+        {
+            self.state.project.autosaver.discard();
         }
-        self.state.claim.release();
+        self.state.project.claim.release();
     }
 }
 

@@ -56,12 +56,12 @@ const RAY_CHOICES: [u32; 6] = [16, 32, 64, 128, 256, 1024];
 impl EditorState {
     /// Opens Mesh > Bake.
     pub fn open_bake(&mut self) {
-        self.bake_dialog = Some(BakeDialog::default());
+        self.dialogs.bake = Some(BakeDialog::default());
     }
 
     /// The Bake dialog's choices, while it is open.
     pub fn bake_dialog(&self) -> Option<BakeDialog> {
-        self.bake_dialog
+        self.dialogs.bake
     }
 
     /// Sets `generator` on the selected layer's mask; where it reads a bake the project
@@ -82,7 +82,7 @@ impl EditorState {
             format!("baking {} first: the mask reads it", names.join(" and ")),
             false,
         ));
-        self.bake_on_demand.pending = Some((self.doc.selected_id(), generator));
+        self.jobs.bake_on_demand.pending = Some((self.doc.selected_id(), generator));
         let dialog = BakeDialog {
             all: BakeMap::ALL.map(|(_, m)| missing.contains(&m)),
             ..BakeDialog::default()
@@ -95,10 +95,10 @@ impl EditorState {
     /// other job runs.
     pub(super) fn bake_missing(&mut self) {
         let version = self.doc.version();
-        if self.job.is_some() || self.bake_on_demand.looked_at == Some(version) {
+        if self.jobs.current.is_some() || self.jobs.bake_on_demand.looked_at == Some(version) {
             return;
         }
-        self.bake_on_demand.looked_at = Some(version);
+        self.jobs.bake_on_demand.looked_at = Some(version);
         let missing = self.doc.missing_bakes();
         if missing.is_empty() || self.doc.surface().is_none() {
             return;
@@ -121,7 +121,7 @@ impl EditorState {
     /// What bakes kept just now unlock: the generator waiting for them, laid if its layer is
     /// still the one selected.
     pub(super) fn baked_on_demand(&mut self) {
-        if let Some((layer, generator)) = self.bake_on_demand.pending.take()
+        if let Some((layer, generator)) = self.jobs.bake_on_demand.pending.take()
             && layer == self.doc.selected_id()
         {
             self.apply(MaskCommand::SetMaskGenerator(Some(generator)));
@@ -130,7 +130,7 @@ impl EditorState {
 
     /// A bake job that failed or was cancelled: the generator waiting for it is dropped.
     pub(super) fn bake_failed(&mut self) {
-        self.bake_on_demand.pending = None;
+        self.jobs.bake_on_demand.pending = None;
     }
 
     /// Bakes `dialog.map` of the project's mesh on a worker; it is kept when it arrives.
@@ -183,7 +183,7 @@ impl EditorState {
     /// The Bake dialog: the map, its rays and distance, the bakes kept, Bake; the maps to
     /// bake together, Bake all checked.
     pub(super) fn bake_window(&mut self, ctx: &egui::Context) {
-        let Some(mut dialog) = self.bake_dialog else {
+        let Some(mut dialog) = self.dialogs.bake else {
             return;
         };
         let (mut open, mut go, mut all) = (true, false, false);
@@ -255,15 +255,15 @@ impl EditorState {
                     .clicked();
             });
         if go {
-            self.bake_dialog = None;
+            self.dialogs.bake = None;
             self.bake(dialog);
         } else if all {
-            self.bake_dialog = None;
+            self.dialogs.bake = None;
             self.bake_all(dialog);
         } else if open {
-            self.bake_dialog = Some(dialog);
+            self.dialogs.bake = Some(dialog);
         } else {
-            self.bake_dialog = None;
+            self.dialogs.bake = None;
         }
     }
 }

@@ -47,14 +47,14 @@ impl EditorState {
     /// Whether `path` may open now: `Some(read_only)` when no other kapaint has it open or the
     /// user answered; `None` when the user is being asked first.
     pub(super) fn may_open(&mut self, path: &Path) -> Option<bool> {
-        if let Some((answered, read_only)) = self.claim.answered.take()
+        if let Some((answered, read_only)) = self.project.claim.answered.take()
             && answered == path
         {
             return Some(read_only);
         }
         match lock::holder(path) {
             Some(owner) => {
-                self.claim.asking = Some((path.to_path_buf(), owner));
+                self.project.claim.asking = Some((path.to_path_buf(), owner));
                 None
             }
             None => Some(false),
@@ -63,7 +63,7 @@ impl EditorState {
 
     /// Asks how to open a project another kapaint has open: read-only, anyway, or not at all.
     pub(super) fn claim_prompt(&mut self, ctx: &egui::Context) {
-        let Some((path, owner)) = self.claim.asking.clone() else {
+        let Some((path, owner)) = self.project.claim.asking.clone() else {
             return;
         };
         let name = path.file_name().map_or_else(
@@ -89,11 +89,11 @@ impl EditorState {
             });
         });
         if read_only || anyway {
-            self.claim.asking = None;
-            self.claim.answered = Some((path.clone(), read_only));
+            self.project.claim.asking = None;
+            self.project.claim.answered = Some((path.clone(), read_only));
             self.open_now(path);
         } else if cancel {
-            self.claim.asking = None;
+            self.project.claim.asking = None;
         }
     }
 }

@@ -16,6 +16,29 @@ use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::{Document, DocumentSettings};
 use kapaint_export::preset::ExportPreset;
 
+/// The dialogs and windows, while open.
+#[derive(Default)]
+pub(super) struct Dialogs {
+    pub(super) export: Option<ExportDialog>,
+    /// The last export's preset and folder, offered again by the next.
+    pub(super) export_choice: Option<(String, String)>,
+    /// The Resize dialog, while open.
+    pub(super) resize: Option<super::resize::ResizeDialog>,
+    /// Mesh > Bake, while open.
+    pub(super) bake: Option<super::bake::BakeDialog>,
+    /// Whether the Preferences window is open.
+    pub(super) preferences_open: bool,
+    /// The New dialog, while open.
+    pub(super) new: Option<NewDialog>,
+    /// The New dialog's project, created once the save its "Save, then create" started is
+    /// done.
+    pub(super) pending_new: Option<NewDialog>,
+    /// Whether Help > Keyboard shortcuts is open.
+    pub(super) shortcuts_open: bool,
+    /// The file chooser: the system's, or kapaint's own without a desktop portal.
+    pub(super) files: super::files::FileChooser,
+}
+
 /// The New dialog's choices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewDialog {
@@ -122,7 +145,7 @@ impl EditorState {
     /// answered the document is a placeholder, and a stroke on it would be autosaved over the
     /// untitled recovery copy.
     pub(super) fn recovery_window(&mut self, ctx: &egui::Context) {
-        let Some(copy) = self.recovery_offer.clone() else {
+        let Some(copy) = self.prompts.recovery_offer.clone() else {
             return;
         };
         egui::Modal::new(egui::Id::new("kapaint-recovery-offer")).show(ctx, |ui| {
@@ -136,15 +159,19 @@ impl EditorState {
                 let enter = ui.input(|i| i.key_pressed(egui::Key::Enter));
                 let recover = ui.button("Recover").on_hover_text("Enter");
                 if recover.clicked() || enter {
-                    self.recovery_offer = None;
-                    let path = self.starting.take().or_else(|| self.path.clone());
+                    self.prompts.recovery_offer = None;
+                    let path = self
+                        .project
+                        .starting
+                        .take()
+                        .or_else(|| self.project.path.clone());
                     self.recover(copy.clone(), path);
                 }
                 if ui.button("Discard").clicked() {
-                    self.recovery_offer = None;
+                    self.prompts.recovery_offer = None;
                     kapaint_core::model::recovery::remove(&copy);
                     // The project named at start opens as saved.
-                    if let Some(p) = self.starting.take() {
+                    if let Some(p) = self.project.starting.take() {
                         self.open_now(p);
                     }
                 }
@@ -156,11 +183,17 @@ impl EditorState {
     pub(super) fn new_project(&mut self) {
         let preset = self
             .presets
+            .materials
             .iter()
             .position(|p| Some(&p.stem) == self.doc.settings().preset.as_ref())
-            .or_else(|| self.presets.iter().position(|p| p.stem == "default"))
+            .or_else(|| {
+                self.presets
+                    .materials
+                    .iter()
+                    .position(|p| p.stem == "default")
+            })
             .unwrap_or(0);
-        self.new_dialog = Some(NewDialog {
+        self.dialogs.new = Some(NewDialog {
             width: self.doc.maps().width(),
             height: self.doc.maps().height(),
             preset,
@@ -175,7 +208,7 @@ impl EditorState {
             mesh: MeshRef::from_spec(&dialog.mesh),
             ..DocumentSettings::default()
         };
-        if let Some(p) = self.presets.get(dialog.preset) {
+        if let Some(p) = self.presets.materials.get(dialog.preset) {
             settings.base = p.value;
             settings.secondary = p.value;
             settings.preset = Some(p.stem.clone());
@@ -194,7 +227,7 @@ impl EditorState {
     /// The New dialog: width and height, base preset, mesh; with unsaved changes, save them
     /// first or discard them.
     pub(super) fn new_window(&mut self, ctx: &egui::Context) {
-        let Some(mut dialog) = self.new_dialog.take() else {
+        let Some(mut dialog) = self.dialogs.new.take() else {
             return;
         };
         let (mut open, mut create, mut choose, mut save_first) = (true, false, false, false);
@@ -219,11 +252,12 @@ impl EditorState {
                 egui::ComboBox::from_label("Base preset")
                     .selected_text(
                         self.presets
+                            .materials
                             .get(dialog.preset)
                             .map_or("", |p| p.name.as_str()),
                     )
                     .show_ui(ui, |ui| {
-                        for (i, p) in self.presets.iter().enumerate() {
+                        for (i, p) in self.presets.materials.iter().enumerate() {
                             ui.selectable_value(&mut dialog.preset, i, &p.name);
                         }
                     });
@@ -259,10 +293,10 @@ impl EditorState {
         } else if save_first {
             // Created once the save is done (untitled work asks where first); a save that
             // fails or is cancelled creates nothing.
-            self.pending_new = Some(dialog);
+            self.dialogs.pending_new = Some(dialog);
             self.save();
         } else if open {
-            self.new_dialog = Some(dialog);
+            self.dialogs.new = Some(dialog);
             if choose {
                 self.choose_file(FilePurpose::NewMesh);
             }
@@ -271,19 +305,21 @@ impl EditorState {
 
     /// Remembers `path` at the top of the recent files.
     pub(super) fn remember(&mut self, path: &Path) {
-        push_recent(&mut self.recent, path);
-        save_recent(&self.recent);
+        push_recent(&mut self.project.recent, path);
+        save_recent(&self.project.recent);
     }
 
     /// Starts the export on a worker (replacing the set at the folder where `replace`); the
     /// dialog's choices are kept for the next export.
     pub(super) fn export_now(&mut self, replace: bool) {
-        let Some(dialog) = &self.export else { return };
+        let Some(dialog) = &self.dialogs.export else {
+            return;
+        };
         let Some(preset) = dialog.presets.get(dialog.chosen).cloned() else {
             return;
         };
         let out = PathBuf::from(dialog.folder.trim());
-        self.export_choice = Some((preset.name.clone(), dialog.folder.clone()));
+        self.dialogs.export_choice = Some((preset.name.clone(), dialog.folder.clone()));
         let pbr = preset.format.is_gltf_pbr();
         let mesh = self
             .doc
@@ -291,7 +327,7 @@ impl EditorState {
             .filter(|_| pbr && dialog.glb)
             .map(Arc::clone);
         let snapshot = self.snapshot();
-        self.export = None;
+        self.dialogs.export = None;
         self.start_job("Export", move |progress| {
             let glb = mesh.as_ref().map(|s| &s.mesh);
             let gpu = kapaint_gpu::blocks::for_export(&preset);
@@ -305,20 +341,20 @@ impl EditorState {
     pub(super) fn open_export(&mut self) {
         let presets = kapaint_export::preset::builtin();
         // The last export's choices, else the project's name and the first preset.
-        let (chosen, folder) = match &self.export_choice {
+        let (chosen, folder) = match &self.dialogs.export_choice {
             Some((name, folder)) => (
                 presets.iter().position(|p| &p.name == name).unwrap_or(0),
                 folder.clone(),
             ),
             None => (
                 0,
-                self.path.as_ref().map_or_else(
+                self.project.path.as_ref().map_or_else(
                     || "export".to_string(),
                     |p| p.with_extension("").display().to_string() + "-set",
                 ),
             ),
         };
-        self.export = Some(ExportDialog {
+        self.dialogs.export = Some(ExportDialog {
             presets,
             chosen,
             folder,
@@ -339,13 +375,13 @@ impl EditorState {
     /// preset or the maps changed, and takes the result when it is done.
     pub(super) fn update_export_plan(&mut self, ctx: &egui::Context) {
         let version = self.doc.maps().version();
-        let snapshot = self.export.as_ref().and_then(|d| {
+        let snapshot = self.dialogs.export.as_ref().and_then(|d| {
             let current = |(p, v): (usize, u64)| p == d.chosen && v == version;
             let planned = d.plan.as_ref().is_some_and(|(p, v, _)| current((*p, *v)));
             // One plan at a time: a stale one finishes first, then the current one starts.
             (!planned && d.planning.is_none()).then(|| self.snapshot())
         });
-        let Some(dialog) = &mut self.export else {
+        let Some(dialog) = &mut self.dialogs.export else {
             return;
         };
         if let Some(doc) = snapshot
@@ -375,7 +411,7 @@ impl EditorState {
     pub(super) fn export_window(&mut self, ctx: &egui::Context) {
         self.update_export_plan(ctx);
         let has_mesh = self.doc.surface().is_some();
-        let Some(dialog) = &mut self.export else {
+        let Some(dialog) = &mut self.dialogs.export else {
             return;
         };
         let mut open = true;
@@ -462,7 +498,7 @@ impl EditorState {
                 }
             });
         if !open {
-            self.export = None;
+            self.dialogs.export = None;
         } else if choose {
             self.choose_file(FilePurpose::ExportFolder);
         } else if replace {
@@ -476,11 +512,11 @@ impl EditorState {
     /// something else is. The dialog and its choices stay until the export starts.
     fn ask_or_export(&mut self) {
         use kapaint_export::set::{SetKind, Target, holds, target};
-        let Some(dialog) = &mut self.export else {
+        let Some(dialog) = &mut self.dialogs.export else {
             return;
         };
         let folder = Path::new(dialog.folder.trim());
-        if let Some(project) = self.path.as_deref().filter(|p| holds(folder, p)) {
+        if let Some(project) = self.project.path.as_deref().filter(|p| holds(folder, p)) {
             dialog.problem = Some(format!(
                 "{} holds the project {}: choose another folder",
                 folder.display(),

@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 
 use egui_file_dialog::{DialogState, FileDialog};
 
+use crate::EditorState;
 use kapaint_core::model::texel::Channel;
 
 /// What a file is chosen for: its title, filter and what the editor does with it.
@@ -452,16 +453,17 @@ pub fn portal_has_file_chooser() -> bool {
     })
 }
 
-impl super::EditorState {
+impl EditorState {
     /// Asks for a file for `purpose`, starting in the project's folder.
     pub(super) fn choose_file(&mut self, purpose: FilePurpose) {
         let dir = self
+            .project
             .path
             .as_deref()
             .and_then(Path::parent)
             .filter(|d| !d.as_os_str().is_empty())
             .map(Path::to_path_buf);
-        if !self.files.request(purpose, dir) {
+        if !self.dialogs.files.request(purpose, dir) {
             self.notices
                 .push(super::notice("a file dialog is open already", true));
         }
@@ -469,11 +471,11 @@ impl super::EditorState {
 
     /// Draws the in-app dialog, if open, and acts on what was chosen.
     pub(super) fn files_ui(&mut self, ctx: &egui::Context) {
-        match self.files.update(ctx) {
+        match self.dialogs.files.update(ctx) {
             Some(ChooserEvent::FellBack(text)) => self.notices.push(super::notice(text, false)),
             Some(ChooserEvent::Cancelled(FilePurpose::SaveProject)) => {
-                self.quit.after_save = false;
-                self.pending_new = None;
+                self.prompts.quit.after_save = false;
+                self.dialogs.pending_new = None;
             }
             None | Some(ChooserEvent::Cancelled(_)) => {}
             Some(ChooserEvent::Picked(Picked { purpose, path })) => match purpose {
@@ -484,12 +486,12 @@ impl super::EditorState {
                 FilePurpose::ImportPbr => self.import_pbr(path),
                 FilePurpose::StampImage => self.load_stamp(path),
                 FilePurpose::NewMesh => {
-                    if let Some(dialog) = &mut self.new_dialog {
+                    if let Some(dialog) = &mut self.dialogs.new {
                         dialog.mesh = path.display().to_string();
                     }
                 }
                 FilePurpose::ExportFolder => {
-                    if let Some(dialog) = &mut self.export {
+                    if let Some(dialog) = &mut self.dialogs.export {
                         dialog.choose_folder(&path);
                     }
                 }
@@ -499,7 +501,7 @@ impl super::EditorState {
 
     /// The file chooser (tests choose its backend and starting folder).
     pub fn files_mut(&mut self) -> &mut FileChooser {
-        &mut self.files
+        &mut self.dialogs.files
     }
 }
 

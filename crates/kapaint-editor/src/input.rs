@@ -14,6 +14,38 @@ use kapaint_core::model::brush::SurfacePos;
 use kapaint_core::render::FrameSettings;
 use kapaint_core::tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
 
+/// Where the pointer is and what it holds.
+pub(super) struct Pointer {
+    /// The view the primary button went down on, until it goes up.
+    pub(super) held: Option<Tab>,
+    /// The texel under the cursor, in either view.
+    pub(super) hover: Option<(u32, u32)>,
+    /// `hover` as of the last frame (the status bar is drawn before the tabs).
+    pub(super) shown_hover: Option<(u32, u32)>,
+    /// The tab under the cursor.
+    pub(super) hover_tab: Option<Tab>,
+    /// Texels per screen point under the cursor (canvas zoom, or the surface's scale).
+    pub(super) texels_per_point: Option<f32>,
+    /// The brush circle drawn on the UV canvas this frame: centre and radius in points.
+    pub(super) canvas_outline: Option<(egui::Pos2, f32)>,
+    /// The pen's last pressure in the current stroke (1 with a mouse).
+    pub(super) pressure: f32,
+}
+
+impl Default for Pointer {
+    fn default() -> Self {
+        Self {
+            held: None,
+            hover: None,
+            shown_hover: None,
+            hover_tab: None,
+            texels_per_point: None,
+            canvas_outline: None,
+            pressure: 1.0,
+        }
+    }
+}
+
 impl EditorState {
     /// The texel under a map-space position, if inside.
     fn texel_at(&self, p: Vec2) -> Option<(u32, u32)> {
@@ -32,7 +64,7 @@ impl EditorState {
             })
         });
         if let Some(f) = force {
-            self.pressure = f;
+            self.pointer.pressure = f;
         }
     }
 
@@ -67,14 +99,14 @@ impl EditorState {
         samples: Vec<(Sample, Option<Place>)>,
         reserved: bool,
     ) {
-        let pressure = self.pressure;
+        let pressure = self.pointer.pressure;
         for (sample, at) in samples {
             match sample {
                 Sample::Down(p) => {
                     let on_view = response.interact_rect.contains(p)
                         && response.ctx.layer_id_at(p) == Some(response.layer_id);
-                    if self.held.is_none() && on_view && !reserved {
-                        self.held = Some(tab);
+                    if self.pointer.held.is_none() && on_view && !reserved {
+                        self.pointer.held = Some(tab);
                         if self.tools.active_meta().cursor == ToolCursor::BrushOutline {
                             self.fit_brush_to_screen();
                         }
@@ -83,7 +115,7 @@ impl EditorState {
                         }
                     }
                 }
-                Sample::Move(_) | Sample::Up(_) if self.held == Some(tab) => {
+                Sample::Move(_) | Sample::Up(_) if self.pointer.held == Some(tab) => {
                     if let Some(at) = at {
                         self.tool_event(ToolEvent::Drag { at, pressure });
                     }
@@ -95,7 +127,7 @@ impl EditorState {
             }
         }
         // A release egui never reported (the pointer left the window): end the stroke.
-        if self.held == Some(tab) && !response.ctx.input(|i| i.pointer.primary_down()) {
+        if self.pointer.held == Some(tab) && !response.ctx.input(|i| i.pointer.primary_down()) {
             self.release();
         }
     }
@@ -115,8 +147,8 @@ impl EditorState {
 
     /// Ends the stroke under way.
     fn release(&mut self) {
-        self.held = None;
-        self.pressure = 1.0;
+        self.pointer.held = None;
+        self.pointer.pressure = 1.0;
         self.tool_event(ToolEvent::Release);
     }
 
@@ -126,11 +158,11 @@ impl EditorState {
         let pointer = response.interact_pointer_pos().or(response.hover_pos());
         let pos = pointer.map(|p| self.canvas.to_texel(rect, p, size));
         if response.hovered() {
-            self.hover = pos.and_then(|p| self.texel_at(p));
-            self.hover_tab = Some(Tab::Canvas);
+            self.pointer.hover = pos.and_then(|p| self.texel_at(p));
+            self.pointer.hover_tab = Some(Tab::Canvas);
         }
-        if pointer.is_some() && (response.hovered() || self.held == Some(Tab::Canvas)) {
-            self.texels_per_point = Some(size.0 as f32 / rect.width().max(1e-3));
+        if pointer.is_some() && (response.hovered() || self.pointer.held == Some(Tab::Canvas)) {
+            self.pointer.texels_per_point = Some(size.0 as f32 / rect.width().max(1e-3));
         }
         let space = response.ctx.input(|i| i.key_down(Key::Space));
         let samples = pointer_samples(&response.ctx)
@@ -143,13 +175,13 @@ impl EditorState {
         self.pointer_input(Tab::Canvas, response, samples, space);
         self.tool_cursor(response, space);
         // The brush circle: the dab's radius in texels, at the canvas's zoom.
-        self.canvas_outline = None;
+        self.pointer.canvas_outline = None;
         if let Some(p) = response.hover_pos()
             && self.tools.active_meta().cursor == ToolCursor::BrushOutline
             && !space
         {
-            let radius = if self.brush_size.on_screen {
-                self.brush_size.screen_radius
+            let radius = if self.tool_panel.brush_size.on_screen {
+                self.tool_panel.brush_size.screen_radius
             } else {
                 self.doc.settings().brush.radius_px * rect.width() / size.0 as f32
             };
@@ -161,7 +193,7 @@ impl EditorState {
                 egui::Stroke::new(1.0, egui::Color32::BLACK),
             );
             painter.circle_stroke(p, radius, egui::Stroke::new(1.0, egui::Color32::WHITE));
-            self.canvas_outline = Some((p, radius));
+            self.pointer.canvas_outline = Some((p, radius));
         }
         if let Some(Overlay::Arrow { from, to }) = self.tools.overlay() {
             let at = |p: Vec2| {
@@ -195,21 +227,22 @@ impl EditorState {
         };
         let place = hit.as_ref().map(place_of);
         if response.hovered() {
-            self.hover_tab = Some(Tab::Viewport);
-            self.hover = place.and_then(Place::texel).and_then(|p| self.texel_at(p));
+            self.pointer.hover_tab = Some(Tab::Viewport);
+            self.pointer.hover = place.and_then(Place::texel).and_then(|p| self.texel_at(p));
         }
         // A screen point's size on the surface under the cursor, in texels.
         if let (Some(p), Some(hit), Some(surface)) = (pointer, &hit, self.doc.surface())
-            && (response.hovered() || self.held == Some(Tab::Viewport))
+            && (response.hovered() || self.pointer.held == Some(Tab::Viewport))
         {
             let picture = self.viewport.picture_at(rect, p);
-            self.texels_per_point = points_per_world(&self.viewport.camera, picture, hit.position)
-                .map(|ppw| 1.0 / (ppw * surface.units_per_texel));
+            self.pointer.texels_per_point =
+                points_per_world(&self.viewport.camera, picture, hit.position)
+                    .map(|ppw| 1.0 / (ppw * surface.units_per_texel));
         }
         // Picking every sample costs a ray each; only while a stroke may start or is held.
         let samples = pointer_samples(&response.ctx)
             .into_iter()
-            .filter(|_| self.held.is_none() || self.held == Some(Tab::Viewport))
+            .filter(|_| self.pointer.held.is_none() || self.pointer.held == Some(Tab::Viewport))
             .map(|s| {
                 let hit = self
                     .viewport
@@ -233,9 +266,9 @@ impl EditorState {
             && let Some(hit) = self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh)
         {
             let picture = self.viewport.picture_at(rect, p);
-            let world = if self.brush_size.on_screen {
+            let world = if self.tool_panel.brush_size.on_screen {
                 points_per_world(&self.viewport.camera, picture, hit.position)
-                    .map_or(0.0, |ppw| self.brush_size.screen_radius / ppw)
+                    .map_or(0.0, |ppw| self.tool_panel.brush_size.screen_radius / ppw)
             } else {
                 self.doc.settings().brush.radius_px * surface.units_per_texel
             };
@@ -259,14 +292,14 @@ impl EditorState {
     /// What the viewport draws this frame: the light in the world (turned with the camera
     /// when it follows the camera).
     pub fn frame_settings(&self) -> FrameSettings {
-        let mut lighting = self.lighting;
-        if self.light_follows_camera {
+        let mut lighting = self.look.lighting;
+        if self.look.light_follows_camera {
             lighting.light = self.viewport.camera.rotation() * lighting.direction();
         }
         FrameSettings {
             model: self.doc.settings().model,
             approx: self.doc.settings().approx,
-            view: self.view,
+            view: self.look.mode,
             lighting,
             camera: self.viewport.camera,
         }
@@ -275,22 +308,23 @@ impl EditorState {
     /// Turns the light by `yaw` about the vertical and raises it by `pitch` (radians; its
     /// height stays within 89 degrees of the horizon).
     pub(super) fn turn_light(&mut self, yaw: f32, pitch: f32) {
-        let (around, height) = self.lighting.angles();
+        let (around, height) = self.look.lighting.angles();
         let limit = 89f32.to_radians();
-        self.lighting
+        self.look
+            .lighting
             .set_angles(around + yaw, (height + pitch).clamp(-limit, limit));
     }
 
     /// Makes the light follow the camera (kept relative to the view, so turning the model
     /// never leaves it dark) or stay put in the world; it does not jump either way.
     pub fn set_light_follows_camera(&mut self, follow: bool) {
-        if follow == self.light_follows_camera {
+        if follow == self.look.light_follows_camera {
             return;
         }
         let turn = self.viewport.camera.rotation();
-        let l = self.lighting.direction();
-        self.lighting.light = if follow { turn.inverse() * l } else { turn * l };
-        self.light_follows_camera = follow;
+        let l = self.look.lighting.direction();
+        self.look.lighting.light = if follow { turn.inverse() * l } else { turn * l };
+        self.look.light_follows_camera = follow;
     }
 }
 

@@ -13,6 +13,20 @@ use kapaint_core::model::{Document, DocumentSettings, ModelError, project, recov
 use kapaint_core::model::{ImportCommand, SettingsCommand};
 use kapaint_core::task::Progress;
 
+/// Work on workers: the one job with a progress bar, and the workers panels keep.
+pub(super) struct Jobs {
+    pub(super) current: Option<Job>,
+    /// The window's context, for a worker to wake the window when its job is done (a frame
+    /// is drawn then, not at the next progress tick).
+    pub(super) waker: Option<egui::Context>,
+    /// Exact `chi` values for the status bar, integrated on a worker.
+    pub(super) exact_chi: super::readout::ExactChi,
+    /// The bakes the editor makes on its own: a generator mask set while a bake it reads was
+    /// missing (laid once they arrive), and the document version last looked at for bakes its
+    /// masks read and lack.
+    pub(super) bake_on_demand: super::bake::OnDemand,
+}
+
 /// What a worker hands back.
 pub(super) enum JobResult {
     /// A project opened (or recovered).
@@ -211,7 +225,7 @@ impl EditorState {
         }
         let progress = Arc::new(Progress::default());
         let shared = Arc::clone(&progress);
-        let waker = self.waker.clone();
+        let waker = self.jobs.waker.clone();
         match std::thread::Builder::new()
             .name(format!("kapaint-{}", label.to_lowercase()))
             .spawn(move || {
@@ -222,7 +236,7 @@ impl EditorState {
                 result
             }) {
             Ok(handle) => {
-                self.job = Some(Job {
+                self.jobs.current = Some(Job {
                     label: label.into(),
                     opens,
                     modal,
@@ -237,10 +251,17 @@ impl EditorState {
     }
 
     pub(super) fn poll_job(&mut self) {
-        if !self.job.as_ref().is_some_and(|j| j.handle.is_finished()) {
+        if !self
+            .jobs
+            .current
+            .as_ref()
+            .is_some_and(|j| j.handle.is_finished())
+        {
             return;
         }
-        let Some(job) = self.job.take() else { return };
+        let Some(job) = self.jobs.current.take() else {
+            return;
+        };
         let result = job
             .handle
             .join()
@@ -261,7 +282,7 @@ impl EditorState {
             JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
             JobResult::Exported(dir, m) => self.notices.push(exported_notice(&dir, *m)),
             JobResult::Material(path, m) => self.take_material(&path, *m),
-            JobResult::MaterialSize(prompt) => self.size_prompt = Some(*prompt),
+            JobResult::MaterialSize(prompt) => self.prompts.size = Some(*prompt),
             JobResult::Adopted(resized, path, m) => {
                 let (w, h) = (resized.0.0.width, resized.0.0.height);
                 self.apply(ImportCommand::Resize(resized));
@@ -298,12 +319,12 @@ impl EditorState {
             }
             JobResult::Created(doc) => {
                 self.replace_document(*doc);
-                self.saved_version = self.doc.version();
-                self.path = None;
-                self.claim.hold(None, None, false);
+                self.project.saved_version = self.doc.version();
+                self.project.path = None;
+                self.project.claim.hold(None, None, false);
                 // The old document was saved or its changes discarded (asked before).
-                self.autosaver.discard();
-                self.autosaver =
+                self.project.autosaver.discard();
+                self.project.autosaver =
                     recovery::Autosaver::new(self.preferences.autosave_interval(), None, &self.doc);
             }
             JobResult::Stamp(path, stamp) => {
@@ -314,8 +335,8 @@ impl EditorState {
                     .push(notice(format!("stamp {}", path.display()), false));
             }
             JobResult::Failed(e) => {
-                self.quit.after_save = false;
-                self.pending_new = None;
+                self.prompts.quit.after_save = false;
+                self.dialogs.pending_new = None;
                 self.bake_failed();
                 self.notices.push(notice(e, true));
             }
@@ -330,9 +351,8 @@ impl EditorState {
             self.canvas.fit();
         }
         // The texel under the cursor was found on the old maps.
-        self.hover = None;
-        self.shown_hover = None;
-        self.layers_panel.document_replaced();
+        self.pointer.hover = None;
+        self.pointer.shown_hover = None;
         self.doc = doc;
         if let Some(mesh) = mesh {
             self.mesh = MeshState::new(mesh, self.mesh.id + 1);
@@ -410,7 +430,7 @@ impl EditorState {
     /// What the window over the editor says while a job it waits for runs (a project
     /// opening, the maps being resized), if one does.
     pub(super) fn modal_job(&self) -> Option<&str> {
-        self.job.as_ref().and_then(|j| j.modal.as_deref())
+        self.jobs.current.as_ref().and_then(|j| j.modal.as_deref())
     }
 
     /// While a project opens or the maps are resized: a window over the editor saying so,

@@ -254,9 +254,9 @@ impl EditorState {
     pub(super) fn hotkeys(&mut self, ctx: &egui::Context) {
         // Nor while a file dialog is open: its keys are its own.
         if ctx.egui_wants_keyboard_input()
-            || self.files.open_for().is_some()
+            || self.dialogs.files.open_for().is_some()
             || self.modal_job().is_some()
-            || self.recovery_offer.is_some()
+            || self.prompts.recovery_offer.is_some()
         {
             return;
         }
@@ -274,17 +274,17 @@ impl EditorState {
                 Action::NewLayer => self.new_layer(kapaint_core::model::LayerKind::Paint),
                 Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer),
                 Action::MergeDown => self.apply(LayerCommand::MergeDown),
-                Action::Quit => self.quit.asked = true,
+                Action::Quit => self.prompts.quit.asked = true,
                 Action::Tool(kind) => self.select_tool(kind),
                 Action::FillOrFrame => {
-                    if self.hover_tab == Some(Tab::Canvas) {
+                    if self.pointer.hover_tab == Some(Tab::Canvas) {
                         self.select_tool(ToolKind::FILL);
                     } else {
                         self.viewport.frame(&self.mesh.mesh);
                     }
                 }
                 Action::FitCanvas => self.canvas.fit(),
-                Action::Shortcuts => self.shortcuts_open = !self.shortcuts_open,
+                Action::Shortcuts => self.dialogs.shortcuts_open = !self.dialogs.shortcuts_open,
                 Action::SwapMaterials => self.apply(SettingsCommand::SwapMaterials),
                 Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
@@ -294,8 +294,8 @@ impl EditorState {
                     self.tool_event(ToolEvent::Escape);
                     // The button stays with nobody until it is released and pressed again:
                     // the rest of the drag and its release paint nothing.
-                    self.held = None;
-                    self.pressure = 1.0;
+                    self.pointer.held = None;
+                    self.pointer.pressure = 1.0;
                 }
             }
         }
@@ -306,7 +306,7 @@ impl EditorState {
 
     /// Help > Keyboard shortcuts: the keymap, as the input code reads it.
     pub(super) fn shortcuts_window(&mut self, ctx: &egui::Context) {
-        let mut open = self.shortcuts_open;
+        let mut open = self.dialogs.shortcuts_open;
         super::dialogs::centred(egui::Window::new("Keyboard shortcuts"), ctx)
             .open(&mut open)
             .collapsible(false)
@@ -324,7 +324,7 @@ impl EditorState {
                     }
                 });
             });
-        self.shortcuts_open = open;
+        self.dialogs.shortcuts_open = open;
     }
 }
 

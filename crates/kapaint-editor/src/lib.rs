@@ -32,12 +32,11 @@ pub mod screen_brush;
 pub mod viewport;
 
 pub use app::{Editor, run};
-use dialogs::ExportDialog;
 pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, export_folder_in, parse_recent, push_recent};
-use jobs::{Job, JobResult};
+use jobs::JobResult;
 pub use layout::{default_layout, layout_json, parse_layout};
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use egui::Color32;
@@ -47,8 +46,7 @@ use canvas::{Canvas, CanvasChannel};
 use kapaint_core::mesh::Mesh;
 use kapaint_core::mesh::pick::Bvh;
 use kapaint_core::model::texel::Channel;
-use kapaint_core::model::texel::MaterialValue;
-use kapaint_core::model::{Command, Document, recovery};
+use kapaint_core::model::{Command, Document};
 use kapaint_core::render::{Lighting, ViewMode};
 use kapaint_core::tools::Tools;
 use viewport::Viewport;
@@ -169,23 +167,17 @@ impl MeshState {
     }
 }
 
-/// Everything the panels and tabs read and change (the dock lives beside it).
+/// Everything the panels and tabs read and change (the dock lives beside it): the document,
+/// and each part of the editor owning its own state.
 pub struct EditorState {
     /// The document.
     doc: Document,
-    /// Where it is saved.
-    path: Option<PathBuf>,
-    /// The project named at start, while the recovery offer decides how it opens.
-    starting: Option<PathBuf>,
-    saved_version: u64,
+    /// Where it is saved, its claim on the file, its recovery copy.
+    project: project_jobs::Project,
     /// The tools and which one is active.
     tools: Tools,
-    /// View mode of the viewport.
-    view: ViewMode,
-    /// Lights (relative to the camera while `light_follows_camera`).
-    lighting: Lighting,
-    /// The light turns with the camera.
-    light_follows_camera: bool,
+    /// How the viewport shades and lights.
+    look: Look,
     /// The 3D viewport.
     viewport: Viewport,
     /// The UV canvas.
@@ -193,93 +185,32 @@ pub struct EditorState {
     mesh: MeshState,
     /// Messages.
     notices: Notices,
-    job: Option<Job>,
-    /// The window's context, for a worker to wake the window when its job is done (a frame
-    /// is drawn then, not at the next progress tick).
-    waker: Option<egui::Context>,
-    export: Option<ExportDialog>,
-    /// The last export's preset and folder, offered again by the next.
-    export_choice: Option<(String, String)>,
-    /// The Resize dialog, while open.
-    resize_dialog: Option<resize::ResizeDialog>,
-    /// Mesh > Bake, while open.
-    bake_dialog: Option<bake::BakeDialog>,
+    /// Work on workers: the job under way, the exact chi, bakes made on demand.
+    jobs: jobs::Jobs,
+    /// The dialogs and windows, while open.
+    dialogs: dialogs::Dialogs,
+    /// The questions asked before the editor goes on.
+    prompts: prompts::Prompts,
+    /// Where the pointer is and what it holds.
+    pointer: input::Pointer,
+    /// The tool panel's own state (brush size, colour field, recent materials).
+    tool_panel: panels::tool_panel::ToolPanel,
+    /// Material, brush and mask presets.
+    presets: panels::presets::Presets,
+    /// The Layers tab's thumbnails and rename, and the layer view chosen.
+    layers_panel: panels::layers::PanelState,
     /// The editor's settings that outlive a run (Edit > Preferences).
     preferences: preferences::Preferences,
-    /// Whether the Preferences window is open.
-    preferences_open: bool,
-    /// The other model's exponent matching the primary's `n` (the tools panel shows it), for
-    /// the model and `n` (its bits) it was found for.
-    equivalent_n: Option<((kapaint_core::reflectance::ShadingModel, u32), f64)>,
-    /// The bakes the editor makes on its own: a generator mask set while a bake it reads was
-    /// missing (laid once they arrive), and the document version last looked at for bakes its
-    /// masks read and lack.
-    bake_on_demand: bake::OnDemand,
-    /// The New dialog, while open.
-    new_dialog: Option<NewDialog>,
-    /// The New dialog's project, created once the save its "Save, then create" started is
-    /// done.
-    pending_new: Option<NewDialog>,
-    /// A project to open once the user has decided about the unsaved changes.
-    pending_open: Option<PathBuf>,
-    /// An imported glTF mesh whose material has textures: asking whether to bring them in.
-    material_prompt: Option<PathBuf>,
-    /// A PBR material of another size than the maps: asking whether to adopt its size.
-    size_prompt: Option<jobs::SizePrompt>,
-    /// A mesh import waiting on whether to unwrap the mesh.
-    unwrap_prompt: Option<jobs::UnwrapPrompt>,
-    /// Recently opened or saved projects, newest first.
-    recent: Vec<PathBuf>,
-    /// The pen's last pressure in the current stroke (1 with a mouse).
-    pressure: f32,
-    /// The view the primary button went down on, until it goes up.
-    held: Option<Tab>,
-    /// The brush stamp's preview texture, and which stamp it shows.
-    stamp_preview: Option<(u64, egui::TextureHandle)>,
-    /// The texel under the cursor, in either view.
-    hover: Option<(u32, u32)>,
-    /// The tab under the cursor.
-    hover_tab: Option<Tab>,
-    /// How the brush's size is given: in texels, or on screen.
-    brush_size: screen_brush::BrushSize,
-    /// The hex field's text while it is typed in (`None`: it shows the primary's `k_d`).
-    hex_text: Option<String>,
-    /// Materials laid last by a stroke, fill or gradient, newest first.
-    recent_materials: Vec<MaterialValue>,
-    /// Texels per screen point under the cursor (canvas zoom, or the surface's scale).
-    texels_per_point: Option<f32>,
-    /// The brush circle drawn on the UV canvas this frame: centre and radius in points.
-    canvas_outline: Option<(egui::Pos2, f32)>,
-    /// `hover` as of the last frame (the status bar is drawn before the tabs).
-    shown_hover: Option<(u32, u32)>,
-    /// Exact `chi` values for the status bar, integrated on a worker.
-    exact_chi: readout::ExactChi,
-    /// Quitting: asked, waiting for a save, or allowed.
-    quit: Quit,
-    /// The file chooser: the system's, or kapaint's own without a desktop portal.
-    files: files::FileChooser,
-    /// Whether Help > Keyboard shortcuts is open.
-    shortcuts_open: bool,
-    /// A recovery copy found at start, newer than the project.
-    recovery_offer: Option<PathBuf>,
-    /// Material presets with their thumbnails (rendered a few per frame) and the mesh each
-    /// thumbnail shows.
-    presets: Vec<panels::presets::PresetEntry>,
-    /// Brush presets, shipped and the user's.
-    brush_presets: Vec<kapaint_core::model::brush::preset::BrushPreset>,
-    /// Smart masks, shipped and the user's.
-    mask_presets: Vec<kapaint_core::model::generator::preset::MaskPreset>,
-    /// The user preset folder presets are saved to.
-    preset_dir: Option<PathBuf>,
-    /// A preset's name being typed, what it names, and whether its field opened this frame.
-    naming: Option<(panels::presets::Naming, String, bool)>,
-    autosaver: recovery::Autosaver,
-    /// The project file as read or saved, its lock, and whether it opened read-only.
-    claim: claim::Claim,
-    /// The Layers tab's thumbnails and the name being typed.
-    layers_panel: panels::layers::PanelState,
-    /// What the viewport and canvas show of the layers.
-    pub layer_view: panels::layers::LayerView,
+}
+
+/// How the viewport shades and where its light comes from.
+struct Look {
+    /// View mode of the viewport.
+    mode: ViewMode,
+    /// Lights (relative to the camera while `light_follows_camera`).
+    lighting: Lighting,
+    /// The light turns with the camera.
+    light_follows_camera: bool,
 }
 
 /// Where quitting stands.
@@ -330,7 +261,7 @@ impl EditorState {
 
     /// Where the document is saved, if anywhere yet.
     pub fn path(&self) -> Option<&Path> {
-        self.path.as_deref()
+        self.project.path.as_deref()
     }
 
     /// The tools and which one is active.
@@ -350,38 +281,41 @@ impl EditorState {
 
     /// The New dialog's choices, while it is open.
     pub fn new_dialog(&self) -> Option<&NewDialog> {
-        self.new_dialog.as_ref()
+        self.dialogs.new.as_ref()
     }
 
     /// Sets the New dialog's choices (opening it).
     pub fn set_new_dialog(&mut self, dialog: NewDialog) {
-        self.new_dialog = Some(dialog);
+        self.dialogs.new = Some(dialog);
     }
 
     /// The brush circle on the UV canvas (centre and radius in points), while the cursor is
     /// over it with a painting tool.
     pub fn canvas_outline(&self) -> Option<(egui::Pos2, f32)> {
-        self.canvas_outline
+        self.pointer.canvas_outline
     }
 
     /// What the open file dialog is for, if one is open.
     pub fn file_dialog_open_for(&self) -> Option<files::FilePurpose> {
-        self.files.open_for()
+        self.dialogs.files.open_for()
     }
 
     /// Whether the window is closing (quit asked, and nothing unsaved, or discarded).
     pub fn closing(&self) -> bool {
-        self.quit.asked && (self.quit.allowed.is_some() || !self.dirty())
+        self.prompts.quit.asked && (self.prompts.quit.allowed.is_some() || !self.dirty())
     }
 
     /// The export dialog's folder, while it is open.
     pub fn export_folder(&self) -> Option<&str> {
-        self.export.as_ref().map(dialogs::ExportDialog::folder)
+        self.dialogs
+            .export
+            .as_ref()
+            .map(dialogs::ExportDialog::folder)
     }
 
     /// A project waiting to be opened until the user decides about unsaved changes.
     pub fn pending_open(&self) -> Option<&Path> {
-        self.pending_open.as_deref()
+        self.prompts.pending_open.as_deref()
     }
 
     /// The messages shown in the corner.
@@ -395,31 +329,37 @@ impl EditorState {
     /// # Errors
     /// The autosave's failure.
     pub fn autosave_now(&mut self) -> Result<(), String> {
-        self.autosaver
+        self.project
+            .autosaver
             .save_now(&self.doc)
             .map_err(|e| e.to_string())
     }
 
     /// This editor's recovery copy (its session folder; it may not exist yet).
     pub fn recovery_copy(&self) -> std::path::PathBuf {
-        self.autosaver.session()
+        self.project.autosaver.session()
+    }
+
+    /// The layer view chosen (see [`Self::shown_layer_view`] for what is shown).
+    pub fn layer_view(&self) -> LayerView {
+        self.layers_panel.view
     }
 
     /// What the viewport and canvas show of the layers: the chosen view, except that a mask
     /// tools paint shows alone, in grey, while the chosen view is the whole stack.
     pub fn shown_layer_view(&self) -> panels::layers::LayerView {
         use panels::layers::LayerView;
-        if self.doc.painting_mask() && self.layer_view == LayerView::Composite {
+        if self.doc.painting_mask() && self.layers_panel.view == LayerView::Composite {
             LayerView::Mask
         } else {
-            self.layer_view
+            self.layers_panel.view
         }
     }
 
     /// Whether anything the project file stores (maps or settings) changed since the last
     /// save.
     pub fn dirty(&self) -> bool {
-        self.doc.version() != self.saved_version
+        self.doc.version() != self.project.saved_version
     }
 
     /// What the UV canvas shows.
@@ -438,6 +378,7 @@ impl EditorState {
     pub fn thumbnail_meshes(&self) -> (Vec<Option<u64>>, u64) {
         let shown = self
             .presets
+            .materials
             .iter()
             .map(|p| p.thumbnail.as_ref().map(|(id, _)| *id))
             .collect();
@@ -448,12 +389,13 @@ impl EditorState {
     /// unsaved changes, then the program's name.
     pub fn window_title(&self) -> String {
         let name = self
+            .project
             .path
             .as_deref()
             .and_then(Path::file_name)
             .map_or_else(|| "untitled".into(), |n| n.to_string_lossy().into_owned());
         let marker = if self.dirty() { "*" } else { "" };
-        let read_only = if self.claim.read_only {
+        let read_only = if self.project.claim.read_only {
             " [read-only]"
         } else {
             ""
@@ -509,12 +451,12 @@ impl EditorState {
 
     /// Whether a job runs (a bake, an export, an open, ...).
     pub fn busy(&self) -> bool {
-        self.job.is_some()
+        self.jobs.current.is_some()
     }
 
     /// The project being opened (or recovered) on a worker, if one is: the document is about
     /// to be replaced, so it takes no input meanwhile.
     pub fn opening(&self) -> Option<&Path> {
-        self.job.as_ref().and_then(|j| j.opens.as_deref())
+        self.jobs.current.as_ref().and_then(|j| j.opens.as_deref())
     }
 }

@@ -119,14 +119,14 @@ impl EditorState {
 
     /// The size question, while it is open.
     pub fn size_prompt(&self) -> Option<&SizePrompt> {
-        self.size_prompt.as_ref()
+        self.prompts.size.as_ref()
     }
 
     /// Answers the size question: adopt the material's size (the maps resized on a worker with
     /// the mesh baked again, then the material converted there: two undo steps), resample the
     /// material to the maps, or import nothing.
     pub fn answer_size_prompt(&mut self, answer: SizeAnswer) {
-        let Some(prompt) = self.size_prompt.take() else {
+        let Some(prompt) = self.prompts.size.take() else {
             return;
         };
         let (model, mapping) = (self.doc.settings().model, self.doc.settings().n_mapping());
@@ -182,7 +182,7 @@ impl EditorState {
     /// The size question: the two sizes, Adopt / Resample / Cancel, the default first and
     /// taken by Enter.
     pub(super) fn size_prompt_window(&mut self, ctx: &egui::Context) {
-        let Some(prompt) = &self.size_prompt else {
+        let Some(prompt) = &self.prompts.size else {
             return;
         };
         let ((w, h), (pw, ph)) = (prompt.size, prompt.project);

@@ -21,7 +21,7 @@ impl EditorState {
         match result {
             JobResult::Mesh(path, surface, textured) => {
                 if textured {
-                    self.material_prompt = Some(path.clone());
+                    self.prompts.material = Some(path.clone());
                 }
                 let mesh = MeshRef::from_spec(&path.display().to_string());
                 let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
@@ -34,7 +34,7 @@ impl EditorState {
                     Err(e) => self.notices.push(notice(e.to_string(), true)),
                 }
             }
-            JobResult::NeedsUnwrap(prompt) => self.unwrap_prompt = Some(prompt),
+            JobResult::NeedsUnwrap(prompt) => self.prompts.unwrap = Some(prompt),
             JobResult::Baked(baked) => {
                 let lines: Vec<String> = baked
                     .iter()
@@ -133,7 +133,7 @@ impl EditorState {
         } else {
             "has no UVs"
         };
-        self.unwrap_prompt = Some(UnwrapPrompt {
+        self.prompts.unwrap = Some(UnwrapPrompt {
             path: PathBuf::from(self.doc.settings().mesh.spec()),
             mesh,
             why: why.to_string(),

@@ -87,7 +87,7 @@ fn path() -> Option<PathBuf> {
 impl EditorState {
     /// Opens Edit > Preferences.
     pub fn open_preferences(&mut self) {
-        self.preferences_open = true;
+        self.dialogs.preferences_open = true;
     }
 
     /// The preferences in force.
@@ -102,7 +102,9 @@ impl EditorState {
             return;
         }
         self.preferences = preferences;
-        self.autosaver.set_interval(preferences.autosave_interval());
+        self.project
+            .autosaver
+            .set_interval(preferences.autosave_interval());
         if let Err(e) = preferences.save() {
             self.notices.push(super::notice(
                 format!("the preferences hold for this run only: {e}"),
@@ -113,7 +115,7 @@ impl EditorState {
 
     /// The Preferences window.
     pub(super) fn preferences_window(&mut self, ctx: &egui::Context) {
-        if !self.preferences_open {
+        if !self.dialogs.preferences_open {
             return;
         }
         let mut open = true;
@@ -135,7 +137,7 @@ impl EditorState {
                 );
             });
         self.set_preferences(p);
-        self.preferences_open = open;
+        self.dialogs.preferences_open = open;
     }
 }
 

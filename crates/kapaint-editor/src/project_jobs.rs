@@ -8,33 +8,49 @@ use super::jobs::{JobResult, OpenedProject, load_project, with_fallback};
 use super::{EditorState, notice};
 use kapaint_core::model::{project, recovery};
 
+/// The project file the document belongs to: where it is saved, what was saved, the claim on
+/// the file, the recovery copy, and the projects opened lately.
+pub(super) struct Project {
+    /// Where it is saved.
+    pub(super) path: Option<PathBuf>,
+    /// The project named at start, while the recovery offer decides how it opens.
+    pub(super) starting: Option<PathBuf>,
+    /// The document version last saved.
+    pub(super) saved_version: u64,
+    /// Recently opened or saved projects, newest first.
+    pub(super) recent: Vec<PathBuf>,
+    pub(super) autosaver: recovery::Autosaver,
+    /// The project file as read or saved, its lock, and whether it opened read-only.
+    pub(super) claim: super::claim::Claim,
+}
+
 impl EditorState {
     /// A save finished: the document version it holds, and the file as written.
     pub(super) fn saved(&mut self, path: PathBuf, version: u64, on_disk: project::OnDisk) {
-        self.saved_version = version;
-        self.claim.hold(Some(&path), Some(on_disk), false);
+        self.project.saved_version = version;
+        self.project.claim.hold(Some(&path), Some(on_disk), false);
         self.notices
             .push(notice(format!("saved {}", path.display()), false));
         self.remember(&path);
-        if self.path.as_deref() != Some(path.as_path()) {
+        if self.project.path.as_deref() != Some(path.as_path()) {
             // Save As (or the first save): the recovery copy follows the work.
-            self.autosaver.relocate(Some(&path));
+            self.project.autosaver.relocate(Some(&path));
         }
         // What was saved needs no recovery copy (unless it changed while saving).
-        self.autosaver.saved(&self.doc, version);
-        self.path = Some(path);
-        if std::mem::take(&mut self.quit.after_save) && !self.dirty() {
+        self.project.autosaver.saved(&self.doc, version);
+        self.project.path = Some(path);
+        if std::mem::take(&mut self.prompts.quit.after_save) && !self.dirty() {
             // The quit prompt's Save: the work is safe, so the window closes.
-            self.quit.allowed = Some(super::QuitAllowed::Saved);
-            self.quit.asked = true;
+            self.prompts.quit.allowed = Some(super::QuitAllowed::Saved);
+            self.prompts.quit.asked = true;
         }
         if !self.dirty()
-            && let Some(next) = self.pending_open.take()
+            && let Some(next) = self.prompts.pending_open.take()
         {
             self.open_now(next);
         }
         if !self.dirty()
-            && let Some(dialog) = self.pending_new.take()
+            && let Some(dialog) = self.dialogs.pending_new.take()
         {
             self.create_project(&dialog);
         }
@@ -43,16 +59,17 @@ impl EditorState {
     /// A save found its project changed on disk: the work went to `written` instead.
     pub(super) fn conflicted(&mut self, message: String, written: PathBuf, version: u64) {
         // The work is safe beside the project: the editor goes on with that file.
-        self.saved_version = version;
+        self.project.saved_version = version;
         self.notices.push(notice(message, true));
         self.remember(&written);
-        self.autosaver.relocate(Some(&written));
-        self.autosaver.saved(&self.doc, version);
-        self.claim
+        self.project.autosaver.relocate(Some(&written));
+        self.project.autosaver.saved(&self.doc, version);
+        self.project
+            .claim
             .hold(Some(&written), project::OnDisk::of(&written), false);
-        self.path = Some(written);
-        self.quit.after_save = false;
-        self.pending_new = None;
+        self.project.path = Some(written);
+        self.prompts.quit.after_save = false;
+        self.dialogs.pending_new = None;
     }
 
     /// Makes `doc` the document, with its mesh shown and framed.
@@ -66,13 +83,13 @@ impl EditorState {
             read_only,
             ..
         } = opened;
-        self.claim.hold(path.as_deref(), on_disk, read_only);
+        self.project.claim.hold(path.as_deref(), on_disk, read_only);
         self.replace_document(doc);
         // The old document was saved or its changes discarded (asked before).
-        self.autosaver.discard();
+        self.project.autosaver.discard();
         let interval = self.preferences.autosave_interval();
         // Recovered work is unsaved work, and its copy stays until this editor has its own.
-        (self.saved_version, self.autosaver) = match recovered.clone() {
+        (self.project.saved_version, self.project.autosaver) = match recovered.clone() {
             Some(from) => (
                 u64::MAX,
                 recovery::Autosaver::recovering(interval, path.as_deref(), &self.doc, from),
@@ -97,7 +114,7 @@ impl EditorState {
         if let Some(p) = &path {
             self.remember(p);
         }
-        self.path = path;
+        self.project.path = path;
     }
 
     /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
@@ -106,8 +123,8 @@ impl EditorState {
         let version = self.doc.version();
         // Over its own file, a save expects the file as this editor last read or wrote it;
         // elsewhere (Save As) the user chose to replace what is there.
-        let expected = (self.path.as_deref() == Some(path.as_path()))
-            .then(|| self.claim.on_disk.clone())
+        let expected = (self.project.path.as_deref() == Some(path.as_path()))
+            .then(|| self.project.claim.on_disk.clone())
             .flatten();
         self.start_job("Save", move |progress| {
             progress.start("save", 1);
@@ -132,7 +149,7 @@ impl EditorState {
     pub fn open(&mut self, path: PathBuf) {
         if self.dirty() {
             // Unsaved work is never dropped: ask first (see `open_prompt`).
-            self.pending_open = Some(path);
+            self.prompts.pending_open = Some(path);
             return;
         }
         self.open_now(path);
@@ -206,8 +223,8 @@ impl EditorState {
     }
 
     pub(super) fn save(&mut self) {
-        match self.path.clone() {
-            Some(p) if !self.claim.read_only => self.save_to(p),
+        match self.project.path.clone() {
+            Some(p) if !self.project.claim.read_only => self.save_to(p),
             _ => self.save_as(),
         }
     }

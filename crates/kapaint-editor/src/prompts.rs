@@ -5,10 +5,27 @@
 use super::EditorState;
 use super::dialogs::centred;
 
+/// The questions asked before the editor goes on, while asked.
+#[derive(Default)]
+pub(super) struct Prompts {
+    /// A project to open once the user has decided about the unsaved changes.
+    pub(super) pending_open: Option<std::path::PathBuf>,
+    /// An imported glTF mesh whose material has textures: asking whether to bring them in.
+    pub(super) material: Option<std::path::PathBuf>,
+    /// A PBR material of another size than the maps: asking whether to adopt its size.
+    pub(super) size: Option<super::jobs::SizePrompt>,
+    /// A mesh import waiting on whether to unwrap the mesh.
+    pub(super) unwrap: Option<super::jobs::UnwrapPrompt>,
+    /// A recovery copy found at start, newer than the project.
+    pub(super) recovery_offer: Option<std::path::PathBuf>,
+    /// Quitting: asked, waiting for a save, or allowed.
+    pub(super) quit: super::Quit,
+}
+
 impl EditorState {
     /// After a glTF mesh import: asks whether to bring its material's textures in too.
     pub(super) fn material_prompt_window(&mut self, ctx: &egui::Context) {
-        let Some(path) = self.material_prompt.clone() else {
+        let Some(path) = self.prompts.material.clone() else {
             return;
         };
         let (mut bring, mut skip) = (false, false);
@@ -29,17 +46,17 @@ impl EditorState {
                 });
             });
         if bring {
-            self.material_prompt = None;
+            self.prompts.material = None;
             self.import_pbr(path);
         } else if skip {
-            self.material_prompt = None;
+            self.prompts.material = None;
         }
     }
 
     /// After a mesh import whose UVs cannot be painted as they are: unwrap automatically, keep
     /// its UVs (when it has some), or cancel the import.
     pub(super) fn unwrap_prompt_window(&mut self, ctx: &egui::Context) {
-        let Some(prompt) = self.unwrap_prompt.clone() else {
+        let Some(prompt) = self.prompts.unwrap.clone() else {
             return;
         };
         let (mut unwrap, mut keep, mut cancel) = (false, false, false);
@@ -64,7 +81,7 @@ impl EditorState {
                 });
             });
         if unwrap || keep || cancel {
-            self.unwrap_prompt = None;
+            self.prompts.unwrap = None;
         }
         if unwrap {
             self.unwrap_mesh(prompt);
@@ -76,7 +93,7 @@ impl EditorState {
     /// Asks what to do with unsaved changes before opening another project: save them first
     /// (the project opens once saved), discard them, or cancel.
     pub(super) fn open_prompt(&mut self, ctx: &egui::Context) {
-        let Some(path) = self.pending_open.clone() else {
+        let Some(path) = self.prompts.pending_open.clone() else {
             return;
         };
         let (mut save, mut discard, mut cancel) = (false, false, false);
@@ -96,25 +113,27 @@ impl EditorState {
                 });
             });
         if discard {
-            self.pending_open = None;
+            self.prompts.pending_open = None;
             self.open_now(path);
         } else if cancel {
-            self.pending_open = None;
+            self.prompts.pending_open = None;
         } else if save {
             self.save();
         }
     }
 
     pub(super) fn close_prompt(&mut self, ctx: &egui::Context) {
-        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit.asked;
-        if close_requested && self.dirty() && self.quit.allowed.is_none() {
+        let close_requested =
+            ctx.input(|i| i.viewport().close_requested()) || self.prompts.quit.asked;
+        if close_requested && self.dirty() && self.prompts.quit.allowed.is_none() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.quit.asked = true;
-        } else if self.quit.asked && (self.quit.allowed.is_some() || !self.dirty()) {
+            self.prompts.quit.asked = true;
+        } else if self.prompts.quit.asked && (self.prompts.quit.allowed.is_some() || !self.dirty())
+        {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             return;
         }
-        if self.quit.asked && self.dirty() && self.quit.allowed.is_none() {
+        if self.prompts.quit.asked && self.dirty() && self.prompts.quit.allowed.is_none() {
             egui::Window::new("Unsaved changes")
                 .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
                 .collapsible(false)
@@ -123,15 +142,15 @@ impl EditorState {
                     ui.horizontal(|ui| {
                         if ui.button("Save").clicked() {
                             // Untitled work asks where first; the window closes once saved.
-                            self.quit.after_save = true;
+                            self.prompts.quit.after_save = true;
                             self.save();
-                            self.quit.asked = false;
+                            self.prompts.quit.asked = false;
                         }
                         if ui.button("Discard").clicked() {
-                            self.quit.allowed = Some(super::QuitAllowed::Discarded);
+                            self.prompts.quit.allowed = Some(super::QuitAllowed::Discarded);
                         }
                         if ui.button("Cancel").clicked() {
-                            self.quit.asked = false;
+                            self.prompts.quit.asked = false;
                         }
                     });
                 });

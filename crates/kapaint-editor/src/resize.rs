@@ -32,7 +32,7 @@ const SIZES: [u32; 6] = [
 impl EditorState {
     /// Opens Image > Resize at the current size.
     pub fn open_resize(&mut self) {
-        self.resize_dialog = Some(ResizeDialog {
+        self.dialogs.resize = Some(ResizeDialog {
             width: self.doc.maps().width(),
             height: self.doc.maps().height(),
         });
@@ -40,12 +40,12 @@ impl EditorState {
 
     /// The Resize dialog's choices, while it is open.
     pub fn resize_dialog(&self) -> Option<ResizeDialog> {
-        self.resize_dialog
+        self.dialogs.resize
     }
 
     /// Sets the Resize dialog's choices (opening it).
     pub fn set_resize_dialog(&mut self, dialog: ResizeDialog) {
-        self.resize_dialog = Some(dialog);
+        self.dialogs.resize = Some(dialog);
     }
 
     /// Resamples the maps to `width x height` on a worker (the mesh baked again at that
@@ -74,7 +74,7 @@ impl EditorState {
 
     /// The Resize dialog: width and height, the memory before and after, Resize.
     pub(super) fn resize_window(&mut self, ctx: &egui::Context) {
-        let Some(mut dialog) = self.resize_dialog else {
+        let Some(mut dialog) = self.dialogs.resize else {
             return;
         };
         let (mut open, mut go) = (true, false);
@@ -118,12 +118,12 @@ impl EditorState {
                     .clicked();
             });
         if go {
-            self.resize_dialog = None;
+            self.dialogs.resize = None;
             self.resize_maps(dialog.width, dialog.height);
         } else if open {
-            self.resize_dialog = Some(dialog);
+            self.dialogs.resize = Some(dialog);
         } else {
-            self.resize_dialog = None;
+            self.dialogs.resize = None;
         }
     }
 }

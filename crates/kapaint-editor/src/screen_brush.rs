@@ -50,13 +50,13 @@ pub fn points_per_world(
 impl EditorState {
     /// How the brush's size is given.
     pub fn brush_size(&self) -> BrushSize {
-        self.brush_size
+        self.tool_panel.brush_size
     }
 
     /// Sets how the brush's size is given (the radius on screen kept in range).
     pub fn set_brush_size(&mut self, size: BrushSize) {
         let (lo, hi) = (*SCREEN_RADIUS_RANGE.start(), *SCREEN_RADIUS_RANGE.end());
-        self.brush_size = BrushSize {
+        self.tool_panel.brush_size = BrushSize {
             screen_radius: if size.screen_radius.is_finite() {
                 size.screen_radius.clamp(lo, hi)
             } else {
@@ -68,19 +68,19 @@ impl EditorState {
 
     /// Texels per screen point under the cursor this frame, if it is over the map or the mesh.
     pub fn texels_per_point(&self) -> Option<f32> {
-        self.texels_per_point
+        self.pointer.texels_per_point
     }
 
     /// The brush radius in texels that the size on screen gives under the cursor.
     pub(super) fn screen_radius_in_texels(&self) -> Option<f32> {
-        let scale = self.texels_per_point?;
-        Some((self.brush_size.screen_radius * scale).clamp(0.5, 4096.0))
+        let scale = self.pointer.texels_per_point?;
+        Some((self.tool_panel.brush_size.screen_radius * scale).clamp(0.5, 4096.0))
     }
 
     /// Before a stroke starts: with the size on screen, sets the brush's radius in texels
     /// from the view under the cursor.
     pub(super) fn fit_brush_to_screen(&mut self) {
-        if !self.brush_size.on_screen {
+        if !self.tool_panel.brush_size.on_screen {
             return;
         }
         let Some(radius) = self.screen_radius_in_texels() else {
@@ -99,10 +99,10 @@ impl EditorState {
         brush: &mut kapaint_core::model::brush::BrushSettings,
         by: f32,
     ) {
-        if self.brush_size.on_screen {
+        if self.tool_panel.brush_size.on_screen {
             let size = BrushSize {
-                screen_radius: self.brush_size.screen_radius * by,
-                ..self.brush_size
+                screen_radius: self.tool_panel.brush_size.screen_radius * by,
+                ..self.tool_panel.brush_size
             };
             self.set_brush_size(size);
         } else {
@@ -117,7 +117,7 @@ impl EditorState {
         ui: &mut egui::Ui,
         brush: &mut kapaint_core::model::brush::BrushSettings,
     ) {
-        let mut size = self.brush_size;
+        let mut size = self.tool_panel.brush_size;
         if size.on_screen {
             ui.add(
                 egui::Slider::new(&mut size.screen_radius, SCREEN_RADIUS_RANGE)
@@ -146,7 +146,7 @@ impl EditorState {
                 ui.weak(format!("= {texels:.1} texels here"));
             }
         });
-        if size != self.brush_size {
+        if size != self.tool_panel.brush_size {
             self.set_brush_size(size);
         }
     }

@@ -15,7 +15,7 @@ impl EditorState {
         ui.horizontal(|ui| {
             // A job's progress and Cancel first: the readouts after them may run past the
             // window's edge, the job's controls never do.
-            if let Some(job) = &self.job {
+            if let Some(job) = &self.jobs.current {
                 ui.add(
                     egui::ProgressBar::new(job.progress.fraction())
                         .desired_width(160.0)
@@ -45,7 +45,7 @@ impl EditorState {
                 None => ui.label("no GPU"),
             };
             if let Some((x, y)) = self
-                .shown_hover
+                .pointer.shown_hover
                 .filter(|&(x, y)| x < maps.width() && y < maps.height())
             {
                 let v = maps.value(x, y);
@@ -56,7 +56,7 @@ impl EditorState {
                 // Integrated on a worker, shown when it arrives: never on this thread.
                 let n_bits = maps.texel(x, y).n;
                 let exact = self
-                    .exact_chi
+                    .jobs.exact_chi
                     .get(ui.ctx(), model, n_bits)
                     .map_or_else(
                         || "...".to_string(),
@@ -92,11 +92,11 @@ impl EditorState {
                     self.open_dialog();
                 }
                 ui.menu_button("Open Recent", |ui| {
-                    if self.recent.is_empty() {
+                    if self.project.recent.is_empty() {
                         ui.label("No recent files");
                     }
                     let mut chosen = None;
-                    for p in &self.recent {
+                    for p in &self.project.recent {
                         let name = p.file_name().map_or_else(
                             || p.display().to_string(),
                             |n| n.to_string_lossy().into_owned(),
@@ -147,7 +147,7 @@ impl EditorState {
                 }
                 ui.separator();
                 if item(ui, "Quit", Action::Quit) {
-                    self.quit.asked = true;
+                    self.prompts.quit.asked = true;
                 }
             });
             ui.menu_button("Edit", |ui| {
@@ -165,7 +165,7 @@ impl EditorState {
             self.image_and_mesh_menus(ui);
             ui.menu_button("Help", |ui| {
                 if ui.button("Keyboard shortcuts").clicked() {
-                    self.shortcuts_open = true;
+                    self.dialogs.shortcuts_open = true;
                 }
             });
         });

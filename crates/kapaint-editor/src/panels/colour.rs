@@ -114,7 +114,10 @@ impl EditorState {
             }
             ui.label("Hex");
             let shown = hex_of(primary.kd);
-            let text = self.hex_text.get_or_insert_with(|| shown.clone());
+            let text = self
+                .tool_panel
+                .hex_text
+                .get_or_insert_with(|| shown.clone());
             let edit = ui.add(
                 egui::TextEdit::singleline(text)
                     .desired_width(64.0)
@@ -128,7 +131,7 @@ impl EditorState {
             }
             if !edit.has_focus() {
                 // Follows the colour whenever the field is not being typed in.
-                self.hex_text = Some(hex_of(primary.kd));
+                self.tool_panel.hex_text = Some(hex_of(primary.kd));
             }
         });
         let srgb = primary.kd.map(linear_to_srgb);
@@ -190,13 +193,13 @@ impl EditorState {
 
     /// The materials used last (a click makes one the primary).
     pub(super) fn recent_materials_ui(&mut self, ui: &mut egui::Ui) {
-        if self.recent_materials.is_empty() {
+        if self.tool_panel.recent_materials.is_empty() {
             return;
         }
         let mut chosen = None;
         ui.horizontal_wrapped(|ui| {
             ui.label("Recent");
-            for (i, value) in self.recent_materials.iter().enumerate() {
+            for (i, value) in self.tool_panel.recent_materials.iter().enumerate() {
                 if swatch(ui, value.kd, 18.0, &format!("Recent material {}", i + 1))
                     .on_hover_text(describe(value))
                     .clicked()
@@ -214,14 +217,14 @@ impl EditorState {
     /// has laid it).
     pub(crate) fn remember_material(&mut self) {
         let value = self.doc.settings().primary;
-        self.recent_materials.retain(|v| *v != value);
-        self.recent_materials.insert(0, value);
-        self.recent_materials.truncate(RECENT_MATERIALS);
+        self.tool_panel.recent_materials.retain(|v| *v != value);
+        self.tool_panel.recent_materials.insert(0, value);
+        self.tool_panel.recent_materials.truncate(RECENT_MATERIALS);
     }
 
     /// The materials used last, newest first.
     pub fn recent_materials(&self) -> &[MaterialValue] {
-        &self.recent_materials
+        &self.tool_panel.recent_materials
     }
 }
 

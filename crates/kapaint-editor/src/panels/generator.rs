@@ -255,13 +255,14 @@ impl EditorState {
             let mut chosen = None;
             egui::ComboBox::from_label("Smart mask")
                 .selected_text(
-                    self.mask_presets
+                    self.presets
+                        .masks
                         .iter()
                         .find(|p| Some(&p.mask) == current.as_ref())
                         .map_or("(apply one)", |p| p.name.as_str()),
                 )
                 .show_ui(ui, |ui| {
-                    for p in &self.mask_presets {
+                    for p in &self.presets.masks {
                         if ui.selectable_label(false, &p.name).clicked() {
                             chosen = Some(p.mask.clone());
                         }
@@ -310,7 +311,7 @@ impl EditorState {
 
     /// The selected layer's mask as it applies, made again when the document changes.
     fn generator_thumb_ui(&mut self, ui: &mut egui::Ui, layer: &Layer) {
-        let version = self.doc.version();
+        let version = (self.doc.instance(), self.doc.version());
         let thumb = &mut self.layers_panel.generator_thumb;
         if thumb.as_ref().is_none_or(|(v, _)| *v != version)
             && let Some(pixels) = thumbnail::mask(self.doc.stack(), layer, THUMB)
@@ -338,6 +339,6 @@ impl EditorState {
 
     /// The smart masks: shipped, then the user's.
     pub fn mask_preset_names(&self) -> Vec<&str> {
-        self.mask_presets.iter().map(|p| p.name.as_str()).collect()
+        self.presets.masks.iter().map(|p| p.name.as_str()).collect()
     }
 }

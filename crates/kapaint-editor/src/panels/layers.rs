@@ -33,7 +33,8 @@ struct DraggedLayer(Vec<usize>);
 /// every [`STROKE_REFRESH`] during a stroke).
 #[derive(Default)]
 struct LayerThumbs {
-    version: Option<u64>,
+    /// The document (its instance) and its version they show.
+    shows: Option<(u64, u64)>,
     made: Option<Instant>,
     content: HashMap<Vec<usize>, egui::TextureHandle>,
     masks: HashMap<Vec<usize>, egui::TextureHandle>,
@@ -42,12 +43,13 @@ struct LayerThumbs {
 
 impl LayerThumbs {
     fn refresh(&mut self, ctx: &egui::Context, doc: &Document) {
-        let version = doc.version();
+        let key = (doc.instance(), doc.version());
         let recent = self.made.is_some_and(|t| t.elapsed() < STROKE_REFRESH);
-        if self.version == Some(version) || (doc.stroking() && recent) {
+        let same_document = self.shows.is_some_and(|(instance, _)| instance == key.0);
+        if self.shows == Some(key) || (same_document && doc.stroking() && recent) {
             return;
         }
-        self.version = Some(version);
+        self.shows = Some(key);
         self.made = Some(Instant::now());
         let stack = doc.stack();
         let walk = stack.walk();
@@ -103,18 +105,10 @@ pub struct PanelState {
     release_keyboard: bool,
     /// The maps a layer view shows.
     pub(crate) view_maps: crate::layer_view::ViewMaps,
-    /// The mask generator's live thumbnail and the document version it shows.
-    pub(super) generator_thumb: Option<(u64, egui::TextureHandle)>,
-}
-
-impl PanelState {
-    /// Forgets what was made from the document replaced (thumbnails, memory, a rename under
-    /// way): a new document's version numbers start again, and may equal the old one's.
-    pub(crate) fn document_replaced(&mut self) {
-        self.thumbs = LayerThumbs::default();
-        self.rename = None;
-        self.generator_thumb = None;
-    }
+    /// The mask generator's live thumbnail and the document (instance and version) it shows.
+    pub(super) generator_thumb: Option<((u64, u64), egui::TextureHandle)>,
+    /// What the viewport and canvas show of the layers, as chosen.
+    pub(crate) view: LayerView,
 }
 
 /// What a row asked for this frame.
@@ -181,12 +175,11 @@ impl EditorState {
         self.layer_buttons_ui(ui);
         ui.separator();
         let mut actions = Vec::new();
-        // A rename of a layer that is gone (deleted, undone) ends with it.
-        let mut rename = self
-            .layers_panel
-            .rename
-            .take()
-            .filter(|r| self.doc.stack().path_of(r.id).is_some());
+        // A rename of a layer that is gone (deleted, undone, another document opened) ends
+        // with it.
+        let mut rename = self.layers_panel.rename.take().filter(|r| {
+            r.document == self.doc.instance() && self.doc.stack().path_of(r.id).is_some()
+        });
         egui::ScrollArea::vertical()
             .id_salt("layers")
             .max_height((ui.available_height() - 230.0).max(120.0))
@@ -437,7 +430,7 @@ impl EditorState {
                     self.apply(MaskCommand::SelectMask);
                 }
                 if alone {
-                    self.layer_view = LayerView::Mask;
+                    self.layers_panel.view = LayerView::Mask;
                 }
             }
             RowAction::Toggle(command) => {
@@ -455,6 +448,7 @@ impl EditorState {
             RowAction::Rename => {
                 self.apply(LayerCommand::SelectPath(path));
                 self.layers_panel.rename = self.doc.selected_layer().map(|l| Rename {
+                    document: self.doc.instance(),
                     id: l.props.id,
                     text: l.props.name.clone(),
                     focused: false,
@@ -537,5 +531,31 @@ fn drop_place(rect: Rect, pointer: egui::Pos2, content: &LayerContent) -> LayerP
         LayerContent::Group(_) if (0.3..0.7).contains(&t) => LayerPlace::Into,
         _ if t < 0.5 => LayerPlace::Above,
         _ => LayerPlace::Below,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LayerThumbs;
+    use kapaint_core::model::{Document, DocumentSettings};
+
+    /// Regression: the thumbnails were kept by the document's version alone, and a document
+    /// opened in place of another starts its versions again, so the list showed the old
+    /// document's layers until something reset it by hand.
+    #[test]
+    fn thumbnails_follow_another_document_of_the_same_version() -> Result<(), String> {
+        let ctx = egui::Context::default();
+        let first =
+            Document::new(16, 16, DocumentSettings::default()).map_err(|e| e.to_string())?;
+        let second =
+            Document::new(16, 16, DocumentSettings::default()).map_err(|e| e.to_string())?;
+        assert_eq!(first.version(), second.version());
+        assert_ne!(first.instance(), second.instance());
+        let mut thumbs = LayerThumbs::default();
+        thumbs.refresh(&ctx, &first);
+        assert_eq!(thumbs.shows, Some((first.instance(), first.version())));
+        thumbs.refresh(&ctx, &second);
+        assert_eq!(thumbs.shows, Some((second.instance(), second.version())));
+        Ok(())
     }
 }

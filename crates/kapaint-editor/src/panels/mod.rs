@@ -8,7 +8,7 @@ pub(super) mod generator;
 mod layer_settings;
 pub mod layers;
 pub(super) mod presets;
-mod tool_panel;
+pub(super) mod tool_panel;
 mod view_panel;
 
 pub(super) use bars::channel_label;

@@ -9,6 +9,21 @@ use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::brush::preset::{self as brush_preset, BrushPreset};
 use kapaint_core::model::texel::MaterialValue;
 
+/// Material, brush and mask presets, shipped and the user's.
+pub(crate) struct Presets {
+    /// Material presets with their thumbnails (rendered a few per frame) and the mesh each
+    /// thumbnail shows.
+    pub(crate) materials: Vec<PresetEntry>,
+    /// Brush presets.
+    pub(crate) brushes: Vec<kapaint_core::model::brush::preset::BrushPreset>,
+    /// Smart masks.
+    pub(crate) masks: Vec<kapaint_core::model::generator::preset::MaskPreset>,
+    /// The user preset folder presets are saved to.
+    pub(crate) dir: Option<std::path::PathBuf>,
+    /// A preset's name being typed, what it names, and whether its field opened this frame.
+    pub(crate) naming: Option<(Naming, String, bool)>,
+}
+
 /// A material preset in the browser.
 pub(crate) struct PresetEntry {
     /// The file stem: what a project names as its base preset.
@@ -107,20 +122,20 @@ impl EditorState {
         // A thumbnail of another mesh (before New, Open or a mesh import) is drawn again.
         let mut budget = 3;
         let mesh = self.mesh.id;
-        for i in 0..self.presets.len() {
-            let stale = self.presets[i]
+        for i in 0..self.presets.materials.len() {
+            let stale = self.presets.materials[i]
                 .thumbnail
                 .as_ref()
                 .is_none_or(|(id, _)| *id != mesh);
             if stale && budget > 0 {
                 budget -= 1;
-                let image = self.thumbnail(self.presets[i].value);
+                let image = self.thumbnail(self.presets.materials[i].value);
                 let texture = ui.ctx().load_texture(
-                    format!("preset {}", self.presets[i].stem),
+                    format!("preset {}", self.presets.materials[i].stem),
                     image,
                     egui::TextureOptions::LINEAR,
                 );
-                self.presets[i].thumbnail = Some((mesh, texture));
+                self.presets.materials[i].thumbnail = Some((mesh, texture));
             }
         }
         if budget == 0 {
@@ -134,7 +149,7 @@ impl EditorState {
             .max_height(200.0)
             .show(ui, |ui| {
                 ui.horizontal_wrapped(|ui| {
-                    for p in &self.presets {
+                    for p in &self.presets.materials {
                         ui.allocate_ui(egui::vec2(58.0, 62.0), |ui| {
                             ui.vertical_centered(|ui| {
                                 let response = match &p.thumbnail {
@@ -174,7 +189,8 @@ impl EditorState {
     pub(super) fn brush_presets_ui(&mut self, ui: &mut egui::Ui) {
         let current = &self.doc.settings().brush;
         let shown = self
-            .brush_presets
+            .presets
+            .brushes
             .iter()
             .find(|p| p.brush == *current)
             .map_or("(custom)", |p| p.name.as_str())
@@ -183,7 +199,7 @@ impl EditorState {
         egui::ComboBox::from_label("Brush preset")
             .selected_text(shown)
             .show_ui(ui, |ui| {
-                for p in &self.brush_presets {
+                for p in &self.presets.brushes {
                     if ui.selectable_label(p.brush == *current, &p.name).clicked() {
                         chosen = Some(p.brush.clone());
                     }
@@ -197,7 +213,7 @@ impl EditorState {
 
     /// A button that opens a name field, then saves what `kind` names under that name.
     pub(super) fn naming_ui(&mut self, ui: &mut egui::Ui, kind: Naming, button: &str) {
-        match &mut self.naming {
+        match &mut self.presets.naming {
             Some((k, name, just_opened)) if *k == kind => {
                 let mut save = false;
                 let mut cancel = false;
@@ -217,12 +233,12 @@ impl EditorState {
                     let name = name.clone();
                     self.save_preset(kind, &name);
                 } else if cancel {
-                    self.naming = None;
+                    self.presets.naming = None;
                 }
             }
             _ => {
                 if ui.button(button).clicked() {
-                    self.naming = Some((kind, String::new(), true));
+                    self.presets.naming = Some((kind, String::new(), true));
                 }
             }
         }
@@ -233,7 +249,8 @@ impl EditorState {
     fn save_preset(&mut self, kind: Naming, name: &str) {
         let saved = match kind {
             Naming::Material => self
-                .preset_dir
+                .presets
+                .dir
                 .clone()
                 .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
                 .and_then(|dir| {
@@ -241,8 +258,8 @@ impl EditorState {
                     kapaint_core::model::preset::save_user(&dir, name, value)
                         .map_err(|e| e.to_string())
                         .map(|(stem, path)| {
-                            self.presets.retain(|p| p.stem != stem);
-                            self.presets.push(PresetEntry {
+                            self.presets.materials.retain(|p| p.stem != stem);
+                            self.presets.materials.push(PresetEntry {
                                 stem,
                                 name: name.trim().to_string(),
                                 value: value.sanitized(),
@@ -252,7 +269,8 @@ impl EditorState {
                         })
                 }),
             Naming::Brush => self
-                .preset_dir
+                .presets
+                .dir
                 .as_ref()
                 .map(|d| d.join("brushes"))
                 .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
@@ -262,12 +280,13 @@ impl EditorState {
                         brush: self.doc.settings().brush.clone(),
                     };
                     let path = preset.save(&dir).map_err(|e| e.to_string())?;
-                    self.brush_presets.retain(|p| p.name != preset.name);
-                    self.brush_presets.push(preset);
+                    self.presets.brushes.retain(|p| p.name != preset.name);
+                    self.presets.brushes.push(preset);
                     Ok(path)
                 }),
             Naming::Mask => self
-                .preset_dir
+                .presets
+                .dir
                 .as_ref()
                 .map(|d| d.join("masks"))
                 .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
@@ -284,14 +303,14 @@ impl EditorState {
                         mask,
                     };
                     let path = preset.save(&dir).map_err(|e| e.to_string())?;
-                    self.mask_presets.retain(|p| p.name != preset.name);
-                    self.mask_presets.push(preset);
+                    self.presets.masks.retain(|p| p.name != preset.name);
+                    self.presets.masks.push(preset);
                     Ok(path)
                 }),
         };
         match saved {
             Ok(path) => {
-                self.naming = None;
+                self.presets.naming = None;
                 self.notices.push(notice(
                     format!("Saved preset {:?} to {}", name.trim(), path.display()),
                     false,
@@ -305,26 +324,34 @@ impl EditorState {
 
     /// Saves presets into `dir` from now on (the user preset folder by default).
     pub fn set_preset_dir(&mut self, dir: std::path::PathBuf) {
-        self.preset_dir = Some(dir);
+        self.presets.dir = Some(dir);
     }
 
     /// Reads the presets again: the shipped ones, then the user's from the preset folder (a
     /// malformed file is a notice).
     pub fn reload_presets(&mut self) {
-        let dir = self.preset_dir.clone();
-        self.presets = load_material_presets(dir.as_deref(), &mut self.notices);
-        self.brush_presets = load_brush_presets(dir.as_deref(), &mut self.notices);
-        self.mask_presets = load_mask_presets(dir.as_deref(), &mut self.notices);
+        let dir = self.presets.dir.clone();
+        self.presets.materials = load_material_presets(dir.as_deref(), &mut self.notices);
+        self.presets.brushes = load_brush_presets(dir.as_deref(), &mut self.notices);
+        self.presets.masks = load_mask_presets(dir.as_deref(), &mut self.notices);
     }
 
     /// The names of the material presets, as the browser shows them.
     pub fn preset_names(&self) -> Vec<&str> {
-        self.presets.iter().map(|p| p.name.as_str()).collect()
+        self.presets
+            .materials
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect()
     }
 
     /// The brush presets' names.
     pub fn brush_preset_names(&self) -> Vec<&str> {
-        self.brush_presets.iter().map(|p| p.name.as_str()).collect()
+        self.presets
+            .brushes
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect()
     }
 }
 

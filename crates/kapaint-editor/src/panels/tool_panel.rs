@@ -6,6 +6,22 @@ use kapaint_core::model::SettingsCommand;
 use kapaint_core::reflectance;
 use kapaint_core::tools::{OptionValue, OptionWidget, ToolOption};
 
+/// The tool panel's own state.
+#[derive(Default)]
+pub(crate) struct ToolPanel {
+    /// How the brush's size is given: in texels, or on screen.
+    pub(crate) brush_size: crate::screen_brush::BrushSize,
+    /// The hex field's text while it is typed in (`None`: it shows the primary's `k_d`).
+    pub(crate) hex_text: Option<String>,
+    /// Materials laid last by a stroke, fill or gradient, newest first.
+    pub(crate) recent_materials: Vec<kapaint_core::model::texel::MaterialValue>,
+    /// The other model's exponent matching the primary's `n`, for the model and `n` (its
+    /// bits) it was found for.
+    pub(crate) equivalent_n: Option<((kapaint_core::reflectance::ShadingModel, u32), f64)>,
+    /// The brush stamp's preview texture, and which stamp it shows.
+    pub(crate) stamp_preview: Option<(u64, egui::TextureHandle)>,
+}
+
 impl EditorState {
     /// The active tool's options, drawn from what the tool says they are.
     fn tool_options_ui(&mut self, ui: &mut egui::Ui) {
@@ -88,11 +104,11 @@ impl EditorState {
         // A root search over the lobes' integrals (about 4 ms): made again only when the
         // exponent or the model changes, not every frame.
         let key = (model, primary.n.to_bits());
-        let eq = match self.equivalent_n {
+        let eq = match self.tool_panel.equivalent_n {
             Some((k, eq)) if k == key => eq,
             _ => {
                 let eq = reflectance::equivalent::equivalent_exponent(model, f64::from(primary.n));
-                self.equivalent_n = Some((key, eq));
+                self.tool_panel.equivalent_n = Some((key, eq));
                 eq
             }
         };
@@ -140,16 +156,21 @@ impl EditorState {
                 }
                 Some(stamp) => {
                     let key = stamp_key(stamp);
-                    if self.stamp_preview.as_ref().is_none_or(|(k, _)| *k != key) {
+                    if self
+                        .tool_panel
+                        .stamp_preview
+                        .as_ref()
+                        .is_none_or(|(k, _)| *k != key)
+                    {
                         let image = stamp_image(stamp, 32);
                         let texture = ui.ctx().load_texture(
                             "brush stamp",
                             image,
                             egui::TextureOptions::LINEAR,
                         );
-                        self.stamp_preview = Some((key, texture));
+                        self.tool_panel.stamp_preview = Some((key, texture));
                     }
-                    if let Some((_, texture)) = &self.stamp_preview {
+                    if let Some((_, texture)) = &self.tool_panel.stamp_preview {
                         ui.image((texture.id(), egui::vec2(32.0, 32.0)))
                             .on_hover_text(format!("{}x{} stamp", stamp.width(), stamp.height()));
                     }

@@ -91,15 +91,16 @@ impl EditorState {
     fn light_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Light");
         // Shown and edited in degrees, as artists think of angles; kept as a direction.
-        let (yaw, pitch) = self.lighting.angles();
+        let (yaw, pitch) = self.look.lighting.angles();
         let (mut yaw, mut pitch) = (yaw.to_degrees(), pitch.to_degrees());
         let a = ui.add(degrees(&mut yaw, 180.0, "Light yaw"));
         let b = ui.add(degrees(&mut pitch, 89.0, "Light pitch"));
         if a.changed() || b.changed() {
-            self.lighting
+            self.look
+                .lighting
                 .set_angles(yaw.to_radians(), pitch.to_radians());
         }
-        let mut follow = self.light_follows_camera;
+        let mut follow = self.look.light_follows_camera;
         if ui
             .checkbox(&mut follow, "Light follows camera")
             .on_hover_text(
@@ -110,8 +111,8 @@ impl EditorState {
         {
             self.set_light_follows_camera(follow);
         }
-        ui.add(egui::Slider::new(&mut self.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
-        ui.add(egui::Slider::new(&mut self.lighting.il, 0.0..=4.0).text("Light I_l"));
+        ui.add(egui::Slider::new(&mut self.look.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
+        ui.add(egui::Slider::new(&mut self.look.lighting.il, 0.0..=4.0).text("Light I_l"));
     }
 
     /// Right panel: model, view, compare, light, canvas channel, history.
@@ -154,21 +155,21 @@ impl EditorState {
         self.compare_ui(ui);
         ui.heading("View");
         egui::ComboBox::from_label("View mode")
-            .selected_text(self.view.label())
+            .selected_text(self.look.mode.label())
             .width(COMBO_WIDTH)
             // Every view in sight at once, no scrolling to the last ones.
             .height(f32::INFINITY)
             .show_ui(ui, |ui| {
                 for v in ViewMode::ALL {
-                    ui.selectable_value(&mut self.view, v, v.label());
+                    ui.selectable_value(&mut self.look.mode, v, v.label());
                 }
             });
         egui::ComboBox::from_label("Layers shown")
-            .selected_text(self.layer_view.label())
+            .selected_text(self.layers_panel.view.label())
             .width(COMBO_WIDTH)
             .show_ui(ui, |ui| {
                 for v in LayerView::ALL {
-                    ui.selectable_value(&mut self.layer_view, v, v.label());
+                    ui.selectable_value(&mut self.layers_panel.view, v, v.label());
                 }
             })
             .response

@@ -123,6 +123,13 @@ impl Document {
             opacity_run: None,
             generator_run: None,
             id: DocumentId::random(),
+            instance: next_instance(),
         }
     }
+}
+
+/// A number no document value of this process had before.
+fn next_instance() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }

@@ -148,6 +148,8 @@ pub struct Document {
     /// Which document this is: kept in its project file and its recovery journal, so a
     /// journal is only ever recovered into the project it was written for.
     id: DocumentId,
+    /// Which document value this is in this process (see [`Document::instance`]).
+    instance: u64,
 }
 
 impl std::fmt::Debug for Document {
@@ -264,6 +266,14 @@ impl Document {
             mix(mix(0, self.state.revision), self.settings_version),
             stroke,
         )
+    }
+
+    /// Which document value this is in this process: every document made, opened or
+    /// recovered has its own number, never reused. With [`Document::version`] it keys what a
+    /// view makes from a document (thumbnails, a rename under way): a document opened in
+    /// place of another may have the other's version, never its instance.
+    pub fn instance(&self) -> u64 {
+        self.instance
     }
 
     /// The attached mesh surface.

@@ -8,6 +8,8 @@ use crate::EditorState;
 /// A layer's name being typed in place of its label in the list: Enter, Tab or a click
 /// elsewhere commits it, Escape cancels, and the keyboard is the editor's again either way.
 pub(in crate::panels) struct Rename {
+    /// The document (its instance) the layer is in.
+    pub(super) document: u64,
     /// The layer renamed.
     pub(super) id: LayerId,
     /// What is typed so far.
