@@ -1,5 +1,5 @@
 //! The product's sources and ARCHITECTURE.md's file lists, for the tests that hold a unit to
-//! its files (`model_unit.rs`, `codec_unit.rs`).
+//! its files (`model_unit.rs`, `codec_unit.rs`, `editor_unit.rs`).
 
 use std::path::{Path, PathBuf};
 

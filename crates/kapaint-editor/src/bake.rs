@@ -6,7 +6,6 @@ use std::sync::Arc;
 
 use super::EditorState;
 use super::dialogs::centred;
-use super::jobs::JobResult;
 use kapaint_core::mesh::bakes::{BakeMap, BakeOptions, bake_map};
 use kapaint_core::model::MaskCommand;
 use kapaint_core::model::generator::Generator;
@@ -164,20 +163,24 @@ impl EditorState {
             rays: dialog.rays,
             max_distance: dialog.max_distance,
         };
-        self.start_job("Bake", move |progress| {
-            let mut baked = Vec::with_capacity(maps.len());
-            for map in maps {
-                let start = std::time::Instant::now();
-                match bake_map(&surface.mesh, &surface.bake, map, options, Some(progress)) {
-                    Ok(b) => {
-                        let stats = b.stats(&surface.bake);
-                        baked.push((Arc::new(b), stats, start.elapsed().as_secs_f64()));
+        self.start_job(
+            "Bake",
+            move |progress| {
+                let mut baked = Vec::with_capacity(maps.len());
+                for map in maps {
+                    let start = std::time::Instant::now();
+                    match bake_map(&surface.mesh, &surface.bake, map, options, Some(progress)) {
+                        Ok(b) => {
+                            let stats = b.stats(&surface.bake);
+                            baked.push((Arc::new(b), stats, start.elapsed().as_secs_f64()));
+                        }
+                        Err(e) => return Err(format!("bake {}: {e}", map.name())),
                     }
-                    Err(e) => return JobResult::Failed(format!("bake {}: {e}", map.name())),
                 }
-            }
-            JobResult::Baked(baked)
-        });
+                Ok(baked)
+            },
+            Self::baked,
+        );
     }
 
     /// The Bake dialog: the map, its rays and distance, the bakes kept, Bake; the maps to

@@ -7,11 +7,11 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use super::EditorState;
 use super::export_plan::{block_search_ui, export_plan_ui};
 use super::files::FilePurpose;
 use super::jobs::new_document_with;
 use super::layout::layout_path;
-use super::{EditorState, JobResult};
 use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::{Document, DocumentSettings};
 use kapaint_export::preset::ExportPreset;
@@ -215,13 +215,17 @@ impl EditorState {
         }
         let size = (dialog.width, dialog.height);
         // Loading and baking the mesh at up to 8192^2 takes seconds: a worker does it.
-        self.start_job("New", move |progress| {
-            progress.start("bake", 1);
-            match new_document_with(size, settings) {
-                Ok(doc) => JobResult::Created(Box::new(doc)),
-                Err(e) => JobResult::Failed(format!("new project: {e}")),
-            }
-        });
+        self.start_job(
+            "New",
+            move |progress| {
+                progress.start("bake", 1);
+                match new_document_with(size, settings) {
+                    Ok(doc) => Ok(Box::new(doc)),
+                    Err(e) => Err(format!("new project: {e}")),
+                }
+            },
+            Self::create_done,
+        );
     }
 
     /// The New dialog: width and height, base preset, mesh; with unsaved changes, save them
@@ -328,14 +332,18 @@ impl EditorState {
             .map(Arc::clone);
         let snapshot = self.snapshot();
         self.dialogs.export = None;
-        self.start_job("Export", move |progress| {
-            let glb = mesh.as_ref().map(|s| &s.mesh);
-            let gpu = kapaint_gpu::blocks::for_export(&preset);
-            match kapaint_export::run(&snapshot, &preset, &out, progress, replace, glb, gpu) {
-                Ok(m) => JobResult::Exported(out, Box::new(m)),
-                Err(e) => JobResult::Failed(format!("export failed: {e}")),
-            }
-        });
+        self.start_job(
+            "Export",
+            move |progress| {
+                let glb = mesh.as_ref().map(|s| &s.mesh);
+                let gpu = kapaint_gpu::blocks::for_export(&preset);
+                match kapaint_export::run(&snapshot, &preset, &out, progress, replace, glb, gpu) {
+                    Ok(m) => Ok((out, Box::new(m))),
+                    Err(e) => Err(format!("export failed: {e}")),
+                }
+            },
+            Self::export_done,
+        );
     }
 
     pub(super) fn open_export(&mut self) {

@@ -7,7 +7,6 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use super::{EditorState, MeshState, notice};
-use kapaint_core::model::surface::Surface;
 use kapaint_core::model::texel::Channel;
 use kapaint_core::model::{Document, DocumentSettings, ModelError, project, recovery};
 use kapaint_core::model::{ImportCommand, SettingsCommand};
@@ -27,10 +26,14 @@ pub(super) struct Jobs {
     pub(super) bake_on_demand: super::bake::OnDemand,
 }
 
-/// What a worker hands back.
-pub(super) enum JobResult {
-    /// A project opened (or recovered).
-    Opened(Box<OpenedProject>),
+/// What a finished job does to the editor: made on the worker from the job's own typed
+/// result (each job names its result type and the function that takes it), run on the UI
+/// thread. A job's failure is its error line.
+pub(super) type Finish = Box<dyn FnOnce(&mut EditorState) + Send>;
+
+/// A save's outcome: saved at the path (the document version saved, and the file as
+/// written), or conflicted.
+pub(super) enum Saved {
     /// Saved at the path: the document version saved, and the file as written.
     Saved(PathBuf, u64, project::OnDisk),
     /// A save that found its project changed on disk (another kapaint saved it): the work went
@@ -43,43 +46,6 @@ pub(super) enum JobResult {
         /// The document version written there.
         version: u64,
     },
-    Exported(PathBuf, Box<kapaint_export::Exported>),
-    /// A mesh loaded and baked at the map size, and whether its file has a textured material
-    /// (the editor then offers to bring it in).
-    Mesh(PathBuf, Arc<Surface>, bool),
-    /// A mesh that cannot be painted as it is (no UVs) or would paint two places at once
-    /// (overlapping UVs): the editor asks whether to unwrap it.
-    NeedsUnwrap(UnwrapPrompt),
-    /// Maps baked from the mesh (one, or "Bake all"'s), what each holds and how many seconds
-    /// it took.
-    Baked(
-        Vec<(
-            Arc<kapaint_core::mesh::bakes::Baked>,
-            kapaint_core::mesh::bakes::BakeStats,
-            f64,
-        )>,
-    ),
-    /// A mesh unwrapped and baked at the map size: the project keeps it.
-    Unwrapped(PathBuf, Arc<Surface>, String),
-    /// A PBR material converted at the map size for the document's model.
-    Material(PathBuf, Box<PbrMaterial>),
-    /// A PBR material of another size than the maps: the editor asks whether to adopt it.
-    MaterialSize(Box<SizePrompt>),
-    /// The maps resized to a material's size, and the material converted at it.
-    Adopted(
-        kapaint_core::model::resize::ResizedMaps,
-        PathBuf,
-        Box<PbrMaterial>,
-    ),
-    /// An image decoded and resampled into a channel's planes.
-    Image(PathBuf, Box<kapaint_core::model::import::ChannelPlanes>),
-    /// The maps resized, with the mesh baked at their size.
-    Resized(kapaint_core::model::resize::ResizedMaps),
-    /// A new project (File > New), its mesh baked.
-    Created(Box<Document>),
-    /// A brush stamp read from an image.
-    Stamp(PathBuf, kapaint_core::model::brush::Stamp),
-    Failed(String),
 }
 
 /// A mesh whose UVs cannot be painted as they are, and why.
@@ -134,7 +100,7 @@ pub(super) struct Job {
     /// until it is done (the document is about to be replaced or resized).
     pub(super) modal: Option<String>,
     pub(super) progress: Arc<Progress>,
-    pub(super) handle: JoinHandle<JobResult>,
+    pub(super) handle: JoinHandle<Finish>,
 }
 
 /// A new `size`^2 document on the default settings, with its mesh.
@@ -175,48 +141,52 @@ pub(super) fn with_fallback(
 }
 
 impl EditorState {
-    pub(super) fn start_job(
+    /// Starts a job: `work` runs on a worker, and `done` takes its result on the UI thread
+    /// (an error becomes a notice).
+    pub(super) fn start_job<T: Send + 'static>(
         &mut self,
         label: &str,
-        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+        work: impl FnOnce(&Progress) -> Result<T, String> + Send + 'static,
+        done: fn(&mut EditorState, T),
     ) {
-        self.start_job_opening(label, None, work);
+        self.start_job_with(label, None, None, work, done);
     }
 
-    /// Starts a job; one that `opens` a project replaces the document when done, and the
-    /// editor takes no input until then.
-    pub(super) fn start_job_opening(
+    /// Starts a job that opens a project: it replaces the document when done, and the editor
+    /// takes no input until then.
+    pub(super) fn start_job_opening<T: Send + 'static>(
         &mut self,
         label: &str,
-        opens: Option<PathBuf>,
-        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+        opens: PathBuf,
+        work: impl FnOnce(&Progress) -> Result<T, String> + Send + 'static,
+        done: fn(&mut EditorState, T),
     ) {
-        let modal = opens.as_ref().map(|path| {
-            let name = path.file_name().map_or_else(
-                || path.display().to_string(),
-                |n| n.to_string_lossy().into_owned(),
-            );
-            format!("Opening {name}…")
-        });
-        self.start_job_with(label, opens, modal, work);
+        let name = opens.file_name().map_or_else(
+            || opens.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        let modal = format!("Opening {name}…");
+        self.start_job_with(label, Some(opens), Some(modal), work, done);
     }
 
     /// Starts a job that the editor waits for behind a window saying `modal`.
-    pub(super) fn start_job_modal(
+    pub(super) fn start_job_modal<T: Send + 'static>(
         &mut self,
         label: &str,
         modal: String,
-        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+        work: impl FnOnce(&Progress) -> Result<T, String> + Send + 'static,
+        done: fn(&mut EditorState, T),
     ) {
-        self.start_job_with(label, None, Some(modal), work);
+        self.start_job_with(label, None, Some(modal), work, done);
     }
 
-    fn start_job_with(
+    fn start_job_with<T: Send + 'static>(
         &mut self,
         label: &str,
         opens: Option<PathBuf>,
         modal: Option<String>,
-        work: impl FnOnce(&Progress) -> JobResult + Send + 'static,
+        work: impl FnOnce(&Progress) -> Result<T, String> + Send + 'static,
+        done: fn(&mut EditorState, T),
     ) {
         if self.busy() {
             self.notices
@@ -229,11 +199,14 @@ impl EditorState {
         match std::thread::Builder::new()
             .name(format!("kapaint-{}", label.to_lowercase()))
             .spawn(move || {
-                let result = work(&shared);
+                let finish: Finish = match work(&shared) {
+                    Ok(value) => Box::new(move |s: &mut EditorState| done(s, value)),
+                    Err(e) => Box::new(move |s: &mut EditorState| s.job_failed(e)),
+                };
                 if let Some(ctx) = waker {
                     ctx.request_repaint();
                 }
-                result
+                finish
             }) {
             Ok(handle) => {
                 self.jobs.current = Some(Job {
@@ -250,6 +223,7 @@ impl EditorState {
         }
     }
 
+    /// Once the job under way is done: what it made goes where its starter said.
     pub(super) fn poll_job(&mut self) {
         if !self
             .jobs
@@ -262,85 +236,96 @@ impl EditorState {
         let Some(job) = self.jobs.current.take() else {
             return;
         };
-        let result = job
-            .handle
-            .join()
-            .unwrap_or_else(|_| JobResult::Failed(format!("{} failed unexpectedly", job.label)));
-        match result {
-            JobResult::Opened(opened) => {
-                let note = opened.note.clone();
-                self.opened(*opened);
-                if let Some(note) = note {
-                    self.notices.push(notice(note, true));
-                }
-            }
-            JobResult::Conflicted {
+        let label = job.label;
+        let finish = job.handle.join().unwrap_or_else(|_| {
+            Box::new(move |s: &mut EditorState| {
+                s.job_failed(format!("{label} failed unexpectedly"));
+            })
+        });
+        finish(self);
+    }
+
+    /// A job failed: what waited on it is dropped, and the error shown.
+    fn job_failed(&mut self, e: String) {
+        self.prompts.quit.after_save = false;
+        self.dialogs.pending_new = None;
+        self.bake_failed();
+        self.notices.push(notice(e, true));
+    }
+
+    /// A project opened (or recovered), with its note.
+    pub(super) fn open_done(&mut self, opened: Box<OpenedProject>) {
+        let note = opened.note.clone();
+        self.opened(*opened);
+        if let Some(note) = note {
+            self.notices.push(notice(note, true));
+        }
+    }
+
+    /// A save done, or conflicted.
+    pub(super) fn save_done(&mut self, saved: Saved) {
+        match saved {
+            Saved::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
+            Saved::Conflicted {
                 message,
                 written,
                 version,
             } => self.conflicted(message, written, version),
-            JobResult::Saved(path, version, on_disk) => self.saved(path, version, on_disk),
-            JobResult::Exported(dir, m) => self.notices.push(exported_notice(&dir, *m)),
-            JobResult::Material(path, m) => self.take_material(&path, *m),
-            JobResult::MaterialSize(prompt) => self.prompts.size = Some(*prompt),
-            JobResult::Adopted(resized, path, m) => {
-                let (w, h) = (resized.0.0.width, resized.0.0.height);
-                self.apply(ImportCommand::Resize(resized));
-                self.notices.push(notice(
-                    format!("Resized the maps to the material's {w}x{h}"),
-                    false,
-                ));
-                self.take_material(&path, *m);
-            }
-            result @ (JobResult::Mesh(..)
-            | JobResult::NeedsUnwrap(_)
-            | JobResult::Baked(..)
-            | JobResult::Unwrapped(..)) => self.mesh_arrived(result),
-            JobResult::Image(path, planes) => {
-                let channel = planes.channel();
-                let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
-                match self.doc.apply(ImportCommand::ImportChannel(imported)) {
-                    Ok(()) => self.notices.push(notice(
-                        format!(
-                            "{} imported into {}",
-                            path.display(),
-                            crate::panels::channel_label(channel)
-                        ),
-                        false,
-                    )),
-                    Err(e) => self.notices.push(notice(e.to_string(), true)),
-                }
-            }
-            JobResult::Resized(resized) => {
-                let (w, h) = (resized.0.0.width, resized.0.0.height);
-                self.apply(ImportCommand::Resize(resized));
-                self.notices
-                    .push(notice(format!("Resized the maps to {w}x{h}"), false));
-            }
-            JobResult::Created(doc) => {
-                self.replace_document(*doc);
-                self.project.saved_version = self.doc.version();
-                self.project.path = None;
-                self.project.claim.hold(None, None, false);
-                // The old document was saved or its changes discarded (asked before).
-                self.project.autosaver.discard();
-                self.project.autosaver =
-                    recovery::Autosaver::new(self.preferences.autosave_interval(), None, &self.doc);
-            }
-            JobResult::Stamp(path, stamp) => {
-                let mut brush = self.doc.settings().brush.clone();
-                brush.stamp = Some(stamp);
-                self.apply(SettingsCommand::SetBrush(brush));
-                self.notices
-                    .push(notice(format!("stamp {}", path.display()), false));
-            }
-            JobResult::Failed(e) => {
-                self.prompts.quit.after_save = false;
-                self.dialogs.pending_new = None;
-                self.bake_failed();
-                self.notices.push(notice(e, true));
-            }
         }
+    }
+
+    /// An export written.
+    pub(super) fn export_done(&mut self, (dir, m): (PathBuf, Box<kapaint_export::Exported>)) {
+        self.notices.push(exported_notice(&dir, *m));
+    }
+
+    /// An image decoded and resampled into a channel's planes: into the document.
+    fn image_done(
+        &mut self,
+        (path, planes): (PathBuf, Box<kapaint_core::model::import::ChannelPlanes>),
+    ) {
+        let channel = planes.channel();
+        let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
+        match self.doc.apply(ImportCommand::ImportChannel(imported)) {
+            Ok(()) => self.notices.push(notice(
+                format!(
+                    "{} imported into {}",
+                    path.display(),
+                    crate::panels::channel_label(channel)
+                ),
+                false,
+            )),
+            Err(e) => self.notices.push(notice(e.to_string(), true)),
+        }
+    }
+
+    /// The maps resized, with the mesh baked at their size.
+    pub(super) fn resize_done(&mut self, resized: kapaint_core::model::resize::ResizedMaps) {
+        let (w, h) = (resized.0.0.width, resized.0.0.height);
+        self.apply(ImportCommand::Resize(resized));
+        self.notices
+            .push(notice(format!("Resized the maps to {w}x{h}"), false));
+    }
+
+    /// A new project (File > New), its mesh baked.
+    pub(super) fn create_done(&mut self, doc: Box<Document>) {
+        self.replace_document(*doc);
+        self.project.saved_version = self.doc.version();
+        self.project.path = None;
+        self.project.claim.hold(None, None, false);
+        // The old document was saved or its changes discarded (asked before).
+        self.project.autosaver.discard();
+        self.project.autosaver =
+            recovery::Autosaver::new(self.preferences.autosave_interval(), None, &self.doc);
+    }
+
+    /// A brush stamp read from an image.
+    fn stamp_done(&mut self, (path, stamp): (PathBuf, kapaint_core::model::brush::Stamp)) {
+        let mut brush = self.doc.settings().brush.clone();
+        brush.stamp = Some(stamp);
+        self.apply(SettingsCommand::SetBrush(brush));
+        self.notices
+            .push(notice(format!("stamp {}", path.display()), false));
     }
 
     pub(super) fn replace_document(&mut self, doc: Document) {
@@ -401,30 +386,38 @@ impl EditorState {
 
     /// Loads a brush stamp from an image on a worker thread.
     pub fn load_stamp(&mut self, path: PathBuf) {
-        self.start_job("Stamp", move |progress| {
-            progress.start("decode", 1);
-            match kapaint_core::model::import::read_stamp(&path) {
-                Ok(stamp) => JobResult::Stamp(path, stamp),
-                Err(e) => JobResult::Failed(e.to_string()),
-            }
-        });
+        self.start_job(
+            "Stamp",
+            move |progress| {
+                progress.start("decode", 1);
+                match kapaint_core::model::import::read_stamp(&path) {
+                    Ok(stamp) => Ok((path, stamp)),
+                    Err(e) => Err(e.to_string()),
+                }
+            },
+            Self::stamp_done,
+        );
     }
 
     /// Decodes and resamples an image on a worker; it is written into `channel` (one undo
     /// step) when it arrives.
     pub fn import_image(&mut self, path: PathBuf, channel: Channel) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
-        self.start_job("Image", move |progress| {
-            progress.start("decode", 1);
-            match kapaint_core::model::import::read_image(&path) {
-                Ok(image) => {
-                    progress.start("resample", 1);
-                    let planes = kapaint_core::model::import::resample(&image, channel, w, h);
-                    JobResult::Image(path, Box::new(planes))
+        self.start_job(
+            "Image",
+            move |progress| {
+                progress.start("decode", 1);
+                match kapaint_core::model::import::read_image(&path) {
+                    Ok(image) => {
+                        progress.start("resample", 1);
+                        let planes = kapaint_core::model::import::resample(&image, channel, w, h);
+                        Ok((path, Box::new(planes)))
+                    }
+                    Err(e) => Err(e.to_string()),
                 }
-                Err(e) => JobResult::Failed(e.to_string()),
-            }
-        });
+            },
+            Self::image_done,
+        );
     }
 
     /// What the window over the editor says while a job it waits for runs (a project

@@ -33,7 +33,6 @@ pub mod viewport;
 
 pub use app::{Editor, run};
 pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, export_folder_in, parse_recent, push_recent};
-use jobs::JobResult;
 pub use layout::{default_layout, layout_json, parse_layout};
 
 use std::path::Path;

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use super::EditorState;
 use super::dialogs::centred;
 pub use super::jobs::SizePrompt;
-use super::jobs::{JobResult, LoadedMaterial, PbrMaterial};
+use super::jobs::{LoadedMaterial, PbrMaterial};
 use kapaint_core::model::ModelError;
 use kapaint_core::model::resize::{ResizedMaps, resized_stack};
 use kapaint_core::model::surface::Surface;
@@ -82,7 +82,34 @@ fn convert(
     })
 }
 
+/// A material import's outcome: converted, or a question about its size first.
+pub(super) enum Material {
+    /// Converted at the map size for the document's model.
+    Converted(PathBuf, Box<PbrMaterial>),
+    /// Of another size than the maps: the editor asks whether to adopt it.
+    AskSize(Box<SizePrompt>),
+}
+
 impl EditorState {
+    /// A material converted, or the size question.
+    fn material_done(&mut self, material: Material) {
+        match material {
+            Material::Converted(path, m) => self.take_material(&path, *m),
+            Material::AskSize(prompt) => self.prompts.size = Some(*prompt),
+        }
+    }
+
+    /// The maps resized to a material's size, and the material converted at it.
+    fn adopted(&mut self, (resized, path, m): (ResizedMaps, PathBuf, Box<PbrMaterial>)) {
+        let (w, h) = (resized.0.0.width, resized.0.0.height);
+        self.apply(kapaint_core::model::ImportCommand::Resize(resized));
+        self.notices.push(super::notice(
+            format!("Resized the maps to the material's {w}x{h}"),
+            false,
+        ));
+        self.take_material(&path, *m);
+    }
+
     /// Converts the material of the glTF at `path`, or the texture set `path` is one image of
     /// ([`kapaint_pbr::names`]), for the document's model, on a worker; it replaces the
     /// selected layer's channels (one undo step) when it arrives. A material of another size
@@ -91,30 +118,34 @@ impl EditorState {
         let project = (self.doc.maps().width(), self.doc.maps().height());
         let (model, mapping) = (self.doc.settings().model, self.doc.settings().n_mapping());
         let adopt_by_default = !self.doc.stack().holds_paint();
-        self.start_job("Material", move |progress| {
-            progress.start("decode", 1);
-            let fail = |e: ModelError| JobResult::Failed(format!("{}: {e}", path.display()));
-            let loaded = match load(&path) {
-                Ok(l) => l,
-                Err(e) => return fail(e),
-            };
-            match kapaint_pbr::import::native_size(&loaded.set) {
-                Ok(Some(size)) if size != project => {
-                    JobResult::MaterialSize(Box::new(SizePrompt {
-                        path,
-                        loaded: Arc::new(loaded),
-                        size,
-                        project,
-                        adopt_by_default,
-                    }))
-                }
-                Ok(_) => match convert(&loaded, project, model, mapping, progress) {
-                    Ok(m) => JobResult::Material(path, Box::new(m)),
+        self.start_job(
+            "Material",
+            move |progress| {
+                progress.start("decode", 1);
+                let fail = |e: ModelError| Err(format!("{}: {e}", path.display()));
+                let loaded = match load(&path) {
+                    Ok(l) => l,
+                    Err(e) => return fail(e),
+                };
+                match kapaint_pbr::import::native_size(&loaded.set) {
+                    Ok(Some(size)) if size != project => {
+                        Ok(Material::AskSize(Box::new(SizePrompt {
+                            path,
+                            loaded: Arc::new(loaded),
+                            size,
+                            project,
+                            adopt_by_default,
+                        })))
+                    }
+                    Ok(_) => match convert(&loaded, project, model, mapping, progress) {
+                        Ok(m) => Ok(Material::Converted(path, Box::new(m))),
+                        Err(e) => fail(e),
+                    },
                     Err(e) => fail(e),
-                },
-                Err(e) => fail(e),
-            }
-        });
+                }
+            },
+            Self::material_done,
+        );
     }
 
     /// The size question, while it is open.
@@ -139,12 +170,14 @@ impl EditorState {
         } = prompt;
         match answer {
             SizeAnswer::Cancel => {}
-            SizeAnswer::Resample => self.start_job("Material", move |progress| {
-                match convert(&loaded, project, model, mapping, progress) {
-                    Ok(m) => JobResult::Material(path, Box::new(m)),
-                    Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
-                }
-            }),
+            SizeAnswer::Resample => self.start_job(
+                "Material",
+                move |progress| match convert(&loaded, project, model, mapping, progress) {
+                    Ok(m) => Ok(Material::Converted(path, Box::new(m))),
+                    Err(e) => Err(format!("{}: {e}", path.display())),
+                },
+                Self::material_done,
+            ),
             SizeAnswer::Adopt => {
                 let stack = self.doc.stack().clone();
                 let mesh = self.doc.surface().map(|s| s.mesh.clone());
@@ -153,8 +186,7 @@ impl EditorState {
                     "Material",
                     format!("Resizing the maps to {w}x{h} and converting the material…"),
                     move |progress| {
-                        let fail =
-                            |e: String| JobResult::Failed(format!("{}: {e}", path.display()));
+                        let fail = |e: String| Err(format!("{}: {e}", path.display()));
                         progress.start("resample", 1);
                         let stack = match resized_stack(&stack, w, h) {
                             Ok(s) => s,
@@ -166,14 +198,15 @@ impl EditorState {
                             Err(e) => return fail(format!("resize: the mesh: {e}")),
                         };
                         match convert(&loaded, size, model, mapping, progress) {
-                            Ok(m) => JobResult::Adopted(
+                            Ok(m) => Ok((
                                 ResizedMaps(Arc::new((stack, surface))),
                                 path.clone(),
                                 Box::new(m),
-                            ),
+                            )),
                             Err(e) => fail(e.to_string()),
                         }
                     },
+                    Self::adopted,
                 );
             }
         }

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use super::jobs::{JobResult, UnwrapPrompt};
+use super::jobs::UnwrapPrompt;
 use super::{EditorState, notice};
 use kapaint_core::mesh::unwrap;
 use kapaint_core::model::ImportCommand;
@@ -12,75 +12,102 @@ use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::surface::Surface;
 use kapaint_core::task::Progress;
 
+/// A mesh import's outcome.
+enum MeshImport {
+    /// Loaded and baked at the map size, and whether its file has a textured material (the
+    /// editor then offers to bring it in).
+    Baked(PathBuf, Arc<Surface>, bool),
+    /// A mesh that cannot be painted as it is (no UVs) or would paint two places at once
+    /// (overlapping UVs): the editor asks whether to unwrap it.
+    NeedsUnwrap(UnwrapPrompt),
+}
+
+/// A map baked from the mesh, what it holds and how many seconds it took.
+pub(super) type Baked = (
+    Arc<kapaint_core::mesh::bakes::Baked>,
+    kapaint_core::mesh::bakes::BakeStats,
+    f64,
+);
+
 /// Fraction of a mesh's texels claimed twice above which the editor offers to unwrap it.
 const OVERLAP_OFFER: f64 = 0.01;
 
 impl EditorState {
-    /// What a mesh job made: a mesh to bake, a question, a bake, an unwrapped mesh.
-    pub(super) fn mesh_arrived(&mut self, result: JobResult) {
-        match result {
-            JobResult::Mesh(path, surface, textured) => {
-                if textured {
-                    self.prompts.material = Some(path.clone());
-                }
-                let mesh = MeshRef::from_spec(&path.display().to_string());
-                let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
-                match self.doc.apply(ImportCommand::SetMesh(attached)) {
-                    Ok(()) => {
-                        self.follow_mesh();
-                        self.notices
-                            .push(notice(format!("mesh {}", path.display()), false));
-                    }
-                    Err(e) => self.notices.push(notice(e.to_string(), true)),
-                }
+    /// A mesh import's outcome: the mesh baked, or the question whether to unwrap it.
+    fn mesh_done(&mut self, mesh: MeshImport) {
+        match mesh {
+            MeshImport::Baked(path, surface, textured) => {
+                self.mesh_baked((path, surface, textured));
             }
-            JobResult::NeedsUnwrap(prompt) => self.prompts.unwrap = Some(prompt),
-            JobResult::Baked(baked) => {
-                let lines: Vec<String> = baked
-                    .iter()
-                    .map(|(b, stats, seconds)| {
-                        format!(
-                            "baked {}: {} texels, mean {:.3}, min {:.3}, {seconds:.1} s",
-                            b.map.name(),
-                            stats.texels,
-                            stats.mean,
-                            stats.min
-                        )
-                    })
-                    .collect();
-                let bakes = baked
-                    .into_iter()
-                    .map(|(b, _, _)| kapaint_core::model::document::AttachedBake(b))
-                    .collect();
-                match self.doc.apply(ImportCommand::SetBakes(bakes)) {
-                    Ok(()) => {
-                        for line in lines {
-                            self.notices.push(notice(line, false));
-                        }
-                        self.baked_on_demand();
-                    }
-                    Err(e) => {
-                        self.bake_failed();
-                        self.notices.push(notice(e.to_string(), true));
-                    }
-                }
+            MeshImport::NeedsUnwrap(prompt) => self.prompts.unwrap = Some(prompt),
+        }
+    }
+
+    /// A mesh loaded and baked at the map size: the project's mesh now, and the question
+    /// about its material when its file has a textured one.
+    fn mesh_baked(&mut self, (path, surface, textured): (PathBuf, Arc<Surface>, bool)) {
+        if textured {
+            self.prompts.material = Some(path.clone());
+        }
+        let mesh = MeshRef::from_spec(&path.display().to_string());
+        let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
+        match self.doc.apply(ImportCommand::SetMesh(attached)) {
+            Ok(()) => {
+                self.follow_mesh();
+                self.notices
+                    .push(notice(format!("mesh {}", path.display()), false));
             }
-            JobResult::Unwrapped(path, surface, summary) => {
-                let attached = kapaint_core::model::document::AttachedMesh {
-                    mesh: MeshRef::Embedded(surface.mesh.name.clone()),
-                    surface,
-                };
-                match self.doc.apply(ImportCommand::SetMesh(attached)) {
-                    Ok(()) => {
-                        self.follow_mesh();
-                        self.notices.push(notice(summary, false));
-                    }
-                    Err(e) => self
-                        .notices
-                        .push(notice(format!("{}: {e}", path.display()), true)),
+            Err(e) => self.notices.push(notice(e.to_string(), true)),
+        }
+    }
+
+    /// Maps baked from the mesh (one, or "Bake all"'s), what each holds and how many seconds
+    /// it took: into the document.
+    pub(super) fn baked(&mut self, baked: Vec<Baked>) {
+        let lines: Vec<String> = baked
+            .iter()
+            .map(|(b, stats, seconds)| {
+                format!(
+                    "baked {}: {} texels, mean {:.3}, min {:.3}, {seconds:.1} s",
+                    b.map.name(),
+                    stats.texels,
+                    stats.mean,
+                    stats.min
+                )
+            })
+            .collect();
+        let bakes = baked
+            .into_iter()
+            .map(|(b, _, _)| kapaint_core::model::document::AttachedBake(b))
+            .collect();
+        match self.doc.apply(ImportCommand::SetBakes(bakes)) {
+            Ok(()) => {
+                for line in lines {
+                    self.notices.push(notice(line, false));
                 }
+                self.baked_on_demand();
             }
-            _ => {}
+            Err(e) => {
+                self.bake_failed();
+                self.notices.push(notice(e.to_string(), true));
+            }
+        }
+    }
+
+    /// A mesh unwrapped and baked at the map size: the project keeps it.
+    fn unwrapped(&mut self, (path, surface, summary): (PathBuf, Arc<Surface>, String)) {
+        let attached = kapaint_core::model::document::AttachedMesh {
+            mesh: MeshRef::Embedded(surface.mesh.name.clone()),
+            surface,
+        };
+        match self.doc.apply(ImportCommand::SetMesh(attached)) {
+            Ok(()) => {
+                self.follow_mesh();
+                self.notices.push(notice(summary, false));
+            }
+            Err(e) => self
+                .notices
+                .push(notice(format!("{}: {e}", path.display()), true)),
         }
     }
 
@@ -92,7 +119,7 @@ impl EditorState {
             progress.start("load", 1);
             let mesh = match kapaint_core::mesh::open(&path) {
                 Ok(m) => m,
-                Err(e) => return JobResult::Failed(format!("{}: {e}", path.display())),
+                Err(e) => return Err(format!("{}: {e}", path.display())),
             };
             progress.start("check UVs", 1);
             let why = if mesh.uvs.is_none() {
@@ -107,15 +134,16 @@ impl EditorState {
                 })
             };
             if let Some(why) = why {
-                return JobResult::NeedsUnwrap(UnwrapPrompt {
+                return Ok(MeshImport::NeedsUnwrap(UnwrapPrompt {
                     has_uvs: mesh.uvs.is_some(),
                     path,
                     mesh: Arc::new(mesh),
                     why,
-                });
+                }));
             }
-            Self::bake_mesh(path, mesh, (w, h), progress)
-        });
+            let (path, surface, textured) = Self::bake_mesh(path, mesh, (w, h), progress)?;
+            Ok(MeshImport::Baked(path, surface, textured))
+        }, Self::mesh_done);
     }
 
     /// Mesh > Unwrap automatically: asks, for the project's mesh, whether to replace its UVs
@@ -144,9 +172,11 @@ impl EditorState {
     /// Bakes a mesh whose UVs are kept as they are (the answer "Keep its UVs").
     pub(super) fn keep_mesh_uvs(&mut self, prompt: UnwrapPrompt) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
-        self.start_job("Mesh", move |progress| {
-            Self::bake_mesh(prompt.path, (*prompt.mesh).clone(), (w, h), progress)
-        });
+        self.start_job(
+            "Mesh",
+            move |progress| Self::bake_mesh(prompt.path, (*prompt.mesh).clone(), (w, h), progress),
+            Self::mesh_baked,
+        );
     }
 
     fn bake_mesh(
@@ -154,14 +184,14 @@ impl EditorState {
         mesh: kapaint_core::mesh::Mesh,
         (w, h): (u32, u32),
         progress: &Progress,
-    ) -> JobResult {
+    ) -> Result<(PathBuf, Arc<Surface>, bool), String> {
         progress.start("bake", 1);
         match Surface::new(mesh, w, h) {
             Ok(s) => {
                 let textured = kapaint_pbr::gltf::has_textured_material(&path);
-                JobResult::Mesh(path, Arc::new(s), textured)
+                Ok((path, Arc::new(s), textured))
             }
-            Err(e) => JobResult::Failed(format!("{}: {e}", path.display())),
+            Err(e) => Err(format!("{}: {e}", path.display())),
         }
     }
 
@@ -169,25 +199,29 @@ impl EditorState {
     /// project keeps the unwrapped mesh (the answer "Unwrap automatically").
     pub(super) fn unwrap_mesh(&mut self, prompt: UnwrapPrompt) {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
-        self.start_job("Unwrap", move |progress| {
-            let options = unwrap::UnwrapOptions::for_size(w.min(h).max(64));
-            let mut done = match unwrap::unwrap(&prompt.mesh, options, Some(progress)) {
-                Ok(done) => done,
-                Err(e) => return JobResult::Failed(format!("{}: {e}", prompt.path.display())),
-            };
-            let summary = format!(
-                "{} unwrapped: {} charts, {:.0} % of the map covered",
-                prompt.path.display(),
-                done.charts,
-                100.0 * done.coverage
-            );
-            let base = done.mesh.name.trim_end_matches(", unwrapped").to_string();
-            done.mesh.name = format!("{base}, unwrapped");
-            progress.start("bake", 1);
-            match Surface::new(done.mesh, w, h) {
-                Ok(s) => JobResult::Unwrapped(prompt.path, Arc::new(s), summary),
-                Err(e) => JobResult::Failed(format!("{}: {e}", prompt.path.display())),
-            }
-        });
+        self.start_job(
+            "Unwrap",
+            move |progress| {
+                let options = unwrap::UnwrapOptions::for_size(w.min(h).max(64));
+                let mut done = match unwrap::unwrap(&prompt.mesh, options, Some(progress)) {
+                    Ok(done) => done,
+                    Err(e) => return Err(format!("{}: {e}", prompt.path.display())),
+                };
+                let summary = format!(
+                    "{} unwrapped: {} charts, {:.0} % of the map covered",
+                    prompt.path.display(),
+                    done.charts,
+                    100.0 * done.coverage
+                );
+                let base = done.mesh.name.trim_end_matches(", unwrapped").to_string();
+                done.mesh.name = format!("{base}, unwrapped");
+                progress.start("bake", 1);
+                match Surface::new(done.mesh, w, h) {
+                    Ok(s) => Ok((prompt.path, Arc::new(s), summary)),
+                    Err(e) => Err(format!("{}: {e}", prompt.path.display())),
+                }
+            },
+            Self::unwrapped,
+        );
     }
 }

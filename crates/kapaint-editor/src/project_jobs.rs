@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::files::FilePurpose;
-use super::jobs::{JobResult, OpenedProject, load_project, with_fallback};
+use super::jobs::{OpenedProject, Saved, load_project, with_fallback};
 use super::{EditorState, notice};
 use kapaint_core::model::{project, recovery};
 
@@ -126,23 +126,27 @@ impl EditorState {
         let expected = (self.project.path.as_deref() == Some(path.as_path()))
             .then(|| self.project.claim.on_disk.clone())
             .flatten();
-        self.start_job("Save", move |progress| {
-            progress.start("save", 1);
-            match project::save_checked(&snapshot, &path, expected.as_ref()) {
-                Ok(on_disk) => JobResult::Saved(path, version, on_disk),
-                Err(e @ kapaint_core::model::ModelError::Conflict { .. }) => {
-                    let kapaint_core::model::ModelError::Conflict { written, .. } = &e else {
-                        unreachable!("matched above")
-                    };
-                    JobResult::Conflicted {
-                        written: written.clone(),
-                        message: e.to_string(),
-                        version,
+        self.start_job(
+            "Save",
+            move |progress| {
+                progress.start("save", 1);
+                match project::save_checked(&snapshot, &path, expected.as_ref()) {
+                    Ok(on_disk) => Ok(Saved::Saved(path, version, on_disk)),
+                    Err(e @ kapaint_core::model::ModelError::Conflict { .. }) => {
+                        let kapaint_core::model::ModelError::Conflict { written, .. } = &e else {
+                            unreachable!("matched above")
+                        };
+                        Ok(Saved::Conflicted {
+                            written: written.clone(),
+                            message: e.to_string(),
+                            version,
+                        })
                     }
+                    Err(e) => Err(format!("could not save: {e}")),
                 }
-                Err(e) => JobResult::Failed(format!("could not save: {e}")),
-            }
-        });
+            },
+            Self::save_done,
+        );
     }
 
     /// Opens `path` on a worker.
@@ -160,21 +164,26 @@ impl EditorState {
         let Some(read_only) = self.may_open(&path) else {
             return;
         };
-        self.start_job_opening("Open", Some(path.clone()), move |progress| {
-            progress.start("open", 1);
-            let on_disk = project::OnDisk::of(&path);
-            match load_project(&path) {
-                Ok((doc, note)) => JobResult::Opened(Box::new(OpenedProject {
-                    path: Some(path),
-                    doc,
-                    recovered: None,
-                    note,
-                    on_disk,
-                    read_only,
-                })),
-                Err(e) => JobResult::Failed(format!("could not open {}: {e}", path.display())),
-            }
-        });
+        self.start_job_opening(
+            "Open",
+            path.clone(),
+            move |progress| {
+                progress.start("open", 1);
+                let on_disk = project::OnDisk::of(&path);
+                match load_project(&path) {
+                    Ok((doc, note)) => Ok(Box::new(OpenedProject {
+                        path: Some(path),
+                        doc,
+                        recovered: None,
+                        note,
+                        on_disk,
+                        read_only,
+                    })),
+                    Err(e) => Err(format!("could not open {}: {e}", path.display())),
+                }
+            },
+            Self::open_done,
+        );
     }
 
     /// Opens the recovery copy `from` as the project at `path` (unsaved). A copy that cannot
@@ -182,44 +191,50 @@ impl EditorState {
     /// saved, with a notice saying why.
     pub(super) fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
         let opens = path.clone().unwrap_or_else(|| from.clone());
-        self.start_job_opening("Recover", Some(opens), move |progress| {
-            progress.start("open", 1);
-            // Recovered work replaces the project as it is on disk now.
-            let on_disk = path.as_deref().and_then(project::OnDisk::of);
-            let recovered = recovery::load(&from)
-                .map_err(|e| e.to_string())
-                .and_then(|mut doc| {
-                    let failed = project::attach_own_mesh(&mut doc).err();
-                    with_fallback(doc, failed)
-                });
-            let e = match recovered {
-                Ok((doc, note)) => {
-                    return JobResult::Opened(Box::new(OpenedProject {
+        self.start_job_opening(
+            "Recover",
+            opens,
+            move |progress| {
+                progress.start("open", 1);
+                // Recovered work replaces the project as it is on disk now.
+                let on_disk = path.as_deref().and_then(project::OnDisk::of);
+                let recovered =
+                    recovery::load(&from)
+                        .map_err(|e| e.to_string())
+                        .and_then(|mut doc| {
+                            let failed = project::attach_own_mesh(&mut doc).err();
+                            with_fallback(doc, failed)
+                        });
+                let e = match recovered {
+                    Ok((doc, note)) => {
+                        return Ok(Box::new(OpenedProject {
+                            path,
+                            doc,
+                            recovered: Some(from),
+                            note,
+                            on_disk,
+                            read_only: false,
+                        }));
+                    }
+                    Err(e) => e,
+                };
+                recovery::remove(&from);
+                let why = format!("could not recover {}: {e}", from.display());
+                match path.as_deref().filter(|p| p.exists()).map(load_project) {
+                    Some(Ok((doc, _))) => Ok(Box::new(OpenedProject {
                         path,
                         doc,
-                        recovered: Some(from),
-                        note,
+                        recovered: None,
+                        note: Some(format!("{why}; opened the saved project")),
                         on_disk,
                         read_only: false,
-                    }));
+                    })),
+                    Some(Err(open)) => Err(format!("{why}; {open}")),
+                    None => Err(why),
                 }
-                Err(e) => e,
-            };
-            recovery::remove(&from);
-            let why = format!("could not recover {}: {e}", from.display());
-            match path.as_deref().filter(|p| p.exists()).map(load_project) {
-                Some(Ok((doc, _))) => JobResult::Opened(Box::new(OpenedProject {
-                    path,
-                    doc,
-                    recovered: None,
-                    note: Some(format!("{why}; opened the saved project")),
-                    on_disk,
-                    read_only: false,
-                })),
-                Some(Err(open)) => JobResult::Failed(format!("{why}; {open}")),
-                None => JobResult::Failed(why),
-            }
-        });
+            },
+            Self::open_done,
+        );
     }
 
     pub(super) fn save(&mut self) {

@@ -5,7 +5,6 @@ use std::sync::Arc;
 
 use super::EditorState;
 use super::dialogs::{NEW_SIZES, centred};
-use super::jobs::JobResult;
 use kapaint_core::memory::human;
 use kapaint_core::model::resize::{ResizedMaps, peak_bytes, resized_stack};
 use kapaint_core::model::surface::Surface;
@@ -60,15 +59,16 @@ impl EditorState {
                 progress.start("resample", 1);
                 let stack = match resized_stack(&stack, width, height) {
                     Ok(m) => m,
-                    Err(e) => return JobResult::Failed(format!("resize: {e}")),
+                    Err(e) => return Err(format!("resize: {e}")),
                 };
                 progress.start("bake", 1);
                 let surface = match mesh.map(|m| Surface::new(m, width, height)).transpose() {
                     Ok(s) => s.map(Arc::new),
-                    Err(e) => return JobResult::Failed(format!("resize: the mesh: {e}")),
+                    Err(e) => return Err(format!("resize: the mesh: {e}")),
                 };
-                JobResult::Resized(ResizedMaps(Arc::new((stack, surface))))
+                Ok(ResizedMaps(Arc::new((stack, surface))))
             },
+            Self::resize_done,
         );
     }
 
