@@ -10,6 +10,7 @@ use glam::Vec2;
 
 use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
+use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::brush::SurfacePos;
 use kapaint_core::render::FrameSettings;
 use kapaint_core::tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
@@ -81,7 +82,8 @@ impl EditorState {
             let lays = self.tools.lays_material(&command);
             self.apply(command);
             if lays {
-                self.remember_material();
+                let value = self.doc.settings().primary;
+                self.tool_panel.remember_material(value);
             }
         }
     }
@@ -108,7 +110,13 @@ impl EditorState {
                     if self.pointer.held.is_none() && on_view && !reserved {
                         self.pointer.held = Some(tab);
                         if self.tools.active_meta().cursor == ToolCursor::BrushOutline {
-                            self.fit_brush_to_screen();
+                            let brush = &self.doc.settings().brush;
+                            if let Some(brush) = self
+                                .tool_panel
+                                .fitted_brush(brush, self.pointer.texels_per_point)
+                            {
+                                self.apply(SettingsCommand::SetBrush(brush));
+                            }
                         }
                         if let Some(at) = at {
                             self.tool_event(ToolEvent::Press { at, pressure });

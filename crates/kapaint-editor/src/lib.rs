@@ -402,6 +402,52 @@ impl EditorState {
         format!("{name}{marker}{read_only} - kapaint")
     }
 
+    /// The left panel: tools, brush, material, channels (the tool panel asks, the editor
+    /// carries it out).
+    fn tools_ui(&mut self, ui: &mut egui::Ui) {
+        let mut desk = panels::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        self.tool_panel.ui(ui, &mut desk, &mut self.presets);
+        let asks = desk.into_asks();
+        self.carry_out(asks);
+    }
+
+    /// Carries out what a panel asked, in order.
+    fn carry_out(&mut self, asks: Vec<panels::Ask>) {
+        for ask in asks {
+            match ask {
+                panels::Ask::Command(command) => self.apply(command),
+                panels::Ask::SelectTool(kind) => self.select_tool(kind),
+                panels::Ask::ToolOption(id, value) => {
+                    for command in self.tools.set_option(id, value, &self.doc) {
+                        self.apply(command);
+                    }
+                }
+                panels::Ask::ChooseFile(purpose) => self.choose_file(purpose),
+                panels::Ask::Notice(notice) => self.notices.push(notice),
+            }
+        }
+    }
+
+    /// How the brush's size is given.
+    pub fn brush_size(&self) -> screen_brush::BrushSize {
+        self.tool_panel.brush_size
+    }
+
+    /// Sets how the brush's size is given (the radius on screen kept in range).
+    pub fn set_brush_size(&mut self, size: screen_brush::BrushSize) {
+        self.tool_panel.set_brush_size(size);
+    }
+
+    /// Texels per screen point under the cursor this frame, if it is over the map or the mesh.
+    pub fn texels_per_point(&self) -> Option<f32> {
+        self.pointer.texels_per_point
+    }
+
+    /// The materials used last, newest first.
+    pub fn recent_materials(&self) -> &[kapaint_core::model::texel::MaterialValue] {
+        &self.tool_panel.recent_materials
+    }
+
     /// Applies a command as the panels do (an error becomes a notice).
     pub fn apply_command(&mut self, command: impl Into<Command>) {
         self.apply(command);

@@ -7,8 +7,9 @@
 
 use glam::Vec3;
 
-use super::{EditorState, project};
-use kapaint_core::model::SettingsCommand;
+use super::panels::tool_panel::ToolPanel;
+use super::project;
+use kapaint_core::model::brush::BrushSettings;
 
 /// How the brush's size is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,16 +48,11 @@ pub fn points_per_world(
     (d.is_finite() && d > 0.0).then_some(d)
 }
 
-impl EditorState {
-    /// How the brush's size is given.
-    pub fn brush_size(&self) -> BrushSize {
-        self.tool_panel.brush_size
-    }
-
+impl ToolPanel {
     /// Sets how the brush's size is given (the radius on screen kept in range).
-    pub fn set_brush_size(&mut self, size: BrushSize) {
+    pub(crate) fn set_brush_size(&mut self, size: BrushSize) {
         let (lo, hi) = (*SCREEN_RADIUS_RANGE.start(), *SCREEN_RADIUS_RANGE.end());
-        self.tool_panel.brush_size = BrushSize {
+        self.brush_size = BrushSize {
             screen_radius: if size.screen_radius.is_finite() {
                 size.screen_radius.clamp(lo, hi)
             } else {
@@ -66,43 +62,35 @@ impl EditorState {
         };
     }
 
-    /// Texels per screen point under the cursor this frame, if it is over the map or the mesh.
-    pub fn texels_per_point(&self) -> Option<f32> {
-        self.pointer.texels_per_point
+    /// The brush radius in texels that the size on screen gives where a screen point is
+    /// `texels_per_point` texels.
+    pub(crate) fn screen_radius_in_texels(&self, texels_per_point: Option<f32>) -> Option<f32> {
+        Some((self.brush_size.screen_radius * texels_per_point?).clamp(0.5, 4096.0))
     }
 
-    /// The brush radius in texels that the size on screen gives under the cursor.
-    pub(super) fn screen_radius_in_texels(&self) -> Option<f32> {
-        let scale = self.pointer.texels_per_point?;
-        Some((self.tool_panel.brush_size.screen_radius * scale).clamp(0.5, 4096.0))
-    }
-
-    /// Before a stroke starts: with the size on screen, sets the brush's radius in texels
-    /// from the view under the cursor.
-    pub(super) fn fit_brush_to_screen(&mut self) {
-        if !self.tool_panel.brush_size.on_screen {
-            return;
+    /// Before a stroke starts: with the size on screen, the brush with its radius in texels
+    /// from the view under the cursor, if that changes it.
+    pub(crate) fn fitted_brush(
+        &self,
+        brush: &BrushSettings,
+        texels_per_point: Option<f32>,
+    ) -> Option<BrushSettings> {
+        if !self.brush_size.on_screen {
+            return None;
         }
-        let Some(radius) = self.screen_radius_in_texels() else {
-            return;
-        };
-        let mut brush = self.doc.settings().brush.clone();
-        if (brush.radius_px - radius).abs() > 1e-3 * radius {
-            brush.radius_px = radius;
-            self.apply(SettingsCommand::SetBrush(brush));
-        }
+        let radius = self.screen_radius_in_texels(texels_per_point)?;
+        ((brush.radius_px - radius).abs() > 1e-3 * radius).then(|| BrushSettings {
+            radius_px: radius,
+            ..brush.clone()
+        })
     }
 
     /// The `[` and `]` keys: the radius shrinks or grows by 1.25, on screen or in texels.
-    pub(super) fn scale_brush(
-        &mut self,
-        brush: &mut kapaint_core::model::brush::BrushSettings,
-        by: f32,
-    ) {
-        if self.tool_panel.brush_size.on_screen {
+    pub(crate) fn scale_brush(&mut self, brush: &mut BrushSettings, by: f32) {
+        if self.brush_size.on_screen {
             let size = BrushSize {
-                screen_radius: self.tool_panel.brush_size.screen_radius * by,
-                ..self.tool_panel.brush_size
+                screen_radius: self.brush_size.screen_radius * by,
+                ..self.brush_size
             };
             self.set_brush_size(size);
         } else {
@@ -112,12 +100,13 @@ impl EditorState {
 
     /// The brush radius row of the panel: in texels, or on screen with what it is in texels
     /// under the cursor.
-    pub(super) fn brush_radius_ui(
+    pub(crate) fn brush_radius_ui(
         &mut self,
         ui: &mut egui::Ui,
-        brush: &mut kapaint_core::model::brush::BrushSettings,
+        brush: &mut BrushSettings,
+        texels_per_point: Option<f32>,
     ) {
-        let mut size = self.tool_panel.brush_size;
+        let mut size = self.brush_size;
         if size.on_screen {
             ui.add(
                 egui::Slider::new(&mut size.screen_radius, SCREEN_RADIUS_RANGE)
@@ -141,12 +130,12 @@ impl EditorState {
                  rather than its size in texels",
                 );
             if size.on_screen
-                && let Some(texels) = self.screen_radius_in_texels()
+                && let Some(texels) = self.screen_radius_in_texels(texels_per_point)
             {
                 ui.weak(format!("= {texels:.1} texels here"));
             }
         });
-        if size != self.tool_panel.brush_size {
+        if size != self.brush_size {
             self.set_brush_size(size);
         }
     }

@@ -4,7 +4,8 @@
 
 use glam::Vec3;
 
-use crate::EditorState;
+use super::Desk;
+use super::tool_panel::ToolPanel;
 use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8, srgb_to_linear};
 
@@ -97,11 +98,18 @@ fn describe(v: &MaterialValue) -> String {
     )
 }
 
-impl EditorState {
+impl ToolPanel {
     /// The primary and secondary swatches (a click on the secondary swaps them) and the
-    /// primary's `k_d` in sRGB: hex, RGB 0-255 and HSV.
-    pub(super) fn colour_ui(&mut self, ui: &mut egui::Ui, primary: &mut MaterialValue) {
-        let secondary = self.doc.settings().secondary;
+    /// primary's `k_d` in sRGB: hex, RGB 0-255 and HSV. Whether the swatches were swapped
+    /// (`primary` is the secondary then).
+    pub(super) fn colour_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        primary: &mut MaterialValue,
+        desk: &mut Desk,
+    ) -> bool {
+        let secondary = desk.doc.settings().secondary;
+        let mut swapped = false;
         ui.horizontal(|ui| {
             swatch(ui, primary.kd, 28.0, "Primary")
                 .on_hover_text(format!("Primary: {}", describe(primary)));
@@ -109,15 +117,13 @@ impl EditorState {
                 .on_hover_text(format!("Secondary (X swaps): {}", describe(&secondary)))
                 .clicked()
             {
-                self.apply(SettingsCommand::SwapMaterials);
-                *primary = self.doc.settings().primary;
+                desk.command(SettingsCommand::SwapMaterials);
+                *primary = secondary;
+                swapped = true;
             }
             ui.label("Hex");
             let shown = hex_of(primary.kd);
-            let text = self
-                .tool_panel
-                .hex_text
-                .get_or_insert_with(|| shown.clone());
+            let text = self.hex_text.get_or_insert_with(|| shown.clone());
             let edit = ui.add(
                 egui::TextEdit::singleline(text)
                     .desired_width(64.0)
@@ -131,7 +137,7 @@ impl EditorState {
             }
             if !edit.has_focus() {
                 // Follows the colour whenever the field is not being typed in.
-                self.tool_panel.hex_text = Some(hex_of(primary.kd));
+                self.hex_text = Some(hex_of(primary.kd));
             }
         });
         let srgb = primary.kd.map(linear_to_srgb);
@@ -189,17 +195,18 @@ impl EditorState {
         } else if hsv_changed {
             primary.kd = srgb_of_hsv(hsv).map(srgb_to_linear);
         }
+        swapped
     }
 
     /// The materials used last (a click makes one the primary).
-    pub(super) fn recent_materials_ui(&mut self, ui: &mut egui::Ui) {
-        if self.tool_panel.recent_materials.is_empty() {
+    pub(super) fn recent_materials_ui(&self, ui: &mut egui::Ui, desk: &mut Desk) {
+        if self.recent_materials.is_empty() {
             return;
         }
         let mut chosen = None;
         ui.horizontal_wrapped(|ui| {
             ui.label("Recent");
-            for (i, value) in self.tool_panel.recent_materials.iter().enumerate() {
+            for (i, value) in self.recent_materials.iter().enumerate() {
                 if swatch(ui, value.kd, 18.0, &format!("Recent material {}", i + 1))
                     .on_hover_text(describe(value))
                     .clicked()
@@ -209,22 +216,16 @@ impl EditorState {
             }
         });
         if let Some(v) = chosen {
-            self.apply(SettingsCommand::SetPrimary(v));
+            desk.command(SettingsCommand::SetPrimary(v));
         }
     }
 
-    /// Puts the primary material first among the recent ones (a stroke, fill or gradient
-    /// has laid it).
-    pub(crate) fn remember_material(&mut self) {
-        let value = self.doc.settings().primary;
-        self.tool_panel.recent_materials.retain(|v| *v != value);
-        self.tool_panel.recent_materials.insert(0, value);
-        self.tool_panel.recent_materials.truncate(RECENT_MATERIALS);
-    }
-
-    /// The materials used last, newest first.
-    pub fn recent_materials(&self) -> &[MaterialValue] {
-        &self.tool_panel.recent_materials
+    /// Puts `value` first among the recent materials (a stroke, fill or gradient has laid
+    /// it).
+    pub(crate) fn remember_material(&mut self, value: MaterialValue) {
+        self.recent_materials.retain(|v| *v != value);
+        self.recent_materials.insert(0, value);
+        self.recent_materials.truncate(RECENT_MATERIALS);
     }
 }
 

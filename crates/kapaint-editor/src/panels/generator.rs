@@ -7,6 +7,7 @@ use kapaint_core::model::MaskCommand;
 use kapaint_core::model::generator::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
 use kapaint_core::model::layers::{Layer, thumbnail};
 
+use super::Desk;
 use super::presets::Naming;
 use crate::EditorState;
 
@@ -299,7 +300,11 @@ impl EditorState {
                 );
             }
             self.generator_thumb_ui(ui, layer);
-            self.naming_ui(ui, Naming::Mask, "Save as smart mask…");
+            let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+            self.presets
+                .naming_ui(ui, &mut desk, Naming::Mask, "Save as smart mask…");
+            let asks = desk.into_asks();
+            self.carry_out(asks);
         }
         for c in commands {
             self.apply(c);

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::{Ask, Desk};
 use crate::{EditorState, notice};
 use kapaint_core::model::SettingsCommand;
 use kapaint_core::model::brush::preset::{self as brush_preset, BrushPreset};
@@ -141,7 +142,11 @@ impl EditorState {
         if budget == 0 {
             ui.ctx().request_repaint();
         }
-        self.naming_ui(ui, Naming::Material, "Save primary as preset…");
+        let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        self.presets
+            .naming_ui(ui, &mut desk, Naming::Material, "Save primary as preset…");
+        let asks = desk.into_asks();
+        self.carry_out(asks);
         let mut chosen = None;
         // A few rows high, scrolled: the history below stays in view.
         egui::ScrollArea::vertical()
@@ -185,143 +190,6 @@ impl EditorState {
         }
     }
 
-    /// The brush presets: a choice applies one; the current settings can be saved as one.
-    pub(super) fn brush_presets_ui(&mut self, ui: &mut egui::Ui) {
-        let current = &self.doc.settings().brush;
-        let shown = self
-            .presets
-            .brushes
-            .iter()
-            .find(|p| p.brush == *current)
-            .map_or("(custom)", |p| p.name.as_str())
-            .to_string();
-        let mut chosen = None;
-        egui::ComboBox::from_label("Brush preset")
-            .selected_text(shown)
-            .show_ui(ui, |ui| {
-                for p in &self.presets.brushes {
-                    if ui.selectable_label(p.brush == *current, &p.name).clicked() {
-                        chosen = Some(p.brush.clone());
-                    }
-                }
-            });
-        if let Some(b) = chosen {
-            self.apply(SettingsCommand::SetBrush(b));
-        }
-        self.naming_ui(ui, Naming::Brush, "Save brush…");
-    }
-
-    /// A button that opens a name field, then saves what `kind` names under that name.
-    pub(super) fn naming_ui(&mut self, ui: &mut egui::Ui, kind: Naming, button: &str) {
-        match &mut self.presets.naming {
-            Some((k, name, just_opened)) if *k == kind => {
-                let mut save = false;
-                let mut cancel = false;
-                ui.horizontal(|ui| {
-                    let label = ui.label("Preset name");
-                    let field = ui
-                        .add(egui::TextEdit::singleline(name).desired_width(120.0))
-                        .labelled_by(label.id);
-                    if std::mem::take(just_opened) {
-                        field.request_focus();
-                    }
-                    save = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-                    save |= ui.button("Save").clicked();
-                    cancel = ui.button("Cancel").clicked();
-                });
-                if save {
-                    let name = name.clone();
-                    self.save_preset(kind, &name);
-                } else if cancel {
-                    self.presets.naming = None;
-                }
-            }
-            _ => {
-                if ui.button(button).clicked() {
-                    self.presets.naming = Some((kind, String::new(), true));
-                }
-            }
-        }
-    }
-
-    /// Saves the primary material or the brush as the user's preset `name` (the naming row
-    /// stays open on an error).
-    fn save_preset(&mut self, kind: Naming, name: &str) {
-        let saved = match kind {
-            Naming::Material => self
-                .presets
-                .dir
-                .clone()
-                .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
-                .and_then(|dir| {
-                    let value = self.doc.settings().primary;
-                    kapaint_core::model::preset::save_user(&dir, name, value)
-                        .map_err(|e| e.to_string())
-                        .map(|(stem, path)| {
-                            self.presets.materials.retain(|p| p.stem != stem);
-                            self.presets.materials.push(PresetEntry {
-                                stem,
-                                name: name.trim().to_string(),
-                                value: value.sanitized(),
-                                thumbnail: None,
-                            });
-                            path
-                        })
-                }),
-            Naming::Brush => self
-                .presets
-                .dir
-                .as_ref()
-                .map(|d| d.join("brushes"))
-                .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
-                .and_then(|dir| {
-                    let preset = BrushPreset {
-                        name: name.trim().to_string(),
-                        brush: self.doc.settings().brush.clone(),
-                    };
-                    let path = preset.save(&dir).map_err(|e| e.to_string())?;
-                    self.presets.brushes.retain(|p| p.name != preset.name);
-                    self.presets.brushes.push(preset);
-                    Ok(path)
-                }),
-            Naming::Mask => self
-                .presets
-                .dir
-                .as_ref()
-                .map(|d| d.join("masks"))
-                .ok_or_else(|| "there is no user preset folder (no HOME)".to_string())
-                .and_then(|dir| {
-                    let mask = self
-                        .doc
-                        .selected_layer()
-                        .and_then(|l| l.mask.as_ref())
-                        .and_then(|m| m.generator())
-                        .cloned()
-                        .ok_or("the selected layer's mask is not made by a generator")?;
-                    let preset = kapaint_core::model::generator::preset::MaskPreset {
-                        name: name.trim().to_string(),
-                        mask,
-                    };
-                    let path = preset.save(&dir).map_err(|e| e.to_string())?;
-                    self.presets.masks.retain(|p| p.name != preset.name);
-                    self.presets.masks.push(preset);
-                    Ok(path)
-                }),
-        };
-        match saved {
-            Ok(path) => {
-                self.presets.naming = None;
-                self.notices.push(notice(
-                    format!("Saved preset {:?} to {}", name.trim(), path.display()),
-                    false,
-                ));
-            }
-            Err(e) => self
-                .notices
-                .push(notice(format!("preset not saved: {e}"), true)),
-        }
-    }
-
     /// Saves presets into `dir` from now on (the user preset folder by default).
     pub fn set_preset_dir(&mut self, dir: std::path::PathBuf) {
         self.presets.dir = Some(dir);
@@ -352,6 +220,142 @@ impl EditorState {
             .iter()
             .map(|p| p.name.as_str())
             .collect()
+    }
+}
+
+impl Presets {
+    /// The brush presets: a choice applies one; the current settings can be saved as one.
+    pub(super) fn brush_ui(&mut self, ui: &mut egui::Ui, desk: &mut Desk) {
+        let current = &desk.doc.settings().brush;
+        let shown = self
+            .brushes
+            .iter()
+            .find(|p| p.brush == *current)
+            .map_or("(custom)", |p| p.name.as_str())
+            .to_string();
+        let mut chosen = None;
+        egui::ComboBox::from_label("Brush preset")
+            .selected_text(shown)
+            .show_ui(ui, |ui| {
+                for p in &self.brushes {
+                    if ui.selectable_label(p.brush == *current, &p.name).clicked() {
+                        chosen = Some(p.brush.clone());
+                    }
+                }
+            });
+        if let Some(b) = chosen {
+            desk.command(SettingsCommand::SetBrush(b));
+        }
+        self.naming_ui(ui, desk, Naming::Brush, "Save brush…");
+    }
+
+    /// A button that opens a name field, then saves what `kind` names under that name.
+    pub(super) fn naming_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        desk: &mut Desk,
+        kind: Naming,
+        button: &str,
+    ) {
+        match &mut self.naming {
+            Some((k, name, just_opened)) if *k == kind => {
+                let mut save = false;
+                let mut cancel = false;
+                ui.horizontal(|ui| {
+                    let label = ui.label("Preset name");
+                    let field = ui
+                        .add(egui::TextEdit::singleline(name).desired_width(120.0))
+                        .labelled_by(label.id);
+                    if std::mem::take(just_opened) {
+                        field.request_focus();
+                    }
+                    save = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    save |= ui.button("Save").clicked();
+                    cancel = ui.button("Cancel").clicked();
+                });
+                if save {
+                    let name = name.clone();
+                    self.save(desk, kind, &name);
+                } else if cancel {
+                    self.naming = None;
+                }
+            }
+            _ => {
+                if ui.button(button).clicked() {
+                    self.naming = Some((kind, String::new(), true));
+                }
+            }
+        }
+    }
+
+    /// Saves the primary material or the brush as the user's preset `name` (the naming row
+    /// stays open on an error).
+    fn save(&mut self, desk: &mut Desk, kind: Naming, name: &str) {
+        let doc = desk.doc;
+        let no_folder = || "there is no user preset folder (no HOME)".to_string();
+        let saved = match kind {
+            Naming::Material => self.dir.clone().ok_or_else(no_folder).and_then(|dir| {
+                let value = doc.settings().primary;
+                kapaint_core::model::preset::save_user(&dir, name, value)
+                    .map_err(|e| e.to_string())
+                    .map(|(stem, path)| {
+                        self.materials.retain(|p| p.stem != stem);
+                        self.materials.push(PresetEntry {
+                            stem,
+                            name: name.trim().to_string(),
+                            value: value.sanitized(),
+                            thumbnail: None,
+                        });
+                        path
+                    })
+            }),
+            Naming::Brush => self
+                .dir
+                .as_ref()
+                .map(|d| d.join("brushes"))
+                .ok_or_else(no_folder)
+                .and_then(|dir| {
+                    let preset = BrushPreset {
+                        name: name.trim().to_string(),
+                        brush: doc.settings().brush.clone(),
+                    };
+                    let path = preset.save(&dir).map_err(|e| e.to_string())?;
+                    self.brushes.retain(|p| p.name != preset.name);
+                    self.brushes.push(preset);
+                    Ok(path)
+                }),
+            Naming::Mask => self
+                .dir
+                .as_ref()
+                .map(|d| d.join("masks"))
+                .ok_or_else(no_folder)
+                .and_then(|dir| {
+                    let mask = doc
+                        .selected_layer()
+                        .and_then(|l| l.mask.as_ref())
+                        .and_then(|m| m.generator())
+                        .cloned()
+                        .ok_or("the selected layer's mask is not made by a generator")?;
+                    let preset = kapaint_core::model::generator::preset::MaskPreset {
+                        name: name.trim().to_string(),
+                        mask,
+                    };
+                    let path = preset.save(&dir).map_err(|e| e.to_string())?;
+                    self.masks.retain(|p| p.name != preset.name);
+                    self.masks.push(preset);
+                    Ok(path)
+                }),
+        };
+        match saved {
+            Ok(path) => {
+                self.naming = None;
+                desk.ask(Ask::Notice(notice(
+                    format!("Saved preset {:?} to {}", name.trim(), path.display()),
+                    false,
+                )));
+            }
+            Err(e) => desk.ask(Ask::Notice(notice(format!("preset not saved: {e}"), true))),
+        }
     }
 }
 

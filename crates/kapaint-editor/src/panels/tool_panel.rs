@@ -1,7 +1,9 @@
 //! The left panel: tools and their options, brush settings and stamp, material, channels.
 
+use super::presets::Presets;
+use super::{Ask, Desk};
 use crate::files::FilePurpose;
-use crate::{EditorState, stamp_image, stamp_key};
+use crate::{stamp_image, stamp_key};
 use kapaint_core::model::SettingsCommand;
 use kapaint_core::reflectance;
 use kapaint_core::tools::{OptionValue, OptionWidget, ToolOption};
@@ -22,42 +24,36 @@ pub(crate) struct ToolPanel {
     pub(crate) stamp_preview: Option<(u64, egui::TextureHandle)>,
 }
 
-impl EditorState {
+impl ToolPanel {
     /// The active tool's options, drawn from what the tool says they are.
-    fn tool_options_ui(&mut self, ui: &mut egui::Ui) {
-        let mut changed = Vec::new();
-        for option in self.tools.options(&self.doc) {
+    fn tool_options_ui(ui: &mut egui::Ui, desk: &mut Desk) {
+        for option in desk.tools.options(desk.doc) {
             if let Some(value) = option_ui(ui, &option) {
-                changed.push((option.id, value));
-            }
-        }
-        for (id, value) in changed {
-            for command in self.tools.set_option(id, value, &self.doc) {
-                self.apply(command);
+                desk.ask(Ask::ToolOption(option.id, value));
             }
         }
     }
 
     /// Left panel: tools, brush, material, channels.
-    pub(crate) fn tools_ui(&mut self, ui: &mut egui::Ui) {
+    pub(crate) fn ui(&mut self, ui: &mut egui::Ui, desk: &mut Desk, presets: &mut Presets) {
+        let doc = desk.doc;
         ui.heading("Tools");
-        let mut chosen = self.tools.active();
-        let tools: Vec<_> = self.tools.metas().collect();
+        let mut chosen = desk.tools.active();
         ui.horizontal_wrapped(|ui| {
-            for tool in tools {
+            for tool in desk.tools.metas() {
                 ui.selectable_value(&mut chosen, tool.kind, tool.label)
                     .on_hover_text(format!("{} ({})", tool.label, tool.key_help));
             }
         });
-        if chosen != self.tools.active() {
-            self.select_tool(chosen);
+        if chosen != desk.tools.active() {
+            desk.ask(Ask::SelectTool(chosen));
         }
-        self.tool_options_ui(ui);
+        Self::tool_options_ui(ui, desk);
         ui.separator();
         ui.heading("Brush settings");
-        self.brush_presets_ui(ui);
-        let mut brush = self.doc.settings().brush.clone();
-        self.brush_radius_ui(ui, &mut brush);
+        presets.brush_ui(ui, desk);
+        let mut brush = doc.settings().brush.clone();
+        self.brush_radius_ui(ui, &mut brush, desk.texels_per_point);
         ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
             .on_hover_text("Shift+[ and Shift+] change the hardness");
         ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
@@ -66,15 +62,19 @@ impl EditorState {
         ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
         ui.checkbox(&mut brush.pressure_size, "Pressure: size");
         ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
-        self.stamp_ui(ui, &mut brush);
+        self.stamp_ui(ui, &mut brush, desk);
         stroke_options_ui(ui, &mut brush);
-        if brush != self.doc.settings().brush {
-            self.apply(SettingsCommand::SetBrush(brush));
+        if brush != doc.settings().brush {
+            desk.command(SettingsCommand::SetBrush(brush));
         }
         ui.separator();
         ui.heading("Material");
-        let mut primary = self.doc.settings().primary;
-        self.colour_ui(ui, &mut primary);
+        // The primary as the frame's commands leave it (a swap makes the secondary it).
+        let mut before = doc.settings().primary;
+        let mut primary = before;
+        if self.colour_ui(ui, &mut primary, desk) {
+            before = primary;
+        }
         ui.horizontal(|ui| {
             let mut kd = primary.kd.to_array();
             egui::color_picker::color_edit_button_rgb(ui, &mut kd)
@@ -99,16 +99,16 @@ impl EditorState {
                 .logarithmic(true)
                 .text("n"),
         );
-        let model = self.doc.settings().model;
+        let model = doc.settings().model;
         let other = reflectance::equivalent::counterpart(model);
         // A root search over the lobes' integrals (about 4 ms): made again only when the
         // exponent or the model changes, not every frame.
         let key = (model, primary.n.to_bits());
-        let eq = match self.tool_panel.equivalent_n {
+        let eq = match self.equivalent_n {
             Some((k, eq)) if k == key => eq,
             _ => {
                 let eq = reflectance::equivalent::equivalent_exponent(model, f64::from(primary.n));
-                self.tool_panel.equivalent_n = Some((key, eq));
+                self.equivalent_n = Some((key, eq));
                 eq
             }
         };
@@ -117,27 +117,27 @@ impl EditorState {
             super::view_panel::model_label(other)
         ))
         .on_hover_text("The exponent of the other model with the closest highlight");
-        if primary != self.doc.settings().primary {
-            self.apply(SettingsCommand::SetPrimary(primary));
+        if primary != before {
+            desk.command(SettingsCommand::SetPrimary(primary));
         }
         if ui
             .button("Swap primary / secondary")
             .on_hover_text("X")
             .clicked()
         {
-            self.apply(SettingsCommand::SwapMaterials);
+            desk.command(SettingsCommand::SwapMaterials);
         }
-        self.recent_materials_ui(ui);
+        self.recent_materials_ui(ui, desk);
         ui.separator();
         ui.heading("Channels");
-        let mut ch = self.doc.settings().channels;
+        let mut ch = doc.settings().channels;
         ui.horizontal(|ui| {
             ui.checkbox(&mut ch.kd, "k_d");
             ui.checkbox(&mut ch.ks, "k_s");
             ui.checkbox(&mut ch.n, "n");
         });
-        if ch != self.doc.settings().channels {
-            self.apply(SettingsCommand::SetChannels(ch));
+        if ch != doc.settings().channels {
+            desk.command(SettingsCommand::SetChannels(ch));
         }
     }
 
@@ -147,6 +147,7 @@ impl EditorState {
         &mut self,
         ui: &mut egui::Ui,
         brush: &mut kapaint_core::model::brush::BrushSettings,
+        desk: &mut Desk,
     ) {
         ui.horizontal(|ui| {
             ui.label("Stamp");
@@ -156,21 +157,16 @@ impl EditorState {
                 }
                 Some(stamp) => {
                     let key = stamp_key(stamp);
-                    if self
-                        .tool_panel
-                        .stamp_preview
-                        .as_ref()
-                        .is_none_or(|(k, _)| *k != key)
-                    {
+                    if self.stamp_preview.as_ref().is_none_or(|(k, _)| *k != key) {
                         let image = stamp_image(stamp, 32);
                         let texture = ui.ctx().load_texture(
                             "brush stamp",
                             image,
                             egui::TextureOptions::LINEAR,
                         );
-                        self.tool_panel.stamp_preview = Some((key, texture));
+                        self.stamp_preview = Some((key, texture));
                     }
-                    if let Some((_, texture)) = &self.tool_panel.stamp_preview {
+                    if let Some((_, texture)) = &self.stamp_preview {
                         ui.image((texture.id(), egui::vec2(32.0, 32.0)))
                             .on_hover_text(format!("{}x{} stamp", stamp.width(), stamp.height()));
                     }
@@ -188,7 +184,7 @@ impl EditorState {
                 .on_hover_text("A stamp from an image (luminance times alpha)")
                 .clicked()
             {
-                self.choose_file(FilePurpose::StampImage);
+                desk.ask(Ask::ChooseFile(FilePurpose::StampImage));
             }
             if brush.stamp.is_some() && ui.button("Round").clicked() {
                 brush.stamp = None;
