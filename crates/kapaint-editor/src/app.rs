@@ -132,7 +132,7 @@ impl Editor {
                     dir: preset_dir,
                     naming: None,
                 },
-                layers_panel: super::panels::layers::PanelState::default(),
+                layers_panel: super::panels::layers::LayersPanel::default(),
                 preferences,
             },
             dock,
@@ -203,7 +203,7 @@ impl TabViewer for Tabs<'_> {
                 if std::mem::take(&mut s.viewport.untraced_requested) {
                     s.look.mode = s.look.mode.untraced();
                 }
-                s.painting_label(ui, rect);
+                s.layers_panel.painting_label(&s.doc, ui, rect);
                 s.viewport_input(&response, rect);
             }
             Tab::Canvas => {
@@ -222,7 +222,7 @@ impl TabViewer for Tabs<'_> {
                 let (response, rect) = s.canvas.show(ui, &s.doc, maps, &lines);
                 s.canvas.channel = channel;
                 s.mesh.uv_lines = lines;
-                s.painting_label(ui, rect);
+                s.layers_panel.painting_label(&s.doc, ui, rect);
                 s.canvas_input(&response, rect);
             }
             Tab::Layers => {

@@ -271,7 +271,10 @@ impl EditorState {
                 Action::Open => self.open_dialog(),
                 Action::New => self.new_project(),
                 Action::Export => self.open_export(),
-                Action::NewLayer => self.new_layer(kapaint_core::model::LayerKind::Paint),
+                Action::NewLayer => self.apply(crate::panels::layers::new_layer(
+                    &self.doc,
+                    kapaint_core::model::LayerKind::Paint,
+                )),
                 Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer),
                 Action::MergeDown => self.apply(LayerCommand::MergeDown),
                 Action::Quit => self.prompts.quit.asked = true,

@@ -197,7 +197,7 @@ pub struct EditorState {
     /// Material, brush and mask presets.
     presets: panels::presets::Presets,
     /// The Layers tab's thumbnails and rename, and the layer view chosen.
-    layers_panel: panels::layers::PanelState,
+    layers_panel: panels::layers::LayersPanel,
     /// The editor's settings that outlive a run (Edit > Preferences).
     preferences: preferences::Preferences,
 }
@@ -346,13 +346,8 @@ impl EditorState {
 
     /// What the viewport and canvas show of the layers: the chosen view, except that a mask
     /// tools paint shows alone, in grey, while the chosen view is the whole stack.
-    pub fn shown_layer_view(&self) -> panels::layers::LayerView {
-        use panels::layers::LayerView;
-        if self.doc.painting_mask() && self.layers_panel.view == LayerView::Composite {
-            LayerView::Mask
-        } else {
-            self.layers_panel.view
-        }
+    pub fn shown_layer_view(&self) -> LayerView {
+        self.layers_panel.shown_view(&self.doc)
     }
 
     /// Whether anything the project file stores (maps or settings) changed since the last
@@ -411,6 +406,20 @@ impl EditorState {
         self.carry_out(asks);
     }
 
+    /// The Layers tab (the panel asks, the editor carries it out).
+    fn layers_ui(&mut self, ui: &mut egui::Ui) {
+        let mut desk = panels::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        self.layers_panel.ui(ui, &mut desk, &mut self.presets);
+        let asks = desk.into_asks();
+        self.carry_out(asks);
+    }
+
+    /// What tools paint (a layer or its mask) and which layer view is shown, as the viewport
+    /// and canvas say it.
+    pub fn painting_text(&self) -> Option<String> {
+        self.layers_panel.painting_text(&self.doc)
+    }
+
     /// Carries out what a panel asked, in order.
     fn carry_out(&mut self, asks: Vec<panels::Ask>) {
         for ask in asks {
@@ -424,6 +433,7 @@ impl EditorState {
                 }
                 panels::Ask::ChooseFile(purpose) => self.choose_file(purpose),
                 panels::Ask::Notice(notice) => self.notices.push(notice),
+                panels::Ask::LayGenerator(generator) => self.set_generator_baking(generator),
             }
         }
     }

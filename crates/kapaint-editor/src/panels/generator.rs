@@ -3,13 +3,13 @@
 //! thumbnail, and the smart masks to apply or save. Dragging a parameter previews coarsely
 //! (`PreviewMaskGenerator`); letting go sets it (`SetMaskGenerator`), the drag one undo step.
 
-use kapaint_core::model::MaskCommand;
 use kapaint_core::model::generator::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
 use kapaint_core::model::layers::{Layer, thumbnail};
+use kapaint_core::model::{Document, MaskCommand};
 
-use super::Desk;
-use super::presets::Naming;
-use crate::EditorState;
+use super::layers::LayersPanel;
+use super::presets::{Naming, Presets};
+use super::{Ask, Desk};
 
 /// The live thumbnail's side in texels and on screen.
 const THUMB: u32 = 96;
@@ -229,9 +229,16 @@ fn parameters_ui(ui: &mut egui::Ui, g: &mut Generator, edit: &mut Edit) {
     }
 }
 
-impl EditorState {
+impl LayersPanel {
     /// What makes the selected layer's mask, its parameters and thumbnail, and smart masks.
-    pub(super) fn generator_ui(&mut self, ui: &mut egui::Ui, layer: &Layer) {
+    pub(super) fn generator_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        desk: &mut Desk,
+        layer: &Layer,
+        presets: &mut Presets,
+    ) {
+        let doc = desk.doc;
         let current = layer.mask.as_ref().and_then(|m| m.generator()).cloned();
         let mut commands = Vec::new();
         // A generator to lay, baking first what it reads and the project lacks.
@@ -256,14 +263,14 @@ impl EditorState {
             let mut chosen = None;
             egui::ComboBox::from_label("Smart mask")
                 .selected_text(
-                    self.presets
+                    presets
                         .masks
                         .iter()
                         .find(|p| Some(&p.mask) == current.as_ref())
                         .map_or("(apply one)", |p| p.name.as_str()),
                 )
                 .show_ui(ui, |ui| {
-                    for p in &self.presets.masks {
+                    for p in &presets.masks {
                         if ui.selectable_label(false, &p.name).clicked() {
                             chosen = Some(p.mask.clone());
                         }
@@ -282,7 +289,7 @@ impl EditorState {
             let missing: Vec<&str> = edited
                 .bakes_needed()
                 .into_iter()
-                .filter(|&m| self.doc.bake_of(m).is_none())
+                .filter(|&m| doc.bake_of(m).is_none())
                 .map(kapaint_core::mesh::bakes::BakeMap::name)
                 .collect();
             if edit.released || (edit.changed && (!edit.dragging || !missing.is_empty())) {
@@ -299,27 +306,23 @@ impl EditorState {
                     .weak(),
                 );
             }
-            self.generator_thumb_ui(ui, layer);
-            let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
-            self.presets
-                .naming_ui(ui, &mut desk, Naming::Mask, "Save as smart mask…");
-            let asks = desk.into_asks();
-            self.carry_out(asks);
+            self.generator_thumb_ui(ui, doc, layer);
+            presets.naming_ui(ui, desk, Naming::Mask, "Save as smart mask…");
         }
         for c in commands {
-            self.apply(c);
+            desk.command(c);
         }
         if let Some(g) = baking {
-            self.set_generator_baking(g);
+            desk.ask(Ask::LayGenerator(g));
         }
     }
 
     /// The selected layer's mask as it applies, made again when the document changes.
-    fn generator_thumb_ui(&mut self, ui: &mut egui::Ui, layer: &Layer) {
-        let version = (self.doc.instance(), self.doc.version());
-        let thumb = &mut self.layers_panel.generator_thumb;
+    fn generator_thumb_ui(&mut self, ui: &mut egui::Ui, doc: &Document, layer: &Layer) {
+        let version = (doc.instance(), doc.version());
+        let thumb = &mut self.generator_thumb;
         if thumb.as_ref().is_none_or(|(v, _)| *v != version)
-            && let Some(pixels) = thumbnail::mask(self.doc.stack(), layer, THUMB)
+            && let Some(pixels) = thumbnail::mask(doc.stack(), layer, THUMB)
         {
             let side = usize::try_from(THUMB).unwrap_or(1);
             let image =
@@ -340,10 +343,5 @@ impl EditorState {
                     .alt_text("The mask as it applies"),
             );
         }
-    }
-
-    /// The smart masks: shipped, then the user's.
-    pub fn mask_preset_names(&self) -> Vec<&str> {
-        self.presets.masks.iter().map(|p| p.name.as_str()).collect()
     }
 }

@@ -2,16 +2,24 @@
 //! modes, a fill layer's material, its mask's switches and the moves. Each change is a
 //! [`Command`].
 
-use crate::EditorState;
+use super::Desk;
+use super::layers::LayersPanel;
+use super::presets::Presets;
 use kapaint_core::model::layers::{Layer, LayerBlend, LayerContent};
 use kapaint_core::model::texel::{Channel, Channels};
 use kapaint_core::model::{Command, LayerMove};
 use kapaint_core::model::{LayerCommand, MaskCommand};
 
-impl EditorState {
+impl LayersPanel {
     /// The selected layer's name, opacity, channels and blends, fill material, mask and moves.
-    pub(super) fn selected_layer_ui(&mut self, ui: &mut egui::Ui) {
-        let Some(layer) = self.doc.selected_layer().cloned() else {
+    pub(super) fn selected_layer_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        desk: &mut Desk,
+        presets: &mut Presets,
+    ) {
+        let doc = desk.doc;
+        let Some(layer) = doc.selected_layer() else {
             ui.label("No layer is selected.");
             return;
         };
@@ -29,21 +37,25 @@ impl EditorState {
         {
             commands.push(LayerCommand::SetLayerOpacity(opacity / 100.0).into());
         }
-        commands.extend(channels_ui(ui, &layer).into_iter().map(Command::from));
+        commands.extend(channels_ui(ui, layer).into_iter().map(Command::from));
         if let LayerContent::Fill(value) = layer.content
             && ui
                 .button("Fill with the primary material")
                 .on_hover_text(format!("Now: n {:.0}", value.n))
                 .clicked()
         {
-            commands.push(LayerCommand::SetLayerFill(self.doc.settings().primary).into());
+            commands.push(LayerCommand::SetLayerFill(doc.settings().primary).into());
         }
         commands.extend(
-            mask_ui(ui, &layer, self.doc.painting_mask())
+            mask_ui(ui, layer, doc.painting_mask())
                 .into_iter()
                 .map(Command::from),
         );
-        self.generator_ui(ui, &layer);
+        // The generator's commands follow the ones above, in the order they were asked.
+        for c in commands.drain(..) {
+            desk.command(c);
+        }
+        self.generator_ui(ui, desk, layer, presets);
         ui.horizontal_wrapped(|ui| {
             for (text, m) in [
                 ("Up", LayerMove::Up),
@@ -63,7 +75,7 @@ impl EditorState {
             }
         });
         for c in commands {
-            self.apply(c);
+            desk.command(c);
         }
     }
 }

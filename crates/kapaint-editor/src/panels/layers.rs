@@ -13,7 +13,8 @@ use std::time::{Duration, Instant};
 
 use egui::{Color32, Rect, Sense, Vec2};
 
-use crate::EditorState;
+use super::Desk;
+use super::presets::Presets;
 use kapaint_core::model::layers::{Layer, LayerContent, thumbnail};
 use kapaint_core::model::{Command, Document, LayerKind, LayerPlace};
 use kapaint_core::model::{LayerCommand, MaskCommand};
@@ -94,9 +95,10 @@ impl LayerThumbs {
     }
 }
 
-/// The Layers tab's own state.
+/// The Layers tab: its own state (thumbnails, a rename under way, the layer view chosen), and
+/// what it draws from the document.
 #[derive(Default)]
-pub struct PanelState {
+pub struct LayersPanel {
     thumbs: LayerThumbs,
     /// A layer's new name being typed in its row.
     pub(super) rename: Option<Rename>,
@@ -127,30 +129,52 @@ enum RowAction {
     Drop(Vec<usize>, LayerPlace),
 }
 
-impl EditorState {
+/// A new layer of `kind`, named after how many layers there are.
+pub(crate) fn new_layer(doc: &Document, kind: LayerKind) -> LayerCommand {
+    let count = doc.stack().walk().len();
+    let name = match kind {
+        LayerKind::Paint => format!("Layer {}", count + 1),
+        LayerKind::Fill => format!("Fill {}", count + 1),
+        LayerKind::Group => format!("Group {}", count + 1),
+    };
+    LayerCommand::AddLayer { kind, name }
+}
+
+impl LayersPanel {
+    /// What the viewport and canvas show of the layers: the chosen view, except that a mask
+    /// tools paint shows alone, in grey, while the chosen view is the whole stack.
+    pub(crate) fn shown_view(&self, doc: &Document) -> LayerView {
+        if doc.painting_mask() && self.view == LayerView::Composite {
+            LayerView::Mask
+        } else {
+            self.view
+        }
+    }
+
     /// What tools paint (a layer or its mask) and which layer view is shown, as the viewport
     /// and canvas say it.
-    pub fn painting_text(&self) -> Option<String> {
-        let layer = self.doc.selected_layer()?;
-        let mut text = if self.doc.painting_mask() {
+    pub(crate) fn painting_text(&self, doc: &Document) -> Option<String> {
+        let layer = doc.selected_layer()?;
+        let mut text = if doc.painting_mask() {
             format!("Painting the mask of \"{}\"", layer.props.name)
         } else {
             format!("Painting \"{}\"", layer.props.name)
         };
-        if self.shown_layer_view() != LayerView::Composite {
+        let shown = self.shown_view(doc);
+        if shown != LayerView::Composite {
             text.push_str(" · showing ");
-            text.push_str(&self.shown_layer_view().label().to_lowercase());
+            text.push_str(&shown.label().to_lowercase());
         }
         Some(text)
     }
 
     /// Says in a corner of the viewport or canvas (`rect`) what tools paint (a layer or its
     /// mask) and which layer view is shown.
-    pub(crate) fn painting_label(&self, ui: &egui::Ui, rect: Rect) {
-        let Some(text) = self.painting_text() else {
+    pub(crate) fn painting_label(&self, doc: &Document, ui: &egui::Ui, rect: Rect) {
+        let Some(text) = self.painting_text(doc) else {
             return;
         };
-        let colour = if self.doc.painting_mask() {
+        let colour = if doc.painting_mask() {
             Color32::from_rgb(255, 200, 120)
         } else {
             Color32::from_gray(220)
@@ -167,33 +191,32 @@ impl EditorState {
     }
 
     /// The Layers tab.
-    pub(crate) fn layers_ui(&mut self, ui: &mut egui::Ui) {
-        if std::mem::take(&mut self.layers_panel.release_keyboard) {
+    pub(crate) fn ui(&mut self, ui: &mut egui::Ui, desk: &mut Desk, presets: &mut Presets) {
+        let doc = desk.doc;
+        if std::mem::take(&mut self.release_keyboard) {
             ui.memory_mut(egui::Memory::stop_text_input);
         }
-        self.layers_panel.thumbs.refresh(ui.ctx(), &self.doc);
-        self.layer_buttons_ui(ui);
+        self.thumbs.refresh(ui.ctx(), doc);
+        Self::layer_buttons_ui(ui, desk);
         ui.separator();
         let mut actions = Vec::new();
         // A rename of a layer that is gone (deleted, undone, another document opened) ends
         // with it.
-        let mut rename = self.layers_panel.rename.take().filter(|r| {
-            r.document == self.doc.instance() && self.doc.stack().path_of(r.id).is_some()
-        });
+        let mut rename = self
+            .rename
+            .take()
+            .filter(|r| r.document == doc.instance() && doc.stack().path_of(r.id).is_some());
         egui::ScrollArea::vertical()
             .id_salt("layers")
             .max_height((ui.available_height() - 230.0).max(120.0))
             .show(ui, |ui| {
-                let layers = &self.doc.stack().layers;
-                self.rows_ui(ui, layers, &[], &mut rename, &mut actions);
+                let layers = &doc.stack().layers;
+                self.rows_ui(ui, doc, layers, &[], &mut rename, &mut actions);
                 ui.label(
-                    egui::RichText::new(format!(
-                        "Base material (n {:.0})",
-                        self.doc.stack().base.n
-                    ))
-                    .weak(),
+                    egui::RichText::new(format!("Base material (n {:.0})", doc.stack().base.n))
+                        .weak(),
                 );
-                if let Some(normal) = self.doc.normal() {
+                if let Some(normal) = doc.normal() {
                     ui.label(
                         egui::RichText::new(format!(
                             "Normal map {}x{} (imported; lighting only, never in k_a)",
@@ -208,15 +231,16 @@ impl EditorState {
                     );
                 }
             });
-        self.layers_panel.rename = rename;
+        self.rename = rename;
         for (path, action) in actions {
-            self.row_action(path, action);
+            self.row_action(desk, path, action);
         }
         ui.separator();
-        self.selected_layer_ui(ui);
+        self.selected_layer_ui(ui, desk, presets);
     }
 
-    fn layer_buttons_ui(&mut self, ui: &mut egui::Ui) {
+    fn layer_buttons_ui(ui: &mut egui::Ui, desk: &mut Desk) {
+        let doc = desk.doc;
         ui.horizontal_wrapped(|ui| {
             let add = |ui: &mut egui::Ui, text: &str, tip: &str| {
                 ui.button(text).on_hover_text(tip).clicked()
@@ -226,48 +250,38 @@ impl EditorState {
                 "+ Paint",
                 "A new paint layer above the selected one (Ctrl+Shift+N)",
             ) {
-                self.new_layer(LayerKind::Paint);
+                desk.command(new_layer(doc, LayerKind::Paint));
             }
             if add(
                 ui,
                 "+ Fill",
                 "A fill layer of the primary material, shaped by its mask",
             ) {
-                self.new_layer(LayerKind::Fill);
+                desk.command(new_layer(doc, LayerKind::Fill));
             }
             if add(ui, "+ Group", "A new, empty group") {
-                self.new_layer(LayerKind::Group);
+                desk.command(new_layer(doc, LayerKind::Group));
             }
             if add(ui, "Duplicate", "Duplicate the selected layer (Ctrl+J)") {
-                self.apply(LayerCommand::DuplicateLayer);
+                desk.command(LayerCommand::DuplicateLayer);
             }
             if add(ui, "Delete", "Delete the selected layer") {
-                self.apply(LayerCommand::DeleteLayer);
+                desk.command(LayerCommand::DeleteLayer);
             }
             if add(ui, "Merge down", "Merge into the layer below (Ctrl+E)") {
-                self.apply(LayerCommand::MergeDown);
+                desk.command(LayerCommand::MergeDown);
             }
             if add(ui, "Flatten", "Every layer into one paint layer") {
-                self.apply(LayerCommand::Flatten);
+                desk.command(LayerCommand::Flatten);
             }
         });
-    }
-
-    /// Adds a layer of `kind`, named after how many layers there are.
-    pub(crate) fn new_layer(&mut self, kind: LayerKind) {
-        let count = self.doc.stack().walk().len();
-        let name = match kind {
-            LayerKind::Paint => format!("Layer {}", count + 1),
-            LayerKind::Fill => format!("Fill {}", count + 1),
-            LayerKind::Group => format!("Group {}", count + 1),
-        };
-        self.apply(LayerCommand::AddLayer { kind, name });
     }
 
     /// Rows of `layers` (top first), groups' children indented under them.
     fn rows_ui(
         &self,
         ui: &mut egui::Ui,
+        doc: &Document,
         layers: &[Layer],
         parent: &[usize],
         rename: &mut Option<Rename>,
@@ -275,11 +289,11 @@ impl EditorState {
     ) {
         for (i, layer) in layers.iter().enumerate().rev() {
             let path = [parent, &[i]].concat();
-            if let Some(action) = self.row_ui(ui, layer, &path, rename) {
+            if let Some(action) = self.row_ui(ui, doc, layer, &path, rename) {
                 actions.push((path.clone(), action));
             }
             if let LayerContent::Group(children) = &layer.content {
-                self.rows_ui(ui, children, &path, rename, actions);
+                self.rows_ui(ui, doc, children, &path, rename, actions);
             }
         }
     }
@@ -287,11 +301,12 @@ impl EditorState {
     fn row_ui(
         &self,
         ui: &mut egui::Ui,
+        doc: &Document,
         layer: &Layer,
         path: &[usize],
         rename: &mut Option<Rename>,
     ) -> Option<RowAction> {
-        let selected = self.doc.selected_id() == Some(layer.props.id);
+        let selected = doc.selected_id() == Some(layer.props.id);
         let mut action = None;
         let row = ui.horizontal(|ui| {
             ui.add_space(14.0 * (path.len() - 1) as f32);
@@ -322,8 +337,8 @@ impl EditorState {
             });
             let content = Self::thumb_ui(
                 ui,
-                self.layers_panel.thumbs.content.get(path),
-                selected && !self.doc.painting_mask(),
+                self.thumbs.content.get(path),
+                selected && !doc.painting_mask(),
                 &format!("Content of {}", p.name),
             );
             if content.clicked() {
@@ -335,8 +350,8 @@ impl EditorState {
             if let Some(mask) = &layer.mask {
                 let r = Self::thumb_ui(
                     ui,
-                    self.layers_panel.thumbs.masks.get(path),
-                    selected && self.doc.painting_mask(),
+                    self.thumbs.masks.get(path),
+                    selected && doc.painting_mask(),
                     &format!("Mask of {}", p.name),
                 )
                 .on_hover_text("Paint the mask (Alt + click: show it alone)");
@@ -354,13 +369,7 @@ impl EditorState {
             if let Some(a) = Self::name_ui(ui, layer, selected, rename) {
                 action = Some(a);
             }
-            let bytes = self
-                .layers_panel
-                .thumbs
-                .bytes
-                .get(path)
-                .copied()
-                .unwrap_or(0);
+            let bytes = self.thumbs.bytes.get(path).copied().unwrap_or(0);
             ui.label(
                 egui::RichText::new(super::view_panel::megabytes(bytes))
                     .weak()
@@ -422,51 +431,53 @@ impl EditorState {
         response
     }
 
-    fn row_action(&mut self, path: Vec<usize>, action: RowAction) {
+    /// What a row asked, as commands (read against the document as the frame found it).
+    fn row_action(&mut self, desk: &mut Desk, path: Vec<usize>, action: RowAction) {
+        let doc = desk.doc;
         match action {
             RowAction::Select { mask, alone } => {
-                self.apply(LayerCommand::SelectPath(path));
+                desk.command(LayerCommand::SelectPath(path));
                 if mask {
-                    self.apply(MaskCommand::SelectMask);
+                    desk.command(MaskCommand::SelectMask);
                 }
                 if alone {
-                    self.layers_panel.view = LayerView::Mask;
+                    self.view = LayerView::Mask;
                 }
             }
             RowAction::Toggle(command) => {
                 // The eye and the lock act on their row's layer, leaving the selection be.
-                let before = self.doc.selection();
-                self.apply(LayerCommand::SelectPath(path));
-                self.apply(command);
-                if self.doc.stack().layer(&before.path).is_some() {
-                    self.apply(LayerCommand::SelectPath(before.path));
+                let before = doc.selection();
+                desk.command(LayerCommand::SelectPath(path));
+                desk.command(command);
+                if doc.stack().layer(&before.path).is_some() {
+                    desk.command(LayerCommand::SelectPath(before.path));
                     if before.mask {
-                        self.apply(MaskCommand::SelectMask);
+                        desk.command(MaskCommand::SelectMask);
                     }
                 }
             }
             RowAction::Rename => {
-                self.apply(LayerCommand::SelectPath(path));
-                self.layers_panel.rename = self.doc.selected_layer().map(|l| Rename {
-                    document: self.doc.instance(),
+                self.rename = doc.stack().layer(&path).map(|l| Rename {
+                    document: doc.instance(),
                     id: l.props.id,
                     text: l.props.name.clone(),
                     focused: false,
                 });
+                desk.command(LayerCommand::SelectPath(path));
             }
             RowAction::Renamed { name, tabbed } => {
-                self.layers_panel.rename = None;
+                self.rename = None;
                 // Tab handed the keyboard to the next field: the next frame gives it back to
                 // the editor instead, so the shortcuts are live again.
-                self.layers_panel.release_keyboard = tabbed;
+                self.release_keyboard = tabbed;
                 if let Some(name) = name {
-                    self.apply(LayerCommand::SelectPath(path));
-                    self.apply(LayerCommand::RenameLayer(name));
+                    desk.command(LayerCommand::SelectPath(path));
+                    desk.command(LayerCommand::RenameLayer(name));
                 }
             }
             RowAction::Drop(from, place) => {
-                self.apply(LayerCommand::SelectPath(from));
-                self.apply(LayerCommand::MoveLayerTo {
+                desk.command(LayerCommand::SelectPath(from));
+                desk.command(LayerCommand::MoveLayerTo {
                     target: path,
                     place,
                 });

@@ -45,6 +45,9 @@ pub(crate) enum Ask {
     ChooseFile(FilePurpose),
     /// Show a message.
     Notice(Notice),
+    /// Lay this generator as the selected layer's mask, baking first what it reads and the
+    /// project lacks.
+    LayGenerator(kapaint_core::model::generator::Generator),
 }
 
 impl<'a> Desk<'a> {

@@ -213,6 +213,11 @@ impl EditorState {
             .collect()
     }
 
+    /// The smart masks: shipped, then the user's.
+    pub fn mask_preset_names(&self) -> Vec<&str> {
+        self.presets.masks.iter().map(|p| p.name.as_str()).collect()
+    }
+
     /// The brush presets' names.
     pub fn brush_preset_names(&self) -> Vec<&str> {
         self.presets

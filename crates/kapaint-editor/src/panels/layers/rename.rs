@@ -2,8 +2,8 @@
 
 use kapaint_core::model::layers::{Layer, LayerId};
 
+use super::LayersPanel;
 use super::RowAction;
-use crate::EditorState;
 
 /// A layer's name being typed in place of its label in the list: Enter, Tab or a click
 /// elsewhere commits it, Escape cancels, and the keyboard is the editor's again either way.
@@ -18,7 +18,7 @@ pub(in crate::panels) struct Rename {
     pub(super) focused: bool,
 }
 
-impl EditorState {
+impl LayersPanel {
     /// The layer's name in its row: a label to select (double-click renames), or the field
     /// of a rename under way.
     pub(super) fn name_ui(
