@@ -203,7 +203,7 @@ pub struct EditorState {
 }
 
 /// How the viewport shades and where its light comes from.
-struct Look {
+pub(crate) struct Look {
     /// View mode of the viewport.
     mode: ViewMode,
     /// Lights (relative to the camera while `light_follows_camera`).
@@ -420,6 +420,24 @@ impl EditorState {
         self.layers_panel.painting_text(&self.doc)
     }
 
+    /// The right panel: shading, compare, view, light, material presets, history (the panel
+    /// asks, the editor carries it out).
+    fn view_ui(&mut self, ui: &mut egui::Ui) {
+        let frame = self.frame_settings();
+        let mut desk = panels::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut shown = panels::view_panel::Shown {
+            look: &mut self.look,
+            comparison: &mut self.viewport.comparison,
+            layers: &mut self.layers_panel.view,
+            canvas: &mut self.canvas,
+        };
+        let (gpu, mesh) = (&mut self.viewport.gpu, &self.mesh);
+        let mut thumbnail = |value| panels::view_panel::thumbnail(gpu.as_mut(), mesh, frame, value);
+        shown.ui(ui, &mut desk, &mut self.presets, (mesh.id, &mut thumbnail));
+        let asks = desk.into_asks();
+        self.carry_out(asks);
+    }
+
     /// Carries out what a panel asked, in order.
     fn carry_out(&mut self, asks: Vec<panels::Ask>) {
         for ask in asks {
@@ -434,6 +452,7 @@ impl EditorState {
                 panels::Ask::ChooseFile(purpose) => self.choose_file(purpose),
                 panels::Ask::Notice(notice) => self.notices.push(notice),
                 panels::Ask::LayGenerator(generator) => self.set_generator_baking(generator),
+                panels::Ask::LightFollowsCamera(follow) => self.set_light_follows_camera(follow),
             }
         }
     }

@@ -9,7 +9,7 @@ mod layer_settings;
 pub mod layers;
 pub(super) mod presets;
 pub(super) mod tool_panel;
-mod view_panel;
+pub(super) mod view_panel;
 
 pub(super) use bars::channel_label;
 
@@ -48,6 +48,8 @@ pub(crate) enum Ask {
     /// Lay this generator as the selected layer's mask, baking first what it reads and the
     /// project lacks.
     LayGenerator(kapaint_core::model::generator::Generator),
+    /// Make the light follow the camera, or stay put in the world.
+    LightFollowsCamera(bool),
 }
 
 impl<'a> Desk<'a> {

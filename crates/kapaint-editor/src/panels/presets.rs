@@ -116,80 +116,6 @@ pub(crate) fn load_brush_presets(
 }
 
 impl EditorState {
-    /// The material presets: thumbnails with their names (a click makes one the primary),
-    /// and saving the primary as a preset of the user's.
-    pub(super) fn presets_ui(&mut self, ui: &mut egui::Ui) {
-        // A few thumbnails per frame keep the first frames fast.
-        // A thumbnail of another mesh (before New, Open or a mesh import) is drawn again.
-        let mut budget = 3;
-        let mesh = self.mesh.id;
-        for i in 0..self.presets.materials.len() {
-            let stale = self.presets.materials[i]
-                .thumbnail
-                .as_ref()
-                .is_none_or(|(id, _)| *id != mesh);
-            if stale && budget > 0 {
-                budget -= 1;
-                let image = self.thumbnail(self.presets.materials[i].value);
-                let texture = ui.ctx().load_texture(
-                    format!("preset {}", self.presets.materials[i].stem),
-                    image,
-                    egui::TextureOptions::LINEAR,
-                );
-                self.presets.materials[i].thumbnail = Some((mesh, texture));
-            }
-        }
-        if budget == 0 {
-            ui.ctx().request_repaint();
-        }
-        let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
-        self.presets
-            .naming_ui(ui, &mut desk, Naming::Material, "Save primary as preset…");
-        let asks = desk.into_asks();
-        self.carry_out(asks);
-        let mut chosen = None;
-        // A few rows high, scrolled: the history below stays in view.
-        egui::ScrollArea::vertical()
-            .id_salt("material presets")
-            .max_height(200.0)
-            .show(ui, |ui| {
-                ui.horizontal_wrapped(|ui| {
-                    for p in &self.presets.materials {
-                        ui.allocate_ui(egui::vec2(58.0, 62.0), |ui| {
-                            ui.vertical_centered(|ui| {
-                                let response = match &p.thumbnail {
-                                    Some((_, t)) => ui.add(egui::Button::image(
-                                        egui::Image::from_texture(
-                                            egui::load::SizedTexture::from_handle(t),
-                                        )
-                                        .fit_to_exact_size(egui::vec2(40.0, 40.0)),
-                                    )),
-                                    None => ui.add_sized([48.0, 48.0], egui::Button::new("…")),
-                                };
-                                let v = p.value;
-                                if response
-                                    .on_hover_text(format!(
-                                        "{}: k_d {:.2} {:.2} {:.2}, k_s {:.2}, n {:.0}",
-                                        p.name, v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n
-                                    ))
-                                    .clicked()
-                                {
-                                    chosen = Some(v);
-                                }
-                                ui.add(
-                                    egui::Label::new(egui::RichText::new(&p.name).small())
-                                        .truncate(),
-                                );
-                            });
-                        });
-                    }
-                });
-            });
-        if let Some(v) = chosen {
-            self.apply(SettingsCommand::SetPrimary(v));
-        }
-    }
-
     /// Saves presets into `dir` from now on (the user preset folder by default).
     pub fn set_preset_dir(&mut self, dir: std::path::PathBuf) {
         self.presets.dir = Some(dir);
@@ -229,6 +155,81 @@ impl EditorState {
 }
 
 impl Presets {
+    /// The material presets: thumbnails with their names (a click makes one the primary),
+    /// and saving the primary as a preset of the user's.
+    pub(super) fn materials_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        desk: &mut Desk,
+        mesh: u64,
+        thumbnail: &mut dyn FnMut(MaterialValue) -> egui::ColorImage,
+    ) {
+        // A few thumbnails per frame keep the first frames fast.
+        // A thumbnail of another mesh (before New, Open or a mesh import) is drawn again.
+        let mut budget = 3;
+        for i in 0..self.materials.len() {
+            let stale = self.materials[i]
+                .thumbnail
+                .as_ref()
+                .is_none_or(|(id, _)| *id != mesh);
+            if stale && budget > 0 {
+                budget -= 1;
+                let image = thumbnail(self.materials[i].value);
+                let texture = ui.ctx().load_texture(
+                    format!("preset {}", self.materials[i].stem),
+                    image,
+                    egui::TextureOptions::LINEAR,
+                );
+                self.materials[i].thumbnail = Some((mesh, texture));
+            }
+        }
+        if budget == 0 {
+            ui.ctx().request_repaint();
+        }
+        self.naming_ui(ui, desk, Naming::Material, "Save primary as preset…");
+        let mut chosen = None;
+        // A few rows high, scrolled: the history below stays in view.
+        egui::ScrollArea::vertical()
+            .id_salt("material presets")
+            .max_height(200.0)
+            .show(ui, |ui| {
+                ui.horizontal_wrapped(|ui| {
+                    for p in &self.materials {
+                        ui.allocate_ui(egui::vec2(58.0, 62.0), |ui| {
+                            ui.vertical_centered(|ui| {
+                                let response = match &p.thumbnail {
+                                    Some((_, t)) => ui.add(egui::Button::image(
+                                        egui::Image::from_texture(
+                                            egui::load::SizedTexture::from_handle(t),
+                                        )
+                                        .fit_to_exact_size(egui::vec2(40.0, 40.0)),
+                                    )),
+                                    None => ui.add_sized([48.0, 48.0], egui::Button::new("…")),
+                                };
+                                let v = p.value;
+                                if response
+                                    .on_hover_text(format!(
+                                        "{}: k_d {:.2} {:.2} {:.2}, k_s {:.2}, n {:.0}",
+                                        p.name, v.kd.x, v.kd.y, v.kd.z, v.ks.x, v.n
+                                    ))
+                                    .clicked()
+                                {
+                                    chosen = Some(v);
+                                }
+                                ui.add(
+                                    egui::Label::new(egui::RichText::new(&p.name).small())
+                                        .truncate(),
+                                );
+                            });
+                        });
+                    }
+                });
+            });
+        if let Some(v) = chosen {
+            desk.command(SettingsCommand::SetPrimary(v));
+        }
+    }
+
     /// The brush presets: a choice applies one; the current settings can be saved as one.
     pub(super) fn brush_ui(&mut self, ui: &mut egui::Ui, desk: &mut Desk) {
         let current = &desk.doc.settings().brush;

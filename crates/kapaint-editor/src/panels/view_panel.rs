@@ -2,21 +2,36 @@
 
 use std::sync::Arc;
 
-use crate::EditorState;
-use crate::canvas::CanvasChannel;
+use super::presets::Presets;
+use super::{Ask, Desk};
+use crate::canvas::{Canvas, CanvasChannel};
 use crate::layer_view::LayerView;
-use crate::viewport::Compare;
+use crate::viewport::{Compare, Comparison, ViewportGpu};
+use crate::{Look, MeshState};
 use kapaint_core::model::texel::MaterialValue;
 use kapaint_core::model::{HistoryCommand, SettingsCommand};
 use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
 use kapaint_core::render::{FrameSettings, ViewMode};
 
-impl EditorState {
+/// What the right panel changes of how the editor shows the document (none of it is the
+/// document's: no undo step, not saved).
+pub(crate) struct Shown<'a> {
+    /// How the viewport shades and lights.
+    pub(crate) look: &'a mut Look,
+    /// What the viewport compares.
+    pub(crate) comparison: &'a mut Comparison,
+    /// The layer view chosen.
+    pub(crate) layers: &'a mut LayerView,
+    /// What the canvas shows.
+    pub(crate) canvas: &'a mut Canvas,
+}
+
+impl Shown<'_> {
     /// Compare controls: the mode, then each side's model and approximation, the divider or
     /// the heatmap's scale.
     fn compare_ui(&mut self, ui: &mut egui::Ui) {
         ui.heading("Compare");
-        let c = &mut self.viewport.comparison;
+        let c = &mut *self.comparison;
         ui.horizontal_wrapped(|ui| {
             for (mode, label) in Compare::ALL {
                 ui.selectable_value(&mut c.mode, mode, label);
@@ -88,7 +103,7 @@ impl EditorState {
     }
 
     /// The light: yaw and pitch in degrees, following the camera, intensities.
-    fn light_ui(&mut self, ui: &mut egui::Ui) {
+    fn light_ui(&mut self, ui: &mut egui::Ui, desk: &mut Desk) {
         ui.heading("Light");
         // Shown and edited in degrees, as artists think of angles; kept as a direction.
         let (yaw, pitch) = self.look.lighting.angles();
@@ -109,16 +124,24 @@ impl EditorState {
             )
             .changed()
         {
-            self.set_light_follows_camera(follow);
+            desk.ask(Ask::LightFollowsCamera(follow));
         }
         ui.add(egui::Slider::new(&mut self.look.lighting.ia, 0.0..=2.0).text("Ambient I_a"));
         ui.add(egui::Slider::new(&mut self.look.lighting.il, 0.0..=4.0).text("Light I_l"));
     }
 
-    /// Right panel: model, view, compare, light, canvas channel, history.
-    pub(crate) fn view_ui(&mut self, ui: &mut egui::Ui) {
+    /// Right panel: model, view, compare, light, canvas channel, material presets (with their
+    /// thumbnails, drawn by `thumbnail` on mesh `mesh`), history.
+    pub(crate) fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        desk: &mut Desk,
+        presets: &mut Presets,
+        (mesh, thumbnail): (u64, &mut dyn FnMut(MaterialValue) -> egui::ColorImage),
+    ) {
+        let doc = desk.doc;
         ui.heading("Shading");
-        let mut model = self.doc.settings().model;
+        let mut model = doc.settings().model;
         // The paper's models on one row, the others below: rows of fixed content keep the
         // panel's width the same from the first frame on.
         let (paper, others): (Vec<_>, Vec<_>) = ShadingModel::ALL
@@ -131,10 +154,10 @@ impl EditorState {
                 }
             });
         }
-        if model != self.doc.settings().model {
-            self.apply(SettingsCommand::SetModel(model));
+        if model != doc.settings().model {
+            desk.command(SettingsCommand::SetModel(model));
         }
-        let mut approx = self.doc.settings().approx;
+        let mut approx = doc.settings().approx;
         ui.add_enabled_ui(model.has_paper_forms(), |ui| {
             egui::ComboBox::from_label("Approximation")
                 .selected_text(approx.for_model(model).name())
@@ -149,8 +172,8 @@ impl EditorState {
             "The paper printed no approximation for Cook-Torrance: its k_a always uses \
              kapaint's fit (within 2e-5 of the exact integral)",
         );
-        if approx != self.doc.settings().approx {
-            self.apply(SettingsCommand::SetApprox(approx));
+        if approx != doc.settings().approx {
+            desk.command(SettingsCommand::SetApprox(approx));
         }
         self.compare_ui(ui);
         ui.heading("View");
@@ -165,11 +188,11 @@ impl EditorState {
                 }
             });
         egui::ComboBox::from_label("Layers shown")
-            .selected_text(self.layers_panel.view.label())
+            .selected_text(self.layers.label())
             .width(COMBO_WIDTH)
             .show_ui(ui, |ui| {
                 for v in LayerView::ALL {
-                    ui.selectable_value(&mut self.layers_panel.view, v, v.label());
+                    ui.selectable_value(&mut *self.layers, v, v.label());
                 }
             })
             .response
@@ -180,108 +203,102 @@ impl EditorState {
                 for c in CanvasChannel::ALL {
                     ui.selectable_value(&mut self.canvas.channel, c, c.label());
                 }
-                for b in self.doc.bakes() {
+                for b in doc.bakes() {
                     let c = CanvasChannel::Bake(b.map);
                     ui.selectable_value(&mut self.canvas.channel, c, c.label());
                 }
             });
         ui.checkbox(&mut self.canvas.wireframe, "UV wireframe");
-        self.light_ui(ui);
+        self.light_ui(ui, desk);
         egui::CollapsingHeader::new("Material presets")
             .default_open(true)
-            .show(ui, |ui| self.presets_ui(ui));
+            .show(ui, |ui| presets.materials_ui(ui, desk, mesh, thumbnail));
         ui.heading("History");
         ui.label(history_summary(
-            self.doc.history().undo_steps().count(),
-            self.doc.history().bytes(),
+            doc.history().undo_steps().count(),
+            doc.history().bytes(),
         ));
-        self.history_list_ui(ui);
+        history_list_ui(ui, desk);
     }
+}
 
-    /// The steps, oldest first: a click jumps to the state after a step (undone steps stay
-    /// listed, greyed, until a new edit drops them); "Original" is the state before them.
-    fn history_list_ui(&mut self, ui: &mut egui::Ui) {
-        let history = self.doc.history();
-        let applied = history.undo_steps().count();
-        let mut jump = None;
-        egui::ScrollArea::vertical()
-            .id_salt("history")
-            .max_height(160.0)
-            .stick_to_bottom(true)
-            .show(ui, |ui| {
-                if ui
-                    .selectable_label(applied == 0, "Original")
-                    .on_hover_text("Before the oldest step kept")
-                    .clicked()
-                {
-                    jump = Some(0);
+/// The steps, oldest first: a click jumps to the state after a step (undone steps stay
+/// listed, greyed, until a new edit drops them); "Original" is the state before them.
+fn history_list_ui(ui: &mut egui::Ui, desk: &mut Desk) {
+    let history = desk.doc.history();
+    let applied = history.undo_steps().count();
+    let mut jump = None;
+    egui::ScrollArea::vertical()
+        .id_salt("history")
+        .max_height(160.0)
+        .stick_to_bottom(true)
+        .show(ui, |ui| {
+            if ui
+                .selectable_label(applied == 0, "Original")
+                .on_hover_text("Before the oldest step kept")
+                .clicked()
+            {
+                jump = Some(0);
+            }
+            for (i, step) in history.undo_steps().chain(history.redo_steps()).enumerate() {
+                let text = format!("{}. {} · {} KB", i + 1, step.label, step.bytes() / 1024);
+                let text = if i < applied {
+                    egui::RichText::new(text)
+                } else {
+                    egui::RichText::new(text).weak().italics()
+                };
+                let response = ui.selectable_label(i + 1 == applied, text);
+                let response = if i < applied {
+                    response
+                } else {
+                    response.on_hover_text("Undone: a click redoes up to here")
+                };
+                if response.clicked() {
+                    jump = Some(i + 1);
                 }
-                for (i, step) in history.undo_steps().chain(history.redo_steps()).enumerate() {
-                    let text = format!("{}. {} · {} KB", i + 1, step.label, step.bytes() / 1024);
-                    let text = if i < applied {
-                        egui::RichText::new(text)
-                    } else {
-                        egui::RichText::new(text).weak().italics()
-                    };
-                    let response = ui.selectable_label(i + 1 == applied, text);
-                    let response = if i < applied {
-                        response
-                    } else {
-                        response.on_hover_text("Undone: a click redoes up to here")
-                    };
-                    if response.clicked() {
-                        jump = Some(i + 1);
-                    }
-                }
-            });
-        if let Some(n) = jump {
-            self.apply(HistoryCommand::HistoryJump(n));
-        }
+            }
+        });
+    if let Some(n) = jump {
+        desk.command(HistoryCommand::HistoryJump(n));
     }
+}
 
-    /// Renders a thumbnail: on the GPU with the preview renderer, else with the CPU reference
-    /// renderer (the same shading, ray traced).
-    pub(super) fn thumbnail(&mut self, value: MaterialValue) -> egui::ColorImage {
-        const SIZE: u32 = 56;
-        let camera = kapaint_core::render::Camera::default()
-            .orbit(0.5, 0.35)
-            .framing(&self.mesh.mesh.positions);
-        let settings = FrameSettings {
-            camera,
-            view: ViewMode::Shaded,
-            ..self.frame_settings()
-        };
-        let mesh = (self.mesh.id, Arc::clone(&self.mesh.mesh));
-        if let Some(image) = self
-            .viewport
-            .gpu
-            .as_mut()
-            .and_then(|g| g.thumbnail(&mesh, value, &settings, SIZE))
-        {
-            return image;
-        }
-        let material =
-            kapaint_core::render::reference::Material::Uniform(kapaint_core::render::Sample {
-                kd: value.kd,
-                ks: value.ks,
-                n: value.n,
-            });
-        let pixels = kapaint_core::render::reference::render(
-            &self.mesh.mesh,
-            &self.mesh.bvh,
-            &material,
-            &settings,
-            SIZE,
-            SIZE,
-        );
-        let c =
-            |x: f32| (kapaint_core::model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
-        let rgba: Vec<u8> = pixels
-            .iter()
-            .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])
-            .collect();
-        egui::ColorImage::from_rgba_unmultiplied([SIZE as usize; 2], &rgba)
+/// Renders a material preset's thumbnail on `mesh`, lit as `frame`: on the GPU with the
+/// preview renderer, else with the CPU reference renderer (the same shading, ray traced).
+pub(crate) fn thumbnail(
+    gpu: Option<&mut ViewportGpu>,
+    mesh: &MeshState,
+    frame: FrameSettings,
+    value: MaterialValue,
+) -> egui::ColorImage {
+    const SIZE: u32 = 56;
+    let camera = kapaint_core::render::Camera::default()
+        .orbit(0.5, 0.35)
+        .framing(&mesh.mesh.positions);
+    let settings = FrameSettings {
+        camera,
+        view: ViewMode::Shaded,
+        ..frame
+    };
+    let shown = (mesh.id, Arc::clone(&mesh.mesh));
+    if let Some(image) = gpu.and_then(|g| g.thumbnail(&shown, value, &settings, SIZE)) {
+        return image;
     }
+    let material =
+        kapaint_core::render::reference::Material::Uniform(kapaint_core::render::Sample {
+            kd: value.kd,
+            ks: value.ks,
+            n: value.n,
+        });
+    let pixels = kapaint_core::render::reference::render(
+        &mesh.mesh, &mesh.bvh, &material, &settings, SIZE, SIZE,
+    );
+    let c = |x: f32| (kapaint_core::model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
+    let rgba: Vec<u8> = pixels
+        .iter()
+        .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])
+        .collect();
+    egui::ColorImage::from_rgba_unmultiplied([SIZE as usize; 2], &rgba)
 }
 
 /// The width of the right panel's drop-down menus: wide enough for the longest entry
