@@ -1,6 +1,7 @@
 //! An editor panel is a unit (issue 55, item 3): the editor's state is a few parts that own
 //! their own state, not one struct that takes in every feature, and a job hands its own typed
 //! result to the function its starter names, not a variant of one enum that one match reads.
+//! A tool's options are its own type (item 5), never a string id.
 
 #![expect(
     clippy::expect_used,
@@ -71,6 +72,27 @@ fn jobs_report_through_their_own_types() {
         found.is_empty(),
         "one enum for every job's result (each job names its result type and the function \
          that takes it): {found:?}"
+    );
+}
+
+#[test]
+fn tool_options_are_typed_per_tool() {
+    let mut files = Vec::new();
+    product_sources::files(&root().join("crates"), "rs", &mut files);
+    let mut found = Vec::new();
+    for file in files {
+        let text = std::fs::read_to_string(&file).expect("a source file");
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            if code.contains("OptionValue") || code.contains("fn set_option(&mut self, id: &str") {
+                found.push(format!("{}:{}", file.display(), i + 1));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "a tool option set by a string id and an untyped value (each tool's options are its own \
+         type inside OptionChange): {found:?}"
     );
 }
 

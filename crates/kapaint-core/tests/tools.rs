@@ -16,7 +16,7 @@ use kapaint_core::model::texel::{Channel, MaterialValue, Texel};
 use kapaint_core::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
 use kapaint_core::model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint_core::tools::{
-    Fill, FillMode, Gradient, OptionValue, OptionWidget, Place, ToolEvent, ToolKind, Tools,
+    Fill, FillMode, Gradient, OptionWidget, Place, ToolEvent, ToolKind, Tools,
 };
 
 fn document() -> Document {
@@ -426,16 +426,14 @@ fn every_tool_describes_itself_and_its_options_drive_it() {
     tools.select(ToolKind::FILL, &doc);
     let options = tools.options(&doc);
     assert_eq!(options.len(), 1, "island mode shows only the mode");
-    assert!(
-        tools
-            .set_option("mode", OptionValue::Choice(1), &doc)
-            .is_empty()
-    );
-    let ids: Vec<_> = tools.options(&doc).iter().map(|o| o.id).collect();
-    assert_eq!(ids, ["mode", "channel", "tolerance"]);
-    tools.set_option("channel", OptionValue::Choice(2), &doc);
-    tools.set_option("tolerance", OptionValue::Number(0.2), &doc);
-    tools.set_option("tolerance", OptionValue::Number(f32::NAN), &doc);
+    assert!(choose(&mut tools, &doc, "Similar texels").is_empty());
+    let labels: Vec<_> = tools.options(&doc).iter().map(|o| o.label).collect();
+    assert_eq!(labels, ["Fill", "Compared channel", "Tolerance"]);
+    choose(&mut tools, &doc, "n");
+    slide(&mut tools, &doc, "Tolerance", 0.2);
+    slide(&mut tools, &doc, "Tolerance", f32::NAN);
+    // Choosing the mode it has keeps its parameters.
+    choose(&mut tools, &doc, "Similar texels");
     assert_eq!(
         tools.handle(press(10.0, 10.0), &doc),
         vec![Command::from(PaintCommand::Fill(FillRegion::Similar {
@@ -447,7 +445,7 @@ fn every_tool_describes_itself_and_its_options_drive_it() {
     );
     // The blur's radius is a brush setting: the option answers with the command.
     tools.select(ToolKind::BLUR, &doc);
-    let commands = tools.set_option("radius", OptionValue::Number(7.4), &doc);
+    let commands = slide(&mut tools, &doc, "Blur radius", 7.4);
     for c in commands {
         doc.apply(c).expect("radius");
     }
@@ -460,7 +458,7 @@ fn every_tool_describes_itself_and_its_options_drive_it() {
     assert!((value - 7.0).abs() < 1e-6);
     // The gradient's shape and its overlay while dragged.
     tools.select(ToolKind::GRADIENT, &doc);
-    tools.set_option("shape", OptionValue::Choice(1), &doc);
+    choose(&mut tools, &doc, "Radial");
     assert_eq!(tools.overlay(), None);
     tools.handle(press(10.0, 10.0), &doc);
     tools.handle(
@@ -488,7 +486,7 @@ fn every_tool_describes_itself_and_its_options_drive_it() {
     assert!(tools.lays_material(&laid[0]));
     // The picker reads the selected layer when asked.
     tools.select(ToolKind::PICKER, &doc);
-    tools.set_option("from", OptionValue::Choice(1), &doc);
+    choose(&mut tools, &doc, "Selected layer");
     assert_eq!(
         tools.handle(press(3.0, 4.0), &doc),
         vec![Command::from(PaintCommand::PickLayer { x: 3, y: 4 })]
@@ -500,4 +498,33 @@ fn every_tool_describes_itself_and_its_options_drive_it() {
         tools.get_mut::<Fill>().map(|f| f.mode),
         Some(FillMode::Similar { .. })
     ));
+}
+
+/// Makes the change the active tool's choice named `name` offers, as the panel does.
+fn choose(tools: &mut Tools, doc: &Document, name: &str) -> Vec<Command> {
+    let change = tools
+        .options(doc)
+        .into_iter()
+        .find_map(|o| match o.widget {
+            OptionWidget::Choice { choices, .. } => choices
+                .into_iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, c)| c),
+            OptionWidget::Slider { .. } => None,
+        })
+        .expect("the tool offers the choice");
+    tools.set_option(change, doc)
+}
+
+/// Sets the active tool's slider labelled `label` to `value`, as the panel does.
+fn slide(tools: &mut Tools, doc: &Document, label: &str, value: f32) -> Vec<Command> {
+    let change = tools
+        .options(doc)
+        .into_iter()
+        .find_map(|o| match o.widget {
+            OptionWidget::Slider { change, .. } if o.label == label => Some(change(value)),
+            _ => None,
+        })
+        .expect("the tool offers the slider");
+    tools.set_option(change, doc)
 }

@@ -444,8 +444,8 @@ impl EditorState {
             match ask {
                 panels::Ask::Command(command) => self.apply(command),
                 panels::Ask::SelectTool(kind) => self.select_tool(kind),
-                panels::Ask::ToolOption(id, value) => {
-                    for command in self.tools.set_option(id, value, &self.doc) {
+                panels::Ask::ToolOption(change) => {
+                    for command in self.tools.set_option(change, &self.doc) {
                         self.apply(command);
                     }
                 }

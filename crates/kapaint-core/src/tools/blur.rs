@@ -4,8 +4,15 @@ use crate::model::{Command, Document, SettingsCommand, StrokeTool};
 
 use super::stroke::{Stroke, StrokeState};
 use super::{
-    OptionValue, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+    OptionChange, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
 };
+
+/// A change to the blur tool's options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BlurOption {
+    /// The kernel's radius in texels, `[1, 16]` (rounded).
+    Radius(f32),
+}
 
 /// The blur tool: a stroke from press to release, one undo step, abandoned by Escape.
 #[derive(Clone, Debug)]
@@ -52,7 +59,6 @@ impl Tool for Blur {
     /// The kernel's radius, a brush setting of the document.
     fn options(&self, doc: &Document) -> Vec<ToolOption> {
         vec![ToolOption {
-            id: "radius",
             label: "Blur radius",
             hover: "Kernel radius in texels",
             widget: OptionWidget::Slider {
@@ -60,14 +66,18 @@ impl Tool for Blur {
                 min: 1.0,
                 max: 16.0,
                 integer: true,
+                change: |r| OptionChange::Blur(BlurOption::Radius(r)),
             },
         }]
     }
 
-    fn set_option(&mut self, id: &str, value: OptionValue, doc: &Document) -> Vec<Command> {
-        let (&"radius", OptionValue::Number(r)) = (&id, value) else {
+    fn set_option(&mut self, change: OptionChange, doc: &Document) -> Vec<Command> {
+        let OptionChange::Blur(BlurOption::Radius(r)) = change else {
             return Vec::new();
         };
+        if !r.is_finite() {
+            return Vec::new();
+        }
         let mut brush = doc.settings().brush.clone();
         brush.blur_radius_px = r.round().clamp(1.0, 16.0) as u32;
         if brush == doc.settings().brush {

@@ -5,7 +5,7 @@ use crate::model::texel::Channel;
 use crate::model::{Command, Document, FillRegion};
 
 use super::{
-    OptionValue, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+    OptionChange, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
 };
 
 /// What a fill covers.
@@ -72,10 +72,36 @@ impl ToolKind {
     pub const FILL: Self = Self("fill");
 }
 
-/// The fill modes as the panel names them, in [`FillMode`]'s order.
-const MODES: &[&str] = &["UV island (or all)", "Similar texels", "Whole map"];
-/// The channels as the panel names them, in [`Channel::ALL`]'s order.
-const CHANNELS: &[&str] = &["k_d", "k_s", "n"];
+/// A change to the fill tool's options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FillOption {
+    /// What a fill covers (a fill of similar texels starts comparing `k_d` within 0.05).
+    Mode(FillKind),
+    /// The channel a fill of similar texels compares.
+    Channel(Channel),
+    /// The largest difference a fill of similar texels still fills, `[0, 1]`.
+    Tolerance(f32),
+}
+
+/// A channel as the panel names it.
+fn channel_label(channel: Channel) -> &'static str {
+    match channel {
+        Channel::Kd => "k_d",
+        Channel::Ks => "k_s",
+        Channel::N => "n",
+    }
+}
+
+/// What a fill covers, without its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FillKind {
+    /// [`FillMode::Island`].
+    Island,
+    /// [`FillMode::Similar`].
+    Similar,
+    /// [`FillMode::All`].
+    All,
+}
 
 impl Tool for Fill {
     fn meta(&self) -> ToolMeta {
@@ -101,29 +127,34 @@ impl Tool for Fill {
             FillMode::Similar { .. } => 1,
             FillMode::All => 2,
         };
+        let mode = |name, kind| (name, OptionChange::Fill(FillOption::Mode(kind)));
         let mut options = vec![ToolOption {
-            id: "mode",
             label: "Fill",
             hover: "",
             widget: OptionWidget::Choice {
-                choices: MODES,
+                choices: vec![
+                    mode("UV island (or all)", FillKind::Island),
+                    mode("Similar texels", FillKind::Similar),
+                    mode("Whole map", FillKind::All),
+                ],
                 chosen,
                 dropdown: true,
             },
         }];
         if let FillMode::Similar { channel, tolerance } = self.mode {
             options.push(ToolOption {
-                id: "channel",
                 label: "Compared channel",
                 hover: "",
                 widget: OptionWidget::Choice {
-                    choices: CHANNELS,
+                    choices: Channel::ALL
+                        .iter()
+                        .map(|&c| (channel_label(c), OptionChange::Fill(FillOption::Channel(c))))
+                        .collect(),
                     chosen: Channel::ALL.iter().position(|&c| c == channel).unwrap_or(0),
                     dropdown: true,
                 },
             });
             options.push(ToolOption {
-                id: "tolerance",
                 label: "Tolerance",
                 hover: "The largest difference still filled, in blend space",
                 widget: OptionWidget::Slider {
@@ -131,33 +162,39 @@ impl Tool for Fill {
                     min: 0.0,
                     max: 1.0,
                     integer: false,
+                    change: |t| OptionChange::Fill(FillOption::Tolerance(t)),
                 },
             });
         }
         options
     }
 
-    fn set_option(&mut self, id: &str, value: OptionValue, _doc: &Document) -> Vec<Command> {
-        match (id, value, &mut self.mode) {
-            ("mode", OptionValue::Choice(0), mode) => *mode = FillMode::Island,
-            ("mode", OptionValue::Choice(1), mode @ (FillMode::Island | FillMode::All)) => {
+    fn set_option(&mut self, change: OptionChange, _doc: &Document) -> Vec<Command> {
+        let OptionChange::Fill(option) = change else {
+            return Vec::new();
+        };
+        match (option, &mut self.mode) {
+            (FillOption::Mode(FillKind::Island), mode) => *mode = FillMode::Island,
+            (FillOption::Mode(FillKind::Similar), mode @ (FillMode::Island | FillMode::All)) => {
                 *mode = FillMode::Similar {
                     channel: Channel::Kd,
                     tolerance: 0.05,
                 };
             }
-            ("mode", OptionValue::Choice(2), mode) => *mode = FillMode::All,
-            ("channel", OptionValue::Choice(i), FillMode::Similar { channel, .. }) => {
-                if let Some(&c) = Channel::ALL.get(i) {
-                    *channel = c;
+            (FillOption::Mode(FillKind::All), mode) => *mode = FillMode::All,
+            (FillOption::Channel(c), FillMode::Similar { channel, .. }) => *channel = c,
+            (FillOption::Tolerance(t), FillMode::Similar { tolerance, .. }) => {
+                if t.is_finite() {
+                    *tolerance = t.clamp(0.0, 1.0);
                 }
             }
-            ("tolerance", OptionValue::Number(t), FillMode::Similar { tolerance, .. })
-                if t.is_finite() =>
-            {
-                *tolerance = t.clamp(0.0, 1.0);
-            }
-            _ => {}
+            // Similar texels already: its channel and tolerance stay. A channel or tolerance
+            // only means something to a fill of similar texels.
+            (FillOption::Mode(FillKind::Similar), FillMode::Similar { .. })
+            | (
+                FillOption::Channel(_) | FillOption::Tolerance(_),
+                FillMode::Island | FillMode::All,
+            ) => {}
         }
         Vec::new()
     }

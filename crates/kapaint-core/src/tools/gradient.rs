@@ -10,7 +10,8 @@ use crate::model::paint::GradientShape;
 use crate::model::{Command, Document};
 
 use super::{
-    OptionValue, OptionWidget, Overlay, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+    OptionChange, OptionWidget, Overlay, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta,
+    ToolOption,
 };
 
 /// The gradient tool, its shape, and the drag under way.
@@ -42,8 +43,12 @@ impl ToolKind {
     pub const GRADIENT: Self = Self("gradient");
 }
 
-/// The shapes as the panel names them.
-const SHAPES: &[&str] = &["Linear", "Radial"];
+/// A change to the gradient tool's options.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GradientOption {
+    /// Its shape.
+    Shape(GradientShape),
+}
 
 impl Tool for Gradient {
     fn meta(&self) -> ToolMeta {
@@ -73,23 +78,24 @@ impl Tool for Gradient {
     }
 
     fn options(&self, _doc: &Document) -> Vec<ToolOption> {
+        let shape = |name, s| (name, OptionChange::Gradient(GradientOption::Shape(s)));
         vec![ToolOption {
-            id: "shape",
             label: "",
             hover: "",
             widget: OptionWidget::Choice {
-                choices: SHAPES,
+                choices: vec![
+                    shape("Linear", GradientShape::Linear),
+                    shape("Radial", GradientShape::Radial),
+                ],
                 chosen: usize::from(self.shape == GradientShape::Radial),
                 dropdown: false,
             },
         }]
     }
 
-    fn set_option(&mut self, id: &str, value: OptionValue, _doc: &Document) -> Vec<Command> {
-        match (id, value) {
-            ("shape", OptionValue::Choice(0)) => self.shape = GradientShape::Linear,
-            ("shape", OptionValue::Choice(1)) => self.shape = GradientShape::Radial,
-            _ => {}
+    fn set_option(&mut self, change: OptionChange, _doc: &Document) -> Vec<Command> {
+        if let OptionChange::Gradient(GradientOption::Shape(shape)) = change {
+            self.shape = shape;
         }
         Vec::new()
     }

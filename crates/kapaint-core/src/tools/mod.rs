@@ -16,12 +16,12 @@ mod gradient;
 mod picker;
 mod stroke;
 
-pub use blur::Blur;
+pub use blur::{Blur, BlurOption};
 pub use brush::Brush;
 pub use eraser::Eraser;
-pub use fill::{Fill, FillMode};
-pub use gradient::Gradient;
-pub use picker::Picker;
+pub use fill::{Fill, FillMode, FillOption};
+pub use gradient::{Gradient, GradientOption};
+pub use picker::{Picker, PickerOption};
 
 use std::any::Any;
 
@@ -120,9 +120,9 @@ pub trait Tool: Any + std::fmt::Debug {
         Vec::new()
     }
 
-    /// Sets the option `id` (one of [`Tool::options`]); the commands it takes, if the option
-    /// lives in the document (a brush setting).
-    fn set_option(&mut self, _id: &str, _value: OptionValue, _doc: &Document) -> Vec<Command> {
+    /// Makes a change one of its [`Tool::options`] offered; the commands it takes, if the
+    /// option lives in the document (a brush setting). Another tool's change does nothing.
+    fn set_option(&mut self, _change: OptionChange, _doc: &Document) -> Vec<Command> {
         Vec::new()
     }
 }
@@ -178,11 +178,10 @@ pub enum Overlay {
     },
 }
 
-/// One of a tool's options, as the panel shows it.
-#[derive(Clone, Debug, PartialEq)]
+/// One of a tool's options, as the panel shows it: its control, and the typed change each
+/// of the control's values makes.
+#[derive(Clone, Debug)]
 pub struct ToolOption {
-    /// What [`Tool::set_option`] calls it.
-    pub id: &'static str,
     /// Its label (empty: none).
     pub label: &'static str,
     /// Its tooltip (empty: none).
@@ -191,13 +190,13 @@ pub struct ToolOption {
     pub widget: OptionWidget,
 }
 
-/// An option's control.
-#[derive(Clone, Debug, PartialEq)]
+/// An option's control; each value it offers is the change it makes.
+#[derive(Clone, Debug)]
 pub enum OptionWidget {
     /// One of a few named choices.
     Choice {
-        /// The choices' names.
-        choices: &'static [&'static str],
+        /// The choices: each one's name and the change choosing it makes.
+        choices: Vec<(&'static str, OptionChange)>,
         /// The one chosen.
         chosen: usize,
         /// A drop-down list (else a row of buttons).
@@ -213,16 +212,23 @@ pub enum OptionWidget {
         max: f32,
         /// Whole numbers only.
         integer: bool,
+        /// The change setting it to a value makes.
+        change: fn(f32) -> OptionChange,
     },
 }
 
-/// A value the panel sets an option to.
+/// A change to one of a tool's options, in the tool's own type (as Graphite's per-tool
+/// option updates): a tool answers its own with an exhaustive match, never a string.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum OptionValue {
-    /// The index of a choice.
-    Choice(usize),
-    /// A number.
-    Number(f32),
+pub enum OptionChange {
+    /// The fill tool's.
+    Fill(FillOption),
+    /// The blur tool's.
+    Blur(BlurOption),
+    /// The gradient tool's.
+    Gradient(GradientOption),
+    /// The picker's.
+    Picker(PickerOption),
 }
 
 /// Every tool, in the order the editor lists them: adding a tool is its file and one line here.
@@ -316,10 +322,10 @@ impl Tools {
         self.active_tool().options(doc)
     }
 
-    /// Sets one of the active tool's options; the commands it takes.
-    pub fn set_option(&mut self, id: &str, value: OptionValue, doc: &Document) -> Vec<Command> {
+    /// Makes a change one of the active tool's options offered; the commands it takes.
+    pub fn set_option(&mut self, change: OptionChange, doc: &Document) -> Vec<Command> {
         let active = self.active;
-        self.tools[active].set_option(id, value, doc)
+        self.tools[active].set_option(change, doc)
     }
 
     /// The tool of type `T`, to read or set its state directly (tests, presets).

@@ -5,7 +5,7 @@ use crate::model::PaintCommand;
 use crate::model::{Command, Document};
 
 use super::{
-    OptionValue, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+    OptionChange, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
 };
 
 /// The picker tool.
@@ -20,8 +20,12 @@ impl ToolKind {
     pub const PICKER: Self = Self("picker");
 }
 
-/// Where the picker reads, as the panel names it.
-const SOURCES: &[&str] = &["All layers", "Selected layer"];
+/// A change to the picker's options.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PickerOption {
+    /// Read the selected layer (`true`) or the composite.
+    FromLayer(bool),
+}
 
 impl Tool for Picker {
     fn meta(&self) -> ToolMeta {
@@ -36,21 +40,21 @@ impl Tool for Picker {
     }
 
     fn options(&self, _doc: &Document) -> Vec<ToolOption> {
+        let from = |name, layer| (name, OptionChange::Picker(PickerOption::FromLayer(layer)));
         vec![ToolOption {
-            id: "from",
             label: "",
             hover: "Read the composite, or what the selected layer holds",
             widget: OptionWidget::Choice {
-                choices: SOURCES,
+                choices: vec![from("All layers", false), from("Selected layer", true)],
                 chosen: usize::from(self.from_layer),
                 dropdown: false,
             },
         }]
     }
 
-    fn set_option(&mut self, id: &str, value: OptionValue, _doc: &Document) -> Vec<Command> {
-        if let ("from", OptionValue::Choice(i @ (0 | 1))) = (id, value) {
-            self.from_layer = i == 1;
+    fn set_option(&mut self, change: OptionChange, _doc: &Document) -> Vec<Command> {
+        if let OptionChange::Picker(PickerOption::FromLayer(layer)) = change {
+            self.from_layer = layer;
         }
         Vec::new()
     }

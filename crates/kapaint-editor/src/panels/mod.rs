@@ -14,7 +14,7 @@ pub(super) mod view_panel;
 pub(super) use bars::channel_label;
 
 use kapaint_core::model::{Command, Document};
-use kapaint_core::tools::{OptionValue, ToolKind, Tools};
+use kapaint_core::tools::{OptionChange, ToolKind, Tools};
 
 use crate::Notice;
 use crate::files::FilePurpose;
@@ -40,7 +40,7 @@ pub(crate) enum Ask {
     /// Make this the active tool.
     SelectTool(ToolKind),
     /// Set one of the active tool's options.
-    ToolOption(&'static str, OptionValue),
+    ToolOption(OptionChange),
     /// Open the file chooser for this.
     ChooseFile(FilePurpose),
     /// Show a message.

@@ -6,7 +6,7 @@ use crate::files::FilePurpose;
 use crate::{stamp_image, stamp_key};
 use kapaint_core::model::SettingsCommand;
 use kapaint_core::reflectance;
-use kapaint_core::tools::{OptionValue, OptionWidget, ToolOption};
+use kapaint_core::tools::{OptionChange, OptionWidget, ToolOption};
 
 /// The tool panel's own state.
 #[derive(Default)]
@@ -29,7 +29,7 @@ impl ToolPanel {
     fn tool_options_ui(ui: &mut egui::Ui, desk: &mut Desk) {
         for option in desk.tools.options(desk.doc) {
             if let Some(value) = option_ui(ui, &option) {
-                desk.ask(Ask::ToolOption(option.id, value));
+                desk.ask(Ask::ToolOption(value));
             }
         }
     }
@@ -241,8 +241,8 @@ fn blend_label(mode: kapaint_core::model::brush::BlendMode) -> &'static str {
     }
 }
 
-/// One tool option's control; the value it was set to this frame, if it changed.
-fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionValue> {
+/// One tool option's control; the change it was given this frame, if any.
+fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionChange> {
     let (value, response) = match &option.widget {
         OptionWidget::Choice {
             choices,
@@ -251,11 +251,11 @@ fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionValue> {
         } => {
             let mut picked = *chosen;
             let response = if *dropdown {
-                let name = choices.get(*chosen).copied().unwrap_or_default();
+                let name = choices.get(*chosen).map_or("", |(n, _)| *n);
                 egui::ComboBox::from_label(option.label)
                     .selected_text(name)
                     .show_ui(ui, |ui| {
-                        for (i, choice) in choices.iter().enumerate() {
+                        for (i, (choice, _)) in choices.iter().enumerate() {
                             ui.selectable_value(&mut picked, i, *choice);
                         }
                     })
@@ -265,14 +265,17 @@ fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionValue> {
                     if !option.label.is_empty() {
                         ui.label(option.label);
                     }
-                    for (i, choice) in choices.iter().enumerate() {
+                    for (i, (choice, _)) in choices.iter().enumerate() {
                         ui.selectable_value(&mut picked, i, *choice);
                     }
                 })
                 .response
             };
             (
-                (picked != *chosen).then_some(OptionValue::Choice(picked)),
+                choices
+                    .get(picked)
+                    .filter(|_| picked != *chosen)
+                    .map(|(_, change)| *change),
                 response,
             )
         }
@@ -281,11 +284,12 @@ fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionValue> {
             min,
             max,
             integer,
+            change,
         } => {
             let mut v = value;
             let slider = egui::Slider::new(&mut v, min..=max).text(option.label);
             let response = ui.add(if integer { slider.integer() } else { slider });
-            ((v != value).then_some(OptionValue::Number(v)), response)
+            ((v != value).then(|| change(v)), response)
         }
     };
     if !option.hover.is_empty() {
