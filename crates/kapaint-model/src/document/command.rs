@@ -77,7 +77,8 @@ pub enum Command {
 }
 
 /// Commands that change the tool settings (no undo step: they are not part of the material).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SettingsCommand {
     /// Replaces the brush settings (sanitised).
     SetBrush(BrushSettings),
@@ -96,7 +97,8 @@ pub enum SettingsCommand {
 }
 
 /// Strokes: each is one undo step.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum StrokeCommand {
     /// Starts a stroke (one undo step).
     BeginStroke(StrokeTool),
@@ -125,7 +127,8 @@ pub enum StrokeCommand {
 }
 
 /// The one-click tools.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum PaintCommand {
     /// Fills with the primary material.
     Fill(FillRegion),
@@ -134,8 +137,10 @@ pub enum PaintCommand {
         /// Linear or radial.
         shape: GradientShape,
         /// Start point in texel units.
+        #[serde(deserialize_with = "crate::check::finite_vec2")]
         start: Vec2,
         /// End point in texel units.
+        #[serde(deserialize_with = "crate::check::finite_vec2")]
         end: Vec2,
     },
     /// Reads every channel at a texel into the primary material.
@@ -181,7 +186,8 @@ pub enum ImportCommand {
 }
 
 /// Moves through the undo history.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum HistoryCommand {
     /// Undoes the last step.
     Undo,
@@ -193,13 +199,15 @@ pub enum HistoryCommand {
 }
 
 /// The layer stack: selection, properties and structure; each change is one undo step.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum LayerCommand {
     /// Adds a layer above the selected one (in its group) and selects it.
     AddLayer {
         /// Paint, fill (the primary material) or group.
         kind: LayerKind,
         /// Its name.
+        #[serde(deserialize_with = "crate::check::layer_name")]
         name: String,
     },
     /// Selects a layer by index (0: the bottom of the top level), name (the topmost of that
@@ -208,13 +216,13 @@ pub enum LayerCommand {
     /// Selects the layer at a path of indices into groups (the Layers panel).
     SelectPath(Vec<usize>),
     /// Sets the selected layer's opacity (clamped to `[0, 1]`).
-    SetLayerOpacity(f32),
+    SetLayerOpacity(#[serde(deserialize_with = "crate::check::layer_opacity")] f32),
     /// Shows or hides the selected layer.
     SetLayerVisible(bool),
     /// Locks or unlocks the selected layer against painting.
     SetLayerLocked(bool),
     /// Renames the selected layer.
-    RenameLayer(String),
+    RenameLayer(#[serde(deserialize_with = "crate::check::layer_name")] String),
     /// Sets the blend mode of one of the selected layer's channels.
     SetLayerBlend {
         /// The channel.
@@ -250,7 +258,8 @@ pub enum LayerCommand {
 }
 
 /// The selected layer's mask; each change is one undo step.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum MaskCommand {
     /// Adds a white mask to the selected layer.
     AddMask,
@@ -272,15 +281,20 @@ pub enum MaskCommand {
         /// The channel read.
         channel: Channel,
         /// The threshold.
+        #[serde(deserialize_with = "crate::check::finite_f32")]
         threshold: f32,
     },
     /// Makes the selected layer's mask by a generator (a mask is added if the layer has
     /// none), keeping what is painted over the generator it had; `None` turns the mask back
     /// into pixels, keeping what it showed.
-    SetMaskGenerator(Option<crate::generator::Generator>),
+    SetMaskGenerator(
+        #[serde(deserialize_with = "super::script::mask_generator")]
+        Option<crate::generator::Generator>,
+    ),
     /// The editor's drag of a generator parameter: the mask made coarsely by `generator`
     /// (one value per 4 x 4 texels), joining the step of the previews before it; the
     /// `SetMaskGenerator` that ends the drag joins it too.
+    #[serde(skip_deserializing)]
     PreviewMaskGenerator(crate::generator::Generator),
 }
 

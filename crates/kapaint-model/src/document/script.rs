@@ -1,172 +1,281 @@
-//! The names scripts give commands: one flat list, as the script format has always had it
-//! (`SetPrimary((...))`, `AddLayer(kind: Paint, name: "dirt")`), read into the room each
-//! belongs to. The script format is a contract: a name here never changes meaning.
+//! The names scripts give commands: each room's own serde form (`SetPrimary((...))`,
+//! `AddLayer(kind: Paint, name: "dirt")`), read flat, without the room. A script names a
+//! command by its variant's name in its room ([`SettingsCommand`], [`StrokeCommand`], ...);
+//! which room a name belongs to comes from the rooms' derived forms themselves, so there is
+//! no list to keep. The script format is a contract: a name never changes meaning.
+//! [`ImportCommand`](super::command::ImportCommand)s have no script form (their content comes
+//! from a decoder or a worker), nor has the editor's `PreviewMaskGenerator`.
 
-use glam::Vec2;
-use serde::Deserialize;
+use std::sync::OnceLock;
+
+use serde::de::{self, Deserialize, DeserializeSeed, Deserializer, EnumAccess, IntoDeserializer};
 
 use super::command::{
-    Command, FillRegion, HistoryCommand, LayerCommand, LayerKind, LayerMove, LayerPlace, LayerRef,
-    MaskCommand, PaintCommand, SettingsCommand, StrokeCommand, StrokeTool,
+    Command, HistoryCommand, LayerCommand, MaskCommand, PaintCommand, SettingsCommand,
+    StrokeCommand,
 };
-use crate::brush::{BrushSettings, StrokePoint, SurfacePoint};
-use crate::paint::GradientShape;
-use crate::texel::{Channel, Channels, MaterialValue};
-use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
-/// A command as a script names it (see [`Command`] for what each does; the commands made by
-/// workers from files have no script name).
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) enum ScriptCommand {
-    SetBrush(BrushSettings),
-    SetPrimary(MaterialValue),
-    SetSecondary(MaterialValue),
-    SwapMaterials,
-    SetChannels(Channels),
-    SetModel(ShadingModel),
-    SetApprox(AmbientApprox),
-    BeginStroke(StrokeTool),
-    StrokeTo(StrokePoint),
-    EndStroke,
-    AbortStroke,
-    Stroke {
-        tool: StrokeTool,
-        points: Vec<StrokePoint>,
-    },
-    SurfaceStrokeTo(SurfacePoint),
-    SurfaceStroke {
-        tool: StrokeTool,
-        points: Vec<SurfacePoint>,
-    },
-    Fill(FillRegion),
-    Gradient {
-        shape: GradientShape,
-        #[serde(deserialize_with = "crate::check::finite_vec2")]
-        start: Vec2,
-        #[serde(deserialize_with = "crate::check::finite_vec2")]
-        end: Vec2,
-    },
-    Pick {
-        x: u32,
-        y: u32,
-    },
-    PickLayer {
-        x: u32,
-        y: u32,
-    },
-    Undo,
-    Redo,
-    HistoryJump(usize),
-    AddLayer {
-        kind: LayerKind,
-        #[serde(deserialize_with = "crate::check::layer_name")]
-        name: String,
-    },
-    SelectLayer(LayerRef),
-    SelectPath(Vec<usize>),
-    SetLayerOpacity(#[serde(deserialize_with = "crate::check::layer_opacity")] f32),
-    SetLayerVisible(bool),
-    SetLayerLocked(bool),
-    RenameLayer(#[serde(deserialize_with = "crate::check::layer_name")] String),
-    SetLayerBlend {
-        channel: Channel,
-        mode: crate::layers::LayerBlend,
-    },
-    SetLayerChannels(Channels),
-    SetLayerFill(MaterialValue),
-    MoveLayer(LayerMove),
-    MoveLayerTo {
-        target: Vec<usize>,
-        place: LayerPlace,
-    },
-    DeleteLayer,
-    DuplicateLayer,
-    MergeDown,
-    Flatten,
-    AddMask,
-    DeleteMask,
-    ApplyMask,
-    SelectMask,
-    SelectContent,
-    InvertMask,
-    SetMaskEnabled(bool),
-    MaskFromChannel {
-        channel: Channel,
-        #[serde(deserialize_with = "crate::check::finite_f32")]
-        threshold: f32,
-    },
-    SetMaskGenerator(crate::generator::MaskGenerator),
-    Group,
-    Ungroup,
+/// A room of commands that scripts name.
+#[derive(Clone, Copy, Debug)]
+enum Room {
+    Settings,
+    Stroke,
+    Paint,
+    History,
+    Layer,
+    Mask,
 }
 
-impl<'de> Deserialize<'de> for Command {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        ScriptCommand::deserialize(deserializer).map(Self::from)
+impl Room {
+    const ALL: [Self; 6] = [
+        Self::Settings,
+        Self::Stroke,
+        Self::Paint,
+        Self::History,
+        Self::Layer,
+        Self::Mask,
+    ];
+
+    /// The script names of the room's commands, as its derived form knows them.
+    fn names(self) -> &'static [&'static str] {
+        match self {
+            Self::Settings => variants::<SettingsCommand>(),
+            Self::Stroke => variants::<StrokeCommand>(),
+            Self::Paint => variants::<PaintCommand>(),
+            Self::History => variants::<HistoryCommand>(),
+            Self::Layer => variants::<LayerCommand>(),
+            Self::Mask => variants::<MaskCommand>(),
+        }
+    }
+
+    /// Reads the command `name` of this room from its content.
+    fn read<'de, V: de::VariantAccess<'de>>(
+        self,
+        name: &str,
+        content: V,
+    ) -> Result<Command, V::Error> {
+        let named = Named { name, content };
+        Ok(match self {
+            Self::Settings => SettingsCommand::deserialize(named)?.into(),
+            Self::Stroke => StrokeCommand::deserialize(named)?.into(),
+            Self::Paint => PaintCommand::deserialize(named)?.into(),
+            Self::History => HistoryCommand::deserialize(named)?.into(),
+            Self::Layer => LayerCommand::deserialize(named)?.into(),
+            Self::Mask => MaskCommand::deserialize(named)?.into(),
+        })
     }
 }
 
-impl From<ScriptCommand> for Command {
-    fn from(command: ScriptCommand) -> Self {
-        use ScriptCommand as S;
-        match command {
-            S::SetBrush(b) => SettingsCommand::SetBrush(b).into(),
-            S::SetPrimary(v) => SettingsCommand::SetPrimary(v).into(),
-            S::SetSecondary(v) => SettingsCommand::SetSecondary(v).into(),
-            S::SwapMaterials => SettingsCommand::SwapMaterials.into(),
-            S::SetChannels(c) => SettingsCommand::SetChannels(c).into(),
-            S::SetModel(m) => SettingsCommand::SetModel(m).into(),
-            S::SetApprox(a) => SettingsCommand::SetApprox(a).into(),
-            S::BeginStroke(tool) => StrokeCommand::BeginStroke(tool).into(),
-            S::StrokeTo(p) => StrokeCommand::StrokeTo(p).into(),
-            S::EndStroke => StrokeCommand::EndStroke.into(),
-            S::AbortStroke => StrokeCommand::AbortStroke.into(),
-            S::Stroke { tool, points } => StrokeCommand::Stroke { tool, points }.into(),
-            S::SurfaceStrokeTo(p) => StrokeCommand::SurfaceStrokeTo(p).into(),
-            S::SurfaceStroke { tool, points } => {
-                StrokeCommand::SurfaceStroke { tool, points }.into()
+/// Every script name, in the rooms' order: what an unknown name's error lists.
+fn all_names() -> &'static [&'static str] {
+    static NAMES: OnceLock<Vec<&'static str>> = OnceLock::new();
+    NAMES.get_or_init(|| Room::ALL.iter().flat_map(|r| r.names()).copied().collect())
+}
+
+/// The variants an enum's derived `Deserialize` reads (its skipped ones left out): asked of
+/// the derive itself, which hands them to `deserialize_enum`.
+fn variants<'de, T: Deserialize<'de>>() -> &'static [&'static str] {
+    let mut seen = None;
+    // The probe answers every request with an error: only what it saw matters.
+    let _ = T::deserialize(Probe(&mut seen));
+    seen.unwrap_or(&[])
+}
+
+/// A deserializer that notes the variants of the enum asked of it, and reads nothing.
+struct Probe<'a>(&'a mut Option<&'static [&'static str]>);
+
+impl<'de> Deserializer<'de> for Probe<'_> {
+    type Error = de::value::Error;
+
+    fn deserialize_any<V: de::Visitor<'de>>(self, _: V) -> Result<V::Value, Self::Error> {
+        Err(de::Error::custom("a probe reads nothing"))
+    }
+
+    fn deserialize_enum<V: de::Visitor<'de>>(
+        self,
+        _name: &'static str,
+        variants: &'static [&'static str],
+        _: V,
+    ) -> Result<V::Value, Self::Error> {
+        *self.0 = Some(variants);
+        Err(de::Error::custom("a probe reads nothing"))
+    }
+
+    serde::forward_to_deserialize_any! {
+        bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf
+        option unit unit_struct newtype_struct seq tuple tuple_struct map struct identifier
+        ignored_any
+    }
+}
+
+/// A command whose name was read already, with its content still to read: a room's derived
+/// form reads it as if it had read the name itself.
+struct Named<'a, V> {
+    name: &'a str,
+    content: V,
+}
+
+impl<'de, A: de::VariantAccess<'de>> Deserializer<'de> for Named<'_, A> {
+    type Error = A::Error;
+
+    fn deserialize_any<W: de::Visitor<'de>>(self, visitor: W) -> Result<W::Value, Self::Error> {
+        visitor.visit_enum(self)
+    }
+
+    serde::forward_to_deserialize_any! {
+        bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf
+        option unit unit_struct newtype_struct seq tuple tuple_struct map struct enum
+        identifier ignored_any
+    }
+}
+
+impl<'de, A: de::VariantAccess<'de>> EnumAccess<'de> for Named<'_, A> {
+    type Error = A::Error;
+    type Variant = A;
+
+    fn variant_seed<S: DeserializeSeed<'de>>(
+        self,
+        seed: S,
+    ) -> Result<(S::Value, Self::Variant), Self::Error> {
+        let name: de::value::StrDeserializer<'_, Self::Error> = self.name.into_deserializer();
+        Ok((seed.deserialize(name)?, self.content))
+    }
+}
+
+/// A command's name, read as an identifier (as a derived enum reads its variant's).
+struct Name(String);
+
+impl<'de> Deserialize<'de> for Name {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct NameVisitor;
+        impl de::Visitor<'_> for NameVisitor {
+            type Value = Name;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a command's name")
             }
-            S::Fill(region) => PaintCommand::Fill(region).into(),
-            S::Gradient { shape, start, end } => {
-                PaintCommand::Gradient { shape, start, end }.into()
+
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Name, E> {
+                Ok(Name(v.to_owned()))
             }
-            S::Pick { x, y } => PaintCommand::Pick { x, y }.into(),
-            S::PickLayer { x, y } => PaintCommand::PickLayer { x, y }.into(),
-            S::Undo => HistoryCommand::Undo.into(),
-            S::Redo => HistoryCommand::Redo.into(),
-            S::HistoryJump(steps) => HistoryCommand::HistoryJump(steps).into(),
-            S::AddLayer { kind, name } => LayerCommand::AddLayer { kind, name }.into(),
-            S::SelectLayer(r) => LayerCommand::SelectLayer(r).into(),
-            S::SelectPath(path) => LayerCommand::SelectPath(path).into(),
-            S::SetLayerOpacity(o) => LayerCommand::SetLayerOpacity(o).into(),
-            S::SetLayerVisible(v) => LayerCommand::SetLayerVisible(v).into(),
-            S::SetLayerLocked(v) => LayerCommand::SetLayerLocked(v).into(),
-            S::RenameLayer(name) => LayerCommand::RenameLayer(name).into(),
-            S::SetLayerBlend { channel, mode } => {
-                LayerCommand::SetLayerBlend { channel, mode }.into()
-            }
-            S::SetLayerChannels(c) => LayerCommand::SetLayerChannels(c).into(),
-            S::SetLayerFill(v) => LayerCommand::SetLayerFill(v).into(),
-            S::MoveLayer(m) => LayerCommand::MoveLayer(m).into(),
-            S::MoveLayerTo { target, place } => LayerCommand::MoveLayerTo { target, place }.into(),
-            S::DeleteLayer => LayerCommand::DeleteLayer.into(),
-            S::DuplicateLayer => LayerCommand::DuplicateLayer.into(),
-            S::MergeDown => LayerCommand::MergeDown.into(),
-            S::Flatten => LayerCommand::Flatten.into(),
-            S::Group => LayerCommand::Group.into(),
-            S::Ungroup => LayerCommand::Ungroup.into(),
-            S::AddMask => MaskCommand::AddMask.into(),
-            S::DeleteMask => MaskCommand::DeleteMask.into(),
-            S::ApplyMask => MaskCommand::ApplyMask.into(),
-            S::SelectMask => MaskCommand::SelectMask.into(),
-            S::SelectContent => MaskCommand::SelectContent.into(),
-            S::InvertMask => MaskCommand::InvertMask.into(),
-            S::SetMaskEnabled(on) => MaskCommand::SetMaskEnabled(on).into(),
-            S::MaskFromChannel { channel, threshold } => {
-                MaskCommand::MaskFromChannel { channel, threshold }.into()
-            }
-            S::SetMaskGenerator(g) => MaskCommand::SetMaskGenerator(g.0).into(),
         }
+        d.deserialize_identifier(NameVisitor)
+    }
+}
+
+/// Reads a script's command: its name, then the room that has it reads its content.
+struct CommandVisitor;
+
+impl<'de> de::Visitor<'de> for CommandVisitor {
+    type Value = Command;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a command, as SetPrimary((...)) or Undo")
+    }
+
+    fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Command, A::Error> {
+        let (Name(name), content): (Name, A::Variant) = data.variant()?;
+        let Some(room) = Room::ALL
+            .into_iter()
+            .find(|r| r.names().contains(&name.as_str()))
+        else {
+            return Err(de::Error::unknown_variant(&name, all_names()));
+        };
+        room.read(&name, content)
+    }
+}
+
+impl<'de> Deserialize<'de> for Command {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_enum("Command", all_names(), CommandVisitor)
+    }
+}
+
+/// `SetMaskGenerator`'s content: `None`, or a generator, checked as it is read.
+pub(super) fn mask_generator<'de, D: Deserializer<'de>>(
+    d: D,
+) -> Result<Option<crate::generator::Generator>, D::Error> {
+    crate::generator::MaskGenerator::deserialize(d).map(|g| g.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_room_names_its_commands_and_no_name_is_in_two() {
+        let names = all_names();
+        assert!(
+            names.contains(&"SetPrimary") && names.contains(&"Ungroup"),
+            "{names:?}"
+        );
+        assert!(
+            !names.contains(&"PreviewMaskGenerator"),
+            "the editor's drag only"
+        );
+        assert!(
+            !names.contains(&"ImportChannel"),
+            "a worker's, not a script's"
+        );
+        let mut sorted = names.to_vec();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), names.len(), "a name in two rooms: {names:?}");
+        // The script format is a contract: the names scripts have always used, each still
+        // read (a renamed variant would fail here).
+        let contract = [
+            "SetBrush",
+            "SetPrimary",
+            "SetSecondary",
+            "SwapMaterials",
+            "SetChannels",
+            "SetModel",
+            "SetApprox",
+            "BeginStroke",
+            "StrokeTo",
+            "EndStroke",
+            "AbortStroke",
+            "Stroke",
+            "SurfaceStrokeTo",
+            "SurfaceStroke",
+            "Fill",
+            "Gradient",
+            "Pick",
+            "PickLayer",
+            "Undo",
+            "Redo",
+            "HistoryJump",
+            "AddLayer",
+            "SelectLayer",
+            "SelectPath",
+            "SetLayerOpacity",
+            "SetLayerVisible",
+            "SetLayerLocked",
+            "RenameLayer",
+            "SetLayerBlend",
+            "SetLayerChannels",
+            "SetLayerFill",
+            "MoveLayer",
+            "MoveLayerTo",
+            "DeleteLayer",
+            "DuplicateLayer",
+            "MergeDown",
+            "Flatten",
+            "AddMask",
+            "DeleteMask",
+            "ApplyMask",
+            "SelectMask",
+            "SelectContent",
+            "InvertMask",
+            "SetMaskEnabled",
+            "MaskFromChannel",
+            "SetMaskGenerator",
+            "Group",
+            "Ungroup",
+        ];
+        for name in contract {
+            assert!(names.contains(&name), "{name} is no longer read");
+        }
+        assert_eq!(names.len(), contract.len(), "{names:?}");
     }
 }
