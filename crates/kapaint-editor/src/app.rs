@@ -112,13 +112,13 @@ impl Editor {
                 canvas: Canvas::default(),
                 mesh,
                 notices,
-                jobs: super::jobs::Jobs {
+                jobs: super::parts::Jobs {
                     current: None,
                     waker: None,
                     exact_chi: readout::ExactChi::new(),
                     bake_on_demand: crate::bake::OnDemand::default(),
                 },
-                dialogs: super::dialogs::Dialogs::default(),
+                dialogs: super::parts::Dialogs::default(),
                 prompts: super::prompts::Prompts {
                     recovery_offer,
                     ..Default::default()

@@ -16,29 +16,6 @@ use kapaint_core::model::document::MeshRef;
 use kapaint_core::model::{Document, DocumentSettings};
 use kapaint_export::preset::ExportPreset;
 
-/// The dialogs and windows, while open.
-#[derive(Default)]
-pub(super) struct Dialogs {
-    pub(super) export: Option<ExportDialog>,
-    /// The last export's preset and folder, offered again by the next.
-    pub(super) export_choice: Option<(String, String)>,
-    /// The Resize dialog, while open.
-    pub(super) resize: Option<super::resize::ResizeDialog>,
-    /// Mesh > Bake, while open.
-    pub(super) bake: Option<super::bake::BakeDialog>,
-    /// Whether the Preferences window is open.
-    pub(super) preferences_open: bool,
-    /// The New dialog, while open.
-    pub(super) new: Option<NewDialog>,
-    /// The New dialog's project, created once the save its "Save, then create" started is
-    /// done.
-    pub(super) pending_new: Option<NewDialog>,
-    /// Whether Help > Keyboard shortcuts is open.
-    pub(super) shortcuts_open: bool,
-    /// The file chooser: the system's, or kapaint's own without a desktop portal.
-    pub(super) files: super::files::FileChooser,
-}
-
 /// The New dialog's choices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NewDialog {

@@ -71,7 +71,7 @@ impl FilePurpose {
             Self::SaveProject => "Save project".into(),
             Self::ImportMesh => "Import mesh".into(),
             Self::ImportImage(c) => {
-                format!("Import image into {}", super::panels::channel_label(c))
+                format!("Import image into {}", c.label())
             }
             Self::StampImage => "Load brush stamp".into(),
             Self::ImportPbr => "Import PBR material".into(),

@@ -113,6 +113,7 @@ impl EditorState {
                             let brush = &self.doc.settings().brush;
                             if let Some(brush) = self
                                 .tool_panel
+                                .brush_size
                                 .fitted_brush(brush, self.pointer.texels_per_point)
                             {
                                 self.apply(SettingsCommand::SetBrush(brush));

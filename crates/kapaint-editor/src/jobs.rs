@@ -12,20 +12,6 @@ use kapaint_core::model::{Document, DocumentSettings, ModelError, project, recov
 use kapaint_core::model::{ImportCommand, SettingsCommand};
 use kapaint_core::task::Progress;
 
-/// Work on workers: the one job with a progress bar, and the workers panels keep.
-pub(super) struct Jobs {
-    pub(super) current: Option<Job>,
-    /// The window's context, for a worker to wake the window when its job is done (a frame
-    /// is drawn then, not at the next progress tick).
-    pub(super) waker: Option<egui::Context>,
-    /// Exact `chi` values for the status bar, integrated on a worker.
-    pub(super) exact_chi: super::readout::ExactChi,
-    /// The bakes the editor makes on its own: a generator mask set while a bake it reads was
-    /// missing (laid once they arrive), and the document version last looked at for bakes its
-    /// masks read and lack.
-    pub(super) bake_on_demand: super::bake::OnDemand,
-}
-
 /// What a finished job does to the editor: made on the worker from the job's own typed
 /// result (each job names its result type and the function that takes it), run on the UI
 /// thread. A job's failure is its error line.
@@ -288,11 +274,7 @@ impl EditorState {
         let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
         match self.doc.apply(ImportCommand::ImportChannel(imported)) {
             Ok(()) => self.notices.push(notice(
-                format!(
-                    "{} imported into {}",
-                    path.display(),
-                    crate::panels::channel_label(channel)
-                ),
+                format!("{} imported into {}", path.display(), channel.label()),
                 false,
             )),
             Err(e) => self.notices.push(notice(e.to_string(), true)),

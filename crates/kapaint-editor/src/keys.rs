@@ -291,8 +291,8 @@ impl EditorState {
                 Action::SwapMaterials => self.apply(SettingsCommand::SwapMaterials),
                 Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
-                Action::SmallerBrush => self.tool_panel.scale_brush(&mut brush, 1.0 / 1.25),
-                Action::LargerBrush => self.tool_panel.scale_brush(&mut brush, 1.25),
+                Action::SmallerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.0 / 1.25),
+                Action::LargerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.25),
                 Action::Abort => {
                     self.tool_event(ToolEvent::Escape);
                     // The button stays with nobody until it is released and pressed again:

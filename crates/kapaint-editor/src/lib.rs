@@ -22,6 +22,7 @@ mod mesh_jobs;
 pub mod notices;
 pub use notices::{Notice, NoticeLevel, Notices};
 mod panels;
+mod parts;
 pub mod preferences;
 mod project_jobs;
 mod prompts;
@@ -185,9 +186,9 @@ pub struct EditorState {
     /// Messages.
     notices: Notices,
     /// Work on workers: the job under way, the exact chi, bakes made on demand.
-    jobs: jobs::Jobs,
+    jobs: parts::Jobs,
     /// The dialogs and windows, while open.
-    dialogs: dialogs::Dialogs,
+    dialogs: parts::Dialogs,
     /// The questions asked before the editor goes on.
     prompts: prompts::Prompts,
     /// Where the pointer is and what it holds.
@@ -464,7 +465,7 @@ impl EditorState {
 
     /// Sets how the brush's size is given (the radius on screen kept in range).
     pub fn set_brush_size(&mut self, size: screen_brush::BrushSize) {
-        self.tool_panel.set_brush_size(size);
+        self.tool_panel.brush_size = size.clamped();
     }
 
     /// Texels per screen point under the cursor this frame, if it is over the map or the mesh.

@@ -7,7 +7,6 @@
 
 use glam::Vec3;
 
-use super::panels::tool_panel::ToolPanel;
 use super::project;
 use kapaint_core::model::brush::BrushSettings;
 
@@ -48,65 +47,66 @@ pub fn points_per_world(
     (d.is_finite() && d > 0.0).then_some(d)
 }
 
-impl ToolPanel {
-    /// Sets how the brush's size is given (the radius on screen kept in range).
-    pub(crate) fn set_brush_size(&mut self, size: BrushSize) {
+impl BrushSize {
+    /// This size with its radius on screen kept in range.
+    #[must_use]
+    pub fn clamped(self) -> Self {
         let (lo, hi) = (*SCREEN_RADIUS_RANGE.start(), *SCREEN_RADIUS_RANGE.end());
-        self.brush_size = BrushSize {
-            screen_radius: if size.screen_radius.is_finite() {
-                size.screen_radius.clamp(lo, hi)
+        Self {
+            screen_radius: if self.screen_radius.is_finite() {
+                self.screen_radius.clamp(lo, hi)
             } else {
-                BrushSize::default().screen_radius
+                Self::default().screen_radius
             },
-            ..size
-        };
+            ..self
+        }
     }
 
     /// The brush radius in texels that the size on screen gives where a screen point is
     /// `texels_per_point` texels.
-    pub(crate) fn screen_radius_in_texels(&self, texels_per_point: Option<f32>) -> Option<f32> {
-        Some((self.brush_size.screen_radius * texels_per_point?).clamp(0.5, 4096.0))
+    pub(crate) fn radius_in_texels(self, texels_per_point: Option<f32>) -> Option<f32> {
+        Some((self.screen_radius * texels_per_point?).clamp(0.5, 4096.0))
     }
 
     /// Before a stroke starts: with the size on screen, the brush with its radius in texels
     /// from the view under the cursor, if that changes it.
     pub(crate) fn fitted_brush(
-        &self,
+        self,
         brush: &BrushSettings,
         texels_per_point: Option<f32>,
     ) -> Option<BrushSettings> {
-        if !self.brush_size.on_screen {
+        if !self.on_screen {
             return None;
         }
-        let radius = self.screen_radius_in_texels(texels_per_point)?;
+        let radius = self.radius_in_texels(texels_per_point)?;
         ((brush.radius_px - radius).abs() > 1e-3 * radius).then(|| BrushSettings {
             radius_px: radius,
             ..brush.clone()
         })
     }
 
-    /// The `[` and `]` keys: the radius shrinks or grows by 1.25, on screen or in texels.
-    pub(crate) fn scale_brush(&mut self, brush: &mut BrushSettings, by: f32) {
-        if self.brush_size.on_screen {
-            let size = BrushSize {
-                screen_radius: self.brush_size.screen_radius * by,
-                ..self.brush_size
-            };
-            self.set_brush_size(size);
+    /// The `[` and `]` keys: the radius shrinks or grows by `by`, on screen or in texels.
+    pub(crate) fn scale(&mut self, brush: &mut BrushSettings, by: f32) {
+        if self.on_screen {
+            *self = Self {
+                screen_radius: self.screen_radius * by,
+                ..*self
+            }
+            .clamped();
         } else {
             brush.radius_px = (brush.radius_px * by).clamp(0.5, 2048.0);
         }
     }
 
-    /// The brush radius row of the panel: in texels, or on screen with what it is in texels
-    /// under the cursor.
-    pub(crate) fn brush_radius_ui(
+    /// The brush radius row of the tool panel: in texels, or on screen with what it is in
+    /// texels under the cursor.
+    pub(crate) fn radius_ui(
         &mut self,
         ui: &mut egui::Ui,
         brush: &mut BrushSettings,
         texels_per_point: Option<f32>,
     ) {
-        let mut size = self.brush_size;
+        let mut size = *self;
         if size.on_screen {
             ui.add(
                 egui::Slider::new(&mut size.screen_radius, SCREEN_RADIUS_RANGE)
@@ -130,13 +130,13 @@ impl ToolPanel {
                  rather than its size in texels",
                 );
             if size.on_screen
-                && let Some(texels) = self.screen_radius_in_texels(texels_per_point)
+                && let Some(texels) = size.radius_in_texels(texels_per_point)
             {
                 ui.weak(format!("= {texels:.1} texels here"));
             }
         });
-        if size != self.brush_size {
-            self.set_brush_size(size);
+        if size != *self {
+            *self = size.clamped();
         }
     }
 }

@@ -1,7 +1,8 @@
-//! WGSL sources: the files of `shaders/`, embedded, and the one generated file of ids, put
-//! together by [`resolve`]. A line `#include "name.wgsl"` is replaced by that file, its own
-//! includes resolved first, each file once (a second include of it is dropped); a missing
-//! file or a cycle is an error. The renderer and the tests (naga) use the same resolver.
+//! WGSL sources: the files of `shaders/`, embedded, and the generated files (the ids, the
+//! preview's bindings), put together by [`resolve`]. A line `#include "name.wgsl"` is replaced
+//! by that file, its own includes resolved first, each file once (a second include of it is
+//! dropped); a missing file or a cycle is an error. The renderer and the tests (naga) use the
+//! same resolver.
 
 use std::fmt::Write as _;
 
@@ -9,7 +10,7 @@ use kapaint_core::reflectance::wgsl::{IDS_FILE, model_and_approx_ids, screaming_
 use kapaint_core::render::ViewMode;
 
 /// Every file in `shaders/`, by name.
-pub const FILES: [(&str, &str); 12] = [
+pub const FILES: [(&str, &str); 11] = [
     (
         "ambient.wgsl",
         include_str!("../../../shaders/ambient.wgsl"),
@@ -35,10 +36,6 @@ pub const FILES: [(&str, &str); 12] = [
     (
         "preview.wgsl",
         include_str!("../../../shaders/preview.wgsl"),
-    ),
-    (
-        "preview_bindings.wgsl",
-        include_str!("../../../shaders/preview_bindings.wgsl"),
     ),
     (
         "preview_functions.wgsl",
@@ -78,10 +75,13 @@ pub fn ids_wgsl() -> String {
     out
 }
 
-/// A file of `shaders/`, or the generated ids.
+/// A file of `shaders/`, or a generated one (the ids, the preview's bindings).
 pub fn file(name: &str) -> Option<String> {
     if name == IDS_FILE {
         return Some(ids_wgsl());
+    }
+    if name == crate::preview::bindings::FILE {
+        return Some(crate::preview::bindings::wgsl());
     }
     FILES
         .iter()

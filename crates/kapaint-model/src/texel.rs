@@ -159,6 +159,15 @@ impl Channel {
     /// All channels in storage order.
     pub const ALL: [Self; 3] = [Self::Kd, Self::Ks, Self::N];
 
+    /// The name people read: `k_d`, `k_s`, `n` (the editor's panels, messages and tools).
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Kd => "k_d",
+            Self::Ks => "k_s",
+            Self::N => "n",
+        }
+    }
+
     /// The name used on the command line and in files.
     pub fn name(self) -> &'static str {
         match self {

@@ -83,15 +83,6 @@ pub enum FillOption {
     Tolerance(f32),
 }
 
-/// A channel as the panel names it.
-fn channel_label(channel: Channel) -> &'static str {
-    match channel {
-        Channel::Kd => "k_d",
-        Channel::Ks => "k_s",
-        Channel::N => "n",
-    }
-}
-
 /// What a fill covers, without its parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FillKind {
@@ -148,7 +139,7 @@ impl Tool for Fill {
                 widget: OptionWidget::Choice {
                     choices: Channel::ALL
                         .iter()
-                        .map(|&c| (channel_label(c), OptionChange::Fill(FillOption::Channel(c))))
+                        .map(|&c| (c.label(), OptionChange::Fill(FillOption::Channel(c))))
                         .collect(),
                     chosen: Channel::ALL.iter().position(|&c| c == channel).unwrap_or(0),
                     dropdown: true,

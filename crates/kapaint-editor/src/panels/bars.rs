@@ -139,7 +139,7 @@ impl EditorState {
                 }
                 for channel in [Channel::Kd, Channel::Ks, Channel::N] {
                     if ui
-                        .button(format!("Import image into {}…", channel_label(channel)))
+                        .button(format!("Import image into {}…", channel.label()))
                         .clicked()
                     {
                         self.choose_file(FilePurpose::ImportImage(channel));
@@ -259,15 +259,6 @@ impl EditorState {
         if let Some(wait) = self.notices.next_expiry() {
             ctx.request_repaint_after(wait + Duration::from_millis(10));
         }
-    }
-}
-
-/// A channel as the editor names it everywhere: `k_d`, `k_s`, `n`.
-pub(crate) fn channel_label(channel: Channel) -> &'static str {
-    match channel {
-        Channel::Kd => "k_d",
-        Channel::Ks => "k_s",
-        Channel::N => "n",
     }
 }
 

@@ -11,8 +11,6 @@ pub(super) mod presets;
 pub(super) mod tool_panel;
 pub(super) mod view_panel;
 
-pub(super) use bars::channel_label;
-
 use kapaint_core::model::{Command, Document};
 use kapaint_core::tools::{OptionChange, ToolKind, Tools};
 

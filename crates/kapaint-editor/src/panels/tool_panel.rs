@@ -53,7 +53,8 @@ impl ToolPanel {
         ui.heading("Brush settings");
         presets.brush_ui(ui, desk);
         let mut brush = doc.settings().brush.clone();
-        self.brush_radius_ui(ui, &mut brush, desk.texels_per_point);
+        self.brush_size
+            .radius_ui(ui, &mut brush, desk.texels_per_point);
         ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
             .on_hover_text("Shift+[ and Shift+] change the hardness");
         ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
@@ -129,16 +130,7 @@ impl ToolPanel {
         }
         self.recent_materials_ui(ui, desk);
         ui.separator();
-        ui.heading("Channels");
-        let mut ch = doc.settings().channels;
-        ui.horizontal(|ui| {
-            ui.checkbox(&mut ch.kd, "k_d");
-            ui.checkbox(&mut ch.ks, "k_s");
-            ui.checkbox(&mut ch.n, "n");
-        });
-        if ch != doc.settings().channels {
-            desk.command(SettingsCommand::SetChannels(ch));
-        }
+        channels_ui(ui, desk);
     }
 
     /// The brush's stamp row: a preview of the stamp, the built-in grain, loading one from an
@@ -190,6 +182,20 @@ impl ToolPanel {
                 brush.stamp = None;
             }
         });
+    }
+}
+
+/// The channels tools paint.
+fn channels_ui(ui: &mut egui::Ui, desk: &mut Desk) {
+    ui.heading("Channels");
+    let mut ch = desk.doc.settings().channels;
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut ch.kd, "k_d");
+        ui.checkbox(&mut ch.ks, "k_s");
+        ui.checkbox(&mut ch.n, "n");
+    });
+    if ch != desk.doc.settings().channels {
+        desk.command(SettingsCommand::SetChannels(ch));
     }
 }
 

@@ -134,39 +134,20 @@ fn bind_group(
 ) -> wgpu::BindGroup {
     let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
     let (kd, ks, n, normal) = (view(kd), view(ks), view(n), view(normal));
+    // In the order of `bindings::PREVIEW`.
+    let entries = super::bindings::entries([
+        buffer.as_entire_binding(),
+        wgpu::BindingResource::TextureView(&kd),
+        wgpu::BindingResource::TextureView(&ks),
+        wgpu::BindingResource::TextureView(&n),
+        wgpu::BindingResource::Sampler(&preview.sampler),
+        wgpu::BindingResource::TextureView(&normal),
+        wgpu::BindingResource::TextureView(&preview.view_table),
+    ]);
     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("preview"),
         layout: &preview.bind_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: buffer.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&kd),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&ks),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: wgpu::BindingResource::TextureView(&n),
-            },
-            wgpu::BindGroupEntry {
-                binding: 4,
-                resource: wgpu::BindingResource::Sampler(&preview.sampler),
-            },
-            wgpu::BindGroupEntry {
-                binding: 5,
-                resource: wgpu::BindingResource::TextureView(&normal),
-            },
-            wgpu::BindGroupEntry {
-                binding: 6,
-                resource: wgpu::BindingResource::TextureView(&preview.view_table),
-            },
-        ],
+        entries: &entries,
     })
 }
 

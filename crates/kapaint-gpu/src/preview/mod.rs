@@ -11,6 +11,7 @@
 //! It draws into any colour target, and headless into an offscreen image that is read back
 //! ([`Preview::render_offscreen`]).
 
+pub(crate) mod bindings;
 mod draw_data;
 mod layout;
 mod mesh;
@@ -51,35 +52,9 @@ impl Preview {
     pub fn new(gpu: &Gpu) -> Self {
         let device = &gpu.device;
         let module = super::shader_module(device, "preview.wgsl");
-        let texture_entry = |binding| super::texture_entry(binding, true);
-        // The bindings of shaders/preview_bindings.wgsl.
         let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<FrameUniforms>() as u64,
-                        ),
-                    },
-                    count: None,
-                },
-                texture_entry(1),
-                texture_entry(2),
-                texture_entry(3),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                texture_entry(5),
-                super::texture_entry(6, false),
-            ],
+            entries: &bindings::layout_entries(std::mem::size_of::<FrameUniforms>() as u64),
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("preview"),
