@@ -214,3 +214,75 @@ fn nothing_in_the_build_needs_libclang() {
         );
     }
 }
+
+/// Whether `line` re-exports a kapaint crate whole (`pub use kapaint_model as model;`) or its
+/// modules (`pub use kapaint_base::{atomic, task};`, lower-case names): a facade. An item
+/// (`pub use kapaint_core::render::Compare;`) is a type the crate's own API hands out.
+fn re_exports_a_crate_or_its_modules(line: &str) -> bool {
+    let Some(rest) = line.trim_start().strip_prefix("pub use kapaint_") else {
+        return false;
+    };
+    let rest = rest.trim_end().trim_end_matches(';');
+    let Some((_krate, path)) = rest.split_once("::") else {
+        // The crate itself, renamed or not.
+        return true;
+    };
+    let names = path.trim_start_matches('{').trim_end_matches('}');
+    !names.contains("::")
+        && names
+            .split(',')
+            .map(str::trim)
+            .filter(|n| !n.is_empty())
+            .all(|n| n.chars().next().is_some_and(|c| c.is_ascii_lowercase()))
+}
+
+#[test]
+fn the_facade_reader_tells_crates_and_modules_from_items() {
+    assert!(re_exports_a_crate_or_its_modules(
+        "pub use kapaint_model as model;"
+    ));
+    assert!(re_exports_a_crate_or_its_modules(
+        "pub use kapaint_base::{atomic, task};"
+    ));
+    assert!(re_exports_a_crate_or_its_modules(
+        "pub use kapaint_mesh::pick;"
+    ));
+    assert!(!re_exports_a_crate_or_its_modules(
+        "pub use kapaint_core::render::Compare;"
+    ));
+    assert!(!re_exports_a_crate_or_its_modules(
+        "pub use kapaint_model::provenance::{A, B};"
+    ));
+    assert!(!re_exports_a_crate_or_its_modules(
+        "use kapaint_model as model;"
+    ));
+}
+
+/// No facade: a crate under the command line re-exports no other kapaint crate, so what a
+/// crate uses is what its Cargo.toml names (`cargo tree -p` tells the truth about it). The
+/// root package, the command line and the binary, names the rooms for its users.
+#[test]
+fn no_crate_under_the_command_line_re_exports_another() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut found = Vec::new();
+    for (krate, _) in LAYERS.iter().filter(|(k, _)| *k != "kapaint") {
+        let dir = root.join("crates").join(krate).join("src");
+        let mut stack = vec![dir];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).expect("a source folder").flatten() {
+                let path = entry.path();
+                if path.is_dir() {
+                    stack.push(path);
+                } else if path.extension().is_some_and(|e| e == "rs") {
+                    let text = std::fs::read_to_string(&path).expect("a source file");
+                    for (i, line) in text.lines().enumerate() {
+                        if re_exports_a_crate_or_its_modules(line) {
+                            found.push(format!("{}:{}: {line}", path.display(), i + 1));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "facade re-exports: {found:#?}");
+}

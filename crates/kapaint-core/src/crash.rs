@@ -83,7 +83,7 @@ fn keep_file_size_errors() {
 /// Writes the report into `crash-<seconds>-<pid>.log` in the state folder; `None` when it
 /// cannot be written (the one line still says what happened).
 fn write_report(report: &str) -> Option<PathBuf> {
-    let dir = crate::model::project::state_dir();
+    let dir = kapaint_model::project::state_dir();
     std::fs::create_dir_all(&dir).ok()?;
     let seconds = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)

@@ -1,12 +1,12 @@
 //! Acceptance tests of the approximations against the exact integrator.
 
-use kapaint_core::reflectance::exact::chi_exact;
-use kapaint_core::reflectance::fit::{self, power_law_max_error};
-use kapaint_core::reflectance::{
+use kapaint_core::report::accuracy::{ExactSamples, Grid, error_stats};
+use kapaint_reflectance::exact::chi_exact;
+use kapaint_reflectance::fit::{self, power_law_max_error};
+use kapaint_reflectance::{
     AmbientApprox, PAPER_BLINN, PAPER_BLINN_CORRECTED_EXPONENT, PAPER_PHONG, ShadingModel, chi_f32,
     chi_f64,
 };
-use kapaint_core::report::accuracy::{ExactSamples, Grid, error_stats};
 
 fn samples(model: ShadingModel, lo: f64, hi: f64, count: usize) -> ExactSamples {
     ExactSamples::compute(model, &Grid::log_spaced(lo, hi, count))

@@ -8,16 +8,16 @@
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use kapaint_core::mesh::uv_sphere;
-use kapaint_core::model::brush::SurfacePos;
-use kapaint_core::model::paint::GradientShape;
-use kapaint_core::model::surface::Surface;
-use kapaint_core::model::texel::{Channel, MaterialValue, Texel};
-use kapaint_core::model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
-use kapaint_core::model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint_core::tools::{
     Fill, FillMode, Gradient, OptionWidget, Place, ToolEvent, ToolKind, Tools,
 };
+use kapaint_mesh::uv_sphere;
+use kapaint_model::brush::SurfacePos;
+use kapaint_model::paint::GradientShape;
+use kapaint_model::surface::Surface;
+use kapaint_model::texel::{Channel, MaterialValue, Texel};
+use kapaint_model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
+use kapaint_model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
 
 fn document() -> Document {
     let mut doc = Document::new(128, 64, DocumentSettings::default()).expect("doc");
@@ -70,7 +70,7 @@ fn on_surface(doc: &Document, point: Vec3) -> Place {
     let texel = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .filter(|&(x, y)| {
-            surface.bake.coverage((y * w + x) as usize) != kapaint_core::mesh::bake::Coverage::Empty
+            surface.bake.coverage((y * w + x) as usize) != kapaint_mesh::bake::Coverage::Empty
         })
         .min_by(|a, b| {
             let d =

@@ -15,10 +15,10 @@ use super::layout::{load_layout, save_layout};
 use super::panels::layers::LayerView;
 use super::viewport::{Viewport, ViewportGpu};
 use super::{DEFAULT_SIZE, EditorState, MeshState, Tab, default_layout, notice, readout};
-use kapaint_core::model::texel::MaterialValue;
-use kapaint_core::model::{Document, DocumentSettings, recovery};
 use kapaint_core::render::{Lighting, ViewMode};
 use kapaint_core::tools::Tools;
+use kapaint_model::texel::MaterialValue;
+use kapaint_model::{Document, DocumentSettings, recovery};
 
 /// The map size of the document shown while a project named at start opens.
 const PLACEHOLDER_SIZE: u32 = 16;
@@ -44,7 +44,7 @@ fn first_document(size: u32, notices: &mut super::Notices) -> (Document, MeshSta
             notices.push(notice(e, true));
             let doc = Document::new(16, 16, DocumentSettings::default())
                 .unwrap_or_else(|_| unreachable_doc());
-            (doc, MeshState::new(kapaint_core::mesh::plane(), 1))
+            (doc, MeshState::new(kapaint_mesh::plane(), 1))
         }
     }
 }
@@ -86,7 +86,7 @@ impl Editor {
             untitled_until_open.as_deref(),
             &doc,
         );
-        let preset_dir = kapaint_core::model::preset::user_dir();
+        let preset_dir = kapaint_model::preset::user_dir();
         let (presets, brush_presets, mask_presets) =
             super::panels::presets::load_all(preset_dir.as_deref(), &mut notices);
         let dock = load_layout().unwrap_or_else(default_layout);
@@ -155,7 +155,7 @@ impl Editor {
 /// A 16 x 16 document cannot fail to allocate; this is only for the type checker.
 fn unreachable_doc() -> Document {
     Document::from_parts(
-        kapaint_core::model::MaterialMaps::new(1, 1, MaterialValue::default())
+        kapaint_model::MaterialMaps::new(1, 1, MaterialValue::default())
             .unwrap_or_else(|_| std::process::abort()),
         DocumentSettings::default(),
     )
@@ -193,10 +193,7 @@ impl TabViewer for Tabs<'_> {
                 let mesh = (s.mesh.id, Arc::clone(&s.mesh.mesh));
                 let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
                 let normal = s.doc.normal().cloned();
-                s.viewport.ao_bake = s
-                    .doc
-                    .bake_of(kapaint_core::mesh::bakes::BakeMap::Ao)
-                    .cloned();
+                s.viewport.ao_bake = s.doc.bake_of(kapaint_mesh::bakes::BakeMap::Ao).cloned();
                 let (response, rect) =
                     s.viewport
                         .show(ui, (maps.0, maps.1, normal.as_ref()), &mesh, &settings);

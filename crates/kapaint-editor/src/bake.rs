@@ -6,10 +6,10 @@ use std::sync::Arc;
 
 use super::EditorState;
 use super::dialogs::centred;
-use kapaint_core::mesh::bakes::{BakeMap, BakeOptions, bake_map};
-use kapaint_core::model::MaskCommand;
-use kapaint_core::model::generator::Generator;
-use kapaint_core::model::layers::LayerId;
+use kapaint_mesh::bakes::{BakeMap, BakeOptions, bake_map};
+use kapaint_model::MaskCommand;
+use kapaint_model::generator::Generator;
+use kapaint_model::layers::LayerId;
 
 /// The Bake dialog's choices.
 #[derive(Clone, Copy, Debug, PartialEq)]

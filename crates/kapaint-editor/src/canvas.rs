@@ -3,12 +3,12 @@
 
 use egui::{Color32, ColorImage, Pos2, Rect, Sense, TextureHandle, TextureOptions, Vec2};
 
-use kapaint_core::mesh::bakes::BakeMap;
-use kapaint_core::model::texel::{MaterialValue, linear_to_srgb};
-use kapaint_core::model::{Document, MaterialMaps};
-use kapaint_core::reflectance;
 use kapaint_core::render::n_false_colour;
+use kapaint_mesh::bakes::BakeMap;
+use kapaint_model::texel::{MaterialValue, linear_to_srgb};
+use kapaint_model::{Document, MaterialMaps};
 use kapaint_pbr::round_trip::RoundTrip;
+use kapaint_reflectance as reflectance;
 
 /// The canvas's accessible name (tests and screen readers find it by this).
 pub const CANVAS_LABEL: &str = "UV canvas painting area";
@@ -145,7 +145,7 @@ fn tile_image(
     id: usize,
     channel: CanvasChannel,
 ) -> ColorImage {
-    let kapaint_core::model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
+    let kapaint_model::maps::TexelRect { x0, y0, x1, y1 } = maps.tile_rect(id);
     let (w, h) = (x1 - x0, y1 - y0);
     let mut pixels = Vec::with_capacity((w * h) as usize);
     let bake = match channel {
@@ -218,8 +218,7 @@ impl Canvas {
             if !was.uniform {
                 let dirty = maps.tiles_changed_since(was.version);
                 for &id in &dirty {
-                    let kapaint_core::model::maps::TexelRect { x0: x, y0: y, .. } =
-                        maps.tile_rect(id);
+                    let kapaint_model::maps::TexelRect { x0: x, y0: y, .. } = maps.tile_rect(id);
                     tex.set_partial(
                         [x as usize, y as usize],
                         tile_image(doc, maps, id, self.channel),
@@ -248,7 +247,7 @@ impl Canvas {
         } else {
             let mut image = ColorImage::filled([w as usize, h as usize], Color32::BLACK);
             for id in 0..maps.tile_count() {
-                let kapaint_core::model::maps::TexelRect { x0, y0, x1, .. } = maps.tile_rect(id);
+                let kapaint_model::maps::TexelRect { x0, y0, x1, .. } = maps.tile_rect(id);
                 let tw = (x1 - x0) as usize;
                 let tile = tile_image(doc, maps, id, self.channel);
                 for y in 0..tile.size[1] {
@@ -361,8 +360,8 @@ impl Canvas {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use kapaint_core::model::PaintCommand;
-    use kapaint_core::model::{DocumentSettings, FillRegion};
+    use kapaint_model::PaintCommand;
+    use kapaint_model::{DocumentSettings, FillRegion};
 
     #[test]
     fn another_document_of_the_same_size_is_mirrored_whole() {

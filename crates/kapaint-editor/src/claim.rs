@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use super::EditorState;
-use kapaint_core::model::project::lock::{self, OnDisk, ProjectLock};
-use kapaint_core::model::recovery::session::Owner;
+use kapaint_model::project::lock::{self, OnDisk, ProjectLock};
+use kapaint_model::recovery::session::Owner;
 
 /// What the editor holds of its project file.
 #[derive(Debug, Default)]

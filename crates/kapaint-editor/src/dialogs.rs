@@ -12,9 +12,9 @@ use super::export_plan::{block_search_ui, export_plan_ui};
 use super::files::FilePurpose;
 use super::jobs::new_document_with;
 use super::layout::layout_path;
-use kapaint_core::model::document::MeshRef;
-use kapaint_core::model::{Document, DocumentSettings};
 use kapaint_export::preset::ExportPreset;
+use kapaint_model::document::MeshRef;
+use kapaint_model::{Document, DocumentSettings};
 
 /// The New dialog's choices.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,7 +49,7 @@ pub(super) fn recent_path() -> Option<PathBuf> {
 
 pub(super) fn load_recent() -> Vec<PathBuf> {
     recent_path()
-        .and_then(|p| kapaint_core::file_check::read_limited(&p, 1 << 20).ok())
+        .and_then(|p| kapaint_base::file_check::read_limited(&p, 1 << 20).ok())
         .map(|text| parse_recent(&text))
         .unwrap_or_default()
 }
@@ -64,10 +64,10 @@ pub fn parse_recent(json: &[u8]) -> Vec<PathBuf> {
     list.into_iter()
         .filter(|p| {
             !p.is_empty()
-                && kapaint_core::model::check::bounded_text(
+                && kapaint_model::check::bounded_text(
                     "path",
                     p,
-                    kapaint_core::model::check::MAX_PATH_BYTES,
+                    kapaint_model::check::MAX_PATH_BYTES,
                 )
                 .is_ok()
         })
@@ -81,7 +81,7 @@ pub(super) fn save_recent(list: &[PathBuf]) {
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        let _ = kapaint_core::atomic::write_atomic(&path, &json);
+        let _ = kapaint_base::atomic::write_atomic(&path, &json);
     }
 }
 
@@ -146,7 +146,7 @@ impl EditorState {
                 }
                 if ui.button("Discard").clicked() {
                     self.prompts.recovery_offer = None;
-                    kapaint_core::model::recovery::remove(&copy);
+                    kapaint_model::recovery::remove(&copy);
                     // The project named at start opens as saved.
                     if let Some(p) = self.project.starting.take() {
                         self.open_now(p);
@@ -246,7 +246,7 @@ impl EditorState {
                     egui::ComboBox::from_label("Mesh")
                         .selected_text(&dialog.mesh)
                         .show_ui(ui, |ui| {
-                            for m in kapaint_core::mesh::BUILTIN_NAMES {
+                            for m in kapaint_mesh::BUILTIN_NAMES {
                                 ui.selectable_value(&mut dialog.mesh, m.to_string(), m);
                             }
                         });

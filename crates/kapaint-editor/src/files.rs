@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 use egui_file_dialog::{DialogState, FileDialog};
 
 use crate::EditorState;
-use kapaint_core::model::texel::Channel;
+use kapaint_model::texel::Channel;
 
 /// What a file is chosen for: its title, filter and what the editor does with it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

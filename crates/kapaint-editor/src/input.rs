@@ -10,10 +10,10 @@ use glam::Vec2;
 
 use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
-use kapaint_core::model::SettingsCommand;
-use kapaint_core::model::brush::SurfacePos;
 use kapaint_core::render::FrameSettings;
 use kapaint_core::tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
+use kapaint_model::SettingsCommand;
+use kapaint_model::brush::SurfacePos;
 
 /// Where the pointer is and what it holds.
 pub(super) struct Pointer {
@@ -227,7 +227,7 @@ impl EditorState {
             self.doc.maps().width() as f32,
             self.doc.maps().height() as f32,
         );
-        let place_of = |hit: &kapaint_core::mesh::pick::Hit| Place::Surface {
+        let place_of = |hit: &kapaint_mesh::pick::Hit| Place::Surface {
             pos: SurfacePos {
                 point: hit.position,
                 normal: hit.normal,

@@ -7,10 +7,10 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 use super::{EditorState, MeshState, notice};
-use kapaint_core::model::texel::Channel;
-use kapaint_core::model::{Document, DocumentSettings, ModelError, project, recovery};
-use kapaint_core::model::{ImportCommand, SettingsCommand};
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
+use kapaint_model::texel::Channel;
+use kapaint_model::{Document, DocumentSettings, ModelError, project, recovery};
+use kapaint_model::{ImportCommand, SettingsCommand};
 
 /// What a finished job does to the editor: made on the worker from the job's own typed
 /// result (each job names its result type and the function that takes it), run on the UI
@@ -38,7 +38,7 @@ pub(super) enum Saved {
 #[derive(Clone)]
 pub(super) struct UnwrapPrompt {
     pub(super) path: PathBuf,
-    pub(super) mesh: Arc<kapaint_core::mesh::Mesh>,
+    pub(super) mesh: Arc<kapaint_mesh::Mesh>,
     /// What is wrong with its UVs, for the question.
     pub(super) why: String,
     /// Whether it has UVs of its own to keep.
@@ -50,7 +50,7 @@ pub struct LoadedMaterial {
     /// What the size question calls it: "The texture set Bricks", "cow.glb's material".
     pub(super) name: String,
     pub(super) set: kapaint_pbr::import::PbrSet,
-    pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
+    pub(super) normal: Option<kapaint_model::normal::NormalMap>,
     pub(super) notes: Vec<String>,
     /// The material is seen from both sides (glTF's `doubleSided`).
     pub(super) double_sided: bool,
@@ -72,9 +72,9 @@ pub struct SizePrompt {
 
 /// A glTF material converted on a worker (File > Import PBR material).
 pub(super) struct PbrMaterial {
-    pub(super) maps: kapaint_core::model::MaterialMaps,
-    pub(super) normal: Option<kapaint_core::model::normal::NormalMap>,
-    pub(super) report: kapaint_core::model::provenance::ImportReport,
+    pub(super) maps: kapaint_model::MaterialMaps,
+    pub(super) normal: Option<kapaint_model::normal::NormalMap>,
+    pub(super) report: kapaint_model::provenance::ImportReport,
 }
 
 /// Long work on a worker thread.
@@ -266,12 +266,9 @@ impl EditorState {
     }
 
     /// An image decoded and resampled into a channel's planes: into the document.
-    fn image_done(
-        &mut self,
-        (path, planes): (PathBuf, Box<kapaint_core::model::import::ChannelPlanes>),
-    ) {
+    fn image_done(&mut self, (path, planes): (PathBuf, Box<kapaint_model::import::ChannelPlanes>)) {
         let channel = planes.channel();
-        let imported = kapaint_core::model::document::ImportedChannel(Arc::new(*planes));
+        let imported = kapaint_model::document::ImportedChannel(Arc::new(*planes));
         match self.doc.apply(ImportCommand::ImportChannel(imported)) {
             Ok(()) => self.notices.push(notice(
                 format!("{} imported into {}", path.display(), channel.label()),
@@ -282,7 +279,7 @@ impl EditorState {
     }
 
     /// The maps resized, with the mesh baked at their size.
-    pub(super) fn resize_done(&mut self, resized: kapaint_core::model::resize::ResizedMaps) {
+    pub(super) fn resize_done(&mut self, resized: kapaint_model::resize::ResizedMaps) {
         let (w, h) = (resized.0.0.width, resized.0.0.height);
         self.apply(ImportCommand::Resize(resized));
         self.notices
@@ -302,7 +299,7 @@ impl EditorState {
     }
 
     /// A brush stamp read from an image.
-    fn stamp_done(&mut self, (path, stamp): (PathBuf, kapaint_core::model::brush::Stamp)) {
+    fn stamp_done(&mut self, (path, stamp): (PathBuf, kapaint_model::brush::Stamp)) {
         let mut brush = self.doc.settings().brush.clone();
         brush.stamp = Some(stamp);
         self.apply(SettingsCommand::SetBrush(brush));
@@ -335,7 +332,7 @@ impl EditorState {
             normal,
             report,
         } = m;
-        let imported = kapaint_core::model::document::ImportedMaterial {
+        let imported = kapaint_model::document::ImportedMaterial {
             maps: Arc::new(maps),
             normal: normal.map(Arc::new),
             report: Some(report.clone()),
@@ -372,7 +369,7 @@ impl EditorState {
             "Stamp",
             move |progress| {
                 progress.start("decode", 1);
-                match kapaint_core::model::import::read_stamp(&path) {
+                match kapaint_model::import::read_stamp(&path) {
                     Ok(stamp) => Ok((path, stamp)),
                     Err(e) => Err(e.to_string()),
                 }
@@ -389,10 +386,10 @@ impl EditorState {
             "Image",
             move |progress| {
                 progress.start("decode", 1);
-                match kapaint_core::model::import::read_image(&path) {
+                match kapaint_model::import::read_image(&path) {
                     Ok(image) => {
                         progress.start("resample", 1);
-                        let planes = kapaint_core::model::import::resample(&image, channel, w, h);
+                        let planes = kapaint_model::import::resample(&image, channel, w, h);
                         Ok((path, Box::new(planes)))
                     }
                     Err(e) => Err(e.to_string()),
@@ -489,13 +486,13 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
 pub(super) struct OpenedProject {
     /// Where it is saved (`None` for recovered untitled work).
     pub(super) path: Option<std::path::PathBuf>,
-    pub(super) doc: kapaint_core::model::Document,
+    pub(super) doc: kapaint_model::Document,
     /// The recovery copy it came from, if it did.
     pub(super) recovered: Option<std::path::PathBuf>,
     /// A note for the user (its mesh could not be loaded, its recovery failed).
     pub(super) note: Option<String>,
     /// The project file as it was when read: what a save expects to replace.
-    pub(super) on_disk: Option<kapaint_core::model::project::OnDisk>,
+    pub(super) on_disk: Option<kapaint_model::project::OnDisk>,
     /// Opened read-only (another kapaint has it open).
     pub(super) read_only: bool,
 }

@@ -5,8 +5,8 @@
 use egui::{Key, KeyboardShortcut, Modifiers};
 
 use super::{EditorState, Tab};
-use kapaint_core::model::{HistoryCommand, LayerCommand, SettingsCommand};
 use kapaint_core::tools::{ToolEvent, ToolKind, Tools};
+use kapaint_model::{HistoryCommand, LayerCommand, SettingsCommand};
 
 /// What a key does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -273,7 +273,7 @@ impl EditorState {
                 Action::Export => self.open_export(),
                 Action::NewLayer => self.apply(crate::panels::layers::new_layer(
                     &self.doc,
-                    kapaint_core::model::LayerKind::Paint,
+                    kapaint_model::LayerKind::Paint,
                 )),
                 Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer),
                 Action::MergeDown => self.apply(LayerCommand::MergeDown),

@@ -2,8 +2,8 @@
 //! "mask" views, maps composited from a stack of that layer (or mask) alone, kept up to date
 //! tile by tile as it is painted.
 
-use kapaint_core::model::layers::{Compositor, ops};
-use kapaint_core::model::{Document, MaterialMaps};
+use kapaint_model::layers::{Compositor, ops};
+use kapaint_model::{Document, MaterialMaps};
 
 /// What the viewport and canvas show of the layers.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

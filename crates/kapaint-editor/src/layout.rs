@@ -40,7 +40,7 @@ pub(super) fn layout_path() -> Option<PathBuf> {
 
 /// The saved layout, if there is a readable one holding both tabs.
 pub(super) fn load_layout() -> Option<DockState<Tab>> {
-    parse_layout(&kapaint_core::file_check::read_limited(&layout_path()?, 1 << 20).ok()?)
+    parse_layout(&kapaint_base::file_check::read_limited(&layout_path()?, 1 << 20).ok()?)
 }
 
 /// A dock layout from its JSON, if it parses and holds both tabs (the `null` coordinates
@@ -59,7 +59,7 @@ pub(super) fn save_layout(dock: &DockState<Tab>) {
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        let _ = kapaint_core::atomic::write_atomic(&path, &json);
+        let _ = kapaint_base::atomic::write_atomic(&path, &json);
     }
 }
 

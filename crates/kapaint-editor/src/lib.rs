@@ -43,12 +43,12 @@ use egui::Color32;
 use glam::Vec2;
 
 use canvas::{Canvas, CanvasChannel};
-use kapaint_core::mesh::Mesh;
-use kapaint_core::mesh::pick::Bvh;
-use kapaint_core::model::texel::Channel;
-use kapaint_core::model::{Command, Document};
 use kapaint_core::render::{Lighting, ViewMode};
 use kapaint_core::tools::Tools;
+use kapaint_mesh::Mesh;
+use kapaint_mesh::pick::Bvh;
+use kapaint_model::texel::Channel;
+use kapaint_model::{Command, Document};
 use viewport::Viewport;
 
 /// Default map size of a new project.
@@ -106,7 +106,7 @@ pub fn brush_outline(
 }
 
 /// A cheap identity of a stamp for its preview cache: size and a few samples' bits.
-fn stamp_key(stamp: &kapaint_core::model::brush::Stamp) -> u64 {
+fn stamp_key(stamp: &kapaint_model::brush::Stamp) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
     (stamp.width(), stamp.height()).hash(&mut h);
@@ -118,7 +118,7 @@ fn stamp_key(stamp: &kapaint_core::model::brush::Stamp) -> u64 {
 }
 
 /// A `size`^2 grey picture of a stamp (white where it paints).
-fn stamp_image(stamp: &kapaint_core::model::brush::Stamp, size: usize) -> egui::ColorImage {
+fn stamp_image(stamp: &kapaint_model::brush::Stamp, size: usize) -> egui::ColorImage {
     let mut pixels = Vec::with_capacity(size * size);
     for y in 0..size {
         for x in 0..size {
@@ -135,7 +135,7 @@ struct MeshState {
     id: u64,
     /// The document's bake this was made from: when the document's differs (undo of a mesh
     /// import, a resize), the state follows it.
-    from: std::sync::Weak<kapaint_core::model::surface::Surface>,
+    from: std::sync::Weak<kapaint_model::surface::Surface>,
     mesh: Arc<Mesh>,
     bvh: Bvh,
     /// UV edges in map fractions (u, 1 - v), for the canvas wireframe.
@@ -474,7 +474,7 @@ impl EditorState {
     }
 
     /// The materials used last, newest first.
-    pub fn recent_materials(&self) -> &[kapaint_core::model::texel::MaterialValue] {
+    pub fn recent_materials(&self) -> &[kapaint_model::texel::MaterialValue] {
         &self.tool_panel.recent_materials
     }
 

@@ -11,12 +11,12 @@ use super::EditorState;
 use super::dialogs::centred;
 pub use super::jobs::SizePrompt;
 use super::jobs::{LoadedMaterial, PbrMaterial};
-use kapaint_core::model::ModelError;
-use kapaint_core::model::resize::{ResizedMaps, resized_stack};
-use kapaint_core::model::surface::Surface;
-use kapaint_core::reflectance::ShadingModel;
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
+use kapaint_model::ModelError;
+use kapaint_model::resize::{ResizedMaps, resized_stack};
+use kapaint_model::surface::Surface;
 use kapaint_pbr::NMapping;
+use kapaint_reflectance::ShadingModel;
 
 /// The answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,7 +102,7 @@ impl EditorState {
     /// The maps resized to a material's size, and the material converted at it.
     fn adopted(&mut self, (resized, path, m): (ResizedMaps, PathBuf, Box<PbrMaterial>)) {
         let (w, h) = (resized.0.0.width, resized.0.0.height);
-        self.apply(kapaint_core::model::ImportCommand::Resize(resized));
+        self.apply(kapaint_model::ImportCommand::Resize(resized));
         self.notices.push(super::notice(
             format!("Resized the maps to the material's {w}x{h}"),
             false,

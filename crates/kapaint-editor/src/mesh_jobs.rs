@@ -6,11 +6,11 @@ use std::sync::Arc;
 
 use super::jobs::UnwrapPrompt;
 use super::{EditorState, notice};
-use kapaint_core::mesh::unwrap;
-use kapaint_core::model::ImportCommand;
-use kapaint_core::model::document::MeshRef;
-use kapaint_core::model::surface::Surface;
-use kapaint_core::task::Progress;
+use kapaint_base::task::Progress;
+use kapaint_mesh::unwrap;
+use kapaint_model::ImportCommand;
+use kapaint_model::document::MeshRef;
+use kapaint_model::surface::Surface;
 
 /// A mesh import's outcome.
 enum MeshImport {
@@ -24,8 +24,8 @@ enum MeshImport {
 
 /// A map baked from the mesh, what it holds and how many seconds it took.
 pub(super) type Baked = (
-    Arc<kapaint_core::mesh::bakes::Baked>,
-    kapaint_core::mesh::bakes::BakeStats,
+    Arc<kapaint_mesh::bakes::Baked>,
+    kapaint_mesh::bakes::BakeStats,
     f64,
 );
 
@@ -50,7 +50,7 @@ impl EditorState {
             self.prompts.material = Some(path.clone());
         }
         let mesh = MeshRef::from_spec(&path.display().to_string());
-        let attached = kapaint_core::model::document::AttachedMesh { mesh, surface };
+        let attached = kapaint_model::document::AttachedMesh { mesh, surface };
         match self.doc.apply(ImportCommand::SetMesh(attached)) {
             Ok(()) => {
                 self.follow_mesh();
@@ -78,7 +78,7 @@ impl EditorState {
             .collect();
         let bakes = baked
             .into_iter()
-            .map(|(b, _, _)| kapaint_core::model::document::AttachedBake(b))
+            .map(|(b, _, _)| kapaint_model::document::AttachedBake(b))
             .collect();
         match self.doc.apply(ImportCommand::SetBakes(bakes)) {
             Ok(()) => {
@@ -96,7 +96,7 @@ impl EditorState {
 
     /// A mesh unwrapped and baked at the map size: the project keeps it.
     fn unwrapped(&mut self, (path, surface, summary): (PathBuf, Arc<Surface>, String)) {
-        let attached = kapaint_core::model::document::AttachedMesh {
+        let attached = kapaint_model::document::AttachedMesh {
             mesh: MeshRef::Embedded(surface.mesh.name.clone()),
             surface,
         };
@@ -117,7 +117,7 @@ impl EditorState {
         let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
         self.start_job("Mesh", move |progress| {
             progress.start("load", 1);
-            let mesh = match kapaint_core::mesh::open(&path) {
+            let mesh = match kapaint_mesh::open(&path) {
                 Ok(m) => m,
                 Err(e) => return Err(format!("{}: {e}", path.display())),
             };
@@ -181,7 +181,7 @@ impl EditorState {
 
     fn bake_mesh(
         path: PathBuf,
-        mesh: kapaint_core::mesh::Mesh,
+        mesh: kapaint_mesh::Mesh,
         (w, h): (u32, u32),
         progress: &Progress,
     ) -> Result<(PathBuf, Arc<Surface>, bool), String> {

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::EditorState;
 use super::dialogs::centred;
-use kapaint_core::model::recovery;
+use kapaint_model::recovery;
 
 /// Shortest autosave interval offered (seconds).
 pub const AUTOSAVE_MIN_SECONDS: u32 = 5;
@@ -46,7 +46,7 @@ impl Preferences {
     /// The preferences saved, or the defaults.
     pub fn load() -> Self {
         path()
-            .and_then(|p| kapaint_core::file_check::read_limited(&p, 1 << 16).ok())
+            .and_then(|p| kapaint_base::file_check::read_limited(&p, 1 << 16).ok())
             .and_then(|json| Self::parse(&json))
             .unwrap_or_default()
     }
@@ -61,7 +61,7 @@ impl Preferences {
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         let json = serde_json::to_vec_pretty(self).map_err(|e| e.to_string())?;
-        kapaint_core::atomic::write_atomic(&path, &json)
+        kapaint_base::atomic::write_atomic(&path, &json)
             .map_err(|e| format!("{}: {e}", path.display()))
     }
 

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use super::files::FilePurpose;
 use super::jobs::{OpenedProject, Saved, load_project, with_fallback};
 use super::{EditorState, notice};
-use kapaint_core::model::{project, recovery};
+use kapaint_model::{project, recovery};
 
 /// The project file the document belongs to: where it is saved, what was saved, the claim on
 /// the file, the recovery copy, and the projects opened lately.
@@ -132,8 +132,8 @@ impl EditorState {
                 progress.start("save", 1);
                 match project::save_checked(&snapshot, &path, expected.as_ref()) {
                     Ok(on_disk) => Ok(Saved::Saved(path, version, on_disk)),
-                    Err(e @ kapaint_core::model::ModelError::Conflict { .. }) => {
-                        let kapaint_core::model::ModelError::Conflict { written, .. } = &e else {
+                    Err(e @ kapaint_model::ModelError::Conflict { .. }) => {
+                        let kapaint_model::ModelError::Conflict { written, .. } = &e else {
                             unreachable!("matched above")
                         };
                         Ok(Saved::Conflicted {

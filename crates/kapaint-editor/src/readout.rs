@@ -8,8 +8,8 @@ use std::collections::HashMap;
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, OnceLock};
 
-use kapaint_core::reflectance::ShadingModel;
-use kapaint_core::reflectance::exact::chi_parts_exact;
+use kapaint_reflectance::ShadingModel;
+use kapaint_reflectance::exact::chi_parts_exact;
 
 /// One value to integrate: a model and the half-float bits of `n`.
 type Key = (ShadingModel, u16);

@@ -5,9 +5,9 @@ use std::sync::Arc;
 
 use super::EditorState;
 use super::dialogs::{NEW_SIZES, centred};
-use kapaint_core::memory::human;
-use kapaint_core::model::resize::{ResizedMaps, peak_bytes, resized_stack};
-use kapaint_core::model::surface::Surface;
+use kapaint_base::memory::human;
+use kapaint_model::resize::{ResizedMaps, peak_bytes, resized_stack};
+use kapaint_model::surface::Surface;
 
 /// The Resize dialog's choices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -103,7 +103,7 @@ impl EditorState {
                 ));
                 ui.label(format!("Undo keeps the old maps: {maps_now}"));
                 let peak = peak_bytes(now, dialog.width, dialog.height);
-                let available = kapaint_core::memory::available_bytes();
+                let available = kapaint_base::memory::available_bytes();
                 let text = format!("Peak while resampling: {}", human(peak));
                 let fits = available.is_none_or(|a| peak < a);
                 if fits {

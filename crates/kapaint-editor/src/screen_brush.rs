@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use super::project;
-use kapaint_core::model::brush::BrushSettings;
+use kapaint_model::brush::BrushSettings;
 
 /// How the brush's size is given.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,8 +2,8 @@
 //! models' lobes and the per-view table's coordinates (`shaders/model_check.wgsl`) checked
 //! against the Rust core, and any WGSL function over a list of values ([`run_kernel`]).
 
-use kapaint_core::reflectance::wgsl::shader_id;
-use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
+use kapaint_reflectance::wgsl::shader_id;
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
 use super::{Gpu, GpuError, shader_source};
 

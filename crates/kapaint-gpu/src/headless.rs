@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use super::{Gpu, GpuError, Layout, MapTextures, MeshBuffers, Offscreen, Preview, RenderedImage};
-use kapaint_core::mesh::Mesh;
-use kapaint_core::model::MaterialMaps;
-use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::render::{FrameSettings, ViewMode};
+use kapaint_mesh::Mesh;
+use kapaint_model::MaterialMaps;
+use kapaint_reflectance::ShadingModel;
 
 pub use kapaint_core::render::Compare;
 
@@ -19,7 +19,7 @@ pub struct Request<'a> {
     /// The maps.
     pub maps: &'a MaterialMaps,
     /// The material's normal map, if it has one.
-    pub normal: Option<&'a std::sync::Arc<kapaint_core::model::normal::NormalMap>>,
+    pub normal: Option<&'a std::sync::Arc<kapaint_model::normal::NormalMap>>,
     /// Model, approximation, view, lights, camera.
     pub settings: FrameSettings,
     /// Single model or a comparison.
@@ -160,12 +160,12 @@ pub fn write_image(
         // n does not fit [0, 1]: a PNG holds it on the log scale of the painting engine.
         for px in p.chunks_exact_mut(4) {
             for v in &mut px[..3] {
-                *v = kapaint_core::model::texel::n_to_blend(*v);
+                *v = kapaint_model::texel::n_to_blend(*v);
             }
         }
     }
     let bytes = encode(&pixels, kind)?;
-    kapaint_core::atomic::write_atomic(out, &bytes)
+    kapaint_base::atomic::write_atomic(out, &bytes)
         .map_err(|e| GpuError(format!("cannot write {}: {e}", out.display())))?;
     Ok(note)
 }
@@ -188,7 +188,7 @@ fn draw_view_legend(view: ViewMode, pixels: &mut RenderedImage) -> Option<String
     match view {
         ViewMode::NFalseColour => {
             draw_legend(pixels, |t| {
-                let span = (1.0 + kapaint_core::model::texel::N_MAX).ln();
+                let span = (1.0 + kapaint_model::texel::N_MAX).ln();
                 kapaint_core::render::n_false_colour((span * t).exp() - 1.0)
             });
             Some(", legend: n = 0 (left) to 16384 (right), log scale".into())
@@ -218,7 +218,7 @@ fn draw_legend(image: &mut RenderedImage, ramp: impl Fn(f32) -> glam::Vec3) {
             let i = (y * width + x) as usize * 4;
             match image {
                 RenderedImage::Srgb8 { pixels, .. } => {
-                    let byte = kapaint_core::model::texel::linear_to_srgb8;
+                    let byte = kapaint_model::texel::linear_to_srgb8;
                     pixels[i..i + 4].copy_from_slice(&[byte(c.x), byte(c.y), byte(c.z), 255]);
                 }
                 RenderedImage::Linear { pixels, .. } => {
@@ -243,7 +243,7 @@ fn heatmap(diff: &[f32], width: u32, height: u32, max: f32) -> RenderedImage {
         } else {
             (ramp(p[0] * scale), p[3])
         };
-        let byte = kapaint_core::model::texel::linear_to_srgb8;
+        let byte = kapaint_model::texel::linear_to_srgb8;
         pixels.extend_from_slice(&[byte(c.x), byte(c.y), byte(c.z), (a * 255.0 + 0.5) as u8]);
     }
     RenderedImage::Srgb8 {

@@ -5,11 +5,11 @@
 //! CPU from the tile, rounded once per level): staged by `gpu::upload` straight into a
 //! mapped buffer and copied by one command buffer of sub-rectangle copies.
 
-use kapaint_core::model::{Channels, MaterialMaps};
+use kapaint_model::{Channels, MaterialMaps};
 
 use super::upload::{self, StagingPool};
 use super::{Gpu, GpuError};
-use kapaint_core::model::mips::TopSums;
+use kapaint_model::mips::TopSums;
 
 /// Which channels are one value over the whole map (the preview then skips their fetch).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -28,11 +28,11 @@ impl UniformChannels {
     /// Scans the tiles' planes (no texel is read unless a plane is full).
     pub fn of(maps: &MaterialMaps) -> Self {
         let (kd, ks, n) = maps.uniform_channels();
-        let rgb = |v: [u16; 3]| v.map(kapaint_core::model::texel::decode_unorm);
+        let rgb = |v: [u16; 3]| v.map(kapaint_model::texel::decode_unorm);
         Self {
             kd: kd.map(rgb),
             ks: ks.map(rgb),
-            n: n.map(kapaint_core::model::texel::decode_n),
+            n: n.map(kapaint_model::texel::decode_n),
             normal_map: false,
         }
     }
@@ -194,7 +194,7 @@ impl MapTextures {
     pub fn set_normal(
         &mut self,
         gpu: &Gpu,
-        normal: Option<&std::sync::Arc<kapaint_core::model::normal::NormalMap>>,
+        normal: Option<&std::sync::Arc<kapaint_model::normal::NormalMap>>,
     ) -> Result<(), GpuError> {
         self.normal.sync(gpu, normal)?;
         self.uniform.normal_map = self.normal.present();

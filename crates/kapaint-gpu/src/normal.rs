@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use super::{Gpu, GpuError};
-use kapaint_core::model::normal::NormalMap;
+use kapaint_model::normal::NormalMap;
 
 /// The normal map's texture and the map it mirrors.
 pub struct NormalTexture {

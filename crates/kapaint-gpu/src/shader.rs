@@ -6,8 +6,8 @@
 
 use std::fmt::Write as _;
 
-use kapaint_core::reflectance::wgsl::{IDS_FILE, model_and_approx_ids, screaming_snake, shader_id};
 use kapaint_core::render::ViewMode;
+use kapaint_reflectance::wgsl::{IDS_FILE, model_and_approx_ids, screaming_snake, shader_id};
 
 /// Every file in `shaders/`, by name.
 pub const FILES: [(&str, &str); 11] = [
@@ -277,9 +277,7 @@ mod tests {
 
     #[test]
     fn the_per_view_shader_holds_the_tables_constants() {
-        use kapaint_core::reflectance::view::{
-            VIEW_COEFFICIENTS, VIEW_GRAZE, VIEW_N_MAX, VIEW_NODES,
-        };
+        use kapaint_reflectance::view::{VIEW_COEFFICIENTS, VIEW_GRAZE, VIEW_N_MAX, VIEW_NODES};
         // With its includes: the table's coordinates are in view_coords.wgsl.
         let wgsl = resolve("ambient_view.wgsl").expect("embedded");
         for line in [

@@ -11,7 +11,7 @@ pub use views::{N_RAMP, VIEW_ERROR_TOP, ViewMode, heat_ramp, n_false_colour, rel
 use glam::{Mat4, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
-use crate::reflectance::{self, AmbientApprox, ShadingModel};
+use kapaint_reflectance::{self as reflectance, AmbientApprox, ShadingModel};
 
 /// How a frame compares the two shading models (or two sides with their own model and
 /// approximation, in the editor).
@@ -376,7 +376,7 @@ mod tests {
                 "{text} missing from preview_functions.wgsl"
             );
         }
-        let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln();
+        let span = (1.0 + f64::from(kapaint_model::texel::N_MAX)).ln();
         assert!(
             wgsl.contains(&format!("const N_LOG_SPAN: f32 = {span:?}f;")),
             "{span}"

@@ -6,9 +6,9 @@ use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::{FrameSettings, Sample, shade};
-use crate::mesh::Mesh;
-use crate::mesh::pick::Bvh;
-use crate::model::MaterialMaps;
+use kapaint_mesh::Mesh;
+use kapaint_mesh::pick::Bvh;
+use kapaint_model::MaterialMaps;
 
 /// Where material samples come from.
 pub enum Material<'a> {

@@ -1,5 +1,5 @@
 //! The ray-traced reference of the ambient term: per pixel, the same per-view integral as
-//! `k_a` per view ([`crate::reflectance::view`]), with each light direction masked by whether a
+//! `k_a` per view ([`kapaint_reflectance::view`]), with each light direction masked by whether a
 //! ray from the surface point along it escapes the mesh. It is what backward ray tracing of the
 //! scattered light would compute, and what `k_a` stands in for.
 //!
@@ -26,10 +26,10 @@ use rayon::prelude::*;
 
 use super::reference::Material;
 use super::{FrameSettings, VIEW_ERROR_TOP, ViewMode, heat_ramp, relative_error};
-use crate::mesh::Mesh;
-use crate::mesh::bakes::RayMesh;
-use crate::mesh::pick::Bvh;
-use crate::reflectance::{self, ShadingModel};
+use kapaint_mesh::Mesh;
+use kapaint_mesh::bakes::RayMesh;
+use kapaint_mesh::pick::Bvh;
+use kapaint_reflectance::{self as reflectance, ShadingModel};
 
 /// The most samples per pixel a traced view takes (`kapaint render --samples` refuses more).
 pub const MAX_SAMPLES: u32 = 1 << 20;
@@ -176,7 +176,7 @@ impl Traced {
 
     /// Reads the AO bake at every pixel's texture coordinate (its nearest texel), for the AO
     /// stand-in's error view ([`ViewMode::KaAoTracedError`]).
-    pub fn set_ao_bake(&mut self, bake: &crate::mesh::bakes::Baked) {
+    pub fn set_ao_bake(&mut self, bake: &kapaint_mesh::bakes::Baked) {
         let (w, h) = (bake.width, bake.height);
         self.ao = Some(
             self.points
@@ -293,7 +293,7 @@ impl Traced {
     /// pixel's surface point, the cosine-weighted fraction of `rays` directions about the
     /// triangle's normal that escape the mesh.
     pub fn ambient_occlusion(&self, mesh: &RayMesh, rays: u32) -> Vec<Option<f32>> {
-        let set = crate::mesh::bakes::Directions::new(rays);
+        let set = kapaint_mesh::bakes::Directions::new(rays);
         let far = self.far;
         self.points
             .par_iter()

@@ -28,7 +28,7 @@ pub enum ViewMode {
     /// `n` in false colour on the log scale [`N_RAMP`] (a picture, not data).
     NFalseColour,
     /// `k_a` per view (linear data): the ambient coefficient with `chi_view` at the pixel's own
-    /// view angle instead of its mean over the view (see [`crate::reflectance::view::ka_view`]).
+    /// view angle instead of its mean over the view (see [`kapaint_reflectance::view::ka_view`]).
     KaView,
     /// The view-average error: `k_a`'s relative difference from `k_a` per view
     /// ([`relative_error`]) as a heatmap, 0 to [`VIEW_ERROR_TOP`] (a picture, not data).
@@ -91,7 +91,7 @@ pub fn heat_ramp(t: f32) -> Vec3 {
 
 /// The false colour of `n` (linear RGB).
 pub fn n_false_colour(n: f32) -> Vec3 {
-    let span = (1.0 + f64::from(crate::model::texel::N_MAX)).ln() as f32;
+    let span = (1.0 + f64::from(kapaint_model::texel::N_MAX)).ln() as f32;
     let t = ((1.0 + n).ln() / span).clamp(0.0, 1.0) * 4.0;
     let i = (t as usize).min(3);
     Vec3::from(N_RAMP[i]).lerp(Vec3::from(N_RAMP[i + 1]), t - i as f32)

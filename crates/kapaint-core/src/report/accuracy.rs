@@ -4,8 +4,8 @@ use std::fmt::Write as _;
 
 use rayon::prelude::*;
 
-use crate::reflectance::cook_torrance::{self, karis};
-use crate::reflectance::{AmbientApprox, ShadingModel, chi_f32, chi_parts_f32, exact::chi_exact};
+use kapaint_reflectance::cook_torrance::{self, karis};
+use kapaint_reflectance::{AmbientApprox, ShadingModel, chi_f32, chi_parts_f32, exact::chi_exact};
 
 /// A range of `n` sampled for an accuracy report.
 #[derive(Clone, Debug, PartialEq)]
@@ -208,7 +208,7 @@ pub struct AccuracyReport {
 /// Blinn-Phong exponent): the model whose exponent the report checks.
 fn has_corrected_exponent(model: ShadingModel) -> bool {
     let [printed, corrected] = [AmbientApprox::PaperPrinted, AmbientApprox::PaperCorrected]
-        .map(|approx| crate::reflectance::paper_constants(model, approx));
+        .map(|approx| kapaint_reflectance::paper_constants(model, approx));
     printed.is_some() && printed != corrected
 }
 
@@ -350,7 +350,7 @@ pub struct ExponentCheck {
 
 /// Runs the exponent check on Blinn-Phong samples.
 pub fn exponent_check(exact: &ExactSamples) -> ExponentCheck {
-    use crate::reflectance::{PAPER_BLINN, PAPER_BLINN_CORRECTED_EXPONENT, fit};
+    use kapaint_reflectance::{PAPER_BLINN, PAPER_BLINN_CORRECTED_EXPONENT, fit};
     let (a, b, c) = PAPER_BLINN;
     let err = |c: f64| fit::power_law_max_error(a, b, c, &exact.samples);
     ExponentCheck {

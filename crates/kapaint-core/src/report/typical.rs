@@ -5,12 +5,12 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use crate::model::brush::{BrushSettings, StrokePoint};
-use crate::model::paint::GradientShape;
-use crate::model::{
+use kapaint_model::brush::{BrushSettings, StrokePoint};
+use kapaint_model::paint::GradientShape;
+use kapaint_model::{
     Channel, Channels, Command, Document, DocumentSettings, MaterialValue, StrokeTool, import,
 };
-use crate::model::{PaintCommand, SettingsCommand, StrokeCommand};
+use kapaint_model::{PaintCommand, SettingsCommand, StrokeCommand};
 
 /// [`textured`] with painting on `n` alone (what the documents then paint).
 fn textured_n_only(side: u32, texture: Option<&Path>) -> Result<Document, String> {
@@ -158,9 +158,9 @@ pub fn stroke_edge_document(side: u32, texture: Option<&Path>) -> Result<Documen
 /// about 10 % of the map (every tenth band of tiles, a different band per layer: a uniform
 /// material at varied coverage) with a varied mask there: the layered document of the layer
 /// benchmarks.
-pub fn layered_stack(side: u32, layers: usize) -> crate::model::layers::LayerStack {
-    use crate::model::layers::{Layer, LayerStack, Mask, PaintTile, Stamped};
-    use crate::model::tile::Plane;
+pub fn layered_stack(side: u32, layers: usize) -> kapaint_model::layers::LayerStack {
+    use kapaint_model::layers::{Layer, LayerStack, Mask, PaintTile, Stamped};
+    use kapaint_model::tile::Plane;
     use std::sync::Arc;
     let mut stack = LayerStack::new(side, side, MaterialValue::default());
     stack.layers.clear();

@@ -1,6 +1,6 @@
 //! The blur tool. Smooths the enabled channels under the brush, on the UV canvas or on the mesh.
 
-use crate::model::{Command, Document, SettingsCommand, StrokeTool};
+use kapaint_model::{Command, Document, SettingsCommand, StrokeTool};
 
 use super::stroke::{Stroke, StrokeState};
 use super::{

@@ -1,6 +1,6 @@
 //! The brush tool. Paints the primary material with the brush settings, on the UV canvas or on the mesh.
 
-use crate::model::{Command, Document, StrokeCommand, StrokeTool};
+use kapaint_model::{Command, Document, StrokeCommand, StrokeTool};
 
 use super::stroke::{Stroke, StrokeState};
 use super::{Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta};

@@ -1,6 +1,6 @@
 //! The eraser tool. Paints the base material back, on the UV canvas or on the mesh.
 
-use crate::model::{Command, Document, StrokeTool};
+use kapaint_model::{Command, Document, StrokeTool};
 
 use super::stroke::{Stroke, StrokeState};
 use super::{Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta};

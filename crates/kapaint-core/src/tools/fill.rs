@@ -1,8 +1,8 @@
 //! The fill tool: a press fills with the primary material, as its mode says.
 
-use crate::model::PaintCommand;
-use crate::model::texel::Channel;
-use crate::model::{Command, Document, FillRegion};
+use kapaint_model::PaintCommand;
+use kapaint_model::texel::Channel;
+use kapaint_model::{Command, Document, FillRegion};
 
 use super::{
     OptionChange, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,

@@ -5,9 +5,9 @@
 
 use glam::Vec2;
 
-use crate::model::PaintCommand;
-use crate::model::paint::GradientShape;
-use crate::model::{Command, Document};
+use kapaint_model::PaintCommand;
+use kapaint_model::paint::GradientShape;
+use kapaint_model::{Command, Document};
 
 use super::{
     OptionChange, OptionWidget, Overlay, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta,

@@ -27,8 +27,8 @@ use std::any::Any;
 
 use glam::Vec2;
 
-use crate::model::brush::SurfacePos;
-use crate::model::{Command, Document};
+use kapaint_model::brush::SurfacePos;
+use kapaint_model::{Command, Document};
 
 /// Where a pointer event happened, in the model's terms.
 #[derive(Clone, Copy, Debug, PartialEq)]

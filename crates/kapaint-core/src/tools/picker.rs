@@ -1,8 +1,8 @@
 //! The picker: a press reads every channel under the pointer into the primary material, on
 //! the UV canvas or on the mesh: of the composite, or (an option) of the selected layer.
 
-use crate::model::PaintCommand;
-use crate::model::{Command, Document};
+use kapaint_model::PaintCommand;
+use kapaint_model::{Command, Document};
 
 use super::{
     OptionChange, OptionWidget, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,

@@ -1,9 +1,9 @@
 //! The state machine the stroke tools share: a press begins a stroke (one undo step), drags
 //! add points in the view it began in, release ends it, Escape abandons it.
 
-use crate::model::StrokeCommand;
-use crate::model::brush::StrokePoint;
-use crate::model::{Command, Document, StrokeTool};
+use kapaint_model::StrokeCommand;
+use kapaint_model::brush::StrokePoint;
+use kapaint_model::{Command, Document, StrokeTool};
 
 use super::{Place, ToolEvent};
 

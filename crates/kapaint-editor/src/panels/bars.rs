@@ -6,9 +6,9 @@ use std::time::Duration;
 use crate::files::FilePurpose;
 use crate::keys::{self, Action};
 use crate::{EditorState, notice};
-use kapaint_core::model::HistoryCommand;
-use kapaint_core::model::texel::Channel;
-use kapaint_core::reflectance::{self, AmbientApprox, ShadingModel};
+use kapaint_model::HistoryCommand;
+use kapaint_model::texel::Channel;
+use kapaint_reflectance::{self as reflectance, AmbientApprox, ShadingModel};
 
 impl EditorState {
     pub(crate) fn status_bar_ui(&mut self, ui: &mut egui::Ui) {

@@ -6,8 +6,8 @@ use glam::Vec3;
 
 use super::Desk;
 use super::tool_panel::ToolPanel;
-use kapaint_core::model::SettingsCommand;
-use kapaint_core::model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8, srgb_to_linear};
+use kapaint_model::SettingsCommand;
+use kapaint_model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8, srgb_to_linear};
 
 /// How many recent materials the panel keeps.
 pub const RECENT_MATERIALS: usize = 8;

@@ -3,9 +3,9 @@
 //! thumbnail, and the smart masks to apply or save. Dragging a parameter previews coarsely
 //! (`PreviewMaskGenerator`); letting go sets it (`SetMaskGenerator`), the drag one undo step.
 
-use kapaint_core::model::generator::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
-use kapaint_core::model::layers::{Layer, thumbnail};
-use kapaint_core::model::{Document, MaskCommand};
+use kapaint_model::generator::{Axis, BlendOp, Generator, Levels, Noise, NoiseKind, Space};
+use kapaint_model::layers::{Layer, thumbnail};
+use kapaint_model::{Document, MaskCommand};
 
 use super::layers::LayersPanel;
 use super::presets::{Naming, Presets};
@@ -290,7 +290,7 @@ impl LayersPanel {
                 .bakes_needed()
                 .into_iter()
                 .filter(|&m| doc.bake_of(m).is_none())
-                .map(kapaint_core::mesh::bakes::BakeMap::name)
+                .map(kapaint_mesh::bakes::BakeMap::name)
                 .collect();
             if edit.released || (edit.changed && (!edit.dragging || !missing.is_empty())) {
                 baking = Some(edited);

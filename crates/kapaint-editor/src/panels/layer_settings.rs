@@ -5,10 +5,10 @@
 use super::Desk;
 use super::layers::LayersPanel;
 use super::presets::Presets;
-use kapaint_core::model::layers::{Layer, LayerBlend, LayerContent};
-use kapaint_core::model::texel::{Channel, Channels};
-use kapaint_core::model::{Command, LayerMove};
-use kapaint_core::model::{LayerCommand, MaskCommand};
+use kapaint_model::layers::{Layer, LayerBlend, LayerContent};
+use kapaint_model::texel::{Channel, Channels};
+use kapaint_model::{Command, LayerMove};
+use kapaint_model::{LayerCommand, MaskCommand};
 
 impl LayersPanel {
     /// The selected layer's name, opacity, channels and blends, fill material, mask and moves.

@@ -15,9 +15,9 @@ use egui::{Color32, Rect, Sense, Vec2};
 
 use super::Desk;
 use super::presets::Presets;
-use kapaint_core::model::layers::{Layer, LayerContent, thumbnail};
-use kapaint_core::model::{Command, Document, LayerKind, LayerPlace};
-use kapaint_core::model::{LayerCommand, MaskCommand};
+use kapaint_model::layers::{Layer, LayerContent, thumbnail};
+use kapaint_model::{Command, Document, LayerKind, LayerPlace};
+use kapaint_model::{LayerCommand, MaskCommand};
 
 /// Thumbnails' side in texels.
 const THUMB: u32 = 32;
@@ -548,7 +548,7 @@ fn drop_place(rect: Rect, pointer: egui::Pos2, content: &LayerContent) -> LayerP
 #[cfg(test)]
 mod tests {
     use super::LayerThumbs;
-    use kapaint_core::model::{Document, DocumentSettings};
+    use kapaint_model::{Document, DocumentSettings};
 
     /// Regression: the thumbnails were kept by the document's version alone, and a document
     /// opened in place of another starts its versions again, so the list showed the old

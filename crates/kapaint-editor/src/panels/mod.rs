@@ -1,6 +1,6 @@
 //! The editor's panels: tools, brush and material on the left; shading, compare, view, light
 //! and presets on the right; the menu bar, the status bar, dropped files and notices. Each
-//! reads the state and issues [`Command`](kapaint_core::model::Command)s.
+//! reads the state and issues [`Command`](kapaint_model::Command)s.
 
 mod bars;
 pub mod colour;
@@ -11,8 +11,8 @@ pub(super) mod presets;
 pub(super) mod tool_panel;
 pub(super) mod view_panel;
 
-use kapaint_core::model::{Command, Document};
 use kapaint_core::tools::{OptionChange, ToolKind, Tools};
+use kapaint_model::{Command, Document};
 
 use crate::Notice;
 use crate::files::FilePurpose;
@@ -45,7 +45,7 @@ pub(crate) enum Ask {
     Notice(Notice),
     /// Lay this generator as the selected layer's mask, baking first what it reads and the
     /// project lacks.
-    LayGenerator(kapaint_core::model::generator::Generator),
+    LayGenerator(kapaint_model::generator::Generator),
     /// Make the light follow the camera, or stay put in the world.
     LightFollowsCamera(bool),
 }

@@ -6,9 +6,9 @@ use std::path::Path;
 
 use super::{Ask, Desk};
 use crate::{EditorState, notice};
-use kapaint_core::model::SettingsCommand;
-use kapaint_core::model::brush::preset::{self as brush_preset, BrushPreset};
-use kapaint_core::model::texel::MaterialValue;
+use kapaint_model::SettingsCommand;
+use kapaint_model::brush::preset::{self as brush_preset, BrushPreset};
+use kapaint_model::texel::MaterialValue;
 
 /// Material, brush and mask presets, shipped and the user's.
 pub(crate) struct Presets {
@@ -16,9 +16,9 @@ pub(crate) struct Presets {
     /// thumbnail shows.
     pub(crate) materials: Vec<PresetEntry>,
     /// Brush presets.
-    pub(crate) brushes: Vec<kapaint_core::model::brush::preset::BrushPreset>,
+    pub(crate) brushes: Vec<kapaint_model::brush::preset::BrushPreset>,
     /// Smart masks.
-    pub(crate) masks: Vec<kapaint_core::model::generator::preset::MaskPreset>,
+    pub(crate) masks: Vec<kapaint_model::generator::preset::MaskPreset>,
     /// The user preset folder presets are saved to.
     pub(crate) dir: Option<std::path::PathBuf>,
     /// A preset's name being typed, what it names, and whether its field opened this frame.
@@ -57,7 +57,7 @@ pub(crate) fn load_all(
 ) -> (
     Vec<PresetEntry>,
     Vec<BrushPreset>,
-    Vec<kapaint_core::model::generator::preset::MaskPreset>,
+    Vec<kapaint_model::generator::preset::MaskPreset>,
 ) {
     (
         load_material_presets(dir, notices),
@@ -70,18 +70,18 @@ pub(crate) fn load_material_presets(
     dir: Option<&Path>,
     notices: &mut crate::Notices,
 ) -> Vec<PresetEntry> {
-    let entry = |stem: String, p: &kapaint_core::model::preset::MaterialPreset| PresetEntry {
+    let entry = |stem: String, p: &kapaint_model::preset::MaterialPreset| PresetEntry {
         stem,
         name: p.name.clone(),
         value: p.value(),
         thumbnail: None,
     };
-    let mut list: Vec<PresetEntry> = kapaint_core::model::preset::builtin()
+    let mut list: Vec<PresetEntry> = kapaint_model::preset::builtin()
         .iter()
         .map(|(stem, p)| entry(stem.clone(), p))
         .collect();
     if let Some(dir) = dir {
-        for found in kapaint_core::model::preset::load_dir(dir) {
+        for found in kapaint_model::preset::load_dir(dir) {
             match found {
                 Ok((stem, p)) => {
                     // A user preset of a shipped preset's file name takes its place.
@@ -302,7 +302,7 @@ impl Presets {
         let saved = match kind {
             Naming::Material => self.dir.clone().ok_or_else(no_folder).and_then(|dir| {
                 let value = doc.settings().primary;
-                kapaint_core::model::preset::save_user(&dir, name, value)
+                kapaint_model::preset::save_user(&dir, name, value)
                     .map_err(|e| e.to_string())
                     .map(|(stem, path)| {
                         self.materials.retain(|p| p.stem != stem);
@@ -342,7 +342,7 @@ impl Presets {
                         .and_then(|m| m.generator())
                         .cloned()
                         .ok_or("the selected layer's mask is not made by a generator")?;
-                    let preset = kapaint_core::model::generator::preset::MaskPreset {
+                    let preset = kapaint_model::generator::preset::MaskPreset {
                         name: name.trim().to_string(),
                         mask,
                     };
@@ -370,8 +370,8 @@ impl Presets {
 pub(crate) fn load_mask_presets(
     dir: Option<&std::path::Path>,
     notices: &mut crate::Notices,
-) -> Vec<kapaint_core::model::generator::preset::MaskPreset> {
-    use kapaint_core::model::generator::preset;
+) -> Vec<kapaint_model::generator::preset::MaskPreset> {
+    use kapaint_model::generator::preset;
     let mut list = preset::builtin();
     if let Some(dir) = dir {
         for found in preset::load_dir(&dir.join("masks")) {

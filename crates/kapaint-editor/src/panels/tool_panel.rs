@@ -4,9 +4,9 @@ use super::presets::Presets;
 use super::{Ask, Desk};
 use crate::files::FilePurpose;
 use crate::{stamp_image, stamp_key};
-use kapaint_core::model::SettingsCommand;
-use kapaint_core::reflectance;
 use kapaint_core::tools::{OptionChange, OptionWidget, ToolOption};
+use kapaint_model::SettingsCommand;
+use kapaint_reflectance as reflectance;
 
 /// The tool panel's own state.
 #[derive(Default)]
@@ -16,10 +16,10 @@ pub(crate) struct ToolPanel {
     /// The hex field's text while it is typed in (`None`: it shows the primary's `k_d`).
     pub(crate) hex_text: Option<String>,
     /// Materials laid last by a stroke, fill or gradient, newest first.
-    pub(crate) recent_materials: Vec<kapaint_core::model::texel::MaterialValue>,
+    pub(crate) recent_materials: Vec<kapaint_model::texel::MaterialValue>,
     /// The other model's exponent matching the primary's `n`, for the model and `n` (its
     /// bits) it was found for.
-    pub(crate) equivalent_n: Option<((kapaint_core::reflectance::ShadingModel, u32), f64)>,
+    pub(crate) equivalent_n: Option<((kapaint_reflectance::ShadingModel, u32), f64)>,
     /// The brush stamp's preview texture, and which stamp it shows.
     pub(crate) stamp_preview: Option<(u64, egui::TextureHandle)>,
 }
@@ -96,7 +96,7 @@ impl ToolPanel {
             primary.ks = glam::Vec3::splat(grey);
         }
         ui.add(
-            egui::Slider::new(&mut primary.n, 0.0..=kapaint_core::model::texel::N_MAX)
+            egui::Slider::new(&mut primary.n, 0.0..=kapaint_model::texel::N_MAX)
                 .logarithmic(true)
                 .text("n"),
         );
@@ -138,7 +138,7 @@ impl ToolPanel {
     fn stamp_ui(
         &mut self,
         ui: &mut egui::Ui,
-        brush: &mut kapaint_core::model::brush::BrushSettings,
+        brush: &mut kapaint_model::brush::BrushSettings,
         desk: &mut Desk,
     ) {
         ui.horizontal(|ui| {
@@ -169,7 +169,7 @@ impl ToolPanel {
                 .on_hover_text("A built-in grainy stamp")
                 .clicked()
             {
-                brush.stamp = Some(kapaint_core::model::brush::Stamp::grain(64));
+                brush.stamp = Some(kapaint_model::brush::Stamp::grain(64));
             }
             if ui
                 .button("Load…")
@@ -200,8 +200,8 @@ fn channels_ui(ui: &mut egui::Ui, desk: &mut Desk) {
 }
 
 /// The stroke's options: blend mode, lazy mouse, mirrors, front faces only, energy guard.
-fn stroke_options_ui(ui: &mut egui::Ui, brush: &mut kapaint_core::model::brush::BrushSettings) {
-    use kapaint_core::model::brush::BlendMode;
+fn stroke_options_ui(ui: &mut egui::Ui, brush: &mut kapaint_model::brush::BrushSettings) {
+    use kapaint_model::brush::BlendMode;
     egui::ComboBox::from_label("Blend")
         .selected_text(blend_label(brush.blend))
         .show_ui(ui, |ui| {
@@ -237,8 +237,8 @@ fn stroke_options_ui(ui: &mut egui::Ui, brush: &mut kapaint_core::model::brush::
 }
 
 /// A blend mode's name in the panel.
-fn blend_label(mode: kapaint_core::model::brush::BlendMode) -> &'static str {
-    use kapaint_core::model::brush::BlendMode;
+fn blend_label(mode: kapaint_model::brush::BlendMode) -> &'static str {
+    use kapaint_model::brush::BlendMode;
     match mode {
         BlendMode::Normal => "Normal",
         BlendMode::Add => "Add",

@@ -8,10 +8,10 @@ use crate::canvas::{Canvas, CanvasChannel};
 use crate::layer_view::LayerView;
 use crate::viewport::{Compare, Comparison, ViewportGpu};
 use crate::{Look, MeshState};
-use kapaint_core::model::texel::MaterialValue;
-use kapaint_core::model::{HistoryCommand, SettingsCommand};
-use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
 use kapaint_core::render::{FrameSettings, ViewMode};
+use kapaint_model::texel::MaterialValue;
+use kapaint_model::{HistoryCommand, SettingsCommand};
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
 /// What the right panel changes of how the editor shows the document (none of it is the
 /// document's: no undo step, not saved).
@@ -293,7 +293,7 @@ pub(crate) fn thumbnail(
     let pixels = kapaint_core::render::reference::render(
         &mesh.mesh, &mesh.bvh, &material, &settings, SIZE, SIZE,
     );
-    let c = |x: f32| (kapaint_core::model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
+    let c = |x: f32| (kapaint_model::texel::linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0) as u8;
     let rgba: Vec<u8> = pixels
         .iter()
         .flat_map(|p| [c(p.x), c(p.y), c(p.z), (p.w.clamp(0.0, 1.0) * 255.0) as u8])

@@ -13,11 +13,11 @@ use std::sync::Arc;
 
 use egui::{Color32, Pos2, Rect, Sense};
 
-use kapaint_core::mesh::Mesh;
-use kapaint_core::mesh::pick::{Bvh, Hit};
-use kapaint_core::model::MaterialMaps;
-use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
 use kapaint_core::render::{Camera, FrameSettings, ViewMode};
+use kapaint_mesh::Mesh;
+use kapaint_mesh::pick::{Bvh, Hit};
+use kapaint_model::MaterialMaps;
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
 /// The viewport's accessible name.
 pub const VIEWPORT_LABEL: &str = "3D viewport painting area";
@@ -29,7 +29,7 @@ pub use kapaint_core::render::Compare;
 pub type MapsIn<'a> = (
     &'a MaterialMaps,
     u64,
-    Option<&'a Arc<kapaint_core::model::normal::NormalMap>>,
+    Option<&'a Arc<kapaint_model::normal::NormalMap>>,
 );
 
 /// One side of a comparison: its shading model and approximation of `chi`.
@@ -135,7 +135,7 @@ pub struct Viewport {
     /// The traced views' worker and picture.
     pub traced: traced::TracedView,
     /// The project's AO bake, for the AO stand-in's view (the editor sets it each frame).
-    pub ao_bake: Option<Arc<kapaint_core::mesh::bakes::Baked>>,
+    pub ao_bake: Option<Arc<kapaint_mesh::bakes::Baked>>,
     /// Set when the user asked for the untraced view instead of a trace that does not fit;
     /// the editor switches the view and clears it.
     pub untraced_requested: bool,

@@ -53,7 +53,7 @@ impl Viewport {
                 label(mid, egui::Align2::LEFT_TOP, c.right.label());
             }
             Compare::ThreeWay => {
-                for (i, model) in kapaint_core::reflectance::ShadingModel::ALL
+                for (i, model) in kapaint_reflectance::ShadingModel::ALL
                     .into_iter()
                     .enumerate()
                 {
@@ -102,10 +102,10 @@ pub const N_LEGEND_LABEL: &str = "n false-colour scale, 0 to 16384, logarithmic"
 pub(super) fn n_legend_ui(ui: &egui::Ui, painter: &egui::Painter, rect: Rect) {
     let bar = scale_bar(rect);
     ramp_ui(painter, bar, |t| {
-        let span = (1.0 + f64::from(kapaint_core::model::texel::N_MAX)).ln() as f32;
+        let span = (1.0 + f64::from(kapaint_model::texel::N_MAX)).ln() as f32;
         kapaint_core::render::n_false_colour((t * span).exp() - 1.0)
     });
-    let span = (1.0 + f64::from(kapaint_core::model::texel::N_MAX)).ln() as f32;
+    let span = (1.0 + f64::from(kapaint_model::texel::N_MAX)).ln() as f32;
     for n in [0.0_f32, 10.0, 100.0, 1000.0, 16384.0] {
         tick(painter, bar, (1.0 + n).ln() / span, &format!("{n}"));
     }
@@ -190,7 +190,7 @@ pub(crate) fn scale_bar(rect: Rect) -> Rect {
 /// Fills `bar` with `ramp(t)` (linear RGB) for `t` from 0 at the left to 1 at the right.
 fn ramp_ui(painter: &egui::Painter, bar: Rect, ramp: impl Fn(f32) -> glam::Vec3) {
     let steps = 64;
-    let srgb = kapaint_core::model::texel::linear_to_srgb8;
+    let srgb = kapaint_model::texel::linear_to_srgb8;
     for i in 0..steps {
         let t0 = i as f32 / steps as f32;
         let c = ramp(t0 + 0.5 / steps as f32);

@@ -9,10 +9,6 @@ use eframe::egui_wgpu;
 use egui::TextureId;
 
 use super::{Compare, Comparison, Side};
-use kapaint_core::mesh::Mesh;
-use kapaint_core::model::MaterialMaps;
-use kapaint_core::model::texel::MaterialValue;
-use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::render::FrameSettings;
 use kapaint_gpu::difference::{Difference, DifferenceBindings, SIDE_FORMAT};
 use kapaint_gpu::maps::MapTextures;
@@ -21,6 +17,10 @@ use kapaint_gpu::preview::{
     PipelineKey, Preview, PreviewDrawData, RenderedImage, begin_pass,
 };
 use kapaint_gpu::{Gpu, GpuError};
+use kapaint_mesh::Mesh;
+use kapaint_model::MaterialMaps;
+use kapaint_model::texel::MaterialValue;
+use kapaint_reflectance::ShadingModel;
 
 /// GPU objects of the viewport.
 pub struct ViewportGpu {

@@ -11,12 +11,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use egui::{Color32, ColorImage, Pos2, Rect, TextureHandle};
-use kapaint_core::mesh::bakes::{Baked, RayMesh};
-use kapaint_core::mesh::{Mesh, pick::Bvh};
-use kapaint_core::model::MaterialMaps;
 use kapaint_core::render::FrameSettings;
 use kapaint_core::render::reference::Material;
 use kapaint_core::render::traced::{self, Traced};
+use kapaint_mesh::bakes::{Baked, RayMesh};
+use kapaint_mesh::{Mesh, pick::Bvh};
+use kapaint_model::MaterialMaps;
 
 /// The most pixels a traced picture has.
 pub const PIXELS: u32 = 400_000;
@@ -233,7 +233,7 @@ fn work(
     let (w, h) = key.size;
     let bytes = traced::ray_mesh_bytes(mesh.triangles.len())
         + u64::from(w) * u64::from(h) * traced::bytes_per_pixel();
-    if let Err(e) = kapaint_core::memory::check_fits("tracing this mesh", bytes) {
+    if let Err(e) = kapaint_base::memory::check_fits("tracing this mesh", bytes) {
         publish(Published::Refused(e));
         return;
     }
@@ -293,7 +293,7 @@ fn work(
 
 /// Linear RGBA pixels as an sRGB picture (transparent where no surface).
 fn picture(pixels: &[glam::Vec4], (w, h): (u32, u32)) -> ColorImage {
-    let byte = kapaint_core::model::texel::linear_to_srgb8;
+    let byte = kapaint_model::texel::linear_to_srgb8;
     let rgba: Vec<u8> = pixels
         .iter()
         .flat_map(|p| {

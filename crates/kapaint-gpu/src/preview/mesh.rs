@@ -3,7 +3,7 @@
 use glam::Vec3;
 
 use crate::{Gpu, GpuError};
-use kapaint_core::mesh::Mesh;
+use kapaint_mesh::Mesh;
 
 /// Interleaved vertex: position, normal, UV, MikkTSpace tangent.
 #[repr(C)]
@@ -68,7 +68,7 @@ impl MeshBuffers {
     fn upload(gpu: &Gpu, mesh: &Mesh, tangents: bool) -> Self {
         use wgpu::util::DeviceExt;
         let with_tangents = tangents
-            .then(|| kapaint_core::mesh::tangents::generate(mesh))
+            .then(|| kapaint_mesh::tangents::generate(mesh))
             .flatten();
         let (mesh, tangents) = match &with_tangents {
             Some(t) => (&t.mesh, Some(&t.tangents)),

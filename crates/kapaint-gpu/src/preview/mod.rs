@@ -102,7 +102,7 @@ impl Preview {
 /// The per-view table's spline coefficients as one `R32Float` texture, the four tables
 /// stacked in rows (`shaders/ambient_view.wgsl` reads it): 270 KB, made once per renderer.
 fn view_table(gpu: &Gpu) -> wgpu::TextureView {
-    use kapaint_core::reflectance::view::{VIEW_COEFFICIENTS, view_coefficients};
+    use kapaint_reflectance::view::{VIEW_COEFFICIENTS, view_coefficients};
     use wgpu::util::DeviceExt as _;
     let tables = view_coefficients();
     let texels: Vec<f32> = tables.iter().flatten().copied().collect();

@@ -4,8 +4,8 @@ use super::{DEPTH_FORMAT, Layout, MeshBuffers, PipelineKey, Preview, PreviewDraw
 use crate::maps::MapTextures;
 use crate::readback::read_texture;
 use crate::{Gpu, GpuError};
-use kapaint_core::reflectance::ShadingModel;
 use kapaint_core::render::FrameSettings;
+use kapaint_reflectance::ShadingModel;
 
 /// What an offscreen render produces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,9 +5,9 @@ use super::DEPTH_FORMAT;
 use super::mesh::Vertex;
 use crate::maps::UniformChannels;
 use crate::shader::view_id;
-use kapaint_core::reflectance::wgsl::shader_id;
-use kapaint_core::reflectance::{AmbientApprox, ShadingModel};
 use kapaint_core::render::{FrameSettings, ViewMode};
+use kapaint_reflectance::wgsl::shader_id;
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
 /// The overridable constants of one pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

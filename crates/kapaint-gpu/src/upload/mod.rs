@@ -13,7 +13,7 @@ pub use plan::{TileRect, batches, tile_rects};
 pub use pool::StagingPool;
 pub use stage::{fill_rects, fill_top};
 
-use kapaint_core::model::tile::TILE_SIZE;
+use kapaint_model::tile::TILE_SIZE;
 
 /// Tiles along each side of the largest rectangle staged as one image.
 const RECT_TILES: usize = 8;

@@ -2,9 +2,9 @@
 //! out in the staging buffer, in batches of bounded size.
 
 use super::{BATCH_BYTES, RECT_TILES, TILE_LEVEL};
-use kapaint_core::model::Channels;
-use kapaint_core::model::maps::TexelRect;
-use kapaint_core::model::tile::TILE_SIZE;
+use kapaint_model::Channels;
+use kapaint_model::maps::TexelRect;
+use kapaint_model::tile::TILE_SIZE;
 
 /// A rectangle of tiles: columns `x0..x1`, rows `y0..y1`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,5 +1,5 @@
 //! Staging: each parallel job writes one row of a rectangle's tiles, level 0 straight from the
-//! tiles' planes and the mips from [`kapaint_core::model::mips`], into its own mapped views of the
+//! tiles' planes and the mips from [`kapaint_model::mips`], into its own mapped views of the
 //! staging buffer.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -7,10 +7,10 @@ use std::sync::{Mutex, PoisonError};
 
 use super::plan::{Batch, StagedImage, TileRect, rect_texels};
 use crate::GpuError;
-use kapaint_core::model::MaterialMaps;
-use kapaint_core::model::mips::{self, MipRows, Sums, TileSums, TopSums, alpha};
-use kapaint_core::model::texel::{Channel, decode_unorm};
-use kapaint_core::model::tile::{Plane, TILE_SIZE};
+use kapaint_model::MaterialMaps;
+use kapaint_model::mips::{self, MipRows, Sums, TileSums, TopSums, alpha};
+use kapaint_model::texel::{Channel, decode_unorm};
+use kapaint_model::tile::{Plane, TILE_SIZE};
 
 /// A run of rows of one staged image (all three textures), each mapped for writing.
 struct Band {

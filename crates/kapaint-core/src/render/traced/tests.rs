@@ -4,10 +4,10 @@
 use glam::Vec3;
 
 use super::*;
-use crate::mesh;
-use crate::reflectance::AmbientApprox;
 use crate::render::reference;
 use crate::render::{Camera, Lighting, Sample};
+use kapaint_mesh as mesh;
+use kapaint_reflectance::AmbientApprox;
 
 fn settings(model: ShadingModel, view: ViewMode, camera: Camera) -> FrameSettings {
     FrameSettings {

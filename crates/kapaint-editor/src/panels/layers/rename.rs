@@ -1,6 +1,6 @@
 //! Renaming a layer in its row of the list.
 
-use kapaint_core::model::layers::{Layer, LayerId};
+use kapaint_model::layers::{Layer, LayerId};
 
 use super::LayersPanel;
 use super::RowAction;
