@@ -488,3 +488,52 @@ fn image_resize_shows_its_memory_first_and_is_one_undo_step() {
     assert_eq!(texels(harness.state()), painted);
     assert!((harness.state().state.canvas_zoom() / zoom - 1.0).abs() < 1e-3);
 }
+
+/// Regression: the export dialog's measured set arrived from a worker above the folder row,
+/// and the window grew under the pointer: a click aimed at "…" (or Export) as it arrived hit
+/// the measurement instead (`every_file_request_reaches_its_command` waited for the folder in
+/// vain about one run in eight here). The controls now sit above what is measured, so its
+/// arrival moves none of them.
+#[test]
+fn the_export_dialogs_controls_sit_above_what_arrives_from_the_worker() {
+    let mut harness = editor();
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
+    harness.run_steps(2);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness.query_by_label("Packed layout").is_none() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the set was never measured"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+    harness.run_steps(2);
+    let measured = harness.get_by_label("Packed layout").rect().min.y;
+    for (name, button) in [
+        ("the folder's button", folder_button(&harness)),
+        ("Export", export_button(&harness)),
+    ] {
+        assert!(
+            button.max.y < measured,
+            "{name} ({button:?}) sits under the measured set (from y = {measured})"
+        );
+    }
+}
+
+/// The export dialog's folder button ("…" on the Folder row: the preset browser has "…"
+/// buttons too, for thumbnails not drawn yet).
+#[expect(clippy::expect_used, reason = "a test helper: no button, no test")]
+fn folder_button(harness: &Harness<'_, Editor>) -> egui::Rect {
+    let row = harness.get_by_label("Folder").rect().center().y;
+    harness
+        .get_all_by_role_and_label(Role::Button, "…")
+        .map(|b| b.rect())
+        .find(|r| (r.center().y - row).abs() < 12.0)
+        .expect("the folder's button")
+}
+
+/// The export dialog's Export button.
+fn export_button(harness: &Harness<'_, Editor>) -> egui::Rect {
+    harness.get_by_role_and_label(Role::Button, "Export").rect()
+}

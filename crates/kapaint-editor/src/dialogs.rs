@@ -426,25 +426,10 @@ impl EditorState {
                     .presets
                     .get(dialog.chosen)
                     .is_some_and(|p| p.format.is_gltf_pbr());
-                match &dialog.plan {
-                    Some((p, _, plan)) if *p == dialog.chosen => {
-                        export_plan_ui(ui, plan, pbr);
-                        if let Some(preset) = dialog.presets.get(dialog.chosen) {
-                            block_search_ui(ui, preset);
-                        }
-                    }
-                    _ => {
-                        ui.horizontal(|ui| {
-                            ui.spinner();
-                            ui.label("Measuring the set…");
-                        });
-                    }
-                }
-                ui.separator();
                 ui.horizontal(|ui| {
                     ui.label("Folder");
-                    // A fixed id: the measurement arriving above it must not take the
-                    // keyboard from a folder being typed.
+                    // A fixed id: the measurement arriving must not take the keyboard from a
+                    // folder being typed.
                     let field =
                         egui::TextEdit::singleline(&mut dialog.folder).id_salt("export folder");
                     if ui.add(field).changed() {
@@ -480,6 +465,23 @@ impl EditorState {
                     });
                 } else {
                     go = ui.button("Export").clicked();
+                }
+                // The measured set below what is clicked: it arrives from a worker, and a
+                // window growing above the controls would move them from under the pointer.
+                ui.separator();
+                match &dialog.plan {
+                    Some((p, _, plan)) if *p == dialog.chosen => {
+                        export_plan_ui(ui, plan, pbr);
+                        if let Some(preset) = dialog.presets.get(dialog.chosen) {
+                            block_search_ui(ui, preset);
+                        }
+                    }
+                    _ => {
+                        ui.horizontal(|ui| {
+                            ui.spinner();
+                            ui.label("Measuring the set…");
+                        });
+                    }
                 }
             });
         if !open {
