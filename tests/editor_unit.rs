@@ -42,6 +42,22 @@ fn fields(source: &str, name: &str) -> Option<Vec<String>> {
     )
 }
 
+/// `file:line` of every line of the Rust files under `dir` (from the root) that `matches`.
+fn lines_where(dir: &str, matches: impl Fn(&str) -> bool) -> Vec<String> {
+    let mut files = Vec::new();
+    product_sources::files(&root().join(dir), "rs", &mut files);
+    let mut found = Vec::new();
+    for file in files {
+        let text = std::fs::read_to_string(&file).expect("a source file");
+        for (i, line) in text.lines().enumerate() {
+            if matches(line) {
+                found.push(format!("{}:{}", file.display(), i + 1));
+            }
+        }
+    }
+    found
+}
+
 #[test]
 fn the_editor_state_keeps_at_most_sixteen_parts() {
     let lib = std::fs::read_to_string(root().join("crates/kapaint-editor/src/lib.rs"))
@@ -57,17 +73,9 @@ fn the_editor_state_keeps_at_most_sixteen_parts() {
 
 #[test]
 fn jobs_report_through_their_own_types() {
-    let mut files = Vec::new();
-    product_sources::files(&root().join("crates/kapaint-editor/src"), "rs", &mut files);
-    let mut found = Vec::new();
-    for file in files {
-        let text = std::fs::read_to_string(&file).expect("a source file");
-        for (i, line) in text.lines().enumerate() {
-            if line.contains("enum JobResult") || line.contains("JobResult::") {
-                found.push(format!("{}:{}", file.display(), i + 1));
-            }
-        }
-    }
+    let found = lines_where("crates/kapaint-editor/src", |line| {
+        line.contains("enum JobResult") || line.contains("JobResult::")
+    });
     assert!(
         found.is_empty(),
         "one enum for every job's result (each job names its result type and the function \
@@ -77,18 +85,10 @@ fn jobs_report_through_their_own_types() {
 
 #[test]
 fn tool_options_are_typed_per_tool() {
-    let mut files = Vec::new();
-    product_sources::files(&root().join("crates"), "rs", &mut files);
-    let mut found = Vec::new();
-    for file in files {
-        let text = std::fs::read_to_string(&file).expect("a source file");
-        for (i, line) in text.lines().enumerate() {
-            let code = line.split("//").next().unwrap_or("");
-            if code.contains("OptionValue") || code.contains("fn set_option(&mut self, id: &str") {
-                found.push(format!("{}:{}", file.display(), i + 1));
-            }
-        }
-    }
+    let found = lines_where("crates", |line| {
+        let code = line.split("//").next().unwrap_or("");
+        code.contains("OptionValue") || code.contains("fn set_option(&mut self, id: &str")
+    });
     assert!(
         found.is_empty(),
         "a tool option set by a string id and an untyped value (each tool's options are its own \

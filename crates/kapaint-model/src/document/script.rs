@@ -36,16 +36,21 @@ impl Room {
         Self::Mask,
     ];
 
-    /// The script names of the room's commands, as its derived form knows them.
+    /// The script names of the room's commands, as its derived form knows them (asked once
+    /// per process, not once per command read).
     fn names(self) -> &'static [&'static str] {
-        match self {
-            Self::Settings => variants::<SettingsCommand>(),
-            Self::Stroke => variants::<StrokeCommand>(),
-            Self::Paint => variants::<PaintCommand>(),
-            Self::History => variants::<HistoryCommand>(),
-            Self::Layer => variants::<LayerCommand>(),
-            Self::Mask => variants::<MaskCommand>(),
-        }
+        static NAMES: OnceLock<[&'static [&'static str]; 6]> = OnceLock::new();
+        let names = NAMES.get_or_init(|| {
+            Room::ALL.map(|room| match room {
+                Self::Settings => variants::<SettingsCommand>(),
+                Self::Stroke => variants::<StrokeCommand>(),
+                Self::Paint => variants::<PaintCommand>(),
+                Self::History => variants::<HistoryCommand>(),
+                Self::Layer => variants::<LayerCommand>(),
+                Self::Mask => variants::<MaskCommand>(),
+            })
+        });
+        names[self as usize]
     }
 
     /// Reads the command `name` of this room from its content.
@@ -204,6 +209,9 @@ mod tests {
 
     #[test]
     fn every_room_names_its_commands_and_no_name_is_in_two() {
+        for (i, room) in Room::ALL.into_iter().enumerate() {
+            assert_eq!(room as usize, i, "Room::ALL is in declaration order");
+        }
         let names = all_names();
         assert!(
             names.contains(&"SetPrimary") && names.contains(&"Ungroup"),
