@@ -19,6 +19,10 @@ use product_sources::root;
 /// The most fields `EditorState` may keep (the issue's bound).
 const MOST_FIELDS: usize = 16;
 
+/// The most files that may hold `impl EditorState` (the issue's bound): its accessors, the
+/// one place asks are carried out, the jobs' machinery and the input.
+const MOST_IMPL_FILES: usize = 4;
+
 /// The fields of `struct NAME` in `source`: its lines at the struct's indentation plus four
 /// that declare a field (`name: Type,`).
 fn fields(source: &str, name: &str) -> Option<Vec<String>> {
@@ -80,6 +84,37 @@ fn jobs_report_through_their_own_types() {
         found.is_empty(),
         "one enum for every job's result (each job names its result type and the function \
          that takes it): {found:?}"
+    );
+}
+
+#[test]
+fn the_editor_state_is_changed_in_at_most_four_files() {
+    let found = lines_where("crates/kapaint-editor/src", |line| {
+        line.starts_with("impl EditorState")
+    });
+    let mut files: Vec<&str> = found
+        .iter()
+        .map(|at| at.rsplit_once(':').map_or(at.as_str(), |(file, _)| file))
+        .collect();
+    files.dedup();
+    assert!(
+        !files.is_empty() && files.len() <= MOST_IMPL_FILES,
+        "impl EditorState in {} files (at most {MOST_IMPL_FILES}: a panel, a dialog or a job \
+         is a view that reads the document and asks through a Desk): {files:?}",
+        files.len()
+    );
+}
+
+#[test]
+fn finished_jobs_ask_through_a_desk() {
+    let found = lines_where("crates/kapaint-editor/src", |line| {
+        let code = line.split("//").next().unwrap_or("");
+        code.contains("fn(&mut EditorState") || code.contains("FnOnce(&mut EditorState")
+    });
+    assert!(
+        found.is_empty(),
+        "a job that changes the editor itself when done (its done function reads the \
+         document and asks through a Desk): {found:?}"
     );
 }
 

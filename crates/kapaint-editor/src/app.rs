@@ -9,12 +9,13 @@ use egui_dock::{DockArea, DockState, TabViewer};
 
 use super::canvas::Canvas;
 use super::canvas::CanvasChannel;
-use super::dialogs::load_recent;
 use super::jobs::new_document;
 use super::layout::{load_layout, save_layout};
 use super::panels::layers::LayerView;
+use super::project_jobs::load_recent;
 use super::viewport::{Viewport, ViewportGpu};
 use super::{DEFAULT_SIZE, EditorState, MeshState, Tab, default_layout, notice, readout};
+use crate::desk::Desk;
 use kapaint_core::render::{Lighting, ViewMode};
 use kapaint_core::tools::Tools;
 use kapaint_model::texel::MaterialValue;
@@ -243,11 +244,19 @@ impl Editor {
         let s = &mut self.state;
         s.jobs.waker = Some(ctx.clone());
         s.poll_job();
-        s.bake_missing();
+        let busy = s.busy();
+        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+        s.jobs.bake_on_demand.look(busy, &mut desk);
+        let asks = desk.into_asks();
+        s.carry_out(asks);
         s.track_pressure(&ctx);
         s.hotkeys(&ctx);
         s.follow_mesh();
-        s.dropped_files(&ctx);
+        let channel = s.canvas_target();
+        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+        crate::panels::bars::dropped_files(&ctx, channel, &mut desk);
+        let asks = desk.into_asks();
+        s.carry_out(asks);
         let now = Instant::now();
         if let Some(Err(e)) = s.project.autosaver.poll(&s.doc, now) {
             s.notices
@@ -259,8 +268,20 @@ impl Editor {
         }
         s.pointer.shown_hover = s.pointer.hover.take();
         s.pointer.hover_tab = None;
-        egui::Panel::top("menu").show(ui, |ui| s.menu_ui(ui));
-        egui::Panel::bottom("status").show(ui, |ui| s.status_bar_ui(ui));
+        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+        egui::Panel::top("menu").show(ui, |ui| {
+            crate::panels::bars::menu_ui(ui, &s.project.recent, &mut desk);
+        });
+        let asks = desk.into_asks();
+        s.carry_out(asks);
+        let status = crate::panels::bars::Status {
+            doc: &s.doc,
+            job: s.jobs.current.as_ref(),
+            viewport: &s.viewport,
+            hover: s.pointer.shown_hover,
+            exact_chi: &mut s.jobs.exact_chi,
+        };
+        egui::Panel::bottom("status").show(ui, |ui| status.ui(ui));
         egui::Panel::left("tools")
             .resizable(true)
             .default_size(250.0)
@@ -280,22 +301,9 @@ impl Editor {
                 .show_leaf_collapse_buttons(false)
                 .show_inside(ui, &mut Tabs(s));
         });
-        s.export_window(&ctx);
-        s.new_window(&ctx);
-        s.resize_window(&ctx);
-        s.bake_window(&ctx);
-        s.recovery_window(&ctx);
-        s.shortcuts_window(&ctx);
-        s.preferences_window(&ctx);
-        s.notices_ui(&ctx);
-        s.close_prompt(&ctx);
-        s.open_prompt(&ctx);
-        s.claim_prompt(&ctx);
-        s.material_prompt_window(&ctx);
-        s.size_prompt_window(&ctx);
-        s.unwrap_prompt_window(&ctx);
-        s.modal_job_ui(&ctx);
-        s.files_ui(&ctx);
+        windows(s, &ctx);
+        let chosen = s.dialogs.files.update(&ctx);
+        s.file_chosen(chosen);
         if s.jobs.current.is_some() {
             // One progress update a second: on a software renderer each frame of the window
             // takes about 0.1 s of the CPU the job runs on (four a second slowed an AO bake
@@ -316,6 +324,42 @@ impl Editor {
             );
         }
     }
+}
+
+/// The editor's windows over the dock, each a view asking through a desk: the dialogs, the
+/// recovery offer, the shortcut sheet, preferences, notices, then the prompts and the window
+/// of a job the editor waits for.
+fn windows(s: &mut EditorState, ctx: &egui::Context) {
+    let dirty = s.dirty();
+    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+    let export = (&mut s.dialogs.export, &mut s.dialogs.export_choice);
+    crate::export_dialog::export_window(export, s.project.path.as_deref(), ctx, &mut desk);
+    let new = (&mut s.dialogs.new, &mut s.dialogs.pending_new);
+    crate::dialogs::new_window(new, &s.presets.materials, dirty, ctx, &mut desk);
+    crate::resize::resize_window(&mut s.dialogs.resize, ctx, &mut desk);
+    crate::bake::bake_window(&mut s.dialogs.bake, ctx, &mut desk);
+    let asks = desk.into_asks();
+    s.carry_out(asks);
+    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+    let offer = &mut s.prompts.recovery_offer;
+    crate::dialogs::recovery_window(offer, &mut s.project, ctx, &mut desk);
+    crate::dialogs::shortcuts_window(&mut s.dialogs.shortcuts_open, ctx);
+    let open = &mut s.dialogs.preferences_open;
+    crate::dialogs::preferences_window(open, s.preferences, ctx, &mut desk);
+    let asks = desk.into_asks();
+    s.carry_out(asks);
+    crate::panels::bars::notices_ui(&mut s.notices, ctx);
+    let dirty = s.dirty();
+    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+    s.prompts.close_window(ctx, dirty, &mut desk);
+    s.prompts.open_window(ctx, &mut desk);
+    s.project.claim.prompt(ctx, &mut desk);
+    s.prompts.material_window(ctx, &mut desk);
+    crate::material_size::size_prompt_window(&mut s.prompts.size, ctx, &mut desk);
+    s.prompts.unwrap_window(ctx, &mut desk);
+    let asks = desk.into_asks();
+    s.carry_out(asks);
+    crate::jobs::modal_job_ui(s.modal_job(), ctx);
 }
 
 impl eframe::App for Editor {

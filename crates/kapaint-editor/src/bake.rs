@@ -4,9 +4,10 @@
 
 use std::sync::Arc;
 
-use super::EditorState;
-use super::dialogs::centred;
+use super::notice;
+use crate::desk::{Ask, Desk, JobStart, centred};
 use kapaint_mesh::bakes::{BakeMap, BakeOptions, bake_map};
+use kapaint_model::Document;
 use kapaint_model::MaskCommand;
 use kapaint_model::generator::Generator;
 use kapaint_model::layers::LayerId;
@@ -49,61 +50,60 @@ pub(super) struct OnDemand {
     looked_at: Option<u64>,
 }
 
+/// A map baked from the mesh, what it holds and how many seconds it took.
+pub(super) type Baked = (
+    Arc<kapaint_mesh::bakes::Baked>,
+    kapaint_mesh::bakes::BakeStats,
+    f64,
+);
+
 /// Ray counts the dialog offers.
 const RAY_CHOICES: [u32; 6] = [16, 32, 64, 128, 256, 1024];
 
-impl EditorState {
-    /// Opens Mesh > Bake.
-    pub fn open_bake(&mut self) {
-        self.dialogs.bake = Some(BakeDialog::default());
-    }
-
-    /// The Bake dialog's choices, while it is open.
-    pub fn bake_dialog(&self) -> Option<BakeDialog> {
-        self.dialogs.bake
-    }
-
-    /// Sets `generator` on the selected layer's mask; where it reads a bake the project
-    /// lacks, bakes that first (one job, with progress and Cancel) and sets it when the bake
-    /// arrives.
-    pub(super) fn set_generator_baking(&mut self, generator: Generator) {
+impl OnDemand {
+    /// Asks for `generator` on the selected layer's mask; where it reads a bake the project
+    /// lacks, asks for that bake first (one job, with progress and Cancel) and keeps the
+    /// generator until the bake arrives.
+    pub(super) fn lay(&mut self, generator: Generator, desk: &mut Desk) {
+        let doc = desk.doc;
         let missing: Vec<BakeMap> = generator
             .bakes_needed()
             .into_iter()
-            .filter(|&m| self.doc.bake_of(m).is_none())
+            .filter(|&m| doc.bake_of(m).is_none())
             .collect();
         if missing.is_empty() {
-            self.apply(MaskCommand::SetMaskGenerator(Some(generator)));
+            desk.command(MaskCommand::SetMaskGenerator(Some(generator)));
             return;
         }
         let names: Vec<&str> = missing.iter().map(|m| m.name()).collect();
-        self.notices.push(super::notice(
+        desk.notice(notice(
             format!("baking {} first: the mask reads it", names.join(" and ")),
             false,
         ));
-        self.jobs.bake_on_demand.pending = Some((self.doc.selected_id(), generator));
+        self.pending = Some((doc.selected_id(), generator));
         let dialog = BakeDialog {
             all: BakeMap::ALL.map(|(_, m)| missing.contains(&m)),
             ..BakeDialog::default()
         };
-        self.bake_all(dialog);
+        desk.ask(bake_all(doc, dialog));
     }
 
-    /// Starts a bake of the maps the document's generator masks read and lack (a project
+    /// Asks for a bake of the maps the document's generator masks read and lack (a project
     /// opened without them, a mesh changed under them), once per document version, when no
-    /// other job runs.
-    pub(super) fn bake_missing(&mut self) {
-        let version = self.doc.version();
-        if self.jobs.current.is_some() || self.jobs.bake_on_demand.looked_at == Some(version) {
+    /// other job runs (`busy`).
+    pub(super) fn look(&mut self, busy: bool, desk: &mut Desk) {
+        let doc = desk.doc;
+        let version = doc.version();
+        if busy || self.looked_at == Some(version) {
             return;
         }
-        self.jobs.bake_on_demand.looked_at = Some(version);
-        let missing = self.doc.missing_bakes();
-        if missing.is_empty() || self.doc.surface().is_none() {
+        self.looked_at = Some(version);
+        let missing = doc.missing_bakes();
+        if missing.is_empty() || doc.surface().is_none() {
             return;
         }
         let names: Vec<&str> = missing.iter().map(|(m, _)| m.name()).collect();
-        self.notices.push(super::notice(
+        desk.notice(notice(
             format!(
                 "baking {}: the masks read it and the project lacks it",
                 names.join(" and ")
@@ -114,159 +114,181 @@ impl EditorState {
             all: BakeMap::ALL.map(|(_, m)| missing.iter().any(|(x, _)| *x == m)),
             ..BakeDialog::default()
         };
-        self.bake_all(dialog);
+        desk.ask(bake_all(doc, dialog));
     }
 
-    /// What bakes kept just now unlock: the generator waiting for them, laid if its layer is
-    /// still the one selected.
-    pub(super) fn baked_on_demand(&mut self) {
-        if let Some((layer, generator)) = self.jobs.bake_on_demand.pending.take()
-            && layer == self.doc.selected_id()
-        {
-            self.apply(MaskCommand::SetMaskGenerator(Some(generator)));
-        }
+    /// What bakes kept just now unlock: the generator waiting for them, if its layer is still
+    /// the one selected and `doc` now holds every bake it reads (read from the document,
+    /// never assumed from the job).
+    pub(super) fn baked(&mut self, doc: &Document) -> Option<MaskCommand> {
+        let (layer, generator) = self.pending.take()?;
+        let ready = generator
+            .bakes_needed()
+            .into_iter()
+            .all(|m| doc.bake_of(m).is_some());
+        (ready && layer == doc.selected_id())
+            .then_some(MaskCommand::SetMaskGenerator(Some(generator)))
     }
 
     /// A bake job that failed or was cancelled: the generator waiting for it is dropped.
-    pub(super) fn bake_failed(&mut self) {
-        self.jobs.bake_on_demand.pending = None;
+    pub(super) fn failed(&mut self) {
+        self.pending = None;
     }
+}
 
-    /// Bakes `dialog.map` of the project's mesh on a worker; it is kept when it arrives.
-    pub fn bake(&mut self, dialog: BakeDialog) {
-        self.bake_maps(dialog, vec![dialog.map]);
+/// Bakes `dialog.map` of `doc`'s mesh on a worker; it is kept when it arrives.
+pub(super) fn bake(doc: &Document, dialog: BakeDialog) -> Ask {
+    bake_maps(doc, dialog, vec![dialog.map])
+}
+
+/// Bakes the maps `dialog.all` checks, one after the other in one job (one progress bar, one
+/// Cancel); they are kept together as one undo step when the last arrives.
+pub(super) fn bake_all(doc: &Document, dialog: BakeDialog) -> Ask {
+    let maps = BakeMap::ALL
+        .iter()
+        .zip(dialog.all)
+        .filter_map(|((_, m), on)| on.then_some(*m))
+        .collect();
+    bake_maps(doc, dialog, maps)
+}
+
+/// The job baking `maps` of `doc`'s mesh, or why there is none.
+fn bake_maps(doc: &Document, dialog: BakeDialog, maps: Vec<BakeMap>) -> Ask {
+    let Some(surface) = doc.surface().cloned() else {
+        return Ask::Notice(notice("there is no mesh to bake", true));
+    };
+    if maps.is_empty() {
+        return Ask::Notice(notice("no map is checked to bake", true));
     }
-
-    /// Bakes the maps `dialog.all` checks, one after the other in one job (one progress bar,
-    /// one Cancel); they are kept together as one undo step when the last arrives.
-    pub fn bake_all(&mut self, dialog: BakeDialog) {
-        let maps = BakeMap::ALL
-            .iter()
-            .zip(dialog.all)
-            .filter_map(|((_, m), on)| on.then_some(*m))
-            .collect();
-        self.bake_maps(dialog, maps);
-    }
-
-    fn bake_maps(&mut self, dialog: BakeDialog, maps: Vec<BakeMap>) {
-        let Some(surface) = self.doc.surface().cloned() else {
-            self.notices
-                .push(super::notice("there is no mesh to bake", true));
-            return;
-        };
-        if maps.is_empty() {
-            self.notices
-                .push(super::notice("no map is checked to bake", true));
-            return;
-        }
-        let options = BakeOptions {
-            rays: dialog.rays,
-            max_distance: dialog.max_distance,
-        };
-        self.start_job(
-            "Bake",
-            move |progress| {
-                let mut baked = Vec::with_capacity(maps.len());
-                for map in maps {
-                    let start = std::time::Instant::now();
-                    match bake_map(&surface.mesh, &surface.bake, map, options, Some(progress)) {
-                        Ok(b) => {
-                            let stats = b.stats(&surface.bake);
-                            baked.push((Arc::new(b), stats, start.elapsed().as_secs_f64()));
-                        }
-                        Err(e) => return Err(format!("bake {}: {e}", map.name())),
+    let options = BakeOptions {
+        rays: dialog.rays,
+        max_distance: dialog.max_distance,
+    };
+    Ask::Job(JobStart::new(
+        "Bake",
+        move |progress| {
+            let mut baked = Vec::with_capacity(maps.len());
+            for map in maps {
+                let start = std::time::Instant::now();
+                match bake_map(&surface.mesh, &surface.bake, map, options, Some(progress)) {
+                    Ok(b) => {
+                        let stats = b.stats(&surface.bake);
+                        baked.push((Arc::new(b), stats, start.elapsed().as_secs_f64()));
                     }
+                    Err(e) => return Err(format!("bake {}: {e}", map.name())),
                 }
-                Ok(baked)
-            },
-            Self::baked,
-        );
-    }
+            }
+            Ok(baked)
+        },
+        baked,
+    ))
+}
 
-    /// The Bake dialog: the map, its rays and distance, the bakes kept, Bake; the maps to
-    /// bake together, Bake all checked.
-    pub(super) fn bake_window(&mut self, ctx: &egui::Context) {
-        let Some(mut dialog) = self.dialogs.bake else {
-            return;
-        };
-        let (mut open, mut go, mut all) = (true, false, false);
-        let (w, h) = (self.doc.maps().width(), self.doc.maps().height());
-        centred(egui::Window::new("Bake mesh maps"), ctx)
-            .open(&mut open)
-            .collapsible(false)
-            .resizable(false)
-            .show(ctx, |ui| {
-                let mesh = self.doc.settings().mesh.spec().to_string();
-                ui.label(format!("{mesh}, at {w}x{h}"));
-                egui::ComboBox::from_label("Map")
-                    .selected_text(dialog.map.name())
+/// Maps baked from the mesh (one, or "Bake all"'s), what each holds and how many seconds it
+/// took: into the document, then the generator mask that waited for them.
+fn baked(baked: Vec<Baked>, desk: &mut Desk) {
+    let lines = baked
+        .iter()
+        .map(|(b, stats, seconds)| {
+            notice(
+                format!(
+                    "baked {}: {} texels, mean {:.3}, min {:.3}, {seconds:.1} s",
+                    b.map.name(),
+                    stats.texels,
+                    stats.mean,
+                    stats.min
+                ),
+                false,
+            )
+        })
+        .collect();
+    let bakes = baked
+        .into_iter()
+        .map(|(b, _, _)| kapaint_model::document::AttachedBake(b))
+        .collect();
+    desk.command_saying(kapaint_model::ImportCommand::SetBakes(bakes), lines);
+    desk.ask(Ask::BakedOnDemand);
+}
+
+/// The Bake dialog, while `open`: the map, its rays and distance, the bakes kept, Bake; the
+/// maps to bake together, Bake all checked.
+pub(super) fn bake_window(open: &mut Option<BakeDialog>, ctx: &egui::Context, desk: &mut Desk) {
+    let Some(mut dialog) = *open else {
+        return;
+    };
+    let doc = desk.doc;
+    let (mut shown, mut go, mut all) = (true, false, false);
+    let (w, h) = (doc.maps().width(), doc.maps().height());
+    centred(egui::Window::new("Bake mesh maps"), ctx)
+        .open(&mut shown)
+        .collapsible(false)
+        .resizable(false)
+        .show(ctx, |ui| {
+            let mesh = doc.settings().mesh.spec().to_string();
+            ui.label(format!("{mesh}, at {w}x{h}"));
+            egui::ComboBox::from_label("Map")
+                .selected_text(dialog.map.name())
+                .show_ui(ui, |ui| {
+                    for (name, map) in BakeMap::ALL {
+                        ui.selectable_value(&mut dialog.map, map, name);
+                    }
+                });
+            ui.add_enabled_ui(dialog.map.casts_rays(), |ui| {
+                egui::ComboBox::from_label("Rays per texel")
+                    .selected_text(dialog.rays.to_string())
                     .show_ui(ui, |ui| {
-                        for (name, map) in BakeMap::ALL {
-                            ui.selectable_value(&mut dialog.map, map, name);
+                        for rays in RAY_CHOICES {
+                            ui.selectable_value(&mut dialog.rays, rays, rays.to_string());
                         }
                     });
-                ui.add_enabled_ui(dialog.map.casts_rays(), |ui| {
-                    egui::ComboBox::from_label("Rays per texel")
-                        .selected_text(dialog.rays.to_string())
-                        .show_ui(ui, |ui| {
-                            for rays in RAY_CHOICES {
-                                ui.selectable_value(&mut dialog.rays, rays, rays.to_string());
-                            }
-                        });
-                    let mut bounded = dialog.max_distance.is_some();
-                    ui.checkbox(&mut bounded, "Limit the ray distance");
-                    if bounded {
-                        let mut d = dialog.max_distance.unwrap_or(1.0);
-                        ui.add(
-                            egui::DragValue::new(&mut d)
-                                .range(1e-4..=1e6)
-                                .speed(0.01)
-                                .prefix("distance "),
-                        );
-                        dialog.max_distance = Some(d);
-                    } else {
-                        dialog.max_distance = None;
-                    }
-                });
-                if !self.doc.bakes().is_empty() {
-                    ui.separator();
-                    ui.label("Kept:");
-                    for b in self.doc.bakes() {
-                        let rays = if b.map.casts_rays() {
-                            format!(", {} rays", b.options.rays)
-                        } else {
-                            String::new()
-                        };
-                        ui.label(format!("{}{rays}", b.map.name()));
-                    }
+                let mut bounded = dialog.max_distance.is_some();
+                ui.checkbox(&mut bounded, "Limit the ray distance");
+                if bounded {
+                    let mut d = dialog.max_distance.unwrap_or(1.0);
+                    ui.add(
+                        egui::DragValue::new(&mut d)
+                            .range(1e-4..=1e6)
+                            .speed(0.01)
+                            .prefix("distance "),
+                    );
+                    dialog.max_distance = Some(d);
+                } else {
+                    dialog.max_distance = None;
                 }
-                go = ui
-                    .add_enabled(self.doc.surface().is_some(), egui::Button::new("Bake"))
-                    .clicked();
-                ui.separator();
-                ui.horizontal_wrapped(|ui| {
-                    for ((name, _), on) in BakeMap::ALL.iter().zip(&mut dialog.all) {
-                        ui.checkbox(on, *name);
-                    }
-                });
-                all = ui
-                    .add_enabled(
-                        self.doc.surface().is_some() && dialog.all.contains(&true),
-                        egui::Button::new("Bake all checked"),
-                    )
-                    .on_hover_text("One job, one progress bar; kept as one undo step")
-                    .clicked();
             });
-        if go {
-            self.dialogs.bake = None;
-            self.bake(dialog);
-        } else if all {
-            self.dialogs.bake = None;
-            self.bake_all(dialog);
-        } else if open {
-            self.dialogs.bake = Some(dialog);
-        } else {
-            self.dialogs.bake = None;
-        }
+            if !doc.bakes().is_empty() {
+                ui.separator();
+                ui.label("Kept:");
+                for b in doc.bakes() {
+                    let rays = if b.map.casts_rays() {
+                        format!(", {} rays", b.options.rays)
+                    } else {
+                        String::new()
+                    };
+                    ui.label(format!("{}{rays}", b.map.name()));
+                }
+            }
+            go = ui
+                .add_enabled(doc.surface().is_some(), egui::Button::new("Bake"))
+                .clicked();
+            ui.separator();
+            ui.horizontal_wrapped(|ui| {
+                for ((name, _), on) in BakeMap::ALL.iter().zip(&mut dialog.all) {
+                    ui.checkbox(on, *name);
+                }
+            });
+            all = ui
+                .add_enabled(
+                    doc.surface().is_some() && dialog.all.contains(&true),
+                    egui::Button::new("Bake all checked"),
+                )
+                .on_hover_text("One job, one progress bar; kept as one undo step")
+                .clicked();
+        });
+    *open = (shown && !go && !all).then_some(dialog);
+    if go {
+        desk.ask(bake(doc, dialog));
+    } else if all {
+        desk.ask(bake_all(doc, dialog));
     }
 }

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::EditorState;
+use crate::desk::{Ask, Desk};
 use kapaint_model::project::lock::{self, OnDisk, ProjectLock};
 use kapaint_model::recovery::session::Owner;
 
@@ -41,20 +41,18 @@ impl Claim {
     pub(super) fn release(&mut self) {
         self.lock = None;
     }
-}
 
-impl EditorState {
     /// Whether `path` may open now: `Some(read_only)` when no other kapaint has it open or the
     /// user answered; `None` when the user is being asked first.
     pub(super) fn may_open(&mut self, path: &Path) -> Option<bool> {
-        if let Some((answered, read_only)) = self.project.claim.answered.take()
+        if let Some((answered, read_only)) = self.answered.take()
             && answered == path
         {
             return Some(read_only);
         }
         match lock::holder(path) {
             Some(owner) => {
-                self.project.claim.asking = Some((path.to_path_buf(), owner));
+                self.asking = Some((path.to_path_buf(), owner));
                 None
             }
             None => Some(false),
@@ -62,8 +60,8 @@ impl EditorState {
     }
 
     /// Asks how to open a project another kapaint has open: read-only, anyway, or not at all.
-    pub(super) fn claim_prompt(&mut self, ctx: &egui::Context) {
-        let Some((path, owner)) = self.project.claim.asking.clone() else {
+    pub(super) fn prompt(&mut self, ctx: &egui::Context, desk: &mut Desk) {
+        let Some((path, owner)) = self.asking.clone() else {
             return;
         };
         let name = path.file_name().map_or_else(
@@ -89,11 +87,11 @@ impl EditorState {
             });
         });
         if read_only || anyway {
-            self.project.claim.asking = None;
-            self.project.claim.answered = Some((path.clone(), read_only));
-            self.open_now(path);
+            self.asking = None;
+            self.answered = Some((path.clone(), read_only));
+            desk.ask(Ask::OpenNow(path));
         } else if cancel {
-            self.project.claim.asking = None;
+            self.asking = None;
         }
     }
 }

@@ -15,7 +15,6 @@ use std::time::{Duration, Instant};
 
 use egui_file_dialog::{DialogState, FileDialog};
 
-use crate::EditorState;
 use kapaint_model::texel::Channel;
 
 /// What a file is chosen for: its title, filter and what the editor does with it.
@@ -453,61 +452,9 @@ pub fn portal_has_file_chooser() -> bool {
     })
 }
 
-impl EditorState {
-    /// Asks for a file for `purpose`, starting in the project's folder.
-    pub(super) fn choose_file(&mut self, purpose: FilePurpose) {
-        let dir = self
-            .project
-            .path
-            .as_deref()
-            .and_then(Path::parent)
-            .filter(|d| !d.as_os_str().is_empty())
-            .map(Path::to_path_buf);
-        if !self.dialogs.files.request(purpose, dir) {
-            self.notices
-                .push(super::notice("a file dialog is open already", true));
-        }
-    }
-
-    /// Draws the in-app dialog, if open, and acts on what was chosen.
-    pub(super) fn files_ui(&mut self, ctx: &egui::Context) {
-        match self.dialogs.files.update(ctx) {
-            Some(ChooserEvent::FellBack(text)) => self.notices.push(super::notice(text, false)),
-            Some(ChooserEvent::Cancelled(FilePurpose::SaveProject)) => {
-                self.prompts.quit.after_save = false;
-                self.dialogs.pending_new = None;
-            }
-            None | Some(ChooserEvent::Cancelled(_)) => {}
-            Some(ChooserEvent::Picked(Picked { purpose, path })) => match purpose {
-                FilePurpose::OpenProject => self.open(path),
-                FilePurpose::SaveProject => self.save_to(with_project_extension(path)),
-                FilePurpose::ImportMesh => self.import_mesh(path),
-                FilePurpose::ImportImage(channel) => self.import_image(path, channel),
-                FilePurpose::ImportPbr => self.import_pbr(path),
-                FilePurpose::StampImage => self.load_stamp(path),
-                FilePurpose::NewMesh => {
-                    if let Some(dialog) = &mut self.dialogs.new {
-                        dialog.mesh = path.display().to_string();
-                    }
-                }
-                FilePurpose::ExportFolder => {
-                    if let Some(dialog) = &mut self.dialogs.export {
-                        dialog.choose_folder(&path);
-                    }
-                }
-            },
-        }
-    }
-
-    /// The file chooser (tests choose its backend and starting folder).
-    pub fn files_mut(&mut self) -> &mut FileChooser {
-        &mut self.dialogs.files
-    }
-}
-
 /// `path`, with `.kapaint` added where the name has another extension or none (a system
 /// dialog may return the name as typed).
-fn with_project_extension(path: PathBuf) -> PathBuf {
+pub(super) fn with_project_extension(path: PathBuf) -> PathBuf {
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("kapaint"))

@@ -12,7 +12,12 @@ use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
 use kapaint_core::render::FrameSettings;
 use kapaint_core::tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
-use kapaint_model::SettingsCommand;
+use kapaint_model::{HistoryCommand, LayerCommand, SettingsCommand};
+
+use crate::dialogs::NewDialog;
+use crate::export_dialog::ExportDialog;
+use crate::files::FilePurpose;
+use crate::keys::{self, Action};
 use kapaint_model::brush::SurfacePos;
 
 /// Where the pointer is and what it holds.
@@ -48,6 +53,77 @@ impl Default for Pointer {
 }
 
 impl EditorState {
+    /// Runs the actions of the keys pressed this frame (none while a text field has the
+    /// keyboard).
+    pub(super) fn hotkeys(&mut self, ctx: &egui::Context) {
+        // Nor while a file dialog is open: its keys are its own.
+        if ctx.egui_wants_keyboard_input()
+            || self.dialogs.files.open_for().is_some()
+            || self.modal_job().is_some()
+            || self.prompts.recovery_offer.is_some()
+        {
+            return;
+        }
+        let actions: Vec<Action> = ctx.input_mut(|i| keys::pressed_actions(&mut i.events));
+        self.act(&actions);
+    }
+
+    /// Does what key bindings (or the menu entries showing them) do, in order; the brush's
+    /// changes among them are one command.
+    pub(super) fn act(&mut self, actions: &[Action]) {
+        let mut brush = self.doc.settings().brush.clone();
+        for &action in actions {
+            match action {
+                Action::Undo => self.apply(HistoryCommand::Undo),
+                Action::Redo => self.apply(HistoryCommand::Redo),
+                Action::Save => self.save(),
+                Action::SaveAs => self.choose_file(FilePurpose::SaveProject),
+                Action::Open => self.choose_file(FilePurpose::OpenProject),
+                Action::New => {
+                    let dialog = NewDialog::starting(&self.doc, &self.presets.materials);
+                    self.dialogs.new = Some(dialog);
+                }
+                Action::Export => {
+                    let path = self.project.path.as_deref();
+                    let last = self.dialogs.export_choice.as_ref();
+                    self.dialogs.export = Some(ExportDialog::new(last, path));
+                }
+                Action::NewLayer => self.apply(crate::panels::layers::new_layer(
+                    &self.doc,
+                    kapaint_model::LayerKind::Paint,
+                )),
+                Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer),
+                Action::MergeDown => self.apply(LayerCommand::MergeDown),
+                Action::Quit => self.prompts.quit.asked = true,
+                Action::Tool(kind) => self.select_tool(kind),
+                Action::FillOrFrame => {
+                    if self.pointer.hover_tab == Some(Tab::Canvas) {
+                        self.select_tool(ToolKind::FILL);
+                    } else {
+                        self.viewport.frame(&self.mesh.mesh);
+                    }
+                }
+                Action::FitCanvas => self.canvas.fit(),
+                Action::Shortcuts => self.dialogs.shortcuts_open = !self.dialogs.shortcuts_open,
+                Action::SwapMaterials => self.apply(SettingsCommand::SwapMaterials),
+                Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
+                Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
+                Action::SmallerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.0 / 1.25),
+                Action::LargerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.25),
+                Action::Abort => {
+                    self.tool_event(ToolEvent::Escape);
+                    // The button stays with nobody until it is released and pressed again:
+                    // the rest of the drag and its release paint nothing.
+                    self.pointer.held = None;
+                    self.pointer.pressure = 1.0;
+                }
+            }
+        }
+        if brush != self.doc.settings().brush {
+            self.apply(SettingsCommand::SetBrush(brush));
+        }
+    }
+
     /// The texel under a map-space position, if inside.
     fn texel_at(&self, p: Vec2) -> Option<(u32, u32)> {
         Place::Canvas(p).texel_index((self.doc.maps().width(), self.doc.maps().height()))

@@ -4,9 +4,7 @@
 
 use egui::{Key, KeyboardShortcut, Modifiers};
 
-use super::{EditorState, Tab};
-use kapaint_core::tools::{ToolEvent, ToolKind, Tools};
-use kapaint_model::{HistoryCommand, LayerCommand, SettingsCommand};
+use kapaint_core::tools::{ToolKind, Tools};
 
 /// What a key does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -246,89 +244,6 @@ pub fn written(shortcut: &KeyboardShortcut) -> String {
     }
     out.push_str(shortcut.logical_key.symbol_or_name());
     out
-}
-
-impl EditorState {
-    /// Runs the actions of the keys pressed this frame (none while a text field has the
-    /// keyboard).
-    pub(super) fn hotkeys(&mut self, ctx: &egui::Context) {
-        // Nor while a file dialog is open: its keys are its own.
-        if ctx.egui_wants_keyboard_input()
-            || self.dialogs.files.open_for().is_some()
-            || self.modal_job().is_some()
-            || self.prompts.recovery_offer.is_some()
-        {
-            return;
-        }
-        let actions: Vec<Action> = ctx.input_mut(|i| pressed_actions(&mut i.events));
-        let mut brush = self.doc.settings().brush.clone();
-        for action in actions {
-            match action {
-                Action::Undo => self.apply(HistoryCommand::Undo),
-                Action::Redo => self.apply(HistoryCommand::Redo),
-                Action::Save => self.save(),
-                Action::SaveAs => self.save_as(),
-                Action::Open => self.open_dialog(),
-                Action::New => self.new_project(),
-                Action::Export => self.open_export(),
-                Action::NewLayer => self.apply(crate::panels::layers::new_layer(
-                    &self.doc,
-                    kapaint_model::LayerKind::Paint,
-                )),
-                Action::DuplicateLayer => self.apply(LayerCommand::DuplicateLayer),
-                Action::MergeDown => self.apply(LayerCommand::MergeDown),
-                Action::Quit => self.prompts.quit.asked = true,
-                Action::Tool(kind) => self.select_tool(kind),
-                Action::FillOrFrame => {
-                    if self.pointer.hover_tab == Some(Tab::Canvas) {
-                        self.select_tool(ToolKind::FILL);
-                    } else {
-                        self.viewport.frame(&self.mesh.mesh);
-                    }
-                }
-                Action::FitCanvas => self.canvas.fit(),
-                Action::Shortcuts => self.dialogs.shortcuts_open = !self.dialogs.shortcuts_open,
-                Action::SwapMaterials => self.apply(SettingsCommand::SwapMaterials),
-                Action::SofterBrush => brush.hardness = (brush.hardness - 0.1).max(0.0),
-                Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
-                Action::SmallerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.0 / 1.25),
-                Action::LargerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.25),
-                Action::Abort => {
-                    self.tool_event(ToolEvent::Escape);
-                    // The button stays with nobody until it is released and pressed again:
-                    // the rest of the drag and its release paint nothing.
-                    self.pointer.held = None;
-                    self.pointer.pressure = 1.0;
-                }
-            }
-        }
-        if brush != self.doc.settings().brush {
-            self.apply(SettingsCommand::SetBrush(brush));
-        }
-    }
-
-    /// Help > Keyboard shortcuts: the keymap, as the input code reads it.
-    pub(super) fn shortcuts_window(&mut self, ctx: &egui::Context) {
-        let mut open = self.dialogs.shortcuts_open;
-        super::dialogs::centred(egui::Window::new("Keyboard shortcuts"), ctx)
-            .open(&mut open)
-            .collapsible(false)
-            .show(ctx, |ui| {
-                egui::Grid::new("keymap").striped(true).show(ui, |ui| {
-                    for b in keymap() {
-                        ui.label(printed(ctx, &b.shortcut));
-                        ui.label(b.description);
-                        ui.end_row();
-                    }
-                    for (keys, what) in MOUSE {
-                        ui.label(*keys);
-                        ui.label(*what);
-                        ui.end_row();
-                    }
-                });
-            });
-        self.dialogs.shortcuts_open = open;
-    }
 }
 
 /// The pointer's bindings (egui reads these from the pointer, not the keymap).

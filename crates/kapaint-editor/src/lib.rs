@@ -8,11 +8,16 @@
 mod app;
 pub mod bake;
 pub mod canvas;
+mod carry;
 mod claim;
+mod desk;
 mod dialogs;
+mod export_dialog;
 mod export_plan;
 pub mod files;
 mod input;
+mod mesh_state;
+use mesh_state::MeshState;
 mod jobs;
 pub mod keys;
 mod layer_view;
@@ -29,24 +34,22 @@ mod prompts;
 pub use panels::layers::LayerView;
 mod readout;
 pub mod resize;
+mod results;
 pub mod screen_brush;
 pub mod viewport;
 
 pub use app::{Editor, run};
-pub use dialogs::{NEW_SIZES, NewDialog, RECENT_MAX, export_folder_in, parse_recent, push_recent};
+pub use dialogs::{NEW_SIZES, NewDialog};
+pub use export_dialog::export_folder_in;
 pub use layout::{default_layout, layout_json, parse_layout};
+pub use project_jobs::{RECENT_MAX, parse_recent, push_recent};
 
 use std::path::Path;
 use std::sync::Arc;
 
-use egui::Color32;
-use glam::Vec2;
-
 use canvas::{Canvas, CanvasChannel};
 use kapaint_core::render::{Lighting, ViewMode};
 use kapaint_core::tools::Tools;
-use kapaint_mesh::Mesh;
-use kapaint_mesh::pick::Bvh;
 use kapaint_model::texel::Channel;
 use kapaint_model::{Command, Document};
 use viewport::Viewport;
@@ -103,68 +106,6 @@ pub fn brush_outline(
             )
         })
         .collect()
-}
-
-/// A cheap identity of a stamp for its preview cache: size and a few samples' bits.
-fn stamp_key(stamp: &kapaint_model::brush::Stamp) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    (stamp.width(), stamp.height()).hash(&mut h);
-    let step = (stamp.alpha().len() / 61).max(1);
-    for v in stamp.alpha().iter().step_by(step) {
-        v.to_bits().hash(&mut h);
-    }
-    h.finish()
-}
-
-/// A `size`^2 grey picture of a stamp (white where it paints).
-fn stamp_image(stamp: &kapaint_model::brush::Stamp, size: usize) -> egui::ColorImage {
-    let mut pixels = Vec::with_capacity(size * size);
-    for y in 0..size {
-        for x in 0..size {
-            let at = |i: usize| (i as f32 + 0.5) / size as f32 * 2.0 - 1.0;
-            let a = stamp.sample(at(x), at(y));
-            pixels.push(Color32::from_gray((a * 255.0 + 0.5) as u8));
-        }
-    }
-    egui::ColorImage::new([size, size], pixels)
-}
-
-/// The mesh being painted, with what picking and the renderer need.
-struct MeshState {
-    id: u64,
-    /// The document's bake this was made from: when the document's differs (undo of a mesh
-    /// import, a resize), the state follows it.
-    from: std::sync::Weak<kapaint_model::surface::Surface>,
-    mesh: Arc<Mesh>,
-    bvh: Bvh,
-    /// UV edges in map fractions (u, 1 - v), for the canvas wireframe.
-    uv_lines: Vec<[Vec2; 2]>,
-}
-
-impl MeshState {
-    fn new(mesh: Mesh, id: u64) -> Self {
-        let bvh = Bvh::build(&mesh);
-        let mut uv_lines = Vec::new();
-        if let Some(uvs) = &mesh.uvs {
-            for tri in &mesh.triangles {
-                for k in 0..3 {
-                    let (a, b) = (tri[k] as usize, tri[(k + 1) % 3] as usize);
-                    if a < b || mesh.triangles.len() < 4 {
-                        let at = |i: usize| Vec2::new(uvs[i].x, 1.0 - uvs[i].y);
-                        uv_lines.push([at(a), at(b)]);
-                    }
-                }
-            }
-        }
-        Self {
-            id,
-            from: std::sync::Weak::new(),
-            mesh: Arc::new(mesh),
-            bvh,
-            uv_lines,
-        }
-    }
 }
 
 /// Everything the panels and tabs read and change (the dock lives beside it): the document,
@@ -310,7 +251,7 @@ impl EditorState {
         self.dialogs
             .export
             .as_ref()
-            .map(dialogs::ExportDialog::folder)
+            .map(export_dialog::ExportDialog::folder)
     }
 
     /// A project waiting to be opened until the user decides about unsaved changes.
@@ -401,7 +342,7 @@ impl EditorState {
     /// The left panel: tools, brush, material, channels (the tool panel asks, the editor
     /// carries it out).
     fn tools_ui(&mut self, ui: &mut egui::Ui) {
-        let mut desk = panels::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
         self.tool_panel.ui(ui, &mut desk, &mut self.presets);
         let asks = desk.into_asks();
         self.carry_out(asks);
@@ -409,7 +350,7 @@ impl EditorState {
 
     /// The Layers tab (the panel asks, the editor carries it out).
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
-        let mut desk = panels::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
         self.layers_panel.ui(ui, &mut desk, &mut self.presets);
         let asks = desk.into_asks();
         self.carry_out(asks);
@@ -425,7 +366,7 @@ impl EditorState {
     /// asks, the editor carries it out).
     fn view_ui(&mut self, ui: &mut egui::Ui) {
         let frame = self.frame_settings();
-        let mut desk = panels::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
         let mut shown = panels::view_panel::Shown {
             look: &mut self.look,
             comparison: &mut self.viewport.comparison,
@@ -437,25 +378,6 @@ impl EditorState {
         shown.ui(ui, &mut desk, &mut self.presets, (mesh.id, &mut thumbnail));
         let asks = desk.into_asks();
         self.carry_out(asks);
-    }
-
-    /// Carries out what a panel asked, in order.
-    fn carry_out(&mut self, asks: Vec<panels::Ask>) {
-        for ask in asks {
-            match ask {
-                panels::Ask::Command(command) => self.apply(command),
-                panels::Ask::SelectTool(kind) => self.select_tool(kind),
-                panels::Ask::ToolOption(change) => {
-                    for command in self.tools.set_option(change, &self.doc) {
-                        self.apply(command);
-                    }
-                }
-                panels::Ask::ChooseFile(purpose) => self.choose_file(purpose),
-                panels::Ask::Notice(notice) => self.notices.push(notice),
-                panels::Ask::LayGenerator(generator) => self.set_generator_baking(generator),
-                panels::Ask::LightFollowsCamera(follow) => self.set_light_follows_camera(follow),
-            }
-        }
     }
 
     /// How the brush's size is given.
@@ -476,6 +398,39 @@ impl EditorState {
     /// The materials used last, newest first.
     pub fn recent_materials(&self) -> &[kapaint_model::texel::MaterialValue] {
         &self.tool_panel.recent_materials
+    }
+
+    /// Saves presets into `dir` from now on (the user preset folder by default).
+    pub fn set_preset_dir(&mut self, dir: std::path::PathBuf) {
+        self.presets.dir = Some(dir);
+    }
+
+    /// The names of the material presets, as the browser shows them.
+    pub fn preset_names(&self) -> Vec<&str> {
+        self.presets
+            .materials
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect()
+    }
+
+    /// The smart masks: shipped, then the user's.
+    pub fn mask_preset_names(&self) -> Vec<&str> {
+        self.presets.masks.iter().map(|p| p.name.as_str()).collect()
+    }
+
+    /// The brush presets' names.
+    pub fn brush_preset_names(&self) -> Vec<&str> {
+        self.presets
+            .brushes
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect()
+    }
+
+    /// The file chooser (tests choose its backend and starting folder).
+    pub fn files_mut(&mut self) -> &mut files::FileChooser {
+        &mut self.dialogs.files
     }
 
     /// Applies a command as the panels do (an error becomes a notice).

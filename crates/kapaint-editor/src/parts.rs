@@ -4,7 +4,7 @@
 /// The dialogs and windows, while open.
 #[derive(Default)]
 pub(super) struct Dialogs {
-    pub(super) export: Option<super::dialogs::ExportDialog>,
+    pub(super) export: Option<super::export_dialog::ExportDialog>,
     /// The last export's preset and folder, offered again by the next.
     pub(super) export_choice: Option<(String, String)>,
     /// The Resize dialog, while open.

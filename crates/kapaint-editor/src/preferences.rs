@@ -7,8 +7,6 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use super::EditorState;
-use super::dialogs::centred;
 use kapaint_model::recovery;
 
 /// Shortest autosave interval offered (seconds).
@@ -82,63 +80,6 @@ impl Preferences {
 /// Where the preferences are kept.
 fn path() -> Option<PathBuf> {
     super::layout::layout_path().map(|p| p.with_file_name("preferences.json"))
-}
-
-impl EditorState {
-    /// Opens Edit > Preferences.
-    pub fn open_preferences(&mut self) {
-        self.dialogs.preferences_open = true;
-    }
-
-    /// The preferences in force.
-    pub fn preferences(&self) -> Preferences {
-        self.preferences
-    }
-
-    /// Sets the preferences: kept for the next run, and in force at once (the autosave's next
-    /// copy falls due at the new interval).
-    pub fn set_preferences(&mut self, preferences: Preferences) {
-        if preferences == self.preferences {
-            return;
-        }
-        self.preferences = preferences;
-        self.project
-            .autosaver
-            .set_interval(preferences.autosave_interval());
-        if let Err(e) = preferences.save() {
-            self.notices.push(super::notice(
-                format!("the preferences hold for this run only: {e}"),
-                true,
-            ));
-        }
-    }
-
-    /// The Preferences window.
-    pub(super) fn preferences_window(&mut self, ctx: &egui::Context) {
-        if !self.dialogs.preferences_open {
-            return;
-        }
-        let mut open = true;
-        let mut p = self.preferences;
-        centred(egui::Window::new("Preferences"), ctx)
-            .open(&mut open)
-            .collapsible(false)
-            .resizable(false)
-            .show(ctx, |ui| {
-                ui.add(
-                    egui::DragValue::new(&mut p.autosave_seconds)
-                        .range(AUTOSAVE_MIN_SECONDS..=AUTOSAVE_MAX_SECONDS)
-                        .suffix(" s")
-                        .prefix("Autosave every "),
-                )
-                .on_hover_text(
-                    "How often a changed project's recovery copy is written: a crash loses at \
-                     most this much work",
-                );
-            });
-        self.set_preferences(p);
-        self.dialogs.preferences_open = open;
-    }
 }
 
 #[cfg(test)]

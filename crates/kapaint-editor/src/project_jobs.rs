@@ -1,12 +1,13 @@
-//! The jobs that open, recover and save the project, and what the editor does with their
-//! results: the recovery copy and the claim on the file follow the work.
+//! The jobs that open, recover and save the project, and the project file the document
+//! belongs to, with the recent files (what the editor does with their results is [`crate::carry`]'s).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use super::files::FilePurpose;
-use super::jobs::{OpenedProject, Saved, load_project, with_fallback};
-use super::{EditorState, notice};
-use kapaint_model::{project, recovery};
+use super::jobs::{load_project, open_done, save_done, with_fallback};
+use super::layout::layout_path;
+use crate::desk::JobStart;
+use crate::results::{OpenedProject, Saved};
+use kapaint_model::{Document, project, recovery};
 
 /// The project file the document belongs to: where it is saved, what was saved, the claim on
 /// the file, the recovery copy, and the projects opened lately.
@@ -24,149 +25,53 @@ pub(super) struct Project {
     pub(super) claim: super::claim::Claim,
 }
 
-impl EditorState {
-    /// A save finished: the document version it holds, and the file as written.
-    pub(super) fn saved(&mut self, path: PathBuf, version: u64, on_disk: project::OnDisk) {
-        self.project.saved_version = version;
-        self.project.claim.hold(Some(&path), Some(on_disk), false);
-        self.notices
-            .push(notice(format!("saved {}", path.display()), false));
-        self.remember(&path);
-        if self.project.path.as_deref() != Some(path.as_path()) {
-            // Save As (or the first save): the recovery copy follows the work.
-            self.project.autosaver.relocate(Some(&path));
-        }
-        // What was saved needs no recovery copy (unless it changed while saving).
-        self.project.autosaver.saved(&self.doc, version);
-        self.project.path = Some(path);
-        if std::mem::take(&mut self.prompts.quit.after_save) && !self.dirty() {
-            // The quit prompt's Save: the work is safe, so the window closes.
-            self.prompts.quit.allowed = Some(super::QuitAllowed::Saved);
-            self.prompts.quit.asked = true;
-        }
-        if !self.dirty()
-            && let Some(next) = self.prompts.pending_open.take()
-        {
-            self.open_now(next);
-        }
-        if !self.dirty()
-            && let Some(dialog) = self.dialogs.pending_new.take()
-        {
-            self.create_project(&dialog);
-        }
+impl Project {
+    /// Remembers `path` at the top of the recent files.
+    pub(super) fn remember(&mut self, path: &Path) {
+        push_recent(&mut self.recent, path);
+        save_recent(&self.recent);
     }
+}
 
-    /// A save found its project changed on disk: the work went to `written` instead.
-    pub(super) fn conflicted(&mut self, message: String, written: PathBuf, version: u64) {
-        // The work is safe beside the project: the editor goes on with that file.
-        self.project.saved_version = version;
-        self.notices.push(notice(message, true));
-        self.remember(&written);
-        self.project.autosaver.relocate(Some(&written));
-        self.project.autosaver.saved(&self.doc, version);
-        self.project
-            .claim
-            .hold(Some(&written), project::OnDisk::of(&written), false);
-        self.project.path = Some(written);
-        self.prompts.quit.after_save = false;
-        self.dialogs.pending_new = None;
-    }
-
-    /// Makes `doc` the document, with its mesh shown and framed.
-    /// Takes an opened (or recovered) project as the document.
-    pub(super) fn opened(&mut self, opened: OpenedProject) {
-        let OpenedProject {
-            path,
-            doc,
-            recovered,
-            on_disk,
-            read_only,
-            ..
-        } = opened;
-        self.project.claim.hold(path.as_deref(), on_disk, read_only);
-        self.replace_document(doc);
-        // The old document was saved or its changes discarded (asked before).
-        self.project.autosaver.discard();
-        let interval = self.preferences.autosave_interval();
-        // Recovered work is unsaved work, and its copy stays until this editor has its own.
-        (self.project.saved_version, self.project.autosaver) = match recovered.clone() {
-            Some(from) => (
-                u64::MAX,
-                recovery::Autosaver::recovering(interval, path.as_deref(), &self.doc, from),
-            ),
-            None => (
-                self.doc.version(),
-                recovery::Autosaver::new(interval, path.as_deref(), &self.doc),
-            ),
-        };
-        let recovered = recovered.is_some();
-        let name = path
-            .as_deref()
-            .map_or_else(|| "an untitled project".into(), |p| p.display().to_string());
-        let text = if recovered {
-            format!("recovered the unsaved work of {name}: save to keep it")
-        } else if read_only {
-            format!("opened {name} read-only: Save asks for another file")
-        } else {
-            format!("opened {name}")
-        };
-        self.notices.push(notice(text, false));
-        if let Some(p) = &path {
-            self.remember(p);
-        }
-        self.project.path = path;
-    }
-
-    /// Saves to `path` on a worker (a snapshot of the maps, so painting goes on).
-    pub fn save_to(&mut self, path: PathBuf) {
-        let snapshot = self.doc.snapshot();
-        let version = self.doc.version();
-        // Over its own file, a save expects the file as this editor last read or wrote it;
-        // elsewhere (Save As) the user chose to replace what is there.
-        let expected = (self.project.path.as_deref() == Some(path.as_path()))
-            .then(|| self.project.claim.on_disk.clone())
-            .flatten();
-        self.start_job(
-            "Save",
-            move |progress| {
-                progress.start("save", 1);
-                match project::save_checked(&snapshot, &path, expected.as_ref()) {
-                    Ok(on_disk) => Ok(Saved::Saved(path, version, on_disk)),
-                    Err(e @ kapaint_model::ModelError::Conflict { .. }) => {
-                        let kapaint_model::ModelError::Conflict { written, .. } = &e else {
-                            unreachable!("matched above")
-                        };
-                        Ok(Saved::Conflicted {
-                            written: written.clone(),
-                            message: e.to_string(),
-                            version,
-                        })
-                    }
-                    Err(e) => Err(format!("could not save: {e}")),
+/// Saves `doc` to `path` on a worker (a snapshot of the maps, so painting goes on); a save
+/// over the project's own file expects it as `expected` (as this editor last read or wrote
+/// it).
+pub(super) fn save_to(
+    doc: &Document,
+    path: PathBuf,
+    expected: Option<project::OnDisk>,
+) -> JobStart {
+    let snapshot = doc.snapshot();
+    let version = doc.version();
+    JobStart::new(
+        "Save",
+        move |progress| {
+            progress.start("save", 1);
+            match project::save_checked(&snapshot, &path, expected.as_ref()) {
+                Ok(on_disk) => Ok(Saved::Saved(path, version, on_disk)),
+                Err(e @ kapaint_model::ModelError::Conflict { .. }) => {
+                    let kapaint_model::ModelError::Conflict { written, .. } = &e else {
+                        unreachable!("matched above")
+                    };
+                    Ok(Saved::Conflicted {
+                        written: written.clone(),
+                        message: e.to_string(),
+                        version,
+                    })
                 }
-            },
-            Self::save_done,
-        );
-    }
+                Err(e) => Err(format!("could not save: {e}")),
+            }
+        },
+        save_done,
+    )
+}
 
-    /// Opens `path` on a worker.
-    pub fn open(&mut self, path: PathBuf) {
-        if self.dirty() {
-            // Unsaved work is never dropped: ask first (see `open_prompt`).
-            self.prompts.pending_open = Some(path);
-            return;
-        }
-        self.open_now(path);
-    }
-
-    /// Opens `path` on a worker, once the user has answered if another kapaint has it open.
-    pub(super) fn open_now(&mut self, path: PathBuf) {
-        let Some(read_only) = self.may_open(&path) else {
-            return;
-        };
-        self.start_job_opening(
-            "Open",
-            path.clone(),
+/// Opens `path` on a worker (`read_only`: another kapaint has it and the user chose so).
+pub(super) fn open(path: PathBuf, read_only: bool) -> JobStart {
+    JobStart::new(
+        "Open",
+        {
+            let path = path.clone();
             move |progress| {
                 progress.start("open", 1);
                 let on_disk = project::OnDisk::of(&path);
@@ -181,74 +86,112 @@ impl EditorState {
                     })),
                     Err(e) => Err(format!("could not open {}: {e}", path.display())),
                 }
-            },
-            Self::open_done,
-        );
-    }
+            }
+        },
+        open_done,
+    )
+    .opening(path)
+}
 
-    /// Opens the recovery copy `from` as the project at `path` (unsaved). A copy that cannot
-    /// be recovered is removed (it would be offered at every start) and the project opens as
-    /// saved, with a notice saying why.
-    pub(super) fn recover(&mut self, from: PathBuf, path: Option<PathBuf>) {
-        let opens = path.clone().unwrap_or_else(|| from.clone());
-        self.start_job_opening(
-            "Recover",
-            opens,
-            move |progress| {
-                progress.start("open", 1);
-                // Recovered work replaces the project as it is on disk now.
-                let on_disk = path.as_deref().and_then(project::OnDisk::of);
-                let recovered =
-                    recovery::load(&from)
-                        .map_err(|e| e.to_string())
-                        .and_then(|mut doc| {
-                            let failed = project::attach_own_mesh(&mut doc).err();
-                            with_fallback(doc, failed)
-                        });
-                let e = match recovered {
-                    Ok((doc, note)) => {
-                        return Ok(Box::new(OpenedProject {
-                            path,
-                            doc,
-                            recovered: Some(from),
-                            note,
-                            on_disk,
-                            read_only: false,
-                        }));
-                    }
-                    Err(e) => e,
-                };
-                recovery::remove(&from);
-                let why = format!("could not recover {}: {e}", from.display());
-                match path.as_deref().filter(|p| p.exists()).map(load_project) {
-                    Some(Ok((doc, _))) => Ok(Box::new(OpenedProject {
+/// Opens the recovery copy `from` as the project at `path` (unsaved). A copy that cannot be
+/// recovered is removed (it would be offered at every start) and the project opens as saved,
+/// with a notice saying why.
+pub(super) fn recover(from: PathBuf, path: Option<PathBuf>) -> JobStart {
+    let opens = path.clone().unwrap_or_else(|| from.clone());
+    JobStart::new(
+        "Recover",
+        move |progress| {
+            progress.start("open", 1);
+            // Recovered work replaces the project as it is on disk now.
+            let on_disk = path.as_deref().and_then(project::OnDisk::of);
+            let recovered = recovery::load(&from)
+                .map_err(|e| e.to_string())
+                .and_then(|mut doc| {
+                    let failed = project::attach_own_mesh(&mut doc).err();
+                    with_fallback(doc, failed)
+                });
+            let e = match recovered {
+                Ok((doc, note)) => {
+                    return Ok(Box::new(OpenedProject {
                         path,
                         doc,
-                        recovered: None,
-                        note: Some(format!("{why}; opened the saved project")),
+                        recovered: Some(from),
+                        note,
                         on_disk,
                         read_only: false,
-                    })),
-                    Some(Err(open)) => Err(format!("{why}; {open}")),
-                    None => Err(why),
+                    }));
                 }
-            },
-            Self::open_done,
-        );
-    }
+                Err(e) => e,
+            };
+            recovery::remove(&from);
+            let why = format!("could not recover {}: {e}", from.display());
+            match path.as_deref().filter(|p| p.exists()).map(load_project) {
+                Some(Ok((doc, _))) => Ok(Box::new(OpenedProject {
+                    path,
+                    doc,
+                    recovered: None,
+                    note: Some(format!("{why}; opened the saved project")),
+                    on_disk,
+                    read_only: false,
+                })),
+                Some(Err(open)) => Err(format!("{why}; {open}")),
+                None => Err(why),
+            }
+        },
+        open_done,
+    )
+    .opening(opens)
+}
 
-    pub(super) fn save(&mut self) {
-        match self.project.path.clone() {
-            Some(p) if !self.project.claim.read_only => self.save_to(p),
-            _ => self.save_as(),
+/// How many recent files are kept.
+pub const RECENT_MAX: usize = 10;
+
+/// `list` with `path` moved to the front, without duplicates, at most [`RECENT_MAX`] long.
+pub fn push_recent(list: &mut Vec<PathBuf>, path: &Path) {
+    let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    list.retain(|p| *p != path);
+    list.insert(0, path);
+    list.truncate(RECENT_MAX);
+}
+
+pub(super) fn recent_path() -> Option<PathBuf> {
+    layout_path().map(|p| p.with_file_name("recent.json"))
+}
+
+pub(super) fn load_recent() -> Vec<PathBuf> {
+    recent_path()
+        .and_then(|p| kapaint_base::file_check::read_limited(&p, 1 << 20).ok())
+        .map(|text| parse_recent(&text))
+        .unwrap_or_default()
+}
+
+/// The recent-files list from its JSON: at most [`RECENT_MAX`] entries, each a path of at
+/// most 4096 bytes without control characters (anything else is dropped, a list that does
+/// not parse is empty).
+pub fn parse_recent(json: &[u8]) -> Vec<PathBuf> {
+    let Ok(list) = serde_json::from_slice::<Vec<String>>(json) else {
+        return Vec::new();
+    };
+    list.into_iter()
+        .filter(|p| {
+            !p.is_empty()
+                && kapaint_model::check::bounded_text(
+                    "path",
+                    p,
+                    kapaint_model::check::MAX_PATH_BYTES,
+                )
+                .is_ok()
+        })
+        .take(RECENT_MAX)
+        .map(PathBuf::from)
+        .collect()
+}
+
+pub(super) fn save_recent(list: &[PathBuf]) {
+    if let (Some(path), Ok(json)) = (recent_path(), serde_json::to_vec_pretty(list)) {
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
         }
-    }
-
-    pub(super) fn save_as(&mut self) {
-        self.choose_file(FilePurpose::SaveProject);
-    }
-
-    pub(super) fn open_dialog(&mut self) {
-        self.choose_file(FilePurpose::OpenProject);
+        let _ = kapaint_base::atomic::write_atomic(&path, &json);
     }
 }

@@ -2,8 +2,7 @@
 //! the window closes, whether a glTF mesh's material comes in with it, and whether a mesh
 //! whose UVs cannot be painted is unwrapped.
 
-use super::EditorState;
-use super::dialogs::centred;
+use crate::desk::{Ask, Desk, centred};
 
 /// The questions asked before the editor goes on, while asked.
 #[derive(Default)]
@@ -13,19 +12,19 @@ pub(super) struct Prompts {
     /// An imported glTF mesh whose material has textures: asking whether to bring them in.
     pub(super) material: Option<std::path::PathBuf>,
     /// A PBR material of another size than the maps: asking whether to adopt its size.
-    pub(super) size: Option<super::jobs::SizePrompt>,
+    pub(super) size: Option<crate::results::SizePrompt>,
     /// A mesh import waiting on whether to unwrap the mesh.
-    pub(super) unwrap: Option<super::jobs::UnwrapPrompt>,
+    pub(super) unwrap: Option<crate::results::UnwrapPrompt>,
     /// A recovery copy found at start, newer than the project.
     pub(super) recovery_offer: Option<std::path::PathBuf>,
     /// Quitting: asked, waiting for a save, or allowed.
     pub(super) quit: super::Quit,
 }
 
-impl EditorState {
+impl Prompts {
     /// After a glTF mesh import: asks whether to bring its material's textures in too.
-    pub(super) fn material_prompt_window(&mut self, ctx: &egui::Context) {
-        let Some(path) = self.prompts.material.clone() else {
+    pub(super) fn material_window(&mut self, ctx: &egui::Context, desk: &mut Desk) {
+        let Some(path) = self.material.clone() else {
             return;
         };
         let (mut bring, mut skip) = (false, false);
@@ -38,7 +37,7 @@ impl EditorState {
                      metallic and roughness are converted for {} into the selected layer's \
                      k_d, k_s and n (one undo step), and its normal map is kept.",
                     path.display(),
-                    self.doc.settings().model.label()
+                    desk.doc.settings().model.label()
                 ));
                 ui.horizontal(|ui| {
                     bring = ui.button("Bring the material in").clicked();
@@ -46,17 +45,17 @@ impl EditorState {
                 });
             });
         if bring {
-            self.prompts.material = None;
-            self.import_pbr(path);
+            self.material = None;
+            desk.job(crate::material_size::import_pbr(desk.doc, path));
         } else if skip {
-            self.prompts.material = None;
+            self.material = None;
         }
     }
 
     /// After a mesh import whose UVs cannot be painted as they are: unwrap automatically, keep
     /// its UVs (when it has some), or cancel the import.
-    pub(super) fn unwrap_prompt_window(&mut self, ctx: &egui::Context) {
-        let Some(prompt) = self.prompts.unwrap.clone() else {
+    pub(super) fn unwrap_window(&mut self, ctx: &egui::Context, desk: &mut Desk) {
+        let Some(prompt) = self.unwrap.clone() else {
             return;
         };
         let (mut unwrap, mut keep, mut cancel) = (false, false, false);
@@ -69,8 +68,8 @@ impl EditorState {
                      ({}x{}), padded, none overlapping. The project keeps the unwrapped mesh.",
                     prompt.path.display(),
                     prompt.why,
-                    self.doc.maps().width(),
-                    self.doc.maps().height()
+                    desk.doc.maps().width(),
+                    desk.doc.maps().height()
                 ));
                 ui.horizontal(|ui| {
                     unwrap = ui.button("Unwrap automatically").clicked();
@@ -81,19 +80,19 @@ impl EditorState {
                 });
             });
         if unwrap || keep || cancel {
-            self.prompts.unwrap = None;
+            self.unwrap = None;
         }
         if unwrap {
-            self.unwrap_mesh(prompt);
+            desk.job(crate::mesh_jobs::unwrap_mesh(desk.doc, prompt));
         } else if keep {
-            self.keep_mesh_uvs(prompt);
+            desk.job(crate::mesh_jobs::keep_mesh_uvs(desk.doc, prompt));
         }
     }
 
     /// Asks what to do with unsaved changes before opening another project: save them first
     /// (the project opens once saved), discard them, or cancel.
-    pub(super) fn open_prompt(&mut self, ctx: &egui::Context) {
-        let Some(path) = self.prompts.pending_open.clone() else {
+    pub(super) fn open_window(&mut self, ctx: &egui::Context, desk: &mut Desk) {
+        let Some(path) = self.pending_open.clone() else {
             return;
         };
         let (mut save, mut discard, mut cancel) = (false, false, false);
@@ -113,27 +112,26 @@ impl EditorState {
                 });
             });
         if discard {
-            self.prompts.pending_open = None;
-            self.open_now(path);
+            self.pending_open = None;
+            desk.ask(Ask::OpenNow(path));
         } else if cancel {
-            self.prompts.pending_open = None;
+            self.pending_open = None;
         } else if save {
-            self.save();
+            desk.ask(Ask::Save);
         }
     }
 
-    pub(super) fn close_prompt(&mut self, ctx: &egui::Context) {
-        let close_requested =
-            ctx.input(|i| i.viewport().close_requested()) || self.prompts.quit.asked;
-        if close_requested && self.dirty() && self.prompts.quit.allowed.is_none() {
+    /// Quitting with unsaved changes (`dirty`): asks to save them, discard them, or stay.
+    pub(super) fn close_window(&mut self, ctx: &egui::Context, dirty: bool, desk: &mut Desk) {
+        let close_requested = ctx.input(|i| i.viewport().close_requested()) || self.quit.asked;
+        if close_requested && dirty && self.quit.allowed.is_none() {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
-            self.prompts.quit.asked = true;
-        } else if self.prompts.quit.asked && (self.prompts.quit.allowed.is_some() || !self.dirty())
-        {
+            self.quit.asked = true;
+        } else if self.quit.asked && (self.quit.allowed.is_some() || !dirty) {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             return;
         }
-        if self.prompts.quit.asked && self.dirty() && self.prompts.quit.allowed.is_none() {
+        if self.quit.asked && dirty && self.quit.allowed.is_none() {
             egui::Window::new("Unsaved changes")
                 .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
                 .collapsible(false)
@@ -142,15 +140,15 @@ impl EditorState {
                     ui.horizontal(|ui| {
                         if ui.button("Save").clicked() {
                             // Untitled work asks where first; the window closes once saved.
-                            self.prompts.quit.after_save = true;
-                            self.save();
-                            self.prompts.quit.asked = false;
+                            self.quit.after_save = true;
+                            desk.ask(Ask::Save);
+                            self.quit.asked = false;
                         }
                         if ui.button("Discard").clicked() {
-                            self.prompts.quit.allowed = Some(super::QuitAllowed::Discarded);
+                            self.quit.allowed = Some(super::QuitAllowed::Discarded);
                         }
                         if ui.button("Cancel").clicked() {
-                            self.prompts.quit.asked = false;
+                            self.quit.asked = false;
                         }
                     });
                 });

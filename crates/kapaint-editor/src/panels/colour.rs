@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 
-use super::Desk;
 use super::tool_panel::ToolPanel;
+use crate::desk::Desk;
 use kapaint_model::SettingsCommand;
 use kapaint_model::texel::{MaterialValue, linear_to_srgb, linear_to_srgb8, srgb_to_linear};
 

@@ -9,7 +9,7 @@ use kapaint_model::{Document, MaskCommand};
 
 use super::layers::LayersPanel;
 use super::presets::{Naming, Presets};
-use super::{Ask, Desk};
+use crate::desk::{Ask, Desk};
 
 /// The live thumbnail's side in texels and on screen.
 const THUMB: u32 = 96;

@@ -2,9 +2,9 @@
 //! modes, a fill layer's material, its mask's switches and the moves. Each change is a
 //! [`Command`].
 
-use super::Desk;
 use super::layers::LayersPanel;
 use super::presets::Presets;
+use crate::desk::Desk;
 use kapaint_model::layers::{Layer, LayerBlend, LayerContent};
 use kapaint_model::texel::{Channel, Channels};
 use kapaint_model::{Command, LayerMove};

@@ -13,8 +13,8 @@ use std::time::{Duration, Instant};
 
 use egui::{Color32, Rect, Sense, Vec2};
 
-use super::Desk;
 use super::presets::Presets;
+use crate::desk::Desk;
 use kapaint_model::layers::{Layer, LayerContent, thumbnail};
 use kapaint_model::{Command, Document, LayerKind, LayerPlace};
 use kapaint_model::{LayerCommand, MaskCommand};

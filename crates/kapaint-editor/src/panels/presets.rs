@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use super::{Ask, Desk};
-use crate::{EditorState, notice};
+use crate::desk::{Ask, Desk};
+use crate::{Notices, notice};
 use kapaint_model::SettingsCommand;
 use kapaint_model::brush::preset::{self as brush_preset, BrushPreset};
 use kapaint_model::texel::MaterialValue;
@@ -115,46 +115,16 @@ pub(crate) fn load_brush_presets(
     list
 }
 
-impl EditorState {
-    /// Saves presets into `dir` from now on (the user preset folder by default).
-    pub fn set_preset_dir(&mut self, dir: std::path::PathBuf) {
-        self.presets.dir = Some(dir);
-    }
-
+impl Presets {
     /// Reads the presets again: the shipped ones, then the user's from the preset folder (a
     /// malformed file is a notice).
-    pub fn reload_presets(&mut self) {
-        let dir = self.presets.dir.clone();
-        self.presets.materials = load_material_presets(dir.as_deref(), &mut self.notices);
-        self.presets.brushes = load_brush_presets(dir.as_deref(), &mut self.notices);
-        self.presets.masks = load_mask_presets(dir.as_deref(), &mut self.notices);
+    pub(crate) fn reload(&mut self, notices: &mut Notices) {
+        let dir = self.dir.clone();
+        self.materials = load_material_presets(dir.as_deref(), notices);
+        self.brushes = load_brush_presets(dir.as_deref(), notices);
+        self.masks = load_mask_presets(dir.as_deref(), notices);
     }
 
-    /// The names of the material presets, as the browser shows them.
-    pub fn preset_names(&self) -> Vec<&str> {
-        self.presets
-            .materials
-            .iter()
-            .map(|p| p.name.as_str())
-            .collect()
-    }
-
-    /// The smart masks: shipped, then the user's.
-    pub fn mask_preset_names(&self) -> Vec<&str> {
-        self.presets.masks.iter().map(|p| p.name.as_str()).collect()
-    }
-
-    /// The brush presets' names.
-    pub fn brush_preset_names(&self) -> Vec<&str> {
-        self.presets
-            .brushes
-            .iter()
-            .map(|p| p.name.as_str())
-            .collect()
-    }
-}
-
-impl Presets {
     /// The material presets: thumbnails with their names (a click makes one the primary),
     /// and saving the primary as a preset of the user's.
     pub(super) fn materials_ui(

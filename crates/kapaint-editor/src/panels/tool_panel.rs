@@ -1,9 +1,9 @@
 //! The left panel: tools and their options, brush settings and stamp, material, channels.
 
 use super::presets::Presets;
-use super::{Ask, Desk};
+use crate::desk::{Ask, Desk};
 use crate::files::FilePurpose;
-use crate::{stamp_image, stamp_key};
+use egui::Color32;
 use kapaint_core::tools::{OptionChange, OptionWidget, ToolOption};
 use kapaint_model::SettingsCommand;
 use kapaint_reflectance as reflectance;
@@ -302,4 +302,29 @@ fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionChange> {
         response.on_hover_text(option.hover);
     }
     value
+}
+
+/// A cheap identity of a stamp for its preview cache: size and a few samples' bits.
+fn stamp_key(stamp: &kapaint_model::brush::Stamp) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (stamp.width(), stamp.height()).hash(&mut h);
+    let step = (stamp.alpha().len() / 61).max(1);
+    for v in stamp.alpha().iter().step_by(step) {
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
+}
+
+/// A `size`^2 grey picture of a stamp (white where it paints).
+fn stamp_image(stamp: &kapaint_model::brush::Stamp, size: usize) -> egui::ColorImage {
+    let mut pixels = Vec::with_capacity(size * size);
+    for y in 0..size {
+        for x in 0..size {
+            let at = |i: usize| (i as f32 + 0.5) / size as f32 * 2.0 - 1.0;
+            let a = stamp.sample(at(x), at(y));
+            pixels.push(Color32::from_gray((a * 255.0 + 0.5) as u8));
+        }
+    }
+    egui::ColorImage::new([size, size], pixels)
 }

@@ -3,8 +3,8 @@
 use std::sync::Arc;
 
 use super::presets::Presets;
-use super::{Ask, Desk};
 use crate::canvas::{Canvas, CanvasChannel};
+use crate::desk::{Ask, Desk};
 use crate::layer_view::LayerView;
 use crate::viewport::{Compare, Comparison, ViewportGpu};
 use crate::{Look, MeshState};
