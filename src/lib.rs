@@ -7,7 +7,8 @@
 //! (`kapaint-editor`). The `kapaint` binary is a thin shell around [`cli::main`].
 
 pub use kapaint_base::{atomic, file_check, memory, task};
-pub use kapaint_core::{crash, render, tools};
+pub use kapaint_core::{crash, render};
+pub use kapaint_tools as tools;
 pub use kapaint_editor as ui;
 pub use kapaint_export as export;
 pub use kapaint_gpu as gpu;

@@ -55,7 +55,7 @@ fn kapaint_deps(krate: &str) -> BTreeSet<String> {
 }
 
 /// Each crate with the kapaint crates under it (its whole tree, not only what it names).
-const LAYERS: [(&str, &[&str]); 10] = [
+const LAYERS: [(&str, &[&str]); 11] = [
     ("kapaint-base", &[]),
     ("kapaint-reflectance", &[]),
     ("kapaint-mesh", &["kapaint-base"]),
@@ -65,6 +65,7 @@ const LAYERS: [(&str, &[&str]); 10] = [
     ),
     ("kapaint-pbr", &BELOW_CORE),
     ("kapaint-core", &BELOW_CORE),
+    ("kapaint-tools", &BELOW_CORE),
     (
         "kapaint-export",
         &[
@@ -98,6 +99,7 @@ const LAYERS: [(&str, &[&str]); 10] = [
             "kapaint-export",
             "kapaint-gpu",
             "kapaint-pbr",
+            "kapaint-tools",
         ],
     ),
     (
@@ -112,6 +114,7 @@ const LAYERS: [(&str, &[&str]); 10] = [
             "kapaint-export",
             "kapaint-gpu",
             "kapaint-pbr",
+            "kapaint-tools",
         ],
     ),
 ];
@@ -146,6 +149,7 @@ fn the_core_and_everything_under_it_link_no_gui_or_gpu_crate() {
         "kapaint-model",
         "kapaint-pbr",
         "kapaint-core",
+        "kapaint-tools",
         "kapaint-export",
     ] {
         assert_free_of(krate, &forbidden);
@@ -158,6 +162,15 @@ fn the_core_and_everything_under_it_link_no_gui_or_gpu_crate() {
 fn the_export_links_neither_the_core_nor_its_charts() {
     assert_free_of("kapaint-export", &["kapaint-core", "plotters"]);
     assert_free_of("kapaint-pbr", &["kapaint-core", "plotters"]);
+}
+
+/// The tools are the editor's: the GPU crate (and so the export's GPU encoder) never links
+/// them (issue 55: they sat in the core, under the GPU crate).
+#[test]
+fn the_tools_are_the_editors_alone() {
+    assert_free_of("kapaint-gpu", &["kapaint-tools"]);
+    assert_free_of("kapaint-core", &["kapaint-tools"]);
+    assert_free_of("kapaint-export", &["kapaint-tools"]);
 }
 
 /// The reports' charts are the command line's: no crate of the workspace links `plotters`

@@ -17,7 +17,7 @@ use super::viewport::{Viewport, ViewportGpu};
 use super::{DEFAULT_SIZE, EditorState, MeshState, Tab, default_layout, notice, readout};
 use crate::desk::Desk;
 use kapaint_core::render::{Lighting, ViewMode};
-use kapaint_core::tools::Tools;
+use kapaint_tools::Tools;
 use kapaint_model::texel::MaterialValue;
 use kapaint_model::{Document, DocumentSettings, recovery};
 

@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use kapaint_core::tools::{OptionChange, ToolKind, Tools};
+use kapaint_tools::{OptionChange, ToolKind, Tools};
 use kapaint_model::{Command, Document};
 
 use crate::Notice;

@@ -4,7 +4,7 @@
 
 use egui::{Key, KeyboardShortcut, Modifiers};
 
-use kapaint_core::tools::{ToolKind, Tools};
+use kapaint_tools::{ToolKind, Tools};
 
 /// What a key does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -49,7 +49,7 @@ use std::sync::Arc;
 
 use canvas::{Canvas, CanvasChannel};
 use kapaint_core::render::{Lighting, ViewMode};
-use kapaint_core::tools::Tools;
+use kapaint_tools::Tools;
 use kapaint_model::texel::Channel;
 use kapaint_model::{Command, Document};
 use viewport::Viewport;

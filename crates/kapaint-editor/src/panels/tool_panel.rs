@@ -4,7 +4,7 @@ use super::presets::Presets;
 use crate::desk::{Ask, Desk};
 use crate::files::FilePurpose;
 use egui::Color32;
-use kapaint_core::tools::{OptionChange, OptionWidget, ToolOption};
+use kapaint_tools::{OptionChange, OptionWidget, ToolOption};
 use kapaint_model::SettingsCommand;
 use kapaint_reflectance as reflectance;
 

@@ -3,7 +3,7 @@
 //! active tool answers; tests feed events directly, with no window.
 //!
 //! ```text
-//! egui input --> ui::input --> ToolEvent --> Tools::handle --> [Command] --> Document::apply
+//! egui input --> editor::input --> ToolEvent --> Tools::handle --> [Command] --> Document::apply
 //! ```
 //!
 //! Tools read the document (its size, its mesh's UV islands) but never change it themselves.

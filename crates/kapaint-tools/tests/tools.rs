@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use kapaint_core::tools::{
+use kapaint_tools::{
     Fill, FillMode, Gradient, OptionWidget, Place, ToolEvent, ToolKind, Tools,
 };
 use kapaint_mesh::uv_sphere;
@@ -470,7 +470,7 @@ fn every_tool_describes_itself_and_its_options_drive_it() {
     );
     assert_eq!(
         tools.overlay(),
-        Some(kapaint_core::tools::Overlay::Arrow {
+        Some(kapaint_tools::Overlay::Arrow {
             from: Vec2::new(10.0, 10.0),
             to: Vec2::new(50.0, 20.0)
         })
