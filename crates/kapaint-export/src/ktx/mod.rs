@@ -22,6 +22,28 @@ use super::codec::{Codec, CodecError, Effort};
 use crate::file_kind::Compression;
 use kapaint_base::task::Progress;
 
+/// Why a KTX2 file could not be written: what a caller acts on (a cancel ends an export
+/// quietly; anything else is its error line).
+#[derive(Debug, thiserror::Error)]
+pub enum KtxError {
+    /// The image cannot be stored so: an empty image, a component count outside 1..=4,
+    /// levels that are not a full chain.
+    #[error("cannot write {0}")]
+    Shape(String),
+    /// Half floats asked for uncompressed (they are written only as BC6H blocks).
+    #[error("half floats are written only as BC6H blocks")]
+    HalfUncompressed,
+    /// The block codec failed.
+    #[error(transparent)]
+    Codec(#[from] CodecError),
+    /// The container could not describe the format.
+    #[error("data format descriptor: {0}")]
+    Container(String),
+    /// Cancelled through its [`Progress`].
+    #[error("cancelled")]
+    Cancelled,
+}
+
 /// A texel's component in its averaging space (`value(texel, component)`, unquantised).
 pub trait Values: Sync {
     /// Texel `i`'s component `k`.
@@ -65,7 +87,7 @@ impl Source<'_> {
         texel_layout(self.spaces).0
     }
 
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), KtxError> {
         let (w, h, ch) = (self.width, self.height, self.channels());
         let half = self.spaces.iter().filter(|s| **s == Space::Half).count();
         if w == 0
@@ -74,7 +96,7 @@ impl Source<'_> {
             || (half > 0 && (half != ch || ch != 3))
             || self.level0.len() != w as usize * h as usize * self.texel_bytes()
         {
-            return Err(format!("cannot write a {w}x{h} image of {ch} components"));
+            return Err(KtxError::Shape(format!("a {w}x{h} image of {ch} components")));
         }
         Ok(())
     }
@@ -272,13 +294,14 @@ pub type Blocks<'a> = (Coder<'a>, &'a dyn Codec, Effort);
 ///
 /// # Errors
 /// An empty image, a component count outside 1..=4, half floats uncompressed or not as
-/// three components, or cancelled.
+/// three components ([`KtxError::Shape`], [`KtxError::HalfUncompressed`]), the codec's
+/// failure, or [`KtxError::Cancelled`].
 pub fn encode(
     source: &Source<'_>,
     compressed: Option<Blocks<'_>>,
     level0: Option<Compressed>,
     progress: &Progress,
-) -> Result<Written, String> {
+) -> Result<Written, KtxError> {
     source.check()?;
     let chain = mips(source);
     let image = Image {
@@ -305,16 +328,15 @@ fn write_levels(
     compressed: Option<Blocks<'_>>,
     level0: Option<Compressed>,
     progress: &Progress,
-) -> Result<Written, String> {
+) -> Result<Written, KtxError> {
     let ((w, h), spaces, chain) = (image.size, image.spaces, image.chain);
     let ch = spaces.len();
     let per = texel_layout(spaces).0;
     let srgb = ch >= 3 && spaces[0].is_colour();
     if compressed.is_none() && per != ch {
-        return Err("half floats are written only as BC6H blocks".into());
+        return Err(KtxError::HalfUncompressed);
     }
     let (format, compression) = format_of(spaces, srgb, compressed.map(|c| c.1));
-    let failed = |e: CodecError| e.to_string();
     let mut level_bytes = Vec::with_capacity(chain.len() + 1);
     let mut decoded = Vec::with_capacity(chain.len() + 1);
     let mut psnr_values = None;
@@ -345,23 +367,24 @@ fn write_levels(
                     progress.advance(u64::from(h));
                     c
                 }
-                None => compress_level(encoder, blocks, image.level0, (w, h), per, Some(progress))
-                    .map_err(failed)?,
+                None => {
+                    compress_level(encoder, blocks, image.level0, (w, h), per, Some(progress))?
+                }
             };
             if progress.is_cancelled() {
-                return Err("cancelled".into());
+                return Err(KtxError::Cancelled);
             }
             psnr_values = Some(first.psnr(image.level0, spaces).to_vec());
             level_bytes.push(first.blocks);
             decoded.push(first.decoded);
             for (size, bytes) in chain {
-                let c = compress_level(encoder, blocks, bytes, *size, per, None).map_err(failed)?;
+                let c = compress_level(encoder, blocks, bytes, *size, per, None)?;
                 level_bytes.push(c.blocks);
                 decoded.push(c.decoded);
             }
         }
     }
-    let bytes = container(format, (w, h), &level_bytes)?;
+    let bytes = container(format, (w, h), &level_bytes).map_err(KtxError::Container)?;
     Ok(Written {
         bytes,
         decoded,
@@ -374,6 +397,39 @@ fn write_levels(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A cancel is a type the export acts on (it ends quietly), not an error line whose words
+    /// it would have to read; a shape that cannot be stored is another.
+    #[test]
+    fn a_cancelled_encode_and_a_bad_shape_say_so_in_their_type() {
+        let spaces = [Space::Linear; 4];
+        let level0 = vec![128_u8; 16 * 16 * 4];
+        let value = |_: usize, _: usize| 0.5_f32;
+        let source = Source {
+            width: 16,
+            height: 16,
+            spaces: &spaces,
+            level0: &level0,
+            value: &value,
+        };
+        let bc = crate::preset::Format::Ktx2Bc {
+            max_effort: Effort::Fast,
+            bc6h: false,
+        };
+        let codec = bc.codec(&spaces).expect("BC7 for four components");
+        let progress = Progress::default();
+        progress.cancel();
+        let blocks = Some((Coder::best_cpu(), &*codec, Effort::Fast));
+        let cancelled = encode(&source, blocks, None, &progress);
+        assert!(matches!(cancelled, Err(KtxError::Cancelled)), "{:?}", cancelled.err());
+        let empty = Source {
+            width: 0,
+            level0: &[],
+            ..source
+        };
+        let shape = encode(&empty, None, None, &Progress::default());
+        assert!(matches!(shape, Err(KtxError::Shape(_))), "{:?}", shape.err());
+    }
 
     fn gradient(w: u32, h: u32, ch: usize) -> Vec<f32> {
         (0..w * h)

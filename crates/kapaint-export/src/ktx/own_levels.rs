@@ -2,7 +2,7 @@
 //! which no per-component average of its bytes gives).
 
 use super::levels::half;
-use super::{Blocks, Image, Progress, Space, Written, level_count, write_levels};
+use super::{Blocks, Image, KtxError, Progress, Space, Written, level_count, write_levels};
 
 /// Writes an image whose levels the caller made (finest first, a full chain: `levels[k]` of
 /// the size [`level_count`]'s level `k` has) of `channels` linear bytes per texel, as a KTX2
@@ -11,15 +11,15 @@ use super::{Blocks, Image, Progress, Space, Written, level_count, write_levels};
 ///
 /// # Errors
 /// No levels, levels that are not a full chain of `channels` bytes per texel, or a component
-/// count outside 1..=4.
+/// count outside 1..=4 ([`KtxError::Shape`]); the codec's failure.
 pub fn encode_levels(
     levels: &[((u32, u32), Vec<u8>)],
     channels: usize,
     compressed: Option<Blocks<'_>>,
-) -> Result<Written, String> {
+) -> Result<Written, KtxError> {
     let spaces = vec![Space::Linear; channels];
     let Some(((w, h), level0)) = levels.first() else {
-        return Err("no levels".into());
+        return Err(KtxError::Shape("no levels".into()));
     };
     let mut size = (*w, *h);
     let whole = levels.len() == level_count(size.0, size.1) as usize
@@ -30,10 +30,10 @@ pub fn encode_levels(
             *s == size && bytes.len() == s.0 as usize * s.1 as usize * channels
         });
     if !whole || !(1..=4).contains(&channels) || *w == 0 || *h == 0 {
-        return Err(format!(
-            "cannot write {} levels of a {w}x{h} image of {channels} components",
+        return Err(KtxError::Shape(format!(
+            "{} levels of a {w}x{h} image of {channels} components",
             levels.len()
-        ));
+        )));
     }
     let image = Image {
         spaces: &spaces,

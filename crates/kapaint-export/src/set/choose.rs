@@ -28,6 +28,7 @@ use std::time::Instant;
 
 use super::budget::{better, nearer, reachable, storage_misses, within};
 use super::choice::{BlockChoice, BlockLayout, NEAREST_RULE, Trial};
+use super::failure::Failure;
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, spaces_of, srgb_image};
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
@@ -100,7 +101,7 @@ impl TrialImage<'_> {
         effort: Effort,
         job: &Job<'_>,
         p: &Progress,
-    ) -> Result<(), String> {
+    ) -> Result<(), Failure> {
         let size = job.size;
         let runs = self.codec.effort(effort);
         if self.compressed.as_ref().is_some_and(|(e, _)| *e == runs) {
@@ -148,7 +149,7 @@ fn prepare<'a>(
     want: &Images,
     half: bool,
     job: &Job<'a>,
-) -> Result<(), String> {
+) -> Result<(), Failure> {
     let half_of = |comps: &[Comp]| half && half_image(comps);
     images.retain(|i| {
         want.iter()
@@ -202,13 +203,13 @@ fn tried(trials: &[Trial], layout: BlockLayout) -> bool {
 /// module), then the chosen images with their mip chains.
 ///
 /// # Errors
-/// A failed encode, or cancelled (`"cancelled"`).
+/// A failed encode, or [`Failure::Cancelled`].
 pub(super) fn encode_blocks(
     job: &Job<'_>,
     packed: &Images,
     apart: Option<&Images>,
     progress: &Progress,
-) -> Result<(Vec<Encoded>, BlockChoice), String> {
+) -> Result<(Vec<Encoded>, BlockChoice), Failure> {
     // The brought encoder encodes what it can; the CPU the rest ([`blocks::encode`]).
     let encoder = Coder::best(job.brought);
     let search = Search::new(job, packed, apart);
@@ -317,7 +318,7 @@ impl<'j, 'a> Search<'j, 'a> {
         images: &mut Vec<TrialImage<'a>>,
         encoder: Coder<'_>,
         progress: &Progress,
-    ) -> Result<Found, String> {
+    ) -> Result<Found, Failure> {
         let budget = self.job.preset.budget;
         let (mut layout, mut step) = (self.layouts[0], 0);
         let mut trials: Vec<Trial> = Vec::new();
@@ -474,7 +475,7 @@ fn compress_all(
     effort: Effort,
     job: &Job<'_>,
     progress: &Progress,
-) -> Result<(), String> {
+) -> Result<(), Failure> {
     progress.start("encode", images.len() as u64 * u64::from(job.size.1));
     for image in images {
         image.compress(encoder, effort, job, progress)?;
@@ -494,11 +495,11 @@ fn run_trial(
     effort: Effort,
     job: &Job<'_>,
     progress: &Progress,
-) -> Result<Trial, String> {
+) -> Result<Trial, Failure> {
     let started = Instant::now();
     compress_all(images, encoder, effort, job, progress)?;
     if progress.is_cancelled() {
-        return Err("cancelled".into());
+        return Err(Failure::Cancelled);
     }
     let stored: Vec<StoredImage> = images.iter().map(TrialImage::stored).collect();
     let (ka_error, ka_error_srgb) = job.measure(&stored);
@@ -529,7 +530,7 @@ fn with_mips(
     (encoder, effort): (Coder<'_>, Effort),
     size: (u32, u32),
     progress: &Progress,
-) -> Result<Vec<Encoded>, String> {
+) -> Result<Vec<Encoded>, Failure> {
     progress.start("encode", images.len() as u64 * u64::from(size.1));
     let mut encoded = Vec::with_capacity(images.len());
     for image in images {
@@ -541,7 +542,7 @@ fn with_mips(
             progress,
         )?;
         if progress.is_cancelled() {
-            return Err("cancelled".into());
+            return Err(Failure::Cancelled);
         }
         encoded.push((
             image.role.file("ktx2"),

@@ -4,6 +4,7 @@ use glam::Vec3;
 use image::ExtendedColorType as C;
 use rayon::prelude::*;
 
+use super::failure::Failure;
 use super::manifest::{Comp, Compression, is_colour};
 use crate::encoding::NEncoding;
 use crate::ktx::{Space, texel_layout};
@@ -92,7 +93,7 @@ pub(super) fn encode_image(
     preset: &ExportPreset,
     n_enc: Option<NEncoding>,
     progress: &Progress,
-) -> Result<EncodedImage, String> {
+) -> Result<EncodedImage, Failure> {
     let format = preset.format;
     let channels = comps.len();
     let srgb = srgb_image(format, comps);

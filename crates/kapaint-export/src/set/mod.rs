@@ -7,6 +7,7 @@ mod budget;
 mod choice;
 mod choose;
 mod encode;
+mod failure;
 mod import;
 pub(crate) mod manifest;
 mod measure;
@@ -24,6 +25,7 @@ use rayon::prelude::*;
 pub use self::choice::{BlockChoice, BlockLayout, Trial};
 pub(crate) use self::encode::png_bytes;
 use self::encode::{Encoded, StoredImage, encode_image, rows};
+use self::failure::Failure;
 pub use self::import::import;
 pub use self::manifest::{
     Approximation, ColourSpace, Compression, Constants, FileEntry, MANIFEST_FORMAT,
@@ -226,12 +228,9 @@ impl<'d> Source<'d> {
         brought: Option<&dyn crate::blocks::BlockEncoder>,
         tmp: &Path,
     ) -> Result<(Vec<Encoded>, Option<Box<BlockChoice>>), SetError> {
-        let fail = |e: String, file: &str| {
-            if progress.is_cancelled() {
-                SetError::Cancelled
-            } else {
-                io(&tmp.join(file), e)
-            }
+        let fail = |e: Failure, file: &str| match e {
+            Failure::Cancelled => SetError::Cancelled,
+            Failure::Failed(e) => io(&tmp.join(file), e),
         };
         let n_enc = self.planned.n_encoding;
         if preset.format.is_blocks() {
