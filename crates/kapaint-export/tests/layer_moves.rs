@@ -7,13 +7,13 @@
 )]
 
 use glam::{Vec2, Vec3};
-use kapaint::model::brush::StrokePoint;
-use kapaint::model::layers::{Compositor, ops, thumbnail};
-use kapaint::model::texel::Texel;
-use kapaint::model::{
+use kapaint_model::brush::StrokePoint;
+use kapaint_model::layers::{Compositor, ops, thumbnail};
+use kapaint_model::texel::Texel;
+use kapaint_model::{
     Document, DocumentSettings, LayerKind, LayerPlace, MaterialMaps, MaterialValue,
 };
-use kapaint::model::{
+use kapaint_model::{
     HistoryCommand, LayerCommand, MaskCommand, PaintCommand, SettingsCommand, StrokeCommand,
 };
 
@@ -47,10 +47,10 @@ fn select(doc: &mut Document, path: &[usize]) {
 }
 
 fn stroke(doc: &mut Document, from: Vec2, to: Vec2) {
-    stroke_with(doc, kapaint::model::StrokeTool::Brush, from, to);
+    stroke_with(doc, kapaint_model::StrokeTool::Brush, from, to);
 }
 
-fn stroke_with(doc: &mut Document, tool: kapaint::model::StrokeTool, from: Vec2, to: Vec2) {
+fn stroke_with(doc: &mut Document, tool: kapaint_model::StrokeTool, from: Vec2, to: Vec2) {
     let points = (0..=8)
         .map(|k| StrokePoint {
             pos: from.lerp(to, k as f32 / 8.0),
@@ -130,8 +130,8 @@ fn groups_nest_no_deeper_than_a_project_stores() {
     assert_eq!(k, 15, "15 groups around the layer, then an error");
     assert!(e.contains("deeper than 16"), "{e}");
     // And the document still saves and loads.
-    let bytes = kapaint::model::project::to_bytes(&doc).expect("saves");
-    kapaint::model::project::from_reader(std::io::Cursor::new(bytes)).expect("loads");
+    let bytes = kapaint_model::project::to_bytes(&doc).expect("saves");
+    kapaint_model::project::from_reader(std::io::Cursor::new(bytes)).expect("loads");
 }
 
 #[test]
@@ -168,7 +168,7 @@ fn the_picker_reads_the_selected_layer_or_the_composite() {
     doc.apply(SettingsCommand::SetPrimary(red))
         .expect("primary");
     doc.apply(SettingsCommand::SetChannels(
-        kapaint::model::texel::Channels {
+        kapaint_model::texel::Channels {
             kd: true,
             ks: false,
             n: false,
@@ -211,7 +211,7 @@ fn thumbnails_show_content_coverage_and_masks() {
         10.0,
     )))
     .expect("primary");
-    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint_model::FillRegion::All))
         .expect("fill");
     doc.apply(MaskCommand::AddMask).expect("mask");
     doc.apply(MaskCommand::InvertMask).expect("invert");
@@ -229,7 +229,7 @@ fn thumbnails_show_content_coverage_and_masks() {
     assert!(thumbnail::mask(stack, &stack.layers[1], 8).is_none());
 }
 
-fn composite(stack: &kapaint::model::layers::LayerStack) -> MaterialMaps {
+fn composite(stack: &kapaint_model::layers::LayerStack) -> MaterialMaps {
     let mut maps = MaterialMaps::new(stack.width, stack.height, stack.base).expect("maps");
     Compositor::new().update(stack, &mut maps);
     maps
@@ -249,7 +249,7 @@ fn the_layer_views_show_one_layer_over_the_base_or_its_mask_in_grey() {
         5.0,
     )))
     .expect("primary");
-    doc.apply(PaintCommand::Fill(kapaint::model::FillRegion::All))
+    doc.apply(PaintCommand::Fill(kapaint_model::FillRegion::All))
         .expect("fill");
     doc.apply(LayerCommand::SetLayerVisible(false))
         .expect("hide");
@@ -257,7 +257,7 @@ fn the_layer_views_show_one_layer_over_the_base_or_its_mask_in_grey() {
     doc.apply(MaskCommand::SelectMask).expect("mask");
     stroke_with(
         &mut doc,
-        kapaint::model::StrokeTool::Eraser,
+        kapaint_model::StrokeTool::Eraser,
         Vec2::new(96.0, 0.0),
         Vec2::new(96.0, 127.0),
     );
@@ -289,12 +289,12 @@ fn an_export_manifest_says_how_many_layers_it_flattened() {
     let mut doc = document();
     add(&mut doc, LayerKind::Group, "G");
     add(&mut doc, LayerKind::Paint, "In G");
-    doc.apply(LayerCommand::MoveLayer(kapaint::model::LayerMove::Down))
+    doc.apply(LayerCommand::MoveLayer(kapaint_model::LayerMove::Down))
         .expect("move");
     let dir = std::env::temp_dir().join(format!("kapaint-layer-count-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let preset = kapaint::export::preset::find("compact").expect("preset");
-    let manifest = kapaint::export::set::export(&doc, &preset, &dir).expect("export");
+    let preset = kapaint_export::preset::find("compact").expect("preset");
+    let manifest = kapaint_export::set::export(&doc, &preset, &dir).expect("export");
     assert_eq!(manifest.layers, 3);
     let json = std::fs::read_to_string(dir.join("material.json")).expect("manifest");
     assert!(json.contains("\"layers\": 3"), "{json}");

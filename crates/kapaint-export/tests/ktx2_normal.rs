@@ -13,12 +13,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{DVec3, Vec2, Vec3};
-use kapaint::export::preset;
-use kapaint::export::set::{self, Compression, Manifest, NormalFile};
-use kapaint::model::brush::StrokePoint;
-use kapaint::model::normal::NormalMap;
-use kapaint::model::texel::MaterialValue;
-use kapaint::model::{Document, DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
+use kapaint_export::preset;
+use kapaint_export::set::{self, Compression, Manifest, NormalFile};
+use kapaint_model::brush::StrokePoint;
+use kapaint_model::normal::NormalMap;
+use kapaint_model::texel::MaterialValue;
+use kapaint_model::{Document, DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
 
 fn temp(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("kapaint-normal-{tag}-{}", std::process::id()));
@@ -120,7 +120,7 @@ fn decode_xy(format: ktx2::Format, data: &[u8], (w, h): (u32, u32)) -> Vec<[u8; 
         return out;
     }
     let (block, srgb) =
-        kapaint::export::codec::AstcBlock::of_vk_format(format.value()).expect("an ASTC format");
+        kapaint_export::codec::AstcBlock::of_vk_format(format.value()).expect("an ASTC format");
     assert!(!srgb, "a normal map is not colour");
     let (bw, bh) = block.dims();
     let mut image = vec![0_u32; w * h];
@@ -251,7 +251,7 @@ fn ktx2_sets_hold_the_normal_maps_x_and_y_with_its_angular_error() {
         // kapaint's own decode (its measure, its import) reads the same bytes: exactly for
         // BC5 and RG8, within a level for ASTC (as `tests/ktx2_astc.rs` finds for colour).
         let bytes = std::fs::read(out.join("normal.ktx2")).expect("read");
-        let ours = kapaint::export::ktx::decode(&bytes).expect("decode");
+        let ours = kapaint_export::ktx::decode(&bytes).expect("decode");
         let second = if xy == "ra" { 3 } else { 1 };
         let off = levels[0]
             .iter()
