@@ -379,6 +379,7 @@ fn a_mesh_without_uvs_is_unwrapped_on_request_and_kept() {
 /// While a bake runs the window redraws once a second for its progress, and not between: on a
 /// software renderer each frame takes about 0.1 s of the CPU the bake runs on (four frames a
 /// second, and the notices' two, made an AO bake in the editor take 1.4 times the CLI's).
+/// Cancelling it is no error.
 #[test]
 fn a_running_bake_redraws_the_window_once_a_second() {
     use kapaint::mesh::bakes::BakeMap;
@@ -412,6 +413,18 @@ fn a_running_bake_redraws_the_window_once_a_second() {
         "the next frame is asked for in {last:?} ({delays:?})"
     );
     wait_until(&mut harness, "cancelled", |e| !e.state.busy());
+    // Cancelled is what the user asked for: said as information, never as an error (it was
+    // "bake AO: cancelled" in red).
+    let notices = harness.state().state.notices();
+    let said = notices.last().map(|n| (n.text.as_str(), n.level));
+    assert_eq!(said, Some(("Bake cancelled", kapaint::ui::NoticeLevel::Info)));
+    assert!(
+        notices
+            .iter()
+            .all(|n| n.level != kapaint::ui::NoticeLevel::Error),
+        "{:?}",
+        notices.iter().map(|n| &n.text).collect::<Vec<_>>()
+    );
 }
 
 /// Mesh > Bake bakes a map of the mesh on a worker and keeps it in the project as one undo

@@ -123,7 +123,7 @@ impl BakeArgs {
                 Some(&progress),
             )
         })
-        .map_err(CliError::usage)?;
+        .map_err(|e| CliError::usage(e.to_string()))?;
         let seconds = start.elapsed().as_secs_f64();
         let stats = baked.stats(&surface.bake);
         let line = summary(&self.project, &surface.mesh.name, &baked, &stats, seconds);

@@ -43,7 +43,14 @@ impl EditorState {
                 }
                 Ask::LightFollowsCamera(follow) => self.set_light_follows_camera(follow),
                 Ask::Job(job) => self.start(job),
-                Ask::JobFailed(e) => self.job_failed(e),
+                Ask::JobFailed(e) => {
+                    self.job_dropped();
+                    self.notices.push(notice(e, true));
+                }
+                Ask::JobCancelled(label) => {
+                    self.job_dropped();
+                    self.notices.push(notice(format!("{label} cancelled"), false));
+                }
                 Ask::Prompt(Prompt::Material(path)) => self.prompts.material = Some(path),
                 Ask::Prompt(Prompt::Size(prompt)) => self.prompts.size = Some(*prompt),
                 Ask::Prompt(Prompt::Unwrap(prompt)) => self.prompts.unwrap = Some(prompt),
@@ -245,12 +252,11 @@ impl EditorState {
         }
     }
 
-    /// A job failed: what waited on it is dropped, and the error shown.
-    fn job_failed(&mut self, e: String) {
+    /// A job failed or was cancelled: what waited on it is dropped.
+    fn job_dropped(&mut self) {
         self.prompts.quit.after_save = false;
         self.dialogs.pending_new = None;
         self.jobs.bake_on_demand.failed();
-        self.notices.push(notice(e, true));
     }
 
     /// Opens `path` on a worker; with unsaved changes, asks first.

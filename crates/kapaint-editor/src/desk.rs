@@ -51,6 +51,9 @@ pub(crate) enum Ask {
     Job(JobStart),
     /// A job failed: what waited on it is dropped, and the error shown.
     JobFailed(String),
+    /// The user cancelled the job with this label: what waited on it is dropped, and that is
+    /// all (no error).
+    JobCancelled(String),
     /// Ask the user this before going on.
     Prompt(Prompt),
     /// Open this project now: the user answered about unsaved changes or another editor's
@@ -157,18 +160,24 @@ pub(crate) struct JobStart {
 
 impl JobStart {
     /// A job: `work` runs on a worker, and `done` takes its typed result on the UI thread,
-    /// asking the editor through a [`Desk`] (an error becomes a notice).
+    /// asking the editor through a [`Desk`] (an error becomes a notice; work that stops
+    /// because the user cancelled it is no error).
     pub(crate) fn new<T: Send + 'static>(
         label: &str,
         work: impl FnOnce(&Progress) -> Result<T, String> + Send + 'static,
         done: fn(T, &mut Desk),
     ) -> Self {
+        let named = label.to_string();
         Self {
             label: label.into(),
             opens: None,
             modal: None,
             run: Box::new(move |progress| match work(progress) {
                 Ok(value) => Box::new(move |desk: &mut Desk| done(value, desk)),
+                // The Cancel button set it: the job stopped because it was asked to.
+                Err(_) if progress.is_cancelled() => {
+                    Box::new(move |desk: &mut Desk| desk.ask(Ask::JobCancelled(named)))
+                }
                 Err(e) => Box::new(move |desk: &mut Desk| desk.ask(Ask::JobFailed(e))),
             }),
         }

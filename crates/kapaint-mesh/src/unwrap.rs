@@ -59,6 +59,29 @@ pub struct Unwrapped {
     pub coverage: f32,
 }
 
+/// Why an unwrap did not finish: cancelled (the caller ends quietly), or failed (why).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum UnwrapError {
+    /// Cancelled through its progress.
+    #[error("cancelled")]
+    Cancelled,
+    /// The mesh or the options cannot be unwrapped, and why.
+    #[error("{0}")]
+    Failed(String),
+}
+
+impl From<String> for UnwrapError {
+    fn from(reason: String) -> Self {
+        Self::Failed(reason)
+    }
+}
+
+impl From<&str> for UnwrapError {
+    fn from(reason: &str) -> Self {
+        Self::Failed(reason.into())
+    }
+}
+
 /// Unwraps `mesh` into a new atlas (its own UVs, if any, are ignored). `progress` follows the
 /// stages and cancels the work.
 ///
@@ -70,12 +93,12 @@ pub fn unwrap(
     mesh: &Mesh,
     options: UnwrapOptions,
     progress: Option<&Progress>,
-) -> Result<Unwrapped, String> {
+) -> Result<Unwrapped, UnwrapError> {
     if !(64..=16384).contains(&options.size) {
-        return Err(format!(
+        return Err(UnwrapError::Failed(format!(
             "an atlas of {} texels a side is outside 64 to 16384",
             options.size
-        ));
+        )));
     }
     let frame = crate::frame::UnitFrame::checked(&mesh.positions)?;
     kapaint_base::memory::check_fits(
@@ -119,9 +142,9 @@ pub fn unwrap(
     };
     let atlas = uvunwrap::generate_with_progress(&[input], &settings, report).map_err(|e| {
         if e == uvunwrap::Error::Cancelled {
-            "cancelled".to_string()
+            UnwrapError::Cancelled
         } else {
-            format!("the mesh could not be unwrapped: {e}")
+            UnwrapError::Failed(format!("the mesh could not be unwrapped: {e}"))
         }
     })?;
     if atlas.chart_count == 0 {
@@ -443,7 +466,7 @@ mod tests {
             had_normals: false,
         };
         let e = unwrap(&flat, UnwrapOptions::for_size(256), None).expect_err("nothing to chart");
-        assert!(e.contains("degenerate"), "{e}");
+        assert!(e.to_string().contains("degenerate"), "{e}");
         let progress = Progress::default();
         progress.cancel();
         let e = unwrap(
@@ -452,6 +475,6 @@ mod tests {
             Some(&progress),
         )
         .expect_err("cancelled");
-        assert_eq!(e, "cancelled");
+        assert_eq!(e, UnwrapError::Cancelled);
     }
 }

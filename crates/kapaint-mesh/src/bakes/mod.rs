@@ -255,6 +255,24 @@ fn check(map: BakeMap, options: BakeOptions) -> Result<(), String> {
     Ok(())
 }
 
+/// Why a bake did not finish: cancelled (the caller ends quietly), or refused (why, for the
+/// user).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BakeError {
+    /// Cancelled through its progress.
+    #[error("cancelled")]
+    Cancelled,
+    /// The options or the mesh cannot be baked, and why.
+    #[error("{0}")]
+    Refused(String),
+}
+
+impl From<String> for BakeError {
+    fn from(reason: String) -> Self {
+        Self::Refused(reason)
+    }
+}
+
 /// Bakes `map` at every texel `uv` gives a surface point (padding texels included, so seams
 /// are padded like the maps). `progress` counts rows and cancels.
 ///
@@ -268,10 +286,12 @@ pub fn bake_map(
     map: BakeMap,
     options: BakeOptions,
     progress: Option<&Progress>,
-) -> Result<Baked, String> {
+) -> Result<Baked, BakeError> {
     check(map, options)?;
     if uv.triangle_count() != mesh.triangles.len() {
-        return Err("the UV bake was made from another mesh".into());
+        return Err(BakeError::Refused(
+            "the UV bake was made from another mesh".into(),
+        ));
     }
     let frame = UnitFrame::checked(&mesh.positions)?;
     let (w, h) = (uv.width as usize, uv.height as usize);
@@ -319,7 +339,7 @@ pub fn bake_map(
             }
         });
     if cancelled.into_inner() {
-        return Err("cancelled".into());
+        return Err(BakeError::Cancelled);
     }
     Ok(Baked {
         map,
