@@ -8,7 +8,6 @@
 
 pub use kapaint_base::{atomic, file_check, memory, task};
 pub use kapaint_core::{crash, render};
-pub use kapaint_tools as tools;
 pub use kapaint_editor as ui;
 pub use kapaint_export as export;
 pub use kapaint_gpu as gpu;
@@ -16,6 +15,7 @@ pub use kapaint_mesh as mesh;
 pub use kapaint_model as model;
 pub use kapaint_pbr as pbr;
 pub use kapaint_reflectance as reflectance;
+pub use kapaint_tools as tools;
 
 pub mod cli;
 pub mod report;

@@ -417,7 +417,10 @@ fn a_running_bake_redraws_the_window_once_a_second() {
     // "bake AO: cancelled" in red).
     let notices = harness.state().state.notices();
     let said = notices.last().map(|n| (n.text.as_str(), n.level));
-    assert_eq!(said, Some(("Bake cancelled", kapaint::ui::NoticeLevel::Info)));
+    assert_eq!(
+        said,
+        Some(("Bake cancelled", kapaint::ui::NoticeLevel::Info))
+    );
     assert!(
         notices
             .iter()

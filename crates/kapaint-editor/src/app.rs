@@ -17,9 +17,9 @@ use super::viewport::{Viewport, ViewportGpu};
 use super::{DEFAULT_SIZE, EditorState, MeshState, Tab, default_layout, notice, readout};
 use crate::desk::Desk;
 use kapaint_core::render::{Lighting, ViewMode};
-use kapaint_tools::Tools;
 use kapaint_model::texel::MaterialValue;
 use kapaint_model::{Document, DocumentSettings, recovery};
+use kapaint_tools::Tools;
 
 /// The map size of the document shown while a project named at start opens.
 const PLACEHOLDER_SIZE: u32 = 16;

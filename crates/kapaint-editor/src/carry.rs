@@ -49,7 +49,8 @@ impl EditorState {
                 }
                 Ask::JobCancelled(label) => {
                     self.job_dropped();
-                    self.notices.push(notice(format!("{label} cancelled"), false));
+                    self.notices
+                        .push(notice(format!("{label} cancelled"), false));
                 }
                 Ask::Prompt(Prompt::Material(path)) => self.prompts.material = Some(path),
                 Ask::Prompt(Prompt::Size(prompt)) => self.prompts.size = Some(*prompt),

@@ -6,8 +6,8 @@
 
 use std::path::PathBuf;
 
-use kapaint_tools::{OptionChange, ToolKind, Tools};
 use kapaint_model::{Command, Document};
+use kapaint_tools::{OptionChange, ToolKind, Tools};
 
 use crate::Notice;
 use crate::files::FilePurpose;

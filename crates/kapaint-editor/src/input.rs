@@ -11,8 +11,8 @@ use glam::Vec2;
 use super::screen_brush::points_per_world;
 use super::{EditorState, Tab, brush_outline};
 use kapaint_core::render::FrameSettings;
-use kapaint_tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
 use kapaint_model::{HistoryCommand, LayerCommand, SettingsCommand};
+use kapaint_tools::{Overlay, Place, ToolCursor, ToolEvent, ToolKind};
 
 use crate::dialogs::NewDialog;
 use crate::export_dialog::ExportDialog;

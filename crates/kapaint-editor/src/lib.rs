@@ -49,9 +49,9 @@ use std::sync::Arc;
 
 use canvas::{Canvas, CanvasChannel};
 use kapaint_core::render::{Lighting, ViewMode};
-use kapaint_tools::Tools;
 use kapaint_model::texel::Channel;
 use kapaint_model::{Command, Document};
+use kapaint_tools::Tools;
 use viewport::Viewport;
 
 /// Default map size of a new project.

@@ -8,9 +8,6 @@
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use kapaint_tools::{
-    Fill, FillMode, Gradient, OptionWidget, Place, ToolEvent, ToolKind, Tools,
-};
 use kapaint_mesh::uv_sphere;
 use kapaint_model::brush::SurfacePos;
 use kapaint_model::paint::GradientShape;
@@ -18,6 +15,7 @@ use kapaint_model::surface::Surface;
 use kapaint_model::texel::{Channel, MaterialValue, Texel};
 use kapaint_model::{Command, Document, DocumentSettings, FillRegion, StrokeTool};
 use kapaint_model::{HistoryCommand, PaintCommand, SettingsCommand, StrokeCommand};
+use kapaint_tools::{Fill, FillMode, Gradient, OptionWidget, Place, ToolEvent, ToolKind, Tools};
 
 fn document() -> Document {
     let mut doc = Document::new(128, 64, DocumentSettings::default()).expect("doc");

@@ -4,9 +4,9 @@ use super::presets::Presets;
 use crate::desk::{Ask, Desk};
 use crate::files::FilePurpose;
 use egui::Color32;
-use kapaint_tools::{OptionChange, OptionWidget, ToolOption};
 use kapaint_model::SettingsCommand;
 use kapaint_reflectance as reflectance;
+use kapaint_tools::{OptionChange, OptionWidget, ToolOption};
 
 /// The tool panel's own state.
 #[derive(Default)]

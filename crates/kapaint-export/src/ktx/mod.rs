@@ -96,7 +96,9 @@ impl Source<'_> {
             || (half > 0 && (half != ch || ch != 3))
             || self.level0.len() != w as usize * h as usize * self.texel_bytes()
         {
-            return Err(KtxError::Shape(format!("a {w}x{h} image of {ch} components")));
+            return Err(KtxError::Shape(format!(
+                "a {w}x{h} image of {ch} components"
+            )));
         }
         Ok(())
     }
@@ -367,9 +369,7 @@ fn write_levels(
                     progress.advance(u64::from(h));
                     c
                 }
-                None => {
-                    compress_level(encoder, blocks, image.level0, (w, h), per, Some(progress))?
-                }
+                None => compress_level(encoder, blocks, image.level0, (w, h), per, Some(progress))?,
             };
             if progress.is_cancelled() {
                 return Err(KtxError::Cancelled);
@@ -421,14 +421,22 @@ mod tests {
         progress.cancel();
         let blocks = Some((Coder::best_cpu(), &*codec, Effort::Fast));
         let cancelled = encode(&source, blocks, None, &progress);
-        assert!(matches!(cancelled, Err(KtxError::Cancelled)), "{:?}", cancelled.err());
+        assert!(
+            matches!(cancelled, Err(KtxError::Cancelled)),
+            "{:?}",
+            cancelled.err()
+        );
         let empty = Source {
             width: 0,
             level0: &[],
             ..source
         };
         let shape = encode(&empty, None, None, &Progress::default());
-        assert!(matches!(shape, Err(KtxError::Shape(_))), "{:?}", shape.err());
+        assert!(
+            matches!(shape, Err(KtxError::Shape(_))),
+            "{:?}",
+            shape.err()
+        );
     }
 
     fn gradient(w: u32, h: u32, ch: usize) -> Vec<f32> {

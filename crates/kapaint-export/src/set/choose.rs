@@ -28,8 +28,8 @@ use std::time::Instant;
 
 use super::budget::{better, nearer, reachable, storage_misses, within};
 use super::choice::{BlockChoice, BlockLayout, NEAREST_RULE, Trial};
-use super::failure::Failure;
 use super::encode::{Encoded, KtxTexels, StoredImage, ktx_image, spaces_of, srgb_image};
+use super::failure::Failure;
 use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
 use super::perceptual::SrgbError;

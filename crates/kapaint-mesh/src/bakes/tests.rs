@@ -261,7 +261,10 @@ fn a_mesh_too_large_to_measure_is_refused_not_baked() {
     let uv = bake(&huge, 32, 32, 2).expect("the UV bake needs no positions");
     for map in [BakeMap::Ao, BakeMap::Thickness, BakeMap::Curvature] {
         let e = bake_map(&huge, &uv, map, BakeOptions::default(), None).expect_err("refused");
-        assert!(e.to_string().contains("too large to measure"), "{map:?}: {e}");
+        assert!(
+            e.to_string().contains("too large to measure"),
+            "{map:?}: {e}"
+        );
     }
     // Long on one axis only, it is measured and baked.
     let mut long = crate::uv_sphere(16, 8);
