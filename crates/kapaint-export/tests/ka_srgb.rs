@@ -10,11 +10,11 @@
 
 use std::path::{Path, PathBuf};
 
-use kapaint::export::preset;
-use kapaint::export::set::{self, Manifest};
-use kapaint::model::Document;
-use kapaint::model::texel::linear_to_srgb;
-use kapaint::reflectance::ka;
+use kapaint_export::preset;
+use kapaint_export::set::{self, Manifest};
+use kapaint_model::Document;
+use kapaint_model::texel::linear_to_srgb;
+use kapaint_reflectance::ka;
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("kapaint-ka-srgb-{}-{name}", std::process::id()));
@@ -24,8 +24,8 @@ fn dir(name: &str) -> PathBuf {
 
 fn project(side: u32) -> Document {
     let texture =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_texture.png");
-    kapaint::report::typical::typical_document(side, Some(&texture), 12).expect("project")
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/testdata/spot/spot_texture.png");
+    kapaint_core::report::typical::typical_document(side, Some(&texture), 12).expect("project")
 }
 
 /// The error in levels of one texel, computed here from the two documents' values in f64.

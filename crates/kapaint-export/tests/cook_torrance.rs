@@ -1,9 +1,9 @@
 //! Cook-Torrance's `Fast` against the exact integrator: the contract of 2e-5 relative
 //! on `n in [0, 16384]` for both parts, continuity across octaves, and its shape.
 
-use kapaint::reflectance::cook_torrance::{self, fit::CT_FIT_OCTAVES, karis};
-use kapaint::reflectance::{AmbientApprox, ShadingModel, chi_parts_f32, chi_parts_f64};
-use kapaint::report::accuracy::{CtSamples, Grid};
+use kapaint_reflectance::cook_torrance::{self, fit::CT_FIT_OCTAVES, karis};
+use kapaint_reflectance::{AmbientApprox, ShadingModel, chi_parts_f32, chi_parts_f64};
+use kapaint_core::report::accuracy::{CtSamples, Grid};
 use rayon::prelude::*;
 
 const CT: ShadingModel = ShadingModel::CookTorrance;
@@ -99,11 +99,11 @@ fn karis_fit_is_far_from_this_integral() {
 #[test]
 fn a_cook_torrance_set_names_its_model_and_measures_its_k_a() {
     use glam::{Vec2, Vec3};
-    use kapaint::export::{preset, set};
-    use kapaint::model::brush::StrokePoint;
-    use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{Document, DocumentSettings, StrokeTool};
-    use kapaint::model::{SettingsCommand, StrokeCommand};
+    use kapaint_export::{preset, set};
+    use kapaint_model::brush::StrokePoint;
+    use kapaint_model::texel::MaterialValue;
+    use kapaint_model::{Document, DocumentSettings, StrokeTool};
+    use kapaint_model::{SettingsCommand, StrokeCommand};
     let mut doc = Document::new(
         160,
         96,
@@ -152,7 +152,7 @@ fn a_cook_torrance_set_names_its_model_and_measures_its_k_a() {
         for x in 0..doc.maps().width() {
             let (p, q) = (doc.maps().value(x, y), back.maps().value(x, y));
             let ka = |v: MaterialValue| {
-                kapaint::reflectance::ka(CT, AmbientApprox::Fast, v.kd, v.ks, v.n).as_dvec3()
+                kapaint_reflectance::ka(CT, AmbientApprox::Fast, v.kd, v.ks, v.n).as_dvec3()
             };
             let (a, b) = (ka(p), ka(q));
             worst = worst.max(((b - a) / a).abs().max_element());
