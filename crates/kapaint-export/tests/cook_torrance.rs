@@ -1,9 +1,9 @@
 //! Cook-Torrance's `Fast` against the exact integrator: the contract of 2e-5 relative
 //! on `n in [0, 16384]` for both parts, continuity across octaves, and its shape.
 
+use kapaint_core::report::accuracy::{CtSamples, Grid};
 use kapaint_reflectance::cook_torrance::{self, fit::CT_FIT_OCTAVES, karis};
 use kapaint_reflectance::{AmbientApprox, ShadingModel, chi_parts_f32, chi_parts_f64};
-use kapaint_core::report::accuracy::{CtSamples, Grid};
 use rayon::prelude::*;
 
 const CT: ShadingModel = ShadingModel::CookTorrance;

@@ -23,8 +23,8 @@ fn dir(name: &str) -> PathBuf {
 }
 
 fn project(side: u32) -> Document {
-    let texture =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/testdata/spot/spot_texture.png");
+    let texture = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/testdata/spot/spot_texture.png");
     kapaint_core::report::typical::typical_document(side, Some(&texture), 12).expect("project")
 }
 
