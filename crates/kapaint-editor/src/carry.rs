@@ -21,11 +21,11 @@ impl EditorState {
             match ask {
                 Ask::Command(command) => self.apply(command),
                 Ask::CommandSaying(command, said) => {
-                    match self.doc.apply(command) {
-                        Ok(()) => said.into_iter().for_each(|n| self.notices.push(n)),
-                        Err(e) => self.notices.push(notice(e.to_string(), true)),
+                    if self.applied(command) {
+                        for n in said {
+                            self.notices.push(n);
+                        }
                     }
-                    self.follow_mesh();
                 }
                 Ask::SelectTool(kind) => self.select_tool(kind),
                 Ask::ToolOption(change) => {

@@ -439,10 +439,17 @@ impl EditorState {
     }
 
     fn apply(&mut self, command: impl Into<Command>) {
-        if let Err(e) = self.doc.apply(command) {
+        self.applied(command);
+    }
+
+    /// Applies `command`; whether it was done (an error becomes a notice).
+    fn applied(&mut self, command: impl Into<Command>) -> bool {
+        let done = self.doc.apply(command);
+        if let Err(e) = &done {
             self.notices.push(notice(e.to_string(), true));
         }
         self.follow_mesh();
+        done.is_ok()
     }
 
     /// The mesh shown, picked and drawn on follows the document's (a mesh import, its undo):
