@@ -19,7 +19,7 @@ use kapaint::export::set::{self, BlockLayout, ColourSpace, Compression, Manifest
 use kapaint::model::Document;
 use kapaint::report::typical::typical_document;
 
-#[path = "common/grey.rs"]
+#[path = "../crates/kapaint-export/tests/common/grey.rs"]
 mod grey;
 use grey::grey_project;
 

@@ -1,15 +1,16 @@
-//! A project whose k_a mean no 8-bit file meets: the ktx2 tests' storage floor.
+//! A project whose k_a mean no 8-bit file meets: the ktx2 tests' storage floor (shared with
+//! the top-level tests/ktx2_astc.rs, which runs the binary).
 
-use kapaint::model::Document;
+use kapaint_model::Document;
 
 /// A mid-grey k_d (0.5 linear, 187.5 in 8-bit sRGB: stored in 8 bits, half a level off
 /// everywhere) with one red stroke: a k_a mean of 0.3 levels that no 8-bit file meets and BC6H's
 /// half floats do.
 pub fn grey_project(side: u32) -> Document {
     use glam::{Vec2, Vec3};
-    use kapaint::model::brush::StrokePoint;
-    use kapaint::model::texel::MaterialValue;
-    use kapaint::model::{DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
+    use kapaint_model::brush::StrokePoint;
+    use kapaint_model::texel::MaterialValue;
+    use kapaint_model::{DocumentSettings, SettingsCommand, StrokeCommand, StrokeTool};
     let mut doc = Document::new(
         side,
         side,

@@ -12,11 +12,11 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use kapaint::export::codec::Effort;
-use kapaint::export::preset::{self, BlockBudget, ExportPreset, Format};
-use kapaint::export::set::{self, BlockLayout, Manifest};
-use kapaint::model::Document;
-use kapaint::report::typical::stroke_edge_document;
+use kapaint_core::report::typical::stroke_edge_document;
+use kapaint_export::codec::Effort;
+use kapaint_export::preset::{self, BlockBudget, ExportPreset, Format};
+use kapaint_export::set::{self, BlockLayout, Manifest};
+use kapaint_model::Document;
 
 #[path = "common/grey.rs"]
 mod grey;
@@ -29,8 +29,8 @@ fn temp(tag: &str) -> PathBuf {
 }
 
 fn spot() -> Option<PathBuf> {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot/spot_texture.png");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/testdata/spot/spot_texture.png");
     path.exists().then_some(path)
 }
 
@@ -226,7 +226,7 @@ fn decode_level(format: ktx2::Format, data: &[u8], (w, h): (u32, u32)) -> Vec<u8
                     for t in 0..16 {
                         for c in 0..3 {
                             let v = half::f16::from_bits(rgb[t * 3 + c]).to_f32();
-                            texels[t * 4 + c] = kapaint::model::texel::linear_to_srgb8(v);
+                            texels[t * 4 + c] = kapaint_model::texel::linear_to_srgb8(v);
                         }
                     }
                 }
@@ -335,7 +335,7 @@ fn compare_with_raw(
     // adds error: bcdec's may only be lower, and still over 45 dB.
     let mut half_files = 0;
     for file in &bc.files {
-        let bc6h = file.compression == kapaint::export::set::Compression::Ktx2Bc6h;
+        let bc6h = file.compression == kapaint_export::set::Compression::Ktx2Bc6h;
         half_files += usize::from(bc6h);
         let psnr_listed = file
             .psnr
@@ -397,7 +397,7 @@ fn the_cheapest_encoding_that_meets_the_budget_is_kept_and_no_more_is_spent() {
     assert!(blocks.within_budget && blocks.reason.contains("within the budget"));
     assert!(
         cfg!(not(target_arch = "x86_64"))
-            || blocks.encoder == kapaint::export::blocks::Encoder::Ispc
+            || blocks.encoder == kapaint_export::blocks::Encoder::Ispc
     );
     // The choice is in material.json, and a set with it imports.
     let text = std::fs::read_to_string(dir.join("material.json")).expect("manifest");
@@ -411,7 +411,7 @@ fn the_cheapest_encoding_that_meets_the_budget_is_kept_and_no_more_is_spent() {
 }
 
 /// How many of a trial's three measures miss `budget`.
-fn failing(t: &kapaint::export::set::Trial, budget: &BlockBudget) -> usize {
+fn failing(t: &kapaint_export::set::Trial, budget: &BlockBudget) -> usize {
     let srgb = t.ka_error_srgb.expect("measured");
     usize::from(srgb.p999 > budget.ka_error_srgb_p999)
         + usize::from(srgb.mean > budget.ka_error_srgb_mean)
@@ -568,8 +568,8 @@ fn presets_name_their_budget_and_bad_budgets_are_refused() {
 /// three quarters of a level on average over that project.
 #[test]
 fn blocks_of_one_colour_decode_exactly() {
-    use kapaint::export::blocks::{Coder, encode};
-    use kapaint::export::codec::Bc7;
+    use kapaint_export::blocks::{Coder, encode};
+    use kapaint_export::codec::Bc7;
     let colours: [[u8; 4]; 8] = [
         [255, 238, 230, 255],
         [255, 198, 167, 255],
