@@ -414,6 +414,77 @@ fn layer_dabs(c: &mut Criterion) {
     group.finish();
 }
 
+/// Issue 56's tools, a 128 px dab each (one a point, 12.8 texels apart) over a 4096^2 document whose
+/// every texel differs (nothing uniform to read or write), beside the brush's own dab there: clone (its source 160 texels
+/// along the row), smudge, and the brush through a 256 x 256 checker stencil.
+fn tool_dabs(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tools_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(4));
+    let checker = image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(256, 256, |x, y| {
+        image::Luma([if (x / 32 + y / 32) % 2 == 0 { 255 } else { 40 }])
+    }));
+    let stencil = kapaint::model::paint_image::PaintImage::decoded(
+        std::path::Path::new("checker.png"),
+        &checker,
+    )
+    .expect("stencil");
+    for (name, tool) in [
+        ("brush_dab_128px", StrokeTool::Brush),
+        ("clone_dab_128px", StrokeTool::Clone),
+        ("smudge_dab_128px", StrokeTool::Smudge),
+        ("brush_dab_128px_through_stencil", StrokeTool::Brush),
+    ] {
+        let mut doc = painted_document(SIDE);
+        // Spacing 10 % (smudge's most), one dab a point along rows 320 texels apart.
+        doc.apply(SettingsCommand::SetBrush(BrushSettings {
+            spacing_percent: 10.0,
+            ..brush128()
+        }))
+        .expect("brush");
+        let path = |k: u32| {
+            let (row, col) = ((k / 250) % 12, k % 250);
+            Vec2::new(256.5 + 12.8 * col as f32, 256.5 + 320.0 * row as f32)
+        };
+        let first = path(0);
+        doc.apply(SettingsCommand::SetCloneSource(
+            first + Vec2::new(160.0, 0.0),
+        ))
+        .expect("source");
+        if name.ends_with("stencil") {
+            doc.apply(SettingsCommand::SetStencil {
+                image: stencil.clone(),
+                center: Vec2::splat(2048.0),
+                size: 4096.0,
+                rotation: 15.0,
+                opacity: 1.0,
+                tiled: true,
+            })
+            .expect("stencil");
+        }
+        let mut k = 0u32;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                // A stroke a row: no jump between rows inside a stroke.
+                if k.is_multiple_of(250) {
+                    doc.apply(StrokeCommand::EndStroke).expect("end");
+                    doc.apply(StrokeCommand::BeginStroke(tool)).expect("begin");
+                    k %= 3000;
+                }
+                k += 1;
+                doc.apply(StrokeCommand::StrokeTo(StrokePoint {
+                    pos: path(k - 1),
+                    pressure: 1.0,
+                }))
+                .expect("dab");
+                doc.maps().version()
+            });
+        });
+    }
+    group.finish();
+}
+
 /// Saving and opening a 16-layer 4096^2 project (the stack of [`layered_stack`]: every
 /// layer painted over 10 % of the map, with masks); issue 18 asks <= 3 s each.
 fn layered_project_io(c: &mut Criterion) {
@@ -539,6 +610,7 @@ criterion_group!(
     resize,
     layers,
     layered_project_io,
-    generators
+    generators,
+    tool_dabs
 );
 criterion_main!(benches);

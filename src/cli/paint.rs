@@ -31,7 +31,16 @@ impl PaintArgs {
     /// A project, script or mesh that does not load, a command that cannot apply, or a
     /// failed write; the project is untouched then.
     pub fn run(self) -> Result<String, CliError> {
-        let commands = read_script(&self.script)?;
+        let mut commands = read_script(&self.script)?;
+        // The images commands paint through, named from the script's folder.
+        let folder = self.script.parent().unwrap_or(Path::new("."));
+        for (i, command) in commands.iter_mut().enumerate() {
+            for image in command.images_mut() {
+                image.load(folder).map_err(|e| {
+                    CliError::usage(format!("{}: command {}: {e}", self.script.display(), i + 1))
+                })?;
+            }
+        }
         // The file as read: a save finds out if another run saved over it meanwhile.
         let on_disk = project::OnDisk::of(&self.file);
         let mut doc = super::open_project(&self.file)?;

@@ -183,7 +183,13 @@ impl EditorState {
                 Sample::Down(p) => {
                     let on_view = response.interact_rect.contains(p)
                         && response.ctx.layer_id_at(p) == Some(response.layer_id);
-                    if self.pointer.held.is_none() && on_view && !reserved {
+                    let ctrl = response.ctx.input(|i| i.modifiers.command);
+                    if self.pointer.held.is_none() && on_view && !reserved && ctrl {
+                        // Ctrl+click picks a source (clone's); nothing is held.
+                        if let Some(at) = at {
+                            self.tool_event(ToolEvent::PickSource { at });
+                        }
+                    } else if self.pointer.held.is_none() && on_view && !reserved {
                         self.pointer.held = Some(tab);
                         if self.tools.active_meta().cursor == ToolCursor::BrushOutline {
                             let brush = &self.doc.settings().brush;
@@ -280,15 +286,42 @@ impl EditorState {
             painter.circle_stroke(p, radius, egui::Stroke::new(1.0, egui::Color32::WHITE));
             self.pointer.canvas_outline = Some((p, radius));
         }
-        if let Some(Overlay::Arrow { from, to }) = self.tools.overlay() {
-            let at = |p: Vec2| {
-                rect.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * rect.size()
-            };
-            response.ctx.layer_painter(response.layer_id).arrow(
-                at(from),
-                at(to) - at(from),
-                egui::Stroke::new(2.0, egui::Color32::WHITE),
-            );
+        let at =
+            |p: Vec2| rect.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * rect.size();
+        let painter = response.ctx.layer_painter(response.layer_id);
+        match self.tools.overlay() {
+            Some(Overlay::Arrow { from, to }) => {
+                painter.arrow(
+                    at(from),
+                    at(to) - at(from),
+                    egui::Stroke::new(2.0, egui::Color32::WHITE),
+                );
+            }
+            Some(Overlay::CloneSource) => {
+                // At the source; once a stroke fixed the offset, where the brush copies from.
+                if let Some((source, offset)) = self.doc.clone_source() {
+                    let marker = match (offset, pos) {
+                        (Some(offset), Some(p)) if response.hovered() => p + offset,
+                        _ => source,
+                    };
+                    let c = at(marker);
+                    for (width, colour) in
+                        [(3.0, egui::Color32::BLACK), (1.0, egui::Color32::WHITE)]
+                    {
+                        let stroke = egui::Stroke::new(width, colour);
+                        painter.circle_stroke(c, 6.0, stroke);
+                        painter.line_segment(
+                            [c - egui::vec2(10.0, 0.0), c + egui::vec2(10.0, 0.0)],
+                            stroke,
+                        );
+                        painter.line_segment(
+                            [c - egui::vec2(0.0, 10.0), c + egui::vec2(0.0, 10.0)],
+                            stroke,
+                        );
+                    }
+                }
+            }
+            None => {}
         }
     }
 

@@ -238,6 +238,11 @@ pub fn optional_name<'de, D: Deserializer<'de>>(d: D) -> Result<Option<String>, 
     Ok(v)
 }
 
+/// One: the default of a field read as an opacity or a scale.
+pub fn one() -> f32 {
+    1.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

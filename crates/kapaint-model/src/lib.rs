@@ -15,6 +15,7 @@ pub mod mesh_ref;
 pub mod mips;
 pub mod normal;
 pub mod paint;
+pub mod paint_image;
 pub mod preset;
 pub mod project;
 pub mod provenance;

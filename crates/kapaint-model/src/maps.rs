@@ -202,9 +202,20 @@ impl MaterialMaps {
         self.texel(x, y).decode()
     }
 
+    /// Every tile, row-major.
+    pub fn tiles(&self) -> &[Arc<Tile>] {
+        &self.tiles
+    }
+
     /// A tile, shared.
     pub fn tile(&self, id: TileId) -> &Arc<Tile> {
         &self.tiles[id]
+    }
+
+    /// Every tile as it is now, shared: what a clone stroke reads while it writes (a write
+    /// after this copies the tile it writes, so these stay as they were).
+    pub fn shared_tiles(&self) -> Vec<Arc<Tile>> {
+        self.tiles.clone()
     }
 
     /// A tile for writing: cloned first if anything else (history) holds it. Bumps its version.

@@ -198,7 +198,10 @@ impl Tool for Fill {
                 .map(|t| PaintCommand::Fill(self.region(doc, t)).into())
                 .into_iter()
                 .collect(),
-            ToolEvent::Drag { .. } | ToolEvent::Release | ToolEvent::Escape => Vec::new(),
+            ToolEvent::Drag { .. }
+            | ToolEvent::Release
+            | ToolEvent::Escape
+            | ToolEvent::PickSource { .. } => Vec::new(),
         }
     }
 

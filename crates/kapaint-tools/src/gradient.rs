@@ -130,6 +130,7 @@ impl Tool for Gradient {
                 self.drag = None;
                 Vec::new()
             }
+            ToolEvent::PickSource { .. } => Vec::new(),
         }
     }
 

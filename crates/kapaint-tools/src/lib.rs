@@ -10,18 +10,22 @@
 
 mod blur;
 mod brush;
+mod clone;
 mod eraser;
 mod fill;
 mod gradient;
 mod picker;
+mod smudge;
 mod stroke;
 
 pub use blur::{Blur, BlurOption};
 pub use brush::Brush;
+pub use clone::CloneTool;
 pub use eraser::Eraser;
 pub use fill::{Fill, FillMode, FillOption};
 pub use gradient::{Gradient, GradientOption};
 pub use picker::{Picker, PickerOption};
+pub use smudge::Smudge;
 
 use std::any::Any;
 
@@ -83,6 +87,11 @@ pub enum ToolEvent {
     Release,
     /// Escape: abandon what is under way (a stroke is undone, a drag dropped).
     Escape,
+    /// The primary button went down with Ctrl held: a source to copy from (clone's).
+    PickSource {
+        /// Where.
+        at: Place,
+    },
 }
 
 /// What every tool is and does. Everything the editor knows of a tool it asks here: its name
@@ -176,6 +185,9 @@ pub enum Overlay {
         /// Where it points.
         to: Vec2,
     },
+    /// The clone source's marker: at the document's clone source, and once a stroke fixed
+    /// the offset, at the pointer plus that offset (it follows the brush).
+    CloneSource,
 }
 
 /// One of a tool's options, as the panel shows it: its control, and the typed change each
@@ -237,6 +249,8 @@ fn registry() -> Vec<Box<dyn Tool>> {
         Box::new(Brush::default()),
         Box::new(Eraser::default()),
         Box::new(Blur::default()),
+        Box::new(CloneTool::default()),
+        Box::new(Smudge::default()),
         Box::new(Fill::default()),
         Box::new(Gradient::default()),
         Box::new(Picker::default()),

@@ -74,7 +74,7 @@ impl Tool for Picker {
                 })
                 .into_iter()
                 .collect(),
-            ToolEvent::Release | ToolEvent::Escape => Vec::new(),
+            ToolEvent::Release | ToolEvent::Escape | ToolEvent::PickSource { .. } => Vec::new(),
         }
     }
 

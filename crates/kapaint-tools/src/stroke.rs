@@ -79,7 +79,7 @@ impl Stroke {
                 self.state = StrokeState::Ready;
                 vec![StrokeCommand::AbortStroke.into()]
             }
-            ToolEvent::Release | ToolEvent::Escape => Vec::new(),
+            ToolEvent::Release | ToolEvent::Escape | ToolEvent::PickSource { .. } => Vec::new(),
         }
     }
 }

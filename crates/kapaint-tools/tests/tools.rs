@@ -407,7 +407,7 @@ fn a_stroke_stays_in_the_view_it_began_in() {
 #[test]
 fn every_tool_describes_itself_and_its_options_drive_it() {
     let all = Tools::all();
-    assert_eq!(all.len(), 6);
+    assert_eq!(all.len(), 8);
     for (i, a) in all.iter().enumerate() {
         assert!(!a.label.is_empty() && !a.key_help.is_empty(), "{a:?}");
         for b in &all[i + 1..] {
@@ -525,4 +525,48 @@ fn slide(tools: &mut Tools, doc: &Document, label: &str, value: f32) -> Vec<Comm
         })
         .expect("the tool offers the slider");
     tools.set_option(change, doc)
+}
+
+/// Clone: Ctrl+click sets the source (no stroke, no undo step), the stroke after it copies,
+/// and its overlay is the source's marker; smudge strokes as the brush does.
+#[test]
+fn clone_takes_its_source_from_a_ctrl_click_and_smudge_strokes() {
+    let mut doc = document();
+    let mut tools = Tools::default();
+    tools.select(ToolKind::CLONE, &doc);
+    assert_eq!(tools.overlay(), Some(kapaint_tools::Overlay::CloneSource));
+    // Before a source, a stroke is refused by the document (the editor shows why).
+    let begin = tools.handle(press(40.0, 40.0), &doc);
+    assert!(doc.apply(begin[0].clone()).is_err());
+    tools.handle(ToolEvent::Release, &doc);
+    let pick = ToolEvent::PickSource {
+        at: Place::Canvas(Vec2::new(20.0, 30.0)),
+    };
+    let commands = run(&mut tools, &mut doc, &[pick]);
+    assert_eq!(
+        commands,
+        [Command::Settings(SettingsCommand::SetCloneSource(
+            Vec2::new(20.0, 30.0)
+        ))]
+    );
+    assert_eq!(doc.clone_source(), Some((Vec2::new(20.0, 30.0), None)));
+    let steps = doc.history().undo_steps().count();
+    run(
+        &mut tools,
+        &mut doc,
+        &[press(60.0, 40.0), drag(70.0, 40.0), ToolEvent::Release],
+    );
+    assert_eq!(doc.history().undo_steps().count(), steps + 1);
+    assert_eq!(
+        doc.clone_source(),
+        Some((Vec2::new(20.0, 30.0), Some(Vec2::new(-40.0, -10.0))))
+    );
+    tools.select(ToolKind::SMUDGE, &doc);
+    assert!(tools.handle(pick, &doc).is_empty(), "smudge has no source");
+    run(
+        &mut tools,
+        &mut doc,
+        &[press(20.0, 20.0), drag(40.0, 20.0), ToolEvent::Release],
+    );
+    assert_eq!(doc.history().undo_steps().count(), steps + 2);
 }

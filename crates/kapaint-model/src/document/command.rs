@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::brush::{BrushSettings, StrokePoint, SurfacePoint};
 use crate::paint::GradientShape;
+use crate::paint_image::PaintImage;
 use crate::texel::{Channel, Channels, MaterialValue};
 use kapaint_reflectance::{AmbientApprox, ShadingModel};
 
@@ -19,6 +20,11 @@ pub enum StrokeTool {
     Eraser,
     /// Smooths the enabled channels.
     Blur,
+    /// Paints what the maps held at the clone source, aligned (see
+    /// [`SettingsCommand::SetCloneSource`]).
+    Clone,
+    /// Picks up what is under the brush and drags it along the stroke.
+    Smudge,
 }
 
 /// Which texels a fill writes.
@@ -94,6 +100,32 @@ pub enum SettingsCommand {
     SetModel(ShadingModel),
     /// Sets the approximation of `chi`.
     SetApprox(AmbientApprox),
+    /// Paints the brush, the eraser and clone through an image on the canvas (see
+    /// [`crate::paint::Stencil`]): `SetStencil(image: "stars.png", center: (512, 512),
+    /// size: 256, rotation: 0, opacity: 1)`.
+    SetStencil {
+        /// The image (a relative path from the script's folder).
+        image: PaintImage,
+        /// Its centre, in texels.
+        center: Vec2,
+        /// Its width, in texels.
+        size: f32,
+        /// Its rotation, in degrees.
+        #[serde(default)]
+        rotation: f32,
+        /// How much it holds the paint back (1: paint only through its light parts).
+        #[serde(default = "crate::check::one")]
+        opacity: f32,
+        /// Whether the image repeats beyond its edges.
+        #[serde(default)]
+        tiled: bool,
+    },
+    /// Takes the stencil away.
+    ClearStencil,
+    /// Sets the clone source, in texels: the next clone stroke copies from there, its first
+    /// point taking the source's texel, and later strokes keep that offset (aligned) until a
+    /// new source is set.
+    SetCloneSource(Vec2),
 }
 
 /// Strokes: each is one undo step.
@@ -434,6 +466,15 @@ impl PartialEq for AttachedMesh {
 }
 
 impl Command {
+    /// The images the command paints through: whoever applies it loads them first
+    /// ([`PaintImage::load`]).
+    pub fn images_mut(&mut self) -> Vec<&mut PaintImage> {
+        match self {
+            Self::Settings(SettingsCommand::SetStencil { image, .. }) => vec![image],
+            _ => Vec::new(),
+        }
+    }
+
     /// Whether the command paints on the mesh (and so needs
     /// [`Document::with_surface`](super::Document::with_surface)).
     pub fn needs_surface(&self) -> bool {

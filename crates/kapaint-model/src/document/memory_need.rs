@@ -31,7 +31,10 @@ impl SettingsCommand {
             | Self::SwapMaterials
             | Self::SetChannels(_)
             | Self::SetModel(_)
-            | Self::SetApprox(_) => false,
+            | Self::SetApprox(_)
+            | Self::SetStencil { .. }
+            | Self::ClearStencil
+            | Self::SetCloneSource(_) => false,
         }
     }
 }

@@ -4,7 +4,9 @@
 //! [`Document::apply`]. Every command leaves the maps valid (every texel decodes to finite,
 //! in-range values) and every stroke, fill, gradient or import is one undo step.
 
+mod aids;
 mod command;
+mod copy_dab;
 mod fill;
 mod id;
 mod import;
@@ -150,6 +152,8 @@ pub struct Document {
     id: DocumentId,
     /// Which document value this is in this process (see [`Document::instance`]).
     instance: u64,
+    /// The stencil and the clone source.
+    aids: aids::Aids,
 }
 
 impl std::fmt::Debug for Document {
@@ -305,10 +309,7 @@ impl Document {
         let opacity_run = self.opacity_run.take();
         let generator_run = self.generator_run.take();
         match command {
-            Command::Settings(c) => {
-                self.settings_command(c);
-                Ok(())
-            }
+            Command::Settings(c) => self.settings_command(c),
             Command::Stroke(c) => self.stroke_command(c),
             Command::Paint(c) => self.paint_command(c),
             Command::Import(c) => self.import_command(c),
@@ -322,7 +323,7 @@ impl Document {
     }
 
     /// The settings room: no undo step, a settings version counted where a value changed.
-    fn settings_command(&mut self, command: SettingsCommand) {
+    fn settings_command(&mut self, command: SettingsCommand) -> Result<(), ModelError> {
         /// Sets a setting, counting a change.
         fn set<T: PartialEq>(field: &mut T, value: T, version: &mut u64) {
             if *field != value {
@@ -344,7 +345,27 @@ impl Document {
             SettingsCommand::SetChannels(c) => set(&mut s.channels, c, v),
             SettingsCommand::SetModel(m) => set(&mut s.model, m, v),
             SettingsCommand::SetApprox(a) => set(&mut s.approx, a, v),
+            SettingsCommand::SetStencil {
+                image,
+                center,
+                size,
+                rotation,
+                opacity,
+                tiled,
+            } => {
+                return self.set_stencil(&aids::StencilSpec {
+                    image,
+                    center,
+                    size,
+                    rotation,
+                    opacity,
+                    tiled,
+                });
+            }
+            SettingsCommand::ClearStencil => self.aids.stencil = None,
+            SettingsCommand::SetCloneSource(at) => return self.set_clone_source(at),
         }
+        Ok(())
     }
 
     /// The stroke room.

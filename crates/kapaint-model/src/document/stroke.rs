@@ -2,18 +2,20 @@
 
 use glam::{Vec2, Vec3};
 
+use super::copy_dab::{self, CloneSource};
 use super::{Document, StrokeTool};
 use crate::ModelError;
+use crate::brush::BlendMode;
 use crate::brush::{
     BrushSettings, DabPoint, Resampler, Smoother, StrokePoint, SurfacePoint, SurfacePos,
 };
 use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes};
 use crate::layers::{Compositor, LayerStroke, State};
 use crate::maps::MaterialMaps;
-use crate::paint::{Coverage, DiscFootprint, Footprint};
+use crate::paint::{Coverage, DiscFootprint, Footprint, Stencil};
 use crate::surface::{BallFootprint, Surface};
 use crate::texel::Channels;
-use crate::tile::TileSpans;
+use crate::tile::{TILE_SIZE, TileSpans};
 
 /// A stroke in progress.
 pub(super) struct ActiveStroke {
@@ -32,6 +34,10 @@ pub(super) struct ActiveStroke {
     surface_smoother: Smoother<SurfacePos>,
     coverage: Coverage,
     rng: u64,
+    /// A clone stroke's source (set at its first point).
+    clone: Option<CloneSource>,
+    /// A smudge stroke's last dab centres, one per mirrored copy.
+    last_dabs: Vec<Vec2>,
 }
 
 /// The parts of a stroke a dab reads, borrowed apart so a footprint can hold the brush.
@@ -43,6 +49,7 @@ struct StrokeParts<'a> {
     channels: Channels,
     coverage: &'a mut Coverage,
     touched: &'a mut bool,
+    clone: Option<&'a CloneSource>,
 }
 
 impl ActiveStroke {
@@ -55,6 +62,7 @@ impl ActiveStroke {
             channels: self.channels,
             coverage: &mut self.coverage,
             touched: &mut self.touched,
+            clone: self.clone.as_ref(),
         }
     }
 }
@@ -80,6 +88,15 @@ impl Document {
             StrokeTool::Brush => (LayerStroke::Brush(brush.blend), "Brush stroke"),
             StrokeTool::Eraser => (LayerStroke::Erase, "Eraser stroke"),
             StrokeTool::Blur => (LayerStroke::Brush(brush.blend), "Blur stroke"),
+            StrokeTool::Clone => {
+                if self.aids.clone_source.is_none() {
+                    return Err(ModelError::Command(
+                        "clone needs a source: set one first (SetCloneSource, or Ctrl+click in the editor)".into(),
+                    ));
+                }
+                (LayerStroke::Brush(BlendMode::Normal), "Clone stroke")
+            }
+            StrokeTool::Smudge => (LayerStroke::Brush(BlendMode::Normal), "Smudge stroke"),
         };
         let target = self.layer_edit(self.settings.primary, self.settings.primary, stroke);
         // On a mesh, sizes in texels become object units at the mesh's texel density.
@@ -88,6 +105,14 @@ impl Document {
             .surface
             .as_ref()
             .map_or(1.0, |s| s.units_per_texel);
+        // A smudge drags by whole dab steps: at most a tenth of the radius apart, so the
+        // steps do not show as bands across the smear.
+        let spacing = match tool {
+            StrokeTool::Smudge => brush.spacing_px().min((0.1 * brush.radius_px).max(0.5)),
+            StrokeTool::Brush | StrokeTool::Eraser | StrokeTool::Blur | StrokeTool::Clone => {
+                brush.spacing_px()
+            }
+        };
         self.stroke = Some(ActiveStroke {
             tool,
             target,
@@ -95,13 +120,15 @@ impl Document {
             label,
             touched: false,
             channels: self.settings.channels,
-            resampler: Resampler::new(brush.spacing_px()),
+            resampler: Resampler::new(spacing),
             smoother: Smoother::new(brush.smoothing_px),
-            surface_resampler: Resampler::new(brush.spacing_px() * units),
+            surface_resampler: Resampler::new(spacing * units),
             surface_smoother: Smoother::new(brush.smoothing_px * units),
             coverage: Coverage::default(),
             rng: 0x5EED_0F4A_9A1E_5700,
             brush,
+            clone: None,
+            last_dabs: Vec::new(),
         });
         Ok(())
     }
@@ -112,6 +139,19 @@ impl Document {
         let Some(stroke) = &mut self.stroke else {
             return Ok(());
         };
+        if stroke.tool == StrokeTool::Clone && stroke.clone.is_none() {
+            // Aligned: the offset from the first clone stroke's first point, kept until a new
+            // source is set.
+            let source = self.aids.clone_source.unwrap_or(point.pos);
+            let offset = *self
+                .aids
+                .clone_offset
+                .get_or_insert_with(|| (source - point.pos).round());
+            stroke.clone = Some(CloneSource {
+                tiles: self.maps.shared_tiles(),
+                offset,
+            });
+        }
         let Some(pos) = stroke.smoother.follow(point.pos) else {
             return Ok(());
         };
@@ -138,6 +178,11 @@ impl Document {
         let Some(stroke) = &mut self.stroke else {
             return Ok(());
         };
+        if matches!(stroke.tool, StrokeTool::Clone | StrokeTool::Smudge) {
+            return Err(ModelError::Command(
+                "clone and smudge paint on the canvas (in texels); on the mesh they are not available yet".into(),
+            ));
+        }
         let Some(pos) = stroke.surface_smoother.follow(point.pos) else {
             return Ok(());
         };
@@ -220,13 +265,20 @@ impl Document {
                 state: &mut self.state,
                 compositor: &mut self.compositor,
             };
-            Self::dab_with(&mut to, parts, alpha, &fp);
+            Self::dab_with(&mut to, parts, alpha, &fp, (Vec2::ZERO, None));
         }
     }
 
     /// Applies the stroke's tool through footprint `fp` (which may borrow `stroke.brush`) to
-    /// the selected planes, and recomposites the tiles it touched.
-    fn dab_with(to: &mut DabTarget<'_>, stroke: StrokeParts<'_>, alpha: f32, fp: &impl Footprint) {
+    /// the selected planes, and recomposites the tiles it touched; a smudge drags by `step`,
+    /// and a stencil caps what the brush, the eraser and clone cover.
+    fn dab_with(
+        to: &mut DabTarget<'_>,
+        stroke: StrokeParts<'_>,
+        alpha: f32,
+        fp: &impl Footprint,
+        (step, stencil): (Vec2, Option<&Stencil>),
+    ) {
         let StrokeParts {
             tool,
             target,
@@ -235,6 +287,7 @@ impl Document {
             channels,
             coverage,
             touched,
+            clone,
         } = stroke;
         let mut ids = fp.tiles(to.maps);
         ids.sort_unstable();
@@ -252,18 +305,44 @@ impl Document {
             return;
         };
         let maps: &MaterialMaps = to.maps;
+        let pre = || {
+            before
+                .stack
+                .layer(&selection.path)
+                .and_then(|l| l.planes(selection.mask))
+        };
         *touched = true;
         let written = match tool {
             StrokeTool::Brush | StrokeTool::Eraser => {
-                let Some(pre) = before
-                    .stack
-                    .layer(&selection.path)
-                    .and_then(|l| l.planes(selection.mask))
-                else {
+                let Some(pre) = pre() else {
                     return;
                 };
-                let dab = (alpha, brush.opacity);
-                cover_dab((planes, pre), target, coverage, (maps, &ids), fp, dab)
+                let raise = DabRaise {
+                    fp,
+                    maps,
+                    alpha,
+                    opacity: brush.opacity,
+                    stencil,
+                };
+                cover_dab((planes, pre), target, coverage, (maps, &ids), &raise)
+            }
+            StrokeTool::Clone => {
+                let (Some(pre), Some(source)) = (pre(), clone) else {
+                    return;
+                };
+                let raise = DabRaise {
+                    fp,
+                    maps,
+                    alpha,
+                    opacity: brush.opacity,
+                    stencil,
+                };
+                let at = (maps, ids.as_slice());
+                copy_dab::clone_dab((planes, pre), target, coverage, at, source, &raise)
+            }
+            StrokeTool::Smudge => {
+                let strength = alpha * brush.opacity;
+                copy_dab::smudge_dab(planes, target, (maps, &ids), fp, strength, step)
             }
             StrokeTool::Blur => {
                 let ch = [channels.kd, channels.ks, channels.n];
@@ -318,7 +397,28 @@ impl Document {
         if b.mirror_u && b.mirror_v {
             centers.push(Vec2::new(w - center.x, h - center.y));
         }
-        for c in centers {
+        // A smudge's first dab only picks up; each later one drags by the step since the
+        // same mirrored copy's last dab.
+        let mut steps = vec![Vec2::ZERO; centers.len()];
+        if stroke.tool == StrokeTool::Smudge {
+            let first = stroke.last_dabs.len() != centers.len();
+            for (k, &c) in centers.iter().enumerate() {
+                steps[k] = if first {
+                    Vec2::ZERO
+                } else {
+                    c - stroke.last_dabs[k]
+                };
+            }
+            stroke.last_dabs.clone_from(&centers);
+            if first {
+                return;
+            }
+        }
+        let stencil = match stroke.tool {
+            StrokeTool::Brush | StrokeTool::Eraser | StrokeTool::Clone => self.aids.stencil.clone(),
+            StrokeTool::Blur | StrokeTool::Smudge => None,
+        };
+        for (c, step) in centers.into_iter().zip(steps) {
             let parts = stroke.parts();
             let brush = parts.brush;
             let fp = DiscFootprint {
@@ -331,7 +431,7 @@ impl Document {
                 state: &mut self.state,
                 compositor: &mut self.compositor,
             };
-            Self::dab_with(&mut to, parts, alpha, &fp);
+            Self::dab_with(&mut to, parts, alpha, &fp, (step, stencil.as_deref()));
         }
     }
 
@@ -353,9 +453,9 @@ impl Document {
     }
 }
 
-/// A brush or eraser dab through `fp` at `(alpha, opacity)`: the stroke's coverage rises
-/// where the dab reaches, then every texel whose coverage rose takes its pre-stroke value at
-/// that coverage. Returns, per tile of `ids`, the texels written.
+/// A brush or eraser dab raising the stroke's coverage by `raise`: the coverage rises where
+/// the dab reaches, then every texel whose coverage rose takes its pre-stroke value at that
+/// coverage. Returns, per tile of `ids`, the texels written.
 ///
 /// A texel whose coverage did not rise (the stroke already covers it as much as this dab
 /// would) already holds its pre-stroke value at that coverage, and is left alone: where dabs
@@ -365,26 +465,20 @@ fn cover_dab(
     target: &LayerEdit,
     coverage: &mut Coverage,
     (maps, ids): (&MaterialMaps, &[usize]),
-    fp: &impl Footprint,
-    (alpha, opacity): (f32, f32),
+    raise: &impl edit::Raise,
 ) -> Vec<TileSpans> {
     let covers = coverage.tiles_mut(maps.tile_count(), ids);
-    let raise = DabRaise {
-        fp,
-        maps,
-        alpha,
-        opacity,
-    };
-    edit::edit_cover((planes, pre), target, ids, covers, &raise)
+    edit::edit_cover((planes, pre), target, ids, covers, raise)
 }
 
-/// A dab's raise of the stroke's coverage: towards `opacity` by the footprint's weight
-/// times `alpha`.
+/// A dab's raise of the stroke's coverage: towards `opacity` (times the stencil's weight,
+/// where there is one) by the footprint's weight times `alpha`.
 struct DabRaise<'a, F> {
     fp: &'a F,
     maps: &'a MaterialMaps,
     alpha: f32,
     opacity: f32,
+    stencil: Option<&'a Stencil>,
 }
 
 impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
@@ -398,20 +492,36 @@ impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
         let mut rose = TileSpans::EMPTY;
         // A row's run at a time: the raise in a loop that vectorises, then where it rose.
         let mut up = [false; crate::tile::TILE_SIZE];
-        self.fp
-            .visit_runs(id, self.maps.tile_rect(id), |start, weights| {
-                let row = &mut cov[start..start + weights.len()];
-                let up = &mut up[..weights.len()];
-                for ((c, &w), up) in row.iter_mut().zip(weights).zip(up.iter_mut()) {
-                    let next = *c + (opacity - *c) * (w * alpha).min(1.0);
-                    *up = next > *c;
-                    *c = if *up { next } else { *c };
+        let mut caps = [opacity; crate::tile::TILE_SIZE];
+        let rect = self.maps.tile_rect(id);
+        self.fp.visit_runs(id, rect, |start, weights| {
+            let row = &mut cov[start..start + weights.len()];
+            let up = &mut up[..weights.len()];
+            let caps = &mut caps[..weights.len()];
+            if let Some(stencil) = self.stencil {
+                let (y, x0) = (start / TILE_SIZE, start % TILE_SIZE);
+                let y = (rect.y0 as usize + y) as f32 + 0.5;
+                let x = (rect.x0 as usize + x0) as f32 + 0.5;
+                stencil.weights(Vec2::new(x, y), caps);
+                for cap in caps.iter_mut() {
+                    *cap *= opacity;
                 }
-                let first = up.iter().position(|&u| u);
-                if let (Some(first), Some(last)) = (first, up.iter().rposition(|&u| u)) {
-                    rose.include_run(start + first, start + last + 1);
-                }
-            });
+            }
+            for (((c, &w), up), &cap) in row
+                .iter_mut()
+                .zip(weights)
+                .zip(up.iter_mut())
+                .zip(caps.iter())
+            {
+                let next = *c + (cap - *c) * (w * alpha).min(1.0);
+                *up = next > *c;
+                *c = if *up { next } else { *c };
+            }
+            let first = up.iter().position(|&u| u);
+            if let (Some(first), Some(last)) = (first, up.iter().rposition(|&u| u)) {
+                rose.include_run(start + first, start + last + 1);
+            }
+        });
         rose
     }
 }

@@ -21,7 +21,7 @@ mod cover;
 
 pub use blur::blur;
 pub use cover::{Raise, edit_cover};
-use cover::{cover_alpha, cover_channel, erase_channel};
+use cover::{Targets, cover_alpha, cover_channel, erase_channel};
 
 /// A material as the layer kernels blend it: `k_d`, `k_s` linear, `n` in blend space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -196,14 +196,30 @@ fn component(tile: &crate::tile::Tile, k: usize, i: usize) -> u16 {
 impl Slot<'_> {
     /// Writes texel `i` at coverage `a`, with the material or gray at gradient position `t`.
     fn write(&mut self, edit: &LayerEdit, i: usize, a: f32, t: f32) {
+        let target = if t == 0.0 {
+            edit.from
+        } else {
+            edit.from.lerp(&edit.to, t)
+        };
+        let gray = edit.gray[0] + (edit.gray[1] - edit.gray[0]) * t;
+        self.write_target(
+            edit,
+            i,
+            a,
+            &Target {
+                value: target,
+                gray,
+            },
+        );
+    }
+
+    /// Writes texel `i` at coverage `a` with `target`: its material on a paint layer, its
+    /// gray on a mask.
+    fn write_target(&mut self, edit: &LayerEdit, i: usize, a: f32, target: &Target) {
         match self {
             Self::Paint(slot, pre, written) => {
                 let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
-                let target = if t == 0.0 {
-                    edit.from
-                } else {
-                    edit.from.lerp(&edit.to, t)
-                };
+                let target = &target.value;
                 for (ch, range) in RANGES.iter().enumerate() {
                     if !edit.channels[ch] {
                         continue;
@@ -237,7 +253,7 @@ impl Slot<'_> {
                 }
             }
             Self::Mask(slot, pre, written) => {
-                let g = edit.gray[0] + (edit.gray[1] - edit.gray[0]) * t;
+                let g = target.gray;
                 let p = decode_unorm(pre.get().get(i));
                 let a = a.clamp(0.0, 1.0);
                 writable(slot, written).data_mut()[i] = encode_unorm(p + (g - p) * a);
@@ -251,13 +267,21 @@ impl Slot<'_> {
         clippy::inline_always,
         reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
     )]
-    fn write_cover(&mut self, edit: &LayerEdit, spans: &TileSpans, cover: &[f32]) {
+    fn write_cover(
+        &mut self,
+        edit: &LayerEdit,
+        spans: &TileSpans,
+        cover: &[f32],
+        varying: Option<&[[f32; 7]]>,
+    ) {
         match self {
             Self::Paint(slot, pre, written) => {
                 // A brush on a tile the layer did not have before the stroke: every texel it
                 // reaches takes the target exactly (see `LayerStroke::apply`), so the tile
                 // holds the target in one value per channel and the dabs write coverage only.
-                let fresh = pre.is_none() && matches!(edit.stroke, LayerStroke::Brush(_));
+                let fresh = pre.is_none()
+                    && matches!(edit.stroke, LayerStroke::Brush(_))
+                    && varying.is_none();
                 let created = slot.is_none();
                 let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                 if fresh && created {
@@ -272,7 +296,10 @@ impl Slot<'_> {
                         cover_alpha(&mut tile.alpha[ch], spans, cover);
                         continue;
                     }
-                    let target = &edit.from.c[range.clone()];
+                    let target = match varying {
+                        None => Targets::Uniform(&edit.from.c[range.clone()]),
+                        Some(v) => Targets::Varying(v, range.clone()),
+                    };
                     let channel = (&mut *tile, pre, ch, target, spans, cover);
                     // One loop per mode, each with its arithmetic inlined.
                     match edit.stroke {
@@ -302,11 +329,12 @@ impl Slot<'_> {
                 }
             }
             Self::Mask(slot, pre, written) => {
-                let g = edit.gray[0];
                 let plane = writable(slot, written).data_mut();
                 let pre = pre.get();
                 for i in spans.indices() {
                     let a = cover[i];
+                    // A varying target holds the gray first.
+                    let g = varying.map_or(edit.gray[0], |v| v[i][0]);
                     if a > 0.0 {
                         let p = decode_unorm(pre.get(i));
                         plane[i] = encode_unorm(p + (g - p) * a.min(1.0));
@@ -328,6 +356,84 @@ impl Slot<'_> {
             _ => {}
         }
     }
+}
+
+/// What a texel is written towards: a material on a paint layer, a stored gray on a mask.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Target {
+    /// The material (paint layers).
+    value: EditValue,
+    /// The mask's stored gray (masks).
+    gray: f32,
+}
+
+/// Per-texel targets of a tile, for [`edit_varying`]: each texel's seven components (a
+/// mask's gray first).
+pub type TileTargets = Vec<[f32; 7]>;
+
+/// Writes tiles `ids` (sorted, unique) in parallel, each texel from its pre-operation value
+/// towards its own target at its own coverage, a row at a time as [`edit_cover`] does:
+/// `prepare(id, cover, targets)` sets a tile's coverage (texels left at zero are not written)
+/// and the targets where it is positive, and returns the texels to write. Returns, per tile,
+/// those texels.
+pub fn edit_varying(
+    (planes, pre): (Planes<'_>, PrePlanes<'_>),
+    edit: &LayerEdit,
+    ids: &[usize],
+    covers: Vec<&mut [f32]>,
+    prepare: &(impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync),
+) -> Vec<TileSpans> {
+    slots(planes, pre, ids)
+        .into_par_iter()
+        .zip(covers)
+        .zip(ids)
+        .map(|((mut slot, cover), &id)| {
+            TARGETS.with_borrow_mut(|targets| {
+                targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
+                let spans = prepare(id, cover, targets);
+                if !spans.is_empty() {
+                    crate::simd::vectorized(VaryingWrite {
+                        slot: &mut slot,
+                        edit,
+                        spans: &spans,
+                        cover,
+                        targets,
+                    });
+                }
+                spans
+            })
+        })
+        .collect()
+}
+
+/// The write of [`edit_varying`]'s tile, compiled for the CPU's widest vectors.
+struct VaryingWrite<'s, 'a> {
+    slot: &'s mut Slot<'a>,
+    edit: &'s LayerEdit,
+    spans: &'s TileSpans,
+    cover: &'s [f32],
+    targets: &'s [[f32; 7]],
+}
+
+impl crate::simd::Kernel for VaryingWrite<'_, '_> {
+    type Output = ();
+
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        self.slot
+            .write_cover(self.edit, self.spans, self.cover, Some(self.targets));
+        self.slot.compact();
+    }
+}
+
+thread_local! {
+    /// A worker's tile of targets for [`edit_varying`], kept from dab to dab (only the
+    /// texels `prepare` returns are read, and it sets each of them).
+    static TARGETS: std::cell::RefCell<TileTargets> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Writes tiles `work` (each an id and the data its visitor needs) in parallel. For each

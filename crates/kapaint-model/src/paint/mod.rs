@@ -11,12 +11,14 @@
 mod fill;
 mod footprint;
 mod gradient;
+mod stencil;
 #[cfg(test)]
 mod tests;
 
 pub use fill::flood_region;
 pub use footprint::{DiscFootprint, Footprint};
 pub use gradient::GradientShape;
+pub use stencil::Stencil;
 
 use std::sync::OnceLock;
 

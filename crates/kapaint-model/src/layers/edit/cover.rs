@@ -71,7 +71,7 @@ impl<R: Raise> crate::simd::Kernel for CoverTile<'_, '_, R> {
         } = self;
         let spans = raise.raise(id, cover);
         if !spans.is_empty() {
-            slot.write_cover(edit, &spans, cover);
+            slot.write_cover(edit, &spans, cover, None);
             slot.compact();
         }
         spans
@@ -122,7 +122,7 @@ pub(super) fn cover_channel(
         &mut PaintTile,
         Option<&PaintTile>,
         usize,
-        &[f32],
+        Targets<'_>,
         &TileSpans,
         &[f32],
     ),
@@ -146,7 +146,21 @@ pub(super) fn cover_channel(
             let (coverage, weight) = LayerStroke::cover(pre_alpha[j], aj);
             (a[j], w[j], alpha[j]) = (aj, weight, encode_unorm(coverage.min(1.0)));
         }
-        for (c, &t) in target.iter().enumerate() {
+        let components = match &target {
+            Targets::Uniform(t) => t.len(),
+            Targets::Varying(_, range) => range.len(),
+        };
+        let mut t = [0.0_f32; TILE_SIZE];
+        for c in 0..components {
+            let t = &mut t[..width];
+            match &target {
+                Targets::Uniform(u) => t.fill(u[c]),
+                Targets::Varying(v, range) => {
+                    for (t, v) in t.iter_mut().zip(&v[start..start + width]) {
+                        *t = v[range.start + c];
+                    }
+                }
+            }
             if let Some(p) = pre {
                 let out = &mut pre_value[..width];
                 match ch {
@@ -158,12 +172,12 @@ pub(super) fn cover_channel(
             let encoded = &mut out[c][..width];
             if ch == 2 {
                 for j in 0..width {
-                    let v = value((w[j], a[j]), pre_value[j], t);
+                    let v = value((w[j], a[j]), pre_value[j], t[j]);
                     encoded[j] = n_bits_from_blend_in(n_bits, v);
                 }
             } else {
                 for j in 0..width {
-                    encoded[j] = encode_unorm(value((w[j], a[j]), pre_value[j], t));
+                    encoded[j] = encode_unorm(value((w[j], a[j]), pre_value[j], t[j]));
                 }
             }
         }
@@ -187,6 +201,16 @@ pub(super) fn cover_channel(
             _ => write_row(&mut tile.value.n, start, &out[0][..width], cov, all),
         }
     }
+}
+
+/// A channel's targets: one value a component, or one a texel (each texel's seven
+/// components, of which `range` are the channel's).
+#[derive(Clone)]
+pub(super) enum Targets<'a> {
+    /// The same components everywhere.
+    Uniform(&'a [f32]),
+    /// Per texel of the tile.
+    Varying(&'a [[f32; 7]], std::ops::Range<usize>),
 }
 
 /// Whether a dab reached every texel of a row's run (as a disc does).

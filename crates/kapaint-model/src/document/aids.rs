@@ -1,0 +1,71 @@
+//! What the painting tools hold between strokes and no project stores: the stencil and the
+//! clone source (with the offset an aligned clone keeps).
+
+use std::sync::Arc;
+
+use glam::Vec2;
+
+use super::Document;
+use crate::ModelError;
+use crate::paint::Stencil;
+use crate::paint_image::PaintImage;
+
+/// The painting aids of a document.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Aids {
+    pub(super) stencil: Option<Arc<Stencil>>,
+    pub(super) clone_source: Option<Vec2>,
+    /// Source minus the first point of the first clone stroke since the source was set.
+    pub(super) clone_offset: Option<Vec2>,
+}
+
+/// The stencil as `SetStencil` names it.
+pub(super) struct StencilSpec {
+    pub(super) image: PaintImage,
+    pub(super) center: Vec2,
+    pub(super) size: f32,
+    pub(super) rotation: f32,
+    pub(super) opacity: f32,
+    pub(super) tiled: bool,
+}
+
+impl Document {
+    /// The stencil the brush, the eraser and clone paint through.
+    pub fn stencil(&self) -> Option<&Arc<Stencil>> {
+        self.aids.stencil.as_ref()
+    }
+
+    /// The clone source (texels), and the offset from a stroke's point to its source once
+    /// a clone stroke fixed it.
+    pub fn clone_source(&self) -> Option<(Vec2, Option<Vec2>)> {
+        self.aids.clone_source.map(|s| (s, self.aids.clone_offset))
+    }
+
+    /// `SetStencil`.
+    pub(super) fn set_stencil(&mut self, spec: &StencilSpec) -> Result<(), ModelError> {
+        let image = Arc::clone(spec.image.pixels()?);
+        let mut stencil = Stencil::new(image, spec.center, spec.size, spec.rotation);
+        stencil.opacity = spec.opacity;
+        stencil.tiled = spec.tiled;
+        stencil.check().map_err(ModelError::Command)?;
+        self.aids.stencil = Some(Arc::new(stencil));
+        Ok(())
+    }
+
+    /// `SetCloneSource`.
+    pub(super) fn set_clone_source(&mut self, at: Vec2) -> Result<(), ModelError> {
+        let (w, h) = (self.maps.width() as f32, self.maps.height() as f32);
+        if !(at.is_finite() && (0.0..w).contains(&at.x) && (0.0..h).contains(&at.y)) {
+            return Err(ModelError::Command(format!(
+                "the clone source ({}, {}) is outside the {}x{} map",
+                at.x,
+                at.y,
+                self.maps.width(),
+                self.maps.height()
+            )));
+        }
+        self.aids.clone_source = Some(at);
+        self.aids.clone_offset = None;
+        Ok(())
+    }
+}

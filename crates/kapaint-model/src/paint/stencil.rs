@@ -1,0 +1,140 @@
+//! A stencil: an image the brush, the eraser and clone paint through. Its luminance times its
+//! alpha caps what a stroke can cover at each texel (the brush's opacity times the stencil's
+//! weight there), so a mid-grey stencil lets half the paint through however many dabs pass.
+//!
+//! On the canvas the stencil lies in texel space: its centre and width in texels, the image's
+//! pixel `(0, 0)` at its top-left corner and rows growing downward as the canvas's texel rows
+//! do, turned by its rotation (degrees, clockwise on the canvas, whose rows grow downward).
+
+use std::sync::Arc;
+
+use glam::Vec2;
+
+use crate::paint_image::Pixels;
+
+/// A stencil placed on the canvas.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stencil {
+    /// The image.
+    pub image: Arc<Pixels>,
+    /// Its centre, in texels.
+    pub center: Vec2,
+    /// Its width, in texels (its height follows the image's aspect).
+    pub size: f32,
+    /// Its rotation, in degrees.
+    pub rotation: f32,
+    /// How much it holds the paint back: 1 paints only through its light parts, 0 ignores it.
+    pub opacity: f32,
+    /// Whether the image repeats beyond its edges (else nothing paints there).
+    pub tiled: bool,
+    /// The image's luminance times alpha per pixel, what a dab reads.
+    plane: Arc<[f32]>,
+}
+
+impl Stencil {
+    /// A stencil of `image` placed on the canvas.
+    pub fn new(image: Arc<Pixels>, center: Vec2, size: f32, rotation: f32) -> Self {
+        let plane = image.covered_gray().into();
+        Self {
+            image,
+            center,
+            size,
+            rotation,
+            opacity: 1.0,
+            tiled: false,
+            plane,
+        }
+    }
+
+    /// Checks a stencil's numbers.
+    ///
+    /// # Errors
+    /// A size that is not positive and finite, a centre or rotation that is not finite, an
+    /// opacity outside `[0, 1]`.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.size.is_finite() && self.size > 0.0) {
+            return Err(format!(
+                "a stencil's size must be a positive number of texels, not {}",
+                self.size
+            ));
+        }
+        if !self.center.is_finite() || !self.rotation.is_finite() {
+            return Err("a stencil's centre and rotation must be finite numbers".into());
+        }
+        if !(0.0..=1.0).contains(&self.opacity) {
+            return Err(format!(
+                "a stencil's opacity must be in [0, 1], not {}",
+                self.opacity
+            ));
+        }
+        Ok(())
+    }
+
+    /// The image's coordinates (`(0, 0)` top-left, `(1, 1)` bottom-right) at canvas point `p`
+    /// (texels).
+    pub fn uv(&self, p: Vec2) -> Vec2 {
+        let (sin, cos) = (-self.rotation.to_radians()).sin_cos();
+        let d = p - self.center;
+        let local = Vec2::new(d.x * cos - d.y * sin, d.x * sin + d.y * cos);
+        local / Vec2::new(self.size, self.size * self.image.aspect()) + 0.5
+    }
+
+    /// The weight the stencil gives a texel whose centre is at `p`.
+    pub fn weight(&self, p: Vec2) -> f32 {
+        let mut w = [0.0];
+        self.weights(p, &mut w);
+        w[0]
+    }
+
+    /// The weights of texels along a row from the one centred at `p` (one texel apart).
+    pub fn weights(&self, p: Vec2, out: &mut [f32]) {
+        let (sin, cos) = (-self.rotation.to_radians()).sin_cos();
+        let scale = Vec2::new(self.size, self.size * self.image.aspect()).recip();
+        let (w, h) = (
+            i64::from(self.image.width()),
+            i64::from(self.image.height()),
+        );
+        let size = Vec2::new(w as f32, h as f32);
+        // Pixel coordinates of the first texel and the step to the next, in the image.
+        let start = self.uv(p) * size - 0.5;
+        let step = Vec2::new(cos, sin) * scale * size;
+        let hold = 1.0 - self.opacity;
+        let (wf, hf) = (w as f32, h as f32);
+        let (iw, ih) = (1.0 / wf, 1.0 / hf);
+        let (w, h) = (w as usize, h as usize);
+        for (k, o) in out.iter_mut().enumerate() {
+            let mut q = start + step * k as f32;
+            if self.tiled {
+                // Into [0, size): the four taps then wrap with a compare, not a division.
+                q = Vec2::new(q.x - (q.x * iw).floor() * wf, q.y - (q.y * ih).floor() * hf);
+            }
+            let (xf, yf) = (q.x.floor(), q.y.floor());
+            let (fx, fy) = (q.x - xf, q.y - yf);
+            let near = xf >= -1.0 && yf >= -1.0 && xf < wf && yf < hf;
+            let v = if self.tiled || near {
+                let (x0, y0) = (xf as i64, yf as i64);
+                // Each tap's index, or none where it is off the image (untiled).
+                let wrap = |v: i64, n: usize| -> Option<usize> {
+                    if v >= 0 && (v as usize) < n {
+                        Some(v as usize)
+                    } else if self.tiled {
+                        Some(v.rem_euclid(n as i64) as usize)
+                    } else {
+                        None
+                    }
+                };
+                let (xa, xb, ya, yb) = (wrap(x0, w), wrap(x0 + 1, w), wrap(y0, h), wrap(y0 + 1, h));
+                let at = |x: Option<usize>, y: Option<usize>| match (x, y) {
+                    (Some(x), Some(y)) => self.plane[y * w + x],
+                    _ => 0.0,
+                };
+                let top = at(xa, ya) * (1.0 - fx) + at(xb, ya) * fx;
+                let bottom = at(xa, yb) * (1.0 - fx) + at(xb, yb) * fx;
+                top * (1.0 - fy) + bottom * fy
+            } else {
+                0.0
+            };
+            *o = hold + self.opacity * v;
+        }
+    }
+}
