@@ -485,6 +485,83 @@ fn tool_dabs(c: &mut Criterion) {
     group.finish();
 }
 
+/// `ProjectImage` of a 1024^2 image at 4096^2 on the sphere: planar (with its depth map, over
+/// a quarter of the sphere) and tri-planar (every texel), and `PlaceDecal` of the same image
+/// half a unit wide; each one undo step, undone after.
+fn projections(c: &mut Criterion) {
+    use kapaint::model::paint::projection::Projection;
+    let mut group = c.benchmark_group("tools_4096");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(8));
+    let logo = image::DynamicImage::ImageRgba8(image::RgbaImage::from_fn(1024, 1024, |x, y| {
+        image::Rgba([
+            (x / 4) as u8,
+            (y / 4) as u8,
+            128,
+            if (x / 64 + y / 64) % 3 == 0 { 0 } else { 255 },
+        ])
+    }));
+    let image =
+        kapaint::model::paint_image::PaintImage::decoded(std::path::Path::new("logo.png"), &logo)
+            .expect("image");
+    let surface = std::sync::Arc::new(
+        kapaint::model::surface::Surface::new(kapaint::mesh::uv_sphere(128, 64), SIDE, SIDE)
+            .expect("bake"),
+    );
+    let mut doc = Document::new(SIDE, SIDE, DocumentSettings::default())
+        .expect("size")
+        .with_surface(Some(surface))
+        .expect("surface");
+    for (name, projection) in [
+        (
+            "project_planar_1024px_image",
+            Projection::Planar {
+                origin: Vec3::new(0.0, 0.0, 1.0),
+                normal: Vec3::Z,
+                up: Vec3::Y,
+                width: 1.0,
+                height: 1.0,
+            },
+        ),
+        (
+            "project_triplanar_1024px_image",
+            Projection::Triplanar {
+                scale: 2.0,
+                blend: 0.5,
+            },
+        ),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                doc.apply(PaintCommand::ProjectImage {
+                    image: image.clone(),
+                    projection,
+                    channels: kapaint::model::Channels::ALL,
+                    opacity: 1.0,
+                })
+                .expect("project");
+                doc.apply(HistoryCommand::Undo).expect("undo");
+            });
+        });
+    }
+    group.bench_function("place_decal_1024px_image", |b| {
+        b.iter(|| {
+            doc.apply(PaintCommand::PlaceDecal {
+                image: image.clone(),
+                at: Vec3::new(0.3, 0.4, 1.2),
+                size: 0.5,
+                rotation: 20.0,
+                channels: kapaint::model::Channels::ALL,
+                opacity: 1.0,
+            })
+            .expect("decal");
+            doc.apply(HistoryCommand::Undo).expect("undo");
+        });
+    });
+    group.finish();
+}
+
 /// Saving and opening a 16-layer 4096^2 project (the stack of [`layered_stack`]: every
 /// layer painted over 10 % of the map, with masks); issue 18 asks <= 3 s each.
 fn layered_project_io(c: &mut Criterion) {
@@ -611,6 +688,7 @@ criterion_group!(
     layers,
     layered_project_io,
     generators,
-    tool_dabs
+    tool_dabs,
+    projections
 );
 criterion_main!(benches);

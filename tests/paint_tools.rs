@@ -121,3 +121,48 @@ fn a_missing_huge_or_corrupt_image_is_one_line_exit_2_and_nothing_written() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `ProjectImage` through the CLI: the project's own mesh is baked for a planar projection,
+/// and a degenerate one or one that reaches nothing is refused with nothing written.
+#[test]
+fn a_script_projects_an_image_onto_the_projects_mesh_and_refuses_bad_projections() {
+    let d = dir("project");
+    let a = project(&d);
+    let before = std::fs::read(&a).expect("read");
+    checker(&d.join("checker.png"));
+    let run = |projection: &str| {
+        let script = d.join("p.ron");
+        let text = format!(
+            r#"(commands: [ProjectImage(image: "checker.png", projection: {projection}, channels: (kd: true, ks: false, n: false), opacity: 1)])"#
+        );
+        std::fs::write(&script, text).expect("script");
+        let out = d.join("out.kapaint");
+        let _ = std::fs::remove_file(&out);
+        let o = kapaint(&["paint", s(&a), "--script", s(&script), "--out", s(&out)]);
+        (o, out)
+    };
+    let (o, out) =
+        run("Planar(origin: (0, 0, 1), normal: (0, 0, 1), up: (0, 1, 0), width: 1, height: 1)");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.exists());
+    for (projection, want) in [
+        (
+            "Planar(origin: (0, 0, 1), normal: (0, 0, 1), up: (0, 0, 2), width: 1, height: 1)",
+            "parallel",
+        ),
+        (
+            "Planar(origin: (0, 0, 9), normal: (0, 0, 1), up: (0, 1, 0), width: 0.001, height: 0.001)",
+            "reaches no texel",
+        ),
+        ("Triplanar(scale: 0, blend: 0.5)", "scale"),
+    ] {
+        let (o, out) = run(projection);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{projection}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(e.contains(want), "{projection}: {e}");
+        assert!(!out.exists(), "{projection} wrote a result");
+    }
+    assert_eq!(std::fs::read(&a).expect("read"), before);
+    let _ = std::fs::remove_dir_all(&d);
+}

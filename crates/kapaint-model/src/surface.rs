@@ -138,9 +138,22 @@ impl Surface {
     /// The unit normal of the surface near `point`: the normal of the baked texel closest to
     /// it within `radius`, if any.
     pub fn normal_near(&self, point: Vec3, radius: f32) -> Option<Vec3> {
+        self.nearest(point, radius).map(|(_, n)| n)
+    }
+
+    /// The tiles whose baked texels may lie within `radius` of `point`.
+    pub fn tiles_near(&self, point: Vec3, radius: f32) -> Vec<TileId> {
+        let r2 = radius * radius;
+        (0..self.tile_boxes.len())
+            .filter(|&id| self.tile_boxes[id].meets_ball(point, r2))
+            .collect()
+    }
+
+    /// The baked surface texel nearest `point` within `radius`: its position and normal.
+    pub fn nearest(&self, point: Vec3, radius: f32) -> Option<(Vec3, Vec3)> {
         let r2 = radius * radius;
         let w = self.bake.width as usize;
-        let mut best: Option<(f32, Vec3)> = None;
+        let mut best: Option<((f32, Vec3), Vec3)> = None;
         for (id, tile) in self.tile_boxes.iter().enumerate() {
             if !tile.meets_ball(point, r2) {
                 continue;
@@ -161,15 +174,16 @@ impl Surface {
                         if self.bake.coverage(i) != Coverage::Surface {
                             continue;
                         }
-                        let d2 = self.bake.position(i).distance_squared(point);
-                        if d2 <= r2 && best.is_none_or(|(bd, _)| d2 < bd) {
-                            best = Some((d2, self.bake.normal(i)));
+                        let p = self.bake.position(i);
+                        let d2 = p.distance_squared(point);
+                        if d2 <= r2 && best.is_none_or(|(bd, _)| d2 < bd.0) {
+                            best = Some(((d2, p), self.bake.normal(i)));
                         }
                     }
                 }
             }
         }
-        best.map(|(_, n)| n)
+        best.map(|((_, p), n)| (p, n))
     }
 
     /// A mask of the texels (covered or padding) of the UV island under texel `(x, y)`, or

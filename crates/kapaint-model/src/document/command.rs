@@ -2,11 +2,12 @@
 
 use std::sync::Arc;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::brush::{BrushSettings, StrokePoint, SurfacePoint};
 use crate::paint::GradientShape;
+use crate::paint::projection::Projection;
 use crate::paint_image::PaintImage;
 use crate::texel::{Channel, Channels, MaterialValue};
 use kapaint_reflectance::{AmbientApprox, ShadingModel};
@@ -159,7 +160,7 @@ pub enum StrokeCommand {
 }
 
 /// The one-click tools.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum PaintCommand {
     /// Fills with the primary material.
@@ -174,6 +175,42 @@ pub enum PaintCommand {
         /// End point in texel units.
         #[serde(deserialize_with = "crate::check::finite_vec2")]
         end: Vec2,
+    },
+    /// Paints an image through a projection into the selected layer (one undo step): its
+    /// colour into `k_d`, its luminance into `k_s`, its gray into `n` (as `kapaint import
+    /// --channel n` maps it), each where `channels` enables it; its alpha times `opacity` is
+    /// the coverage.
+    ProjectImage {
+        /// The image (a relative path from the script's folder).
+        image: PaintImage,
+        /// How it is laid on the surface.
+        projection: Projection,
+        /// The channels it paints (all by default).
+        #[serde(default = "all_channels")]
+        channels: Channels,
+        /// Its strength (1 by default).
+        #[serde(default = "crate::check::one")]
+        opacity: f32,
+    },
+    /// Places an image on the surface as a decal (one undo step): a planar projection along
+    /// the surface's normal at the surface point nearest `at`, `size` object units wide (its
+    /// height by the image's aspect), turned by `rotation` degrees, bounded to the image.
+    PlaceDecal {
+        /// The image (a relative path from the script's folder).
+        image: PaintImage,
+        /// A point near the surface, in object space.
+        at: Vec3,
+        /// Width in object units.
+        size: f32,
+        /// Turn about the surface's normal, degrees (counter-clockwise seen from outside).
+        #[serde(default)]
+        rotation: f32,
+        /// The channels it paints (all by default).
+        #[serde(default = "all_channels")]
+        channels: Channels,
+        /// Its strength (1 by default).
+        #[serde(default = "crate::check::one")]
+        opacity: f32,
     },
     /// Reads every channel at a texel into the primary material.
     Pick {
@@ -470,7 +507,10 @@ impl Command {
     /// ([`PaintImage::load`]).
     pub fn images_mut(&mut self) -> Vec<&mut PaintImage> {
         match self {
-            Self::Settings(SettingsCommand::SetStencil { image, .. }) => vec![image],
+            Self::Settings(SettingsCommand::SetStencil { image, .. })
+            | Self::Paint(
+                PaintCommand::ProjectImage { image, .. } | PaintCommand::PlaceDecal { image, .. },
+            ) => vec![image],
             _ => Vec::new(),
         }
     }
@@ -484,6 +524,12 @@ impl Command {
                 | Self::Paint(PaintCommand::Fill(
                     FillRegion::Island { .. } | FillRegion::Part { .. }
                 ))
-        )
+        ) || matches!(self, Self::Paint(PaintCommand::PlaceDecal { .. }))
+            || matches!(self, Self::Paint(PaintCommand::ProjectImage { projection, .. }) if projection.needs_surface())
     }
+}
+
+/// Every channel: what a projection paints unless it says otherwise.
+fn all_channels() -> Channels {
+    Channels::ALL
 }

@@ -55,7 +55,10 @@ impl StrokeCommand {
 impl PaintCommand {
     fn may_write_a_whole_layer(&self) -> bool {
         match self {
-            Self::Fill(_) | Self::Gradient { .. } => true,
+            Self::Fill(_)
+            | Self::Gradient { .. }
+            | Self::ProjectImage { .. }
+            | Self::PlaceDecal { .. } => true,
             Self::Pick { .. } | Self::PickLayer { .. } => false,
         }
     }

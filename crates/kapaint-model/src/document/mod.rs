@@ -17,6 +17,7 @@ mod masks;
 mod memory_need;
 mod moves;
 mod paths;
+mod project_image;
 mod script;
 mod structure;
 mod surface;
@@ -403,6 +404,32 @@ impl Document {
         match command {
             PaintCommand::Fill(region) => self.fill(region),
             PaintCommand::Gradient { shape, start, end } => self.gradient(shape, start, end),
+            PaintCommand::ProjectImage {
+                image,
+                projection,
+                channels,
+                opacity,
+            } => self.project_image(&project_image::ProjectSpec {
+                image: &image,
+                projection: &projection,
+                channels,
+                opacity,
+            }),
+            PaintCommand::PlaceDecal {
+                image,
+                at,
+                size,
+                rotation,
+                channels,
+                opacity,
+            } => self.place_decal(&project_image::DecalSpec {
+                image: &image,
+                at,
+                size,
+                rotation,
+                channels,
+                opacity,
+            }),
             PaintCommand::Pick { x, y } => self.pick(x, y, false),
             PaintCommand::PickLayer { x, y } => self.pick(x, y, true),
         }

@@ -251,6 +251,8 @@ mod tests {
             "SurfaceStroke",
             "Fill",
             "Gradient",
+            "ProjectImage",
+            "PlaceDecal",
             "Pick",
             "PickLayer",
             "Undo",

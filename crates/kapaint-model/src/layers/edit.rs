@@ -406,6 +406,38 @@ pub fn edit_varying(
         .collect()
 }
 
+/// [`edit_varying`] for a one-off operation over tiles `ids` (a projection): each tile's
+/// coverage starts at zero in a worker's own buffer.
+pub fn edit_each(
+    (planes, pre): (Planes<'_>, PrePlanes<'_>),
+    edit: &LayerEdit,
+    ids: &[usize],
+    prepare: &(impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync),
+) {
+    slots(planes, pre, ids)
+        .into_par_iter()
+        .zip(ids)
+        .for_each(|(mut slot, &id)| {
+            COVER.with_borrow_mut(|cover| {
+                cover.clear();
+                cover.resize(TILE_SIZE * TILE_SIZE, 0.0);
+                TARGETS.with_borrow_mut(|targets| {
+                    targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
+                    let spans = prepare(id, cover, targets);
+                    if !spans.is_empty() {
+                        crate::simd::vectorized(VaryingWrite {
+                            slot: &mut slot,
+                            edit,
+                            spans: &spans,
+                            cover,
+                            targets,
+                        });
+                    }
+                });
+            });
+        });
+}
+
 /// The write of [`edit_varying`]'s tile, compiled for the CPU's widest vectors.
 struct VaryingWrite<'s, 'a> {
     slot: &'s mut Slot<'a>,
@@ -434,6 +466,8 @@ thread_local! {
     /// A worker's tile of targets for [`edit_varying`], kept from dab to dab (only the
     /// texels `prepare` returns are read, and it sets each of them).
     static TARGETS: std::cell::RefCell<TileTargets> = const { std::cell::RefCell::new(Vec::new()) };
+    /// A worker's tile of coverage for [`edit_each`].
+    static COVER: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Writes tiles `work` (each an id and the data its visitor needs) in parallel. For each

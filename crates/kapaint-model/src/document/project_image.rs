@@ -1,0 +1,335 @@
+//! `ProjectImage`: an image painted through a projection into the selected layer, one undo
+//! step: its colour (decoded from sRGB) into `k_d`, its luminance into `k_s`, its gray into
+//! `n` through the import's mapping, each where the command enables it; its alpha times the
+//! opacity is the coverage (0 outside the image).
+
+use glam::{Vec2, Vec3};
+
+use super::Document;
+use crate::ModelError;
+use crate::brush::BlendMode;
+use crate::layers::LayerStroke;
+use crate::layers::edit::{self, TileTargets};
+use crate::paint::projection::{DepthMap, Frame3, PlaneFrame, Projection};
+use crate::paint_image::{PaintImage, Pixels, Sample};
+use crate::surface::Surface;
+use crate::texel::{Channels, n_to_blend};
+use crate::tile::{TILE_SIZE, TileSpans};
+use kapaint_mesh::bake::Coverage;
+
+/// A projection made ready for a map: its frame, and for a planar one the mesh's depth map.
+enum Mapper {
+    Planar(PlaneFrame, DepthMap),
+    Cylindrical(Vec3, Frame3, f32),
+    Spherical(Vec3, Frame3),
+    Triplanar(f32, f32),
+    Uv(Vec2, Vec2, f32),
+}
+
+/// What the image gives a texel: its seven target components (a mask's gray first when
+/// `mask`), and its coverage before the opacity.
+fn target(s: &Sample, mask: bool) -> ([f32; 7], f32) {
+    let l = s.luminance();
+    let c = if mask {
+        [s.gray, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    } else {
+        [s.rgb.x, s.rgb.y, s.rgb.z, l, l, l, n_to_blend(s.n)]
+    };
+    (c, s.alpha)
+}
+
+impl Mapper {
+    fn new(
+        projection: &Projection,
+        surface: Option<&Surface>,
+        image: &Pixels,
+        slab: Option<f32>,
+    ) -> Result<Self, ModelError> {
+        let bad = ModelError::Command;
+        Ok(match *projection {
+            Projection::Planar {
+                origin,
+                normal,
+                up,
+                width,
+                height,
+            } => {
+                let frame =
+                    PlaneFrame::new(origin, normal, up, Vec2::new(width, height)).map_err(bad)?;
+                let surface = surface.ok_or_else(|| {
+                    ModelError::Command("a planar projection needs a mesh".into())
+                })?;
+                // A cell per image pixel, within reason.
+                let side = image.width().max(image.height()).clamp(64, 2048) as usize;
+                Self::Planar(frame, DepthMap::new(&frame, &surface.mesh, side, slab))
+            }
+            Projection::Cylindrical {
+                origin,
+                axis,
+                front,
+                height,
+            } => Self::Cylindrical(origin, Frame3::new(axis, front).map_err(bad)?, height),
+            Projection::Spherical { origin, up, front } => {
+                Self::Spherical(origin, Frame3::new(up, front).map_err(bad)?)
+            }
+            Projection::Triplanar { scale, blend } => Self::Triplanar(scale, blend),
+            Projection::Uv {
+                offset,
+                scale,
+                rotation,
+            } => Self::Uv(offset, scale, rotation.to_radians()),
+        })
+    }
+
+    /// The image at a texel: `uv` its place on the map (in maps), `p` and `n` its baked
+    /// position and normal.
+    fn sample(&self, image: &Pixels, uv: Vec2, p: Vec3, n: Vec3, mask: bool) -> ([f32; 7], f32) {
+        const NONE: ([f32; 7], f32) = ([0.0; 7], 0.0);
+        match self {
+            Self::Planar(frame, depth) => {
+                if !frame.faces(n) {
+                    return NONE;
+                }
+                let (at, d) = frame.image_uv(p);
+                if !depth.visible(frame, at, d, n) {
+                    return NONE;
+                }
+                target(&image.sample(at, false), mask)
+            }
+            Self::Cylindrical(origin, frame, height) => {
+                let d = p - *origin;
+                let along = d.dot(frame.pole);
+                let radial = d - frame.pole * along;
+                if n.dot(radial) <= 0.0 {
+                    return NONE;
+                }
+                let at = Vec2::new(frame.around(radial), 0.5 - along / height);
+                target(&image.sample(at, false), mask)
+            }
+            Self::Spherical(origin, frame) => {
+                let Some(d) = (p - *origin).try_normalize() else {
+                    return NONE;
+                };
+                if n.dot(d) <= 0.0 {
+                    return NONE;
+                }
+                let latitude = d.dot(frame.pole).clamp(-1.0, 1.0).asin();
+                let at = Vec2::new(frame.around(d), 0.5 - latitude / std::f32::consts::PI);
+                target(&image.sample(at, false), mask)
+            }
+            Self::Triplanar(scale, blend) => {
+                let a = n.abs();
+                let top = a.max_element();
+                let w = (a - Vec3::splat((1.0 - blend) * top)).max(Vec3::ZERO);
+                let sum = w.element_sum();
+                if sum <= 0.0 {
+                    return NONE;
+                }
+                // Each axis's plane, the image's top towards +Y (the Y plane's towards -Z).
+                let planes = [(p.z, p.y), (p.x, -p.z), (p.x, p.y)];
+                let mut out = [0.0_f32; 7];
+                let mut alpha = 0.0;
+                for (k, (h, v)) in planes.into_iter().enumerate() {
+                    if w[k] <= 0.0 {
+                        continue;
+                    }
+                    let at = Vec2::new(h * scale, -v * scale);
+                    let (c, a) = target(&image.sample(at, true), mask);
+                    let wk = w[k] / sum;
+                    for (o, c) in out.iter_mut().zip(c) {
+                        *o += c * a * wk;
+                    }
+                    alpha += a * wk;
+                }
+                if alpha <= 0.0 {
+                    return NONE;
+                }
+                (out.map(|c| c / alpha), alpha)
+            }
+            Self::Uv(offset, scale, rotation) => {
+                let (sin, cos) = (-rotation).sin_cos();
+                let d = uv - 0.5;
+                let turned = Vec2::new(d.x * cos - d.y * sin, d.x * sin + d.y * cos) + 0.5;
+                target(&image.sample(turned * *scale + *offset, true), mask)
+            }
+        }
+    }
+}
+
+/// What `ProjectImage` names.
+pub(super) struct ProjectSpec<'a> {
+    pub(super) image: &'a PaintImage,
+    pub(super) projection: &'a Projection,
+    pub(super) channels: Channels,
+    pub(super) opacity: f32,
+}
+
+/// What `PlaceDecal` names.
+pub(super) struct DecalSpec<'a> {
+    pub(super) image: &'a PaintImage,
+    pub(super) at: Vec3,
+    pub(super) size: f32,
+    pub(super) rotation: f32,
+    pub(super) channels: Channels,
+    pub(super) opacity: f32,
+}
+
+impl Document {
+    /// `PlaceDecal`: a planar projection along the surface's normal at the surface point
+    /// nearest `at`, `size` object units wide (its height by the image's aspect), turned by
+    /// `rotation` degrees about the normal (counter-clockwise seen from outside), reaching
+    /// only the surface within its half-diagonal of that point.
+    pub(super) fn place_decal(&mut self, spec: &DecalSpec<'_>) -> Result<(), ModelError> {
+        let surface = self.require_surface("placing a decal")?;
+        let aspect = spec.image.pixels()?.aspect();
+        if !(spec.at.is_finite() && spec.rotation.is_finite()) {
+            return Err(ModelError::Command(
+                "a decal's point and rotation must be finite".into(),
+            ));
+        }
+        if !(spec.size.is_finite() && spec.size > 0.0) {
+            return Err(ModelError::Command(format!(
+                "a decal's size must be positive, not {}",
+                spec.size
+            )));
+        }
+        let radius = 0.5 * spec.size * (1.0 + aspect * aspect).sqrt();
+        // The nearest surface, looked for ever further (the index costs what it visits).
+        let (lo, hi) = surface.mesh.bounds();
+        let reach = lo.distance(hi).max(spec.size);
+        let mut r = spec.size;
+        let found = loop {
+            if let Some(found) = surface.nearest(spec.at, r) {
+                break found;
+            }
+            if r > 2.0 * reach + spec.at.length() {
+                return Err(ModelError::Command(
+                    "the decal finds no surface near its point".into(),
+                ));
+            }
+            r *= 4.0;
+        };
+        let (origin, normal) = found;
+        let reference = if normal.dot(Vec3::Y).abs() > 0.99 {
+            Vec3::NEG_Z
+        } else {
+            Vec3::Y
+        };
+        let up = glam::Quat::from_axis_angle(normal, spec.rotation.to_radians()) * reference;
+        let projection = Projection::Planar {
+            origin,
+            normal,
+            up,
+            width: spec.size,
+            height: spec.size * aspect,
+        };
+        let project = ProjectSpec {
+            image: spec.image,
+            projection: &projection,
+            channels: spec.channels,
+            opacity: spec.opacity,
+        };
+        self.project(&project, Some(radius), "Place decal")
+    }
+
+    /// `ProjectImage`.
+    pub(super) fn project_image(&mut self, spec: &ProjectSpec<'_>) -> Result<(), ModelError> {
+        self.project(spec, None, "Project image")
+    }
+
+    /// A projection into the selected layer as one undo step `label`; a decal reaches only
+    /// the surface within `reach` of its origin.
+    fn project(
+        &mut self,
+        spec: &ProjectSpec<'_>,
+        reach: Option<f32>,
+        label: &str,
+    ) -> Result<(), ModelError> {
+        self.end_stroke();
+        let pixels = std::sync::Arc::clone(spec.image.pixels()?);
+        spec.projection.check().map_err(ModelError::Command)?;
+        if !(0.0..=1.0).contains(&spec.opacity) {
+            return Err(ModelError::Command(format!(
+                "a projection's opacity must be in [0, 1], not {}",
+                spec.opacity
+            )));
+        }
+        let surface = if spec.projection.needs_surface() {
+            Some(self.require_surface("projecting an image onto the mesh")?)
+        } else {
+            None
+        };
+        self.check_paintable()?;
+        let mapper = Mapper::new(spec.projection, surface.as_deref(), &pixels, reach)?;
+        let mut edit = self.layer_edit(
+            self.settings.primary,
+            self.settings.primary,
+            LayerStroke::Brush(BlendMode::Normal),
+        );
+        edit.channels = [spec.channels.kd, spec.channels.ks, spec.channels.n];
+        let mask = self.painting_mask();
+        let (w, h) = (self.maps.width(), self.maps.height());
+        let opacity = spec.opacity;
+        let maps = &self.maps;
+        let surface = surface.as_deref();
+        // Whether any texel took the image, to refuse a projection that hits nothing.
+        let reached = std::sync::atomic::AtomicBool::new(false);
+        let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
+            let rect = maps.tile_rect(id);
+            let mut spans = TileSpans::EMPTY;
+            for y in rect.y0..rect.y1 {
+                for x in rect.x0..rect.x1 {
+                    let i = (y - rect.y0) as usize * TILE_SIZE + (x - rect.x0) as usize;
+                    let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                    let (p, n) = match surface {
+                        Some(s) => {
+                            let t = y as usize * w as usize + x as usize;
+                            if s.bake.coverage(t) == Coverage::Empty {
+                                continue;
+                            }
+                            (s.bake.position(t), s.bake.normal(t))
+                        }
+                        None => (Vec3::ZERO, Vec3::Z),
+                    };
+                    let (c, a) = mapper.sample(&pixels, uv, p, n, mask);
+                    let a = (a * opacity).min(1.0);
+                    if a > 0.0 {
+                        cover[i] = a;
+                        targets[i] = c;
+                        spans.include(i);
+                    }
+                }
+            }
+            if !spans.is_empty() {
+                reached.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+            spans
+        };
+        let ids: Vec<usize> = match (reach, surface, spec.projection) {
+            (Some(r), Some(s), Projection::Planar { origin, .. }) => s.tiles_near(*origin, r),
+            _ => (0..maps.tile_count()).collect(),
+        };
+        let before = self.state.clone();
+        let sel = self.state.selection();
+        let pre = before
+            .stack
+            .layer(&sel.path)
+            .and_then(|l| l.planes(sel.mask));
+        let planes = self
+            .state
+            .stack
+            .layer_mut(&sel.path)
+            .and_then(|l| l.planes_mut(sel.mask));
+        if let (Some(planes), Some(pre)) = (planes, pre) {
+            edit::edit_each((planes, pre), &edit, &ids, &prepare);
+        }
+        if !reached.into_inner() {
+            self.state = before;
+            return Err(ModelError::Command(
+                "the projection reaches no texel of the map (nothing faces it, or it lies off the mesh)".into(),
+            ));
+        }
+        self.commit(label, before);
+        Ok(())
+    }
+}
