@@ -272,6 +272,10 @@ impl Document {
         let opacity = spec.opacity;
         let maps = &self.maps;
         let surface = surface.as_deref();
+        let ball = match (reach, spec.projection) {
+            (Some(r), Projection::Planar { origin, .. }) => Some((*origin, r * r)),
+            _ => None,
+        };
         // Whether any texel took the image, to refuse a projection that hits nothing.
         let reached = std::sync::atomic::AtomicBool::new(false);
         let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
@@ -287,7 +291,12 @@ impl Document {
                             if s.bake.coverage(t) == Coverage::Empty {
                                 continue;
                             }
-                            (s.bake.position(t), s.bake.normal(t))
+                            let p = s.bake.position(t);
+                            // A decal reaches only the surface near its point.
+                            if ball.is_some_and(|(c, r2)| p.distance_squared(c) > r2) {
+                                continue;
+                            }
+                            (p, s.bake.normal(t))
                         }
                         None => (Vec3::ZERO, Vec3::Z),
                     };
