@@ -450,3 +450,54 @@ fn a_decal_lands_at_the_surface_point_nearest_its_point_and_nowhere_else() {
     }
     assert_eq!(doc.history().undo_steps().count(), 1);
 }
+
+/// An open cylinder about +Y, radius 1 and 2 tall, its UVs unrolled: u the angle from +X
+/// towards -Z (the seam at +X), v the height.
+fn cylinder(segments: u32) -> Mesh {
+    let (mut positions, mut normals, mut uvs, mut triangles) = (vec![], vec![], vec![], vec![]);
+    for i in 0..=segments {
+        let u = i as f32 / segments as f32;
+        let a = u * std::f32::consts::TAU;
+        let n = Vec3::new(a.cos(), 0.0, -a.sin());
+        for (j, y) in [-1.0_f32, 1.0].into_iter().enumerate() {
+            positions.push(n + Vec3::Y * y);
+            normals.push(n);
+            uvs.push(Vec2::new(u, j as f32));
+        }
+    }
+    for i in 0..segments {
+        let (a, b) = (2 * i, 2 * i + 2);
+        triangles.push([a, b, a + 1]);
+        triangles.push([b, b + 1, a + 1]);
+    }
+    Mesh {
+        name: "cylinder".into(),
+        positions,
+        normals,
+        uvs: Some(uvs),
+        triangles,
+        had_normals: true,
+    }
+}
+
+#[test]
+fn a_cylindrical_dot_lands_within_half_a_texel_of_its_point_on_a_cylinder() {
+    let mut doc = document(Some(cylinder(256)));
+    // The image's middle faces -X (u = 0.5 on the mesh too), at mid-height.
+    project(
+        &mut doc,
+        &dot(),
+        Projection::Cylindrical {
+            origin: Vec3::ZERO,
+            axis: Vec3::Y,
+            front: Vec3::NEG_X,
+            height: 2.0,
+        },
+    )
+    .expect("project");
+    let got = centroid(&doc);
+    // The cylinder's own UVs: -X is u = 0.5, mid-height v = 0.5: texel (256, 256).
+    let want = Vec2::splat(SIDE as f32 / 2.0);
+    eprintln!("cylindrical dot: centroid {got}, analytic {want}");
+    assert!(got.distance(want) < 0.5, "{got} vs {want}");
+}
