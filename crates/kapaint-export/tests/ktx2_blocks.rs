@@ -2,7 +2,7 @@
 //! KTX2 file the tests write is parsed with the `ktx2` crate's reader and held to the KTX2
 //! specification's rules for its header, level index and data format descriptor, and every
 //! mip level is decoded with `bcdec_rs` (not `block_compression`) and compared with the same
-//! project's uncompressed levels. The effort search is checked for what it chooses and why.
+//! project's uncompressed levels. The effort search is checked in `ktx2_budget.rs`.
 
 #![expect(
     clippy::expect_used,
@@ -10,40 +10,20 @@
 )]
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use kapaint_core::report::typical::stroke_edge_document;
 use kapaint_export::codec::Effort;
-use kapaint_export::preset::{self, BlockBudget, ExportPreset, Format};
-use kapaint_export::set::{self, BlockLayout, Manifest};
+use kapaint_export::preset::{self, ExportPreset, Format};
+use kapaint_export::set::Manifest;
 use kapaint_model::Document;
 
 #[path = "common/grey.rs"]
 mod grey;
 use grey::grey_project;
 
-fn temp(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("kapaint-ktx2-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
-fn spot() -> Option<PathBuf> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/testdata/spot/spot_texture.png");
-    path.exists().then_some(path)
-}
-
-/// The stroke-edge project at `side`: the spot texture in k_d, soft strokes of n = 3000 and 2.
-fn project(side: u32) -> Document {
-    stroke_edge_document(side, spot().as_deref()).expect("project")
-}
-
-fn export(doc: &Document, preset: &ExportPreset, tag: &str) -> (PathBuf, Manifest) {
-    let out = temp(tag);
-    let manifest = set::export(doc, preset, &out).expect("export");
-    (out, manifest)
-}
+#[path = "common/stroke_edge.rs"]
+mod stroke_edge;
+use stroke_edge::{export, project, relative_budget, with_budget};
 
 /// Bytes per block (or per texel, uncompressed), and the texel block's side.
 fn block_of(format: ktx2::Format) -> (usize, u32) {
@@ -361,205 +341,6 @@ fn compare_with_raw(
     }
     let _ = std::fs::remove_dir_all(bc_dir);
     half_files
-}
-
-/// A budget of the older measures alone (relative `k_a` errors and PSNR), the perceptual
-/// one left loose: the search paths these tests follow were made for those.
-fn relative_budget(max: f64, mean: f64, psnr: f64) -> BlockBudget {
-    BlockBudget {
-        ka_error_srgb_p999: 255.0,
-        ka_error_srgb_mean: 255.0,
-        max_ka_error: Some(max),
-        mean_ka_error: Some(mean),
-        min_psnr: Some(psnr),
-    }
-}
-
-fn with_budget(budget: BlockBudget, ceiling: Effort) -> ExportPreset {
-    let mut p = preset::find("ktx2").expect("preset");
-    p.budget = budget;
-    p.format = Format::Ktx2Bc {
-        max_effort: ceiling,
-        bc6h: true,
-    };
-    p
-}
-
-#[test]
-fn the_cheapest_encoding_that_meets_the_budget_is_kept_and_no_more_is_spent() {
-    let doc = project(128);
-    let loose = with_budget(relative_budget(10.0, 1.0, 20.0), Effort::Basic);
-    let (dir, manifest) = export(&doc, &loose, "loose");
-    let blocks = manifest.blocks.expect("a block choice");
-    assert_eq!(blocks.trials.len(), 1, "{blocks:?}");
-    assert_eq!(blocks.layout, BlockLayout::Packed);
-    assert_eq!(blocks.bc7_effort, Effort::UltraFast);
-    assert!(blocks.within_budget && blocks.reason.contains("within the budget"));
-    assert!(
-        cfg!(not(target_arch = "x86_64"))
-            || blocks.encoder == kapaint_export::blocks::Encoder::Ispc
-    );
-    // The choice is in material.json, and a set with it imports.
-    let text = std::fs::read_to_string(dir.join("material.json")).expect("manifest");
-    assert!(
-        text.contains("\"blocks\"") && text.contains("\"trials\""),
-        "{text}"
-    );
-    assert!(text.contains("\"level_ka_error\""));
-    set::import(&dir.join("material.json")).expect("import");
-    let _ = std::fs::remove_dir_all(dir);
-}
-
-/// How many of a trial's three measures miss `budget`.
-fn failing(t: &kapaint_export::set::Trial, budget: &BlockBudget) -> usize {
-    let srgb = t.ka_error_srgb.expect("measured");
-    usize::from(srgb.p999 > budget.ka_error_srgb_p999)
-        + usize::from(srgb.mean > budget.ka_error_srgb_mean)
-        + usize::from(budget.max_ka_error.is_some_and(|m| t.ka_error.max > m))
-        + usize::from(budget.mean_ka_error.is_some_and(|m| t.ka_error.mean > m))
-        + usize::from(
-            budget
-                .min_psnr
-                .is_some_and(|m| t.min_psnr.is_some_and(|p| p < m)),
-        )
-}
-
-#[test]
-fn n_and_colour_move_out_of_bc7_when_packing_fails_the_budget() {
-    // Regression: n in k_d's BC7 alpha shares endpoints with k_d, which ruins both at the
-    // strokes' edges; the export kept that layout whatever it cost.
-    let doc = project(256);
-    // First the three layouts at the lowest effort, against a budget nothing meets: the
-    // cheapest first, then n apart in BC7, then k_d as BC6H too (the grey project's budget,
-    // which only BC6H meets, is in `every_level_...`). Then a relative mean between n
-    // apart's and packed's.
-    let none = with_budget(relative_budget(1e-6, 1e-9, 40.0), Effort::UltraFast);
-    let (dir, manifest) = export(&doc, &none, "strict-first");
-    let _ = std::fs::remove_dir_all(dir);
-    let first = manifest.blocks.expect("a block choice").trials;
-    let order: Vec<_> = first.iter().map(|t| (t.layout, t.bc7_effort)).collect();
-    assert_eq!(
-        order,
-        [
-            (BlockLayout::Packed, Effort::UltraFast),
-            (BlockLayout::NApart, Effort::UltraFast),
-            (BlockLayout::HalfColour, Effort::UltraFast)
-        ],
-        "the cheapest first, then n apart, then k_d as BC6H, at the same effort"
-    );
-    let (packed, apart) = (first[0].ka_error.mean, first[1].ka_error.mean);
-    assert!(apart < packed, "n out of k_d's blocks: {first:?}");
-    let budget = relative_budget(1e-6, (packed * apart).sqrt(), 40.0);
-    let strict = with_budget(budget, Effort::Fast);
-    let (dir, manifest) = export(&doc, &strict, "strict");
-    let blocks = manifest.blocks.expect("a block choice");
-    let tried: Vec<_> = blocks
-        .trials
-        .iter()
-        .map(|t| (t.layout, t.bc7_effort))
-        .collect();
-    assert_eq!(tried[..3], order, "{blocks:?}");
-    assert!(
-        !blocks.within_budget && blocks.reason.contains("no trial"),
-        "{}",
-        blocks.reason
-    );
-    // The reason names the trial kept, not only the last one tried.
-    let kept = format!(
-        "kept the trial nearest it, {:?} at {:?}",
-        blocks.layout, blocks.bc7_effort
-    );
-    assert!(blocks.reason.contains(&kept), "{}", blocks.reason);
-    // Effort stops at the ceiling, and BC6H has no very-fast step of its own.
-    assert!(
-        blocks.trials.len() <= 5
-            && blocks.trials.iter().all(|t| t.bc7_effort <= Effort::Fast
-                && (t.layout != BlockLayout::HalfColour || t.bc7_effort != Effort::VeryFast)),
-        "effort stops at the ceiling: {blocks:?}"
-    );
-    // The chosen trial misses the fewest measures, and the files are its layout.
-    let fewest = blocks
-        .trials
-        .iter()
-        .map(|t| failing(t, &budget))
-        .min()
-        .expect("trials");
-    let chosen = blocks
-        .trials
-        .iter()
-        .find(|t| t.layout == blocks.layout && t.bc7_effort == blocks.bc7_effort)
-        .expect("the chosen trial");
-    assert_eq!(failing(chosen, &budget), fewest, "{blocks:?}");
-    assert!((manifest.ka_error.max - chosen.ka_error.max).abs() < 1e-12);
-    let names: Vec<&str> = manifest.files.iter().map(|f| f.path.as_str()).collect();
-    assert_eq!(blocks.layout, BlockLayout::NApart);
-    assert_eq!(names, ["kd.ktx2", "n.ktx2"]);
-    assert_eq!(manifest.files[0].bit_depth, 8);
-    set::import(&dir.join("material.json")).expect("import");
-    let _ = std::fs::remove_dir_all(dir);
-}
-
-#[test]
-fn without_bc6h_n_moves_apart_in_bc7() {
-    let doc = project(128);
-    let mut strict = with_budget(relative_budget(1e-6, 1e-7, 90.0), Effort::UltraFast);
-    strict.format = Format::Ktx2Bc {
-        max_effort: Effort::UltraFast,
-        bc6h: false,
-    };
-    let (dir, manifest) = export(&doc, &strict, "no-bc6h");
-    let blocks = manifest.blocks.expect("a block choice");
-    let layouts: Vec<BlockLayout> = blocks.trials.iter().map(|t| t.layout).collect();
-    assert_eq!(layouts, [BlockLayout::Packed, BlockLayout::NApart]);
-    assert!(
-        blocks.trials[1].ka_error.mean < blocks.trials[0].ka_error.mean,
-        "n apart lowers the k_a error: {blocks:?}"
-    );
-    assert!(manifest.files.iter().all(|f| f.bit_depth == 8));
-    let _ = std::fs::remove_dir_all(dir);
-}
-
-#[test]
-fn presets_name_their_budget_and_bad_budgets_are_refused() {
-    let p = preset::find("ktx2").expect("preset");
-    assert_eq!(p.budget, BlockBudget::default());
-    assert_eq!(p.format.max_effort(), Some(Effort::Basic));
-    // Version-1 presets named the ceiling bc7_quality, then max_bc7_effort, beside the
-    // format: refused, with the spelling to write instead.
-    let old = ExportPreset::parse(
-        Path::new("old.ron"),
-        "(name: \"old\", format: Ktx2Bc, layout: Packed, n_bits: 8, bc7_quality: Fast)",
-    )
-    .expect_err("a version-1 preset")
-    .to_string();
-    assert!(
-        old.ends_with("write version: 2 and format: Ktx2Bc(max_effort: Fast, bc6h: true)"),
-        "{old}"
-    );
-    // The relative limits stay limits, beside the perceptual ones.
-    let relative = ExportPreset::parse(
-        Path::new("old.ron"),
-        "(version: 2, name: \"old\", format: Ktx2Bc(), layout: Packed, n_bits: 8, max_ka_error: 0.02, mean_ka_error: 0.002, min_psnr: 45.0)",
-    )
-    .expect("an older preset with relative limits");
-    assert_eq!(relative.budget.max_ka_error, Some(0.02));
-    assert_eq!(relative.budget.min_psnr, Some(45.0));
-    assert_eq!(relative.budget.ka_error_srgb_p999, 2.0);
-    for bad in [
-        "max_ka_error: -0.1",
-        "mean_ka_error: inf",
-        "min_psnr: 500.0",
-        "ka_error_srgb_p999: -1.0",
-        "ka_error_srgb_mean: NaN",
-    ] {
-        let text = format!(
-            "(version: 2, name: \"b\", format: Ktx2Bc(), layout: Packed, n_bits: 8, {bad})"
-        );
-        assert!(
-            ExportPreset::parse(Path::new("b.ron"), &text).is_err(),
-            "{bad}"
-        );
-    }
 }
 
 /// A block of one colour decodes to that colour exactly (decoded by `bcdec_rs`), from every
