@@ -202,7 +202,8 @@ impl MaterialMaps {
         self.texel(x, y).decode()
     }
 
-    /// Every tile, row-major.
+    /// Every tile, row-major (shared: a clone stroke keeps a copy of the list to read while
+    /// it writes, and a write after that copies the tile it writes).
     pub fn tiles(&self) -> &[Arc<Tile>] {
         &self.tiles
     }
@@ -210,12 +211,6 @@ impl MaterialMaps {
     /// A tile, shared.
     pub fn tile(&self, id: TileId) -> &Arc<Tile> {
         &self.tiles[id]
-    }
-
-    /// Every tile as it is now, shared: what a clone stroke reads while it writes (a write
-    /// after this copies the tile it writes, so these stay as they were).
-    pub fn shared_tiles(&self) -> Vec<Arc<Tile>> {
-        self.tiles.clone()
     }
 
     /// A tile for writing: cloned first if anything else (history) holds it. Bumps its version.

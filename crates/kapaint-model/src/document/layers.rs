@@ -121,6 +121,24 @@ impl Document {
         f: impl FnOnce(Planes<'_>, PrePlanes<'_>, usize),
         and: impl FnOnce(&mut State),
     ) -> Result<(), ModelError> {
+        self.try_edit_planes(
+            label,
+            |planes, pre, count| {
+                f(planes, pre, count);
+                Ok(())
+            },
+            and,
+        )
+    }
+
+    /// As [`Document::edit_planes_and`], where `f` may find the edit void: its error leaves
+    /// the state as it was, with no undo step.
+    pub(super) fn try_edit_planes(
+        &mut self,
+        label: &str,
+        f: impl FnOnce(Planes<'_>, PrePlanes<'_>, usize) -> Result<(), ModelError>,
+        and: impl FnOnce(&mut State),
+    ) -> Result<(), ModelError> {
         self.check_paintable()?;
         let before = self.state.clone();
         let count = self.state.stack.tile_count();
@@ -134,8 +152,11 @@ impl Document {
             .stack
             .layer_mut(&sel.path)
             .and_then(|l| l.planes_mut(sel.mask));
-        if let (Some(planes), Some(pre)) = (planes, pre) {
-            f(planes, pre, count);
+        if let (Some(planes), Some(pre)) = (planes, pre)
+            && let Err(e) = f(planes, pre, count)
+        {
+            self.state = before;
+            return Err(e);
         }
         and(&mut self.state);
         self.commit(label, before);

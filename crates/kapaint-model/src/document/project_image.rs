@@ -14,7 +14,7 @@ use crate::paint::projection::{DepthMap, Frame3, PlaneFrame, Projection};
 use crate::paint_image::{PaintImage, Pixels, Sample};
 use crate::surface::Surface;
 use crate::texel::{Channels, n_to_blend};
-use crate::tile::{TILE_SIZE, TileSpans};
+use crate::tile::TileSpans;
 use kapaint_mesh::bake::Coverage;
 
 /// A projection made ready for a map: its frame, and for a planar one the mesh's depth map.
@@ -270,7 +270,6 @@ impl Document {
         let mask = self.painting_mask();
         let (w, h) = (self.maps.width(), self.maps.height());
         let opacity = spec.opacity;
-        let maps = &self.maps;
         let surface = surface.as_deref();
         let ball = match (reach, spec.projection) {
             (Some(r), Projection::Planar { origin, .. }) => Some((*origin, r * r)),
@@ -279,34 +278,30 @@ impl Document {
         // Whether any texel took the image, to refuse a projection that hits nothing.
         let reached = std::sync::atomic::AtomicBool::new(false);
         let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
-            let rect = maps.tile_rect(id);
             let mut spans = TileSpans::EMPTY;
-            for y in rect.y0..rect.y1 {
-                for x in rect.x0..rect.x1 {
-                    let i = (y - rect.y0) as usize * TILE_SIZE + (x - rect.x0) as usize;
-                    let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-                    let (p, n) = match surface {
-                        Some(s) => {
-                            let t = y as usize * w as usize + x as usize;
-                            if s.bake.coverage(t) == Coverage::Empty {
-                                continue;
-                            }
-                            let p = s.bake.position(t);
-                            // A decal reaches only the surface near its point.
-                            if ball.is_some_and(|(c, r2)| p.distance_squared(c) > r2) {
-                                continue;
-                            }
-                            (p, s.bake.normal(t))
+            for (i, x, y) in edit::tile_texels(w, h, id) {
+                let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                let (p, n) = match surface {
+                    Some(s) => {
+                        let t = y as usize * w as usize + x as usize;
+                        if s.bake.coverage(t) == Coverage::Empty {
+                            continue;
                         }
-                        None => (Vec3::ZERO, Vec3::Z),
-                    };
-                    let (c, a) = mapper.sample(&pixels, uv, p, n, mask);
-                    let a = (a * opacity).min(1.0);
-                    if a > 0.0 {
-                        cover[i] = a;
-                        targets[i] = c;
-                        spans.include(i);
+                        let p = s.bake.position(t);
+                        // A decal reaches only the surface near its point.
+                        if ball.is_some_and(|(c, r2)| p.distance_squared(c) > r2) {
+                            continue;
+                        }
+                        (p, s.bake.normal(t))
                     }
+                    None => (Vec3::ZERO, Vec3::Z),
+                };
+                let (c, a) = mapper.sample(&pixels, uv, p, n, mask);
+                let a = (a * opacity).min(1.0);
+                if a > 0.0 {
+                    cover[i] = a;
+                    targets[i] = c;
+                    spans.include(i);
                 }
             }
             if !spans.is_empty() {
@@ -314,31 +309,23 @@ impl Document {
             }
             spans
         };
-        let ids: Vec<usize> = match (reach, surface, spec.projection) {
-            (Some(r), Some(s), Projection::Planar { origin, .. }) => s.tiles_near(*origin, r),
-            _ => (0..maps.tile_count()).collect(),
+        let ids: Vec<usize> = match (ball, surface) {
+            (Some((origin, r2)), Some(s)) => s.tiles_near(origin, r2.sqrt()),
+            _ => (0..self.maps.tile_count()).collect(),
         };
-        let before = self.state.clone();
-        let sel = self.state.selection();
-        let pre = before
-            .stack
-            .layer(&sel.path)
-            .and_then(|l| l.planes(sel.mask));
-        let planes = self
-            .state
-            .stack
-            .layer_mut(&sel.path)
-            .and_then(|l| l.planes_mut(sel.mask));
-        if let (Some(planes), Some(pre)) = (planes, pre) {
-            edit::edit_each((planes, pre), &edit, &ids, &prepare);
-        }
-        if !reached.into_inner() {
-            self.state = before;
-            return Err(ModelError::Command(
-                "the projection reaches no texel of the map (nothing faces it, or it lies off the mesh)".into(),
-            ));
-        }
-        self.commit(label, before);
-        Ok(())
+        self.try_edit_planes(
+            label,
+            |planes, pre, _| {
+                edit::edit_each((planes, pre), &edit, &ids, &prepare);
+                if reached.load(std::sync::atomic::Ordering::Relaxed) {
+                    Ok(())
+                } else {
+                    Err(ModelError::Command(
+                        "the projection reaches no texel of the map (nothing faces it, or it lies off the mesh)".into(),
+                    ))
+                }
+            },
+            |_| {},
+        )
     }
 }

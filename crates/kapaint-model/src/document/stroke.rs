@@ -148,7 +148,7 @@ impl Document {
                 .clone_offset
                 .get_or_insert_with(|| (source - point.pos).round());
             stroke.clone = Some(CloneSource {
-                tiles: self.maps.shared_tiles(),
+                tiles: self.maps.tiles().to_vec(),
                 offset,
             });
         }
@@ -312,30 +312,24 @@ impl Document {
                 .and_then(|l| l.planes(selection.mask))
         };
         *touched = true;
+        // What the brush, the eraser and clone raise the stroke's coverage by.
+        let raise = DabRaise {
+            fp,
+            maps,
+            alpha,
+            opacity: brush.opacity,
+            stencil,
+        };
         let written = match tool {
             StrokeTool::Brush | StrokeTool::Eraser => {
                 let Some(pre) = pre() else {
                     return;
-                };
-                let raise = DabRaise {
-                    fp,
-                    maps,
-                    alpha,
-                    opacity: brush.opacity,
-                    stencil,
                 };
                 cover_dab((planes, pre), target, coverage, (maps, &ids), &raise)
             }
             StrokeTool::Clone => {
                 let (Some(pre), Some(source)) = (pre(), clone) else {
                     return;
-                };
-                let raise = DabRaise {
-                    fp,
-                    maps,
-                    alpha,
-                    opacity: brush.opacity,
-                    stencil,
                 };
                 let at = (maps, ids.as_slice());
                 copy_dab::clone_dab((planes, pre), target, coverage, at, source, &raise)

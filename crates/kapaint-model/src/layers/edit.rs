@@ -387,22 +387,7 @@ pub fn edit_varying(
         .into_par_iter()
         .zip(covers)
         .zip(ids)
-        .map(|((mut slot, cover), &id)| {
-            TARGETS.with_borrow_mut(|targets| {
-                targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
-                let spans = prepare(id, cover, targets);
-                if !spans.is_empty() {
-                    crate::simd::vectorized(VaryingWrite {
-                        slot: &mut slot,
-                        edit,
-                        spans: &spans,
-                        cover,
-                        targets,
-                    });
-                }
-                spans
-            })
-        })
+        .map(|((mut slot, cover), &id)| write_varying(&mut slot, edit, id, cover, prepare))
         .collect()
 }
 
@@ -421,21 +406,34 @@ pub fn edit_each(
             COVER.with_borrow_mut(|cover| {
                 cover.clear();
                 cover.resize(TILE_SIZE * TILE_SIZE, 0.0);
-                TARGETS.with_borrow_mut(|targets| {
-                    targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
-                    let spans = prepare(id, cover, targets);
-                    if !spans.is_empty() {
-                        crate::simd::vectorized(VaryingWrite {
-                            slot: &mut slot,
-                            edit,
-                            spans: &spans,
-                            cover,
-                            targets,
-                        });
-                    }
-                });
+                write_varying(&mut slot, edit, id, cover, prepare);
             });
         });
+}
+
+/// One tile of [`edit_varying`] and [`edit_each`]: `prepare` fills its coverage and targets
+/// (in a worker's own buffer of targets), then the texels it returns are written.
+fn write_varying(
+    slot: &mut Slot<'_>,
+    edit: &LayerEdit,
+    id: usize,
+    cover: &mut [f32],
+    prepare: &impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans,
+) -> TileSpans {
+    TARGETS.with_borrow_mut(|targets| {
+        targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
+        let spans = prepare(id, cover, targets);
+        if !spans.is_empty() {
+            crate::simd::vectorized(VaryingWrite {
+                slot,
+                edit,
+                spans: &spans,
+                cover,
+                targets,
+            });
+        }
+        spans
+    })
 }
 
 /// The write of [`edit_varying`]'s tile, compiled for the CPU's widest vectors.
