@@ -506,13 +506,37 @@ impl Command {
     /// The images the command paints through: whoever applies it loads them first
     /// ([`PaintImage::load`]).
     pub fn images_mut(&mut self) -> Vec<&mut PaintImage> {
-        match self {
-            Self::Settings(SettingsCommand::SetStencil { image, .. })
-            | Self::Paint(
-                PaintCommand::ProjectImage { image, .. } | PaintCommand::PlaceDecal { image, .. },
-            ) => vec![image],
-            _ => Vec::new(),
-        }
+        // Every room and every command that may carry an image named: a new one does not
+        // compile until it says whether it does.
+        let image = match self {
+            Self::Settings(c) => match c {
+                SettingsCommand::SetStencil { image, .. } => Some(image),
+                SettingsCommand::SetBrush(_)
+                | SettingsCommand::SetPrimary(_)
+                | SettingsCommand::SetSecondary(_)
+                | SettingsCommand::SwapMaterials
+                | SettingsCommand::SetChannels(_)
+                | SettingsCommand::SetModel(_)
+                | SettingsCommand::SetApprox(_)
+                | SettingsCommand::ClearStencil
+                | SettingsCommand::SetCloneSource(_) => None,
+            },
+            Self::Paint(c) => match c {
+                PaintCommand::ProjectImage { image, .. }
+                | PaintCommand::PlaceDecal { image, .. } => Some(image),
+                PaintCommand::Fill(_)
+                | PaintCommand::Gradient { .. }
+                | PaintCommand::Pick { .. }
+                | PaintCommand::PickLayer { .. } => None,
+            },
+            // Strokes, imports (decoded on a worker), history, layers and masks name no file.
+            Self::Stroke(_)
+            | Self::Import(_)
+            | Self::History(_)
+            | Self::Layer(_)
+            | Self::Mask(_) => None,
+        };
+        image.into_iter().collect()
     }
 
     /// Whether the command paints on the mesh (and so needs
