@@ -97,7 +97,10 @@ fn every_file_request_reaches_its_command() {
         let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot");
         Some(match request.purpose {
             FilePurpose::ImportMesh | FilePurpose::NewMesh => spot.join("spot_triangulated.obj"),
-            FilePurpose::ImportImage(_) | FilePurpose::StampImage => spot.join("spot_texture.png"),
+            FilePurpose::ImportImage(_)
+            | FilePurpose::StampImage
+            | FilePurpose::ToolImage
+            | FilePurpose::StencilImage => spot.join("spot_texture.png"),
             FilePurpose::ExportFolder => std::env::temp_dir().join("kapaint-export-choice"),
             FilePurpose::OpenProject | FilePurpose::SaveProject | FilePurpose::ImportPbr => {
                 return None;

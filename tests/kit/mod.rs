@@ -165,6 +165,11 @@ pub fn noisy_project(path: &std::path::Path) -> kapaint::model::Document {
 /// A right-button drag across the viewport, with `modifiers` held, over a few frames.
 pub fn right_drag(harness: &mut Harness<'_, Editor>, modifiers: Modifiers, by: Vec2) {
     let a = harness.get_by_label(VIEWPORT_LABEL).rect().center();
+    right_drag_from(harness, a, modifiers, by);
+}
+
+/// A right-button drag from `a`, with `modifiers` held, over a few frames.
+pub fn right_drag_from(harness: &mut Harness<'_, Editor>, a: Pos2, modifiers: Modifiers, by: Vec2) {
     let button = |pos, pressed| egui::Event::PointerButton {
         pos,
         button: egui::PointerButton::Secondary,

@@ -70,6 +70,8 @@ pub struct Canvas {
     /// Draw the UV wireframe.
     pub wireframe: bool,
     texture: Option<TextureHandle>,
+    /// The stencil's picture.
+    pub(crate) stencil: crate::stencil_view::StencilOverlay,
     /// What the texture shows.
     mirrored: Option<Mirrored>,
 }
@@ -102,6 +104,7 @@ impl Default for Canvas {
             pan: Vec2::ZERO,
             wireframe: true,
             texture: None,
+            stencil: crate::stencil_view::StencilOverlay::default(),
             mirrored: None,
         }
     }

@@ -229,6 +229,8 @@ impl EditorState {
                 FilePurpose::ImportImage(channel) => self.import_image(path, channel),
                 FilePurpose::ImportPbr => self.import_pbr(path),
                 FilePurpose::StampImage => self.load_stamp(path),
+                FilePurpose::ToolImage => self.start(jobs::load_tool_image(path)),
+                FilePurpose::StencilImage => self.start(jobs::load_stencil(path)),
                 FilePurpose::NewMesh => {
                     if let Some(dialog) = &mut self.dialogs.new {
                         dialog.mesh = path.display().to_string();

@@ -32,6 +32,10 @@ pub enum FilePurpose {
     ImportPbr,
     /// The brush stamp's Load.
     StampImage,
+    /// An image for the active tool (the decal's).
+    ToolImage,
+    /// The stencil's Load.
+    StencilImage,
     /// New > File: the mesh of the new project.
     NewMesh,
     /// The export dialog's folder.
@@ -73,6 +77,8 @@ impl FilePurpose {
                 format!("Import image into {}", c.label())
             }
             Self::StampImage => "Load brush stamp".into(),
+            Self::ToolImage => "Image for the tool".into(),
+            Self::StencilImage => "Load stencil".into(),
             Self::ImportPbr => "Import PBR material".into(),
             Self::NewMesh => "Mesh of the new project".into(),
             Self::ExportFolder => "Export into folder".into(),
@@ -83,7 +89,9 @@ impl FilePurpose {
         match self {
             Self::OpenProject | Self::SaveProject => Some(PROJECT),
             Self::ImportMesh | Self::NewMesh => Some(MESH),
-            Self::ImportImage(_) | Self::StampImage => Some(IMAGE),
+            Self::ImportImage(_) | Self::StampImage | Self::ToolImage | Self::StencilImage => {
+                Some(IMAGE)
+            }
             Self::ImportPbr => Some(PBR),
             Self::ExportFolder => None,
         }

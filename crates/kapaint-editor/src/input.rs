@@ -110,6 +110,7 @@ impl EditorState {
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
                 Action::SmallerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.0 / 1.25),
                 Action::LargerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.25),
+                Action::Commit => self.tool_event(ToolEvent::Commit),
                 Action::Abort => {
                     self.tool_event(ToolEvent::Escape);
                     // The button stays with nobody until it is released and pressed again:
@@ -265,6 +266,28 @@ impl EditorState {
             .collect();
         self.pointer_input(Tab::Canvas, response, samples, space);
         self.tool_cursor(response, space);
+        // The overlays stay inside the canvas (a clone source near the map's edge, a stencil
+        // larger than the view).
+        let painter = response
+            .ctx
+            .layer_painter(response.layer_id)
+            .with_clip_rect(response.rect);
+        // The stencil: a right-drag places it; shown unless a stroke is painting.
+        if response.dragged_by(egui::PointerButton::Secondary) {
+            let modifiers = response.ctx.input(|i| i.modifiers);
+            let per_point = size.0 as f32 / rect.width().max(1e-3);
+            if let Some(command) =
+                crate::stencil_view::dragged(&self.doc, response.drag_delta(), per_point, modifiers)
+            {
+                self.apply(command);
+            }
+        }
+        if let Some(stencil) = self.doc.stencil().cloned()
+            && self.pointer.held.is_none()
+            && crate::stencil_view::paints_through(self.tools.active())
+        {
+            self.canvas.stencil.draw(&painter, rect, size, &stencil);
+        }
         // The brush circle: the dab's radius in texels, at the canvas's zoom.
         self.pointer.canvas_outline = None;
         if let Some(p) = response.hover_pos()
@@ -276,7 +299,6 @@ impl EditorState {
             } else {
                 self.doc.settings().brush.radius_px * rect.width() / size.0 as f32
             };
-            let painter = response.ctx.layer_painter(response.layer_id);
             // Dark under light, so it shows on any material.
             painter.circle_stroke(
                 p,
@@ -288,7 +310,6 @@ impl EditorState {
         }
         let at =
             |p: Vec2| rect.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * rect.size();
-        let painter = response.ctx.layer_painter(response.layer_id);
         match self.tools.overlay() {
             Some(Overlay::Arrow { from, to }) => {
                 painter.arrow(

@@ -207,6 +207,57 @@ pub(super) fn load_stamp(path: PathBuf) -> JobStart {
     )
 }
 
+/// Loads an image to paint through (a decal's, a stencil's) on a worker.
+fn load_paint_image(path: PathBuf) -> Result<kapaint_model::paint_image::PaintImage, String> {
+    let mut image = kapaint_model::paint_image::PaintImage::named(path);
+    image
+        .load(std::path::Path::new(""))
+        .map_err(|e| e.to_string())?;
+    Ok(image)
+}
+
+/// The active tool's image (the decal's), loaded on a worker.
+pub(super) fn load_tool_image(path: PathBuf) -> JobStart {
+    JobStart::new(
+        "Image",
+        move |progress| {
+            progress.start("decode", 1);
+            load_paint_image(path)
+        },
+        |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
+            let said = notice(format!("image {}", image.path().display()), false);
+            desk.ask(Ask::ToolOption(kapaint_tools::OptionChange::Image(image)));
+            desk.ask(Ask::Notice(said));
+        },
+    )
+}
+
+/// A stencil from an image, loaded on a worker: laid over the middle of the map, half its
+/// width wide.
+pub(super) fn load_stencil(path: PathBuf) -> JobStart {
+    JobStart::new(
+        "Stencil",
+        move |progress| {
+            progress.start("decode", 1);
+            load_paint_image(path)
+        },
+        |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
+            let said = notice(format!("stencil {}", image.path().display()), false);
+            let maps = desk.doc.maps();
+            let (w, h) = (maps.width() as f32, maps.height() as f32);
+            let stencil = SettingsCommand::SetStencil {
+                image,
+                center: glam::Vec2::new(w, h) * 0.5,
+                size: 0.5 * w,
+                rotation: 0.0,
+                opacity: 1.0,
+                tiled: false,
+            };
+            desk.command_saying(stencil, vec![said]);
+        },
+    )
+}
+
 /// Decodes and resamples an image on a worker to `doc`'s size; it is written into `channel`
 /// (one undo step) when it arrives.
 pub(super) fn import_image(doc: &Document, path: PathBuf, channel: Channel) -> JobStart {

@@ -36,6 +36,7 @@ mod readout;
 pub mod resize;
 mod results;
 pub mod screen_brush;
+mod stencil_view;
 pub mod viewport;
 
 pub use app::{Editor, run};

@@ -201,7 +201,8 @@ impl Tool for Fill {
             ToolEvent::Drag { .. }
             | ToolEvent::Release
             | ToolEvent::Escape
-            | ToolEvent::PickSource { .. } => Vec::new(),
+            | ToolEvent::PickSource { .. }
+            | ToolEvent::Commit => Vec::new(),
         }
     }
 

@@ -130,7 +130,7 @@ impl Tool for Gradient {
                 self.drag = None;
                 Vec::new()
             }
-            ToolEvent::PickSource { .. } => Vec::new(),
+            ToolEvent::PickSource { .. } | ToolEvent::Commit => Vec::new(),
         }
     }
 

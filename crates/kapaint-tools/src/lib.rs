@@ -11,6 +11,7 @@
 mod blur;
 mod brush;
 mod clone;
+mod decal;
 mod eraser;
 mod fill;
 mod gradient;
@@ -21,6 +22,7 @@ mod stroke;
 pub use blur::{Blur, BlurOption};
 pub use brush::Brush;
 pub use clone::CloneTool;
+pub use decal::{DecalOption, DecalTool};
 pub use eraser::Eraser;
 pub use fill::{Fill, FillMode, FillOption};
 pub use gradient::{Gradient, GradientOption};
@@ -92,6 +94,8 @@ pub enum ToolEvent {
         /// Where.
         at: Place,
     },
+    /// Enter: commit what is being placed (a decal).
+    Commit,
 }
 
 /// What every tool is and does. Everything the editor knows of a tool it asks here: its name
@@ -227,11 +231,17 @@ pub enum OptionWidget {
         /// The change setting it to a value makes.
         change: fn(f32) -> OptionChange,
     },
+    /// An image file: the editor shows its name and a button that chooses another, and
+    /// answers with [`OptionChange::Image`] once the image is loaded.
+    Image {
+        /// The file chosen (none yet).
+        path: Option<std::path::PathBuf>,
+    },
 }
 
 /// A change to one of a tool's options, in the tool's own type (as Graphite's per-tool
 /// option updates): a tool answers its own with an exhaustive match, never a string.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum OptionChange {
     /// The fill tool's.
     Fill(FillOption),
@@ -241,6 +251,10 @@ pub enum OptionChange {
     Gradient(GradientOption),
     /// The picker's.
     Picker(PickerOption),
+    /// The decal tool's.
+    Decal(DecalOption),
+    /// The image an [`OptionWidget::Image`] asked for, loaded.
+    Image(kapaint_model::paint_image::PaintImage),
 }
 
 /// Every tool, in the order the editor lists them: adding a tool is its file and one line here.
@@ -251,6 +265,7 @@ fn registry() -> Vec<Box<dyn Tool>> {
         Box::new(Blur::default()),
         Box::new(CloneTool::default()),
         Box::new(Smudge::default()),
+        Box::new(DecalTool::default()),
         Box::new(Fill::default()),
         Box::new(Gradient::default()),
         Box::new(Picker::default()),

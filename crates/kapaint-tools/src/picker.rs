@@ -74,7 +74,10 @@ impl Tool for Picker {
                 })
                 .into_iter()
                 .collect(),
-            ToolEvent::Release | ToolEvent::Escape | ToolEvent::PickSource { .. } => Vec::new(),
+            ToolEvent::Release
+            | ToolEvent::Escape
+            | ToolEvent::PickSource { .. }
+            | ToolEvent::Commit => Vec::new(),
         }
     }
 

@@ -79,7 +79,10 @@ impl Stroke {
                 self.state = StrokeState::Ready;
                 vec![StrokeCommand::AbortStroke.into()]
             }
-            ToolEvent::Release | ToolEvent::Escape | ToolEvent::PickSource { .. } => Vec::new(),
+            ToolEvent::Release
+            | ToolEvent::Escape
+            | ToolEvent::PickSource { .. }
+            | ToolEvent::Commit => Vec::new(),
         }
     }
 }

@@ -407,7 +407,7 @@ fn a_stroke_stays_in_the_view_it_began_in() {
 #[test]
 fn every_tool_describes_itself_and_its_options_drive_it() {
     let all = Tools::all();
-    assert_eq!(all.len(), 8);
+    assert_eq!(all.len(), 9);
     for (i, a) in all.iter().enumerate() {
         assert!(!a.label.is_empty() && !a.key_help.is_empty(), "{a:?}");
         for b in &all[i + 1..] {
@@ -508,7 +508,7 @@ fn choose(tools: &mut Tools, doc: &Document, name: &str) -> Vec<Command> {
                 .into_iter()
                 .find(|(n, _)| *n == name)
                 .map(|(_, c)| c),
-            OptionWidget::Slider { .. } => None,
+            OptionWidget::Slider { .. } | OptionWidget::Image { .. } => None,
         })
         .expect("the tool offers the choice");
     tools.set_option(change, doc)

@@ -28,7 +28,9 @@ impl ToolPanel {
     /// The active tool's options, drawn from what the tool says they are.
     fn tool_options_ui(ui: &mut egui::Ui, desk: &mut Desk) {
         for option in desk.tools.options(desk.doc) {
-            if let Some(value) = option_ui(ui, &option) {
+            if let OptionWidget::Image { path } = &option.widget {
+                image_option_ui(ui, &option, path.as_deref(), desk);
+            } else if let Some(value) = option_ui(ui, &option) {
                 desk.ask(Ask::ToolOption(value));
             }
         }
@@ -49,6 +51,9 @@ impl ToolPanel {
             desk.ask(Ask::SelectTool(chosen));
         }
         Self::tool_options_ui(ui, desk);
+        if crate::stencil_view::paints_through(desk.tools.active()) {
+            crate::stencil_view::panel_ui(ui, desk);
+        }
         ui.separator();
         ui.heading("Brush settings");
         presets.brush_ui(ui, desk);
@@ -281,7 +286,7 @@ fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionChange> {
                 choices
                     .get(picked)
                     .filter(|_| picked != *chosen)
-                    .map(|(_, change)| *change),
+                    .map(|(_, change)| change.clone()),
                 response,
             )
         }
@@ -297,11 +302,42 @@ fn option_ui(ui: &mut egui::Ui, option: &ToolOption) -> Option<OptionChange> {
             let response = ui.add(if integer { slider.integer() } else { slider });
             ((v != value).then(|| change(v)), response)
         }
+        // Drawn by `image_option_ui`, which asks for the file itself.
+        OptionWidget::Image { .. } => return None,
     };
     if !option.hover.is_empty() {
         response.on_hover_text(option.hover);
     }
     value
+}
+
+/// An image option: the file's name and a button that chooses another (loaded on a worker,
+/// then handed to the tool).
+fn image_option_ui(
+    ui: &mut egui::Ui,
+    option: &ToolOption,
+    path: Option<&std::path::Path>,
+    desk: &mut Desk,
+) {
+    ui.horizontal(|ui| {
+        ui.label(option.label);
+        let name = path
+            .and_then(|p| p.file_name())
+            .map_or("none".into(), |n| n.to_string_lossy().into_owned());
+        let label = ui.label(name);
+        if let Some(p) = path {
+            label.on_hover_text(p.display().to_string());
+        }
+        let choose = ui.button("Choose…");
+        let choose = if option.hover.is_empty() {
+            choose
+        } else {
+            choose.on_hover_text(option.hover)
+        };
+        if choose.clicked() {
+            desk.ask(Ask::ChooseFile(FilePurpose::ToolImage));
+        }
+    });
 }
 
 /// A cheap identity of a stamp for its preview cache: size and a few samples' bits.

@@ -14,6 +14,9 @@ use crate::paint_image::PaintImage;
 #[derive(Clone, Debug, Default)]
 pub(super) struct Aids {
     pub(super) stencil: Option<Arc<Stencil>>,
+    /// The stencil's image as `SetStencil` named it (the editor moves the stencil by naming
+    /// it again).
+    pub(super) stencil_image: Option<PaintImage>,
     pub(super) clone_source: Option<Vec2>,
     /// Source minus the first point of the first clone stroke since the source was set.
     pub(super) clone_offset: Option<Vec2>,
@@ -35,6 +38,11 @@ impl Document {
         self.aids.stencil.as_ref()
     }
 
+    /// The stencil's image, as the command that set it named it.
+    pub fn stencil_image(&self) -> Option<&PaintImage> {
+        self.aids.stencil_image.as_ref()
+    }
+
     /// The clone source (texels), and the offset from a stroke's point to its source once
     /// a clone stroke fixed it.
     pub fn clone_source(&self) -> Option<(Vec2, Option<Vec2>)> {
@@ -44,11 +52,18 @@ impl Document {
     /// `SetStencil`.
     pub(super) fn set_stencil(&mut self, spec: &StencilSpec) -> Result<(), ModelError> {
         let image = Arc::clone(spec.image.pixels()?);
-        let mut stencil = Stencil::new(image, spec.center, spec.size, spec.rotation);
+        // The same image moved: its weights are kept (a drag sets the stencil every frame).
+        let mut stencil = match &self.aids.stencil {
+            Some(s) if Arc::ptr_eq(&s.image, &image) => {
+                s.placed(spec.center, spec.size, spec.rotation)
+            }
+            _ => Stencil::new(image, spec.center, spec.size, spec.rotation),
+        };
         stencil.opacity = spec.opacity;
         stencil.tiled = spec.tiled;
         stencil.check().map_err(ModelError::Command)?;
         self.aids.stencil = Some(Arc::new(stencil));
+        self.aids.stencil_image = Some(spec.image.clone());
         Ok(())
     }
 

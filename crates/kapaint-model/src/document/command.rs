@@ -212,6 +212,15 @@ pub enum PaintCommand {
         #[serde(default = "crate::check::one")]
         opacity: f32,
     },
+    /// The editor's Decal tool while it places a decal: laid as `PlaceDecal` lays it, in
+    /// place of the previous preview's placement and in its undo step (a drag and the
+    /// fields' changes are one step, which the `PlaceDecal` that commits it joins too).
+    #[serde(skip_deserializing)]
+    PreviewDecal(Box<super::decal::Decal>),
+    /// The Decal tool's Escape: the decal being placed is taken back out, its step with it
+    /// (nothing, once another command ended the placement).
+    #[serde(skip_deserializing)]
+    DropDecal,
     /// Reads every channel at a texel into the primary material.
     Pick {
         /// Texel column.
@@ -228,6 +237,20 @@ pub enum PaintCommand {
         /// Texel row.
         y: u32,
     },
+}
+
+impl super::decal::Decal {
+    /// The command that places it for good (joining the step of a preview of it).
+    pub fn place(self) -> PaintCommand {
+        PaintCommand::PlaceDecal {
+            image: self.image,
+            at: self.at,
+            size: self.size,
+            rotation: self.rotation,
+            channels: self.channels,
+            opacity: self.opacity,
+        }
+    }
 }
 
 /// What a worker made from a file, each put in place as one undo step. Not for scripts: their
@@ -524,7 +547,9 @@ impl Command {
             Self::Paint(c) => match c {
                 PaintCommand::ProjectImage { image, .. }
                 | PaintCommand::PlaceDecal { image, .. } => Some(image),
-                PaintCommand::Fill(_)
+                PaintCommand::PreviewDecal(decal) => Some(&mut decal.image),
+                PaintCommand::DropDecal
+                | PaintCommand::Fill(_)
                 | PaintCommand::Gradient { .. }
                 | PaintCommand::Pick { .. }
                 | PaintCommand::PickLayer { .. } => None,
@@ -548,8 +573,10 @@ impl Command {
                 | Self::Paint(PaintCommand::Fill(
                     FillRegion::Island { .. } | FillRegion::Part { .. }
                 ))
-        ) || matches!(self, Self::Paint(PaintCommand::PlaceDecal { .. }))
-            || matches!(self, Self::Paint(PaintCommand::ProjectImage { projection, .. }) if projection.needs_surface())
+        ) || matches!(
+            self,
+            Self::Paint(PaintCommand::PlaceDecal { .. } | PaintCommand::PreviewDecal(_))
+        ) || matches!(self, Self::Paint(PaintCommand::ProjectImage { projection, .. }) if projection.needs_surface())
     }
 }
 

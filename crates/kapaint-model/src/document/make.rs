@@ -122,6 +122,7 @@ impl Document {
             revisions: 0,
             opacity_run: None,
             generator_run: None,
+            decal_run: None,
             aids: super::aids::Aids::default(),
             id: DocumentId::random(),
             instance: next_instance(),

@@ -58,8 +58,9 @@ impl PaintCommand {
             Self::Fill(_)
             | Self::Gradient { .. }
             | Self::ProjectImage { .. }
-            | Self::PlaceDecal { .. } => true,
-            Self::Pick { .. } | Self::PickLayer { .. } => false,
+            | Self::PlaceDecal { .. }
+            | Self::PreviewDecal(_) => true,
+            Self::Pick { .. } | Self::PickLayer { .. } | Self::DropDecal => false,
         }
     }
 }

@@ -12,12 +12,14 @@ mod id;
 mod import;
 mod layers;
 
+mod decal;
 mod make;
 mod masks;
 mod memory_need;
 mod moves;
 mod paths;
 mod project_image;
+pub use decal::Decal;
 mod script;
 mod structure;
 mod surface;
@@ -148,6 +150,9 @@ pub struct Document {
     /// The layer whose mask generator the last command previewed (a drag in progress): the
     /// next change of it joins that step.
     generator_run: Option<LayerId>,
+    /// The layer the Decal tool's last preview placed a decal in (a placement under way):
+    /// the next placement there replaces it, in its step.
+    decal_run: Option<LayerId>,
     /// Which document this is: kept in its project file and its recovery journal, so a
     /// journal is only ever recovered into the project it was written for.
     id: DocumentId,
@@ -309,10 +314,11 @@ impl Document {
         self.check_memory(&command)?;
         let opacity_run = self.opacity_run.take();
         let generator_run = self.generator_run.take();
+        let decal_run = self.decal_run.take();
         match command {
             Command::Settings(c) => self.settings_command(c),
             Command::Stroke(c) => self.stroke_command(c),
-            Command::Paint(c) => self.paint_command(c),
+            Command::Paint(c) => self.paint_command(c, decal_run),
             Command::Import(c) => self.import_command(c),
             Command::History(c) => {
                 self.history_command(c);
@@ -363,7 +369,10 @@ impl Document {
                     tiled,
                 });
             }
-            SettingsCommand::ClearStencil => self.aids.stencil = None,
+            SettingsCommand::ClearStencil => {
+                self.aids.stencil = None;
+                self.aids.stencil_image = None;
+            }
             SettingsCommand::SetCloneSource(at) => return self.set_clone_source(at),
         }
         Ok(())
@@ -400,7 +409,11 @@ impl Document {
     }
 
     /// The one-click tools.
-    fn paint_command(&mut self, command: PaintCommand) -> Result<(), ModelError> {
+    fn paint_command(
+        &mut self,
+        command: PaintCommand,
+        decal_run: Option<LayerId>,
+    ) -> Result<(), ModelError> {
         match command {
             PaintCommand::Fill(region) => self.fill(region),
             PaintCommand::Gradient { shape, start, end } => self.gradient(shape, start, end),
@@ -422,14 +435,32 @@ impl Document {
                 rotation,
                 channels,
                 opacity,
-            } => self.place_decal(&project_image::DecalSpec {
-                image: &image,
-                at,
-                size,
-                rotation,
-                channels,
-                opacity,
-            }),
+            } => {
+                let decal = Decal {
+                    image,
+                    at,
+                    size,
+                    rotation,
+                    channels,
+                    opacity,
+                };
+                self.decal_step(&decal, decal_run)
+            }
+            PaintCommand::PreviewDecal(decal) => {
+                let placed = self.decal_step(&decal, decal_run);
+                // A move refused keeps the placement under way (its preview stays).
+                let id = self.state.selection.id;
+                self.decal_run = if placed.is_ok() {
+                    id
+                } else {
+                    decal_run.filter(|_| decal_run == id)
+                };
+                placed
+            }
+            PaintCommand::DropDecal => {
+                self.drop_decal(decal_run);
+                Ok(())
+            }
             PaintCommand::Pick { x, y } => self.pick(x, y, false),
             PaintCommand::PickLayer { x, y } => self.pick(x, y, true),
         }

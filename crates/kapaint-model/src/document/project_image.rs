@@ -6,6 +6,7 @@
 use glam::{Vec2, Vec3};
 
 use super::Document;
+use super::decal::Decal;
 use crate::ModelError;
 use crate::brush::BlendMode;
 use crate::layers::LayerStroke;
@@ -164,22 +165,48 @@ pub(super) struct ProjectSpec<'a> {
     pub(super) opacity: f32,
 }
 
-/// What `PlaceDecal` names.
-pub(super) struct DecalSpec<'a> {
-    pub(super) image: &'a PaintImage,
-    pub(super) at: Vec3,
-    pub(super) size: f32,
-    pub(super) rotation: f32,
-    pub(super) channels: Channels,
-    pub(super) opacity: f32,
-}
+/// The undo step's label of a decal's placement.
+const DECAL_STEP: &str = "Place decal";
 
 impl Document {
+    /// A decal placed as one undo step; right after a preview in the same layer (`run`), in
+    /// place of that preview and in its step.
+    pub(super) fn decal_step(
+        &mut self,
+        decal: &Decal,
+        run: Option<crate::layers::LayerId>,
+    ) -> Result<(), ModelError> {
+        let id = self.state.selection.id;
+        let joined = id.is_some() && run == id && !self.stroking();
+        let Some(before) = joined.then(|| self.history.take_last(DECAL_STEP)).flatten() else {
+            return self.place_decal(decal);
+        };
+        // The preview's placement goes; the new one is laid on what lay before it.
+        let preview = std::mem::replace(&mut self.state, before);
+        self.place_decal(decal).inspect_err(|_| {
+            // Refused (it reaches nothing there): the preview and its step stay as they were.
+            let before = std::mem::replace(&mut self.state, preview);
+            self.history.push(DECAL_STEP, before, &self.state);
+        })
+    }
+
+    /// `DropDecal`: the placement under way in the same layer (`run`) taken back out.
+    pub(super) fn drop_decal(&mut self, run: Option<crate::layers::LayerId>) {
+        let id = self.state.selection.id;
+        if id.is_none() || run != id || self.stroking() {
+            return;
+        }
+        if let Some(before) = self.history.take_last(DECAL_STEP) {
+            self.state = before;
+            self.compositor.update(&self.state.stack, &mut self.maps);
+        }
+    }
+
     /// `PlaceDecal`: a planar projection along the surface's normal at the surface point
     /// nearest `at`, `size` object units wide (its height by the image's aspect), turned by
     /// `rotation` degrees about the normal (counter-clockwise seen from outside), reaching
     /// only the surface within its half-diagonal of that point.
-    pub(super) fn place_decal(&mut self, spec: &DecalSpec<'_>) -> Result<(), ModelError> {
+    fn place_decal(&mut self, spec: &Decal) -> Result<(), ModelError> {
         let surface = self.require_surface("placing a decal")?;
         let aspect = spec.image.pixels()?.aspect();
         if !(spec.at.is_finite() && spec.rotation.is_finite()) {
@@ -224,12 +251,12 @@ impl Document {
             height: spec.size * aspect,
         };
         let project = ProjectSpec {
-            image: spec.image,
+            image: &spec.image,
             projection: &projection,
             channels: spec.channels,
             opacity: spec.opacity,
         };
-        self.project(&project, Some(radius), "Place decal")
+        self.project(&project, Some(radius), DECAL_STEP)
     }
 
     /// `ProjectImage`.

@@ -46,6 +46,17 @@ impl Stencil {
         }
     }
 
+    /// This stencil moved, scaled or turned (its image's weights kept, not read again).
+    #[must_use]
+    pub fn placed(&self, center: Vec2, size: f32, rotation: f32) -> Self {
+        Self {
+            center,
+            size,
+            rotation,
+            ..self.clone()
+        }
+    }
+
     /// Checks a stencil's numbers.
     ///
     /// # Errors

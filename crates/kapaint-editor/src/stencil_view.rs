@@ -1,0 +1,210 @@
+//! The stencil in the editor: its picture over the UV canvas (hidden while a stroke paints),
+//! moved by a right-drag, scaled by Shift+right-drag and turned by Ctrl+right-drag; and its
+//! section of the tool panel (load, size, rotation, opacity, tiling, clear). The stencil
+//! itself is the document's: every change is a `SetStencil` naming its image again.
+
+use std::sync::Arc;
+
+use egui::{Color32, Pos2, Rect, TextureHandle};
+use glam::Vec2;
+
+use kapaint_model::paint::Stencil;
+use kapaint_model::{Document, SettingsCommand};
+use kapaint_tools::ToolKind;
+
+use crate::desk::{Ask, Desk};
+use crate::files::FilePurpose;
+
+/// Largest side of the stencil's picture on the canvas (it is a guide, not the stencil).
+const PICTURE_SIDE: u32 = 512;
+
+/// The tools that paint through a stencil.
+pub(crate) fn paints_through(tool: ToolKind) -> bool {
+    [ToolKind::BRUSH, ToolKind::ERASER, ToolKind::CLONE].contains(&tool)
+}
+
+/// The stencil's placement as the panel and the drags change it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Placement {
+    pub(crate) center: Vec2,
+    pub(crate) size: f32,
+    pub(crate) rotation: f32,
+    pub(crate) opacity: f32,
+    pub(crate) tiled: bool,
+}
+
+impl Placement {
+    fn of(stencil: &Stencil) -> Self {
+        Self {
+            center: stencil.center,
+            size: stencil.size,
+            rotation: stencil.rotation,
+            opacity: stencil.opacity,
+            tiled: stencil.tiled,
+        }
+    }
+}
+
+/// The command that places the document's stencil as `placement` says (none without one).
+pub(crate) fn place(doc: &Document, placement: Placement) -> Option<SettingsCommand> {
+    Some(SettingsCommand::SetStencil {
+        image: doc.stencil_image()?.clone(),
+        center: placement.center,
+        size: placement.size,
+        rotation: placement.rotation,
+        opacity: placement.opacity,
+        tiled: placement.tiled,
+    })
+}
+
+/// The document's stencil moved by a right-drag of `delta` points on a canvas showing
+/// `texels_per_point`: moved, or with Shift scaled (right grows it), or with Ctrl turned
+/// (right turns it clockwise).
+pub(crate) fn dragged(
+    doc: &Document,
+    delta: egui::Vec2,
+    texels_per_point: f32,
+    modifiers: egui::Modifiers,
+) -> Option<SettingsCommand> {
+    let stencil = doc.stencil()?;
+    let mut p = Placement::of(stencil);
+    if modifiers.command {
+        p.rotation += delta.x * 0.5;
+    } else if modifiers.shift {
+        p.size = (p.size * (delta.x * 0.01).exp()).max(1.0);
+    } else {
+        p.center += Vec2::new(delta.x, delta.y) * texels_per_point;
+    }
+    (p != Placement::of(stencil))
+        .then(|| place(doc, p))
+        .flatten()
+}
+
+/// The stencil's picture on the canvas, made once per image.
+#[derive(Default)]
+pub(crate) struct StencilOverlay {
+    texture: Option<(usize, TextureHandle)>,
+}
+
+impl StencilOverlay {
+    /// Draws `stencil` over the map shown in `map` (a `size` map): its picture, translucent,
+    /// and its frame.
+    pub(crate) fn draw(
+        &mut self,
+        painter: &egui::Painter,
+        map: Rect,
+        size: (u32, u32),
+        stencil: &Stencil,
+    ) {
+        let key = Arc::as_ptr(&stencil.image) as usize;
+        if self.texture.as_ref().is_none_or(|(k, _)| *k != key) {
+            let picture = picture(stencil);
+            let texture =
+                painter
+                    .ctx()
+                    .load_texture("stencil", picture, egui::TextureOptions::LINEAR);
+            self.texture = Some((key, texture));
+        }
+        let to_screen =
+            |p: Vec2| map.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * map.size();
+        let (sin, cos) = stencil.rotation.to_radians().sin_cos();
+        let half = Vec2::new(stencil.size, stencil.size * stencil.image.aspect()) * 0.5;
+        let corner = |sx: f32, sy: f32| {
+            let l = Vec2::new(sx * half.x, sy * half.y);
+            to_screen(stencil.center + Vec2::new(l.x * cos - l.y * sin, l.x * sin + l.y * cos))
+        };
+        let corners = [
+            corner(-1.0, -1.0),
+            corner(1.0, -1.0),
+            corner(1.0, 1.0),
+            corner(-1.0, 1.0),
+        ];
+        if let Some((_, texture)) = &self.texture {
+            let mut mesh = egui::Mesh::with_texture(texture.id());
+            let uvs = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+            for (pos, (u, v)) in corners.into_iter().zip(uvs) {
+                mesh.vertices.push(egui::epaint::Vertex {
+                    pos,
+                    uv: Pos2::new(u, v),
+                    color: Color32::from_white_alpha(110),
+                });
+            }
+            mesh.add_triangle(0, 1, 2);
+            mesh.add_triangle(0, 2, 3);
+            painter.add(egui::Shape::mesh(mesh));
+        }
+        for (width, colour) in [(3.0, Color32::BLACK), (1.0, Color32::WHITE)] {
+            painter.add(egui::Shape::closed_line(
+                corners.to_vec(),
+                egui::Stroke::new(width, colour),
+            ));
+        }
+    }
+}
+
+/// What the stencil lets through, as a grey picture at most [`PICTURE_SIDE`] a side: white
+/// where it paints, clear where it holds the paint back.
+fn picture(stencil: &Stencil) -> egui::ColorImage {
+    let image = &stencil.image;
+    let scale = (PICTURE_SIDE as f32 / image.width().max(image.height()) as f32).min(1.0);
+    let w = ((image.width() as f32 * scale).round() as usize).max(1);
+    let h = ((image.height() as f32 * scale).round() as usize).max(1);
+    let mut pixels = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let s = image.sample(uv, false);
+            let weight = (s.gray * s.alpha).clamp(0.0, 1.0);
+            pixels.push(Color32::from_white_alpha((weight * 255.0 + 0.5) as u8));
+        }
+    }
+    egui::ColorImage::new([w, h], pixels)
+}
+
+/// The stencil's section of the tool panel.
+pub(crate) fn panel_ui(ui: &mut egui::Ui, desk: &mut Desk) {
+    let doc = desk.doc;
+    ui.horizontal(|ui| {
+        ui.label("Stencil");
+        let name = doc
+            .stencil_image()
+            .and_then(|i| i.path().file_name())
+            .map_or("none".into(), |n| n.to_string_lossy().into_owned());
+        ui.label(name);
+        if ui
+            .button("Load stencil…")
+            .on_hover_text(
+                "Paint through an image: its light parts let the paint through. On the canvas, \
+                 right-drag moves it, Shift+right-drag scales it, Ctrl+right-drag turns it",
+            )
+            .clicked()
+        {
+            desk.ask(Ask::ChooseFile(FilePurpose::StencilImage));
+        }
+        if doc.stencil().is_some() && ui.button("Clear").clicked() {
+            desk.command(SettingsCommand::ClearStencil);
+        }
+    });
+    let Some(stencil) = doc.stencil() else {
+        return;
+    };
+    let before = Placement::of(stencil);
+    let mut p = before;
+    let width = doc.maps().width() as f32;
+    ui.add(
+        egui::Slider::new(&mut p.size, 1.0..=4.0 * width)
+            .logarithmic(true)
+            .text("Stencil size"),
+    )
+    .on_hover_text("Its width in texels");
+    ui.add(egui::Slider::new(&mut p.rotation, -180.0..=180.0).text("Stencil rotation"));
+    ui.add(egui::Slider::new(&mut p.opacity, 0.0..=1.0).text("Stencil opacity"))
+        .on_hover_text("How much it holds the paint back (0: not at all)");
+    ui.checkbox(&mut p.tiled, "Tile the stencil")
+        .on_hover_text("Repeat the image beyond its edges");
+    if p != before
+        && let Some(command) = place(doc, p)
+    {
+        desk.command(command);
+    }
+}

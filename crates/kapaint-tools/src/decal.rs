@@ -1,0 +1,254 @@
+//! The decal tool: a click on the mesh (or on the canvas, where the map lies on the mesh)
+//! places the chosen image there as a decal, dragging moves it over the surface, the fields
+//! scale, turn and fade it, Enter commits it and Escape takes it back out. What is shown
+//! while it is placed is the decal itself, laid in the selected layer by the model (one undo
+//! step for the whole placement, which each move replaces).
+
+use glam::Vec3;
+
+use kapaint_model::paint_image::PaintImage;
+use kapaint_model::{Command, Decal, Document, PaintCommand};
+
+use super::{
+    OptionChange, OptionWidget, Place, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+};
+
+/// A change to the decal tool's options.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DecalOption {
+    /// Its width in object units.
+    Size(f32),
+    /// Its turn about the surface's normal, degrees.
+    Rotation(f32),
+    /// Its strength in `[0, 1]`.
+    Opacity(f32),
+}
+
+/// The decal tool: its image and placement, and the decal being placed.
+#[derive(Clone, Debug)]
+pub struct DecalTool {
+    /// The image it places (none until one is chosen).
+    pub image: Option<PaintImage>,
+    /// Width in object units (`None`: a fifth of the mesh's size, fixed at the first click).
+    pub size: Option<f32>,
+    /// Turn about the surface's normal, degrees.
+    pub rotation: f32,
+    /// Strength.
+    pub opacity: f32,
+    /// The point of the decal being placed (laid as a preview, not yet committed).
+    placing: Option<Vec3>,
+    /// Whether the button is down (a drag moves it).
+    dragging: bool,
+}
+
+impl Default for DecalTool {
+    fn default() -> Self {
+        Self {
+            image: None,
+            size: None,
+            rotation: 0.0,
+            opacity: 1.0,
+            placing: None,
+            dragging: false,
+        }
+    }
+}
+
+impl ToolKind {
+    /// The decal.
+    pub const DECAL: Self = Self("decal");
+}
+
+/// The mesh's size: the diagonal of its bounds (1 without a mesh).
+fn mesh_size(doc: &Document) -> f32 {
+    doc.surface()
+        .map(|s| {
+            let (lo, hi) = s.mesh.bounds();
+            lo.distance(hi)
+        })
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .unwrap_or(1.0)
+}
+
+/// The surface point under `at`: the mesh's point, or the baked position of the canvas's
+/// texel where the map lies on the mesh.
+fn surface_point(at: Place, doc: &Document) -> Option<Vec3> {
+    match at {
+        Place::Surface { pos, .. } => Some(pos.point),
+        Place::Canvas(_) => {
+            let surface = doc.surface()?;
+            let (w, h) = (doc.maps().width(), doc.maps().height());
+            let (x, y) = at.texel_index((w, h))?;
+            let t = y as usize * w as usize + x as usize;
+            surface.bake.triangle(t).map(|_| surface.bake.position(t))
+        }
+    }
+}
+
+impl DecalTool {
+    /// The point of the decal being placed, if one is.
+    pub fn placing(&self) -> Option<Vec3> {
+        self.placing
+    }
+
+    /// The decal at `at` as the options say, if an image is chosen.
+    fn decal(&self, at: Vec3, doc: &Document) -> Option<Decal> {
+        Some(Decal {
+            image: self.image.clone()?,
+            at,
+            size: self.size.unwrap_or_else(|| 0.2 * mesh_size(doc)),
+            rotation: self.rotation,
+            channels: doc.settings().channels,
+            opacity: self.opacity,
+        })
+    }
+
+    /// The preview of the decal being placed, as the options now say.
+    fn preview(&self, doc: &Document) -> Vec<Command> {
+        self.placing
+            .and_then(|at| self.decal(at, doc))
+            .map(|d| PaintCommand::PreviewDecal(Box::new(d)).into())
+            .into_iter()
+            .collect()
+    }
+
+    /// Commits the decal being placed.
+    fn commit(&mut self, doc: &Document) -> Vec<Command> {
+        self.dragging = false;
+        self.placing
+            .take()
+            .and_then(|at| self.decal(at, doc))
+            .map(|d| d.place().into())
+            .into_iter()
+            .collect()
+    }
+}
+
+impl Tool for DecalTool {
+    fn meta(&self) -> ToolMeta {
+        ToolMeta {
+            kind: ToolKind::DECAL,
+            label: "Decal",
+            key: Some('D'),
+            key_help: "D; Enter commits, Escape takes it back",
+            summary: "decal (click places, drag moves, Enter commits)",
+            cursor: ToolCursor::Crosshair,
+        }
+    }
+
+    fn handle(&mut self, event: ToolEvent, doc: &Document) -> Vec<Command> {
+        match event {
+            ToolEvent::Press { at, .. } => {
+                let Some(p) = surface_point(at, doc) else {
+                    return Vec::new();
+                };
+                if self.image.is_none() {
+                    return Vec::new();
+                }
+                if self.size.is_none() {
+                    self.size = Some(0.2 * mesh_size(doc));
+                }
+                self.dragging = true;
+                self.placing = Some(p);
+                self.preview(doc)
+            }
+            ToolEvent::Drag { at, .. } if self.dragging => {
+                let Some(p) = surface_point(at, doc) else {
+                    return Vec::new();
+                };
+                // Moves under a hundredth of its size are not worth laying it again.
+                let step = 0.01 * self.size.unwrap_or(1.0);
+                if self.placing.is_some_and(|q| q.distance(p) < step) {
+                    return Vec::new();
+                }
+                self.placing = Some(p);
+                self.preview(doc)
+            }
+            ToolEvent::Release => {
+                self.dragging = false;
+                Vec::new()
+            }
+            ToolEvent::Commit => self.commit(doc),
+            ToolEvent::Escape => {
+                self.dragging = false;
+                match self.placing.take() {
+                    Some(_) => vec![PaintCommand::DropDecal.into()],
+                    None => Vec::new(),
+                }
+            }
+            ToolEvent::Drag { .. } | ToolEvent::PickSource { .. } => Vec::new(),
+        }
+    }
+
+    fn busy(&self) -> bool {
+        self.placing.is_some()
+    }
+
+    /// Another tool chosen: the decal being placed is kept.
+    fn leave(&mut self, doc: &Document) -> Vec<Command> {
+        self.commit(doc)
+    }
+
+    fn options(&self, doc: &Document) -> Vec<ToolOption> {
+        let size = mesh_size(doc);
+        vec![
+            ToolOption {
+                label: "Image",
+                hover: "The picture the decal lays: colour into k_d, luminance into k_s, gray into n, alpha the coverage",
+                widget: OptionWidget::Image {
+                    path: self.image.as_ref().map(|i| i.path().to_path_buf()),
+                },
+            },
+            ToolOption {
+                label: "Size",
+                hover: "Width in object units (the height by the image's aspect)",
+                widget: OptionWidget::Slider {
+                    value: self.size.unwrap_or(0.2 * size),
+                    min: 0.001 * size,
+                    max: size,
+                    integer: false,
+                    change: |v| OptionChange::Decal(DecalOption::Size(v)),
+                },
+            },
+            ToolOption {
+                label: "Rotation",
+                hover: "Degrees about the surface's normal, counter-clockwise seen from outside",
+                widget: OptionWidget::Slider {
+                    value: self.rotation,
+                    min: -180.0,
+                    max: 180.0,
+                    integer: false,
+                    change: |v| OptionChange::Decal(DecalOption::Rotation(v)),
+                },
+            },
+            ToolOption {
+                label: "Decal opacity",
+                hover: "How strongly the decal covers what is under it",
+                widget: OptionWidget::Slider {
+                    value: self.opacity,
+                    min: 0.0,
+                    max: 1.0,
+                    integer: false,
+                    change: |v| OptionChange::Decal(DecalOption::Opacity(v)),
+                },
+            },
+        ]
+    }
+
+    fn set_option(&mut self, change: OptionChange, doc: &Document) -> Vec<Command> {
+        match change {
+            OptionChange::Image(image) => self.image = Some(image),
+            OptionChange::Decal(DecalOption::Size(v)) if v.is_finite() && v > 0.0 => {
+                self.size = Some(v);
+            }
+            OptionChange::Decal(DecalOption::Rotation(v)) if v.is_finite() => {
+                self.rotation = v;
+            }
+            OptionChange::Decal(DecalOption::Opacity(v)) if v.is_finite() => {
+                self.opacity = v.clamp(0.0, 1.0);
+            }
+            _ => return Vec::new(),
+        }
+        self.preview(doc)
+    }
+}

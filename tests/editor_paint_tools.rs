@@ -1,0 +1,152 @@
+//! Issue 56 in the editor, driven through egui_kittest: the Decal tool (an image chosen, a
+//! click places it, a drag moves it, Enter commits, Escape takes it back, one undo step) and
+//! the stencil (loaded from the panel, placed by right-drags on the canvas, painted through).
+
+use egui::accesskit::Role;
+use egui::{Modifiers, Vec2};
+use egui_kittest::kittest::Queryable;
+use kapaint::ui::Editor;
+use kapaint::ui::canvas::CANVAS_LABEL;
+use kapaint::ui::files::{FileDialogBackend, FilePurpose, FileRequest};
+use kapaint::ui::viewport::VIEWPORT_LABEL;
+
+#[expect(dead_code, reason = "each editor test file uses some of the helpers")]
+mod kit;
+use kit::*;
+
+/// The stand-in for the system dialog: spot's texture for an image, nothing else.
+fn answer(request: &FileRequest) -> Option<std::path::PathBuf> {
+    let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot");
+    matches!(
+        request.purpose,
+        FilePurpose::ToolImage | FilePurpose::StencilImage
+    )
+    .then(|| spot.join("spot_texture.png"))
+}
+
+fn labels(editor: &Editor) -> Vec<String> {
+    editor
+        .state
+        .doc()
+        .history()
+        .undo_steps()
+        .map(|s| s.label.clone())
+        .collect()
+}
+
+fn click(harness: &mut egui_kittest::Harness<'_, Editor>, at: egui::Pos2) {
+    harness.hover_at(at);
+    harness.run();
+    harness.drag_at(at);
+    harness.run();
+    harness.drop_at(at);
+    harness.run();
+}
+
+#[test]
+fn a_decal_is_placed_moved_committed_and_taken_back_in_the_viewport() {
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer);
+    harness.key_press(egui::Key::D);
+    harness.run();
+    assert_eq!(harness.state().state.tools().active().name(), "decal");
+    harness
+        .get_by_role_and_label(Role::Button, "Choose…")
+        .click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "decal image loaded", |e| {
+        e.state
+            .notices()
+            .iter()
+            .any(|n| n.text.contains("spot_texture.png"))
+    });
+    let blank = texels(harness.state());
+    let centre = harness.get_by_label(VIEWPORT_LABEL).rect().center();
+    click(&mut harness, centre);
+    let placed = texels(harness.state());
+    assert!(changed(&blank, &placed) > 100, "the decal is shown at once");
+    assert_eq!(labels(harness.state()), ["Place decal"]);
+    assert!(harness.state().state.tools().busy(), "waiting for Enter");
+    // Dragged: moved over the surface, the same one step.
+    drag(&mut harness, centre, centre + Vec2::new(60.0, 10.0));
+    let moved = texels(harness.state());
+    assert!(changed(&placed, &moved) > 100);
+    assert_eq!(labels(harness.state()), ["Place decal"]);
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    assert!(!harness.state().state.tools().busy(), "committed");
+    assert_eq!(texels(harness.state()), moved);
+    // A second one, taken back by Escape: the first stays, alone in the history.
+    click(&mut harness, centre - Vec2::new(60.0, 0.0));
+    assert_eq!(labels(harness.state()), ["Place decal", "Place decal"]);
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert_eq!(labels(harness.state()), ["Place decal"]);
+    assert_eq!(texels(harness.state()), moved);
+    // Undo takes the committed decal out whole.
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(texels(harness.state()), blank);
+}
+
+#[test]
+fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer);
+    harness.key_press(egui::Key::B);
+    harness.run();
+    harness
+        .get_by_role_and_label(Role::Button, "Load stencil…")
+        .click();
+    harness.run_steps(2);
+    wait_until(&mut harness, "stencil loaded", |e| {
+        e.state.doc().stencil().is_some()
+    });
+    let stencil = |e: &Editor| {
+        let s = e.state.doc().stencil().expect("stencil");
+        (s.center, s.size, s.rotation)
+    };
+    let width = harness.state().state.doc().maps().width() as f32;
+    let (centre, size, rotation) = stencil(harness.state());
+    assert_eq!(centre, glam::Vec2::splat(width / 2.0));
+    assert_eq!((size, rotation), (width / 2.0, 0.0));
+    // A right-drag moves it, with Shift scales it, with Ctrl turns it.
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect().center();
+    let per_point = harness.state().state.canvas_zoom().recip();
+    right_drag_from(
+        &mut harness,
+        canvas,
+        Modifiers::default(),
+        Vec2::new(40.0, 0.0),
+    );
+    let (moved, _, _) = stencil(harness.state());
+    let want = 40.0 * per_point;
+    assert!(
+        (moved.x - centre.x - want).abs() < 0.1 * want && (moved.y - centre.y).abs() < 1.0,
+        "{moved} from {centre}, {want} texels right"
+    );
+    right_drag_from(&mut harness, canvas, Modifiers::SHIFT, Vec2::new(30.0, 0.0));
+    let (_, larger, _) = stencil(harness.state());
+    assert!(larger > 1.2 * size, "{larger} from {size}");
+    right_drag_from(
+        &mut harness,
+        canvas,
+        Modifiers::COMMAND,
+        Vec2::new(30.0, 0.0),
+    );
+    let (_, _, turned) = stencil(harness.state());
+    assert!(turned > 5.0, "{turned}");
+    // Painted through: a stroke paints, and the stencil stays for the next.
+    let before = texels(harness.state());
+    drag(&mut harness, canvas, canvas + Vec2::new(40.0, 0.0));
+    assert!(changed(&before, &texels(harness.state())) > 0);
+    assert!(harness.state().state.doc().stencil().is_some());
+    // Clear takes it away.
+    harness.get_by_role_and_label(Role::Button, "Clear").click();
+    harness.run();
+    assert!(harness.state().state.doc().stencil().is_none());
+}
