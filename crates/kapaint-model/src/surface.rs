@@ -151,9 +151,21 @@ impl Surface {
 
     /// The baked surface texel nearest `point` within `radius`: its position and normal.
     pub fn nearest(&self, point: Vec3, radius: f32) -> Option<(Vec3, Vec3)> {
+        let mut best: Option<(f32, usize)> = None;
+        self.visit_near(point, radius, |i, p| {
+            let d2 = p.distance_squared(point);
+            if best.is_none_or(|(bd, _)| d2 < bd) {
+                best = Some((d2, i));
+            }
+        });
+        best.map(|(_, i)| (self.bake.position(i), self.bake.normal(i)))
+    }
+
+    /// Calls `f` with the index and position of every baked surface texel (not padding)
+    /// within `radius` of `point`.
+    pub fn visit_near(&self, point: Vec3, radius: f32, mut f: impl FnMut(usize, Vec3)) {
         let r2 = radius * radius;
         let w = self.bake.width as usize;
-        let mut best: Option<((f32, Vec3), Vec3)> = None;
         for (id, tile) in self.tile_boxes.iter().enumerate() {
             if !tile.meets_ball(point, r2) {
                 continue;
@@ -175,15 +187,13 @@ impl Surface {
                             continue;
                         }
                         let p = self.bake.position(i);
-                        let d2 = p.distance_squared(point);
-                        if d2 <= r2 && best.is_none_or(|(bd, _)| d2 < bd.0) {
-                            best = Some(((d2, p), self.bake.normal(i)));
+                        if p.distance_squared(point) <= r2 {
+                            f(i, p);
                         }
                     }
                 }
             }
         }
-        best.map(|((_, p), n)| (p, n))
     }
 
     /// A mask of the texels (covered or padding) of the UV island under texel `(x, y)`, or

@@ -20,6 +20,10 @@ pub(super) struct Aids {
     pub(super) clone_source: Option<Vec2>,
     /// Source minus the first point of the first clone stroke since the source was set.
     pub(super) clone_offset: Option<Vec2>,
+    /// The clone source on the mesh (object space).
+    pub(super) surface_clone_source: Option<glam::Vec3>,
+    /// Its offset, as `clone_offset` (object units).
+    pub(super) surface_clone_offset: Option<glam::Vec3>,
 }
 
 /// The stencil as `SetStencil` names it.
@@ -64,6 +68,29 @@ impl Document {
         stencil.check().map_err(ModelError::Command)?;
         self.aids.stencil = Some(Arc::new(stencil));
         self.aids.stencil_image = Some(spec.image.clone());
+        Ok(())
+    }
+
+    /// The clone source on the mesh (object space), and the offset from a mesh stroke's
+    /// point to its source once a clone stroke fixed it.
+    pub fn surface_clone_source(&self) -> Option<(glam::Vec3, Option<glam::Vec3>)> {
+        self.aids
+            .surface_clone_source
+            .map(|s| (s, self.aids.surface_clone_offset))
+    }
+
+    /// `SetSurfaceCloneSource`: the point must be finite and on (near) the mesh.
+    pub(super) fn set_surface_clone_source(&mut self, at: glam::Vec3) -> Result<(), ModelError> {
+        let surface = self.require_surface("a clone source on the mesh")?;
+        let near = 4.0 * surface.units_per_texel;
+        if !at.is_finite() || surface.nearest(at, near).is_none() {
+            return Err(ModelError::Command(format!(
+                "the clone source ({}, {}, {}) is not on the mesh",
+                at.x, at.y, at.z
+            )));
+        }
+        self.aids.surface_clone_source = Some(at);
+        self.aids.surface_clone_offset = None;
         Ok(())
     }
 

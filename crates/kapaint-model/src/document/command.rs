@@ -127,6 +127,10 @@ pub enum SettingsCommand {
     /// point taking the source's texel, and later strokes keep that offset (aligned) until a
     /// new source is set.
     SetCloneSource(Vec2),
+    /// Sets the clone source on the mesh, a point of its surface in object space: a clone
+    /// stroke on the mesh (`SurfaceStroke(tool: Clone, ...)`) copies from there, aligned in
+    /// object space (across UV seams) as `SetCloneSource` aligns on the canvas.
+    SetSurfaceCloneSource(Vec3),
 }
 
 /// Strokes: each is one undo step.
@@ -542,7 +546,8 @@ impl Command {
                 | SettingsCommand::SetModel(_)
                 | SettingsCommand::SetApprox(_)
                 | SettingsCommand::ClearStencil
-                | SettingsCommand::SetCloneSource(_) => None,
+                | SettingsCommand::SetCloneSource(_)
+                | SettingsCommand::SetSurfaceCloneSource(_) => None,
             },
             Self::Paint(c) => match c {
                 PaintCommand::ProjectImage { image, .. }

@@ -24,6 +24,9 @@ pub(super) struct CloneSource {
     pub(super) tiles: Vec<Arc<Tile>>,
     /// Texels from a stroke's point to its source (whole texels: a copy, not a resample).
     pub(super) offset: Vec2,
+    /// On the mesh: object units from a stroke's point to its source (the source is then
+    /// found in object space, see `surface_clone`).
+    pub(super) object: Option<glam::Vec3>,
 }
 
 /// The value of a composite tile's texel `i`, as the layer kernels blend it (`k_d`, `k_s`,
@@ -52,7 +55,7 @@ fn mask_gray(tiles: &[crate::layers::SharedMaskTile], maps: &MaterialMaps, x: u3
 
 /// What a texel of the map holds as a target: the composite's value, or the mask's gray.
 #[inline]
-fn value_at(
+pub(super) fn value_at(
     tiles: &[Arc<Tile>],
     mask: Option<&[crate::layers::SharedMaskTile]>,
     maps: &MaterialMaps,

@@ -34,7 +34,8 @@ impl SettingsCommand {
             | Self::SetApprox(_)
             | Self::SetStencil { .. }
             | Self::ClearStencil
-            | Self::SetCloneSource(_) => false,
+            | Self::SetCloneSource(_)
+            | Self::SetSurfaceCloneSource(_) => false,
         }
     }
 }

@@ -27,6 +27,7 @@ pub use super::mesh_ref::MeshRef;
 pub use id::DocumentId;
 pub use paths::MAX_LAYERS;
 mod stroke;
+mod surface_clone;
 
 pub use command::{
     AttachedBake, AttachedMesh, AttachedNormal, Command, FillRegion, HistoryCommand, ImportCommand,
@@ -374,6 +375,9 @@ impl Document {
                 self.aids.stencil_image = None;
             }
             SettingsCommand::SetCloneSource(at) => return self.set_clone_source(at),
+            SettingsCommand::SetSurfaceCloneSource(at) => {
+                return self.set_surface_clone_source(at);
+            }
         }
         Ok(())
     }

@@ -242,6 +242,7 @@ mod tests {
             "SetStencil",
             "ClearStencil",
             "SetCloneSource",
+            "SetSurfaceCloneSource",
             "BeginStroke",
             "StrokeTo",
             "EndStroke",

@@ -3,6 +3,7 @@
 use glam::{Vec2, Vec3};
 
 use super::copy_dab::{self, CloneSource};
+use super::surface_clone::{self, SourceGrid};
 use super::{Document, StrokeTool};
 use crate::ModelError;
 use crate::brush::BlendMode;
@@ -89,7 +90,7 @@ impl Document {
             StrokeTool::Eraser => (LayerStroke::Erase, "Eraser stroke"),
             StrokeTool::Blur => (LayerStroke::Brush(brush.blend), "Blur stroke"),
             StrokeTool::Clone => {
-                if self.aids.clone_source.is_none() {
+                if self.aids.clone_source.is_none() && self.aids.surface_clone_source.is_none() {
                     return Err(ModelError::Command(
                         "clone needs a source: set one first (SetCloneSource, or Ctrl+click in the editor)".into(),
                     ));
@@ -150,6 +151,7 @@ impl Document {
             stroke.clone = Some(CloneSource {
                 tiles: self.maps.tiles().to_vec(),
                 offset,
+                object: None,
             });
         }
         let Some(pos) = stroke.smoother.follow(point.pos) else {
@@ -178,10 +180,29 @@ impl Document {
         let Some(stroke) = &mut self.stroke else {
             return Ok(());
         };
-        if matches!(stroke.tool, StrokeTool::Clone | StrokeTool::Smudge) {
+        if stroke.tool == StrokeTool::Smudge {
             return Err(ModelError::Command(
-                "clone and smudge paint on the canvas (in texels); on the mesh they are not available yet".into(),
+                "smudge paints on the canvas (in texels); on the mesh it is not available yet"
+                    .into(),
             ));
+        }
+        if stroke.tool == StrokeTool::Clone && stroke.clone.is_none() {
+            // Aligned in object space: the offset from the first mesh clone stroke's first
+            // point, kept until a new source is set.
+            let Some(source) = self.aids.surface_clone_source else {
+                return Err(ModelError::Command(
+                    "clone on the mesh needs a source on the mesh: set one first (SetSurfaceCloneSource, or Ctrl+click on the mesh in the editor)".into(),
+                ));
+            };
+            let offset = *self
+                .aids
+                .surface_clone_offset
+                .get_or_insert(source - point.pos.point);
+            stroke.clone = Some(CloneSource {
+                tiles: self.maps.tiles().to_vec(),
+                offset: Vec2::ZERO,
+                object: Some(offset),
+            });
         }
         let Some(pos) = stroke.surface_smoother.follow(point.pos) else {
             return Ok(());
@@ -252,6 +273,11 @@ impl Document {
         let front = b.front_faces_only;
         for (center, normal) in dabs {
             let parts = stroke.parts();
+            // A mesh clone's sources near this dab, found in object space.
+            let grid = parts
+                .clone
+                .and_then(|c| c.object)
+                .map(|offset| SourceGrid::new(surface, center, radius, offset));
             let brush = parts.brush;
             let fp = BallFootprint {
                 surface,
@@ -265,7 +291,13 @@ impl Document {
                 state: &mut self.state,
                 compositor: &mut self.compositor,
             };
-            Self::dab_with(&mut to, parts, alpha, &fp, (Vec2::ZERO, None));
+            Self::dab_with(
+                &mut to,
+                parts,
+                alpha,
+                &fp,
+                (Vec2::ZERO, None, grid.as_ref()),
+            );
         }
     }
 
@@ -277,7 +309,7 @@ impl Document {
         stroke: StrokeParts<'_>,
         alpha: f32,
         fp: &impl Footprint,
-        (step, stencil): (Vec2, Option<&Stencil>),
+        (step, stencil, grid): (Vec2, Option<&Stencil>, Option<&SourceGrid<'_>>),
     ) {
         let StrokeParts {
             tool,
@@ -332,7 +364,19 @@ impl Document {
                     return;
                 };
                 let at = (maps, ids.as_slice());
-                copy_dab::clone_dab((planes, pre), target, coverage, at, source, &raise)
+                match grid {
+                    Some(grid) => surface_clone::surface_clone_dab(
+                        (planes, pre),
+                        target,
+                        coverage,
+                        at,
+                        (source, grid),
+                        &raise,
+                    ),
+                    None => {
+                        copy_dab::clone_dab((planes, pre), target, coverage, at, source, &raise)
+                    }
+                }
             }
             StrokeTool::Smudge => {
                 let strength = alpha * brush.opacity;
@@ -425,7 +469,7 @@ impl Document {
                 state: &mut self.state,
                 compositor: &mut self.compositor,
             };
-            Self::dab_with(&mut to, parts, alpha, &fp, (step, stencil.as_deref()));
+            Self::dab_with(&mut to, parts, alpha, &fp, (step, stencil.as_deref(), None));
         }
     }
 

@@ -1,0 +1,249 @@
+//! Clone on the mesh, in object space: a texel takes what the composite held (before the
+//! stroke) at the surface point nearest its own baked point moved by the stroke's offset.
+//! The source is found in object space, so a clone runs across UV seams: the nearest baked
+//! texel names the triangle, the point is projected onto that triangle, and its UV is read
+//! bilinearly from the composite.
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+
+use super::copy_dab::{CloneSource, value_at};
+use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes, TileTargets};
+use crate::maps::MaterialMaps;
+use crate::paint::Coverage;
+use crate::surface::Surface;
+use crate::tile::{TILE_SIZE, Tile, TileSpans};
+
+/// Packs a cell's coordinates (each within +-2^20) into one sortable key.
+fn key([x, y, z]: [i32; 3]) -> u64 {
+    const BIAS: i64 = 1 << 20;
+    let part = |v: i32| ((i64::from(v) + BIAS) as u64) & 0x1F_FFFF;
+    part(x) << 42 | part(y) << 21 | part(z)
+}
+
+/// The surface texels near a dab's source, in a grid of cubes, for nearest-texel queries.
+pub(super) struct SourceGrid<'a> {
+    surface: &'a Surface,
+    /// From a stroke's point to its source, object units.
+    offset: Vec3,
+    cell: f32,
+    /// The farthest a source may lie from the surface.
+    reach: f32,
+    /// (cell key, texel index), sorted by key.
+    texels: Vec<(u64, u32)>,
+}
+
+impl<'a> SourceGrid<'a> {
+    /// The grid for a dab at `center` of `radius` (object units), its source `offset` away.
+    pub(super) fn new(surface: &'a Surface, center: Vec3, radius: f32, offset: Vec3) -> Self {
+        let upt = surface.units_per_texel.max(f32::MIN_POSITIVE);
+        let cell = 2.0 * upt;
+        let reach = radius + 4.0 * upt;
+        let mut texels = Vec::new();
+        surface.visit_near(center + offset, radius + reach, |i, p| {
+            texels.push((key(Self::cell_of(p, cell)), i as u32));
+        });
+        texels.sort_unstable();
+        Self {
+            surface,
+            offset,
+            cell,
+            reach,
+            texels,
+        }
+    }
+
+    fn cell_of(p: Vec3, cell: f32) -> [i32; 3] {
+        (p / cell).floor().as_ivec3().to_array()
+    }
+
+    /// The baked texel nearest `q`, if one lies within the reach.
+    fn nearest(&self, q: Vec3) -> Option<usize> {
+        let c = Self::cell_of(q, self.cell);
+        let shells = (self.reach / self.cell).ceil() as i32 + 1;
+        let mut best: Option<(f32, usize)> = None;
+        for k in 0..=shells {
+            // A texel in shell k lies at least (k - 1) cells away: once the best is nearer,
+            // no later shell holds a nearer one.
+            if let Some((d2, _)) = best
+                && ((k - 1) as f32 * self.cell).powi(2) > d2
+            {
+                break;
+            }
+            for dz in -k..=k {
+                for dy in -k..=k {
+                    for dx in -k..=k {
+                        if dx.abs().max(dy.abs()).max(dz.abs()) != k {
+                            continue;
+                        }
+                        let kk = key([c[0] + dx, c[1] + dy, c[2] + dz]);
+                        let start = self.texels.partition_point(|&(k2, _)| k2 < kk);
+                        for &(k2, i) in &self.texels[start..] {
+                            if k2 != kk {
+                                break;
+                            }
+                            let d2 = self.surface.bake.position(i as usize).distance_squared(q);
+                            if best.is_none_or(|(b, _)| d2 < b) {
+                                best = Some((d2, i as usize));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        best.filter(|&(d2, _)| d2 <= self.reach * self.reach)
+            .map(|(_, i)| i)
+    }
+
+    /// Where on the map (texel units) the source of a texel whose point is `p` lies.
+    pub(super) fn source_texel(&self, p: Vec3) -> Option<Vec2> {
+        let q = p + self.offset;
+        let i = self.nearest(q)?;
+        let bake = &self.surface.bake;
+        let t = bake.triangle(i)?;
+        let uvs = self.surface.mesh.uvs.as_ref()?;
+        let corners = bake.corners(t);
+        let w = closest_on_triangle(q, corners);
+        let [a, b, c] = self.surface.mesh.triangles[t as usize].map(|v| uvs[v as usize]);
+        let uv = a * w.x + b * w.y + c * w.z;
+        Some(Vec2::new(
+            uv.x * bake.width as f32,
+            (1.0 - uv.y) * bake.height as f32,
+        ))
+    }
+}
+
+/// A clone dab on the mesh raising the stroke's coverage by `raise`: each texel it rose at
+/// takes its source's value (see the module's notes); a texel whose source lies off the
+/// surface is not written. Returns, per tile of `ids`, the texels written.
+pub(super) fn surface_clone_dab(
+    (planes, pre): (Planes<'_>, PrePlanes<'_>),
+    target: &LayerEdit,
+    coverage: &mut Coverage,
+    (maps, ids): (&MaterialMaps, &[usize]),
+    (source, grid): (&CloneSource, &SourceGrid<'_>),
+    raise: &impl edit::Raise,
+) -> Vec<TileSpans> {
+    let covers = coverage.tiles_mut(maps.tile_count(), ids);
+    let mask = match pre {
+        PrePlanes::Mask(m) => Some(m),
+        PrePlanes::Paint(_) => None,
+    };
+    let blend = crate::paint::n_blend_table();
+    let bake = &grid.surface.bake;
+    let w = maps.width() as usize;
+    let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
+        let rose = raise.raise(id, cover);
+        let rect = maps.tile_rect(id);
+        let mut written = TileSpans::EMPTY;
+        for (y, x0, x1) in rose.rows() {
+            let row = (rect.y0 as usize + y) * w + rect.x0 as usize;
+            for x in x0..x1 {
+                let k = y * TILE_SIZE + x;
+                let found = bake
+                    .triangle(row + x)
+                    .and_then(|_| grid.source_texel(bake.position(row + x)));
+                match found {
+                    Some(at) => targets[k] = bilinear(&source.tiles, mask, maps, at, blend),
+                    // Its source is off the surface for the whole stroke (the offset is fixed).
+                    None => cover[k] = 0.0,
+                }
+            }
+            written.include_run(y * TILE_SIZE + x0, y * TILE_SIZE + x1);
+        }
+        written
+    };
+    edit::edit_varying((planes, pre), target, ids, covers, &prepare)
+}
+
+/// The barycentric weights of the point of triangle `[a, b, c]` nearest `p`.
+fn closest_on_triangle(p: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
+    let (e0, e1, d) = (b - a, c - a, p - a);
+    let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
+    let (d20, d21) = (d.dot(e0), d.dot(e1));
+    let denom = d00 * d11 - d01 * d01;
+    if denom.abs() > f32::MIN_POSITIVE {
+        let v = (d11 * d20 - d01 * d21) / denom;
+        let w = (d00 * d21 - d01 * d20) / denom;
+        if v >= 0.0 && w >= 0.0 && v + w <= 1.0 {
+            return Vec3::new(1.0 - v - w, v, w);
+        }
+    }
+    // Outside (or degenerate): the nearest point of the three edges.
+    let edge = |p0: Vec3, p1: Vec3| {
+        let e = p1 - p0;
+        let len2 = e.length_squared();
+        let t = if len2 > 0.0 {
+            ((p - p0).dot(e) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (t, (p0 + e * t).distance_squared(p))
+    };
+    let (tab, dab) = edge(a, b);
+    let (tbc, dbc) = edge(b, c);
+    let (tca, dca) = edge(c, a);
+    if dab <= dbc && dab <= dca {
+        Vec3::new(1.0 - tab, tab, 0.0)
+    } else if dbc <= dca {
+        Vec3::new(0.0, 1.0 - tbc, tbc)
+    } else {
+        Vec3::new(tca, 0.0, 1.0 - tca)
+    }
+}
+
+/// The composite (or the mask's gray) at texel-unit point `at`, bilinear between texel
+/// centres and clamped to the map.
+pub(super) fn bilinear(
+    tiles: &[Arc<Tile>],
+    mask: Option<&[crate::layers::SharedMaskTile]>,
+    maps: &MaterialMaps,
+    at: Vec2,
+    blend: &[f32],
+) -> [f32; 7] {
+    let (w, h) = (i64::from(maps.width()), i64::from(maps.height()));
+    let p = at - 0.5;
+    let (x0, y0) = (p.x.floor(), p.y.floor());
+    let (fx, fy) = (p.x - x0, p.y - y0);
+    let mut out = [0.0_f32; 7];
+    for (dy, wy) in [(0, 1.0 - fy), (1, fy)] {
+        for (dx, wx) in [(0, 1.0 - fx), (1, fx)] {
+            let weight = wx * wy;
+            if weight <= 0.0 {
+                continue;
+            }
+            let x = (x0 as i64 + dx).clamp(0, w - 1) as u32;
+            let y = (y0 as i64 + dy).clamp(0, h - 1) as u32;
+            let v = value_at(tiles, mask, maps, (x, y), blend);
+            for (o, v) in out.iter_mut().zip(v) {
+                *o += v * weight;
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_nearest_point_of_a_triangle_is_inside_or_on_its_edges() {
+        let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let w = closest_on_triangle(Vec3::new(0.25, 0.25, 3.0), t);
+        assert!((w - Vec3::new(0.5, 0.25, 0.25)).length() < 1e-6, "{w}");
+        let w = closest_on_triangle(Vec3::new(2.0, -1.0, 0.0), t);
+        assert!((w - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-6, "{w}");
+        let w = closest_on_triangle(Vec3::new(0.5, -1.0, 0.0), t);
+        assert!((w - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6, "{w}");
+    }
+
+    #[test]
+    fn keys_keep_neighbouring_cells_apart() {
+        let a = key([0, 0, 0]);
+        assert_ne!(a, key([0, 0, 1]));
+        assert_ne!(a, key([-1, 0, 0]));
+        assert_ne!(key([1, 0, 0]), key([0, 1, 0]));
+    }
+}

@@ -1,0 +1,167 @@
+//! Issue 56, item 4 on the mesh: a clone stroke on the surface copies, in object space, what
+//! lay at its points moved by the offset from its first point to the source on the mesh,
+//! across the UV seam (the sphere's, at +X); bad input refused with the document unchanged.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use kapaint_model::brush::{BrushSettings, SurfacePoint, SurfacePos};
+use kapaint_model::surface::Surface;
+use kapaint_model::texel::{Texel, linear_to_srgb};
+use kapaint_model::{
+    Document, DocumentSettings, MaterialMaps, MaterialValue, SettingsCommand, StrokeCommand,
+    StrokeTool,
+};
+
+const SIDE: u32 = 512;
+
+/// What the source holds at a surface point: `k_d` changing smoothly over the sphere.
+fn pattern(p: Vec3) -> Vec3 {
+    Vec3::splat(0.5) + 0.4 * p
+}
+
+/// The sphere with `pattern` painted over every texel of its surface.
+fn painted_sphere() -> Document {
+    let surface = Surface::new(kapaint_mesh::uv_sphere(64, 32), SIDE, SIDE).expect("bake");
+    let base = MaterialValue::new(Vec3::splat(0.2), Vec3::splat(0.04), 10.0);
+    let mut maps = MaterialMaps::new(SIDE, SIDE, base).expect("maps");
+    for y in 0..SIDE {
+        for x in 0..SIDE {
+            let t = (y * SIDE + x) as usize;
+            if surface.bake.triangle(t).is_some() {
+                let v = MaterialValue::new(pattern(surface.bake.position(t)), base.ks, base.n);
+                let (id, i) = maps.locate(x, y);
+                maps.tile_mut(id).set_texel(i, Texel::encode(v));
+            }
+        }
+    }
+    let settings = DocumentSettings {
+        base,
+        ..DocumentSettings::default()
+    };
+    Document::from_parts(maps, settings)
+        .with_surface(Some(Arc::new(surface)))
+        .expect("surface")
+}
+
+fn equator(phi: f32) -> Vec3 {
+    Vec3::new(phi.cos(), 0.0, -phi.sin())
+}
+
+fn points(from: f32, to: f32, steps: usize) -> Vec<SurfacePoint> {
+    (0..=steps)
+        .map(|k| {
+            let p = equator(from + (to - from) * k as f32 / steps as f32);
+            SurfacePoint {
+                pos: SurfacePos {
+                    point: p,
+                    normal: p,
+                },
+                pressure: 1.0,
+            }
+        })
+        .collect()
+}
+
+fn srgb8(v: f32) -> f32 {
+    (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round()
+}
+
+#[test]
+fn a_clone_stroke_on_the_mesh_copies_its_source_across_the_uv_seam() {
+    let mut doc = painted_sphere();
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
+        radius_px: 10.0,
+        hardness: 1.0,
+        opacity: 1.0,
+        pressure_size: false,
+        ..BrushSettings::default()
+    }))
+    .expect("brush");
+    // The source a quarter of a unit above the stroke's first point, on the surface.
+    let first = equator(-0.3);
+    let source = (first + Vec3::Y * 0.25).normalize();
+    doc.apply(SettingsCommand::SetSurfaceCloneSource(source))
+        .expect("source");
+    let offset = source - first;
+    // Across the seam at longitude 0 (+X): the map's left and right edges.
+    doc.apply(StrokeCommand::SurfaceStroke {
+        tool: StrokeTool::Clone,
+        points: points(-0.3, 0.3, 60),
+    })
+    .expect("cloned");
+    assert_eq!(doc.surface_clone_source(), Some((source, Some(offset))));
+    let s = Arc::clone(doc.surface().expect("surface"));
+    let radius = 10.0 * s.units_per_texel;
+    let (mut checked, mut left, mut right, mut worst) = (0, 0, 0, 0.0_f32);
+    for y in 0..SIDE {
+        for x in 0..SIDE {
+            let t = (y * SIDE + x) as usize;
+            if s.bake.triangle(t).is_none()
+                || s.bake.coverage(t) != kapaint_mesh::bake::Coverage::Surface
+            {
+                continue;
+            }
+            let p = s.bake.position(t);
+            // Under the hard core: within half the radius of the stroke's arc, away from its
+            // ends.
+            let phi = (-p.z).atan2(p.x);
+            if p.y.abs() > 0.5 * radius || !(-0.25..=0.25).contains(&phi) {
+                continue;
+            }
+            let want = pattern((p + offset).normalize());
+            let got = doc.maps().value(x, y).kd;
+            for c in 0..3 {
+                worst = worst.max((srgb8(got[c]) - srgb8(want[c])).abs());
+            }
+            checked += 1;
+            left += usize::from(x < 16);
+            right += usize::from(x >= SIDE - 16);
+        }
+    }
+    eprintln!(
+        "mesh clone across the seam: {checked} texels under the core ({left} at the map's left edge, {right} at its right), worst {worst} levels (8-bit sRGB)"
+    );
+    assert!(
+        checked > 300 && left > 10 && right > 10,
+        "{checked} {left} {right}"
+    );
+    assert!(worst <= 1.0, "{worst} levels");
+    assert_eq!(doc.history().undo_steps().count(), 1);
+}
+
+#[test]
+fn a_mesh_clone_without_a_source_on_the_mesh_or_from_off_it_is_refused() {
+    let mut doc = painted_sphere();
+    let version = doc.version();
+    let e = doc
+        .apply(StrokeCommand::SurfaceStroke {
+            tool: StrokeTool::Clone,
+            points: points(0.0, 0.2, 4),
+        })
+        .expect_err("no source");
+    assert!(e.to_string().contains("source"), "{e}");
+    // A canvas source is not a mesh source.
+    doc.apply(SettingsCommand::SetCloneSource(glam::Vec2::new(10.0, 10.0)))
+        .expect("canvas source");
+    let e = doc
+        .apply(StrokeCommand::SurfaceStroke {
+            tool: StrokeTool::Clone,
+            points: points(0.0, 0.2, 4),
+        })
+        .expect_err("no mesh source");
+    assert!(e.to_string().contains("SetSurfaceCloneSource"), "{e}");
+    for bad in [Vec3::splat(3.0), Vec3::new(f32::NAN, 0.0, 0.0)] {
+        let e = doc
+            .apply(SettingsCommand::SetSurfaceCloneSource(bad))
+            .expect_err("off the mesh");
+        assert!(e.to_string().contains("not on the mesh"), "{e}");
+    }
+    assert!(doc.surface_clone_source().is_none());
+    assert_eq!(doc.version(), version);
+    assert_eq!(doc.history().undo_steps().count(), 0);
+}
