@@ -12,6 +12,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
+use crate::layers::SharedMaskTile;
 use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes, TileTargets};
 use crate::maps::MaterialMaps;
 use crate::paint::{Coverage, Footprint};
@@ -48,7 +49,7 @@ fn edit_value(tile: &Tile, i: usize, blend: &[f32]) -> [f32; 7] {
 
 /// A mask's stored gray at texel `(x, y)`.
 #[inline]
-fn mask_gray(tiles: &[crate::layers::SharedMaskTile], maps: &MaterialMaps, x: u32, y: u32) -> f32 {
+fn mask_gray(tiles: &[SharedMaskTile], maps: &MaterialMaps, x: u32, y: u32) -> f32 {
     let (id, i) = maps.locate(x, y);
     decode_unorm(tiles[id].get().get(i))
 }
@@ -57,7 +58,7 @@ fn mask_gray(tiles: &[crate::layers::SharedMaskTile], maps: &MaterialMaps, x: u3
 #[inline]
 pub(super) fn value_at(
     tiles: &[Arc<Tile>],
-    mask: Option<&[crate::layers::SharedMaskTile]>,
+    mask: Option<&[SharedMaskTile]>,
     maps: &MaterialMaps,
     (x, y): (u32, u32),
     blend: &[f32],
@@ -74,7 +75,7 @@ pub(super) fn value_at(
 /// clamped too), as targets: a tile at a time, with the row's texels in a plain loop.
 fn decode_row(
     tiles: &[Arc<Tile>],
-    mask: Option<&[crate::layers::SharedMaskTile]>,
+    mask: Option<&[SharedMaskTile]>,
     maps: &MaterialMaps,
     (x0, y): (i64, i64),
     out: &mut [[f32; 7]],
@@ -173,23 +174,44 @@ pub(super) fn smudge_dab(
 ) -> Vec<TileSpans> {
     let mut scratch: Vec<Vec<f32>> = ids.iter().map(|_| vec![0.0; TILE_TEXELS]).collect();
     let covers: Vec<&mut [f32]> = scratch.iter_mut().map(Vec::as_mut_slice).collect();
-    let blend = crate::paint::n_blend_table();
-    // Each dab blends from the layer as it is now (the dabs before it included).
-    let (now_paint, now_mask);
-    let (planes, pre, mask) = match planes {
+    from_now(planes, |planes, pre, mask| {
+        smudge_from(
+            (planes, pre, mask),
+            target,
+            (maps, ids),
+            (fp, strength, step),
+            covers,
+        )
+    })
+}
+
+/// Runs `f` on the planes, the same planes as they are now (what a smudge dab blends from:
+/// the dabs before it included), and a mask's own planes as they are now.
+pub(super) fn from_now<R>(
+    planes: Planes<'_>,
+    f: impl FnOnce(Planes<'_>, PrePlanes<'_>, Option<&[SharedMaskTile]>) -> R,
+) -> R {
+    match planes {
         Planes::Paint(tiles) => {
-            now_paint = tiles.to_vec();
-            (Planes::Paint(tiles), PrePlanes::Paint(&now_paint), None)
+            let now = tiles.to_vec();
+            f(Planes::Paint(tiles), PrePlanes::Paint(&now), None)
         }
         Planes::Mask(tiles) => {
-            now_mask = tiles.to_vec();
-            (
-                Planes::Mask(tiles),
-                PrePlanes::Mask(&now_mask),
-                Some(now_mask.as_slice()),
-            )
+            let now = tiles.to_vec();
+            f(Planes::Mask(tiles), PrePlanes::Mask(&now), Some(&now))
         }
-    };
+    }
+}
+
+/// [`smudge_dab`] once the planes as they are now are at hand.
+fn smudge_from(
+    (planes, pre, mask): (Planes<'_>, PrePlanes<'_>, Option<&[SharedMaskTile]>),
+    target: &LayerEdit,
+    (maps, ids): (&MaterialMaps, &[usize]),
+    (fp, strength, step): (&impl Footprint, f32, Vec2),
+    covers: Vec<&mut [f32]>,
+) -> Vec<TileSpans> {
+    let blend = crate::paint::n_blend_table();
     // Texel centres are whole texels apart, so every texel reads its four neighbours at the
     // same whole offset and with the same bilinear weights.
     // Texel (x, y) reads the point (x, y) - step between texel centres: (x + ix, y + iy)

@@ -27,7 +27,7 @@ pub use super::mesh_ref::MeshRef;
 pub use id::DocumentId;
 pub use paths::MAX_LAYERS;
 mod stroke;
-mod surface_clone;
+mod surface_copy;
 
 pub use command::{
     AttachedBake, AttachedMesh, AttachedNormal, Command, FillRegion, HistoryCommand, ImportCommand,

@@ -3,18 +3,17 @@
 use glam::{Vec2, Vec3};
 
 use super::copy_dab::{self, CloneSource};
-use super::surface_clone::{self, SourceGrid};
+use super::surface_copy::{self, SourceGrid};
+
+mod surface;
 use super::{Document, StrokeTool};
 use crate::ModelError;
 use crate::brush::BlendMode;
-use crate::brush::{
-    BrushSettings, DabPoint, Resampler, Smoother, StrokePoint, SurfacePoint, SurfacePos,
-};
+use crate::brush::{BrushSettings, Resampler, Smoother, StrokePoint, SurfacePos};
 use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes};
 use crate::layers::{Compositor, LayerStroke, State};
 use crate::maps::MaterialMaps;
 use crate::paint::{Coverage, DiscFootprint, Footprint, Stencil};
-use crate::surface::{BallFootprint, Surface};
 use crate::texel::Channels;
 use crate::tile::{TILE_SIZE, TileSpans};
 
@@ -39,6 +38,8 @@ pub(super) struct ActiveStroke {
     clone: Option<CloneSource>,
     /// A smudge stroke's last dab centres, one per mirrored copy.
     last_dabs: Vec<Vec2>,
+    /// The same on the mesh (object space).
+    last_surface_dabs: Vec<Vec3>,
 }
 
 /// The parts of a stroke a dab reads, borrowed apart so a footprint can hold the brush.
@@ -130,6 +131,7 @@ impl Document {
             brush,
             clone: None,
             last_dabs: Vec::new(),
+            last_surface_dabs: Vec::new(),
         });
         Ok(())
     }
@@ -171,56 +173,6 @@ impl Document {
         placed.map_err(|e| ModelError::Command(e.to_string()))
     }
 
-    /// [`Self::stroke_to`] on the mesh.
-    pub(super) fn surface_stroke_to(
-        &mut self,
-        surface: &Surface,
-        point: SurfacePoint,
-    ) -> Result<(), ModelError> {
-        let Some(stroke) = &mut self.stroke else {
-            return Ok(());
-        };
-        if stroke.tool == StrokeTool::Smudge {
-            return Err(ModelError::Command(
-                "smudge paints on the canvas (in texels); on the mesh it is not available yet"
-                    .into(),
-            ));
-        }
-        if stroke.tool == StrokeTool::Clone && stroke.clone.is_none() {
-            // Aligned in object space: the offset from the first mesh clone stroke's first
-            // point, kept until a new source is set.
-            let Some(source) = self.aids.surface_clone_source else {
-                return Err(ModelError::Command(
-                    "clone on the mesh needs a source on the mesh: set one first (SetSurfaceCloneSource, or Ctrl+click on the mesh in the editor)".into(),
-                ));
-            };
-            let offset = *self
-                .aids
-                .surface_clone_offset
-                .get_or_insert(source - point.pos.point);
-            stroke.clone = Some(CloneSource {
-                tiles: self.maps.tiles().to_vec(),
-                offset: Vec2::ZERO,
-                object: Some(offset),
-            });
-        }
-        let Some(pos) = stroke.surface_smoother.follow(point.pos) else {
-            return Ok(());
-        };
-        let mut dabs = Vec::new();
-        let placed = stroke.surface_resampler.push(
-            StrokePoint {
-                pos,
-                pressure: point.pressure,
-            },
-            &mut dabs,
-        );
-        for dab in dabs {
-            self.apply_surface_dab(surface, dab);
-        }
-        placed.map_err(|e| ModelError::Command(e.to_string()))
-    }
-
     /// Radius and alpha of a dab at `pressure`, in texels.
     fn dab_size(brush: &BrushSettings, pressure: f32) -> (f32, f32) {
         let radius = if brush.pressure_size {
@@ -234,71 +186,6 @@ impl Document {
             brush.flow
         };
         (radius, alpha)
-    }
-
-    /// One object-space dab and its mirrored copies.
-    fn apply_surface_dab(&mut self, surface: &Surface, dab: DabPoint<SurfacePos>) {
-        let Some(stroke) = &mut self.stroke else {
-            return;
-        };
-        let b = &stroke.brush;
-        let (radius_px, alpha) = Self::dab_size(b, dab.pressure);
-        let radius = radius_px * surface.units_per_texel;
-        let mut center = dab.pos.point;
-        let normal = if dab.pos.normal.length_squared() > 0.0 {
-            dab.pos.normal.normalize_or_zero()
-        } else {
-            surface.normal_near(center, radius).unwrap_or(Vec3::ZERO)
-        };
-        if b.jitter > 0.0 {
-            let (dx, dy) = (next_unit(&mut stroke.rng), next_unit(&mut stroke.rng));
-            let (t, u) = if normal == Vec3::ZERO {
-                (Vec3::X, Vec3::Y)
-            } else {
-                normal.any_orthonormal_pair()
-            };
-            center += (t * dx + u * dy) * (b.jitter * radius);
-        }
-        let mut dabs = vec![(center, normal)];
-        for (on, axis) in [(b.mirror_x, 0), (b.mirror_y, 1), (b.mirror_z, 2)] {
-            if on {
-                let flip = |mut v: Vec3| {
-                    v[axis] = -v[axis];
-                    v
-                };
-                let mirrored: Vec<_> = dabs.iter().map(|&(c, n)| (flip(c), flip(n))).collect();
-                dabs.extend(mirrored);
-            }
-        }
-        let front = b.front_faces_only;
-        for (center, normal) in dabs {
-            let parts = stroke.parts();
-            // A mesh clone's sources near this dab, found in object space.
-            let grid = parts
-                .clone
-                .and_then(|c| c.object)
-                .map(|offset| SourceGrid::new(surface, center, radius, offset));
-            let brush = parts.brush;
-            let fp = BallFootprint {
-                surface,
-                center,
-                radius,
-                normal: if front { normal } else { Vec3::ZERO },
-                brush,
-            };
-            let mut to = DabTarget {
-                maps: &mut self.maps,
-                state: &mut self.state,
-                compositor: &mut self.compositor,
-            };
-            Self::dab_with(
-                &mut to,
-                parts,
-                alpha,
-                &fp,
-                (Vec2::ZERO, None, grid.as_ref()),
-            );
-        }
     }
 
     /// Applies the stroke's tool through footprint `fp` (which may borrow `stroke.brush`) to
@@ -365,7 +252,7 @@ impl Document {
                 };
                 let at = (maps, ids.as_slice());
                 match grid {
-                    Some(grid) => surface_clone::surface_clone_dab(
+                    Some(grid) => surface_copy::surface_clone_dab(
                         (planes, pre),
                         target,
                         coverage,
@@ -380,7 +267,16 @@ impl Document {
             }
             StrokeTool::Smudge => {
                 let strength = alpha * brush.opacity;
-                copy_dab::smudge_dab(planes, target, (maps, &ids), fp, strength, step)
+                match grid {
+                    Some(grid) => surface_copy::surface_smudge_dab(
+                        planes,
+                        target,
+                        (maps, &ids),
+                        (fp, strength),
+                        grid,
+                    ),
+                    None => copy_dab::smudge_dab(planes, target, (maps, &ids), fp, strength, step),
+                }
             }
             StrokeTool::Blur => {
                 let ch = [channels.kd, channels.ks, channels.n];
@@ -394,11 +290,22 @@ impl Document {
                 )
             }
         };
+        Self::recomposite(to, &ids, written, &current);
+    }
+
+    /// Recomposites what a dab wrote in the tiles `ids` (all of a tile that was not up to
+    /// date before it).
+    fn recomposite(
+        to: &mut DabTarget<'_>,
+        ids: &[usize],
+        written: Vec<TileSpans>,
+        current: &[bool],
+    ) {
         let regions: Vec<_> = ids
             .iter()
             .zip(written)
             .zip(current)
-            .filter_map(|((&id, spans), current)| {
+            .filter_map(|((&id, spans), &current)| {
                 if !current {
                     Some((id, TileSpans::FULL))
                 } else if spans.is_empty() {

@@ -1,4 +1,5 @@
-//! Issue 56, item 4 on the mesh: a clone stroke on the surface copies, in object space, what
+//! Issue 56, items 4 and 5 on the mesh: a clone stroke on the surface copies, in object space,
+//! what
 //! lay at its points moved by the offset from its first point to the source on the mesh,
 //! across the UV seam (the sphere's, at +X); bad input refused with the document unchanged.
 #![expect(
@@ -164,4 +165,69 @@ fn a_mesh_clone_without_a_source_on_the_mesh_or_from_off_it_is_refused() {
     assert!(doc.surface_clone_source().is_none());
     assert_eq!(doc.version(), version);
     assert_eq!(doc.history().undo_steps().count(), 0);
+}
+
+#[test]
+fn a_smudge_on_the_mesh_carries_the_picked_colour_across_the_uv_seam() {
+    let surface = Surface::new(kapaint_mesh::uv_sphere(64, 32), SIDE, SIDE).expect("bake");
+    let settings = DocumentSettings {
+        base: MaterialValue::new(Vec3::splat(0.5), Vec3::splat(0.04), 10.0),
+        ..DocumentSettings::default()
+    };
+    let mut doc = Document::new(SIDE, SIDE, settings)
+        .expect("doc")
+        .with_surface(Some(Arc::new(surface)))
+        .expect("surface");
+    let brush = |doc: &mut Document, hardness: f32| {
+        doc.apply(SettingsCommand::SetBrush(BrushSettings {
+            radius_px: 16.0,
+            hardness,
+            opacity: 1.0,
+            pressure_size: false,
+            ..BrushSettings::default()
+        }))
+        .expect("brush");
+    };
+    let red = MaterialValue::new(Vec3::new(0.9, 0.05, 0.05), Vec3::splat(0.04), 10.0);
+    doc.apply(SettingsCommand::SetPrimary(red)).expect("red");
+    brush(&mut doc, 1.0);
+    doc.apply(StrokeCommand::SurfaceStroke {
+        tool: StrokeTool::Brush,
+        points: points(-0.32, -0.28, 4),
+    })
+    .expect("red spot");
+    brush(&mut doc, 0.7);
+    let texel = |phi: f32| {
+        let u = (phi / std::f32::consts::TAU).rem_euclid(1.0);
+        ((u * SIDE as f32) as u32).min(SIDE - 1)
+    };
+    assert!(
+        doc.maps().value(texel(0.01), SIDE / 2).kd.x < 0.6,
+        "grey past the seam before"
+    );
+    // From the spot across the seam at longitude 0.
+    let (from, to) = (-0.3_f32, 0.3_f32);
+    doc.apply(StrokeCommand::SurfaceStroke {
+        tool: StrokeTool::Smudge,
+        points: points(from, to, 120),
+    })
+    .expect("smudged");
+    // Along the equator (texel row SIDE / 2; u the longitude over 2 pi), how far the texels
+    // stay nearer the red than the grey base.
+    let steps = 600;
+    let carried = (0..steps)
+        .map(|k| from + (to - from) * k as f32 / steps as f32)
+        .take_while(|&phi| doc.maps().value(texel(phi), SIDE / 2).kd.x > 0.7)
+        .count();
+    let fraction = carried as f32 / steps as f32;
+    eprintln!(
+        "smudge on the mesh at opacity 1 carried the red {:.0} % of the stroke (across the seam)",
+        100.0 * fraction
+    );
+    assert!(fraction >= 0.8, "{fraction}");
+    assert!(
+        doc.maps().value(texel(0.01), SIDE / 2).kd.x > 0.7,
+        "past the seam"
+    );
+    assert_eq!(doc.history().undo_steps().count(), 2);
 }

@@ -1,19 +1,20 @@
-//! Clone on the mesh, in object space: a texel takes what the composite held (before the
-//! stroke) at the surface point nearest its own baked point moved by the stroke's offset.
-//! The source is found in object space, so a clone runs across UV seams: the nearest baked
-//! texel names the triangle, the point is projected onto that triangle, and its UV is read
-//! bilinearly from the composite.
+//! Clone and smudge on the mesh, in object space: a clone texel takes what the composite
+//! held (before the stroke) at the surface point nearest its own baked point moved by the
+//! stroke's offset; a smudge texel moves towards what the composite holds now one dab-step
+//! (object space) behind it. The source is found in object space, so both run across UV
+//! seams: the nearest baked texel names the triangle, the point is projected onto that
+//! triangle, and its UV is read bilinearly from the composite.
 
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::copy_dab::{CloneSource, value_at};
+use super::copy_dab::{CloneSource, from_now, value_at};
 use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes, TileTargets};
 use crate::maps::MaterialMaps;
-use crate::paint::Coverage;
+use crate::paint::{Coverage, Footprint};
 use crate::surface::Surface;
-use crate::tile::{TILE_SIZE, Tile, TileSpans};
+use crate::tile::{TILE_SIZE, TILE_TEXELS, Tile, TileSpans};
 
 /// Packs a cell's coordinates (each within +-2^20) into one sortable key.
 fn key([x, y, z]: [i32; 3]) -> u64 {
@@ -155,6 +156,49 @@ pub(super) fn surface_clone_dab(
         written
     };
     edit::edit_varying((planes, pre), target, ids, covers, &prepare)
+}
+
+/// A smudge dab on the mesh through `fp` at `strength`: each texel moves towards the
+/// composite as it is now at its point moved by the grid's offset (back along the step).
+/// Returns, per tile of `ids`, the texels written.
+pub(super) fn surface_smudge_dab(
+    planes: Planes<'_>,
+    target: &LayerEdit,
+    (maps, ids): (&MaterialMaps, &[usize]),
+    (fp, strength): (&impl Footprint, f32),
+    grid: &SourceGrid<'_>,
+) -> Vec<TileSpans> {
+    let mut scratch: Vec<Vec<f32>> = ids.iter().map(|_| vec![0.0; TILE_TEXELS]).collect();
+    let covers: Vec<&mut [f32]> = scratch.iter_mut().map(Vec::as_mut_slice).collect();
+    let blend = crate::paint::n_blend_table();
+    let bake = &grid.surface.bake;
+    let w = maps.width() as usize;
+    let tiles = maps.tiles();
+    from_now(planes, |planes, pre, mask| {
+        let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
+            let rect = maps.tile_rect(id);
+            let mut written = TileSpans::EMPTY;
+            fp.visit_runs(id, rect, |start, dab| {
+                for (k, &wgt) in dab.iter().enumerate() {
+                    let i = start + k;
+                    let a = (wgt * strength).min(1.0);
+                    let t =
+                        (rect.y0 as usize + i / TILE_SIZE) * w + rect.x0 as usize + i % TILE_SIZE;
+                    let found = (a > 0.0)
+                        .then(|| bake.triangle(t))
+                        .flatten()
+                        .and_then(|_| grid.source_texel(bake.position(t)));
+                    if let Some(at) = found {
+                        cover[i] = a;
+                        targets[i] = bilinear(tiles, mask, maps, at, blend);
+                        written.include(i);
+                    }
+                }
+            });
+            written
+        };
+        edit::edit_varying((planes, pre), target, ids, covers, &prepare)
+    })
 }
 
 /// The barycentric weights of the point of triangle `[a, b, c]` nearest `p`.
