@@ -559,6 +559,49 @@ fn projections(c: &mut Criterion) {
             doc.apply(HistoryCommand::Undo).expect("undo");
         });
     });
+    // Clone and smudge on the mesh (object space, the source found through the baked texels):
+    // the brush's 128-texel dab at spacing 10 %, around the sphere's equator.
+    doc.apply(SettingsCommand::SetBrush(BrushSettings {
+        spacing_percent: 10.0,
+        ..brush128()
+    }))
+    .expect("brush");
+    let units = doc.surface().map_or(1.0, |s| s.units_per_texel);
+    let on_equator = |k: u32| {
+        let phi = k as f32 * 12.8 * units;
+        let p = Vec3::new(phi.cos(), 0.0, -phi.sin());
+        kapaint::model::brush::SurfacePoint {
+            pos: kapaint::model::brush::SurfacePos {
+                point: p,
+                normal: p,
+            },
+            pressure: 1.0,
+        }
+    };
+    // The source a little above the stroke's start, as an artist picks one.
+    doc.apply(SettingsCommand::SetSurfaceCloneSource(
+        Vec3::new(1.0, 0.3, 0.0).normalize(),
+    ))
+    .expect("source");
+    for (name, tool) in [
+        ("clone_dab_on_mesh_128px", StrokeTool::Clone),
+        ("smudge_dab_on_mesh_128px", StrokeTool::Smudge),
+    ] {
+        let mut k = 0u32;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                if k.is_multiple_of(200) {
+                    doc.apply(StrokeCommand::EndStroke).expect("end");
+                    doc.apply(StrokeCommand::BeginStroke(tool)).expect("begin");
+                }
+                k += 1;
+                doc.apply(StrokeCommand::SurfaceStrokeTo(on_equator(k % 200)))
+                    .expect("dab");
+                doc.maps().version()
+            });
+        });
+        doc.apply(StrokeCommand::EndStroke).expect("end");
+    }
     group.finish();
 }
 

@@ -1,7 +1,8 @@
 //! Clone and smudge on the mesh, in object space: a clone texel takes what the composite
 //! held (before the stroke) at the surface point nearest its own baked point moved by the
 //! stroke's offset; a smudge texel moves towards what the composite holds now one dab-step
-//! (object space) behind it. The source is found in object space, so both run across UV
+//! (object space) behind it. Each dab's centre, moved so, is put back on the surface first,
+//! and its texels read at their displacement from there (see [`SourceGrid`]). The source is found in object space, so both run across UV
 //! seams: the nearest baked texel names the triangle, the point is projected onto that
 //! triangle, and its UV is read bilinearly from the composite.
 
@@ -24,35 +25,95 @@ fn key([x, y, z]: [i32; 3]) -> u64 {
 }
 
 /// The surface texels near a dab's source, in a grid of cubes, for nearest-texel queries.
+///
+/// The dab's centre moved by the offset is put back on the surface (its nearest surface
+/// point): each texel of the dab then reads the surface at its own displacement from that
+/// point, so a source far from the surface (an offset across a curved mesh) still lands on
+/// it, and every query starts within a few texels of the surface.
 pub(super) struct SourceGrid<'a> {
     surface: &'a Surface,
-    /// From a stroke's point to its source, object units.
-    offset: Vec3,
+    /// From a texel's point under this dab to its source's, object units.
+    shift: Vec3,
     cell: f32,
-    /// The farthest a source may lie from the surface.
+    /// The farthest a source may lie from the surface (a dab's rim on a differently curved
+    /// part of the mesh, beyond it, is not written).
     reach: f32,
-    /// (cell key, texel index), sorted by key.
-    texels: Vec<(u64, u32)>,
+    /// (cell key, texel index, its point), sorted by key.
+    texels: Vec<(u64, u32, Vec3)>,
+    /// The cells the texels lie in: a box of cells from `low`, `dims` a side, one bit a
+    /// cell set where a texel is (an empty cell costs a bit test, not a search).
+    low: [i32; 3],
+    dims: [i32; 3],
+    occupied: Vec<u64>,
 }
 
 impl<'a> SourceGrid<'a> {
-    /// The grid for a dab at `center` of `radius` (object units), its source `offset` away.
-    pub(super) fn new(surface: &'a Surface, center: Vec3, radius: f32, offset: Vec3) -> Self {
+    /// The grid for a dab at `center` of `radius` (object units), its source `offset` away;
+    /// `None` when no surface lies near the source.
+    pub(super) fn new(
+        surface: &'a Surface,
+        center: Vec3,
+        radius: f32,
+        offset: Vec3,
+    ) -> Option<Self> {
         let upt = surface.units_per_texel.max(f32::MIN_POSITIVE);
         let cell = 2.0 * upt;
-        let reach = radius + 4.0 * upt;
+        let reach = 6.0 * upt;
+        let source = center + offset;
+        // The surface point nearest the source, looked for ever further.
+        let (lo, hi) = surface.mesh.bounds();
+        let far = lo.distance(hi) + source.distance(0.5 * (lo + hi));
+        let mut r = 4.0 * upt;
+        let anchor = loop {
+            if let Some((p, _)) = surface.nearest(source, r) {
+                break p;
+            }
+            if !(r.is_finite() && r < far) {
+                return None;
+            }
+            r *= 4.0;
+        };
         let mut texels = Vec::new();
-        surface.visit_near(center + offset, radius + reach, |i, p| {
-            texels.push((key(Self::cell_of(p, cell)), i as u32));
+        let extent = radius + 2.0 * reach;
+        surface.visit_near(anchor, extent, |i, p| {
+            texels.push((key(Self::cell_of(p, cell)), i as u32, p));
         });
-        texels.sort_unstable();
-        Self {
+        texels.sort_unstable_by_key(|&(k, i, _)| (k, i));
+        let low = Self::cell_of(anchor - Vec3::splat(extent), cell);
+        let high = Self::cell_of(anchor + Vec3::splat(extent), cell);
+        let dims: [i32; 3] = std::array::from_fn(|a| high[a] - low[a] + 1);
+        let cells = dims.iter().map(|&d| d.max(1) as usize).product::<usize>();
+        let mut grid = Self {
             surface,
-            offset,
+            shift: anchor - center,
             cell,
             reach,
-            texels,
+            texels: Vec::new(),
+            low,
+            dims,
+            occupied: vec![0; cells.div_ceil(64)],
+        };
+        for &(_, _, p) in &texels {
+            if let Some(bit) = grid.bit(Self::cell_of(p, cell)) {
+                grid.occupied[bit / 64] |= 1 << (bit % 64);
+            }
         }
+        grid.texels = texels;
+        Some(grid)
+    }
+
+    /// The occupancy bit of cell `c`, if it is inside the box.
+    fn bit(&self, c: [i32; 3]) -> Option<usize> {
+        let l: [i32; 3] = std::array::from_fn(|a| c[a] - self.low[a]);
+        (0..3)
+            .all(|a| (0..self.dims[a]).contains(&l[a]))
+            .then(|| ((l[0] * self.dims[1] + l[1]) * self.dims[2] + l[2]) as usize)
+    }
+
+    /// Whether a texel lies in cell `c`.
+    fn occupied(&self, c: [i32; 3]) -> bool {
+        self.bit(c)
+            .is_some_and(|b| self.occupied[b / 64] & (1 << (b % 64)) != 0)
     }
 
     fn cell_of(p: Vec3, cell: f32) -> [i32; 3] {
@@ -63,6 +124,12 @@ impl<'a> SourceGrid<'a> {
     fn nearest(&self, q: Vec3) -> Option<usize> {
         let c = Self::cell_of(q, self.cell);
         let shells = (self.reach / self.cell).ceil() as i32 + 1;
+        // At most (2 shells + 1)^3 cells a query: the reach bounds the work.
+        if (0..3)
+            .any(|a| c[a] < self.low[a] - shells || c[a] >= self.low[a] + self.dims[a] + shells)
+        {
+            return None;
+        }
         let mut best: Option<(f32, usize)> = None;
         for k in 0..=shells {
             // A texel in shell k lies at least (k - 1) cells away: once the best is nearer,
@@ -78,13 +145,17 @@ impl<'a> SourceGrid<'a> {
                         if dx.abs().max(dy.abs()).max(dz.abs()) != k {
                             continue;
                         }
-                        let kk = key([c[0] + dx, c[1] + dy, c[2] + dz]);
-                        let start = self.texels.partition_point(|&(k2, _)| k2 < kk);
-                        for &(k2, i) in &self.texels[start..] {
+                        let cell = [c[0] + dx, c[1] + dy, c[2] + dz];
+                        if !self.occupied(cell) {
+                            continue;
+                        }
+                        let kk = key(cell);
+                        let start = self.texels.partition_point(|&(k2, _, _)| k2 < kk);
+                        for &(k2, i, p) in &self.texels[start..] {
                             if k2 != kk {
                                 break;
                             }
-                            let d2 = self.surface.bake.position(i as usize).distance_squared(q);
+                            let d2 = p.distance_squared(q);
                             if best.is_none_or(|(b, _)| d2 < b) {
                                 best = Some((d2, i as usize));
                             }
@@ -99,7 +170,7 @@ impl<'a> SourceGrid<'a> {
 
     /// Where on the map (texel units) the source of a texel whose point is `p` lies.
     pub(super) fn source_texel(&self, p: Vec3) -> Option<Vec2> {
-        let q = p + self.offset;
+        let q = p + self.shift;
         let i = self.nearest(q)?;
         let bake = &self.surface.bake;
         let t = bake.triangle(i)?;

@@ -121,7 +121,14 @@ impl Document {
                 Some(steps) => Some(-steps[k]),
                 None => parts.clone.and_then(|c| c.object),
             };
-            let grid = shift.map(|offset| SourceGrid::new(surface, center, radius, offset));
+            let grid = match shift {
+                Some(offset) => match SourceGrid::new(surface, center, radius, offset) {
+                    Some(grid) => Some(grid),
+                    // No surface near this dab's source: it copies nothing.
+                    None => continue,
+                },
+                None => None,
+            };
             let brush = parts.brush;
             let fp = BallFootprint {
                 surface,
