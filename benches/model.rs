@@ -559,8 +559,16 @@ fn projections(c: &mut Criterion) {
             doc.apply(HistoryCommand::Undo).expect("undo");
         });
     });
-    // Clone and smudge on the mesh (object space, the source found through the baked texels):
-    // the brush's 128-texel dab at spacing 10 %, around the sphere's equator.
+    mesh_copy_dabs(&mut group, &mut doc);
+    group.finish();
+}
+
+/// Clone and smudge on the mesh (object space, the source found through the baked texels):
+/// the brush's 128-texel dab at spacing 10 %, around the sphere's equator of `doc`.
+fn mesh_copy_dabs(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    doc: &mut Document,
+) {
     doc.apply(SettingsCommand::SetBrush(BrushSettings {
         spacing_percent: 10.0,
         ..brush128()
@@ -602,7 +610,6 @@ fn projections(c: &mut Criterion) {
         });
         doc.apply(StrokeCommand::EndStroke).expect("end");
     }
-    group.finish();
 }
 
 /// Saving and opening a 16-layer 4096^2 project (the stack of [`layered_stack`]: every
