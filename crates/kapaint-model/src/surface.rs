@@ -151,6 +151,12 @@ impl Surface {
 
     /// The baked surface texel nearest `point` within `radius`: its position and normal.
     pub fn nearest(&self, point: Vec3, radius: f32) -> Option<(Vec3, Vec3)> {
+        self.nearest_texel(point, radius)
+            .map(|i| (self.bake.position(i), self.bake.normal(i)))
+    }
+
+    /// The index of the baked surface texel nearest `point` within `radius`.
+    pub fn nearest_texel(&self, point: Vec3, radius: f32) -> Option<usize> {
         let mut best: Option<(f32, usize)> = None;
         self.visit_near(point, radius, |i, p| {
             let d2 = p.distance_squared(point);
@@ -158,7 +164,7 @@ impl Surface {
                 best = Some((d2, i));
             }
         });
-        best.map(|(_, i)| (self.bake.position(i), self.bake.normal(i)))
+        best.map(|(_, i)| i)
     }
 
     /// Calls `f` with the index and position of every baked surface texel (not padding)

@@ -1,7 +1,8 @@
 //! Issue 56, items 4 and 5 on the mesh: a clone stroke on the surface copies, in object space,
-//! what
-//! lay at its points moved by the offset from its first point to the source on the mesh,
-//! across the UV seam (the sphere's, at +X); bad input refused with the document unchanged.
+//! what lay about its dabs' centres moved by the offset from its first point to the source
+//! (each dab's patch laid on the surface there, turned as the surface turns), across the UV
+//! seam (the sphere's, at +X); a smudge drags along the surface across the seam too; bad
+//! input refused with the document unchanged.
 #![expect(
     clippy::expect_used,
     reason = "test helpers: a failed expectation is a failed test"
@@ -114,7 +115,13 @@ fn a_clone_stroke_on_the_mesh_copies_its_source_across_the_uv_seam() {
             if p.y.abs() > 0.5 * radius || !(-0.25..=0.25).contains(&phi) {
                 continue;
             }
-            let want = pattern((p + offset).normalize());
+            // The first dab to reach the texel (at coverage 1 it is the one that writes it):
+            // its centre c, its source's point a on the surface; the patch turned from c's
+            // normal to a's, which on the sphere is the turn taking c to a.
+            let reach = (radius * radius - p.y * p.y).max(0.0).sqrt();
+            let c = equator((phi - reach).max(-0.3));
+            let a = (c + offset).normalize();
+            let want = pattern(glam::Quat::from_rotation_arc(c, a) * p);
             let got = doc.maps().value(x, y).kd;
             for c in 0..3 {
                 worst = worst.max((srgb8(got[c]) - srgb8(want[c])).abs());

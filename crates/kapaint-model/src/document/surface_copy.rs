@@ -2,9 +2,10 @@
 //! held (before the stroke) at the surface point nearest its own baked point moved by the
 //! stroke's offset; a smudge texel moves towards what the composite holds now one dab-step
 //! (object space) behind it. Each dab's centre, moved so, is put back on the surface first,
-//! and its texels read at their displacement from there (see [`SourceGrid`]). The source is found in object space, so both run across UV
-//! seams: the nearest baked texel names the triangle, the point is projected onto that
-//! triangle, and its UV is read bilinearly from the composite.
+//! and its texels read at their displacement from there (see [`SourceGrid`]). The source is
+//! found in object space, so both run across UV seams: the nearest baked texel names the
+//! triangle, the point is projected onto that triangle, and its UV is read bilinearly from
+//! the composite.
 
 use std::sync::Arc;
 
@@ -17,103 +18,132 @@ use crate::paint::{Coverage, Footprint};
 use crate::surface::Surface;
 use crate::tile::{TILE_SIZE, TILE_TEXELS, Tile, TileSpans};
 
-/// Packs a cell's coordinates (each within +-2^20) into one sortable key.
-fn key([x, y, z]: [i32; 3]) -> u64 {
-    const BIAS: i64 = 1 << 20;
-    let part = |v: i32| ((i64::from(v) + BIAS) as u64) & 0x1F_FFFF;
-    part(x) << 42 | part(y) << 21 | part(z)
-}
+/// Most cells a grid keeps (4 bytes each): a larger box takes larger cells.
+const MAX_CELLS: usize = 1 << 22;
 
 /// The surface texels near a dab's source, in a grid of cubes, for nearest-texel queries.
 ///
 /// The dab's centre moved by the offset is put back on the surface (its nearest surface
-/// point): each texel of the dab then reads the surface at its own displacement from that
-/// point, so a source far from the surface (an offset across a curved mesh) still lands on
-/// it, and every query starts within a few texels of the surface.
+/// point, the anchor): each texel of the dab then reads the surface at its own displacement
+/// from the dab's centre, turned as the surface turns from there to the anchor (the shortest
+/// turn from the dab's normal to the anchor's), so the patch lies on the surface where the
+/// source is, whichever way it faces, and every query starts within a few texels of it. The texels are sorted by
+/// cell over the box they span (each cell's run found by its index, no search).
 pub(super) struct SourceGrid<'a> {
     surface: &'a Surface,
-    /// From a texel's point under this dab to its source's, object units.
-    shift: Vec3,
+    /// The dab's centre, and where its source lies on the surface.
+    center: Vec3,
+    anchor: Vec3,
+    /// The turn from the dab's normal to the anchor's.
+    turn: glam::Quat,
     cell: f32,
     /// The farthest a source may lie from the surface (a dab's rim on a differently curved
     /// part of the mesh, beyond it, is not written).
     reach: f32,
-    /// (cell key, texel index, its point), sorted by key.
-    texels: Vec<(u64, u32, Vec3)>,
-    /// The cells the texels lie in: a box of cells from `low`, `dims` a side, one bit a
-    /// cell set where a texel is (an empty cell costs a bit test, not a search).
+    /// The box of cells: its first cell and its size in cells.
     low: [i32; 3],
     dims: [i32; 3],
-    occupied: Vec<u64>,
+    /// Where each cell's texels start in `points` and `texels` (one more entry at the end).
+    starts: Vec<u32>,
+    points: Vec<Vec3>,
+    texels: Vec<u32>,
 }
 
 impl<'a> SourceGrid<'a> {
-    /// The grid for a dab at `center` of `radius` (object units), its source `offset` away;
-    /// `None` when no surface lies near the source.
+    /// The grid for a dab at `center` (facing `normal`, zero: unknown) of `radius` (object
+    /// units), its source `offset` away; `None` when no surface lies near the source.
     pub(super) fn new(
         surface: &'a Surface,
-        center: Vec3,
+        (center, normal): (Vec3, Vec3),
         radius: f32,
         offset: Vec3,
     ) -> Option<Self> {
         let upt = surface.units_per_texel.max(f32::MIN_POSITIVE);
-        let cell = 2.0 * upt;
         let reach = 6.0 * upt;
         let source = center + offset;
         // The surface point nearest the source, looked for ever further.
         let (lo, hi) = surface.mesh.bounds();
         let far = lo.distance(hi) + source.distance(0.5 * (lo + hi));
         let mut r = 4.0 * upt;
-        let anchor = loop {
-            if let Some((p, _)) = surface.nearest(source, r) {
-                break p;
+        let near = loop {
+            if let Some(i) = surface.nearest_texel(source, r) {
+                break i;
             }
             if !(r.is_finite() && r < far) {
                 return None;
             }
             r *= 4.0;
         };
-        let mut texels = Vec::new();
-        let extent = radius + 2.0 * reach;
-        surface.visit_near(anchor, extent, |i, p| {
-            texels.push((key(Self::cell_of(p, cell)), i as u32, p));
+        // On the surface itself: the nearest texel's triangle's nearest point (a texel's
+        // centre would shift the whole patch by up to half a texel).
+        let (anchor, anchor_normal) = surface_point(surface, source, near);
+        let turn = if normal.length_squared() > 0.0 && anchor_normal.length_squared() > 0.0 {
+            glam::Quat::from_rotation_arc(normal.normalize(), anchor_normal)
+        } else {
+            glam::Quat::IDENTITY
+        };
+        let mut found: Vec<(u32, Vec3)> = Vec::new();
+        let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        surface.visit_near(anchor, radius + 2.0 * reach, |i, p| {
+            found.push((i as u32, p));
+            min = min.min(p);
+            max = max.max(p);
         });
-        texels.sort_unstable_by_key(|&(k, i, _)| (k, i));
-        let low = Self::cell_of(anchor - Vec3::splat(extent), cell);
-        let high = Self::cell_of(anchor + Vec3::splat(extent), cell);
-        let dims: [i32; 3] = std::array::from_fn(|a| high[a] - low[a] + 1);
-        let cells = dims.iter().map(|&d| d.max(1) as usize).product::<usize>();
+        if found.is_empty() {
+            return None;
+        }
+        // Cells of two texels, or larger where the box would hold too many.
+        let mut cell = 2.0 * upt;
+        let (low, dims, cells) = loop {
+            let low = Self::cell_of(min, cell);
+            let high = Self::cell_of(max, cell);
+            let dims: [i32; 3] = std::array::from_fn(|a| high[a] - low[a] + 1);
+            let cells = dims.iter().map(|&d| d as usize).product::<usize>();
+            if cells <= MAX_CELLS {
+                break (low, dims, cells);
+            }
+            cell *= 2.0;
+        };
         let mut grid = Self {
             surface,
-            shift: anchor - center,
+            center,
+            anchor,
+            turn,
             cell,
-            reach,
-            texels: Vec::new(),
+            reach: reach.max(cell),
             low,
             dims,
-            occupied: vec![0; cells.div_ceil(64)],
+            starts: vec![0; cells + 1],
+            points: vec![Vec3::ZERO; found.len()],
+            texels: vec![0; found.len()],
         };
-        for &(_, _, p) in &texels {
-            if let Some(bit) = grid.bit(Self::cell_of(p, cell)) {
-                grid.occupied[bit / 64] |= 1 << (bit % 64);
-            }
+        // A counting sort by cell.
+        let index: Vec<usize> = found
+            .iter()
+            .map(|&(_, p)| grid.index(Self::cell_of(p, cell)).unwrap_or(0))
+            .collect();
+        for &c in &index {
+            grid.starts[c + 1] += 1;
         }
-        grid.texels = texels;
+        for c in 0..cells {
+            grid.starts[c + 1] += grid.starts[c];
+        }
+        let mut next = grid.starts.clone();
+        for (&(i, p), &c) in found.iter().zip(&index) {
+            let at = next[c] as usize;
+            next[c] += 1;
+            grid.points[at] = p;
+            grid.texels[at] = i;
+        }
         Some(grid)
     }
 
-    /// The occupancy bit of cell `c`, if it is inside the box.
-    fn bit(&self, c: [i32; 3]) -> Option<usize> {
+    /// The index of cell `c` in the box, if it is inside it.
+    fn index(&self, c: [i32; 3]) -> Option<usize> {
         let l: [i32; 3] = std::array::from_fn(|a| c[a] - self.low[a]);
         (0..3)
             .all(|a| (0..self.dims[a]).contains(&l[a]))
-            .then(|| ((l[0] * self.dims[1] + l[1]) * self.dims[2] + l[2]) as usize)
-    }
-
-    /// Whether a texel lies in cell `c`.
-    fn occupied(&self, c: [i32; 3]) -> bool {
-        self.bit(c)
-            .is_some_and(|b| self.occupied[b / 64] & (1 << (b % 64)) != 0)
+            .then(|| ((l[2] * self.dims[1] + l[1]) * self.dims[0] + l[0]) as usize)
     }
 
     fn cell_of(p: Vec3, cell: f32) -> [i32; 3] {
@@ -145,16 +175,11 @@ impl<'a> SourceGrid<'a> {
                         if dx.abs().max(dy.abs()).max(dz.abs()) != k {
                             continue;
                         }
-                        let cell = [c[0] + dx, c[1] + dy, c[2] + dz];
-                        if !self.occupied(cell) {
+                        let Some(cell) = self.index([c[0] + dx, c[1] + dy, c[2] + dz]) else {
                             continue;
-                        }
-                        let kk = key(cell);
-                        let start = self.texels.partition_point(|&(k2, _, _)| k2 < kk);
-                        for &(k2, i, p) in &self.texels[start..] {
-                            if k2 != kk {
-                                break;
-                            }
+                        };
+                        let run = self.starts[cell] as usize..self.starts[cell + 1] as usize;
+                        for (&p, &i) in self.points[run.clone()].iter().zip(&self.texels[run]) {
                             let d2 = p.distance_squared(q);
                             if best.is_none_or(|(b, _)| d2 < b) {
                                 best = Some((d2, i as usize));
@@ -170,7 +195,7 @@ impl<'a> SourceGrid<'a> {
 
     /// Where on the map (texel units) the source of a texel whose point is `p` lies.
     pub(super) fn source_texel(&self, p: Vec3) -> Option<Vec2> {
-        let q = p + self.shift;
+        let q = self.anchor + self.turn * (p - self.center);
         let i = self.nearest(q)?;
         let bake = &self.surface.bake;
         let t = bake.triangle(i)?;
@@ -272,6 +297,23 @@ pub(super) fn surface_smudge_dab(
     })
 }
 
+/// The point of the surface nearest `q`, and its normal, on the triangle of the baked texel
+/// `near` (the texel nearest `q`).
+fn surface_point(surface: &Surface, q: Vec3, near: usize) -> (Vec3, Vec3) {
+    let bake = &surface.bake;
+    let Some(t) = bake.triangle(near) else {
+        return (bake.position(near), bake.normal(near));
+    };
+    let corners = bake.corners(t);
+    let w = closest_on_triangle(q, corners);
+    let [a, b, c] = bake.corner_normals(t);
+    let normal = (a * w.x + b * w.y + c * w.z).normalize_or_zero();
+    (
+        corners[0] * w.x + corners[1] * w.y + corners[2] * w.z,
+        normal,
+    )
+}
+
 /// The barycentric weights of the point of triangle `[a, b, c]` nearest `p`.
 fn closest_on_triangle(p: Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
     let (e0, e1, d) = (b - a, c - a, p - a);
@@ -352,13 +394,5 @@ mod tests {
         assert!((w - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-6, "{w}");
         let w = closest_on_triangle(Vec3::new(0.5, -1.0, 0.0), t);
         assert!((w - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6, "{w}");
-    }
-
-    #[test]
-    fn keys_keep_neighbouring_cells_apart() {
-        let a = key([0, 0, 0]);
-        assert_ne!(a, key([0, 0, 1]));
-        assert_ne!(a, key([-1, 0, 0]));
-        assert_ne!(key([1, 0, 0]), key([0, 1, 0]));
     }
 }

@@ -122,7 +122,7 @@ impl Document {
                 None => parts.clone.and_then(|c| c.object),
             };
             let grid = match shift {
-                Some(offset) => match SourceGrid::new(surface, center, radius, offset) {
+                Some(offset) => match SourceGrid::new(surface, (center, normal), radius, offset) {
                     Some(grid) => Some(grid),
                     // No surface near this dab's source: it copies nothing.
                     None => continue,
