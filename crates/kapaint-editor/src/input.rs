@@ -66,6 +66,12 @@ impl EditorState {
         }
         let actions: Vec<Action> = ctx.input_mut(|i| keys::pressed_actions(&mut i.events));
         self.act(&actions);
+        // Enter commits what the active tool is placing (a decal). Not a binding of the
+        // keymap, which takes the keys it matches out of the frame's events: Enter stays for
+        // a prompt or a field that answers to it.
+        if self.tools.busy() && ctx.input(|i| i.key_pressed(Key::Enter)) {
+            self.tool_event(ToolEvent::Commit);
+        }
     }
 
     /// Does what key bindings (or the menu entries showing them) do, in order; the brush's
@@ -110,7 +116,6 @@ impl EditorState {
                 Action::HarderBrush => brush.hardness = (brush.hardness + 0.1).min(1.0),
                 Action::SmallerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.0 / 1.25),
                 Action::LargerBrush => self.tool_panel.brush_size.scale(&mut brush, 1.25),
-                Action::Commit => self.tool_event(ToolEvent::Commit),
                 Action::Abort => {
                     self.tool_event(ToolEvent::Escape);
                     // The button stays with nobody until it is released and pressed again:

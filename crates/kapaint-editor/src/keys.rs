@@ -43,8 +43,6 @@ pub enum Action {
     HarderBrush,
     /// Abandon the stroke or gradient under way.
     Abort,
-    /// Commit what is being placed (a decal).
-    Commit,
     /// Show the keyboard shortcuts.
     Shortcuts,
     /// A new paint layer above the selected one.
@@ -158,12 +156,6 @@ const EDITOR_KEYS: &[Binding] = &[
         Key::Escape,
         Action::Abort,
         "abandon the stroke or gradient under way; take back the decal being placed",
-    ),
-    bind(
-        NONE,
-        Key::Enter,
-        Action::Commit,
-        "commit the decal being placed",
     ),
 ];
 
@@ -287,7 +279,6 @@ mod tests {
             Action::SofterBrush,
             Action::HarderBrush,
             Action::Abort,
-            Action::Commit,
             Action::NewLayer,
             Action::DuplicateLayer,
             Action::MergeDown,
