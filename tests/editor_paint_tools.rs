@@ -150,3 +150,63 @@ fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
     harness.run();
     assert!(harness.state().state.doc().stencil().is_none());
 }
+
+#[test]
+fn ctrl_click_on_the_mesh_sets_the_clone_source_and_its_marker_shows_there() {
+    let mut harness = editor();
+    harness.key_press(egui::Key::S);
+    harness.run();
+    assert!(harness.state().state.viewport_clone_marker().is_none());
+    let centre = harness.get_by_label(VIEWPORT_LABEL).rect().center();
+    let ctrl_click = |pressed| egui::Event::PointerButton {
+        pos: centre,
+        button: egui::PointerButton::Primary,
+        pressed,
+        modifiers: Modifiers::COMMAND,
+    };
+    harness.event(egui::Event::ModifiersChanged(Modifiers::COMMAND));
+    harness.event(egui::Event::PointerMoved(centre));
+    harness.step();
+    harness.event(ctrl_click(true));
+    harness.step();
+    harness.event(ctrl_click(false));
+    harness.event(egui::Event::ModifiersChanged(Modifiers::default()));
+    harness.run();
+    let (source, offset) = harness
+        .state()
+        .state
+        .doc()
+        .surface_clone_source()
+        .expect("a source on the mesh");
+    assert!(offset.is_none());
+    assert!(
+        (source.length() - 1.0).abs() < 0.02,
+        "on the sphere: {source}"
+    );
+    assert_eq!(labels(harness.state()), Vec::<String>::new(), "no step");
+    // The marker sits where the source was picked, wherever the pointer is.
+    harness.hover_at(centre + Vec2::new(50.0, 30.0));
+    harness.run();
+    let marker = harness
+        .state()
+        .state
+        .viewport_clone_marker()
+        .expect("the marker");
+    assert!(marker.distance(centre) < 2.0, "{marker:?} vs {centre:?}");
+    // A clone stroke on the mesh from there: one step, and the marker then follows the
+    // pointer at the stroke's offset.
+    let from = centre + Vec2::new(-60.0, 40.0);
+    drag(&mut harness, from, from + Vec2::new(30.0, 0.0));
+    assert_eq!(labels(harness.state()), ["Clone stroke"]);
+    harness.hover_at(from);
+    harness.run();
+    let marker = harness
+        .state()
+        .state
+        .viewport_clone_marker()
+        .expect("the marker");
+    assert!(
+        marker.distance(centre) < 6.0,
+        "at the pointer plus the offset, back at the source: {marker:?} vs {centre:?}"
+    );
+}

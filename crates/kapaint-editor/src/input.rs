@@ -34,6 +34,8 @@ pub(super) struct Pointer {
     pub(super) texels_per_point: Option<f32>,
     /// The brush circle drawn on the UV canvas this frame: centre and radius in points.
     pub(super) canvas_outline: Option<(egui::Pos2, f32)>,
+    /// The mesh clone source's marker drawn in the viewport this frame.
+    pub(super) viewport_clone_marker: Option<egui::Pos2>,
     /// The pen's last pressure in the current stroke (1 with a mouse).
     pub(super) pressure: f32,
 }
@@ -47,6 +49,7 @@ impl Default for Pointer {
             hover_tab: None,
             texels_per_point: None,
             canvas_outline: None,
+            viewport_clone_marker: None,
             pressure: 1.0,
         }
     }
@@ -330,21 +333,7 @@ impl EditorState {
                         (Some(offset), Some(p)) if response.hovered() => p + offset,
                         _ => source,
                     };
-                    let c = at(marker);
-                    for (width, colour) in
-                        [(3.0, egui::Color32::BLACK), (1.0, egui::Color32::WHITE)]
-                    {
-                        let stroke = egui::Stroke::new(width, colour);
-                        painter.circle_stroke(c, 6.0, stroke);
-                        painter.line_segment(
-                            [c - egui::vec2(10.0, 0.0), c + egui::vec2(10.0, 0.0)],
-                            stroke,
-                        );
-                        painter.line_segment(
-                            [c - egui::vec2(0.0, 10.0), c + egui::vec2(0.0, 10.0)],
-                            stroke,
-                        );
-                    }
+                    clone_marker(&painter, at(marker));
                 }
             }
             None => {}
@@ -431,6 +420,40 @@ impl EditorState {
                     egui::Stroke::new(1.0, egui::Color32::WHITE),
                 ));
         }
+        self.draw_viewport_clone_marker(response, rect);
+    }
+
+    /// The mesh clone source's marker in the viewport: at the source on the surface; once a
+    /// stroke fixed the offset, at the surface under the pointer plus that offset.
+    fn draw_viewport_clone_marker(&mut self, response: &egui::Response, rect: egui::Rect) {
+        self.pointer.viewport_clone_marker = None;
+        let Some((source, offset)) = self.doc.surface_clone_source() else {
+            return;
+        };
+        if self.tools.overlay() != Some(Overlay::CloneSource) {
+            return;
+        }
+        let hover = response.hover_pos();
+        let hit = hover.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
+        let world = match (offset, hit) {
+            (Some(offset), Some(hit)) => hit.position + offset,
+            _ => source,
+        };
+        let picture = self
+            .viewport
+            .picture_at(rect, hover.unwrap_or(rect.center()));
+        let view_proj = self
+            .viewport
+            .camera
+            .view_proj(picture.width() / picture.height().max(1.0));
+        if let Some(c) = crate::project(view_proj, picture, world) {
+            let painter = response
+                .ctx
+                .layer_painter(response.layer_id)
+                .with_clip_rect(response.rect);
+            clone_marker(&painter, c);
+            self.pointer.viewport_clone_marker = Some(c);
+        }
     }
 
     /// What the viewport draws this frame: the light in the world (turned with the camera
@@ -513,4 +536,20 @@ fn pointer_samples(ctx: &egui::Context) -> Vec<Sample> {
             })
             .collect()
     })
+}
+
+/// The clone source's marker at `c`: a circle and a cross, white over black.
+fn clone_marker(painter: &egui::Painter, c: egui::Pos2) {
+    for (width, colour) in [(3.0, egui::Color32::BLACK), (1.0, egui::Color32::WHITE)] {
+        let stroke = egui::Stroke::new(width, colour);
+        painter.circle_stroke(c, 6.0, stroke);
+        painter.line_segment(
+            [c - egui::vec2(10.0, 0.0), c + egui::vec2(10.0, 0.0)],
+            stroke,
+        );
+        painter.line_segment(
+            [c - egui::vec2(0.0, 10.0), c + egui::vec2(0.0, 10.0)],
+            stroke,
+        );
+    }
 }

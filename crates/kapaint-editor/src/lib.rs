@@ -237,6 +237,11 @@ impl EditorState {
         self.pointer.canvas_outline
     }
 
+    /// Where the mesh clone source's marker was drawn in the viewport this frame.
+    pub fn viewport_clone_marker(&self) -> Option<egui::Pos2> {
+        self.pointer.viewport_clone_marker
+    }
+
     /// What the open file dialog is for, if one is open.
     pub fn file_dialog_open_for(&self) -> Option<files::FilePurpose> {
         self.dialogs.files.open_for()
