@@ -52,6 +52,9 @@ fn a_decal_is_placed_moved_committed_and_taken_back_in_the_viewport() {
     harness.key_press(egui::Key::D);
     harness.run();
     assert_eq!(harness.state().state.tools().active().name(), "decal");
+    // The brush's settings are not the decal's: the panel shows the decal's own.
+    assert_eq!(harness.query_all_by_label("Hardness").count(), 0);
+    assert!(harness.query_all_by_label("Rotation").count() > 0);
     harness
         .get_by_role_and_label(Role::Button, "Choose…")
         .click();
@@ -99,6 +102,7 @@ fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
     files.set_system_dialog(answer);
     harness.key_press(egui::Key::B);
     harness.run();
+    assert!(harness.query_all_by_label("Hardness").count() > 0);
     harness
         .get_by_role_and_label(Role::Button, "Load stencil…")
         .click();

@@ -54,24 +54,10 @@ impl ToolPanel {
         if crate::stencil_view::paints_through(desk.tools.active()) {
             crate::stencil_view::panel_ui(ui, desk);
         }
-        ui.separator();
-        ui.heading("Brush settings");
-        presets.brush_ui(ui, desk);
-        let mut brush = doc.settings().brush.clone();
-        self.brush_size
-            .radius_ui(ui, &mut brush, desk.texels_per_point);
-        ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
-            .on_hover_text("Shift+[ and Shift+] change the hardness");
-        ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
-        ui.add(egui::Slider::new(&mut brush.flow, 0.0..=1.0).text("Flow"));
-        ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing %"));
-        ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
-        ui.checkbox(&mut brush.pressure_size, "Pressure: size");
-        ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
-        self.stamp_ui(ui, &mut brush, desk);
-        stroke_options_ui(ui, &mut brush);
-        if brush != doc.settings().brush {
-            desk.command(SettingsCommand::SetBrush(brush));
+        // The brush's settings with the tools that paint with the brush (not a decal's
+        // placement, a fill, a gradient or the picker).
+        if desk.tools.active_meta().cursor == kapaint_tools::ToolCursor::BrushOutline {
+            self.brush_ui(ui, desk, presets);
         }
         ui.separator();
         ui.heading("Material");
@@ -136,6 +122,31 @@ impl ToolPanel {
         self.recent_materials_ui(ui, desk);
         ui.separator();
         channels_ui(ui, desk);
+    }
+
+    /// The brush's settings: its preset, size, hardness, opacity, flow, spacing, jitter,
+    /// pressure, stamp and the stroke's options.
+    fn brush_ui(&mut self, ui: &mut egui::Ui, desk: &mut Desk, presets: &mut Presets) {
+        let doc = desk.doc;
+        ui.separator();
+        ui.heading("Brush settings");
+        presets.brush_ui(ui, desk);
+        let mut brush = doc.settings().brush.clone();
+        self.brush_size
+            .radius_ui(ui, &mut brush, desk.texels_per_point);
+        ui.add(egui::Slider::new(&mut brush.hardness, 0.0..=1.0).text("Hardness"))
+            .on_hover_text("Shift+[ and Shift+] change the hardness");
+        ui.add(egui::Slider::new(&mut brush.opacity, 0.0..=1.0).text("Opacity"));
+        ui.add(egui::Slider::new(&mut brush.flow, 0.0..=1.0).text("Flow"));
+        ui.add(egui::Slider::new(&mut brush.spacing_percent, 1.0..=200.0).text("Spacing %"));
+        ui.add(egui::Slider::new(&mut brush.jitter, 0.0..=1.0).text("Jitter"));
+        ui.checkbox(&mut brush.pressure_size, "Pressure: size");
+        ui.checkbox(&mut brush.pressure_opacity, "Pressure: opacity");
+        self.stamp_ui(ui, &mut brush, desk);
+        stroke_options_ui(ui, &mut brush);
+        if brush != doc.settings().brush {
+            desk.command(SettingsCommand::SetBrush(brush));
+        }
     }
 
     /// The brush's stamp row: a preview of the stamp, the built-in grain, loading one from an
