@@ -155,6 +155,27 @@ impl Surface {
             .map(|i| (self.bake.position(i), self.bake.normal(i)))
     }
 
+    /// The index of the baked surface texel nearest `point`, however far: looked for within
+    /// `start`, then four times as far, and so on until the ball holds the whole mesh (the
+    /// index costs what it visits, so a point near the surface is found cheaply).
+    pub fn nearest_texel_from(&self, point: Vec3, start: f32) -> Option<usize> {
+        if !point.is_finite() {
+            return None;
+        }
+        let (lo, hi) = self.mesh.bounds();
+        let far = lo.distance(hi) + point.distance(0.5 * (lo + hi));
+        let mut r = start.max(self.units_per_texel).max(f32::MIN_POSITIVE);
+        loop {
+            if let Some(i) = self.nearest_texel(point, r) {
+                return Some(i);
+            }
+            if !(r.is_finite() && r < far) {
+                return None;
+            }
+            r *= 4.0;
+        }
+    }
+
     /// The index of the baked surface texel nearest `point` within `radius`.
     pub fn nearest_texel(&self, point: Vec3, radius: f32) -> Option<usize> {
         let mut best: Option<(f32, usize)> = None;

@@ -238,3 +238,28 @@ fn a_smudge_on_the_mesh_carries_the_picked_colour_across_the_uv_seam() {
     );
     assert_eq!(doc.history().undo_steps().count(), 2);
 }
+
+#[test]
+fn the_nearest_surface_texel_is_found_from_near_or_far_and_never_from_nowhere() {
+    let s = Surface::new(kapaint_mesh::uv_sphere(32, 16), 128, 128).expect("bake");
+    // The texel nearest a point is the one whose baked point is nearest, however far the
+    // point lies and whatever radius the search starts from.
+    for (point, start) in [
+        (Vec3::new(0.2, 0.9, 0.1), 0.01),
+        (Vec3::new(30.0, -5.0, 2.0), 0.01),
+        (Vec3::new(-0.1, 0.05, 0.0), 100.0),
+    ] {
+        let found = s.nearest_texel_from(point, start).expect("a texel");
+        let want = (0..128 * 128)
+            .filter(|&i| s.bake.coverage(i) == kapaint_mesh::bake::Coverage::Surface)
+            .map(|i| s.bake.position(i).distance(point))
+            .fold(f32::INFINITY, f32::min);
+        let got = s.bake.position(found).distance(point);
+        assert!((got - want).abs() < 1e-5, "{point}: {got} vs {want}");
+    }
+    assert_eq!(
+        s.nearest_texel_from(Vec3::new(f32::NAN, 0.0, 0.0), 1.0),
+        None
+    );
+    assert_eq!(s.nearest_texel_from(Vec3::splat(f32::INFINITY), 1.0), None);
+}

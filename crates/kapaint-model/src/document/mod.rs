@@ -457,7 +457,7 @@ impl Document {
                 self.decal_run = if placed.is_ok() {
                     id
                 } else {
-                    decal_run.filter(|_| decal_run == id)
+                    decal_run.filter(|&run| Some(run) == id)
                 };
                 placed
             }

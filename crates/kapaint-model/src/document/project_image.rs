@@ -221,22 +221,12 @@ impl Document {
             )));
         }
         let radius = 0.5 * spec.size * (1.0 + aspect * aspect).sqrt();
-        // The nearest surface, looked for ever further (the index costs what it visits).
-        let (lo, hi) = surface.mesh.bounds();
-        let reach = lo.distance(hi).max(spec.size);
-        let mut r = spec.size;
-        let found = loop {
-            if let Some(found) = surface.nearest(spec.at, r) {
-                break found;
-            }
-            if r > 2.0 * reach + spec.at.length() {
-                return Err(ModelError::Command(
-                    "the decal finds no surface near its point".into(),
-                ));
-            }
-            r *= 4.0;
+        let Some(near) = surface.nearest_texel_from(spec.at, spec.size) else {
+            return Err(ModelError::Command(
+                "the decal finds no surface near its point".into(),
+            ));
         };
-        let (origin, normal) = found;
+        let (origin, normal) = (surface.bake.position(near), surface.bake.normal(near));
         let reference = if normal.dot(Vec3::Y).abs() > 0.99 {
             Vec3::NEG_Z
         } else {

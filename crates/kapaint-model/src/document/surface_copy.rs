@@ -27,8 +27,9 @@ const MAX_CELLS: usize = 1 << 22;
 /// point, the anchor): each texel of the dab then reads the surface at its own displacement
 /// from the dab's centre, turned as the surface turns from there to the anchor (the shortest
 /// turn from the dab's normal to the anchor's), so the patch lies on the surface where the
-/// source is, whichever way it faces, and every query starts within a few texels of it. The texels are sorted by
-/// cell over the box they span (each cell's run found by its index, no search).
+/// source is, whichever way it faces, and every query starts within a few texels of it. The
+/// texels are sorted by cell over the box they span (each cell's run found by its index, no
+/// search).
 pub(super) struct SourceGrid<'a> {
     surface: &'a Surface,
     /// The dab's centre, and where its source lies on the surface.
@@ -61,19 +62,7 @@ impl<'a> SourceGrid<'a> {
         let upt = surface.units_per_texel.max(f32::MIN_POSITIVE);
         let reach = 6.0 * upt;
         let source = center + offset;
-        // The surface point nearest the source, looked for ever further.
-        let (lo, hi) = surface.mesh.bounds();
-        let far = lo.distance(hi) + source.distance(0.5 * (lo + hi));
-        let mut r = 4.0 * upt;
-        let near = loop {
-            if let Some(i) = surface.nearest_texel(source, r) {
-                break i;
-            }
-            if !(r.is_finite() && r < far) {
-                return None;
-            }
-            r *= 4.0;
-        };
+        let near = surface.nearest_texel_from(source, 4.0 * upt)?;
         // On the surface itself: the nearest texel's triangle's nearest point (a texel's
         // centre would shift the whole patch by up to half a texel).
         let (anchor, anchor_normal) = surface_point(surface, source, near);
@@ -243,7 +232,8 @@ pub(super) fn surface_clone_dab(
                     .and_then(|_| grid.source_texel(bake.position(row + x)));
                 match found {
                     Some(at) => targets[k] = bilinear(&source.tiles, mask, maps, at, blend),
-                    // Its source is off the surface for the whole stroke (the offset is fixed).
+                    // Its source lies off the surface as this dab lays it: not written (a later
+                    // dab of the stroke may reach it from elsewhere).
                     None => cover[k] = 0.0,
                 }
             }
