@@ -9,6 +9,7 @@ use egui::{Color32, Pos2, Rect, TextureHandle};
 use glam::Vec2;
 
 use kapaint_model::paint::Stencil;
+use kapaint_model::paint_image::Pixels;
 use kapaint_model::{Document, SettingsCommand};
 use kapaint_tools::ToolKind;
 
@@ -83,10 +84,30 @@ pub(crate) fn dragged(
 /// The stencil's picture on the canvas, made once per image.
 #[derive(Default)]
 pub(crate) struct StencilOverlay {
-    texture: Option<(usize, TextureHandle)>,
+    /// The image shown (held, so it is known by itself, never by an address another image
+    /// may come to have) and its picture.
+    texture: Option<(Arc<Pixels>, TextureHandle)>,
 }
 
 impl StencilOverlay {
+    /// The picture of `stencil`'s image, made when the image is not the one shown.
+    fn texture(&mut self, ctx: &egui::Context, stencil: &Stencil) -> &TextureHandle {
+        let shown = &stencil.image;
+        if self
+            .texture
+            .as_ref()
+            .is_some_and(|(image, _)| !Arc::ptr_eq(image, shown))
+        {
+            self.texture = None;
+        }
+        let (_, texture) = self.texture.get_or_insert_with(|| {
+            let picture = picture(stencil);
+            let texture = ctx.load_texture("stencil", picture, egui::TextureOptions::LINEAR);
+            (Arc::clone(shown), texture)
+        });
+        texture
+    }
+
     /// Draws `stencil` over the map shown in `map` (a `size` map): its picture, translucent,
     /// and its frame.
     pub(crate) fn draw(
@@ -96,15 +117,7 @@ impl StencilOverlay {
         size: (u32, u32),
         stencil: &Stencil,
     ) {
-        let key = Arc::as_ptr(&stencil.image) as usize;
-        if self.texture.as_ref().is_none_or(|(k, _)| *k != key) {
-            let picture = picture(stencil);
-            let texture =
-                painter
-                    .ctx()
-                    .load_texture("stencil", picture, egui::TextureOptions::LINEAR);
-            self.texture = Some((key, texture));
-        }
+        let texture = self.texture(painter.ctx(), stencil).id();
         let to_screen =
             |p: Vec2| map.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * map.size();
         let (sin, cos) = stencil.rotation.to_radians().sin_cos();
@@ -119,8 +132,8 @@ impl StencilOverlay {
             corner(1.0, 1.0),
             corner(-1.0, 1.0),
         ];
-        if let Some((_, texture)) = &self.texture {
-            let mut mesh = egui::Mesh::with_texture(texture.id());
+        {
+            let mut mesh = egui::Mesh::with_texture(texture);
             let uvs = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
             for (pos, (u, v)) in corners.into_iter().zip(uvs) {
                 mesh.vertices.push(egui::epaint::Vertex {
@@ -206,5 +219,48 @@ pub(crate) fn panel_ui(ui: &mut egui::Ui, desk: &mut Desk) {
         && let Some(command) = place(doc, p)
     {
         desk.command(command);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stencil of an 8 x 8 image of one grey.
+    fn stencil(grey: u8) -> Stencil {
+        let image = image::DynamicImage::ImageLuma8(image::GrayImage::from_pixel(
+            8,
+            8,
+            image::Luma([grey]),
+        ));
+        let image = kapaint_model::paint_image::PaintImage::decoded(
+            std::path::Path::new("stencil.png"),
+            &image,
+        )
+        .expect("decoded");
+        let pixels = Arc::clone(image.pixels().expect("loaded"));
+        Stencil::new(pixels, Vec2::ZERO, 8.0, 0.0)
+    }
+
+    /// Regression: the picture was known by the address of the image it showed, and a new
+    /// image allocated where a dropped one had been kept the old picture.
+    #[test]
+    fn a_new_image_gets_its_own_picture_even_where_the_old_one_lay() {
+        let ctx = egui::Context::default();
+        let mut overlay = StencilOverlay::default();
+        let first = stencil(255);
+        let shown = overlay.texture(&ctx, &first).id();
+        assert_eq!(overlay.texture(&ctx, &first).id(), shown, "made once");
+        drop(first);
+        // The same size of image again, as often as it takes the allocator to reuse the
+        // old place (it usually does at once).
+        for _ in 0..64 {
+            let next = stencil(0);
+            assert_ne!(
+                overlay.texture(&ctx, &next).id(),
+                shown,
+                "another image, the old picture"
+            );
+        }
     }
 }
