@@ -91,12 +91,17 @@ impl DecalTool {
         self.placing
     }
 
+    /// Its width: the one set, else a fifth of the mesh's size.
+    fn width(&self, doc: &Document) -> f32 {
+        self.size.unwrap_or_else(|| 0.2 * mesh_size(doc))
+    }
+
     /// The decal at `at` as the options say, if an image is chosen.
     fn decal(&self, at: Vec3, doc: &Document) -> Option<Decal> {
         Some(Decal {
             image: self.image.clone()?,
             at,
-            size: self.size.unwrap_or_else(|| 0.2 * mesh_size(doc)),
+            size: self.width(doc),
             rotation: self.rotation,
             channels: doc.settings().channels,
             opacity: self.opacity,
@@ -145,9 +150,7 @@ impl Tool for DecalTool {
                 if self.image.is_none() {
                     return Vec::new();
                 }
-                if self.size.is_none() {
-                    self.size = Some(0.2 * mesh_size(doc));
-                }
+                self.size = Some(self.width(doc));
                 self.dragging = true;
                 self.placing = Some(p);
                 self.preview(doc)
@@ -157,7 +160,7 @@ impl Tool for DecalTool {
                     return Vec::new();
                 };
                 // Moves under a hundredth of its size are not worth laying it again.
-                let step = 0.01 * self.size.unwrap_or(1.0);
+                let step = 0.01 * self.width(doc);
                 if self.placing.is_some_and(|q| q.distance(p) < step) {
                     return Vec::new();
                 }
@@ -203,7 +206,7 @@ impl Tool for DecalTool {
                 label: "Size",
                 hover: "Width in object units (the height by the image's aspect)",
                 widget: OptionWidget::Slider {
-                    value: self.size.unwrap_or(0.2 * size),
+                    value: self.width(doc),
                     min: 0.001 * size,
                     max: size,
                     integer: false,

@@ -182,8 +182,16 @@ impl<'a> SourceGrid<'a> {
             .map(|(_, i)| i)
     }
 
+    /// Where on the map (texel units) the source of texel `t` (its index in the map) lies;
+    /// none for a texel off the mesh or a source off the surface.
+    fn source_of(&self, t: usize) -> Option<Vec2> {
+        let bake = &self.surface.bake;
+        bake.triangle(t)?;
+        self.source_texel(bake.position(t))
+    }
+
     /// Where on the map (texel units) the source of a texel whose point is `p` lies.
-    pub(super) fn source_texel(&self, p: Vec3) -> Option<Vec2> {
+    fn source_texel(&self, p: Vec3) -> Option<Vec2> {
         let q = self.anchor + self.turn * (p - self.center);
         let i = self.nearest(q)?;
         let bake = &self.surface.bake;
@@ -217,7 +225,6 @@ pub(super) fn surface_clone_dab(
         PrePlanes::Paint(_) => None,
     };
     let blend = crate::paint::n_blend_table();
-    let bake = &grid.surface.bake;
     let w = maps.width() as usize;
     let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
         let rose = raise.raise(id, cover);
@@ -227,10 +234,7 @@ pub(super) fn surface_clone_dab(
             let row = (rect.y0 as usize + y) * w + rect.x0 as usize;
             for x in x0..x1 {
                 let k = y * TILE_SIZE + x;
-                let found = bake
-                    .triangle(row + x)
-                    .and_then(|_| grid.source_texel(bake.position(row + x)));
-                match found {
+                match grid.source_of(row + x) {
                     Some(at) => targets[k] = bilinear(&source.tiles, mask, maps, at, blend),
                     // Its source lies off the surface as this dab lays it: not written (a later
                     // dab of the stroke may reach it from elsewhere).
@@ -257,7 +261,6 @@ pub(super) fn surface_smudge_dab(
     let mut scratch: Vec<Vec<f32>> = ids.iter().map(|_| vec![0.0; TILE_TEXELS]).collect();
     let covers: Vec<&mut [f32]> = scratch.iter_mut().map(Vec::as_mut_slice).collect();
     let blend = crate::paint::n_blend_table();
-    let bake = &grid.surface.bake;
     let w = maps.width() as usize;
     let tiles = maps.tiles();
     from_now(planes, |planes, pre, mask| {
@@ -270,11 +273,7 @@ pub(super) fn surface_smudge_dab(
                     let a = (wgt * strength).min(1.0);
                     let t =
                         (rect.y0 as usize + i / TILE_SIZE) * w + rect.x0 as usize + i % TILE_SIZE;
-                    let found = (a > 0.0)
-                        .then(|| bake.triangle(t))
-                        .flatten()
-                        .and_then(|_| grid.source_texel(bake.position(t)));
-                    if let Some(at) = found {
+                    if let Some(at) = (a > 0.0).then(|| grid.source_of(t)).flatten() {
                         cover[i] = a;
                         targets[i] = bilinear(tiles, mask, maps, at, blend);
                         written.include(i);
