@@ -460,6 +460,7 @@ fn tool_dabs(c: &mut Criterion) {
                 rotation: 15.0,
                 opacity: 1.0,
                 tiled: true,
+                view: None,
             })
             .expect("stencil");
         }

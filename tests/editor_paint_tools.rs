@@ -94,8 +94,9 @@ fn a_decal_is_placed_moved_committed_and_taken_back_in_the_viewport() {
     assert_eq!(texels(harness.state()), blank);
 }
 
-#[test]
-fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
+/// The editor with the brush chosen (its settings shown) and a stencil loaded through the
+/// panel.
+fn editor_with_stencil() -> egui_kittest::Harness<'static, Editor> {
     let mut harness = editor();
     let files = harness.state_mut().state.files_mut();
     files.force(FileDialogBackend::System);
@@ -110,6 +111,12 @@ fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
     wait_until(&mut harness, "stencil loaded", |e| {
         e.state.doc().stencil().is_some()
     });
+    harness
+}
+
+#[test]
+fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
+    let mut harness = editor_with_stencil();
     let stencil = |e: &Editor| {
         let s = e.state.doc().stencil().expect("stencil");
         (s.center, s.size, s.rotation)
@@ -153,6 +160,110 @@ fn the_stencil_is_loaded_placed_by_right_drags_and_painted_through() {
     harness.get_by_role_and_label(Role::Button, "Clear").click();
     harness.run();
     assert!(harness.state().state.doc().stencil().is_none());
+}
+
+#[test]
+fn a_stencil_on_the_viewport_follows_the_camera_moves_by_a_drag_on_it_and_holds_strokes_back() {
+    let mut harness = editor_with_stencil();
+    let stencil = |e: &Editor| {
+        e.state
+            .doc()
+            .stencil()
+            .map(|s| (**s).clone())
+            .expect("stencil")
+    };
+    assert!(
+        stencil(harness.state()).view.is_none(),
+        "on the canvas first"
+    );
+    // On the viewport: over the middle of its picture, half its width wide.
+    // (Below the brush's settings: scrolled to first, as a user would.)
+    harness.get_by_label("Viewport").scroll_to_me();
+    harness.run_steps(2);
+    harness.get_by_label("Viewport").click();
+    harness.run_steps(2);
+    let viewport = harness.get_by_label(VIEWPORT_LABEL).rect();
+    let placed = stencil(harness.state());
+    let view = placed.view.expect("on the screen");
+    assert!(
+        (view.size.x - viewport.width()).abs() < 1.0
+            && (view.size.y - viewport.height()).abs() < 1.0,
+        "{:?} for a viewport of {:?}",
+        view.size,
+        viewport.size()
+    );
+    assert_eq!(placed.center, view.size * 0.5);
+    // A right-drag that starts on it moves it, and the camera stays.
+    right_drag_from(
+        &mut harness,
+        viewport.center(),
+        Modifiers::default(),
+        Vec2::new(40.0, 0.0),
+    );
+    let moved = stencil(harness.state());
+    assert!(
+        (moved.center.x - placed.center.x - 40.0).abs() < 4.0
+            && (moved.center.y - placed.center.y).abs() < 1.0,
+        "{} from {}",
+        moved.center,
+        placed.center
+    );
+    assert_eq!(moved.view, placed.view, "the camera did not move");
+    // One that starts off it orbits the camera; the stencil stays where it is on the screen,
+    // on the new view.
+    let corner = viewport.min + Vec2::new(12.0, viewport.height() - 12.0);
+    right_drag_from(
+        &mut harness,
+        corner,
+        Modifiers::default(),
+        Vec2::new(40.0, 0.0),
+    );
+    let orbited = stencil(harness.state());
+    assert_eq!(orbited.center, moved.center);
+    let eye = |s: &kapaint::model::paint::Stencil| s.view.expect("view").eye;
+    assert!(
+        eye(&orbited).distance(eye(&moved)) > 0.05,
+        "the camera orbited"
+    );
+    // A stroke on the mesh through it paints; with the stencil moved off the picture, the
+    // same stroke is held back.
+    let centre = viewport.center();
+    let before = texels(harness.state());
+    drag(&mut harness, centre, centre + Vec2::new(30.0, 0.0));
+    let painted = texels(harness.state());
+    assert!(changed(&before, &painted) > 0, "painted through");
+    let image = harness
+        .state()
+        .state
+        .doc()
+        .stencil_image()
+        .cloned()
+        .expect("image");
+    harness
+        .state_mut()
+        .state
+        .apply_command(kapaint::model::SettingsCommand::SetStencil {
+            image,
+            center: glam::Vec2::splat(-10_000.0),
+            size: orbited.size,
+            rotation: 0.0,
+            opacity: 1.0,
+            tiled: false,
+            view: orbited.view,
+        });
+    harness.run();
+    drag(
+        &mut harness,
+        centre + Vec2::new(0.0, 20.0),
+        centre + Vec2::new(30.0, 20.0),
+    );
+    assert_eq!(changed(&painted, &texels(harness.state())), 0, "held back");
+    // Back on the canvas, the viewport's right button orbits wherever it starts.
+    harness.get_by_label("Canvas").scroll_to_me();
+    harness.run_steps(2);
+    harness.get_by_label("Canvas").click();
+    harness.run_steps(2);
+    assert!(stencil(harness.state()).view.is_none());
 }
 
 #[test]

@@ -245,7 +245,7 @@ impl Editor {
         s.jobs.waker = Some(ctx.clone());
         s.poll_job();
         let busy = s.busy();
-        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.seen());
         s.jobs.bake_on_demand.look(busy, &mut desk);
         let asks = desk.into_asks();
         s.carry_out(asks);
@@ -253,7 +253,7 @@ impl Editor {
         s.hotkeys(&ctx);
         s.follow_mesh();
         let channel = s.canvas_target();
-        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.seen());
         crate::panels::bars::dropped_files(&ctx, channel, &mut desk);
         let asks = desk.into_asks();
         s.carry_out(asks);
@@ -268,7 +268,7 @@ impl Editor {
         }
         s.pointer.shown_hover = s.pointer.hover.take();
         s.pointer.hover_tab = None;
-        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+        let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.seen());
         egui::Panel::top("menu").show(ui, |ui| {
             crate::panels::bars::menu_ui(ui, &s.project.recent, &mut desk);
         });
@@ -331,7 +331,7 @@ impl Editor {
 /// of a job the editor waits for.
 fn windows(s: &mut EditorState, ctx: &egui::Context) {
     let dirty = s.dirty();
-    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.seen());
     let export = (&mut s.dialogs.export, &mut s.dialogs.export_choice);
     crate::export_dialog::export_window(export, s.project.path.as_deref(), ctx, &mut desk);
     let new = (&mut s.dialogs.new, &mut s.dialogs.pending_new);
@@ -340,7 +340,7 @@ fn windows(s: &mut EditorState, ctx: &egui::Context) {
     crate::bake::bake_window(&mut s.dialogs.bake, ctx, &mut desk);
     let asks = desk.into_asks();
     s.carry_out(asks);
-    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.seen());
     let offer = &mut s.prompts.recovery_offer;
     crate::dialogs::recovery_window(offer, &mut s.project, ctx, &mut desk);
     crate::dialogs::shortcuts_window(&mut s.dialogs.shortcuts_open, ctx);
@@ -350,7 +350,7 @@ fn windows(s: &mut EditorState, ctx: &egui::Context) {
     s.carry_out(asks);
     crate::panels::bars::notices_ui(&mut s.notices, ctx);
     let dirty = s.dirty();
-    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.texels_per_point);
+    let mut desk = Desk::new(&s.doc, &s.tools, s.pointer.seen());
     s.prompts.close_window(ctx, dirty, &mut desk);
     s.prompts.open_window(ctx, &mut desk);
     s.project.claim.prompt(ctx, &mut desk);

@@ -36,7 +36,7 @@ impl EditorState {
                 Ask::ChooseFile(purpose) => self.choose_file(purpose),
                 Ask::Notice(notice) => self.notices.push(notice),
                 Ask::LayGenerator(generator) => {
-                    let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+                    let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.seen());
                     self.jobs.bake_on_demand.lay(generator, &mut desk);
                     let asks = desk.into_asks();
                     self.carry_out(asks);

@@ -6,6 +6,7 @@
 
 use std::path::PathBuf;
 
+use kapaint_model::paint::ScreenView;
 use kapaint_model::{Command, Document};
 use kapaint_tools::{OptionChange, ToolKind, Tools};
 
@@ -24,7 +25,19 @@ pub(crate) struct Desk<'a> {
     pub(crate) tools: &'a Tools,
     /// Texels per screen point under the cursor (canvas zoom, or the surface's scale).
     pub(crate) texels_per_point: Option<f32>,
+    /// The view the viewport's picture shows (none without a viewport drawn).
+    pub(crate) screen_view: Option<ScreenView>,
     asks: Vec<Ask>,
+}
+
+/// What the pointer's views tell the panels and the jobs: the scale under the cursor, the
+/// viewport's view.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Seen {
+    /// Texels per screen point under the cursor.
+    pub(crate) texels_per_point: Option<f32>,
+    /// The viewport's view.
+    pub(crate) screen_view: Option<ScreenView>,
 }
 
 /// What a view or a finished job asks of the editor.
@@ -104,11 +117,12 @@ pub(crate) enum Prompt {
 
 impl<'a> Desk<'a> {
     /// A desk over the document and the tools, with nothing asked yet.
-    pub(crate) fn new(doc: &'a Document, tools: &'a Tools, texels_per_point: Option<f32>) -> Self {
+    pub(crate) fn new(doc: &'a Document, tools: &'a Tools, seen: Seen) -> Self {
         Self {
             doc,
             tools,
-            texels_per_point,
+            texels_per_point: seen.texels_per_point,
+            screen_view: seen.screen_view,
             asks: Vec::new(),
         }
     }

@@ -19,6 +19,7 @@ use crate::export_dialog::ExportDialog;
 use crate::files::FilePurpose;
 use crate::keys::{self, Action};
 use kapaint_model::brush::SurfacePos;
+use kapaint_model::paint::ScreenView;
 
 /// Where the pointer is and what it holds.
 pub(super) struct Pointer {
@@ -36,6 +37,8 @@ pub(super) struct Pointer {
     pub(super) canvas_outline: Option<(egui::Pos2, f32)>,
     /// The mesh clone source's marker drawn in the viewport this frame.
     pub(super) viewport_clone_marker: Option<egui::Pos2>,
+    /// The view the viewport's picture showed last frame (its size in points).
+    pub(super) screen_view: Option<ScreenView>,
     /// The pen's last pressure in the current stroke (1 with a mouse).
     pub(super) pressure: f32,
 }
@@ -50,7 +53,18 @@ impl Default for Pointer {
             texels_per_point: None,
             canvas_outline: None,
             viewport_clone_marker: None,
+            screen_view: None,
             pressure: 1.0,
+        }
+    }
+}
+
+impl Pointer {
+    /// What the panels and jobs may know of the views.
+    pub(super) fn seen(&self) -> crate::desk::Seen {
+        crate::desk::Seen {
+            texels_per_point: self.texels_per_point,
+            screen_view: self.screen_view,
         }
     }
 }
@@ -294,7 +308,8 @@ impl EditorState {
             && self.pointer.held.is_none()
             && crate::stencil_view::paints_through(self.tools.active())
         {
-            self.canvas.stencil.draw(&painter, rect, size, &stencil);
+            let map_size = Vec2::new(size.0 as f32, size.1 as f32);
+            self.canvas.stencil.draw(&painter, rect, map_size, &stencil);
         }
         // The brush circle: the dab's radius in texels, at the canvas's zoom.
         self.pointer.canvas_outline = None;
@@ -385,8 +400,10 @@ impl EditorState {
             .collect();
         self.pointer_input(Tab::Viewport, response, samples, alt);
         self.tool_cursor(response, alt);
+        self.screen_stencil(response, rect);
         // Shift + right drag turns the light: across for its yaw, up and down for its height.
         if response.dragged_by(egui::PointerButton::Secondary)
+            && !self.viewport.stencil_held(&response.ctx, rect)
             && response.ctx.input(|i| i.modifiers.shift)
         {
             let d = response.drag_delta();
@@ -421,6 +438,61 @@ impl EditorState {
                 ));
         }
         self.draw_viewport_clone_marker(response, rect);
+    }
+
+    /// The stencil on the viewport's screen: kept on the camera's view, moved (scaled, turned)
+    /// by a right-drag that starts on it, drawn over each picture unless a stroke paints.
+    fn screen_stencil(&mut self, response: &egui::Response, rect: egui::Rect) {
+        let view = crate::stencil_view::screen_view(
+            &self.viewport.camera,
+            self.viewport.picture_at(rect, rect.min),
+        );
+        self.pointer.screen_view = Some(view);
+        if let Some(command) = crate::stencil_view::follow(&self.doc, view) {
+            self.apply(command);
+        }
+        let stencil = self
+            .doc
+            .stencil()
+            .filter(|s| {
+                s.view.is_some() && crate::stencil_view::paints_through(self.tools.active())
+            })
+            .cloned();
+        self.viewport.stencil.clone_from(&stencil);
+        let Some(stencil) = stencil else {
+            return;
+        };
+        if response.dragged_by(egui::PointerButton::Secondary)
+            && self.viewport.stencil_held(&response.ctx, rect)
+        {
+            let modifiers = response.ctx.input(|i| i.modifiers);
+            if let Some(command) =
+                crate::stencil_view::dragged(&self.doc, response.drag_delta(), 1.0, modifiers)
+            {
+                self.apply(command);
+            }
+        }
+        if self.pointer.held.is_some() {
+            return;
+        }
+        let painter = response
+            .ctx
+            .layer_painter(response.layer_id)
+            .with_clip_rect(response.rect);
+        let columns = self.viewport.comparison.mode.columns();
+        for k in 0..columns {
+            let x = rect.min.x + rect.width() * (k as f32 + 0.5) / columns as f32;
+            let picture = self
+                .viewport
+                .picture_at(rect, egui::pos2(x, rect.center().y));
+            let stencil_size = Vec2::new(picture.width(), picture.height());
+            self.canvas.stencil.draw(
+                &painter.with_clip_rect(picture),
+                picture,
+                stencil_size,
+                &stencil,
+            );
+        }
     }
 
     /// The mesh clone source's marker in the viewport: at the source on the surface; once a

@@ -123,7 +123,7 @@ impl EditorState {
                 desk.ask(Ask::JobFailed(format!("{label} failed unexpectedly")));
             })
         });
-        let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = Desk::new(&self.doc, &self.tools, self.pointer.seen());
         finish(&mut desk);
         let asks = desk.into_asks();
         self.carry_out(asks);
@@ -233,7 +233,7 @@ pub(super) fn load_tool_image(path: PathBuf) -> JobStart {
 }
 
 /// A stencil from an image, loaded on a worker: laid over the middle of the map, half its
-/// width wide.
+/// width wide (of the viewport's picture, where the stencil before lay on the screen).
 pub(super) fn load_stencil(path: PathBuf) -> JobStart {
     JobStart::new(
         "Stencil",
@@ -243,16 +243,12 @@ pub(super) fn load_stencil(path: PathBuf) -> JobStart {
         },
         |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
             let said = notice(format!("stencil {}", image.path().display()), false);
-            let maps = desk.doc.maps();
-            let (w, h) = (maps.width() as f32, maps.height() as f32);
-            let stencil = SettingsCommand::SetStencil {
-                image,
-                center: glam::Vec2::new(w, h) * 0.5,
-                size: 0.5 * w,
-                rotation: 0.0,
-                opacity: 1.0,
-                tiled: false,
+            let on_screen = desk.doc.stencil().is_some_and(|s| s.view.is_some());
+            let placement = match desk.screen_view {
+                Some(view) if on_screen => crate::stencil_view::Placement::on_screen(view),
+                _ => crate::stencil_view::Placement::on_canvas(desk.doc),
             };
+            let stencil = crate::stencil_view::placed(image, placement);
             desk.command_saying(stencil, vec![said]);
         },
     )

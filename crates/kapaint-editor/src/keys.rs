@@ -252,6 +252,10 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("Right drag, Alt + left drag", "orbit (viewport)"),
     ("Middle drag", "pan (viewport)"),
     ("Shift + right drag", "turn the light (viewport)"),
+    (
+        "Right drag on the stencil",
+        "move it (Shift: scale, Ctrl: turn), canvas or viewport",
+    ),
     ("Space + drag", "pan the UV canvas"),
     ("Wheel", "zoom"),
 ];

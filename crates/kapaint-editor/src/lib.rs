@@ -348,7 +348,7 @@ impl EditorState {
     /// The left panel: tools, brush, material, channels (the tool panel asks, the editor
     /// carries it out).
     fn tools_ui(&mut self, ui: &mut egui::Ui) {
-        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.seen());
         self.tool_panel.ui(ui, &mut desk, &mut self.presets);
         let asks = desk.into_asks();
         self.carry_out(asks);
@@ -356,7 +356,7 @@ impl EditorState {
 
     /// The Layers tab (the panel asks, the editor carries it out).
     fn layers_ui(&mut self, ui: &mut egui::Ui) {
-        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.seen());
         self.layers_panel.ui(ui, &mut desk, &mut self.presets);
         let asks = desk.into_asks();
         self.carry_out(asks);
@@ -372,7 +372,7 @@ impl EditorState {
     /// asks, the editor carries it out).
     fn view_ui(&mut self, ui: &mut egui::Ui) {
         let frame = self.frame_settings();
-        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.texels_per_point);
+        let mut desk = desk::Desk::new(&self.doc, &self.tools, self.pointer.seen());
         let mut shown = panels::view_panel::Shown {
             look: &mut self.look,
             comparison: &mut self.viewport.comparison,

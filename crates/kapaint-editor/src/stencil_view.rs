@@ -1,14 +1,18 @@
-//! The stencil in the editor: its picture over the UV canvas (hidden while a stroke paints),
-//! moved by a right-drag, scaled by Shift+right-drag and turned by Ctrl+right-drag; and its
-//! section of the tool panel (load, size, rotation, opacity, tiling, clear). The stencil
-//! itself is the document's: every change is a `SetStencil` naming its image again.
+//! The stencil in the editor: its picture over the UV canvas, or over the 3D viewport's
+//! picture when it lies on the screen (hidden while a stroke paints), moved by a right-drag,
+//! scaled by Shift+right-drag and turned by Ctrl+right-drag (in the viewport, a drag that
+//! starts on the stencil; elsewhere the right button still orbits); and its section of the
+//! tool panel (load, where it lies, size, rotation, opacity, tiling, clear). The stencil
+//! itself is the document's: every change is a `SetStencil` naming its image again, and a
+//! stencil on the screen follows the viewport's camera the same way.
 
 use std::sync::Arc;
 
 use egui::{Color32, Pos2, Rect, TextureHandle};
 use glam::Vec2;
 
-use kapaint_model::paint::Stencil;
+use kapaint_core::render::Camera;
+use kapaint_model::paint::{ScreenView, Stencil};
 use kapaint_model::paint_image::Pixels;
 use kapaint_model::{Document, SettingsCommand};
 use kapaint_tools::ToolKind;
@@ -32,6 +36,8 @@ pub(crate) struct Placement {
     pub(crate) rotation: f32,
     pub(crate) opacity: f32,
     pub(crate) tiled: bool,
+    /// The view whose screen it lies on (none: the canvas).
+    pub(crate) view: Option<ScreenView>,
 }
 
 impl Placement {
@@ -42,20 +48,85 @@ impl Placement {
             rotation: stencil.rotation,
             opacity: stencil.opacity,
             tiled: stencil.tiled,
+            view: stencil.view,
+        }
+    }
+
+    /// Over the middle of the map, half its width wide.
+    pub(crate) fn on_canvas(doc: &Document) -> Self {
+        let (w, h) = (doc.maps().width() as f32, doc.maps().height() as f32);
+        Self {
+            center: Vec2::new(w, h) * 0.5,
+            size: 0.5 * w,
+            rotation: 0.0,
+            opacity: 1.0,
+            tiled: false,
+            view: None,
+        }
+    }
+
+    /// Over the middle of the viewport's picture, half its width wide.
+    pub(crate) fn on_screen(view: ScreenView) -> Self {
+        Self {
+            center: view.size * 0.5,
+            size: 0.5 * view.size.x,
+            rotation: 0.0,
+            opacity: 1.0,
+            tiled: false,
+            view: Some(view),
         }
     }
 }
 
+/// The view a picture of the viewport shows: `camera`'s, onto `picture` (points).
+pub(crate) fn screen_view(camera: &Camera, picture: Rect) -> ScreenView {
+    ScreenView {
+        eye: camera.eye(),
+        target: camera.target,
+        up: glam::Vec3::Y,
+        fov: camera.fov_y.to_degrees(),
+        size: Vec2::new(picture.width().max(1.0), picture.height().max(1.0)),
+    }
+}
+
+/// The command that keeps a stencil on the screen on the viewport's `view` as the camera
+/// moves (none for a stencil on the canvas, or one already there).
+pub(crate) fn follow(doc: &Document, view: ScreenView) -> Option<SettingsCommand> {
+    let stencil = doc.stencil()?;
+    let mut p = Placement::of(stencil);
+    if p.view.is_none() || p.view == Some(view) {
+        return None;
+    }
+    p.view = Some(view);
+    place(doc, p)
+}
+
+/// Whether a right-drag from `at` (points from the picture's corner) takes hold of a stencil
+/// on the screen: it starts inside the stencil's frame.
+pub(crate) fn holds(stencil: &Stencil, at: Vec2) -> bool {
+    let uv = stencil.uv(at);
+    stencil.view.is_some() && (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y)
+}
+
 /// The command that places the document's stencil as `placement` says (none without one).
 pub(crate) fn place(doc: &Document, placement: Placement) -> Option<SettingsCommand> {
-    Some(SettingsCommand::SetStencil {
-        image: doc.stencil_image()?.clone(),
+    Some(placed(doc.stencil_image()?.clone(), placement))
+}
+
+/// The command that places a stencil of `image` as `placement` says.
+pub(crate) fn placed(
+    image: kapaint_model::paint_image::PaintImage,
+    placement: Placement,
+) -> SettingsCommand {
+    SettingsCommand::SetStencil {
+        image,
         center: placement.center,
         size: placement.size,
         rotation: placement.rotation,
         opacity: placement.opacity,
         tiled: placement.tiled,
-    })
+        view: placement.view,
+    }
 }
 
 /// The document's stencil moved by a right-drag of `delta` points on a canvas showing
@@ -108,18 +179,17 @@ impl StencilOverlay {
         texture
     }
 
-    /// Draws `stencil` over the map shown in `map` (a `size` map): its picture, translucent,
-    /// and its frame.
+    /// Draws `stencil` over what `map` shows (a map of `size` texels, or a viewport's picture
+    /// of `size` points): its picture, translucent, and its frame.
     pub(crate) fn draw(
         &mut self,
         painter: &egui::Painter,
         map: Rect,
-        size: (u32, u32),
+        size: Vec2,
         stencil: &Stencil,
     ) {
         let texture = self.texture(painter.ctx(), stencil).id();
-        let to_screen =
-            |p: Vec2| map.min + egui::vec2(p.x / size.0 as f32, p.y / size.1 as f32) * map.size();
+        let to_screen = |p: Vec2| map.min + egui::vec2(p.x / size.x, p.y / size.y) * map.size();
         let (sin, cos) = stencil.rotation.to_radians().sin_cos();
         let half = Vec2::new(stencil.size, stencil.size * stencil.image.aspect()) * 0.5;
         let corner = |sx: f32, sy: f32| {
@@ -203,13 +273,51 @@ pub(crate) fn panel_ui(ui: &mut egui::Ui, desk: &mut Desk) {
     };
     let before = Placement::of(stencil);
     let mut p = before;
-    let width = doc.maps().width() as f32;
+    ui.horizontal(|ui| {
+        ui.label("Lies on");
+        if ui
+            .selectable_label(p.view.is_none(), "Canvas")
+            .on_hover_text("On the UV canvas: strokes on the mesh read it where their texels lie")
+            .clicked()
+            && p.view.is_some()
+        {
+            p = Placement {
+                opacity: p.opacity,
+                tiled: p.tiled,
+                ..Placement::on_canvas(doc)
+            };
+        }
+        let screen = ui
+            .add_enabled(
+                desk.screen_view.is_some(),
+                egui::Button::selectable(p.view.is_some(), "Viewport"),
+            )
+            .on_hover_text(
+                "On the 3D viewport's screen, projected through the view onto the mesh \
+                 (right-drag on it moves it there)",
+            )
+            .on_disabled_hover_text("Needs the 3D viewport shown");
+        if screen.clicked()
+            && p.view.is_none()
+            && let Some(view) = desk.screen_view
+        {
+            p = Placement {
+                opacity: p.opacity,
+                tiled: p.tiled,
+                ..Placement::on_screen(view)
+            };
+        }
+    });
+    let width = match p.view {
+        Some(view) => view.size.x,
+        None => doc.maps().width() as f32,
+    };
     ui.add(
         egui::Slider::new(&mut p.size, 1.0..=4.0 * width)
             .logarithmic(true)
             .text("Stencil size"),
     )
-    .on_hover_text("Its width in texels");
+    .on_hover_text("Its width in texels (on the viewport, in points)");
     ui.add(egui::Slider::new(&mut p.rotation, -180.0..=180.0).text("Stencil rotation"));
     ui.add(egui::Slider::new(&mut p.opacity, 0.0..=1.0).text("Stencil opacity"))
         .on_hover_text("How much it holds the paint back (0: not at all)");

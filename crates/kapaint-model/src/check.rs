@@ -238,6 +238,11 @@ pub fn optional_name<'de, D: Deserializer<'de>>(d: D) -> Result<Option<String>, 
     Ok(v)
 }
 
+/// An optional field written without `Some(...)`: present, it is the value.
+pub fn some<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
+}
+
 /// One: the default of a field read as an opacity or a scale.
 pub fn one() -> f32 {
     1.0

@@ -278,6 +278,7 @@ fn stencil(path: &std::path::Path, center: Vec2, size: f32, rotation: f32) -> Se
         rotation,
         opacity: 1.0,
         tiled: false,
+        view: None,
     }
 }
 
@@ -337,6 +338,7 @@ fn the_brush_paints_only_through_the_stencils_light_part() {
             rotation: 0.0,
             opacity: 1.0,
             tiled: false,
+            view: None,
         })
         .expect_err("not loaded");
     assert!(e.to_string().contains("not-loaded.png"), "{e}");

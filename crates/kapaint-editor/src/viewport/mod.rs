@@ -139,6 +139,9 @@ pub struct Viewport {
     /// Set when the user asked for the untraced view instead of a trace that does not fit;
     /// the editor switches the view and clears it.
     pub untraced_requested: bool,
+    /// A stencil on the screen the right button can take hold of (the editor sets it each
+    /// frame): a right-drag that starts on it moves it instead of the camera.
+    pub stencil: Option<Arc<kapaint_model::paint::Stencil>>,
 }
 
 impl Viewport {
@@ -156,7 +159,26 @@ impl Viewport {
             traced: traced::TracedView::default(),
             ao_bake: None,
             untraced_requested: false,
+            stencil: None,
         }
+    }
+
+    /// Whether the right button went down on the stencil (then its drag is the stencil's).
+    pub fn stencil_held(&self, ctx: &egui::Context, rect: Rect) -> bool {
+        let Some(stencil) = &self.stencil else {
+            return false;
+        };
+        let origin = ctx.input(|i| {
+            i.pointer
+                .button_down(egui::PointerButton::Secondary)
+                .then(|| i.pointer.press_origin())
+                .flatten()
+        });
+        origin.is_some_and(|o| {
+            let picture = self.picture_at(rect, o);
+            let at = o - picture.min;
+            crate::stencil_view::holds(stencil, glam::Vec2::new(at.x, at.y))
+        })
     }
 
     /// Frames the mesh (F) at the next draw, when the viewport's aspect is known.
@@ -223,7 +245,8 @@ impl Viewport {
         }
         let (alt, shift) = ui.input(|i| (i.modifiers.alt, i.modifiers.shift));
         let delta = response.drag_delta();
-        let right = response.dragged_by(egui::PointerButton::Secondary);
+        let right = response.dragged_by(egui::PointerButton::Secondary)
+            && !self.stencil_held(ui.ctx(), rect);
         let middle = response.dragged_by(egui::PointerButton::Middle);
         let left = response.dragged_by(egui::PointerButton::Primary);
         // Shift + right drag turns the light (the editor reads it from the response).

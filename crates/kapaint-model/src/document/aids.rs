@@ -34,6 +34,7 @@ pub(super) struct StencilSpec {
     pub(super) rotation: f32,
     pub(super) opacity: f32,
     pub(super) tiled: bool,
+    pub(super) view: Option<crate::paint::ScreenView>,
 }
 
 impl Document {
@@ -65,6 +66,7 @@ impl Document {
         };
         stencil.opacity = spec.opacity;
         stencil.tiled = spec.tiled;
+        stencil.view = spec.view;
         stencil.check().map_err(ModelError::Command)?;
         self.aids.stencil = Some(Arc::new(stencil));
         self.aids.stencil_image = Some(spec.image.clone());

@@ -28,6 +28,13 @@ pub enum StrokeTool {
     Smudge,
 }
 
+impl StrokeTool {
+    /// Whether the tool paints through the stencil (the brush, the eraser and clone).
+    pub fn paints_through_stencil(self) -> bool {
+        matches!(self, Self::Brush | Self::Eraser | Self::Clone)
+    }
+}
+
 /// Which texels a fill writes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -103,7 +110,8 @@ pub enum SettingsCommand {
     SetApprox(AmbientApprox),
     /// Paints the brush, the eraser and clone through an image on the canvas (see
     /// [`crate::paint::Stencil`]): `SetStencil(image: "stars.png", center: (512, 512),
-    /// size: 256, rotation: 0, opacity: 1)`.
+    /// size: 256, rotation: 0, opacity: 1)`; with a `view`, on the screen of that view
+    /// instead (centre and size in its pixels), for strokes on the mesh.
     SetStencil {
         /// The image (a relative path from the script's folder).
         image: PaintImage,
@@ -120,6 +128,9 @@ pub enum SettingsCommand {
         /// Whether the image repeats beyond its edges.
         #[serde(default)]
         tiled: bool,
+        /// The view whose screen it lies on (none: the canvas).
+        #[serde(default, deserialize_with = "crate::check::some")]
+        view: Option<crate::paint::ScreenView>,
     },
     /// Takes the stencil away.
     ClearStencil,

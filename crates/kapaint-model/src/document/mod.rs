@@ -360,6 +360,7 @@ impl Document {
                 rotation,
                 opacity,
                 tiled,
+                view,
             } => {
                 return self.set_stencil(&aids::StencilSpec {
                     image,
@@ -368,6 +369,7 @@ impl Document {
                     rotation,
                     opacity,
                     tiled,
+                    view,
                 });
             }
             SettingsCommand::ClearStencil => {

@@ -14,6 +14,7 @@ use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes};
 use crate::layers::{Compositor, LayerStroke, State};
 use crate::maps::MaterialMaps;
 use crate::paint::{Coverage, DiscFootprint, Footprint, Stencil};
+use crate::surface::Surface;
 use crate::texel::Channels;
 use crate::tile::{TILE_SIZE, TileSpans};
 
@@ -196,7 +197,7 @@ impl Document {
         stroke: StrokeParts<'_>,
         alpha: f32,
         fp: &impl Footprint,
-        (step, stencil, grid): (Vec2, Option<&Stencil>, Option<&SourceGrid<'_>>),
+        (step, stencil, grid): (Vec2, Option<StencilOn<'_>>, Option<&SourceGrid<'_>>),
     ) {
         let StrokeParts {
             tool,
@@ -359,10 +360,13 @@ impl Document {
                 return;
             }
         }
-        let stencil = match stroke.tool {
-            StrokeTool::Brush | StrokeTool::Eraser | StrokeTool::Clone => self.aids.stencil.clone(),
-            StrokeTool::Blur | StrokeTool::Smudge => None,
-        };
+        // A stencil on the screen is for strokes on the mesh.
+        let stencil = stroke
+            .tool
+            .paints_through_stencil()
+            .then(|| self.aids.stencil.clone())
+            .flatten()
+            .filter(|s| s.view.is_none());
         for (c, step) in centers.into_iter().zip(steps) {
             let parts = stroke.parts();
             let brush = parts.brush;
@@ -376,7 +380,8 @@ impl Document {
                 state: &mut self.state,
                 compositor: &mut self.compositor,
             };
-            Self::dab_with(&mut to, parts, alpha, &fp, (step, stencil.as_deref(), None));
+            let stencil = stencil.as_deref().map(StencilOn::Texels);
+            Self::dab_with(&mut to, parts, alpha, &fp, (step, stencil, None));
         }
     }
 
@@ -416,6 +421,44 @@ fn cover_dab(
     edit::edit_cover((planes, pre), target, ids, covers, raise)
 }
 
+/// A stencil as a dab reads it: on the canvas (each texel's weight where the texel lies), or
+/// on the screen of a view (where the texel's surface point projects through it).
+#[derive(Clone, Copy)]
+pub(super) enum StencilOn<'a> {
+    /// In texel space.
+    Texels(&'a Stencil),
+    /// On the screen: the stencil, the baked surface, the view's matrix to clip space.
+    Screen(&'a Stencil, &'a Surface, glam::Mat4),
+}
+
+impl StencilOn<'_> {
+    /// The weights of the row of texels from `(x, y)` (texel indices) on.
+    #[inline]
+    fn weights(&self, (x, y): (usize, usize), out: &mut [f32]) {
+        match *self {
+            Self::Texels(stencil) => {
+                stencil.weights(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), out);
+            }
+            Self::Screen(stencil, surface, to_clip) => {
+                let Some(view) = &stencil.view else {
+                    out.fill(1.0);
+                    return;
+                };
+                let row = y * surface.bake.width as usize + x;
+                for (k, o) in out.iter_mut().enumerate() {
+                    let i = row + k;
+                    *o = match surface.bake.triangle(i) {
+                        Some(_) => view
+                            .to_screen(&to_clip, surface.bake.position(i))
+                            .map_or(0.0, |p| stencil.weight(p)),
+                        None => 0.0,
+                    };
+                }
+            }
+        }
+    }
+}
+
 /// A dab's raise of the stroke's coverage: towards `opacity` (times the stencil's weight,
 /// where there is one) by the footprint's weight times `alpha`.
 struct DabRaise<'a, F> {
@@ -423,7 +466,7 @@ struct DabRaise<'a, F> {
     maps: &'a MaterialMaps,
     alpha: f32,
     opacity: f32,
-    stencil: Option<&'a Stencil>,
+    stencil: Option<StencilOn<'a>>,
 }
 
 impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
@@ -443,11 +486,10 @@ impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
             let row = &mut cov[start..start + weights.len()];
             let up = &mut up[..weights.len()];
             let caps = &mut caps[..weights.len()];
-            if let Some(stencil) = self.stencil {
+            if let Some(stencil) = &self.stencil {
                 let (y, x0) = (start / TILE_SIZE, start % TILE_SIZE);
-                let y = (rect.y0 as usize + y) as f32 + 0.5;
-                let x = (rect.x0 as usize + x0) as f32 + 0.5;
-                stencil.weights(Vec2::new(x, y), caps);
+                let at = (rect.x0 as usize + x0, rect.y0 as usize + y);
+                stencil.weights(at, caps);
                 for cap in caps.iter_mut() {
                     *cap *= opacity;
                 }

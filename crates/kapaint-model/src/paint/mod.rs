@@ -19,7 +19,7 @@ mod tests;
 pub use fill::flood_region;
 pub use footprint::{DiscFootprint, Footprint};
 pub use gradient::GradientShape;
-pub use stencil::Stencil;
+pub use stencil::{ScreenView, Stencil};
 
 use std::sync::OnceLock;
 

@@ -5,10 +5,16 @@
 //! On the canvas the stencil lies in texel space: its centre and width in texels, the image's
 //! pixel `(0, 0)` at its top-left corner and rows growing downward as the canvas's texel rows
 //! do, turned by its rotation (degrees, clockwise on the canvas, whose rows grow downward).
+//!
+//! In the 3D viewport the stencil lies on the screen instead: with a [`ScreenView`] its centre
+//! and width are in that view's pixels (`(0, 0)` the top-left corner, rows growing downward),
+//! and a stroke on the mesh reads the weight where each texel's surface point projects through
+//! the view.
 
 use std::sync::Arc;
 
-use glam::Vec2;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use serde::Deserialize;
 
 use crate::paint_image::Pixels;
 
@@ -27,6 +33,8 @@ pub struct Stencil {
     pub opacity: f32,
     /// Whether the image repeats beyond its edges (else nothing paints there).
     pub tiled: bool,
+    /// The view it lies in, for a stencil on the screen (none: on the canvas).
+    pub view: Option<ScreenView>,
     /// The image's luminance times alpha per pixel, what a dab reads.
     plane: Arc<[f32]>,
 }
@@ -42,6 +50,7 @@ impl Stencil {
             rotation,
             opacity: 1.0,
             tiled: false,
+            view: None,
             plane,
         }
     }
@@ -71,6 +80,9 @@ impl Stencil {
         }
         if !self.center.is_finite() || !self.rotation.is_finite() {
             return Err("a stencil's centre and rotation must be finite numbers".into());
+        }
+        if let Some(view) = &self.view {
+            view.check()?;
         }
         if !(0.0..=1.0).contains(&self.opacity) {
             return Err(format!(
@@ -147,5 +159,92 @@ impl Stencil {
             };
             *o = hold + self.opacity * v;
         }
+    }
+}
+
+/// A view a stencil on the screen lies in: a perspective camera at `eye` looking at `target`
+/// with `up` up, `fov` degrees of vertical field, onto a picture `size` pixels wide and high
+/// (as the editor's viewport shows the mesh).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScreenView {
+    /// Where the camera is (object space).
+    pub eye: Vec3,
+    /// The point it looks at.
+    pub target: Vec3,
+    /// Up on the screen (made perpendicular to the view); +Y by default.
+    #[serde(default = "up_y")]
+    pub up: Vec3,
+    /// The vertical field of view, in degrees.
+    pub fov: f32,
+    /// The picture's width and height, in pixels.
+    pub size: Vec2,
+}
+
+fn up_y() -> Vec3 {
+    Vec3::Y
+}
+
+impl ScreenView {
+    /// Checks a view's numbers.
+    ///
+    /// # Errors
+    /// A non-finite number, the eye at the target, `up` along the view, a field of view
+    /// outside (0, 180) degrees, a picture with no area.
+    pub fn check(&self) -> Result<(), String> {
+        let finite = self.eye.is_finite()
+            && self.target.is_finite()
+            && self.up.is_finite()
+            && self.fov.is_finite()
+            && self.size.is_finite();
+        if !finite {
+            return Err("a stencil's view must be made of finite numbers".into());
+        }
+        let forward = self.target - self.eye;
+        if forward.length() <= 1e-6 * (1.0 + self.eye.length()) {
+            return Err("a stencil's view needs its eye away from its target".into());
+        }
+        if forward
+            .normalize()
+            .cross(self.up.normalize_or_zero())
+            .length()
+            < 1e-4
+        {
+            return Err(
+                "a stencil's view needs an up direction across the view, not along it".into(),
+            );
+        }
+        if !(self.fov > 0.0 && self.fov < 180.0) {
+            return Err(format!(
+                "a stencil's view needs a field of view between 0 and 180 degrees, not {}",
+                self.fov
+            ));
+        }
+        if !(self.size.x >= 1.0 && self.size.y >= 1.0) {
+            return Err(format!(
+                "a stencil's view needs a picture at least 1 x 1 pixel, not {} x {}",
+                self.size.x, self.size.y
+            ));
+        }
+        Ok(())
+    }
+
+    /// The matrix from object space to clip space (its depth is of no use here).
+    pub fn to_clip(&self) -> Mat4 {
+        let aspect = self.size.x / self.size.y;
+        glam::camera::rh::proj::directx::perspective(self.fov.to_radians(), aspect, 1e-3, 1e3)
+            * glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up)
+    }
+
+    /// Where `p` lands in the picture, in pixels, through `to_clip` (this view's
+    /// [`Self::to_clip`]); none behind the eye.
+    #[inline]
+    pub fn to_screen(&self, to_clip: &Mat4, p: Vec3) -> Option<Vec2> {
+        let c: Vec4 = *to_clip * p.extend(1.0);
+        if c.w <= 1e-6 {
+            return None;
+        }
+        let ndc = Vec2::new(c.x, c.y) / c.w;
+        Some(Vec2::new(ndc.x + 1.0, 1.0 - ndc.y) * 0.5 * self.size)
     }
 }

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{DabTarget, next_unit};
+use super::{DabTarget, StencilOn, next_unit};
 use crate::ModelError;
 use crate::brush::{DabPoint, StrokePoint, SurfacePoint, SurfacePos};
 use crate::document::copy_dab::CloneSource;
@@ -91,6 +91,17 @@ impl Document {
             }
         }
         let front = b.front_faces_only;
+        // The stencil, on the canvas (where each texel lies) or on the screen (where its
+        // surface point projects).
+        let stencil = stroke
+            .tool
+            .paints_through_stencil()
+            .then(|| self.aids.stencil.clone())
+            .flatten();
+        let to_clip = stencil
+            .as_ref()
+            .and_then(|s| s.view.as_ref())
+            .map(crate::paint::ScreenView::to_clip);
         // A smudge's first dab only picks up; each later one drags by the step (object
         // space) since the same mirrored copy's last dab.
         let steps = if stroke.tool == StrokeTool::Smudge {
@@ -142,12 +153,16 @@ impl Document {
                 state: &mut self.state,
                 compositor: &mut self.compositor,
             };
+            let stencil = stencil.as_deref().map(|s| match to_clip {
+                Some(m) => StencilOn::Screen(s, surface, m),
+                None => StencilOn::Texels(s),
+            });
             Self::dab_with(
                 &mut to,
                 parts,
                 alpha,
                 &fp,
-                (Vec2::ZERO, None, grid.as_ref()),
+                (Vec2::ZERO, stencil, grid.as_ref()),
             );
         }
     }
