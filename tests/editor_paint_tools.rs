@@ -225,6 +225,15 @@ fn a_stencil_on_the_viewport_follows_the_camera_moves_by_a_drag_on_it_and_holds_
         eye(&orbited).distance(eye(&moved)) > 0.05,
         "the camera orbited"
     );
+    // A right-drag on the canvas leaves a stencil on the viewport alone (it moved it).
+    let canvas = harness.get_by_label(CANVAS_LABEL).rect().center();
+    right_drag_from(
+        &mut harness,
+        canvas,
+        Modifiers::default(),
+        Vec2::new(40.0, 0.0),
+    );
+    assert_eq!(stencil(harness.state()).center, orbited.center);
     // A stroke on the mesh through it paints; with the stencil moved off the picture, the
     // same stroke is held back.
     let centre = viewport.center();

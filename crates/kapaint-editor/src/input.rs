@@ -294,8 +294,9 @@ impl EditorState {
             .ctx
             .layer_painter(response.layer_id)
             .with_clip_rect(response.rect);
-        // The stencil: a right-drag places it; shown unless a stroke is painting.
-        if response.dragged_by(egui::PointerButton::Secondary) {
+        // The stencil on the canvas: a right-drag places it; shown unless a stroke is painting.
+        let on_canvas = self.doc.stencil().is_some_and(|s| s.view.is_none());
+        if on_canvas && response.dragged_by(egui::PointerButton::Secondary) {
             let modifiers = response.ctx.input(|i| i.modifiers);
             let per_point = size.0 as f32 / rect.width().max(1e-3);
             if let Some(command) =
@@ -305,6 +306,7 @@ impl EditorState {
             }
         }
         if let Some(stencil) = self.doc.stencil().cloned()
+            && on_canvas
             && self.pointer.held.is_none()
             && crate::stencil_view::paints_through(self.tools.active())
         {
