@@ -27,9 +27,11 @@ const MAX_CELLS: usize = 1 << 22;
 /// point, the anchor): each texel of the dab then reads the surface at its own displacement
 /// from the dab's centre, turned as the surface turns from there to the anchor (the shortest
 /// turn from the dab's normal to the anchor's), so the patch lies on the surface where the
-/// source is, whichever way it faces, and every query starts within a few texels of it. The
-/// texels are sorted by cell over the box they span (each cell's run found by its index, no
-/// search).
+/// source is, whichever way it faces, and every query starts within a few texels of it. A
+/// texel whose source falls on the triangle the texel before it found (projected inside it,
+/// within a texel of its plane) takes it from there; only the others ask the cells, made on
+/// the first such query: the surface texels near the anchor sorted by cube (each cube's run
+/// found by its index, no search).
 pub(super) struct SourceGrid<'a> {
     surface: &'a Surface,
     /// The dab's centre, and where its source lies on the surface.
@@ -37,9 +39,21 @@ pub(super) struct SourceGrid<'a> {
     anchor: Vec3,
     /// The turn from the dab's normal to the anchor's.
     turn: glam::Quat,
-    cell: f32,
     /// The farthest a source may lie from the surface (a dab's rim on a differently curved
     /// part of the mesh, beyond it, is not written).
+    reach: f32,
+    /// The dab's radius (object units).
+    radius: f32,
+    /// The anchor's triangle: where the first texel's search starts.
+    anchor_triangle: Option<u32>,
+    /// The cells, made when a texel's source first leaves the triangle of the texel before
+    /// it (most of a dab's texels find their source on that triangle).
+    cells: std::sync::OnceLock<Cells>,
+}
+
+/// The surface texels near a dab's source, sorted into cubes.
+struct Cells {
+    cell: f32,
     reach: f32,
     /// The box of cells: its first cell and its size in cells.
     low: [i32; 3],
@@ -71,17 +85,46 @@ impl<'a> SourceGrid<'a> {
         } else {
             glam::Quat::IDENTITY
         };
+        Some(Self {
+            surface,
+            center,
+            anchor,
+            turn,
+            reach,
+            radius,
+            anchor_triangle: surface.bake.triangle(near),
+            cells: std::sync::OnceLock::new(),
+        })
+    }
+
+    /// The cells, made on first use.
+    fn cells(&self) -> &Cells {
+        self.cells.get_or_init(|| {
+            Cells::new(
+                self.surface,
+                self.anchor,
+                self.radius + 2.0 * self.reach,
+                self.reach,
+            )
+        })
+    }
+}
+
+impl Cells {
+    /// The surface texels within `within` of `anchor`, in cubes of two texels (larger where
+    /// the box would hold too many).
+    fn new(surface: &Surface, anchor: Vec3, within: f32, reach: f32) -> Self {
+        let upt = surface.units_per_texel.max(f32::MIN_POSITIVE);
         let mut found: Vec<(u32, Vec3)> = Vec::new();
         let (mut min, mut max) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        surface.visit_near(anchor, radius + 2.0 * reach, |i, p| {
+        surface.visit_near(anchor, within, |i, p| {
             found.push((i as u32, p));
             min = min.min(p);
             max = max.max(p);
         });
         if found.is_empty() {
-            return None;
+            (min, max) = (anchor, anchor);
         }
-        // Cells of two texels, or larger where the box would hold too many.
         let mut cell = 2.0 * upt;
         let (low, dims, cells) = loop {
             let low = Self::cell_of(min, cell);
@@ -94,10 +137,6 @@ impl<'a> SourceGrid<'a> {
             cell *= 2.0;
         };
         let mut grid = Self {
-            surface,
-            center,
-            anchor,
-            turn,
             cell,
             reach: reach.max(cell),
             low,
@@ -124,7 +163,7 @@ impl<'a> SourceGrid<'a> {
             grid.points[at] = p;
             grid.texels[at] = i;
         }
-        Some(grid)
+        grid
     }
 
     /// The index of cell `c` in the box, if it is inside it.
@@ -181,24 +220,38 @@ impl<'a> SourceGrid<'a> {
         best.filter(|&(d2, _)| d2 <= self.reach * self.reach)
             .map(|(_, i)| i)
     }
+}
 
+impl SourceGrid<'_> {
     /// Where on the map (texel units) the source of texel `t` (its index in the map) lies;
-    /// none for a texel off the mesh or a source off the surface.
-    fn source_of(&self, t: usize) -> Option<Vec2> {
+    /// none for a texel off the mesh or a source off the surface. `hint`: the triangle the
+    /// source of the texel before lay on (none at a row's start), updated.
+    fn source_of(&self, t: usize, hint: &mut Option<u32>) -> Option<Vec2> {
         let bake = &self.surface.bake;
         bake.triangle(t)?;
-        self.source_texel(bake.position(t))
+        self.source_texel(bake.position(t), hint)
     }
 
     /// Where on the map (texel units) the source of a texel whose point is `p` lies.
-    fn source_texel(&self, p: Vec3) -> Option<Vec2> {
+    fn source_texel(&self, p: Vec3, hint: &mut Option<u32>) -> Option<Vec2> {
         let q = self.anchor + self.turn * (p - self.center);
-        let i = self.nearest(q)?;
         let bake = &self.surface.bake;
-        let t = bake.triangle(i)?;
+        // The triangle before, where `q` projects inside it and near enough that no other
+        // sheet of the surface can be nearer: the texels of a row are a texel apart, so this
+        // is most of them. Else the nearest baked texel names the triangle.
+        let near = self.surface.units_per_texel.powi(2);
+        let on_hint = hint
+            .or(self.anchor_triangle)
+            .and_then(|t| inside_near(q, bake.corners(t), near).map(|w| (t, w)));
+        let (t, w) = if let Some(found) = on_hint {
+            found
+        } else {
+            let i = self.cells().nearest(q)?;
+            let t = bake.triangle(i)?;
+            (t, closest_on_triangle(q, bake.corners(t)))
+        };
+        *hint = Some(t);
         let uvs = self.surface.mesh.uvs.as_ref()?;
-        let corners = bake.corners(t);
-        let w = closest_on_triangle(q, corners);
         let [a, b, c] = self.surface.mesh.triangles[t as usize].map(|v| uvs[v as usize]);
         let uv = a * w.x + b * w.y + c * w.z;
         Some(Vec2::new(
@@ -206,6 +259,26 @@ impl<'a> SourceGrid<'a> {
             (1.0 - uv.y) * bake.height as f32,
         ))
     }
+}
+
+/// The barycentric weights of `p`'s projection on triangle `[a, b, c]` where it falls inside
+/// the triangle and `p` lies within `sqrt(near2)` of it.
+#[inline]
+fn inside_near(p: Vec3, [a, b, c]: [Vec3; 3], near2: f32) -> Option<Vec3> {
+    let (e0, e1, d) = (b - a, c - a, p - a);
+    let n = e0.cross(e1);
+    let n2 = n.length_squared();
+    if n2 <= f32::MIN_POSITIVE {
+        return None;
+    }
+    let height = d.dot(n);
+    if height * height > near2 * n2 {
+        return None;
+    }
+    // Barycentrics of the projection, by the areas of the sub-triangles.
+    let v = d.cross(e1).dot(n) / n2;
+    let w = e0.cross(d).dot(n) / n2;
+    (v >= 0.0 && w >= 0.0 && v + w <= 1.0).then(|| Vec3::new(1.0 - v - w, v, w))
 }
 
 /// A clone dab on the mesh raising the stroke's coverage by `raise`: each texel it rose at
@@ -232,9 +305,10 @@ pub(super) fn surface_clone_dab(
         let mut written = TileSpans::EMPTY;
         for (y, x0, x1) in rose.rows() {
             let row = (rect.y0 as usize + y) * w + rect.x0 as usize;
+            let mut hint = None;
             for x in x0..x1 {
                 let k = y * TILE_SIZE + x;
-                match grid.source_of(row + x) {
+                match grid.source_of(row + x, &mut hint) {
                     Some(at) => targets[k] = bilinear(&source.tiles, mask, maps, at, blend),
                     // Its source lies off the surface as this dab lays it: not written (a later
                     // dab of the stroke may reach it from elsewhere).
@@ -268,12 +342,13 @@ pub(super) fn surface_smudge_dab(
             let rect = maps.tile_rect(id);
             let mut written = TileSpans::EMPTY;
             fp.visit_runs(id, rect, |start, dab| {
+                let mut hint = None;
                 for (k, &wgt) in dab.iter().enumerate() {
                     let i = start + k;
                     let a = (wgt * strength).min(1.0);
                     let t =
                         (rect.y0 as usize + i / TILE_SIZE) * w + rect.x0 as usize + i % TILE_SIZE;
-                    if let Some(at) = (a > 0.0).then(|| grid.source_of(t)).flatten() {
+                    if let Some(at) = (a > 0.0).then(|| grid.source_of(t, &mut hint)).flatten() {
                         cover[i] = a;
                         targets[i] = bilinear(tiles, mask, maps, at, blend);
                         written.include(i);
