@@ -350,10 +350,10 @@ impl EditorState {
                         (Some(offset), Some(p)) if response.hovered() => p + offset,
                         _ => source,
                     };
-                    clone_marker(&painter, at(marker));
+                    crate::tool_overlays::clone_marker(&painter, at(marker));
                 }
             }
-            None => {}
+            Some(Overlay::Decal { .. }) | None => {}
         }
     }
 
@@ -440,94 +440,7 @@ impl EditorState {
                 ));
         }
         self.draw_viewport_clone_marker(response, rect);
-    }
-
-    /// The stencil on the viewport's screen: kept on the camera's view, moved (scaled, turned)
-    /// by a right-drag that starts on it, drawn over each picture unless a stroke paints.
-    fn screen_stencil(&mut self, response: &egui::Response, rect: egui::Rect) {
-        let view = crate::stencil_view::screen_view(
-            &self.viewport.camera,
-            self.viewport.picture_at(rect, rect.min),
-        );
-        self.pointer.screen_view = Some(view);
-        if let Some(command) = crate::stencil_view::follow(&self.doc, view) {
-            self.apply(command);
-        }
-        let stencil = self
-            .doc
-            .stencil()
-            .filter(|s| {
-                s.view.is_some() && crate::stencil_view::paints_through(self.tools.active())
-            })
-            .cloned();
-        self.viewport.stencil.clone_from(&stencil);
-        let Some(stencil) = stencil else {
-            return;
-        };
-        if response.dragged_by(egui::PointerButton::Secondary)
-            && self.viewport.stencil_held(&response.ctx, rect)
-        {
-            let modifiers = response.ctx.input(|i| i.modifiers);
-            if let Some(command) =
-                crate::stencil_view::dragged(&self.doc, response.drag_delta(), 1.0, modifiers)
-            {
-                self.apply(command);
-            }
-        }
-        if self.pointer.held.is_some() {
-            return;
-        }
-        let painter = response
-            .ctx
-            .layer_painter(response.layer_id)
-            .with_clip_rect(response.rect);
-        let columns = self.viewport.comparison.mode.columns();
-        for k in 0..columns {
-            let x = rect.min.x + rect.width() * (k as f32 + 0.5) / columns as f32;
-            let picture = self
-                .viewport
-                .picture_at(rect, egui::pos2(x, rect.center().y));
-            let stencil_size = Vec2::new(picture.width(), picture.height());
-            self.canvas.stencil.draw(
-                &painter.with_clip_rect(picture),
-                picture,
-                stencil_size,
-                &stencil,
-            );
-        }
-    }
-
-    /// The mesh clone source's marker in the viewport: at the source on the surface; once a
-    /// stroke fixed the offset, at the surface under the pointer plus that offset.
-    fn draw_viewport_clone_marker(&mut self, response: &egui::Response, rect: egui::Rect) {
-        self.pointer.viewport_clone_marker = None;
-        let Some((source, offset)) = self.doc.surface_clone_source() else {
-            return;
-        };
-        if self.tools.overlay() != Some(Overlay::CloneSource) {
-            return;
-        }
-        let hover = response.hover_pos();
-        let hit = hover.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
-        let world = match (offset, hit) {
-            (Some(offset), Some(hit)) => hit.position + offset,
-            _ => source,
-        };
-        let picture = self
-            .viewport
-            .picture_at(rect, hover.unwrap_or(rect.center()));
-        let view_proj = self
-            .viewport
-            .camera
-            .view_proj(picture.width() / picture.height().max(1.0));
-        if let Some(c) = crate::project(view_proj, picture, world) {
-            let painter = response
-                .ctx
-                .layer_painter(response.layer_id)
-                .with_clip_rect(response.rect);
-            clone_marker(&painter, c);
-            self.pointer.viewport_clone_marker = Some(c);
-        }
+        self.draw_decal_outline(response, rect);
     }
 
     /// What the viewport draws this frame: the light in the world (turned with the camera
@@ -610,20 +523,4 @@ fn pointer_samples(ctx: &egui::Context) -> Vec<Sample> {
             })
             .collect()
     })
-}
-
-/// The clone source's marker at `c`: a circle and a cross, white over black.
-fn clone_marker(painter: &egui::Painter, c: egui::Pos2) {
-    for (width, colour) in [(3.0, egui::Color32::BLACK), (1.0, egui::Color32::WHITE)] {
-        let stroke = egui::Stroke::new(width, colour);
-        painter.circle_stroke(c, 6.0, stroke);
-        painter.line_segment(
-            [c - egui::vec2(10.0, 0.0), c + egui::vec2(10.0, 0.0)],
-            stroke,
-        );
-        painter.line_segment(
-            [c - egui::vec2(0.0, 10.0), c + egui::vec2(0.0, 10.0)],
-            stroke,
-        );
-    }
 }

@@ -37,6 +37,7 @@ pub mod resize;
 mod results;
 pub mod screen_brush;
 mod stencil_view;
+mod tool_overlays;
 pub mod viewport;
 
 pub use app::{Editor, run};

@@ -28,9 +28,9 @@ pub mod texel;
 pub mod tile;
 
 pub use document::{
-    Command, Decal, Document, DocumentSettings, FillRegion, HistoryCommand, ImportCommand,
-    LayerCommand, LayerKind, LayerMove, LayerPlace, LayerRef, MaskCommand, PaintCommand,
-    SettingsCommand, StrokeCommand, StrokeTool,
+    Command, Decal, DecalFrame, Document, DocumentSettings, FillRegion, HistoryCommand,
+    ImportCommand, LayerCommand, LayerKind, LayerMove, LayerPlace, LayerRef, MaskCommand,
+    PaintCommand, SettingsCommand, StrokeCommand, StrokeTool,
 };
 pub use error::ModelError;
 pub use maps::MaterialMaps;

@@ -1,17 +1,35 @@
 //! The decal tool: a click on the mesh (or on the canvas, where the map lies on the mesh)
-//! places the chosen image there as a decal, dragging moves it over the surface, the fields
-//! scale, turn and fade it, Enter commits it and Escape takes it back out. What is shown
+//! places the chosen image there as a decal, dragging moves it over the surface, its handles
+//! (drawn with its outline in the viewport) and the fields scale and turn it, the fields fade
+//! it, Enter commits it and Escape takes it back out. What is shown
 //! while it is placed is the decal itself, laid in the selected layer by the model (one undo
 //! step for the whole placement, which each move replaces).
 
 use glam::Vec3;
 
 use kapaint_model::paint_image::PaintImage;
-use kapaint_model::{Command, Decal, Document, PaintCommand};
+use kapaint_model::{Command, Decal, DecalFrame, Document, PaintCommand};
 
 use super::{
-    OptionChange, OptionWidget, Place, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta, ToolOption,
+    OptionChange, OptionWidget, Overlay, Place, Tool, ToolCursor, ToolEvent, ToolKind, ToolMeta,
+    ToolOption,
 };
+
+/// What a press on the decal being placed takes hold of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Grip {
+    /// The decal itself: a drag moves it.
+    Move,
+    /// The scale handle: a drag sets its size so the corner follows the pointer (in the frame
+    /// the press found).
+    Scale(DecalFrame),
+    /// The turn handle: a drag turns it so the handle points at the pointer, from its
+    /// rotation at the press.
+    Turn(DecalFrame, f32),
+}
+
+/// How near a handle (a fraction of the decal's width, in its plane) a press takes hold of it.
+const HANDLE_REACH: f32 = 0.12;
 
 /// A change to the decal tool's options.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,8 +55,10 @@ pub struct DecalTool {
     pub opacity: f32,
     /// The point of the decal being placed (laid as a preview, not yet committed).
     placing: Option<Vec3>,
-    /// Whether the button is down (a drag moves it).
-    dragging: bool,
+    /// Where it lies, as its last preview laid it.
+    frame: Option<DecalFrame>,
+    /// What the button, while down, holds.
+    grip: Option<Grip>,
 }
 
 impl Default for DecalTool {
@@ -49,7 +69,8 @@ impl Default for DecalTool {
             rotation: 0.0,
             opacity: 1.0,
             placing: None,
-            dragging: false,
+            frame: None,
+            grip: None,
         }
     }
 }
@@ -108,18 +129,79 @@ impl DecalTool {
         })
     }
 
-    /// The preview of the decal being placed, as the options now say.
-    fn preview(&self, doc: &Document) -> Vec<Command> {
-        self.placing
-            .and_then(|at| self.decal(at, doc))
+    /// The preview of the decal being placed, as the options now say (and where it lies).
+    fn preview(&mut self, doc: &Document) -> Vec<Command> {
+        let decal = self.placing.and_then(|at| self.decal(at, doc));
+        self.frame = decal
+            .as_ref()
+            .zip(doc.surface())
+            .and_then(|(d, s)| d.frame(s).ok());
+        decal
             .map(|d| PaintCommand::PreviewDecal(Box::new(d)).into())
             .into_iter()
             .collect()
     }
 
+    /// What a press at surface point `p` takes hold of: a handle of the decal being placed
+    /// when it is near one, else the decal (moved there).
+    fn grip_at(&self, p: Vec3) -> Grip {
+        let Some(frame) = self.frame else {
+            return Grip::Move;
+        };
+        let reach = HANDLE_REACH * frame.width;
+        let at = frame.local(p);
+        if at.distance(frame.local(frame.scale_handle())) < reach {
+            Grip::Scale(frame)
+        } else if at.distance(frame.local(frame.turn_handle())) < reach {
+            Grip::Turn(frame, self.rotation)
+        } else {
+            Grip::Move
+        }
+    }
+
+    /// A drag to surface point `p` with `grip`: the decal moved, scaled or turned; whether it
+    /// changed enough to lay it again.
+    fn drag_to(&mut self, grip: Grip, p: Vec3, doc: &Document) -> bool {
+        match grip {
+            Grip::Move => {
+                // Moves under a hundredth of its size are not worth laying it again.
+                let step = 0.01 * self.width(doc);
+                if self.placing.is_some_and(|q| q.distance(p) < step) {
+                    return false;
+                }
+                self.placing = Some(p);
+            }
+            Grip::Scale(frame) => {
+                // The corner under the pointer: its half-diagonal is the pointer's distance.
+                let aspect = frame.height / frame.width;
+                let width = 2.0 * frame.local(p).length() / (1.0 + aspect * aspect).sqrt();
+                let old = self.width(doc);
+                if !(width.is_finite() && width > 0.0) || (width - old).abs() < 0.01 * old {
+                    return false;
+                }
+                self.size = Some(width);
+            }
+            Grip::Turn(frame, from) => {
+                // Counter-clockwise seen from outside turns the top towards the left.
+                let at = frame.local(p);
+                if at.length() <= 1e-6 * frame.width {
+                    return false;
+                }
+                let turn = (-at.x).atan2(at.y).to_degrees();
+                let rotation = (from + turn + 180.0).rem_euclid(360.0) - 180.0;
+                if (rotation - self.rotation).abs() < 0.5 {
+                    return false;
+                }
+                self.rotation = rotation;
+            }
+        }
+        true
+    }
+
     /// Commits the decal being placed.
     fn commit(&mut self, doc: &Document) -> Vec<Command> {
-        self.dragging = false;
+        self.grip = None;
+        self.frame = None;
         self.placing
             .take()
             .and_then(|at| self.decal(at, doc))
@@ -151,29 +233,34 @@ impl Tool for DecalTool {
                     return Vec::new();
                 }
                 self.size = Some(self.width(doc));
-                self.dragging = true;
-                self.placing = Some(p);
-                self.preview(doc)
-            }
-            ToolEvent::Drag { at, .. } if self.dragging => {
-                let Some(p) = surface_point(at, doc) else {
-                    return Vec::new();
+                let grip = match self.placing {
+                    Some(_) => self.grip_at(p),
+                    None => Grip::Move,
                 };
-                // Moves under a hundredth of its size are not worth laying it again.
-                let step = 0.01 * self.width(doc);
-                if self.placing.is_some_and(|q| q.distance(p) < step) {
+                self.grip = Some(grip);
+                if grip != Grip::Move {
                     return Vec::new();
                 }
                 self.placing = Some(p);
                 self.preview(doc)
             }
+            ToolEvent::Drag { at, .. } if self.grip.is_some() => {
+                let (Some(p), Some(grip)) = (surface_point(at, doc), self.grip) else {
+                    return Vec::new();
+                };
+                if !self.drag_to(grip, p, doc) {
+                    return Vec::new();
+                }
+                self.preview(doc)
+            }
             ToolEvent::Release => {
-                self.dragging = false;
+                self.grip = None;
                 Vec::new()
             }
             ToolEvent::Commit => self.commit(doc),
             ToolEvent::Escape => {
-                self.dragging = false;
+                self.grip = None;
+                self.frame = None;
                 match self.placing.take() {
                     Some(_) => vec![PaintCommand::DropDecal.into()],
                     None => Vec::new(),
@@ -185,6 +272,14 @@ impl Tool for DecalTool {
 
     fn busy(&self) -> bool {
         self.placing.is_some()
+    }
+
+    fn overlay(&self) -> Option<Overlay> {
+        let frame = self.frame.filter(|_| self.placing.is_some())?;
+        Some(Overlay::Decal {
+            corners: frame.corners(),
+            handles: [frame.scale_handle(), frame.turn_handle()],
+        })
     }
 
     /// Another tool chosen: the decal being placed is kept.

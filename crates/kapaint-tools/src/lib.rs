@@ -192,6 +192,15 @@ pub enum Overlay {
     /// The clone source's marker: at the document's clone source, and once a stroke fixed
     /// the offset, at the pointer plus that offset (it follows the brush).
     CloneSource,
+    /// A decal being placed, in object space: its outline (top-left, top-right,
+    /// bottom-right, bottom-left) and its handles (scale at the top-right corner, turn above
+    /// the top edge), drawn through the viewport's camera.
+    Decal {
+        /// Its corners.
+        corners: [glam::Vec3; 4],
+        /// The scale handle and the turn handle.
+        handles: [glam::Vec3; 2],
+    },
 }
 
 /// One of a tool's options, as the panel shows it: its control, and the typed change each

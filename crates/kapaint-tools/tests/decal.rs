@@ -208,3 +208,95 @@ fn a_click_on_the_canvas_places_the_decal_where_that_texel_lies_on_the_mesh() {
     // The texel itself took the decal.
     assert!(doc.maps().value(100, 128).kd.x > 0.5);
 }
+
+#[test]
+fn the_handles_scale_and_turn_the_decal_and_its_outline_follows() {
+    let mut doc = document();
+    let mut tools = decal_tools(&doc);
+    let press = |p: Vec3| ToolEvent::Press {
+        at: on_surface(p),
+        pressure: 1.0,
+    };
+    let drag = |p: Vec3| ToolEvent::Drag {
+        at: on_surface(p),
+        pressure: 1.0,
+    };
+    assert!(tools.overlay().is_none(), "no outline before a decal");
+    run(&mut tools, &mut doc, &[press(Vec3::Z), ToolEvent::Release]);
+    let outline = |tools: &Tools| match tools.overlay() {
+        Some(kapaint_tools::Overlay::Decal { corners, handles }) => (corners, handles),
+        other => panic!("no decal outline: {other:?}"),
+    };
+    let (corners, [scale, turn]) = outline(&tools);
+    let width = corners[0].distance(corners[1]);
+    let size = |tools: &mut Tools| {
+        tools
+            .get_mut::<DecalTool>()
+            .and_then(|t| t.size)
+            .expect("size")
+    };
+    assert!((width - size(&mut tools)).abs() < 1e-4, "{width}");
+    // The scale handle dragged out along the diagonal by half again: 1.5 times as wide, the
+    // same step, still at the same point.
+    let centre = (corners[0] + corners[2]) * 0.5;
+    let farther = centre + (scale - centre) * 1.5;
+    run(
+        &mut tools,
+        &mut doc,
+        &[press(scale), drag(farther), ToolEvent::Release],
+    );
+    let grown = size(&mut tools);
+    assert!((grown / width - 1.5).abs() < 0.02, "{grown} from {width}");
+    assert_eq!(labels(&doc), ["Place decal"]);
+    let placing = tools
+        .get_mut::<DecalTool>()
+        .and_then(|t| t.placing())
+        .expect("placed");
+    assert!(placing.distance(Vec3::Z) < 1e-5, "not moved: {placing}");
+    let (corners, [_, turn_after]) = outline(&tools);
+    assert!((corners[0].distance(corners[1]) - grown).abs() < 1e-4);
+    assert!(
+        turn_after.distance(centre) > turn.distance(centre),
+        "the outline follows"
+    );
+    // The turn handle dragged a quarter turn to the right (seen from outside, +Z): turned
+    // clockwise, -90 degrees.
+    let (corners, [_, turn]) = outline(&tools);
+    let centre = (corners[0] + corners[2]) * 0.5;
+    let right = (corners[1] - corners[0]).normalize();
+    let to_right = centre + right * turn.distance(centre);
+    run(
+        &mut tools,
+        &mut doc,
+        &[press(turn), drag(to_right), ToolEvent::Release],
+    );
+    let rotation = tools
+        .get_mut::<DecalTool>()
+        .map(|t| t.rotation)
+        .expect("rotation");
+    assert!((rotation + 90.0).abs() < 2.0, "{rotation}");
+    let (turned, _) = outline(&tools);
+    let top = (turned[0] + turned[1]) * 0.5 - centre;
+    assert!(
+        top.normalize().dot(right) > 0.95,
+        "its top now faces right: {top}"
+    );
+    // A press on the decal away from its handles moves it; Escape takes it all back.
+    run(
+        &mut tools,
+        &mut doc,
+        &[press(Vec3::new(0.05, -0.05, 1.0).normalize())],
+    );
+    let placing = tools
+        .get_mut::<DecalTool>()
+        .and_then(|t| t.placing())
+        .expect("placed");
+    assert!(placing.distance(Vec3::Z) > 0.01);
+    run(
+        &mut tools,
+        &mut doc,
+        &[ToolEvent::Release, ToolEvent::Escape],
+    );
+    assert!(labels(&doc).is_empty());
+    assert!(tools.overlay().is_none());
+}

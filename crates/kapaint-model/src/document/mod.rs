@@ -19,7 +19,7 @@ mod memory_need;
 mod moves;
 mod paths;
 mod project_image;
-pub use decal::Decal;
+pub use decal::{Decal, DecalFrame};
 mod script;
 mod structure;
 mod surface;

@@ -208,37 +208,14 @@ impl Document {
     /// only the surface within its half-diagonal of that point.
     fn place_decal(&mut self, spec: &Decal) -> Result<(), ModelError> {
         let surface = self.require_surface("placing a decal")?;
-        let aspect = spec.image.pixels()?.aspect();
-        if !(spec.at.is_finite() && spec.rotation.is_finite()) {
-            return Err(ModelError::Command(
-                "a decal's point and rotation must be finite".into(),
-            ));
-        }
-        if !(spec.size.is_finite() && spec.size > 0.0) {
-            return Err(ModelError::Command(format!(
-                "a decal's size must be positive, not {}",
-                spec.size
-            )));
-        }
-        let radius = 0.5 * spec.size * (1.0 + aspect * aspect).sqrt();
-        let Some(near) = surface.nearest_texel_from(spec.at, spec.size) else {
-            return Err(ModelError::Command(
-                "the decal finds no surface near its point".into(),
-            ));
-        };
-        let (origin, normal) = (surface.bake.position(near), surface.bake.normal(near));
-        let reference = if normal.dot(Vec3::Y).abs() > 0.99 {
-            Vec3::NEG_Z
-        } else {
-            Vec3::Y
-        };
-        let up = glam::Quat::from_axis_angle(normal, spec.rotation.to_radians()) * reference;
+        let frame = spec.frame(&surface)?;
+        let radius = 0.5 * (frame.width * frame.width + frame.height * frame.height).sqrt();
         let projection = Projection::Planar {
-            origin,
-            normal,
-            up,
-            width: spec.size,
-            height: spec.size * aspect,
+            origin: frame.origin,
+            normal: frame.normal,
+            up: frame.up,
+            width: frame.width,
+            height: frame.height,
         };
         let project = ProjectSpec {
             image: &spec.image,
