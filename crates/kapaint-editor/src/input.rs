@@ -440,7 +440,77 @@ impl EditorState {
                 ));
         }
         self.draw_viewport_clone_marker(response, rect);
-        self.draw_decal_outline(response, rect);
+        crate::tool_overlays::decal_outline(response, &self.viewport, rect, self.tools.overlay());
+    }
+
+    /// The stencil on the viewport's screen: kept on the camera's view, moved (scaled,
+    /// turned) by a right-drag that starts on it, drawn over each picture unless a stroke
+    /// paints.
+    fn screen_stencil(&mut self, response: &egui::Response, rect: egui::Rect) {
+        let picture = self.viewport.picture_at(rect, rect.min);
+        let view = crate::stencil_view::screen_view(&self.viewport.camera, picture);
+        self.pointer.screen_view = Some(view);
+        if let Some(command) = crate::stencil_view::follow(&self.doc, view) {
+            self.apply(command);
+        }
+        let through = crate::stencil_view::paints_through(self.tools.active());
+        let stencil = (self.doc.stencil())
+            .filter(|s| s.view.is_some() && through)
+            .cloned();
+        self.viewport.stencil.clone_from(&stencil);
+        let Some(stencil) = stencil else {
+            return;
+        };
+        if response.dragged_by(egui::PointerButton::Secondary)
+            && self.viewport.stencil_held(&response.ctx, rect)
+        {
+            let modifiers = response.ctx.input(|i| i.modifiers);
+            let delta = response.drag_delta();
+            if let Some(command) = crate::stencil_view::dragged(&self.doc, delta, 1.0, modifiers) {
+                self.apply(command);
+            }
+        }
+        if self.pointer.held.is_none() {
+            let at = (&self.viewport, rect);
+            crate::tool_overlays::screen_stencil(response, at, &mut self.canvas.stencil, &stencil);
+        }
+    }
+
+    /// The mesh clone source's marker in the viewport: at the source on the surface; once a
+    /// stroke fixed the offset, at the surface under the pointer plus that offset.
+    pub(super) fn draw_viewport_clone_marker(
+        &mut self,
+        response: &egui::Response,
+        rect: egui::Rect,
+    ) {
+        self.pointer.viewport_clone_marker = None;
+        let Some((source, offset)) = self.doc.surface_clone_source() else {
+            return;
+        };
+        if self.tools.overlay() != Some(Overlay::CloneSource) {
+            return;
+        }
+        let hover = response.hover_pos();
+        let hit = hover.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
+        let world = match (offset, hit) {
+            (Some(offset), Some(hit)) => hit.position + offset,
+            _ => source,
+        };
+        let picture = self
+            .viewport
+            .picture_at(rect, hover.unwrap_or(rect.center()));
+        let view_proj = self
+            .viewport
+            .camera
+            .view_proj(picture.width() / picture.height().max(1.0));
+        if let Some(c) = crate::project(view_proj, picture, world) {
+            let painter = response
+                .ctx
+                .layer_painter(response.layer_id)
+                .with_clip_rect(response.rect);
+            crate::tool_overlays::clone_marker(&painter, c);
+            self.pointer.viewport_clone_marker = Some(c);
+        }
     }
 
     /// What the viewport draws this frame: the light in the world (turned with the camera

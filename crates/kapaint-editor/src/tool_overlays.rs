@@ -1,153 +1,90 @@
-//! What the tools draw over the 3D viewport: the stencil on the screen (kept on the
-//! camera's view, moved by a right-drag that starts on it), the decal being placed (its
-//! outline and handles) and the mesh clone source's marker; and the clone marker's shape,
-//! which the canvas draws too.
+//! What the tools draw over the 3D viewport: the decal being placed (its outline and
+//! handles) and the stencil on the screen, on each picture; and the clone source's marker,
+//! which the canvas and the viewport draw.
 
+use egui::Rect;
 use glam::Vec2;
+use kapaint_model::paint::Stencil;
 use kapaint_tools::Overlay;
 
-use super::EditorState;
+use crate::stencil_view::StencilOverlay;
+use crate::viewport::Viewport;
 
-impl EditorState {
-    /// The decal being placed: its outline and handles on each picture, drawn through the
-    /// camera (dark under light, so they show on any material).
-    pub(super) fn draw_decal_outline(&self, response: &egui::Response, rect: egui::Rect) {
-        let Some(Overlay::Decal { corners, handles }) = self.tools.overlay() else {
-            return;
-        };
-        let painter = response
-            .ctx
-            .layer_painter(response.layer_id)
-            .with_clip_rect(response.rect);
-        let columns = self.viewport.comparison.mode.columns();
-        for k in 0..columns {
-            let x = rect.min.x + rect.width() * (k as f32 + 0.5) / columns as f32;
-            let picture = self
-                .viewport
-                .picture_at(rect, egui::pos2(x, rect.center().y));
-            let view_proj = self
-                .viewport
-                .camera
-                .view_proj(picture.width() / picture.height().max(1.0));
-            let on_screen = |p| crate::project(view_proj, picture, p);
-            let Some(outline) = corners
-                .iter()
-                .map(|&c| on_screen(c))
-                .collect::<Option<Vec<_>>>()
-            else {
-                continue;
-            };
-            for (width, colour) in [(3.0, egui::Color32::BLACK), (1.0, egui::Color32::WHITE)] {
-                painter.add(egui::Shape::closed_line(
-                    outline.clone(),
-                    egui::Stroke::new(width, colour),
-                ));
-            }
-            let [scale, turn] = handles.map(on_screen);
-            if let (Some(turn), Some(top)) = (turn, on_screen((corners[0] + corners[1]) * 0.5)) {
-                painter.line_segment([top, turn], egui::Stroke::new(1.0, egui::Color32::WHITE));
-            }
-            for handle in [scale, turn].into_iter().flatten() {
-                painter.circle(
-                    handle,
-                    5.0,
-                    egui::Color32::WHITE,
-                    egui::Stroke::new(1.5, egui::Color32::BLACK),
-                );
-            }
-        }
-    }
+/// The painter over the viewport's response, clipped to it.
+fn painter(response: &egui::Response) -> egui::Painter {
+    response
+        .ctx
+        .layer_painter(response.layer_id)
+        .with_clip_rect(response.rect)
+}
 
-    /// The stencil on the viewport's screen: kept on the camera's view, moved (scaled, turned)
-    /// by a right-drag that starts on it, drawn over each picture unless a stroke paints.
-    pub(super) fn screen_stencil(&mut self, response: &egui::Response, rect: egui::Rect) {
-        let view = crate::stencil_view::screen_view(
-            &self.viewport.camera,
-            self.viewport.picture_at(rect, rect.min),
-        );
-        self.pointer.screen_view = Some(view);
-        if let Some(command) = crate::stencil_view::follow(&self.doc, view) {
-            self.apply(command);
-        }
-        let stencil = self
-            .doc
-            .stencil()
-            .filter(|s| {
-                s.view.is_some() && crate::stencil_view::paints_through(self.tools.active())
-            })
-            .cloned();
-        self.viewport.stencil.clone_from(&stencil);
-        let Some(stencil) = stencil else {
-            return;
-        };
-        if response.dragged_by(egui::PointerButton::Secondary)
-            && self.viewport.stencil_held(&response.ctx, rect)
-        {
-            let modifiers = response.ctx.input(|i| i.modifiers);
-            if let Some(command) =
-                crate::stencil_view::dragged(&self.doc, response.drag_delta(), 1.0, modifiers)
-            {
-                self.apply(command);
-            }
-        }
-        if self.pointer.held.is_some() {
-            return;
-        }
-        let painter = response
-            .ctx
-            .layer_painter(response.layer_id)
-            .with_clip_rect(response.rect);
-        let columns = self.viewport.comparison.mode.columns();
-        for k in 0..columns {
+/// The viewport's pictures in `rect`: the whole of it, or each one side by side.
+fn pictures(viewport: &Viewport, rect: Rect) -> Vec<Rect> {
+    let columns = viewport.comparison.mode.columns();
+    (0..columns)
+        .map(|k| {
             let x = rect.min.x + rect.width() * (k as f32 + 0.5) / columns as f32;
-            let picture = self
-                .viewport
-                .picture_at(rect, egui::pos2(x, rect.center().y));
-            let stencil_size = Vec2::new(picture.width(), picture.height());
-            self.canvas.stencil.draw(
-                &painter.with_clip_rect(picture),
-                picture,
-                stencil_size,
-                &stencil,
+            viewport.picture_at(rect, egui::pos2(x, rect.center().y))
+        })
+        .collect()
+}
+
+/// The decal being placed (`overlay`, the active tool's): its outline and handles on each
+/// picture, drawn through the camera (dark under light, so they show on any material).
+pub(crate) fn decal_outline(
+    response: &egui::Response,
+    viewport: &Viewport,
+    rect: Rect,
+    overlay: Option<Overlay>,
+) {
+    let Some(Overlay::Decal { corners, handles }) = overlay else {
+        return;
+    };
+    let painter = painter(response);
+    for picture in pictures(viewport, rect) {
+        let view_proj = viewport
+            .camera
+            .view_proj(picture.width() / picture.height().max(1.0));
+        let on_screen = |p| crate::project(view_proj, picture, p);
+        let Some(outline) = corners
+            .iter()
+            .map(|&c| on_screen(c))
+            .collect::<Option<Vec<_>>>()
+        else {
+            continue;
+        };
+        for (width, colour) in [(3.0, egui::Color32::BLACK), (1.0, egui::Color32::WHITE)] {
+            painter.add(egui::Shape::closed_line(
+                outline.clone(),
+                egui::Stroke::new(width, colour),
+            ));
+        }
+        let [scale, turn] = handles.map(on_screen);
+        if let (Some(turn), Some(top)) = (turn, on_screen((corners[0] + corners[1]) * 0.5)) {
+            painter.line_segment([top, turn], egui::Stroke::new(1.0, egui::Color32::WHITE));
+        }
+        for handle in [scale, turn].into_iter().flatten() {
+            painter.circle(
+                handle,
+                5.0,
+                egui::Color32::WHITE,
+                egui::Stroke::new(1.5, egui::Color32::BLACK),
             );
         }
     }
+}
 
-    /// The mesh clone source's marker in the viewport: at the source on the surface; once a
-    /// stroke fixed the offset, at the surface under the pointer plus that offset.
-    pub(super) fn draw_viewport_clone_marker(
-        &mut self,
-        response: &egui::Response,
-        rect: egui::Rect,
-    ) {
-        self.pointer.viewport_clone_marker = None;
-        let Some((source, offset)) = self.doc.surface_clone_source() else {
-            return;
-        };
-        if self.tools.overlay() != Some(Overlay::CloneSource) {
-            return;
-        }
-        let hover = response.hover_pos();
-        let hit = hover.and_then(|p| self.viewport.pick(rect, p, &self.mesh.mesh, &self.mesh.bvh));
-        let world = match (offset, hit) {
-            (Some(offset), Some(hit)) => hit.position + offset,
-            _ => source,
-        };
-        let picture = self
-            .viewport
-            .picture_at(rect, hover.unwrap_or(rect.center()));
-        let view_proj = self
-            .viewport
-            .camera
-            .view_proj(picture.width() / picture.height().max(1.0));
-        if let Some(c) = crate::project(view_proj, picture, world) {
-            let painter = response
-                .ctx
-                .layer_painter(response.layer_id)
-                .with_clip_rect(response.rect);
-            clone_marker(&painter, c);
-            self.pointer.viewport_clone_marker = Some(c);
-        }
+/// A stencil on the screen over each picture of the viewport.
+pub(crate) fn screen_stencil(
+    response: &egui::Response,
+    (viewport, rect): (&Viewport, Rect),
+    overlay: &mut StencilOverlay,
+    stencil: &Stencil,
+) {
+    let painter = painter(response);
+    for picture in pictures(viewport, rect) {
+        let size = Vec2::new(picture.width(), picture.height());
+        overlay.draw(&painter.with_clip_rect(picture), picture, size, stencil);
     }
 }
 
