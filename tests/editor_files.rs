@@ -100,7 +100,8 @@ fn every_file_request_reaches_its_command() {
             FilePurpose::ImportImage(_)
             | FilePurpose::StampImage
             | FilePurpose::ToolImage
-            | FilePurpose::StencilImage => spot.join("spot_texture.png"),
+            | FilePurpose::StencilImage
+            | FilePurpose::ProjectImage => spot.join("spot_texture.png"),
             FilePurpose::ExportFolder => std::env::temp_dir().join("kapaint-export-choice"),
             FilePurpose::OpenProject | FilePurpose::SaveProject | FilePurpose::ImportPbr => {
                 return None;

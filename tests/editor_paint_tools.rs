@@ -1,6 +1,7 @@
 //! Issue 56 in the editor, driven through egui_kittest: the Decal tool (an image chosen, a
 //! click places it, a drag moves it, Enter commits, Escape takes it back, one undo step) and
-//! the stencil (loaded from the panel, placed by right-drags on the canvas, painted through).
+//! the stencil (loaded from the panel, placed by right-drags on the canvas or on the viewport,
+//! painted through), Image > Project image.
 
 use egui::accesskit::Role;
 use egui::{Modifiers, Vec2};
@@ -19,7 +20,7 @@ fn answer(request: &FileRequest) -> Option<std::path::PathBuf> {
     let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot");
     matches!(
         request.purpose,
-        FilePurpose::ToolImage | FilePurpose::StencilImage
+        FilePurpose::ToolImage | FilePurpose::StencilImage | FilePurpose::ProjectImage
     )
     .then(|| spot.join("spot_texture.png"))
 }
@@ -333,4 +334,59 @@ fn ctrl_click_on_the_mesh_sets_the_clone_source_and_its_marker_shows_there() {
         marker.distance(centre) < 6.0,
         "at the pointer plus the offset, back at the source: {marker:?} vs {centre:?}"
     );
+}
+
+#[test]
+fn image_project_image_paints_the_chosen_image_through_a_projection_in_one_step() {
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer);
+    harness.get_by_label("Image").click();
+    harness.run_steps(2);
+    harness.get_by_label("Project image…").click();
+    harness.run_steps(2);
+    // Nothing to project before an image is chosen.
+    harness
+        .get_by_role_and_label(Role::Button, "Project")
+        .click();
+    harness.run_steps(2);
+    assert!(labels(harness.state()).is_empty());
+    harness
+        .get_by_role_and_label(Role::Button, "Choose…")
+        .click();
+    harness.run_steps(2);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness.query_by_label("spot_texture.png").is_none() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the image did not load"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+    let blank = texels(harness.state());
+    harness
+        .get_by_role_and_label(Role::Button, "Project")
+        .click();
+    harness.run_steps(2);
+    let projected = texels(harness.state());
+    assert!(
+        changed(&blank, &projected) > 1000,
+        "the image is laid on the mesh"
+    );
+    assert_eq!(labels(harness.state()), ["Project image"]);
+    // Again, tri-planar: its own step.
+    harness
+        .get_by_role_and_label(Role::ComboBox, "Projection")
+        .click();
+    harness.run();
+    harness.get_by_label("Tri-planar").click();
+    harness.run();
+    harness
+        .get_by_role_and_label(Role::Button, "Project")
+        .click();
+    harness.run_steps(2);
+    assert_eq!(labels(harness.state()), ["Project image", "Project image"]);
+    assert!(changed(&projected, &texels(harness.state())) > 1000);
 }

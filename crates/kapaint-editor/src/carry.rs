@@ -28,6 +28,11 @@ impl EditorState {
                     }
                 }
                 Ask::SelectTool(kind) => self.select_tool(kind),
+                Ask::ProjectImage(image) => {
+                    if let Some(dialog) = &mut self.dialogs.project {
+                        dialog.image = Some(image);
+                    }
+                }
                 Ask::ToolOption(change) => {
                     for command in self.tools.set_option(change, &self.doc) {
                         self.apply(command);
@@ -231,6 +236,7 @@ impl EditorState {
                 FilePurpose::StampImage => self.load_stamp(path),
                 FilePurpose::ToolImage => self.start(jobs::load_tool_image(path)),
                 FilePurpose::StencilImage => self.start(jobs::load_stencil(path)),
+                FilePurpose::ProjectImage => self.start(jobs::load_project_image(path)),
                 FilePurpose::NewMesh => {
                     if let Some(dialog) = &mut self.dialogs.new {
                         dialog.mesh = path.display().to_string();
@@ -249,6 +255,11 @@ impl EditorState {
     fn show(&mut self, window: Window) {
         match window {
             Window::Resize => self.open_resize(),
+            Window::ProjectImage => {
+                let dialog =
+                    crate::project_dialog::ProjectDialog::new(&self.doc, &self.viewport.camera);
+                self.dialogs.project = Some(dialog);
+            }
             Window::Bake => self.open_bake(),
             Window::Preferences => self.open_preferences(),
             Window::Shortcuts => self.dialogs.shortcuts_open = true,

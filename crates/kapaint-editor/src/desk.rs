@@ -88,6 +88,8 @@ pub(crate) enum Ask {
     Act(crate::keys::Action),
     /// Open this window.
     Show(Window),
+    /// The image Image > Project image projects.
+    ProjectImage(kapaint_model::paint_image::PaintImage),
     /// Open this project (asking first about unsaved changes).
     Open(PathBuf),
 }
@@ -97,6 +99,8 @@ pub(crate) enum Ask {
 pub(crate) enum Window {
     /// Image > Resize.
     Resize,
+    /// Image > Project image.
+    ProjectImage,
     /// Mesh > Bake.
     Bake,
     /// Edit > Preferences.

@@ -36,6 +36,8 @@ pub enum FilePurpose {
     ToolImage,
     /// The stencil's Load.
     StencilImage,
+    /// Image > Project image's image.
+    ProjectImage,
     /// New > File: the mesh of the new project.
     NewMesh,
     /// The export dialog's folder.
@@ -79,6 +81,7 @@ impl FilePurpose {
             Self::StampImage => "Load brush stamp".into(),
             Self::ToolImage => "Image for the tool".into(),
             Self::StencilImage => "Load stencil".into(),
+            Self::ProjectImage => "Image to project".into(),
             Self::ImportPbr => "Import PBR material".into(),
             Self::NewMesh => "Mesh of the new project".into(),
             Self::ExportFolder => "Export into folder".into(),
@@ -89,9 +92,11 @@ impl FilePurpose {
         match self {
             Self::OpenProject | Self::SaveProject => Some(PROJECT),
             Self::ImportMesh | Self::NewMesh => Some(MESH),
-            Self::ImportImage(_) | Self::StampImage | Self::ToolImage | Self::StencilImage => {
-                Some(IMAGE)
-            }
+            Self::ImportImage(_)
+            | Self::StampImage
+            | Self::ToolImage
+            | Self::StencilImage
+            | Self::ProjectImage => Some(IMAGE),
             Self::ImportPbr => Some(PBR),
             Self::ExportFolder => None,
         }

@@ -232,6 +232,20 @@ pub(super) fn load_tool_image(path: PathBuf) -> JobStart {
     )
 }
 
+/// Image > Project image's image, loaded on a worker.
+pub(super) fn load_project_image(path: PathBuf) -> JobStart {
+    JobStart::new(
+        "Image",
+        move |progress| {
+            progress.start("decode", 1);
+            load_paint_image(path)
+        },
+        |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
+            desk.ask(Ask::ProjectImage(image));
+        },
+    )
+}
+
 /// A stencil from an image, loaded on a worker: laid over the middle of the map, half its
 /// width wide (of the viewport's picture, where the stencil before lay on the screen).
 pub(super) fn load_stencil(path: PathBuf) -> JobStart {

@@ -29,6 +29,7 @@ pub use notices::{Notice, NoticeLevel, Notices};
 mod panels;
 mod parts;
 pub mod preferences;
+mod project_dialog;
 mod project_jobs;
 mod prompts;
 pub use panels::layers::LayerView;

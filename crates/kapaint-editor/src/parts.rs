@@ -11,6 +11,8 @@ pub(super) struct Dialogs {
     pub(super) resize: Option<super::resize::ResizeDialog>,
     /// Mesh > Bake, while open.
     pub(super) bake: Option<super::bake::BakeDialog>,
+    /// Image > Project image, while open.
+    pub(super) project: Option<super::project_dialog::ProjectDialog>,
     /// Whether the Preferences window is open.
     pub(super) preferences_open: bool,
     /// The New dialog, while open.

@@ -186,7 +186,7 @@ pub(crate) fn menu_ui(ui: &mut egui::Ui, recent: &[PathBuf], desk: &mut Desk) {
     });
 }
 
-/// The Image menu (resize) and the Mesh menu (bake).
+/// The Image menu (resize, project an image) and the Mesh menu (bake).
 fn image_and_mesh_menus(ui: &mut egui::Ui, desk: &mut Desk) {
     ui.menu_button("Image", |ui| {
         if ui
@@ -195,6 +195,16 @@ fn image_and_mesh_menus(ui: &mut egui::Ui, desk: &mut Desk) {
             .clicked()
         {
             desk.ask(Ask::Show(Window::Resize));
+        }
+        if ui
+            .button("Project image…")
+            .on_hover_text(
+                "Paint an image onto the mesh through a planar, cylindrical, spherical, \
+                 tri-planar or UV projection (one undo step)",
+            )
+            .clicked()
+        {
+            desk.ask(Ask::Show(Window::ProjectImage));
         }
     });
     ui.menu_button("Mesh", |ui| {
