@@ -72,6 +72,8 @@ pub struct Surface {
     tile_boxes: Vec<Aabb>,
     /// Per tile, its `BLOCKS_PER_TILE^2` block boxes (row-major).
     block_boxes: Vec<[Aabb; BLOCKS_PER_TILE * BLOCKS_PER_TILE]>,
+    /// Per triangle, the triangles across its edges, made on first use.
+    neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
 }
 
 impl Surface {
@@ -122,7 +124,16 @@ impl Surface {
             tiles_x,
             tile_boxes,
             block_boxes,
+            neighbours: std::sync::OnceLock::new(),
         })
+    }
+
+    /// Per triangle, the triangle across the edge opposite each corner (`u32::MAX`: none),
+    /// meeting where the corners lie at the same point (across UV seams too); made on first
+    /// use.
+    pub fn neighbours(&self) -> &[[u32; 3]] {
+        self.neighbours
+            .get_or_init(|| triangle_neighbours(&self.mesh))
     }
 
     /// Width of the bake in texels.
@@ -278,6 +289,45 @@ fn units_per_texel(mesh: &Mesh, width: u32, height: u32) -> f32 {
     } else {
         1.0
     }
+}
+
+/// Per triangle of `mesh`, the triangle across the edge opposite each corner (`u32::MAX`:
+/// none); corners at the same point are the same, so seams split in UV are crossed.
+fn triangle_neighbours(mesh: &Mesh) -> Vec<[u32; 3]> {
+    let mut welded: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
+    let ids: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let next = welded.len() as u32;
+            *welded.entry(p.to_array().map(f32::to_bits)).or_insert(next)
+        })
+        .collect();
+    let mut open: std::collections::HashMap<(u32, u32), (u32, usize)> =
+        std::collections::HashMap::with_capacity(mesh.triangles.len() * 3 / 2);
+    let mut out = vec![[u32::MAX; 3]; mesh.triangles.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let a = ids
+                .get(tri[(k + 1) % 3] as usize)
+                .copied()
+                .unwrap_or(u32::MAX);
+            let b = ids
+                .get(tri[(k + 2) % 3] as usize)
+                .copied()
+                .unwrap_or(u32::MAX);
+            match open.remove(&(a.min(b), a.max(b))) {
+                Some((other, edge)) => {
+                    out[t][k] = other;
+                    out[other as usize][edge] = t as u32;
+                }
+                None => {
+                    open.insert((a.min(b), a.max(b)), (t as u32, k));
+                }
+            }
+        }
+    }
+    out
 }
 
 /// An object-space dab: a ball around a point on the surface, with the brush's hardness

@@ -263,3 +263,32 @@ fn the_nearest_surface_texel_is_found_from_near_or_far_and_never_from_nowhere() 
     );
     assert_eq!(s.nearest_texel_from(Vec3::splat(f32::INFINITY), 1.0), None);
 }
+
+#[test]
+fn every_triangle_of_the_sphere_meets_three_others_across_its_uv_seam_too() {
+    let surface = Surface::new(kapaint_mesh::uv_sphere(16, 8), 64, 64).expect("bake");
+    let near = surface.neighbours();
+    assert_eq!(near.len(), surface.mesh.triangles.len());
+    let mut across_seam = 0;
+    for (t, sides) in near.iter().enumerate() {
+        for (k, &o) in sides.iter().enumerate() {
+            // Degenerate pole triangles aside, every edge is shared, and both sides agree.
+            if o == u32::MAX {
+                continue;
+            }
+            assert!(
+                near[o as usize].contains(&(t as u32)),
+                "{t} -> {o} is not mutual"
+            );
+            let tri = surface.mesh.triangles[t];
+            let other = surface.mesh.triangles[o as usize];
+            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            // Met by position; across the seam the vertex indices differ.
+            across_seam += usize::from(!other.contains(&a) || !other.contains(&b));
+        }
+    }
+    let open = near.iter().flatten().filter(|&&o| o == u32::MAX).count();
+    eprintln!("{open} open edges, {across_seam} meetings across the seam");
+    assert!(across_seam > 0, "the seam is crossed");
+    assert!(open <= 2 * 16 * 3, "{open} open edges");
+}

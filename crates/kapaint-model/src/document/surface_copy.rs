@@ -240,9 +240,7 @@ impl SourceGrid<'_> {
         // sheet of the surface can be nearer: the texels of a row are a texel apart, so this
         // is most of them. Else the nearest baked texel names the triangle.
         let near = self.surface.units_per_texel.powi(2);
-        let on_hint = hint
-            .or(self.anchor_triangle)
-            .and_then(|t| inside_near(q, bake.corners(t), near).map(|w| (t, w)));
+        let on_hint = self.walk(q, hint.or(self.anchor_triangle), near);
         let (t, w) = if let Some(found) = on_hint {
             found
         } else {
@@ -261,24 +259,65 @@ impl SourceGrid<'_> {
     }
 }
 
-/// The barycentric weights of `p`'s projection on triangle `[a, b, c]` where it falls inside
-/// the triangle and `p` lies within `sqrt(near2)` of it.
+impl SourceGrid<'_> {
+    /// The triangle `q` projects inside, within `sqrt(near2)` of its plane, found by walking
+    /// from `start` across the edge `q` lies beyond, eight triangles at most.
+    fn walk(&self, q: Vec3, start: Option<u32>, near2: f32) -> Option<(u32, Vec3)> {
+        let bake = &self.surface.bake;
+        let mut t = start?;
+        for _ in 0..8 {
+            match locate(q, bake.corners(t), near2) {
+                Locate::Inside(w) => return Some((t, w)),
+                Locate::Beyond(k) => {
+                    t = *self.surface.neighbours().get(t as usize)?.get(k)?;
+                    if t == u32::MAX {
+                        return None;
+                    }
+                }
+                Locate::Away => return None,
+            }
+        }
+        None
+    }
+}
+
+/// Where a point lies for a triangle.
+enum Locate {
+    /// Its projection falls inside, these barycentric weights, and it is near the plane.
+    Inside(Vec3),
+    /// Its projection falls beyond the edge opposite this corner.
+    Beyond(usize),
+    /// The triangle has no area, or the point is off its plane.
+    Away,
+}
+
+/// Where `p` lies for triangle `[a, b, c]`: inside it (its projection inside, `p` within
+/// `sqrt(near2)` of its plane), or beyond the edge opposite the corner of the most negative
+/// weight.
 #[inline]
-fn inside_near(p: Vec3, [a, b, c]: [Vec3; 3], near2: f32) -> Option<Vec3> {
+fn locate(p: Vec3, [a, b, c]: [Vec3; 3], near2: f32) -> Locate {
     let (e0, e1, d) = (b - a, c - a, p - a);
     let n = e0.cross(e1);
     let n2 = n.length_squared();
     if n2 <= f32::MIN_POSITIVE {
-        return None;
-    }
-    let height = d.dot(n);
-    if height * height > near2 * n2 {
-        return None;
+        return Locate::Away;
     }
     // Barycentrics of the projection, by the areas of the sub-triangles.
     let v = d.cross(e1).dot(n) / n2;
     let w = e0.cross(d).dot(n) / n2;
-    (v >= 0.0 && w >= 0.0 && v + w <= 1.0).then(|| Vec3::new(1.0 - v - w, v, w))
+    let weights = [1.0 - v - w, v, w];
+    if weights.iter().all(|&x| x >= 0.0) {
+        let height = d.dot(n);
+        return if height * height <= near2 * n2 {
+            Locate::Inside(Vec3::from_array(weights))
+        } else {
+            Locate::Away
+        };
+    }
+    let k = (0..3)
+        .min_by(|&i, &j| weights[i].total_cmp(&weights[j]))
+        .unwrap_or(0);
+    Locate::Beyond(k)
 }
 
 /// A clone dab on the mesh raising the stroke's coverage by `raise`: each texel it rose at
@@ -303,9 +342,10 @@ pub(super) fn surface_clone_dab(
         let rose = raise.raise(id, cover);
         let rect = maps.tile_rect(id);
         let mut written = TileSpans::EMPTY;
+        // The triangle the texel before's source lay on, kept from row to row.
+        let mut hint = None;
         for (y, x0, x1) in rose.rows() {
             let row = (rect.y0 as usize + y) * w + rect.x0 as usize;
-            let mut hint = None;
             for x in x0..x1 {
                 let k = y * TILE_SIZE + x;
                 match grid.source_of(row + x, &mut hint) {
@@ -341,8 +381,8 @@ pub(super) fn surface_smudge_dab(
         let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
             let rect = maps.tile_rect(id);
             let mut written = TileSpans::EMPTY;
+            let mut hint = None;
             fp.visit_runs(id, rect, |start, dab| {
-                let mut hint = None;
                 for (k, &wgt) in dab.iter().enumerate() {
                     let i = start + k;
                     let a = (wgt * strength).min(1.0);
