@@ -10,6 +10,7 @@ mod copy_dab;
 mod fill;
 mod id;
 mod import;
+mod layer_command;
 mod layers;
 
 mod decal;
