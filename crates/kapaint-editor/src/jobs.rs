@@ -10,6 +10,7 @@ use super::{EditorState, MeshState, notice};
 use crate::desk::{Ask, Desk, Finish, JobStart};
 use crate::results::{OpenedProject, Saved};
 use kapaint_base::task::Progress;
+use kapaint_model::paint_image::PaintImage;
 use kapaint_model::texel::Channel;
 use kapaint_model::{Document, DocumentSettings, ModelError, project};
 use kapaint_model::{ImportCommand, SettingsCommand};
@@ -208,64 +209,55 @@ pub(super) fn load_stamp(path: PathBuf) -> JobStart {
 }
 
 /// Loads an image to paint through (a decal's, a stencil's) on a worker.
-fn load_paint_image(path: PathBuf) -> Result<kapaint_model::paint_image::PaintImage, String> {
-    let mut image = kapaint_model::paint_image::PaintImage::named(path);
+fn load_paint_image(path: PathBuf) -> Result<PaintImage, String> {
+    let mut image = PaintImage::named(path);
     image
         .load(std::path::Path::new(""))
         .map_err(|e| e.to_string())?;
     Ok(image)
 }
 
-/// The active tool's image (the decal's), loaded on a worker.
-pub(super) fn load_tool_image(path: PathBuf) -> JobStart {
+/// An image decoded on a worker (job `label`), handed to `done`.
+fn image_job(label: &str, path: PathBuf, done: fn(PaintImage, &mut Desk)) -> JobStart {
     JobStart::new(
-        "Image",
+        label,
         move |progress| {
             progress.start("decode", 1);
             load_paint_image(path)
         },
-        |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
-            let said = notice(format!("image {}", image.path().display()), false);
-            desk.ask(Ask::ToolOption(kapaint_tools::OptionChange::Image(image)));
-            desk.ask(Ask::Notice(said));
-        },
+        done,
     )
+}
+
+/// The active tool's image (the decal's), loaded on a worker.
+pub(super) fn load_tool_image(path: PathBuf) -> JobStart {
+    image_job("Image", path, |image, desk| {
+        let said = notice(format!("image {}", image.path().display()), false);
+        desk.ask(Ask::ToolOption(kapaint_tools::OptionChange::Image(image)));
+        desk.ask(Ask::Notice(said));
+    })
 }
 
 /// Image > Project image's image, loaded on a worker.
 pub(super) fn load_project_image(path: PathBuf) -> JobStart {
-    JobStart::new(
-        "Image",
-        move |progress| {
-            progress.start("decode", 1);
-            load_paint_image(path)
-        },
-        |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
-            desk.ask(Ask::ProjectImage(image));
-        },
-    )
+    image_job("Image", path, |image, desk| {
+        desk.ask(Ask::ProjectImage(image));
+    })
 }
 
 /// A stencil from an image, loaded on a worker: laid over the middle of the map, half its
 /// width wide (of the viewport's picture, where the stencil before lay on the screen).
 pub(super) fn load_stencil(path: PathBuf) -> JobStart {
-    JobStart::new(
-        "Stencil",
-        move |progress| {
-            progress.start("decode", 1);
-            load_paint_image(path)
-        },
-        |image: kapaint_model::paint_image::PaintImage, desk: &mut Desk| {
-            let said = notice(format!("stencil {}", image.path().display()), false);
-            let on_screen = desk.doc.stencil().is_some_and(|s| s.view.is_some());
-            let placement = match desk.screen_view {
-                Some(view) if on_screen => crate::stencil_view::Placement::on_screen(view),
-                _ => crate::stencil_view::Placement::on_canvas(desk.doc),
-            };
-            let stencil = crate::stencil_view::placed(image, placement);
-            desk.command_saying(stencil, vec![said]);
-        },
-    )
+    image_job("Stencil", path, |image, desk| {
+        let said = notice(format!("stencil {}", image.path().display()), false);
+        let on_screen = desk.doc.stencil().is_some_and(|s| s.view.is_some());
+        let placement = match desk.screen_view {
+            Some(view) if on_screen => crate::stencil_view::Placement::on_screen(view),
+            _ => crate::stencil_view::Placement::on_canvas(desk.doc),
+        };
+        let stencil = crate::stencil_view::placed(image, placement);
+        desk.command_saying(stencil, vec![said]);
+    })
 }
 
 /// Decodes and resamples an image on a worker to `doc`'s size; it is written into `channel`

@@ -18,17 +18,6 @@ fn painter(response: &egui::Response) -> egui::Painter {
         .with_clip_rect(response.rect)
 }
 
-/// The viewport's pictures in `rect`: the whole of it, or each one side by side.
-fn pictures(viewport: &Viewport, rect: Rect) -> Vec<Rect> {
-    let columns = viewport.comparison.mode.columns();
-    (0..columns)
-        .map(|k| {
-            let x = rect.min.x + rect.width() * (k as f32 + 0.5) / columns as f32;
-            viewport.picture_at(rect, egui::pos2(x, rect.center().y))
-        })
-        .collect()
-}
-
 /// The decal being placed (`overlay`, the active tool's): its outline and handles on each
 /// picture, drawn through the camera (dark under light, so they show on any material).
 pub(crate) fn decal_outline(
@@ -41,7 +30,7 @@ pub(crate) fn decal_outline(
         return;
     };
     let painter = painter(response);
-    for picture in pictures(viewport, rect) {
+    for picture in viewport.pictures(rect) {
         let view_proj = viewport
             .camera
             .view_proj(picture.width() / picture.height().max(1.0));
@@ -82,7 +71,7 @@ pub(crate) fn screen_stencil(
     stencil: &Stencil,
 ) {
     let painter = painter(response);
-    for picture in pictures(viewport, rect) {
+    for picture in viewport.pictures(rect) {
         let size = Vec2::new(picture.width(), picture.height());
         overlay.draw(&painter.with_clip_rect(picture), picture, size, stencil);
     }

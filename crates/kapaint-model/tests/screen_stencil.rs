@@ -111,6 +111,40 @@ fn front_stroke(doc: &mut Document) {
     .expect("stroke");
 }
 
+/// Over the texels under the hard core of [`front_stroke`] (on the front, near the equator,
+/// inside it), those `side` says should be painted (`Some(true)`) or held back
+/// (`Some(false)`; `None`: too near the stencil's edge to say) and how many are not:
+/// `(painted, held, wrong)`.
+fn sides(doc: &Document, side: impl Fn(u32, Vec3) -> Option<bool>) -> (usize, usize, usize) {
+    let s = doc.surface().expect("surface");
+    let (mut painted, mut held, mut wrong) = (0, 0, 0);
+    for y in 0..SIDE {
+        for x in 0..SIDE {
+            let t = (y * SIDE + x) as usize;
+            if s.bake.triangle(t).is_none() {
+                continue;
+            }
+            let p = s.bake.position(t);
+            if p.z < 0.5 || p.y.abs() > 0.05 || p.x.abs() > 0.2 {
+                continue;
+            }
+            let red = doc.maps().value(x, y).kd.x;
+            match side(x, p) {
+                Some(true) => {
+                    painted += 1;
+                    wrong += usize::from(red < 0.85);
+                }
+                Some(false) => {
+                    held += 1;
+                    wrong += usize::from((red - GREY).abs() > 1e-3);
+                }
+                None => {}
+            }
+        }
+    }
+    (painted, held, wrong)
+}
+
 #[test]
 fn a_stencil_on_the_screen_paints_where_the_surface_projects_through_its_light_part() {
     let mut doc = sphere();
@@ -125,31 +159,11 @@ fn a_stencil_on_the_screen_paints_where_the_surface_projects_through_its_light_p
     ))
     .expect("stencil");
     front_stroke(&mut doc);
-    let s = Arc::clone(doc.surface().expect("surface"));
     let to_clip = view.to_clip();
-    let (mut painted, mut held, mut wrong) = (0, 0, 0);
-    for y in 0..SIDE {
-        for x in 0..SIDE {
-            let t = (y * SIDE + x) as usize;
-            if s.bake.triangle(t).is_none() {
-                continue;
-            }
-            let p = s.bake.position(t);
-            // Under the hard core of the stroke (on the front, near the equator, inside it).
-            if p.z < 0.5 || p.y.abs() > 0.05 || p.x.abs() > 0.2 {
-                continue;
-            }
-            let sx = view.to_screen(&to_clip, p).expect("in front").x;
-            let red = doc.maps().value(x, y).kd.x;
-            if sx > 201.0 {
-                painted += 1;
-                wrong += usize::from(red < 0.85);
-            } else if sx < 199.0 {
-                held += 1;
-                wrong += usize::from((red - GREY).abs() > 1e-3);
-            }
-        }
-    }
+    let (painted, held, wrong) = sides(&doc, |_, p| {
+        let sx = view.to_screen(&to_clip, p).expect("in front").x;
+        (!(199.0..=201.0).contains(&sx)).then_some(sx > 201.0)
+    });
     eprintln!(
         "screen stencil: {painted} texels painted, {held} held back, {wrong} wrong (more than a pixel from the stencil's edge)"
     );
@@ -170,8 +184,9 @@ fn a_stencil_on_the_screen_paints_where_the_surface_projects_through_its_light_p
     .expect("stencil");
     front_stroke(&mut doc);
     let red_at = |doc: &Document, p: Vec3| {
+        let s = doc.surface().expect("surface");
         let t = s.nearest_texel(p, 0.05).expect("near");
-        let (w, _) = (SIDE as usize, 0);
+        let w = SIDE as usize;
         doc.maps().value((t % w) as u32, (t / w) as u32).kd.x
     };
     let (left, right) = (
@@ -200,28 +215,7 @@ fn a_stencil_on_the_canvas_holds_back_a_mesh_stroke_where_its_texels_lie() {
     doc.apply(set_stencil(&image, Vec2::new(192.0, 128.0), 256.0, None))
         .expect("stencil");
     front_stroke(&mut doc);
-    let (mut painted, mut held, mut wrong) = (0, 0, 0);
-    let s = Arc::clone(doc.surface().expect("surface"));
-    for y in 0..SIDE {
-        for x in 0..SIDE {
-            let t = (y * SIDE + x) as usize;
-            if s.bake.triangle(t).is_none() {
-                continue;
-            }
-            let p = s.bake.position(t);
-            if p.z < 0.5 || p.y.abs() > 0.05 || p.x.abs() > 0.2 {
-                continue;
-            }
-            let red = doc.maps().value(x, y).kd.x;
-            if x > 193 {
-                painted += 1;
-                wrong += usize::from(red < 0.85);
-            } else if x < 191 {
-                held += 1;
-                wrong += usize::from((red - GREY).abs() > 1e-3);
-            }
-        }
-    }
+    let (painted, held, wrong) = sides(&doc, |x, _| (!(191..=193).contains(&x)).then_some(x > 193));
     assert!(painted > 20 && held > 20, "{painted} {held}");
     assert_eq!(wrong, 0);
 }

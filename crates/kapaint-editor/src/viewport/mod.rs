@@ -200,6 +200,17 @@ impl Viewport {
         Rect::from_min_size(Pos2::new(x, rect.min.y), egui::vec2(width, rect.height()))
     }
 
+    /// Every picture in `rect`: the whole of it, or each one side by side.
+    pub fn pictures(&self, rect: Rect) -> Vec<Rect> {
+        let count = self.comparison.mode.columns();
+        (0..count)
+            .map(|k| {
+                let x = rect.min.x + rect.width() * (k as f32 + 0.5) / count as f32;
+                self.picture_at(rect, Pos2::new(x, rect.center().y))
+            })
+            .collect()
+    }
+
     /// The surface point under a screen position, if the ray hits the mesh.
     pub fn pick(&self, rect: Rect, pos: Pos2, mesh: &Mesh, bvh: &Bvh) -> Option<Hit> {
         let rect = self.picture_at(rect, pos);
