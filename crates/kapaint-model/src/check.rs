@@ -202,6 +202,15 @@ pub fn finite_f32<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     }
 }
 
+/// A projection whose numbers make a frame ([`Projection::check`](crate::paint::projection::Projection::check)).
+pub fn projection<'de, D: Deserializer<'de>>(
+    d: D,
+) -> Result<crate::paint::projection::Projection, D::Error> {
+    let v = crate::paint::projection::Projection::deserialize(d)?;
+    v.check().map_err(D::Error::custom)?;
+    Ok(v)
+}
+
 /// The most layers (groups and their children included) a document holds.
 pub const MAX_LAYERS: usize = 256;
 

@@ -130,6 +130,61 @@ impl Pixels {
         })
     }
 
+    /// Its pixels as kept, row-major: RGBA (linear colour premultiplied by alpha, and alpha)
+    /// and gray-alpha (the gray and `n`'s blend value, both premultiplied), each part unorm16:
+    /// what a project keeps of a projection fill's image.
+    pub fn raw(&self) -> (Vec<u16>, Vec<u16>) {
+        let rgba = self
+            .texels
+            .iter()
+            .flat_map(|p| [p.rgb[0], p.rgb[1], p.rgb[2], p.alpha])
+            .collect();
+        let gray = self
+            .texels
+            .iter()
+            .flat_map(|p| [p.gray, p.n_blend])
+            .collect();
+        (rgba, gray)
+    }
+
+    /// The pixels [`Self::raw`] gave.
+    ///
+    /// # Errors
+    /// Parts of another length than `width x height` pixels, or an image over
+    /// [`MAX_PAINT_IMAGE_SIDE`] a side.
+    pub fn from_raw(width: u32, height: u32, rgba: &[u16], gray: &[u16]) -> Result<Self, String> {
+        if width == 0
+            || height == 0
+            || width > MAX_PAINT_IMAGE_SIDE
+            || height > MAX_PAINT_IMAGE_SIDE
+        {
+            return Err(format!(
+                "an image of {width}x{height} pixels cannot be painted through"
+            ));
+        }
+        let count = width as usize * height as usize;
+        if rgba.len() != count * 4 || gray.len() != count * 2 {
+            return Err(format!(
+                "the image's parts do not hold {width}x{height} pixels"
+            ));
+        }
+        let texels = rgba
+            .chunks_exact(4)
+            .zip(gray.chunks_exact(2))
+            .map(|(c, g)| Pixel {
+                rgb: [c[0], c[1], c[2]],
+                gray: g[0],
+                n_blend: g[1],
+                alpha: c[3],
+            })
+            .collect();
+        Ok(Self {
+            width,
+            height,
+            texels,
+        })
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width
@@ -227,6 +282,14 @@ impl PaintImage {
             path: path.to_path_buf(),
             pixels: Some(Arc::new(pixels)),
         })
+    }
+
+    /// Pixels already made (a project's projection fill, read back), named by `path`.
+    pub fn of_pixels(path: impl Into<PathBuf>, pixels: Arc<Pixels>) -> Self {
+        Self {
+            path: path.into(),
+            pixels: Some(pixels),
+        }
     }
 
     /// Named by path, not loaded yet.

@@ -156,7 +156,8 @@ fn resize_layers(
                     })
                     .collect();
             }
-            LayerContent::Fill(_) => {}
+            // Laid again on the new size by the document.
+            LayerContent::Fill(_) | LayerContent::Projected(_) => {}
             LayerContent::Group(children) => resize_layers(children, from, to, count)?,
         }
     }

@@ -419,7 +419,12 @@ impl Command {
                 | PaintCommand::Pick { .. }
                 | PaintCommand::PickLayer { .. } => None,
             },
-            // Strokes, imports (decoded on a worker), history, layers and masks name no file.
+            Self::Layer(
+                LayerCommand::SetLayerProjection { image, .. }
+                | LayerCommand::AddProjectionFill { image, .. },
+            ) => Some(image),
+            // Strokes, imports (decoded on a worker), history, other layer commands and masks
+            // name no file.
             Self::Stroke(_)
             | Self::Import(_)
             | Self::History(_)
@@ -442,6 +447,7 @@ impl Command {
             self,
             Self::Paint(PaintCommand::PlaceDecal { .. } | PaintCommand::PreviewDecal(_))
         ) || matches!(self, Self::Paint(PaintCommand::ProjectImage { projection, .. }) if projection.needs_surface())
+            || matches!(self, Self::Layer(LayerCommand::SetLayerProjection { projection, .. } | LayerCommand::AddProjectionFill { projection, .. }) if projection.needs_surface())
     }
 }
 

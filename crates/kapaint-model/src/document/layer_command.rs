@@ -3,7 +3,14 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::paint::projection::Projection;
+use crate::paint_image::PaintImage;
 use crate::texel::{Channel, Channels, MaterialValue};
+
+/// Every channel: what a projection fill fills unless it says otherwise.
+fn all_channels() -> Channels {
+    Channels::ALL
+}
 
 /// The layer stack: selection, properties and structure; each change is one undo step.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -39,8 +46,35 @@ pub enum LayerCommand {
     },
     /// Which of its channels the selected layer lays over the layers below.
     SetLayerChannels(Channels),
-    /// Sets a fill layer's material.
+    /// Sets a fill layer's material (a projection fill becomes a fill of that material).
     SetLayerFill(MaterialValue),
+    /// Makes the selected fill layer a projection fill: `image` laid through `projection`
+    /// (its colour into `k_d`, its luminance into `k_s`, its gray into `n`, as `ProjectImage`
+    /// paints them) in the `channels` it names, its alpha the layer's coverage; laid again
+    /// whenever the mesh changes.
+    SetLayerProjection {
+        /// The image (a relative path from the script's folder).
+        image: PaintImage,
+        /// How it is laid on the surface.
+        projection: Projection,
+        /// The channels it fills (all by default).
+        #[serde(default = "all_channels")]
+        channels: Channels,
+    },
+    /// Adds a projection fill (as `SetLayerProjection` makes one) above the selected layer
+    /// and selects it: one undo step.
+    AddProjectionFill {
+        /// Its name.
+        #[serde(deserialize_with = "crate::check::layer_name")]
+        name: String,
+        /// The image (a relative path from the script's folder).
+        image: PaintImage,
+        /// How it is laid on the surface.
+        projection: Projection,
+        /// The channels it fills (all by default).
+        #[serde(default = "all_channels")]
+        channels: Channels,
+    },
     /// Moves the selected layer.
     MoveLayer(LayerMove),
     /// Moves the selected layer next to or into another (the Layers panel's drag and drop).

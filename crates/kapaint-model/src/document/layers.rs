@@ -64,6 +64,31 @@ impl Document {
         }
     }
 
+    /// A projection fill's parameters, checked: a loaded image, a projection whose numbers
+    /// make a frame, and the mesh it needs.
+    fn projection_fill(
+        &self,
+        image: crate::paint_image::PaintImage,
+        projection: crate::paint::projection::Projection,
+        channels: crate::texel::Channels,
+    ) -> Result<crate::layers::projected::ProjectionFill, ModelError> {
+        image.pixels()?;
+        projection.check().map_err(ModelError::Command)?;
+        if projection.needs_surface() {
+            self.require_surface("a projection fill")?;
+        }
+        if !(channels.kd || channels.ks || channels.n) {
+            return Err(command_error(
+                "a projection fill must fill at least one channel",
+            ));
+        }
+        Ok(crate::layers::projected::ProjectionFill {
+            image,
+            projection,
+            channels,
+        })
+    }
+
     /// The selected layer's value at texel `(x, y)` over `under`: the channels a paint layer
     /// (or a group's merge) covers there, or a fill layer's material.
     pub(super) fn layer_value(&self, x: u32, y: u32, under: MaterialValue) -> MaterialValue {
@@ -75,6 +100,7 @@ impl Document {
         let tile = match &layer.content {
             LayerContent::Fill(value) => return *value,
             LayerContent::Paint(tiles) => tiles.get(id).and_then(Option::as_ref).map(|t| t.get()),
+            LayerContent::Projected(p) => p.tile(id).map(|t| t.get()),
             LayerContent::Group(children) => {
                 merged = crate::layers::merge_tile(children, id);
                 merged.as_ref()
@@ -236,6 +262,42 @@ impl Document {
                 Ok(())
             }),
             LayerCommand::SetLayerFill(v) => self.props("Fill material", |l| set_fill(l, v)),
+            LayerCommand::SetLayerProjection {
+                image,
+                projection,
+                channels,
+            } => {
+                let fill = self.projection_fill(image, projection, channels)?;
+                self.change("Fill projection", |st, _| {
+                    let source = super::masks::source_of(st);
+                    let layer = selected_mut(st)?;
+                    if !matches!(
+                        layer.content,
+                        LayerContent::Fill(_) | LayerContent::Projected(_)
+                    ) {
+                        return Err(command_error(format!(
+                            "the layer \"{}\" is not a fill layer",
+                            layer.props.name
+                        )));
+                    }
+                    layer.content = laid(fill, source)?;
+                    Ok(())
+                })
+            }
+            LayerCommand::AddProjectionFill {
+                name,
+                image,
+                projection,
+                channels,
+            } => {
+                let fill = self.projection_fill(image, projection, channels)?;
+                self.change("Add projection fill", |st, cx| {
+                    structure::add(st, cx, crate::document::LayerKind::Fill, name)?;
+                    let source = super::masks::source_of(st);
+                    selected_mut(st)?.content = laid(fill, source)?;
+                    Ok(())
+                })
+            }
             LayerCommand::AddLayer { kind, name } => {
                 self.change("Add layer", |st, cx| structure::add(st, cx, kind, name))
             }
@@ -352,11 +414,28 @@ fn set_blend(
     Ok(())
 }
 
-/// Sets a fill layer's material.
+/// A projection fill laid on `source`, refused where it reaches no texel (its tiles laid now,
+/// in parallel: the composite reads them next).
+fn laid(
+    fill: crate::layers::projected::ProjectionFill,
+    source: crate::generator::tiles::Source,
+) -> Result<LayerContent, ModelError> {
+    use rayon::prelude::*;
+    let laid = crate::layers::projected::Projected::new(fill, source);
+    let count = laid.tile_count();
+    if !(0..count).into_par_iter().any(|id| laid.tile(id).is_some()) {
+        return Err(command_error(
+            "the projection reaches no texel of the map (nothing faces it, or it lies off the mesh)",
+        ));
+    }
+    Ok(LayerContent::Projected(std::sync::Arc::new(laid)))
+}
+
+/// Sets a fill layer's material (a projection fill's included).
 fn set_fill(l: &mut Layer, v: MaterialValue) -> Result<(), ModelError> {
     match &mut l.content {
-        LayerContent::Fill(value) => {
-            *value = v.sanitized();
+        LayerContent::Fill(_) | LayerContent::Projected(_) => {
+            l.content = LayerContent::Fill(v.sanitized());
             Ok(())
         }
         _ => Err(command_error(format!(

@@ -135,7 +135,7 @@ fn missing_bake(map: kapaint_mesh::bakes::BakeMap) -> String {
 }
 
 /// What a generator reads in `st`: its surface, bakes and map size.
-fn source_of(st: &State) -> Source {
+pub(super) fn source_of(st: &State) -> Source {
     Source::new(
         st.surface.clone(),
         &st.bakes,

@@ -91,11 +91,14 @@ impl HistoryCommand {
 }
 
 impl LayerCommand {
-    /// Merging and flattening make new tiles; a new, duplicated or fill layer shares them or
-    /// holds none.
+    /// Merging and flattening make new tiles, and a projection fill lays a whole layer of
+    /// them; a new, duplicated or fill layer shares them or holds none.
     fn may_write_a_whole_layer(&self) -> bool {
         match self {
-            Self::MergeDown | Self::Flatten => true,
+            Self::MergeDown
+            | Self::Flatten
+            | Self::SetLayerProjection { .. }
+            | Self::AddProjectionFill { .. } => true,
             Self::AddLayer { .. }
             | Self::SelectLayer(_)
             | Self::SelectPath(_)

@@ -269,6 +269,8 @@ mod tests {
             "SetLayerBlend",
             "SetLayerChannels",
             "SetLayerFill",
+            "SetLayerProjection",
+            "AddProjectionFill",
             "MoveLayer",
             "MoveLayerTo",
             "DeleteLayer",

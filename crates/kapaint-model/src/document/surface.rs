@@ -52,14 +52,15 @@ impl Document {
         self
     }
 
-    /// Whether a layer's mask is made by a generator, which is laid on the mesh: the
-    /// composite is only right with the mesh's surface attached.
+    /// Whether a layer is laid on the mesh (a generator mask, or a projection fill that
+    /// projects onto the surface): the composite is only right with the mesh's surface
+    /// attached.
     pub fn needs_mesh(&self) -> bool {
-        self.state
-            .stack
-            .walk()
-            .iter()
-            .any(|(_, l)| l.mask.as_ref().is_some_and(|m| m.generator.is_some()))
+        self.state.stack.walk().iter().any(|(_, l)| {
+            l.mask.as_ref().is_some_and(|m| m.generator.is_some())
+                || matches!(&l.content, crate::layers::LayerContent::Projected(p)
+                    if p.fill().projection.needs_surface())
+        })
     }
 
     /// The bakes a generator mask reads that the document does not keep, each with the name

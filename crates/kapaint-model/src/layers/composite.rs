@@ -89,6 +89,7 @@ fn active_at(layers: &[Layer], id: usize, generated: bool) -> Vec<Active<'_>> {
         .filter_map(|l| match &l.content {
             LayerContent::Paint(tiles) => tiles[id].as_ref().map(|t| Active::Paint(l, t)),
             LayerContent::Fill(v) => Some(Active::Fill(l, values(Texel::encode(*v)))),
+            LayerContent::Projected(p) => p.tile(id).map(|t| Active::Paint(l, t)),
             LayerContent::Group(children) => {
                 let inner = active_at(children, id, generated);
                 (!inner.is_empty()).then_some(Active::Group(l, inner))

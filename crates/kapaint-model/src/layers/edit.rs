@@ -505,18 +505,7 @@ fn slots<'a>(planes: Planes<'a>, pre: PrePlanes<'a>, ids: &[usize]) -> Vec<Slot<
     }
 }
 
-/// Texel indices inside tile `id` of a `width x height` map, with their map coordinates.
-pub fn tile_texels(width: u32, height: u32, id: usize) -> impl Iterator<Item = (usize, u32, u32)> {
-    let tiles_x = (width as usize).div_ceil(TILE_SIZE);
-    let (x0, y0) = ((id % tiles_x) * TILE_SIZE, (id / tiles_x) * TILE_SIZE);
-    let (x1, y1) = (
-        (x0 + TILE_SIZE).min(width as usize),
-        (y0 + TILE_SIZE).min(height as usize),
-    );
-    (y0..y1).flat_map(move |y| {
-        (x0..x1).map(move |x| ((y - y0) * TILE_SIZE + (x - x0), x as u32, y as u32))
-    })
-}
+pub use crate::tile::tile_texels;
 
 /// A whole-map fill at full coverage in the normal mode as uniform tiles: no per-texel work
 /// and no memory. Returns false when the fill needs the per-texel path.

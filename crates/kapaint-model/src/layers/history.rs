@@ -112,6 +112,7 @@ fn each_tile(layers: &[Layer], f: &mut impl FnMut(usize, usize)) {
                     f(Arc::as_ptr(t) as usize, t.get().heap_bytes());
                 }
             }
+            LayerContent::Projected(p) => f(Arc::as_ptr(p) as usize, p.heap_bytes()),
             LayerContent::Fill(_) => {}
             LayerContent::Group(children) => each_tile(children, f),
         }

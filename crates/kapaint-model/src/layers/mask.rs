@@ -127,7 +127,7 @@ pub fn neutral_tile() -> SharedMaskTile {
     )))
 }
 
-/// Lays every generator mask in `layers` (at any depth) on `source` where it was laid on
+/// Lays every generator mask and projection fill in `layers` (at any depth) on `source` where it was laid on
 /// other inputs (a new stamp: recomposited), or gives it `source`'s surface where it was laid
 /// on the same mesh before the surface was attached (the same stamp); whether any changed. A
 /// `source` without a surface keeps the mesh each generator was laid on.
@@ -160,8 +160,15 @@ pub fn lay_generators(layers: &mut [Layer], source: &crate::generator::tiles::So
                 changed = true;
             }
         }
-        if let LayerContent::Group(children) = &mut layer.content {
-            changed |= lay_generators(children, source);
+        match &mut layer.content {
+            LayerContent::Group(children) => changed |= lay_generators(children, source),
+            LayerContent::Projected(p) => {
+                if let Some(again) = super::projected::relaid(p, source) {
+                    *p = Arc::new(again);
+                    changed = true;
+                }
+            }
+            LayerContent::Paint(_) | LayerContent::Fill(_) => {}
         }
     }
     changed

@@ -18,6 +18,7 @@ pub mod history;
 mod mask;
 pub mod ops;
 pub mod paint;
+pub mod projected;
 pub mod thumbnail;
 
 pub use blend::{Covered, LayerBlend};
@@ -217,6 +218,8 @@ pub enum LayerContent {
     Paint(Vec<Option<SharedPaintTile>>),
     /// One material everywhere.
     Fill(MaterialValue),
+    /// A fill of an image through a projection (a fill layer's other kind).
+    Projected(Arc<projected::Projected>),
     /// Layers composited first, bottom first.
     Group(Vec<Layer>),
 }
@@ -278,6 +281,7 @@ impl Layer {
                 tiles.iter().flatten().map(|t| t.get().heap_bytes()).sum()
             }
             LayerContent::Fill(_) => 0,
+            LayerContent::Projected(p) => p.heap_bytes(),
             LayerContent::Group(children) => children.iter().map(Layer::heap_bytes).sum(),
         };
         own + self.mask.as_ref().map_or(0, Mask::heap_bytes)
@@ -437,7 +441,7 @@ impl LayerStack {
     pub fn holds_paint(&self) -> bool {
         self.walk().iter().any(|(_, l)| match &l.content {
             LayerContent::Paint(tiles) => tiles.iter().any(Option::is_some),
-            LayerContent::Fill(_) => true,
+            LayerContent::Fill(_) | LayerContent::Projected(_) => true,
             LayerContent::Group(_) => false,
         })
     }
@@ -514,7 +518,7 @@ impl Layer {
     pub fn kind_name(&self) -> &'static str {
         match self.content {
             LayerContent::Paint(_) => "paint",
-            LayerContent::Fill(_) => "fill",
+            LayerContent::Fill(_) | LayerContent::Projected(_) => "fill",
             LayerContent::Group(_) => "group",
         }
     }

@@ -33,15 +33,22 @@ pub fn content(stack: &LayerStack, layer: &Layer, size: u32) -> Option<Vec<[u8; 
     match &layer.content {
         LayerContent::Group(_) => None,
         LayerContent::Fill(value) => Some(vec![picture(*value, [u16::MAX; 3]); pixels(size)]),
-        LayerContent::Paint(tiles) => Some(sample(stack, size, |id, i| {
-            tiles.get(id).and_then(Option::as_ref).map_or([0; 4], |t| {
-                let t = t.get();
-                picture(
-                    Texel::decode(t.value.texel(i)),
-                    t.alpha.each_ref().map(|a| a.get(i)),
-                )
-            })
-        })),
+        LayerContent::Paint(_) | LayerContent::Projected(_) => {
+            Some(sample(stack, size, |id, i| {
+                let tile = match &layer.content {
+                    LayerContent::Paint(tiles) => tiles.get(id).and_then(Option::as_ref),
+                    LayerContent::Projected(p) => p.tile(id),
+                    _ => None,
+                };
+                tile.map_or([0; 4], |t| {
+                    let t = t.get();
+                    picture(
+                        Texel::decode(t.value.texel(i)),
+                        t.alpha.each_ref().map(|a| a.get(i)),
+                    )
+                })
+            }))
+        }
     }
 }
 

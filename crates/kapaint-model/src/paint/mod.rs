@@ -11,6 +11,7 @@
 mod fill;
 mod footprint;
 mod gradient;
+pub mod mapper;
 pub mod projection;
 mod stencil;
 #[cfg(test)]

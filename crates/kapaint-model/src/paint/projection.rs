@@ -6,12 +6,12 @@
 //! bottom-right, as [`crate::paint_image::Pixels::sample`] reads them.
 
 use glam::{Vec2, Vec3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use kapaint_mesh::Mesh;
 
 /// How an image is laid on the surface.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Projection {
     /// From the side `normal` points to, the image's centre at `origin`, its right along

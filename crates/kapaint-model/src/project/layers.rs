@@ -12,11 +12,13 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use super::ChannelEntry;
+use crate::layers::projected::{Projected, ProjectionFill};
 use crate::layers::{
     ChannelBlend, Layer, LayerBlend, LayerContent, LayerId, LayerProps, LayerStack, Mask,
     PaintTile, Stamped,
 };
 use crate::maps::MaterialMaps;
+use crate::paint_image::PaintImage;
 use crate::texel::{Channel, MaterialValue};
 use crate::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile};
 
@@ -89,6 +91,27 @@ pub struct MaskEntry {
     pub generator: Option<crate::generator::Generator>,
 }
 
+/// A projection fill (version 5): how its image is laid, and the image, kept in the project.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProjectionEntry {
+    /// How the image is laid (checked as it is read).
+    #[serde(deserialize_with = "crate::check::projection")]
+    pub projection: crate::paint::projection::Projection,
+    /// The channels it fills.
+    pub channels: crate::texel::Channels,
+    /// The file the image was chosen from (what the editor names; the pixels are kept here).
+    pub source: String,
+    /// Its colour and coverage: a 16-bit RGBA PNG in the archive (linear, premultiplied).
+    pub rgba: String,
+    /// Its gray and exponent: a 16-bit gray-alpha PNG in the archive (premultiplied).
+    pub gray: String,
+    /// Its size in pixels.
+    pub width: u32,
+    /// Its size in pixels.
+    pub height: u32,
+}
+
 /// One layer in the manifest.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -113,6 +136,9 @@ pub struct LayerEntry {
     /// A fill layer's material.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fill: Option<MaterialValue>,
+    /// A projection fill's projection and image (a fill layer has this or `fill`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub projection: Option<ProjectionEntry>,
     /// A paint layer's planes (none: nothing painted).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub planes: Option<PlanesEntry>,
@@ -182,6 +208,8 @@ pub struct LayerMaps {
     pub mask_fill: u16,
     /// Mask as `k_d`.
     pub mask: Option<MaterialMaps>,
+    /// A projection fill's image.
+    pub projection: Option<Arc<crate::paint_image::Pixels>>,
 }
 
 impl LayerMaps {
@@ -195,6 +223,7 @@ impl LayerMaps {
             mask_tiles: Vec::new(),
             mask_fill: u16::MAX,
             mask: None,
+            projection: None,
         }
     }
 }
@@ -223,6 +252,11 @@ pub fn layer_maps(stack: &LayerStack) -> Result<Vec<LayerMaps>, String> {
         .enumerate()
         .map(|(k, (_, layer))| {
             let mut out = LayerMaps::empty(k);
+            if let LayerContent::Projected(p) = &layer.content {
+                out.projection = Some(Arc::clone(
+                    p.fill().image.pixels().map_err(|e| e.to_string())?,
+                ));
+            }
             if let LayerContent::Paint(tiles) = &layer.content {
                 let painted: Vec<(u32, &PaintTile)> = (0u32..)
                     .zip(tiles)
@@ -297,7 +331,7 @@ pub fn entries(
                 name: p.name.clone(),
                 kind: match layer.content {
                     LayerContent::Paint(_) => KindEntry::Paint,
-                    LayerContent::Fill(_) => KindEntry::Fill,
+                    LayerContent::Fill(_) | LayerContent::Projected(_) => KindEntry::Fill,
                     LayerContent::Group(_) => KindEntry::Group,
                 },
                 visible: p.visible,
@@ -309,6 +343,10 @@ pub fn entries(
                 }),
                 fill: match layer.content {
                     LayerContent::Fill(v) => Some(v),
+                    _ => None,
+                },
+                projection: match &layer.content {
+                    LayerContent::Projected(laid) => Some(projection_entry(laid.fill(), k)),
                     _ => None,
                 },
                 planes,
@@ -331,6 +369,42 @@ pub fn entries(
         .collect()
 }
 
+/// The entry of a projection fill stored as layer `k`.
+fn projection_entry(fill: &ProjectionFill, k: usize) -> ProjectionEntry {
+    let (width, height) = fill
+        .image
+        .pixels()
+        .map_or((0, 0), |p| (p.width(), p.height()));
+    ProjectionEntry {
+        projection: fill.projection,
+        channels: fill.channels,
+        source: fill.image.path().to_string_lossy().into_owned(),
+        rgba: format!("layer{k}_projection_rgba.png"),
+        gray: format!("layer{k}_projection_gray.png"),
+        width,
+        height,
+    }
+}
+
+/// Whether a layer among `entries` (at any depth) is a projection fill.
+pub fn any_projection(entries: &[LayerEntry]) -> bool {
+    entries
+        .iter()
+        .any(|e| e.projection.is_some() || any_projection(&e.children))
+}
+
+/// Whether a layer among `entries` (at any depth) is laid on the mesh: a generator mask, or a
+/// projection fill that projects onto the surface.
+pub fn any_on_mesh(entries: &[LayerEntry]) -> bool {
+    entries.iter().any(|e| {
+        e.mask.as_ref().is_some_and(|m| m.generator.is_some())
+            || e.projection
+                .as_ref()
+                .is_some_and(|p| p.projection.needs_surface())
+            || any_on_mesh(&e.children)
+    })
+}
+
 /// Whether a mask among `entries` (at any depth) is made by a generator.
 pub fn any_generator(entries: &[LayerEntry]) -> bool {
     entries.iter().any(|e| {
@@ -349,8 +423,20 @@ pub fn check_shape(entries: &[LayerEntry], depth: usize, count: &mut usize) -> R
             return Err(format!("the project holds more than {MAX_LAYERS} layers"));
         }
         match (e.kind, &e.fill, &e.planes, e.children.is_empty()) {
-            (KindEntry::Fill, None, _, _) => {
+            (KindEntry::Fill, None, _, _) if e.projection.is_none() => {
                 return Err(format!("the fill layer {:?} has no fill material", e.name));
+            }
+            (KindEntry::Fill, Some(_), _, _) if e.projection.is_some() => {
+                return Err(format!(
+                    "the fill layer {:?} has both a material and a projection",
+                    e.name
+                ));
+            }
+            (KindEntry::Paint | KindEntry::Group, _, _, _) if e.projection.is_some() => {
+                return Err(format!(
+                    "the layer {:?} is not a fill layer but has a projection",
+                    e.name
+                ));
             }
             (KindEntry::Paint | KindEntry::Group, Some(_), _, _) => {
                 return Err(format!(
@@ -414,7 +500,21 @@ pub fn build(
             };
             let content = match e.kind {
                 KindEntry::Paint => LayerContent::Paint(paint_tiles(&stored, tile_count)),
-                KindEntry::Fill => LayerContent::Fill(e.fill.unwrap_or_default().sanitized()),
+                KindEntry::Fill => match (&e.projection, &stored.projection) {
+                    (Some(p), Some(pixels)) => LayerContent::Projected(Arc::new(Projected::new(
+                        ProjectionFill {
+                            image: PaintImage::of_pixels(&p.source, Arc::clone(pixels)),
+                            projection: p.projection,
+                            channels: p.channels,
+                        },
+                        // Laid on the map alone for now, as a generator is.
+                        crate::generator::tiles::Source::new(None, &[], size.0, size.1),
+                    ))),
+                    (Some(_), None) => {
+                        return Err(format!("the projection fill {:?} has no image", e.name));
+                    }
+                    (None, _) => LayerContent::Fill(e.fill.unwrap_or_default().sanitized()),
+                },
                 KindEntry::Group => {
                     LayerContent::Group(build(&e.children, next, (tile_count, size), read)?)
                 }

@@ -11,6 +11,7 @@
 //! the first problem as one error; it never panics on any input.
 
 mod bakes;
+mod images;
 pub use bakes::to_png as bake_png;
 pub mod layers;
 pub mod lock;
@@ -35,9 +36,13 @@ use write::write_project;
 /// The format name in the manifest.
 pub const FORMAT: &str = "kapaint-project";
 
-/// The newest manifest version this build writes: 3 for a project that keeps its mesh inside
-/// itself, else 2, which every build since layers reads. It reads 1, 2 and 3.
-pub const VERSION: u32 = 4;
+/// The newest manifest version this build writes: 5 for a project with a projection fill, 4
+/// for one with a generator mask, 3 for one that keeps its mesh inside itself, else 2, which
+/// every build since layers reads. It reads 1 to 5.
+pub const VERSION: u32 = 5;
+
+/// The version that first held generator masks.
+const GENERATOR_VERSION: u32 = 4;
 
 /// The version that first kept a mesh and bakes.
 const MESH_VERSION: u32 = 3;
@@ -487,16 +492,22 @@ fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
     }
     match (manifest.version, &manifest.layers) {
         (1, None) => {}
-        (2..=4, Some(entries)) => {
+        (2..=VERSION, Some(entries)) => {
             layers::check_shape(entries, 0, &mut 0)?;
-            if manifest.version < VERSION && layers::any_generator(entries) {
+            if manifest.version < GENERATOR_VERSION && layers::any_generator(entries) {
                 return Err(format!(
-                    "a version {} project has no generator masks (they are version {VERSION})",
+                    "a version {} project has no generator masks (they are version {GENERATOR_VERSION})",
+                    manifest.version
+                ));
+            }
+            if manifest.version < VERSION && layers::any_projection(entries) {
+                return Err(format!(
+                    "a version {} project has no projection fills (they are version {VERSION})",
                     manifest.version
                 ));
             }
         }
-        (1..=4, _) => {
+        (1..=VERSION, _) => {
             return Err(format!(
                 "a version {} project {} layers",
                 manifest.version,

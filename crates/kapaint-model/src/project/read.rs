@@ -114,11 +114,11 @@ pub(super) fn read(reader: impl Read + Seek) -> Result<ReadProject, String> {
         let mut stored =
             MaterialMaps::new(w, h, MaterialValue::default()).map_err(|e| e.to_string())?;
         fill_maps(&mut stored, &kd, &ks, &n);
-        let needs_mesh = super::layers::any_generator(entries);
+        let needs_mesh = super::layers::any_on_mesh(entries);
         let mut stack = stack;
         if needs_mesh {
-            // Generator masks wait for the mesh the project names (nothing is computed for
-            // them until it is attached): its hash where the project says, else one no mesh
+            // Generator masks and projection fills wait for the mesh the project names
+            // (nothing is computed for them until it is attached): its hash where the project says, else one no mesh
             // has.
             let hash = match (&mesh, &manifest.settings.mesh) {
                 (Some(m), _) => m.content_hash(),
@@ -224,6 +224,16 @@ fn check_declared(manifest: &super::Manifest) -> Result<(), String> {
         if let Some(m) = &e.mask {
             name(&m.gray)?;
             texel_bytes += atlas_texels(&m.tiles) * 20;
+        }
+        if let Some(p) = &e.projection {
+            for file in [&p.rgba, &p.gray] {
+                name(&ChannelEntry::Image {
+                    file: file.clone(),
+                    encoding: String::new(),
+                })?;
+            }
+            // The PNGs' samples (12 bytes a pixel) and the pixels kept (12 more).
+            texel_bytes += u64::from(p.width) * u64::from(p.height) * 24;
         }
     }
     kapaint_base::memory::check_fits("opening it", texel_bytes)
@@ -423,6 +433,9 @@ fn read_layer<R: Read + Seek>(
         out.mask_tiles = tiles;
         out.mask_fill = m.fill.unwrap_or(u16::MAX);
         out.mask = Some(mask);
+    }
+    if let Some(p) = &e.projection {
+        out.projection = Some(super::images::read(zip, p, &name("projection"))?);
     }
     Ok(out)
 }

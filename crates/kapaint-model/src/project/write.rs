@@ -203,16 +203,11 @@ pub(super) fn write_project(
         .map(|((_, r), &(w, h))| encode_png(r, w, h))
         .collect();
     let layers = super::layers::entries(&doc.stack().layers, &mut 0, &|k| stored[k].clone());
+    let files = projection_files(&layers, &layer_maps)?;
     let kept_mesh = kept_mesh(doc, &settings)?;
     let manifest = Manifest {
         format: FORMAT.into(),
-        version: if has_generator(&doc.stack().layers) {
-            VERSION
-        } else if kept_mesh.is_some() || !doc.bakes().is_empty() {
-            super::MESH_VERSION
-        } else {
-            super::LAYERS_VERSION
-        },
+        version: version_of(&layers, kept_mesh.is_some() || !doc.bakes().is_empty()),
         width: w,
         height: h,
         settings,
@@ -258,7 +253,12 @@ pub(super) fn write_project(
         )));
     }
     let pngs = pngs.into_iter().collect::<Result<Vec<_>, String>>()?;
-    write_archive(out, &json, &rasters, &pngs, doc, kept_mesh.as_ref())
+    let stored = Stored {
+        rasters: &rasters,
+        pngs: &pngs,
+        files: &files,
+    };
+    write_archive(out, &json, &stored, doc, kept_mesh.as_ref())
 }
 
 /// The archive: the manifest, every channel that is not one value, the normal map and the
@@ -266,8 +266,7 @@ pub(super) fn write_project(
 fn write_archive(
     out: impl Write + Seek,
     json: &[u8],
-    rasters: &[(String, Raster)],
-    pngs: &[Vec<u8>],
+    stored: &Stored<'_>,
     doc: &Document,
     kept_mesh: Option<&(String, u64)>,
 ) -> Result<(), WriteFailure> {
@@ -280,12 +279,17 @@ fn write_archive(
     zip.start_file("manifest.json", deflated)
         .map_err(|e| e.to_string())?;
     zip.write_all(json).map_err(|e| e.to_string())?;
-    for ((name, raster), png) in rasters.iter().zip(pngs) {
+    for ((name, raster), png) in stored.rasters.iter().zip(stored.pngs) {
         if !matches!(raster, Raster::Uniform(_)) {
             zip.start_file(format!("{name}.png"), stored_file)
                 .map_err(|e| e.to_string())?;
             zip.write_all(png).map_err(|e| e.to_string())?;
         }
+    }
+    for (name, bytes) in stored.files {
+        zip.start_file(name, stored_file)
+            .map_err(|e| e.to_string())?;
+        zip.write_all(bytes).map_err(|e| e.to_string())?;
     }
     if let Some(normal) = doc.normal() {
         let png = normal.to_png()?;
@@ -340,10 +344,55 @@ fn invalid_n_in(maps: &MaterialMaps) -> Option<u16> {
         })
 }
 
-/// Whether a mask in `layers` (at any depth) is made by a generator.
-fn has_generator(layers: &[crate::layers::Layer]) -> bool {
-    layers.iter().any(|l| {
-        l.mask.as_ref().is_some_and(|m| m.generator.is_some())
-            || matches!(&l.content, crate::layers::LayerContent::Group(c) if has_generator(c))
-    })
+/// What the archive holds besides the manifest, the normal map, the mesh and the bakes: the
+/// channel rasters (as PNGs where not uniform) and other files, named.
+struct Stored<'a> {
+    rasters: &'a [(String, Raster)],
+    pngs: &'a [Vec<u8>],
+    files: &'a [(String, Vec<u8>)],
+}
+
+/// The oldest version that holds what `layers` hold, and a kept mesh or bakes where `mesh`.
+fn version_of(layers: &[super::layers::LayerEntry], mesh: bool) -> u32 {
+    if super::layers::any_projection(layers) {
+        VERSION
+    } else if super::layers::any_generator(layers) {
+        super::GENERATOR_VERSION
+    } else if mesh {
+        super::MESH_VERSION
+    } else {
+        super::LAYERS_VERSION
+    }
+}
+
+/// The projection fills' images, each as its entry names it.
+fn projection_files(
+    entries: &[super::layers::LayerEntry],
+    layer_maps: &[super::layers::LayerMaps],
+) -> Result<Vec<(String, Vec<u8>)>, String> {
+    let mut files = Vec::new();
+    for (k, e) in entries_walk(entries) {
+        if let (Some(p), Some(pixels)) = (&e.projection, &layer_maps[k].projection) {
+            let [rgba, gray] = super::images::encode(pixels)?;
+            files.push((p.rgba.clone(), rgba));
+            files.push((p.gray.clone(), gray));
+        }
+    }
+    Ok(files)
+}
+
+/// Every entry of `entries`, depth first as [`super::layers::entries`] numbers them.
+fn entries_walk(entries: &[super::layers::LayerEntry]) -> Vec<(usize, &super::layers::LayerEntry)> {
+    fn go<'a>(
+        list: &'a [super::layers::LayerEntry],
+        out: &mut Vec<(usize, &'a super::layers::LayerEntry)>,
+    ) {
+        for e in list {
+            out.push((out.len(), e));
+            go(&e.children, out);
+        }
+    }
+    let mut out = Vec::new();
+    go(entries, &mut out);
+    out
 }

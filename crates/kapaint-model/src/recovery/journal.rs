@@ -18,8 +18,10 @@ use bytemuck::Pod;
 use serde::{Deserialize, Serialize};
 
 use crate::document::{Document, DocumentId, DocumentSettings};
+use crate::layers::projected::ProjectionFill;
 use crate::layers::{Layer, LayerContent, LayerStack, Selection, SharedMaskTile, SharedPaintTile};
 use crate::normal::NormalMap;
+use crate::paint_image::Pixels;
 use crate::project::SelectionEntry;
 use crate::project::layers::{BlendEntry, KindEntry};
 use crate::texel::MaterialValue;
@@ -60,6 +62,14 @@ pub(super) struct Known {
     lists: HashSet<u64>,
     normal: Option<Arc<NormalMap>>,
     mesh: Option<Arc<kapaint_mesh::Mesh>>,
+    /// The projection fills' images, by key: held, so that no other image takes a key while
+    /// the journal refers to it.
+    images: Vec<(u64, Arc<Pixels>)>,
+}
+
+/// The key a record names an image by: where it lives while the journal holds it.
+fn image_key(image: &Arc<Pixels>) -> u64 {
+    Arc::as_ptr(image) as usize as u64
 }
 
 /// A record's description of the document.
@@ -77,6 +87,23 @@ pub(super) struct Meta {
     /// a record without one reads and writes as before.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) mesh: Option<u64>,
+    /// The keys of the projection fills' images whose pixels follow the mesh, in order (the
+    /// images the record before did not carry).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) images: Vec<u64>,
+}
+
+/// A projection fill in a record: its parameters and its image's key.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ProjectionMeta {
+    #[serde(deserialize_with = "crate::check::projection")]
+    pub(super) projection: crate::paint::projection::Projection,
+    pub(super) channels: crate::texel::Channels,
+    pub(super) source: String,
+    pub(super) image: u64,
+    pub(super) width: u32,
+    pub(super) height: u32,
 }
 
 /// One layer in a record: its settings, and its tiles and mask as tile-list keys.
@@ -95,6 +122,8 @@ pub(super) struct LayerMeta {
     pub(super) channels: [BlendEntry; 3],
     #[serde(default)]
     pub(super) fill: Option<MaterialValue>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) projection: Option<ProjectionMeta>,
     #[serde(default)]
     pub(super) tiles: Option<u64>,
     #[serde(default)]
@@ -133,6 +162,9 @@ struct Gathered<'a> {
     paint: Vec<&'a SharedPaintTile>,
     masks: Vec<&'a SharedMaskTile>,
     tiles: HashSet<u64>,
+    /// The images the record refers to, and of those the ones it carries.
+    images: Vec<(u64, Arc<Pixels>)>,
+    carried: Vec<Arc<Pixels>>,
 }
 
 impl<'a> Gathered<'a> {
@@ -170,6 +202,7 @@ impl<'a> Gathered<'a> {
                 )
             }
             LayerContent::Fill(v) => (KindEntry::Fill, Some(*v), None, vec![]),
+            LayerContent::Projected(_) => (KindEntry::Fill, None, None, vec![]),
             LayerContent::Group(children) => {
                 (KindEntry::Group, None, None, self.layers(known, children))
             }
@@ -192,6 +225,10 @@ impl<'a> Gathered<'a> {
                 generator: m.generator().cloned(),
             }
         });
+        let projection = match &l.content {
+            LayerContent::Projected(p) => self.projection(known, p.fill()),
+            _ => None,
+        };
         LayerMeta {
             id: Some(l.props.id.0),
             name: l.props.name.clone(),
@@ -204,10 +241,31 @@ impl<'a> Gathered<'a> {
                 mode: c.mode,
             }),
             fill,
+            projection,
             tiles,
             mask,
             children,
         }
+    }
+
+    /// A projection fill's description; its image is carried unless the journal holds it.
+    fn projection(&mut self, known: &Known, fill: &ProjectionFill) -> Option<ProjectionMeta> {
+        let image = fill.image.pixels().ok()?;
+        let key = image_key(image);
+        if self.images.iter().all(|(k, _)| *k != key) {
+            self.images.push((key, Arc::clone(image)));
+            if known.images.iter().all(|(k, _)| *k != key) {
+                self.carried.push(Arc::clone(image));
+            }
+        }
+        Some(ProjectionMeta {
+            projection: fill.projection,
+            channels: fill.channels,
+            source: fill.image.path().to_string_lossy().into_owned(),
+            image: key,
+            width: image.width(),
+            height: image.height(),
+        })
     }
 }
 
@@ -244,6 +302,7 @@ pub(super) fn write_record(
             .mesh
             .as_ref()
             .map(|_| obj.as_ref().map_or(0, |o| o.len() as u64)),
+        images: gathered.carried.iter().map(image_key).collect(),
     };
     let json = serde_json::to_vec(&meta).map_err(std::io::Error::other)?;
     out.write_all(&snap.stack.width.to_le_bytes())?;
@@ -284,11 +343,17 @@ pub(super) fn write_record(
     if let Some(obj) = &obj {
         out.write_all(obj.as_bytes())?;
     }
+    for image in &gathered.carried {
+        let (rgba, gray) = image.raw();
+        write_le(out, &rgba)?;
+        write_le(out, &gray)?;
+    }
     Ok(Known {
         tiles: gathered.tiles,
         lists: gathered.list_keys,
         normal: snap.normal.clone(),
         mesh: snap.mesh.clone(),
+        images: gathered.images,
     })
 }
 

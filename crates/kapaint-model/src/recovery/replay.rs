@@ -8,14 +8,16 @@ use std::sync::Arc;
 use bytemuck::Pod;
 use serde::Deserialize;
 
-use super::journal::{LayerMeta, MAX_META_BYTES, Meta, swap_pairs};
+use super::journal::{LayerMeta, MAX_META_BYTES, Meta, ProjectionMeta, swap_pairs};
 use super::record::Payload;
 use crate::document::{Document, DocumentId};
+use crate::layers::projected::{Projected, ProjectionFill};
 use crate::layers::{
     ChannelBlend, Layer, LayerContent, LayerId, LayerProps, LayerStack, Mask, PaintTile,
     SharedMaskTile, SharedPaintTile, Stamped,
 };
 use crate::normal::NormalMap;
+use crate::paint_image::{PaintImage, Pixels};
 use crate::project::layers::{KindEntry, MAX_DEPTH, MAX_LAYERS};
 use crate::texel::Channel;
 use crate::tile::{Plane, TILE_TEXELS, Tile};
@@ -68,6 +70,35 @@ pub(super) struct Decoded {
     masks: HashMap<u64, SharedMaskTile>,
     normal: Option<Arc<NormalMap>>,
     mesh: Option<Arc<kapaint_mesh::Mesh>>,
+    images: HashMap<u64, Arc<Pixels>>,
+}
+
+/// The size its projection fills give image `key`, if one names it.
+fn image_size(layers: &[LayerMeta], key: u64) -> Option<(u32, u32)> {
+    layers.iter().find_map(|l| match &l.projection {
+        Some(p) if p.image == key => Some((p.width, p.height)),
+        _ => image_size(&l.children, key),
+    })
+}
+
+/// The images a record carries (after its mesh), each of the size a layer names it by.
+fn read_images<R: Read>(
+    r: &mut Payload<'_, R>,
+    meta: &Meta,
+) -> Result<HashMap<u64, Arc<Pixels>>, String> {
+    let mut images = HashMap::new();
+    for &key in &meta.images {
+        let (w, h) =
+            image_size(&meta.layers, key).ok_or("the record carries an image no layer names")?;
+        let count = w as usize * h as usize;
+        if count as u64 * 12 > r.left() {
+            return Err("an image is larger than the record".into());
+        }
+        let rgba: Vec<u16> = read_le(r, count * 4)?;
+        let gray: Vec<u16> = read_le(r, count * 2)?;
+        images.insert(key, Arc::new(Pixels::from_raw(w, h, &rgba, &gray)?));
+    }
+    Ok(images)
 }
 
 /// Reads one record's payload (checked as it goes; the checksum is the caller's).
@@ -154,6 +185,7 @@ pub(super) fn decode<R: Read>(r: &mut Payload<'_, R>) -> Result<Decoded, String>
         }
         _ => None,
     };
+    let images = read_images(r, &meta)?;
     Ok(Decoded {
         width,
         height,
@@ -163,6 +195,7 @@ pub(super) fn decode<R: Read>(r: &mut Payload<'_, R>) -> Result<Decoded, String>
         masks,
         normal,
         mesh,
+        images,
     })
 }
 
@@ -183,9 +216,13 @@ fn check_layers(layers: &[LayerMeta], depth: usize, count: &mut usize) -> Result
         }
         let shape_ok = match l.kind {
             KindEntry::Paint => l.tiles.is_some() && l.fill.is_none() && l.children.is_empty(),
-            KindEntry::Fill => l.tiles.is_none() && l.fill.is_some() && l.children.is_empty(),
+            KindEntry::Fill => {
+                l.tiles.is_none()
+                    && l.fill.is_some() != l.projection.is_some()
+                    && l.children.is_empty()
+            }
             KindEntry::Group => l.tiles.is_none() && l.fill.is_none(),
-        };
+        } && (l.kind == KindEntry::Fill || l.projection.is_none());
         if !shape_ok {
             return Err(format!("the layer {:?} does not match its kind", l.name));
         }
@@ -212,6 +249,7 @@ pub(super) struct Replay {
     masks: HashMap<u64, SharedMaskTile>,
     normal: Option<Arc<NormalMap>>,
     mesh: Option<Arc<kapaint_mesh::Mesh>>,
+    images: HashMap<u64, Arc<Pixels>>,
     /// The document as of the last record applied.
     doc: Option<Document>,
 }
@@ -224,6 +262,7 @@ impl Replay {
         let mut lists = d.lists;
         let mut paint = d.paint;
         let mut masks = d.masks;
+        let mut images = d.images;
         let normal = match (d.meta.normal, d.normal) {
             (false, _) => None,
             (true, Some(n)) => Some(n),
@@ -241,6 +280,7 @@ impl Replay {
             lists: &mut lists,
             paint: &mut paint,
             masks: &mut masks,
+            images: &mut images,
             keep: Replay::default(),
         };
         let layers = take.layers(&d.meta.layers)?;
@@ -279,6 +319,7 @@ struct Taken<'a> {
     lists: &'a mut HashMap<u64, Vec<u64>>,
     paint: &'a mut HashMap<u64, SharedPaintTile>,
     masks: &'a mut HashMap<u64, SharedMaskTile>,
+    images: &'a mut HashMap<u64, Arc<Pixels>>,
     /// What the record refers to: the journal as of it.
     keep: Replay,
 }
@@ -322,7 +363,10 @@ impl Taken<'_> {
                 }
                 LayerContent::Paint(tiles)
             }
-            KindEntry::Fill => LayerContent::Fill(m.fill.unwrap_or_default().sanitized()),
+            KindEntry::Fill => match &m.projection {
+                Some(p) => LayerContent::Projected(Arc::new(self.projected(p)?)),
+                None => LayerContent::Fill(m.fill.unwrap_or_default().sanitized()),
+            },
             KindEntry::Group => LayerContent::Group(self.layers(&m.children)?),
         };
         let mask = match &m.mask {
@@ -374,6 +418,28 @@ impl Taken<'_> {
             content,
             mask,
         })
+    }
+}
+
+impl Taken<'_> {
+    /// A projection fill, its image from the record or the journal, laid on the map alone
+    /// until the document attaches its mesh.
+    fn projected(&mut self, p: &ProjectionMeta) -> Result<Projected, String> {
+        let image = self
+            .images
+            .get(&p.image)
+            .or_else(|| self.old.images.get(&p.image))
+            .cloned()
+            .filter(|i| (i.width(), i.height()) == (p.width, p.height))
+            .ok_or("the record refers to an image the journal does not hold")?;
+        self.keep.images.insert(p.image, Arc::clone(&image));
+        let fill = ProjectionFill {
+            image: PaintImage::of_pixels(&p.source, image),
+            projection: p.projection,
+            channels: p.channels,
+        };
+        let source = crate::generator::tiles::Source::new(None, &[], self.size.0, self.size.1);
+        Ok(Projected::new(fill, source))
     }
 }
 

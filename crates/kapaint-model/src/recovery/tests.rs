@@ -50,6 +50,13 @@ fn same_document(a: &Document, b: &Document) -> bool {
                 .zip(y)
                 .all(|(s, t)| s.as_ref().map(|s| s.get()) == t.as_ref().map(|t| t.get())),
             (LayerContent::Fill(x), LayerContent::Fill(y)) => x == y,
+            (LayerContent::Projected(x), LayerContent::Projected(y)) => {
+                let (x, y) = (x.fill(), y.fill());
+                x.projection == y.projection
+                    && x.channels == y.channels
+                    && x.image.path() == y.image.path()
+                    && x.image.pixels().ok() == y.image.pixels().ok()
+            }
             (LayerContent::Group(x), LayerContent::Group(y)) => {
                 x.len() == y.len() && x.iter().zip(y).all(|(s, t)| same_layer(s, t))
             }
@@ -227,6 +234,59 @@ fn a_generator_mask_is_recovered_as_its_parameters() {
     assert!(same_document(&back, &doc));
     let mask = back.stack().layers[1].mask.clone().unwrap();
     assert_eq!(mask.generator(), Some(&noise));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_projection_fill_is_recovered_and_its_image_written_once() {
+    let dir = temp("projection-fill");
+    let mut doc = layered(128, 128);
+    let mut saver = Autosaver::new(Duration::ZERO, Some(&dir.join("p.kapaint")), &doc);
+    // 256 x 256 pixels: 768 KiB kept, far more than a stroke's record.
+    let picture = image::RgbaImage::from_fn(256, 256, |x, y| {
+        image::Rgba([x as u8, y as u8, (x ^ y) as u8, 255])
+    });
+    let image = crate::paint_image::PaintImage::decoded(
+        std::path::Path::new("grid.png"),
+        &image::DynamicImage::ImageRgba8(picture),
+    )
+    .unwrap();
+    doc.apply(LayerCommand::AddProjectionFill {
+        name: "Grid".into(),
+        image,
+        projection: crate::paint::projection::Projection::Uv {
+            offset: glam::Vec2::ZERO,
+            scale: glam::Vec2::splat(2.0),
+            rotation: 15.0,
+        },
+        channels: crate::Channels::ALL,
+    })
+    .unwrap();
+    saver.poll(&doc, Instant::now());
+    saver.wait().unwrap().unwrap();
+    let back = load(&saver.session()).unwrap();
+    assert!(same_document(&back, &doc));
+    assert!(same_maps(&back, &doc));
+    let journal_len = |saver: &Autosaver| {
+        let stamps = generations(&saver.session());
+        std::fs::metadata(journal_file(&saver.session(), stamps[0]))
+            .unwrap()
+            .len()
+    };
+    let first = journal_len(&saver);
+    assert!(first > 256 * 256 * 12, "the image is in the first record");
+    doc.apply(LayerCommand::SelectLayer(crate::LayerRef::Index(0)))
+        .unwrap();
+    stroke(&mut doc, 40.0);
+    saver.poll(&doc, Instant::now());
+    saver.wait().unwrap().unwrap();
+    assert!(
+        journal_len(&saver) - first < 256 * 256 * 12,
+        "the next record refers to the image the journal holds"
+    );
+    let back = load(&saver.session()).unwrap();
+    assert!(same_document(&back, &doc));
+    assert!(same_maps(&back, &doc));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
