@@ -336,9 +336,8 @@ fn ctrl_click_on_the_mesh_sets_the_clone_source_and_its_marker_shows_there() {
     );
 }
 
-#[test]
-fn image_project_image_paints_the_chosen_image_through_a_projection_in_one_step() {
-    let mut harness = editor();
+/// Opens Image > Project image.
+fn open_project_image(harness: &mut egui_kittest::Harness<'_, Editor>) {
     let files = harness.state_mut().state.files_mut();
     files.force(FileDialogBackend::System);
     files.set_system_dialog(answer);
@@ -346,12 +345,10 @@ fn image_project_image_paints_the_chosen_image_through_a_projection_in_one_step(
     harness.run_steps(2);
     harness.get_by_label("Project image…").click();
     harness.run_steps(2);
-    // Nothing to project before an image is chosen.
-    harness
-        .get_by_role_and_label(Role::Button, "Project")
-        .click();
-    harness.run_steps(2);
-    assert!(labels(harness.state()).is_empty());
+}
+
+/// Chooses spot's texture in the Project image window and waits for it.
+fn choose_spot(harness: &mut egui_kittest::Harness<'_, Editor>) {
     harness
         .get_by_role_and_label(Role::Button, "Choose…")
         .click();
@@ -365,6 +362,29 @@ fn image_project_image_paints_the_chosen_image_through_a_projection_in_one_step(
         std::thread::sleep(std::time::Duration::from_millis(50));
         harness.step();
     }
+}
+
+/// Picks projection `kind` in the Project image window.
+fn pick_kind(harness: &mut egui_kittest::Harness<'_, Editor>, kind: &str) {
+    harness
+        .get_by_role_and_label(Role::ComboBox, "Projection")
+        .click();
+    harness.run();
+    harness.get_by_label(kind).click();
+    harness.run();
+}
+
+#[test]
+fn image_project_image_paints_the_chosen_image_through_a_projection_in_one_step() {
+    let mut harness = editor();
+    open_project_image(&mut harness);
+    // Nothing to project before an image is chosen.
+    harness
+        .get_by_role_and_label(Role::Button, "Project")
+        .click();
+    harness.run_steps(2);
+    assert!(labels(harness.state()).is_empty());
+    choose_spot(&mut harness);
     let blank = texels(harness.state());
     harness
         .get_by_role_and_label(Role::Button, "Project")
@@ -377,16 +397,82 @@ fn image_project_image_paints_the_chosen_image_through_a_projection_in_one_step(
     );
     assert_eq!(labels(harness.state()), ["Project image"]);
     // Again, tri-planar: its own step.
-    harness
-        .get_by_role_and_label(Role::ComboBox, "Projection")
-        .click();
-    harness.run();
-    harness.get_by_label("Tri-planar").click();
-    harness.run();
+    pick_kind(&mut harness, "Tri-planar");
     harness
         .get_by_role_and_label(Role::Button, "Project")
         .click();
     harness.run_steps(2);
     assert_eq!(labels(harness.state()), ["Project image", "Project image"]);
     assert!(changed(&projected, &texels(harness.state())) > 1000);
+}
+
+#[test]
+fn a_projection_fill_is_added_edited_and_made_flat_from_the_window_and_the_layers_tab() {
+    let mut harness = editor();
+    open_project_image(&mut harness);
+    choose_spot(&mut harness);
+    let blank = texels(harness.state());
+    assert!(harness.query_by_label("Update the fill").is_none());
+    harness
+        .get_by_role_and_label(Role::Button, "New fill layer")
+        .click();
+    harness.run_steps(2);
+    assert_eq!(labels(harness.state()), ["Add projection fill"]);
+    let filled = texels(harness.state());
+    assert!(
+        changed(&blank, &filled) > 1000,
+        "the fill shows on the mesh"
+    );
+    let doc = harness.state().state.doc();
+    let layer = doc.selected_layer().expect("selected");
+    assert_eq!(layer.props.name, "spot_texture (projection)");
+    assert!(matches!(
+        layer.content,
+        kapaint_model::layers::LayerContent::Projected(_)
+    ));
+    // The Layers tab names it; the window, open on it, updates it in one step.
+    assert!(
+        harness
+            .query_by_label("Projection: spot_texture.png, Planar")
+            .is_some()
+    );
+    pick_kind(&mut harness, "Spherical");
+    harness
+        .get_by_role_and_label(Role::Button, "Update the fill")
+        .click();
+    harness.run_steps(2);
+    assert_eq!(
+        labels(harness.state()),
+        ["Add projection fill", "Fill projection"]
+    );
+    assert!(changed(&filled, &texels(harness.state())) > 1000);
+    assert!(
+        harness
+            .query_by_label("Projection: spot_texture.png, Spherical")
+            .is_some()
+    );
+    // A flat fill again, from the Layers tab.
+    let flat = harness
+        .get_all_by_label("Fill with the primary material")
+        .next()
+        .expect("the button")
+        .rect()
+        .center();
+    harness.hover_at(flat);
+    harness.run();
+    harness
+        .get_by_label("Fill with the primary material")
+        .click();
+    harness.run_steps(2);
+    assert!(matches!(
+        harness
+            .state()
+            .state
+            .doc()
+            .selected_layer()
+            .expect("selected")
+            .content,
+        kapaint_model::layers::LayerContent::Fill(_)
+    ));
+    assert_eq!(labels(harness.state()).len(), 3);
 }

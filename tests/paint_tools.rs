@@ -166,3 +166,61 @@ fn a_script_projects_an_image_onto_the_projects_mesh_and_refuses_bad_projections
     assert_eq!(std::fs::read(&a).expect("read"), before);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A projection fill through a script: the project keeps its image (the file may go), opens
+/// laid on its mesh, lists as a fill and exports what the editor shows; a bad one is refused.
+#[test]
+fn a_script_adds_a_projection_fill_that_the_project_keeps_without_its_file() {
+    let d = dir("projection-fill");
+    let a = project(&d);
+    checker(&d.join("checker.png"));
+    let script = d.join("f.ron");
+    std::fs::write(
+        &script,
+        r#"(commands: [AddProjectionFill(name: "Checks", image: "checker.png", projection: Spherical(origin: (0, 0, 0), up: (0, 1, 0), front: (0, 0, 1)), channels: (kd: true, ks: false, n: false))])"#,
+    )
+    .expect("script");
+    let out = d.join("filled.kapaint");
+    let o = kapaint(&["paint", s(&a), "--script", s(&script), "--out", s(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = kapaint(&["layers", s(&out)]);
+    let listed = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        listed.lines().any(|l| l.contains(",fill,Checks,")),
+        "{listed}"
+    );
+    let export = |to: &str| {
+        let folder = d.join(to);
+        let o = kapaint(&["export", s(&out), "--preset", "16-bit", "--out", s(&folder)]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut files: Vec<_> = std::fs::read_dir(&folder)
+            .expect("set")
+            .map(|e| e.expect("entry").path())
+            .filter(|p| p.extension().is_some_and(|e| e == "png"))
+            .collect();
+        files.sort();
+        files
+            .iter()
+            .map(|f| std::fs::read(f).expect("read"))
+            .collect::<Vec<_>>()
+    };
+    let first = export("set1");
+    // The image is kept in the project: without its file it opens and exports the same.
+    std::fs::remove_file(d.join("checker.png")).expect("remove");
+    assert_eq!(export("set2"), first);
+    // A fill that reaches nothing is refused, nothing written.
+    let bad = d.join("bad.ron");
+    checker(&d.join("checker.png"));
+    std::fs::write(
+        &bad,
+        r#"(commands: [AddProjectionFill(name: "Off", image: "checker.png", projection: Planar(origin: (0, 0, 9), normal: (0, 0, 1), up: (0, 1, 0), width: 0.001, height: 0.001))])"#,
+    )
+    .expect("script");
+    let before = std::fs::read(&out).expect("read");
+    let o = kapaint(&["paint", s(&out), "--script", s(&bad)]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("reaches no texel"), "{e}");
+    assert_eq!(std::fs::read(&out).expect("read"), before);
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -6,9 +6,11 @@
 use glam::{Vec2, Vec3};
 
 use kapaint_core::render::Camera;
+use kapaint_model::layers::LayerContent;
+use kapaint_model::layers::projected::ProjectionFill;
 use kapaint_model::paint::projection::Projection;
 use kapaint_model::paint_image::PaintImage;
-use kapaint_model::{Channels, Document, PaintCommand};
+use kapaint_model::{Channels, Command, Document, LayerCommand, PaintCommand};
 
 use crate::desk::{Ask, Desk, centred};
 use crate::files::FilePurpose;
@@ -30,8 +32,17 @@ pub struct ProjectDialog {
 }
 
 impl ProjectDialog {
-    /// A planar projection facing `camera` over the middle of `doc`'s mesh, as wide as it.
+    /// The selected projection fill's choices, or a planar projection facing `camera` over
+    /// the middle of `doc`'s mesh, as wide as it.
     pub fn new(doc: &Document, camera: &Camera) -> Self {
+        if let Some(fill) = selected_fill(doc) {
+            return Self {
+                image: Some(fill.image.clone()),
+                projection: fill.projection,
+                channels: fill.channels,
+                opacity: 1.0,
+            };
+        }
         Self {
             image: None,
             projection: kind_from_view(0, doc, camera),
@@ -39,6 +50,29 @@ impl ProjectDialog {
             opacity: 1.0,
         }
     }
+}
+
+/// The selected layer's projection, when it is a projection fill.
+fn selected_fill(doc: &Document) -> Option<&ProjectionFill> {
+    match &doc.selected_layer()?.content {
+        LayerContent::Projected(p) => Some(p.fill()),
+        _ => None,
+    }
+}
+
+/// The name of a projection fill of `image`: its file's stem.
+fn fill_name(image: &PaintImage) -> String {
+    let stem = image
+        .path()
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    kapaint_model::check::fit_name(&stem, " (projection)", "Projection")
+}
+
+/// A projection's kind, as the dialog names it.
+pub(crate) fn kind_name(projection: &Projection) -> &'static str {
+    KINDS[kind_of(projection)]
 }
 
 /// The mesh's middle and size (the origin and 1 without a mesh).
@@ -179,6 +213,80 @@ fn fields_ui(ui: &mut egui::Ui, projection: &mut Projection) {
     }
 }
 
+/// What the window's buttons do.
+#[derive(Clone, Copy, Debug)]
+enum Action {
+    /// Paint into the selected layer.
+    Project,
+    /// Add a projection fill.
+    NewFill,
+    /// Change the selected projection fill.
+    UpdateFill,
+}
+
+impl Action {
+    fn command(self, dialog: &ProjectDialog, image: PaintImage) -> Command {
+        let (projection, channels) = (dialog.projection, dialog.channels);
+        match self {
+            Self::Project => PaintCommand::ProjectImage {
+                image,
+                projection,
+                channels,
+                opacity: dialog.opacity,
+            }
+            .into(),
+            Self::NewFill => LayerCommand::AddProjectionFill {
+                name: fill_name(&image),
+                image,
+                projection,
+                channels,
+            }
+            .into(),
+            Self::UpdateFill => LayerCommand::SetLayerProjection {
+                image,
+                projection,
+                channels,
+            }
+            .into(),
+        }
+    }
+}
+
+/// Project, New fill layer and (with a projection fill selected) Update the fill: the one
+/// clicked, enabled once an image is chosen.
+fn actions_ui(ui: &mut egui::Ui, ready: bool, editing: bool) -> Option<Action> {
+    let mut go = None;
+    ui.horizontal(|ui| {
+        if ui
+            .add_enabled(ready, egui::Button::new("Project"))
+            .on_hover_text(
+                "Paint the image into the selected layer through the projection (one undo step)",
+            )
+            .clicked()
+        {
+            go = Some(Action::Project);
+        }
+        if ui
+            .add_enabled(ready, egui::Button::new("New fill layer"))
+            .on_hover_text(
+                "Add a fill layer that keeps this projection, laid again when the mesh changes",
+            )
+            .clicked()
+        {
+            go = Some(Action::NewFill);
+        }
+        if editing
+            && ui
+                .add_enabled(ready, egui::Button::new("Update the fill"))
+                .on_hover_text("Give the selected projection fill these choices (one undo step)")
+                .clicked()
+        {
+            go = Some(Action::UpdateFill);
+        }
+    });
+    go
+}
+
 /// The Project image window, while `open`: the image, the projection and its fields (from
 /// the view of `camera`), the channels, the opacity, Project.
 pub(crate) fn project_window(
@@ -191,7 +299,9 @@ pub(crate) fn project_window(
         return;
     };
     let doc = desk.doc;
-    let (mut shown, mut go) = (true, false);
+    let mut shown = true;
+    let mut go: Option<Action> = None;
+    let editing = selected_fill(doc).is_some();
     centred(egui::Window::new("Project image"), ctx)
         .open(&mut shown)
         .collapsible(false)
@@ -234,20 +344,10 @@ pub(crate) fn project_window(
                 ui.checkbox(&mut dialog.channels.n, "n");
             });
             ui.add(egui::Slider::new(&mut dialog.opacity, 0.0..=1.0).text("Opacity"));
-            go = ui
-                .add_enabled(dialog.image.is_some(), egui::Button::new("Project"))
-                .on_hover_text(
-                    "Paint the image into the selected layer through the projection (one undo step)",
-                )
-                .clicked();
+            go = actions_ui(ui, dialog.image.is_some(), editing);
         });
-    if go && let Some(image) = dialog.image.clone() {
-        desk.command(PaintCommand::ProjectImage {
-            image,
-            projection: dialog.projection,
-            channels: dialog.channels,
-            opacity: dialog.opacity,
-        });
+    if let (Some(action), Some(image)) = (go, dialog.image.clone()) {
+        desk.command(action.command(dialog, image));
     }
     if !shown {
         *open = None;

@@ -4,7 +4,7 @@
 
 use super::layers::LayersPanel;
 use super::presets::Presets;
-use crate::desk::Desk;
+use crate::desk::{Ask, Desk, Window};
 use kapaint_model::layers::{Layer, LayerBlend, LayerContent};
 use kapaint_model::texel::{Channel, Channels};
 use kapaint_model::{Command, LayerMove};
@@ -45,6 +45,34 @@ impl LayersPanel {
                 .clicked()
         {
             commands.push(LayerCommand::SetLayerFill(doc.settings().primary).into());
+        }
+        if let LayerContent::Projected(p) = &layer.content {
+            let fill = p.fill();
+            let name = fill
+                .image
+                .path()
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            ui.label(format!(
+                "Projection: {name}, {}",
+                crate::project_dialog::kind_name(&fill.projection)
+            ));
+            ui.horizontal_wrapped(|ui| {
+                if ui
+                    .button("Edit projection…")
+                    .on_hover_text("Image > Project image, on this fill's choices")
+                    .clicked()
+                {
+                    desk.ask(Ask::Show(Window::ProjectImage));
+                }
+                if ui
+                    .button("Fill with the primary material")
+                    .on_hover_text("Make it a flat fill again")
+                    .clicked()
+                {
+                    commands.push(LayerCommand::SetLayerFill(doc.settings().primary).into());
+                }
+            });
         }
         commands.extend(
             mask_ui(ui, layer, doc.painting_mask())
