@@ -30,7 +30,7 @@ impl EditorState {
                 Ask::SelectTool(kind) => self.select_tool(kind),
                 Ask::ProjectImage(image) => {
                     if let Some(dialog) = &mut self.dialogs.project {
-                        dialog.image = Some(image);
+                        dialog.choose(image);
                     }
                 }
                 Ask::ToolOption(change) => {

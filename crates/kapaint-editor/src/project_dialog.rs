@@ -52,6 +52,19 @@ impl ProjectDialog {
     }
 }
 
+impl ProjectDialog {
+    /// Takes `image`; a planar projection takes its aspect (its height from its width), so
+    /// the picture lands unstretched.
+    pub fn choose(&mut self, image: PaintImage) {
+        if let (Projection::Planar { width, height, .. }, Ok(pixels)) =
+            (&mut self.projection, image.pixels())
+        {
+            *height = *width * pixels.aspect();
+        }
+        self.image = Some(image);
+    }
+}
+
 /// The selected layer's projection, when it is a projection fill.
 fn selected_fill(doc: &Document) -> Option<&ProjectionFill> {
     match &doc.selected_layer()?.content {
