@@ -545,6 +545,21 @@ fn projections(c: &mut Criterion) {
                 doc.apply(HistoryCommand::Undo).expect("undo");
             });
         });
+        // The same projection as a projection fill: laid (every tile at once, as the
+        // composite reads them) and composited, what a new mesh costs it too.
+        let fill = name.replace("project_", "projection_fill_");
+        group.bench_function(fill.as_str(), |b| {
+            b.iter(|| {
+                doc.apply(LayerCommand::AddProjectionFill {
+                    name: "Fill".into(),
+                    image: image.clone(),
+                    projection,
+                    channels: kapaint::model::Channels::ALL,
+                })
+                .expect("fill");
+                doc.apply(HistoryCommand::Undo).expect("undo");
+            });
+        });
     }
     group.bench_function("place_decal_1024px_image", |b| {
         b.iter(|| {

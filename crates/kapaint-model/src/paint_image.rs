@@ -50,13 +50,19 @@ pub struct Sample {
     pub rgb: Vec3,
     /// The gray as stored, in `[0, 1]`.
     pub gray: f32,
-    /// `n` through the import's mapping.
-    pub n: f32,
+    /// `n` through the import's mapping, in the log space layers blend it in
+    /// ([`n_to_blend`]; [`Self::n`] is the exponent).
+    pub n_blend: f32,
     /// Coverage in `[0, 1]`: 0 outside the image.
     pub alpha: f32,
 }
 
 impl Sample {
+    /// `n` through the import's mapping.
+    pub fn n(&self) -> f32 {
+        n_from_blend(self.n_blend)
+    }
+
     /// The linear luminance (`k_s` from an image).
     pub fn luminance(&self) -> f32 {
         0.2126 * self.rgb.x + 0.7152 * self.rgb.y + 0.0722 * self.rgb.z
@@ -212,7 +218,7 @@ impl Pixels {
         const NONE: Sample = Sample {
             rgb: Vec3::ZERO,
             gray: 0.0,
-            n: 0.0,
+            n_blend: 0.0,
             alpha: 0.0,
         };
         if !uv.is_finite() || (!tiled && (uv.cmplt(Vec2::ZERO).any() || uv.cmpgt(Vec2::ONE).any()))
@@ -223,39 +229,44 @@ impl Pixels {
         let p = uv * Vec2::new(self.width as f32, self.height as f32) - 0.5;
         let (x0, y0) = (p.x.floor(), p.y.floor());
         let (fx, fy) = (p.x - x0, p.y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let at = |x: i64, y: i64| {
-            let (x, y) = if tiled {
-                (x.rem_euclid(w), y.rem_euclid(h))
+        // The two columns (rows) the sample falls between, wrapped or clamped once each.
+        let pair = |v: i64, n: i64| -> (usize, usize) {
+            if tiled {
+                let a = v.rem_euclid(n);
+                (a as usize, if a + 1 == n { 0 } else { a as usize + 1 })
             } else {
-                (x.clamp(0, w - 1), y.clamp(0, h - 1))
-            };
-            self.texels[(y * w + x) as usize]
+                (v.clamp(0, n - 1) as usize, (v + 1).clamp(0, n - 1) as usize)
+            }
         };
+        let ((xa, xb), (ya, yb)) = (pair(x0 as i64, w), pair(y0 as i64, h));
+        let row = self.width as usize;
+        // Sums of the stored values (unorm16 as they are: the colour's share of the alpha does
+        // not need them scaled, the alpha is scaled once).
         let mut sum = [0.0_f32; 6];
-        for (dx, dy, wgt) in [
-            (0, 0, (1.0 - fx) * (1.0 - fy)),
-            (1, 0, fx * (1.0 - fy)),
-            (0, 1, (1.0 - fx) * fy),
-            (1, 1, fx * fy),
+        for (at, wgt) in [
+            (ya * row + xa, (1.0 - fx) * (1.0 - fy)),
+            (ya * row + xb, fx * (1.0 - fy)),
+            (yb * row + xa, (1.0 - fx) * fy),
+            (yb * row + xb, fx * fy),
         ] {
-            let px = at(x0 + dx, y0 + dy);
+            let px = self.texels[at];
             let parts = [
                 px.rgb[0], px.rgb[1], px.rgb[2], px.gray, px.n_blend, px.alpha,
             ];
             for (s, v) in sum.iter_mut().zip(parts) {
-                *s += from_unorm(v) * wgt;
+                *s += f32::from(v) * wgt;
             }
         }
-        let alpha = sum[5];
+        let alpha = sum[5] / 65535.0;
         if alpha <= 1e-6 {
             return NONE;
         }
-        let un = |v: f32| (v / alpha).clamp(0.0, 1.0);
+        let alpha_sum = sum[5];
+        let un = |v: f32| (v / alpha_sum).clamp(0.0, 1.0);
         Sample {
             rgb: Vec3::new(un(sum[0]), un(sum[1]), un(sum[2])),
             gray: un(sum[3]),
-            n: n_from_blend(un(sum[4])),
+            n_blend: un(sum[4]),
             alpha: alpha.min(1.0),
         }
     }
@@ -395,7 +406,7 @@ mod tests {
         let grey = p.sample(Vec2::new(0.75, 0.75), false);
         assert!((grey.gray - 128.0 / 255.0).abs() < 1e-4, "{grey:?}");
         assert!((grey.rgb.x - srgb_to_linear(128.0 / 255.0)).abs() < 1e-4);
-        assert!((grey.n - n_from_blend(128.0 / 255.0)).abs() < 1e-2 * grey.n);
+        assert!((grey.n() - n_from_blend(128.0 / 255.0)).abs() < 1e-2 * grey.n());
         assert_eq!(p.sample(Vec2::new(0.25, 0.75), false).alpha, 0.0);
         assert_eq!(p.sample(Vec2::new(1.5, 0.25), false).alpha, 0.0);
         let tiled = p.sample(Vec2::new(1.25, 0.25), true);

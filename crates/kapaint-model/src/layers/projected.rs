@@ -123,10 +123,11 @@ impl Projected {
             ks: encode_rgb(glam::Vec3::new(t[3], t[4], t[5])),
             n: crate::paint::n_bits_from_blend(t[6]),
         };
+        let texels: Vec<Texel> = targets.iter().map(texel).collect();
         let mut value = Tile::uniform(texel(&[0.0; 7]));
-        value.kd = Plane::Data(targets.iter().map(|t| texel(t).kd).collect());
-        value.ks = Plane::Data(targets.iter().map(|t| texel(t).ks).collect());
-        value.n = Plane::Data(targets.iter().map(|t| texel(t).n).collect());
+        value.kd = Plane::Data(texels.iter().map(|t| t.kd).collect());
+        value.ks = Plane::Data(texels.iter().map(|t| t.ks).collect());
+        value.n = Plane::Data(texels.iter().map(|t| t.n).collect());
         value.kd.compact();
         value.ks.compact();
         value.n.compact();

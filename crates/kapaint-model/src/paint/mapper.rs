@@ -12,7 +12,6 @@ use kapaint_mesh::bake::Coverage;
 use super::projection::{DepthMap, Frame3, PlaneFrame, Projection};
 use crate::paint_image::{Pixels, Sample};
 use crate::surface::Surface;
-use crate::texel::n_to_blend;
 use crate::tile::{TILE_SIZE, TileSpans, tile_texels};
 
 /// How texels find their place on the image.
@@ -31,7 +30,7 @@ fn target(s: &Sample, mask: bool) -> ([f32; 7], f32) {
     let c = if mask {
         [s.gray, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
     } else {
-        [s.rgb.x, s.rgb.y, s.rgb.z, l, l, l, n_to_blend(s.n)]
+        [s.rgb.x, s.rgb.y, s.rgb.z, l, l, l, s.n_blend]
     };
     (c, s.alpha)
 }
