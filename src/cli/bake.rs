@@ -58,6 +58,23 @@ pub struct BakeArgs {
     /// The PNG to write instead of keeping the bake in the project.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// A high-poly mesh (OBJ or glTF) to bake from, onto the project's mesh (with --map
+    /// normal): rays from the project's mesh take the nearest high surface's normal. Kept as
+    /// the project's normal map (tangent space, one undo step), or written with --out.
+    #[arg(long)]
+    high: Option<PathBuf>,
+    /// The space of a normal baked from --high: tangent (the project's mesh's MikkTSpace
+    /// frame, what the preview and the exports read) or object (needs --out).
+    #[arg(long, value_enum, default_value_t = super::bake_high::SpaceArg::Tangent)]
+    space: super::bake_high::SpaceArg,
+    /// How far above the project's mesh a ray from it starts, in object units (default 2 %
+    /// of the diagonal of the box both meshes fill).
+    #[arg(long)]
+    front: Option<f32>,
+    /// How far below the project's mesh a ray still looks, in object units (default as
+    /// --front).
+    #[arg(long)]
+    rear: Option<f32>,
     /// Overwrite an existing file.
     #[arg(long)]
     force: bool,
@@ -94,6 +111,21 @@ impl BakeArgs {
             return Err(CliError::usage(format!(
                 "--max-distance {d} is not a positive number"
             )));
+        }
+        if let Some(high) = &self.high {
+            if !matches!(self.map, MapArg::Normal) {
+                return Err(CliError::usage(
+                    "--high bakes --map normal (the other maps from a high mesh are not built yet)",
+                ));
+            }
+            return super::bake_high::run(&super::bake_high::HighRequest {
+                project: &self.project,
+                high,
+                space: self.space,
+                front: self.front,
+                rear: self.rear,
+                out: self.out.as_ref(),
+            });
         }
         // The file as read: a save finds out if another run saved over it meanwhile.
         let on_disk = project::OnDisk::of(&self.project);

@@ -16,6 +16,7 @@ use crate::model::ModelError;
 mod accuracy;
 mod args;
 mod bake;
+mod bake_high;
 mod bench;
 mod chi;
 mod debug_panic;

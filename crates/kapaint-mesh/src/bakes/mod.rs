@@ -16,7 +16,9 @@ use glam::Vec3;
 use kapaint_base::task::Progress;
 use rayon::prelude::*;
 
+mod high;
 mod rays;
+pub use high::{DEFAULT_DISTANCE, HighNormals, HighOptions, NormalSpace, bake_normals_from};
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};
 
@@ -422,5 +424,7 @@ fn curvature_in(mesh: &Mesh, local: &[Vec3]) -> Vec<f32> {
         .collect()
 }
 
+#[cfg(test)]
+mod high_tests;
 #[cfg(test)]
 mod tests;

@@ -19,6 +19,8 @@ pub struct RayMesh {
     /// The triangles in the BVH's order (no lookup through its primitive indices per test), in
     /// local coordinates.
     triangles: Vec<Triangle>,
+    /// Per triangle (in the BVH's order), its index in the mesh.
+    sources: Vec<u32>,
     /// Where the triangles are.
     frame: UnitFrame,
     /// The bounding box's diagonal (object units; saturated at `f32::MAX`).
@@ -32,19 +34,15 @@ impl RayMesh {
     pub fn new(mesh: &Mesh) -> Self {
         let frame = UnitFrame::of(&mesh.positions);
         let local = frame.local_positions(&mesh.positions);
-        let triangles: Vec<Triangle> = mesh
-            .triangles
-            .iter()
-            .filter_map(|t| {
+        let (kept, triangles): (Vec<u32>, Vec<Triangle>) = (0u32..)
+            .zip(&mesh.triangles)
+            .filter_map(|(k, t)| {
                 let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
                 let (v0, v1, v2) = (v0?, v1?, v2?);
-                (v0.is_finite() && v1.is_finite() && v2.is_finite()).then_some(Triangle {
-                    v0,
-                    v1,
-                    v2,
-                })
+                (v0.is_finite() && v1.is_finite() && v2.is_finite())
+                    .then_some((k, Triangle { v0, v1, v2 }))
             })
-            .collect();
+            .unzip();
         // A slower build for fewer node visits: a mesh is built once and cast millions of
         // rays at.
         let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
@@ -52,14 +50,15 @@ impl RayMesh {
             obvhs::BvhBuildParams::slow_build(),
             &mut std::time::Duration::default(),
         );
-        let triangles = bvh
+        let (sources, triangles) = bvh
             .primitive_indices
             .iter()
-            .map(|&i| triangles[i as usize])
-            .collect();
+            .map(|&i| (kept[i as usize], triangles[i as usize]))
+            .unzip();
         Self {
             bvh,
             triangles,
+            sources,
             diagonal: frame.diagonal(),
             frame,
         }
@@ -130,9 +129,28 @@ impl RayMesh {
         )
     }
 
+    /// The nearest triangle a ray from `origin` along unit `dir` meets before `far` (object
+    /// units): the distance to it (object units) and its index in the mesh.
+    pub fn nearest(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<(f32, u32)> {
+        let ray = ray(
+            self.frame.local_from_object(origin),
+            dir,
+            self.frame.local_length(far),
+        );
+        let mut hit = obvhs::ray::RayHit::none();
+        self.bvh
+            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
+            .then(|| {
+                (
+                    self.frame.object_length(hit.t),
+                    self.sources[hit.primitive_id as usize],
+                )
+            })
+    }
+
     /// [`RayMesh::occluded`] in local units.
     fn occluded_local(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
-        let ray = Ray::new(origin.into(), dir.into(), 0.0, far);
+        let ray = ray(origin, dir, far);
         !self
             .bvh
             .ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
@@ -140,7 +158,7 @@ impl RayMesh {
 
     /// [`RayMesh::distance`] in local units.
     fn distance_local(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
-        let ray = Ray::new(origin.into(), dir.into(), 0.0, far);
+        let ray = ray(origin, dir, far);
         let mut hit = obvhs::ray::RayHit::none();
         self.bvh
             .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
@@ -189,6 +207,13 @@ impl RayMesh {
     fn offset(&self) -> f32 {
         self.frame.local_diagonal() * 1e-5
     }
+}
+
+/// A ray from `origin` along unit `dir` to `far` (local units). A direction's negative zero is
+/// made positive: the BVH's traversal takes a component's sign from its bits and misses every
+/// triangle for a ray with a `-0.0` component (a ray straight down, `-Y`, met nothing).
+fn ray(origin: Vec3, dir: Vec3, far: f32) -> Ray {
+    Ray::new(origin.into(), (dir + Vec3::ZERO).into(), 0.0, far)
 }
 
 /// A cosine-weighted Hammersley set of directions about `+z`, made once per bake; each texel

@@ -1,0 +1,153 @@
+//! `kapaint bake --high`: normals baked from a high-poly mesh onto the project's mesh, kept as
+//! the project's normal map (tangent space, one undo step) or written as a 16-bit PNG.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::{CliError, model_error};
+use crate::mesh::bakes::{HighNormals, HighOptions, NormalSpace, bake_normals_from};
+use crate::model::project;
+
+/// The space a normal is baked in.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum SpaceArg {
+    /// The project's mesh's MikkTSpace frame (what the preview and the exports read).
+    Tangent,
+    /// Object space.
+    Object,
+}
+
+/// What `kapaint bake --high` is asked.
+pub struct HighRequest<'a> {
+    /// The project.
+    pub project: &'a Path,
+    /// The high mesh.
+    pub high: &'a Path,
+    /// The space written.
+    pub space: SpaceArg,
+    /// Ray distances.
+    pub front: Option<f32>,
+    /// Ray distances.
+    pub rear: Option<f32>,
+    /// The PNG to write instead of keeping the map.
+    pub out: Option<&'a PathBuf>,
+}
+
+/// Bakes and keeps or writes the normals; returns what the command prints.
+///
+/// # Errors
+/// A project without a mesh, a high mesh that does not load or cannot be baked, distances
+/// that are not positive, object space without `--out`, a failed write.
+pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
+    let space = match r.space {
+        SpaceArg::Tangent => NormalSpace::Tangent,
+        SpaceArg::Object => NormalSpace::Object,
+    };
+    if space == NormalSpace::Object && r.out.is_none() {
+        return Err(CliError::usage(
+            "--space object needs --out: the project keeps a tangent-space normal map",
+        ));
+    }
+    let on_disk = project::OnDisk::of(r.project);
+    let (mut doc, failed) = project::open_with_mesh(r.project, None).map_err(model_error)?;
+    if let Some(e) = failed {
+        return Err(CliError::usage(format!(
+            "{}: its mesh cannot be baked: {e}",
+            r.project.display()
+        )));
+    }
+    let surface = doc
+        .surface()
+        .cloned()
+        .ok_or_else(|| CliError::usage(format!("{}: no mesh to bake onto", r.project.display())))?;
+    let high = crate::mesh::open(r.high)
+        .map_err(|e| CliError::usage(format!("{}: {e}", r.high.display())))?;
+    let start = Instant::now();
+    let progress = crate::task::Progress::default();
+    let options = HighOptions {
+        space,
+        front: r.front,
+        rear: r.rear,
+    };
+    let baked = super::progress::with_bar("bake", &progress, || {
+        bake_normals_from(
+            &surface.mesh,
+            &surface.bake,
+            &high,
+            options,
+            Some(&progress),
+        )
+    })
+    .map_err(|e| CliError::usage(e.to_string()))?;
+    let line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
+    if let Some(out) = r.out {
+        let png = png16(&baked).map_err(CliError::io)?;
+        crate::atomic::write_atomic(out, &png)
+            .map_err(|e| CliError::of_io(format!("{}: {e}", out.display()), &e))?;
+        return Ok(format!("{line}\nwrote {}\n", out.display()));
+    }
+    let image = image::RgbImage::from_fn(baked.width, baked.height, |x, y| {
+        let i = (y * baked.width + x) as usize * 3;
+        image::Rgb([0, 1, 2].map(|c| (baked.data[i + c] >> 8) as u8))
+    });
+    let normal = crate::model::normal::NormalMap::new(image).map_err(CliError::usage)?;
+    doc.apply(crate::model::ImportCommand::SetNormal(
+        crate::model::document::AttachedNormal(Some(std::sync::Arc::new(normal))),
+    ))
+    .map_err(model_error)?;
+    project::save_checked(&doc, r.project, on_disk.as_ref()).map_err(model_error)?;
+    Ok(format!(
+        "{line}\nkept as the normal map of {}\n",
+        r.project.display()
+    ))
+}
+
+/// The normals as a 16-bit RGB PNG.
+fn png16(baked: &HighNormals) -> Result<Vec<u8>, String> {
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let mut bytes = Vec::new();
+    image::ImageBuffer::<image::Rgb<u16>, &[u16]>::from_raw(
+        baked.width,
+        baked.height,
+        baked.data.as_slice(),
+    )
+    .ok_or("bake size mismatch")?
+    .write_with_encoder(PngEncoder::new_with_quality(
+        &mut bytes,
+        CompressionType::Fast,
+        FilterType::Up,
+    ))
+    .map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+/// One line on what was baked: the meshes, the distances and what the rays missed.
+fn summary(
+    r: &HighRequest<'_>,
+    high: &crate::mesh::Mesh,
+    baked: &HighNormals,
+    seconds: f64,
+) -> String {
+    let share = baked.missed as f64 / baked.covered.max(1) as f64 * 100.0;
+    format!(
+        "baked normal ({} space) of {} from {} ({} triangles): {}x{}, {} texels, front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s",
+        match baked.space {
+            NormalSpace::Tangent => "tangent",
+            NormalSpace::Object => "object",
+        },
+        r.project.display(),
+        r.high.display(),
+        high.triangles.len(),
+        baked.width,
+        baked.height,
+        baked.covered,
+        baked.front,
+        baked.rear,
+        if r.front.is_none() || r.rear.is_none() {
+            ", by default 2 % of the meshes' diagonal"
+        } else {
+            ""
+        },
+        baked.missed,
+    )
+}

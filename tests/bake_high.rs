@@ -1,0 +1,135 @@
+//! Issue 57's first step through the CLI: `kapaint bake --map normal --high HIGH` bakes a
+//! high mesh's normals onto the project's mesh (spot's own mesh onto its quad version here),
+//! written as a 16-bit PNG or kept as the project's normal map; bad input refused with the
+//! project untouched.
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn kapaint(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(args)
+        .output()
+        .expect("kapaint runs")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn spot(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/spot")
+        .join(name)
+}
+
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("kapaint-bake-high-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("dir");
+    d
+}
+
+fn low(d: &Path) -> PathBuf {
+    let p = d.join("low.kapaint");
+    let mesh = spot("spot_triangulated.obj");
+    let o = kapaint(&["new", "--size", "256", "--mesh", s(&mesh), "--out", s(&p)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    p
+}
+
+#[test]
+fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
+    let d = dir("spot");
+    let p = low(&d);
+    let high = spot("spot_quadrangulated.obj");
+    let png = d.join("n.png");
+    let o = kapaint(&[
+        "bake",
+        s(&p),
+        "--map",
+        "normal",
+        "--high",
+        s(&high),
+        "--out",
+        s(&png),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        text.contains("tangent space") && text.contains("front"),
+        "{text}"
+    );
+    // The same surface (its quads split the other way): no ray misses, every normal within a
+    // few degrees of flat.
+    assert!(text.contains("missed 0 texels"), "{text}");
+    let img = image::open(&png).expect("png").into_rgb16();
+    let (mut n, mut sum) = (0_u32, 0.0_f64);
+    for px in img.pixels() {
+        if px.0 == [0, 0, 0] {
+            continue;
+        }
+        let v = px.0.map(|c| f64::from(c) / 65535.0 * 2.0 - 1.0);
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        sum += (v[2] / len).clamp(-1.0, 1.0).acos().to_degrees();
+        n += 1;
+    }
+    let mean = sum / f64::from(n);
+    assert!(
+        n > 10_000 && mean < 3.0,
+        "{n} texels, mean {mean} degrees off flat"
+    );
+    // Without --out: the project's normal map, one step, saved.
+    let o = kapaint(&["bake", s(&p), "--map", "normal", "--high", s(&high)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc = kapaint::model::project::load(&p).expect("opens");
+    assert!(doc.normal().is_some(), "kept as the normal map");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn bad_high_bakes_are_refused_and_the_project_stays() {
+    let d = dir("bad");
+    let p = low(&d);
+    let before = std::fs::read(&p).expect("read");
+    let high = spot("spot_quadrangulated.obj");
+    let empty = d.join("empty.obj");
+    std::fs::write(&empty, "# nothing\n").expect("write");
+    let nan = d.join("nan.obj");
+    std::fs::write(&nan, "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n").expect("write");
+    for (args, want) in [
+        (vec!["--map", "ao", "--high", s(&high)], "--map normal"),
+        (
+            vec!["--map", "normal", "--high", s(&high), "--front=-1"],
+            "not a positive number",
+        ),
+        (
+            vec!["--map", "normal", "--high", s(&high), "--rear", "0"],
+            "not a positive number",
+        ),
+        (
+            vec!["--map", "normal", "--high", s(&high), "--space", "object"],
+            "needs --out",
+        ),
+        (
+            vec!["--map", "normal", "--high", "nowhere.obj"],
+            "nowhere.obj",
+        ),
+        (vec!["--map", "normal", "--high", s(&empty)], "empty.obj"),
+        (vec!["--map", "normal", "--high", s(&nan)], "nan.obj"),
+    ] {
+        let mut all = vec!["bake", s(&p)];
+        all.extend(args);
+        let o = kapaint(&all);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(e.contains(want), "{all:?}: {e}");
+        assert_eq!(std::fs::read(&p).expect("read"), before, "{all:?}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
