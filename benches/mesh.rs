@@ -363,8 +363,121 @@ fn traced(c: &mut Criterion) {
     group.finish();
 }
 
+/// Issue 57's procedural pair: spot split four times (each triangle into four at its edges'
+/// midpoints, 5,856 -> 1,499,136 triangles), displaced along its smooth normals by a sum of
+/// waves (0.6 % of its size), no UVs: the high mesh. Made here, never stored.
+fn sculpt(low: &mesh::Mesh) -> mesh::Mesh {
+    use glam::Vec3;
+    use std::collections::HashMap;
+    // Welded by position first: the OBJ's vertices are split at UV seams, and split vertices
+    // pushed along their own normals would open cracks in the sculpt.
+    let mut first: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let welded: Vec<u32> = low
+        .positions
+        .iter()
+        .map(|p| {
+            *first
+                .entry(p.to_array().map(f32::to_bits))
+                .or_insert_with(|| {
+                    positions.push(*p);
+                    (positions.len() - 1) as u32
+                })
+        })
+        .collect();
+    let mut triangles: Vec<[u32; 3]> = low
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| welded[v as usize]))
+        .collect();
+    for _ in 0..4 {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut at = |a: u32, b: u32, positions: &mut Vec<Vec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                positions.push((positions[a as usize] + positions[b as usize]) * 0.5);
+                (positions.len() - 1) as u32
+            })
+        };
+        let mut next = Vec::with_capacity(triangles.len() * 4);
+        for [a, b, c] in triangles {
+            let (ab, bc, ca) = (
+                at(a, b, &mut positions),
+                at(b, c, &mut positions),
+                at(c, a, &mut positions),
+            );
+            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        triangles = next;
+    }
+    let normals = |positions: &[Vec3]| {
+        let mut sums = vec![Vec3::ZERO; positions.len()];
+        for t in &triangles {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            for v in t {
+                sums[*v as usize] += (b - a).cross(c - a);
+            }
+        }
+        sums.into_iter()
+            .map(Vec3::normalize_or_zero)
+            .collect::<Vec<_>>()
+    };
+    let smooth = normals(&positions);
+    for (p, n) in positions.iter_mut().zip(&smooth) {
+        let wave = (p.x * 40.0).sin() * (p.y * 37.0).cos() + 0.5 * (p.z * 83.0).sin();
+        *p += *n * 0.006 * wave;
+    }
+    let normals = normals(&positions);
+    mesh::Mesh {
+        name: "spot sculpt".into(),
+        positions,
+        normals,
+        uvs: None,
+        triangles,
+        had_normals: false,
+    }
+}
+
+/// Normals from the sculpt onto spot at 4096^2 (issue 57: the BVH in at most 4 s, a tangent
+/// normal bake at one sample in at most 15 s, on this 2-core machine).
+fn high_bakes(c: &mut Criterion) {
+    use kapaint::mesh::bakes::{HighOptions, NormalSpace, RayMesh, bake_normals_from};
+    let spot = mesh::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/testdata/spot/spot_triangulated.obj"),
+    )
+    .expect("spot loads");
+    let high = sculpt(&spot);
+    assert!(high.triangles.len() > 1_400_000);
+    let uv = bake(&spot, 4096, 4096, 4).expect("bakes");
+    let mut group = c.benchmark_group("bake_from_high_1_5m");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    group.bench_function("bvh_build", |b| b.iter(|| RayMesh::new(&high)));
+    let options = HighOptions {
+        space: NormalSpace::Tangent,
+        front: None,
+        rear: None,
+    };
+    let once = bake_normals_from(&spot, &uv, &high, options, None).expect("bakes");
+    eprintln!(
+        "sculpt onto spot: {} high triangles, {} texels, {} missed ({:.4} %), front {:.4} rear {:.4}",
+        high.triangles.len(),
+        once.covered,
+        once.missed,
+        once.missed as f64 / once.covered as f64 * 100.0,
+        once.front,
+        once.rear
+    );
+    group.bench_function("tangent_normal_4096", |b| {
+        b.iter(|| bake_normals_from(&spot, &uv, &high, options, None).expect("bakes"));
+    });
+    group.finish();
+}
+
 criterion_group!(
     benches,
+    high_bakes,
     traced,
     bakes,
     picking,
