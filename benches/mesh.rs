@@ -440,7 +440,7 @@ fn sculpt(low: &mesh::Mesh) -> mesh::Mesh {
 /// Normals from the sculpt onto spot at 4096^2 (issue 57: the BVH in at most 4 s, a tangent
 /// normal bake at one sample in at most 15 s, on this 2-core machine).
 fn high_bakes(c: &mut Criterion) {
-    use kapaint::mesh::bakes::{HighOptions, NormalSpace, RayMesh, bake_normals_from};
+    use kapaint::mesh::bakes::{HighMap, HighOptions, NormalSpace, RayMesh, bake_from_high};
     let spot = mesh::load(
         &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../shared/testdata/spot/spot_triangulated.obj"),
@@ -455,11 +455,11 @@ fn high_bakes(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(30));
     group.bench_function("bvh_build", |b| b.iter(|| RayMesh::new(&high)));
     let options = HighOptions {
-        space: NormalSpace::Tangent,
+        map: HighMap::Normal(NormalSpace::Tangent),
         front: None,
         rear: None,
     };
-    let once = bake_normals_from(&spot, &uv, &high, options, None).expect("bakes");
+    let once = bake_from_high(&spot, &uv, &high, options, None).expect("bakes");
     eprintln!(
         "sculpt onto spot: {} high triangles, {} texels, {} missed ({:.4} %), front {:.4} rear {:.4}",
         high.triangles.len(),
@@ -470,7 +470,7 @@ fn high_bakes(c: &mut Criterion) {
         once.rear
     );
     group.bench_function("tangent_normal_4096", |b| {
-        b.iter(|| bake_normals_from(&spot, &uv, &high, options, None).expect("bakes"));
+        b.iter(|| bake_from_high(&spot, &uv, &high, options, None).expect("bakes"));
     });
     group.finish();
 }

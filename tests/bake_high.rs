@@ -83,6 +83,35 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
         n > 10_000 && mean < 3.0,
         "{n} texels, mean {mean} degrees off flat"
     );
+    // Height: the same surface stands at the middle of the distances (0.5), as a float EXR.
+    let exr = d.join("h.exr");
+    let o = kapaint(&[
+        "bake",
+        s(&p),
+        "--map",
+        "height",
+        "--high",
+        s(&high),
+        "--out",
+        s(&exr),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        text.contains("height (0 at") && text.contains("missed 0 texels"),
+        "{text}"
+    );
+    let heights = image::open(&exr).expect("exr").into_rgb32f();
+    let surface: Vec<f32> = heights
+        .pixels()
+        .map(|p| p.0[0])
+        .filter(|&v| v > 0.0)
+        .collect();
+    let mean = surface.iter().sum::<f32>() / surface.len() as f32;
+    assert!(
+        surface.len() > 10_000 && (mean - 0.5).abs() < 0.01,
+        "{mean}"
+    );
     // Without --out: the project's normal map, one step, saved.
     let o = kapaint(&["bake", s(&p), "--map", "normal", "--high", s(&high)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -113,8 +142,10 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
         ),
         (
             vec!["--map", "normal", "--high", s(&high), "--space", "object"],
-            "needs --out",
+            "need --out",
         ),
+        (vec!["--map", "height", "--high", s(&high)], "need --out"),
+        (vec!["--map", "height"], "give --high"),
         (
             vec!["--map", "normal", "--high", "nowhere.obj"],
             "nowhere.obj",

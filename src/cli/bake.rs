@@ -20,18 +20,22 @@ pub enum MapArg {
     Thickness,
     /// Object-space position, normalised to the bounding box (RGB).
     Position,
-    /// Object-space normal, 0.5 + 0.5 n (RGB).
+    /// Object-space normal, 0.5 + 0.5 n (RGB); with --high, the high mesh's normal.
     Normal,
+    /// With --high: the high surface's height over the project's mesh, by the ray distances.
+    Height,
 }
 
-impl From<MapArg> for BakeMap {
-    fn from(m: MapArg) -> Self {
-        match m {
-            MapArg::Ao => Self::Ao,
-            MapArg::Curvature => Self::Curvature,
-            MapArg::Thickness => Self::Thickness,
-            MapArg::Position => Self::Position,
-            MapArg::Normal => Self::Normal,
+impl MapArg {
+    /// The map baked from the project's own mesh, if it is one.
+    fn own(self) -> Option<BakeMap> {
+        match self {
+            Self::Ao => Some(BakeMap::Ao),
+            Self::Curvature => Some(BakeMap::Curvature),
+            Self::Thickness => Some(BakeMap::Thickness),
+            Self::Position => Some(BakeMap::Position),
+            Self::Normal => Some(BakeMap::Normal),
+            Self::Height => None,
         }
     }
 }
@@ -92,10 +96,12 @@ impl BakeArgs {
                 .extension()
                 .and_then(|e| e.to_str())
                 .map(str::to_ascii_lowercase);
-            if ext.as_deref() != Some("png") {
+            let height = matches!(self.map, MapArg::Height);
+            if ext.as_deref() != Some("png") && !(height && ext.as_deref() == Some("exr")) {
                 return Err(CliError::usage(format!(
-                    "{}: --out must end in .png",
-                    out.display()
+                    "{}: --out must end in .png{}",
+                    out.display(),
+                    if height { " or .exr" } else { "" }
                 )));
             }
             if out.exists() && !self.force {
@@ -113,20 +119,29 @@ impl BakeArgs {
             )));
         }
         if let Some(high) = &self.high {
-            if !matches!(self.map, MapArg::Normal) {
-                return Err(CliError::usage(
-                    "--high bakes --map normal (the other maps from a high mesh are not built yet)",
-                ));
-            }
+            let map = match self.map {
+                MapArg::Normal => super::bake_high::Made::Normal(self.space),
+                MapArg::Height => super::bake_high::Made::Height,
+                _ => {
+                    return Err(CliError::usage(
+                        "--high bakes --map normal or height (the other maps from a high mesh are not built yet)",
+                    ));
+                }
+            };
             return super::bake_high::run(&super::bake_high::HighRequest {
                 project: &self.project,
                 high,
-                space: self.space,
+                map,
                 front: self.front,
                 rear: self.rear,
                 out: self.out.as_ref(),
             });
         }
+        let Some(map) = self.map.own() else {
+            return Err(CliError::usage(
+                "--map height is baked from a high mesh: give --high HIGH",
+            ));
+        };
         // The file as read: a save finds out if another run saved over it meanwhile.
         let on_disk = project::OnDisk::of(&self.project);
         let (mut doc, failed) =
@@ -147,13 +162,7 @@ impl BakeArgs {
         let start = Instant::now();
         let progress = crate::task::Progress::default();
         let baked = super::progress::with_bar("bake", &progress, || {
-            bake_map(
-                &surface.mesh,
-                &surface.bake,
-                self.map.into(),
-                options,
-                Some(&progress),
-            )
+            bake_map(&surface.mesh, &surface.bake, map, options, Some(&progress))
         })
         .map_err(|e| CliError::usage(e.to_string()))?;
         let seconds = start.elapsed().as_secs_f64();

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{CliError, model_error};
-use crate::mesh::bakes::{HighNormals, HighOptions, NormalSpace, bake_normals_from};
+use crate::mesh::bakes::{HighBake, HighMap, HighOptions, NormalSpace, bake_from_high};
 use crate::model::project;
 
 /// The space a normal is baked in.
@@ -17,14 +17,23 @@ pub enum SpaceArg {
     Object,
 }
 
+/// The map asked of the high mesh.
+#[derive(Clone, Copy, Debug)]
+pub enum Made {
+    /// Normals, in a space.
+    Normal(SpaceArg),
+    /// Height.
+    Height,
+}
+
 /// What `kapaint bake --high` is asked.
 pub struct HighRequest<'a> {
     /// The project.
     pub project: &'a Path,
     /// The high mesh.
     pub high: &'a Path,
-    /// The space written.
-    pub space: SpaceArg,
+    /// The map.
+    pub map: Made,
     /// Ray distances.
     pub front: Option<f32>,
     /// Ray distances.
@@ -39,13 +48,14 @@ pub struct HighRequest<'a> {
 /// A project without a mesh, a high mesh that does not load or cannot be baked, distances
 /// that are not positive, object space without `--out`, a failed write.
 pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
-    let space = match r.space {
-        SpaceArg::Tangent => NormalSpace::Tangent,
-        SpaceArg::Object => NormalSpace::Object,
+    let map = match r.map {
+        Made::Normal(SpaceArg::Tangent) => HighMap::Normal(NormalSpace::Tangent),
+        Made::Normal(SpaceArg::Object) => HighMap::Normal(NormalSpace::Object),
+        Made::Height => HighMap::Height,
     };
-    if space == NormalSpace::Object && r.out.is_none() {
+    if r.out.is_none() && map != HighMap::Normal(NormalSpace::Tangent) {
         return Err(CliError::usage(
-            "--space object needs --out: the project keeps a tangent-space normal map",
+            "--space object and --map height need --out: the project keeps a tangent-space normal map",
         ));
     }
     let on_disk = project::OnDisk::of(r.project);
@@ -65,12 +75,12 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     let start = Instant::now();
     let progress = crate::task::Progress::default();
     let options = HighOptions {
-        space,
+        map,
         front: r.front,
         rear: r.rear,
     };
     let baked = super::progress::with_bar("bake", &progress, || {
-        bake_normals_from(
+        bake_from_high(
             &surface.mesh,
             &surface.bake,
             &high,
@@ -81,7 +91,10 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     .map_err(|e| CliError::usage(e.to_string()))?;
     let line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
     if let Some(out) = r.out {
-        let png = png16(&baked).map_err(CliError::io)?;
+        let exr = out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let png = if exr { exr32(&baked) } else { png16(&baked) }.map_err(CliError::io)?;
         crate::atomic::write_atomic(out, &png)
             .map_err(|e| CliError::of_io(format!("{}: {e}", out.display()), &e))?;
         return Ok(format!("{line}\nwrote {}\n", out.display()));
@@ -102,38 +115,58 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     ))
 }
 
-/// The normals as a 16-bit RGB PNG.
-fn png16(baked: &HighNormals) -> Result<Vec<u8>, String> {
+/// The bake as a 16-bit PNG (RGB normals, grey height).
+fn png16(baked: &HighBake) -> Result<Vec<u8>, String> {
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     let mut bytes = Vec::new();
-    image::ImageBuffer::<image::Rgb<u16>, &[u16]>::from_raw(
-        baked.width,
-        baked.height,
-        baked.data.as_slice(),
-    )
-    .ok_or("bake size mismatch")?
-    .write_with_encoder(PngEncoder::new_with_quality(
-        &mut bytes,
-        CompressionType::Fast,
-        FilterType::Up,
-    ))
+    let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Up);
+    let (w, h, data) = (baked.width, baked.height, baked.data.as_slice());
+    match baked.map {
+        HighMap::Height => image::ImageBuffer::<image::Luma<u16>, &[u16]>::from_raw(w, h, data)
+            .ok_or("bake size mismatch")?
+            .write_with_encoder(encoder),
+        HighMap::Normal(_) => image::ImageBuffer::<image::Rgb<u16>, &[u16]>::from_raw(w, h, data)
+            .ok_or("bake size mismatch")?
+            .write_with_encoder(encoder),
+    }
     .map_err(|e| e.to_string())?;
     Ok(bytes)
+}
+
+/// The bake as a 32-bit float OpenEXR (the samples in `[0, 1]`, grey as RGB).
+fn exr32(baked: &HighBake) -> Result<Vec<u8>, String> {
+    let c = baked.map.channels();
+    let rgb: Vec<f32> = baked
+        .data
+        .chunks_exact(c)
+        .flat_map(|px| [0, 1, 2].map(|k| f32::from(px[k.min(c - 1)]) / 65535.0))
+        .collect();
+    let image =
+        image::Rgb32FImage::from_raw(baked.width, baked.height, rgb).ok_or("bake size mismatch")?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image::DynamicImage::ImageRgb32F(image)
+        .write_to(&mut bytes, image::ImageFormat::OpenExr)
+        .map_err(|e| e.to_string())?;
+    Ok(bytes.into_inner())
 }
 
 /// One line on what was baked: the meshes, the distances and what the rays missed.
 fn summary(
     r: &HighRequest<'_>,
     high: &crate::mesh::Mesh,
-    baked: &HighNormals,
+    baked: &HighBake,
     seconds: f64,
 ) -> String {
     let share = baked.missed as f64 / baked.covered.max(1) as f64 * 100.0;
     format!(
-        "baked normal ({} space) of {} from {} ({} triangles): {}x{}, {} texels, front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s",
-        match baked.space {
-            NormalSpace::Tangent => "tangent",
-            NormalSpace::Object => "object",
+        "baked {} of {} from {} ({} triangles): {}x{}, {} texels, front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s",
+        match baked.map {
+            HighMap::Normal(NormalSpace::Tangent) => "normal (tangent space)".to_string(),
+            HighMap::Normal(NormalSpace::Object) => "normal (object space)".to_string(),
+            HighMap::Height => format!(
+                "height (0 at {:.4} below, 1 at {:.4} above the mesh)",
+                baked.rear, baked.front
+            ),
         },
         r.project.display(),
         r.high.display(),

@@ -1,9 +1,11 @@
-//! Normals baked from a high-poly mesh onto a low one: per texel of the low mesh's UV bake, a
-//! ray from `front` above its surface point back along its (smooth) normal, `front + rear`
-//! long, takes the normal of the nearest high triangle it meets (interpolated from that
-//! triangle's vertex normals). Written in the low mesh's MikkTSpace frame (tangent space, as
-//! the preview and the exports read a normal map) or in object space, `0.5 + 0.5 n`. Texels
-//! whose ray meets nothing keep the low normal (flat in tangent space) and are counted.
+//! Maps baked from a high-poly mesh onto a low one: per texel of the low mesh's UV bake, a ray
+//! from `front` above its surface point back along its (smooth) normal, `front + rear` long,
+//! meets the nearest high triangle. A normal bake takes that triangle's normal (interpolated
+//! from its vertex normals), written in the low mesh's MikkTSpace frame (tangent space, as the
+//! preview and the exports read a normal map) or in object space, `0.5 + 0.5 n`; a height bake
+//! takes how far the high surface lies above the low one, `(h + rear) / (front + rear)` (0 at
+//! `rear` below, 1 at `front` above). Texels whose ray meets nothing keep the low surface (a
+//! flat normal, the height of the low surface) and are counted.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -23,11 +25,30 @@ pub enum NormalSpace {
     Object,
 }
 
+/// What is baked from the high mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HighMap {
+    /// Its normals, in a space (RGB).
+    Normal(NormalSpace),
+    /// Its height over the low surface, by the ray distances (grey).
+    Height,
+}
+
+impl HighMap {
+    /// Samples a texel holds.
+    pub fn channels(self) -> usize {
+        match self {
+            Self::Normal(_) => 3,
+            Self::Height => 1,
+        }
+    }
+}
+
 /// How the rays are cast.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HighOptions {
-    /// The space written.
-    pub space: NormalSpace,
+    /// What is baked.
+    pub map: HighMap,
     /// How far above the low surface a ray starts (object units); `None`: the default.
     pub front: Option<f32>,
     /// How far below it a ray still looks; `None`: the default.
@@ -38,17 +59,18 @@ pub struct HighOptions {
 /// meshes fill.
 pub const DEFAULT_DISTANCE: f32 = 0.02;
 
-/// Normals baked from a high mesh: RGB unorm16, row-major, and what the rays found.
+/// A map baked from a high mesh: unorm16, row-major, and what the rays found.
 #[derive(Clone, Debug, PartialEq)]
-pub struct HighNormals {
+pub struct HighBake {
     /// Width in texels.
     pub width: u32,
     /// Height in texels.
     pub height: u32,
-    /// `0.5 + 0.5 n` per texel, three samples each; 0 where the low mesh has no surface.
+    /// Per texel `0.5 + 0.5 n` (three samples) or the height (one); 0 where the low mesh has
+    /// no surface.
     pub data: Vec<u16>,
-    /// The space written.
-    pub space: NormalSpace,
+    /// What it is.
+    pub map: HighMap,
     /// The distances used (object units).
     pub front: f32,
     /// The distances used (object units).
@@ -87,22 +109,112 @@ impl Frames {
     }
 }
 
-/// Bakes `high`'s normals onto `low` at every texel `uv` gives a surface point. `progress`
-/// counts rows and cancels.
+/// Bakes `options.map` of `high` onto `low` at every texel `uv` gives a surface point.
+/// `progress` counts rows and cancels.
 ///
 /// # Errors
 /// A high mesh with no triangles or positions that are not finite, a low mesh the UV bake was
 /// not made from, distances that are not positive and finite, or cancelled.
-pub fn bake_normals_from(
+pub fn bake_from_high(
     low: &Mesh,
     uv: &UvBake,
     high: &Mesh,
     options: HighOptions,
     progress: Option<&Progress>,
-) -> Result<HighNormals, BakeError> {
+) -> Result<HighBake, BakeError> {
     if uv.triangle_count() != low.triangles.len() {
         return Err("the UV bake was made from another mesh".to_string().into());
     }
+    let (size, front, rear) = distances(low, high, options)?;
+    let rays = RayMesh::new(high);
+    // How far a ray that slipped between two triangles is moved to try again.
+    let nudge = size * 1e-4;
+    let frames = Frames {
+        tangents: (options.map == HighMap::Normal(NormalSpace::Tangent))
+            .then(|| crate::tangents::generate(low))
+            .flatten(),
+    };
+    let (w, h) = (uv.width as usize, uv.height as usize);
+    if let Some(p) = progress {
+        p.start("bake from the high mesh", h as u64);
+    }
+    let channels = options.map.channels();
+    let mut data = vec![0_u16; w * h * channels];
+    let mut misses = vec![false; w * h];
+    let cancelled = std::sync::atomic::AtomicBool::new(false);
+    data.par_chunks_mut(w * channels * BAND_ROWS)
+        .zip(misses.par_chunks_mut(w * BAND_ROWS))
+        .enumerate()
+        .for_each(|(band, (rows, missed))| {
+            if progress.is_some_and(Progress::is_cancelled) {
+                cancelled.store(true, std::sync::atomic::Ordering::Relaxed);
+                return;
+            }
+            let first = band * BAND_ROWS * w;
+            for (k, (out, miss)) in rows
+                .chunks_exact_mut(channels)
+                .zip(missed.iter_mut())
+                .enumerate()
+            {
+                let i = first + k;
+                let Some(t) = uv.triangle(i) else {
+                    continue;
+                };
+                let (p, n) = (uv.position(i), uv.normal(i));
+                let found = cast(&rays, p + n * front, -n, front + rear, nudge);
+                *miss = found.is_none();
+                let unorm = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
+                match options.map {
+                    HighMap::Height => {
+                        // Above the low surface: `front` less the way the ray went.
+                        let above = found.map_or(0.0, |(_, _, d)| front - d);
+                        out[0] = unorm((above + rear) / (front + rear));
+                    }
+                    HighMap::Normal(space) => {
+                        let normal = found.map_or(n, |(q, tri, _)| high_normal(high, tri, q));
+                        let written = match space {
+                            NormalSpace::Object => normal,
+                            NormalSpace::Tangent => {
+                                let (ta, bi, no) = frames.at(uv, t, i, n);
+                                Vec3::new(normal.dot(ta), normal.dot(bi), normal.dot(no))
+                            }
+                        };
+                        for (o, c) in out.iter_mut().zip(written.to_array()) {
+                            *o = unorm(0.5 + 0.5 * c);
+                        }
+                    }
+                }
+            }
+            if let Some(p) = progress {
+                p.advance((rows.len() / (w * channels)) as u64);
+            }
+        });
+    if cancelled.into_inner() {
+        return Err(BakeError::Cancelled);
+    }
+    let covered = (0..w * h)
+        .filter(|&i| uv.coverage(i) != Coverage::Empty)
+        .count() as u64;
+    let missed = misses.iter().filter(|&&m| m).count() as u64;
+    Ok(HighBake {
+        width: uv.width,
+        height: uv.height,
+        data,
+        map: options.map,
+        front,
+        rear,
+        covered,
+        missed,
+        misses,
+    })
+}
+
+/// The default distance's size, and the front and rear distances (object units).
+///
+/// # Errors
+/// A high mesh with no triangles or positions that are not finite, distances that are not
+/// positive and finite.
+fn distances(low: &Mesh, high: &Mesh, options: HighOptions) -> Result<(f32, f32, f32), BakeError> {
     if high.triangles.is_empty() {
         return Err(format!("the high mesh {} has no triangles", high.name).into());
     }
@@ -126,86 +238,21 @@ pub fn bake_normals_from(
         distance(options.front, "front")?,
         distance(options.rear, "rear")?,
     );
-    let rays = RayMesh::new(high);
-    // How far a ray that slipped between two triangles is moved to try again.
-    let nudge = size * 1e-4;
-    let frames = Frames {
-        tangents: (options.space == NormalSpace::Tangent)
-            .then(|| crate::tangents::generate(low))
-            .flatten(),
-    };
-    let (w, h) = (uv.width as usize, uv.height as usize);
-    if let Some(p) = progress {
-        p.start("bake normal from the high mesh", h as u64);
-    }
-    let mut data = vec![0_u16; w * h * 3];
-    let mut misses = vec![false; w * h];
-    let cancelled = std::sync::atomic::AtomicBool::new(false);
-    data.par_chunks_mut(w * 3 * BAND_ROWS)
-        .zip(misses.par_chunks_mut(w * BAND_ROWS))
-        .enumerate()
-        .for_each(|(band, (rows, missed))| {
-            if progress.is_some_and(Progress::is_cancelled) {
-                cancelled.store(true, std::sync::atomic::Ordering::Relaxed);
-                return;
-            }
-            let first = band * BAND_ROWS * w;
-            for (k, (out, miss)) in rows.chunks_exact_mut(3).zip(missed.iter_mut()).enumerate() {
-                let i = first + k;
-                let Some(t) = uv.triangle(i) else {
-                    continue;
-                };
-                let (p, n) = (uv.position(i), uv.normal(i));
-                let found = cast(&rays, p + n * front, -n, front + rear, nudge)
-                    .map(|(q, tri)| high_normal(high, tri, q));
-                *miss = found.is_none();
-                let normal = found.unwrap_or(n);
-                let written = match options.space {
-                    NormalSpace::Object => normal,
-                    NormalSpace::Tangent => {
-                        let (ta, bi, no) = frames.at(uv, t, i, n);
-                        Vec3::new(normal.dot(ta), normal.dot(bi), normal.dot(no))
-                    }
-                };
-                for (o, c) in out.iter_mut().zip(written.to_array()) {
-                    *o = ((0.5 + 0.5 * c).clamp(0.0, 1.0) * 65535.0).round() as u16;
-                }
-            }
-            if let Some(p) = progress {
-                p.advance((rows.len() / (w * 3)) as u64);
-            }
-        });
-    if cancelled.into_inner() {
-        return Err(BakeError::Cancelled);
-    }
-    let covered = (0..w * h)
-        .filter(|&i| uv.coverage(i) != Coverage::Empty)
-        .count() as u64;
-    let missed = misses.iter().filter(|&&m| m).count() as u64;
-    Ok(HighNormals {
-        width: uv.width,
-        height: uv.height,
-        data,
-        space: options.space,
-        front,
-        rear,
-        covered,
-        missed,
-        misses,
-    })
+    Ok((size, front, rear))
 }
 
-/// Where a ray from `origin` along `dir` first meets the mesh within `far`, and the triangle
-/// there. A ray exactly through a vertex or along an edge can slip between its triangles (the
+/// Where a ray from `origin` along `dir` first meets the mesh within `far`, the triangle
+/// there and how far along it is. A ray exactly through a vertex or along an edge can slip between its triangles (the
 /// triangle test is not watertight there; on a fine sphere 61 of 64,575 rays near the pole,
 /// where many thin triangles meet): a miss is cast again twice, moved `nudge` across.
-fn cast(rays: &RayMesh, origin: Vec3, dir: Vec3, far: f32, nudge: f32) -> Option<(Vec3, u32)> {
+fn cast(rays: &RayMesh, origin: Vec3, dir: Vec3, far: f32, nudge: f32) -> Option<(Vec3, u32, f32)> {
     let (a, b) = dir.any_orthonormal_pair();
     [Vec3::ZERO, a * nudge, (b - a) * nudge]
         .into_iter()
         .find_map(|shift| {
             let o = origin + shift;
-            rays.nearest(o, dir, far).map(|(d, tri)| (o + dir * d, tri))
+            rays.nearest(o, dir, far)
+                .map(|(d, tri)| (o + dir * d, tri, d))
         })
 }
 

@@ -3,18 +3,18 @@
 
 use glam::Vec3;
 
-use super::high::{HighNormals, HighOptions, NormalSpace, bake_normals_from};
+use super::high::{HighBake, HighMap, HighOptions, NormalSpace, bake_from_high};
 use crate::Mesh;
 use crate::bake::bake;
 
-fn decode(n: &HighNormals, i: usize) -> Vec3 {
+fn decode(n: &HighBake, i: usize) -> Vec3 {
     let c = |k: usize| f32::from(n.data[i * 3 + k]) / 65535.0 * 2.0 - 1.0;
     Vec3::new(c(0), c(1), c(2))
 }
 
 fn options(space: NormalSpace) -> HighOptions {
     HighOptions {
-        space,
+        map: HighMap::Normal(space),
         front: None,
         rear: None,
     }
@@ -28,7 +28,7 @@ fn object_normals_from_a_fine_sphere_are_the_analytic_normals() {
     let high = crate::uv_sphere(512, 256);
     let uv = bake(&low, 256, 256, 2).expect("bakes");
     let baked =
-        bake_normals_from(&low, &uv, &high, options(NormalSpace::Object), None).expect("bakes");
+        bake_from_high(&low, &uv, &high, options(NormalSpace::Object), None).expect("bakes");
     assert!(baked.covered > 30_000, "{}", baked.covered);
     assert_eq!(baked.missed, 0, "every ray meets the fine sphere");
     let mut errors = Vec::new();
@@ -61,8 +61,7 @@ fn object_normals_from_a_fine_sphere_are_the_analytic_normals() {
 fn tangent_normals_are_flat_on_the_mesh_itself_and_lean_on_bumps() {
     let low = crate::uv_sphere(48, 24);
     let uv = bake(&low, 128, 128, 2).expect("bakes");
-    let flat =
-        bake_normals_from(&low, &uv, &low, options(NormalSpace::Tangent), None).expect("bakes");
+    let flat = bake_from_high(&low, &uv, &low, options(NormalSpace::Tangent), None).expect("bakes");
     let mut worst = 0.0_f32;
     for i in 0..(128 * 128) {
         if uv.triangle(i).is_some() && uv.coverage(i) == crate::bake::Coverage::Surface {
@@ -85,7 +84,7 @@ fn tangent_normals_are_flat_on_the_mesh_itself_and_lean_on_bumps() {
     }
     recompute_normals(&mut bumpy);
     let leaned =
-        bake_normals_from(&low, &uv, &bumpy, options(NormalSpace::Tangent), None).expect("bakes");
+        bake_from_high(&low, &uv, &bumpy, options(NormalSpace::Tangent), None).expect("bakes");
     let tilted = (0..128 * 128)
         .filter(|&i| uv.triangle(i).is_some())
         .filter(|&i| decode(&leaned, i).normalize().angle_between(Vec3::Z) > 5f32.to_radians())
@@ -118,16 +117,16 @@ fn bad_high_meshes_and_distances_are_refused() {
     nan.positions[3] = Vec3::NAN;
     for (high, want) in [(&empty, "no triangles"), (&nan, "non-finite")] {
         let e =
-            bake_normals_from(&low, &uv, high, options(NormalSpace::Object), None).expect_err(want);
+            bake_from_high(&low, &uv, high, options(NormalSpace::Object), None).expect_err(want);
         assert!(e.to_string().contains(want), "{e}");
     }
     for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
-        let e = bake_normals_from(
+        let e = bake_from_high(
             &low,
             &uv,
             &low,
             HighOptions {
-                space: NormalSpace::Object,
+                map: HighMap::Normal(NormalSpace::Object),
                 front: Some(d),
                 rear: None,
             },
@@ -142,7 +141,7 @@ fn bad_high_meshes_and_distances_are_refused() {
         ..low.clone()
     };
     let missed =
-        bake_normals_from(&low, &uv, &far, options(NormalSpace::Object), None).expect("bakes");
+        bake_from_high(&low, &uv, &far, options(NormalSpace::Object), None).expect("bakes");
     assert_eq!(missed.missed, missed.covered);
 }
 
@@ -164,4 +163,41 @@ fn a_ray_straight_down_meets_the_mesh_below_it() {
         assert!(rays.occluded(Vec3::new(0.1, 3.0, 0.1), dir, 10.0));
         assert!(rays.distance(Vec3::new(0.1, 3.0, 0.1), dir, 10.0).is_some());
     }
+}
+
+/// Height: a sphere of radius 1.01 over the unit sphere stands 0.01 above it everywhere, read
+/// through the distances (`(h + rear) / (front + rear)`); the sphere itself stands at 0.
+#[test]
+fn height_is_the_high_surface_over_the_low_one_by_the_distances() {
+    let low = crate::uv_sphere(64, 32);
+    let uv = bake(&low, 128, 128, 2).expect("bakes");
+    let grown = Mesh {
+        positions: low.positions.iter().map(|p| *p * 1.01).collect(),
+        ..low.clone()
+    };
+    let height = |high: &Mesh| {
+        let opts = HighOptions {
+            map: HighMap::Height,
+            front: Some(0.05),
+            rear: Some(0.05),
+        };
+        let b = bake_from_high(&low, &uv, high, opts, None).expect("bakes");
+        assert_eq!(b.missed, 0);
+        let values: Vec<f32> = (0..128 * 128)
+            .filter(|&i| uv.coverage(i) == crate::bake::Coverage::Surface)
+            .map(|i| f32::from(b.data[i]) / 65535.0 * 0.1 - 0.05)
+            .collect();
+        let mean = values.iter().sum::<f32>() / values.len() as f32;
+        let worst = values.iter().map(|v| (v - mean).abs()).fold(0.0, f32::max);
+        (mean, worst)
+    };
+    let (same, spread) = height(&low);
+    assert!(same.abs() < 1e-4 && spread < 1e-4, "{same} {spread}");
+    let (above, spread) = height(&grown);
+    // The texels lie on the low facets, a little inside the unit sphere: 0.01 above it and
+    // the facets' sag.
+    assert!(
+        (above - 0.0107).abs() < 0.002 && spread < 0.002,
+        "{above} {spread}"
+    );
 }

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 mod high;
 mod rays;
-pub use high::{DEFAULT_DISTANCE, HighNormals, HighOptions, NormalSpace, bake_normals_from};
+pub use high::{DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, NormalSpace, bake_from_high};
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};
 
