@@ -121,6 +121,51 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
 }
 
 #[test]
+fn a_miss_map_draws_what_short_rays_missed() {
+    let d = dir("misses");
+    let p = low(&d);
+    let high = spot("spot_quadrangulated.obj");
+    let png = d.join("n.png");
+    // Distances too short for where the quads split the other way: the misses are counted
+    // and drawn, one white texel each.
+    let misses = d.join("misses.png");
+    let o = kapaint(&[
+        "bake",
+        s(&p),
+        "--map",
+        "normal",
+        "--high",
+        s(&high),
+        "--front",
+        "0.001",
+        "--rear",
+        "0.001",
+        "--out",
+        s(&png),
+        "--force",
+        "--misses",
+        s(&misses),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let counted: u32 = text
+        .split("missed ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .expect("a count");
+    let white = image::open(&misses)
+        .expect("png")
+        .into_luma8()
+        .pixels()
+        .filter(|p| p.0[0] == 255)
+        .count();
+    assert!(counted > 100, "{text}");
+    assert_eq!(white, counted as usize, "{text}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn bad_high_bakes_are_refused_and_the_project_stays() {
     let d = dir("bad");
     let p = low(&d);

@@ -79,6 +79,10 @@ pub struct BakeArgs {
     /// --front).
     #[arg(long)]
     rear: Option<f32>,
+    /// With --high: also write the miss map, an 8-bit grey PNG, white where a texel's ray met
+    /// nothing.
+    #[arg(long)]
+    misses: Option<PathBuf>,
     /// Overwrite an existing file.
     #[arg(long)]
     force: bool,
@@ -135,6 +139,7 @@ impl BakeArgs {
                 front: self.front,
                 rear: self.rear,
                 out: self.out.as_ref(),
+                misses: self.misses.as_ref(),
             });
         }
         let Some(map) = self.map.own() else {

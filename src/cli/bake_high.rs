@@ -1,6 +1,7 @@
 //! `kapaint bake --high`: normals baked from a high-poly mesh onto the project's mesh, kept as
 //! the project's normal map (tangent space, one undo step) or written as a 16-bit PNG.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -40,6 +41,8 @@ pub struct HighRequest<'a> {
     pub rear: Option<f32>,
     /// The PNG to write instead of keeping the map.
     pub out: Option<&'a PathBuf>,
+    /// The miss map's PNG, if asked.
+    pub misses: Option<&'a PathBuf>,
 }
 
 /// Bakes and keeps or writes the normals; returns what the command prints.
@@ -57,6 +60,14 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
         return Err(CliError::usage(
             "--space object and --map height need --out: the project keeps a tangent-space normal map",
         ));
+    }
+    if let Some(m) = r.misses
+        && !m.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(CliError::usage(format!(
+            "{}: --misses must end in .png",
+            m.display()
+        )));
     }
     let on_disk = project::OnDisk::of(r.project);
     let (mut doc, failed) = project::open_with_mesh(r.project, None).map_err(model_error)?;
@@ -89,7 +100,22 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
         )
     })
     .map_err(|e| CliError::usage(e.to_string()))?;
-    let line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
+    let mut line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
+    if let Some(m) = r.misses {
+        let map = image::GrayImage::from_fn(baked.width, baked.height, |x, y| {
+            image::Luma([if baked.misses[(y * baked.width + x) as usize] {
+                255
+            } else {
+                0
+            }])
+        });
+        let mut png = std::io::Cursor::new(Vec::new());
+        map.write_to(&mut png, image::ImageFormat::Png)
+            .map_err(|e| CliError::io(e.to_string()))?;
+        crate::atomic::write_atomic(m, png.get_ref())
+            .map_err(|e| CliError::of_io(format!("{}: {e}", m.display()), &e))?;
+        let _ = write!(line, "\nwrote the miss map {}", m.display());
+    }
     if let Some(out) = r.out {
         let exr = out
             .extension()
