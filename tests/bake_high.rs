@@ -173,6 +173,9 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
     let high = spot("spot_quadrangulated.obj");
     let empty = d.join("empty.obj");
     std::fs::write(&empty, "# nothing\n").expect("write");
+    let kept = d.join("kept.png");
+    std::fs::write(&kept, b"the user's own file").expect("write");
+    let fresh = d.join("fresh.png");
     let nan = d.join("nan.obj");
     std::fs::write(&nan, "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n").expect("write");
     for (args, want) in [
@@ -191,6 +194,22 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
         ),
         (vec!["--map", "height", "--high", s(&high)], "need --out"),
         (vec!["--map", "height"], "give --high"),
+        // Flags of a bake from a high mesh, without one; a miss map over a file already there.
+        (vec!["--map", "normal", "--front", "0.1"], "--high"),
+        (vec!["--map", "ao", "--misses", s(&kept)], "--high"),
+        (
+            vec![
+                "--map",
+                "normal",
+                "--high",
+                s(&high),
+                "--out",
+                s(&fresh),
+                "--misses",
+                s(&kept),
+            ],
+            "exists; pass --force",
+        ),
         (
             vec!["--map", "normal", "--high", "nowhere.obj"],
             "nowhere.obj",
@@ -206,6 +225,8 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
         assert_eq!(e.lines().count(), 1, "{e}");
         assert!(e.contains(want), "{all:?}: {e}");
         assert_eq!(std::fs::read(&p).expect("read"), before, "{all:?}");
+        assert_eq!(std::fs::read(&kept).expect("read"), b"the user's own file");
+        assert!(!fresh.exists(), "{all:?} wrote its output");
     }
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -69,19 +69,19 @@ pub struct BakeArgs {
     high: Option<PathBuf>,
     /// The space of a normal baked from --high: tangent (the project's mesh's MikkTSpace
     /// frame, what the preview and the exports read) or object (needs --out).
-    #[arg(long, value_enum, default_value_t = super::bake_high::SpaceArg::Tangent)]
+    #[arg(long, requires = "high", value_enum, default_value_t = super::bake_high::SpaceArg::Tangent)]
     space: super::bake_high::SpaceArg,
     /// How far above the project's mesh a ray from it starts, in object units (default 2 %
     /// of the diagonal of the box both meshes fill).
-    #[arg(long)]
+    #[arg(long, requires = "high")]
     front: Option<f32>,
     /// How far below the project's mesh a ray still looks, in object units (default as
     /// --front).
-    #[arg(long)]
+    #[arg(long, requires = "high")]
     rear: Option<f32>,
     /// With --high: also write the miss map, an 8-bit grey PNG, white where a texel's ray met
     /// nothing.
-    #[arg(long)]
+    #[arg(long, requires = "high")]
     misses: Option<PathBuf>,
     /// Overwrite an existing file.
     #[arg(long)]
@@ -108,10 +108,12 @@ impl BakeArgs {
                     if height { " or .exr" } else { "" }
                 )));
             }
-            if out.exists() && !self.force {
+        }
+        for file in [&self.out, &self.misses].into_iter().flatten() {
+            if file.exists() && !self.force {
                 return Err(CliError::usage(format!(
                     "{} exists; pass --force to overwrite it",
-                    out.display()
+                    file.display()
                 )));
             }
         }
@@ -147,19 +149,7 @@ impl BakeArgs {
                 "--map height is baked from a high mesh: give --high HIGH",
             ));
         };
-        // The file as read: a save finds out if another run saved over it meanwhile.
-        let on_disk = project::OnDisk::of(&self.project);
-        let (mut doc, failed) =
-            project::open_with_mesh(&self.project, None).map_err(model_error)?;
-        if let Some(e) = failed {
-            return Err(CliError::usage(format!(
-                "{}: its mesh cannot be baked: {e}",
-                self.project.display()
-            )));
-        }
-        let surface = doc.surface().cloned().ok_or_else(|| {
-            CliError::usage(format!("{}: no mesh to bake", self.project.display()))
-        })?;
+        let (mut doc, surface, on_disk) = super::bake_high::open_to_bake(&self.project)?;
         let options = BakeOptions {
             rays: self.rays,
             max_distance: self.max_distance,

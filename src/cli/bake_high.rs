@@ -69,18 +69,7 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
             m.display()
         )));
     }
-    let on_disk = project::OnDisk::of(r.project);
-    let (mut doc, failed) = project::open_with_mesh(r.project, None).map_err(model_error)?;
-    if let Some(e) = failed {
-        return Err(CliError::usage(format!(
-            "{}: its mesh cannot be baked: {e}",
-            r.project.display()
-        )));
-    }
-    let surface = doc
-        .surface()
-        .cloned()
-        .ok_or_else(|| CliError::usage(format!("{}: no mesh to bake onto", r.project.display())))?;
+    let (mut doc, surface, on_disk) = open_to_bake(r.project)?;
     let high = crate::mesh::open(r.high)
         .map_err(|e| CliError::usage(format!("{}: {e}", r.high.display())))?;
     let start = Instant::now();
@@ -139,6 +128,36 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
         "{line}\nkept as the normal map of {}\n",
         r.project.display()
     ))
+}
+
+/// The project, opened with its mesh attached, that mesh's surface, and the file as read (a
+/// save finds out if another run saved over it meanwhile).
+///
+/// # Errors
+/// A project that does not open, a mesh that does not load, no mesh.
+pub(super) fn open_to_bake(
+    path: &std::path::Path,
+) -> Result<
+    (
+        crate::model::Document,
+        std::sync::Arc<crate::model::surface::Surface>,
+        Option<project::OnDisk>,
+    ),
+    CliError,
+> {
+    let on_disk = project::OnDisk::of(path);
+    let (doc, failed) = project::open_with_mesh(path, None).map_err(model_error)?;
+    if let Some(e) = failed {
+        return Err(CliError::usage(format!(
+            "{}: its mesh cannot be baked: {e}",
+            path.display()
+        )));
+    }
+    let surface = doc
+        .surface()
+        .cloned()
+        .ok_or_else(|| CliError::usage(format!("{}: no mesh to bake", path.display())))?;
+    Ok((doc, surface, on_disk))
 }
 
 /// The bake as a 16-bit PNG (RGB normals, grey height).

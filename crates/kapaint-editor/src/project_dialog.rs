@@ -268,33 +268,35 @@ impl Action {
 /// Project, New fill layer and (with a projection fill selected) Update the fill: the one
 /// clicked, enabled once an image is chosen.
 fn actions_ui(ui: &mut egui::Ui, ready: bool, editing: bool) -> Option<Action> {
+    let buttons = [
+        (
+            Action::Project,
+            "Project",
+            "Paint the image into the selected layer through the projection (one undo step)",
+        ),
+        (
+            Action::NewFill,
+            "New fill layer",
+            "Add a fill layer that keeps this projection, laid again when the mesh changes",
+        ),
+        (
+            Action::UpdateFill,
+            "Update the fill",
+            "Give the selected projection fill these choices (one undo step)",
+        ),
+    ];
     let mut go = None;
     ui.horizontal(|ui| {
-        if ui
-            .add_enabled(ready, egui::Button::new("Project"))
-            .on_hover_text(
-                "Paint the image into the selected layer through the projection (one undo step)",
-            )
-            .clicked()
-        {
-            go = Some(Action::Project);
-        }
-        if ui
-            .add_enabled(ready, egui::Button::new("New fill layer"))
-            .on_hover_text(
-                "Add a fill layer that keeps this projection, laid again when the mesh changes",
-            )
-            .clicked()
-        {
-            go = Some(Action::NewFill);
-        }
-        if editing
-            && ui
-                .add_enabled(ready, egui::Button::new("Update the fill"))
-                .on_hover_text("Give the selected projection fill these choices (one undo step)")
-                .clicked()
-        {
-            go = Some(Action::UpdateFill);
+        for (action, text, hover) in buttons {
+            let shown = !matches!(action, Action::UpdateFill) || editing;
+            if shown
+                && ui
+                    .add_enabled(ready, egui::Button::new(text))
+                    .on_hover_text(hover)
+                    .clicked()
+            {
+                go = Some(action);
+            }
         }
     });
     go

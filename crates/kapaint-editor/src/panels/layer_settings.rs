@@ -38,41 +38,23 @@ impl LayersPanel {
             commands.push(LayerCommand::SetLayerOpacity(opacity / 100.0).into());
         }
         commands.extend(channels_ui(ui, layer).into_iter().map(Command::from));
-        if let LayerContent::Fill(value) = layer.content
+        // A fill's material, or a projection fill's image and kind: either becomes a fill of
+        // the primary.
+        let flat = match &layer.content {
+            LayerContent::Fill(value) => Some(format!("Now: n {:.0}", value.n)),
+            LayerContent::Projected(p) => {
+                projection_ui(ui, desk, p.fill());
+                Some("Make it a flat fill again".to_string())
+            }
+            LayerContent::Paint(_) | LayerContent::Group(_) => None,
+        };
+        if let Some(hover) = flat
             && ui
                 .button("Fill with the primary material")
-                .on_hover_text(format!("Now: n {:.0}", value.n))
+                .on_hover_text(hover)
                 .clicked()
         {
             commands.push(LayerCommand::SetLayerFill(doc.settings().primary).into());
-        }
-        if let LayerContent::Projected(p) = &layer.content {
-            let fill = p.fill();
-            let name = fill
-                .image
-                .path()
-                .file_name()
-                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-            ui.label(format!(
-                "Projection: {name}, {}",
-                crate::project_dialog::kind_name(&fill.projection)
-            ));
-            ui.horizontal_wrapped(|ui| {
-                if ui
-                    .button("Edit projection…")
-                    .on_hover_text("Image > Project image, on this fill's choices")
-                    .clicked()
-                {
-                    desk.ask(Ask::Show(Window::ProjectImage));
-                }
-                if ui
-                    .button("Fill with the primary material")
-                    .on_hover_text("Make it a flat fill again")
-                    .clicked()
-                {
-                    commands.push(LayerCommand::SetLayerFill(doc.settings().primary).into());
-                }
-            });
         }
         commands.extend(
             mask_ui(ui, layer, doc.painting_mask())
@@ -105,6 +87,30 @@ impl LayersPanel {
         for c in commands {
             desk.command(c);
         }
+    }
+}
+
+/// A projection fill's image and kind, and the button that opens Image > Project image on it.
+fn projection_ui(
+    ui: &mut egui::Ui,
+    desk: &mut Desk,
+    fill: &kapaint_model::layers::projected::ProjectionFill,
+) {
+    let name = fill
+        .image
+        .path()
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    ui.label(format!(
+        "Projection: {name}, {}",
+        crate::project_dialog::kind_name(&fill.projection)
+    ));
+    if ui
+        .button("Edit projection…")
+        .on_hover_text("Image > Project image, on this fill's choices")
+        .clicked()
+    {
+        desk.ask(Ask::Show(Window::ProjectImage));
     }
 }
 

@@ -369,8 +369,18 @@ pub fn entries(
         .collect()
 }
 
+/// The archive's names of a projection fill's two images, for the layer stored as `stem`.
+pub fn projection_files(stem: &str) -> [String; 2] {
+    [
+        format!("{stem}_projection_rgba.png"),
+        format!("{stem}_projection_gray.png"),
+    ]
+}
+
 /// The entry of a projection fill stored as layer `k`.
 fn projection_entry(fill: &ProjectionFill, k: usize) -> ProjectionEntry {
+    // The names the writer stores its images under (see `LayerMaps::stem`).
+    let [rgba, gray] = projection_files(&LayerMaps::empty(k).stem);
     let (width, height) = fill
         .image
         .pixels()
@@ -379,8 +389,8 @@ fn projection_entry(fill: &ProjectionFill, k: usize) -> ProjectionEntry {
         projection: fill.projection,
         channels: fill.channels,
         source: fill.image.path().to_string_lossy().into_owned(),
-        rgba: format!("layer{k}_projection_rgba.png"),
-        gray: format!("layer{k}_projection_gray.png"),
+        rgba,
+        gray,
         width,
         height,
     }

@@ -203,7 +203,7 @@ pub(super) fn write_project(
         .map(|((_, r), &(w, h))| encode_png(r, w, h))
         .collect();
     let layers = super::layers::entries(&doc.stack().layers, &mut 0, &|k| stored[k].clone());
-    let files = projection_files(&layers, &layer_maps)?;
+    let files = projection_files(&layer_maps)?;
     let kept_mesh = kept_mesh(doc, &settings)?;
     let manifest = Manifest {
         format: FORMAT.into(),
@@ -365,34 +365,16 @@ fn version_of(layers: &[super::layers::LayerEntry], mesh: bool) -> u32 {
     }
 }
 
-/// The projection fills' images, each as its entry names it.
+/// The projection fills' images, each under the names its entry gives it.
 fn projection_files(
-    entries: &[super::layers::LayerEntry],
     layer_maps: &[super::layers::LayerMaps],
 ) -> Result<Vec<(String, Vec<u8>)>, String> {
     let mut files = Vec::new();
-    for (k, e) in entries_walk(entries) {
-        if let (Some(p), Some(pixels)) = (&e.projection, &layer_maps[k].projection) {
-            let [rgba, gray] = super::images::encode(pixels)?;
-            files.push((p.rgba.clone(), rgba));
-            files.push((p.gray.clone(), gray));
+    for l in layer_maps {
+        if let Some(pixels) = &l.projection {
+            let names = super::layers::projection_files(&l.stem);
+            files.extend(names.into_iter().zip(super::images::encode(pixels)?));
         }
     }
     Ok(files)
-}
-
-/// Every entry of `entries`, depth first as [`super::layers::entries`] numbers them.
-fn entries_walk(entries: &[super::layers::LayerEntry]) -> Vec<(usize, &super::layers::LayerEntry)> {
-    fn go<'a>(
-        list: &'a [super::layers::LayerEntry],
-        out: &mut Vec<(usize, &'a super::layers::LayerEntry)>,
-    ) {
-        for e in list {
-            out.push((out.len(), e));
-            go(&e.children, out);
-        }
-    }
-    let mut out = Vec::new();
-    go(entries, &mut out);
-    out
 }
