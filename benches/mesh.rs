@@ -454,12 +454,8 @@ fn high_bakes(c: &mut Criterion) {
         .sample_size(10)
         .measurement_time(Duration::from_secs(30));
     group.bench_function("bvh_build", |b| b.iter(|| RayMesh::new(&high)));
-    let options = HighOptions {
-        map: HighMap::Normal(NormalSpace::Tangent),
-        front: None,
-        rear: None,
-    };
-    let once = bake_from_high(&spot, &uv, &high, options, None).expect("bakes");
+    let options = HighOptions::new(HighMap::Normal(NormalSpace::Tangent));
+    let once = bake_from_high(&spot, &uv, &high, None, options, None).expect("bakes");
     eprintln!(
         "sculpt onto spot: {} high triangles, {} texels, {} missed ({:.4} %), front {:.4} rear {:.4}",
         high.triangles.len(),
@@ -470,7 +466,7 @@ fn high_bakes(c: &mut Criterion) {
         once.rear
     );
     group.bench_function("tangent_normal_4096", |b| {
-        b.iter(|| bake_from_high(&spot, &uv, &high, options, None).expect("bakes"));
+        b.iter(|| bake_from_high(&spot, &uv, &high, None, options, None).expect("bakes"));
     });
     group.finish();
 }

@@ -179,7 +179,25 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
     let nan = d.join("nan.obj");
     std::fs::write(&nan, "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n").expect("write");
     for (args, want) in [
-        (vec!["--map", "ao", "--high", s(&high)], "--map normal"),
+        (vec!["--map", "id", "--high", s(&high)], "need --out"),
+        (
+            vec!["--map", "ao", "--high", s(&high), "--samples", "3"],
+            "1, 4 or 16",
+        ),
+        (
+            vec!["--map", "ao", "--high", s(&high), "--rays", "0"],
+            "--rays",
+        ),
+        // spot's quad mesh is not its triangle mesh's topology.
+        (
+            vec!["--map", "ao", "--high", s(&high), "--cage", s(&high)],
+            "topology",
+        ),
+        (vec!["--map", "ao", "--cage", s(&high)], "--high"),
+        (
+            vec!["--map", "ao", "--high", s(&high), "--high", s(&nan)],
+            "nan.obj",
+        ),
         (
             vec!["--map", "normal", "--high", s(&high), "--front=-1"],
             "not a positive number",
@@ -188,15 +206,24 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
             vec!["--map", "normal", "--high", s(&high), "--rear", "0"],
             "not a positive number",
         ),
-        (
-            vec!["--map", "normal", "--high", s(&high), "--space", "object"],
-            "need --out",
-        ),
         (vec!["--map", "height", "--high", s(&high)], "need --out"),
         (vec!["--map", "height"], "give --high"),
         // Flags of a bake from a high mesh, without one; a miss map over a file already there.
         (vec!["--map", "normal", "--front", "0.1"], "--high"),
         (vec!["--map", "ao", "--misses", s(&kept)], "--high"),
+        (
+            vec![
+                "--map",
+                "curvature",
+                "--high",
+                s(&high),
+                "--out",
+                s(&fresh),
+                "--skew",
+                s(&kept),
+            ],
+            "exists; pass --force",
+        ),
         (
             vec![
                 "--map",
@@ -228,5 +255,101 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
         assert_eq!(std::fs::read(&kept).expect("read"), b"the user's own file");
         assert!(!fresh.exists(), "{all:?} wrote its output");
     }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// AO, curvature and position from spot's quad mesh (and a box beside it, a second --high)
+/// are kept as the project's bakes, saying where they came from, and survive a save; ID and
+/// the skew view are written out.
+#[test]
+fn maps_from_high_meshes_are_kept_as_the_projects_bakes_or_written() {
+    let d = dir("maps");
+    let p = low(&d);
+    let high = spot("spot_quadrangulated.obj");
+    let boxed = d.join("box.obj");
+    std::fs::write(
+        &boxed,
+        "o box\nv 2 0 0\nv 3 0 0\nv 3 1 0\nv 2 1 0\nv 2 0 1\nv 3 0 1\nv 3 1 1\nv 2 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .expect("write");
+    for map in ["ao", "curvature", "position"] {
+        let o = kapaint(&[
+            "bake",
+            s(&p),
+            "--map",
+            map,
+            "--high",
+            s(&high),
+            "--high",
+            s(&boxed),
+            "--rays",
+            "16",
+            "--samples",
+            "4",
+        ]);
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            text.contains(&format!("kept as the {map} bake"))
+                && text.contains("4 samples a texel")
+                && text.contains(" + "),
+            "{text}"
+        );
+    }
+    let doc = kapaint::model::project::load(&p).expect("opens");
+    let bakes = doc.bakes();
+    assert_eq!(bakes.len(), 3);
+    for b in bakes {
+        let from = b.from_high.as_ref().expect("from the high mesh");
+        assert_eq!(from.samples, 4);
+        assert!(
+            from.mesh.contains("spot") && from.mesh.contains("box"),
+            "{}",
+            from.mesh
+        );
+    }
+    let ao = bakes
+        .iter()
+        .find(|b| b.map == kapaint::mesh::bakes::BakeMap::Ao)
+        .expect("ao");
+    assert_eq!(ao.options.rays, 16);
+    // Saved again by another command, the bakes stay as they were.
+    let before = bakes.to_vec();
+    let o = kapaint(&["bake", s(&p), "--map", "thickness", "--rays", "4"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc = kapaint::model::project::load(&p).expect("opens");
+    for b in &before {
+        assert!(doc.bakes().iter().any(|k| **k == **b), "{:?} lost", b.map);
+    }
+    // ID and the skew view, written out.
+    let (ids, skew) = (d.join("id.png"), d.join("skew.png"));
+    let o = kapaint(&[
+        "bake",
+        s(&p),
+        "--map",
+        "id",
+        "--high",
+        s(&high),
+        "--out",
+        s(&ids),
+        "--skew",
+        s(&skew),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&ids).expect("png").into_rgb16();
+    let mut colours: Vec<[u16; 3]> = img.pixels().map(|p| p.0).filter(|c| *c != [0; 3]).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(
+        !colours.is_empty() && colours.len() <= 3,
+        "{}",
+        colours.len()
+    );
+    let skewed = image::open(&skew).expect("png").into_luma8();
+    assert!(
+        skewed.pixels().any(|p| p.0[0] > 0),
+        "spot's smooth normals lean off its faces"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }

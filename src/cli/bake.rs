@@ -24,6 +24,8 @@ pub enum MapArg {
     Normal,
     /// With --high: the high surface's height over the project's mesh, by the ray distances.
     Height,
+    /// With --high: the high mesh's parts (separate objects), a colour each (RGB).
+    Id,
 }
 
 impl MapArg {
@@ -35,7 +37,7 @@ impl MapArg {
             Self::Thickness => Some(BakeMap::Thickness),
             Self::Position => Some(BakeMap::Position),
             Self::Normal => Some(BakeMap::Normal),
-            Self::Height => None,
+            Self::Height | Self::Id => None,
         }
     }
 }
@@ -62,11 +64,26 @@ pub struct BakeArgs {
     /// The PNG to write instead of keeping the bake in the project.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// A high-poly mesh (OBJ or glTF) to bake from, onto the project's mesh (with --map
-    /// normal): rays from the project's mesh take the nearest high surface's normal. Kept as
-    /// the project's normal map (tangent space, one undo step), or written with --out.
+    /// A high-poly mesh (OBJ or glTF) to bake from, onto the project's mesh; given more than
+    /// once, the meshes are baked as one. Rays from the project's mesh meet the nearest high
+    /// surface: a tangent-space normal is kept as the project's normal map (one undo step),
+    /// ao, thickness, curvature, position and object-space normal as the project's bakes of
+    /// those maps (what generator masks read); height and id need --out.
     #[arg(long)]
-    high: Option<PathBuf>,
+    high: Vec<PathBuf>,
+    /// With --high: a cage (OBJ or glTF), the project's mesh with its vertices pushed out
+    /// (the same triangles): each ray starts on it and goes towards the project's mesh, and
+    /// --rear past it.
+    #[arg(long, requires = "high")]
+    cage: Option<PathBuf>,
+    /// With --high: samples per texel, 1, 4 (2 x 2) or 16 (4 x 4), averaged (antialiasing).
+    #[arg(long, requires = "high", default_value_t = 1)]
+    samples: u32,
+    /// With --high: also write the skew view, an 8-bit grey PNG, the angle between each
+    /// texel's rays and its triangle's face (black 0, white 90 degrees): where the project's
+    /// averaged normals tilt the rays.
+    #[arg(long, requires = "high")]
+    skew: Option<PathBuf>,
     /// The space of a normal baked from --high: tangent (the project's mesh's MikkTSpace
     /// frame, what the preview and the exports read) or object (needs --out).
     #[arg(long, requires = "high", value_enum, default_value_t = super::bake_high::SpaceArg::Tangent)]
@@ -109,7 +126,7 @@ impl BakeArgs {
                 )));
             }
         }
-        for file in [&self.out, &self.misses].into_iter().flatten() {
+        for file in [&self.out, &self.misses, &self.skew].into_iter().flatten() {
             if file.exists() && !self.force {
                 return Err(CliError::usage(format!(
                     "{} exists; pass --force to overwrite it",
@@ -124,29 +141,41 @@ impl BakeArgs {
                 "--max-distance {d} is not a positive number"
             )));
         }
-        if let Some(high) = &self.high {
+        if !self.high.is_empty() {
+            use crate::mesh::bakes::{HighMap, NormalSpace};
             let map = match self.map {
-                MapArg::Normal => super::bake_high::Made::Normal(self.space),
-                MapArg::Height => super::bake_high::Made::Height,
-                _ => {
-                    return Err(CliError::usage(
-                        "--high bakes --map normal or height (the other maps from a high mesh are not built yet)",
-                    ));
-                }
+                MapArg::Normal => HighMap::Normal(match self.space {
+                    super::bake_high::SpaceArg::Tangent => NormalSpace::Tangent,
+                    super::bake_high::SpaceArg::Object => NormalSpace::Object,
+                }),
+                MapArg::Height => HighMap::Height,
+                MapArg::Ao => HighMap::Ao,
+                MapArg::Thickness => HighMap::Thickness,
+                MapArg::Curvature => HighMap::Curvature,
+                MapArg::Position => HighMap::Position,
+                MapArg::Id => HighMap::Id,
             };
-            return super::bake_high::run(&super::bake_high::HighRequest {
-                project: &self.project,
-                high,
+            let options = crate::mesh::bakes::HighOptions {
                 map,
                 front: self.front,
                 rear: self.rear,
+                rays: self.rays,
+                max_distance: self.max_distance,
+                samples: self.samples,
+            };
+            return super::bake_high::run(&super::bake_high::HighRequest {
+                project: &self.project,
+                high: &self.high,
+                cage: self.cage.as_deref(),
+                options,
                 out: self.out.as_ref(),
                 misses: self.misses.as_ref(),
+                skew: self.skew.as_ref(),
             });
         }
         let Some(map) = self.map.own() else {
             return Err(CliError::usage(
-                "--map height is baked from a high mesh: give --high HIGH",
+                "--map height and --map id are baked from a high mesh: give --high HIGH",
             ));
         };
         let (mut doc, surface, on_disk) = super::bake_high::open_to_bake(&self.project)?;

@@ -1,11 +1,14 @@
-//! `kapaint bake --high`: normals baked from a high-poly mesh onto the project's mesh, kept as
-//! the project's normal map (tangent space, one undo step) or written as a 16-bit PNG.
+//! `kapaint bake --high`: maps baked from high-poly meshes onto the project's mesh, kept in
+//! the project (a tangent-space normal as its normal map, ao, thickness, curvature, position and
+//! object-space normal as its bakes; one undo step) or written as a 16-bit PNG (height also
+//! as an EXR).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{CliError, model_error};
+use crate::mesh::Mesh;
 use crate::mesh::bakes::{HighBake, HighMap, HighOptions, NormalSpace, bake_from_high};
 use crate::model::project;
 
@@ -18,92 +21,88 @@ pub enum SpaceArg {
     Object,
 }
 
-/// The map asked of the high mesh.
-#[derive(Clone, Copy, Debug)]
-pub enum Made {
-    /// Normals, in a space.
-    Normal(SpaceArg),
-    /// Height.
-    Height,
-}
-
 /// What `kapaint bake --high` is asked.
 pub struct HighRequest<'a> {
     /// The project.
     pub project: &'a Path,
-    /// The high mesh.
-    pub high: &'a Path,
-    /// The map.
-    pub map: Made,
-    /// Ray distances.
-    pub front: Option<f32>,
-    /// Ray distances.
-    pub rear: Option<f32>,
+    /// The high meshes (baked as one).
+    pub high: &'a [PathBuf],
+    /// The cage, if any.
+    pub cage: Option<&'a Path>,
+    /// The map, distances, rays and samples.
+    pub options: HighOptions,
     /// The PNG to write instead of keeping the map.
     pub out: Option<&'a PathBuf>,
     /// The miss map's PNG, if asked.
     pub misses: Option<&'a PathBuf>,
+    /// The skew view's PNG, if asked.
+    pub skew: Option<&'a PathBuf>,
 }
 
-/// Bakes and keeps or writes the normals; returns what the command prints.
+/// Bakes and keeps or writes the map; returns what the command prints.
 ///
 /// # Errors
-/// A project without a mesh, a high mesh that does not load or cannot be baked, distances
-/// that are not positive, object space without `--out`, a failed write.
+/// A project without a mesh, a high mesh or cage that does not load or cannot be baked,
+/// distances that are not positive, height or id without `--out`, a failed write.
 pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
-    let map = match r.map {
-        Made::Normal(SpaceArg::Tangent) => HighMap::Normal(NormalSpace::Tangent),
-        Made::Normal(SpaceArg::Object) => HighMap::Normal(NormalSpace::Object),
-        Made::Height => HighMap::Height,
-    };
-    if r.out.is_none() && map != HighMap::Normal(NormalSpace::Tangent) {
+    let map = r.options.map;
+    if r.out.is_none() && matches!(map, HighMap::Height | HighMap::Id) {
         return Err(CliError::usage(
-            "--space object and --map height need --out: the project keeps a tangent-space normal map",
+            "--map height and --map id need --out: a project keeps normals, ao, thickness, curvature and position",
         ));
     }
-    if let Some(m) = r.misses
-        && !m.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
-    {
-        return Err(CliError::usage(format!(
-            "{}: --misses must end in .png",
-            m.display()
-        )));
+    for (flag, file) in [("--misses", r.misses), ("--skew", r.skew)] {
+        if let Some(m) = file
+            && !m.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            return Err(CliError::usage(format!(
+                "{}: {flag} must end in .png",
+                m.display()
+            )));
+        }
     }
     let (mut doc, surface, on_disk) = open_to_bake(r.project)?;
-    let high = crate::mesh::open(r.high)
-        .map_err(|e| CliError::usage(format!("{}: {e}", r.high.display())))?;
+    let open = |p: &Path| {
+        crate::mesh::open(p).map_err(|e| CliError::usage(format!("{}: {e}", p.display())))
+    };
+    let high = Mesh::merged(r.high.iter().map(|p| open(p)).collect::<Result<_, _>>()?)
+        .map_err(CliError::usage)?;
+    let cage = r.cage.map(open).transpose()?;
     let start = Instant::now();
     let progress = crate::task::Progress::default();
-    let options = HighOptions {
-        map,
-        front: r.front,
-        rear: r.rear,
-    };
     let baked = super::progress::with_bar("bake", &progress, || {
         bake_from_high(
             &surface.mesh,
             &surface.bake,
             &high,
-            options,
+            cage.as_ref(),
+            r.options,
             Some(&progress),
         )
     })
     .map_err(|e| CliError::usage(e.to_string()))?;
     let mut line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
-    if let Some(m) = r.misses {
-        let map = image::GrayImage::from_fn(baked.width, baked.height, |x, y| {
-            image::Luma([if baked.misses[(y * baked.width + x) as usize] {
-                255
-            } else {
-                0
-            }])
-        });
+    for (what, file, on) in [
+        (
+            "the miss map",
+            r.misses,
+            &baked
+                .misses
+                .iter()
+                .map(|&m| if m { 255 } else { 0 })
+                .collect::<Vec<u8>>(),
+        ),
+        ("the skew view", r.skew, &baked.skew),
+    ] {
+        let Some(file) = file else { continue };
+        let grey = image::GrayImage::from_raw(baked.width, baked.height, on.clone())
+            .ok_or_else(|| CliError::io("bake size mismatch"))?;
         let mut png = std::io::Cursor::new(Vec::new());
-        map.write_to(&mut png, image::ImageFormat::Png)
+        grey.write_to(&mut png, image::ImageFormat::Png)
             .map_err(|e| CliError::io(e.to_string()))?;
-        crate::atomic::write_atomic(m, png.get_ref())
-            .map_err(|e| CliError::of_io(format!("{}: {e}", m.display()), &e))?;
-        let _ = write!(line, "\nwrote the miss map {}", m.display());
+        crate::atomic::write_atomic(file, png.get_ref())
+            .map_err(|e| CliError::of_io(format!("{}: {e}", file.display()), &e))?;
+        let _ = write!(line, "\nwrote {what} {}", file.display());
     }
     if let Some(out) = r.out {
         let exr = out
@@ -114,20 +113,38 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
             .map_err(|e| CliError::of_io(format!("{}: {e}", out.display()), &e))?;
         return Ok(format!("{line}\nwrote {}\n", out.display()));
     }
-    let image = image::RgbImage::from_fn(baked.width, baked.height, |x, y| {
-        let i = (y * baked.width + x) as usize * 3;
-        image::Rgb([0, 1, 2].map(|c| (baked.data[i + c] >> 8) as u8))
-    });
-    let normal = crate::model::normal::NormalMap::new(image).map_err(CliError::usage)?;
-    doc.apply(crate::model::ImportCommand::SetNormal(
-        crate::model::document::AttachedNormal(Some(std::sync::Arc::new(normal))),
-    ))
-    .map_err(model_error)?;
+    let kept = if let Some(bake) = baked.to_baked(&surface.mesh, &high, cage.as_ref()) {
+        let bake = crate::model::document::AttachedBake(std::sync::Arc::new(bake));
+        doc.apply(crate::model::ImportCommand::SetBake(bake))
+            .map_err(model_error)?;
+        format!("kept as the {} bake of", map_name(map))
+    } else {
+        let image = image::RgbImage::from_fn(baked.width, baked.height, |x, y| {
+            let i = (y * baked.width + x) as usize * 3;
+            image::Rgb([0, 1, 2].map(|c| (baked.data[i + c] >> 8) as u8))
+        });
+        let normal = crate::model::normal::NormalMap::new(image).map_err(CliError::usage)?;
+        doc.apply(crate::model::ImportCommand::SetNormal(
+            crate::model::document::AttachedNormal(Some(std::sync::Arc::new(normal))),
+        ))
+        .map_err(model_error)?;
+        "kept as the normal map of".to_string()
+    };
     project::save_checked(&doc, r.project, on_disk.as_ref()).map_err(model_error)?;
-    Ok(format!(
-        "{line}\nkept as the normal map of {}\n",
-        r.project.display()
-    ))
+    Ok(format!("{line}\n{kept} {}\n", r.project.display()))
+}
+
+/// A map's name as the command line spells it.
+fn map_name(map: HighMap) -> &'static str {
+    match map {
+        HighMap::Normal(_) => "normal",
+        HighMap::Height => "height",
+        HighMap::Ao => "ao",
+        HighMap::Thickness => "thickness",
+        HighMap::Curvature => "curvature",
+        HighMap::Position => "position",
+        HighMap::Id => "id",
+    }
 }
 
 /// The project, opened with its mesh attached, that mesh's surface, and the file as read (a
@@ -166,13 +183,14 @@ fn png16(baked: &HighBake) -> Result<Vec<u8>, String> {
     let mut bytes = Vec::new();
     let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Up);
     let (w, h, data) = (baked.width, baked.height, baked.data.as_slice());
-    match baked.map {
-        HighMap::Height => image::ImageBuffer::<image::Luma<u16>, &[u16]>::from_raw(w, h, data)
+    if baked.map.channels() == 1 {
+        image::ImageBuffer::<image::Luma<u16>, &[u16]>::from_raw(w, h, data)
             .ok_or("bake size mismatch")?
-            .write_with_encoder(encoder),
-        HighMap::Normal(_) => image::ImageBuffer::<image::Rgb<u16>, &[u16]>::from_raw(w, h, data)
+            .write_with_encoder(encoder)
+    } else {
+        image::ImageBuffer::<image::Rgb<u16>, &[u16]>::from_raw(w, h, data)
             .ok_or("bake size mismatch")?
-            .write_with_encoder(encoder),
+            .write_with_encoder(encoder)
     }
     .map_err(|e| e.to_string())?;
     Ok(bytes)
@@ -196,32 +214,36 @@ fn exr32(baked: &HighBake) -> Result<Vec<u8>, String> {
 }
 
 /// One line on what was baked: the meshes, the distances and what the rays missed.
-fn summary(
-    r: &HighRequest<'_>,
-    high: &crate::mesh::Mesh,
-    baked: &HighBake,
-    seconds: f64,
-) -> String {
+fn summary(r: &HighRequest<'_>, high: &Mesh, baked: &HighBake, seconds: f64) -> String {
     let share = baked.missed as f64 / baked.covered.max(1) as f64 * 100.0;
+    let what = match baked.map {
+        HighMap::Normal(NormalSpace::Tangent) => "normal (tangent space)".to_string(),
+        HighMap::Normal(NormalSpace::Object) => "normal (object space)".to_string(),
+        HighMap::Height => format!(
+            "height (0 at {:.4} below, 1 at {:.4} above the mesh)",
+            baked.rear, baked.front
+        ),
+        map if map.casts_rays() => format!("{} ({} rays a sample)", map_name(map), baked.rays),
+        map => map_name(map).to_string(),
+    };
+    let highs: Vec<String> = r.high.iter().map(|p| p.display().to_string()).collect();
+    let defaults = r.options.front.is_none() || r.options.rear.is_none();
     format!(
-        "baked {} of {} from {} ({} triangles): {}x{}, {} texels, front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s",
-        match baked.map {
-            HighMap::Normal(NormalSpace::Tangent) => "normal (tangent space)".to_string(),
-            HighMap::Normal(NormalSpace::Object) => "normal (object space)".to_string(),
-            HighMap::Height => format!(
-                "height (0 at {:.4} below, 1 at {:.4} above the mesh)",
-                baked.rear, baked.front
-            ),
-        },
+        "baked {what} of {} from {} ({} triangles): {}x{}, {} texels, {} sample{} a texel, {}front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s",
         r.project.display(),
-        r.high.display(),
+        highs.join(" + "),
         high.triangles.len(),
         baked.width,
         baked.height,
         baked.covered,
+        baked.samples,
+        if baked.samples == 1 { "" } else { "s" },
+        r.cage
+            .map(|c| format!("from the cage {}, ", c.display()))
+            .unwrap_or_default(),
         baked.front,
         baked.rear,
-        if r.front.is_none() || r.rear.is_none() {
+        if defaults {
             ", by default 2 % of the meshes' diagonal"
         } else {
             ""

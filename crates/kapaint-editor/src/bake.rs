@@ -265,7 +265,12 @@ pub(super) fn bake_window(open: &mut Option<BakeDialog>, ctx: &egui::Context, de
                     } else {
                         String::new()
                     };
-                    ui.label(format!("{}{rays}", b.map.name()));
+                    let from = b
+                        .from_high
+                        .as_ref()
+                        .map(|h| format!(", from {}", h.mesh))
+                        .unwrap_or_default();
+                    ui.label(format!("{}{rays}{from}", b.map.name()));
                 }
             }
             go = ui

@@ -144,6 +144,36 @@ impl Mesh {
         )
     }
 
+    /// One mesh of `meshes` (at least one) side by side: their vertices and triangles in
+    /// order, named after them all; UVs only where every one has them.
+    ///
+    /// # Errors
+    /// No meshes, or more vertices than a triangle indexes.
+    pub fn merged(meshes: Vec<Self>) -> Result<Self, String> {
+        let mut all = meshes.into_iter();
+        let mut out = all.next().ok_or("no meshes to merge")?;
+        for m in all {
+            let base = u32::try_from(out.positions.len())
+                .ok()
+                .filter(|b| b.checked_add(m.positions.len() as u32).is_some())
+                .ok_or("the meshes together have more vertices than a triangle indexes")?;
+            out.name = format!("{} + {}", out.name, m.name);
+            out.positions.extend(m.positions);
+            out.normals.extend(m.normals);
+            out.uvs = match (out.uvs.take(), m.uvs) {
+                (Some(mut a), Some(b)) => {
+                    a.extend(b);
+                    Some(a)
+                }
+                _ => None,
+            };
+            out.triangles
+                .extend(m.triangles.into_iter().map(|t| t.map(|v| v + base)));
+            out.had_normals &= m.had_normals;
+        }
+        Ok(out)
+    }
+
     /// A hash of what the mesh is (positions, UVs, triangles), stable across runs and
     /// builds: the key its bakes are kept under, so a changed mesh is baked again.
     pub fn content_hash(&self) -> u64 {

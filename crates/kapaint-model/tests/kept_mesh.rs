@@ -230,3 +230,58 @@ fn a_bake_is_kept_read_back_and_dropped_with_its_mesh() {
         .expect_err("another mesh");
     assert!(e.to_string().contains("another mesh"), "{e}");
 }
+
+/// A bake from a high mesh keeps where it came from (version 6): read back as it was; a
+/// damaged account of it (a distance that is not positive, samples other than 1, 4 or 16, a
+/// bad hash) or one in an older version is refused.
+#[test]
+fn a_bake_from_a_high_mesh_says_where_it_came_from() {
+    use kapaint_mesh::bakes::{BakeMap, HighMap, HighOptions, bake_from_high};
+    use kapaint_model::document::AttachedBake;
+    let mut doc = kept_document();
+    project::attach_own_mesh(&mut doc).expect("attaches");
+    let surface = doc.surface().expect("attached").clone();
+    let high = kapaint_mesh::torus(1.0, 0.37, 96, 48);
+    let options = HighOptions {
+        rays: 8,
+        samples: 4,
+        ..HighOptions::new(HighMap::Ao)
+    };
+    let baked = bake_from_high(&surface.mesh, &surface.bake, &high, None, options, None)
+        .expect("bakes")
+        .to_baked(&surface.mesh, &high, None)
+        .expect("a project keeps AO");
+    let from = baked.from_high.clone().expect("from the high mesh");
+    assert_eq!((from.mesh.as_str(), from.samples), ("torus", 4));
+    doc.apply(ImportCommand::SetBake(AttachedBake(Arc::new(
+        baked.clone(),
+    ))))
+    .expect("kept");
+    let bytes = to_bytes(&doc).expect("saves");
+    assert_eq!(version(&bytes), 6);
+    let back = from_reader(Cursor::new(&bytes)).expect("reads");
+    assert_eq!(**back.bake_of(BakeMap::Ao).expect("read back"), baked);
+    for (edit, want) in [
+        (
+            Box::new(|m: &mut serde_json::Value| m["bakes"][0]["high"]["front"] = (-1.0).into())
+                as Box<dyn Fn(&mut serde_json::Value)>,
+            "not a positive number",
+        ),
+        (
+            Box::new(|m: &mut serde_json::Value| m["bakes"][0]["high"]["samples"] = 3.into()),
+            "1, 4 or 16",
+        ),
+        (
+            Box::new(|m: &mut serde_json::Value| m["bakes"][0]["high"]["mesh_hash"] = "xyz".into()),
+            "16 hex digits",
+        ),
+        (
+            Box::new(|m: &mut serde_json::Value| m["version"] = 5.into()),
+            "version 6",
+        ),
+    ] {
+        let damaged = with_manifest(&bytes, edit);
+        let e = from_reader(Cursor::new(&damaged)).expect_err(want);
+        assert!(e.contains(want), "{e}");
+    }
+}

@@ -154,7 +154,7 @@ pub fn triangle_islands(mesh: &Mesh) -> Vec<u32> {
 }
 
 /// Barycentrics of the point of triangle `(a, b, c)` nearest to `p`, and its squared distance.
-fn nearest_barycentric(p: Vec2, a: Vec2, b: Vec2, c: Vec2) -> (Vec3, f32) {
+pub(crate) fn nearest_barycentric(p: Vec2, a: Vec2, b: Vec2, c: Vec2) -> (Vec3, f32) {
     let (v0, v1, v2) = (b - a, c - a, p - a);
     let d00 = v0.dot(v0);
     let d01 = v0.dot(v1);

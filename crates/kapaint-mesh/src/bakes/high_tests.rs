@@ -13,11 +13,7 @@ fn decode(n: &HighBake, i: usize) -> Vec3 {
 }
 
 fn options(space: NormalSpace) -> HighOptions {
-    HighOptions {
-        map: HighMap::Normal(space),
-        front: None,
-        rear: None,
-    }
+    HighOptions::new(HighMap::Normal(space))
 }
 
 /// A coarse sphere's texels take a fine sphere's normals: within a degree of the analytic
@@ -28,7 +24,7 @@ fn object_normals_from_a_fine_sphere_are_the_analytic_normals() {
     let high = crate::uv_sphere(512, 256);
     let uv = bake(&low, 256, 256, 2).expect("bakes");
     let baked =
-        bake_from_high(&low, &uv, &high, options(NormalSpace::Object), None).expect("bakes");
+        bake_from_high(&low, &uv, &high, None, options(NormalSpace::Object), None).expect("bakes");
     assert!(baked.covered > 30_000, "{}", baked.covered);
     assert_eq!(baked.missed, 0, "every ray meets the fine sphere");
     let mut errors = Vec::new();
@@ -61,7 +57,8 @@ fn object_normals_from_a_fine_sphere_are_the_analytic_normals() {
 fn tangent_normals_are_flat_on_the_mesh_itself_and_lean_on_bumps() {
     let low = crate::uv_sphere(48, 24);
     let uv = bake(&low, 128, 128, 2).expect("bakes");
-    let flat = bake_from_high(&low, &uv, &low, options(NormalSpace::Tangent), None).expect("bakes");
+    let flat =
+        bake_from_high(&low, &uv, &low, None, options(NormalSpace::Tangent), None).expect("bakes");
     let mut worst = 0.0_f32;
     for i in 0..(128 * 128) {
         if uv.triangle(i).is_some() && uv.coverage(i) == crate::bake::Coverage::Surface {
@@ -83,8 +80,8 @@ fn tangent_normals_are_flat_on_the_mesh_itself_and_lean_on_bumps() {
         *n = Vec3::ZERO;
     }
     recompute_normals(&mut bumpy);
-    let leaned =
-        bake_from_high(&low, &uv, &bumpy, options(NormalSpace::Tangent), None).expect("bakes");
+    let leaned = bake_from_high(&low, &uv, &bumpy, None, options(NormalSpace::Tangent), None)
+        .expect("bakes");
     let tilted = (0..128 * 128)
         .filter(|&i| uv.triangle(i).is_some())
         .filter(|&i| decode(&leaned, i).normalize().angle_between(Vec3::Z) > 5f32.to_radians())
@@ -116,8 +113,8 @@ fn bad_high_meshes_and_distances_are_refused() {
     let mut nan = low.clone();
     nan.positions[3] = Vec3::NAN;
     for (high, want) in [(&empty, "no triangles"), (&nan, "non-finite")] {
-        let e =
-            bake_from_high(&low, &uv, high, options(NormalSpace::Object), None).expect_err(want);
+        let e = bake_from_high(&low, &uv, high, None, options(NormalSpace::Object), None)
+            .expect_err(want);
         assert!(e.to_string().contains(want), "{e}");
     }
     for d in [0.0, -1.0, f32::NAN, f32::INFINITY] {
@@ -125,10 +122,10 @@ fn bad_high_meshes_and_distances_are_refused() {
             &low,
             &uv,
             &low,
+            None,
             HighOptions {
-                map: HighMap::Normal(NormalSpace::Object),
                 front: Some(d),
-                rear: None,
+                ..options(NormalSpace::Object)
             },
             None,
         )
@@ -141,7 +138,7 @@ fn bad_high_meshes_and_distances_are_refused() {
         ..low.clone()
     };
     let missed =
-        bake_from_high(&low, &uv, &far, options(NormalSpace::Object), None).expect("bakes");
+        bake_from_high(&low, &uv, &far, None, options(NormalSpace::Object), None).expect("bakes");
     assert_eq!(missed.missed, missed.covered);
 }
 
@@ -177,11 +174,11 @@ fn height_is_the_high_surface_over_the_low_one_by_the_distances() {
     };
     let height = |high: &Mesh| {
         let opts = HighOptions {
-            map: HighMap::Height,
             front: Some(0.05),
             rear: Some(0.05),
+            ..HighOptions::new(HighMap::Height)
         };
-        let b = bake_from_high(&low, &uv, high, opts, None).expect("bakes");
+        let b = bake_from_high(&low, &uv, high, None, opts, None).expect("bakes");
         assert_eq!(b.missed, 0);
         let values: Vec<f32> = (0..128 * 128)
             .filter(|&i| uv.coverage(i) == crate::bake::Coverage::Surface)

@@ -18,7 +18,9 @@ use rayon::prelude::*;
 
 mod high;
 mod rays;
-pub use high::{DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, NormalSpace, bake_from_high};
+pub use high::{
+    DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, NormalSpace, SAMPLES, bake_from_high,
+};
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};
 
@@ -113,6 +115,27 @@ pub struct Baked {
     pub height: u32,
     /// The samples.
     pub data: Vec<u16>,
+    /// Where it came from when it was baked from a high mesh onto this one (`None`: from this
+    /// mesh itself).
+    pub from_high: Option<FromHigh>,
+}
+
+/// Where a map baked from a high mesh came from, as a project keeps it: the high mesh cannot
+/// be read again, so this is what the bake says of itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FromHigh {
+    /// The high mesh's name.
+    pub mesh: String,
+    /// Its [`Mesh::content_hash`].
+    pub mesh_hash: u64,
+    /// The ray distances (object units).
+    pub front: f32,
+    /// The ray distances (object units).
+    pub rear: f32,
+    /// Samples per texel.
+    pub samples: u32,
+    /// The cage's name, if the rays started on one.
+    pub cage: Option<String>,
 }
 
 /// What a bake holds, over the texels a UV bake gives a surface point.
@@ -350,6 +373,7 @@ pub fn bake_map(
         width: uv.width,
         height: uv.height,
         data,
+        from_high: None,
     })
 }
 
@@ -424,6 +448,8 @@ fn curvature_in(mesh: &Mesh, local: &[Vec3]) -> Vec<f32> {
         .collect()
 }
 
+#[cfg(test)]
+mod high_maps_tests;
 #[cfg(test)]
 mod high_tests;
 #[cfg(test)]

@@ -6,7 +6,7 @@ use std::io::{Read, Seek};
 use std::sync::Arc;
 
 use image::{ImageBuffer, Luma, Rgb};
-use kapaint_mesh::bakes::{BakeMap, BakeOptions, Baked, RAYS};
+use kapaint_mesh::bakes::{BakeMap, BakeOptions, Baked, FromHigh, RAYS, SAMPLES};
 
 use super::Manifest;
 
@@ -33,6 +33,30 @@ pub fn to_png(bake: &Baked) -> Result<Vec<u8>, String> {
     };
     result.map_err(|e| e.to_string())?;
     Ok(bytes)
+}
+
+/// The manifest's entries of `bakes` (none when there are none).
+pub(super) fn entries(bakes: &[Arc<Baked>]) -> Option<Vec<super::BakeEntry>> {
+    (!bakes.is_empty()).then(|| {
+        bakes
+            .iter()
+            .map(|b| super::BakeEntry {
+                map: b.map.name().into(),
+                file: file_of(b.map),
+                mesh_hash: format!("{:016x}", b.mesh_hash),
+                rays: b.options.rays,
+                max_distance: b.options.max_distance,
+                high: b.from_high.as_ref().map(|h| super::HighEntry {
+                    mesh: h.mesh.clone(),
+                    mesh_hash: format!("{:016x}", h.mesh_hash),
+                    front: h.front,
+                    rear: h.rear,
+                    samples: h.samples,
+                    cage: h.cage.clone(),
+                }),
+            })
+            .collect()
+    })
 }
 
 /// The bakes the manifest lists, each checked: a known map listed once, its file, a hash,
@@ -62,15 +86,7 @@ pub(super) fn read<R: Read + Seek>(
                 file_of(map)
             ));
         }
-        let mesh_hash = u64::from_str_radix(&e.mesh_hash, 16)
-            .ok()
-            .filter(|_| e.mesh_hash.len() == 16)
-            .ok_or_else(|| {
-                format!(
-                    "{}: the mesh hash {:?} is not 16 hex digits",
-                    e.file, e.mesh_hash
-                )
-            })?;
+        let mesh_hash = hash_of(&e.file, &e.mesh_hash)?;
         if !RAYS.contains(&e.rays) {
             return Err(format!("{}: {} rays is out of range", e.file, e.rays));
         }
@@ -93,9 +109,44 @@ pub(super) fn read<R: Read + Seek>(
             width: manifest.width,
             height: manifest.height,
             data,
+            from_high: e.high.as_ref().map(|h| from_high(&e.file, h)).transpose()?,
         }));
     }
     Ok(bakes)
+}
+
+/// A 16-hex-digit hash of entry `file`.
+fn hash_of(file: &str, hex: &str) -> Result<u64, String> {
+    u64::from_str_radix(hex, 16)
+        .ok()
+        .filter(|_| hex.len() == 16)
+        .ok_or_else(|| format!("{file}: the mesh hash {hex:?} is not 16 hex digits"))
+}
+
+/// Where entry `file`'s bake came from, checked: a hash, positive finite distances, 1, 4 or
+/// 16 samples.
+fn from_high(file: &str, h: &super::HighEntry) -> Result<FromHigh, String> {
+    for (what, d) in [("front", h.front), ("rear", h.rear)] {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(format!(
+                "{file}: the {what} distance {d} is not a positive number"
+            ));
+        }
+    }
+    if !SAMPLES.contains(&h.samples) {
+        return Err(format!(
+            "{file}: {} samples per texel (1, 4 or 16)",
+            h.samples
+        ));
+    }
+    Ok(FromHigh {
+        mesh: h.mesh.clone(),
+        mesh_hash: hash_of(file, &h.mesh_hash)?,
+        front: h.front,
+        rear: h.rear,
+        samples: h.samples,
+        cage: h.cage.clone(),
+    })
 }
 
 /// A bake's samples from its PNG, which must be the map's size, 16 bits, the map's channels.

@@ -36,10 +36,14 @@ use write::write_project;
 /// The format name in the manifest.
 pub const FORMAT: &str = "kapaint-project";
 
-/// The newest manifest version this build writes: 5 for a project with a projection fill, 4
-/// for one with a generator mask, 3 for one that keeps its mesh inside itself, else 2, which
-/// every build since layers reads. It reads 1 to 5.
-pub const VERSION: u32 = 5;
+/// The newest manifest version this build writes: 6 for a project that keeps a map baked
+/// from a high mesh, 5 for one with a projection fill, 4 for one with a generator mask, 3 for
+/// one that keeps its mesh inside itself, else 2, which every build since layers reads. It
+/// reads 1 to 6.
+pub const VERSION: u32 = 6;
+
+/// The version that first held projection fills.
+const PROJECTION_VERSION: u32 = 5;
 
 /// The version that first held generator masks.
 const GENERATOR_VERSION: u32 = 4;
@@ -133,6 +137,28 @@ pub struct BakeEntry {
     /// How far its rays looked, if bounded.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_distance: Option<f32>,
+    /// Where it came from when it was baked from a high mesh (version 6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub high: Option<HighEntry>,
+}
+
+/// A bake's high mesh, as [`BakeEntry::high`] names it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HighEntry {
+    /// The high mesh's name.
+    pub mesh: String,
+    /// Its hash (16 hex digits).
+    pub mesh_hash: String,
+    /// The ray distances (object units).
+    pub front: f32,
+    /// The ray distances (object units).
+    pub rear: f32,
+    /// Samples per texel (1, 4 or 16).
+    pub samples: u32,
+    /// The cage's name, if the rays started on one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cage: Option<String>,
 }
 
 /// Where a project keeps its mesh.
@@ -490,6 +516,12 @@ fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
             manifest.version
         ));
     }
+    if manifest.version < VERSION && manifest.bakes.iter().flatten().any(|b| b.high.is_some()) {
+        return Err(format!(
+            "a version {} project keeps no bakes from a high mesh (they are version {VERSION})",
+            manifest.version
+        ));
+    }
     match (manifest.version, &manifest.layers) {
         (1, None) => {}
         (2..=VERSION, Some(entries)) => {
@@ -500,9 +532,9 @@ fn parse_manifest(json: &[u8]) -> Result<Manifest, String> {
                     manifest.version
                 ));
             }
-            if manifest.version < VERSION && layers::any_projection(entries) {
+            if manifest.version < PROJECTION_VERSION && layers::any_projection(entries) {
                 return Err(format!(
-                    "a version {} project has no projection fills (they are version {VERSION})",
+                    "a version {} project has no projection fills (they are version {PROJECTION_VERSION})",
                     manifest.version
                 ));
             }

@@ -207,7 +207,11 @@ pub(super) fn write_project(
     let kept_mesh = kept_mesh(doc, &settings)?;
     let manifest = Manifest {
         format: FORMAT.into(),
-        version: version_of(&layers, kept_mesh.is_some() || !doc.bakes().is_empty()),
+        version: if doc.bakes().iter().any(|b| b.from_high.is_some()) {
+            VERSION
+        } else {
+            version_of(&layers, kept_mesh.is_some() || !doc.bakes().is_empty())
+        },
         width: w,
         height: h,
         settings,
@@ -228,18 +232,7 @@ pub(super) fn write_project(
             file: super::MESH_FILE.into(),
             triangles: *triangles,
         }),
-        bakes: (!doc.bakes().is_empty()).then(|| {
-            doc.bakes()
-                .iter()
-                .map(|b| super::BakeEntry {
-                    map: b.map.name().into(),
-                    file: super::bakes::file_of(b.map),
-                    mesh_hash: format!("{:016x}", b.mesh_hash),
-                    rays: b.options.rays,
-                    max_distance: b.options.max_distance,
-                })
-                .collect()
-        }),
+        bakes: super::bakes::entries(doc.bakes()),
     };
     let json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
     // Never write what the loader would refuse: the manifest goes through the loader's own
@@ -355,7 +348,7 @@ struct Stored<'a> {
 /// The oldest version that holds what `layers` hold, and a kept mesh or bakes where `mesh`.
 fn version_of(layers: &[super::layers::LayerEntry], mesh: bool) -> u32 {
     if super::layers::any_projection(layers) {
-        VERSION
+        super::PROJECTION_VERSION
     } else if super::layers::any_generator(layers) {
         super::GENERATOR_VERSION
     } else if mesh {

@@ -1,0 +1,355 @@
+//! Maps baked from a high-poly mesh onto a low one: per sample of a texel of the low mesh's UV
+//! bake, a ray from `front` above its surface point back along its (smooth) normal, `front +
+//! rear` long (or from the same point of a cage, towards the low surface and `rear` past it),
+//! meets the nearest high triangle. A normal bake takes that triangle's normal (interpolated
+//! from its vertex normals), written in the low mesh's MikkTSpace frame (tangent space, as the
+//! preview and the exports read a normal map) or in object space, `0.5 + 0.5 n`; a height bake
+//! takes how far the high surface lies above the low one, `(h + rear) / (front + rear)` (0 at
+//! `rear` below, 1 at `front` above); AO and thickness cast their rays from the point met, on
+//! the high mesh; curvature is the high mesh's, position the point met (in the low mesh's box).
+//! Texels whose rays meet nothing keep the low surface (a flat normal, the height of the low
+//! surface, AO and thickness from the low point against the high mesh) and are counted.
+//!
+//! With `samples` 4 or 16 a texel is the mean of a 2 x 2 or 4 x 4 grid of points across it,
+//! each on the low triangle under it (the texel's own or a neighbour's).
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, RAYS};
+use crate::Mesh;
+use crate::bake::{Coverage, UvBake};
+use crate::frame::UnitFrame;
+use kapaint_base::task::Progress;
+
+mod sample;
+use sample::Sampler;
+
+/// The space normals are written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NormalSpace {
+    /// The low mesh's MikkTSpace frame: `(T, B, N)` per texel, green up the image.
+    Tangent,
+    /// Object space.
+    Object,
+}
+
+/// What is baked from the high mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HighMap {
+    /// Its normals, in a space (RGB).
+    Normal(NormalSpace),
+    /// Its height over the low surface, by the ray distances (grey).
+    Height,
+    /// Ambient occlusion at the point met, on the high mesh (grey, 1 = open sky).
+    Ao,
+    /// Thickness at the point met, inwards through the high mesh (grey).
+    Thickness,
+    /// The high mesh's curvature at the point met (grey, 0.5 flat).
+    Curvature,
+    /// The point met, in the low mesh's bounding box (RGB).
+    Position,
+    /// The high mesh's part at the point met (pieces of surface joined by shared positions,
+    /// so each separate object of a file is one), a colour each (RGB; black where a ray met
+    /// nothing).
+    Id,
+}
+
+impl HighMap {
+    /// Samples a texel holds.
+    pub fn channels(self) -> usize {
+        match self {
+            Self::Normal(_) | Self::Position | Self::Id => 3,
+            _ => 1,
+        }
+    }
+
+    /// Whether it casts rays from the point met (AO, thickness).
+    pub fn casts_rays(self) -> bool {
+        matches!(self, Self::Ao | Self::Thickness)
+    }
+
+    /// The map of the project's own mesh it takes the place of when a project keeps it (what
+    /// generator masks read): none for tangent-space normals (the project's normal map) and
+    /// height.
+    pub fn kept_as(self) -> Option<BakeMap> {
+        match self {
+            Self::Normal(NormalSpace::Object) => Some(BakeMap::Normal),
+            Self::Ao => Some(BakeMap::Ao),
+            Self::Thickness => Some(BakeMap::Thickness),
+            Self::Curvature => Some(BakeMap::Curvature),
+            Self::Position => Some(BakeMap::Position),
+            Self::Normal(NormalSpace::Tangent) | Self::Height | Self::Id => None,
+        }
+    }
+}
+
+/// The samples a texel may take: one, a 2 x 2 grid or a 4 x 4 grid.
+pub const SAMPLES: [u32; 3] = [1, 4, 16];
+
+/// How the rays are cast.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HighOptions {
+    /// What is baked.
+    pub map: HighMap,
+    /// How far above the low surface a ray starts (object units); `None`: the default.
+    pub front: Option<f32>,
+    /// How far below it a ray still looks; `None`: the default.
+    pub rear: Option<f32>,
+    /// Rays per sample from the point met (AO, thickness).
+    pub rays: u32,
+    /// How far those rays look (object units); `None`: unbounded for AO, the high mesh's
+    /// diagonal for thickness.
+    pub max_distance: Option<f32>,
+    /// Samples per texel, one of [`SAMPLES`].
+    pub samples: u32,
+}
+
+impl HighOptions {
+    /// `map` with the default distances, 128 rays, unbounded, one sample a texel.
+    pub fn new(map: HighMap) -> Self {
+        Self {
+            map,
+            front: None,
+            rear: None,
+            rays: 128,
+            max_distance: None,
+            samples: 1,
+        }
+    }
+}
+
+/// The default ray distances, front and rear: this share of the diagonal of the box both
+/// meshes fill.
+pub const DEFAULT_DISTANCE: f32 = 0.02;
+
+/// A map baked from a high mesh: unorm16, row-major, and what the rays found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HighBake {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Per texel `0.5 + 0.5 n` (three samples) or the height (one); 0 where the low mesh has
+    /// no surface.
+    pub data: Vec<u16>,
+    /// What it is.
+    pub map: HighMap,
+    /// The distances used (object units).
+    pub front: f32,
+    /// The distances used (object units).
+    pub rear: f32,
+    /// Rays per sample from the point met (AO, thickness; 0 for the others).
+    pub rays: u32,
+    /// How far those rays looked (object units), if bounded.
+    pub max_distance: Option<f32>,
+    /// Samples per texel.
+    pub samples: u32,
+    /// Whether the rays started on a cage.
+    pub cage: bool,
+    /// Texels baked (surface and padding).
+    pub covered: u64,
+    /// Of those, texels where a ray met nothing.
+    pub missed: u64,
+    /// One per texel: whether a ray met nothing (the miss map).
+    pub misses: Vec<bool>,
+    /// One per texel: the mean angle between its rays and the low triangle's face normal,
+    /// 0 to 90 degrees as 0 to 255 (the skew view: where the low mesh's averaged normals tilt
+    /// the rays).
+    pub skew: Vec<u8>,
+}
+
+impl HighBake {
+    /// The bake as a project keeps it, in place of the low mesh's own map ([`HighMap::kept_as`]),
+    /// with where it came from; `None` for the maps a project does not keep that way.
+    pub fn to_baked(&self, low: &Mesh, high: &Mesh, cage: Option<&Mesh>) -> Option<Baked> {
+        let map = self.map.kept_as()?;
+        Some(Baked {
+            map,
+            options: BakeOptions {
+                rays: if map.casts_rays() { self.rays } else { 128 },
+                max_distance: self.max_distance,
+            },
+            mesh_hash: low.content_hash(),
+            width: self.width,
+            height: self.height,
+            data: self.data.clone(),
+            from_high: Some(super::FromHigh {
+                mesh: high.name.clone(),
+                mesh_hash: high.content_hash(),
+                front: self.front,
+                rear: self.rear,
+                samples: self.samples,
+                cage: cage.map(|c| c.name.clone()),
+            }),
+        })
+    }
+}
+
+/// Bakes `options.map` of `high` onto `low` at every texel `uv` gives a surface point, the
+/// rays from `cage` when one is given (the low mesh pushed out: the same triangles, each ray
+/// from a sample's point on it towards the same point of the low mesh). `progress` counts rows
+/// and cancels.
+///
+/// # Errors
+/// A high mesh with no triangles or positions that are not finite, a low mesh the UV bake was
+/// not made from, a cage whose topology differs from the low mesh's, distances that are not
+/// positive and finite, rays or samples out of range, or cancelled.
+pub fn bake_from_high(
+    low: &Mesh,
+    uv: &UvBake,
+    high: &Mesh,
+    cage: Option<&Mesh>,
+    options: HighOptions,
+    progress: Option<&Progress>,
+) -> Result<HighBake, BakeError> {
+    if uv.triangle_count() != low.triangles.len() {
+        return Err("the UV bake was made from another mesh".to_string().into());
+    }
+    check(options)?;
+    if let Some(c) = cage {
+        check_cage(low, c)?;
+    }
+    let (size, front, rear) = distances(low, high, options)?;
+    let sampler = Sampler::new((low, uv, high, cage), options, (size, front, rear));
+    let (w, h) = (uv.width as usize, uv.height as usize);
+    if let Some(p) = progress {
+        p.start("bake from the high mesh", h as u64);
+    }
+    let channels = options.map.channels();
+    let mut data = vec![0_u16; w * h * channels];
+    let mut misses = vec![false; w * h];
+    let mut skew = vec![0_u8; w * h];
+    let cancelled = std::sync::atomic::AtomicBool::new(false);
+    data.par_chunks_mut(w * channels * BAND_ROWS)
+        .zip(misses.par_chunks_mut(w * BAND_ROWS))
+        .zip(skew.par_chunks_mut(w * BAND_ROWS))
+        .enumerate()
+        .for_each(|(band, ((rows, missed), skewed))| {
+            if progress.is_some_and(Progress::is_cancelled) {
+                cancelled.store(true, std::sync::atomic::Ordering::Relaxed);
+                return;
+            }
+            let first = band * BAND_ROWS * w;
+            for (k, ((out, miss), skew)) in rows
+                .chunks_exact_mut(channels)
+                .zip(missed.iter_mut())
+                .zip(skewed.iter_mut())
+                .enumerate()
+            {
+                if let Some(texel) = sampler.texel(first + k, out) {
+                    *miss = texel.missed;
+                    *skew = (texel.skew_degrees / 90.0 * 255.0)
+                        .round()
+                        .clamp(0.0, 255.0) as u8;
+                }
+            }
+            if let Some(p) = progress {
+                p.advance((rows.len() / (w * channels)) as u64);
+            }
+        });
+    if cancelled.into_inner() {
+        return Err(BakeError::Cancelled);
+    }
+    let covered = (0..w * h)
+        .filter(|&i| uv.coverage(i) != Coverage::Empty)
+        .count() as u64;
+    let missed = misses.iter().filter(|&&m| m).count() as u64;
+    Ok(HighBake {
+        width: uv.width,
+        height: uv.height,
+        data,
+        map: options.map,
+        front,
+        rear,
+        rays: if options.map.casts_rays() {
+            options.rays
+        } else {
+            0
+        },
+        max_distance: options.max_distance,
+        samples: options.samples,
+        cage: cage.is_some(),
+        covered,
+        missed,
+        misses,
+        skew,
+    })
+}
+
+/// Checks the rays, their distance and the samples.
+fn check(options: HighOptions) -> Result<(), BakeError> {
+    if options.map.casts_rays() && !RAYS.contains(&options.rays) {
+        return Err(format!(
+            "{} rays per sample is outside {} to {}",
+            options.rays,
+            RAYS.start(),
+            RAYS.end()
+        )
+        .into());
+    }
+    if let Some(d) = options.max_distance
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(format!("the maximum distance {d} is not a positive number").into());
+    }
+    if !SAMPLES.contains(&options.samples) {
+        return Err(format!(
+            "{} samples per texel: a texel takes 1, 4 or 16",
+            options.samples
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// Refuses a cage that is not the low mesh pushed out: the same vertices and triangles, finite
+/// positions.
+fn check_cage(low: &Mesh, cage: &Mesh) -> Result<(), BakeError> {
+    if cage.positions.len() != low.positions.len() || cage.triangles != low.triangles {
+        return Err(format!(
+            "the cage {} ({} vertices, {} triangles) is not the low mesh's topology ({} vertices, {} triangles): a cage is the low mesh with its vertices moved",
+            cage.name,
+            cage.positions.len(),
+            cage.triangles.len(),
+            low.positions.len(),
+            low.triangles.len()
+        )
+        .into());
+    }
+    UnitFrame::checked(&cage.positions)
+        .map_err(|e| BakeError::Refused(format!("the cage {}: {e}", cage.name)))?;
+    Ok(())
+}
+
+/// The default distance's size, and the front and rear distances (object units).
+///
+/// # Errors
+/// A high mesh with no triangles or positions that are not finite, distances that are not
+/// positive and finite.
+fn distances(low: &Mesh, high: &Mesh, options: HighOptions) -> Result<(f32, f32, f32), BakeError> {
+    if high.triangles.is_empty() {
+        return Err(format!("the high mesh {} has no triangles", high.name).into());
+    }
+    UnitFrame::checked(&high.positions)
+        .map_err(|e| BakeError::Refused(format!("the high mesh {}: {e}", high.name)))?;
+    let both: Vec<Vec3> = low
+        .positions
+        .iter()
+        .chain(&high.positions)
+        .copied()
+        .collect();
+    let size = UnitFrame::checked(&both)?.diagonal() * DEFAULT_DISTANCE;
+    let distance = |d: Option<f32>, what: &str| match d {
+        None => Ok(size),
+        Some(d) if d.is_finite() && d > 0.0 => Ok(d),
+        Some(d) => Err(BakeError::Refused(format!(
+            "the {what} distance {d} is not a positive number"
+        ))),
+    };
+    let (front, rear) = (
+        distance(options.front, "front")?,
+        distance(options.rear, "rear")?,
+    );
+    Ok((size, front, rear))
+}
