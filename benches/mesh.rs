@@ -448,6 +448,13 @@ fn high_bakes(c: &mut Criterion) {
     .expect("spot loads");
     let high = sculpt(&spot);
     assert!(high.triangles.len() > 1_400_000);
+    // For the peers (benches/peers/ao_high_side_by_side.sh): the sculpt as an OBJ, and no
+    // bench.
+    if let Ok(path) = std::env::var("KAPAINT_WRITE_SCULPT") {
+        std::fs::write(&path, mesh::write_obj(&high)).expect("writes the sculpt");
+        eprintln!("wrote {path}");
+        return;
+    }
     let uv = bake(&spot, 4096, 4096, 4).expect("bakes");
     let mut group = c.benchmark_group("bake_from_high_1_5m");
     group
@@ -467,6 +474,37 @@ fn high_bakes(c: &mut Criterion) {
     );
     group.bench_function("tangent_normal_4096", |b| {
         b.iter(|| bake_from_high(&spot, &uv, &high, None, options, None).expect("bakes"));
+    });
+    // AO from the sculpt at 64 rays, at 512^2 (the rays per second carry to any size).
+    let uv = bake(&spot, 512, 512, 4).expect("bakes");
+    let ao = HighOptions {
+        rays: 64,
+        ..HighOptions::new(HighMap::Ao)
+    };
+    // What a bake adds at its peak (the BVH's build included), per high triangle: the
+    // process's peak resident memory reset first (Linux).
+    let kib = |field: &str| {
+        std::fs::read_to_string("/proc/self/status")
+            .ok()
+            .and_then(|s| {
+                s.lines()
+                    .find(|l| l.starts_with(field))
+                    .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+            })
+            .unwrap_or(0)
+    };
+    if std::fs::write("/proc/self/clear_refs", "5").is_ok() {
+        let before = kib("VmRSS:");
+        let baked = bake_from_high(&spot, &uv, &high, None, ao, None).expect("bakes");
+        let peak = kib("VmHWM:");
+        eprintln!(
+            "AO from the sculpt at 512^2: mean {:.4}, {} bytes a high triangle at the peak",
+            baked.data.iter().map(|&v| f64::from(v)).sum::<f64>() / 65535.0 / baked.covered as f64,
+            peak.saturating_sub(before) * 1024 / high.triangles.len() as u64
+        );
+    }
+    group.bench_function("ao_64_rays_512", |b| {
+        b.iter(|| bake_from_high(&spot, &uv, &high, None, ao, None).expect("bakes"));
     });
     group.finish();
 }

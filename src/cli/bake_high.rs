@@ -226,10 +226,27 @@ fn summary(r: &HighRequest<'_>, high: &Mesh, baked: &HighBake, seconds: f64) -> 
         map if map.casts_rays() => format!("{} ({} rays a sample)", map_name(map), baked.rays),
         map => map_name(map).to_string(),
     };
+    let rays = if baked.map.casts_rays() {
+        let cast = baked.covered * u64::from(baked.samples) * u64::from(baked.rays);
+        let tracing = (seconds - baked.bvh_seconds).max(1e-9);
+        format!(
+            " (the BVH {:.2} s), {cast} rays ({:.2} M rays/s after the BVH)",
+            baked.bvh_seconds,
+            cast as f64 / tracing / 1e6
+        )
+    } else {
+        String::new()
+    };
+    let mean = if baked.map.channels() == 1 {
+        let sum: f64 = baked.data.iter().map(|&v| f64::from(v) / 65535.0).sum();
+        format!(", mean {:.4}", sum / baked.covered.max(1) as f64)
+    } else {
+        String::new()
+    };
     let highs: Vec<String> = r.high.iter().map(|p| p.display().to_string()).collect();
     let defaults = r.options.front.is_none() || r.options.rear.is_none();
     format!(
-        "baked {what} of {} from {} ({} triangles): {}x{}, {} texels, {} sample{} a texel, {}front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s",
+        "baked {what} of {} from {} ({} triangles): {}x{}, {} texels{mean}, {} sample{} a texel, {}front {:.4} rear {:.4} (object units{}), missed {} texels ({share:.3} %), {seconds:.2} s{rays}",
         r.project.display(),
         highs.join(" + "),
         high.triangles.len(),

@@ -153,6 +153,8 @@ pub struct HighBake {
     pub missed: u64,
     /// One per texel: whether a ray met nothing (the miss map).
     pub misses: Vec<bool>,
+    /// Seconds spent building the high mesh's BVH (the rest of the bake is the rays).
+    pub bvh_seconds: f64,
     /// One per texel: the mean angle between its rays and the low triangle's face normal,
     /// 0 to 90 degrees as 0 to 255 (the skew view: where the low mesh's averaged normals tilt
     /// the rays).
@@ -211,7 +213,9 @@ pub fn bake_from_high(
         check_cage(low, c)?;
     }
     let (size, front, rear) = distances(low, high, options)?;
+    let built = std::time::Instant::now();
     let sampler = Sampler::new((low, uv, high, cage), options, (size, front, rear));
+    let bvh_seconds = built.elapsed().as_secs_f64();
     let (w, h) = (uv.width as usize, uv.height as usize);
     if let Some(p) = progress {
         p.start("bake from the high mesh", h as u64);
@@ -273,6 +277,7 @@ pub fn bake_from_high(
         covered,
         missed,
         misses,
+        bvh_seconds,
         skew,
     })
 }
