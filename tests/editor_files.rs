@@ -96,7 +96,10 @@ fn every_file_request_reaches_its_command() {
     fn answer(request: &FileRequest) -> Option<std::path::PathBuf> {
         let spot = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/spot");
         Some(match request.purpose {
-            FilePurpose::ImportMesh | FilePurpose::NewMesh => spot.join("spot_triangulated.obj"),
+            FilePurpose::ImportMesh
+            | FilePurpose::NewMesh
+            | FilePurpose::HighMesh
+            | FilePurpose::Cage => spot.join("spot_triangulated.obj"),
             FilePurpose::ImportImage(_)
             | FilePurpose::StampImage
             | FilePurpose::ToolImage

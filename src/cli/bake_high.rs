@@ -119,11 +119,9 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
             .map_err(model_error)?;
         format!("kept as the {} bake of", map_name(map))
     } else {
-        let image = image::RgbImage::from_fn(baked.width, baked.height, |x, y| {
-            let i = (y * baked.width + x) as usize * 3;
-            image::Rgb([0, 1, 2].map(|c| (baked.data[i + c] >> 8) as u8))
-        });
-        let normal = crate::model::normal::NormalMap::new(image).map_err(CliError::usage)?;
+        let normal =
+            crate::model::normal::NormalMap::from_rgb16(baked.width, baked.height, &baked.data)
+                .map_err(CliError::usage)?;
         doc.apply(crate::model::ImportCommand::SetNormal(
             crate::model::document::AttachedNormal(Some(std::sync::Arc::new(normal))),
         ))

@@ -338,6 +338,7 @@ fn windows(s: &mut EditorState, ctx: &egui::Context) {
     crate::dialogs::new_window(new, &s.presets.materials, dirty, ctx, &mut desk);
     crate::resize::resize_window(&mut s.dialogs.resize, ctx, &mut desk);
     crate::bake::bake_window(&mut s.dialogs.bake, ctx, &mut desk);
+    crate::bake_high::high_window(&mut s.dialogs.bake_high, ctx, &mut desk);
     let camera = s.viewport.camera;
     crate::project_dialog::project_window(&mut s.dialogs.project, &camera, ctx, &mut desk);
     let asks = desk.into_asks();

@@ -130,6 +130,18 @@ impl EditorState {
         self.dialogs.bake = Some(bake::BakeDialog::default());
     }
 
+    /// Opens Mesh > Bake from high poly.
+    pub fn open_bake_high(&mut self) {
+        if self.dialogs.bake_high.is_none() {
+            self.dialogs.bake_high = Some(crate::bake_high::HighDialog::default());
+        }
+    }
+
+    /// The Bake from high poly dialog's choices, while it is open.
+    pub fn bake_high_dialog(&self) -> Option<&crate::bake_high::HighDialog> {
+        self.dialogs.bake_high.as_ref()
+    }
+
     /// The Bake dialog's choices, while it is open.
     pub fn bake_dialog(&self) -> Option<bake::BakeDialog> {
         self.dialogs.bake
@@ -237,6 +249,15 @@ impl EditorState {
                 FilePurpose::ToolImage => self.start(jobs::load_tool_image(path)),
                 FilePurpose::StencilImage => self.start(jobs::load_stencil(path)),
                 FilePurpose::ProjectImage => self.start(jobs::load_project_image(path)),
+                FilePurpose::HighMesh | FilePurpose::Cage => {
+                    if let Some(dialog) = &mut self.dialogs.bake_high {
+                        if purpose == FilePurpose::Cage {
+                            dialog.cage = Some(path);
+                        } else if !dialog.highs.contains(&path) {
+                            dialog.highs.push(path);
+                        }
+                    }
+                }
                 FilePurpose::NewMesh => {
                     if let Some(dialog) = &mut self.dialogs.new {
                         dialog.mesh = path.display().to_string();
@@ -261,6 +282,7 @@ impl EditorState {
                 self.dialogs.project = Some(dialog);
             }
             Window::Bake => self.open_bake(),
+            Window::BakeHigh => self.open_bake_high(),
             Window::Preferences => self.open_preferences(),
             Window::Shortcuts => self.dialogs.shortcuts_open = true,
         }

@@ -103,6 +103,8 @@ pub(crate) enum Window {
     ProjectImage,
     /// Mesh > Bake.
     Bake,
+    /// Mesh > Bake from high poly.
+    BakeHigh,
     /// Edit > Preferences.
     Preferences,
     /// Help > Keyboard shortcuts.

@@ -40,6 +40,10 @@ pub enum FilePurpose {
     ProjectImage,
     /// New > File: the mesh of the new project.
     NewMesh,
+    /// Mesh > Bake from high poly: a high-poly mesh.
+    HighMesh,
+    /// Mesh > Bake from high poly: the cage.
+    Cage,
     /// The export dialog's folder.
     ExportFolder,
 }
@@ -84,6 +88,8 @@ impl FilePurpose {
             Self::ProjectImage => "Image to project".into(),
             Self::ImportPbr => "Import PBR material".into(),
             Self::NewMesh => "Mesh of the new project".into(),
+            Self::HighMesh => "High-poly mesh to bake from".into(),
+            Self::Cage => "Cage (the mesh pushed out)".into(),
             Self::ExportFolder => "Export into folder".into(),
         }
     }
@@ -91,7 +97,7 @@ impl FilePurpose {
     fn filter(self) -> Option<(&'static str, &'static [&'static str])> {
         match self {
             Self::OpenProject | Self::SaveProject => Some(PROJECT),
-            Self::ImportMesh | Self::NewMesh => Some(MESH),
+            Self::ImportMesh | Self::NewMesh | Self::HighMesh | Self::Cage => Some(MESH),
             Self::ImportImage(_)
             | Self::StampImage
             | Self::ToolImage

@@ -7,6 +7,7 @@
 
 mod app;
 pub mod bake;
+pub mod bake_high;
 pub mod canvas;
 mod carry;
 mod claim;

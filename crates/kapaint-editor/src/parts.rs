@@ -11,6 +11,8 @@ pub(super) struct Dialogs {
     pub(super) resize: Option<super::resize::ResizeDialog>,
     /// Mesh > Bake, while open.
     pub(super) bake: Option<super::bake::BakeDialog>,
+    /// Mesh > Bake from high poly, while open.
+    pub(super) bake_high: Option<super::bake_high::HighDialog>,
     /// Image > Project image, while open.
     pub(super) project: Option<super::project_dialog::ProjectDialog>,
     /// Whether the Preferences window is open.

@@ -49,6 +49,22 @@ impl NormalMap {
         Ok(Self { image })
     }
 
+    /// A normal map of `width x height` 16-bit RGB samples (a bake's), kept at 8 bits.
+    ///
+    /// # Errors
+    /// Samples that are not the size's, an empty size, or one larger than the maps may be.
+    pub fn from_rgb16(width: u32, height: u32, data: &[u16]) -> Result<Self, String> {
+        if data.len() as u64 != u64::from(width) * u64::from(height) * 3 {
+            return Err(format!(
+                "{} samples are not a {width}x{height} RGB map",
+                data.len()
+            ));
+        }
+        let bytes = data.iter().map(|&v| (v >> 8) as u8).collect();
+        let image = image::RgbImage::from_raw(width, height, bytes).ok_or("a normal map's size")?;
+        Self::new(image)
+    }
+
     /// A flat map (every normal `+Z`) of `w x h`.
     ///
     /// # Errors

@@ -219,6 +219,17 @@ fn image_and_mesh_menus(ui: &mut egui::Ui, desk: &mut Desk) {
             desk.ask(Ask::Show(Window::Bake));
         }
         if ui
+            .button("Bake from high poly…")
+            .on_hover_text(
+                "Bake a high-poly sculpt's normals, or its AO, thickness, curvature and \
+                     position for the masks, onto the mesh (rays, with a cage if you have one; \
+                     one undo step)",
+            )
+            .clicked()
+        {
+            desk.ask(Ask::Show(Window::BakeHigh));
+        }
+        if ui
             .button("Unwrap automatically…")
             .on_hover_text(
                 "Give the mesh a new UV atlas, kept in the project (what is painted stays \

@@ -1,0 +1,125 @@
+//! Mesh > Bake from high poly (issue 57): the high mesh chosen through the file chooser, maps
+//! for the masks baked on a worker and kept as one undo step saying where they came from, then
+//! the normal map.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+#[expect(dead_code, reason = "each editor test file uses some of the helpers")]
+mod kit;
+
+use egui::Modifiers;
+use egui_kittest::kittest::Queryable;
+use kapaint::mesh::bakes::BakeMap;
+use kapaint::ui::files::{FileDialogBackend, FilePurpose, FileRequest};
+use kit::{editor, wait_until};
+
+/// Where the test's high mesh is written (the system dialog's answer is a plain function).
+fn high_path() -> std::path::PathBuf {
+    std::env::temp_dir().join(format!(
+        "kapaint-editor-bake-high-{}.obj",
+        std::process::id()
+    ))
+}
+
+fn answer(request: &FileRequest) -> Option<std::path::PathBuf> {
+    (request.purpose == FilePurpose::HighMesh).then(high_path)
+}
+
+/// Writes a finer sphere than the default document's as the high mesh; returns it as the
+/// editor will load it.
+fn write_high() -> kapaint::mesh::Mesh {
+    let fine = kapaint::mesh::uv_sphere(128, 64);
+    std::fs::write(high_path(), kapaint::mesh::write_obj(&fine)).expect("writes");
+    kapaint::mesh::open(&high_path()).expect("loads")
+}
+
+#[test]
+fn maps_and_the_normal_map_bake_from_a_high_mesh_each_one_undo_step() {
+    let loaded = write_high();
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer);
+
+    harness.get_by_label("Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake from high poly…").click();
+    harness.run_steps(2);
+    assert!(harness.state().state.bake_high_dialog().is_some());
+    harness.get_by_label("Add high mesh…").click();
+    wait_until(&mut harness, "the high mesh chosen", |e| {
+        e.state
+            .bake_high_dialog()
+            .is_some_and(|d| d.highs == [high_path()])
+    });
+    // The window grows by the mesh's line: let it settle before clicking in it.
+    harness.run_steps(3);
+    // The maps for the masks: curvature alone (no rays), then Bake.
+    harness.get_by_label("Maps for the masks:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Ambient occlusion").click();
+    harness.run_steps(2);
+    let dialog = harness
+        .state()
+        .state
+        .bake_high_dialog()
+        .expect("open")
+        .clone();
+    assert_eq!(dialog.maps(), [kapaint::mesh::bakes::HighMap::Curvature]);
+    harness.get_by_label("Bake").click();
+    wait_until(&mut harness, "curvature baked", |e| {
+        e.state.doc().bake_of(BakeMap::Curvature).is_some()
+    });
+    let doc = harness.state().state.doc();
+    let bake = doc.bake_of(BakeMap::Curvature).expect("kept");
+    let from = bake.from_high.as_ref().expect("from the high mesh");
+    assert_eq!(from.mesh_hash, loaded.content_hash());
+    assert!(
+        harness
+            .state()
+            .state
+            .notices()
+            .iter()
+            .any(|n| n.text.contains("baked curvature") && n.text.contains("missed 0")),
+        "a line on what the rays found"
+    );
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert!(
+        harness
+            .state()
+            .state
+            .doc()
+            .bake_of(BakeMap::Curvature)
+            .is_none(),
+        "one undo step"
+    );
+
+    // The normal map, from the dialog opened again (it keeps nothing but its defaults).
+    harness.get_by_label("Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake from high poly…").click();
+    harness.run_steps(2);
+    harness.get_by_label("Add high mesh…").click();
+    wait_until(&mut harness, "the high mesh chosen", |e| {
+        e.state
+            .bake_high_dialog()
+            .is_some_and(|d| !d.highs.is_empty())
+    });
+    harness.run_steps(3);
+    assert!(harness.state().state.doc().normal().is_none());
+    harness.get_by_label("Bake").click();
+    wait_until(&mut harness, "the normal map baked", |e| {
+        e.state.doc().normal().is_some()
+    });
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::Z);
+    harness.run_steps(2);
+    assert!(
+        harness.state().state.doc().normal().is_none(),
+        "one undo step"
+    );
+    let _ = std::fs::remove_file(high_path());
+}
