@@ -353,3 +353,114 @@ fn maps_from_high_meshes_are_kept_as_the_projects_bakes_or_written() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A bumpy sphere written as the high mesh: the default sphere's surface, waved along its
+/// radius, with its normals from its faces.
+fn bumpy_sphere(path: &Path) {
+    let mut m = kapaint::mesh::uv_sphere(256, 128);
+    for p in &mut m.positions {
+        let wave = (p.x * 9.0).sin() * (p.y * 9.0).sin() * (p.z * 9.0).sin();
+        *p *= 1.0 + 0.02 * wave;
+    }
+    let mut sums = vec![glam::Vec3::ZERO; m.positions.len()];
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|v| m.positions[v as usize]);
+        for v in t {
+            sums[*v as usize] += (b - a).cross(c - a);
+        }
+    }
+    m.normals = sums
+        .into_iter()
+        .map(glam::Vec3::normalize_or_zero)
+        .collect();
+    m.uvs = None;
+    std::fs::write(path, kapaint::mesh::write_obj(&m)).expect("write");
+}
+
+/// The grey levels of a render where it shows the mesh (alpha above zero).
+fn grey(path: &Path) -> Vec<Option<f32>> {
+    image::open(path)
+        .expect("render")
+        .into_rgba8()
+        .pixels()
+        .map(|p| (p.0[3] > 0).then(|| f32::from(p.0[0]) + f32::from(p.0[1]) + f32::from(p.0[2])))
+        .collect()
+}
+
+/// The low sphere with its normal map baked from a bumpy sphere shades like the bumpy sphere
+/// (the same camera and light, the silhouettes' parallax aside): at least twice as close as
+/// the low sphere without it.
+#[test]
+fn the_low_mesh_with_its_baked_normal_map_shades_like_the_high_one() {
+    let d = dir("shade");
+    let (flat, mapped, high) = (
+        d.join("flat.kapaint"),
+        d.join("mapped.kapaint"),
+        d.join("bumpy.obj"),
+    );
+    bumpy_sphere(&high);
+    let o = kapaint(&[
+        "new",
+        "--size",
+        "512",
+        "--mesh",
+        "sphere",
+        "--out",
+        s(&flat),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::copy(&flat, &mapped).expect("copy");
+    let o = kapaint(&["bake", s(&mapped), "--map", "normal", "--high", s(&high)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let render = |project: &Path, mesh: Option<&Path>, out: &Path| {
+        let mut args = vec![
+            "render",
+            "--project",
+            s(project),
+            "--model",
+            "phong",
+            "--view",
+            "shaded",
+        ];
+        args.extend(["--size", "256x256", "--out", s(out)]);
+        if let Some(m) = mesh {
+            args.extend(["--mesh", s(m)]);
+        }
+        kapaint(&args)
+    };
+    let shots = [
+        (d.join("flat.png"), render(&flat, None, &d.join("flat.png"))),
+        (
+            d.join("mapped.png"),
+            render(&mapped, None, &d.join("mapped.png")),
+        ),
+        (
+            d.join("high.png"),
+            render(&flat, Some(&high), &d.join("high.png")),
+        ),
+    ];
+    for (_, o) in &shots {
+        if !o.status.success() && std::env::var_os("KAPAINT_REQUIRE_GPU").is_none() {
+            eprintln!("SKIPPED: no GPU adapter here");
+            return;
+        }
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let [flat, mapped, high] = [0, 1, 2].map(|k| grey(&shots[k].0));
+    let off = |img: &[Option<f32>]| {
+        let d: Vec<f32> = img
+            .iter()
+            .zip(&high)
+            .filter_map(|(a, b)| Some((a.as_ref()? - b.as_ref()?).abs() / 3.0))
+            .collect();
+        assert!(d.len() > 20_000, "{} pixels", d.len());
+        d.iter().sum::<f32>() / d.len() as f32
+    };
+    let (without, with) = (off(&flat), off(&mapped));
+    eprintln!("off the high mesh's render: {without:.2} levels without the map, {with:.2} with");
+    assert!(
+        with * 2.0 < without,
+        "with the map {with} levels off, without {without}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
