@@ -10,7 +10,9 @@ use super::notice;
 use crate::desk::{Ask, Desk, JobStart, centred};
 use crate::files::FilePurpose;
 use kapaint_mesh::Mesh;
-use kapaint_mesh::bakes::{HighBake, HighMap, HighOptions, NormalSpace, SAMPLES, bake_from_high};
+use kapaint_mesh::bakes::{
+    HighBake, HighMap, HighOptions, NormalSpace, RayMesh, SAMPLES, bake_from_high_with,
+};
 use kapaint_model::document::{AttachedBake, AttachedNormal};
 use kapaint_model::{Document, ImportCommand};
 
@@ -104,6 +106,8 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
                 |p: &PathBuf| kapaint_mesh::open(p).map_err(|e| format!("{}: {e}", p.display()));
             let high = Mesh::merged(dialog.highs.iter().map(open).collect::<Result<_, _>>()?)?;
             let cage = dialog.cage.as_ref().map(open).transpose()?;
+            // One BVH for every map (the high mesh checked first by each bake).
+            let rays = RayMesh::new(&high);
             let mut made = Vec::with_capacity(maps.len());
             for map in maps {
                 let options = HighOptions {
@@ -115,10 +119,10 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
                 };
                 let start = std::time::Instant::now();
                 let low = &surface.mesh;
-                let baked = bake_from_high(
+                let baked = bake_from_high_with(
                     low,
                     &surface.bake,
-                    &high,
+                    (&high, &rays),
                     cage.as_ref(),
                     options,
                     Some(progress),

@@ -231,3 +231,25 @@ fn the_skew_view_shows_where_averaged_normals_tilt_the_rays() {
     // Facets 30 degrees across: the normals at their corners lean a good part of that.
     assert!(sphere > 5.0 && sphere < 30.0, "{sphere} degrees");
 }
+
+/// One BVH for several maps bakes what a bake that builds its own does.
+#[test]
+fn a_bvh_built_once_bakes_what_each_bake_builds() {
+    let low = crate::uv_sphere(24, 12);
+    let high = crate::torus(1.0, 0.4, 64, 32);
+    let uv = bake(&low, 64, 64, 2).expect("bakes");
+    let rays = super::RayMesh::new(&high);
+    for map in [HighMap::Curvature, HighMap::Ao] {
+        let options = HighOptions {
+            rays: 8,
+            front: Some(0.5),
+            rear: Some(0.5),
+            ..HighOptions::new(map)
+        };
+        let own = bake_from_high(&low, &uv, &high, None, options, None).expect("bakes");
+        let shared = super::bake_from_high_with(&low, &uv, (&high, &rays), None, options, None)
+            .expect("bakes");
+        assert_eq!(own.data, shared.data, "{map:?}");
+        assert_eq!(own.misses, shared.misses);
+    }
+}

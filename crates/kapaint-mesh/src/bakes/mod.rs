@@ -20,6 +20,7 @@ mod high;
 mod rays;
 pub use high::{
     DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, NormalSpace, SAMPLES, bake_from_high,
+    bake_from_high_with,
 };
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};

@@ -16,7 +16,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, RAYS};
+use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, RAYS, RayMesh};
 use crate::Mesh;
 use crate::bake::{Coverage, UvBake};
 use crate::frame::UnitFrame;
@@ -205,17 +205,31 @@ pub fn bake_from_high(
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
-    if uv.triangle_count() != low.triangles.len() {
-        return Err("the UV bake was made from another mesh".to_string().into());
-    }
-    check(options)?;
-    if let Some(c) = cage {
-        check_cage(low, c)?;
-    }
-    let (size, front, rear) = distances(low, high, options)?;
+    checked(low, uv, high, cage, options)?;
     let built = std::time::Instant::now();
-    let sampler = Sampler::new((low, uv, high, cage), options, (size, front, rear));
+    let rays = RayMesh::new(high);
     let bvh_seconds = built.elapsed().as_secs_f64();
+    let mut baked = bake_from_high_with(low, uv, (high, &rays), cage, options, progress)?;
+    baked.bvh_seconds = bvh_seconds;
+    Ok(baked)
+}
+
+/// [`bake_from_high`] with the high mesh's BVH built already (`RayMesh::new(high)`), so that
+/// several maps of one high mesh build it once.
+///
+/// # Errors
+/// As [`bake_from_high`].
+pub fn bake_from_high_with(
+    low: &Mesh,
+    uv: &UvBake,
+    (high, rays): (&Mesh, &RayMesh),
+    cage: Option<&Mesh>,
+    options: HighOptions,
+    progress: Option<&Progress>,
+) -> Result<HighBake, BakeError> {
+    let (size, front, rear) = checked(low, uv, high, cage, options)?;
+    let sampler = Sampler::new((low, uv, high, cage), rays, options, (size, front, rear));
+    let bvh_seconds = 0.0;
     let (w, h) = (uv.width as usize, uv.height as usize);
     if let Some(p) = progress {
         p.start("bake from the high mesh", h as u64);
@@ -280,6 +294,25 @@ pub fn bake_from_high(
         bvh_seconds,
         skew,
     })
+}
+
+/// Checks what a bake is given; returns the default distance's size and the front and rear
+/// distances.
+fn checked(
+    low: &Mesh,
+    uv: &UvBake,
+    high: &Mesh,
+    cage: Option<&Mesh>,
+    options: HighOptions,
+) -> Result<(f32, f32, f32), BakeError> {
+    if uv.triangle_count() != low.triangles.len() {
+        return Err("the UV bake was made from another mesh".to_string().into());
+    }
+    check(options)?;
+    if let Some(c) = cage {
+        check_cage(low, c)?;
+    }
+    distances(low, high, options)
 }
 
 /// Checks the rays, their distance and the samples.

@@ -52,7 +52,7 @@ pub(super) struct Sampler<'a> {
     rear: f32,
     /// How far a ray that slipped between two triangles is moved to try again.
     nudge: f32,
-    rays: RayMesh,
+    rays: &'a RayMesh,
     directions: Directions,
     /// How far AO and thickness rays look (object units).
     far: f32,
@@ -74,10 +74,10 @@ impl<'a> Sampler<'a> {
     /// default's size first).
     pub(super) fn new(
         (low, uv, high, cage): (&'a Mesh, &'a UvBake, &'a Mesh, Option<&'a Mesh>),
+        rays: &'a RayMesh,
         options: HighOptions,
         (size, front, rear): (f32, f32, f32),
     ) -> Self {
-        let rays = RayMesh::new(high);
         let map = options.map;
         let far = match (map, options.max_distance) {
             (_, Some(d)) => d,
@@ -226,7 +226,7 @@ impl<'a> Sampler<'a> {
                 (len > self.nudge).then(|| (from, d / len, len))
             })
             .unwrap_or((p + n * self.front, -n, self.front));
-        let found = cast(&self.rays, origin, dir, to_low + self.rear, self.nudge);
+        let found = cast(self.rays, origin, dir, to_low + self.rear, self.nudge);
         let face = geometric_normal(corners, n);
         let skew_degrees = (-dir).dot(face).clamp(-1.0, 1.0).acos().to_degrees();
         let value = match self.map {
