@@ -464,3 +464,41 @@ fn the_low_mesh_with_its_baked_normal_map_shades_like_the_high_one() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A bake from a high mesh killed while its rays run leaves the project as it was (it is
+/// saved, atomically, only when the bake is done).
+#[test]
+fn a_killed_bake_leaves_the_project_as_it_was() {
+    let d = dir("killed");
+    let p = low(&d);
+    let before = std::fs::read(&p).expect("read");
+    let high = spot("spot_quadrangulated.obj");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args([
+            "bake",
+            s(&p),
+            "--map",
+            "ao",
+            "--high",
+            s(&high),
+            "--rays",
+            "65536",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("starts");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert!(child.try_wait().expect("waits").is_none(), "still baking");
+    child.kill().expect("kills");
+    let _ = child.wait();
+    assert_eq!(std::fs::read(&p).expect("read"), before);
+    let leftovers: Vec<_> = std::fs::read_dir(&d)
+        .expect("dir")
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "low.kapaint" && !n.starts_with(".low.kapaint"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
