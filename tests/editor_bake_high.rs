@@ -123,3 +123,63 @@ fn maps_and_the_normal_map_bake_from_a_high_mesh_each_one_undo_step() {
     );
     let _ = std::fs::remove_file(high_path());
 }
+
+/// Where the cancel test's high mesh is written.
+fn big_path() -> std::path::PathBuf {
+    std::env::temp_dir().join(format!(
+        "kapaint-editor-bake-high-big-{}.obj",
+        std::process::id()
+    ))
+}
+
+fn answer_big(request: &FileRequest) -> Option<std::path::PathBuf> {
+    (request.purpose == FilePurpose::HighMesh).then(big_path)
+}
+
+/// Cancel while the rays run: nothing is kept, the history is as it was, and the cancel is
+/// said as information, not as an error.
+#[test]
+fn a_cancelled_bake_from_high_poly_keeps_nothing() {
+    let fine = kapaint::mesh::uv_sphere(512, 256);
+    std::fs::write(big_path(), kapaint::mesh::write_obj(&fine)).expect("writes");
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer_big);
+    let steps = harness.state().state.doc().history().undo_steps().count();
+    harness.get_by_label("Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake from high poly…").click();
+    harness.run_steps(2);
+    harness.get_by_label("Add high mesh…").click();
+    wait_until(&mut harness, "the high mesh chosen", |e| {
+        e.state
+            .bake_high_dialog()
+            .is_some_and(|d| !d.highs.is_empty())
+    });
+    harness.run_steps(3);
+    // AO and curvature, 64 rays a texel: long enough to cancel.
+    harness.get_by_label("Maps for the masks:").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake").click();
+    wait_until(&mut harness, "the bake running", |e| e.state.busy());
+    harness.run_steps(2);
+    assert!(harness.state().state.busy(), "the bake ended before the test looked");
+    harness
+        .get_by_role_and_label(egui::accesskit::Role::Button, "Cancel")
+        .click();
+    harness.step();
+    wait_until(&mut harness, "cancelled", |e| !e.state.busy());
+    let doc = harness.state().state.doc();
+    assert!(doc.bakes().is_empty(), "nothing kept");
+    assert_eq!(doc.history().undo_steps().count(), steps);
+    let notices = harness.state().state.notices();
+    assert!(
+        notices
+            .iter()
+            .all(|n| n.level != kapaint::ui::NoticeLevel::Error),
+        "{:?}",
+        notices.iter().map(|n| &n.text).collect::<Vec<_>>()
+    );
+    let _ = std::fs::remove_file(big_path());
+}
