@@ -164,7 +164,10 @@ fn a_cancelled_bake_from_high_poly_keeps_nothing() {
     harness.get_by_label("Bake").click();
     wait_until(&mut harness, "the bake running", |e| e.state.busy());
     harness.run_steps(2);
-    assert!(harness.state().state.busy(), "the bake ended before the test looked");
+    assert!(
+        harness.state().state.busy(),
+        "the bake ended before the test looked"
+    );
     harness
         .get_by_role_and_label(egui::accesskit::Role::Button, "Cancel")
         .click();

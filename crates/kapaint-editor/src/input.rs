@@ -441,6 +441,8 @@ impl EditorState {
         }
         self.draw_viewport_clone_marker(response, rect);
         crate::tool_overlays::decal_outline(response, &self.viewport, rect, self.tools.overlay());
+        let cage = self.dialogs.bake_high.as_ref();
+        crate::tool_overlays::cage_preview(response, &self.viewport, rect, &self.mesh.mesh, cage);
     }
 
     /// The stencil on the viewport's screen: kept on the camera's view, moved (scaled,
