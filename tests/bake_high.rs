@@ -17,6 +17,17 @@ fn kapaint(args: &[&str]) -> Output {
         .expect("kapaint runs")
 }
 
+/// Runs kapaint, which must succeed; returns what it printed.
+fn ok(args: &[&str]) -> String {
+    let o = kapaint(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
@@ -37,8 +48,7 @@ fn dir(tag: &str) -> PathBuf {
 fn low(d: &Path) -> PathBuf {
     let p = d.join("low.kapaint");
     let mesh = spot("spot_triangulated.obj");
-    let o = kapaint(&["new", "--size", "256", "--mesh", s(&mesh), "--out", s(&p)]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ok(&["new", "--size", "256", "--mesh", s(&mesh), "--out", s(&p)]);
     p
 }
 
@@ -48,7 +58,7 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
     let p = low(&d);
     let high = spot("spot_quadrangulated.obj");
     let png = d.join("n.png");
-    let o = kapaint(&[
+    let text = ok(&[
         "bake",
         s(&p),
         "--map",
@@ -58,8 +68,6 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
         "--out",
         s(&png),
     ]);
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
         text.contains("tangent space") && text.contains("front"),
         "{text}"
@@ -85,7 +93,7 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
     );
     // Height: the same surface stands at the middle of the distances (0.5), as a float EXR.
     let exr = d.join("h.exr");
-    let o = kapaint(&[
+    let text = ok(&[
         "bake",
         s(&p),
         "--map",
@@ -95,8 +103,6 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
         "--out",
         s(&exr),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(
         text.contains("height (0 at") && text.contains("missed 0 texels"),
         "{text}"
@@ -113,8 +119,7 @@ fn spots_normals_bake_from_its_quad_mesh_flat_in_tangent_space_and_are_kept() {
         "{mean}"
     );
     // Without --out: the project's normal map, one step, saved.
-    let o = kapaint(&["bake", s(&p), "--map", "normal", "--high", s(&high)]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ok(&["bake", s(&p), "--map", "normal", "--high", s(&high)]);
     let doc = kapaint::model::project::load(&p).expect("opens");
     assert!(doc.normal().is_some(), "kept as the normal map");
     let _ = std::fs::remove_dir_all(&d);
@@ -129,7 +134,7 @@ fn a_miss_map_draws_what_short_rays_missed() {
     // Distances too short for where the quads split the other way: the misses are counted
     // and drawn, one white texel each.
     let misses = d.join("misses.png");
-    let o = kapaint(&[
+    let text = ok(&[
         "bake",
         s(&p),
         "--map",
@@ -146,8 +151,6 @@ fn a_miss_map_draws_what_short_rays_missed() {
         "--misses",
         s(&misses),
     ]);
-    let text = String::from_utf8_lossy(&o.stdout).to_string();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let counted: u32 = text
         .split("missed ")
         .nth(1)
@@ -274,7 +277,7 @@ fn maps_from_high_meshes_are_kept_as_the_projects_bakes_or_written() {
     )
     .expect("write");
     for map in ["ao", "curvature", "position"] {
-        let o = kapaint(&[
+        let text = ok(&[
             "bake",
             s(&p),
             "--map",
@@ -288,8 +291,6 @@ fn maps_from_high_meshes_are_kept_as_the_projects_bakes_or_written() {
             "--samples",
             "4",
         ]);
-        let text = String::from_utf8_lossy(&o.stdout).to_string();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         assert!(
             text.contains(&format!("kept as the {map} bake"))
                 && text.contains("4 samples a texel")
@@ -316,15 +317,14 @@ fn maps_from_high_meshes_are_kept_as_the_projects_bakes_or_written() {
     assert_eq!(ao.options.rays, 16);
     // Saved again by another command, the bakes stay as they were.
     let before = bakes.to_vec();
-    let o = kapaint(&["bake", s(&p), "--map", "thickness", "--rays", "4"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ok(&["bake", s(&p), "--map", "thickness", "--rays", "4"]);
     let doc = kapaint::model::project::load(&p).expect("opens");
     for b in &before {
         assert!(doc.bakes().iter().any(|k| **k == **b), "{:?} lost", b.map);
     }
     // ID and the skew view, written out.
     let (ids, skew) = (d.join("id.png"), d.join("skew.png"));
-    let o = kapaint(&[
+    ok(&[
         "bake",
         s(&p),
         "--map",
@@ -336,7 +336,6 @@ fn maps_from_high_meshes_are_kept_as_the_projects_bakes_or_written() {
         "--skew",
         s(&skew),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let img = image::open(&ids).expect("png").into_rgb16();
     let mut colours: Vec<[u16; 3]> = img.pixels().map(|p| p.0).filter(|c| *c != [0; 3]).collect();
     colours.sort_unstable();
@@ -399,7 +398,7 @@ fn the_low_mesh_with_its_baked_normal_map_shades_like_the_high_one() {
         d.join("bumpy.obj"),
     );
     bumpy_sphere(&high);
-    let o = kapaint(&[
+    ok(&[
         "new",
         "--size",
         "512",
@@ -408,10 +407,8 @@ fn the_low_mesh_with_its_baked_normal_map_shades_like_the_high_one() {
         "--out",
         s(&flat),
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     std::fs::copy(&flat, &mapped).expect("copy");
-    let o = kapaint(&["bake", s(&mapped), "--map", "normal", "--high", s(&high)]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ok(&["bake", s(&mapped), "--map", "normal", "--high", s(&high)]);
     let render = |project: &Path, mesh: Option<&Path>, out: &Path| {
         let mut args = vec![
             "render",

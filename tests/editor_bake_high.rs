@@ -11,8 +11,10 @@
 mod kit;
 
 use egui::Modifiers;
+use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use kapaint::mesh::bakes::BakeMap;
+use kapaint::ui::Editor;
 use kapaint::ui::files::{FileDialogBackend, FilePurpose, FileRequest};
 use kit::{editor, wait_until};
 
@@ -36,6 +38,24 @@ fn write_high() -> kapaint::mesh::Mesh {
     kapaint::mesh::open(&high_path()).expect("loads")
 }
 
+/// Mesh > Bake from high poly…, then Add high mesh… (answered with `high`), until the dialog
+/// holds it and its window has settled.
+fn open_with_high(harness: &mut Harness<'static, Editor>, high: &std::path::Path) {
+    harness.get_by_label("Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake from high poly…").click();
+    harness.run_steps(2);
+    assert!(harness.state().state.bake_high_dialog().is_some());
+    harness.get_by_label("Add high mesh…").click();
+    wait_until(harness, "the high mesh chosen", |e| {
+        e.state
+            .bake_high_dialog()
+            .is_some_and(|d| d.highs.iter().any(|h| h == high))
+    });
+    // The window grows by the mesh's line: let it settle before clicking in it.
+    harness.run_steps(3);
+}
+
 #[test]
 fn maps_and_the_normal_map_bake_from_a_high_mesh_each_one_undo_step() {
     let loaded = write_high();
@@ -44,19 +64,15 @@ fn maps_and_the_normal_map_bake_from_a_high_mesh_each_one_undo_step() {
     files.force(FileDialogBackend::System);
     files.set_system_dialog(answer);
 
-    harness.get_by_label("Mesh").click();
-    harness.run_steps(2);
-    harness.get_by_label("Bake from high poly…").click();
-    harness.run_steps(2);
-    assert!(harness.state().state.bake_high_dialog().is_some());
-    harness.get_by_label("Add high mesh…").click();
-    wait_until(&mut harness, "the high mesh chosen", |e| {
-        e.state
+    open_with_high(&mut harness, &high_path());
+    assert_eq!(
+        harness
+            .state()
+            .state
             .bake_high_dialog()
-            .is_some_and(|d| d.highs == [high_path()])
-    });
-    // The window grows by the mesh's line: let it settle before clicking in it.
-    harness.run_steps(3);
+            .map(|d| d.highs.clone()),
+        Some(vec![high_path()])
+    );
     // The maps for the masks: curvature alone (no rays), then Bake.
     harness.get_by_label("Maps for the masks:").click();
     harness.run_steps(2);
@@ -99,17 +115,7 @@ fn maps_and_the_normal_map_bake_from_a_high_mesh_each_one_undo_step() {
     );
 
     // The normal map, from the dialog opened again (it keeps nothing but its defaults).
-    harness.get_by_label("Mesh").click();
-    harness.run_steps(2);
-    harness.get_by_label("Bake from high poly…").click();
-    harness.run_steps(2);
-    harness.get_by_label("Add high mesh…").click();
-    wait_until(&mut harness, "the high mesh chosen", |e| {
-        e.state
-            .bake_high_dialog()
-            .is_some_and(|d| !d.highs.is_empty())
-    });
-    harness.run_steps(3);
+    open_with_high(&mut harness, &high_path());
     assert!(harness.state().state.doc().normal().is_none());
     harness.get_by_label("Bake").click();
     wait_until(&mut harness, "the normal map baked", |e| {
@@ -147,17 +153,7 @@ fn a_cancelled_bake_from_high_poly_keeps_nothing() {
     files.force(FileDialogBackend::System);
     files.set_system_dialog(answer_big);
     let steps = harness.state().state.doc().history().undo_steps().count();
-    harness.get_by_label("Mesh").click();
-    harness.run_steps(2);
-    harness.get_by_label("Bake from high poly…").click();
-    harness.run_steps(2);
-    harness.get_by_label("Add high mesh…").click();
-    wait_until(&mut harness, "the high mesh chosen", |e| {
-        e.state
-            .bake_high_dialog()
-            .is_some_and(|d| !d.highs.is_empty())
-    });
-    harness.run_steps(3);
+    open_with_high(&mut harness, &big_path());
     // AO and curvature, 64 rays a texel: long enough to cancel.
     harness.get_by_label("Maps for the masks:").click();
     harness.run_steps(2);

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use super::{CliError, model_error};
 use crate::mesh::Mesh;
-use crate::mesh::bakes::{HighBake, HighMap, HighOptions, NormalSpace, bake_from_high};
+use crate::mesh::bakes::{HighBake, HighMap, HighOptions, HighSource, NormalSpace, bake_from_high};
 use crate::model::project;
 
 /// The space a normal is baked in.
@@ -82,21 +82,15 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     })
     .map_err(|e| CliError::usage(e.to_string()))?;
     let mut line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
+    let misses: Vec<u8> = baked.misses.iter().map(|&m| u8::from(m) * 255).collect();
     for (what, file, on) in [
-        (
-            "the miss map",
-            r.misses,
-            &baked
-                .misses
-                .iter()
-                .map(|&m| if m { 255 } else { 0 })
-                .collect::<Vec<u8>>(),
-        ),
-        ("the skew view", r.skew, &baked.skew),
+        ("the miss map", r.misses, misses.as_slice()),
+        ("the skew view", r.skew, baked.skew.as_slice()),
     ] {
         let Some(file) = file else { continue };
-        let grey = image::GrayImage::from_raw(baked.width, baked.height, on.clone())
-            .ok_or_else(|| CliError::io("bake size mismatch"))?;
+        let grey =
+            image::ImageBuffer::<image::Luma<u8>, &[u8]>::from_raw(baked.width, baked.height, on)
+                .ok_or_else(|| CliError::io("bake size mismatch"))?;
         let mut png = std::io::Cursor::new(Vec::new());
         grey.write_to(&mut png, image::ImageFormat::Png)
             .map_err(|e| CliError::io(e.to_string()))?;
@@ -113,36 +107,16 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
             .map_err(|e| CliError::of_io(format!("{}: {e}", out.display()), &e))?;
         return Ok(format!("{line}\nwrote {}\n", out.display()));
     }
-    let kept = if let Some(bake) = baked.to_baked(&surface.mesh, &high, cage.as_ref()) {
-        let bake = crate::model::document::AttachedBake(std::sync::Arc::new(bake));
-        doc.apply(crate::model::ImportCommand::SetBake(bake))
-            .map_err(model_error)?;
-        format!("kept as the {} bake of", map_name(map))
-    } else {
-        let normal =
-            crate::model::normal::NormalMap::from_rgb16(baked.width, baked.height, &baked.data)
-                .map_err(CliError::usage)?;
-        doc.apply(crate::model::ImportCommand::SetNormal(
-            crate::model::document::AttachedNormal(Some(std::sync::Arc::new(normal))),
-        ))
-        .map_err(model_error)?;
-        "kept as the normal map of".to_string()
+    let kept = match map.kept_as() {
+        Some(_) => format!("kept as the {} bake of", map.name()),
+        None => "kept as the normal map of".to_string(),
     };
+    let source = HighSource::of(&high, cage.as_ref());
+    let keep = crate::model::ImportCommand::keep_high(vec![baked], surface.mesh_hash, &source)
+        .map_err(CliError::usage)?;
+    doc.apply(keep).map_err(model_error)?;
     project::save_checked(&doc, r.project, on_disk.as_ref()).map_err(model_error)?;
     Ok(format!("{line}\n{kept} {}\n", r.project.display()))
-}
-
-/// A map's name as the command line spells it.
-fn map_name(map: HighMap) -> &'static str {
-    match map {
-        HighMap::Normal(_) => "normal",
-        HighMap::Height => "height",
-        HighMap::Ao => "ao",
-        HighMap::Thickness => "thickness",
-        HighMap::Curvature => "curvature",
-        HighMap::Position => "position",
-        HighMap::Id => "id",
-    }
 }
 
 /// The project, opened with its mesh attached, that mesh's surface, and the file as read (a
@@ -221,8 +195,8 @@ fn summary(r: &HighRequest<'_>, high: &Mesh, baked: &HighBake, seconds: f64) -> 
             "height (0 at {:.4} below, 1 at {:.4} above the mesh)",
             baked.rear, baked.front
         ),
-        map if map.casts_rays() => format!("{} ({} rays a sample)", map_name(map), baked.rays),
-        map => map_name(map).to_string(),
+        map if map.casts_rays() => format!("{} ({} rays a sample)", map.name(), baked.rays),
+        map => map.name().to_string(),
     };
     let rays = if baked.map.casts_rays() {
         let cast = baked.covered * u64::from(baked.samples) * u64::from(baked.rays);

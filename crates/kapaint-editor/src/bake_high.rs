@@ -4,16 +4,14 @@
 //! object-space normal (what generator masks read), in place of the mesh's own.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use super::notice;
 use crate::desk::{Ask, Desk, JobStart, centred};
 use crate::files::FilePurpose;
 use kapaint_mesh::Mesh;
 use kapaint_mesh::bakes::{
-    HighBake, HighMap, HighOptions, NormalSpace, RayMesh, SAMPLES, bake_from_high_with,
+    HighMap, HighOptions, HighSource, NormalSpace, RayMesh, SAMPLES, bake_from_high_with,
 };
-use kapaint_model::document::{AttachedBake, AttachedNormal};
 use kapaint_model::{Document, ImportCommand};
 
 /// The maps kept as the project's bakes, with their names in the dialog.
@@ -78,12 +76,11 @@ impl HighDialog {
     }
 }
 
-/// What a bake from the high meshes made: the maps, each with its seconds.
+/// What a bake from the high meshes made: the step that keeps it, and a line per map on
+/// what its rays found.
 pub(super) struct Made {
-    maps: Vec<(HighBake, f64)>,
-    low: Arc<Mesh>,
-    high: Mesh,
-    cage: Option<Mesh>,
+    keep: ImportCommand,
+    lines: Vec<String>,
 }
 
 /// The job baking `dialog`'s maps of `doc`'s mesh, or why there is none.
@@ -108,7 +105,7 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
             let cage = dialog.cage.as_ref().map(open).transpose()?;
             // One BVH for every map (the high mesh checked first by each bake).
             let rays = RayMesh::new(&high);
-            let mut made = Vec::with_capacity(maps.len());
+            let (mut bakes, mut lines) = (Vec::with_capacity(maps.len()), Vec::new());
             for map in maps {
                 let options = HighOptions {
                     front: dialog.front,
@@ -118,9 +115,8 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
                     ..HighOptions::new(map)
                 };
                 let start = std::time::Instant::now();
-                let low = &surface.mesh;
-                let baked = bake_from_high_with(
-                    low,
+                let b = bake_from_high_with(
+                    &surface.mesh,
                     &surface.bake,
                     (&high, &rays),
                     cage.as_ref(),
@@ -128,14 +124,22 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
                     Some(progress),
                 )
                 .map_err(|e| e.to_string())?;
-                made.push((baked, start.elapsed().as_secs_f64()));
+                let share = b.missed as f64 / b.covered.max(1) as f64 * 100.0;
+                lines.push(format!(
+                    "baked {} from {}: {} texels, front {:.4} rear {:.4}, missed {} ({share:.3} %), {:.1} s",
+                    name(b.map),
+                    high.name,
+                    b.covered,
+                    b.front,
+                    b.rear,
+                    b.missed,
+                    start.elapsed().as_secs_f64()
+                ));
+                bakes.push(b);
             }
-            Ok(Made {
-                maps: made,
-                low: Arc::new(surface.mesh.clone()),
-                high,
-                cage,
-            })
+            let source = HighSource::of(&high, cage.as_ref());
+            let keep = ImportCommand::keep_high(bakes, surface.mesh_hash, &source)?;
+            Ok(Made { keep, lines })
         },
         kept,
     ))
@@ -143,49 +147,12 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
 
 /// The maps baked: into the document as one step, with a line each on what the rays found.
 fn kept(made: Made, desk: &mut Desk) {
-    let Made {
-        maps,
-        low,
-        high,
-        cage,
-    } = made;
-    let lines = maps
-        .iter()
-        .map(|(b, seconds)| {
-            let share = b.missed as f64 / b.covered.max(1) as f64 * 100.0;
-            notice(
-                format!(
-                    "baked {} from {}: {} texels, front {:.4} rear {:.4}, missed {} ({share:.3} %), {seconds:.1} s",
-                    name(b.map),
-                    high.name,
-                    b.covered,
-                    b.front,
-                    b.rear,
-                    b.missed
-                ),
-                false,
-            )
-        })
+    let lines = made
+        .lines
+        .into_iter()
+        .map(|line| notice(line, false))
         .collect();
-    let normal = maps
-        .iter()
-        .find(|(b, _)| b.map == HighMap::Normal(NormalSpace::Tangent));
-    if let Some((b, _)) = normal {
-        match kapaint_model::normal::NormalMap::from_rgb16(b.width, b.height, &b.data) {
-            Ok(n) => desk.command_saying(
-                ImportCommand::SetNormal(AttachedNormal(Some(Arc::new(n)))),
-                lines,
-            ),
-            Err(e) => desk.notice(notice(e, true)),
-        }
-        return;
-    }
-    let bakes = maps
-        .iter()
-        .filter_map(|(b, _)| b.to_baked(&low, &high, cage.as_ref()))
-        .map(|b| AttachedBake(Arc::new(b)))
-        .collect();
-    desk.command_saying(ImportCommand::SetBakes(bakes), lines);
+    desk.command_saying(made.keep, lines);
 }
 
 /// A map's name in notices.

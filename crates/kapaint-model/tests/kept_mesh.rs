@@ -236,27 +236,43 @@ fn a_bake_is_kept_read_back_and_dropped_with_its_mesh() {
 /// bad hash) or one in an older version is refused.
 #[test]
 fn a_bake_from_a_high_mesh_says_where_it_came_from() {
-    use kapaint_mesh::bakes::{BakeMap, HighMap, HighOptions, bake_from_high};
-    use kapaint_model::document::AttachedBake;
+    use kapaint_mesh::bakes::{BakeMap, HighMap, HighOptions, HighSource, bake_from_high};
     let mut doc = kept_document();
     project::attach_own_mesh(&mut doc).expect("attaches");
     let surface = doc.surface().expect("attached").clone();
     let high = kapaint_mesh::torus(1.0, 0.37, 96, 48);
-    let options = HighOptions {
-        rays: 8,
-        samples: 4,
-        ..HighOptions::new(HighMap::Ao)
+    let source = HighSource::of(&high, None);
+    let bake = |map| {
+        let options = HighOptions {
+            rays: 8,
+            samples: 4,
+            ..HighOptions::new(map)
+        };
+        bake_from_high(&surface.mesh, &surface.bake, &high, None, options, None).expect("bakes")
     };
-    let baked = bake_from_high(&surface.mesh, &surface.bake, &high, None, options, None)
-        .expect("bakes")
-        .to_baked(&surface.mesh, &high, None)
+    // What a project does not keep, or the normal map among other maps: refused.
+    for (bakes, want) in [
+        (vec![bake(HighMap::Height)], "no height map"),
+        (vec![bake(HighMap::Id)], "no id map"),
+        (
+            vec![
+                bake(HighMap::Ao),
+                bake(HighMap::Normal(kapaint_mesh::bakes::NormalSpace::Tangent)),
+            ],
+            "among other maps",
+        ),
+        (vec![], "no map was baked"),
+    ] {
+        let e = ImportCommand::keep_high(bakes, surface.mesh_hash, &source).expect_err(want);
+        assert!(e.contains(want), "{e}");
+    }
+    let keep = ImportCommand::keep_high(vec![bake(HighMap::Ao)], surface.mesh_hash, &source)
         .expect("a project keeps AO");
+    doc.apply(keep).expect("kept");
+    let baked = (**doc.bake_of(BakeMap::Ao).expect("kept")).clone();
     let from = baked.from_high.clone().expect("from the high mesh");
     assert_eq!((from.mesh.as_str(), from.samples), ("torus", 4));
-    doc.apply(ImportCommand::SetBake(AttachedBake(Arc::new(
-        baked.clone(),
-    ))))
-    .expect("kept");
+    assert_eq!(from.mesh_hash, high.content_hash());
     let bytes = to_bytes(&doc).expect("saves");
     assert_eq!(version(&bytes), 6);
     let back = from_reader(Cursor::new(&bytes)).expect("reads");

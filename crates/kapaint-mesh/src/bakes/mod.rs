@@ -19,8 +19,8 @@ use rayon::prelude::*;
 mod high;
 mod rays;
 pub use high::{
-    DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, NormalSpace, SAMPLES, bake_from_high,
-    bake_from_high_with,
+    DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, HighSource, NormalSpace, SAMPLES,
+    bake_from_high, bake_from_high_with,
 };
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};

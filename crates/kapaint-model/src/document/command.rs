@@ -296,6 +296,47 @@ pub enum ImportCommand {
     Resize(crate::resize::ResizedMaps),
 }
 
+impl ImportCommand {
+    /// Keeping maps baked from a high mesh onto the project's mesh (whose hash is
+    /// `low_hash`), as one step: a tangent-space normal (alone) becomes the normal map, the
+    /// others the project's bakes of the maps they stand for (what generator masks read),
+    /// each saying it came from `source`. The one place a bake from a high mesh becomes what
+    /// a project keeps: the editor and the command line both call it.
+    ///
+    /// # Errors
+    /// No bakes, the normal map with other maps, a map a project does not keep (height,
+    /// IDs).
+    pub fn keep_high(
+        bakes: Vec<kapaint_mesh::bakes::HighBake>,
+        low_hash: u64,
+        source: &kapaint_mesh::bakes::HighSource,
+    ) -> Result<Self, String> {
+        use kapaint_mesh::bakes::{HighMap, NormalSpace};
+        let count = bakes.len();
+        let mut kept = Vec::with_capacity(count);
+        for bake in bakes {
+            match bake.into_baked(low_hash, source) {
+                Ok(b) => kept.push(AttachedBake(Arc::new(b))),
+                Err(b) if b.map == HighMap::Normal(NormalSpace::Tangent) && count == 1 => {
+                    let normal = crate::normal::NormalMap::from_rgb16(b.width, b.height, &b.data)?;
+                    return Ok(Self::SetNormal(AttachedNormal(Some(Arc::new(normal)))));
+                }
+                Err(b) => {
+                    return Err(format!(
+                        "a project keeps no {} map baked from a high mesh{}",
+                        b.map.name(),
+                        if count > 1 { " among other maps" } else { "" }
+                    ));
+                }
+            }
+        }
+        if kept.is_empty() {
+            return Err("no map was baked".into());
+        }
+        Ok(Self::SetBakes(kept))
+    }
+}
+
 /// Moves through the undo history.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]

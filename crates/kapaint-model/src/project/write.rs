@@ -207,11 +207,7 @@ pub(super) fn write_project(
     let kept_mesh = kept_mesh(doc, &settings)?;
     let manifest = Manifest {
         format: FORMAT.into(),
-        version: if doc.bakes().iter().any(|b| b.from_high.is_some()) {
-            VERSION
-        } else {
-            version_of(&layers, kept_mesh.is_some() || !doc.bakes().is_empty())
-        },
+        version: version_of(&layers, kept_mesh.is_some(), doc.bakes()),
         width: w,
         height: h,
         settings,
@@ -345,13 +341,19 @@ struct Stored<'a> {
     files: &'a [(String, Vec<u8>)],
 }
 
-/// The oldest version that holds what `layers` hold, and a kept mesh or bakes where `mesh`.
-fn version_of(layers: &[super::layers::LayerEntry], mesh: bool) -> u32 {
-    if super::layers::any_projection(layers) {
+/// The oldest version that holds what `layers` hold, a kept mesh where `mesh`, and `bakes`.
+fn version_of(
+    layers: &[super::layers::LayerEntry],
+    mesh: bool,
+    bakes: &[std::sync::Arc<kapaint_mesh::bakes::Baked>],
+) -> u32 {
+    if bakes.iter().any(|b| b.from_high.is_some()) {
+        VERSION
+    } else if super::layers::any_projection(layers) {
         super::PROJECTION_VERSION
     } else if super::layers::any_generator(layers) {
         super::GENERATOR_VERSION
-    } else if mesh {
+    } else if mesh || !bakes.is_empty() {
         super::MESH_VERSION
     } else {
         super::LAYERS_VERSION

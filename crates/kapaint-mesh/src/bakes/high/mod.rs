@@ -64,6 +64,19 @@ impl HighMap {
         }
     }
 
+    /// Its name, as `kapaint bake --map` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Normal(_) => "normal",
+            Self::Height => "height",
+            Self::Ao => "ao",
+            Self::Thickness => "thickness",
+            Self::Curvature => "curvature",
+            Self::Position => "position",
+            Self::Id => "id",
+        }
+    }
+
     /// Whether it casts rays from the point met (AO, thickness).
     pub fn casts_rays(self) -> bool {
         matches!(self, Self::Ao | Self::Thickness)
@@ -161,29 +174,58 @@ pub struct HighBake {
     pub skew: Vec<u8>,
 }
 
+/// The meshes a bake from a high mesh came from, as a project names them: taken once for
+/// every map baked from them (hashing a sculpt of millions of triangles is not free).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HighSource {
+    /// The high mesh's name.
+    pub mesh: String,
+    /// Its [`Mesh::content_hash`].
+    pub mesh_hash: u64,
+    /// The cage's name, if the rays started on one.
+    pub cage: Option<String>,
+}
+
+impl HighSource {
+    /// What names `high` and `cage`.
+    pub fn of(high: &Mesh, cage: Option<&Mesh>) -> Self {
+        Self {
+            mesh: high.name.clone(),
+            mesh_hash: high.content_hash(),
+            cage: cage.map(|c| c.name.clone()),
+        }
+    }
+}
+
 impl HighBake {
-    /// The bake as a project keeps it, in place of the low mesh's own map ([`HighMap::kept_as`]),
-    /// with where it came from; `None` for the maps a project does not keep that way.
-    pub fn to_baked(&self, low: &Mesh, high: &Mesh, cage: Option<&Mesh>) -> Option<Baked> {
-        let map = self.map.kept_as()?;
-        Some(Baked {
+    /// The bake as a project keeps it, in place of the map of the low mesh (whose
+    /// [`Mesh::content_hash`] is `low_hash`) it stands for ([`HighMap::kept_as`]), saying
+    /// where it came from; the bake itself back for the maps a project does not keep that way.
+    ///
+    /// # Errors
+    /// The bake, for tangent-space normals, height and IDs.
+    pub fn into_baked(self, low_hash: u64, source: &HighSource) -> Result<Baked, Box<Self>> {
+        let Some(map) = self.map.kept_as() else {
+            return Err(Box::new(self));
+        };
+        Ok(Baked {
             map,
             options: BakeOptions {
                 rays: if map.casts_rays() { self.rays } else { 128 },
                 max_distance: self.max_distance,
             },
-            mesh_hash: low.content_hash(),
+            mesh_hash: low_hash,
             width: self.width,
             height: self.height,
-            data: self.data.clone(),
             from_high: Some(super::FromHigh {
-                mesh: high.name.clone(),
-                mesh_hash: high.content_hash(),
+                mesh: source.mesh.clone(),
+                mesh_hash: source.mesh_hash,
                 front: self.front,
                 rear: self.rear,
                 samples: self.samples,
-                cage: cage.map(|c| c.name.clone()),
+                cage: source.cage.clone(),
             }),
+            data: self.data,
         })
     }
 }
@@ -205,11 +247,11 @@ pub fn bake_from_high(
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
-    checked(low, uv, high, cage, options)?;
+    let distances = checked(low, uv, high, cage, options)?;
     let built = std::time::Instant::now();
     let rays = RayMesh::new(high);
     let bvh_seconds = built.elapsed().as_secs_f64();
-    let mut baked = bake_from_high_with(low, uv, (high, &rays), cage, options, progress)?;
+    let mut baked = bake_checked((low, uv, high, cage), &rays, options, distances, progress)?;
     baked.bvh_seconds = bvh_seconds;
     Ok(baked)
 }
@@ -227,9 +269,20 @@ pub fn bake_from_high_with(
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
-    let (size, front, rear) = checked(low, uv, high, cage, options)?;
+    let distances = checked(low, uv, high, cage, options)?;
+    bake_checked((low, uv, high, cage), rays, options, distances, progress)
+}
+
+/// [`bake_from_high_with`] once what it is given is checked, with the distances `(size,
+/// front, rear)` [`checked`] found.
+fn bake_checked(
+    (low, uv, high, cage): (&Mesh, &UvBake, &Mesh, Option<&Mesh>),
+    rays: &RayMesh,
+    options: HighOptions,
+    (size, front, rear): (f32, f32, f32),
+    progress: Option<&Progress>,
+) -> Result<HighBake, BakeError> {
     let sampler = Sampler::new((low, uv, high, cage), rays, options, (size, front, rear));
-    let bvh_seconds = 0.0;
     let (w, h) = (uv.width as usize, uv.height as usize);
     if let Some(p) = progress {
         p.start("bake from the high mesh", h as u64);
@@ -291,7 +344,7 @@ pub fn bake_from_high_with(
         covered,
         missed,
         misses,
-        bvh_seconds,
+        bvh_seconds: 0.0,
         skew,
     })
 }
