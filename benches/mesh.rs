@@ -43,6 +43,7 @@ fn bakes(c: &mut Criterion) {
         uvs: Some(vec![glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y]),
         triangles: vec![[0, 1, 2]; 10_000],
         had_normals: true,
+        labels: mesh::Labels::default(),
     };
     group.bench_function("stacked_uvs_10000_copies", |b| {
         b.iter(|| bake(&stack, 1024, 1024, 0).expect("bakes"));
@@ -434,6 +435,7 @@ fn sculpt(low: &mesh::Mesh) -> mesh::Mesh {
         uvs: None,
         triangles,
         had_normals: false,
+        labels: mesh::Labels::default(),
     }
 }
 

@@ -499,3 +499,135 @@ fn a_killed_bake_leaves_the_project_as_it_was() {
     assert!(leftovers.is_empty(), "{leftovers:?}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A unit square at height `z` named `name`, its UVs across `u0..u0 + 0.5`, its first vertex
+/// `first`; `extra` lines go before its face.
+fn square(name: &str, z: f32, u0: f32, first: u32, extra: &str) -> String {
+    let [a, b, c, d] = [first, first + 1, first + 2, first + 3];
+    format!(
+        "o {name}\nv 0 0 {z}\nv 1 0 {z}\nv 1 1 {z}\nv 0 1 {z}\nvt {u0} 0\nvt {u1} 0\nvt {u1} 1\nvt {u0} 1\n{extra}f {a}/{a} {b}/{b} {c}/{c} {d}/{d}\n",
+        u1 = u0 + 0.5
+    )
+}
+
+/// `--match by-name`: two parts lying over each other, `A_low` and `b_low`, each bake from its
+/// own high part (`a_high`, `B_high`) and not from the other's just above; the output says the
+/// pairs. An ID map tells the high mesh's materials apart; `mesh-info` lists the
+/// names a user matches by.
+#[test]
+fn parts_match_by_name_through_the_cli() {
+    let d = dir("match");
+    let (low_obj, high_obj) = (d.join("low.obj"), d.join("high.obj"));
+    std::fs::write(
+        &low_obj,
+        square("A_low", 0.0, 0.0, 1, "") + &square("b_low", 0.01, 0.5, 5, ""),
+    )
+    .expect("write");
+    std::fs::write(
+        &high_obj,
+        square("a_high", 0.002, 0.0, 1, "usemtl paint\n")
+            + &square("B_high", 0.012, 0.5, 5, "usemtl metal\n"),
+    )
+    .expect("write");
+    let info = ok(&["mesh-info", s(&low_obj)]);
+    assert!(info.contains("objects: 2: A_low, b_low"), "{info}");
+    let p = d.join("parts.kapaint");
+    ok(&["new", "--size", "64", "--mesh", s(&low_obj), "--out", s(&p)]);
+    let height = |matching: bool, out: &Path| {
+        let mut args = vec![
+            "bake",
+            s(&p),
+            "--map",
+            "height",
+            "--high",
+            s(&high_obj),
+            "--front",
+            "0.02",
+            "--rear",
+            "0.02",
+            "--out",
+            s(out),
+        ];
+        if matching {
+            args.extend(["--match", "by-name"]);
+        }
+        let text = ok(&args);
+        let img = image::open(out).expect("png").into_luma16();
+        // Texel (16, 32) lies on A.
+        (text, f32::from(img.get_pixel(16, 32).0[0]) / 65535.0)
+    };
+    let (text, matched) = height(true, &d.join("matched.png"));
+    assert!(text.contains("matched by name: 2 pairs (a, b)"), "{text}");
+    assert!((matched - 0.55).abs() < 2e-3, "A from a_high: {matched}");
+    let (_, all) = height(false, &d.join("all.png"));
+    assert!(
+        (all - 0.8).abs() < 2e-3,
+        "A onto B_high without matching: {all}"
+    );
+    let ids = d.join("ids.png");
+    let text = ok(&[
+        "bake",
+        s(&p),
+        "--map",
+        "id",
+        "--high",
+        s(&high_obj),
+        "--out",
+        s(&ids),
+        "--match",
+        "by-name",
+    ]);
+    assert!(text.contains("id (by material)"), "{text}");
+    let img = image::open(&ids).expect("png").into_rgb16();
+    // Matched, A meets a_high's paint and B B_high's metal (unmatched, both met the metal
+    // above).
+    assert_ne!(
+        img.get_pixel(16, 32),
+        img.get_pixel(48, 32),
+        "two materials"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--match by-name` where no parts pair, `--match` without `--high`, and an ID map by vertex
+/// colours the high mesh does not have: one line, exit 2, the project as it was.
+#[test]
+fn matching_and_id_sources_refuse_what_the_meshes_lack() {
+    let d = dir("lack");
+    let p = low(&d);
+    let before = std::fs::read(&p).expect("read");
+    let high = spot("spot_quadrangulated.obj");
+    let out = d.join("ids.png");
+    for (args, want) in [
+        // spot's meshes name no parts.
+        (
+            vec!["--map", "normal", "--high", s(&high), "--match", "by-name"],
+            "no pairs",
+        ),
+        (vec!["--map", "ao", "--match", "by-name"], "--high"),
+        (
+            vec![
+                "--map",
+                "id",
+                "--high",
+                s(&high),
+                "--id-from",
+                "color",
+                "--out",
+                s(&out),
+            ],
+            "vertex colours",
+        ),
+    ] {
+        let mut all = vec!["bake", s(&p)];
+        all.extend(args);
+        let o = kapaint(&all);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(e.contains(want), "{all:?}: {e}");
+        assert_eq!(std::fs::read(&p).expect("read"), before, "{all:?}");
+        assert!(!out.exists());
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

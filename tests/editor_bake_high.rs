@@ -182,3 +182,60 @@ fn a_cancelled_bake_from_high_poly_keeps_nothing() {
     );
     let _ = std::fs::remove_file(big_path());
 }
+
+/// Where the matching test's high mesh is written.
+fn named_path() -> std::path::PathBuf {
+    std::env::temp_dir().join(format!(
+        "kapaint-editor-bake-high-named-{}.obj",
+        std::process::id()
+    ))
+}
+
+fn answer_named(request: &FileRequest) -> Option<std::path::PathBuf> {
+    (request.purpose == FilePurpose::HighMesh).then(named_path)
+}
+
+/// "Match parts by name" against a document whose mesh names no parts: the job says there are
+/// no pairs, as an error, and keeps nothing.
+#[test]
+fn matching_by_name_without_pairs_says_so_and_keeps_nothing() {
+    let text = format!(
+        "o body_high\n{}",
+        kapaint::mesh::write_obj(&kapaint::mesh::uv_sphere(32, 16))
+    );
+    std::fs::write(named_path(), text).expect("writes");
+    let mut harness = editor();
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer_named);
+    let steps = harness.state().state.doc().history().undo_steps().count();
+    open_with_high(&mut harness, &named_path());
+    harness
+        .get_by_label("Match parts by name (X_low with X_high)")
+        .click();
+    harness.run_steps(2);
+    assert!(
+        harness
+            .state()
+            .state
+            .bake_high_dialog()
+            .is_some_and(|d| d.by_name)
+    );
+    harness.get_by_label("Bake").click();
+    wait_until(&mut harness, "the job refused", |e| {
+        e.state
+            .notices()
+            .iter()
+            .any(|n| n.text.contains("no pairs"))
+    });
+    let state = &harness.state().state;
+    let refusal = state
+        .notices()
+        .iter()
+        .find(|n| n.text.contains("no pairs"))
+        .expect("said");
+    assert_eq!(refusal.level, kapaint::ui::NoticeLevel::Error);
+    assert!(refusal.text.contains("body_high"), "{}", refusal.text);
+    assert_eq!(state.doc().history().undo_steps().count(), steps);
+    let _ = std::fs::remove_file(named_path());
+}

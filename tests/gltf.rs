@@ -170,6 +170,40 @@ fn node_transforms_apply_and_mirrored_nodes_keep_facing_out() {
     assert!(m.paintable().is_ok());
 }
 
+/// A mesh's runs of triangles, by name.
+fn runs(r: &[mesh::Run]) -> Vec<(&str, std::ops::Range<u32>)> {
+    r.iter()
+        .map(|r| (r.name.as_str(), r.triangles.clone()))
+        .collect()
+}
+
+/// Nodes' names are the mesh's objects (what `bake --match by-name` pairs), primitives'
+/// materials its materials, `COLOR_0` its vertex colours; `mesh-info` lists them.
+#[test]
+fn node_names_materials_and_vertex_colours_are_read() {
+    let quad = mesh::plane();
+    let nodes =
+        r#"[{"mesh":0,"name":"door_low"},{"mesh":0,"name":"frame_low","translation":[3,0,0]}]"#;
+    let (json, bin) = mesh_gltf(&quad, true, nodes, 4);
+    // The positions read as colours too.
+    let json = json.replace(r#""POSITION":0"#, r#""POSITION":0,"COLOR_0":0"#);
+    let path = temp("named.glb", &glb(&json, &bin));
+    let m = mesh::load(&path).expect("loads");
+    assert_eq!(
+        runs(&m.labels.objects),
+        [("door_low", 0..2), ("frame_low", 2..4)]
+    );
+    assert_eq!(runs(&m.labels.materials), [("default material", 0..4)]);
+    let colors = m.labels.colors.as_ref().expect("colours");
+    assert_eq!(colors[..4], quad.positions[..]);
+    let info = mesh::info_text(&path, &m);
+    assert!(
+        info.contains("objects: 2: door_low, frame_low")
+            && info.contains("vertex colours: present"),
+        "{info}"
+    );
+}
+
 #[test]
 fn missing_normals_are_smooth_over_shared_vertices_and_strips_unroll() {
     let quad = mesh::plane();

@@ -24,7 +24,8 @@ pub enum MapArg {
     Normal,
     /// With --high: the high surface's height over the project's mesh, by the ray distances.
     Height,
-    /// With --high: the high mesh's parts (separate objects), a colour each (RGB).
+    /// With --high: the high mesh's materials, objects, pieces or vertex colours, a colour
+    /// each (RGB; see --id-from).
     Id,
 }
 
@@ -100,6 +101,17 @@ pub struct BakeArgs {
     /// nothing.
     #[arg(long, requires = "high")]
     misses: Option<PathBuf>,
+    /// With --high: pair the project's mesh's parts with the high mesh's by name (OBJ
+    /// objects and groups, glTF nodes): `X_low` bakes only from `X_high`, so parts never bake
+    /// onto each other; parts of no pair bake from the high parts of no pair.
+    #[arg(long = "match", requires = "high", value_enum)]
+    matching: Option<super::bake_high::MatchArg>,
+    /// With --high and --map id: what the colours tell apart: the high mesh's materials,
+    /// objects (OBJ objects and groups, glTF nodes), pieces (surfaces joined by shared
+    /// positions) or its vertex colours themselves (default: materials where it names more
+    /// than one, else objects where it names more than one, else pieces).
+    #[arg(long, requires = "high", value_enum)]
+    id_from: Option<super::bake_high::IdArg>,
     /// Overwrite an existing file.
     #[arg(long)]
     force: bool,
@@ -153,7 +165,8 @@ impl BakeArgs {
                 MapArg::Thickness => HighMap::Thickness,
                 MapArg::Curvature => HighMap::Curvature,
                 MapArg::Position => HighMap::Position,
-                MapArg::Id => HighMap::Id,
+                // Which source, once the high mesh is read (by --id-from, or what it names).
+                MapArg::Id => HighMap::Id(crate::mesh::bakes::IdSource::Piece),
             };
             let options = crate::mesh::bakes::HighOptions {
                 map,
@@ -171,6 +184,8 @@ impl BakeArgs {
                 out: self.out.as_ref(),
                 misses: self.misses.as_ref(),
                 skew: self.skew.as_ref(),
+                matching: self.matching.is_some(),
+                id_from: self.id_from.map(super::bake_high::IdArg::source),
             });
         }
         let Some(map) = self.map.own() else {

@@ -9,7 +9,10 @@ use std::time::Instant;
 
 use super::{CliError, model_error};
 use crate::mesh::Mesh;
-use crate::mesh::bakes::{HighBake, HighMap, HighOptions, HighSource, NormalSpace, bake_from_high};
+use crate::mesh::bakes::{
+    HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching, NormalSpace,
+    bake_from_high_with,
+};
 use crate::model::project;
 
 /// The space a normal is baked in.
@@ -19,6 +22,38 @@ pub enum SpaceArg {
     Tangent,
     /// Object space.
     Object,
+}
+
+/// How the project's parts find the high mesh's (`--match`).
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum MatchArg {
+    /// `X_low` with `X_high` (OBJ objects and groups, glTF nodes; case aside).
+    ByName,
+}
+
+/// What an ID map tells apart (`--id-from`).
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum IdArg {
+    /// Surfaces joined by shared positions.
+    Piece,
+    /// OBJ objects and groups, glTF nodes.
+    Object,
+    /// OBJ `usemtl`, glTF primitives' materials.
+    Material,
+    /// The vertex colours themselves.
+    Color,
+}
+
+impl IdArg {
+    /// The bake's source.
+    pub fn source(self) -> IdSource {
+        match self {
+            Self::Piece => IdSource::Piece,
+            Self::Object => IdSource::Object,
+            Self::Material => IdSource::Material,
+            Self::Color => IdSource::Color,
+        }
+    }
 }
 
 /// What `kapaint bake --high` is asked.
@@ -37,6 +72,10 @@ pub struct HighRequest<'a> {
     pub misses: Option<&'a PathBuf>,
     /// The skew view's PNG, if asked.
     pub skew: Option<&'a PathBuf>,
+    /// Pair parts by name.
+    pub matching: bool,
+    /// What an ID map tells apart; `None`: what the high mesh names.
+    pub id_from: Option<IdSource>,
 }
 
 /// Bakes and keeps or writes the map; returns what the command prints.
@@ -46,7 +85,7 @@ pub struct HighRequest<'a> {
 /// distances that are not positive, height or id without `--out`, a failed write.
 pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     let map = r.options.map;
-    if r.out.is_none() && matches!(map, HighMap::Height | HighMap::Id) {
+    if r.out.is_none() && matches!(map, HighMap::Height | HighMap::Id(_)) {
         return Err(CliError::usage(
             "--map height and --map id need --out: a project keeps normals, ao, thickness, curvature and position",
         ));
@@ -68,20 +107,47 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     let high = Mesh::merged(r.high.iter().map(|p| open(p)).collect::<Result<_, _>>()?)
         .map_err(CliError::usage)?;
     let cage = r.cage.map(open).transpose()?;
+    let options = HighOptions {
+        map: match map {
+            HighMap::Id(_) => HighMap::Id(r.id_from.unwrap_or_else(|| IdSource::for_mesh(&high))),
+            other => other,
+        },
+        ..r.options
+    };
     let start = Instant::now();
+    let matching = if r.matching {
+        Matching::ByName
+    } else {
+        Matching::All
+    };
     let progress = crate::task::Progress::default();
-    let baked = super::progress::with_bar("bake", &progress, || {
-        bake_from_high(
+    let (baked, rays) = super::progress::with_bar("bake", &progress, || {
+        let rays = HighRays::new(&surface.mesh, &high, matching)?;
+        let mut baked = bake_from_high_with(
             &surface.mesh,
             &surface.bake,
-            &high,
+            (&high, &rays),
             cage.as_ref(),
-            r.options,
+            options,
             Some(&progress),
-        )
+        )?;
+        baked.bvh_seconds = rays.bvh_seconds;
+        Ok::<_, crate::mesh::bakes::BakeError>((baked, rays))
     })
     .map_err(|e| CliError::usage(e.to_string()))?;
     let mut line = summary(r, &high, &baked, start.elapsed().as_secs_f64());
+    if r.matching {
+        let _ = write!(
+            line,
+            "\nmatched by name: {} pair{} ({}); {} triangles of the project's mesh and {} of the high mesh in no pair",
+            rays.pairs.len(),
+            if rays.pairs.len() == 1 { "" } else { "s" },
+            rays.pairs.join(", "),
+            rays.unpaired_low,
+            rays.unpaired_high
+        );
+    }
+    drop(rays);
     let misses: Vec<u8> = baked.misses.iter().map(|&m| u8::from(m) * 255).collect();
     for (what, file, on) in [
         ("the miss map", r.misses, misses.as_slice()),
@@ -196,6 +262,7 @@ fn summary(r: &HighRequest<'_>, high: &Mesh, baked: &HighBake, seconds: f64) -> 
             baked.rear, baked.front
         ),
         map if map.casts_rays() => format!("{} ({} rays a sample)", map.name(), baked.rays),
+        HighMap::Id(source) => format!("id (by {})", source.name()),
         map => map.name().to_string(),
     };
     let rays = if baked.map.casts_rays() {

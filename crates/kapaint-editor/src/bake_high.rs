@@ -10,7 +10,7 @@ use crate::desk::{Ask, Desk, JobStart, centred};
 use crate::files::FilePurpose;
 use kapaint_mesh::Mesh;
 use kapaint_mesh::bakes::{
-    HighMap, HighOptions, HighSource, NormalSpace, RayMesh, SAMPLES, bake_from_high_with,
+    HighMap, HighOptions, HighRays, HighSource, Matching, NormalSpace, SAMPLES, bake_from_high_with,
 };
 use kapaint_model::{Document, ImportCommand};
 
@@ -45,6 +45,8 @@ pub struct HighDialog {
     pub samples: u32,
     /// Rays per sample (AO, thickness).
     pub rays: u32,
+    /// Pair `X_low` parts with `X_high` ones, so parts never bake onto each other.
+    pub by_name: bool,
 }
 
 impl Default for HighDialog {
@@ -58,6 +60,7 @@ impl Default for HighDialog {
             rear: None,
             samples: 1,
             rays: 64,
+            by_name: false,
         }
     }
 }
@@ -102,10 +105,25 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
             let open =
                 |p: &PathBuf| kapaint_mesh::open(p).map_err(|e| format!("{}: {e}", p.display()));
             let high = Mesh::merged(dialog.highs.iter().map(open).collect::<Result<_, _>>()?)?;
+            let mut lines = Vec::new();
             let cage = dialog.cage.as_ref().map(open).transpose()?;
-            // One BVH for every map (the high mesh checked first by each bake).
-            let rays = RayMesh::new(&high);
-            let (mut bakes, mut lines) = (Vec::with_capacity(maps.len()), Vec::new());
+            // One set of BVHs for every map (the high mesh checked first by each bake).
+            let matching = if dialog.by_name {
+                Matching::ByName
+            } else {
+                Matching::All
+            };
+            let rays = HighRays::new(&surface.mesh, &high, matching).map_err(|e| e.to_string())?;
+            if matching == Matching::ByName {
+                lines.push(format!(
+                    "matched by name: {} pairs ({}); {} low and {} high triangles in no pair",
+                    rays.pairs.len(),
+                    rays.pairs.join(", "),
+                    rays.unpaired_low,
+                    rays.unpaired_high
+                ));
+            }
+            let mut bakes = Vec::with_capacity(maps.len());
             for map in maps {
                 let options = HighOptions {
                     front: dialog.front,
@@ -165,7 +183,7 @@ fn name(map: HighMap) -> &'static str {
         HighMap::Thickness => "thickness",
         HighMap::Curvature => "curvature",
         HighMap::Position => "position",
-        HighMap::Id => "IDs",
+        HighMap::Id(_) => "IDs",
     }
 }
 
@@ -256,6 +274,14 @@ fn meshes_and_distances(ui: &mut egui::Ui, dialog: &mut HighDialog, desk: &mut D
             dialog.cage = None;
         }
     });
+    ui.checkbox(
+        &mut dialog.by_name,
+        "Match parts by name (X_low with X_high)",
+    )
+    .on_hover_text(
+        "Each low object or group bakes only from the high ones of its name, so parts \
+             never bake onto each other; the rest bake from the high parts of no pair",
+    );
     for (label, value) in [("Front", &mut dialog.front), ("Rear", &mut dialog.rear)] {
         ui.horizontal(|ui| {
             let mut auto = value.is_none();

@@ -43,6 +43,7 @@ fn grid(name: &str, cols: u32, rows: u32, vertex: impl Fn(u32, u32) -> (Vec3, Ve
         uvs: Some(uvs),
         triangles,
         had_normals: true,
+        labels: crate::Labels::default(),
     }
 }
 
@@ -94,6 +95,7 @@ pub fn cube() -> Mesh {
         uvs: Some(vec![]),
         triangles: vec![],
         had_normals: true,
+        labels: crate::Labels::default(),
     };
     for (f, &n) in faces.iter().enumerate() {
         // Two tangents with t1 x t2 = n.

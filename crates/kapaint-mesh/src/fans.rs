@@ -126,6 +126,7 @@ mod tests {
             uvs: None,
             triangles: (0..n).map(|i| [0, i + 1, (i + 1) % n + 1]).collect(),
             had_normals: true,
+            labels: crate::Labels::default(),
         }
     }
 

@@ -83,7 +83,7 @@ pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
     // The default scene (else the first; else every mesh once, untransformed). A node graph
     // can reuse a node many times (2^40 instances from 40 nodes), so what the scene would
     // instantiate is counted before anything is expanded.
-    let mut instances: Vec<(gltf::Mesh<'_>, Mat4)> = Vec::new();
+    let mut instances: Vec<Instance<'_>> = Vec::new();
     match document
         .default_scene()
         .or_else(|| document.scenes().next())
@@ -106,15 +106,25 @@ pub fn load_gltf(path: &Path) -> Result<Mesh, MeshError> {
                 collect(&node, Mat4::IDENTITY, 0, &mut instances).map_err(&invalid)?;
             }
         }
-        None => instances.extend(document.meshes().map(|m| (m, Mat4::IDENTITY))),
+        None => instances.extend(document.meshes().map(|m| Instance {
+            name: m.name().map(str::to_string),
+            mesh: m,
+            transform: Mat4::IDENTITY,
+        })),
     }
 
     let mut out = Builder::default();
-    for (mesh, transform) in &instances {
+    for instance in &instances {
+        let mesh = &instance.mesh;
+        let first = out.triangles.len() as u32;
         for (k, primitive) in mesh.primitives().enumerate() {
             let what = format!("mesh {:?} primitive {k}", mesh.name().unwrap_or("unnamed"));
-            out.add(&primitive, *transform, &buffers)
+            out.add(&primitive, instance.transform, &buffers)
                 .map_err(|e| invalid(format!("{what}: {e}")))?;
+        }
+        if let Some(name) = &instance.name {
+            let run = first..out.triangles.len() as u32;
+            super::Labels::push(&mut out.labels.objects, name, run);
         }
     }
     let name = path
@@ -299,12 +309,20 @@ pub fn file_beside(dir: &Path, uri: &str) -> Result<std::path::PathBuf, String> 
     Ok(file)
 }
 
+/// A mesh the scene places: the name of the node that places it (else the mesh's own), and
+/// where.
+struct Instance<'a> {
+    name: Option<String>,
+    mesh: gltf::Mesh<'a>,
+    transform: Mat4,
+}
+
 /// Walks the node tree, accumulating transforms.
 fn collect<'a>(
     node: &gltf::Node<'a>,
     parent: Mat4,
     depth: usize,
-    out: &mut Vec<(gltf::Mesh<'a>, Mat4)>,
+    out: &mut Vec<Instance<'a>>,
 ) -> Result<(), String> {
     if depth > MAX_DEPTH {
         return Err(format!(
@@ -317,7 +335,11 @@ fn collect<'a>(
         return Err(format!("node {} has a non-finite transform", node.index()));
     }
     if let Some(mesh) = node.mesh() {
-        out.push((mesh, world));
+        out.push(Instance {
+            name: node.name().or(mesh.name()).map(str::to_string),
+            mesh,
+            transform: world,
+        });
     }
     for child in node.children() {
         collect(&child, world, depth + 1, out)?;
@@ -382,6 +404,16 @@ fn check_accessor(
     Ok(())
 }
 
+/// A primitive's material by name (else by number; the default material where it names none).
+fn material_name(primitive: &gltf::Primitive<'_>) -> String {
+    let material = primitive.material();
+    match (material.name(), material.index()) {
+        (Some(name), _) => name.to_string(),
+        (None, Some(i)) => format!("material {i}"),
+        (None, None) => "default material".to_string(),
+    }
+}
+
 /// Merges primitives into one mesh.
 #[derive(Default)]
 struct Builder {
@@ -391,6 +423,10 @@ struct Builder {
     triangles: Vec<[u32; 3]>,
     any_uv: bool,
     missing_normals: bool,
+    labels: super::Labels,
+    /// Per vertex, its colour (white where a primitive has none); whether any has them.
+    colors: Vec<Vec3>,
+    any_color: bool,
 }
 
 impl Builder {
@@ -413,6 +449,14 @@ impl Builder {
             let allowed: &[(T, D)] = match semantic {
                 Semantic::Positions | Semantic::Normals => &[(T::F32, D::Vec3)],
                 Semantic::TexCoords(0) => &[(T::F32, D::Vec2), (T::U8, D::Vec2), (T::U16, D::Vec2)],
+                Semantic::Colors(0) => &[
+                    (T::F32, D::Vec3),
+                    (T::F32, D::Vec4),
+                    (T::U8, D::Vec3),
+                    (T::U8, D::Vec4),
+                    (T::U16, D::Vec3),
+                    (T::U16, D::Vec4),
+                ],
                 _ => continue, // not read
             };
             check_accessor(&accessor, buffers, allowed)?;
@@ -435,8 +479,12 @@ impl Builder {
         let uvs: Option<Vec<Vec2>> = reader
             .read_tex_coords(0)
             .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
+        let colors: Option<Vec<Vec3>> = reader
+            .read_colors(0)
+            .map(|c| c.into_rgb_f32().map(Vec3::from).collect());
         if normals.as_ref().is_some_and(|n| n.len() != count)
             || uvs.as_ref().is_some_and(|t| t.len() != count)
+            || colors.as_ref().is_some_and(|c| c.len() != count)
         {
             return Err("attribute counts differ".into());
         }
@@ -480,9 +528,15 @@ impl Builder {
             self.positions.push(world[i]);
             self.normals.push(vertex_normals[i]);
             self.uvs.push(uv_of(i));
+            self.colors
+                .push(colors.as_ref().map_or(Vec3::ONE, |c| c[i]));
         }
+        self.any_color |= colors.is_some();
+        let first = self.triangles.len() as u32;
         self.triangles
             .extend(triangles.iter().map(|t| t.map(|i| base + i)));
+        let run = first..self.triangles.len() as u32;
+        super::Labels::push(&mut self.labels.materials, &material_name(primitive), run);
         Ok(())
     }
 
@@ -494,6 +548,10 @@ impl Builder {
             uvs: self.any_uv.then_some(self.uvs),
             triangles: self.triangles,
             had_normals: !self.missing_normals,
+            labels: super::Labels {
+                colors: self.any_color.then_some(self.colors),
+                ..self.labels
+            },
         }
     }
 }

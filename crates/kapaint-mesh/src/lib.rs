@@ -11,6 +11,7 @@ mod builtin;
 mod fans;
 pub mod frame;
 pub mod gltf_import;
+mod labels;
 mod obj;
 pub mod pick;
 mod polygon;
@@ -23,6 +24,7 @@ use glam::{Vec2, Vec3};
 
 pub use builtin::{cube, plane, torus, uv_sphere};
 pub use gltf_import::load_gltf;
+pub use labels::{Labels, Named, Run};
 pub use obj::{load_obj, parse_obj, write_obj};
 
 /// Largest mesh file accepted (bytes).
@@ -67,6 +69,8 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// Whether the source provided normals (else they were computed).
     pub had_normals: bool,
+    /// The file's names for its objects and materials, and its vertex colours.
+    pub labels: Labels,
 }
 
 impl Mesh {
@@ -133,7 +137,7 @@ impl Mesh {
                 "triangle {t} refers to a vertex that does not exist"
             ));
         }
-        Ok(())
+        self.labels.validate(self.triangles.len(), n)
     }
 
     /// Axis-aligned bounds `(min, max)`.
@@ -158,6 +162,11 @@ impl Mesh {
                 .filter(|b| b.checked_add(m.positions.len() as u32).is_some())
                 .ok_or("the meshes together have more vertices than a triangle indexes")?;
             out.name = format!("{} + {}", out.name, m.name);
+            out.labels = std::mem::take(&mut out.labels).followed_by(
+                m.labels,
+                out.triangles.len() as u32,
+                out.positions.len(),
+            );
             out.positions.extend(m.positions);
             out.normals.extend(m.normals);
             out.uvs = match (out.uvs.take(), m.uvs) {
@@ -343,9 +352,28 @@ pub fn load(path: &Path) -> Result<Mesh, MeshError> {
 
 /// The `kapaint mesh-info` report.
 pub fn info_text(path: &Path, mesh: &Mesh) -> String {
+    use std::fmt::Write as _;
+    const SHOWN: usize = 12;
     let (lo, hi) = mesh.bounds();
+    let names = |runs: &[Run]| {
+        let named = Named::of(runs, 0).names;
+        let mut list = named
+            .iter()
+            .take(SHOWN)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join(", ");
+        if named.len() > SHOWN {
+            let _ = write!(list, ", … ({} more)", named.len() - SHOWN);
+        }
+        format!(
+            "{}{}{list}",
+            named.len(),
+            if named.is_empty() { "" } else { ": " }
+        )
+    };
     format!(
-        "file: {}\nvertices: {}\ntriangles: {}\nuv islands: {}\nbounds: min ({}, {}, {}) max ({}, {}, {})\nnormals: {}\nuvs: {}\n",
+        "file: {}\nvertices: {}\ntriangles: {}\nuv islands: {}\nbounds: min ({}, {}, {}) max ({}, {}, {})\nnormals: {}\nuvs: {}\nobjects: {}\nmaterials: {}\nvertex colours: {}\n",
         path.display(),
         mesh.vertex_count(),
         mesh.triangles.len(),
@@ -365,6 +393,13 @@ pub fn info_text(path: &Path, mesh: &Mesh) -> String {
             "present"
         } else {
             "missing"
+        },
+        names(&mesh.labels.objects),
+        names(&mesh.labels.materials),
+        if mesh.labels.colors.is_some() {
+            "present"
+        } else {
+            "none"
         },
     )
 }

@@ -2,11 +2,12 @@
 //! ([`crate::polygon`]).
 
 use std::collections::HashMap;
+use std::ops::Range;
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use super::{Mesh, MeshError, smooth_normals};
+use super::{Labels, Mesh, MeshError, smooth_normals};
 
 /// Loads an OBJ file. Vertices are split per distinct (position, UV, normal) index triple;
 /// missing normals are computed smooth per position index.
@@ -49,8 +50,15 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
     let mut normals = Vec::new();
     let mut group = Vec::new();
     let mut triangles = Vec::new();
+    let mut colors = Vec::new();
+    let mut labels = Labels::default();
+    // The material of each face (`usemtl` does not split tobj's models: no material library
+    // is read).
+    let (material_names, material_changes) = face_materials(bytes);
+    let (mut face_count, mut material, mut next_change) = (0_usize, None, 0);
     let mut position_base = 0usize;
     let (mut any_uv, mut all_uv, mut all_normals) = (false, true, true);
+    let mut all_colors = true;
     for model in &models {
         let m = &model.mesh;
         let count = m.positions.len() / 3;
@@ -66,6 +74,9 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
                 model.name
             )));
         }
+        let has_color = !m.vertex_color.is_empty();
+        all_colors &= has_color;
+        let first_triangle = triangles.len() as u32;
         let has_uv = !m.texcoord_indices.is_empty();
         let has_n = !m.normal_indices.is_empty();
         if (has_uv && m.texcoord_indices.len() != m.indices.len())
@@ -106,6 +117,10 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
                 m.positions[pi + 2],
             ));
             group.push(position_base + p as usize);
+            if has_color {
+                let c = m.vertex_color.get(pi..pi + 3).unwrap_or(&[1.0; 3]);
+                colors.push(Vec3::new(c[0], c[1], c[2]));
+            }
             if has_uv {
                 let ti = t as usize * 2;
                 let uv = m.texcoords.get(ti..ti + 2).ok_or_else(|| {
@@ -139,34 +154,26 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
         for arity in arities {
             let face = first..first + arity;
             first += arity;
-            if arity <= 4 {
-                // Split as tobj split them (the meshes that always loaded load the same).
-                if arity >= 3 {
-                    let k = face.start;
-                    triangles.push([corner(k)?, corner(k + 1)?, corner(k + 2)?]);
-                }
-                if arity == 4 {
-                    let k = face.start;
-                    triangles.push([corner(k)?, corner(k + 2)?, corner(k + 3)?]);
-                }
-                continue;
-            }
-            let positions_of: Vec<Vec3> = m.indices[face.clone()]
-                .iter()
-                .map(|&p| {
-                    let pi = p as usize * 3;
-                    m.positions
-                        .get(pi..pi + 3)
-                        .map(|c| Vec3::new(c[0], c[1], c[2]))
-                        .ok_or_else(|| {
-                            invalid(format!("a face refers to vertex {} of {count}", p + 1))
-                        })
-                })
-                .collect::<Result<_, _>>()?;
-            for t in crate::polygon::triangulate(&positions_of) {
-                let [a, b, c] = t.map(|i| face.start + i as usize);
+            let before = triangles.len() as u32;
+            for [a, b, c] in face_triangles(m, face).map_err(&invalid)? {
                 triangles.push([corner(a)?, corner(b)?, corner(c)?]);
             }
+            while let Some(&(from, k)) = material_changes.get(next_change)
+                && from <= face_count
+            {
+                material = Some(k);
+                next_change += 1;
+            }
+            if let Some(k) = material {
+                let run = before..triangles.len() as u32;
+                Labels::push(&mut labels.materials, &material_names[k], run);
+            }
+            face_count += 1;
+        }
+        // tobj's name for faces before any `o` or `g` (or after a bare one).
+        if !model.name.is_empty() && model.name != "unnamed_object" {
+            let run = first_triangle..triangles.len() as u32;
+            Labels::push(&mut labels.objects, &model.name, run);
         }
         position_base += count;
     }
@@ -194,6 +201,7 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
     } else {
         smooth_normals(&positions, &triangles, &group, position_base)
     };
+    labels.colors = (all_colors && !positions.is_empty()).then_some(colors);
     let mesh = Mesh {
         name,
         positions,
@@ -201,9 +209,70 @@ pub fn parse_obj(bytes: &[u8], name: String, path: &Path) -> Result<Mesh, MeshEr
         uvs: any_uv.then_some(uvs),
         triangles,
         had_normals,
+        labels,
     };
     mesh.validate().map_err(invalid)?;
     Ok(mesh)
+}
+
+/// The corners (indices into the model's face indices) of the triangles face `face` of `m`
+/// splits into: a triangle or a quad as tobj splits them (the meshes that always loaded load
+/// the same), a larger polygon by [`crate::polygon::triangulate`].
+fn face_triangles(m: &tobj::Mesh, face: Range<usize>) -> Result<Vec<[usize; 3]>, String> {
+    let k = face.start;
+    match face.len() {
+        0..3 => Ok(Vec::new()),
+        3 => Ok(vec![[k, k + 1, k + 2]]),
+        4 => Ok(vec![[k, k + 1, k + 2], [k, k + 2, k + 3]]),
+        _ => {
+            let count = m.positions.len() / 3;
+            let positions_of: Vec<Vec3> = m.indices[face]
+                .iter()
+                .map(|&p| {
+                    let pi = p as usize * 3;
+                    m.positions
+                        .get(pi..pi + 3)
+                        .map(|c| Vec3::new(c[0], c[1], c[2]))
+                        .ok_or_else(|| format!("a face refers to vertex {} of {count}", p + 1))
+                })
+                .collect::<Result<_, _>>()?;
+            Ok(crate::polygon::triangulate(&positions_of)
+                .into_iter()
+                .map(|t| t.map(|i| k + i as usize))
+                .collect())
+        }
+    }
+}
+
+/// The materials `usemtl` names, and where each takes over: `(face, material)`, faces counted
+/// as tobj keeps them (`f` lines of three corners or more), in order.
+fn face_materials(bytes: &[u8]) -> (Vec<String>, Vec<(usize, usize)>) {
+    let mut names: Vec<String> = Vec::new();
+    let mut changes = Vec::new();
+    let mut faces = 0;
+    for line in bytes.split(|&b| b == b'\n') {
+        let line = line.trim_ascii();
+        if !matches!(line.first(), Some(b'f' | b'u')) {
+            continue;
+        }
+        let line = String::from_utf8_lossy(line);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("f") if words.count() >= 3 => faces += 1,
+            Some("usemtl") => {
+                let name = line["usemtl".len()..].trim();
+                if !name.is_empty() {
+                    let k = names.iter().position(|n| n == name).unwrap_or_else(|| {
+                        names.push(name.to_string());
+                        names.len() - 1
+                    });
+                    changes.push((faces, k));
+                }
+            }
+            _ => {}
+        }
+    }
+    (names, changes)
 }
 
 /// The mesh as an OBJ file: positions, UVs (if any) and normals, one vertex each, and its

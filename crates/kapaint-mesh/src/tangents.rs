@@ -83,6 +83,7 @@ pub fn generate(mesh: &Mesh) -> Option<Tangents> {
         uvs: Some(Vec::with_capacity(mesh.positions.len())),
         triangles: Vec::with_capacity(mesh.triangles.len()),
         had_normals: mesh.had_normals,
+        labels: crate::Labels::default(),
     };
     let mut tangents: Vec<[f32; 4]> = Vec::with_capacity(mesh.positions.len());
     // Per source vertex, the new vertices made of it so far (usually one).
@@ -178,6 +179,7 @@ mod tests {
             ]),
             triangles: vec![[2, 0, 1], [0, 3, 1]],
             had_normals: true,
+            labels: crate::Labels::default(),
         };
         let t = generate(&mesh).expect("tangents");
         assert!(t.mesh.positions.len() > 4, "the shared edge splits");

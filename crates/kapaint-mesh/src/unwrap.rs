@@ -191,6 +191,7 @@ pub fn unwrap(
         triangles,
         // Its normals are the source's, computed or not, and go with it wherever it is written.
         had_normals: true,
+        labels: crate::Labels::default(),
     };
     let coverage = uv_area(&unwrapped) as f32;
     Ok(Unwrapped {
@@ -464,6 +465,7 @@ mod tests {
             uvs: None,
             triangles: vec![[0, 1, 2]],
             had_normals: false,
+            labels: crate::Labels::default(),
         };
         let e = unwrap(&flat, UnwrapOptions::for_size(256), None).expect_err("nothing to chart");
         assert!(e.to_string().contains("degenerate"), "{e}");

@@ -253,7 +253,10 @@ fn a_bake_from_a_high_mesh_says_where_it_came_from() {
     // What a project does not keep, or the normal map among other maps: refused.
     for (bakes, want) in [
         (vec![bake(HighMap::Height)], "no height map"),
-        (vec![bake(HighMap::Id)], "no id map"),
+        (
+            vec![bake(HighMap::Id(kapaint_mesh::bakes::IdSource::Piece))],
+            "no id map",
+        ),
         (
             vec![
                 bake(HighMap::Ao),

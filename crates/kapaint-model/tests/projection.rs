@@ -187,6 +187,7 @@ fn stacked_planes() -> Mesh {
         uvs: Some(uvs),
         triangles: vec![[0, 2, 1], [1, 2, 3], [4, 6, 5], [5, 6, 7]],
         had_normals: true,
+        labels: kapaint_mesh::Labels::default(),
     }
 }
 
@@ -477,6 +478,7 @@ fn cylinder(segments: u32) -> Mesh {
         uvs: Some(uvs),
         triangles,
         had_normals: true,
+        labels: kapaint_mesh::Labels::default(),
     }
 }
 

@@ -51,6 +51,7 @@ fn overlapping_uvs_cost_what_the_covered_texels_cost() {
         uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y]),
         triangles: vec![[0, 1, 2]; copies as usize],
         had_normals: true,
+        labels: crate::Labels::default(),
     };
     let side = 1024;
     let b = bake(&mesh, side, side, 0).unwrap();

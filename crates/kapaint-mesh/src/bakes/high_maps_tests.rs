@@ -99,7 +99,15 @@ fn ao_and_ids_from_a_high_mesh_see_what_the_low_one_has_not() {
         least(&own)
     );
     assert!(least(&ao) < 0.75, "beside the box: {}", least(&ao));
-    let ids = bake_from_high(&plane, &uv, &high, None, options(HighMap::Id), None).expect("bakes");
+    let ids = bake_from_high(
+        &plane,
+        &uv,
+        &high,
+        None,
+        options(HighMap::Id(super::IdSource::Piece)),
+        None,
+    )
+    .expect("bakes");
     let mut colours: Vec<[u16; 3]> = texels
         .iter()
         .map(|&i| [0, 1, 2].map(|c| ids.data[i * 3 + c]))
@@ -133,6 +141,7 @@ fn sixteen_samples_average_a_texel_and_one_takes_its_centre() {
         uvs: None,
         triangles: vec![[0, 2, 1], [1, 2, 3]],
         had_normals: true,
+        labels: crate::Labels::default(),
     };
     // Texel column 32 of 64 spans x 0 to 0.03125; the step at 0.014 leaves two of its four
     // sample columns low and its centre (0.0156) high.
@@ -238,7 +247,7 @@ fn a_bvh_built_once_bakes_what_each_bake_builds() {
     let low = crate::uv_sphere(24, 12);
     let high = crate::torus(1.0, 0.4, 64, 32);
     let uv = bake(&low, 64, 64, 2).expect("bakes");
-    let rays = super::RayMesh::new(&high);
+    let rays = super::HighRays::whole(super::RayMesh::new(&high));
     for map in [HighMap::Curvature, HighMap::Ao] {
         let options = HighOptions {
             rays: 8,

@@ -19,8 +19,8 @@ use rayon::prelude::*;
 mod high;
 mod rays;
 pub use high::{
-    DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, HighSource, NormalSpace, SAMPLES,
-    bake_from_high, bake_from_high_with,
+    DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching,
+    NormalSpace, SAMPLES, bake_from_high, bake_from_high_with,
 };
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};
@@ -451,6 +451,8 @@ fn curvature_in(mesh: &Mesh, local: &[Vec3]) -> Vec<f32> {
 
 #[cfg(test)]
 mod high_maps_tests;
+#[cfg(test)]
+mod high_pairs_tests;
 #[cfg(test)]
 mod high_tests;
 #[cfg(test)]

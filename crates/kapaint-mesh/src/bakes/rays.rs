@@ -34,8 +34,36 @@ impl RayMesh {
     pub fn new(mesh: &Mesh) -> Self {
         let frame = UnitFrame::of(&mesh.positions);
         let local = frame.local_positions(&mesh.positions);
+        Self::of_triangles(mesh, &frame, &local, |_| true)
+    }
+
+    /// One BVH per group of `mesh`'s triangles, `group_of` naming each triangle's (none where
+    /// it is `groups` or more), indices still the mesh's; `None` for a group without a
+    /// triangle. All share the mesh's frame.
+    pub fn split(mesh: &Mesh, group_of: &[u32], groups: usize) -> Vec<Option<Self>> {
+        let frame = UnitFrame::of(&mesh.positions);
+        let local = frame.local_positions(&mesh.positions);
+        (0..groups as u32)
+            .map(|g| {
+                let mine = |k: u32| group_of.get(k as usize) == Some(&g);
+                (0..mesh.triangles.len() as u32)
+                    .any(mine)
+                    .then(|| Self::of_triangles(mesh, &frame, &local, mine))
+            })
+            .collect()
+    }
+
+    /// The BVH of the triangles `keep` accepts, in `frame`, `local` being the mesh's positions
+    /// in it.
+    fn of_triangles(
+        mesh: &Mesh,
+        frame: &UnitFrame,
+        local: &[Vec3],
+        keep: impl Fn(u32) -> bool,
+    ) -> Self {
         let (kept, triangles): (Vec<u32>, Vec<Triangle>) = (0u32..)
             .zip(&mesh.triangles)
+            .filter(|&(k, _)| keep(k))
             .filter_map(|(k, t)| {
                 let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
                 let (v0, v1, v2) = (v0?, v1?, v2?);
@@ -60,7 +88,7 @@ impl RayMesh {
             triangles,
             sources,
             diagonal: frame.diagonal(),
-            frame,
+            frame: *frame,
         }
     }
 

@@ -23,6 +23,7 @@ fn floor_and_wall(h: f32) -> Mesh {
         uvs: None,
         triangles: vec![[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7]],
         had_normals: true,
+        labels: crate::Labels::default(),
     }
 }
 

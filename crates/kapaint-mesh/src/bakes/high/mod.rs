@@ -16,13 +16,15 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, RAYS, RayMesh};
+use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, RAYS};
 use crate::Mesh;
 use crate::bake::{Coverage, UvBake};
 use crate::frame::UnitFrame;
 use kapaint_base::task::Progress;
 
+mod pairs;
 mod sample;
+pub use pairs::{HighRays, Matching};
 use sample::Sampler;
 
 /// The space normals are written in.
@@ -49,17 +51,65 @@ pub enum HighMap {
     Curvature,
     /// The point met, in the low mesh's bounding box (RGB).
     Position,
-    /// The high mesh's part at the point met (pieces of surface joined by shared positions,
-    /// so each separate object of a file is one), a colour each (RGB; black where a ray met
+    /// What the high mesh says of the point met, a colour each (RGB; black where a ray met
     /// nothing).
-    Id,
+    Id(IdSource),
+}
+
+/// What an ID map tells apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IdSource {
+    /// Pieces of surface joined by shared positions (each separate object of a file is one).
+    Piece,
+    /// The file's objects or groups (OBJ `o` and `g`, glTF nodes).
+    Object,
+    /// The file's materials (OBJ `usemtl`, glTF primitives' materials).
+    Material,
+    /// The high mesh's vertex colours themselves.
+    Color,
+}
+
+impl IdSource {
+    /// Every source, by the name `kapaint bake --id-from` takes.
+    pub const ALL: [(&'static str, Self); 4] = [
+        ("piece", Self::Piece),
+        ("object", Self::Object),
+        ("material", Self::Material),
+        ("color", Self::Color),
+    ];
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, s)| *s == self)
+            .map_or("piece", |(n, _)| n)
+    }
+
+    /// What an ID map of `high` tells apart unless told: its materials where it names more
+    /// than one, else its objects where it names more than one, else its pieces.
+    pub fn for_mesh(high: &Mesh) -> Self {
+        let distinct = |runs: &[crate::Run]| {
+            runs.iter()
+                .map(|r| r.name.as_str())
+                .collect::<std::collections::HashSet<_>>()
+                .len()
+        };
+        if distinct(&high.labels.materials) > 1 {
+            Self::Material
+        } else if distinct(&high.labels.objects) > 1 {
+            Self::Object
+        } else {
+            Self::Piece
+        }
+    }
 }
 
 impl HighMap {
     /// Samples a texel holds.
     pub fn channels(self) -> usize {
         match self {
-            Self::Normal(_) | Self::Position | Self::Id => 3,
+            Self::Normal(_) | Self::Position | Self::Id(_) => 3,
             _ => 1,
         }
     }
@@ -73,7 +123,7 @@ impl HighMap {
             Self::Thickness => "thickness",
             Self::Curvature => "curvature",
             Self::Position => "position",
-            Self::Id => "id",
+            Self::Id(_) => "id",
         }
     }
 
@@ -92,7 +142,7 @@ impl HighMap {
             Self::Thickness => Some(BakeMap::Thickness),
             Self::Curvature => Some(BakeMap::Curvature),
             Self::Position => Some(BakeMap::Position),
-            Self::Normal(NormalSpace::Tangent) | Self::Height | Self::Id => None,
+            Self::Normal(NormalSpace::Tangent) | Self::Height | Self::Id(_) => None,
         }
     }
 }
@@ -248,28 +298,31 @@ pub fn bake_from_high(
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
     let distances = checked(low, uv, high, cage, options)?;
-    let built = std::time::Instant::now();
-    let rays = RayMesh::new(high);
-    let bvh_seconds = built.elapsed().as_secs_f64();
+    let rays = HighRays::new(low, high, Matching::All)?;
     let mut baked = bake_checked((low, uv, high, cage), &rays, options, distances, progress)?;
-    baked.bvh_seconds = bvh_seconds;
+    baked.bvh_seconds = rays.bvh_seconds;
     Ok(baked)
 }
 
-/// [`bake_from_high`] with the high mesh's BVH built already (`RayMesh::new(high)`), so that
-/// several maps of one high mesh build it once.
+/// [`bake_from_high`] with the high mesh's BVHs built already ([`HighRays::new`], matched by
+/// name or not), so that several maps of one high mesh build them once.
 ///
 /// # Errors
-/// As [`bake_from_high`].
+/// As [`bake_from_high`]; BVHs matched for another low mesh.
 pub fn bake_from_high_with(
     low: &Mesh,
     uv: &UvBake,
-    (high, rays): (&Mesh, &RayMesh),
+    (high, rays): (&Mesh, &HighRays),
     cage: Option<&Mesh>,
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
     let distances = checked(low, uv, high, cage, options)?;
+    if !rays.fits(low.triangles.len()) {
+        return Err("the BVHs were matched for another low mesh"
+            .to_string()
+            .into());
+    }
     bake_checked((low, uv, high, cage), rays, options, distances, progress)
 }
 
@@ -277,7 +330,7 @@ pub fn bake_from_high_with(
 /// front, rear)` [`checked`] found.
 fn bake_checked(
     (low, uv, high, cage): (&Mesh, &UvBake, &Mesh, Option<&Mesh>),
-    rays: &RayMesh,
+    rays: &HighRays,
     options: HighOptions,
     (size, front, rear): (f32, f32, f32),
     progress: Option<&Progress>,
@@ -362,6 +415,7 @@ fn checked(
         return Err("the UV bake was made from another mesh".to_string().into());
     }
     check(options)?;
+    check_id(high, options.map)?;
     if let Some(c) = cage {
         check_cage(low, c)?;
     }
@@ -392,6 +446,26 @@ fn check(options: HighOptions) -> Result<(), BakeError> {
         .into());
     }
     Ok(())
+}
+
+/// Refuses an ID map by what the high mesh does not have: vertex colours, named objects or
+/// materials.
+fn check_id(high: &Mesh, map: HighMap) -> Result<(), BakeError> {
+    let missing = match map {
+        HighMap::Id(IdSource::Color) if high.labels.colors.is_none() => "vertex colours",
+        HighMap::Id(IdSource::Object) if high.labels.objects.is_empty() => "named objects",
+        HighMap::Id(IdSource::Material) if high.labels.materials.is_empty() => "materials",
+        _ => return Ok(()),
+    };
+    Err(format!(
+        "an ID map by {} needs the high mesh's {missing}, and {} has none",
+        match map {
+            HighMap::Id(source) => source.name(),
+            _ => "",
+        },
+        high.name
+    )
+    .into())
 }
 
 /// Refuses a cage that is not the low mesh pushed out: the same vertices and triangles, finite

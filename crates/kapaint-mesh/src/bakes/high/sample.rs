@@ -2,11 +2,11 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{HighMap, HighOptions, NormalSpace};
-use crate::Mesh;
+use super::{HighMap, HighOptions, HighRays, IdSource, NormalSpace};
 use crate::bake::UvBake;
 use crate::bakes::rays::turn_of;
 use crate::bakes::{Directions, RayMesh, geometric_normal};
+use crate::{Mesh, Named};
 
 /// What a texel's rays found besides its value.
 pub(super) struct TexelFound {
@@ -52,14 +52,14 @@ pub(super) struct Sampler<'a> {
     rear: f32,
     /// How far a ray that slipped between two triangles is moved to try again.
     nudge: f32,
-    rays: &'a RayMesh,
+    rays: &'a HighRays,
     directions: Directions,
     /// How far AO and thickness rays look (object units).
     far: f32,
     frames: Frames,
     /// The high mesh's curvature per vertex (curvature bakes).
     curvature: Vec<f32>,
-    /// The high mesh's part per triangle (ID bakes).
+    /// The high mesh's piece, object or material per triangle (ID bakes but by colour).
     parts: Vec<u32>,
     /// The low mesh's bounding box (position bakes).
     bounds: (Vec3, Vec3),
@@ -74,14 +74,14 @@ impl<'a> Sampler<'a> {
     /// default's size first).
     pub(super) fn new(
         (low, uv, high, cage): (&'a Mesh, &'a UvBake, &'a Mesh, Option<&'a Mesh>),
-        rays: &'a RayMesh,
+        rays: &'a HighRays,
         options: HighOptions,
         (size, front, rear): (f32, f32, f32),
     ) -> Self {
         let map = options.map;
         let far = match (map, options.max_distance) {
             (_, Some(d)) => d,
-            (HighMap::Thickness, None) => rays.diagonal,
+            (HighMap::Thickness, None) => rays.diagonal(),
             _ => f32::INFINITY,
         };
         let grid = options.samples.isqrt().max(1);
@@ -121,10 +121,11 @@ impl<'a> Sampler<'a> {
             } else {
                 Vec::new()
             },
-            parts: if map == HighMap::Id {
-                high.parts()
-            } else {
-                Vec::new()
+            parts: match map {
+                HighMap::Id(IdSource::Piece) => high.parts(),
+                HighMap::Id(IdSource::Object) => labelled(&high.labels.objects, high),
+                HighMap::Id(IdSource::Material) => labelled(&high.labels.materials, high),
+                _ => Vec::new(),
             },
             bounds,
             grid: if texel_uvs.is_empty() { 1 } else { grid },
@@ -159,7 +160,7 @@ impl<'a> Sampler<'a> {
         let mean = sum / count as f32;
         let value = match self.map {
             HighMap::Normal(_) => mean.try_normalize().unwrap_or(Vec3::Z) * 0.5 + 0.5,
-            HighMap::Id => id.unwrap_or(Vec3::ZERO),
+            HighMap::Id(_) => id.unwrap_or(Vec3::ZERO),
             _ => mean,
         };
         let unorm = |v: f32| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
@@ -226,7 +227,8 @@ impl<'a> Sampler<'a> {
                 (len > self.nudge).then(|| (from, d / len, len))
             })
             .unwrap_or((p + n * self.front, -n, self.front));
-        let found = cast(self.rays, origin, dir, to_low + self.rear, self.nudge);
+        let rays = self.rays.for_low(t);
+        let found = rays.and_then(|r| cast(r, origin, dir, to_low + self.rear, self.nudge));
         let face = geometric_normal(corners, n);
         let skew_degrees = (-dir).dot(face).clamp(-1.0, 1.0).acos().to_degrees();
         let value = match self.map {
@@ -251,11 +253,14 @@ impl<'a> Sampler<'a> {
                     (q, geometric_normal(c, high_normal(self.high, tri, q)))
                 });
                 let set = &self.directions;
-                Vec3::splat(if self.map == HighMap::Ao {
-                    self.rays.open_fraction(q, g, set, self.far, turn_of(seed))
-                } else {
-                    self.rays.mean_distance(q, -g, set, self.far, turn_of(seed))
-                })
+                // Nothing to meet (a low part whose pair has no high triangle): open.
+                Vec3::splat(rays.map_or(1.0, |rays| {
+                    if self.map == HighMap::Ao {
+                        rays.open_fraction(q, g, set, self.far, turn_of(seed))
+                    } else {
+                        rays.mean_distance(q, -g, set, self.far, turn_of(seed))
+                    }
+                }))
             }
             HighMap::Curvature => {
                 let k = found.map_or(0.0, |(q, tri, _)| {
@@ -266,7 +271,14 @@ impl<'a> Sampler<'a> {
                 });
                 Vec3::splat(0.5 + 0.5 * k)
             }
-            HighMap::Id => found.map_or(Vec3::ZERO, |(_, tri, _)| {
+            HighMap::Id(IdSource::Color) => found.map_or(Vec3::ZERO, |(q, tri, _)| {
+                let colors = self.high.labels.colors.as_deref().unwrap_or(&[]);
+                let b = barycentric_on(self.high, tri, q);
+                let [ca, cb, cc] = self.high.triangles[tri as usize]
+                    .map(|v| colors.get(v as usize).copied().unwrap_or(Vec3::ONE));
+                ca * b.x + cb * b.y + cc * b.z
+            }),
+            HighMap::Id(_) => found.map_or(Vec3::ZERO, |(_, tri, _)| {
                 part_colour(self.parts.get(tri as usize).copied().unwrap_or(0))
             }),
             HighMap::Position => {
@@ -332,6 +344,18 @@ fn high_normal(mesh: &Mesh, t: u32, q: Vec3) -> Vec3 {
         .try_normalize()
         .or_else(|| (b - a).cross(c - a).try_normalize())
         .unwrap_or(Vec3::Z)
+}
+
+/// Per triangle of `mesh`, the number of its run's name in order of first appearance (a
+/// triangle no run names counts as one more name).
+fn labelled(runs: &[crate::Run], mesh: &Mesh) -> Vec<u32> {
+    let named = Named::of(runs, mesh.triangles.len());
+    let none = named.names.len() as u32;
+    named
+        .of_triangle
+        .into_iter()
+        .map(|k| if k == Named::NONE { none } else { k })
+        .collect()
 }
 
 /// Part `k`'s colour in an ID map: hues a golden angle apart (neighbouring parts far apart on
