@@ -239,3 +239,82 @@ fn matching_by_name_without_pairs_says_so_and_keeps_nothing() {
     assert_eq!(state.doc().history().undo_steps().count(), steps);
     let _ = std::fs::remove_file(named_path());
 }
+
+/// Where the cage test's files are written.
+fn cage_dir() -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("kapaint-editor-cage-{}", std::process::id()))
+}
+
+fn answer_cage(request: &FileRequest) -> Option<std::path::PathBuf> {
+    (request.purpose == FilePurpose::Cage).then(|| cage_dir().join("cage.obj"))
+}
+
+/// A cage chosen in the dialog is read on a worker and drawn as it is (the dialog holds it);
+/// one of another topology is refused with an error and not drawn.
+#[test]
+fn a_chosen_cage_is_read_for_the_preview_and_a_wrong_one_refused() {
+    let dir = cage_dir();
+    std::fs::create_dir_all(&dir).expect("dir");
+    let low_obj = dir.join("low.obj");
+    std::fs::write(
+        &low_obj,
+        kapaint::mesh::write_obj(&kapaint::mesh::uv_sphere(32, 16)),
+    )
+    .expect("writes");
+    let low = kapaint::mesh::open(&low_obj).expect("loads");
+    let mut cage = low.clone();
+    for p in &mut cage.positions {
+        *p *= 1.05;
+    }
+    std::fs::write(dir.join("cage.obj"), kapaint::mesh::write_obj(&cage)).expect("writes");
+    let project = dir.join("low.kapaint");
+    let made = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(["new", "--size", "64", "--mesh"])
+        .arg(&low_obj)
+        .arg("--out")
+        .arg(&project)
+        .output()
+        .expect("runs");
+    assert!(made.status.success(), "{made:?}");
+    let mut harness = kit::editor_on(&project);
+    let files = harness.state_mut().state.files_mut();
+    files.force(FileDialogBackend::System);
+    files.set_system_dialog(answer_cage);
+    harness.get_by_label("Mesh").click();
+    harness.run_steps(2);
+    harness.get_by_label("Bake from high poly…").click();
+    harness.run_steps(2);
+    harness.get_by_label("Choose…").click();
+    wait_until(&mut harness, "the cage read", |e| {
+        e.state
+            .bake_high_dialog()
+            .is_some_and(|d| d.cage_mesh.is_some())
+    });
+    let dialog = harness.state().state.bake_high_dialog().expect("open");
+    assert_eq!(
+        dialog.cage_mesh.as_ref().map(|c| c.positions.clone()),
+        Some(cage.positions.clone())
+    );
+    harness.run_steps(2);
+
+    // Another topology: refused, not drawn.
+    std::fs::write(
+        dir.join("cage.obj"),
+        kapaint::mesh::write_obj(&kapaint::mesh::uv_sphere(16, 8)),
+    )
+    .expect("writes");
+    harness.get_by_label("Choose…").click();
+    wait_until(&mut harness, "the cage refused", |e| {
+        e.state
+            .notices()
+            .iter()
+            .any(|n| n.text.contains("topology"))
+    });
+    let state = &harness.state().state;
+    assert!(
+        state
+            .bake_high_dialog()
+            .is_some_and(|d| d.cage_mesh.is_none())
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

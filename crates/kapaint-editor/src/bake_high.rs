@@ -33,6 +33,8 @@ pub struct HighDialog {
     pub highs: Vec<PathBuf>,
     /// The cage, if the rays start on one.
     pub cage: Option<PathBuf>,
+    /// The cage as read (on a worker once chosen), drawn in the viewport.
+    pub cage_mesh: Option<std::sync::Arc<Mesh>>,
     /// Bake the normal map (tangent space) rather than the maps `bakes` checks.
     pub normal_map: bool,
     /// The maps of [`BAKE_MAPS`] to bake, when not the normal map.
@@ -54,6 +56,7 @@ impl Default for HighDialog {
         Self {
             highs: Vec::new(),
             cage: None,
+            cage_mesh: None,
             normal_map: true,
             bakes: [true, false, true, false, false],
             front: None,
@@ -160,6 +163,24 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
             Ok(Made { keep, lines })
         },
         kept,
+    ))
+}
+
+/// The job reading the cage at `path` and checking it is `doc`'s mesh pushed out; the dialog
+/// draws it once read.
+pub(super) fn read_cage(doc: &Document, path: PathBuf) -> Ask {
+    let Some(surface) = doc.surface().cloned() else {
+        return Ask::Notice(notice("there is no mesh for a cage to fit", true));
+    };
+    Ask::Job(JobStart::new(
+        "Cage",
+        move |progress| {
+            progress.start("read the cage", 1);
+            let cage = kapaint_mesh::open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            kapaint_mesh::bakes::check_cage(&surface.mesh, &cage).map_err(|e| e.to_string())?;
+            Ok((path, std::sync::Arc::new(cage)))
+        },
+        |(path, cage), desk| desk.ask(Ask::CageRead(path, cage)),
     ))
 }
 
@@ -272,6 +293,7 @@ fn meshes_and_distances(ui: &mut egui::Ui, dialog: &mut HighDialog, desk: &mut D
         }
         if dialog.cage.is_some() && ui.button("None").clicked() {
             dialog.cage = None;
+            dialog.cage_mesh = None;
         }
     });
     ui.checkbox(

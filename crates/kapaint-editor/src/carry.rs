@@ -87,6 +87,13 @@ impl EditorState {
                 Ask::Act(action) => self.act(&[action]),
                 Ask::Show(window) => self.show(window),
                 Ask::Open(path) => self.open(path),
+                Ask::CageRead(path, cage) => {
+                    if let Some(dialog) = &mut self.dialogs.bake_high
+                        && dialog.cage.as_ref() == Some(&path)
+                    {
+                        dialog.cage_mesh = Some(cage);
+                    }
+                }
             }
         }
     }
@@ -252,7 +259,10 @@ impl EditorState {
                 FilePurpose::HighMesh | FilePurpose::Cage => {
                     if let Some(dialog) = &mut self.dialogs.bake_high {
                         if purpose == FilePurpose::Cage {
-                            dialog.cage = Some(path);
+                            dialog.cage = Some(path.clone());
+                            dialog.cage_mesh = None;
+                            let read = crate::bake_high::read_cage(&self.doc, path);
+                            self.carry_out(vec![read]);
                         } else if !dialog.highs.contains(&path) {
                             dialog.highs.push(path);
                         }

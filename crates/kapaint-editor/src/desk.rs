@@ -92,6 +92,8 @@ pub(crate) enum Ask {
     ProjectImage(kapaint_model::paint_image::PaintImage),
     /// Open this project (asking first about unsaved changes).
     Open(PathBuf),
+    /// The cage Mesh > Bake from high poly chose, read: drawn while the dialog still names it.
+    CageRead(PathBuf, std::sync::Arc<kapaint_mesh::Mesh>),
 }
 
 /// The editor's windows a menu opens.

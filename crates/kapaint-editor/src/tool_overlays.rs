@@ -97,10 +97,11 @@ pub(crate) fn clone_marker(painter: &egui::Painter, c: egui::Pos2) {
 /// any mesh.
 const CAGE_TRIANGLES: usize = 20_000;
 
-/// Mesh > Bake from high poly's cage while its dialog (`dialog`) is open: `mesh` pushed out
-/// along its normals by the front distance (the dialog's, or by default 2 % of the mesh's
-/// diagonal, as the bake's default reads the meshes' size), drawn as a wireframe of the faces
-/// turned to the camera on each picture, so the distance is seen while it is dragged.
+/// Mesh > Bake from high poly's cage while its dialog (`dialog`) is open: the chosen cage file
+/// once read, else `mesh` pushed out along its normals by the front distance (the dialog's, or
+/// by default 2 % of the mesh's diagonal, as the bake's default reads the meshes' size), drawn
+/// as a wireframe of the faces turned to the camera on each picture, so the distance is seen
+/// while it is dragged.
 pub(crate) fn cage_preview(
     response: &egui::Response,
     viewport: &Viewport,
@@ -118,9 +119,17 @@ pub(crate) fn cage_preview(
     let painter = painter(response);
     let stride = mesh.triangles.len().div_ceil(CAGE_TRIANGLES).max(1);
     let colour = egui::Color32::from_rgba_unmultiplied(255, 190, 60, 150);
+    // A chosen cage, once read, as it is; else the mesh pushed out by the front distance.
+    let cage = dialog
+        .cage_mesh
+        .as_deref()
+        .filter(|c| c.positions.len() == mesh.positions.len());
     let pushed = |v: u32| {
         let v = v as usize;
-        mesh.positions[v] + mesh.normals.get(v).copied().unwrap_or_default() * front
+        match cage {
+            Some(c) => c.positions[v],
+            None => mesh.positions[v] + mesh.normals.get(v).copied().unwrap_or_default() * front,
+        }
     };
     for picture in viewport.pictures(rect) {
         let view_proj = viewport

@@ -20,7 +20,7 @@ mod high;
 mod rays;
 pub use high::{
     DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching,
-    NormalSpace, SAMPLES, bake_from_high, bake_from_high_with,
+    NormalSpace, SAMPLES, bake_from_high, bake_from_high_with, check_cage,
 };
 use rays::turn_of;
 pub use rays::{Directions, RayMesh};

@@ -470,7 +470,10 @@ fn check_id(high: &Mesh, map: HighMap) -> Result<(), BakeError> {
 
 /// Refuses a cage that is not the low mesh pushed out: the same vertices and triangles, finite
 /// positions.
-fn check_cage(low: &Mesh, cage: &Mesh) -> Result<(), BakeError> {
+///
+/// # Errors
+/// What is wrong with the cage.
+pub fn check_cage(low: &Mesh, cage: &Mesh) -> Result<(), BakeError> {
     if cage.positions.len() != low.positions.len() || cage.triangles != low.triangles {
         return Err(format!(
             "the cage {} ({} vertices, {} triangles) is not the low mesh's topology ({} vertices, {} triangles): a cage is the low mesh with its vertices moved",
