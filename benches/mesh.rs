@@ -508,7 +508,45 @@ fn high_bakes(c: &mut Criterion) {
     group.bench_function("ao_64_rays_512", |b| {
         b.iter(|| bake_from_high(&spot, &uv, &high, None, ao, None).expect("bakes"));
     });
+    gpu_ao(&mut group, &spot, &high, ao);
     group.finish();
+}
+
+/// AO at 64 rays at 4096^2 on a GPU (issue 57: at most 3 s on an H100 or H200), the BVH built
+/// already, its upload and the pipeline included: on a hardware adapter, or on any with
+/// `KAPAINT_BENCH_GPU=any` (lavapipe: slower than the CPU); skipped, said, without one.
+fn gpu_ao(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    spot: &mesh::Mesh,
+    high: &mesh::Mesh,
+    ao: kapaint::mesh::bakes::HighOptions,
+) {
+    use kapaint::gpu::rays::{GpuCaster, RaysOn};
+    use kapaint::mesh::bakes::{HighRays, Matching, bake_from_high_on};
+    let choice = if std::env::var("KAPAINT_BENCH_GPU").is_ok_and(|v| v == "any") {
+        RaysOn::Gpu
+    } else {
+        RaysOn::Auto
+    };
+    let Ok(Some(gpu)) = choice.open() else {
+        eprintln!("ao_64_rays_4096_gpu: no hardware GPU here (KAPAINT_BENCH_GPU=any for any)");
+        return;
+    };
+    let uv = bake(spot, 4096, 4096, 4).expect("bakes");
+    let rays = HighRays::new(spot, high, Matching::All).expect("builds");
+    let one = rays.single().expect("one BVH");
+    let run = || {
+        let caster = GpuCaster::new(&gpu, one).expect("uploads");
+        bake_from_high_on(spot, &uv, (high, &rays), None, ao, &caster, None).expect("bakes")
+    };
+    let once = run();
+    eprintln!(
+        "AO on {} at 4096^2, 64 rays: {} texels, mean {:.4}",
+        once.cast_on,
+        once.covered,
+        once.data.iter().map(|&v| f64::from(v)).sum::<f64>() / 65535.0 / once.covered as f64
+    );
+    group.bench_function("ao_64_rays_4096_gpu", |b| b.iter(run));
 }
 
 criterion_group!(

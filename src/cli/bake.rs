@@ -112,6 +112,11 @@ pub struct BakeArgs {
     /// than one, else objects where it names more than one, else pieces).
     #[arg(long, requires = "high", value_enum)]
     id_from: Option<super::bake_high::IdArg>,
+    /// With --high, for ao and thickness: where the rays run: auto (a hardware GPU where
+    /// this machine has one, else the CPU), cpu, or gpu (any adapter, software ones included).
+    /// Parts matched by name bake on the CPU.
+    #[arg(long, requires = "high", value_enum, default_value_t = super::bake_high::DeviceArg::Auto)]
+    device: super::bake_high::DeviceArg,
     /// Overwrite an existing file.
     #[arg(long)]
     force: bool,
@@ -186,6 +191,7 @@ impl BakeArgs {
                 skew: self.skew.as_ref(),
                 matching: self.matching.is_some(),
                 id_from: self.id_from.map(super::bake_high::IdArg::source),
+                device: self.device.choice(),
             });
         }
         let Some(map) = self.map.own() else {

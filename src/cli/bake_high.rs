@@ -8,10 +8,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{CliError, model_error};
+use crate::gpu::rays::{GpuCaster, RaysOn};
 use crate::mesh::Mesh;
 use crate::mesh::bakes::{
-    HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching, NormalSpace,
-    bake_from_high_with,
+    CpuCaster, HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching,
+    NormalSpace, RayCaster, bake_from_high_on,
 };
 use crate::model::project;
 
@@ -56,6 +57,28 @@ impl IdArg {
     }
 }
 
+/// Where AO and thickness rays run (`--device`).
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum DeviceArg {
+    /// A hardware GPU where there is one, else the CPU.
+    Auto,
+    /// The CPU.
+    Cpu,
+    /// Any GPU adapter, software ones included.
+    Gpu,
+}
+
+impl DeviceArg {
+    /// The choice.
+    pub fn choice(self) -> RaysOn {
+        match self {
+            Self::Auto => RaysOn::Auto,
+            Self::Cpu => RaysOn::Cpu,
+            Self::Gpu => RaysOn::Gpu,
+        }
+    }
+}
+
 /// What `kapaint bake --high` is asked.
 pub struct HighRequest<'a> {
     /// The project.
@@ -76,6 +99,8 @@ pub struct HighRequest<'a> {
     pub matching: bool,
     /// What an ID map tells apart; `None`: what the high mesh names.
     pub id_from: Option<IdSource>,
+    /// Where AO and thickness rays run.
+    pub device: RaysOn,
 }
 
 /// Bakes and keeps or writes the map; returns what the command prints.
@@ -120,15 +145,30 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     } else {
         Matching::All
     };
+    // A GPU only for the maps that cast rays from the point met, through one BVH.
+    let device = if options.map.casts_rays() && matching == Matching::All {
+        r.device
+            .open()
+            .map_err(|e| CliError::usage(format!("--device: {e}")))?
+    } else {
+        None
+    };
     let progress = crate::task::Progress::default();
     let (baked, rays) = super::progress::with_bar("bake", &progress, || {
         let rays = HighRays::new(&surface.mesh, &high, matching)?;
-        let mut baked = bake_from_high_with(
+        let on_gpu = match (&device, rays.single()) {
+            (Some(gpu), Some(one)) => Some(GpuCaster::new(gpu, one).map_err(|e| e.to_string())?),
+            _ => None,
+        };
+        let cpu = CpuCaster(rays.meshes());
+        let caster: &dyn RayCaster = on_gpu.as_ref().map_or(&cpu, |g| g);
+        let mut baked = bake_from_high_on(
             &surface.mesh,
             &surface.bake,
             (&high, &rays),
             cage.as_ref(),
             options,
+            caster,
             Some(&progress),
         )?;
         baked.bvh_seconds = rays.bvh_seconds;
@@ -148,22 +188,7 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
         );
     }
     drop(rays);
-    let misses: Vec<u8> = baked.misses.iter().map(|&m| u8::from(m) * 255).collect();
-    for (what, file, on) in [
-        ("the miss map", r.misses, misses.as_slice()),
-        ("the skew view", r.skew, baked.skew.as_slice()),
-    ] {
-        let Some(file) = file else { continue };
-        let grey =
-            image::ImageBuffer::<image::Luma<u8>, &[u8]>::from_raw(baked.width, baked.height, on)
-                .ok_or_else(|| CliError::io("bake size mismatch"))?;
-        let mut png = std::io::Cursor::new(Vec::new());
-        grey.write_to(&mut png, image::ImageFormat::Png)
-            .map_err(|e| CliError::io(e.to_string()))?;
-        crate::atomic::write_atomic(file, png.get_ref())
-            .map_err(|e| CliError::of_io(format!("{}: {e}", file.display()), &e))?;
-        let _ = write!(line, "\nwrote {what} {}", file.display());
-    }
+    write_views(r, &baked, &mut line)?;
     if let Some(out) = r.out {
         let exr = out
             .extension()
@@ -183,6 +208,27 @@ pub fn run(r: &HighRequest<'_>) -> Result<String, CliError> {
     doc.apply(keep).map_err(model_error)?;
     project::save_checked(&doc, r.project, on_disk.as_ref()).map_err(model_error)?;
     Ok(format!("{line}\n{kept} {}\n", r.project.display()))
+}
+
+/// Writes the miss map and the skew view where asked, a line each onto `line`.
+fn write_views(r: &HighRequest<'_>, baked: &HighBake, line: &mut String) -> Result<(), CliError> {
+    let misses: Vec<u8> = baked.misses.iter().map(|&m| u8::from(m) * 255).collect();
+    for (what, file, on) in [
+        ("the miss map", r.misses, misses.as_slice()),
+        ("the skew view", r.skew, baked.skew.as_slice()),
+    ] {
+        let Some(file) = file else { continue };
+        let grey =
+            image::ImageBuffer::<image::Luma<u8>, &[u8]>::from_raw(baked.width, baked.height, on)
+                .ok_or_else(|| CliError::io("bake size mismatch"))?;
+        let mut png = std::io::Cursor::new(Vec::new());
+        grey.write_to(&mut png, image::ImageFormat::Png)
+            .map_err(|e| CliError::io(e.to_string()))?;
+        crate::atomic::write_atomic(file, png.get_ref())
+            .map_err(|e| CliError::of_io(format!("{}: {e}", file.display()), &e))?;
+        let _ = write!(*line, "\nwrote {what} {}", file.display());
+    }
+    Ok(())
 }
 
 /// The project, opened with its mesh attached, that mesh's surface, and the file as read (a
@@ -269,9 +315,10 @@ fn summary(r: &HighRequest<'_>, high: &Mesh, baked: &HighBake, seconds: f64) -> 
         let cast = baked.covered * u64::from(baked.samples) * u64::from(baked.rays);
         let tracing = (seconds - baked.bvh_seconds).max(1e-9);
         format!(
-            " (the BVH {:.2} s), {cast} rays ({:.2} M rays/s after the BVH)",
+            " (the BVH {:.2} s), {cast} rays ({:.2} M rays/s after the BVH) on {}",
             baked.bvh_seconds,
-            cast as f64 / tracing / 1e6
+            cast as f64 / tracing / 1e6,
+            baked.cast_on
         )
     } else {
         String::new()

@@ -8,10 +8,13 @@ use std::path::PathBuf;
 use super::notice;
 use crate::desk::{Ask, Desk, JobStart, centred};
 use crate::files::FilePurpose;
+use kapaint_gpu::rays::{GpuCaster, RaysOn};
 use kapaint_mesh::Mesh;
 use kapaint_mesh::bakes::{
-    HighMap, HighOptions, HighRays, HighSource, Matching, NormalSpace, SAMPLES, bake_from_high_with,
+    CpuCaster, HighMap, HighOptions, HighRays, HighSource, Matching, NormalSpace, RayCaster,
+    SAMPLES, bake_from_high_on,
 };
+use kapaint_model::surface::Surface;
 use kapaint_model::{Document, ImportCommand};
 
 /// The maps kept as the project's bakes, with their names in the dialog.
@@ -126,38 +129,13 @@ pub(super) fn bake(doc: &Document, dialog: &HighDialog) -> Ask {
                     rays.unpaired_high
                 ));
             }
-            let mut bakes = Vec::with_capacity(maps.len());
-            for map in maps {
-                let options = HighOptions {
-                    front: dialog.front,
-                    rear: dialog.rear,
-                    rays: dialog.rays,
-                    samples: dialog.samples,
-                    ..HighOptions::new(map)
-                };
-                let start = std::time::Instant::now();
-                let b = bake_from_high_with(
-                    &surface.mesh,
-                    &surface.bake,
-                    (&high, &rays),
-                    cage.as_ref(),
-                    options,
-                    Some(progress),
-                )
-                .map_err(|e| e.to_string())?;
-                let share = b.missed as f64 / b.covered.max(1) as f64 * 100.0;
-                lines.push(format!(
-                    "baked {} from {}: {} texels, front {:.4} rear {:.4}, missed {} ({share:.3} %), {:.1} s",
-                    name(b.map),
-                    high.name,
-                    b.covered,
-                    b.front,
-                    b.rear,
-                    b.missed,
-                    start.elapsed().as_secs_f64()
-                ));
-                bakes.push(b);
-            }
+            let bakes = bake_maps(
+                (&surface, &high, cage.as_ref(), &rays),
+                &maps,
+                &dialog,
+                progress,
+                &mut lines,
+            )?;
             let source = HighSource::of(&high, cage.as_ref());
             let keep = ImportCommand::keep_high(bakes, surface.mesh_hash, &source)?;
             Ok(Made { keep, lines })
@@ -182,6 +160,67 @@ pub(super) fn read_cage(doc: &Document, path: PathBuf) -> Ask {
         },
         |(path, cage), desk| desk.ask(Ask::CageRead(path, cage)),
     ))
+}
+
+/// Each of `maps` baked onto `surface` from `high` through `rays`, a line each on what its
+/// rays found into `lines`. AO and thickness rays run on a hardware GPU where this machine has
+/// one (a device of the bake's own), else on every core.
+fn bake_maps(
+    (surface, high, cage, rays): (&Surface, &Mesh, Option<&Mesh>, &HighRays),
+    maps: &[HighMap],
+    dialog: &HighDialog,
+    progress: &kapaint_base::task::Progress,
+    lines: &mut Vec<String>,
+) -> Result<Vec<kapaint_mesh::bakes::HighBake>, String> {
+    let gpu = match rays.single() {
+        Some(_) if maps.iter().any(|m| m.casts_rays()) => RaysOn::Auto.open().ok().flatten(),
+        _ => None,
+    };
+    let on_gpu = match (&gpu, rays.single()) {
+        (Some(gpu), Some(one)) => GpuCaster::new(gpu, one).ok(),
+        _ => None,
+    };
+    let cpu = CpuCaster(rays.meshes());
+    let caster: &dyn RayCaster = on_gpu.as_ref().map_or(&cpu, |g| g);
+    let mut bakes = Vec::with_capacity(maps.len());
+    for &map in maps {
+        let options = HighOptions {
+            front: dialog.front,
+            rear: dialog.rear,
+            rays: dialog.rays,
+            samples: dialog.samples,
+            ..HighOptions::new(map)
+        };
+        let start = std::time::Instant::now();
+        let b = bake_from_high_on(
+            &surface.mesh,
+            &surface.bake,
+            (high, rays),
+            cage,
+            options,
+            caster,
+            Some(progress),
+        )
+        .map_err(|e| e.to_string())?;
+        let share = b.missed as f64 / b.covered.max(1) as f64 * 100.0;
+        let on = if b.cast_on.is_empty() {
+            String::new()
+        } else {
+            format!(" on {}", b.cast_on)
+        };
+        lines.push(format!(
+            "baked {} from {}: {} texels, front {:.4} rear {:.4}, missed {} ({share:.3} %), {:.1} s{on}",
+            name(b.map),
+            high.name,
+            b.covered,
+            b.front,
+            b.rear,
+            b.missed,
+            start.elapsed().as_secs_f64()
+        ));
+        bakes.push(b);
+    }
+    Ok(bakes)
 }
 
 /// The maps baked: into the document as one step, with a line each on what the rays found.

@@ -8,6 +8,7 @@ pub mod headless;
 pub mod maps;
 pub mod normal;
 pub mod preview;
+pub mod rays;
 pub mod readback;
 pub mod shader;
 mod upload;

@@ -10,7 +10,7 @@ use kapaint_core::render::ViewMode;
 use kapaint_reflectance::wgsl::{IDS_FILE, model_and_approx_ids, screaming_snake, shader_id};
 
 /// Every file in `shaders/`, by name.
-pub const FILES: [(&str, &str); 11] = [
+pub const FILES: [(&str, &str); 12] = [
     (
         "ambient.wgsl",
         include_str!("../../../shaders/ambient.wgsl"),
@@ -18,6 +18,10 @@ pub const FILES: [(&str, &str); 11] = [
     (
         "ambient_view.wgsl",
         include_str!("../../../shaders/ambient_view.wgsl"),
+    ),
+    (
+        "bake_rays.wgsl",
+        include_str!("../../../shaders/bake_rays.wgsl"),
     ),
     (
         "chi_check.wgsl",

@@ -20,10 +20,10 @@ mod high;
 mod rays;
 pub use high::{
     DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching,
-    NormalSpace, SAMPLES, bake_from_high, bake_from_high_with, check_cage,
+    NormalSpace, SAMPLES, bake_from_high, bake_from_high_on, bake_from_high_with, check_cage,
 };
 use rays::turn_of;
-pub use rays::{Directions, RayMesh};
+pub use rays::{CpuCaster, Directions, RayBatch, RayCaster, RayKind, RayMesh, RayQuery};
 
 use crate::Mesh;
 use crate::bake::{Coverage, UvBake};

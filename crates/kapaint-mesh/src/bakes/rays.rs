@@ -177,7 +177,7 @@ impl RayMesh {
     }
 
     /// [`RayMesh::occluded`] in local units.
-    fn occluded_local(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
+    pub(super) fn occluded_local(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
         let ray = ray(origin, dir, far);
         !self
             .bvh
@@ -185,7 +185,7 @@ impl RayMesh {
     }
 
     /// [`RayMesh::distance`] in local units.
-    fn distance_local(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
+    pub(super) fn distance_local(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
         let ray = ray(origin, dir, far);
         let mut hit = obvhs::ray::RayHit::none();
         self.bvh
@@ -235,6 +235,69 @@ impl RayMesh {
     fn offset(&self) -> f32 {
         self.frame.local_diagonal() * 1e-5
     }
+
+    /// The rays [`RayMesh::open_fraction`] (and, about the opposite normal,
+    /// [`RayMesh::mean_distance`]) casts from `point` about unit `normal`, turned by `turn`,
+    /// as a query: their origin (local units, off the surface) and the frame the set is turned
+    /// into. `group` is the BVH it is for.
+    pub fn query(&self, point: Vec3, normal: Vec3, turn: f32, group: u32) -> RayQuery {
+        let (t, b) = Directions::turned_frame(normal, turn);
+        RayQuery {
+            origin: self.frame.local_from_object(point) + normal * self.offset(),
+            t,
+            b,
+            n: normal,
+            group,
+        }
+    }
+
+    /// The BVH as a GPU reads it: per node 20 words (its origin's three floats' bits; the
+    /// three exponents and the internal-child mask, a byte each; the first child node; the
+    /// first triangle; the children's meta bytes, 8; their quantised boxes, min x, max x, min
+    /// y, max y, min z, max z, 8 bytes each), and per triangle (in the order the leaves name
+    /// them) its three corners, 9 floats, in the BVH's frame.
+    pub fn gpu_layout(&self) -> (Vec<u32>, Vec<f32>) {
+        let word = |b: [u8; 4]| u32::from_le_bytes(b);
+        let pair = |b: [u8; 8]| {
+            [
+                word([b[0], b[1], b[2], b[3]]),
+                word([b[4], b[5], b[6], b[7]]),
+            ]
+        };
+        let nodes = self
+            .bvh
+            .nodes
+            .iter()
+            .flat_map(|n| {
+                let mut w = vec![
+                    n.p.x.to_bits(),
+                    n.p.y.to_bits(),
+                    n.p.z.to_bits(),
+                    word([n.e[0], n.e[1], n.e[2], n.imask]),
+                    n.child_base_idx,
+                    n.primitive_base_idx,
+                ];
+                for bytes in [
+                    n.child_meta,
+                    n.child_min_x,
+                    n.child_max_x,
+                    n.child_min_y,
+                    n.child_max_y,
+                    n.child_min_z,
+                    n.child_max_z,
+                ] {
+                    w.extend(pair(bytes));
+                }
+                w
+            })
+            .collect();
+        let triangles = self
+            .triangles
+            .iter()
+            .flat_map(|t| [t.v0, t.v1, t.v2].into_iter().flat_map(|v| v.to_array()))
+            .collect();
+        (nodes, triangles)
+    }
 }
 
 /// A ray from `origin` along unit `dir` to `far` (local units). A direction's negative zero is
@@ -276,10 +339,127 @@ impl Directions {
 
     /// The set about unit `normal`, turned by `turn` (a fraction of a full turn).
     pub(super) fn around(&self, normal: Vec3, turn: f32) -> impl Iterator<Item = Vec3> + '_ {
+        let (t, b) = Self::turned_frame(normal, turn);
+        self.0.iter().map(move |d| t * d.x + b * d.y + normal * d.z)
+    }
+
+    /// The tangents `(t, b)` the set's `x` and `y` turn into about unit `normal`, turned by
+    /// `turn`: a direction `d` of the set is `t d.x + b d.y + normal d.z`.
+    pub(super) fn turned_frame(normal: Vec3, turn: f32) -> (Vec3, Vec3) {
         let (t, b) = normal.any_orthonormal_pair();
         let (sin, cos) = (std::f32::consts::TAU * turn).sin_cos();
-        let (t, b) = (t * cos + b * sin, b * cos - t * sin);
-        self.0.iter().map(move |d| t * d.x + b * d.y + normal * d.z)
+        (t * cos + b * sin, b * cos - t * sin)
+    }
+
+    /// The directions about `+z`.
+    pub fn as_slice(&self) -> &[Vec3] {
+        &self.0
+    }
+}
+
+/// One sample's AO or thickness rays: from `origin` (the BVH's frame, off the surface), each
+/// direction `d` of the set as `t d.x + b d.y + n d.z`, against BVH `group`
+/// ([`RayQuery::NONE`]: none, so nothing is met).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RayQuery {
+    /// Where the rays start (local units).
+    pub origin: Vec3,
+    /// The set's `x` turned.
+    pub t: Vec3,
+    /// The set's `y` turned.
+    pub b: Vec3,
+    /// The set's `z`: the normal the rays open about.
+    pub n: Vec3,
+    /// Which BVH.
+    pub group: u32,
+}
+
+impl RayQuery {
+    /// No BVH: every ray open.
+    pub const NONE: u32 = u32::MAX;
+}
+
+/// What a batch of queries measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// The fraction of the directions that meet nothing before `far` (ambient occlusion).
+    Open,
+    /// The mean over the directions of `min(distance, far) / far` (thickness).
+    Depth,
+}
+
+/// Queries to cast, with the direction set and how far the rays look (local units).
+pub struct RayBatch<'a> {
+    /// The queries.
+    pub queries: &'a [RayQuery],
+    /// The set about `+z`.
+    pub directions: &'a [Vec3],
+    /// How far a ray looks (local units; may be infinite).
+    pub far: f32,
+    /// What is measured.
+    pub kind: RayKind,
+}
+
+/// What casts a bake's AO and thickness rays: every core ([`CpuCaster`], the reference), or
+/// a GPU.
+pub trait RayCaster: Sync {
+    /// Per query, what `batch.kind` measures.
+    ///
+    /// # Errors
+    /// What the device said.
+    fn cast(&self, batch: &RayBatch<'_>) -> Result<Vec<f32>, String>;
+
+    /// How many queries a batch should hold: few for the CPU (cancelled within moments),
+    /// many for a GPU.
+    fn batch_size(&self) -> usize;
+
+    /// Where the rays ran, for reports ("the CPU", a GPU's name).
+    fn name(&self) -> String;
+}
+
+/// Casts on every core against `groups` (a query's `group` names its BVH).
+pub struct CpuCaster<'a>(pub &'a [Option<RayMesh>]);
+
+impl RayCaster for CpuCaster<'_> {
+    fn cast(&self, batch: &RayBatch<'_>) -> Result<Vec<f32>, String> {
+        use rayon::prelude::*;
+        let set = batch.directions;
+        let count = set.len().max(1) as f32;
+        Ok(batch
+            .queries
+            .par_iter()
+            .with_min_len(16)
+            .map(|q| {
+                let Some(Some(mesh)) = self.0.get(q.group as usize) else {
+                    return 1.0;
+                };
+                let dirs = set.iter().map(|d| q.t * d.x + q.b * d.y + q.n * d.z);
+                match batch.kind {
+                    RayKind::Open => {
+                        dirs.filter(|&dir| !mesh.occluded_local(q.origin, dir, batch.far))
+                            .count() as f32
+                            / count
+                    }
+                    RayKind::Depth => {
+                        dirs.map(|dir| {
+                            mesh.distance_local(q.origin, dir, batch.far)
+                                .map_or(1.0, |t| t / batch.far)
+                        })
+                        .sum::<f32>()
+                            / count
+                    }
+                }
+            })
+            .collect())
+    }
+
+    fn batch_size(&self) -> usize {
+        // About a second of rays on two cores at 64 a query: a cancel is seen within it.
+        1 << 16
+    }
+
+    fn name(&self) -> String {
+        "the CPU".into()
     }
 }
 

@@ -16,7 +16,9 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, RAYS};
+use super::{
+    BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, CpuCaster, RAYS, RayCaster, RayQuery,
+};
 use crate::Mesh;
 use crate::bake::{Coverage, UvBake};
 use crate::frame::UnitFrame;
@@ -222,6 +224,8 @@ pub struct HighBake {
     /// 0 to 90 degrees as 0 to 255 (the skew view: where the low mesh's averaged normals tilt
     /// the rays).
     pub skew: Vec<u8>,
+    /// Where the AO or thickness rays ran ([`RayCaster::name`]); empty for the other maps.
+    pub cast_on: String,
 }
 
 /// The meshes a bake from a high mesh came from, as a project names them: taken once for
@@ -297,9 +301,9 @@ pub fn bake_from_high(
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
-    let distances = checked(low, uv, high, cage, options)?;
+    checked(low, uv, high, cage, options)?;
     let rays = HighRays::new(low, high, Matching::All)?;
-    let mut baked = bake_checked((low, uv, high, cage), &rays, options, distances, progress)?;
+    let mut baked = bake_from_high_with(low, uv, (high, &rays), cage, options, progress)?;
     baked.bvh_seconds = rays.bvh_seconds;
     Ok(baked)
 }
@@ -317,30 +321,71 @@ pub fn bake_from_high_with(
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
+    bake_from_high_on(
+        low,
+        uv,
+        (high, rays),
+        cage,
+        options,
+        &CpuCaster(rays.meshes()),
+        progress,
+    )
+}
+
+/// [`bake_from_high_with`] with AO and thickness rays cast by `caster` (a GPU's, say, made
+/// over [`HighRays::single`]; the CPU's is the reference).
+///
+/// # Errors
+/// As [`bake_from_high_with`]; what the caster said.
+pub fn bake_from_high_on(
+    low: &Mesh,
+    uv: &UvBake,
+    (high, rays): (&Mesh, &HighRays),
+    cage: Option<&Mesh>,
+    options: HighOptions,
+    caster: &dyn RayCaster,
+    progress: Option<&Progress>,
+) -> Result<HighBake, BakeError> {
     let distances = checked(low, uv, high, cage, options)?;
     if !rays.fits(low.triangles.len()) {
         return Err("the BVHs were matched for another low mesh"
             .to_string()
             .into());
     }
-    bake_checked((low, uv, high, cage), rays, options, distances, progress)
+    let sampler = Sampler::new((low, uv, high, cage), rays, options, distances);
+    let mut baked = if options.map.casts_rays() {
+        bake_cast(&sampler, uv, caster, progress)?
+    } else {
+        bake_checked(&sampler, uv, options.map, progress)?
+    };
+    let (_, front, rear) = distances;
+    baked.map = options.map;
+    baked.front = front;
+    baked.rear = rear;
+    baked.rays = if options.map.casts_rays() {
+        options.rays
+    } else {
+        0
+    };
+    baked.max_distance = options.max_distance;
+    baked.samples = options.samples;
+    baked.cage = cage.is_some();
+    Ok(baked)
 }
 
-/// [`bake_from_high_with`] once what it is given is checked, with the distances `(size,
-/// front, rear)` [`checked`] found.
+/// A map but AO and thickness, texel by texel on every core; its options are filled in by
+/// the caller.
 fn bake_checked(
-    (low, uv, high, cage): (&Mesh, &UvBake, &Mesh, Option<&Mesh>),
-    rays: &HighRays,
-    options: HighOptions,
-    (size, front, rear): (f32, f32, f32),
+    sampler: &Sampler<'_>,
+    uv: &UvBake,
+    map: HighMap,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
-    let sampler = Sampler::new((low, uv, high, cage), rays, options, (size, front, rear));
     let (w, h) = (uv.width as usize, uv.height as usize);
     if let Some(p) = progress {
         p.start("bake from the high mesh", h as u64);
     }
-    let channels = options.map.channels();
+    let channels = map.channels();
     let mut data = vec![0_u16; w * h * channels];
     let mut misses = vec![false; w * h];
     let mut skew = vec![0_u8; w * h];
@@ -363,9 +408,7 @@ fn bake_checked(
             {
                 if let Some(texel) = sampler.texel(first + k, out) {
                     *miss = texel.missed;
-                    *skew = (texel.skew_degrees / 90.0 * 255.0)
-                        .round()
-                        .clamp(0.0, 255.0) as u8;
+                    *skew = skew_byte(texel.skew_degrees);
                 }
             }
             if let Some(p) = progress {
@@ -375,31 +418,91 @@ fn bake_checked(
     if cancelled.into_inner() {
         return Err(BakeError::Cancelled);
     }
-    let covered = (0..w * h)
+    Ok(made(uv, data, misses, skew))
+}
+
+/// AO or thickness: per batch of rows, each sample's projection ray on every core, then
+/// its rays cast by `caster`, then each texel the mean of its samples.
+fn bake_cast(
+    sampler: &Sampler<'_>,
+    uv: &UvBake,
+    caster: &dyn RayCaster,
+    progress: Option<&Progress>,
+) -> Result<HighBake, BakeError> {
+    let (w, h) = (uv.width as usize, uv.height as usize);
+    if let Some(p) = progress {
+        p.start("bake from the high mesh", h as u64);
+    }
+    let count = sampler.samples();
+    let mut data = vec![0_u16; w * h];
+    let mut misses = vec![false; w * h];
+    let mut skew = vec![0_u8; w * h];
+    let rows = (caster.batch_size() / (w * count)).clamp(1, h.max(1));
+    for first_row in (0..h).step_by(rows) {
+        if progress.is_some_and(Progress::is_cancelled) {
+            return Err(BakeError::Cancelled);
+        }
+        let span = first_row * w..((first_row + rows).min(h)) * w;
+        let texels: Vec<usize> = span.clone().filter(|&i| uv.triangle(i).is_some()).collect();
+        let mut queries = vec![RayQuery::default(); texels.len() * count];
+        let found: Vec<Option<(bool, u8)>> = queries
+            .par_chunks_mut(count)
+            .zip(&texels)
+            .map(|(out, &i)| {
+                sampler
+                    .texel_queries(i, out)
+                    .map(|f| (f.missed, skew_byte(f.skew_degrees)))
+            })
+            .collect();
+        let values = caster.cast(&sampler.batch(&queries)).map_err(|e| {
+            BakeError::Refused(format!("casting the rays on {}: {e}", caster.name()))
+        })?;
+        for ((&i, seen), v) in texels.iter().zip(found).zip(values.chunks(count)) {
+            if let Some((missed, skewed)) = seen {
+                let mean = v.iter().sum::<f32>() / count as f32;
+                data[i] = (mean.clamp(0.0, 1.0) * 65535.0).round() as u16;
+                misses[i] = missed;
+                skew[i] = skewed;
+            }
+        }
+        if let Some(p) = progress {
+            p.advance(((span.end - span.start) / w) as u64);
+        }
+    }
+    let mut baked = made(uv, data, misses, skew);
+    baked.cast_on = caster.name();
+    Ok(baked)
+}
+
+/// A skew angle (degrees) as the skew view's byte.
+fn skew_byte(degrees: f32) -> u8 {
+    (degrees / 90.0 * 255.0).round().clamp(0.0, 255.0) as u8
+}
+
+/// A bake of `uv`'s size holding `data`, counting what it covered and missed; the options
+/// are its caller's to fill in.
+fn made(uv: &UvBake, data: Vec<u16>, misses: Vec<bool>, skew: Vec<u8>) -> HighBake {
+    let covered = (0..uv.len())
         .filter(|&i| uv.coverage(i) != Coverage::Empty)
         .count() as u64;
-    let missed = misses.iter().filter(|&&m| m).count() as u64;
-    Ok(HighBake {
+    HighBake {
         width: uv.width,
         height: uv.height,
         data,
-        map: options.map,
-        front,
-        rear,
-        rays: if options.map.casts_rays() {
-            options.rays
-        } else {
-            0
-        },
-        max_distance: options.max_distance,
-        samples: options.samples,
-        cage: cage.is_some(),
+        map: HighMap::Height,
+        front: 0.0,
+        rear: 0.0,
+        rays: 0,
+        max_distance: None,
+        samples: 1,
+        cage: false,
         covered,
-        missed,
+        missed: misses.iter().filter(|&&m| m).count() as u64,
         misses,
         bvh_seconds: 0.0,
         skew,
-    })
+        cast_on: String::new(),
+    }
 }
 
 /// Checks what a bake is given; returns the default distance's size and the front and rear

@@ -136,10 +136,32 @@ impl HighRays {
         })
     }
 
-    /// The BVH low triangle `t`'s rays meet, if any.
-    pub(super) fn for_low(&self, t: u32) -> Option<&RayMesh> {
+    /// The BVH low triangle `t`'s rays meet, if any, and its group.
+    pub(super) fn for_low(&self, t: u32) -> Option<(&RayMesh, u32)> {
         let g = self.low_group.get(t as usize).copied().unwrap_or(0);
-        self.rays.get(g as usize)?.as_ref()
+        self.rays.get(g as usize)?.as_ref().map(|r| (r, g))
+    }
+
+    /// The BVHs, by group (`None` where a group has no high triangle).
+    pub fn meshes(&self) -> &[Option<RayMesh>] {
+        &self.rays
+    }
+
+    /// The one BVH of a bake that matched no parts by name.
+    pub fn single(&self) -> Option<&RayMesh> {
+        match self.rays.as_slice() {
+            [Some(one)] if self.low_group.is_empty() => Some(one),
+            _ => None,
+        }
+    }
+
+    /// `far` (object units) in the BVHs' frame (all share the high mesh's).
+    pub(super) fn local_length(&self, far: f32) -> f32 {
+        self.rays
+            .iter()
+            .flatten()
+            .next()
+            .map_or(far, |r| r.frame().local_length(far))
     }
 
     /// The high mesh's diagonal (object units).

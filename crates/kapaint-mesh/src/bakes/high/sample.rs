@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use super::{HighMap, HighOptions, HighRays, IdSource, NormalSpace};
 use crate::bake::UvBake;
 use crate::bakes::rays::turn_of;
-use crate::bakes::{Directions, RayMesh, geometric_normal};
+use crate::bakes::{Directions, RayBatch, RayKind, RayMesh, RayQuery, geometric_normal};
 use crate::{Mesh, Named};
 
 /// What a texel's rays found besides its value.
@@ -149,7 +149,7 @@ impl<'a> Sampler<'a> {
             } else {
                 self.sample_point(i, t, k)
             };
-            let (value, found) = self.sample(tri, w, i * 16 + k as usize);
+            let (value, found) = self.sample(tri, w);
             sum += value.value;
             missed |= !found;
             skew += value.skew_degrees;
@@ -171,6 +171,67 @@ impl<'a> Sampler<'a> {
             missed,
             skew_degrees: skew / count as f32,
         })
+    }
+
+    /// The batch the queries of `queries` make: the direction set, how far (local units),
+    /// what is measured.
+    pub(super) fn batch<'q>(&'q self, queries: &'q [RayQuery]) -> RayBatch<'q> {
+        RayBatch {
+            queries,
+            directions: self.directions.as_slice(),
+            far: self.rays.local_length(self.far),
+            kind: if self.map == HighMap::Ao {
+                RayKind::Open
+            } else {
+                RayKind::Depth
+            },
+        }
+    }
+
+    /// Samples a texel takes.
+    pub(super) fn samples(&self) -> usize {
+        (self.grid * self.grid) as usize
+    }
+
+    /// Texel `i`'s AO or thickness rays, a query per sample into `out` ([`Self::samples`]
+    /// long), and what its projection rays found; `None` where the low mesh has no surface.
+    pub(super) fn texel_queries(&self, i: usize, out: &mut [RayQuery]) -> Option<TexelFound> {
+        let t = self.uv.triangle(i)?;
+        let (mut missed, mut skew) = (false, 0.0_f32);
+        let count = self.grid * self.grid;
+        for (k, query) in (0..count).zip(out.iter_mut()) {
+            let (tri, w) = if count == 1 {
+                (t, self.uv.barycentric(i))
+            } else {
+                self.sample_point(i, t, k)
+            };
+            let seen = self.project(tri, w);
+            missed |= seen.found.is_none();
+            skew += seen.skew_degrees;
+            *query = self.query(&seen, i * 16 + k as usize);
+        }
+        Some(TexelFound {
+            missed,
+            skew_degrees: skew / count as f32,
+        })
+    }
+
+    /// The AO or thickness rays of a sample that saw `seen`: from the point met, on the high
+    /// mesh, about the high triangle's face normal (its opposite for thickness); where nothing
+    /// was met, from the low point about the low face. `seed` turns the set.
+    fn query(&self, seen: &Seen<'_>, seed: usize) -> RayQuery {
+        let (q, g) = seen.found.map_or((seen.p, seen.face), |(q, tri, _)| {
+            let c = self.high.triangles[tri as usize].map(|v| self.high.positions[v as usize]);
+            (q, geometric_normal(c, high_normal(self.high, tri, q)))
+        });
+        let normal = if self.map == HighMap::Ao { g } else { -g };
+        match seen.rays {
+            Some((rays, group)) => rays.query(q, normal, turn_of(seed), group),
+            None => RayQuery {
+                group: RayQuery::NONE,
+                ..RayQuery::default()
+            },
+        }
     }
 
     /// Sample `k` of texel `i` (whose triangle is `t`) on a grid across it: the triangle under
@@ -205,9 +266,10 @@ impl<'a> Sampler<'a> {
         (best.0, best.1)
     }
 
-    /// One sample at barycentric `w` of low triangle `t`: its value (a vector, or a scalar
-    /// in `x`) and whether its ray met the high mesh. `seed` turns its AO directions.
-    fn sample(&self, t: u32, w: Vec3, seed: usize) -> (SampleValue, bool) {
+    /// What a sample at barycentric `w` of low triangle `t` sees: its ray (from the cage's
+    /// point towards the low one, or from `front` above along the normal) and the high
+    /// triangle it met.
+    fn project(&self, t: u32, w: Vec3) -> Seen<'a> {
         let tri = self.low.triangles[t as usize].map(|v| v as usize);
         let corners = tri.map(|v| self.low.positions[v]);
         let p = corners[0] * w.x + corners[1] * w.y + corners[2] * w.z;
@@ -215,8 +277,7 @@ impl<'a> Sampler<'a> {
         let n = (normals[0] * w.x + normals[1] * w.y + normals[2] * w.z)
             .try_normalize()
             .unwrap_or(normals[0]);
-        // The ray: from the cage's point towards the low one, or from `front` above along
-        // the normal; `to_low` is how far along it the low surface lies.
+        // `to_low` is how far along the ray the low surface lies.
         let (origin, dir, to_low) = self
             .cage
             .and_then(|cage| {
@@ -228,12 +289,30 @@ impl<'a> Sampler<'a> {
             })
             .unwrap_or((p + n * self.front, -n, self.front));
         let rays = self.rays.for_low(t);
-        let found = rays.and_then(|r| cast(r, origin, dir, to_low + self.rear, self.nudge));
+        let found = rays.and_then(|(r, _)| cast(r, origin, dir, to_low + self.rear, self.nudge));
         let face = geometric_normal(corners, n);
-        let skew_degrees = (-dir).dot(face).clamp(-1.0, 1.0).acos().to_degrees();
+        Seen {
+            t,
+            w,
+            p,
+            n,
+            face,
+            to_low,
+            found,
+            rays,
+            skew_degrees: (-dir).dot(face).clamp(-1.0, 1.0).acos().to_degrees(),
+        }
+    }
+
+    /// One sample at barycentric `w` of low triangle `t`: its value (a vector, or a scalar
+    /// in `x`) and whether its ray met the high mesh. AO and thickness are cast in batches
+    /// instead ([`Self::texel_queries`]).
+    fn sample(&self, t: u32, w: Vec3) -> (SampleValue, bool) {
+        let seen = self.project(t, w);
+        let (p, n, found) = (seen.p, seen.n, seen.found);
         let value = match self.map {
             HighMap::Height => {
-                let above = found.map_or(0.0, |(_, _, d)| to_low - d);
+                let above = found.map_or(0.0, |(_, _, d)| seen.to_low - d);
                 Vec3::splat((above + self.rear) / (self.front + self.rear))
             }
             HighMap::Normal(space) => {
@@ -241,27 +320,13 @@ impl<'a> Sampler<'a> {
                 match space {
                     NormalSpace::Object => normal,
                     NormalSpace::Tangent => {
-                        let (ta, bi, no) = self.frames.at(t, w, n);
+                        let (ta, bi, no) = self.frames.at(seen.t, seen.w, n);
                         Vec3::new(normal.dot(ta), normal.dot(bi), normal.dot(no))
                     }
                 }
             }
-            HighMap::Ao | HighMap::Thickness => {
-                let (q, g) = found.map_or((p, face), |(q, tri, _)| {
-                    let c =
-                        self.high.triangles[tri as usize].map(|v| self.high.positions[v as usize]);
-                    (q, geometric_normal(c, high_normal(self.high, tri, q)))
-                });
-                let set = &self.directions;
-                // Nothing to meet (a low part whose pair has no high triangle): open.
-                Vec3::splat(rays.map_or(1.0, |rays| {
-                    if self.map == HighMap::Ao {
-                        rays.open_fraction(q, g, set, self.far, turn_of(seed))
-                    } else {
-                        rays.mean_distance(q, -g, set, self.far, turn_of(seed))
-                    }
-                }))
-            }
+            // Cast in batches (`texel_queries`): never asked here.
+            HighMap::Ao | HighMap::Thickness => Vec3::ONE,
             HighMap::Curvature => {
                 let k = found.map_or(0.0, |(q, tri, _)| {
                     let b = barycentric_on(self.high, tri, q);
@@ -290,11 +355,30 @@ impl<'a> Sampler<'a> {
         (
             SampleValue {
                 value,
-                skew_degrees,
+                skew_degrees: seen.skew_degrees,
             },
             found.is_some(),
         )
     }
+}
+
+/// What one sample's projection ray saw.
+struct Seen<'r> {
+    /// The low triangle and the barycentric weights on it.
+    t: u32,
+    w: Vec3,
+    /// The low point, its smooth normal and its face's normal.
+    p: Vec3,
+    n: Vec3,
+    face: Vec3,
+    /// How far along the ray the low surface lies.
+    to_low: f32,
+    /// The point met, the high triangle there and how far along the ray.
+    found: Option<(Vec3, u32, f32)>,
+    /// The BVH the low triangle's rays meet, and its group.
+    rays: Option<(&'r RayMesh, u32)>,
+    /// The angle between the ray and the low face's normal (degrees).
+    skew_degrees: f32,
 }
 
 /// A sample's value and the skew of its ray.
