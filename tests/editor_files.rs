@@ -246,7 +246,9 @@ fn the_recovery_offer_at_start_takes_no_strokes_or_keys_meanwhile() {
     harness
         .get_by_role_and_label(Role::Button, "Recover")
         .click();
-    harness.run();
+    // The recovery runs on a worker behind a spinner: a few frames, then wait for it (a
+    // `run()` here failed its 40 steps when the machine was busy).
+    harness.run_steps(2);
     wait_until(&mut harness, "recovered", |e| {
         e.state.opening().is_none() && e.state.doc().maps().width() == 64
     });

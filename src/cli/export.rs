@@ -380,6 +380,9 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
                 if let Some(normal) = m.normal.as_ref().and_then(|n| n.summary()) {
                     let _ = writeln!(text, "  normal map: {normal}");
                 }
+                if let Some(saved) = m.supercompression_summary() {
+                    let _ = writeln!(text, "  supercompression: {saved}");
+                }
                 if report {
                     write_report(&mut text, &m);
                 }

@@ -326,6 +326,10 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
                 text.push_str("; normal map: ");
                 text.push_str(&normal);
             }
+            if let Some(saved) = m.supercompression_summary() {
+                text.push_str("; supercompression ");
+                text.push_str(&saved);
+            }
             text
         }
         kapaint_export::Exported::Pbr(m) => format!(

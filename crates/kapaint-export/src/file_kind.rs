@@ -128,3 +128,15 @@ impl std::fmt::Display for Compression {
         f.write_str(self.name())
     }
 }
+
+/// A KTX2 file's supercompression: Zstandard at a level, each mip level on its own.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Supercompression {
+    /// The scheme: `"zstd"`.
+    pub scheme: String,
+    /// Its level (1 to 22).
+    pub level: u8,
+    /// The file's size with its levels as encoded, not supercompressed (so the saving is
+    /// `1 - bytes / uncompressed_bytes`).
+    pub uncompressed_bytes: u64,
+}

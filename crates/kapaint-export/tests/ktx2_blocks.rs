@@ -19,6 +19,8 @@ use kapaint_model::Document;
 
 #[path = "common/grey.rs"]
 mod grey;
+#[path = "common/inflate.rs"]
+mod inflate;
 use grey::grey_project;
 
 #[path = "common/stroke_edge.rs"]
@@ -60,13 +62,15 @@ fn check_and_decode(path: &Path) -> Vec<Vec<u8>> {
         32 - w.max(h).leading_zeros(),
         "{what}: a full chain"
     );
-    assert!(header.supercompression_scheme.is_none(), "{what}");
+    // Plain, or each level supercompressed on its own by Zstandard (scheme 2).
+    let zstd = header.supercompression_scheme == Some(ktx2::SupercompressionScheme::Zstandard);
+    assert!(zstd || header.supercompression_scheme.is_none(), "{what}");
     // typeSize: 1 for block-compressed formats and 8-bit components.
     assert_eq!(header.type_size, 1, "{what}: typeSize");
-    // Level index (spec 3.9.7): byteLength of each level's blocks, uncompressedByteLength
-    // equal without supercompression, offsets aligned to lcm(texel block size, 4), levels
-    // stored smallest first without overlap, inside the file.
-    let align = block_bytes.max(4);
+    // Level index (spec 3.9.7): uncompressedByteLength the level's blocks, byteLength equal
+    // without supercompression, offsets aligned to lcm(texel block size, 4) (to 1 when
+    // supercompressed), levels stored smallest first without overlap, inside the file.
+    let align = if zstd { 1 } else { block_bytes.max(4) };
     let mut end_of_previous = None;
     let index_at = 80;
     let mut levels = Vec::new();
@@ -76,14 +80,11 @@ fn check_and_decode(path: &Path) -> Vec<Vec<u8>> {
         let (lw, lh) = ((w >> i).max(1), (h >> i).max(1));
         let blocks = lw.div_ceil(block_side) as usize * lh.div_ceil(block_side) as usize;
         assert_eq!(
-            entry.byte_length as usize,
+            entry.uncompressed_byte_length as usize,
             blocks * block_bytes,
             "{what}: level {i}"
         );
-        assert_eq!(
-            entry.uncompressed_byte_length, entry.byte_length,
-            "{what}: level {i}"
-        );
+        assert!(zstd || entry.uncompressed_byte_length == entry.byte_length);
         assert_eq!(
             entry.byte_offset as usize % align,
             0,
@@ -102,7 +103,13 @@ fn check_and_decode(path: &Path) -> Vec<Vec<u8>> {
         }
         end_of_previous = Some(entry.byte_offset);
         assert_eq!(level.data.len(), entry.byte_length as usize);
-        levels.push(decode_level(format, level.data, (lw, lh)));
+        let data = inflate::level_bytes(header.supercompression_scheme, level.data);
+        assert_eq!(
+            data.len(),
+            blocks * block_bytes,
+            "{what}: level {i} inflated"
+        );
+        levels.push(decode_level(format, &data, (lw, lh)));
     }
     // Data format descriptor (spec 3.10, Khronos Data Format 1.3 section 5): one basic block,
     // its total size first, the colour model of the format, sRGB transfer exactly for the

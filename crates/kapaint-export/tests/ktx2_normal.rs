@@ -12,6 +12,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+#[path = "common/inflate.rs"]
+mod inflate;
+
 use glam::{DVec3, Vec2, Vec3};
 use kapaint_export::preset;
 use kapaint_export::set::{self, Compression, Manifest, NormalFile};
@@ -146,11 +149,13 @@ fn read_levels(path: &Path, format: ktx2::Format) -> ((u32, u32), Vec<Vec<[u8; 2
     let (w, h) = (header.pixel_width, header.pixel_height);
     assert_eq!(header.level_count, 32 - w.max(h).leading_zeros());
     assert_eq!((header.pixel_depth, header.face_count), (0, 1));
-    assert!(header.supercompression_scheme.is_none());
     let levels = reader
         .levels()
         .enumerate()
-        .map(|(k, level)| decode_xy(format, level.data, ((w >> k).max(1), (h >> k).max(1))))
+        .map(|(k, level)| {
+            let data = inflate::level_bytes(header.supercompression_scheme, level.data);
+            decode_xy(format, &data, ((w >> k).max(1), (h >> k).max(1)))
+        })
         .collect();
     ((w, h), levels)
 }

@@ -25,8 +25,66 @@ pub struct Decoded {
 /// then the levels from smallest to largest, each aligned as the specification asks.
 pub(super) fn container(
     format: KtxFormat,
-    (w, h): (u32, u32),
+    size: (u32, u32),
     levels: &[Vec<u8>],
+) -> Result<Vec<u8>, String> {
+    let stored: Vec<(&[u8], u64)> = levels
+        .iter()
+        .map(|l| (l.as_slice(), l.len() as u64))
+        .collect();
+    assemble(format, size, &stored, false)
+}
+
+/// Zstandard levels 1 to 22, as a KTX2 file's supercompression takes them.
+pub const ZSTD_LEVELS: std::ops::RangeInclusive<u8> = 1..=22;
+
+/// A KTX2 file kapaint wrote (no supercompression) with each of its levels compressed by
+/// Zstandard at `level`, independently (supercompression scheme 2), in parallel; the data
+/// format descriptor as it was (`bytesPlane` kept, as KTX 2.0.4 asks).
+///
+/// # Errors
+/// A file that does not read, one supercompressed already, a level out of [`ZSTD_LEVELS`].
+pub fn supercompress(bytes: &[u8], level: u8) -> Result<Vec<u8>, String> {
+    use rayon::prelude::*;
+    if !ZSTD_LEVELS.contains(&level) {
+        return Err(format!(
+            "zstd level {level} is outside {}..={}",
+            ZSTD_LEVELS.start(),
+            ZSTD_LEVELS.end()
+        ));
+    }
+    let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a KTX2 file: {e}"))?;
+    let header = reader.header();
+    if header.supercompression_scheme.is_some() {
+        return Err("the file is supercompressed already".into());
+    }
+    let format = header.format.ok_or("the file has no format")?;
+    let raw: Vec<&[u8]> = reader.levels().map(|l| l.data).collect();
+    let packed: Vec<Vec<u8>> = raw
+        .par_iter()
+        .map(|data| zstd::bulk::compress(data, i32::from(level)).map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()?;
+    let stored: Vec<(&[u8], u64)> = packed
+        .iter()
+        .zip(&raw)
+        .map(|(p, r)| (p.as_slice(), r.len() as u64))
+        .collect();
+    assemble(
+        format,
+        (header.pixel_width, header.pixel_height),
+        &stored,
+        true,
+    )
+}
+
+/// The file of `levels` (each its stored bytes and its length uncompressed), supercompressed
+/// by Zstandard or not: a supercompressed level is aligned to 1, a plain one to lcm(texel
+/// block size, 4).
+fn assemble(
+    format: KtxFormat,
+    (w, h): (u32, u32),
+    levels: &[(&[u8], u64)],
+    zstd: bool,
 ) -> Result<Vec<u8>, String> {
     let (basic, type_size) =
         dfd::Basic::from_format(format).map_err(|e| format!("data format descriptor: {e:?}"))?;
@@ -38,8 +96,12 @@ pub(super) fn container(
     kvd.extend_from_slice(&(entry.len() as u32).to_le_bytes());
     kvd.extend_from_slice(entry.as_bytes());
     kvd.resize(kvd.len().div_ceil(4) * 4, 0);
-    // Level data alignment: lcm(texel block size, 4).
-    let block_bytes = codec::from_vk_format(format).map_or(4, |c| c.block_bytes());
+    // Level data alignment: lcm(texel block size, 4); 1 when supercompressed.
+    let block_bytes = if zstd {
+        1
+    } else {
+        codec::from_vk_format(format).map_or(4, |c| c.block_bytes())
+    };
     let index_at = Header::LENGTH;
     let dfd_at = index_at + levels.len() * LevelIndex::LENGTH;
     let kvd_at = dfd_at + dfd_bytes.len();
@@ -53,13 +115,13 @@ pub(super) fn container(
         levels.len()
     ];
     let mut body = Vec::new();
-    for (i, level) in levels.iter().enumerate().rev() {
+    for (i, &(level, uncompressed)) in levels.iter().enumerate().rev() {
         let aligned = at.div_ceil(block_bytes) * block_bytes;
         body.resize(body.len() + (aligned - at), 0);
         index[i] = LevelIndex {
             byte_offset: aligned as u64,
             byte_length: level.len() as u64,
-            uncompressed_byte_length: level.len() as u64,
+            uncompressed_byte_length: uncompressed,
         };
         body.extend_from_slice(level);
         at = aligned + level.len();
@@ -73,7 +135,7 @@ pub(super) fn container(
         layer_count: 0,
         face_count: 1,
         level_count: levels.len() as u32,
-        supercompression_scheme: None,
+        supercompression_scheme: zstd.then_some(ktx2::SupercompressionScheme::Zstandard),
         index: Index {
             dfd_byte_offset: dfd_at as u32,
             dfd_byte_length: dfd_bytes.len() as u32,
@@ -94,7 +156,8 @@ pub(super) fn container(
     Ok(out)
 }
 
-/// Reads level 0 of a KTX2 file kapaint writes (the formats above, no supercompression).
+/// Reads level 0 of a KTX2 file kapaint writes (the formats above, plain or supercompressed
+/// by Zstandard).
 /// ASTC files come back as RGBA, luminance in RGB and the second of two components in alpha.
 ///
 /// # Errors
@@ -102,15 +165,23 @@ pub(super) fn container(
 pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
     let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a KTX2 file: {e}"))?;
     let header = reader.header();
-    if header.supercompression_scheme.is_some() {
-        return Err("supercompressed KTX2 is not supported".into());
-    }
     let (w, h) = (header.pixel_width, header.pixel_height.max(1));
     if w > kapaint_model::maps::MAX_SIDE || h > kapaint_model::maps::MAX_SIDE {
         return Err(format!("{w}x{h} is larger than kapaint's maps"));
     }
     let level = reader.levels().next().ok_or("the file has no levels")?;
-    let data = level.data;
+    let inflated;
+    let data = match header.supercompression_scheme {
+        None => level.data,
+        Some(ktx2::SupercompressionScheme::Zstandard) => {
+            // At most what level 0 of the largest map can hold: a bomb stops there.
+            let most = (w as usize * h as usize * 16).min(level.uncompressed_byte_length as usize);
+            inflated = zstd::bulk::decompress(level.data, most)
+                .map_err(|e| format!("level 0 does not inflate: {e}"))?;
+            &inflated[..]
+        }
+        Some(other) => return Err(format!("supercompression {other:?} is not supported")),
+    };
     let texels = w as usize * h as usize;
     let (channels, rgba) = match header.format {
         Some(KtxFormat::R8_UNORM | KtxFormat::R8G8_UNORM) => {

@@ -14,7 +14,7 @@ use ktx2::Format as KtxFormat;
 use rayon::prelude::*;
 
 use self::container::container;
-pub use self::container::{Decoded, decode};
+pub use self::container::{Decoded, ZSTD_LEVELS, decode, supercompress};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 pub use self::own_levels::encode_levels;
 use super::blocks::{self, Coder};

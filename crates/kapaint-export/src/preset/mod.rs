@@ -115,6 +115,9 @@ pub struct ExportPreset {
     pub include_ka: bool,
     /// What a block-compressed set may lose.
     pub budget: BlockBudget,
+    /// KTX2 sets: the Zstandard level every KTX2 file's levels are supercompressed at
+    /// ([`crate::ktx::ZSTD_LEVELS`]); `None`: stored as encoded.
+    pub zstd: Option<u8>,
 }
 
 /// An export preset as its file spells it, before it is checked.
@@ -142,6 +145,8 @@ struct ExportPresetFile {
     mean_ka_error: Option<f64>,
     #[serde(default, deserialize_with = "some")]
     min_psnr: Option<f64>,
+    #[serde(default, deserialize_with = "some")]
+    zstd: Option<u8>,
 }
 
 fn version_one() -> u32 {
@@ -225,6 +230,22 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
                 ));
             }
         }
+        if let Some(level) = f.zstd {
+            if !f.format.is_ktx2() {
+                return Err(format!(
+                    "zstd supercompresses KTX2 files; a {} set has none",
+                    f.format.name()
+                ));
+            }
+            let levels = crate::ktx::ZSTD_LEVELS;
+            if !levels.contains(&level) {
+                return Err(format!(
+                    "zstd must be a level in {}..={}, got {level}",
+                    levels.start(),
+                    levels.end()
+                ));
+            }
+        }
         Ok(Self {
             name: f.name,
             description: f.description,
@@ -233,6 +254,7 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             n_bits: f.n_bits,
             include_ka: f.include_ka,
             budget,
+            zstd: f.zstd,
         })
     }
 }

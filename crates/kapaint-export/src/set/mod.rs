@@ -29,7 +29,7 @@ use self::failure::Failure;
 pub use self::import::import;
 pub use self::manifest::{
     Approximation, ColourSpace, Compression, Constants, FileEntry, MANIFEST_FORMAT,
-    MANIFEST_VERSION, Manifest, MemoryReport,
+    MANIFEST_VERSION, Manifest, MemoryReport, Supercompression,
 };
 use self::manifest::{Comp, approximation};
 use self::measure::ka_error_of_set;
@@ -158,7 +158,12 @@ pub(super) fn export_into(
         let written = write_images(&source, preset, tmp, encoded)?;
         let mut manifest = source.manifest(preset, written.files, blocks);
         source.measure(&mut manifest, &written.stored, &written.mips, preset);
-        write_manifest(&mut manifest, doc, NormalStorage::of(preset), tmp)?;
+        write_manifest(
+            &mut manifest,
+            doc,
+            (NormalStorage::of(preset), preset.zstd),
+            tmp,
+        )?;
         Ok(manifest)
     })
 }
@@ -374,10 +379,23 @@ fn write_images(
             });
         }
         let path = tmp.join(&file);
+        let supercompression = match (preset.zstd, &image.ktx) {
+            (Some(level), Some(_)) => {
+                let uncompressed_bytes = image.bytes.len() as u64;
+                image.bytes =
+                    crate::ktx::supercompress(&image.bytes, level).map_err(|e| io(&path, e))?;
+                Some(manifest::Supercompression {
+                    scheme: "zstd".into(),
+                    level,
+                    uncompressed_bytes,
+                })
+            }
+            _ => None,
+        };
         kapaint_base::atomic::write_atomic(&path, &image.bytes).map_err(|e| io(&path, e))?;
-        written
-            .files
-            .push(file_entry(source, preset, file, &comps, &image));
+        let mut entry = file_entry(source, preset, file, &comps, &image);
+        entry.supercompression = supercompression;
+        written.files.push(entry);
         if let Some(data) = image.stored {
             written.stored.push(StoredImage {
                 comps,
@@ -426,6 +444,7 @@ fn file_entry(
             .format
             .astc_block()
             .filter(|_| compression == Compression::Ktx2Astc),
+        supercompression: None,
     }
 }
 
@@ -435,12 +454,12 @@ fn file_entry(
 fn write_manifest(
     manifest: &mut Manifest,
     doc: &Document,
-    normal: NormalStorage,
+    (normal, zstd): (NormalStorage, Option<u8>),
     tmp: &Path,
 ) -> Result<(), SetError> {
     let mut exported = manifest.files.iter().map(|f| f.bytes).sum::<u64>();
     if let Some(map) = doc.normal() {
-        let file = NormalFile::write(map, tmp, normal)?;
+        let file = NormalFile::write(map, tmp, normal, zstd)?;
         exported += file.bytes;
         manifest.normal = Some(Box::new(file));
     }

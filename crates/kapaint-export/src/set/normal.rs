@@ -145,6 +145,9 @@ pub struct NormalFile {
     /// KTX2: level 0 as a consumer decodes it (z rebuilt) against the project's map.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angular_error: Option<AngularError>,
+    /// KTX2 whose levels are supercompressed: how, and the file's size without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub supercompression: Option<crate::file_kind::Supercompression>,
 }
 
 /// Where x and y are in a KTX2 normal map of `compression`.
@@ -157,7 +160,8 @@ fn xy_of(compression: Compression) -> &'static str {
 }
 
 impl NormalFile {
-    /// Writes `normal` into the set folder `dir` as `storage` says; its entry.
+    /// Writes `normal` into the set folder `dir` as `storage` says (a KTX2 file's levels
+    /// supercompressed at `zstd`, where given); its entry.
     ///
     /// # Errors
     /// A failed encode or write.
@@ -165,6 +169,7 @@ impl NormalFile {
         normal: &NormalMap,
         dir: &Path,
         storage: NormalStorage,
+        zstd: Option<u8>,
     ) -> Result<Self, SetError> {
         let path = dir.join(storage.file());
         let blocks = match storage {
@@ -183,6 +188,7 @@ impl NormalFile {
                     xy: None,
                     z: None,
                     angular_error: None,
+                    supercompression: None,
                 });
             }
             NormalStorage::Ktx2(blocks) => blocks,
@@ -202,13 +208,25 @@ impl NormalFile {
         .map_err(|e| io(&path, e))?;
         let decoded = written.decoded.first().map_or(&[][..], |d| &d[..]);
         let angular_error = angular_error(&unit, decoded);
-        kapaint_base::atomic::write_atomic(&path, &written.bytes).map_err(|e| io(&path, e))?;
+        let (bytes, supercompression) = match zstd {
+            Some(level) => (
+                crate::ktx::supercompress(&written.bytes, level).map_err(|e| io(&path, e))?,
+                Some(crate::file_kind::Supercompression {
+                    scheme: "zstd".into(),
+                    level,
+                    uncompressed_bytes: written.bytes.len() as u64,
+                }),
+            ),
+            None => (written.bytes, None),
+        };
+        kapaint_base::atomic::write_atomic(&path, &bytes).map_err(|e| io(&path, e))?;
         Ok(Self {
             path: NORMAL_KTX2_FILE.into(),
             encoding: NORMAL_XY_ENCODING.into(),
             width: size.0,
             height: size.1,
-            bytes: written.bytes.len() as u64,
+            bytes: bytes.len() as u64,
+            supercompression,
             compression: Some(written.compression),
             astc_block: blocks.and_then(|(format, _)| format.astc_block()),
             mip_levels: Some(written.levels),
@@ -248,8 +266,13 @@ impl NormalFile {
             && self.compression.is_none()
             && self.astc_block.is_none()
             && self.xy.is_none()
-            && self.z.is_none();
+            && self.z.is_none()
+            && self.supercompression.is_none();
         let ktx2 = self.path == NORMAL_KTX2_FILE
+            && self
+                .supercompression
+                .as_ref()
+                .is_none_or(|s| s.scheme == "zstd" && crate::ktx::ZSTD_LEVELS.contains(&s.level))
             && self.encoding == NORMAL_XY_ENCODING
             && self.compression.is_some_and(|c| {
                 matches!(
