@@ -28,6 +28,19 @@ fn ok(args: &[&str]) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
+/// `kapaint bake PROJECT ARGS` refused: one line saying `want`, exit 2, the project still
+/// `before`.
+fn refused(project: &Path, args: &[&str], want: &str, before: &[u8]) {
+    let mut all = vec!["bake", s(project)];
+    all.extend(args);
+    let o = kapaint(&all);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{all:?}: {e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.contains(want), "{all:?}: {e}");
+    assert_eq!(std::fs::read(project).expect("read"), before, "{all:?}");
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
@@ -247,16 +260,9 @@ fn bad_high_bakes_are_refused_and_the_project_stays() {
         (vec!["--map", "normal", "--high", s(&empty)], "empty.obj"),
         (vec!["--map", "normal", "--high", s(&nan)], "nan.obj"),
     ] {
-        let mut all = vec!["bake", s(&p)];
-        all.extend(args);
-        let o = kapaint(&all);
-        let e = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{all:?}: {e}");
-        assert_eq!(e.lines().count(), 1, "{e}");
-        assert!(e.contains(want), "{all:?}: {e}");
-        assert_eq!(std::fs::read(&p).expect("read"), before, "{all:?}");
+        refused(&p, &args, want, &before);
         assert_eq!(std::fs::read(&kept).expect("read"), b"the user's own file");
-        assert!(!fresh.exists(), "{all:?} wrote its output");
+        assert!(!fresh.exists(), "{args:?} wrote its output");
     }
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -619,14 +625,7 @@ fn matching_and_id_sources_refuse_what_the_meshes_lack() {
             "vertex colours",
         ),
     ] {
-        let mut all = vec!["bake", s(&p)];
-        all.extend(args);
-        let o = kapaint(&all);
-        let e = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{all:?}: {e}");
-        assert_eq!(e.lines().count(), 1, "{e}");
-        assert!(e.contains(want), "{all:?}: {e}");
-        assert_eq!(std::fs::read(&p).expect("read"), before, "{all:?}");
+        refused(&p, &args, want, &before);
         assert!(!out.exists());
     }
     let _ = std::fs::remove_dir_all(&d);
