@@ -129,14 +129,28 @@ impl std::fmt::Display for Compression {
     }
 }
 
+/// Zstandard levels 1 to 22, as a KTX2 file's supercompression takes them.
+pub const ZSTD_LEVELS: std::ops::RangeInclusive<u8> = 1..=22;
+
 /// A KTX2 file's supercompression: Zstandard at a level, each mip level on its own.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Supercompression {
-    /// The scheme: `"zstd"`.
+    /// The scheme: [`Supercompression::ZSTD`].
     pub scheme: String,
     /// Its level (1 to 22).
     pub level: u8,
     /// The file's size with its levels as encoded, not supercompressed (so the saving is
     /// `1 - bytes / uncompressed_bytes`).
     pub uncompressed_bytes: u64,
+}
+
+impl Supercompression {
+    /// Zstandard, each level on its own (KTX2 scheme 2): the one kapaint writes.
+    pub const ZSTD: &'static str = "zstd";
+
+    /// Whether it is one kapaint writes and reads: zstd at a level in
+    /// [`ZSTD_LEVELS`].
+    pub fn is_known(&self) -> bool {
+        self.scheme == Self::ZSTD && ZSTD_LEVELS.contains(&self.level)
+    }
 }

@@ -35,8 +35,7 @@ pub(super) fn container(
     assemble(format, size, &stored, false)
 }
 
-/// Zstandard levels 1 to 22, as a KTX2 file's supercompression takes them.
-pub const ZSTD_LEVELS: std::ops::RangeInclusive<u8> = 1..=22;
+pub use crate::file_kind::ZSTD_LEVELS;
 
 /// A KTX2 file kapaint wrote (no supercompression) with each of its levels compressed by
 /// Zstandard at `level`, independently (supercompression scheme 2), in parallel; the data

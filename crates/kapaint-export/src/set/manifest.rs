@@ -110,9 +110,7 @@ impl TryFrom<FileEntryFile> for FileEntry {
             ));
         }
         if let Some(sc) = &f.supercompression
-            && (sc.scheme != "zstd"
-                || !crate::ktx::ZSTD_LEVELS.contains(&sc.level)
-                || compression.extension() != "ktx2")
+            && (!sc.is_known() || compression.extension() != "ktx2")
         {
             return Err(format!(
                 "{name}: supercompression must be zstd at a level in 1..=22 on a KTX2 file, got {} {}",

@@ -381,14 +381,9 @@ fn write_images(
         let path = tmp.join(&file);
         let supercompression = match (preset.zstd, &image.ktx) {
             (Some(level), Some(_)) => {
-                let uncompressed_bytes = image.bytes.len() as u64;
-                image.bytes =
-                    crate::ktx::supercompress(&image.bytes, level).map_err(|e| io(&path, e))?;
-                Some(manifest::Supercompression {
-                    scheme: "zstd".into(),
-                    level,
-                    uncompressed_bytes,
-                })
+                let (bytes, said) = supercompressed(&image.bytes, level, &path)?;
+                image.bytes = bytes;
+                Some(said)
             }
             _ => None,
         };
@@ -406,6 +401,24 @@ fn write_images(
         }
     }
     Ok(written)
+}
+
+/// A KTX2 file's bytes (to be written at `path`) with every level supercompressed at zstd
+/// `level`, and what the manifest says of it.
+fn supercompressed(
+    bytes: &[u8],
+    level: u8,
+    path: &Path,
+) -> Result<(Vec<u8>, manifest::Supercompression), SetError> {
+    let packed = crate::ktx::supercompress(bytes, level).map_err(|e| io(path, e))?;
+    Ok((
+        packed,
+        manifest::Supercompression {
+            scheme: manifest::Supercompression::ZSTD.into(),
+            level,
+            uncompressed_bytes: bytes.len() as u64,
+        },
+    ))
 }
 
 /// An image's manifest entry.

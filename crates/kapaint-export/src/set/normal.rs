@@ -209,14 +209,10 @@ impl NormalFile {
         let decoded = written.decoded.first().map_or(&[][..], |d| &d[..]);
         let angular_error = angular_error(&unit, decoded);
         let (bytes, supercompression) = match zstd {
-            Some(level) => (
-                crate::ktx::supercompress(&written.bytes, level).map_err(|e| io(&path, e))?,
-                Some(crate::file_kind::Supercompression {
-                    scheme: "zstd".into(),
-                    level,
-                    uncompressed_bytes: written.bytes.len() as u64,
-                }),
-            ),
+            Some(level) => {
+                let (bytes, said) = super::supercompressed(&written.bytes, level, &path)?;
+                (bytes, Some(said))
+            }
             None => (written.bytes, None),
         };
         kapaint_base::atomic::write_atomic(&path, &bytes).map_err(|e| io(&path, e))?;
@@ -272,7 +268,7 @@ impl NormalFile {
             && self
                 .supercompression
                 .as_ref()
-                .is_none_or(|s| s.scheme == "zstd" && crate::ktx::ZSTD_LEVELS.contains(&s.level))
+                .is_none_or(crate::file_kind::Supercompression::is_known)
             && self.encoding == NORMAL_XY_ENCODING
             && self.compression.is_some_and(|c| {
                 matches!(

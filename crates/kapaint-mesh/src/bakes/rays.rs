@@ -34,7 +34,7 @@ impl RayMesh {
     pub fn new(mesh: &Mesh) -> Self {
         let frame = UnitFrame::of(&mesh.positions);
         let local = frame.local_positions(&mesh.positions);
-        Self::of_triangles(mesh, &frame, &local, |_| true)
+        Self::of_triangles(mesh, &frame, &local, 0..mesh.triangles.len() as u32)
     }
 
     /// One BVH per group of `mesh`'s triangles, `group_of` naming each triangle's (none where
@@ -43,28 +43,32 @@ impl RayMesh {
     pub fn split(mesh: &Mesh, group_of: &[u32], groups: usize) -> Vec<Option<Self>> {
         let frame = UnitFrame::of(&mesh.positions);
         let local = frame.local_positions(&mesh.positions);
-        (0..groups as u32)
-            .map(|g| {
-                let mine = |k: u32| group_of.get(k as usize) == Some(&g);
-                (0..mesh.triangles.len() as u32)
-                    .any(mine)
-                    .then(|| Self::of_triangles(mesh, &frame, &local, mine))
+        // The triangles of each group, in one pass over the mesh.
+        let mut members = vec![Vec::new(); groups];
+        for (k, &g) in (0u32..).zip(group_of) {
+            if let Some(m) = members.get_mut(g as usize) {
+                m.push(k);
+            }
+        }
+        members
+            .into_iter()
+            .map(|m| {
+                (!m.is_empty()).then(|| Self::of_triangles(mesh, &frame, &local, m.into_iter()))
             })
             .collect()
     }
 
-    /// The BVH of the triangles `keep` accepts, in `frame`, `local` being the mesh's positions
+    /// The BVH of the triangles `which` names, in `frame`, `local` being the mesh's positions
     /// in it.
     fn of_triangles(
         mesh: &Mesh,
         frame: &UnitFrame,
         local: &[Vec3],
-        keep: impl Fn(u32) -> bool,
+        which: impl Iterator<Item = u32>,
     ) -> Self {
-        let (kept, triangles): (Vec<u32>, Vec<Triangle>) = (0u32..)
-            .zip(&mesh.triangles)
-            .filter(|&(k, _)| keep(k))
-            .filter_map(|(k, t)| {
+        let (kept, triangles): (Vec<u32>, Vec<Triangle>) = which
+            .filter_map(|k| {
+                let t = mesh.triangles.get(k as usize)?;
                 let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
                 let (v0, v1, v2) = (v0?, v1?, v2?);
                 (v0.is_finite() && v1.is_finite() && v2.is_finite())

@@ -13,19 +13,18 @@
 //! With `samples` 4 or 16 a texel is the mean of a 2 x 2 or 4 x 4 grid of points across it,
 //! each on the low triangle under it (the texel's own or a neighbour's).
 
-use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{
-    BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, CpuCaster, RAYS, RayCaster, RayQuery,
-};
+use super::{BAND_ROWS, BakeError, BakeMap, BakeOptions, Baked, CpuCaster, RayCaster, RayQuery};
 use crate::Mesh;
 use crate::bake::{Coverage, UvBake};
-use crate::frame::UnitFrame;
 use kapaint_base::task::Progress;
 
+mod checks;
 mod pairs;
 mod sample;
+pub use checks::check_cage;
+use checks::checked;
 pub use pairs::{HighRays, Matching};
 use sample::Sampler;
 
@@ -301,9 +300,17 @@ pub fn bake_from_high(
     options: HighOptions,
     progress: Option<&Progress>,
 ) -> Result<HighBake, BakeError> {
-    checked(low, uv, high, cage, options)?;
+    let distances = checked(low, uv, high, cage, options)?;
     let rays = HighRays::new(low, high, Matching::All)?;
-    let mut baked = bake_from_high_with(low, uv, (high, &rays), cage, options, progress)?;
+    let caster = CpuCaster(rays.meshes());
+    let mut baked = run(
+        (low, uv, high, cage),
+        &rays,
+        options,
+        distances,
+        &caster,
+        progress,
+    )?;
     baked.bvh_seconds = rays.bvh_seconds;
     Ok(baked)
 }
@@ -352,47 +359,98 @@ pub fn bake_from_high_on(
             .to_string()
             .into());
     }
-    let sampler = Sampler::new((low, uv, high, cage), rays, options, distances);
-    let mut baked = if options.map.casts_rays() {
-        bake_cast(&sampler, uv, caster, progress)?
-    } else {
-        bake_checked(&sampler, uv, options.map, progress)?
-    };
-    let (_, front, rear) = distances;
-    baked.map = options.map;
-    baked.front = front;
-    baked.rear = rear;
-    baked.rays = if options.map.casts_rays() {
-        options.rays
-    } else {
-        0
-    };
-    baked.max_distance = options.max_distance;
-    baked.samples = options.samples;
-    baked.cage = cage.is_some();
-    Ok(baked)
+    run(
+        (low, uv, high, cage),
+        rays,
+        options,
+        distances,
+        caster,
+        progress,
+    )
 }
 
-/// A map but AO and thickness, texel by texel on every core; its options are filled in by
-/// the caller.
-fn bake_checked(
+/// The bake once what it is given is checked (`distances` as [`checked`] found them).
+fn run(
+    (low, uv, high, cage): (&Mesh, &UvBake, &Mesh, Option<&Mesh>),
+    rays: &HighRays,
+    options: HighOptions,
+    distances: (f32, f32, f32),
+    caster: &dyn RayCaster,
+    progress: Option<&Progress>,
+) -> Result<HighBake, BakeError> {
+    let sampler = Sampler::new((low, uv, high, cage), rays, options, distances);
+    if let Some(p) = progress {
+        p.start("bake from the high mesh", u64::from(uv.height));
+    }
+    let (texels, cast_on) = if options.map.casts_rays() {
+        (bake_cast(&sampler, uv, caster, progress)?, caster.name())
+    } else {
+        (
+            bake_texels(&sampler, uv, options.map, progress)?,
+            String::new(),
+        )
+    };
+    let (_, front, rear) = distances;
+    let Texels { data, misses, skew } = texels;
+    Ok(HighBake {
+        width: uv.width,
+        height: uv.height,
+        data,
+        map: options.map,
+        front,
+        rear,
+        rays: if options.map.casts_rays() {
+            options.rays
+        } else {
+            0
+        },
+        max_distance: options.max_distance,
+        samples: options.samples,
+        cage: cage.is_some(),
+        covered: (0..uv.len())
+            .filter(|&i| uv.coverage(i) != Coverage::Empty)
+            .count() as u64,
+        missed: misses.iter().filter(|&&m| m).count() as u64,
+        misses,
+        bvh_seconds: 0.0,
+        skew,
+        cast_on,
+    })
+}
+
+/// What a bake's texels hold: the samples, whether a ray missed, the skew byte.
+struct Texels {
+    data: Vec<u16>,
+    misses: Vec<bool>,
+    skew: Vec<u8>,
+}
+
+impl Texels {
+    /// Zeros for `texels` texels of `channels` samples.
+    fn new(texels: usize, channels: usize) -> Self {
+        Self {
+            data: vec![0; texels * channels],
+            misses: vec![false; texels],
+            skew: vec![0; texels],
+        }
+    }
+}
+
+/// A map but AO and thickness, texel by texel on every core.
+fn bake_texels(
     sampler: &Sampler<'_>,
     uv: &UvBake,
     map: HighMap,
     progress: Option<&Progress>,
-) -> Result<HighBake, BakeError> {
-    let (w, h) = (uv.width as usize, uv.height as usize);
-    if let Some(p) = progress {
-        p.start("bake from the high mesh", h as u64);
-    }
+) -> Result<Texels, BakeError> {
+    let w = uv.width as usize;
     let channels = map.channels();
-    let mut data = vec![0_u16; w * h * channels];
-    let mut misses = vec![false; w * h];
-    let mut skew = vec![0_u8; w * h];
+    let mut out = Texels::new(uv.len(), channels);
     let cancelled = std::sync::atomic::AtomicBool::new(false);
-    data.par_chunks_mut(w * channels * BAND_ROWS)
-        .zip(misses.par_chunks_mut(w * BAND_ROWS))
-        .zip(skew.par_chunks_mut(w * BAND_ROWS))
+    out.data
+        .par_chunks_mut(w * channels * BAND_ROWS)
+        .zip(out.misses.par_chunks_mut(w * BAND_ROWS))
+        .zip(out.skew.par_chunks_mut(w * BAND_ROWS))
         .enumerate()
         .for_each(|(band, ((rows, missed), skewed))| {
             if progress.is_some_and(Progress::is_cancelled) {
@@ -418,7 +476,7 @@ fn bake_checked(
     if cancelled.into_inner() {
         return Err(BakeError::Cancelled);
     }
-    Ok(made(uv, data, misses, skew))
+    Ok(out)
 }
 
 /// AO or thickness: per batch of rows, each sample's projection ray on every core, then
@@ -428,15 +486,10 @@ fn bake_cast(
     uv: &UvBake,
     caster: &dyn RayCaster,
     progress: Option<&Progress>,
-) -> Result<HighBake, BakeError> {
+) -> Result<Texels, BakeError> {
     let (w, h) = (uv.width as usize, uv.height as usize);
-    if let Some(p) = progress {
-        p.start("bake from the high mesh", h as u64);
-    }
     let count = sampler.samples();
-    let mut data = vec![0_u16; w * h];
-    let mut misses = vec![false; w * h];
-    let mut skew = vec![0_u8; w * h];
+    let mut out = Texels::new(w * h, 1);
     let rows = (caster.batch_size() / (w * count)).clamp(1, h.max(1));
     for first_row in (0..h).step_by(rows) {
         if progress.is_some_and(Progress::is_cancelled) {
@@ -460,167 +513,19 @@ fn bake_cast(
         for ((&i, seen), v) in texels.iter().zip(found).zip(values.chunks(count)) {
             if let Some((missed, skewed)) = seen {
                 let mean = v.iter().sum::<f32>() / count as f32;
-                data[i] = (mean.clamp(0.0, 1.0) * 65535.0).round() as u16;
-                misses[i] = missed;
-                skew[i] = skewed;
+                out.data[i] = (mean.clamp(0.0, 1.0) * 65535.0).round() as u16;
+                out.misses[i] = missed;
+                out.skew[i] = skewed;
             }
         }
         if let Some(p) = progress {
             p.advance(((span.end - span.start) / w) as u64);
         }
     }
-    let mut baked = made(uv, data, misses, skew);
-    baked.cast_on = caster.name();
-    Ok(baked)
+    Ok(out)
 }
 
 /// A skew angle (degrees) as the skew view's byte.
 fn skew_byte(degrees: f32) -> u8 {
     (degrees / 90.0 * 255.0).round().clamp(0.0, 255.0) as u8
-}
-
-/// A bake of `uv`'s size holding `data`, counting what it covered and missed; the options
-/// are its caller's to fill in.
-fn made(uv: &UvBake, data: Vec<u16>, misses: Vec<bool>, skew: Vec<u8>) -> HighBake {
-    let covered = (0..uv.len())
-        .filter(|&i| uv.coverage(i) != Coverage::Empty)
-        .count() as u64;
-    HighBake {
-        width: uv.width,
-        height: uv.height,
-        data,
-        map: HighMap::Height,
-        front: 0.0,
-        rear: 0.0,
-        rays: 0,
-        max_distance: None,
-        samples: 1,
-        cage: false,
-        covered,
-        missed: misses.iter().filter(|&&m| m).count() as u64,
-        misses,
-        bvh_seconds: 0.0,
-        skew,
-        cast_on: String::new(),
-    }
-}
-
-/// Checks what a bake is given; returns the default distance's size and the front and rear
-/// distances.
-fn checked(
-    low: &Mesh,
-    uv: &UvBake,
-    high: &Mesh,
-    cage: Option<&Mesh>,
-    options: HighOptions,
-) -> Result<(f32, f32, f32), BakeError> {
-    if uv.triangle_count() != low.triangles.len() {
-        return Err("the UV bake was made from another mesh".to_string().into());
-    }
-    check(options)?;
-    check_id(high, options.map)?;
-    if let Some(c) = cage {
-        check_cage(low, c)?;
-    }
-    distances(low, high, options)
-}
-
-/// Checks the rays, their distance and the samples.
-fn check(options: HighOptions) -> Result<(), BakeError> {
-    if options.map.casts_rays() && !RAYS.contains(&options.rays) {
-        return Err(format!(
-            "{} rays per sample is outside {} to {}",
-            options.rays,
-            RAYS.start(),
-            RAYS.end()
-        )
-        .into());
-    }
-    if let Some(d) = options.max_distance
-        && !(d.is_finite() && d > 0.0)
-    {
-        return Err(format!("the maximum distance {d} is not a positive number").into());
-    }
-    if !SAMPLES.contains(&options.samples) {
-        return Err(format!(
-            "{} samples per texel: a texel takes 1, 4 or 16",
-            options.samples
-        )
-        .into());
-    }
-    Ok(())
-}
-
-/// Refuses an ID map by what the high mesh does not have: vertex colours, named objects or
-/// materials.
-fn check_id(high: &Mesh, map: HighMap) -> Result<(), BakeError> {
-    let missing = match map {
-        HighMap::Id(IdSource::Color) if high.labels.colors.is_none() => "vertex colours",
-        HighMap::Id(IdSource::Object) if high.labels.objects.is_empty() => "named objects",
-        HighMap::Id(IdSource::Material) if high.labels.materials.is_empty() => "materials",
-        _ => return Ok(()),
-    };
-    Err(format!(
-        "an ID map by {} needs the high mesh's {missing}, and {} has none",
-        match map {
-            HighMap::Id(source) => source.name(),
-            _ => "",
-        },
-        high.name
-    )
-    .into())
-}
-
-/// Refuses a cage that is not the low mesh pushed out: the same vertices and triangles, finite
-/// positions.
-///
-/// # Errors
-/// What is wrong with the cage.
-pub fn check_cage(low: &Mesh, cage: &Mesh) -> Result<(), BakeError> {
-    if cage.positions.len() != low.positions.len() || cage.triangles != low.triangles {
-        return Err(format!(
-            "the cage {} ({} vertices, {} triangles) is not the low mesh's topology ({} vertices, {} triangles): a cage is the low mesh with its vertices moved",
-            cage.name,
-            cage.positions.len(),
-            cage.triangles.len(),
-            low.positions.len(),
-            low.triangles.len()
-        )
-        .into());
-    }
-    UnitFrame::checked(&cage.positions)
-        .map_err(|e| BakeError::Refused(format!("the cage {}: {e}", cage.name)))?;
-    Ok(())
-}
-
-/// The default distance's size, and the front and rear distances (object units).
-///
-/// # Errors
-/// A high mesh with no triangles or positions that are not finite, distances that are not
-/// positive and finite.
-fn distances(low: &Mesh, high: &Mesh, options: HighOptions) -> Result<(f32, f32, f32), BakeError> {
-    if high.triangles.is_empty() {
-        return Err(format!("the high mesh {} has no triangles", high.name).into());
-    }
-    UnitFrame::checked(&high.positions)
-        .map_err(|e| BakeError::Refused(format!("the high mesh {}: {e}", high.name)))?;
-    let both: Vec<Vec3> = low
-        .positions
-        .iter()
-        .chain(&high.positions)
-        .copied()
-        .collect();
-    let size = UnitFrame::checked(&both)?.diagonal() * DEFAULT_DISTANCE;
-    let distance = |d: Option<f32>, what: &str| match d {
-        None => Ok(size),
-        Some(d) if d.is_finite() && d > 0.0 => Ok(d),
-        Some(d) => Err(BakeError::Refused(format!(
-            "the {what} distance {d} is not a positive number"
-        ))),
-    };
-    let (front, rear) = (
-        distance(options.front, "front")?,
-        distance(options.rear, "rear")?,
-    );
-    Ok((size, front, rear))
 }
