@@ -84,7 +84,57 @@ fn imports(c: &mut Criterion) {
         });
     });
     group.finish();
+    engines(c, imported.doc, &dir);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The engine presets at 4096^2, with the worst they meet: a 4096^2 normal map (bumps, which
+/// PNG cannot squeeze to nothing) and a 4096^2 AO bake (target: each at most 3 s on 2 cores).
+fn engines(c: &mut Criterion, doc: kapaint::model::Document, dir: &std::path::Path) {
+    use kapaint::mesh::bakes::{BakeMap, BakeOptions, Baked};
+    use std::sync::Arc;
+    let side = doc.maps().width();
+    let normal = image::RgbImage::from_fn(side, side, |x, y| {
+        let (u, v) = (x as f32 / side as f32, y as f32 / side as f32);
+        let n = glam::Vec3::new(0.4 * (u * 90.0).sin(), 0.4 * (v * 70.0).cos(), 1.0).normalize();
+        image::Rgb(n.to_array().map(|c| ((c + 1.0) * 127.5).round() as u8))
+    });
+    let ao = Baked {
+        map: BakeMap::Ao,
+        options: BakeOptions::default(),
+        mesh_hash: 0,
+        width: side,
+        height: side,
+        data: (0..side * side)
+            .map(|i| {
+                let (x, y) = ((i % side) as f32, (i / side) as f32);
+                (40_000.0 + 20_000.0 * (x * 0.01).sin() * (y * 0.013).cos()) as u16
+            })
+            .collect(),
+        from_high: None,
+    };
+    let doc = doc
+        .with_normal(Some(Arc::new(
+            kapaint::model::normal::NormalMap::new(normal).expect("normal map"),
+        )))
+        .with_bakes(vec![Arc::new(ao)]);
+    let mut group = c.benchmark_group("engine_export_4096");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(30));
+    let progress = kapaint::task::Progress::default();
+    for name in ["unreal", "unity-hdrp", "unity-urp", "godot", "gltf-pbr"] {
+        let preset = kapaint::export::preset::find(name).expect("preset");
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let out = dir.join("engine");
+                let _ = std::fs::remove_dir_all(&out);
+                kapaint::export::run(&doc, &preset, &out, &progress, false, None, None)
+                    .expect("export");
+            });
+        });
+    }
+    group.finish();
 }
 
 criterion_group!(benches, imports);

@@ -18,7 +18,7 @@ mod gltf_asset;
 
 use egui::Modifiers;
 use egui::accesskit::Role;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT as _, Queryable};
 use gltf_asset::{Asset, write_asset};
 use kapaint::ui::Editor;
 use kapaint::ui::files::{FileDialogBackend, FilePurpose, FileRequest};
@@ -509,4 +509,97 @@ fn mesh_unwrap_on_request_replaces_the_uvs() {
     assert_eq!(mesh.triangles.len(), sphere.triangles.len());
     assert_ne!(mesh.uvs, sphere.uvs, "new UVs");
     assert_eq!(kapaint::mesh::unwrap::uv_overlap(mesh, 1024), 0.0);
+}
+
+/// File > Export with an engine preset: the dialog names the layout and where occlusion will
+/// come from, and the set is written in the engine's names, said so in the notice.
+#[test]
+fn an_engine_preset_exports_from_the_dialog_with_its_layout_and_occlusion() {
+    let dir = std::env::temp_dir().join(format!("kapaint-editor-engine-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("crate");
+    let mut harness = editor();
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
+    harness.step();
+    harness.step();
+    // Choose the preset as a user does: open the list, click the name.
+    harness.get_by_label("Preset").click();
+    harness.step();
+    // The list is longer than its popup: the name is chosen by its accessibility action, as a
+    // screen reader does (a pointer click lands where the scrolled-away row would be).
+    harness
+        .get_by_role_and_label(Role::Button, "unreal")
+        .click_accesskit();
+    harness.step();
+    if harness
+        .query_by_role_and_label(Role::Button, "16-bit")
+        .is_some()
+    {
+        // Still open: close it as a user does, on the box.
+        harness.get_by_label("Preset").click();
+        harness.step();
+    }
+    assert!(
+        harness
+            .query_by_role_and_label(Role::Button, "16-bit")
+            .is_none(),
+        "the list closed"
+    );
+    // The plan arrives from a worker (after the one of the preset shown first).
+    let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
+    while harness
+        .query_by_label_contains("unreal PBR textures")
+        .is_none()
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no plan: {:?}",
+            texts(&harness)
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        harness.step();
+    }
+    harness.get_by_label_contains("unreal PBR textures");
+    harness.get_by_label_contains("Occlusion: white: the project has no AO bake");
+    harness.get_by_label_contains("{name}_OcclusionRoughnessMetallic.png");
+    let field = harness
+        .get_all_by_role(Role::TextInput)
+        .find(|n| n.value().as_deref() == Some("export"))
+        .expect("the folder field");
+    field.focus();
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.step();
+    harness
+        .get_all_by_role(Role::TextInput)
+        .find(|n| n.value().as_deref() == Some("export"))
+        .expect("the folder field")
+        .type_text(&out.display().to_string());
+    harness.step();
+    harness
+        .get_by_role_and_label(Role::Button, "Export")
+        .click();
+    harness.step();
+    wait_until(&mut harness, "exported", notice("as unreal PBR textures"));
+    for file in [
+        "crate_BaseColor.png",
+        "crate_OcclusionRoughnessMetallic.png",
+        "material.json",
+    ] {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    let orm = image::open(out.join("crate_OcclusionRoughnessMetallic.png"))
+        .expect("ORM")
+        .to_rgb8();
+    assert!(orm.pixels().all(|p| p.0[0] == 255), "white occlusion");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every text the window shows (labels and values), for a failure's message.
+fn texts(harness: &egui_kittest::Harness<'_, Editor>) -> Vec<String> {
+    harness
+        .root()
+        .children_recursive()
+        .filter_map(|n| n.accesskit_node().label().or(n.accesskit_node().value()))
+        .collect()
 }

@@ -170,7 +170,7 @@ fn every_builtin_preset_exports_and_imports() {
         match p.format {
             Format::Exr => assert!(err < 1e-4, "{}: {err}", p.name),
             Format::Png16 => assert!(err < 1e-3, "{}: {err}", p.name),
-            Format::Png8 | Format::Ktx2 | Format::GltfPbr => {
+            Format::Png8 | Format::Ktx2 | Format::GltfPbr | Format::PbrTextures => {
                 assert!(err < 0.05, "{}: {err}", p.name);
             }
             Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. } => {

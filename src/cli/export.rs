@@ -161,9 +161,14 @@ fn write_pbr(
     report: bool,
 ) {
     let e = m.round_trip;
+    let kind = if m.preset == "gltf-pbr" {
+        "glTF metallic-roughness".to_string()
+    } else {
+        format!("{} PBR textures", m.preset)
+    };
     let _ = writeln!(
         text,
-        "exported {} to {} ({} files, glTF metallic-roughness, {} bytes)",
+        "exported {} to {} ({} files, {kind}, {} bytes)",
         file.display(),
         target.display(),
         m.files.len() + 1,
@@ -176,6 +181,15 @@ fn write_pbr(
         100.0 * e.mean,
         100.0 * e.p99
     );
+    if let Some(o) = &m.occlusion {
+        let _ = writeln!(text, "occlusion: {}", o.note);
+    }
+    if let Some(green) = m.normal_green {
+        let _ = writeln!(text, "normal map: {} green", green.name());
+    }
+    for skipped in &m.skipped {
+        let _ = writeln!(text, "not written: {skipped}");
+    }
     if report {
         let _ = writeln!(text, "  preset: {}", m.preset);
         let _ = writeln!(
@@ -299,7 +313,7 @@ fn preset_help() -> String {
         .map(|p| p.name)
         .collect();
     format!(
-        "Export preset: {} (gltf-pbr writes glTF's metallic-roughness maps; the others kapaint sets), or a user preset",
+        "Export preset: {} (gltf-pbr writes glTF's metallic-roughness maps, unreal, unity-hdrp, unity-urp and godot each engine's PBR textures; the others kapaint sets), or a user preset",
         names.join(", ")
     )
 }
@@ -317,9 +331,9 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
             preset.name
         )));
     }
-    if args.n_mapping.is_some() && !preset.format.is_gltf_pbr() {
+    if args.n_mapping.is_some() && !preset.format.is_pbr() {
         return Err(CliError::usage(format!(
-            "--n-mapping chooses how n becomes roughness: use it with --preset gltf-pbr, not {}",
+            "--n-mapping chooses how n becomes roughness: use it with a PBR preset (gltf-pbr, unreal, unity-hdrp, unity-urp, godot), not {}",
             preset.name
         )));
     }

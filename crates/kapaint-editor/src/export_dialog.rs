@@ -134,7 +134,9 @@ impl ExportDialog {
 
     /// The preset chooser and the chosen preset's description.
     fn preset_ui(&mut self, ui: &mut egui::Ui) {
+        // Tall enough for every built-in preset without scrolling.
         egui::ComboBox::from_label("Preset")
+            .height(420.0)
             .selected_text(
                 self.presets
                     .get(self.chosen)
@@ -251,8 +253,8 @@ pub(super) fn export_window(
             ui.separator();
             match &dialog.plan {
                 Some((p, _, plan)) if *p == dialog.chosen => {
-                    export_plan_ui(ui, plan, pbr);
                     if let Some(preset) = dialog.presets.get(dialog.chosen) {
+                        export_plan_ui(ui, plan, preset);
                         block_search_ui(ui, preset);
                     }
                 }

@@ -6,16 +6,18 @@ use kapaint_export::preset::ExportPreset;
 
 /// The export dialog's preview: the packed layout of each file, the constants, the memory
 /// report and the `k_a` error that `n`'s quantisation costs.
-pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetPlan, pbr: bool) {
+pub(super) fn export_plan_ui(
+    ui: &mut egui::Ui,
+    plan: &kapaint_export::set::SetPlan,
+    preset: &ExportPreset,
+) {
     let mb = |b: u64| b as f64 / 1e6;
-    ui.label(
-        egui::RichText::new(if pbr {
-            "glTF metallic-roughness textures"
-        } else {
-            "Packed layout"
-        })
-        .strong(),
-    );
+    let heading = match preset.format {
+        kapaint_export::preset::Format::GltfPbr => "glTF metallic-roughness textures".into(),
+        kapaint_export::preset::Format::PbrTextures => format!("{} PBR textures", preset.name),
+        _ => "Packed layout".into(),
+    };
+    ui.label(egui::RichText::new(heading).strong());
     egui::Grid::new("export layout")
         .striped(true)
         .show(ui, |ui| {
@@ -43,6 +45,9 @@ pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetP
             n.path, n.width, n.height, n.storage
         ));
     }
+    if let Some(note) = &plan.occlusion {
+        ui.label(format!("Occlusion: {note}"));
+    }
     if plan.files.is_empty() && plan.normal.is_none() {
         ui.label("Every channel is constant: the set is a manifest alone.");
     }
@@ -58,7 +63,7 @@ pub(super) fn export_plan_ui(ui: &mut egui::Ui, plan: &kapaint_export::set::SetP
             e.curve, e.lo, e.hi, e.bits
         ));
     }
-    if pbr {
+    if preset.format.is_pbr() {
         ui.label(
             "Base colour, metallic and roughness are converted back from k_d, k_s and n; \
              the round-trip error is measured as the set is written (material.json).",

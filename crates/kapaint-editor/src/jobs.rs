@@ -333,12 +333,20 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
             text
         }
         kapaint_export::Exported::Pbr(m) => format!(
-            "exported {} as glTF PBR ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%)",
+            "exported {} as {} ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%{})",
             dir.display(),
+            if m.preset == "gltf-pbr" {
+                "glTF PBR".to_string()
+            } else {
+                format!("{} PBR textures", m.preset)
+            },
             m.files.len() + 1,
             m.round_trip.max * 100.0,
             m.round_trip.mean * 100.0,
-            m.round_trip.p99 * 100.0
+            m.round_trip.p99 * 100.0,
+            m.occlusion
+                .as_ref()
+                .map_or_else(String::new, |o| format!("; occlusion {}", o.note))
         ),
     }
 }

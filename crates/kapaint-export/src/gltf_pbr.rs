@@ -1,13 +1,17 @@
-//! The `gltf-pbr` export: a project's `k_d`, `k_s`, `n` back to glTF's metallic-roughness
-//! textures ([`kapaint_pbr::round_trip`]), with the round-trip error in the manifest, and
-//! optionally a `.glb` of the project's mesh with the material embedded ([`super::glb`]).
+//! The PBR exports: a project's `k_d`, `k_s`, `n` back to glTF's metallic-roughness values
+//! ([`kapaint_pbr::round_trip`]), with the round-trip error in the manifest, written in glTF's
+//! layout (the `gltf-pbr` preset, optionally a `.glb` of the project's mesh with the material
+//! embedded, [`super::glb`]) or a preset's own (the engine presets: Unreal's ORM, Unity's
+//! mask map, Godot's ORM, with occlusion from the AO bake; [`super::pbr_files`]).
 
 use std::path::Path;
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::preset::ExportPreset;
-use super::set::{ColourSpace, SetError, claim, commit, padded_texels, png_bytes};
+use super::pbr_files::{Encoded, Sources};
+use super::preset::{ExportPreset, NormalGreen};
+use super::set::{SetError, claim, commit, padded_texels};
 use kapaint_base::task::Progress;
 use kapaint_mesh::Mesh;
 use kapaint_model::Document;
@@ -15,27 +19,13 @@ use kapaint_model::provenance::ErrorSummary;
 use kapaint_pbr::round_trip::convert;
 use kapaint_reflectance::ShadingModel;
 
+pub use crate::pbr_files::{Occlusion, PbrFile};
+pub use crate::preset::textures::GLTF_NORMAL_FILE as NORMAL_FILE;
 pub use crate::set::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, PBR_MANIFEST_FORMAT};
 /// Its version.
 pub const PBR_MANIFEST_VERSION: u32 = 1;
-/// The normal map's name (where the project has one).
-pub const NORMAL_FILE: &str = "normal.png";
 /// The `.glb`'s name.
 pub const GLB_FILE: &str = "model.glb";
-
-/// One file of a glTF PBR set.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PbrFile {
-    /// File name, in the set's folder.
-    pub path: String,
-    /// What it holds, channel by channel (`base.r base.g base.b`, `- roughness metallic`).
-    pub layout: Vec<String>,
-    /// How its colour is encoded (images).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub colour_space: Option<ColourSpace>,
-    /// Size in bytes.
-    pub bytes: u64,
-}
 
 /// A glTF PBR set's `material.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,56 +52,26 @@ pub struct PbrManifest {
     pub files: Vec<PbrFile>,
     /// The preset used.
     pub preset: String,
+    /// Where the occlusion came from, where the layout has an occlusion channel.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub occlusion: Option<Occlusion>,
+    /// Which way the written normal map's green points, where one was written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_green: Option<NormalGreen>,
+    /// The layout's files not written, each with why (`x_Normal.png: the project has no
+    /// normal map`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skipped: Vec<String>,
 }
 
-/// The manifest's list of files, with their sizes.
-fn files_of(
-    base: usize,
-    metallic_roughness: usize,
-    normal: Option<usize>,
-    glb: Option<usize>,
-) -> Vec<PbrFile> {
-    let file = |path: &str, layout: &[&str], colour_space, bytes: usize| PbrFile {
-        path: path.into(),
-        layout: layout.iter().map(ToString::to_string).collect(),
-        colour_space,
-        bytes: bytes as u64,
-    };
-    let mut files = vec![
-        file(
-            BASE_COLOR_FILE,
-            &["base.r", "base.g", "base.b"],
-            Some(ColourSpace::Srgb),
-            base,
-        ),
-        file(
-            METALLIC_ROUGHNESS_FILE,
-            &["-", "roughness", "metallic"],
-            Some(ColourSpace::Linear),
-            metallic_roughness,
-        ),
-    ];
-    if let Some(bytes) = normal {
-        files.push(file(
-            NORMAL_FILE,
-            &["normal.x", "normal.y", "normal.z"],
-            Some(ColourSpace::Linear),
-            bytes,
-        ));
-    }
-    if let Some(bytes) = glb {
-        files.push(file(GLB_FILE, &["mesh", "material"], None, bytes));
-    }
-    files
-}
-
-/// Writes `doc` as a glTF PBR set into the folder `out` (free, or a set to replace when
-/// `replace`): the two images, the normal map where the document has one (as stored),
-/// `material.json`, and with `glb` that mesh with the material embedded ([`GLB_FILE`]).
+/// Writes `doc` as a PBR set into the folder `out` (free, or a set to replace when
+/// `replace`): the preset's layout ([`ExportPreset::pbr_files`]; a normal map's file only
+/// where the document has one), `material.json`, and for glTF's layout with `glb` that mesh
+/// with the material embedded ([`GLB_FILE`]).
 ///
 /// # Errors
-/// A taken target, a mesh without UVs, a failed encode or write (nothing is left at `out`);
-/// cancelled.
+/// A taken target, a layout whose names meet once the set's name is in them, a failed
+/// encode or write (nothing is left at `out`); cancelled.
 pub fn export(
     doc: &Document,
     preset: &ExportPreset,
@@ -122,116 +82,157 @@ pub fn export(
 ) -> Result<PbrManifest, SetError> {
     progress.start("analyse", 1);
     let found = claim(out, replace, crate::set::SetKind::Pbr)?;
-    let (w, h) = (doc.maps().width(), doc.maps().height());
-    let model = doc.settings().model;
-    let (texels, dilated) = padded_texels(doc);
-    progress.check().map_err(|_| SetError::Cancelled)?;
-    progress.start("encode", 2);
-    let mapping = doc.settings().n_mapping();
-    let converted = convert(&texels, model, mapping);
-    drop(texels);
     let invalid = |reason: String| SetError::Invalid {
         path: out.to_path_buf(),
         reason,
     };
-    let png =
-        |rgb: &[[u8; 3]]| png_bytes(rgb.as_flattened(), (w, h), image::ExtendedColorType::Rgb8);
-    let (base, metallic_roughness) = rayon::join(
-        || png(&converted.base),
-        || png(&converted.metallic_roughness),
-    );
-    let (base, metallic_roughness) = (base.map_err(invalid)?, metallic_roughness.map_err(invalid)?);
-    progress.check().map_err(|_| SetError::Cancelled)?;
-    progress.start("measure", 1);
-    // The normal map passes through as stored.
-    let normal = doc
-        .normal()
-        .map(|m| m.to_png())
-        .transpose()
-        .map_err(invalid)?;
     let name = out
         .file_name()
         .map_or_else(|| "kapaint".into(), |n| n.to_string_lossy().into_owned());
+    let layout = preset.pbr_files();
+    let paths = paths_in(&layout, &name).map_err(invalid)?;
+    let wants_occlusion = layout
+        .iter()
+        .any(|f| f.channels.contains(&crate::preset::Channel::Occlusion));
+    let (occlusion, occlusion_note) = if wants_occlusion {
+        let (plane, note) = crate::pbr_files::occlusion(doc);
+        (plane, Some(note))
+    } else {
+        (None, None)
+    };
+    let (model, mapping) = (doc.settings().model, doc.settings().n_mapping());
+    let (texels, occlusion, dilated) = padded_texels(doc, occlusion);
+    progress.check().map_err(|_| SetError::Cancelled)?;
+    progress.start("encode", 2);
+    let converted = convert(&texels, model, mapping);
+    drop(texels);
+    let sources = Sources {
+        size: (doc.maps().width(), doc.maps().height()),
+        converted: &converted,
+        occlusion: occlusion.as_deref(),
+        normal: doc.normal().map(AsRef::as_ref),
+        green: preset.normal_green,
+    };
+    let encoded: Vec<Option<Result<Encoded, String>>> = layout
+        .par_iter()
+        .zip(paths.clone())
+        .map(|(file, path)| sources.encode(file, path))
+        .collect();
+    progress.check().map_err(|_| SetError::Cancelled)?;
+    progress.start("measure", 1);
+    let (mut written, mut skipped) = (Vec::new(), Vec::new());
+    for (file, (path, e)) in layout.iter().zip(paths.iter().zip(encoded)) {
+        match e {
+            Some(e) => written.push(e.map_err(invalid)?),
+            None if file.is_normal() => {
+                skipped.push(format!("{path}: the project has no normal map"));
+            }
+            None => skipped.push(format!("{path}: nothing to write")),
+        }
+    }
+    let normal_green = layout
+        .iter()
+        .any(|f| f.is_normal() && doc.normal().is_some())
+        .then_some(preset.normal_green);
     let glb = glb
-        .map(|mesh| {
-            let textures = super::glb::Textures {
-                base_color: &base,
-                metallic_roughness: &metallic_roughness,
-                normal: normal.as_deref(),
-                double_sided: doc
-                    .settings()
-                    .import
-                    .as_ref()
-                    .is_some_and(|r| r.double_sided),
-            };
-            super::glb::write(mesh, &textures, name)
-        })
+        .map(|mesh| gltf_glb(doc, mesh, &written, name))
         .transpose()
         .map_err(invalid)?;
-    let written = PbrFiles {
-        base,
-        metallic_roughness,
-        normal,
-        glb,
-    };
+    let mut files: Vec<PbrFile> = written.iter().map(|e| e.entry.clone()).collect();
+    if let Some(bytes) = &glb {
+        files.push(PbrFile {
+            path: GLB_FILE.into(),
+            layout: vec!["mesh".into(), "material".into()],
+            colour_space: None,
+            bytes: bytes.len() as u64,
+        });
+    }
     let manifest = PbrManifest {
         format: PBR_MANIFEST_FORMAT.into(),
         version: PBR_MANIFEST_VERSION,
-        width: w,
-        height: h,
+        width: doc.maps().width(),
+        height: doc.maps().height(),
         model,
         n_mapping: mapping.report_name(model).into(),
         round_trip: converted.error,
         dilated,
-        files: written.entries(),
+        files,
         preset: preset.name.clone(),
+        occlusion: occlusion_note,
+        normal_green,
+        skipped,
     };
     commit(out, &found, |tmp| {
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| invalid(e.to_string()))?;
-        written.write(tmp, &json)?;
+        let mut writes: Vec<(&str, &[u8])> = written
+            .iter()
+            .map(|e| (e.entry.path.as_str(), e.bytes.as_slice()))
+            .collect();
+        writes.push(("material.json", &json));
+        if let Some(bytes) = &glb {
+            writes.push((GLB_FILE, bytes));
+        }
+        write_all(tmp, &writes)?;
         Ok(manifest)
     })
 }
 
-/// The files of a glTF PBR set, encoded.
-struct PbrFiles {
-    base: Vec<u8>,
-    metallic_roughness: Vec<u8>,
-    normal: Option<Vec<u8>>,
-    glb: Option<Vec<u8>>,
+/// The layout's file names in a set named `name`.
+///
+/// # Errors
+/// Two that meet (case aside) once the name is in them.
+fn paths_in(layout: &[crate::preset::TextureFile], name: &str) -> Result<Vec<String>, String> {
+    let paths: Vec<String> = layout.iter().map(|f| f.path(name)).collect();
+    for (i, p) in paths.iter().enumerate() {
+        if let Some(j) = paths[..i].iter().position(|q| q.eq_ignore_ascii_case(p)) {
+            return Err(format!(
+                "the layout's files {} and {} are both {p} in a set named {name:?}",
+                layout[j].file, layout[i].file
+            ));
+        }
+    }
+    Ok(paths)
 }
 
-impl PbrFiles {
-    /// Their manifest entries.
-    fn entries(&self) -> Vec<PbrFile> {
-        files_of(
-            self.base.len(),
-            self.metallic_roughness.len(),
-            self.normal.as_ref().map(Vec::len),
-            self.glb.as_ref().map(Vec::len),
-        )
+/// Writes each `(name, bytes)` into the folder `tmp`.
+fn write_all(tmp: &Path, writes: &[(&str, &[u8])]) -> Result<(), SetError> {
+    for (name, bytes) in writes {
+        let path = tmp.join(name);
+        kapaint_base::atomic::write_atomic(&path, bytes).map_err(|e| SetError::Io {
+            path: path.clone(),
+            reason: e.to_string(),
+        })?;
     }
+    Ok(())
+}
 
-    /// Writes them and the manifest's `json` into `tmp`.
-    fn write(&self, tmp: &Path, json: &[u8]) -> Result<(), SetError> {
-        let mut writes: Vec<(&str, &[u8])> = vec![
-            (BASE_COLOR_FILE, &self.base),
-            (METALLIC_ROUGHNESS_FILE, &self.metallic_roughness),
-            ("material.json", json),
-        ];
-        if let Some(bytes) = &self.normal {
-            writes.push((NORMAL_FILE, bytes));
-        }
-        if let Some(bytes) = &self.glb {
-            writes.push((GLB_FILE, bytes));
-        }
-        for (name, bytes) in writes {
-            let path = tmp.join(name);
-            kapaint_base::atomic::write_atomic(&path, bytes).map_err(|e| SetError::Io {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?;
-        }
-        Ok(())
-    }
+/// The `.glb` of `mesh` with glTF's images `written` embedded, named `name`.
+fn gltf_glb(
+    doc: &Document,
+    mesh: &Mesh,
+    written: &[Encoded],
+    name: String,
+) -> Result<Vec<u8>, String> {
+    let file = |path: &str| {
+        written
+            .iter()
+            .find(|e| e.entry.path == path)
+            .map(|e| e.bytes.as_slice())
+    };
+    let (Some(base_color), Some(metallic_roughness)) =
+        (file(BASE_COLOR_FILE), file(METALLIC_ROUGHNESS_FILE))
+    else {
+        return Err("a .glb is written with glTF's layout (the gltf-pbr preset)".into());
+    };
+    let textures = super::glb::Textures {
+        base_color,
+        metallic_roughness,
+        normal: file(NORMAL_FILE),
+        double_sided: doc
+            .settings()
+            .import
+            .as_ref()
+            .is_some_and(|r| r.double_sided),
+    };
+    super::glb::write(mesh, &textures, name)
 }

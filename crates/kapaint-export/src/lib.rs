@@ -9,6 +9,7 @@ pub mod file_kind;
 pub mod glb;
 pub mod gltf_pbr;
 pub mod ktx;
+pub mod pbr_files;
 pub mod preset;
 pub mod set;
 pub mod snippet;
@@ -20,13 +21,13 @@ use std::path::Path;
 pub enum Exported {
     /// A kapaint set (`material.json` in [`set::MANIFEST_FORMAT`]).
     Set(set::Manifest),
-    /// A glTF PBR set (the `gltf-pbr` preset).
+    /// A PBR set (the `gltf-pbr` preset, an engine's, or a user's layout).
     Pbr(gltf_pbr::PbrManifest),
 }
 
 /// Exports `doc` with `preset` into the folder `out`: a kapaint set ([`set::export_with`],
-/// [`set::export_replacing`] where `replace`), or for a [`preset::Format::GltfPbr`] preset a
-/// glTF PBR set, with the `glb` mesh and the material as a `.glb` where given. Blocks are
+/// [`set::export_replacing`] where `replace`), or for a PBR preset ([`preset::Format::is_pbr`])
+/// a PBR set, for glTF's with the `glb` mesh and the material as a `.glb` where given. Blocks are
 /// encoded by `brought` (a GPU's encoder) where given, else on the CPU.
 ///
 /// # Errors
@@ -40,10 +41,7 @@ pub fn run(
     glb: Option<&kapaint_mesh::Mesh>,
     brought: Option<&dyn blocks::BlockEncoder>,
 ) -> Result<Exported, set::SetError> {
-    if preset.format.is_gltf_pbr() {
-        return gltf_pbr::export(doc, preset, out, progress, replace, glb).map(Exported::Pbr);
-    }
-    if glb.is_some() {
+    if glb.is_some() && !preset.format.is_gltf_pbr() {
         return Err(set::SetError::Invalid {
             path: out.to_path_buf(),
             reason: format!(
@@ -51,6 +49,9 @@ pub fn run(
                 preset.name
             ),
         });
+    }
+    if preset.format.is_pbr() {
+        return gltf_pbr::export(doc, preset, out, progress, replace, glb).map(Exported::Pbr);
     }
     set::export_into(doc, preset, out, progress, replace, brought).map(Exported::Set)
 }

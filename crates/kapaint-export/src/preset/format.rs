@@ -45,6 +45,11 @@ pub enum Format {
     /// from `k_d`, `k_s`, `n` ([`crate::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
     /// not apply.
     GltfPbr,
+    /// PBR PNGs in the preset's own layout (`textures:`): engine materials (Unreal's ORM,
+    /// Unity's mask map, Godot's ORM), converted back from `k_d`, `k_s`, `n` as
+    /// [`Self::GltfPbr`] is, occlusion from the AO bake ([`crate::gltf_pbr`]). `layout`,
+    /// `n_bits` and `include_ka` do not apply.
+    PbrTextures,
 }
 
 impl Format {
@@ -58,6 +63,7 @@ impl Format {
             Self::Ktx2Bc { .. } => "Ktx2Bc",
             Self::Ktx2Astc { .. } => "Ktx2Astc",
             Self::GltfPbr => "GltfPbr",
+            Self::PbrTextures => "PbrTextures",
         }
     }
 
@@ -68,7 +74,8 @@ impl Format {
             | Self::Ktx2
             | Self::Ktx2Bc { .. }
             | Self::Ktx2Astc { .. }
-            | Self::GltfPbr => true,
+            | Self::GltfPbr
+            | Self::PbrTextures => true,
             Self::Png16 | Self::Exr => false,
         }
     }
@@ -77,7 +84,7 @@ impl Format {
     pub fn is_ktx2(self) -> bool {
         match self {
             Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } => true,
-            Self::Png8 | Self::Png16 | Self::Exr | Self::GltfPbr => false,
+            Self::Png8 | Self::Png16 | Self::Exr | Self::GltfPbr | Self::PbrTextures => false,
         }
     }
 
@@ -87,16 +94,26 @@ impl Format {
         self.max_effort().is_some()
     }
 
-    /// Whether this is the glTF metallic-roughness export (not a kapaint set).
+    /// Whether this is the glTF metallic-roughness export (a PBR set that may carry a `.glb`).
     pub fn is_gltf_pbr(self) -> bool {
         matches!(self, Self::GltfPbr)
+    }
+
+    /// Whether this writes PBR textures (glTF's or a layout's), not a kapaint set.
+    pub fn is_pbr(self) -> bool {
+        matches!(self, Self::GltfPbr | Self::PbrTextures)
     }
 
     /// The most effort a block-compressed export may spend (`None` without blocks).
     pub fn max_effort(self) -> Option<Effort> {
         match self {
             Self::Ktx2Bc { max_effort, .. } | Self::Ktx2Astc { max_effort, .. } => Some(max_effort),
-            Self::Png8 | Self::Png16 | Self::Exr | Self::Ktx2 | Self::GltfPbr => None,
+            Self::Png8
+            | Self::Png16
+            | Self::Exr
+            | Self::Ktx2
+            | Self::GltfPbr
+            | Self::PbrTextures => None,
         }
     }
 
@@ -130,7 +147,8 @@ impl Format {
             | Self::Ktx2
             | Self::Ktx2Bc { .. }
             | Self::Ktx2Astc { .. }
-            | Self::GltfPbr => 1,
+            | Self::GltfPbr
+            | Self::PbrTextures => 1,
             Self::Png16 => 2,
             Self::Exr => 4,
         }
@@ -139,7 +157,7 @@ impl Format {
     /// The files' extension.
     pub fn extension(self) -> &'static str {
         match self {
-            Self::Png8 | Self::Png16 | Self::GltfPbr => "png",
+            Self::Png8 | Self::Png16 | Self::GltfPbr | Self::PbrTextures => "png",
             Self::Exr => "exr",
             Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } => "ktx2",
         }
@@ -159,7 +177,12 @@ impl Format {
                 2 => Box::new(Bc5),
                 c => Box::new(Bc7::new(c == 4, srgb)),
             }),
-            Self::Png8 | Self::Png16 | Self::Exr | Self::Ktx2 | Self::GltfPbr => None,
+            Self::Png8
+            | Self::Png16
+            | Self::Exr
+            | Self::Ktx2
+            | Self::GltfPbr
+            | Self::PbrTextures => None,
         }
     }
 }

@@ -6,9 +6,11 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 mod format;
+pub mod textures;
 mod version_one;
 
 pub use self::format::Format;
+pub use self::textures::{Channel, NormalGreen, TextureFile};
 use self::version_one::VersionOne;
 pub use crate::codec::{AstcBlock, Effort};
 
@@ -118,6 +120,25 @@ pub struct ExportPreset {
     /// KTX2 sets: the Zstandard level every KTX2 file's levels are supercompressed at
     /// ([`crate::ktx::ZSTD_LEVELS`]); `None`: stored as encoded.
     pub zstd: Option<u8>,
+    /// A [`Format::PbrTextures`] preset's files and what their channels hold (empty for
+    /// every other format).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub textures: Vec<TextureFile>,
+    /// Which way the normal map's green points in a PBR set (glTF's is always OpenGL's).
+    #[serde(default)]
+    pub normal_green: NormalGreen,
+}
+
+impl ExportPreset {
+    /// The files a PBR preset writes, in order: the preset's layout, or glTF's for the
+    /// `gltf-pbr` format (empty for a kapaint set).
+    pub fn pbr_files(&self) -> Vec<TextureFile> {
+        match self.format {
+            Format::GltfPbr => textures::gltf(),
+            Format::PbrTextures => self.textures.clone(),
+            _ => Vec::new(),
+        }
+    }
 }
 
 /// An export preset as its file spells it, before it is checked.
@@ -131,7 +152,9 @@ struct ExportPresetFile {
     #[serde(default)]
     description: String,
     format: Format,
+    #[serde(default = "packed")]
     layout: Layout,
+    #[serde(default = "eight")]
     n_bits: u8,
     #[serde(default)]
     include_ka: bool,
@@ -147,10 +170,22 @@ struct ExportPresetFile {
     min_psnr: Option<f64>,
     #[serde(default, deserialize_with = "some")]
     zstd: Option<u8>,
+    #[serde(default)]
+    textures: Vec<TextureFile>,
+    #[serde(default)]
+    normal_green: NormalGreen,
 }
 
 fn version_one() -> u32 {
     1
+}
+
+fn packed() -> Layout {
+    Layout::Packed
+}
+
+fn eight() -> u8 {
+    8
 }
 
 /// An optional value as a preset spells it: bare (a limit as before the limits became
@@ -193,9 +228,10 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
                 f.format.name()
             ));
         }
-        if f.format.is_gltf_pbr() && f.include_ka {
-            return Err("a glTF PBR set has no k_a map (include_ka: false)".into());
+        if f.format.is_pbr() && f.include_ka {
+            return Err("a PBR set has no k_a map (include_ka: false)".into());
         }
+        check_pbr_layout(&f)?;
         if matches!(f.format, Format::Png16) && f.n_bits != 16 {
             return Err("16-bit PNGs store n in 16 bits (n_bits: 16)".into());
         }
@@ -255,7 +291,26 @@ impl TryFrom<ExportPresetFile> for ExportPreset {
             include_ka: f.include_ka,
             budget,
             zstd: f.zstd,
+            textures: f.textures,
+            normal_green: f.normal_green,
         })
+    }
+}
+
+/// A PBR layout where the format takes one: `textures` with `PbrTextures` (checked), none
+/// elsewhere; DirectX green only where the layout is the preset's own.
+fn check_pbr_layout(f: &ExportPresetFile) -> Result<(), String> {
+    match f.format {
+        Format::PbrTextures => textures::check(&f.textures),
+        other if !f.textures.is_empty() => Err(format!(
+            "textures lays out a PbrTextures set; a {} set has its own files",
+            other.name()
+        )),
+        other if f.normal_green != NormalGreen::OpenGl => Err(format!(
+            "normal_green applies to a PbrTextures set's normal map, not a {} set's",
+            other.name()
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -294,6 +349,10 @@ const BUILTIN: &[(&str, &str)] = &[
         "gltf-pbr",
         include_str!("../../../../presets/export/gltf-pbr.ron"),
     ),
+    (
+        "godot",
+        include_str!("../../../../presets/export/godot.ron"),
+    ),
     ("ktx2", include_str!("../../../../presets/export/ktx2.ron")),
     (
         "ktx2-astc",
@@ -306,6 +365,18 @@ const BUILTIN: &[(&str, &str)] = &[
     (
         "separate",
         include_str!("../../../../presets/export/separate.ron"),
+    ),
+    (
+        "unity-hdrp",
+        include_str!("../../../../presets/export/unity-hdrp.ron"),
+    ),
+    (
+        "unity-urp",
+        include_str!("../../../../presets/export/unity-urp.ron"),
+    ),
+    (
+        "unreal",
+        include_str!("../../../../presets/export/unreal.ron"),
     ),
     (
         "with-ka",
@@ -347,11 +418,11 @@ pub fn builtin() -> Vec<ExportPreset> {
         .collect()
 }
 
-/// The built-in presets that write kapaint sets (every one but the glTF PBR export).
+/// The built-in presets that write kapaint sets (every one but the PBR exports).
 pub fn builtin_sets() -> Vec<ExportPreset> {
     builtin()
         .into_iter()
-        .filter(|p| !p.format.is_gltf_pbr())
+        .filter(|p| !p.format.is_pbr())
         .collect()
 }
 
@@ -424,6 +495,10 @@ mod tests {
             "ktx2-astc",
             "ktx2-raw",
             "gltf-pbr",
+            "unreal",
+            "unity-hdrp",
+            "unity-urp",
+            "godot",
         ] {
             assert_eq!(find(name).unwrap().name, name);
         }
@@ -448,6 +523,12 @@ mod tests {
             "(version: 2, name: \"a\", format: Ktx2Bc(max_effort: Hard), layout: Packed, n_bits: 8)",
             "(version: 3, name: \"a\", format: Png8, layout: Packed, n_bits: 8)",
             "(name: \"a\", format: Ktx2Bc(), layout: Packed, n_bits: 8)",
+            "(version: 2, name: \"a\", format: PbrTextures)",
+            "(version: 2, name: \"a\", format: PbrTextures, textures: [(file: \"a.png\", channels: [\"gloss\"])])",
+            "(version: 2, name: \"a\", format: PbrTextures, textures: [(file: \"a.png\", channels: [\"one\"]), (file: \"A.png\", channels: [\"zero\"])])",
+            "(version: 2, name: \"a\", format: PbrTextures, include_ka: true, textures: [(file: \"a.png\", channels: [\"one\"])])",
+            "(version: 2, name: \"a\", format: GltfPbr, normal_green: DirectX)",
+            "(version: 2, name: \"a\", format: Png8, textures: [(file: \"a.png\", channels: [\"one\"])])",
         ] {
             let err = ExportPreset::parse(path, text).unwrap_err().to_string();
             assert!(err.starts_with("x.ron: "), "{err}");

@@ -80,7 +80,7 @@ fn file_tables(srgb: bool, n_enc: Option<NEncoding>) -> (Vec<f32>, Vec<f32>) {
 }
 
 /// A PNG of `data` (16-bit words native-endian) with `color`.
-pub(crate) fn png_bytes(data: &[u8], size: (u32, u32), color: C) -> Result<Vec<u8>, String> {
+fn png_bytes(data: &[u8], size: (u32, u32), color: C) -> Result<Vec<u8>, String> {
     kapaint_model::import::encode_png(data, size, color)
 }
 
@@ -125,7 +125,7 @@ pub(super) fn encode_image(
         }
     };
     match format {
-        Format::Png8 | Format::GltfPbr => {
+        Format::Png8 | Format::GltfPbr | Format::PbrTextures => {
             let data: Vec<u8> = (0..count * channels)
                 .into_par_iter()
                 .map(|j| (value(j / channels, j % channels).clamp(0.0, 1.0) * 255.0).round() as u8)

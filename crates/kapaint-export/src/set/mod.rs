@@ -23,7 +23,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 pub use self::choice::{BlockChoice, BlockLayout, Trial};
-pub(crate) use self::encode::png_bytes;
 use self::encode::{Encoded, StoredImage, encode_image, rows};
 use self::failure::Failure;
 pub use self::import::import;
@@ -140,10 +139,10 @@ pub(super) fn export_into(
 ) -> Result<Manifest, SetError> {
     progress.start("analyse", 1);
     let found = claim(out, replace, SetKind::Material)?;
-    if preset.format.is_gltf_pbr() {
+    if preset.format.is_pbr() {
         return Err(SetError::Invalid {
             path: out.to_path_buf(),
-            reason: "a glTF PBR set is written by the glTF PBR writer".into(),
+            reason: "a PBR set is written by the PBR writer".into(),
         });
     }
     let source = Source::plan(doc, preset);
@@ -190,7 +189,7 @@ impl<'d> Source<'d> {
         let maps = doc.maps();
         let (model, approx) = (doc.settings().model, doc.settings().approx);
         let (planned, mono_ks, images) = plan_set(doc, preset);
-        let (texels, dilated) = padded_texels(doc);
+        let (texels, _, dilated) = padded_texels(doc, None);
         let ka = if preset.include_ka {
             texels
                 .par_iter()
@@ -539,10 +538,14 @@ fn level_errors(
         .collect()
 }
 
-/// The document's texels, row-major; outside the mesh's UV islands they copy the nearest
-/// island's, so mips and filtering do not pull the background into the edges (`true` when
-/// that was done: the document has a surface with UVs).
-pub(crate) fn padded_texels(doc: &Document) -> (Vec<kapaint_model::texel::Texel>, bool) {
+/// The document's texels, row-major, and `plane` (a grey image of the same size, where
+/// given); outside the mesh's UV islands both copy the nearest island's, so mips and
+/// filtering do not pull the background into the edges (`true` when that was done: the
+/// document has a surface with UVs).
+pub(crate) fn padded_texels(
+    doc: &Document,
+    mut plane: Option<Vec<u8>>,
+) -> (Vec<kapaint_model::texel::Texel>, Option<Vec<u8>>, bool) {
     let maps = doc.maps();
     let (w, h) = (maps.width(), maps.height());
     let mut texels = rows(maps);
@@ -554,9 +557,12 @@ pub(crate) fn padded_texels(doc: &Document) -> (Vec<kapaint_model::texel::Texel>
         if any {
             kapaint_mesh::bake::dilate_grid(&mut filled, w, h, u32::MAX, |k, src| {
                 texels[k] = texels[src];
+                if let Some(p) = plane.as_mut() {
+                    p[k] = p[src];
+                }
             });
         }
         any
     });
-    (texels, dilated)
+    (texels, plane, dilated)
 }

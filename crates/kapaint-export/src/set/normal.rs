@@ -47,7 +47,9 @@ impl NormalStorage {
     /// How a set of `preset` stores it.
     pub fn of(preset: &ExportPreset) -> Self {
         match preset.format {
-            Format::Png8 | Format::Png16 | Format::Exr | Format::GltfPbr => Self::Png,
+            Format::Png8 | Format::Png16 | Format::Exr | Format::GltfPbr | Format::PbrTextures => {
+                Self::Png
+            }
             Format::Ktx2 => Self::Ktx2(None),
             blocks @ (Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. }) => {
                 Self::Ktx2(Some((blocks, NORMAL_EFFORT)))

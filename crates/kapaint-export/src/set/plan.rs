@@ -87,6 +87,8 @@ pub struct SetPlan {
     pub bytes: MemoryReport,
     /// The project's normal map, written beside the maps, when it has one.
     pub normal: Option<PlannedNormal>,
+    /// A PBR layout with an occlusion channel: where it will come from, in words.
+    pub occlusion: Option<String>,
 }
 
 /// The normal map a set will hold: its file, its size, and how it is stored.
@@ -105,6 +107,10 @@ pub struct PlannedNormal {
 /// The plan of exporting `doc` with `preset` (see [`SetPlan`]).
 pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
     let (mut plan, _, _) = plan_set(doc, preset);
+    if preset.format.is_pbr() {
+        // A PBR layout lists the normal map among its files.
+        return plan;
+    }
     let storage = super::NormalStorage::of(preset);
     plan.normal = doc.normal().map(|n| PlannedNormal {
         path: storage.file(),
@@ -119,8 +125,8 @@ pub fn plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
 /// planned images' components.
 pub(super) fn plan_set(doc: &Document, preset: &ExportPreset) -> (SetPlan, bool, Images) {
     let maps = doc.maps();
-    if preset.format.is_gltf_pbr() {
-        return (gltf_pbr_plan(maps), false, Vec::new());
+    if preset.format.is_pbr() {
+        return (pbr_plan(doc, preset), false, Vec::new());
     }
     let (model, approx) = (doc.settings().model, doc.settings().approx);
     let (kd, ks, n) = maps.uniform_channels();
@@ -156,6 +162,7 @@ pub(super) fn plan_set(doc: &Document, preset: &ExportPreset) -> (SetPlan, bool,
     (
         SetPlan {
             normal: None,
+            occlusion: None,
             files,
             constants,
             n_encoding,
@@ -167,22 +174,36 @@ pub(super) fn plan_set(doc: &Document, preset: &ExportPreset) -> (SetPlan, bool,
     )
 }
 
-/// A glTF PBR set's plan: base colour and metallic-roughness, three 8-bit channels each.
-fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
+/// A PBR set's plan: the preset's files (the normal map's where the project has one), 8-bit
+/// channels each.
+fn pbr_plan(doc: &Document, preset: &ExportPreset) -> SetPlan {
+    let maps = doc.maps();
     let texels = u64::from(maps.width()) * u64::from(maps.height());
-    let files: Vec<PlannedFile> = [
-        (BASE_COLOR_FILE, ["base.r", "base.g", "base.b"]),
-        (METALLIC_ROUGHNESS_FILE, ["-", "roughness", "metallic"]),
-    ]
-    .into_iter()
-    .map(|(path, layout)| PlannedFile {
-        path: path.into(),
-        layout: layout.map(String::from).to_vec(),
-        raw_bytes: texels * 3,
-    })
-    .collect();
+    let files: Vec<PlannedFile> = preset
+        .pbr_files()
+        .into_iter()
+        .filter_map(|f| {
+            let size = if f.is_normal() {
+                doc.normal()
+                    .map(|n| u64::from(n.width()) * u64::from(n.height()))?
+            } else {
+                texels
+            };
+            Some(PlannedFile {
+                path: f.file.clone(),
+                layout: f.layout(),
+                raw_bytes: size * f.channels.len() as u64,
+            })
+        })
+        .collect();
+    let occlusion = preset
+        .pbr_files()
+        .iter()
+        .any(|f| f.channels.contains(&crate::preset::Channel::Occlusion))
+        .then(|| crate::pbr_files::occlusion_source(doc).1.note);
     SetPlan {
         normal: None,
+        occlusion,
         bytes: MemoryReport {
             exported: files.iter().map(|f| f.raw_bytes).sum(),
             naive: texels * 10,
@@ -199,7 +220,4 @@ fn gltf_pbr_plan(maps: &MaterialMaps) -> SetPlan {
     }
 }
 
-/// A glTF PBR set's base colour image.
-pub const BASE_COLOR_FILE: &str = "base_color.png";
-/// A glTF PBR set's metallic-roughness image.
-pub const METALLIC_ROUGHNESS_FILE: &str = "metallic_roughness.png";
+pub use crate::preset::textures::{BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE};

@@ -33,7 +33,7 @@ pub enum SetKind {
 impl SetKind {
     /// The kind of set `preset` writes.
     pub fn of(preset: &ExportPreset) -> Self {
-        if preset.format == crate::preset::Format::GltfPbr {
+        if preset.format.is_pbr() {
             Self::Pbr
         } else {
             Self::Material
