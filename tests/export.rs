@@ -173,7 +173,7 @@ fn every_builtin_preset_exports_and_imports() {
             Format::Png8 | Format::Ktx2 | Format::GltfPbr | Format::PbrTextures => {
                 assert!(err < 0.05, "{}: {err}", p.name);
             }
-            Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. } => {
+            Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. } | Format::Ktx2Uastc { .. } => {
                 assert!(err < 0.3, "{}: {err}", p.name);
                 let psnr = m.files[0].psnr.as_ref().expect("psnr");
                 assert!(psnr.iter().all(|p| p.is_none_or(|p| p > 30.0)), "{psnr:?}");

@@ -64,11 +64,15 @@ pub enum Compression {
     /// `vkFormat` and the manifest's `astc_block`).
     #[serde(rename = "ktx2-astc")]
     Ktx2Astc,
+    /// KTX2 with Basis Universal's UASTC blocks (one to four components; `vkFormat`
+    /// UNDEFINED, the data format descriptor says UASTC), transcoded by the runtime.
+    #[serde(rename = "ktx2-uastc")]
+    Ktx2Uastc,
 }
 
 impl Compression {
     /// Every compression, in the order the docs list them.
-    pub const ALL: [Self; 8] = [
+    pub const ALL: [Self; 9] = [
         Self::Png,
         Self::Exr,
         Self::Ktx2,
@@ -77,6 +81,7 @@ impl Compression {
         Self::Ktx2Bc7,
         Self::Ktx2Bc6h,
         Self::Ktx2Astc,
+        Self::Ktx2Uastc,
     ];
 
     /// The name a manifest spells.
@@ -90,7 +95,14 @@ impl Compression {
             Self::Ktx2Bc7 => "ktx2-bc7",
             Self::Ktx2Bc6h => "ktx2-bc6h",
             Self::Ktx2Astc => "ktx2-astc",
+            Self::Ktx2Uastc => "ktx2-uastc",
         }
+    }
+
+    /// Whether two components are stored as luminance and alpha (ASTC's and UASTC's blocks),
+    /// not as red and green.
+    pub fn second_in_alpha(self) -> bool {
+        matches!(self, Self::Ktx2Astc | Self::Ktx2Uastc)
     }
 
     /// The compression a manifest names.
@@ -108,7 +120,8 @@ impl Compression {
             | Self::Ktx2Bc5
             | Self::Ktx2Bc7
             | Self::Ktx2Bc6h
-            | Self::Ktx2Astc => "ktx2",
+            | Self::Ktx2Astc
+            | Self::Ktx2Uastc => "ktx2",
         }
     }
 
@@ -117,7 +130,12 @@ impl Compression {
         match self {
             Self::Png => &[8, 16],
             Self::Exr => &[32],
-            Self::Ktx2 | Self::Ktx2Bc4 | Self::Ktx2Bc5 | Self::Ktx2Bc7 | Self::Ktx2Astc => &[8],
+            Self::Ktx2
+            | Self::Ktx2Bc4
+            | Self::Ktx2Bc5
+            | Self::Ktx2Bc7
+            | Self::Ktx2Astc
+            | Self::Ktx2Uastc => &[8],
             Self::Ktx2Bc6h => &[16],
         }
     }

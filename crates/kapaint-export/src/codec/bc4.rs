@@ -68,8 +68,8 @@ impl Codec for Bc4 {
         "BC4"
     }
 
-    fn vk_format(&self) -> ktx2::Format {
-        ktx2::Format::BC4_UNORM_BLOCK
+    fn vk_format(&self) -> Option<ktx2::Format> {
+        Some(ktx2::Format::BC4_UNORM_BLOCK)
     }
 
     fn compression(&self) -> Compression {

@@ -16,8 +16,8 @@ impl Codec for Bc5 {
         "BC5"
     }
 
-    fn vk_format(&self) -> ktx2::Format {
-        ktx2::Format::BC5_UNORM_BLOCK
+    fn vk_format(&self) -> Option<ktx2::Format> {
+        Some(ktx2::Format::BC5_UNORM_BLOCK)
     }
 
     fn compression(&self) -> Compression {

@@ -18,8 +18,8 @@ impl Codec for Bc6h {
         "BC6H"
     }
 
-    fn vk_format(&self) -> ktx2::Format {
-        ktx2::Format::BC6H_UFLOAT_BLOCK
+    fn vk_format(&self) -> Option<ktx2::Format> {
+        Some(ktx2::Format::BC6H_UFLOAT_BLOCK)
     }
 
     fn compression(&self) -> Compression {

@@ -14,6 +14,7 @@ mod bc4;
 mod bc5;
 mod bc6h;
 mod bc7;
+mod uastc;
 
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +23,7 @@ pub use self::bc4::Bc4;
 pub use self::bc5::Bc5;
 pub use self::bc6h::Bc6h;
 pub use self::bc7::Bc7;
+pub use self::uastc::{Uastc, settings_of as uastc_settings_of};
 use crate::file_kind::Compression;
 
 /// How hard an encoder searches, on one scale every codec maps onto its own settings
@@ -67,6 +69,8 @@ pub enum Encoder {
     Gpu,
     /// ARM's ASTC encoder (`astcenc`), for ASTC blocks.
     Astcenc,
+    /// Binomial's Basis Universal encoder, for UASTC blocks.
+    Basisu,
 }
 
 impl Encoder {
@@ -128,8 +132,21 @@ pub trait Codec: Send + Sync + std::fmt::Debug {
         self.name().into()
     }
 
-    /// The KTX2 (Vulkan) format of its blocks.
-    fn vk_format(&self) -> ktx2::Format;
+    /// The KTX2 (Vulkan) format of its blocks; `None` for UNDEFINED, where the data format
+    /// descriptor alone says what they are (UASTC).
+    fn vk_format(&self) -> Option<ktx2::Format>;
+
+    /// Its KTX2 data format descriptor and the header's `typeSize`: by default the one the
+    /// `ktx2` crate makes for [`Codec::vk_format`].
+    ///
+    /// # Errors
+    /// A codec without a Vulkan format that does not describe itself.
+    fn dfd(&self) -> Result<(ktx2::dfd::Basic, u32), String> {
+        let format = self
+            .vk_format()
+            .ok_or_else(|| format!("{} has no Vulkan format to describe", self.name()))?;
+        ktx2::dfd::Basic::from_format(format).map_err(|e| format!("data format descriptor: {e:?}"))
+    }
 
     /// The manifest's name for its files.
     fn compression(&self) -> Compression;

@@ -21,18 +21,59 @@ pub struct Decoded {
     pub rgba: Vec<f32>,
 }
 
+/// What a KTX2 file's header and data format descriptor say its texels are.
+pub(crate) struct Described {
+    /// The header's `vkFormat` (`None`: UNDEFINED, the descriptor says: UASTC).
+    format: Option<KtxFormat>,
+    /// The data format descriptor as the file holds it (its total size first).
+    dfd: Vec<u8>,
+    /// The header's `typeSize`.
+    type_size: u32,
+    /// Plain level data's alignment: lcm(texel block size, 4).
+    align: usize,
+}
+
+impl Described {
+    /// Texels of `format` (uncompressed, or a block format kapaint reads back).
+    pub(crate) fn of_format(format: KtxFormat) -> Result<Self, String> {
+        let (basic, type_size) = dfd::Basic::from_format(format)
+            .map_err(|e| format!("data format descriptor: {e:?}"))?;
+        let align = codec::from_vk_format(format).map_or(4, |c| c.block_bytes().max(4));
+        Ok(Self::new(Some(format), &basic, type_size, align))
+    }
+
+    /// `codec`'s blocks.
+    pub(crate) fn of_codec(codec: &dyn Codec) -> Result<Self, String> {
+        let (basic, type_size) = codec.dfd()?;
+        Ok(Self::new(
+            codec.vk_format(),
+            &basic,
+            type_size,
+            codec.block_bytes().max(4),
+        ))
+    }
+
+    fn new(format: Option<KtxFormat>, basic: &dfd::Basic, type_size: u32, align: usize) -> Self {
+        let block = dfd::Block::Basic(basic.clone()).to_vec();
+        let mut dfd = ((block.len() + 4) as u32).to_le_bytes().to_vec();
+        dfd.extend_from_slice(&block);
+        Self {
+            format,
+            dfd,
+            type_size,
+            align,
+        }
+    }
+}
+
 /// Assembles a KTX2 file: header, level index, data format descriptor, the writer's name,
 /// then the levels from smallest to largest, each aligned as the specification asks.
-pub(super) fn container(
-    format: KtxFormat,
-    size: (u32, u32),
-    levels: &[Vec<u8>],
-) -> Result<Vec<u8>, String> {
+pub(super) fn container(described: &Described, size: (u32, u32), levels: &[Vec<u8>]) -> Vec<u8> {
     let stored: Vec<(&[u8], u64)> = levels
         .iter()
         .map(|l| (l.as_slice(), l.len() as u64))
         .collect();
-    assemble(format, size, &stored, false)
+    assemble(described, size, &stored, false)
 }
 
 pub use crate::file_kind::ZSTD_LEVELS;
@@ -57,7 +98,19 @@ pub fn supercompress(bytes: &[u8], level: u8) -> Result<Vec<u8>, String> {
     if header.supercompression_scheme.is_some() {
         return Err("the file is supercompressed already".into());
     }
-    let format = header.format.ok_or("the file has no format")?;
+    let (at, len) = (
+        header.index.dfd_byte_offset as usize,
+        header.index.dfd_byte_length as usize,
+    );
+    let dfd = bytes
+        .get(at..at + len)
+        .ok_or("the data format descriptor is outside the file")?;
+    let described = Described {
+        format: header.format,
+        dfd: dfd.to_vec(),
+        type_size: header.type_size,
+        align: 1,
+    };
     let raw: Vec<&[u8]> = reader.levels().map(|l| l.data).collect();
     let packed: Vec<Vec<u8>> = raw
         .par_iter()
@@ -68,39 +121,31 @@ pub fn supercompress(bytes: &[u8], level: u8) -> Result<Vec<u8>, String> {
         .zip(&raw)
         .map(|(p, r)| (p.as_slice(), r.len() as u64))
         .collect();
-    assemble(
-        format,
+    Ok(assemble(
+        &described,
         (header.pixel_width, header.pixel_height),
         &stored,
         true,
-    )
+    ))
 }
 
 /// The file of `levels` (each its stored bytes and its length uncompressed), supercompressed
 /// by Zstandard or not: a supercompressed level is aligned to 1, a plain one to lcm(texel
 /// block size, 4).
 fn assemble(
-    format: KtxFormat,
+    described: &Described,
     (w, h): (u32, u32),
     levels: &[(&[u8], u64)],
     zstd: bool,
-) -> Result<Vec<u8>, String> {
-    let (basic, type_size) =
-        dfd::Basic::from_format(format).map_err(|e| format!("data format descriptor: {e:?}"))?;
-    let block = dfd::Block::Basic(basic).to_vec();
-    let mut dfd_bytes = ((block.len() + 4) as u32).to_le_bytes().to_vec();
-    dfd_bytes.extend_from_slice(&block);
+) -> Vec<u8> {
+    let dfd_bytes = &described.dfd;
     let mut kvd = Vec::new();
     let entry = format!("KTXwriter\0kapaint {}\0", env!("CARGO_PKG_VERSION"));
     kvd.extend_from_slice(&(entry.len() as u32).to_le_bytes());
     kvd.extend_from_slice(entry.as_bytes());
     kvd.resize(kvd.len().div_ceil(4) * 4, 0);
     // Level data alignment: lcm(texel block size, 4); 1 when supercompressed.
-    let block_bytes = if zstd {
-        1
-    } else {
-        codec::from_vk_format(format).map_or(4, |c| c.block_bytes())
-    };
+    let block_bytes = if zstd { 1 } else { described.align };
     let index_at = Header::LENGTH;
     let dfd_at = index_at + levels.len() * LevelIndex::LENGTH;
     let kvd_at = dfd_at + dfd_bytes.len();
@@ -126,8 +171,8 @@ fn assemble(
         at = aligned + level.len();
     }
     let header = Header {
-        format: Some(format),
-        type_size,
+        format: described.format,
+        type_size: described.type_size,
         pixel_width: w,
         pixel_height: h,
         pixel_depth: 0,
@@ -149,10 +194,10 @@ fn assemble(
     for entry in &index {
         out.extend_from_slice(&entry.as_bytes());
     }
-    out.extend_from_slice(&dfd_bytes);
+    out.extend_from_slice(dfd_bytes);
     out.extend_from_slice(&kvd);
     out.extend_from_slice(&body);
-    Ok(out)
+    out
 }
 
 /// Reads level 0 of a KTX2 file kapaint writes (the formats above, plain or supercompressed
@@ -204,6 +249,9 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
             }
             (4, data[..texels * 4].to_vec())
         }
+        None if reader.color_model() == Some(ktx2::ColorModel::UASTC) => {
+            return decode_uastc(data, (w, h));
+        }
         other => {
             let Some(codec) = other.and_then(codec::from_vk_format) else {
                 return Err(format!("KTX2 format {other:?} is not one kapaint writes"));
@@ -217,6 +265,28 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         height: h,
         channels,
         rgba,
+    })
+}
+
+/// Level 0 of a UASTC file as RGBA, as its ASTC 4x4 transcode decodes (UASTC's own texels):
+/// luminance in RGB and the second of two components in alpha, as ASTC's.
+fn decode_uastc(data: &[u8], (w, h): (u32, u32)) -> Result<Decoded, String> {
+    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+    let size = padded.0 as usize / 4 * padded.1 as usize / 4 * 16;
+    if data.len() < size {
+        return Err("level 0 is truncated".into());
+    }
+    let uastc = codec::Uastc::new(4, false);
+    let mut texels = vec![0_u8; padded.0 as usize * padded.1 as usize * 4];
+    uastc
+        .decode_lossless(&data[..size], padded, &mut texels)
+        .map_err(|e| e.to_string())?;
+    let tight = crop(&texels, padded.0, (w, h), 4, 4);
+    Ok(Decoded {
+        width: w,
+        height: h,
+        channels: 4,
+        rgba: tight.iter().map(|b| f32::from(*b) / 255.0).collect(),
     })
 }
 

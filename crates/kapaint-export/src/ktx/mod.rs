@@ -13,8 +13,8 @@ mod own_levels;
 use ktx2::Format as KtxFormat;
 use rayon::prelude::*;
 
-use self::container::container;
 pub use self::container::{Decoded, ZSTD_LEVELS, decode, supercompress};
+use self::container::{Described, container};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 pub use self::own_levels::encode_levels;
 use super::blocks::{self, Coder};
@@ -272,18 +272,23 @@ pub struct Written {
     pub compression: Compression,
 }
 
-/// The KTX2 format and compression name of `channels` components: the codec's where
-/// block-compressed, else 8-bit components.
-fn format_of(spaces: &[Space], srgb: bool, codec: Option<&dyn Codec>) -> (KtxFormat, Compression) {
+/// What the KTX2 file of `spaces` components holds, and its compression's name: the codec's
+/// blocks where block-compressed, else 8-bit components.
+fn format_of(
+    spaces: &[Space],
+    srgb: bool,
+    codec: Option<&dyn Codec>,
+) -> Result<(Described, Compression), String> {
     if let Some(codec) = codec {
-        return (codec.vk_format(), codec.compression());
+        return Ok((Described::of_codec(codec)?, codec.compression()));
     }
-    match spaces.len() {
-        1 => (KtxFormat::R8_UNORM, Compression::Ktx2),
-        2 => (KtxFormat::R8G8_UNORM, Compression::Ktx2),
-        _ if srgb => (KtxFormat::R8G8B8A8_SRGB, Compression::Ktx2),
-        _ => (KtxFormat::R8G8B8A8_UNORM, Compression::Ktx2),
-    }
+    let format = match spaces.len() {
+        1 => KtxFormat::R8_UNORM,
+        2 => KtxFormat::R8G8_UNORM,
+        _ if srgb => KtxFormat::R8G8B8A8_SRGB,
+        _ => KtxFormat::R8G8B8A8_UNORM,
+    };
+    Ok((Described::of_format(format)?, Compression::Ktx2))
 }
 
 /// How an image's blocks are made: the encoder, the codec and its effort.
@@ -338,7 +343,8 @@ fn write_levels(
     if compressed.is_none() && per != ch {
         return Err(KtxError::HalfUncompressed);
     }
-    let (format, compression) = format_of(spaces, srgb, compressed.map(|c| c.1));
+    let (described, compression) =
+        format_of(spaces, srgb, compressed.map(|c| c.1)).map_err(KtxError::Container)?;
     let mut level_bytes = Vec::with_capacity(chain.len() + 1);
     let mut decoded = Vec::with_capacity(chain.len() + 1);
     let mut psnr_values = None;
@@ -384,7 +390,7 @@ fn write_levels(
             }
         }
     }
-    let bytes = container(format, (w, h), &level_bytes).map_err(KtxError::Container)?;
+    let bytes = container(&described, (w, h), &level_bytes);
     Ok(Written {
         bytes,
         decoded,

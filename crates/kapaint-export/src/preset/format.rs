@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{AstcBlock, Effort, default_bc6h};
-use crate::codec::{Astc, Bc4, Bc5, Bc6h, Bc7, Codec};
+use crate::codec::{Astc, Bc4, Bc5, Bc6h, Bc7, Codec, Uastc};
 use crate::ktx::Space;
 
 /// Image format of the exported files, with the parameters that format has.
@@ -40,6 +40,15 @@ pub enum Format {
         #[serde(default)]
         max_effort: Effort,
     },
+    /// KTX2 with Basis Universal's UASTC blocks and a full mip chain, which a runtime
+    /// transcodes to BC7 or ASTC 4x4: the quality level and RDO chosen against the budget
+    /// as measured after transcoding ([`crate::codec::Uastc`]).
+    Ktx2Uastc {
+        /// The most effort (level and RDO: [`crate::codec::uastc_settings_of`]) the export
+        /// may spend meeting its budget.
+        #[serde(default)]
+        max_effort: Effort,
+    },
     /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
     /// roughness, B metallic), and the normal map where the project has one; converted back
     /// from `k_d`, `k_s`, `n` ([`crate::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
@@ -62,6 +71,7 @@ impl Format {
             Self::Ktx2 => "Ktx2",
             Self::Ktx2Bc { .. } => "Ktx2Bc",
             Self::Ktx2Astc { .. } => "Ktx2Astc",
+            Self::Ktx2Uastc { .. } => "Ktx2Uastc",
             Self::GltfPbr => "GltfPbr",
             Self::PbrTextures => "PbrTextures",
         }
@@ -74,6 +84,7 @@ impl Format {
             | Self::Ktx2
             | Self::Ktx2Bc { .. }
             | Self::Ktx2Astc { .. }
+            | Self::Ktx2Uastc { .. }
             | Self::GltfPbr
             | Self::PbrTextures => true,
             Self::Png16 | Self::Exr => false,
@@ -83,7 +94,9 @@ impl Format {
     /// Whether files are KTX2 containers.
     pub fn is_ktx2(self) -> bool {
         match self {
-            Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } => true,
+            Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } | Self::Ktx2Uastc { .. } => {
+                true
+            }
             Self::Png8 | Self::Png16 | Self::Exr | Self::GltfPbr | Self::PbrTextures => false,
         }
     }
@@ -107,7 +120,9 @@ impl Format {
     /// The most effort a block-compressed export may spend (`None` without blocks).
     pub fn max_effort(self) -> Option<Effort> {
         match self {
-            Self::Ktx2Bc { max_effort, .. } | Self::Ktx2Astc { max_effort, .. } => Some(max_effort),
+            Self::Ktx2Bc { max_effort, .. }
+            | Self::Ktx2Astc { max_effort, .. }
+            | Self::Ktx2Uastc { max_effort } => Some(max_effort),
             Self::Png8
             | Self::Png16
             | Self::Exr
@@ -129,7 +144,7 @@ impl Format {
     /// Whether every block costs the same bytes whatever it holds (ASTC's 16 bytes for one to
     /// four components), so an image of fewer components saves nothing.
     pub fn same_bytes_per_block(self) -> bool {
-        matches!(self, Self::Ktx2Astc { .. })
+        matches!(self, Self::Ktx2Astc { .. } | Self::Ktx2Uastc { .. })
     }
 
     /// The ASTC footprint, for an ASTC format.
@@ -147,6 +162,7 @@ impl Format {
             | Self::Ktx2
             | Self::Ktx2Bc { .. }
             | Self::Ktx2Astc { .. }
+            | Self::Ktx2Uastc { .. }
             | Self::GltfPbr
             | Self::PbrTextures => 1,
             Self::Png16 => 2,
@@ -159,7 +175,9 @@ impl Format {
         match self {
             Self::Png8 | Self::Png16 | Self::GltfPbr | Self::PbrTextures => "png",
             Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } => "ktx2",
+            Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } | Self::Ktx2Uastc { .. } => {
+                "ktx2"
+            }
         }
     }
 
@@ -171,6 +189,7 @@ impl Format {
         let srgb = spaces.len() >= 3 && spaces[0].is_colour();
         match self {
             Self::Ktx2Astc { block, .. } => Some(Box::new(Astc::new(block, spaces.len(), srgb))),
+            Self::Ktx2Uastc { .. } => Some(Box::new(Uastc::new(spaces.len(), srgb))),
             Self::Ktx2Bc { .. } if spaces.first() == Some(&Space::Half) => Some(Box::new(Bc6h)),
             Self::Ktx2Bc { .. } => Some(match spaces.len() {
                 1 => Box::new(Bc4),
@@ -212,7 +231,8 @@ mod tests {
                 vec![Space::Half; 3],
             ] {
                 let codec = format.codec(&spaces).expect("a block format");
-                let back = crate::codec::from_vk_format(codec.vk_format()).expect("read back");
+                let vk = codec.vk_format().expect("a Vulkan format");
+                let back = crate::codec::from_vk_format(vk).expect("read back");
                 assert_eq!(back.vk_format(), codec.vk_format());
                 assert_eq!(back.compression(), codec.compression());
                 assert_eq!(back.block_dims(), codec.block_dims());

@@ -359,6 +359,10 @@ const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../../../presets/export/ktx2-astc.ron"),
     ),
     (
+        "ktx2-uastc",
+        include_str!("../../../../presets/export/ktx2-uastc.ron"),
+    ),
+    (
         "ktx2-raw",
         include_str!("../../../../presets/export/ktx2-raw.ron"),
     ),
@@ -494,6 +498,7 @@ mod tests {
             "ktx2",
             "ktx2-astc",
             "ktx2-raw",
+            "ktx2-uastc",
             "gltf-pbr",
             "unreal",
             "unity-hdrp",

@@ -226,7 +226,10 @@ impl BlockChoice {
     /// verdict with every number it rests on, beside the numbers it does not judge (the
     /// manifest's `blocks` has the trials and the reason).
     pub fn summary(&self) -> String {
+        let uastc = self.encoder == Encoder::Basisu;
         let layout = match (self.layout, self.astc_block) {
+            (BlockLayout::Packed, _) if uastc => "UASTC, n packed in k_d's alpha".to_string(),
+            (BlockLayout::NApart, _) if uastc => "UASTC, n apart".to_string(),
             (BlockLayout::Packed, None) => "n packed in k_d's BC7".to_string(),
             (BlockLayout::NApart, None) => "n apart (BC4/BC5), colour BC7".into(),
             (BlockLayout::HalfColour, _) => "n apart (BC4/BC5), colour BC6H".into(),
@@ -238,6 +241,7 @@ impl BlockChoice {
             Encoder::Portable => "portable CPU",
             Encoder::Gpu => "GPU",
             Encoder::Astcenc => "astcenc",
+            Encoder::Basisu => "Basis Universal",
         };
         let encoder = if self.gpu_failed.is_some() {
             format!("{encoder} encoder (the GPU encoder failed part-way)")

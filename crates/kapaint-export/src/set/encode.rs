@@ -148,7 +148,10 @@ pub(super) fn encode_image(
             Ok(plain(png(&data, [C::L16, C::La16, C::Rgb16, C::Rgba16])?))
         }
         Format::Exr => Ok(plain(exr_bytes(&value, channels, (width, height))?)),
-        Format::Ktx2 | Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. } => {
+        Format::Ktx2
+        | Format::Ktx2Bc { .. }
+        | Format::Ktx2Astc { .. }
+        | Format::Ktx2Uastc { .. } => {
             let source = KtxTexels::new(texels, ka, comps, srgb, false, n_enc);
             let level0 = source.level0();
             let codec = preset.format.codec(source.spaces());

@@ -104,8 +104,8 @@ fn read_file(
         .collect::<Result<_, _>>()?;
     let srgb = file.colour_space == ColourSpace::Srgb;
     let exr = file.compression == Compression::Exr;
-    // Two-component ASTC images are luminance + alpha, as grey + alpha PNGs.
-    let second_in_alpha = !exr && (!ktx || file.compression == Compression::Ktx2Astc);
+    // Two-component ASTC and UASTC images are luminance + alpha, as grey + alpha PNGs.
+    let second_in_alpha = !exr && (!ktx || file.compression.second_in_alpha());
     let n_enc = manifest.n_encoding;
     let n_codes: Vec<f32> = n_enc.map_or_else(Vec::new, |e| {
         (0..=((1_u32 << e.bits) - 1) as u16)

@@ -51,9 +51,9 @@ impl NormalStorage {
                 Self::Png
             }
             Format::Ktx2 => Self::Ktx2(None),
-            blocks @ (Format::Ktx2Bc { .. } | Format::Ktx2Astc { .. }) => {
-                Self::Ktx2(Some((blocks, NORMAL_EFFORT)))
-            }
+            blocks @ (Format::Ktx2Bc { .. }
+            | Format::Ktx2Astc { .. }
+            | Format::Ktx2Uastc { .. }) => Self::Ktx2(Some((blocks, NORMAL_EFFORT))),
         }
     }
 
@@ -154,7 +154,7 @@ pub struct NormalFile {
 
 /// Where x and y are in a KTX2 normal map of `compression`.
 fn xy_of(compression: Compression) -> &'static str {
-    if compression == Compression::Ktx2Astc {
+    if compression.second_in_alpha() {
         "ra"
     } else {
         "rg"
@@ -241,6 +241,7 @@ impl NormalFile {
         let error = self.angular_error?;
         let blocks = match (self.compression?, self.astc_block) {
             (Compression::Ktx2Astc, Some(b)) => format!("ASTC {b} (luminance and alpha)"),
+            (Compression::Ktx2Uastc, _) => "UASTC (luminance and alpha)".into(),
             (Compression::Ktx2Bc5, _) => "BC5".into(),
             _ => "8-bit RG".into(),
         };
@@ -275,7 +276,10 @@ impl NormalFile {
             && self.compression.is_some_and(|c| {
                 matches!(
                     c,
-                    Compression::Ktx2 | Compression::Ktx2Bc5 | Compression::Ktx2Astc
+                    Compression::Ktx2
+                        | Compression::Ktx2Bc5
+                        | Compression::Ktx2Astc
+                        | Compression::Ktx2Uastc
                 ) && self.xy.as_deref() == Some(xy_of(c))
                     && self.astc_block.is_some() == (c == Compression::Ktx2Astc)
             })
@@ -283,7 +287,7 @@ impl NormalFile {
         if !sized || !(png || ktx2) {
             return Err(format!(
                 "the normal map must be {NORMAL_FILE} ({NORMAL_ENCODING}) or {NORMAL_KTX2_FILE} \
-                 ({NORMAL_XY_ENCODING}: ktx2, ktx2-bc5 or ktx2-astc, xy rg, or ra for ASTC, z \
+                 ({NORMAL_XY_ENCODING}: ktx2, ktx2-bc5, ktx2-astc or ktx2-uastc, xy rg, or ra for ASTC and UASTC, z \
                  {NORMAL_Z}), 1..={max} a side"
             ));
         }

@@ -159,8 +159,8 @@ impl Codec for Astc {
         }
     }
 
-    fn vk_format(&self) -> ktx2::Format {
-        ktx2::Format::new(self.block.vk_format(self.srgb)).unwrap_or(ktx2::Format::R8_UNORM)
+    fn vk_format(&self) -> Option<ktx2::Format> {
+        ktx2::Format::new(self.block.vk_format(self.srgb))
     }
 
     fn compression(&self) -> Compression {

@@ -29,12 +29,12 @@ impl Codec for Bc7 {
         "BC7"
     }
 
-    fn vk_format(&self) -> ktx2::Format {
-        if self.srgb {
+    fn vk_format(&self) -> Option<ktx2::Format> {
+        Some(if self.srgb {
             ktx2::Format::BC7_SRGB_BLOCK
         } else {
             ktx2::Format::BC7_UNORM_BLOCK
-        }
+        })
     }
 
     fn compression(&self) -> Compression {
