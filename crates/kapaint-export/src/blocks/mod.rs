@@ -26,9 +26,6 @@ fn widen<'a>(
     codec::widen(src, stored, to, codec.filler())
 }
 
-/// Block rows per parallel task.
-const STRIP: usize = 8;
-
 /// The encoder a manifest names for blocks of `codec` that `coder` was asked to encode: the
 /// codec's own where it has one, the CPU's best where a brought encoder does not encode it
 /// (or failed), else `coder`'s.
@@ -108,9 +105,10 @@ pub fn encode_stored(
     let row_bytes = (width / bw) as usize * codec.block_bytes();
     let first_block = row_bytes * (from_row / bh) as usize;
     let first_texel = from_row as usize * width as usize * stored;
-    let strip_texels = STRIP * bh as usize * width as usize * stored;
+    let strip = codec.strip_block_rows((width / bw) as usize);
+    let strip_texels = strip * bh as usize * width as usize * stored;
     blocks[first_block..]
-        .par_chunks_mut(row_bytes * STRIP)
+        .par_chunks_mut(row_bytes * strip)
         .zip(texels[first_texel..].par_chunks(strip_texels))
         .try_for_each(|(out, src)| {
             if progress.is_some_and(Progress::is_cancelled) {
@@ -128,7 +126,7 @@ pub fn encode_stored(
     // The rows a brought encoder did: refined as the CPU's are.
     if first_block > 0 && !progress.is_some_and(Progress::is_cancelled) {
         blocks[..first_block]
-            .par_chunks_mut(row_bytes * STRIP)
+            .par_chunks_mut(row_bytes * strip)
             .zip(texels[..first_texel].par_chunks(strip_texels))
             .for_each(|(out, src)| {
                 codec.refine(out, &widen(codec, src, stored, per), width as usize);
@@ -205,8 +203,9 @@ pub fn decode_stored(
     let row_bytes = (width / bw) as usize * codec.block_bytes();
     let whole = codec.texel_bytes();
     let mut out = vec![0_u8; width as usize * height as usize * stored];
-    out.par_chunks_mut(STRIP * bh as usize * width as usize * stored)
-        .zip(blocks.par_chunks(row_bytes * STRIP))
+    let strip = codec.strip_block_rows((width / bw) as usize);
+    out.par_chunks_mut(strip * bh as usize * width as usize * stored)
+        .zip(blocks.par_chunks(row_bytes * strip))
         .try_for_each(|(dst, src)| {
             let rows = (src.len() / row_bytes) as u32 * bh;
             // Whole texels as the codec decodes them: into `dst` where it holds them whole,

@@ -161,6 +161,12 @@ pub trait Codec: Send + Sync + std::fmt::Debug {
         16
     }
 
+    /// Block rows per parallel strip, for an image `blocks_across` blocks wide: eight by
+    /// default, more for a codec whose encoder works better on more blocks at once.
+    fn strip_block_rows(&self, _blocks_across: usize) -> usize {
+        8
+    }
+
     /// Bytes per texel of the input and of a decoded strip: 1, 2 or 4 bytes, or four
     /// little-endian half floats (8).
     fn texel_bytes(&self) -> usize;

@@ -146,6 +146,12 @@ impl Codec for Uastc {
         4
     }
 
+    /// About 16,384 blocks a strip: the RDO conditions a run of blocks for the LZ coder, and a
+    /// short strip starts its run afresh too often (basisu's own runs are as long).
+    fn strip_block_rows(&self, blocks_across: usize) -> usize {
+        (16_384 / blocks_across.max(1)).max(8)
+    }
+
     fn effort_name(&self, effort: Effort) -> &'static str {
         match effort {
             Effort::UltraFast => "level 1, RDO 3.0",
