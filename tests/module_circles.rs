@@ -254,7 +254,7 @@ fn no_crate_has_a_circle_of_modules() {
     let mut found = Vec::new();
     for src in &sources {
         let all = modules(src);
-        assert!(all.len() > 3, "{} has modules", src.display());
+        assert!(!all.is_empty(), "{} has modules", src.display());
         let reexports: Reexports = all
             .iter()
             .map(|(m, path)| (m.clone(), reexports_of(m, path, &all)))

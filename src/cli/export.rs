@@ -333,7 +333,7 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
     }
     if args.n_mapping.is_some() && !preset.format.is_pbr() {
         return Err(CliError::usage(format!(
-            "--n-mapping chooses how n becomes roughness: use it with a PBR preset (gltf-pbr, unreal, unity-hdrp, unity-urp, godot), not {}",
+            "--n-mapping chooses how n becomes roughness: use it with --preset gltf-pbr or an engine preset (unreal, unity-hdrp, unity-urp, godot), not {}",
             preset.name
         )));
     }
