@@ -613,20 +613,7 @@ fn exporting_over_a_set_asks_then_replaces_and_keeps_the_choices() {
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
     harness.step();
     harness.step();
-    let field = harness
-        .get_all_by_role(Role::TextInput)
-        .find(|n| n.value().as_deref() == Some("export"))
-        .expect("the folder field");
-    field.focus();
-    harness.step();
-    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
-    harness.step();
-    harness
-        .get_all_by_role(Role::TextInput)
-        .find(|n| n.value().as_deref() == Some("export"))
-        .expect("the folder field")
-        .type_text(&folder);
-    harness.step();
+    kit::type_export_folder(&mut harness, &folder);
     assert!(
         folder_field(&harness).contains(&folder),
         "{:?}",

@@ -562,20 +562,7 @@ fn an_engine_preset_exports_from_the_dialog_with_its_layout_and_occlusion() {
     harness.get_by_label_contains("unreal PBR textures");
     harness.get_by_label_contains("Occlusion: white: the project has no AO bake");
     harness.get_by_label_contains("{name}_OcclusionRoughnessMetallic.png");
-    let field = harness
-        .get_all_by_role(Role::TextInput)
-        .find(|n| n.value().as_deref() == Some("export"))
-        .expect("the folder field");
-    field.focus();
-    harness.step();
-    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
-    harness.step();
-    harness
-        .get_all_by_role(Role::TextInput)
-        .find(|n| n.value().as_deref() == Some("export"))
-        .expect("the folder field")
-        .type_text(&out.display().to_string());
-    harness.step();
+    kit::type_export_folder(&mut harness, &out.display().to_string());
     harness
         .get_by_role_and_label(Role::Button, "Export")
         .click();

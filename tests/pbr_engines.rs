@@ -246,12 +246,7 @@ fn a_user_layout_that_cannot_be_written_is_refused_with_nothing_written() {
     ] {
         std::fs::write(presets.join("mine.ron"), &text).expect("preset");
         let out = d.join("out");
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
-            .args(["export", s(&bare), "--preset", "mine", "--out", s(&out)])
-            .env("KAPAINT_EXPORT_PRESET_DIR", &presets)
-            .output()
-            .expect("run");
-        let err = String::from_utf8_lossy(&o.stderr);
+        let (o, err) = export_mine(&bare, &presets, &out);
         assert_eq!(o.status.code(), Some(2), "{text}: {err}");
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.starts_with("kapaint: ") && err.contains(why), "{err}");
@@ -263,13 +258,20 @@ fn a_user_layout_that_cannot_be_written_is_refused_with_nothing_written() {
     );
     std::fs::write(presets.join("mine.ron"), text).expect("preset");
     let out = d.join("x");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
-        .args(["export", s(&bare), "--preset", "mine", "--out", s(&out)])
-        .env("KAPAINT_EXPORT_PRESET_DIR", &presets)
-        .output()
-        .expect("run");
-    let err = String::from_utf8_lossy(&o.stderr);
+    let (o, err) = export_mine(&bare, &presets, &out);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("are both x_a.png"), "{err}");
     assert!(!out.exists(), "nothing written");
+}
+
+/// `kapaint export PROJECT --preset mine --out OUT` with the user presets in `presets`: its
+/// output and its error text.
+fn export_mine(project: &Path, presets: &Path, out: &Path) -> (std::process::Output, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args(["export", s(project), "--preset", "mine", "--out", s(out)])
+        .env("KAPAINT_EXPORT_PRESET_DIR", presets)
+        .output()
+        .expect("run");
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    (o, err)
 }

@@ -161,17 +161,13 @@ fn write_pbr(
     report: bool,
 ) {
     let e = m.round_trip;
-    let kind = if m.preset == "gltf-pbr" {
-        "glTF metallic-roughness".to_string()
-    } else {
-        format!("{} PBR textures", m.preset)
-    };
     let _ = writeln!(
         text,
-        "exported {} to {} ({} files, {kind}, {} bytes)",
+        "exported {} to {} ({} files, {}, {} bytes)",
         file.display(),
         target.display(),
         m.files.len() + 1,
+        m.kind(),
         m.files.iter().map(|f| f.bytes).sum::<u64>()
     );
     let _ = writeln!(

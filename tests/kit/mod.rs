@@ -204,3 +204,23 @@ pub fn as_ended(copy: &std::path::Path) -> std::path::PathBuf {
     std::fs::rename(copy, &to).expect("renamed");
     to
 }
+
+#[expect(clippy::expect_used, reason = "a test helper: no folder field, no test")]
+/// Replaces the export dialog's folder (showing its default, `export`) with `folder`, as a
+/// user does: focus the field, select all, type.
+pub fn type_export_folder(harness: &mut Harness<'_, Editor>, folder: &str) {
+    harness
+        .get_all_by_role(egui::accesskit::Role::TextInput)
+        .find(|n| n.value().as_deref() == Some("export"))
+        .expect("the folder field")
+        .focus();
+    harness.step();
+    harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::A);
+    harness.step();
+    harness
+        .get_all_by_role(egui::accesskit::Role::TextInput)
+        .find(|n| n.value().as_deref() == Some("export"))
+        .expect("the folder field")
+        .type_text(folder);
+    harness.step();
+}

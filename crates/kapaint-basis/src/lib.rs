@@ -53,9 +53,7 @@ pub fn encode_uastc(
     (width, height): (u32, u32),
     how: Uastc,
 ) -> Result<Vec<u8>, String> {
-    if width == 0 || height == 0 || width % 4 != 0 || height % 4 != 0 {
-        return Err(format!("{width}x{height} is not whole 4x4 blocks"));
-    }
+    whole_blocks(width, height)?;
     if rgba.len() != width as usize * height as usize * 4 {
         return Err(format!(
             "{} bytes are not {width}x{height} RGBA texels",
@@ -112,6 +110,14 @@ pub fn encode_uastc(
     Ok(file[at..at + len].to_vec())
 }
 
+/// Whether `width x height` is whole 4x4 blocks (and not empty).
+fn whole_blocks(width: u32, height: u32) -> Result<(), String> {
+    if width == 0 || height == 0 || !width.is_multiple_of(4) || !height.is_multiple_of(4) {
+        return Err(format!("{width}x{height} is not whole 4x4 blocks"));
+    }
+    Ok(())
+}
+
 /// Transcodes UASTC `blocks` of a `width x height` image (sides multiples of 4) to `target`.
 ///
 /// # Errors
@@ -121,9 +127,7 @@ pub fn transcode_uastc(
     (width, height): (u32, u32),
     target: Target,
 ) -> Result<Vec<u8>, String> {
-    if width == 0 || height == 0 || width % 4 != 0 || height % 4 != 0 {
-        return Err(format!("{width}x{height} is not whole 4x4 blocks"));
-    }
+    whole_blocks(width, height)?;
     let (bx, by) = (width / 4, height / 4);
     if blocks.len() != bx as usize * by as usize * BLOCK_BYTES {
         return Err(format!(

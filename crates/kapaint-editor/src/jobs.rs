@@ -335,11 +335,7 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
         kapaint_export::Exported::Pbr(m) => format!(
             "exported {} as {} ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%{})",
             dir.display(),
-            if m.preset == "gltf-pbr" {
-                "glTF PBR".to_string()
-            } else {
-                format!("{} PBR textures", m.preset)
-            },
+            m.kind(),
             m.files.len() + 1,
             m.round_trip.max * 100.0,
             m.round_trip.mean * 100.0,

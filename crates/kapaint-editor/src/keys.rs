@@ -229,7 +229,7 @@ pub fn printed(ctx: &egui::Context, shortcut: &KeyboardShortcut) -> String {
 }
 
 /// A binding as people write it (`Ctrl+Shift+Z`, `Shift+[`, `B`), independent of the platform
-/// (the README and the tests use it; the editor shows egui's own formatting).
+/// (docs/editor.md's key table and the tests use it; the editor shows egui's own formatting).
 pub fn written(shortcut: &KeyboardShortcut) -> String {
     let m = shortcut.modifiers;
     let mut out = String::new();
@@ -309,10 +309,10 @@ mod tests {
     }
 
     #[test]
-    fn the_readme_lists_every_key() {
-        // Every cell of the README's tables, split where one cell lists several keys.
-        let readme = include_str!("../../../README.md");
-        let cells: Vec<&str> = readme
+    fn the_key_table_lists_every_key() {
+        // Every cell of docs/editor.md's tables, split where one cell lists several keys.
+        let doc = include_str!("../../../docs/editor.md");
+        let cells: Vec<&str> = doc
             .lines()
             .filter(|l| l.starts_with('|'))
             .flat_map(|l| l.split('|'))
@@ -324,7 +324,7 @@ mod tests {
             let key = written(&b.shortcut);
             assert!(
                 cells.contains(&key.as_str()),
-                "the README's key table lacks {key} ({})",
+                "docs/editor.md's key table lacks {key} ({})",
                 b.description
             );
         }

@@ -64,6 +64,21 @@ pub struct PbrManifest {
     pub skipped: Vec<String>,
 }
 
+impl PbrManifest {
+    /// What the set is, in words: "glTF metallic-roughness" for glTF's layout, else
+    /// "PRESET PBR textures" (the CLI's line and the editor's notice).
+    pub fn kind(&self) -> String {
+        let gltf = [BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE]
+            .iter()
+            .all(|name| self.files.iter().any(|f| f.path == *name));
+        if gltf {
+            "glTF metallic-roughness".into()
+        } else {
+            format!("{} PBR textures", self.preset)
+        }
+    }
+}
+
 /// Writes `doc` as a PBR set into the folder `out` (free, or a set to replace when
 /// `replace`): the preset's layout ([`ExportPreset::pbr_files`]; a normal map's file only
 /// where the document has one), `material.json`, and for glTF's layout with `glb` that mesh
