@@ -205,7 +205,10 @@ pub fn as_ended(copy: &std::path::Path) -> std::path::PathBuf {
     to
 }
 
-#[expect(clippy::expect_used, reason = "a test helper: no folder field, no test")]
+#[expect(
+    clippy::expect_used,
+    reason = "a test helper: no folder field, no test"
+)]
 /// Replaces the export dialog's folder (showing its default, `export`) with `folder`, as a
 /// user does: focus the field, select all, type.
 pub fn type_export_folder(harness: &mut Harness<'_, Editor>, folder: &str) {
