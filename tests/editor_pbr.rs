@@ -590,3 +590,60 @@ fn texts(harness: &egui_kittest::Harness<'_, Editor>) -> Vec<String> {
         .filter_map(|n| n.accesskit_node().label().or(n.accesskit_node().value()))
         .collect()
 }
+
+/// File > Export with `gltf-pbr`, the `.glb` and its Basis Universal textures ticked: the
+/// `.glb`'s images are KTX2 files, and the notice says how they were encoded.
+#[test]
+fn a_basisu_glb_exports_from_the_dialog() {
+    let dir = std::env::temp_dir().join(format!("kapaint-editor-basisu-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("sphere");
+    let mut harness = editor();
+    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
+    harness.step();
+    harness.step();
+    harness.get_by_label("Preset").click();
+    harness.step();
+    harness
+        .get_by_role_and_label(Role::Button, "gltf-pbr")
+        .click_accesskit();
+    harness.step();
+    if harness
+        .query_by_role_and_label(Role::Button, "16-bit")
+        .is_some()
+    {
+        harness.get_by_label("Preset").click();
+        harness.step();
+    }
+    // Basis Universal is offered only once the .glb is asked for.
+    let basisu = "with Basis Universal textures (KHR_texture_basisu, UASTC + zstd)";
+    assert!(
+        harness.get_by_label(basisu).accesskit_node().is_disabled(),
+        "before the .glb"
+    );
+    harness
+        .get_by_label("Also write model.glb (the mesh with this material)")
+        .click();
+    harness.step();
+    harness.get_by_label(basisu).click();
+    harness.step();
+    kit::type_export_folder(&mut harness, &out.display().to_string());
+    harness
+        .get_by_role_and_label(Role::Button, "Export")
+        .click();
+    harness.step();
+    wait_until(&mut harness, "exported", notice("model.glb textures UASTC"));
+    let glb = std::fs::read(out.join("model.glb")).expect("model.glb");
+    let glb = gltf::binary::Glb::from_slice(&glb).expect("a GLB");
+    let json: serde_json::Value = serde_json::from_slice(&glb.json).expect("JSON");
+    assert_eq!(json["extensionsRequired"][0], "KHR_texture_basisu");
+    assert!(
+        json["images"]
+            .as_array()
+            .expect("images")
+            .iter()
+            .all(|i| i["mimeType"] == "image/ktx2"),
+        "{json}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

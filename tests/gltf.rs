@@ -429,7 +429,9 @@ fn textured_glb() -> Vec<u8> {
 fn byte_flips_and_truncations_of_a_textured_glb_never_panic_in_import_pbr_or_mesh_info() {
     let file = textured_glb();
     let path = temp("barrel.glb", &file);
-    let set = kapaint::pbr::gltf::material_set(&path, None).expect("the unflipped file imports");
+    let set =
+        kapaint::pbr::gltf::material_set(&path, None, Some(kapaint::export::ktx::decode_image))
+            .expect("the unflipped file imports");
     assert_eq!(set.name, "barrel");
     let json_len = u32::from_le_bytes(file[12..16].try_into().expect("len")) as usize;
     let mut state = 0x2545_F491_u32;
@@ -461,7 +463,12 @@ fn byte_flips_and_truncations_of_a_textured_glb_never_panic_in_import_pbr_or_mes
         };
         let path = temp("barrel_mutant.glb", &copy);
         let outcome = std::panic::catch_unwind(|| {
-            let imported = kapaint::pbr::gltf::material_set(&path, None).is_ok();
+            let imported = kapaint::pbr::gltf::material_set(
+                &path,
+                None,
+                Some(kapaint::export::ktx::decode_image),
+            )
+            .is_ok();
             let _ = mesh::load(&path);
             imported
         });

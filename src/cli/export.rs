@@ -186,6 +186,9 @@ fn write_pbr(
     for skipped in &m.skipped {
         let _ = writeln!(text, "not written: {skipped}");
     }
+    if let Some(b) = &m.basisu {
+        let _ = writeln!(text, "basisu: {}", b.summary());
+    }
     if report {
         let _ = writeln!(text, "  preset: {}", m.preset);
         let _ = writeln!(
@@ -236,6 +239,11 @@ pub struct ExportArgs {
     /// embedded.
     #[arg(long)]
     glb: bool,
+    /// With --glb: the .glb's textures as Basis Universal KTX2 files (KHR_texture_basisu:
+    /// UASTC with zstd, its settings the cheapest within the preset's k_a budget) instead of
+    /// PNGs.
+    #[arg(long)]
+    basisu: bool,
     /// With --preset gltf-pbr: how n and k_s become roughness and F0 for Phong and
     /// Blinn-Phong projects (default: the mapping the project was imported with, else
     /// height-fitted).
@@ -327,6 +335,11 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
             preset.name
         )));
     }
+    if args.basisu && !glb {
+        return Err(CliError::usage(
+            "--basisu encodes the .glb's textures: use it with --preset gltf-pbr --glb",
+        ));
+    }
     if args.n_mapping.is_some() && !preset.format.is_pbr() {
         return Err(CliError::usage(format!(
             "--n-mapping chooses how n becomes roughness: use it with --preset gltf-pbr or an engine preset (unreal, unity-hdrp, unity-urp, godot), not {}",
@@ -356,7 +369,10 @@ fn export_command(args: &ExportArgs) -> Result<String, CliError> {
     check_targets(files, &targets, replace, SetKind::of(&preset))?;
     let gpu = crate::gpu::blocks::for_export(&preset);
     for (i, ((file, (doc, mesh)), target)) in files.iter().zip(&docs).zip(&targets).enumerate() {
-        let mesh = mesh.as_ref().map(|s| &s.mesh);
+        let mesh = mesh.as_ref().map(|s| crate::export::gltf_pbr::Glb {
+            mesh: &s.mesh,
+            basisu: args.basisu,
+        });
         let progress = crate::task::Progress::default();
         // A bar with the stage and an estimate on a terminal while it works.
         let what = format!("export {}/{} {}", i + 1, files.len(), file.display());

@@ -105,8 +105,12 @@ impl ImportPbrArgs {
     /// sides.
     fn set(&self) -> Result<(PbrSet, Option<NormalMap>, Vec<String>, bool), CliError> {
         if let Some(gltf) = &self.gltf {
-            let m = crate::pbr::gltf::material_set(gltf, self.material.as_deref())
-                .map_err(model_error)?;
+            let m = crate::pbr::gltf::material_set(
+                gltf,
+                self.material.as_deref(),
+                Some(crate::export::ktx::decode_image),
+            )
+            .map_err(model_error)?;
             return Ok((m.set, m.normal, m.notes, m.double_sided));
         }
         if let Some(file) = &self.set {

@@ -27,6 +27,8 @@ pub(super) struct ExportDialog {
     planning: Option<(usize, u64, JoinHandle<kapaint_export::set::SetPlan>)>,
     /// With a glTF PBR preset: also write the mesh with the material as a `.glb`.
     glb: bool,
+    /// With `glb`: its textures as Basis Universal KTX2 files (`KHR_texture_basisu`).
+    basisu: bool,
 }
 
 impl ExportDialog {
@@ -56,6 +58,7 @@ impl ExportDialog {
             plan: None,
             planning: None,
             glb: false,
+            basisu: false,
         }
     }
 
@@ -79,12 +82,16 @@ impl ExportDialog {
         let choice = (preset.name.clone(), self.folder.clone());
         let pbr = preset.format.is_gltf_pbr();
         let mesh = doc.surface().filter(|_| pbr && self.glb).map(Arc::clone);
+        let basisu = self.basisu;
         // A copy for the worker (the maps' tiles are shared, not copied).
         let snapshot = doc.snapshot();
         let job = JobStart::new(
             "Export",
             move |progress| {
-                let glb = mesh.as_ref().map(|s| &s.mesh);
+                let glb = mesh.as_ref().map(|s| kapaint_export::gltf_pbr::Glb {
+                    mesh: &s.mesh,
+                    basisu,
+                });
                 let gpu = kapaint_gpu::blocks::for_export(&preset);
                 match kapaint_export::run(&snapshot, &preset, &out, progress, replace, glb, gpu) {
                     Ok(m) => Ok((out, Box::new(m))),
@@ -230,6 +237,17 @@ pub(super) fn export_window(
                     ),
                 )
                 .on_disabled_hover_text("The project's mesh is not loaded.");
+                ui.add_enabled(
+                    has_mesh && dialog.glb,
+                    egui::Checkbox::new(
+                        &mut dialog.basisu,
+                        "with Basis Universal textures (KHR_texture_basisu, UASTC + zstd)",
+                    ),
+                )
+                .on_hover_text(
+                    "KTX2 textures a runtime transcodes to BC7 or ASTC: smaller on the GPU; \
+                     the settings are the cheapest within the preset's k_a budget.",
+                );
             }
             if let Some(problem) = &dialog.problem {
                 ui.colored_label(ui.visuals().error_fg_color, problem);

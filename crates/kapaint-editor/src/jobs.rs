@@ -333,7 +333,7 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
             text
         }
         kapaint_export::Exported::Pbr(m) => format!(
-            "exported {} as {} ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%{})",
+            "exported {} as {} ({} files, round-trip error max {:.1}% mean {:.1}% p99 {:.1}%{}{})",
             dir.display(),
             m.kind(),
             m.files.len() + 1,
@@ -342,7 +342,11 @@ fn exported_text(dir: &std::path::Path, m: kapaint_export::Exported) -> String {
             m.round_trip.p99 * 100.0,
             m.occlusion
                 .as_ref()
-                .map_or_else(String::new, |o| format!("; occlusion {}", o.note))
+                .map_or_else(String::new, |o| format!("; occlusion {}", o.note)),
+            m.basisu.as_ref().map_or_else(String::new, |b| format!(
+                "; model.glb textures {}",
+                b.summary()
+            ))
         ),
     }
 }

@@ -37,7 +37,8 @@ fn load(path: &std::path::Path) -> Result<LoadedMaterial, ModelError> {
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
     if gltf {
-        let m = kapaint_pbr::gltf::material_set(path, None)?;
+        let m =
+            kapaint_pbr::gltf::material_set(path, None, Some(kapaint_export::ktx::decode_image))?;
         let file = path.file_name().map_or_else(
             || path.display().to_string(),
             |n| n.to_string_lossy().into_owned(),

@@ -1,5 +1,7 @@
-//! A binary glTF (`.glb`) of a mesh with one metallic-roughness material whose PNG textures
-//! are embedded, built with the `gltf` crate's JSON types.
+//! A binary glTF (`.glb`) of a mesh with one metallic-roughness material whose textures are
+//! embedded, built with the `gltf` crate's JSON types: PNGs, or KTX2 files of Basis Universal
+//! blocks (`KHR_texture_basisu`, [`super::gltf_basisu`]) with no fallback, the extension then
+//! required and each texture's image named by the extension alone, as it states.
 //!
 //! kapaint's meshes keep OBJ's UV convention (`v` up); glTF's `v` runs down, so the file
 //! stores `1 - v`, as [`kapaint_mesh::gltf_import`] undoes on the way in. With a normal map the
@@ -13,8 +15,10 @@ use gltf::json::validation::{Checked::Valid, USize64};
 
 use kapaint_mesh::Mesh;
 
-/// The material's textures, PNG-encoded.
+/// The material's textures, PNG-encoded or (with `ktx2`) Basis Universal KTX2 files.
 pub struct Textures<'a> {
+    /// The images are KTX2 files of Basis Universal blocks (`KHR_texture_basisu`).
+    pub ktx2: bool,
     /// Base colour, sRGB.
     pub base_color: &'a [u8],
     /// Metallic-roughness (G roughness, B metallic).
@@ -88,13 +92,24 @@ impl Bin {
     }
 }
 
-/// A texture of the PNG `png` (a view of the binary chunk), sampled with linear filtering,
-/// trilinear mips and repeat wrapping (sampler 0).
-fn texture(root: &mut json::Root, bin: &mut Bin, png: &[u8], name: &str) -> json::texture::Info {
-    let view = bin.view(root, png, None);
+/// The image type of a KTX2 file, as `KHR_texture_basisu` names it.
+pub const KTX2_MIME: &str = "image/ktx2";
+/// The extension's name.
+pub const BASISU: &str = "KHR_texture_basisu";
+
+/// A texture of the image `bytes` (a view of the binary chunk; a PNG, or a KTX2 file where
+/// `ktx2`), sampled with linear filtering, trilinear mips and repeat wrapping (sampler 0).
+fn texture(
+    root: &mut json::Root,
+    bin: &mut Bin,
+    (bytes, ktx2): (&[u8], bool),
+    name: &str,
+) -> json::texture::Info {
+    let view = bin.view(root, bytes, None);
+    let mime = if ktx2 { KTX2_MIME } else { "image/png" };
     let image = root.push(json::Image {
         buffer_view: Some(view),
-        mime_type: Some(json::image::MimeType("image/png".into())),
+        mime_type: Some(json::image::MimeType(mime.into())),
         name: Some(name.into()),
         uri: None,
         extensions: None,
@@ -195,10 +210,16 @@ fn push_material(
         extensions: None,
         extras: json::Extras::default(),
     });
-    let base = texture(root, bin, textures.base_color, "base_color");
-    let mr = texture(root, bin, textures.metallic_roughness, "metallic_roughness");
-    let normal = textures.normal.map(|png| {
-        let info = texture(root, bin, png, "normal");
+    let k = textures.ktx2;
+    let base = texture(root, bin, (textures.base_color, k), "base_color");
+    let mr = texture(
+        root,
+        bin,
+        (textures.metallic_roughness, k),
+        "metallic_roughness",
+    );
+    let normal = textures.normal.map(|bytes| {
+        let info = texture(root, bin, (bytes, k), "normal");
         json::material::NormalTexture {
             index: info.index,
             scale: 1.0,
@@ -298,7 +319,15 @@ fn write_glb(
         extensions: None,
         extras: json::Extras::default(),
     });
-    let json = json::serialize::to_vec(&root).map_err(|e| e.to_string())?;
+    let ktx2 = textures.is_some_and(|t| t.ktx2);
+    if ktx2 {
+        root.extensions_used.push(BASISU.into());
+        root.extensions_required.push(BASISU.into());
+    }
+    let mut json = json::serialize::to_vec(&root).map_err(|e| e.to_string())?;
+    if ktx2 {
+        json = basisu_sources(&json)?;
+    }
     gltf::binary::Glb {
         header: gltf::binary::Header {
             magic: *b"glTF",
@@ -310,4 +339,28 @@ fn write_glb(
     }
     .to_vec()
     .map_err(|e| e.to_string())
+}
+
+/// The JSON `json` with each texture's `source` moved into its `KHR_texture_basisu`
+/// extension: the image is a KTX2 file with no fallback, which the texture names only there
+/// (the `gltf` crate's types cannot leave `source` out).
+fn basisu_sources(json: &[u8]) -> Result<Vec<u8>, String> {
+    let mut root: serde_json::Value = serde_json::from_slice(json).map_err(|e| e.to_string())?;
+    if let Some(textures) = root
+        .get_mut("textures")
+        .and_then(serde_json::Value::as_array_mut)
+    {
+        for texture in textures
+            .iter_mut()
+            .filter_map(serde_json::Value::as_object_mut)
+        {
+            if let Some(source) = texture.remove("source") {
+                texture.insert(
+                    "extensions".into(),
+                    serde_json::json!({ BASISU: { "source": source } }),
+                );
+            }
+        }
+    }
+    serde_json::to_vec(&root).map_err(|e| e.to_string())
 }

@@ -9,6 +9,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::gltf_basisu::{self, BasisuReport};
 use super::pbr_files::{Encoded, Sources};
 use super::preset::{ExportPreset, NormalGreen};
 use super::set::{SetError, claim, commit, padded_texels};
@@ -62,6 +63,19 @@ pub struct PbrManifest {
     /// normal map`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub skipped: Vec<String>,
+    /// How the `.glb`'s textures were encoded, where they are Basis Universal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub basisu: Option<BasisuReport>,
+}
+
+/// A `.glb` to write beside a glTF set: the mesh, and whether its textures are Basis
+/// Universal KTX2 files (`KHR_texture_basisu`, [`crate::gltf_basisu`]) rather than the PNGs.
+#[derive(Clone, Copy)]
+pub struct Glb<'a> {
+    /// The mesh the material is on.
+    pub mesh: &'a Mesh,
+    /// Basis Universal textures.
+    pub basisu: bool,
 }
 
 impl PbrManifest {
@@ -82,7 +96,7 @@ impl PbrManifest {
 /// Writes `doc` as a PBR set into the folder `out` (free, or a set to replace when
 /// `replace`): the preset's layout ([`ExportPreset::pbr_files`]; a normal map's file only
 /// where the document has one), `material.json`, and for glTF's layout with `glb` that mesh
-/// with the material embedded ([`GLB_FILE`]).
+/// with the material embedded ([`GLB_FILE`]), its textures the PNGs or Basis Universal.
 ///
 /// # Errors
 /// A taken target, a layout whose names meet once the set's name is in them, a failed
@@ -93,7 +107,7 @@ pub fn export(
     out: &Path,
     progress: &Progress,
     replace: bool,
-    glb: Option<&Mesh>,
+    glb: Option<Glb<'_>>,
 ) -> Result<PbrManifest, SetError> {
     progress.start("analyse", 1);
     let found = claim(out, replace, crate::set::SetKind::Pbr)?;
@@ -149,8 +163,12 @@ pub fn export(
         .iter()
         .any(|f| f.is_normal() && doc.normal().is_some())
         .then_some(preset.normal_green);
+    let basisu = match glb {
+        Some(g) if g.basisu => Some(basisu_textures(doc, preset, &sources, &layout, progress)?),
+        _ => None,
+    };
     let glb = glb
-        .map(|mesh| gltf_glb(doc, mesh, &written, name))
+        .map(|g| gltf_glb(doc, g.mesh, &written, basisu.as_ref(), name))
         .transpose()
         .map_err(invalid)?;
     let mut files: Vec<PbrFile> = written.iter().map(|e| e.entry.clone()).collect();
@@ -176,6 +194,7 @@ pub fn export(
         occlusion: occlusion_note,
         normal_green,
         skipped,
+        basisu: basisu.map(|b| b.report),
     };
     commit(out, &found, |tmp| {
         let json = serde_json::to_vec_pretty(&manifest).map_err(|e| invalid(e.to_string()))?;
@@ -221,11 +240,59 @@ fn write_all(tmp: &Path, writes: &[(&str, &[u8])]) -> Result<(), SetError> {
     Ok(())
 }
 
-/// The `.glb` of `mesh` with glTF's images `written` embedded, named `name`.
+/// glTF's textures as Basis Universal KTX2 files, at the effort the preset's budget asks
+/// ([`gltf_basisu::encode`]).
+fn basisu_textures(
+    doc: &Document,
+    preset: &ExportPreset,
+    sources: &Sources<'_>,
+    layout: &[crate::preset::TextureFile],
+    progress: &Progress,
+) -> Result<gltf_basisu::Encoded, SetError> {
+    let fail = |reason: String| {
+        if reason == "cancelled" {
+            SetError::Cancelled
+        } else {
+            SetError::Invalid {
+                path: GLB_FILE.into(),
+                reason: format!("Basis Universal textures: {reason}"),
+            }
+        }
+    };
+    let planes: Vec<Option<crate::pbr_files::Plane>> =
+        [BASE_COLOR_FILE, METALLIC_ROUGHNESS_FILE, NORMAL_FILE]
+            .iter()
+            .map(|name| {
+                layout
+                    .iter()
+                    .find(|f| f.file == *name && f.channels.len() == 3)
+                    .and_then(|f| sources.plane(f))
+            })
+            .collect();
+    let rgb = |k: usize| {
+        planes[k].as_ref().map(|(texels, size)| gltf_basisu::Rgb {
+            texels,
+            size: *size,
+        })
+    };
+    let settings = doc.settings();
+    let reading = gltf_basisu::Reading {
+        model: settings.model,
+        mapping: settings.n_mapping(),
+        approx: settings.approx,
+    };
+    let rows: u32 = planes.iter().flatten().map(|(_, (_, h))| *h).sum();
+    progress.start("basis universal", u64::from(rows));
+    gltf_basisu::encode([rgb(0), rgb(1), rgb(2)], reading, &preset.budget, progress).map_err(fail)
+}
+
+/// The `.glb` of `mesh` with glTF's images embedded, named `name`: the PNGs `written`, or
+/// the Basis Universal files `basisu`.
 fn gltf_glb(
     doc: &Document,
     mesh: &Mesh,
     written: &[Encoded],
+    basisu: Option<&gltf_basisu::Encoded>,
     name: String,
 ) -> Result<Vec<u8>, String> {
     let file = |path: &str| {
@@ -240,9 +307,13 @@ fn gltf_glb(
         return Err("a .glb is written with glTF's layout (the gltf-pbr preset)".into());
     };
     let textures = super::glb::Textures {
-        base_color,
-        metallic_roughness,
-        normal: file(NORMAL_FILE),
+        ktx2: basisu.is_some(),
+        base_color: basisu.map_or(base_color, |b| &b.base_color),
+        metallic_roughness: basisu.map_or(metallic_roughness, |b| &b.metallic_roughness),
+        normal: match basisu {
+            Some(b) => b.normal.as_deref(),
+            None => file(NORMAL_FILE),
+        },
         double_sided: doc
             .settings()
             .import

@@ -7,6 +7,7 @@ pub mod codec;
 pub mod encoding;
 pub mod file_kind;
 pub mod glb;
+pub mod gltf_basisu;
 pub mod gltf_pbr;
 pub mod ktx;
 pub mod pbr_files;
@@ -38,7 +39,7 @@ pub fn run(
     out: &Path,
     progress: &kapaint_base::task::Progress,
     replace: bool,
-    glb: Option<&kapaint_mesh::Mesh>,
+    glb: Option<gltf_pbr::Glb<'_>>,
     brought: Option<&dyn blocks::BlockEncoder>,
 ) -> Result<Exported, set::SetError> {
     if glb.is_some() && !preset.format.is_gltf_pbr() {

@@ -133,6 +133,9 @@ pub struct Encoded {
     pub bytes: Vec<u8>,
 }
 
+/// A file's texels (its channels interleaved, 8-bit) and size.
+pub type Plane = (Vec<u8>, (u32, u32));
+
 impl Sources<'_> {
     /// `file` as a PNG named `path`, or `None` for a normal map's file where the project
     /// has none.
@@ -140,6 +143,34 @@ impl Sources<'_> {
     /// # Errors
     /// The encoder's.
     pub fn encode(&self, file: &TextureFile, path: String) -> Option<Result<Encoded, String>> {
+        let (data, size) = self.plane(file)?;
+        let channels = &file.channels;
+        let colour = [
+            image::ExtendedColorType::L8,
+            image::ExtendedColorType::La8,
+            image::ExtendedColorType::Rgb8,
+            image::ExtendedColorType::Rgba8,
+        ][channels.len() - 1];
+        Some(
+            kapaint_model::import::encode_png(&data, size, colour).map(|bytes| Encoded {
+                entry: PbrFile {
+                    path,
+                    layout: file.layout(),
+                    colour_space: Some(if file.is_colour() {
+                        ColourSpace::Srgb
+                    } else {
+                        ColourSpace::Linear
+                    }),
+                    bytes: bytes.len() as u64,
+                },
+                bytes,
+            }),
+        )
+    }
+
+    /// `file`'s texels (its channels interleaved, 8-bit) and size, or `None` for a normal
+    /// map's file where the project has none.
+    pub fn plane(&self, file: &TextureFile) -> Option<Plane> {
         let channels = &file.channels;
         let (data, size) = if file.is_normal() {
             let normal = self.normal?;
@@ -162,27 +193,7 @@ impl Sources<'_> {
             });
             (data, self.size)
         };
-        let colour = [
-            image::ExtendedColorType::L8,
-            image::ExtendedColorType::La8,
-            image::ExtendedColorType::Rgb8,
-            image::ExtendedColorType::Rgba8,
-        ][channels.len() - 1];
-        Some(
-            kapaint_model::import::encode_png(&data, size, colour).map(|bytes| Encoded {
-                entry: PbrFile {
-                    path,
-                    layout: file.layout(),
-                    colour_space: Some(if file.is_colour() {
-                        ColourSpace::Srgb
-                    } else {
-                        ColourSpace::Linear
-                    }),
-                    bytes: bytes.len() as u64,
-                },
-                bytes,
-            }),
-        )
+        Some((data, size))
     }
 }
 

@@ -49,8 +49,27 @@ pub fn open_gltf(path: &Path) -> Result<Opened, MeshError> {
     } else {
         bytes.clone()
     };
-    let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice_without_validation(&bytes).map_err(not_gltf)?;
+    let gltf::Gltf { document, blob } = match basisu_sources(&json) {
+        // The gltf crate requires a texture's `source`: one named only by its
+        // KHR_texture_basisu extension (a KTX2 image with no fallback) gets that one.
+        Some(patched) => {
+            let blob = if bytes.starts_with(b"glTF") {
+                gltf::binary::Glb::from_slice(&bytes)
+                    .map_err(not_gltf)?
+                    .bin
+                    .map(std::borrow::Cow::into_owned)
+            } else {
+                None
+            };
+            let root = gltf::json::deserialize::from_slice(&patched)
+                .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
+            gltf::Gltf {
+                document: gltf::Document::from_json_without_validation(root),
+                blob,
+            }
+        }
+        None => gltf::Gltf::from_slice_without_validation(&bytes).map_err(not_gltf)?,
+    };
     // gltf-json 1.4.1's own validation indexes the accessor list with the POSITION
     // attribute unchecked (and panics on a dangling one): check references first.
     check_references(document.as_json()).map_err(&invalid)?;
@@ -67,6 +86,56 @@ pub fn open_gltf(path: &Path) -> Result<Opened, MeshError> {
         dir,
         json,
     })
+}
+
+/// The JSON `json` with `KHR_texture_basisu` out of `extensionsRequired` and each texture
+/// that has no `source` but the extension's given that one; `None` where nothing needed it
+/// (or the JSON does not parse: the gltf crate says why).
+fn basisu_sources(json: &[u8]) -> Option<Vec<u8>> {
+    if !json
+        .windows(b"KHR_texture_basisu".len())
+        .any(|w| w == b"KHR_texture_basisu")
+    {
+        return None;
+    }
+    let mut root: serde_json::Value = serde_json::from_slice(json).ok()?;
+    // The gltf crate refuses a required extension it does not know; the material's reader
+    // decides (it reads KTX2 images where it was handed a reader, and refuses them else).
+    let mut changed = false;
+    if let Some(required) = root
+        .get_mut("extensionsRequired")
+        .and_then(serde_json::Value::as_array_mut)
+    {
+        let before = required.len();
+        required.retain(|e| e != "KHR_texture_basisu");
+        changed = required.len() != before;
+    }
+    let textures = root
+        .get_mut("textures")
+        .and_then(serde_json::Value::as_array_mut)
+        .map_or(&mut [][..], |t| t.as_mut_slice());
+    for texture in textures
+        .iter_mut()
+        .filter_map(serde_json::Value::as_object_mut)
+    {
+        if texture.contains_key("source") {
+            continue;
+        }
+        let source = texture
+            .get("extensions")
+            .and_then(|e| e.get("KHR_texture_basisu"))
+            .and_then(|b| b.get("source"))
+            .cloned();
+        if let Some(source) = source {
+            texture.insert("source".into(), source);
+            changed = true;
+        }
+    }
+    if changed {
+        serde_json::to_vec(&root).ok()
+    } else {
+        None
+    }
 }
 
 /// Loads a `.gltf` or `.glb` file.

@@ -1,9 +1,10 @@
 //! A glTF material's metallic-roughness set: its textures (from the GLB's buffers, data:
 //! URIs or files beside the `.gltf`), factors, samplers' wrap modes and texture transforms.
 //!
-//! Images are decoded with the import limits; a KTX2 or Basis Universal texture
-//! (`KHR_texture_basisu`) is refused with the reason, as is a texture on another UV set than
-//! the one kapaint paints (`TEXCOORD_0`).
+//! Images are decoded with the import limits. A KTX2 texture (`KHR_texture_basisu`'s Basis
+//! Universal images, or any KTX2 kapaint writes) is decoded by the [`Ktx2Reader`] the caller
+//! hands in (the export crate's, which sits above this one), or refused with the reason where
+//! none is; so is a texture on another UV set than the one kapaint paints (`TEXCOORD_0`).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -32,6 +33,10 @@ pub struct MaterialSet {
     pub double_sided: bool,
 }
 
+/// Decodes a KTX2 file to its level 0's texels, or says why not in one line: the export
+/// crate's `ktx::decode_image`, handed in by whoever opens the file (the CLI, the editor).
+pub type Ktx2Reader = fn(&[u8]) -> Result<DynamicImage, String>;
+
 fn fail(path: &Path, reason: impl Into<String>) -> ModelError {
     ModelError::Image {
         path: path.to_path_buf(),
@@ -51,15 +56,21 @@ fn basis_reason() -> String {
 ///
 /// # Errors
 /// A file that does not open, a missing material, a texture that does not read (missing,
-/// corrupt, too large, KTX2), or one on another UV set.
-pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, ModelError> {
+/// corrupt, too large, KTX2 without a `ktx2` reader, one the reader refuses), or one on
+/// another UV set.
+pub fn material_set(
+    path: &Path,
+    selector: Option<&str>,
+    ktx2: Option<Ktx2Reader>,
+) -> Result<MaterialSet, ModelError> {
     let opened = open_gltf(path).map_err(|e| {
-        // A texture without a `source` (only a KHR_texture_basisu one) fails the JSON
-        // schema; say why rather than which field.
+        // Without a KTX2 reader, a file naming Basis Universal textures is refused for that,
+        // whatever else the JSON says.
         let raw = std::fs::read(path).unwrap_or_default();
-        if raw
-            .windows(b"KHR_texture_basisu".len())
-            .any(|w| w == b"KHR_texture_basisu")
+        if ktx2.is_none()
+            && raw
+                .windows(b"KHR_texture_basisu".len())
+                .any(|w| w == b"KHR_texture_basisu")
         {
             fail(path, basis_reason())
         } else {
@@ -70,9 +81,10 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
         }
     })?;
     let document = &opened.document;
-    if document
-        .extensions_used()
-        .any(|e| e == "KHR_texture_basisu")
+    if ktx2.is_none()
+        && document
+            .extensions_used()
+            .any(|e| e == "KHR_texture_basisu")
     {
         return Err(fail(path, basis_reason()));
     }
@@ -88,6 +100,7 @@ pub fn material_set(path: &Path, selector: Option<&str>) -> Result<MaterialSet, 
         opened: &opened,
         path,
         cache: HashMap::new(),
+        ktx2,
     };
     let pbr = material.pbr_metallic_roughness();
     let base_factor = Vec3::from_slice(&pbr.base_color_factor()[..3]);
@@ -204,6 +217,7 @@ struct Images<'a> {
     opened: &'a Opened,
     path: &'a Path,
     cache: HashMap<usize, Arc<DynamicImage>>,
+    ktx2: Option<Ktx2Reader>,
 }
 
 impl Images<'_> {
@@ -291,23 +305,32 @@ impl Images<'_> {
 
     fn decode(&self, image: &gltf::Image<'_>, slot: &str) -> Result<DynamicImage, ModelError> {
         let what = |reason: String| fail(self.path, format!("{slot}: {reason}"));
-        let refuse_ktx = |mime: Option<&str>, uri: Option<&str>| {
-            let ktx = mime.is_some_and(|m| m.contains("ktx2") || m.contains("basis"))
+        let is_ktx = |mime: Option<&str>, uri: Option<&str>| {
+            mime.is_some_and(|m| m.contains("ktx2") || m.contains("basis"))
                 || uri.is_some_and(|u| {
                     Path::new(u).extension().is_some_and(|e| {
                         e.eq_ignore_ascii_case("ktx2") || e.eq_ignore_ascii_case("basis")
                     })
-                });
-            if ktx {
-                Err(what(basis_reason()))
-            } else {
-                Ok(())
+                })
+        };
+        // A KTX2 image through the reader handed in; refused where there is none.
+        let read = |bytes: &[u8], ktx: bool, label: &Path| -> Result<DynamicImage, ModelError> {
+            // The KTX2 reader bounds its own sizes (kapaint's largest map).
+            if !ktx {
+                return decode_bytes(bytes, label).map_err(|e| what(e.to_string()));
             }
+            let reader = self.ktx2.ok_or_else(|| what(basis_reason()))?;
+            let decoded = reader(bytes).map_err(|e| {
+                what(format!(
+                    "image {} (KTX2) does not decode: {e}",
+                    image.index()
+                ))
+            })?;
+            Ok(decoded)
         };
         let label = self.path.join(format!("image{}", image.index()));
         match image.source() {
             gltf::image::Source::View { view, mime_type } => {
-                refuse_ktx(Some(mime_type), None)?;
                 let buffer = &self.opened.buffers[view.buffer().index()];
                 let (start, len) = (view.offset(), view.length());
                 let bytes = start
@@ -320,10 +343,10 @@ impl Images<'_> {
                             buffer.len()
                         ))
                     })?;
-                decode_bytes(bytes, &label).map_err(|e| what(e.to_string()))
+                read(bytes, is_ktx(Some(mime_type), None), &label)
             }
             gltf::image::Source::Uri { uri, mime_type } => {
-                refuse_ktx(mime_type, Some(uri))?;
+                let ktx = is_ktx(mime_type, Some(uri));
                 if uri.starts_with("data:") {
                     let bytes = gltf::buffer::Data::from_source_and_blob(
                         gltf::buffer::Source::Uri(uri),
@@ -331,10 +354,19 @@ impl Images<'_> {
                         &mut None,
                     )
                     .map_err(|e| what(format!("its data: URI does not decode: {e}")))?;
-                    decode_bytes(&bytes.0, &label).map_err(|e| what(e.to_string()))
+                    read(&bytes.0, ktx, &label)
                 } else {
                     let file = file_beside(&self.opened.dir, uri).map_err(&what)?;
-                    read_image(&file).map_err(|e| what(e.to_string()))
+                    if ktx {
+                        let bytes = kapaint_base::file_check::read_limited(
+                            &file,
+                            kapaint_mesh::MAX_FILE_BYTES,
+                        )
+                        .map_err(|e| what(e.to_string()))?;
+                        read(&bytes, true, &file)
+                    } else {
+                        read_image(&file).map_err(|e| what(e.to_string()))
+                    }
                 }
             }
         }

@@ -268,6 +268,39 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
     })
 }
 
+/// Level 0 of a KTX2 file kapaint reads ([`decode`]) as an image: 8-bit luminance,
+/// luminance and alpha, RGB or RGBA by its components (BC6H's floats clamped to `[0, 1]`). The
+/// reader a glTF's `KHR_texture_basisu` images go through (`kapaint_pbr::gltf`).
+///
+/// # Errors
+/// [`decode`]'s.
+pub fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, String> {
+    use image::DynamicImage as D;
+    let d = decode(bytes)?;
+    let (w, h) = (d.width, d.height);
+    let wrong = || "the decoded level does not match its size".to_string();
+    let byte = |v: &f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let pick = |k: usize| -> Vec<u8> {
+        d.rgba
+            .chunks_exact(4)
+            .flat_map(|t| t[..k].iter().map(byte).collect::<Vec<u8>>())
+            .collect()
+    };
+    Ok(match d.channels {
+        1 => D::ImageLuma8(image::GrayImage::from_raw(w, h, pick(1)).ok_or_else(wrong)?),
+        2 => {
+            let la: Vec<u8> = d
+                .rgba
+                .chunks_exact(4)
+                .flat_map(|t| [byte(&t[0]), byte(&t[1])])
+                .collect();
+            D::ImageLumaA8(image::GrayAlphaImage::from_raw(w, h, la).ok_or_else(wrong)?)
+        }
+        3 => D::ImageRgb8(image::RgbImage::from_raw(w, h, pick(3)).ok_or_else(wrong)?),
+        _ => D::ImageRgba8(image::RgbaImage::from_raw(w, h, pick(4)).ok_or_else(wrong)?),
+    })
+}
+
 /// Level 0 of a UASTC file as RGBA, as its ASTC 4x4 transcode decodes (UASTC's own texels):
 /// luminance in RGB and the second of two components in alpha, as ASTC's.
 fn decode_uastc(data: &[u8], (w, h): (u32, u32)) -> Result<Decoded, String> {

@@ -13,7 +13,7 @@ mod own_levels;
 use ktx2::Format as KtxFormat;
 use rayon::prelude::*;
 
-pub use self::container::{Decoded, ZSTD_LEVELS, decode, supercompress};
+pub use self::container::{Decoded, ZSTD_LEVELS, decode, decode_image, supercompress};
 use self::container::{Described, container};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 pub use self::own_levels::encode_levels;

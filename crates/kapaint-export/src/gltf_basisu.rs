@@ -1,0 +1,288 @@
+//! glTF's textures as Basis Universal (`KHR_texture_basisu`), for `export --preset gltf-pbr
+//! --glb --basisu`: each texture a KTX2 file of UASTC blocks with a full mip chain, its levels
+//! supercompressed by zstd ([`ZSTD_LEVEL`]), embedded in the `.glb` with no PNG fallback
+//! (the extension is then required, as it states for a texture without a `source`).
+//!
+//! **What decides the settings.** The preset's budget, measured on the `k_a` the textures
+//! give after transcoding: the base colour and metallic-roughness textures as a runtime
+//! decodes them (the BC7 transcode, the worse of its two targets) are read back through the
+//! conversion `import-pbr` uses, and each texel's `k_a` is compared with the one the lossless
+//! values give, in levels of 8-bit sRGB (the budget's p99.9 and mean). Efforts run cheapest in
+//! bytes first (UASTC's level and RDO, [`crate::codec::uastc_settings_of`]) until one is
+//! within; the normal map is encoded at the effort chosen. What this adds comes on top of the
+//! round trip's own error, which the manifest reports beside it.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::blocks::Coder;
+use crate::codec::{Codec, Effort, Uastc};
+use crate::file_kind::ColourSpace;
+use crate::ktx::{self, Compressed, Space};
+use crate::preset::BlockBudget;
+use crate::set::perceptual::{SrgbError, SrgbLevels, SrgbStats};
+use kapaint_base::task::Progress;
+use kapaint_model::provenance::NMapping;
+use kapaint_model::texel::srgb_to_linear;
+use kapaint_pbr::Pbr;
+use kapaint_pbr::convert::Conversion;
+use kapaint_reflectance::{AmbientApprox, ShadingModel};
+
+/// The zstd level of the textures' levels (gltf-transform's default for UASTC).
+pub const ZSTD_LEVEL: u8 = 18;
+
+/// One texture's texels: 8-bit RGB, row major.
+#[derive(Clone, Copy)]
+pub struct Rgb<'a> {
+    /// `width * height * 3` bytes.
+    pub texels: &'a [u8],
+    /// Size in texels.
+    pub size: (u32, u32),
+}
+
+/// How the material's `k_a` is computed: the project's model, the mapping its glTF values
+/// were made with and its ambient approximation.
+#[derive(Clone, Copy, Debug)]
+pub struct Reading {
+    /// The shading model.
+    pub model: ShadingModel,
+    /// How roughness and `F0` become `n` and `k_s`.
+    pub mapping: NMapping,
+    /// The ambient approximation.
+    pub approx: AmbientApprox,
+}
+
+/// One KTX2 texture in the `.glb`, as the manifest lists it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BasisuTexture {
+    /// The glTF image's name (`base_color`, `metallic_roughness`, `normal`).
+    pub name: String,
+    /// Size in texels.
+    pub width: u32,
+    /// Size in texels.
+    pub height: u32,
+    /// Mip levels.
+    pub levels: u32,
+    /// How its colour is encoded.
+    pub colour_space: ColourSpace,
+    /// The KTX2 file's bytes.
+    pub bytes: u64,
+}
+
+/// How the `.glb`'s textures were encoded: the manifest's `basisu`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BasisuReport {
+    /// The block format: `UASTC`.
+    pub codec: String,
+    /// Its settings: "level 2, RDO 1.0".
+    pub settings: String,
+    /// The zstd level of every level.
+    pub zstd_level: u8,
+    /// The `k_a` error the transcoded textures add, in levels of 8-bit sRGB.
+    pub ka_error_srgb: SrgbError,
+    /// Whether that is within the preset's budget (else the best effort was kept).
+    pub within_budget: bool,
+    /// The textures.
+    pub textures: Vec<BasisuTexture>,
+}
+
+impl BasisuReport {
+    /// In the words the CLI and the editor use: "UASTC level 2, RDO 1.0, zstd 18: k_a
+    /// within 0.42 levels of the lossless textures' for 99.9 % of texels (mean 0.031) after
+    /// transcoding, within the budget; 3 KTX2 textures, 123456 bytes".
+    pub fn summary(&self) -> String {
+        format!(
+            "{} {}, zstd {}: k_a within {:.2} levels of the lossless textures' for 99.9 % of texels (mean {:.3}) after transcoding, {}; {} KTX2 textures, {} bytes",
+            self.codec,
+            self.settings,
+            self.zstd_level,
+            self.ka_error_srgb.p999,
+            self.ka_error_srgb.mean,
+            if self.within_budget {
+                "within the budget"
+            } else {
+                "over the budget at the best settings"
+            },
+            self.textures.len(),
+            self.textures.iter().map(|t| t.bytes).sum::<u64>()
+        )
+    }
+}
+
+/// The textures as KTX2 files, and how.
+pub struct Encoded {
+    /// Base colour, sRGB.
+    pub base_color: Vec<u8>,
+    /// Metallic-roughness, linear.
+    pub metallic_roughness: Vec<u8>,
+    /// The normal map, linear, where given.
+    pub normal: Option<Vec<u8>>,
+    /// What the manifest says.
+    pub report: BasisuReport,
+}
+
+/// The base colour, metallic-roughness and (optional) normal textures as UASTC KTX2 files,
+/// at the cheapest effort whose `k_a` is within `budget` (see the module).
+///
+/// # Errors
+/// The encoder's failure, textures of different sizes, or cancelled (`"cancelled"`).
+pub fn encode(
+    textures: [Option<Rgb<'_>>; 3],
+    reading: Reading,
+    budget: &BlockBudget,
+    progress: &Progress,
+) -> Result<Encoded, String> {
+    let [Some(base), Some(mr), normal] = textures else {
+        return Err("the base colour and metallic-roughness textures are needed".into());
+    };
+    if base.size != mr.size || base.texels.len() != mr.texels.len() {
+        return Err("the base colour and metallic-roughness textures differ in size".into());
+    }
+    let (base_codec, data_codec) = (Uastc::new(3, true), Uastc::new(3, false));
+    let exact = ka_of(base.texels, mr.texels, reading);
+    let mut chosen = None;
+    for effort in Effort::ALL {
+        progress.check().map_err(|_| "cancelled".to_string())?;
+        let (b, m) = rayon::join(
+            || level0(&base_codec, effort, base),
+            || level0(&data_codec, effort, mr),
+        );
+        let (b, m) = (b?, m?);
+        let error = ka_error(&exact, &ka_of(&b.decoded, &m.decoded, reading));
+        let within = error.over(budget) == (false, false);
+        chosen = Some((effort, b, m, error, within));
+        if within {
+            break;
+        }
+    }
+    let (effort, b, m, error, within) = chosen.ok_or("no effort was tried")?;
+    progress.check().map_err(|_| "cancelled".to_string())?;
+    let (base_file, mr_file) = rayon::join(
+        || file(&base_codec, effort, base, Space::Srgb, Some(b), progress),
+        || file(&data_codec, effort, mr, Space::Linear, Some(m), progress),
+    );
+    let normal_file = normal
+        .map(|n| file(&data_codec, effort, n, Space::Linear, None, progress))
+        .transpose()?;
+    let (base_file, mr_file) = (base_file?, mr_file?);
+    let entry = |name: &str, rgb: Rgb<'_>, srgb: bool, bytes: &[u8]| BasisuTexture {
+        name: name.into(),
+        width: rgb.size.0,
+        height: rgb.size.1,
+        levels: ktx::level_count(rgb.size.0, rgb.size.1),
+        colour_space: if srgb {
+            ColourSpace::Srgb
+        } else {
+            ColourSpace::Linear
+        },
+        bytes: bytes.len() as u64,
+    };
+    let mut listed = vec![
+        entry("base_color", base, true, &base_file),
+        entry("metallic_roughness", mr, false, &mr_file),
+    ];
+    if let (Some(n), Some(bytes)) = (normal, &normal_file) {
+        listed.push(entry("normal", n, false, bytes));
+    }
+    Ok(Encoded {
+        base_color: base_file,
+        metallic_roughness: mr_file,
+        normal: normal_file,
+        report: BasisuReport {
+            codec: base_codec.name().into(),
+            settings: base_codec.effort_name(effort).into(),
+            zstd_level: ZSTD_LEVEL,
+            ka_error_srgb: error,
+            within_budget: within,
+            textures: listed,
+        },
+    })
+}
+
+/// Level 0 of `rgb` encoded by `codec` at `effort`, and decoded as a runtime would.
+fn level0(codec: &Uastc, effort: Effort, rgb: Rgb<'_>) -> Result<Compressed, String> {
+    ktx::compress_level(
+        Coder::Portable,
+        (codec, effort),
+        rgb.texels,
+        rgb.size,
+        3,
+        None,
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// The KTX2 file of `rgb` (components in `space`) with its full mip chain, level 0 given
+/// where the search encoded it, supercompressed by zstd.
+fn file(
+    codec: &Uastc,
+    effort: Effort,
+    rgb: Rgb<'_>,
+    space: Space,
+    level0: Option<Compressed>,
+    progress: &Progress,
+) -> Result<Vec<u8>, String> {
+    let spaces = [space; 3];
+    let value = |i: usize, k: usize| {
+        let byte = f32::from(rgb.texels[i * 3 + k]) / 255.0;
+        if space == Space::Srgb {
+            srgb_to_linear(byte)
+        } else {
+            byte
+        }
+    };
+    let source = ktx::Source {
+        width: rgb.size.0,
+        height: rgb.size.1,
+        spaces: &spaces,
+        level0: rgb.texels,
+        value: &value,
+    };
+    let written = ktx::encode(
+        &source,
+        Some((Coder::Portable, codec, effort)),
+        level0,
+        progress,
+    )
+    .map_err(|e| e.to_string())?;
+    ktx::supercompress(&written.bytes, ZSTD_LEVEL)
+}
+
+/// Each texel's `k_a` from glTF's 8-bit base colour (sRGB) and metallic-roughness (G
+/// roughness, B metallic), read as `import-pbr` reads them.
+fn ka_of(base: &[u8], mr: &[u8], reading: Reading) -> Vec<[f32; 3]> {
+    let conversion = Conversion::for_model(reading.model, reading.mapping);
+    base.par_chunks_exact(3)
+        .zip(mr.par_chunks_exact(3))
+        .map(|(b, m)| {
+            let pbr = Pbr {
+                base: glam::Vec3::new(
+                    srgb_to_linear(f32::from(b[0]) / 255.0),
+                    srgb_to_linear(f32::from(b[1]) / 255.0),
+                    srgb_to_linear(f32::from(b[2]) / 255.0),
+                ),
+                metallic: f32::from(m[2]) / 255.0,
+                roughness: f32::from(m[1]) / 255.0,
+            };
+            let v = conversion.material(pbr);
+            kapaint_reflectance::ka(reading.model, reading.approx, v.kd, v.ks, v.n).to_array()
+        })
+        .collect()
+}
+
+/// The sRGB-level error of `got` against `exact`, texel by texel.
+fn ka_error(exact: &[[f32; 3]], got: &[[f32; 3]]) -> SrgbError {
+    let levels = SrgbLevels::new();
+    exact
+        .par_chunks(1 << 14)
+        .zip(got.par_chunks(1 << 14))
+        .map(|(e, g)| {
+            let mut stats = SrgbStats::new();
+            for (e, g) in e.iter().zip(g) {
+                stats.add(levels.distance(*e, *g));
+            }
+            stats
+        })
+        .reduce(SrgbStats::new, |a, b| a.merge(&b))
+        .summary()
+}

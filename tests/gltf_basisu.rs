@@ -1,0 +1,358 @@
+//! `export --preset gltf-pbr --glb --basisu`: the `.glb`'s textures as Basis Universal KTX2
+//! files (`KHR_texture_basisu`, UASTC with zstd, no fallback), what the manifest says of them,
+//! and `import-pbr --gltf` reading such a file back (kapaint round-trips its own output);
+//! malformed payloads and a supercompression kapaint does not read refused in one line.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::path::{Path, PathBuf};
+
+use kapaint::export::gltf_pbr::PbrManifest;
+
+#[path = "common/gltf_asset.rs"]
+#[expect(
+    dead_code,
+    reason = "these tests make their material from images, not the glTF asset"
+)]
+mod gltf_asset;
+use gltf_asset::{bumps, dir, kapaint, spot};
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = kapaint(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A 128^2 project of spot with its texture, a roughness checker, metallic stripes and a
+/// bumpy normal map.
+fn project(d: &Path) -> PathBuf {
+    let (w, h) = (128, 128);
+    let rough = image::GrayImage::from_fn(w, h, |x, y| {
+        image::Luma([if (x / 16 + y / 16) % 2 == 0 { 60 } else { 200 }])
+    });
+    let metal = image::GrayImage::from_fn(w, h, |x, _| {
+        image::Luma([if (x / 32) % 2 == 0 { 0 } else { 255 }])
+    });
+    rough.save(d.join("rough.png")).expect("rough");
+    metal.save(d.join("metal.png")).expect("metal");
+    bumps(w, h).save(d.join("normal.png")).expect("normal");
+    let p = d.join("p.kapaint");
+    let (base, mesh) = (
+        spot().join("spot_texture.png"),
+        spot().join("spot_triangulated.obj"),
+    );
+    ok(&[
+        "import-pbr",
+        "--out",
+        s(&p),
+        "--size",
+        "128",
+        "--base-color",
+        s(&base),
+        "--roughness",
+        s(&d.join("rough.png")),
+        "--metallic",
+        s(&d.join("metal.png")),
+        "--normal",
+        s(&d.join("normal.png")),
+        "--mesh",
+        s(&mesh),
+    ]);
+    p
+}
+
+fn manifest(set: &Path) -> PbrManifest {
+    serde_json::from_slice(&std::fs::read(set.join("material.json")).expect("manifest"))
+        .expect("parses")
+}
+
+/// The `.glb`'s JSON and binary chunk.
+fn glb_parts(path: &Path) -> (serde_json::Value, Vec<u8>) {
+    let bytes = std::fs::read(path).expect("glb");
+    let glb = gltf::binary::Glb::from_slice(&bytes).expect("a GLB");
+    let json = serde_json::from_slice(&glb.json).expect("JSON");
+    (json, glb.bin.expect("a binary chunk").into_owned())
+}
+
+/// Image `i`'s bytes in the binary chunk.
+fn image_bytes(json: &serde_json::Value, bin: &[u8], i: usize) -> Vec<u8> {
+    let view = json["images"][i]["bufferView"].as_u64().expect("a view") as usize;
+    let v = &json["bufferViews"][view];
+    let at = v["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let len = v["byteLength"].as_u64().expect("length") as usize;
+    bin[at..at + len].to_vec()
+}
+
+#[test]
+fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
+    let d = dir("gltf-basisu");
+    let p = project(&d);
+    let (png_set, basis_set) = (d.join("png"), d.join("basis"));
+    ok(&[
+        "export",
+        s(&p),
+        "--preset",
+        "gltf-pbr",
+        "--glb",
+        "--out",
+        s(&png_set),
+    ]);
+    let out = ok(&[
+        "export",
+        s(&p),
+        "--preset",
+        "gltf-pbr",
+        "--glb",
+        "--basisu",
+        "--out",
+        s(&basis_set),
+    ]);
+    assert!(out.contains("basisu: UASTC level"), "{out}");
+    let m = manifest(&basis_set);
+    let b = m.basisu.as_ref().expect("the manifest says how");
+    assert_eq!(b.codec, "UASTC");
+    assert_eq!(b.zstd_level, 18);
+    // The spot texture's detail is more than UASTC holds within 2 levels at the 99.9th
+    // percentile (BC7's transcode, the worse target): the best settings are kept and said.
+    let budget = kapaint::export::preset::find("gltf-pbr")
+        .expect("preset")
+        .budget;
+    let over = b.ka_error_srgb.p999 > budget.ka_error_srgb_p999
+        || b.ka_error_srgb.mean > budget.ka_error_srgb_mean;
+    assert_eq!(b.within_budget, !over, "{b:?}");
+    if !b.within_budget {
+        assert_eq!(
+            b.settings, "level 3, no RDO",
+            "the search ends at the best: {b:?}"
+        );
+        assert!(out.contains("over the budget"), "{out}");
+    }
+    assert!(b.ka_error_srgb.mean < 0.5, "{b:?}");
+    assert_eq!(
+        b.textures.len(),
+        3,
+        "base colour, metallic-roughness, normal"
+    );
+    assert!(manifest(&png_set).basisu.is_none());
+
+    textures_are_uastc_ktx2(&basis_set.join("model.glb"), b);
+    // Smaller on the GPU and in the file than the PNGs' glTF? At least no larger than a
+    // whole UASTC chain (16 bytes a block) before zstd.
+    let ktx_bytes: u64 = b.textures.iter().map(|t| t.bytes).sum();
+    assert!(ktx_bytes < 3 * 128 * 128 * 4 / 3, "{ktx_bytes}");
+
+    // Round trip: import-pbr reads the Basis glTF; its maps are near the PNG glTF's.
+    let (from_png, from_basis) = (d.join("from_png.kapaint"), d.join("from_basis.kapaint"));
+    ok(&[
+        "import-pbr",
+        "--gltf",
+        s(&png_set.join("model.glb")),
+        "--out",
+        s(&from_png),
+    ]);
+    let said = ok(&[
+        "import-pbr",
+        "--gltf",
+        s(&basis_set.join("model.glb")),
+        "--out",
+        s(&from_basis),
+    ]);
+    assert!(!said.contains("does not read"), "{said}");
+    let (a, c) = (kd_of(&from_png), kd_of(&from_basis));
+    let mean: f64 = a
+        .iter()
+        .zip(&c)
+        .map(|(x, y)| f64::from((x - y).abs()))
+        .sum::<f64>()
+        / a.len() as f64;
+    assert!(mean < 0.02, "mean k_d difference {mean}");
+    assert!(mean > 0.0, "the KTX2 textures were read, not the PNGs");
+}
+
+/// The file's textures: the extension used and required, each texture's image only in it,
+/// each a UASTC KTX2 file with zstd, the colour space and mips the manifest lists.
+fn textures_are_uastc_ktx2(glb: &Path, b: &kapaint::export::gltf_basisu::BasisuReport) {
+    let (json, bin) = glb_parts(glb);
+    for key in ["extensionsUsed", "extensionsRequired"] {
+        assert_eq!(
+            json[key],
+            serde_json::json!(["KHR_texture_basisu"]),
+            "{key}"
+        );
+    }
+    let textures = json["textures"].as_array().expect("textures");
+    assert_eq!(textures.len(), 3);
+    for (t, listed) in textures.iter().zip(&b.textures) {
+        assert!(t.get("source").is_none(), "no fallback: {t}");
+        let i = t["extensions"]["KHR_texture_basisu"]["source"]
+            .as_u64()
+            .expect("the extension names the image") as usize;
+        assert_eq!(json["images"][i]["mimeType"], "image/ktx2");
+        assert_eq!(json["images"][i]["name"], listed.name.as_str());
+        let ktx = image_bytes(&json, &bin, i);
+        assert_eq!(ktx.len() as u64, listed.bytes);
+        let reader = ktx2::Reader::new(&ktx[..]).expect("a KTX2 file");
+        let header = reader.header();
+        assert_eq!(header.format, None, "UASTC has no Vulkan format");
+        assert_eq!(
+            header.supercompression_scheme,
+            Some(ktx2::SupercompressionScheme::Zstandard)
+        );
+        assert_eq!(reader.color_model(), Some(ktx2::ColorModel::UASTC));
+        assert_eq!(
+            (header.pixel_width, header.pixel_height, header.level_count),
+            (listed.width, listed.height, listed.levels)
+        );
+        assert_eq!(listed.levels, 8, "128 down to 1");
+        let srgb = reader.transfer_function() == Some(ktx2::TransferFunction::SRGB);
+        assert_eq!(srgb, listed.name == "base_color", "{}", listed.name);
+    }
+}
+
+/// Every texel's `k_d` components of a project.
+fn kd_of(project: &Path) -> Vec<f32> {
+    let doc = kapaint::model::project::load(project).expect("loads");
+    let maps = doc.maps();
+    let mut out = Vec::new();
+    for y in 0..maps.height() {
+        for x in 0..maps.width() {
+            out.extend(maps.texel(x, y).kd.map(|c| f32::from(c) / 65535.0));
+        }
+    }
+    out
+}
+
+/// `model.glb` with image `i`'s bytes replaced by `bytes` (views and lengths rewritten).
+fn with_image(glb: &Path, i: usize, bytes: &[u8], to: &Path) {
+    let (mut json, bin) = glb_parts(glb);
+    let view = json["images"][i]["bufferView"].as_u64().expect("a view") as usize;
+    let mut out = bin.clone();
+    while out.len() % 4 != 0 {
+        out.push(0);
+    }
+    let at = out.len();
+    out.extend_from_slice(bytes);
+    while out.len() % 4 != 0 {
+        out.push(0);
+    }
+    json["bufferViews"][view]["byteOffset"] = at.into();
+    json["bufferViews"][view]["byteLength"] = bytes.len().into();
+    json["buffers"][0]["byteLength"] = out.len().into();
+    let text = serde_json::to_vec(&json).expect("JSON");
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header {
+            magic: *b"glTF",
+            version: 2,
+            length: 0,
+        },
+        json: text.into(),
+        bin: Some(out.into()),
+    };
+    std::fs::write(to, glb.to_vec().expect("GLB")).expect("write");
+}
+
+#[test]
+fn a_glb_with_a_bad_basis_payload_is_refused_in_one_line() {
+    let d = dir("gltf-basisu-bad");
+    let p = project(&d);
+    let set = d.join("basis");
+    ok(&[
+        "export",
+        s(&p),
+        "--preset",
+        "gltf-pbr",
+        "--glb",
+        "--basisu",
+        "--out",
+        s(&set),
+    ]);
+    let glb = set.join("model.glb");
+    let (json, bin) = glb_parts(&glb);
+    let good = image_bytes(&json, &bin, 0);
+    // BasisLZ (scheme 1) where zstd was: a supercompression kapaint does not read.
+    let mut basislz = good.clone();
+    basislz[44..48].copy_from_slice(&1_u32.to_le_bytes());
+    let cases: [(&str, Vec<u8>); 3] = [
+        ("truncated", good[..good.len() / 2].to_vec()),
+        ("not-ktx", b"this is not a KTX2 file at all".to_vec()),
+        ("basislz", basislz),
+    ];
+    for (name, bytes) in cases {
+        let bad = d.join(format!("{name}.glb"));
+        with_image(&glb, 0, &bytes, &bad);
+        let out = d.join(format!("{name}.kapaint"));
+        let o = kapaint(&["import-pbr", "--gltf", s(&bad), "--out", s(&out)]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(err.starts_with("kapaint:"), "{name}: {err}");
+        assert!(err.contains("KTX2"), "{name}: {err}");
+        assert!(!out.exists(), "{name}: nothing written");
+    }
+}
+
+#[test]
+fn a_smooth_material_meets_the_budget_at_the_cheapest_settings() {
+    let d = dir("gltf-basisu-smooth");
+    let p = d.join("p.kapaint");
+    ok(&[
+        "import-pbr",
+        "--out",
+        s(&p),
+        "--size",
+        "64",
+        "--base-color",
+        "0.5,0.3,0.2",
+        "--roughness",
+        "0.5",
+        "--metallic",
+        "0",
+        "--mesh",
+        s(&spot().join("spot_triangulated.obj")),
+    ]);
+    let set = d.join("basis");
+    ok(&[
+        "export",
+        s(&p),
+        "--preset",
+        "gltf-pbr",
+        "--glb",
+        "--basisu",
+        "--out",
+        s(&set),
+    ]);
+    let b = manifest(&set).basisu.expect("basisu");
+    assert!(b.within_budget, "{b:?}");
+    assert_eq!(b.settings, "level 1, RDO 3.0", "{b:?}");
+    assert_eq!(b.textures.len(), 2, "no normal map, no normal texture");
+}
+
+#[test]
+fn basisu_is_refused_without_a_glb() {
+    let d = dir("gltf-basisu-usage");
+    let p = project(&d);
+    let o = kapaint(&[
+        "export",
+        s(&p),
+        "--preset",
+        "gltf-pbr",
+        "--basisu",
+        "--out",
+        s(&d.join("x")),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--basisu") && err.contains("--glb"), "{err}");
+    assert!(!d.join("x").exists());
+}

