@@ -632,7 +632,11 @@ fn a_basisu_glb_exports_from_the_dialog() {
         .get_by_role_and_label(Role::Button, "Export")
         .click();
     harness.step();
-    wait_until(&mut harness, "exported", notice("model.glb textures UASTC"));
+    wait_until(
+        &mut harness,
+        "exported",
+        notice("model.glb textures base_color "),
+    );
     let glb = std::fs::read(out.join("model.glb")).expect("model.glb");
     let glb = gltf::binary::Glb::from_slice(&glb).expect("a GLB");
     let json: serde_json::Value = serde_json::from_slice(&glb.json).expect("JSON");

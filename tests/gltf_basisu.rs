@@ -118,11 +118,13 @@ fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
         "--out",
         s(&basis_set),
     ]);
-    assert!(out.contains("basisu: UASTC level"), "{out}");
+    assert!(out.contains("basisu: base_color "), "{out}");
     let m = manifest(&basis_set);
     let b = m.basisu.as_ref().expect("the manifest says how");
-    assert_eq!(b.codec, "UASTC");
     assert_eq!(b.zstd_level, 18);
+    for t in &b.textures[1..] {
+        assert_eq!(t.codec, "UASTC", "the data textures: {t:?}");
+    }
     // The spot texture's detail is more than UASTC holds within 2 levels at the 99.9th
     // percentile (BC7's transcode, the worse target): the best settings are kept and said.
     let budget = kapaint::export::preset::find("gltf-pbr")
@@ -132,10 +134,13 @@ fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
         || b.ka_error_srgb.mean > budget.ka_error_srgb_mean;
     assert_eq!(b.within_budget, !over, "{b:?}");
     if !b.within_budget {
-        assert_eq!(
-            b.settings, "level 3, no RDO",
-            "the search ends at the best: {b:?}"
-        );
+        // The search ends at the best: UASTC's best for every texture.
+        for t in &b.textures {
+            assert_eq!(
+                (t.codec.as_str(), t.settings.as_str()),
+                ("UASTC", "level 3, no RDO")
+            );
+        }
         assert!(out.contains("over the budget"), "{out}");
     }
     assert!(b.ka_error_srgb.mean < 0.5, "{b:?}");
@@ -146,7 +151,7 @@ fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
     );
     assert!(manifest(&png_set).basisu.is_none());
 
-    textures_are_uastc_ktx2(&basis_set.join("model.glb"), b);
+    textures_are_basis_ktx2(&basis_set.join("model.glb"), b, 3);
     // Smaller on the GPU and in the file than the PNGs' glTF? At least no larger than a
     // whole UASTC chain (16 bytes a block) before zstd.
     let ktx_bytes: u64 = b.textures.iter().map(|t| t.bytes).sum();
@@ -180,9 +185,10 @@ fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
     assert!(mean > 0.0, "the KTX2 textures were read, not the PNGs");
 }
 
-/// The file's textures: the extension used and required, each texture's image only in it,
-/// each a UASTC KTX2 file with zstd, the colour space and mips the manifest lists.
-fn textures_are_uastc_ktx2(glb: &Path, b: &kapaint::export::gltf_basisu::BasisuReport) {
+/// The file's `n` textures: the extension used and required, each texture's image only in
+/// it, each a KTX2 file as the manifest lists it (UASTC with zstd, or ETC1S with BasisLZ), the
+/// colour space and mips it lists.
+fn textures_are_basis_ktx2(glb: &Path, b: &kapaint::export::gltf_basisu::BasisuReport, n: usize) {
     let (json, bin) = glb_parts(glb);
     for key in ["extensionsUsed", "extensionsRequired"] {
         assert_eq!(
@@ -192,7 +198,7 @@ fn textures_are_uastc_ktx2(glb: &Path, b: &kapaint::export::gltf_basisu::BasisuR
         );
     }
     let textures = json["textures"].as_array().expect("textures");
-    assert_eq!(textures.len(), 3);
+    assert_eq!(textures.len(), n);
     for (t, listed) in textures.iter().zip(&b.textures) {
         assert!(t.get("source").is_none(), "no fallback: {t}");
         let i = t["extensions"]["KHR_texture_basisu"]["source"]
@@ -204,17 +210,29 @@ fn textures_are_uastc_ktx2(glb: &Path, b: &kapaint::export::gltf_basisu::BasisuR
         assert_eq!(ktx.len() as u64, listed.bytes);
         let reader = ktx2::Reader::new(&ktx[..]).expect("a KTX2 file");
         let header = reader.header();
-        assert_eq!(header.format, None, "UASTC has no Vulkan format");
-        assert_eq!(
-            header.supercompression_scheme,
-            Some(ktx2::SupercompressionScheme::Zstandard)
-        );
-        assert_eq!(reader.color_model(), Some(ktx2::ColorModel::UASTC));
+        assert_eq!(header.format, None, "Basis Universal has no Vulkan format");
+        let (scheme, model) = if listed.codec == "ETC1S" {
+            (
+                ktx2::SupercompressionScheme::BasisLZ,
+                ktx2::ColorModel::ETC1S,
+            )
+        } else {
+            (
+                ktx2::SupercompressionScheme::Zstandard,
+                ktx2::ColorModel::UASTC,
+            )
+        };
+        assert_eq!(header.supercompression_scheme, Some(scheme), "{listed:?}");
+        assert_eq!(reader.color_model(), Some(model), "{listed:?}");
         assert_eq!(
             (header.pixel_width, header.pixel_height, header.level_count),
             (listed.width, listed.height, listed.levels)
         );
-        assert_eq!(listed.levels, 8, "128 down to 1");
+        assert_eq!(
+            listed.levels,
+            listed.width.max(listed.height).ilog2() + 1,
+            "a full chain"
+        );
         let srgb = reader.transfer_function() == Some(ktx2::TransferFunction::SRGB);
         assert_eq!(srgb, listed.name == "base_color", "{}", listed.name);
     }
@@ -280,13 +298,33 @@ fn a_glb_with_a_bad_basis_payload_is_refused_in_one_line() {
     let glb = set.join("model.glb");
     let (json, bin) = glb_parts(&glb);
     let good = image_bytes(&json, &bin, 0);
-    // BasisLZ (scheme 1) where zstd was: a supercompression kapaint does not read.
-    let mut basislz = good.clone();
-    basislz[44..48].copy_from_slice(&1_u32.to_le_bytes());
-    let cases: [(&str, Vec<u8>); 3] = [
+    // The header's supercompression scheme (bytes 44..48): ZLIB (3), which kapaint does not
+    // read; BasisLZ (1) over UASTC blocks.
+    let scheme = |n: u32| {
+        let mut bytes = good.clone();
+        bytes[44..48].copy_from_slice(&n.to_le_bytes());
+        bytes
+    };
+    // An ETC1S file whose global data claims more codebook than it holds.
+    let rgba: Vec<u8> = (0..64 * 64 * 4).map(|i| (i % 251) as u8).collect();
+    let etc1s = kapaint::export::codec::etc1s::encode(
+        &rgba,
+        (64, 64),
+        kapaint::export::codec::Effort::Fast,
+        true,
+    )
+    .expect("ETC1S")
+    .image;
+    let etc1s = kapaint::export::ktx::etc1s_file(&etc1s, true).expect("KTX2");
+    let sgd_at = u64::from_le_bytes(etc1s[64..72].try_into().expect("8 bytes")) as usize;
+    let mut short_codebook = etc1s.clone();
+    short_codebook[sgd_at + 4..sgd_at + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    let cases: [(&str, Vec<u8>); 5] = [
         ("truncated", good[..good.len() / 2].to_vec()),
         ("not-ktx", b"this is not a KTX2 file at all".to_vec()),
-        ("basislz", basislz),
+        ("zlib", scheme(3)),
+        ("basislz-over-uastc", scheme(1)),
+        ("short-codebook", short_codebook),
     ];
     for (name, bytes) in cases {
         let bad = d.join(format!("{name}.glb"));
@@ -302,8 +340,21 @@ fn a_glb_with_a_bad_basis_payload_is_refused_in_one_line() {
     }
 }
 
+/// A user preset `gltf-light`: glTF's layout with a looser budget.
+const LIGHT: &str = r#"(
+    version: 2,
+    name: "gltf-light",
+    description: "glTF metallic-roughness, a looser budget for Basis textures",
+    format: GltfPbr,
+    layout: Packed,
+    n_bits: 8,
+    include_ka: false,
+    ka_error_srgb_p999: 8.0,
+    ka_error_srgb_mean: 3.0,
+)"#;
+
 #[test]
-fn a_smooth_material_meets_the_budget_at_the_cheapest_settings() {
+fn a_smooth_material_takes_the_cheapest_settings_its_budget_allows() {
     let d = dir("gltf-basisu-smooth");
     let p = d.join("p.kapaint");
     ok(&[
@@ -321,6 +372,15 @@ fn a_smooth_material_meets_the_budget_at_the_cheapest_settings() {
         "--mesh",
         s(&spot().join("spot_triangulated.obj")),
     ]);
+    let how = |b: &kapaint::export::gltf_basisu::BasisuReport| -> Vec<(String, String)> {
+        b.textures
+            .iter()
+            .map(|t| (t.codec.clone(), t.settings.clone()))
+            .collect()
+    };
+    let pair = |c: &str, s: &str| (c.to_string(), s.to_string());
+    // The default budget: ETC1S's 5-bit colours miss a flat colour by about two levels on
+    // every texel (a mean over 0.3); UASTC holds it exactly at its cheapest.
     let set = d.join("basis");
     ok(&[
         "export",
@@ -334,8 +394,64 @@ fn a_smooth_material_meets_the_budget_at_the_cheapest_settings() {
     ]);
     let b = manifest(&set).basisu.expect("basisu");
     assert!(b.within_budget, "{b:?}");
-    assert_eq!(b.settings, "level 1, RDO 3.0", "{b:?}");
-    assert_eq!(b.textures.len(), 2, "no normal map, no normal texture");
+    assert_eq!(
+        how(&b),
+        [
+            pair("UASTC", "level 1, RDO 3.0"),
+            pair("UASTC", "level 1, RDO 3.0")
+        ],
+        "no normal map, no normal texture"
+    );
+    textures_are_basis_ktx2(&set.join("model.glb"), &b, 2);
+    // A looser budget takes ETC1S at its lowest quality for the colour.
+    let presets = d.join("presets");
+    std::fs::create_dir_all(&presets).expect("dir");
+    std::fs::write(presets.join("gltf-light.ron"), LIGHT).expect("preset");
+    let light = d.join("light");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_kapaint"))
+        .args([
+            "export",
+            s(&p),
+            "--preset",
+            "gltf-light",
+            "--glb",
+            "--basisu",
+            "--out",
+            s(&light),
+        ])
+        .env("KAPAINT_EXPORT_PRESET_DIR", &presets)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let b = manifest(&light).basisu.expect("basisu");
+    assert!(b.within_budget, "{b:?}");
+    assert_eq!(
+        how(&b),
+        [
+            pair("ETC1S", "quality 32"),
+            pair("UASTC", "level 1, RDO 3.0")
+        ]
+    );
+    textures_are_basis_ktx2(&light.join("model.glb"), &b, 2);
+    // ETC1S reads back (BasisLZ through the BC7 transcode), as close as it was measured.
+    let back = d.join("back.kapaint");
+    ok(&[
+        "import-pbr",
+        "--gltf",
+        s(&light.join("model.glb")),
+        "--out",
+        s(&back),
+    ]);
+    let want = [0.5_f32, 0.3, 0.2];
+    let worst = kd_of(&back)
+        .chunks_exact(3)
+        .map(|t| {
+            (0..3)
+                .map(|c| (t[c] - want[c]).abs())
+                .fold(0.0_f32, f32::max)
+        })
+        .fold(0.0_f32, f32::max);
+    assert!(worst < 0.02, "k_d read back within {worst}");
 }
 
 #[test]

@@ -249,18 +249,69 @@ fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
     }
     assert!(checked >= 2, "{manifest}");
 
-    // The textures inside a Basis glTF, against the manifest's list.
-    let out = d.join("glb");
+    // The textures inside Basis glTFs, against the manifest's lists: a detailed material (UASTC
+    // throughout) and a smooth one (its base colour ETC1S).
+    glb_textures_unpack(&tool, &p, &d.join("detailed"), None);
+    let smooth = d.join("smooth.kapaint");
     ok(&[
+        "import-pbr",
+        "--out",
+        s(&smooth),
+        "--size",
+        "64",
+        "--base-color",
+        "0.5,0.3,0.2",
+        "--roughness",
+        "0.5",
+        "--metallic",
+        "0",
+        "--mesh",
+        s(&spot().join("spot_triangulated.obj")),
+    ]);
+    // A looser budget than gltf-pbr's, so the flat colour is ETC1S (tests/gltf_basisu.rs).
+    let presets = d.join("presets");
+    std::fs::create_dir_all(&presets).expect("dir");
+    std::fs::write(
+        presets.join("gltf-light.ron"),
+        r#"(version: 2, name: "gltf-light", description: "a looser budget", format: GltfPbr,
+            layout: Packed, n_bits: 8, include_ka: false, ka_error_srgb_p999: 8.0,
+            ka_error_srgb_mean: 3.0)"#,
+    )
+    .expect("preset");
+    let codecs = glb_textures_unpack(&tool, &smooth, &d.join("smooth"), Some(&presets));
+    assert_eq!(codecs, ["ETC1S", "UASTC"]);
+}
+
+/// Exports `project` as a Basis `.glb` into `out` (with `gltf-pbr`, or the `gltf-light` preset
+/// of the folder `light`), and checks each of its KTX2 textures with `basisu` against the
+/// manifest's entry; the textures' codecs.
+fn glb_textures_unpack(
+    tool: &Path,
+    project: &Path,
+    out: &Path,
+    light: Option<&Path>,
+) -> Vec<String> {
+    let preset = if light.is_some() {
+        "gltf-light"
+    } else {
+        "gltf-pbr"
+    };
+    let mut export = Command::new(env!("CARGO_BIN_EXE_kapaint"));
+    export.args([
         "export",
-        s(&p),
+        s(project),
         "--preset",
-        "gltf-pbr",
+        preset,
         "--glb",
         "--basisu",
         "--out",
-        s(&out),
+        s(out),
     ]);
+    if let Some(dir) = light {
+        export.env("KAPAINT_EXPORT_PRESET_DIR", dir);
+    }
+    let o = export.output().expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let m: PbrManifest =
         serde_json::from_slice(&std::fs::read(out.join("material.json")).expect("manifest"))
             .expect("parses");
@@ -274,19 +325,26 @@ fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
             &json["bufferViews"][json["images"][i]["bufferView"].as_u64().expect("view") as usize];
         let at = view["byteOffset"].as_u64().unwrap_or(0) as usize;
         let len = view["byteLength"].as_u64().expect("len") as usize;
-        let file = d.join(format!("{}.ktx2", t.name));
+        let file = out.join(format!("{}.ktx2", t.name));
         std::fs::write(&file, &bin[at..at + len]).expect("write");
-        let said = info(&tool, &file);
-        assert!(
-            said.contains(&format!("Resolution: {}x{}", t.width, t.height)),
-            "{said}"
-        );
+        let said = info(tool, &file);
+        let size = format!("Resolution: {}x{}", t.width, t.height);
+        assert!(said.contains(&size), "{size}: {said}");
         assert!(
             said.contains(&format!("Mipmap Levels: {}", t.levels)),
             "{said}"
         );
+        let scheme = if t.codec == "ETC1S" {
+            "BASISLZ"
+        } else {
+            "ZSTANDARD"
+        };
         assert!(
-            said.contains("Supercompression Scheme: ZSTANDARD"),
+            said.contains(&format!("Supercompression Format: {}", t.codec)),
+            "{said}"
+        );
+        assert!(
+            said.contains(&format!("Supercompression Scheme: {scheme}")),
             "{said}"
         );
         let transfer = if t.name == "base_color" {
@@ -298,8 +356,9 @@ fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
             said.contains(&format!("DFD transfer func: {transfer}")),
             "{said}"
         );
-        unpacks_as_kapaint_reads(&tool, &file, &d.join("unpacked"));
+        unpacks_as_kapaint_reads(tool, &file, &out.join("unpacked"));
     }
+    b.textures.iter().map(|t| t.codec.clone()).collect()
 }
 
 /// `basisu -unpack` of `file` into `dir`: its BC7 level 0 is kapaint's own reading of the file

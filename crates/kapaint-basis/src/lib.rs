@@ -9,8 +9,15 @@
 //!   bindings' uncompressed transcode sizes its buffer by blocks, not texels, and the
 //!   transcoder writes past it.
 //!
-//! No mip maps, no `.basis` files leave here: kapaint makes its own mips and writes its own
-//! KTX2 containers; the encoder's `.basis` output is read for its one slice of blocks.
+//! - [`etc1s`]: ETC1S with BasisLZ, the smaller of Basis Universal's two formats: RGBA8
+//!   texels (and the encoder's own mips) to the codebooks, tables and slices KTX2 stores, and
+//!   those back to BC7 or ASTC 4x4.
+//!
+//! No `.basis` files leave here: kapaint writes its own KTX2 containers; the encoder's `.basis`
+//! output is read for its slices (and, for ETC1S, its codebooks), and rebuilt in memory from
+//! them to transcode.
+
+pub mod etc1s;
 
 use basis_universal::{
     BasisTextureFormat, ColorSpace, Compressor, CompressorParams, DecodeFlags,
@@ -81,22 +88,9 @@ pub fn encode_uastc(
     params.set_generate_mipmaps(false);
     params.set_print_status_to_stdout(false);
     params.source_image_mut(0).init(rgba, width, height, 4);
-    let mut compressor = Compressor::new(1);
-    #[expect(
-        unsafe_code,
-        reason = "the bindings mark the compressor's init and run unsafe: the parameters they read live in `params` until both return"
-    )]
-    let run = unsafe {
-        if compressor.init(&params) {
-            compressor
-                .process()
-                .map_err(|e| format!("the UASTC encoder failed: {e:?}"))
-        } else {
-            Err("the UASTC encoder refused its parameters".into())
-        }
-    };
-    run?;
-    let file = compressor.basis_file();
+    // One thread: the export runs strips in parallel.
+    let file = compress(&params, "UASTC", 1)?;
+    let file = file.as_slice();
     let info = Transcoder::new()
         .image_level_info(file, 0, 0)
         .ok_or("the encoder's output has no image")?;
@@ -108,6 +102,27 @@ pub fn encode_uastc(
         ));
     }
     Ok(file[at..at + len].to_vec())
+}
+
+/// Runs Binomial's compressor on `params` (its source images set) with `threads` threads:
+/// the `.basis` file.
+fn compress(params: &CompressorParams, what: &str, threads: u32) -> Result<Vec<u8>, String> {
+    let mut compressor = Compressor::new(threads);
+    #[expect(
+        unsafe_code,
+        reason = "the bindings mark the compressor's init and run unsafe: the parameters they read live in `params` until both return"
+    )]
+    let run = unsafe {
+        if compressor.init(params) {
+            compressor
+                .process()
+                .map_err(|e| format!("the {what} encoder failed: {e:?}"))
+        } else {
+            Err(format!("the {what} encoder refused its parameters"))
+        }
+    };
+    run?;
+    Ok(compressor.basis_file().to_vec())
 }
 
 /// Whether `width x height` is whole 4x4 blocks (and not empty).

@@ -1,22 +1,25 @@
 //! glTF's textures as Basis Universal (`KHR_texture_basisu`), for `export --preset gltf-pbr
-//! --glb --basisu`: each texture a KTX2 file of UASTC blocks with a full mip chain, its levels
-//! supercompressed by zstd ([`ZSTD_LEVEL`]), embedded in the `.glb` with no PNG fallback
-//! (the extension is then required, as it states for a texture without a `source`).
+//! --glb --basisu`: each texture a KTX2 file with a full mip chain, embedded in the `.glb` with
+//! no PNG fallback (the extension is then required, as it states for a texture without a
+//! `source`). The metallic-roughness and normal textures are UASTC, their levels
+//! supercompressed by zstd ([`ZSTD_LEVEL`]); the base colour is ETC1S with BasisLZ (a fraction
+//! of UASTC's bytes) where that meets the budget, else UASTC.
 //!
 //! **What decides the settings.** The preset's budget, measured on the `k_a` the textures
 //! give after transcoding: the base colour and metallic-roughness textures as a runtime
 //! decodes them (the BC7 transcode, the worse of its two targets) are read back through the
 //! conversion `import-pbr` uses, and each texel's `k_a` is compared with the one the lossless
 //! values give, in levels of 8-bit sRGB (the budget's p99.9 and mean). Efforts run cheapest in
-//! bytes first (UASTC's level and RDO, [`crate::codec::uastc_settings_of`]) until one is
-//! within; the normal map is encoded at the effort chosen. What this adds comes on top of the
+//! bytes first (UASTC's level and RDO, [`crate::codec::uastc_settings_of`]; ETC1S's quality,
+//! [`crate::codec::etc1s::quality_of`], tried for the base colour before UASTC at each) until
+//! one is within; the normal map is encoded at the effort chosen. What this adds comes on top of the
 //! round trip's own error, which the manifest reports beside it.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::blocks::Coder;
-use crate::codec::{Codec, Effort, Uastc};
+use crate::codec::{Codec, Effort, Uastc, etc1s};
 use crate::file_kind::ColourSpace;
 use crate::ktx::{self, Compressed, Space};
 use crate::preset::BlockBudget;
@@ -57,6 +60,10 @@ pub struct Reading {
 pub struct BasisuTexture {
     /// The glTF image's name (`base_color`, `metallic_roughness`, `normal`).
     pub name: String,
+    /// Its blocks: `ETC1S` (BasisLZ) or `UASTC` (with zstd).
+    pub codec: String,
+    /// Their settings: "quality 128", "level 2, RDO 1.0".
+    pub settings: String,
     /// Size in texels.
     pub width: u32,
     /// Size in texels.
@@ -72,29 +79,30 @@ pub struct BasisuTexture {
 /// How the `.glb`'s textures were encoded: the manifest's `basisu`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BasisuReport {
-    /// The block format: `UASTC`.
-    pub codec: String,
-    /// Its settings: "level 2, RDO 1.0".
-    pub settings: String,
-    /// The zstd level of every level.
+    /// The zstd level of the UASTC files' levels.
     pub zstd_level: u8,
     /// The `k_a` error the transcoded textures add, in levels of 8-bit sRGB.
     pub ka_error_srgb: SrgbError,
-    /// Whether that is within the preset's budget (else the best effort was kept).
+    /// Whether that is within the preset's budget (else the best settings were kept).
     pub within_budget: bool,
     /// The textures.
     pub textures: Vec<BasisuTexture>,
 }
 
 impl BasisuReport {
-    /// In the words the CLI and the editor use: "UASTC level 2, RDO 1.0, zstd 18: k_a
-    /// within 0.42 levels of the lossless textures' for 99.9 % of texels (mean 0.031) after
-    /// transcoding, within the budget; 3 KTX2 textures, 123456 bytes".
+    /// In the words the CLI and the editor use: "base_color ETC1S quality 128,
+    /// metallic_roughness UASTC level 1, RDO 3.0 (zstd 18): k_a within 0.42 levels of the
+    /// lossless textures' for 99.9 % of texels (mean 0.031) after transcoding, within the
+    /// budget; 2 KTX2 textures, 123456 bytes".
     pub fn summary(&self) -> String {
+        let each: Vec<String> = self
+            .textures
+            .iter()
+            .map(|t| format!("{} {} {}", t.name, t.codec, t.settings))
+            .collect();
         format!(
-            "{} {}, zstd {}: k_a within {:.2} levels of the lossless textures' for 99.9 % of texels (mean {:.3}) after transcoding, {}; {} KTX2 textures, {} bytes",
-            self.codec,
-            self.settings,
+            "{} (zstd {} for UASTC): k_a within {:.2} levels of the lossless textures' for 99.9 % of texels (mean {:.3}) after transcoding, {}; {} KTX2 textures, {} bytes",
+            each.join(", "),
             self.zstd_level,
             self.ka_error_srgb.p999,
             self.ka_error_srgb.mean,
@@ -121,8 +129,93 @@ pub struct Encoded {
     pub report: BasisuReport,
 }
 
-/// The base colour, metallic-roughness and (optional) normal textures as UASTC KTX2 files,
-/// at the cheapest effort whose `k_a` is within `budget` (see the module).
+/// The base colour as the search left it: an ETC1S file made whole, or UASTC's level 0.
+enum Base {
+    Etc1s(etc1s::Etc1sFile),
+    Uastc(Compressed),
+}
+
+impl Base {
+    fn decoded(&self) -> Vec<u8> {
+        match self {
+            // RGBA from the BC7 transcode: the RGB the measure reads.
+            Self::Etc1s(f) => f
+                .decoded
+                .chunks_exact(4)
+                .flat_map(|t| [t[0], t[1], t[2]])
+                .collect(),
+            Self::Uastc(c) => c.decoded.clone(),
+        }
+    }
+}
+
+/// One step of the search: the effort, the base colour, the metallic-roughness level 0, and
+/// the `k_a` error they give.
+struct Step {
+    effort: Effort,
+    base: Base,
+    mr: Compressed,
+    error: SrgbError,
+}
+
+fn step(effort: Effort, base: Base, mr: Compressed, error: SrgbError) -> Step {
+    Step {
+        effort,
+        base,
+        mr,
+        error,
+    }
+}
+
+/// The cheapest step within `budget`, else the last (the best): at each effort, the data
+/// in UASTC and the base colour in ETC1S, then (if that misses) in UASTC.
+fn search(
+    (base, mr): (Rgb<'_>, Rgb<'_>),
+    reading: Reading,
+    budget: &BlockBudget,
+    progress: &Progress,
+) -> Result<(Step, bool), String> {
+    let (base_codec, data_codec) = (Uastc::new(3, true), Uastc::new(3, false));
+    let exact = ka_of(base.texels, mr.texels, reading);
+    let rgba: Vec<u8> = base
+        .texels
+        .chunks_exact(3)
+        .flat_map(|t| [t[0], t[1], t[2], 255])
+        .collect();
+    let mut last: Option<Step> = None;
+    // ETC1S is tried while it may still win: once UASTC at the same effort does better, more
+    // quality in ETC1S will not overtake UASTC's next step.
+    let mut etc1s_alive = true;
+    for effort in Effort::ALL {
+        progress.check().map_err(|_| "cancelled".to_string())?;
+        let m = level0(&data_codec, effort, mr)?;
+        let measure = |b: &Base| ka_error(&exact, &ka_of(&b.decoded(), &m.decoded, reading));
+        let mut etc1s_error = None;
+        if etc1s_alive {
+            let etc = Base::Etc1s(
+                etc1s::encode(&rgba, base.size, effort, true).map_err(|e| e.to_string())?,
+            );
+            let error = measure(&etc);
+            if error.over(budget) == (false, false) {
+                return Ok((step(effort, etc, m, error), true));
+            }
+            etc1s_error = Some(error);
+        }
+        let uastc = Base::Uastc(level0(&base_codec, effort, base)?);
+        let error = measure(&uastc);
+        if error.over(budget) == (false, false) {
+            return Ok((step(effort, uastc, m, error), true));
+        }
+        if etc1s_error.is_some_and(|e| e.p999 > error.p999 && e.mean > error.mean) {
+            etc1s_alive = false;
+        }
+        last = Some(step(effort, uastc, m, error));
+    }
+    Ok((last.ok_or("no effort was tried")?, false))
+}
+
+/// The base colour, metallic-roughness and (optional) normal textures as Basis Universal KTX2
+/// files, at the cheapest settings whose `k_a` is within `budget` (see the module).
 ///
 /// # Errors
 /// The encoder's failure, textures of different sizes, or cancelled (`"cancelled"`).
@@ -138,61 +231,62 @@ pub fn encode(
     if base.size != mr.size || base.texels.len() != mr.texels.len() {
         return Err("the base colour and metallic-roughness textures differ in size".into());
     }
-    let (base_codec, data_codec) = (Uastc::new(3, true), Uastc::new(3, false));
-    let exact = ka_of(base.texels, mr.texels, reading);
-    let mut chosen = None;
-    for effort in Effort::ALL {
-        progress.check().map_err(|_| "cancelled".to_string())?;
-        let (b, m) = rayon::join(
-            || level0(&base_codec, effort, base),
-            || level0(&data_codec, effort, mr),
-        );
-        let (b, m) = (b?, m?);
-        let error = ka_error(&exact, &ka_of(&b.decoded, &m.decoded, reading));
-        let within = error.over(budget) == (false, false);
-        chosen = Some((effort, b, m, error, within));
-        if within {
-            break;
-        }
-    }
-    let (effort, b, m, error, within) = chosen.ok_or("no effort was tried")?;
+    let (step, within) = search((base, mr), reading, budget, progress)?;
     progress.check().map_err(|_| "cancelled".to_string())?;
-    let (base_file, mr_file) = rayon::join(
-        || file(&base_codec, effort, base, Space::Srgb, Some(b), progress),
-        || file(&data_codec, effort, mr, Space::Linear, Some(m), progress),
-    );
+    let (base_codec, data_codec) = (Uastc::new(3, true), Uastc::new(3, false));
+    let effort = step.effort;
+    let uastc_settings = data_codec.effort_name(effort).to_string();
+    let (base_file, base_how) = match step.base {
+        Base::Etc1s(f) => (
+            ktx::etc1s_file(&f.image, true),
+            ("ETC1S", format!("quality {}", f.quality)),
+        ),
+        Base::Uastc(c) => (
+            file(&base_codec, effort, base, Space::Srgb, Some(c), progress),
+            ("UASTC", uastc_settings.clone()),
+        ),
+    };
+    let mr_file = file(
+        &data_codec,
+        effort,
+        mr,
+        Space::Linear,
+        Some(step.mr),
+        progress,
+    )?;
     let normal_file = normal
         .map(|n| file(&data_codec, effort, n, Space::Linear, None, progress))
         .transpose()?;
-    let (base_file, mr_file) = (base_file?, mr_file?);
-    let entry = |name: &str, rgb: Rgb<'_>, srgb: bool, bytes: &[u8]| BasisuTexture {
+    let base_file = base_file?;
+    let entry = |name: &str, rgb: Rgb<'_>, how: (&str, String), bytes: &[u8]| BasisuTexture {
         name: name.into(),
+        codec: how.0.into(),
+        settings: how.1,
         width: rgb.size.0,
         height: rgb.size.1,
         levels: ktx::level_count(rgb.size.0, rgb.size.1),
-        colour_space: if srgb {
+        colour_space: if name == "base_color" {
             ColourSpace::Srgb
         } else {
             ColourSpace::Linear
         },
         bytes: bytes.len() as u64,
     };
+    let uastc = || ("UASTC", uastc_settings.clone());
     let mut listed = vec![
-        entry("base_color", base, true, &base_file),
-        entry("metallic_roughness", mr, false, &mr_file),
+        entry("base_color", base, base_how, &base_file),
+        entry("metallic_roughness", mr, uastc(), &mr_file),
     ];
     if let (Some(n), Some(bytes)) = (normal, &normal_file) {
-        listed.push(entry("normal", n, false, bytes));
+        listed.push(entry("normal", n, uastc(), bytes));
     }
     Ok(Encoded {
         base_color: base_file,
         metallic_roughness: mr_file,
         normal: normal_file,
         report: BasisuReport {
-            codec: base_codec.name().into(),
-            settings: base_codec.effort_name(effort).into(),
             zstd_level: ZSTD_LEVEL,
-            ka_error_srgb: error,
+            ka_error_srgb: step.error,
             within_budget: within,
             textures: listed,
         },

@@ -1,5 +1,6 @@
 //! Block codecs: each block format kapaint writes is one value behind [`Codec`], in one file
-//! (BC4, BC5, BC7, BC6H, ASTC LDR); a preset's format picks an image's codec
+//! (BC4, BC5, BC7, BC6H, ASTC LDR, UASTC; ETC1S stands beside the trait, [`etc1s`]); a
+//! preset's format picks an image's codec
 //! (`preset::Format::codec`). A codec says what its blocks are (the KTX2 format, the
 //! footprint and bytes, the manifest's name), which efforts it tells apart, and encodes and
 //! decodes one strip of block rows; [`crate::blocks`] runs strips in parallel over any codec,
@@ -14,6 +15,7 @@ mod bc4;
 mod bc5;
 mod bc6h;
 mod bc7;
+pub mod etc1s;
 mod uastc;
 
 use serde::{Deserialize, Serialize};

@@ -1,8 +1,9 @@
-//! The KTX2 container: written from the `ktx2` crate's header, level index and data format
-//! descriptor types (that crate reads KTX2 but does not assemble files), and level 0 read back.
+//! The KTX2 container: block or plain levels put in a file (`assembly`), supercompressed by
+//! zstd, and level 0 read back, whatever kapaint writes.
 
-use ktx2::{Format as KtxFormat, Header, Index, LevelIndex, dfd};
+use ktx2::Format as KtxFormat;
 
+use super::assembly::{Described, assemble};
 use super::crop;
 use crate::blocks;
 use crate::codec::{self, Codec};
@@ -21,51 +22,6 @@ pub struct Decoded {
     pub rgba: Vec<f32>,
 }
 
-/// What a KTX2 file's header and data format descriptor say its texels are.
-pub(crate) struct Described {
-    /// The header's `vkFormat` (`None`: UNDEFINED, the descriptor says: UASTC).
-    format: Option<KtxFormat>,
-    /// The data format descriptor as the file holds it (its total size first).
-    dfd: Vec<u8>,
-    /// The header's `typeSize`.
-    type_size: u32,
-    /// Plain level data's alignment: lcm(texel block size, 4).
-    align: usize,
-}
-
-impl Described {
-    /// Texels of `format` (uncompressed, or a block format kapaint reads back).
-    pub(crate) fn of_format(format: KtxFormat) -> Result<Self, String> {
-        let (basic, type_size) = dfd::Basic::from_format(format)
-            .map_err(|e| format!("data format descriptor: {e:?}"))?;
-        let align = codec::from_vk_format(format).map_or(4, |c| c.block_bytes().max(4));
-        Ok(Self::new(Some(format), &basic, type_size, align))
-    }
-
-    /// `codec`'s blocks.
-    pub(crate) fn of_codec(codec: &dyn Codec) -> Result<Self, String> {
-        let (basic, type_size) = codec.dfd()?;
-        Ok(Self::new(
-            codec.vk_format(),
-            &basic,
-            type_size,
-            codec.block_bytes().max(4),
-        ))
-    }
-
-    fn new(format: Option<KtxFormat>, basic: &dfd::Basic, type_size: u32, align: usize) -> Self {
-        let block = dfd::Block::Basic(basic.clone()).to_vec();
-        let mut dfd = ((block.len() + 4) as u32).to_le_bytes().to_vec();
-        dfd.extend_from_slice(&block);
-        Self {
-            format,
-            dfd,
-            type_size,
-            align,
-        }
-    }
-}
-
 /// Assembles a KTX2 file: header, level index, data format descriptor, the writer's name,
 /// then the levels from smallest to largest, each aligned as the specification asks.
 pub(super) fn container(described: &Described, size: (u32, u32), levels: &[Vec<u8>]) -> Vec<u8> {
@@ -73,7 +29,7 @@ pub(super) fn container(described: &Described, size: (u32, u32), levels: &[Vec<u
         .iter()
         .map(|l| (l.as_slice(), l.len() as u64))
         .collect();
-    assemble(described, size, &stored, false)
+    assemble(described, size, &stored, None)
 }
 
 pub use crate::file_kind::ZSTD_LEVELS;
@@ -125,79 +81,8 @@ pub fn supercompress(bytes: &[u8], level: u8) -> Result<Vec<u8>, String> {
         &described,
         (header.pixel_width, header.pixel_height),
         &stored,
-        true,
+        Some((ktx2::SupercompressionScheme::Zstandard, &[])),
     ))
-}
-
-/// The file of `levels` (each its stored bytes and its length uncompressed), supercompressed
-/// by Zstandard or not: a supercompressed level is aligned to 1, a plain one to lcm(texel
-/// block size, 4).
-fn assemble(
-    described: &Described,
-    (w, h): (u32, u32),
-    levels: &[(&[u8], u64)],
-    zstd: bool,
-) -> Vec<u8> {
-    let dfd_bytes = &described.dfd;
-    let mut kvd = Vec::new();
-    let entry = format!("KTXwriter\0kapaint {}\0", env!("CARGO_PKG_VERSION"));
-    kvd.extend_from_slice(&(entry.len() as u32).to_le_bytes());
-    kvd.extend_from_slice(entry.as_bytes());
-    kvd.resize(kvd.len().div_ceil(4) * 4, 0);
-    // Level data alignment: lcm(texel block size, 4); 1 when supercompressed.
-    let block_bytes = if zstd { 1 } else { described.align };
-    let index_at = Header::LENGTH;
-    let dfd_at = index_at + levels.len() * LevelIndex::LENGTH;
-    let kvd_at = dfd_at + dfd_bytes.len();
-    let mut at = kvd_at + kvd.len();
-    let mut index = vec![
-        LevelIndex {
-            byte_offset: 0,
-            byte_length: 0,
-            uncompressed_byte_length: 0,
-        };
-        levels.len()
-    ];
-    let mut body = Vec::new();
-    for (i, &(level, uncompressed)) in levels.iter().enumerate().rev() {
-        let aligned = at.div_ceil(block_bytes) * block_bytes;
-        body.resize(body.len() + (aligned - at), 0);
-        index[i] = LevelIndex {
-            byte_offset: aligned as u64,
-            byte_length: level.len() as u64,
-            uncompressed_byte_length: uncompressed,
-        };
-        body.extend_from_slice(level);
-        at = aligned + level.len();
-    }
-    let header = Header {
-        format: described.format,
-        type_size: described.type_size,
-        pixel_width: w,
-        pixel_height: h,
-        pixel_depth: 0,
-        layer_count: 0,
-        face_count: 1,
-        level_count: levels.len() as u32,
-        supercompression_scheme: zstd.then_some(ktx2::SupercompressionScheme::Zstandard),
-        index: Index {
-            dfd_byte_offset: dfd_at as u32,
-            dfd_byte_length: dfd_bytes.len() as u32,
-            kvd_byte_offset: kvd_at as u32,
-            kvd_byte_length: kvd.len() as u32,
-            sgd_byte_offset: 0,
-            sgd_byte_length: 0,
-        },
-    };
-    let mut out = Vec::with_capacity(at);
-    out.extend_from_slice(&header.as_bytes());
-    for entry in &index {
-        out.extend_from_slice(&entry.as_bytes());
-    }
-    out.extend_from_slice(dfd_bytes);
-    out.extend_from_slice(&kvd);
-    out.extend_from_slice(&body);
-    out
 }
 
 /// Reads level 0 of a KTX2 file kapaint writes (the formats above, plain or supercompressed
@@ -214,6 +99,9 @@ pub fn decode(bytes: &[u8]) -> Result<Decoded, String> {
         return Err(format!("{w}x{h} is larger than kapaint's maps"));
     }
     let level = reader.levels().next().ok_or("the file has no levels")?;
+    if header.supercompression_scheme == Some(ktx2::SupercompressionScheme::BasisLZ) {
+        return decode_etc1s(&reader, (w, h));
+    }
     let inflated;
     let data = match header.supercompression_scheme {
         None => level.data,
@@ -298,6 +186,29 @@ pub fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, String> {
         }
         3 => D::ImageRgb8(image::RgbImage::from_raw(w, h, pick(3)).ok_or_else(wrong)?),
         _ => D::ImageRgba8(image::RgbaImage::from_raw(w, h, pick(4)).ok_or_else(wrong)?),
+    })
+}
+
+/// Level 0 of an ETC1S file (BasisLZ) as RGBA, as its BC7 transcode decodes: colour in RGB,
+/// the alpha slice (where there is one) in alpha.
+fn decode_etc1s(reader: &ktx2::Reader<&[u8]>, (w, h): (u32, u32)) -> Result<Decoded, String> {
+    if reader.color_model() != Some(ktx2::ColorModel::ETC1S) {
+        return Err("a BasisLZ file that is not ETC1S".into());
+    }
+    let (image, srgb) = super::basislz::read_etc1s(reader)?;
+    let alpha = image.has_alpha();
+    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
+    let first = image.levels.first().ok_or("the file has no levels")?;
+    if (first.width, first.height) != (w, h) {
+        return Err("level 0 is not the header's size".into());
+    }
+    let texels = codec::etc1s::decode_level0(&image, srgb).map_err(|e| e.to_string())?;
+    let tight = crop(&texels, padded.0, (w, h), 4, 4);
+    Ok(Decoded {
+        width: w,
+        height: h,
+        channels: if alpha { 4 } else { 3 },
+        rgba: tight.iter().map(|b| f32::from(*b) / 255.0).collect(),
     })
 }
 

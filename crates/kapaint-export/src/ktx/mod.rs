@@ -6,6 +6,8 @@
 //! descriptor types (`container.rs`); blocks come from [`super::blocks`]; mips
 //! (`levels.rs`) are 2x2 boxes, each component averaged in its own space ([`Space`]).
 
+mod assembly;
+mod basislz;
 mod container;
 mod levels;
 mod own_levels;
@@ -13,8 +15,10 @@ mod own_levels;
 use ktx2::Format as KtxFormat;
 use rayon::prelude::*;
 
+use self::assembly::Described;
+pub use self::basislz::{etc1s_file, read_etc1s};
+use self::container::container;
 pub use self::container::{Decoded, ZSTD_LEVELS, decode, decode_image, supercompress};
-use self::container::{Described, container};
 pub use self::levels::{Space, box_down, level_count, mips, quantise, texel_layout};
 pub use self::own_levels::encode_levels;
 use super::blocks::{self, Coder};

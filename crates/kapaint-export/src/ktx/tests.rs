@@ -226,3 +226,48 @@ fn garbage_is_an_error() {
     bytes.truncate(bytes.len() - 10);
     assert!(decode(&bytes).is_err());
 }
+
+#[test]
+fn an_etc1s_file_holds_its_codebooks_and_slices_and_reads_back() {
+    let (w, h) = (32, 16);
+    let rgba: Vec<u8> = (0..w * h)
+        .flat_map(|i| {
+            [
+                (i % w * 8) as u8,
+                (i / w * 16) as u8,
+                90,
+                (i % 7 * 30) as u8,
+            ]
+        })
+        .collect();
+    let encoded = crate::codec::etc1s::encode(&rgba, (w, h), Effort::Fast, false).unwrap();
+    let file = super::etc1s_file(&encoded.image, false).unwrap();
+    let reader = ktx2::Reader::new(&file[..]).unwrap();
+    let header = reader.header();
+    assert_eq!(header.format, None);
+    assert_eq!(header.type_size, 1);
+    assert_eq!(
+        header.supercompression_scheme,
+        Some(ktx2::SupercompressionScheme::BasisLZ)
+    );
+    assert_eq!(header.level_count, 6, "32x16 down to 1x1");
+    assert_eq!(
+        header.index.sgd_byte_offset % 8,
+        0,
+        "the global data aligned to 8"
+    );
+    assert_eq!(reader.color_model(), Some(ktx2::ColorModel::ETC1S));
+    assert!(reader.levels().all(|l| l.uncompressed_byte_length == 0));
+    let (image, srgb) = super::read_etc1s(&reader).unwrap();
+    assert!(!srgb);
+    assert_eq!(image, encoded.image, "what was written reads back");
+    assert!(image.has_alpha());
+    let decoded = super::decode(&file).unwrap();
+    assert_eq!((decoded.width, decoded.height, decoded.channels), (w, h, 4));
+    let same = decoded
+        .rgba
+        .iter()
+        .zip(&encoded.decoded)
+        .all(|(a, b)| (a * 255.0).round() as u8 == *b);
+    assert!(same, "the file decodes as the encoder's measure read it");
+}
