@@ -616,7 +616,7 @@ fn a_basisu_glb_exports_from_the_dialog() {
         harness.step();
     }
     // Basis Universal is offered only once the .glb is asked for.
-    let basisu = "with Basis Universal textures (KHR_texture_basisu, UASTC + zstd)";
+    let basisu = "with Basis Universal textures (KHR_texture_basisu: ETC1S or UASTC)";
     assert!(
         harness.get_by_label(basisu).accesskit_node().is_disabled(),
         "before the .glb"

@@ -241,7 +241,7 @@ pub(super) fn export_window(
                     has_mesh && dialog.glb,
                     egui::Checkbox::new(
                         &mut dialog.basisu,
-                        "with Basis Universal textures (KHR_texture_basisu, UASTC + zstd)",
+                        "with Basis Universal textures (KHR_texture_basisu: ETC1S or UASTC)",
                     ),
                 )
                 .on_hover_text(

@@ -356,13 +356,19 @@ impl Images<'_> {
                     .map_err(|e| what(format!("its data: URI does not decode: {e}")))?;
                     read(&bytes.0, ktx, &label)
                 } else {
-                    let file = file_beside(&self.opened.dir, uri).map_err(&what)?;
+                    let file = file_beside(&self.opened.dir, uri).map_err(|e| {
+                        what(if ktx {
+                            format!("its KTX2 image: {e}")
+                        } else {
+                            e
+                        })
+                    })?;
                     if ktx {
                         let bytes = kapaint_base::file_check::read_limited(
                             &file,
                             kapaint_mesh::MAX_FILE_BYTES,
                         )
-                        .map_err(|e| what(e.to_string()))?;
+                        .map_err(|e| what(format!("its KTX2 image: {e}")))?;
                         read(&bytes, true, &file)
                     } else {
                         read_image(&file).map_err(|e| what(e.to_string()))
