@@ -511,24 +511,18 @@ fn mesh_unwrap_on_request_replaces_the_uvs() {
     assert_eq!(kapaint::mesh::unwrap::uv_overlap(mesh, 1024), 0.0);
 }
 
-/// File > Export with an engine preset: the dialog names the layout and where occlusion will
-/// come from, and the set is written in the engine's names, said so in the notice.
-#[test]
-fn an_engine_preset_exports_from_the_dialog_with_its_layout_and_occlusion() {
-    let dir = std::env::temp_dir().join(format!("kapaint-editor-engine-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let out = dir.join("crate");
-    let mut harness = editor();
+/// Opens File > Export (its shortcut) and chooses `preset` as a user does: open the list,
+/// pick the name.
+fn export_dialog_with(harness: &mut egui_kittest::Harness<'_, Editor>, preset: &str) {
     harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
     harness.step();
     harness.step();
-    // Choose the preset as a user does: open the list, click the name.
     harness.get_by_label("Preset").click();
     harness.step();
     // The list is longer than its popup: the name is chosen by its accessibility action, as a
     // screen reader does (a pointer click lands where the scrolled-away row would be).
     harness
-        .get_by_role_and_label(Role::Button, "unreal")
+        .get_by_role_and_label(Role::Button, preset)
         .click_accesskit();
     harness.step();
     if harness
@@ -545,6 +539,17 @@ fn an_engine_preset_exports_from_the_dialog_with_its_layout_and_occlusion() {
             .is_none(),
         "the list closed"
     );
+}
+
+/// File > Export with an engine preset: the dialog names the layout and where occlusion will
+/// come from, and the set is written in the engine's names, said so in the notice.
+#[test]
+fn an_engine_preset_exports_from_the_dialog_with_its_layout_and_occlusion() {
+    let dir = std::env::temp_dir().join(format!("kapaint-editor-engine-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("crate");
+    let mut harness = editor();
+    export_dialog_with(&mut harness, "unreal");
     // The plan arrives from a worker (after the one of the preset shown first).
     let deadline = std::time::Instant::now() + std::time::Duration::from_mins(1);
     while harness
@@ -599,22 +604,7 @@ fn a_basisu_glb_exports_from_the_dialog() {
     let _ = std::fs::remove_dir_all(&dir);
     let out = dir.join("sphere");
     let mut harness = editor();
-    harness.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, egui::Key::E);
-    harness.step();
-    harness.step();
-    harness.get_by_label("Preset").click();
-    harness.step();
-    harness
-        .get_by_role_and_label(Role::Button, "gltf-pbr")
-        .click_accesskit();
-    harness.step();
-    if harness
-        .query_by_role_and_label(Role::Button, "16-bit")
-        .is_some()
-    {
-        harness.get_by_label("Preset").click();
-        harness.step();
-    }
+    export_dialog_with(&mut harness, "gltf-pbr");
     // Basis Universal is offered only once the .glb is asked for.
     let basisu = "with Basis Universal textures (KHR_texture_basisu: ETC1S or UASTC)";
     assert!(

@@ -8,7 +8,7 @@
     reason = "test helpers: a failed expectation is a failed test"
 )]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use kapaint::export::gltf_pbr::PbrManifest;
 
@@ -18,58 +18,24 @@ use kapaint::export::gltf_pbr::PbrManifest;
     reason = "these tests make their material from images, not the glTF asset"
 )]
 mod gltf_asset;
-use gltf_asset::{bumps, dir, kapaint, spot};
+#[path = "common/pbr_project.rs"]
+mod pbr_project;
+use gltf_asset::{dir, kapaint};
+use pbr_project::{flat_project, ok, s, spot_pbr_project};
 
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = kapaint(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-/// A 128^2 project of spot with its texture, a roughness checker, metallic stripes and a
-/// bumpy normal map.
-fn project(d: &Path) -> PathBuf {
-    let (w, h) = (128, 128);
-    let rough = image::GrayImage::from_fn(w, h, |x, y| {
-        image::Luma([if (x / 16 + y / 16) % 2 == 0 { 60 } else { 200 }])
-    });
-    let metal = image::GrayImage::from_fn(w, h, |x, _| {
-        image::Luma([if (x / 32) % 2 == 0 { 0 } else { 255 }])
-    });
-    rough.save(d.join("rough.png")).expect("rough");
-    metal.save(d.join("metal.png")).expect("metal");
-    bumps(w, h).save(d.join("normal.png")).expect("normal");
-    let p = d.join("p.kapaint");
-    let (base, mesh) = (
-        spot().join("spot_texture.png"),
-        spot().join("spot_triangulated.obj"),
-    );
+/// `kapaint export PROJECT --preset gltf-pbr --glb --basisu --out OUT`, which must succeed; what
+/// it printed.
+fn export_basisu(project: &Path, out: &Path) -> String {
     ok(&[
-        "import-pbr",
+        "export",
+        s(project),
+        "--preset",
+        "gltf-pbr",
+        "--glb",
+        "--basisu",
         "--out",
-        s(&p),
-        "--size",
-        "128",
-        "--base-color",
-        s(&base),
-        "--roughness",
-        s(&d.join("rough.png")),
-        "--metallic",
-        s(&d.join("metal.png")),
-        "--normal",
-        s(&d.join("normal.png")),
-        "--mesh",
-        s(&mesh),
-    ]);
-    p
+        s(out),
+    ])
 }
 
 fn manifest(set: &Path) -> PbrManifest {
@@ -97,7 +63,7 @@ fn image_bytes(json: &serde_json::Value, bin: &[u8], i: usize) -> Vec<u8> {
 #[test]
 fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
     let d = dir("gltf-basisu");
-    let p = project(&d);
+    let p = spot_pbr_project(&d, 128);
     let (png_set, basis_set) = (d.join("png"), d.join("basis"));
     ok(&[
         "export",
@@ -108,16 +74,7 @@ fn a_basisu_glb_holds_uastc_ktx2_textures_and_reads_back() {
         "--out",
         s(&png_set),
     ]);
-    let out = ok(&[
-        "export",
-        s(&p),
-        "--preset",
-        "gltf-pbr",
-        "--glb",
-        "--basisu",
-        "--out",
-        s(&basis_set),
-    ]);
+    let out = export_basisu(&p, &basis_set);
     assert!(out.contains("basisu: base_color "), "{out}");
     let m = manifest(&basis_set);
     let b = m.basisu.as_ref().expect("the manifest says how");
@@ -287,18 +244,9 @@ fn with_image(glb: &Path, i: usize, bytes: &[u8], to: &Path) {
 #[test]
 fn a_glb_with_a_bad_basis_payload_is_refused_in_one_line() {
     let d = dir("gltf-basisu-bad");
-    let p = project(&d);
+    let p = spot_pbr_project(&d, 128);
     let set = d.join("basis");
-    ok(&[
-        "export",
-        s(&p),
-        "--preset",
-        "gltf-pbr",
-        "--glb",
-        "--basisu",
-        "--out",
-        s(&set),
-    ]);
+    export_basisu(&p, &set);
     let glb = set.join("model.glb");
     let (json, bin) = glb_parts(&glb);
     let good = image_bytes(&json, &bin, 0);
@@ -360,22 +308,7 @@ const LIGHT: &str = r#"(
 #[test]
 fn a_smooth_material_takes_the_cheapest_settings_its_budget_allows() {
     let d = dir("gltf-basisu-smooth");
-    let p = d.join("p.kapaint");
-    ok(&[
-        "import-pbr",
-        "--out",
-        s(&p),
-        "--size",
-        "64",
-        "--base-color",
-        "0.5,0.3,0.2",
-        "--roughness",
-        "0.5",
-        "--metallic",
-        "0",
-        "--mesh",
-        s(&spot().join("spot_triangulated.obj")),
-    ]);
+    let p = flat_project(&d, "p.kapaint");
     let how = |b: &kapaint::export::gltf_basisu::BasisuReport| -> Vec<(String, String)> {
         b.textures
             .iter()
@@ -386,16 +319,7 @@ fn a_smooth_material_takes_the_cheapest_settings_its_budget_allows() {
     // The default budget: ETC1S's 5-bit colours miss a flat colour by about two levels on
     // every texel (a mean over 0.3); UASTC holds it exactly at its cheapest.
     let set = d.join("basis");
-    ok(&[
-        "export",
-        s(&p),
-        "--preset",
-        "gltf-pbr",
-        "--glb",
-        "--basisu",
-        "--out",
-        s(&set),
-    ]);
+    export_basisu(&p, &set);
     let b = manifest(&set).basisu.expect("basisu");
     assert!(b.within_budget, "{b:?}");
     assert_eq!(
@@ -461,7 +385,7 @@ fn a_smooth_material_takes_the_cheapest_settings_its_budget_allows() {
 #[test]
 fn basisu_is_refused_without_a_glb() {
     let d = dir("gltf-basisu-usage");
-    let p = project(&d);
+    let p = spot_pbr_project(&d, 128);
     let o = kapaint(&[
         "export",
         s(&p),

@@ -17,60 +17,15 @@ use kapaint::export::gltf_pbr::PbrManifest;
     reason = "these tests make their material from images, not the glTF asset"
 )]
 mod gltf_asset;
-use gltf_asset::{bumps, dir, kapaint, spot};
+#[path = "common/pbr_project.rs"]
+#[expect(dead_code, reason = "the engine presets need no flat material")]
+mod pbr_project;
+use gltf_asset::dir;
+use pbr_project::{ok, s, spot_pbr_project};
 
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = kapaint(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-/// A 256^2 project of spot with its texture, a roughness checker, metallic stripes and a
-/// bumpy normal map, with an AO bake where `ao`.
+/// The 256^2 spot project ([`spot_pbr_project`]), with an AO bake where `ao`.
 fn project(d: &Path, ao: bool) -> PathBuf {
-    let (w, h) = (256, 256);
-    let rough = image::GrayImage::from_fn(w, h, |x, y| {
-        image::Luma([if (x / 32 + y / 32) % 2 == 0 { 40 } else { 220 }])
-    });
-    let metal = image::GrayImage::from_fn(w, h, |x, _| {
-        image::Luma([if (x / 64) % 2 == 0 { 0 } else { 255 }])
-    });
-    rough.save(d.join("rough.png")).expect("rough");
-    metal.save(d.join("metal.png")).expect("metal");
-    bumps(w, h).save(d.join("normal.png")).expect("normal");
-    let p = d.join("p.kapaint");
-    let base = spot().join("spot_texture.png");
-    let mesh = spot().join("spot_triangulated.obj");
-    let (rough, metal, normal) = (
-        d.join("rough.png"),
-        d.join("metal.png"),
-        d.join("normal.png"),
-    );
-    ok(&[
-        "import-pbr",
-        "--out",
-        s(&p),
-        "--size",
-        "256",
-        "--base-color",
-        s(&base),
-        "--roughness",
-        s(&rough),
-        "--metallic",
-        s(&metal),
-        "--normal",
-        s(&normal),
-        "--mesh",
-        s(&mesh),
-    ]);
+    let p = spot_pbr_project(d, 256);
     if ao {
         ok(&["bake", s(&p), "--map", "ao", "--rays", "8"]);
     }

@@ -24,21 +24,10 @@ use kapaint::export::gltf_pbr::PbrManifest;
     reason = "these tests make their material from images, not the glTF asset"
 )]
 mod gltf_asset;
-use gltf_asset::{bumps, dir, kapaint, spot};
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = kapaint(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+#[path = "common/pbr_project.rs"]
+mod pbr_project;
+use gltf_asset::{dir, spot};
+use pbr_project::{flat_project, ok, s, spot_pbr_project};
 
 /// The peers' folder, where they are installed; `None` (said on stderr) where they are not
 /// and the run does not require them.
@@ -103,45 +92,11 @@ fn basisu(peers: &Path) -> PathBuf {
     tool
 }
 
-/// A 128^2 project of spot with its texture, a roughness checker, metallic stripes and a
-/// bumpy normal map.
-fn project(d: &Path) -> PathBuf {
-    let (w, h) = (128, 128);
-    let rough = image::GrayImage::from_fn(w, h, |x, y| {
-        image::Luma([if (x / 16 + y / 16) % 2 == 0 { 60 } else { 200 }])
-    });
-    let metal = image::GrayImage::from_fn(w, h, |x, _| {
-        image::Luma([if (x / 32) % 2 == 0 { 0 } else { 255 }])
-    });
-    rough.save(d.join("rough.png")).expect("rough");
-    metal.save(d.join("metal.png")).expect("metal");
-    bumps(w, h).save(d.join("normal.png")).expect("normal");
-    let p = d.join("p.kapaint");
-    ok(&[
-        "import-pbr",
-        "--out",
-        s(&p),
-        "--size",
-        "128",
-        "--base-color",
-        s(&spot().join("spot_texture.png")),
-        "--roughness",
-        s(&d.join("rough.png")),
-        "--metallic",
-        s(&d.join("metal.png")),
-        "--normal",
-        s(&d.join("normal.png")),
-        "--mesh",
-        s(&spot().join("spot_triangulated.obj")),
-    ]);
-    p
-}
-
 #[test]
 fn every_glb_kapaint_writes_passes_the_khronos_validator() {
     let Some(peers) = peers() else { return };
     let d = dir("peers-glb");
-    let p = project(&d);
+    let p = spot_pbr_project(&d, 128);
     let mut glbs = Vec::new();
     for (name, extra) in [("png", None), ("basisu", Some("--basisu"))] {
         let out = d.join(name);
@@ -224,7 +179,7 @@ fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
     let Some(peers) = peers() else { return };
     let tool = basisu(&peers);
     let d = dir("peers-basisu");
-    let p = project(&d);
+    let p = spot_pbr_project(&d, 128);
     // The ktx2-uastc set.
     let set = d.join("uastc");
     ok(&["export", s(&p), "--preset", "ktx2-uastc", "--out", s(&set)]);
@@ -252,22 +207,7 @@ fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
     // The textures inside Basis glTFs, against the manifest's lists: a detailed material (UASTC
     // throughout) and a smooth one (its base colour ETC1S).
     glb_textures_unpack(&tool, &p, &d.join("detailed"), None);
-    let smooth = d.join("smooth.kapaint");
-    ok(&[
-        "import-pbr",
-        "--out",
-        s(&smooth),
-        "--size",
-        "64",
-        "--base-color",
-        "0.5,0.3,0.2",
-        "--roughness",
-        "0.5",
-        "--metallic",
-        "0",
-        "--mesh",
-        s(&spot().join("spot_triangulated.obj")),
-    ]);
+    let smooth = flat_project(&d, "smooth.kapaint");
     // A looser budget than gltf-pbr's, so the flat colour is ETC1S (tests/gltf_basisu.rs).
     let presets = d.join("presets");
     std::fs::create_dir_all(&presets).expect("dir");
