@@ -14,6 +14,7 @@ use gltf::json;
 use gltf::json::validation::{Checked::Valid, USize64};
 
 use kapaint_mesh::Mesh;
+use kapaint_mesh::gltf_import::KHR_TEXTURE_BASISU as BASISU;
 
 /// The material's textures, PNG-encoded or (with `ktx2`) Basis Universal KTX2 files.
 pub struct Textures<'a> {
@@ -94,8 +95,6 @@ impl Bin {
 
 /// The image type of a KTX2 file, as `KHR_texture_basisu` names it.
 pub const KTX2_MIME: &str = "image/ktx2";
-/// The extension's name.
-pub const BASISU: &str = "KHR_texture_basisu";
 
 /// A texture of the image `bytes` (a view of the binary chunk; a PNG, or a KTX2 file where
 /// `ktx2`), sampled with linear filtering, trilinear mips and repeat wrapping (sampler 0).
@@ -326,7 +325,7 @@ fn write_glb(
     }
     let mut json = json::serialize::to_vec(&root).map_err(|e| e.to_string())?;
     if ktx2 {
-        json = basisu_sources(&json)?;
+        json = sources_into_extension(&json)?;
     }
     gltf::binary::Glb {
         header: gltf::binary::Header {
@@ -344,7 +343,7 @@ fn write_glb(
 /// The JSON `json` with each texture's `source` moved into its `KHR_texture_basisu`
 /// extension: the image is a KTX2 file with no fallback, which the texture names only there
 /// (the `gltf` crate's types cannot leave `source` out).
-fn basisu_sources(json: &[u8]) -> Result<Vec<u8>, String> {
+fn sources_into_extension(json: &[u8]) -> Result<Vec<u8>, String> {
     let mut root: serde_json::Value = serde_json::from_slice(json).map_err(|e| e.to_string())?;
     if let Some(textures) = root
         .get_mut("textures")

@@ -142,15 +142,17 @@ enum Base {
 }
 
 impl Base {
-    fn decoded(&self) -> Vec<u8> {
+    /// Level 0's RGB as a runtime decodes it.
+    fn decoded(&self) -> std::borrow::Cow<'_, [u8]> {
         match self {
             // RGBA from the BC7 transcode: the RGB the measure reads.
             Self::Etc1s(f) => f
                 .decoded
                 .chunks_exact(4)
                 .flat_map(|t| [t[0], t[1], t[2]])
-                .collect(),
-            Self::Uastc(c) => c.decoded.clone(),
+                .collect::<Vec<u8>>()
+                .into(),
+            Self::Uastc(c) => c.decoded.as_slice().into(),
         }
     }
 }

@@ -14,7 +14,7 @@ use glam::{Vec2, Vec3};
 use image::DynamicImage;
 
 use super::import::{Input, PbrSet, Source, UvTransform, Wrap};
-use kapaint_mesh::gltf_import::{Opened, file_beside, open_gltf};
+use kapaint_mesh::gltf_import::{KHR_TEXTURE_BASISU, Opened, file_beside, names_basisu, open_gltf};
 use kapaint_model::ModelError;
 use kapaint_model::import::{decode_bytes, read_image};
 use kapaint_model::normal::NormalMap;
@@ -67,11 +67,7 @@ pub fn material_set(
         // Without a KTX2 reader, a file naming Basis Universal textures is refused for that,
         // whatever else the JSON says.
         let raw = std::fs::read(path).unwrap_or_default();
-        if ktx2.is_none()
-            && raw
-                .windows(b"KHR_texture_basisu".len())
-                .any(|w| w == b"KHR_texture_basisu")
-        {
+        if ktx2.is_none() && names_basisu(&raw) {
             fail(path, basis_reason())
         } else {
             match e {
@@ -81,11 +77,7 @@ pub fn material_set(
         }
     })?;
     let document = &opened.document;
-    if ktx2.is_none()
-        && document
-            .extensions_used()
-            .any(|e| e == "KHR_texture_basisu")
-    {
+    if ktx2.is_none() && document.extensions_used().any(|e| e == KHR_TEXTURE_BASISU) {
         return Err(fail(path, basis_reason()));
     }
     // Before anything reads an image or a factor: what the gltf crate would panic on, misread

@@ -171,7 +171,7 @@ pub fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, String> {
     let pick = |k: usize| -> Vec<u8> {
         d.rgba
             .chunks_exact(4)
-            .flat_map(|t| t[..k].iter().map(byte).collect::<Vec<u8>>())
+            .flat_map(|t| t[..k].iter().map(byte))
             .collect()
     };
     Ok(match d.channels {
