@@ -178,6 +178,14 @@ fn every_builtin_preset_exports_and_imports() {
                 let psnr = m.files[0].psnr.as_ref().expect("psnr");
                 assert!(psnr.iter().all(|p| p.is_none_or(|p| p > 30.0)), "{psnr:?}");
             }
+            // One hue a block: where a stroke's edge crosses a block, dark texels miss by
+            // more than their own k_a (relative max 152 % here), so the mean is what holds;
+            // the import is what the report measured (below).
+            Format::Ktx2Etc1s { .. } => {
+                assert!(m.ka_error.mean < 0.05, "{}: {:?}", p.name, m.ka_error);
+                let psnr = m.files[0].psnr.as_ref().expect("psnr");
+                assert!(psnr.iter().all(|p| p.is_none_or(|p| p > 25.0)), "{psnr:?}");
+            }
         }
         // What import reads is what the report measured (plus the project's own rounding).
         assert!(

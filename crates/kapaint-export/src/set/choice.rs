@@ -7,6 +7,7 @@ use super::perceptual::SrgbError;
 use crate::blocks::Encoder;
 use crate::codec::{AstcBlock, Effort};
 use crate::encoding::KaError;
+use crate::file_kind::Compression;
 use crate::preset::BlockBudget;
 
 /// Where `n` goes in a block-compressed set.
@@ -197,6 +198,10 @@ pub struct BlockChoice {
     /// An ASTC set's footprint (`"4x4"`); absent for BC sets.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub astc_block: Option<AstcBlock>,
+    /// The first image's compression where its blocks are Basis Universal's
+    /// (`"ktx2-uastc"`, `"ktx2-etc1s"`); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub basis: Option<Compression>,
     /// The preset's budget.
     pub budget: BlockBudget,
     /// Whether the chosen trial meets it.
@@ -226,10 +231,16 @@ impl BlockChoice {
     /// verdict with every number it rests on, beside the numbers it does not judge (the
     /// manifest's `blocks` has the trials and the reason).
     pub fn summary(&self) -> String {
-        let uastc = self.encoder == Encoder::Basisu;
+        let basis = match self.basis {
+            Some(Compression::Ktx2Etc1s) => Some("ETC1S"),
+            _ if self.encoder == Encoder::Basisu => Some("UASTC"),
+            _ => None,
+        };
         let layout = match (self.layout, self.astc_block) {
-            (BlockLayout::Packed, _) if uastc => "UASTC, n packed in k_d's alpha".to_string(),
-            (BlockLayout::NApart, _) if uastc => "UASTC, n apart".to_string(),
+            (BlockLayout::Packed, _) if let Some(b) = basis => {
+                format!("{b}, n packed in k_d's alpha")
+            }
+            (BlockLayout::NApart, _) if let Some(b) = basis => format!("{b}, n apart"),
             (BlockLayout::Packed, None) => "n packed in k_d's BC7".to_string(),
             (BlockLayout::NApart, None) => "n apart (BC4/BC5), colour BC7".into(),
             (BlockLayout::HalfColour, _) => "n apart (BC4/BC5), colour BC6H".into(),

@@ -34,10 +34,11 @@ use super::manifest::{Comp, is_colour};
 use super::measure::{Shape, ka_error_of_set};
 use super::perceptual::SrgbError;
 use super::role::{Images, Role};
+use super::trial::{ImageCodec, TrialImage};
 use crate::blocks::{self, BlockEncoder, Coder};
-use crate::codec::{Codec, Effort};
+use crate::codec::{Effort, Encoder};
 use crate::encoding::{KaError, NEncoding};
-use crate::ktx::{self, Compressed};
+use crate::file_kind::Compression;
 use crate::preset::ExportPreset;
 use glam::Vec3;
 use kapaint_base::task::Progress;
@@ -78,67 +79,6 @@ pub(super) struct Job<'a> {
     pub brought: Option<&'a dyn BlockEncoder>,
 }
 
-/// One image of a trial: its texels and codec, level 0 as stored, and level 0 compressed.
-struct TrialImage<'a> {
-    role: Role,
-    comps: Vec<Comp>,
-    srgb: bool,
-    half: bool,
-    texels: KtxTexels<'a>,
-    /// The image's codec (its contexts serve every trial and the mips).
-    codec: Box<dyn Codec>,
-    level0: Vec<u8>,
-    /// Level 0's blocks, and the effort the codec ran for them.
-    compressed: Option<(Effort, Compressed)>,
-}
-
-impl TrialImage<'_> {
-    /// Compresses level 0 at `effort`, unless it already is at an effort the codec does not
-    /// tell apart from it.
-    fn compress(
-        &mut self,
-        encoder: Coder<'_>,
-        effort: Effort,
-        job: &Job<'_>,
-        p: &Progress,
-    ) -> Result<(), Failure> {
-        let size = job.size;
-        let runs = self.codec.effort(effort);
-        if self.compressed.as_ref().is_some_and(|(e, _)| *e == runs) {
-            p.advance(u64::from(size.1));
-            return Ok(());
-        }
-        let per = ktx::texel_layout(self.texels.spaces()).0;
-        let blocks = (&*self.codec, effort);
-        let c = ktx::compress_level(encoder, blocks, &self.level0, size, per, Some(p))
-            .map_err(|e| e.to_string())?;
-        self.compressed = Some((runs, c));
-        Ok(())
-    }
-
-    /// Level 0 as stored before any block: what the uncompressed files would hold.
-    fn uncompressed(&self) -> StoredImage<'_> {
-        StoredImage {
-            comps: self.comps.clone(),
-            data: self.level0[..].into(),
-            srgb: self.srgb,
-            half: self.half,
-        }
-    }
-
-    fn stored(&self) -> StoredImage<'_> {
-        StoredImage {
-            comps: self.comps.clone(),
-            data: self
-                .compressed
-                .as_ref()
-                .map_or_else(Default::default, |(_, c)| c.decoded[..].into()),
-            srgb: self.srgb,
-            half: self.half,
-        }
-    }
-}
-
 /// The images of `want` (three-component colour as half floats where `half`): what the
 /// last trial shares with it is kept (with its blocks), what it lacks is made.
 ///
@@ -160,11 +100,12 @@ fn prepare<'a>(
             let half = half_of(comps);
             let srgb = !half && srgb_image(job.preset.format, comps);
             let texels = KtxTexels::new(job.texels, job.ka, comps, srgb, half, job.n_enc);
-            let codec = job
-                .preset
-                .format
+            let format = job.preset.format;
+            let codec = format
                 .codec(texels.spaces())
-                .ok_or_else(|| format!("{} has no blocks", job.preset.format.name()))?;
+                .map(ImageCodec::Strips)
+                .or_else(|| format.whole_image(texels.spaces()).map(ImageCodec::Whole))
+                .ok_or_else(|| format!("{} has no blocks", format.name()))?;
             let level0 = texels.level0();
             images.push(TrialImage {
                 role: *role,
@@ -174,6 +115,7 @@ fn prepare<'a>(
                 texels,
                 codec,
                 level0,
+                mips: None,
                 compressed: None,
             });
         }
@@ -193,6 +135,29 @@ impl Job<'_> {
             self.approx,
         )
     }
+}
+
+/// The chosen images, level 0 as compressed, with their mip chains: the set's files.
+fn with_mips(
+    images: &mut [TrialImage<'_>],
+    coder: (Coder<'_>, Effort),
+    size: (u32, u32),
+    progress: &Progress,
+) -> Result<Vec<Encoded>, Failure> {
+    progress.start("encode", images.len() as u64 * u64::from(size.1));
+    let mut encoded = Vec::with_capacity(images.len());
+    for image in images {
+        let written = image.written(coder, size, progress)?;
+        if progress.is_cancelled() {
+            return Err(Failure::Cancelled);
+        }
+        encoded.push((
+            image.role.file("ktx2"),
+            image.comps.clone(),
+            ktx_image(written, image.srgb, image.half),
+        ));
+    }
+    Ok(encoded)
 }
 
 fn tried(trials: &[Trial], layout: BlockLayout) -> bool {
@@ -225,9 +190,10 @@ pub(super) fn encode_blocks(
     let encoded = with_mips(&mut images, (encoder, pick.bc7_effort), job.size, progress)?;
     // What the manifest names: the encoder of the first image's blocks (a GPU that failed on
     // the way handed the rest to the CPU, for the rest of the process).
-    let names = images
-        .first()
-        .map_or(encoder.name(), |i| blocks::encoder_name(encoder, &*i.codec));
+    let names = images.first().map_or(encoder.name(), |i| match &i.codec {
+        ImageCodec::Strips(codec) => blocks::encoder_name(encoder, &**codec),
+        ImageCodec::Whole(_) => Encoder::Basisu,
+    });
     let budget = job.preset.budget;
     let within_budget = within(&budget, &pick);
     let uncompressed_ka_error_srgb = found.floor;
@@ -239,6 +205,13 @@ pub(super) fn encode_blocks(
             layout: pick.layout,
             bc7_effort: pick.bc7_effort,
             astc_block: job.preset.format.astc_block(),
+            basis: images
+                .first()
+                .map(|i| match &i.codec {
+                    ImageCodec::Strips(codec) => codec.compression(),
+                    ImageCodec::Whole(codec) => codec.compression(),
+                })
+                .filter(|c| matches!(c, Compression::Ktx2Uastc | Compression::Ktx2Etc1s)),
             budget,
             within_budget,
             uncompressed_ka_error_srgb,
@@ -412,9 +385,11 @@ impl<'j, 'a> Search<'j, 'a> {
             let half = layout.half() && half_image(comps);
             let srgb = !half && srgb_image(format, comps);
             let spaces = spaces_of(comps, srgb, half, job.n_enc);
-            format
-                .codec(&spaces)
-                .is_none_or(|c| c.effort(a) == c.effort(b))
+            // A whole-image codec (ETC1S) tells every effort apart.
+            format.whole_image(&spaces).is_none()
+                && format
+                    .codec(&spaces)
+                    .is_none_or(|c| c.effort(a) == c.effort(b))
         })
     }
 
@@ -478,7 +453,7 @@ fn compress_all(
 ) -> Result<(), Failure> {
     progress.start("encode", images.len() as u64 * u64::from(job.size.1));
     for image in images {
-        image.compress(encoder, effort, job, progress)?;
+        image.compress(encoder, effort, job.size, progress)?;
         if progress.is_cancelled() {
             break;
         }
@@ -505,14 +480,7 @@ fn run_trial(
     let (ka_error, ka_error_srgb) = job.measure(&stored);
     let min_psnr = images
         .iter_mut()
-        .filter_map(|i| {
-            let (_, c) = i.compressed.as_mut()?;
-            c.psnr(&i.level0, i.texels.spaces())
-                .iter()
-                .flatten()
-                .copied()
-                .reduce(f64::min)
-        })
+        .filter_map(|i| i.psnr().into_iter().flatten().reduce(f64::min))
         .reduce(f64::min);
     Ok(Trial {
         layout,
@@ -522,35 +490,6 @@ fn run_trial(
         min_psnr,
         seconds: started.elapsed().as_secs_f64(),
     })
-}
-
-/// The chosen images, level 0 as compressed, with their mip chains: the set's files.
-fn with_mips(
-    images: &mut [TrialImage<'_>],
-    (encoder, effort): (Coder<'_>, Effort),
-    size: (u32, u32),
-    progress: &Progress,
-) -> Result<Vec<Encoded>, Failure> {
-    progress.start("encode", images.len() as u64 * u64::from(size.1));
-    let mut encoded = Vec::with_capacity(images.len());
-    for image in images {
-        let compressed = image.compressed.take().map(|(_, c)| c);
-        let written = ktx::encode(
-            &image.texels.source(size, &image.level0),
-            Some((encoder, &*image.codec, effort)),
-            compressed,
-            progress,
-        )?;
-        if progress.is_cancelled() {
-            return Err(Failure::Cancelled);
-        }
-        encoded.push((
-            image.role.file("ktx2"),
-            image.comps.clone(),
-            ktx_image(written, image.srgb, image.half),
-        ));
-    }
-    Ok(encoded)
 }
 
 #[cfg(test)]

@@ -148,6 +148,10 @@ pub(super) fn encode_image(
             Ok(plain(png(&data, [C::L16, C::La16, C::Rgb16, C::Rgba16])?))
         }
         Format::Exr => Ok(plain(exr_bytes(&value, channels, (width, height))?)),
+        // Its codebooks span the image: the block search encodes it whole (`super::choose`).
+        Format::Ktx2Etc1s { .. } => {
+            Err("ETC1S images are encoded by the block search, not one at a time".into())
+        }
         Format::Ktx2
         | Format::Ktx2Bc { .. }
         | Format::Ktx2Astc { .. }

@@ -16,6 +16,7 @@ pub mod perceptual;
 mod plan;
 mod role;
 mod target;
+mod trial;
 
 use std::path::{Path, PathBuf};
 
@@ -378,8 +379,9 @@ fn write_images(
             });
         }
         let path = tmp.join(&file);
+        // ETC1S files are supercompressed already (BasisLZ): zstd is for the others.
         let supercompression = match (preset.zstd, &image.ktx) {
-            (Some(level), Some(_)) => {
+            (Some(level), Some(k)) if k.compression != Compression::Ktx2Etc1s => {
                 let (bytes, said) = supercompressed(&image.bytes, level, &path)?;
                 image.bytes = bytes;
                 Some(said)

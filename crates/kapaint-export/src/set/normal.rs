@@ -54,6 +54,11 @@ impl NormalStorage {
             blocks @ (Format::Ktx2Bc { .. }
             | Format::Ktx2Astc { .. }
             | Format::Ktx2Uastc { .. }) => Self::Ktx2(Some((blocks, NORMAL_EFFORT))),
+            // ETC1S's endpoints, shared by whole blocks and codebook entries, blur
+            // directions: its normal map is UASTC, as Basis Universal's guidance has it.
+            Format::Ktx2Etc1s { max_effort } => {
+                Self::Ktx2(Some((Format::Ktx2Uastc { max_effort }, NORMAL_EFFORT)))
+            }
         }
     }
 
