@@ -10,6 +10,7 @@
 )]
 
 use kapaint_export::codec::Effort;
+use kapaint_export::codec::etc1s::Etc1sCodec;
 use kapaint_export::file_kind::Compression;
 use kapaint_export::preset::{self, Format};
 use kapaint_export::set;
@@ -105,4 +106,62 @@ fn an_etc1s_set_is_smaller_than_the_uastc_set() {
     assert!(bytes(&me) < bytes(&mu), "{} vs {}", bytes(&me), bytes(&mu));
     let _ = std::fs::remove_dir_all(&a);
     let _ = std::fs::remove_dir_all(&b);
+}
+
+/// ETC1S blocks of a gradient with hue changes, transcoded to both targets a runtime picks
+/// and read by independent decoders: kapaint's measure (its BC7 decode) is bcdec's, and the
+/// ASTC 4x4 transcode (texture2ddecoder) is no farther from the texels, so the measure judges
+/// the worse target.
+#[test]
+fn the_bc7_transcode_of_etc1s_is_the_worse_target() {
+    let (w, h) = (64_u32, 32_u32);
+    let rgb: Vec<u8> = (0..w * h)
+        .flat_map(|i| {
+            let (x, y) = (i % w, i / w);
+            [(x * 4) as u8, (y * 8) as u8, ((x * y) % 256) as u8]
+        })
+        .collect();
+    let codec = Etc1sCodec::new(3, true);
+    let out = codec
+        .encode(&[((w, h), &rgb[..])], Effort::Fast)
+        .expect("encode");
+    let ours = &out.decoded[0];
+    let bc7 = kapaint_basis::etc1s::transcode_etc1s(&out.image, true, kapaint_basis::Target::Bc7)
+        .expect("BC7");
+    let mut theirs = vec![0_u8; (w * h * 4) as usize];
+    for (i, block) in bc7[0].chunks_exact(16).enumerate() {
+        let (bx, by) = (i as u32 % (w / 4), i as u32 / (w / 4));
+        let at = ((by * 4 * w + bx * 4) * 4) as usize;
+        bcdec_rs::bc7(block, &mut theirs[at..], (w * 4) as usize);
+    }
+    let theirs: Vec<u8> = theirs
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    assert!(*ours == theirs, "kapaint decodes BC7 as bcdec does");
+    let astc =
+        kapaint_basis::etc1s::transcode_etc1s(&out.image, true, kapaint_basis::Target::Astc4x4)
+            .expect("ASTC");
+    let mut words = vec![0_u32; (w * h) as usize];
+    texture2ddecoder::decode_astc(&astc[0], w as usize, h as usize, 4, 4, &mut words)
+        .expect("decode ASTC");
+    let astc: Vec<u8> = words
+        .iter()
+        .flat_map(|p| {
+            let [b, g, r, _] = p.to_le_bytes();
+            [r, g, b]
+        })
+        .collect();
+    let sq = |a: &[u8]| -> u64 {
+        a.iter()
+            .zip(&rgb)
+            .map(|(x, y)| u64::from(x.abs_diff(*y)).pow(2))
+            .sum()
+    };
+    assert!(
+        sq(ours) >= sq(&astc),
+        "BC7 {} vs ASTC {}",
+        sq(ours),
+        sq(&astc)
+    );
 }
