@@ -365,6 +365,42 @@ fn the_script_names_the_new_tools_and_each_stroke_is_one_step() {
     assert!(texels(&doc) == before, "two strokes, two steps");
 }
 
+/// A stroke keeps the stencil's weights where its dabs have read them; a stencil turned
+/// inside the stroke is read afresh, not from what the stroke kept.
+#[test]
+fn a_stencil_turned_inside_a_stroke_paints_through_its_new_place() {
+    let dir = std::env::temp_dir().join(format!("kapaint-turned-stencil-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = half_white(&dir);
+    let red = MaterialValue::new(Vec3::new(0.9, 0.05, 0.05), Vec3::splat(0.04), 10.0);
+    let mut doc = document();
+    doc.apply(stencil(&path, Vec2::new(128.0, 128.0), 128.0, 0.0))
+        .expect("stencil");
+    doc.apply(SettingsCommand::SetPrimary(red))
+        .expect("primary");
+    brush(&mut doc, 12.0, 1.0, 1.0);
+    let along = |doc: &mut Document| {
+        for p in line(Vec2::new(80.0, 128.0), Vec2::new(176.0, 128.0), 24) {
+            doc.apply(StrokeCommand::StrokeTo(p)).expect("dab");
+        }
+    };
+    doc.apply(StrokeCommand::BeginStroke(StrokeTool::Brush))
+        .expect("begin");
+    along(&mut doc);
+    let at = |doc: &Document, (x, y)| doc.maps().value(x, y).kd.x;
+    assert!(
+        (at(&doc, (100, 128)) - 0.5).abs() < 1e-3,
+        "held back on the left"
+    );
+    // Turned half a turn, its white half lies on the left: the same stroke paints there now.
+    doc.apply(stencil(&path, Vec2::new(128.0, 128.0), 128.0, 180.0))
+        .expect("turned");
+    along(&mut doc);
+    doc.apply(StrokeCommand::EndStroke).expect("end");
+    assert!(at(&doc, (100, 128)) > 0.85, "{}", at(&doc, (100, 128)));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn a_grey_stencil_lets_its_share_of_the_paint_through_however_many_dabs_pass() {
     let dir = std::env::temp_dir().join(format!("kapaint-grey-stencil-{}", std::process::id()));

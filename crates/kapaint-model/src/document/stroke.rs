@@ -5,7 +5,10 @@ use glam::{Vec2, Vec3};
 use super::copy_dab::{self, CloneSource};
 use super::surface_copy::{self, SourceGrid};
 
+mod stencil_weights;
 mod surface;
+
+use self::stencil_weights::{StencilOn, StencilRead, StencilWeights};
 use super::{Document, StrokeTool};
 use crate::ModelError;
 use crate::brush::BlendMode;
@@ -13,10 +16,9 @@ use crate::brush::{BrushSettings, Resampler, Smoother, StrokePoint, SurfacePos};
 use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes};
 use crate::layers::{Compositor, LayerStroke, State};
 use crate::maps::MaterialMaps;
-use crate::paint::{Coverage, DiscFootprint, Footprint, Stencil};
-use crate::surface::Surface;
+use crate::paint::{Coverage, DiscFootprint, Footprint};
 use crate::texel::Channels;
-use crate::tile::{TILE_SIZE, TileSpans};
+use crate::tile::TileSpans;
 
 /// A stroke in progress.
 pub(super) struct ActiveStroke {
@@ -41,6 +43,8 @@ pub(super) struct ActiveStroke {
     last_dabs: Vec<Vec2>,
     /// The same on the mesh (object space).
     last_surface_dabs: Vec<Vec3>,
+    /// The stencil's weights where the stroke's dabs read them, each tile once.
+    stencil_weights: StencilWeights,
 }
 
 /// The parts of a stroke a dab reads, borrowed apart so a footprint can hold the brush.
@@ -53,6 +57,7 @@ struct StrokeParts<'a> {
     coverage: &'a mut Coverage,
     touched: &'a mut bool,
     clone: Option<&'a CloneSource>,
+    stencil_weights: &'a StencilWeights,
 }
 
 impl ActiveStroke {
@@ -66,6 +71,7 @@ impl ActiveStroke {
             coverage: &mut self.coverage,
             touched: &mut self.touched,
             clone: self.clone.as_ref(),
+            stencil_weights: &self.stencil_weights,
         }
     }
 }
@@ -133,6 +139,7 @@ impl Document {
             clone: None,
             last_dabs: Vec::new(),
             last_surface_dabs: Vec::new(),
+            stencil_weights: StencilWeights::default(),
         });
         Ok(())
     }
@@ -208,6 +215,7 @@ impl Document {
             coverage,
             touched,
             clone,
+            stencil_weights,
         } = stroke;
         let mut ids = fp.tiles(to.maps);
         ids.sort_unstable();
@@ -238,7 +246,7 @@ impl Document {
             maps,
             alpha,
             opacity: brush.opacity,
-            stencil,
+            stencil: stencil.map(|on| StencilRead::new(on, stencil_weights)),
         };
         let written = match tool {
             StrokeTool::Brush | StrokeTool::Eraser => {
@@ -367,6 +375,11 @@ impl Document {
             .then(|| self.aids.stencil.clone())
             .flatten()
             .filter(|s| s.view.is_none());
+        if let Some(s) = &stencil {
+            stroke
+                .stencil_weights
+                .prepare(s, None, self.maps.tile_count());
+        }
         for (c, step) in centers.into_iter().zip(steps) {
             let parts = stroke.parts();
             let brush = parts.brush;
@@ -421,44 +434,6 @@ fn cover_dab(
     edit::edit_cover((planes, pre), target, ids, covers, raise)
 }
 
-/// A stencil as a dab reads it: on the canvas (each texel's weight where the texel lies), or
-/// on the screen of a view (where the texel's surface point projects through it).
-#[derive(Clone, Copy)]
-pub(super) enum StencilOn<'a> {
-    /// In texel space.
-    Texels(&'a Stencil),
-    /// On the screen: the stencil, the baked surface, the view's matrix to clip space.
-    Screen(&'a Stencil, &'a Surface, glam::Mat4),
-}
-
-impl StencilOn<'_> {
-    /// The weights of the row of texels from `(x, y)` (texel indices) on.
-    #[inline]
-    fn weights(&self, (x, y): (usize, usize), out: &mut [f32]) {
-        match *self {
-            Self::Texels(stencil) => {
-                stencil.weights(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), out);
-            }
-            Self::Screen(stencil, surface, to_clip) => {
-                let Some(view) = &stencil.view else {
-                    out.fill(1.0);
-                    return;
-                };
-                let row = y * surface.bake.width as usize + x;
-                for (k, o) in out.iter_mut().enumerate() {
-                    let i = row + k;
-                    *o = match surface.bake.triangle(i) {
-                        Some(_) => view
-                            .to_screen(&to_clip, surface.bake.position(i))
-                            .map_or(0.0, |p| stencil.weight(p)),
-                        None => 0.0,
-                    };
-                }
-            }
-        }
-    }
-}
-
 /// A dab's raise of the stroke's coverage: towards `opacity` (times the stencil's weight,
 /// where there is one) by the footprint's weight times `alpha`.
 struct DabRaise<'a, F> {
@@ -466,7 +441,7 @@ struct DabRaise<'a, F> {
     maps: &'a MaterialMaps,
     alpha: f32,
     opacity: f32,
-    stencil: Option<StencilOn<'a>>,
+    stencil: Option<StencilRead<'a>>,
 }
 
 impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
@@ -487,9 +462,7 @@ impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
             let up = &mut up[..weights.len()];
             let caps = &mut caps[..weights.len()];
             if let Some(stencil) = &self.stencil {
-                let (y, x0) = (start / TILE_SIZE, start % TILE_SIZE);
-                let at = (rect.x0 as usize + x0, rect.y0 as usize + y);
-                stencil.weights(at, caps);
+                stencil.weights(self.maps, id, start, caps);
                 for cap in caps.iter_mut() {
                     *cap *= opacity;
                 }

@@ -129,10 +129,19 @@ impl Stencil {
             let mut q = start + step * k as f32;
             if self.tiled {
                 // Into [0, size): the four taps then wrap with a compare, not a division.
-                q = Vec2::new(q.x - (q.x * iw).floor() * wf, q.y - (q.y * ih).floor() * hf);
+                q = Vec2::new(q.x - floor(q.x * iw) * wf, q.y - floor(q.y * ih) * hf);
             }
-            let (xf, yf) = (q.x.floor(), q.y.floor());
+            let (xf, yf) = (floor(q.x), floor(q.y));
             let (fx, fy) = (q.x - xf, q.y - yf);
+            // Most texels: all four taps on the image, read straight (no wrapping).
+            if xf >= 0.0 && yf >= 0.0 && xf + 1.0 < wf && yf + 1.0 < hf {
+                let i = yf as usize * w + xf as usize;
+                let plane = &self.plane[i..i + w + 2];
+                let top = plane[0] * (1.0 - fx) + plane[1] * fx;
+                let bottom = plane[w] * (1.0 - fx) + plane[w + 1] * fx;
+                *o = hold + self.opacity * (top * (1.0 - fy) + bottom * fy);
+                continue;
+            }
             let near = xf >= -1.0 && yf >= -1.0 && xf < wf && yf < hf;
             let v = if self.tiled || near {
                 let (x0, y0) = (xf as i64, yf as i64);
@@ -159,6 +168,23 @@ impl Stencil {
             };
             *o = hold + self.opacity * v;
         }
+    }
+}
+
+/// `v` rounded down, without a call: the baseline x86-64 target has no rounding instruction,
+/// so `f32::floor` there is a libm call, four of them a texel in a dab's weights. Exact where
+/// `|v| < 2^23`; larger floats are whole already.
+#[inline(always)]
+#[expect(
+    clippy::inline_always,
+    reason = "a few instructions in a per-texel loop, which a call would cost more than"
+)]
+fn floor(v: f32) -> f32 {
+    if v.abs() < 8_388_608.0 {
+        let t = v as i32 as f32;
+        t - f32::from(u8::from(t > v))
+    } else {
+        v
     }
 }
 
@@ -246,5 +272,92 @@ impl ScreenView {
         }
         let ndc = Vec2::new(c.x, c.y) / c.w;
         Some(Vec2::new(ndc.x + 1.0, 1.0 - ndc.y) * 0.5 * self.size)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 7x5 stencil of distinct greys (luminance only, alpha 1).
+    fn stencil(tiled: bool) -> Stencil {
+        let (w, h) = (7_u32, 5_u32);
+        let grey: Vec<u16> = (0..w * h).map(|i| (i * 1871 % 65_536) as u16).collect();
+        let rgba: Vec<u16> = grey.iter().flat_map(|g| [*g, *g, *g, u16::MAX]).collect();
+        let gray: Vec<u16> = grey.iter().flat_map(|g| [*g, 0]).collect();
+        let pixels = Pixels::from_raw(w, h, &rgba, &gray).expect("pixels");
+        let mut s = Stencil::new(Arc::new(pixels), Vec2::new(20.0, 11.0), 30.0, 23.0);
+        s.tiled = tiled;
+        s.opacity = 0.8;
+        s
+    }
+
+    /// The bilinear weight at image pixel coordinates `q`, tap by tap: wrapped where tiled,
+    /// zero off the image otherwise.
+    fn reference(s: &Stencil, q: Vec2) -> f32 {
+        let (w, h) = (i64::from(s.image.width()), i64::from(s.image.height()));
+        let tap = |x: i64, y: i64| -> f32 {
+            let (x, y) = if s.tiled {
+                (x.rem_euclid(w), y.rem_euclid(h))
+            } else if x < 0 || y < 0 || x >= w || y >= h {
+                return 0.0;
+            } else {
+                (x, y)
+            };
+            s.plane[(y * w + x) as usize]
+        };
+        let (x0, y0) = (q.x.floor(), q.y.floor());
+        let (fx, fy) = (q.x - x0, q.y - y0);
+        let (x, y) = (x0 as i64, y0 as i64);
+        let top = tap(x, y) * (1.0 - fx) + tap(x + 1, y) * fx;
+        let bottom = tap(x, y + 1) * (1.0 - fx) + tap(x + 1, y + 1) * fx;
+        1.0 - s.opacity + s.opacity * (top * (1.0 - fy) + bottom * fy)
+    }
+
+    #[test]
+    fn floor_without_a_call_is_floor() {
+        for v in [
+            0.0_f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999,
+            -2.001,
+            1e6 + 0.5,
+            -1e6 - 0.5,
+            8_388_607.5,
+            -8_388_607.5,
+            3e9,
+            -3e9,
+            1e30,
+        ] {
+            assert_eq!(floor(v), v.floor(), "{v}");
+        }
+        assert!(floor(f32::NAN).is_nan());
+    }
+
+    #[test]
+    fn a_row_of_weights_is_the_bilinear_image_inside_at_and_past_its_edges() {
+        for tiled in [false, true] {
+            let s = stencil(tiled);
+            let size = Vec2::new(s.image.width() as f32, s.image.height() as f32);
+            for y in 0..24 {
+                let mut row = [0.0_f32; 48];
+                s.weights(Vec2::new(0.5, y as f32 + 0.5), &mut row);
+                for (x, got) in row.iter().enumerate() {
+                    let mut q = s.uv(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)) * size - 0.5;
+                    if tiled {
+                        q = Vec2::new(q.x.rem_euclid(size.x), q.y.rem_euclid(size.y));
+                    }
+                    let want = reference(&s, q);
+                    assert!(
+                        (got - want).abs() < 2e-4,
+                        "tiled {tiled}, ({x}, {y}): {got} vs {want}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -91,17 +91,8 @@ impl Document {
             }
         }
         let front = b.front_faces_only;
-        // The stencil, on the canvas (where each texel lies) or on the screen (where its
-        // surface point projects).
-        let stencil = stroke
-            .tool
-            .paints_through_stencil()
-            .then(|| self.aids.stencil.clone())
-            .flatten();
-        let to_clip = stencil
-            .as_ref()
-            .and_then(|s| s.view.as_ref())
-            .map(crate::paint::ScreenView::to_clip);
+        let (stencil, to_clip) =
+            surface_stencil(stroke, self.aids.stencil.as_ref(), surface, &self.maps);
         // A smudge's first dab only picks up; each later one drags by the step (object
         // space) since the same mirrored copy's last dab.
         let steps = if stroke.tool == StrokeTool::Smudge {
@@ -166,4 +157,32 @@ impl Document {
             );
         }
     }
+}
+
+/// The stencil a stroke on the mesh paints through, on the canvas (where each texel lies) or
+/// on the screen (where its surface point projects: with the view's matrix to clip space),
+/// its weights made ready in the stroke.
+fn surface_stencil(
+    stroke: &mut super::ActiveStroke,
+    stencil: Option<&std::sync::Arc<crate::paint::Stencil>>,
+    surface: &Surface,
+    maps: &crate::maps::MaterialMaps,
+) -> (
+    Option<std::sync::Arc<crate::paint::Stencil>>,
+    Option<glam::Mat4>,
+) {
+    let stencil = stencil
+        .filter(|_| stroke.tool.paints_through_stencil())
+        .cloned();
+    let to_clip = stencil
+        .as_ref()
+        .and_then(|s| s.view.as_ref())
+        .map(crate::paint::ScreenView::to_clip);
+    if let Some(s) = &stencil {
+        let on_screen = to_clip.is_some().then_some(surface);
+        stroke
+            .stencil_weights
+            .prepare(s, on_screen, maps.tile_count());
+    }
+    (stencil, to_clip)
 }
