@@ -78,7 +78,7 @@ pub fn encode_uastc(
     }
     let mut params = CompressorParams::new();
     params.set_basis_format(BasisTextureFormat::UASTC4x4);
-    params.set_uastc_quality_level(how.level);
+    set_uastc_level(&mut params, how.level);
     params.set_rdo_uastc(how.rdo);
     params.set_color_space(if how.srgb {
         ColorSpace::Srgb
@@ -102,6 +102,20 @@ pub fn encode_uastc(
         ));
     }
     Ok(file[at..at + len].to_vec())
+}
+
+/// Sets the UASTC pack flags to `level` alone. The crate's `set_uastc_quality_level` ORs the
+/// level into the flags the parameters start with (level 2), so levels 0 and 1 came out as 2
+/// and 3, and 4 as 6.
+fn set_uastc_level(params: &mut CompressorParams, level: u32) {
+    let flags = basis_universal::sys::UastcPackFlags::try_from(level).unwrap_or_default();
+    #[expect(
+        unsafe_code,
+        reason = "the bindings mark this setter unsafe: it writes one field of the parameters `params` owns, alive for the call"
+    )]
+    unsafe {
+        basis_universal::sys::compressor_params_set_pack_uastc_flags(params.0, flags);
+    }
 }
 
 /// Runs Binomial's compressor on `params` (its source images set) with `threads` threads:
@@ -169,6 +183,31 @@ pub fn transcode_uastc(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each level is the level asked: the encoder's blocks at levels 0, 1 and 2 all differ
+    /// (with the level ORed into the default 2, 0 and 2 gave the same blocks, and 1 gave 3's).
+    #[test]
+    fn each_uastc_level_is_the_level_asked() {
+        let (w, h) = (32_u32, 32_u32);
+        let rgba: Vec<u8> = (0..w * h)
+            .flat_map(|i| {
+                let (x, y) = (i % w, i / w);
+                [(x * 8) as u8, (y * 8) as u8, ((x * y * 7) % 256) as u8, 255]
+            })
+            .collect();
+        let at = |level| {
+            let how = Uastc {
+                level,
+                rdo: None,
+                srgb: true,
+            };
+            encode_uastc(&rgba, (w, h), how).expect("encode")
+        };
+        let blocks: Vec<Vec<u8>> = (0..=3).map(at).collect();
+        assert_ne!(blocks[0], blocks[2], "level 0 is not level 2");
+        assert_ne!(blocks[1], blocks[3], "level 1 is not level 3");
+        assert_ne!(blocks[0], blocks[1], "level 0 is not level 1");
+    }
 
     fn gradient(w: u32, h: u32) -> Vec<u8> {
         (0..w * h)
