@@ -259,14 +259,13 @@ fn a_glb_with_a_bad_basis_payload_is_refused_in_one_line() {
     };
     // An ETC1S file whose global data claims more codebook than it holds.
     let rgba: Vec<u8> = (0..64 * 64 * 4).map(|i| (i % 251) as u8).collect();
-    let etc1s = kapaint::export::codec::etc1s::encode(
-        &rgba,
-        (64, 64),
-        kapaint::export::codec::Effort::Fast,
-        true,
-    )
-    .expect("ETC1S")
-    .image;
+    let etc1s = kapaint::export::codec::etc1s::Etc1sCodec::new(4, true)
+        .encode(
+            &[((64, 64), &rgba[..])],
+            kapaint::export::codec::Effort::Fast,
+        )
+        .expect("ETC1S")
+        .image;
     let etc1s = kapaint::export::ktx::etc1s_file(&etc1s, true).expect("KTX2");
     let sgd_at = u64::from_le_bytes(etc1s[64..72].try_into().expect("8 bytes")) as usize;
     let mut short_codebook = etc1s.clone();

@@ -7,8 +7,8 @@
 //! Binomial's encoder writes `.basis` files: [`encode_etc1s`] reads one into the split (its
 //! header and slice descriptions, the format's documented fixed-size records), and
 //! [`transcode_etc1s`] writes the split back into a `.basis` file in memory for the
-//! transcoder. The mips are the encoder's own (`basisu -mipmap`), filtered in linear light
-//! for sRGB colour.
+//! transcoder. The mips are the caller's ([`encode_etc1s_levels`]), or else the encoder's own
+//! (`basisu -mipmap`, filtered in linear light for sRGB colour).
 
 use basis_universal::{
     BasisTextureFormat, ColorSpace, CompressorParams, TranscodeParameters, Transcoder,

@@ -10,7 +10,7 @@
 //!   transcoder writes past it.
 //!
 //! - [`etc1s`]: ETC1S with BasisLZ, the smaller of Basis Universal's two formats: RGBA8
-//!   texels (and the encoder's own mips) to the codebooks, tables and slices KTX2 stores, and
+//!   texels (and the caller's mips, or the encoder's) to the codebooks, tables and slices KTX2 stores, and
 //!   those back to BC7 or ASTC 4x4.
 //!
 //! No `.basis` files leave here: kapaint writes its own KTX2 containers; the encoder's `.basis`

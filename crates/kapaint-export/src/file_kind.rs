@@ -112,6 +112,12 @@ impl Compression {
         matches!(self, Self::Ktx2Astc | Self::Ktx2Uastc | Self::Ktx2Etc1s)
     }
 
+    /// Whether its files carry a supercompression of their own (ETC1S's BasisLZ), so a
+    /// preset's zstd does not go over them.
+    pub fn has_own_supercompression(self) -> bool {
+        matches!(self, Self::Ktx2Etc1s)
+    }
+
     /// The compression a manifest names.
     pub fn parse(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|c| c.name() == name)

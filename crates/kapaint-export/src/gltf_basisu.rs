@@ -20,7 +20,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::blocks::Coder;
-use crate::codec::{Codec, Effort, Uastc, etc1s};
+use crate::codec::etc1s::{Etc1sCodec, Etc1sLevels};
+use crate::codec::{Codec, Effort, Uastc};
 use crate::file_kind::ColourSpace;
 use crate::ktx::{self, Compressed, Space};
 use crate::preset::BlockBudget;
@@ -37,7 +38,8 @@ pub const ZSTD_LEVEL: u8 = 18;
 
 /// The normal map's effort: UASTC level 3 without RDO, whatever the search chose for the
 /// material. RDO trades a normal's direction for bytes, and on a noisy 1024^2 normal map it
-/// was the slower too: 13 to 17 s at level 1 with RDO, 8.8 s at level 3 without.
+/// was the slower too: 13 to 17 s with RDO (at level 3: the crate's level 1 ran as 3 then),
+/// 8.8 s without.
 pub const NORMAL_EFFORT: Effort = Effort::Slow;
 
 /// One texture's texels: 8-bit RGB, row major.
@@ -135,24 +137,19 @@ pub struct Encoded {
     pub report: BasisuReport,
 }
 
-/// The base colour as the search left it: an ETC1S file made whole, or UASTC's level 0.
+/// The base colour as the search left it: an ETC1S file made whole (with the mips every
+/// texture has), or UASTC's level 0.
 enum Base {
-    Etc1s(etc1s::Etc1sFile),
+    Etc1s(Etc1sLevels),
     Uastc(Compressed),
 }
 
 impl Base {
     /// Level 0's RGB as a runtime decodes it.
-    fn decoded(&self) -> std::borrow::Cow<'_, [u8]> {
+    fn decoded(&self) -> &[u8] {
         match self {
-            // RGBA from the BC7 transcode: the RGB the measure reads.
-            Self::Etc1s(f) => f
-                .decoded
-                .chunks_exact(4)
-                .flat_map(|t| [t[0], t[1], t[2]])
-                .collect::<Vec<u8>>()
-                .into(),
-            Self::Uastc(c) => c.decoded.as_slice().into(),
+            Self::Etc1s(f) => f.decoded.first().map_or(&[], Vec::as_slice),
+            Self::Uastc(c) => &c.decoded,
         }
     }
 }
@@ -201,11 +198,12 @@ fn search(
 ) -> Result<(Step, bool), String> {
     let (base_codec, data_codec) = (Uastc::new(3, true), Uastc::new(3, false));
     let exact = ka_of(base.texels, mr.texels, reading);
-    let rgba: Vec<u8> = base
-        .texels
-        .chunks_exact(3)
-        .flat_map(|t| [t[0], t[1], t[2], 255])
+    // ETC1S's trials encode the whole file, with the mips every texture has.
+    let mips = with_source(base, Space::Srgb, ktx::mips);
+    let levels: Vec<((u32, u32), &[u8])> = std::iter::once((base.size, base.texels))
+        .chain(mips.iter().map(|(size, t)| (*size, &t[..])))
         .collect();
+    let etc1s = Etc1sCodec::new(3, true);
     let mut last: Option<Step> = None;
     // ETC1S is tried while it may still win: once UASTC at the same effort does better, more
     // quality in ETC1S will not overtake UASTC's next step.
@@ -214,12 +212,10 @@ fn search(
     for (i, effort) in Effort::ALL.into_iter().enumerate() {
         progress.check().map_err(|_| "cancelled".to_string())?;
         let m = level0(&data_codec, effort, mr)?;
-        let measure = |b: &Base| ka_error(&exact, &ka_of(&b.decoded(), &m.decoded, reading));
+        let measure = |b: &Base| ka_error(&exact, &ka_of(b.decoded(), &m.decoded, reading));
         let mut etc1s_error = None;
         if etc1s_alive {
-            let etc = Base::Etc1s(
-                etc1s::encode(&rgba, base.size, effort, true).map_err(|e| e.to_string())?,
-            );
+            let etc = Base::Etc1s(etc1s.encode(&levels, effort).map_err(|e| e.to_string())?);
             let error = measure(&etc);
             if error.over(budget) == (false, false) {
                 return Ok((step(effort, etc, m, error), true));
@@ -347,6 +343,21 @@ fn file(
     level0: Option<Compressed>,
     progress: &Progress,
 ) -> Result<Vec<u8>, String> {
+    let written = with_source(rgb, space, |source| {
+        ktx::encode(
+            source,
+            Some((Coder::Portable, codec, effort)),
+            level0,
+            progress,
+        )
+    })
+    .map_err(|e| e.to_string())?;
+    ktx::supercompress(&written.bytes, ZSTD_LEVEL)
+}
+
+/// `f` of `rgb` as the KTX2 writer takes it (components in `space`, averaged for mips in
+/// linear light where sRGB).
+fn with_source<R>(rgb: Rgb<'_>, space: Space, f: impl FnOnce(&ktx::Source<'_>) -> R) -> R {
     let spaces = [space; 3];
     let value = |i: usize, k: usize| {
         let byte = f32::from(rgb.texels[i * 3 + k]) / 255.0;
@@ -356,21 +367,13 @@ fn file(
             byte
         }
     };
-    let source = ktx::Source {
+    f(&ktx::Source {
         width: rgb.size.0,
         height: rgb.size.1,
         spaces: &spaces,
         level0: rgb.texels,
         value: &value,
-    };
-    let written = ktx::encode(
-        &source,
-        Some((Coder::Portable, codec, effort)),
-        level0,
-        progress,
-    )
-    .map_err(|e| e.to_string())?;
-    ktx::supercompress(&written.bytes, ZSTD_LEVEL)
+    })
 }
 
 /// Each texel's `k_a` from glTF's 8-bit base colour (sRGB) and metallic-roughness (G

@@ -2,21 +2,21 @@
 //! takes 8), whose blocks index codebooks of endpoints and selectors that the whole image and
 //! all its mips share. It cannot be a strip codec behind [`super::Codec`]: a strip encoded
 //! apart would have codebooks of its own, and a KTX2 file holds one set. So it stands beside
-//! the trait: a whole image in, its codebooks and slices out (with the encoder's mips,
-//! [`kapaint_basis::etc1s`]; `crate::ktx::etc1s_file` writes them as KTX2),
-//! and level 0 as a runtime decodes it after transcoding to BC7 (the measure's input).
+//! the trait: a whole image in, its codebooks and slices out ([`kapaint_basis::etc1s`];
+//! `crate::ktx::etc1s_file` writes them as KTX2).
 //!
-//! A set's images go through [`Etc1sCodec`]: their stored components (one as luminance, two
-//! as luminance and alpha, three as RGB, four as RGBA, as UASTC takes them) and kapaint's own
-//! mips (averaged in each component's space, as every KTX2 set's), encoded together so the
-//! codebooks serve every level; every level comes back as the BC7 transcode decodes it.
+//! Every image goes through [`Etc1sCodec`] (a set's, the Basis `.glb`'s base colour, a file
+//! read back): its stored components (one as luminance, two as luminance and alpha, three as
+//! RGB, four as RGBA, as UASTC takes them) and kapaint's own mips (averaged in each
+//! component's space, as every KTX2 file's), encoded together so the codebooks serve every
+//! level; levels come back as the BC7 transcode decodes them (the measure's input).
 //!
 //! **Efforts** map onto ETC1S's quality level (the codebooks' size): 32, 64, 128, 192, 255.
 
 use super::{Bc7, Codec, CodecError, Effort};
 use crate::blocks;
 use crate::file_kind::Compression;
-use kapaint_basis::etc1s::{Etc1s, encode_etc1s, encode_etc1s_levels, transcode_etc1s};
+use kapaint_basis::etc1s::{Etc1s, encode_etc1s_levels, transcode_etc1s};
 pub use kapaint_basis::etc1s::{Etc1sImage, Level};
 
 /// ETC1S's quality level for an effort.
@@ -30,68 +30,11 @@ pub fn quality_of(effort: Effort) -> u32 {
     }
 }
 
-/// An image encoded as ETC1S.
-pub struct Etc1sFile {
-    /// The image: codebooks, tables and every level's slices (`crate::ktx::etc1s_file`
-    /// writes its KTX2 file).
-    pub image: Etc1sImage,
-    /// Level 0 as the BC7 transcode decodes it: RGBA8, the image's size.
-    pub decoded: Vec<u8>,
-    /// The quality level it was encoded at.
-    pub quality: u32,
-}
-
 fn library(reason: String) -> CodecError {
     CodecError::Library {
         codec: "ETC1S",
         reason,
     }
-}
-
-/// `rgba` (`size`, RGBA8, sides multiples of 4) as ETC1S at `effort`, sRGB colour where
-/// `srgb`, with its full mip chain.
-///
-/// # Errors
-/// The encoder's or transcoder's failure.
-pub fn encode(
-    rgba: &[u8],
-    size: (u32, u32),
-    effort: Effort,
-    srgb: bool,
-) -> Result<Etc1sFile, CodecError> {
-    let quality = quality_of(effort);
-    let how = Etc1s {
-        quality,
-        srgb,
-        mips: true,
-    };
-    let image = encode_etc1s(rgba, size, how).map_err(library)?;
-    let decoded = decode_level0(&image, srgb)?;
-    Ok(Etc1sFile {
-        image,
-        decoded,
-        quality,
-    })
-}
-
-/// Level 0 of `image` as a runtime decodes it after transcoding to BC7: RGBA8 at its size
-/// padded to whole blocks (alpha 255 where the image has no alpha slice).
-///
-/// # Errors
-/// Codebooks or slices the transcoder cannot read.
-pub fn decode_level0(image: &Etc1sImage, srgb: bool) -> Result<Vec<u8>, CodecError> {
-    let first = image
-        .levels
-        .first()
-        .ok_or_else(|| library("no levels".into()))?;
-    let size = (first.width.div_ceil(4) * 4, first.height.div_ceil(4) * 4);
-    let bc7 = transcode_etc1s(image, srgb, kapaint_basis::Target::Bc7).map_err(library)?;
-    let level0 = bc7.first().ok_or_else(|| library("no levels".into()))?;
-    let codec = Bc7::new(true, srgb);
-    if level0.len() != codec.blocks_len(size) {
-        return Err(library("level 0 transcodes to the wrong size".into()));
-    }
-    blocks::decode(&codec, level0, size)
 }
 
 /// ETC1S for an image of `channels` stored components (1 to 4), sRGB colour where `srgb`:
@@ -130,15 +73,6 @@ impl Etc1sCodec {
     /// The manifest's name for its files.
     pub fn compression(self) -> Compression {
         Compression::Ktx2Etc1s
-    }
-
-    /// What its files hold, in words for people.
-    pub fn describe(self) -> String {
-        match self.channels {
-            1 => "ETC1S (luminance)".into(),
-            2 => "ETC1S (luminance and alpha)".into(),
-            _ => "ETC1S".into(),
-        }
     }
 
     /// `stored` texels (`channels` bytes each) as RGBA: one as luminance, two as luminance
@@ -196,7 +130,7 @@ impl Etc1sCodec {
             mips: false,
         };
         let image = encode_etc1s_levels(&given, how).map_err(library)?;
-        let decoded = self.decode(&image)?;
+        let decoded = self.decode(&image, image.levels.len())?;
         Ok(Etc1sLevels {
             image,
             decoded,
@@ -204,18 +138,19 @@ impl Etc1sCodec {
         })
     }
 
-    /// Every level of `image` as the BC7 transcode decodes it, stored components only, each
-    /// at its own size.
+    /// The first `levels` levels of `image` as the BC7 transcode decodes them, stored
+    /// components only (alpha 255 where the image has no alpha slice), each at its own size.
     ///
     /// # Errors
     /// Codebooks or slices the transcoder cannot read.
-    pub fn decode(self, image: &Etc1sImage) -> Result<Vec<Vec<u8>>, CodecError> {
+    pub fn decode(self, image: &Etc1sImage, levels: usize) -> Result<Vec<Vec<u8>>, CodecError> {
         let bc7 = transcode_etc1s(image, self.srgb, kapaint_basis::Target::Bc7).map_err(library)?;
         let codec = Bc7::new(true, self.srgb);
         image
             .levels
             .iter()
             .zip(&bc7)
+            .take(levels)
             .map(|(level, blocks)| {
                 let (w, h) = (level.width, level.height);
                 let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);

@@ -197,13 +197,14 @@ fn decode_etc1s(reader: &ktx2::Reader<&[u8]>, (w, h): (u32, u32)) -> Result<Deco
     }
     let (image, srgb) = super::basislz::read_etc1s(reader)?;
     let alpha = image.has_alpha();
-    let padded = (w.div_ceil(4) * 4, h.div_ceil(4) * 4);
     let first = image.levels.first().ok_or("the file has no levels")?;
     if (first.width, first.height) != (w, h) {
         return Err("level 0 is not the header's size".into());
     }
-    let texels = codec::etc1s::decode_level0(&image, srgb).map_err(|e| e.to_string())?;
-    let tight = crop(&texels, padded.0, (w, h), 4, 4);
+    let tight = codec::etc1s::Etc1sCodec::new(4, srgb)
+        .decode(&image, 1)
+        .map_err(|e| e.to_string())?
+        .swap_remove(0);
     Ok(Decoded {
         width: w,
         height: h,

@@ -379,9 +379,8 @@ fn write_images(
             });
         }
         let path = tmp.join(&file);
-        // ETC1S files are supercompressed already (BasisLZ): zstd is for the others.
         let supercompression = match (preset.zstd, &image.ktx) {
-            (Some(level), Some(k)) if k.compression != Compression::Ktx2Etc1s => {
+            (Some(level), Some(k)) if !k.compression.has_own_supercompression() => {
                 let (bytes, said) = supercompressed(&image.bytes, level, &path)?;
                 image.bytes = bytes;
                 Some(said)

@@ -23,10 +23,11 @@ pub(super) enum ImageCodec {
     Whole(Etc1sCodec),
 }
 
-/// What a trial's encode left: level 0's blocks, or the whole image's levels.
+/// What a trial's encode left: level 0's blocks (their PSNR measured once asked), or the
+/// whole image's levels with level 0's PSNR.
 pub(super) enum Blocks {
     Strips(Compressed),
-    Whole(Etc1sLevels),
+    Whole(Etc1sLevels, Vec<Option<f64>>),
 }
 
 /// One image of a trial: its texels and codec, level 0 as stored, and level 0 compressed.
@@ -79,8 +80,13 @@ impl TrialImage<'_> {
                     .chain(mips.iter().map(|(s, t)| (*s, &t[..])))
                     .collect();
                 let whole = codec.encode(&levels, effort).map_err(|e| e.to_string())?;
+                let spaces = self.texels.spaces();
+                let psnr = whole
+                    .decoded
+                    .first()
+                    .map_or_else(Vec::new, |d| ktx::psnr(&self.level0, d, spaces));
                 p.advance(u64::from(size.1));
-                Blocks::Whole(whole)
+                Blocks::Whole(whole, psnr)
             }
         };
         self.compressed = Some((runs, blocks));
@@ -91,7 +97,7 @@ impl TrialImage<'_> {
     fn decoded(&self) -> Option<&[u8]> {
         Some(match &self.compressed.as_ref()?.1 {
             Blocks::Strips(c) => &c.decoded,
-            Blocks::Whole(w) => w.decoded.first()?,
+            Blocks::Whole(w, _) => w.decoded.first()?,
         })
     }
 
@@ -100,10 +106,7 @@ impl TrialImage<'_> {
         let spaces = self.texels.spaces();
         match self.compressed.as_mut() {
             Some((_, Blocks::Strips(c))) => c.psnr(&self.level0, spaces).to_vec(),
-            Some((_, Blocks::Whole(w))) => w
-                .decoded
-                .first()
-                .map_or_else(Vec::new, |d| ktx::psnr(&self.level0, d, spaces)),
+            Some((_, Blocks::Whole(_, psnr))) => psnr.clone(),
             None => Vec::new(),
         }
     }
@@ -138,19 +141,15 @@ impl TrialImage<'_> {
         progress: &Progress,
     ) -> Result<ktx::Written, Failure> {
         Ok(match (&self.codec, self.compressed.take()) {
-            (ImageCodec::Whole(codec), Some((_, Blocks::Whole(whole)))) => {
-                let psnr = whole
-                    .decoded
-                    .first()
-                    .map(|d| ktx::psnr(&self.level0, d, self.texels.spaces()));
+            (ImageCodec::Whole(codec), Some((_, Blocks::Whole(whole, psnr)))) => {
                 progress.advance(u64::from(size.1));
-                whole_written(*codec, whole, psnr)?
+                whole_written(*codec, whole, Some(psnr))?
             }
             (ImageCodec::Whole(_), _) => return Err("the ETC1S image was not encoded".into()),
             (ImageCodec::Strips(codec), compressed) => {
                 let compressed = compressed.and_then(|(_, c)| match c {
                     Blocks::Strips(c) => Some(c),
-                    Blocks::Whole(_) => None,
+                    Blocks::Whole(..) => None,
                 });
                 ktx::encode(
                     &self.texels.source(size, &self.level0),
