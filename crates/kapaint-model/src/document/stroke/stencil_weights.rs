@@ -53,7 +53,9 @@ impl StencilOn<'_> {
 /// out at the first dab that reads it, for the stencil (and surface) they were worked out for.
 #[derive(Default)]
 pub(in crate::document) struct StencilWeights {
-    /// The stencil and the surface's address the tiles hold the weights of.
+    /// The stencil and the surface's address the tiles hold the weights of (an address is
+    /// enough: the stroke's state before it holds the surface, so no other takes its place
+    /// while the stroke lasts).
     key: Option<(Arc<Stencil>, usize)>,
     tiles: Vec<OnceLock<Box<[f32]>>>,
 }
