@@ -377,7 +377,7 @@ pub(super) fn surface_smudge_dab(
     let blend = crate::paint::n_blend_table();
     let w = maps.width() as usize;
     let tiles = maps.tiles();
-    from_now(planes, |planes, pre, mask| {
+    from_now(planes, ids, |planes, pre, mask| {
         let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
             let rect = maps.tile_rect(id);
             let mut written = TileSpans::EMPTY;

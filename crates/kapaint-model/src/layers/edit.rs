@@ -367,6 +367,26 @@ struct Target {
     gray: f32,
 }
 
+/// What sets a tile's coverage and targets for [`edit_varying`] and [`edit_each`]
+/// (`prepare(id, cover, targets)`, see there); a closure is one.
+pub trait Prepare: Sync {
+    /// Sets tile `id`'s coverage and targets; returns the texels to write. Mark it
+    /// `#[inline(always)]`: it runs inside [`vectorized`](crate::simd::vectorized) (a
+    /// closure's body stays compiled for the baseline).
+    fn prepare(&self, id: usize, cover: &mut [f32], targets: &mut TileTargets) -> TileSpans;
+}
+
+impl<F: Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync> Prepare for F {
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn prepare(&self, id: usize, cover: &mut [f32], targets: &mut TileTargets) -> TileSpans {
+        self(id, cover, targets)
+    }
+}
+
 /// Per-texel targets of a tile, for [`edit_varying`]: each texel's seven components (a
 /// mask's gray first).
 pub type TileTargets = Vec<[f32; 7]>;
@@ -381,7 +401,7 @@ pub fn edit_varying(
     edit: &LayerEdit,
     ids: &[usize],
     covers: Vec<&mut [f32]>,
-    prepare: &(impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync),
+    prepare: &impl Prepare,
 ) -> Vec<TileSpans> {
     slots(planes, pre, ids)
         .into_par_iter()
@@ -397,7 +417,7 @@ pub fn edit_each(
     (planes, pre): (Planes<'_>, PrePlanes<'_>),
     edit: &LayerEdit,
     ids: &[usize],
-    prepare: &(impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync),
+    prepare: &impl Prepare,
 ) {
     slots(planes, pre, ids)
         .into_par_iter()
@@ -413,50 +433,52 @@ pub fn edit_each(
 
 /// One tile of [`edit_varying`] and [`edit_each`]: `prepare` fills its coverage and targets
 /// (in a worker's own buffer of targets), then the texels it returns are written.
-fn write_varying(
+fn write_varying<P: Prepare>(
     slot: &mut Slot<'_>,
     edit: &LayerEdit,
     id: usize,
     cover: &mut [f32],
-    prepare: &impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans,
+    prepare: &P,
 ) -> TileSpans {
     TARGETS.with_borrow_mut(|targets| {
         targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
-        let spans = prepare(id, cover, targets);
-        if !spans.is_empty() {
-            crate::simd::vectorized(VaryingWrite {
-                slot,
-                edit,
-                spans: &spans,
-                cover,
-                targets,
-            });
-        }
-        spans
+        crate::simd::vectorized(VaryingWrite {
+            slot,
+            edit,
+            id,
+            cover,
+            targets,
+            prepare,
+        })
     })
 }
 
-/// The write of [`edit_varying`]'s tile, compiled for the CPU's widest vectors.
-struct VaryingWrite<'s, 'a> {
+/// [`edit_varying`]'s tile, its preparation and write compiled for the CPU's widest vectors.
+struct VaryingWrite<'s, 'a, P> {
     slot: &'s mut Slot<'a>,
     edit: &'s LayerEdit,
-    spans: &'s TileSpans,
-    cover: &'s [f32],
-    targets: &'s [[f32; 7]],
+    id: usize,
+    cover: &'s mut [f32],
+    targets: &'s mut TileTargets,
+    prepare: &'s P,
 }
 
-impl crate::simd::Kernel for VaryingWrite<'_, '_> {
-    type Output = ();
+impl<P: Prepare> crate::simd::Kernel for VaryingWrite<'_, '_, P> {
+    type Output = TileSpans;
 
     #[inline(always)]
     #[expect(
         clippy::inline_always,
         reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
     )]
-    fn with_simd<S: pulp::Simd>(self, _: S) {
-        self.slot
-            .write_cover(self.edit, self.spans, self.cover, Some(self.targets));
-        self.slot.compact();
+    fn with_simd<S: pulp::Simd>(self, _: S) -> TileSpans {
+        let spans = self.prepare.prepare(self.id, self.cover, self.targets);
+        if !spans.is_empty() {
+            self.slot
+                .write_cover(self.edit, &spans, self.cover, Some(self.targets));
+            self.slot.compact();
+        }
+        spans
     }
 }
 

@@ -97,6 +97,34 @@ fn decode_run<T: Copy + PartialEq>(
     }
 }
 
+/// Decodes `len` texels of an RGB `plane` from texel `start` into `out`, a component each.
+#[inline(always)]
+fn decode_rgb_run(
+    plane: &Plane<[u16; 3]>,
+    start: usize,
+    len: usize,
+    out: &mut [[f32; TILE_SIZE]; 3],
+) {
+    let [r, g, b] = out;
+    match plane {
+        Plane::Uniform(v) => {
+            r[..len].fill(decode_unorm(v[0]));
+            g[..len].fill(decode_unorm(v[1]));
+            b[..len].fill(decode_unorm(v[2]));
+        }
+        Plane::Data(d) => {
+            for (((v, r), g), b) in d[start..start + len]
+                .iter()
+                .zip(r.iter_mut())
+                .zip(g.iter_mut())
+                .zip(b.iter_mut())
+            {
+                (*r, *g, *b) = (decode_unorm(v[0]), decode_unorm(v[1]), decode_unorm(v[2]));
+            }
+        }
+    }
+}
+
 /// The coverage of a transparent texel after a brush at `cover`, at texels `spans` of a
 /// channel's coverage plane (the value is the target's: see [`Slot::write_cover`]).
 #[inline(always)]
@@ -131,7 +159,9 @@ pub(super) fn cover_channel(
     let table = crate::paint::n_blend_table();
     let n_bits = crate::paint::n_bits_table();
     let mut pre_alpha = [0.0_f32; TILE_SIZE];
-    let mut pre_value = [0.0_f32; TILE_SIZE];
+    // Per component: the pre-operation values and the targets of a run.
+    let mut pre_value = [[0.0_f32; TILE_SIZE]; 3];
+    let mut t = [[0.0_f32; TILE_SIZE]; 3];
     let (mut a, mut w) = ([0.0_f32; TILE_SIZE], [0.0_f32; TILE_SIZE]);
     let mut alpha = [0_u16; TILE_SIZE];
     let mut out = [[0_u16; TILE_SIZE]; 3];
@@ -150,25 +180,45 @@ pub(super) fn cover_channel(
             Targets::Uniform(t) => t.len(),
             Targets::Varying(_, range) => range.len(),
         };
-        let mut t = [0.0_f32; TILE_SIZE];
-        for c in 0..components {
-            let t = &mut t[..width];
-            match &target {
-                Targets::Uniform(u) => t.fill(u[c]),
-                Targets::Varying(v, range) => {
-                    for (t, v) in t.iter_mut().zip(&v[start..start + width]) {
-                        *t = v[range.start + c];
+        // Every component's targets and pre-operation values of the run in one pass each
+        // (the texels' components lie interleaved).
+        match &target {
+            Targets::Uniform(u) => {
+                for (t, &u) in t.iter_mut().zip(u.iter()) {
+                    t[..width].fill(u);
+                }
+            }
+            Targets::Varying(v, range) => {
+                let v = &v[start..start + width];
+                if let [r, g, b] = &mut t
+                    && range.len() == 3
+                {
+                    for (((v, r), g), b) in v
+                        .iter()
+                        .zip(r.iter_mut())
+                        .zip(g.iter_mut())
+                        .zip(b.iter_mut())
+                    {
+                        (*r, *g, *b) = (v[range.start], v[range.start + 1], v[range.start + 2]);
+                    }
+                } else {
+                    for (t, v) in t[0].iter_mut().zip(v) {
+                        *t = v[range.start];
                     }
                 }
             }
-            if let Some(p) = pre {
-                let out = &mut pre_value[..width];
-                match ch {
-                    0 => decode_run(&p.value.kd, start, out, |v| decode_unorm(v[c])),
-                    1 => decode_run(&p.value.ks, start, out, |v| decode_unorm(v[c])),
-                    _ => decode_run(&p.value.n, start, out, |bits| table[bits as usize]),
-                }
+        }
+        if let Some(p) = pre {
+            match ch {
+                0 => decode_rgb_run(&p.value.kd, start, width, &mut pre_value),
+                1 => decode_rgb_run(&p.value.ks, start, width, &mut pre_value),
+                _ => decode_run(&p.value.n, start, &mut pre_value[0][..width], |bits| {
+                    table[bits as usize]
+                }),
             }
+        }
+        for c in 0..components {
+            let (t, pre_value) = (&t[c], &pre_value[c]);
             let encoded = &mut out[c][..width];
             if ch == 2 {
                 for j in 0..width {
