@@ -13,8 +13,7 @@ use std::time::Duration;
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use kapaint::model::brush::{BrushSettings, StrokePoint};
-use kapaint::model::texel::{MaterialValue, Texel};
-use kapaint::model::tile::TILE_TEXELS;
+use kapaint::model::texel::MaterialValue;
 use kapaint::model::{Document, DocumentSettings, FillRegion, MaterialMaps, StrokeTool, project};
 use kapaint::model::{HistoryCommand, LayerCommand, PaintCommand, SettingsCommand, StrokeCommand};
 use kapaint::reflectance::{AmbientApprox, ShadingModel};
@@ -24,25 +23,7 @@ const SIDE: u32 = 4096;
 
 /// A document whose every tile holds varied data (nothing uniform).
 fn painted_document(side: u32) -> Document {
-    let mut maps = MaterialMaps::new(side, side, MaterialValue::default()).expect("size");
-    let count = maps.tile_count();
-    for id in 0..count {
-        let tile = maps.tile_mut(id);
-        for i in 0..TILE_TEXELS {
-            let h = (id * TILE_TEXELS + i) as u32;
-            let f =
-                |k: u32| ((h.wrapping_mul(2_654_435_761).rotate_left(k)) % 1000) as f32 / 1000.0;
-            tile.set_texel(
-                i,
-                Texel::encode(MaterialValue::new(
-                    Vec3::new(f(1), f(5), f(9)),
-                    Vec3::splat(f(13)),
-                    f(17) * 2000.0,
-                )),
-            );
-        }
-    }
-    Document::from_parts(maps, DocumentSettings::default())
+    kapaint::report::typical::varied_document(side).expect("size")
 }
 
 fn brush128() -> BrushSettings {
@@ -422,48 +403,16 @@ fn tool_dabs(c: &mut Criterion) {
     group
         .sample_size(20)
         .measurement_time(Duration::from_secs(4));
-    let checker = image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(256, 256, |x, y| {
-        image::Luma([if (x / 32 + y / 32) % 2 == 0 { 255 } else { 40 }])
-    }));
-    let stencil = kapaint::model::paint_image::PaintImage::decoded(
-        std::path::Path::new("checker.png"),
-        &checker,
-    )
-    .expect("stencil");
+    // The same document and dabs as examples/tool_dab_profile.rs.
+    let path = kapaint::report::typical::tool_dab_path;
     for (name, tool) in [
         ("brush_dab_128px", StrokeTool::Brush),
         ("clone_dab_128px", StrokeTool::Clone),
         ("smudge_dab_128px", StrokeTool::Smudge),
         ("brush_dab_128px_through_stencil", StrokeTool::Brush),
     ] {
-        let mut doc = painted_document(SIDE);
-        // Spacing 10 % (smudge's most), one dab a point along rows 320 texels apart.
-        doc.apply(SettingsCommand::SetBrush(BrushSettings {
-            spacing_percent: 10.0,
-            ..brush128()
-        }))
-        .expect("brush");
-        let path = |k: u32| {
-            let (row, col) = ((k / 250) % 12, k % 250);
-            Vec2::new(256.5 + 12.8 * col as f32, 256.5 + 320.0 * row as f32)
-        };
-        let first = path(0);
-        doc.apply(SettingsCommand::SetCloneSource(
-            first + Vec2::new(160.0, 0.0),
-        ))
-        .expect("source");
-        if name.ends_with("stencil") {
-            doc.apply(SettingsCommand::SetStencil {
-                image: stencil.clone(),
-                center: Vec2::splat(2048.0),
-                size: 4096.0,
-                rotation: 15.0,
-                opacity: 1.0,
-                tiled: true,
-                view: None,
-            })
-            .expect("stencil");
-        }
+        let mut doc = kapaint::report::typical::tool_dab_document(name.ends_with("stencil"))
+            .expect("document");
         let mut k = 0u32;
         group.bench_function(name, |b| {
             b.iter(|| {

@@ -255,3 +255,80 @@ pub fn write_pbr_set(
     mr.save(&m).map_err(|e| e.to_string())?;
     Ok((b, m))
 }
+
+/// A `side x side` document whose every texel holds a different material (no tile uniform),
+/// for dab and resampling benchmarks.
+///
+/// # Errors
+/// When the size is refused.
+pub fn varied_document(side: u32) -> Result<Document, String> {
+    use kapaint_model::texel::Texel;
+    use kapaint_model::tile::TILE_TEXELS;
+    let mut maps = kapaint_model::MaterialMaps::new(side, side, MaterialValue::default())
+        .map_err(|e| e.to_string())?;
+    for id in 0..maps.tile_count() {
+        let tile = maps.tile_mut(id);
+        for i in 0..TILE_TEXELS {
+            let h = (id * TILE_TEXELS + i) as u32;
+            let f =
+                |k: u32| ((h.wrapping_mul(2_654_435_761).rotate_left(k)) % 1000) as f32 / 1000.0;
+            tile.set_texel(
+                i,
+                Texel::encode(MaterialValue::new(
+                    Vec3::new(f(1), f(5), f(9)),
+                    Vec3::splat(f(13)),
+                    f(17) * 2000.0,
+                )),
+            );
+        }
+    }
+    Ok(Document::from_parts(maps, DocumentSettings::default()))
+}
+
+/// Dab `k` of the painting tools' benchmark: 250 dabs a row, 12.8 texels apart (10 % of a
+/// 128 px radius), rows 320 texels apart across a 4096^2 map, 12 rows before it starts over.
+pub fn tool_dab_path(k: u32) -> Vec2 {
+    let (row, col) = ((k / 250) % 12, k % 250);
+    Vec2::new(256.5 + 12.8 * col as f32, 256.5 + 320.0 * row as f32)
+}
+
+/// The painting tools' benchmark document: [`varied_document`] at 4096^2, a 128 px brush
+/// (hardness 0.5, flow 0.5, spacing 10 %), a clone source 160 texels along the first row
+/// and, with `stencil`, a tiled 256^2 checker stencil over the map turned 15 degrees.
+///
+/// # Errors
+/// When a command is refused.
+pub fn tool_dab_document(stencil: bool) -> Result<Document, String> {
+    let mut doc = varied_document(4096)?;
+    let run = |doc: &mut Document, c: Command| doc.apply(c).map_err(|e| e.to_string());
+    let brush = BrushSettings {
+        radius_px: 128.0,
+        hardness: 0.5,
+        flow: 0.5,
+        spacing_percent: 10.0,
+        ..BrushSettings::default()
+    };
+    run(&mut doc, SettingsCommand::SetBrush(brush).into())?;
+    let source = tool_dab_path(0) + Vec2::new(160.0, 0.0);
+    run(&mut doc, SettingsCommand::SetCloneSource(source).into())?;
+    if stencil {
+        let checker =
+            image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(256, 256, |x, y| {
+                image::Luma([if (x / 32 + y / 32) % 2 == 0 { 255 } else { 40 }])
+            }));
+        let image =
+            kapaint_model::paint_image::PaintImage::decoded(Path::new("checker.png"), &checker)
+                .map_err(|e| e.to_string())?;
+        let set = SettingsCommand::SetStencil {
+            image,
+            center: Vec2::splat(2048.0),
+            size: 4096.0,
+            rotation: 15.0,
+            opacity: 1.0,
+            tiled: true,
+            view: None,
+        };
+        run(&mut doc, set.into())?;
+    }
+    Ok(doc)
+}

@@ -31,20 +31,12 @@ pub(super) struct CloneSource {
 }
 
 /// The value of a composite tile's texel `i`, as the layer kernels blend it (`k_d`, `k_s`,
-/// `n` in blend space).
+/// `n` in blend space): [`decode_tile_run`] of one texel.
 #[inline]
 fn edit_value(tile: &Tile, i: usize, blend: &[f32]) -> [f32; 7] {
-    let kd = tile.kd.get(i).map(decode_unorm);
-    let ks = tile.ks.get(i).map(decode_unorm);
-    [
-        kd[0],
-        kd[1],
-        kd[2],
-        ks[0],
-        ks[1],
-        ks[2],
-        blend[tile.n.get(i) as usize],
-    ]
+    let mut out = [[0.0; 7]];
+    decode_tile_run(tile, i, &mut out, blend);
+    out[0]
 }
 
 /// A mask's stored gray at texel `(x, y)`.
@@ -71,8 +63,8 @@ pub(super) fn value_at(
     }
 }
 
-/// Texels `i..i + out.len()` of a composite tile as targets ([`edit_value`]'s), a plane at
-/// a time.
+/// Texels `i..i + out.len()` of a composite tile as the layer kernels blend them (`k_d`,
+/// `k_s`, `n` in blend space), a plane at a time.
 #[inline(always)]
 #[expect(
     clippy::inline_always,

@@ -190,9 +190,8 @@ pub(super) fn cover_channel(
             }
             Targets::Varying(v, range) => {
                 let v = &v[start..start + width];
-                if let [r, g, b] = &mut t
-                    && range.len() == 3
-                {
+                if range.len() == 3 {
+                    let [r, g, b] = &mut t;
                     for (((v, r), g), b) in v
                         .iter()
                         .zip(r.iter_mut())
