@@ -2,7 +2,8 @@
 //! spacing along rows of a painted 4096^2 document, a stroke a row) for the brush, clone,
 //! smudge and the brush through a tiled stencil, without criterion's set-up of the other
 //! benchmarks: `perf record` this, or read the milliseconds a dab it prints (the tools
-//! interleaved round by round, so their ratios hold on a noisy machine).
+//! interleaved round by round, so their ratios hold on a noisy machine; the fastest stroke's
+//! dabs are the least disturbed by the machine's other work).
 //!
 //! Usage: `cargo run --release --example tool_dab_profile [brush|clone|smudge|stencil|all]
 //! [DABS]`
@@ -35,10 +36,11 @@ fn main() -> Result<(), String> {
         .iter()
         .map(|n| prepared(n))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut totals = vec![0.0_f64; names.len()];
+    // Seconds a dab, stroke by stroke, per tool.
+    let mut strokes = vec![Vec::new(); names.len()];
     // Rounds of 250 dabs (one stroke), the tools taking turns.
     for round in 0..dabs.div_ceil(250) {
-        for ((doc, tool), total) in docs.iter_mut().zip(&mut totals) {
+        for ((doc, tool), times) in docs.iter_mut().zip(&mut strokes) {
             let start = std::time::Instant::now();
             doc.apply(StrokeCommand::BeginStroke(*tool))
                 .map_err(|e| e.to_string())?;
@@ -51,12 +53,17 @@ fn main() -> Result<(), String> {
             }
             doc.apply(StrokeCommand::EndStroke)
                 .map_err(|e| e.to_string())?;
-            *total += start.elapsed().as_secs_f64();
+            times.push(start.elapsed().as_secs_f64() / 250.0);
         }
     }
-    let count = f64::from(dabs.div_ceil(250) * 250);
-    for (name, total) in names.iter().zip(totals) {
-        println!("{name}: {:.3} ms a dab", total / count * 1e3);
+    for (name, times) in names.iter().zip(strokes) {
+        let mean = times.iter().sum::<f64>() / times.len() as f64;
+        let fastest = times.iter().copied().fold(f64::INFINITY, f64::min);
+        println!(
+            "{name}: {:.3} ms a dab (fastest stroke {:.3} ms)",
+            mean * 1e3,
+            fastest * 1e3
+        );
     }
     Ok(())
 }

@@ -13,11 +13,11 @@ use std::sync::Arc;
 use glam::Vec2;
 
 use crate::layers::SharedMaskTile;
-use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes, TileTargets};
+use crate::layers::edit::{self, Components, LayerEdit, Planes, PrePlanes, TileTargets, set_run};
 use crate::maps::MaterialMaps;
 use crate::paint::{Coverage, Footprint};
 use crate::texel::decode_unorm;
-use crate::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileSpans};
+use crate::tile::{Plane, TILE_SIZE, Tile, TileSpans};
 
 /// What a clone stroke reads: the composite and the mask as they were before it.
 pub(super) struct CloneSource {
@@ -34,9 +34,9 @@ pub(super) struct CloneSource {
 /// `n` in blend space): [`decode_tile_run`] of one texel.
 #[inline]
 fn edit_value(tile: &Tile, i: usize, blend: &[f32]) -> [f32; 7] {
-    let mut out = [[0.0; 7]];
-    decode_tile_run(tile, i, &mut out, blend);
-    out[0]
+    let mut out = [0.0; 7];
+    decode_tile_run(tile, i, out.each_mut().map(std::slice::from_mut), blend);
+    out
 }
 
 /// A mask's stored gray at texel `(x, y)`.
@@ -63,49 +63,43 @@ pub(super) fn value_at(
     }
 }
 
-/// Texels `i..i + out.len()` of a composite tile as the layer kernels blend them (`k_d`,
-/// `k_s`, `n` in blend space), a plane at a time.
+/// Texels `i..` of a composite tile as the layer kernels blend them (`k_d`, `k_s`, `n` in
+/// blend space), a component into each of `out` (all of one length), a plane at a time.
 #[inline(always)]
 #[expect(
     clippy::inline_always,
     reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
 )]
-fn decode_tile_run(tile: &Tile, i: usize, out: &mut [[f32; 7]], blend: &[f32]) {
-    let n = out.len();
-    for (plane, first) in [(&tile.kd, 0), (&tile.ks, 3)] {
+fn decode_tile_run(tile: &Tile, i: usize, out: [&mut [f32]; 7], blend: &[f32]) {
+    let [r0, g0, b0, r1, g1, b1, n_out] = out;
+    let n = n_out.len();
+    for (plane, [r, g, b]) in [(&tile.kd, [r0, g0, b0]), (&tile.ks, [r1, g1, b1])] {
         match plane {
             Plane::Uniform(v) => {
-                let v = v.map(decode_unorm);
-                for o in out.iter_mut() {
-                    o[first..first + 3].copy_from_slice(&v);
-                }
+                r.fill(decode_unorm(v[0]));
+                g.fill(decode_unorm(v[1]));
+                b.fill(decode_unorm(v[2]));
             }
             Plane::Data(d) => {
-                for (o, v) in out.iter_mut().zip(&d[i..i + n]) {
-                    for c in 0..3 {
-                        o[first + c] = decode_unorm(v[c]);
-                    }
+                for (((v, r), g), b) in d[i..i + n].iter().zip(r).zip(g).zip(b) {
+                    (*r, *g, *b) = (decode_unorm(v[0]), decode_unorm(v[1]), decode_unorm(v[2]));
                 }
             }
         }
     }
     match &tile.n {
-        Plane::Uniform(bits) => {
-            let v = blend[*bits as usize];
-            for o in out.iter_mut() {
-                o[6] = v;
-            }
-        }
+        Plane::Uniform(bits) => n_out.fill(blend[*bits as usize]),
         Plane::Data(d) => {
-            for (o, &bits) in out.iter_mut().zip(&d[i..i + n]) {
-                o[6] = blend[bits as usize];
+            for (o, &bits) in n_out.iter_mut().zip(&d[i..i + n]) {
+                *o = blend[bits as usize];
             }
         }
     }
 }
 
-/// Row `y` of the map (clamped to it) from column `x0` for `out.len()` texels (columns
-/// clamped too), as targets: a tile at a time, with the row's texels in a plain loop.
+/// Row `y` of the map (clamped to it) from column `x0` for as many texels as `out` holds
+/// (columns clamped too), as targets: a tile at a time, with the row's texels in a plain
+/// loop. A mask's gray goes to the first component only.
 #[inline(always)]
 #[expect(
     clippy::inline_always,
@@ -116,31 +110,32 @@ fn decode_row(
     mask: Option<&[SharedMaskTile]>,
     maps: &MaterialMaps,
     (x0, y): (i64, i64),
-    out: &mut [[f32; 7]],
+    mut out: [&mut [f32]; 7],
     blend: &[f32],
 ) {
     let (w, h) = (i64::from(maps.width()), i64::from(maps.height()));
     let y = y.clamp(0, h - 1) as u32;
+    let len = out[0].len();
     let mut k = 0;
-    while k < out.len() {
+    while k < len {
         let x = x0 + k as i64;
         if x < 0 || x >= w {
             let edge = x.clamp(0, w - 1) as u32;
-            out[k] = value_at(tiles, mask, maps, (edge, y), blend);
+            set_run(&mut out, k, value_at(tiles, mask, maps, (edge, y), blend));
             k += 1;
             continue;
         }
         // The run inside one tile.
         let (id, i) = maps.locate(x as u32, y);
         let in_tile = TILE_SIZE - (x as usize % TILE_SIZE);
-        let n = in_tile.min(out.len() - k).min((w - x) as usize);
-        let run = &mut out[k..k + n];
+        let n = in_tile.min(len - k).min((w - x) as usize);
         if let Some(m) = mask {
             let plane = m[id].get();
-            for (j, o) in run.iter_mut().enumerate() {
-                *o = [decode_unorm(plane.get(i + j)), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+            for (j, o) in out[0][k..k + n].iter_mut().enumerate() {
+                *o = decode_unorm(plane.get(i + j));
             }
         } else {
+            let run = out.each_mut().map(|c| &mut c[k..k + n]);
             decode_tile_run(&tiles[id], i, run, blend);
         }
         k += n;
@@ -212,16 +207,20 @@ impl<R: edit::Raise> edit::Prepare for CloneTile<'_, R> {
                 self.mask,
                 self.maps,
                 (sx0, sy),
-                &mut targets[start..end],
+                targets.run_mut(start, end),
                 self.blend,
             );
-            for (k, c) in cover[start..end].iter_mut().enumerate() {
-                let sx = sx0 + k as i64;
-                if sx < 0 || sy < 0 || sx >= w || sy >= h {
-                    // Its source is off the map for the whole stroke (the offset is fixed).
-                    *c = 0.0;
-                }
-            }
+            // Texels whose source is off the map (for the whole stroke: the offset is fixed)
+            // are not written: all of the run but columns `inside`.
+            let len = (end - start) as i64;
+            let inside = if (0..h).contains(&sy) {
+                (-sx0).clamp(0, len) as usize..(w - sx0).clamp(0, len) as usize
+            } else {
+                0..0
+            };
+            let run = &mut cover[start..end];
+            run[..inside.start].fill(0.0);
+            run[inside.end.max(inside.start)..].fill(0.0);
             written.include_run(start, end);
         }
         written
@@ -239,15 +238,12 @@ pub(super) fn smudge_dab(
     strength: f32,
     step: Vec2,
 ) -> Vec<TileSpans> {
-    let mut scratch: Vec<Vec<f32>> = ids.iter().map(|_| vec![0.0; TILE_TEXELS]).collect();
-    let covers: Vec<&mut [f32]> = scratch.iter_mut().map(Vec::as_mut_slice).collect();
     from_now(planes, ids, |planes, pre, mask| {
         smudge_from(
             (planes, pre, mask),
             target,
             (maps, ids),
             (fp, strength, step),
-            covers,
         )
     })
 }
@@ -282,7 +278,6 @@ fn smudge_from(
     target: &LayerEdit,
     (maps, ids): (&MaterialMaps, &[usize]),
     (fp, strength, step): (&impl Footprint, f32, Vec2),
-    covers: Vec<&mut [f32]>,
 ) -> Vec<TileSpans> {
     let blend = crate::paint::n_blend_table();
     // Texel centres are whole texels apart, so every texel reads its four neighbours at the
@@ -309,7 +304,7 @@ fn smudge_from(
         offset: (ix, iy),
         weights,
     };
-    edit::edit_varying((planes, pre), target, ids, covers, &prepare)
+    edit::edit_each((planes, pre), target, ids, &prepare)
 }
 
 /// A smudge dab's tile for [`edit::edit_varying`]: each texel's coverage, and its target
@@ -337,35 +332,49 @@ impl<F: Footprint> edit::Prepare for SmudgeTile<'_, F> {
     fn prepare(&self, id: usize, cover: &mut [f32], targets: &mut TileTargets) -> TileSpans {
         let rect = self.maps.tile_rect(id);
         let mut written = TileSpans::EMPTY;
-        SOURCE_ROWS.with_borrow_mut(|rows| {
-            // Source row r is map row rect.y0 + r + iy, column c map column rect.x0 + c + ix:
-            // each texel of it decoded once, for the run above it and the run on it.
-            rows.reset();
-            let decode = |(r, c0): (usize, usize), out: &mut [[f32; 7]]| {
-                let sy = i64::from(rect.y0) + r as i64 + self.offset.1;
-                let sx = i64::from(rect.x0) + c0 as i64 + self.offset.0;
-                decode_row(self.tiles, self.mask, self.maps, (sx, sy), out, self.blend);
-            };
-            self.fp.visit_runs(id, rect, |start, dab| {
+        // The worker's rows taken and put back (not borrowed in a closure: `LocalKey::with`
+        // left out of line would hold the whole body, compiled for the baseline).
+        let mut rows = SOURCE_ROWS.take().unwrap_or_default();
+        // Source row r is map row rect.y0 + r + iy, column c map column rect.x0 + c + ix:
+        // each texel of it decoded once, for the run above it and the run on it.
+        rows.reset();
+        // A mask's gray is its only component.
+        let components = if self.mask.is_some() { 1 } else { 7 };
+        // The run's body inlined too (a closure left out of line is compiled for the
+        // baseline).
+        self.fp.visit_runs(
+            id,
+            rect,
+            #[inline(always)]
+            |start, dab| {
                 let (y, x0) = (start / TILE_SIZE, start % TILE_SIZE);
                 let n = dab.len();
-                rows.ensure((y, x0, x0 + n + 1), decode);
-                rows.ensure((y + 1, x0, x0 + n + 1), decode);
-                // The taps of a run as flat components: texel k's are at 7k, its right
-                // neighbour's at 7k + 7, so the blend is one plain loop over the run.
-                let top = rows.row(y)[x0..=x0 + n].as_flattened();
-                let bottom = rows.row(y + 1)[x0..=x0 + n].as_flattened();
-                let out = targets[start..start + n].as_flattened_mut();
-                let len = out.len();
+                for r in [y, y + 1] {
+                    rows.ensure(
+                        (r, x0, x0 + n + 1),
+                        #[inline(always)]
+                        |(row, c0), out| {
+                            let sy = i64::from(rect.y0) + row as i64 + self.offset.1;
+                            let sx = i64::from(rect.x0) + c0 as i64 + self.offset.0;
+                            decode_row(self.tiles, self.mask, self.maps, (sx, sy), out, self.blend);
+                        },
+                    );
+                }
                 let [w0, w1, w2, w3] = self.weights;
-                for ((((o, &a), &b), &c), &d) in out
-                    .iter_mut()
-                    .zip(&top[..len])
-                    .zip(&top[7..])
-                    .zip(&bottom[..len])
-                    .zip(&bottom[7..])
-                {
-                    *o = a * w0 + b * w1 + c * w2 + d * w3;
+                for c in 0..components {
+                    // The run's taps: texel k's at k and k + 1 of its row and the row below.
+                    let top = &rows.row(c, y)[x0..=x0 + n];
+                    let bottom = &rows.row(c, y + 1)[x0..=x0 + n];
+                    let out = &mut targets.plane_mut(c)[start..start + n];
+                    for ((((o, &tl), &tr), &bl), &br) in out
+                        .iter_mut()
+                        .zip(top)
+                        .zip(&top[1..])
+                        .zip(bottom)
+                        .zip(&bottom[1..])
+                    {
+                        *o = tl * w0 + tr * w1 + bl * w2 + br * w3;
+                    }
                 }
                 let run = &mut cover[start..start + n];
                 for (c, &wgt) in run.iter_mut().zip(dab) {
@@ -375,8 +384,9 @@ impl<F: Footprint> edit::Prepare for SmudgeTile<'_, F> {
                 if let (Some(first), Some(last)) = (first, run.iter().rposition(|&a| a > 0.0)) {
                     written.include_run(start + first, start + last + 1);
                 }
-            });
-        });
+            },
+        );
+        SOURCE_ROWS.set(Some(rows));
         written
     }
 }
@@ -390,48 +400,53 @@ const SOURCE_STRIDE: usize = TILE_SIZE + 1;
 struct SourceRows {
     /// The decoded columns of each row, `lo..hi` (empty: `lo >= hi`).
     ranges: Vec<(usize, usize)>,
-    data: Vec<[f32; 7]>,
+    data: Components<{ SOURCE_STRIDE * SOURCE_STRIDE }>,
 }
 
 impl SourceRows {
     fn reset(&mut self) {
         self.ranges.clear();
         self.ranges.resize(SOURCE_STRIDE, (0, 0));
-        self.data.resize(SOURCE_STRIDE * SOURCE_STRIDE, [0.0; 7]);
     }
 
     /// Makes columns `c0..c1` of row `r` decoded, through `decode((r, c), out)` for the
     /// columns from `c` that are not yet.
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
     fn ensure(
         &mut self,
         (r, c0, c1): (usize, usize, usize),
-        decode: impl Fn((usize, usize), &mut [[f32; 7]]),
+        decode: impl Fn((usize, usize), [&mut [f32]; 7]),
     ) {
-        let row = &mut self.data[r * SOURCE_STRIDE..(r + 1) * SOURCE_STRIDE];
+        let row = r * SOURCE_STRIDE;
         let (lo, hi) = self.ranges[r];
         if lo >= hi {
-            decode((r, c0), &mut row[c0..c1]);
+            decode((r, c0), self.data.run_mut(row + c0, row + c1));
             self.ranges[r] = (c0, c1);
             return;
         }
         // Grown at either end (a gap between is decoded too, keeping one range a row).
         if c0 < lo {
-            decode((r, c0), &mut row[c0..lo]);
+            decode((r, c0), self.data.run_mut(row + c0, row + lo));
         }
         if c1 > hi {
-            decode((r, hi), &mut row[hi..c1]);
+            decode((r, hi), self.data.run_mut(row + hi, row + c1));
         }
         self.ranges[r] = (lo.min(c0), hi.max(c1));
     }
 
-    fn row(&self, r: usize) -> &[[f32; 7]] {
-        &self.data[r * SOURCE_STRIDE..(r + 1) * SOURCE_STRIDE]
+    /// Component `c` of row `r`.
+    fn row(&self, c: usize, r: usize) -> &[f32] {
+        &self.data.plane(c)[r * SOURCE_STRIDE..(r + 1) * SOURCE_STRIDE]
     }
 }
 
 thread_local! {
-    /// A worker's [`SourceRows`], kept from tile to tile.
-    static SOURCE_ROWS: std::cell::RefCell<SourceRows> = std::cell::RefCell::new(SourceRows::default());
+    /// A worker's [`SourceRows`], kept from tile to tile (taken while in use).
+    static SOURCE_ROWS: std::cell::Cell<Option<Box<SourceRows>>> = const { std::cell::Cell::new(None) };
 }
 
 #[cfg(test)]
@@ -443,10 +458,10 @@ mod tests {
     #[test]
     fn source_rows_decode_each_texel_once() {
         let decoded = std::cell::RefCell::new(vec![0_u32; SOURCE_STRIDE * SOURCE_STRIDE]);
-        let decode = |(r, c0): (usize, usize), out: &mut [[f32; 7]]| {
-            for (k, o) in out.iter_mut().enumerate() {
+        let decode = |(r, c0): (usize, usize), mut out: [&mut [f32]; 7]| {
+            for k in 0..out[0].len() {
                 decoded.borrow_mut()[r * SOURCE_STRIDE + c0 + k] += 1;
-                *o = [(r * 100 + c0 + k) as f32; 7];
+                set_run(&mut out, k, [(r * 100 + c0 + k) as f32; 7]);
             }
         };
         let mut rows = SourceRows::default();
@@ -455,7 +470,7 @@ mod tests {
         for &(r, c0, c1) in &[(3, 10, 20), (3, 5, 25), (3, 8, 12), (3, 40, 45), (4, 0, 65)] {
             rows.ensure((r, c0, c1), decode);
             for c in c0..c1 {
-                assert_eq!(rows.row(r)[c][0], (r * 100 + c) as f32);
+                assert_eq!(rows.row(6, r)[c], (r * 100 + c) as f32);
             }
         }
         assert!(decoded.borrow().iter().all(|&n| n <= 1));

@@ -135,7 +135,7 @@ impl Document {
         self.try_edit_planes(
             label,
             |planes, pre, _| {
-                edit::edit_each((planes, pre), &edit, &ids, &prepare);
+                let _ = edit::edit_each((planes, pre), &edit, &ids, &prepare);
                 if reached.load(std::sync::atomic::Ordering::Relaxed) {
                     Ok(())
                 } else {

@@ -457,31 +457,37 @@ impl<F: Footprint + Sync> edit::Raise for DabRaise<'_, F> {
         let mut up = [false; crate::tile::TILE_SIZE];
         let mut caps = [opacity; crate::tile::TILE_SIZE];
         let rect = self.maps.tile_rect(id);
-        self.fp.visit_runs(id, rect, |start, weights| {
-            let row = &mut cov[start..start + weights.len()];
-            let up = &mut up[..weights.len()];
-            let caps = &mut caps[..weights.len()];
-            if let Some(stencil) = &self.stencil {
-                stencil.weights(self.maps, id, start, caps);
-                for cap in caps.iter_mut() {
-                    *cap *= opacity;
+        // The run's body inlined too (a closure left out of line is compiled for the baseline).
+        self.fp.visit_runs(
+            id,
+            rect,
+            #[inline(always)]
+            |start, weights| {
+                let row = &mut cov[start..start + weights.len()];
+                let up = &mut up[..weights.len()];
+                let caps = &mut caps[..weights.len()];
+                if let Some(stencil) = &self.stencil {
+                    stencil.weights(self.maps, id, start, caps);
+                    for cap in caps.iter_mut() {
+                        *cap *= opacity;
+                    }
                 }
-            }
-            for (((c, &w), up), &cap) in row
-                .iter_mut()
-                .zip(weights)
-                .zip(up.iter_mut())
-                .zip(caps.iter())
-            {
-                let next = *c + (cap - *c) * (w * alpha).min(1.0);
-                *up = next > *c;
-                *c = if *up { next } else { *c };
-            }
-            let first = up.iter().position(|&u| u);
-            if let (Some(first), Some(last)) = (first, up.iter().rposition(|&u| u)) {
-                rose.include_run(start + first, start + last + 1);
-            }
-        });
+                for (((c, &w), up), &cap) in row
+                    .iter_mut()
+                    .zip(weights)
+                    .zip(up.iter_mut())
+                    .zip(caps.iter())
+                {
+                    let next = *c + (cap - *c) * (w * alpha).min(1.0);
+                    *up = next > *c;
+                    *c = if *up { next } else { *c };
+                }
+                let first = up.iter().position(|&u| u);
+                if let (Some(first), Some(last)) = (first, up.iter().rposition(|&u| u)) {
+                    rose.include_run(start + first, start + last + 1);
+                }
+            },
+        );
         rose
     }
 }

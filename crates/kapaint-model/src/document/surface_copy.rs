@@ -349,7 +349,7 @@ pub(super) fn surface_clone_dab(
             for x in x0..x1 {
                 let k = y * TILE_SIZE + x;
                 match grid.source_of(row + x, &mut hint) {
-                    Some(at) => targets[k] = bilinear(&source.tiles, mask, maps, at, blend),
+                    Some(at) => targets.set(k, bilinear(&source.tiles, mask, maps, at, blend)),
                     // Its source lies off the surface as this dab lays it: not written (a later
                     // dab of the stroke may reach it from elsewhere).
                     None => cover[k] = 0.0,
@@ -390,7 +390,7 @@ pub(super) fn surface_smudge_dab(
                         (rect.y0 as usize + i / TILE_SIZE) * w + rect.x0 as usize + i % TILE_SIZE;
                     if let Some(at) = (a > 0.0).then(|| grid.source_of(t, &mut hint)).flatten() {
                         cover[i] = a;
-                        targets[i] = bilinear(tiles, mask, maps, at, blend);
+                        targets.set(i, bilinear(tiles, mask, maps, at, blend));
                         written.include(i);
                     }
                 }

@@ -18,10 +18,12 @@ use crate::tile::{Plane, TILE_SIZE, Tile, TileSpans, select_mut};
 
 mod blur;
 mod cover;
+mod targets;
 
 pub use blur::blur;
 pub use cover::{Raise, edit_cover};
 use cover::{Targets, cover_alpha, cover_channel, erase_channel};
+pub use targets::{Components, TileTargets, set_run};
 
 /// A material as the layer kernels blend it: `k_d`, `k_s` linear, `n` in blend space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -272,7 +274,7 @@ impl Slot<'_> {
         edit: &LayerEdit,
         spans: &TileSpans,
         cover: &[f32],
-        varying: Option<&[[f32; 7]]>,
+        varying: Option<&TileTargets>,
     ) {
         match self {
             Self::Paint(slot, pre, written) => {
@@ -334,7 +336,7 @@ impl Slot<'_> {
                 for i in spans.indices() {
                     let a = cover[i];
                     // A varying target holds the gray first.
-                    let g = varying.map_or(edit.gray[0], |v| v[i][0]);
+                    let g = varying.map_or(edit.gray[0], |v| v.plane(0)[i]);
                     if a > 0.0 {
                         let p = decode_unorm(pre.get(i));
                         plane[i] = encode_unorm(p + (g - p) * a.min(1.0));
@@ -387,10 +389,6 @@ impl<F: Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync> Prepare for
     }
 }
 
-/// Per-texel targets of a tile, for [`edit_varying`]: each texel's seven components (a
-/// mask's gray first).
-pub type TileTargets = Vec<[f32; 7]>;
-
 /// Writes tiles `ids` (sorted, unique) in parallel, each texel from its pre-operation value
 /// towards its own target at its own coverage, a row at a time as [`edit_cover`] does:
 /// `prepare(id, cover, targets)` sets a tile's coverage (texels left at zero are not written)
@@ -411,24 +409,26 @@ pub fn edit_varying(
         .collect()
 }
 
-/// [`edit_varying`] for a one-off operation over tiles `ids` (a projection): each tile's
-/// coverage starts at zero in a worker's own buffer.
+/// [`edit_varying`] for an operation whose coverage is its own (a projection, a smudge dab)
+/// over tiles `ids`: each tile's coverage starts at zero in a worker's own buffer. Returns,
+/// per tile, the texels written.
 pub fn edit_each(
     (planes, pre): (Planes<'_>, PrePlanes<'_>),
     edit: &LayerEdit,
     ids: &[usize],
     prepare: &impl Prepare,
-) {
+) -> Vec<TileSpans> {
     slots(planes, pre, ids)
         .into_par_iter()
         .zip(ids)
-        .for_each(|(mut slot, &id)| {
+        .map(|(mut slot, &id)| {
             COVER.with_borrow_mut(|cover| {
                 cover.clear();
                 cover.resize(TILE_SIZE * TILE_SIZE, 0.0);
-                write_varying(&mut slot, edit, id, cover, prepare);
-            });
-        });
+                write_varying(&mut slot, edit, id, cover, prepare)
+            })
+        })
+        .collect()
 }
 
 /// One tile of [`edit_varying`] and [`edit_each`]: `prepare` fills its coverage and targets
@@ -441,7 +441,6 @@ fn write_varying<P: Prepare>(
     prepare: &P,
 ) -> TileSpans {
     TARGETS.with_borrow_mut(|targets| {
-        targets.resize(TILE_SIZE * TILE_SIZE, [0.0; 7]);
         crate::simd::vectorized(VaryingWrite {
             slot,
             edit,
@@ -485,7 +484,7 @@ impl<P: Prepare> crate::simd::Kernel for VaryingWrite<'_, '_, P> {
 thread_local! {
     /// A worker's tile of targets for [`edit_varying`], kept from dab to dab (only the
     /// texels `prepare` returns are read, and it sets each of them).
-    static TARGETS: std::cell::RefCell<TileTargets> = const { std::cell::RefCell::new(Vec::new()) };
+    static TARGETS: std::cell::RefCell<TileTargets> = std::cell::RefCell::new(TileTargets::default());
     /// A worker's tile of coverage for [`edit_each`].
     static COVER: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
 }

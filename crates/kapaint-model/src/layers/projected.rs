@@ -111,7 +111,7 @@ impl Projected {
     fn lay(&self, id: usize) -> Option<PaintTile> {
         let mapper = self.mapper()?;
         let mut cover = vec![0.0_f32; TILE_TEXELS];
-        let mut targets = vec![[0.0_f32; 7]; TILE_TEXELS];
+        let mut targets = super::edit::TileTargets::default();
         if mapper
             .lay_tile(id, (1.0, false), &mut cover, &mut targets)
             .is_empty()
@@ -123,7 +123,7 @@ impl Projected {
             ks: encode_rgb(glam::Vec3::new(t[3], t[4], t[5])),
             n: crate::paint::n_bits_from_blend(t[6]),
         };
-        let texels: Vec<Texel> = targets.iter().map(texel).collect();
+        let texels: Vec<Texel> = (0..TILE_TEXELS).map(|i| texel(&targets.get(i))).collect();
         let mut value = Tile::uniform(texel(&[0.0; 7]));
         value.kd = Plane::Data(texels.iter().map(|t| t.kd).collect());
         value.ks = Plane::Data(texels.iter().map(|t| t.ks).collect());

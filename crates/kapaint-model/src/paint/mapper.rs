@@ -210,7 +210,7 @@ impl Mapper {
         id: usize,
         (opacity, mask): (f32, bool),
         cover: &mut [f32],
-        targets: &mut [[f32; 7]],
+        targets: &mut crate::layers::edit::TileTargets,
     ) -> TileSpans {
         let (w, h) = (self.width, self.height);
         let mut spans = TileSpans::EMPTY;
@@ -235,7 +235,7 @@ impl Mapper {
             let a = (a * opacity).min(1.0);
             if a > 0.0 {
                 cover[i] = a;
-                targets[i] = c;
+                targets.set(i, c);
                 spans.include(i);
             }
         }

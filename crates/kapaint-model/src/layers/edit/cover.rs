@@ -159,9 +159,18 @@ pub(super) fn cover_channel(
     let table = crate::paint::n_blend_table();
     let n_bits = crate::paint::n_bits_table();
     let mut pre_alpha = [0.0_f32; TILE_SIZE];
-    // Per component: the pre-operation values and the targets of a run.
+    // Per component: the pre-operation values of a run, and the uniform targets of any.
     let mut pre_value = [[0.0_f32; TILE_SIZE]; 3];
-    let mut t = [[0.0_f32; TILE_SIZE]; 3];
+    let mut uniform = [[0.0_f32; TILE_SIZE]; 3];
+    let components = match &target {
+        Targets::Uniform(u) => {
+            for (t, &u) in uniform.iter_mut().zip(u.iter()) {
+                t.fill(u);
+            }
+            u.len()
+        }
+        Targets::Varying(_, range) => range.len(),
+    };
     let (mut a, mut w) = ([0.0_f32; TILE_SIZE], [0.0_f32; TILE_SIZE]);
     let mut alpha = [0_u16; TILE_SIZE];
     let mut out = [[0_u16; TILE_SIZE]; 3];
@@ -176,37 +185,15 @@ pub(super) fn cover_channel(
             let (coverage, weight) = LayerStroke::cover(pre_alpha[j], aj);
             (a[j], w[j], alpha[j]) = (aj, weight, encode_unorm(coverage.min(1.0)));
         }
-        let components = match &target {
-            Targets::Uniform(t) => t.len(),
-            Targets::Varying(_, range) => range.len(),
-        };
-        // Every component's targets and pre-operation values of the run in one pass each
-        // (the texels' components lie interleaved).
-        match &target {
-            Targets::Uniform(u) => {
-                for (t, &u) in t.iter_mut().zip(u.iter()) {
-                    t[..width].fill(u);
-                }
+        // Every component's targets of the run (the varying ones where they lie), then its
+        // pre-operation values (interleaved in the tile: taken apart in one pass).
+        let t: [&[f32]; 3] = std::array::from_fn(|c| match &target {
+            Targets::Uniform(_) => &uniform[c][..width],
+            Targets::Varying(v, range) if c < range.len() => {
+                &v.plane(range.start + c)[start..start + width]
             }
-            Targets::Varying(v, range) => {
-                let v = &v[start..start + width];
-                if range.len() == 3 {
-                    let [r, g, b] = &mut t;
-                    for (((v, r), g), b) in v
-                        .iter()
-                        .zip(r.iter_mut())
-                        .zip(g.iter_mut())
-                        .zip(b.iter_mut())
-                    {
-                        (*r, *g, *b) = (v[range.start], v[range.start + 1], v[range.start + 2]);
-                    }
-                } else {
-                    for (t, v) in t[0].iter_mut().zip(v) {
-                        *t = v[range.start];
-                    }
-                }
-            }
-        }
+            Targets::Varying(..) => &[],
+        });
         if let Some(p) = pre {
             match ch {
                 0 => decode_rgb_run(&p.value.kd, start, width, &mut pre_value),
@@ -217,7 +204,7 @@ pub(super) fn cover_channel(
             }
         }
         for c in 0..components {
-            let (t, pre_value) = (&t[c], &pre_value[c]);
+            let (t, pre_value) = (t[c], &pre_value[c][..width]);
             let encoded = &mut out[c][..width];
             if ch == 2 {
                 for j in 0..width {
@@ -252,14 +239,14 @@ pub(super) fn cover_channel(
     }
 }
 
-/// A channel's targets: one value a component, or one a texel (each texel's seven
-/// components, of which `range` are the channel's).
+/// A channel's targets: one value a component, or one a texel (seven components, of which
+/// `range` are the channel's).
 #[derive(Clone)]
 pub(super) enum Targets<'a> {
     /// The same components everywhere.
     Uniform(&'a [f32]),
     /// Per texel of the tile.
-    Varying(&'a [[f32; 7]], std::ops::Range<usize>),
+    Varying(&'a super::TileTargets, std::ops::Range<usize>),
 }
 
 /// Whether a dab reached every texel of a row's run (as a disc does).
