@@ -255,6 +255,43 @@ fn smudge_blends_n_in_log_space_and_keeps_the_energy_guard() {
     }
 }
 
+/// A smudge on a mask drags the mask's own gray (as it is at each dab), not the composite's.
+#[test]
+fn smudge_on_a_mask_drags_its_gray() {
+    let mut doc = document();
+    run(
+        &mut doc,
+        r"(commands: [
+            AddMask, SelectMask,
+            SetBrush((radius_px: 16.0, hardness: 1.0, flow: 1.0, opacity: 1.0)),
+            SetPrimary((kd: (0.0, 0.0, 0.0), ks: (0.5, 0.5, 0.5), n: 10.0)),
+            Stroke(tool: Brush, points: [(pos: (40.0, 128.0), pressure: 1.0)]),
+        ])",
+    );
+    let gray = |doc: &Document, x: usize, y: usize| -> f32 {
+        let layer = doc.stack().layer(&doc.selection().path).expect("layer");
+        let mask = layer.mask.as_ref().expect("a mask");
+        let tile = &mask.tiles[(y / 64) * 4 + x / 64];
+        f32::from(tile.get().get((y % 64) * 64 + x % 64)) / 65535.0
+    };
+    assert!(gray(&doc, 40, 128) < 0.01 && gray(&doc, 100, 128) > 0.99);
+    brush(&mut doc, 16.0, 0.7, 1.0);
+    let length = 120.0;
+    stroke(
+        &mut doc,
+        StrokeTool::Smudge,
+        line(Vec2::new(40.0, 128.0), Vec2::new(40.0 + length, 128.0), 60),
+    );
+    let dark = (40..(40 + length as usize))
+        .take_while(|&x| gray(&doc, x, 128) < 0.3)
+        .count();
+    assert!(dark as f32 >= 0.6 * length, "the black went {dark} texels");
+    assert!(
+        gray(&doc, 120, 20) > 0.99,
+        "beside the stroke the mask is white"
+    );
+}
+
 /// A 64 x 4 image, black on the left half and white on the right.
 fn half_white(dir: &std::path::Path) -> std::path::PathBuf {
     let mut img = image::GrayImage::new(64, 4);

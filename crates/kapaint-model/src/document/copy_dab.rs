@@ -238,78 +238,34 @@ pub(super) fn smudge_dab(
     strength: f32,
     step: Vec2,
 ) -> Vec<TileSpans> {
-    from_now(planes, ids, |planes, pre, mask| {
-        smudge_from(
-            (planes, pre, mask),
-            target,
-            (maps, ids),
-            (fp, strength, step),
-        )
-    })
-}
-
-/// Runs `f` on the planes, the same planes as they are now at tiles `ids` (what a smudge dab
-/// blends from: the dabs before it included; a paint layer's other tiles are left out, as
-/// only the tiles written are read), and a mask's own planes as they are now (all of them:
-/// a smudge on a mask reads its neighbours).
-pub(super) fn from_now<R>(
-    planes: Planes<'_>,
-    ids: &[usize],
-    f: impl FnOnce(Planes<'_>, PrePlanes<'_>, Option<&[SharedMaskTile]>) -> R,
-) -> R {
+    let dab = (fp, strength, step);
     match planes {
+        // The source is the composite: the layer's own tiles are read in place.
         Planes::Paint(tiles) => {
-            let mut now = vec![None; tiles.len()];
-            for &id in ids {
-                now[id].clone_from(&tiles[id]);
-            }
-            f(Planes::Paint(tiles), PrePlanes::Paint(&now), None)
+            let prepare = SmudgeTile::new((maps, None), dab);
+            edit::edit_each_in_place(tiles, target, ids, &prepare)
         }
-        Planes::Mask(tiles) => {
-            let now = tiles.to_vec();
-            f(Planes::Mask(tiles), PrePlanes::Mask(&now), Some(&now))
-        }
+        Planes::Mask(tiles) => mask_now(tiles, |planes, now| {
+            let prepare = SmudgeTile::new((maps, Some(now)), dab);
+            edit::edit_each(planes, target, ids, &prepare)
+        }),
     }
 }
 
-/// [`smudge_dab`] once the planes as they are now are at hand.
-fn smudge_from(
-    (planes, pre, mask): (Planes<'_>, PrePlanes<'_>, Option<&[SharedMaskTile]>),
-    target: &LayerEdit,
-    (maps, ids): (&MaterialMaps, &[usize]),
-    (fp, strength, step): (&impl Footprint, f32, Vec2),
-) -> Vec<TileSpans> {
-    let blend = crate::paint::n_blend_table();
-    // Texel centres are whole texels apart, so every texel reads its four neighbours at the
-    // same whole offset and with the same bilinear weights.
-    // Texel (x, y) reads the point (x, y) - step between texel centres: (x + ix, y + iy)
-    // and its right and lower neighbours, at (fx, fy) between them.
-    let back = -step;
-    let (ix, iy) = (back.x.floor(), back.y.floor());
-    let (fx, fy) = (back.x - ix, back.y - iy);
-    let (ix, iy) = (ix as i64, iy as i64);
-    let weights = [
-        (1.0 - fx) * (1.0 - fy),
-        fx * (1.0 - fy),
-        (1.0 - fx) * fy,
-        fx * fy,
-    ];
-    let prepare = SmudgeTile {
-        fp,
-        maps,
-        tiles: maps.tiles(),
-        mask,
-        blend,
-        strength,
-        offset: (ix, iy),
-        weights,
-    };
-    edit::edit_each((planes, pre), target, ids, &prepare)
+/// Runs `f` on a mask's planes and the same planes as they are now (what a smudge dab on a
+/// mask blends from and writes relative to, the dabs before it included: all of them, as it
+/// reads its neighbours).
+pub(super) fn mask_now<R>(
+    tiles: &mut [SharedMaskTile],
+    f: impl FnOnce((Planes<'_>, PrePlanes<'_>), &[SharedMaskTile]) -> R,
+) -> R {
+    let now = tiles.to_vec();
+    f((Planes::Mask(tiles), PrePlanes::Mask(&now)), &now)
 }
 
-/// A smudge dab's tile for [`edit::edit_varying`]: each texel's coverage, and its target
-/// blended from the composite one step behind (a struct, not a closure, so that it is
-/// compiled into the vectorised kernel).
+/// A smudge dab's tile for [`edit::edit_each`]: each texel's coverage, and its target
+/// blended from the composite (or the mask) one step behind (a struct, not a closure, so that
+/// it is compiled into the vectorised kernel).
 struct SmudgeTile<'a, F> {
     fp: &'a F,
     maps: &'a MaterialMaps,
@@ -321,6 +277,38 @@ struct SmudgeTile<'a, F> {
     offset: (i64, i64),
     /// The four taps' bilinear weights.
     weights: [f32; 4],
+}
+
+impl<'a, F> SmudgeTile<'a, F> {
+    /// A dab through `fp` at `strength`, the brush having moved `step` texels since the last,
+    /// reading the composite (or `mask`, as it is now).
+    fn new(
+        (maps, mask): (&'a MaterialMaps, Option<&'a [SharedMaskTile]>),
+        (fp, strength, step): (&'a F, f32, Vec2),
+    ) -> Self {
+        // Texel centres are whole texels apart, so every texel reads its four neighbours at
+        // the same whole offset and with the same bilinear weights. Texel (x, y) reads the
+        // point (x, y) - step between texel centres: (x + ix, y + iy) and its right and lower
+        // neighbours, at (fx, fy) between them.
+        let back = -step;
+        let (ix, iy) = (back.x.floor(), back.y.floor());
+        let (fx, fy) = (back.x - ix, back.y - iy);
+        Self {
+            fp,
+            maps,
+            tiles: maps.tiles(),
+            mask,
+            blend: crate::paint::n_blend_table(),
+            strength,
+            offset: (ix as i64, iy as i64),
+            weights: [
+                (1.0 - fx) * (1.0 - fy),
+                fx * (1.0 - fy),
+                (1.0 - fx) * fy,
+                fx * fy,
+            ],
+        }
+    }
 }
 
 impl<F: Footprint> edit::Prepare for SmudgeTile<'_, F> {

@@ -11,12 +11,13 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::copy_dab::{CloneSource, from_now, value_at};
+use super::copy_dab::{CloneSource, mask_now, value_at};
+use crate::layers::SharedMaskTile;
 use crate::layers::edit::{self, LayerEdit, Planes, PrePlanes, TileTargets};
 use crate::maps::MaterialMaps;
 use crate::paint::{Coverage, Footprint};
 use crate::surface::Surface;
-use crate::tile::{TILE_SIZE, TILE_TEXELS, Tile, TileSpans};
+use crate::tile::{TILE_SIZE, Tile, TileSpans};
 
 /// Most cells a grid keeps (4 bytes each): a larger box takes larger cells.
 const MAX_CELLS: usize = 1 << 22;
@@ -363,8 +364,8 @@ pub(super) fn surface_clone_dab(
 }
 
 /// A smudge dab on the mesh through `fp` at `strength`: each texel moves towards the
-/// composite as it is now at its point moved by the grid's offset (back along the step).
-/// Returns, per tile of `ids`, the texels written.
+/// composite (or the mask) as it is now at its point moved by the grid's offset (back along
+/// the step). Returns, per tile of `ids`, the texels written.
 pub(super) fn surface_smudge_dab(
     planes: Planes<'_>,
     target: &LayerEdit,
@@ -372,33 +373,46 @@ pub(super) fn surface_smudge_dab(
     (fp, strength): (&impl Footprint, f32),
     grid: &SourceGrid<'_>,
 ) -> Vec<TileSpans> {
-    let mut scratch: Vec<Vec<f32>> = ids.iter().map(|_| vec![0.0; TILE_TEXELS]).collect();
-    let covers: Vec<&mut [f32]> = scratch.iter_mut().map(Vec::as_mut_slice).collect();
+    match planes {
+        // The source is the composite: the layer's own tiles are read in place.
+        Planes::Paint(tiles) => {
+            let prepare = surface_smudge_tile((maps, None), (fp, strength), grid);
+            edit::edit_each_in_place(tiles, target, ids, &prepare)
+        }
+        Planes::Mask(tiles) => mask_now(tiles, |planes, now| {
+            let prepare = surface_smudge_tile((maps, Some(now)), (fp, strength), grid);
+            edit::edit_each(planes, target, ids, &prepare)
+        }),
+    }
+}
+
+/// [`surface_smudge_dab`]'s tile for [`edit::edit_each`], reading the composite (or `mask`).
+fn surface_smudge_tile<'a>(
+    (maps, mask): (&'a MaterialMaps, Option<&'a [SharedMaskTile]>),
+    (fp, strength): (&'a impl Footprint, f32),
+    grid: &'a SourceGrid<'_>,
+) -> impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync + 'a {
     let blend = crate::paint::n_blend_table();
     let w = maps.width() as usize;
     let tiles = maps.tiles();
-    from_now(planes, ids, |planes, pre, mask| {
-        let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
-            let rect = maps.tile_rect(id);
-            let mut written = TileSpans::EMPTY;
-            let mut hint = None;
-            fp.visit_runs(id, rect, |start, dab| {
-                for (k, &wgt) in dab.iter().enumerate() {
-                    let i = start + k;
-                    let a = (wgt * strength).min(1.0);
-                    let t =
-                        (rect.y0 as usize + i / TILE_SIZE) * w + rect.x0 as usize + i % TILE_SIZE;
-                    if let Some(at) = (a > 0.0).then(|| grid.source_of(t, &mut hint)).flatten() {
-                        cover[i] = a;
-                        targets.set(i, bilinear(tiles, mask, maps, at, blend));
-                        written.include(i);
-                    }
+    move |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
+        let rect = maps.tile_rect(id);
+        let mut written = TileSpans::EMPTY;
+        let mut hint = None;
+        fp.visit_runs(id, rect, |start, dab| {
+            for (k, &wgt) in dab.iter().enumerate() {
+                let i = start + k;
+                let a = (wgt * strength).min(1.0);
+                let t = (rect.y0 as usize + i / TILE_SIZE) * w + rect.x0 as usize + i % TILE_SIZE;
+                if let Some(at) = (a > 0.0).then(|| grid.source_of(t, &mut hint)).flatten() {
+                    cover[i] = a;
+                    targets.set(i, bilinear(tiles, mask, maps, at, blend));
+                    written.include(i);
                 }
-            });
-            written
-        };
-        edit::edit_varying((planes, pre), target, ids, covers, &prepare)
-    })
+            }
+        });
+        written
+    }
 }
 
 /// The point of the surface nearest `q`, and its normal, on the triangle of the baked texel

@@ -183,8 +183,9 @@ fn encode_rgb_planes(planes: [&[f32]; 3], out: &mut Vec<[u16; 3]>) {
                 *d = encode_unorm(v);
             }
         }
-        for (j, o) in o.iter_mut().enumerate() {
-            *o = [q[0][j], q[1][j], q[2][j]];
+        let [r, g, b] = &q;
+        for (((o, &r), &g), &b) in o.iter_mut().zip(r).zip(g).zip(b) {
+            *o = [r, g, b];
         }
     }
 }

@@ -142,10 +142,20 @@ pub enum PrePlanes<'a> {
 enum Slot<'a> {
     Paint(
         &'a mut Option<SharedPaintTile>,
-        Option<&'a SharedPaintTile>,
+        Pre<&'a SharedPaintTile>,
         bool,
     ),
     Mask(&'a mut SharedMaskTile, &'a SharedMaskTile, bool),
+}
+
+/// Where a paint tile's pre-operation texels are read.
+#[derive(Clone, Copy)]
+enum Pre<T> {
+    /// The tile as it was before the operation (none: transparent).
+    Before(Option<T>),
+    /// The tile being written itself: each texel holds its pre-operation value until it is
+    /// written, and is written once (a smudge dab), so no copy of the tile is held.
+    InPlace,
 }
 
 /// The data of a shared tile to write: copied (if shared) and stamped on the first write of an
@@ -220,18 +230,28 @@ impl Slot<'_> {
     fn write_target(&mut self, edit: &LayerEdit, i: usize, a: f32, target: &Target) {
         match self {
             Self::Paint(slot, pre, written) => {
-                let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                 let target = &target.value;
                 for (ch, range) in RANGES.iter().enumerate() {
                     if !edit.channels[ch] {
                         continue;
                     }
-                    let pre_alpha = pre.map_or(0.0, |p| decode_unorm(p.get().alpha[ch].get(i)));
+                    // The texel before the operation, read before the tile is written.
+                    let p = match *pre {
+                        Pre::Before(p) => p,
+                        Pre::InPlace => slot.as_ref(),
+                    };
+                    let pre_alpha = p.map_or(0.0, |p| decode_unorm(p.get().alpha[ch].get(i)));
+                    let pre_values: [f32; 3] = std::array::from_fn(|s| match p {
+                        Some(p) if s < range.len() => {
+                            decode(ch, component(&p.get().value, range.start + s, i))
+                        }
+                        _ => 0.0,
+                    });
+                    let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                     let mut alpha = pre_alpha;
                     let mut values = [0_u16; 3];
                     for (slot, k) in range.clone().enumerate() {
-                        let pre_value =
-                            pre.map_or(0.0, |p| decode(ch, component(&p.get().value, k, i)));
+                        let pre_value = pre_values[slot];
                         let out = edit.stroke.apply(
                             LayerValue {
                                 value: pre_value,
@@ -250,6 +270,7 @@ impl Slot<'_> {
                         _ => tile.value.n.data_mut()[i] = values[0],
                     }
                 }
+                let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                 if edit.energy_guard {
                     guard_texel(tile, edit.channels, i);
                 }
@@ -281,7 +302,7 @@ impl Slot<'_> {
                 // A brush on a tile the layer did not have before the stroke: every texel it
                 // reaches takes the target exactly (see `LayerStroke::apply`), so the tile
                 // holds the target in one value per channel and the dabs write coverage only.
-                let fresh = pre.is_none()
+                let fresh = matches!(pre, Pre::Before(None))
                     && matches!(edit.stroke, LayerStroke::Brush(_))
                     && varying.is_none();
                 let created = slot.is_none();
@@ -289,7 +310,10 @@ impl Slot<'_> {
                 if fresh && created {
                     tile.value = edit.from.uniform_tile();
                 }
-                let pre = pre.map(|p| p.get());
+                let pre = match *pre {
+                    Pre::Before(p) => Pre::Before(p.map(|p| p.get())),
+                    Pre::InPlace => Pre::InPlace,
+                };
                 for (ch, range) in RANGES.iter().enumerate() {
                     if !edit.channels[ch] {
                         continue;
@@ -418,7 +442,33 @@ pub fn edit_each(
     ids: &[usize],
     prepare: &impl Prepare,
 ) -> Vec<TileSpans> {
-    slots(planes, pre, ids)
+    write_each(slots(planes, pre, ids), edit, ids, prepare)
+}
+
+/// [`edit_each`] on a paint layer's tiles `ids` read in place: a texel's pre-operation value
+/// is what it holds until it is written, once, so no copy of a tile is held (a smudge dab,
+/// whose source is the composite, not the layer).
+pub fn edit_each_in_place(
+    tiles: &mut [Option<SharedPaintTile>],
+    edit: &LayerEdit,
+    ids: &[usize],
+    prepare: &impl Prepare,
+) -> Vec<TileSpans> {
+    let slots = select_mut(tiles, ids)
+        .into_iter()
+        .map(|t| Slot::Paint(t, Pre::InPlace, false))
+        .collect();
+    write_each(slots, edit, ids, prepare)
+}
+
+/// Writes `slots` (tiles `ids`) through [`write_varying`] with a worker's coverage buffer.
+fn write_each(
+    slots: Vec<Slot<'_>>,
+    edit: &LayerEdit,
+    ids: &[usize],
+    prepare: &impl Prepare,
+) -> Vec<TileSpans> {
+    slots
         .into_par_iter()
         .zip(ids)
         .map(|(mut slot, &id)| {
@@ -515,7 +565,7 @@ fn slots<'a>(planes: Planes<'a>, pre: PrePlanes<'a>, ids: &[usize]) -> Vec<Slot<
         (Planes::Paint(tiles), PrePlanes::Paint(pre)) => select_mut(tiles, ids)
             .into_iter()
             .zip(ids)
-            .map(|(t, &id)| Slot::Paint(t, pre[id].as_ref(), false))
+            .map(|(t, &id)| Slot::Paint(t, Pre::Before(pre[id].as_ref()), false))
             .collect(),
         (Planes::Mask(tiles), PrePlanes::Mask(pre)) => select_mut(tiles, ids)
             .into_iter()

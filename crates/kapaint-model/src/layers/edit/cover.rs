@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::{LayerEdit, Planes, PrePlanes, Slot, slots};
+use super::{LayerEdit, Planes, Pre, PrePlanes, Slot, slots};
 use crate::layers::{LayerStroke, LayerValue, PaintTile};
 use crate::paint::n_bits_from_blend_in;
 use crate::texel::{decode_unorm, encode_unorm};
@@ -141,14 +141,15 @@ pub(super) fn cover_alpha(alpha: &mut Plane<u16>, spans: &TileSpans, cover: &[f3
 }
 
 /// Channel `ch` of a paint tile's texels `spans` after a brush of `target` (its components)
-/// whose mode gives `value` ([`LayerStroke::value`]) at coverage `cover`, from the pre-operation tile (none: transparent), a row at a
+/// whose mode gives `value` ([`LayerStroke::value`]) at coverage `cover`, from the
+/// pre-operation texels (a tile before, none: transparent, or the tile's own), a row at a
 /// time: the coverage and the pre-stroke value's weight once per texel, then each component
 /// in a plain loop over the row ([`LayerStroke::apply`], term for term).
 #[inline(always)]
 pub(super) fn cover_channel(
     (tile, pre, ch, target, spans, cover): (
         &mut PaintTile,
-        Option<&PaintTile>,
+        Pre<&PaintTile>,
         usize,
         Targets<'_>,
         &TileSpans,
@@ -177,8 +178,20 @@ pub(super) fn cover_channel(
     for (y, x0, x1) in spans.rows() {
         let (start, width) = (y * TILE_SIZE + x0, x1 - x0);
         let cov = &cover[start..start + width];
+        // Every buffer at the run's width, so that the loops below run without bounds checks.
+        let (a, w, alpha, pre_alpha) = (
+            &mut a[..width],
+            &mut w[..width],
+            &mut alpha[..width],
+            &mut pre_alpha[..width],
+        );
+        // The run's texels before the operation (in place: read before the run is written).
+        let pre = match pre {
+            Pre::Before(p) => p,
+            Pre::InPlace => Some(&*tile),
+        };
         if let Some(p) = pre {
-            decode_run(&p.alpha[ch], start, &mut pre_alpha[..width], decode_unorm);
+            decode_run(&p.alpha[ch], start, pre_alpha, decode_unorm);
         }
         for j in 0..width {
             let aj = cov[j].clamp(0.0, 1.0);
@@ -204,7 +217,7 @@ pub(super) fn cover_channel(
             }
         }
         for c in 0..components {
-            let (t, pre_value) = (t[c], &pre_value[c][..width]);
+            let (t, pre_value) = (&t[c][..width], &pre_value[c][..width]);
             let encoded = &mut out[c][..width];
             if ch == 2 {
                 for j in 0..width {
@@ -219,7 +232,7 @@ pub(super) fn cover_channel(
         }
         // Only texels the stroke reached change.
         let all = all_reached(cov);
-        write_row(&mut tile.alpha[ch], start, &alpha[..width], cov, all);
+        write_row(&mut tile.alpha[ch], start, alpha, cov, all);
         match ch {
             0 | 1 => {
                 let [r, g, b] = &out;
@@ -283,34 +296,40 @@ fn write_row<T: Copy + PartialEq>(
 }
 
 /// The eraser on channel `ch` of a paint tile's texels `spans` at coverage `cover`, from the
-/// pre-operation tile: the coverage falls ([`LayerStroke::apply`]); values stay.
+/// pre-operation texels: the coverage falls ([`LayerStroke::apply`]); values stay.
 #[inline(always)]
 pub(super) fn erase_channel(
-    (tile, pre, ch, spans, cover): (
-        &mut PaintTile,
-        Option<&PaintTile>,
-        usize,
-        &TileSpans,
-        &[f32],
-    ),
+    (tile, pre, ch, spans, cover): (&mut PaintTile, Pre<&PaintTile>, usize, &TileSpans, &[f32]),
 ) {
-    let Some(pre) = pre else {
+    let erased = |pre_alpha: u16, a: f32| {
+        let before = LayerValue {
+            value: 0.0,
+            alpha: decode_unorm(pre_alpha),
+        };
+        encode_unorm(LayerStroke::Erase.apply(before, 0.0, a).alpha)
+    };
+    let pre = match pre {
+        Pre::Before(Some(p)) => p,
         // Nothing to erase: the tile is as transparent as before the stroke.
-        return;
+        Pre::Before(None) => return,
+        Pre::InPlace => {
+            let plane = tile.alpha[ch].data_mut();
+            for i in spans.indices() {
+                let a = cover[i];
+                plane[i] = if a > 0.0 {
+                    erased(plane[i], a)
+                } else {
+                    plane[i]
+                };
+            }
+            return;
+        }
     };
     let plane = tile.alpha[ch].data_mut();
     for i in spans.indices() {
         let a = cover[i];
-        let out = LayerStroke::Erase.apply(
-            LayerValue {
-                value: 0.0,
-                alpha: decode_unorm(pre.alpha[ch].get(i)),
-            },
-            0.0,
-            a,
-        );
         plane[i] = if a > 0.0 {
-            encode_unorm(out.alpha)
+            erased(pre.alpha[ch].get(i), a)
         } else {
             plane[i]
         };
