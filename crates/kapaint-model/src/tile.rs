@@ -161,6 +161,50 @@ impl<T: Copy + PartialEq> Plane<T> {
             Self::Data(d) => std::mem::size_of_val(&**d),
         }
     }
+
+    /// Texels `start..start + out.len()` through `f` into `out`, in a plain loop.
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    pub fn decode_into(&self, start: usize, out: &mut [f32], f: impl Fn(T) -> f32) {
+        match self {
+            Self::Uniform(v) => out.fill(f(*v)),
+            Self::Data(d) => {
+                let d = &d[start..start + out.len()];
+                for (o, &v) in out.iter_mut().zip(d) {
+                    *o = f(v);
+                }
+            }
+        }
+    }
+}
+
+impl Plane<[u16; 3]> {
+    /// Texels `start..` of an RGB plane, unorm16 decoded, a component into each of `r`, `g`,
+    /// `b` (as many texels as `r` holds): the texels taken apart in one pass.
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    pub fn decode_rgb_into(&self, start: usize, [r, g, b]: [&mut [f32]; 3]) {
+        let decode = super::texel::decode_unorm;
+        match self {
+            Self::Uniform(v) => {
+                r.fill(decode(v[0]));
+                g.fill(decode(v[1]));
+                b.fill(decode(v[2]));
+            }
+            Self::Data(d) => {
+                let d = &d[start..start + r.len()];
+                for (((v, r), g), b) in d.iter().zip(r).zip(g).zip(b) {
+                    (*r, *g, *b) = (decode(v[0]), decode(v[1]), decode(v[2]));
+                }
+            }
+        }
+    }
 }
 
 /// One tile of every channel.

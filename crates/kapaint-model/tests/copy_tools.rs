@@ -19,7 +19,7 @@ use kapaint_model::{
 #[path = "common/layer_doc.rs"]
 #[expect(dead_code, reason = "its 192 x 128 document is not used here")]
 mod layer_doc;
-use layer_doc::{run, texels};
+use layer_doc::{mask_gray, run, texels};
 
 /// A 256 x 256 document over a grey base.
 fn document() -> Document {
@@ -268,13 +268,7 @@ fn smudge_on_a_mask_drags_its_gray() {
             Stroke(tool: Brush, points: [(pos: (40.0, 128.0), pressure: 1.0)]),
         ])",
     );
-    let gray = |doc: &Document, x: usize, y: usize| -> f32 {
-        let layer = doc.stack().layer(&doc.selection().path).expect("layer");
-        let mask = layer.mask.as_ref().expect("a mask");
-        let tile = &mask.tiles[(y / 64) * 4 + x / 64];
-        f32::from(tile.get().get((y % 64) * 64 + x % 64)) / 65535.0
-    };
-    assert!(gray(&doc, 40, 128) < 0.01 && gray(&doc, 100, 128) > 0.99);
+    assert!(mask_gray(&doc, 40, 128) < 0.01 && mask_gray(&doc, 100, 128) > 0.99);
     brush(&mut doc, 16.0, 0.7, 1.0);
     let length = 120.0;
     stroke(
@@ -282,12 +276,12 @@ fn smudge_on_a_mask_drags_its_gray() {
         StrokeTool::Smudge,
         line(Vec2::new(40.0, 128.0), Vec2::new(40.0 + length, 128.0), 60),
     );
-    let dark = (40..(40 + length as usize))
-        .take_while(|&x| gray(&doc, x, 128) < 0.3)
+    let dark = (40..(40 + length as u32))
+        .take_while(|&x| mask_gray(&doc, x, 128) < 0.3)
         .count();
     assert!(dark as f32 >= 0.6 * length, "the black went {dark} texels");
     assert!(
-        gray(&doc, 120, 20) > 0.99,
+        mask_gray(&doc, 120, 20) > 0.99,
         "beside the stroke the mask is white"
     );
 }

@@ -18,6 +18,7 @@ use kapaint_model::texel::Texel;
 use kapaint_model::{Command, Document, HistoryCommand, LayerCommand, MaskCommand};
 
 #[path = "common/layer_doc.rs"]
+#[expect(dead_code, reason = "each test file uses some of the helpers")]
 mod layer_doc;
 use layer_doc::{document, run, texels};
 

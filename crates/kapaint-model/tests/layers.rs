@@ -16,6 +16,7 @@ use kapaint_model::{
 };
 
 #[path = "common/layer_doc.rs"]
+#[expect(dead_code, reason = "each test file uses some of the helpers")]
 mod layer_doc;
 use layer_doc::{document, run, texels};
 

@@ -17,7 +17,7 @@ use crate::layers::edit::{self, Components, LayerEdit, Planes, PrePlanes, TileTa
 use crate::maps::MaterialMaps;
 use crate::paint::{Coverage, Footprint};
 use crate::texel::decode_unorm;
-use crate::tile::{Plane, TILE_SIZE, Tile, TileSpans};
+use crate::tile::{TILE_SIZE, Tile, TileSpans};
 
 /// What a clone stroke reads: the composite and the mask as they were before it.
 pub(super) struct CloneSource {
@@ -71,30 +71,10 @@ pub(super) fn value_at(
     reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
 )]
 fn decode_tile_run(tile: &Tile, i: usize, out: [&mut [f32]; 7], blend: &[f32]) {
-    let [r0, g0, b0, r1, g1, b1, n_out] = out;
-    let n = n_out.len();
-    for (plane, [r, g, b]) in [(&tile.kd, [r0, g0, b0]), (&tile.ks, [r1, g1, b1])] {
-        match plane {
-            Plane::Uniform(v) => {
-                r.fill(decode_unorm(v[0]));
-                g.fill(decode_unorm(v[1]));
-                b.fill(decode_unorm(v[2]));
-            }
-            Plane::Data(d) => {
-                for (((v, r), g), b) in d[i..i + n].iter().zip(r).zip(g).zip(b) {
-                    (*r, *g, *b) = (decode_unorm(v[0]), decode_unorm(v[1]), decode_unorm(v[2]));
-                }
-            }
-        }
-    }
-    match &tile.n {
-        Plane::Uniform(bits) => n_out.fill(blend[*bits as usize]),
-        Plane::Data(d) => {
-            for (o, &bits) in n_out.iter_mut().zip(&d[i..i + n]) {
-                *o = blend[bits as usize];
-            }
-        }
-    }
+    let [r0, g0, b0, r1, g1, b1, n] = out;
+    tile.kd.decode_rgb_into(i, [r0, g0, b0]);
+    tile.ks.decode_rgb_into(i, [r1, g1, b1]);
+    tile.n.decode_into(i, n, |bits| blend[bits as usize]);
 }
 
 /// Row `y` of the map (clamped to it) from column `x0` for as many texels as `out` holds

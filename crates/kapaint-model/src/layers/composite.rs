@@ -262,15 +262,8 @@ fn decode_runs<T: Copy + PartialEq>(
     out: &mut [f32],
     f: impl Fn(T) -> f32,
 ) {
-    match plane {
-        Plane::Uniform(v) => out.fill(f(*v)),
-        Plane::Data(d) => {
-            for &(start, at, len) in runs {
-                for (o, &v) in out[at..at + len].iter_mut().zip(&d[start..start + len]) {
-                    *o = f(v);
-                }
-            }
-        }
+    for &(start, at, len) in runs {
+        plane.decode_into(start, &mut out[at..at + len], &f);
     }
 }
 
@@ -312,26 +305,13 @@ fn channel_values(
         }
     };
     let [r, g, b] = out;
-    match rgb {
-        Plane::Uniform(v) => {
-            r.fill(decode_unorm(v[0]));
-            g.fill(decode_unorm(v[1]));
-            b.fill(decode_unorm(v[2]));
-        }
-        Plane::Data(d) => {
-            for &(start, at, len) in runs {
-                let (r, g, b) = (
-                    &mut r[at..at + len],
-                    &mut g[at..at + len],
-                    &mut b[at..at + len],
-                );
-                for (j, v) in d[start..start + len].iter().enumerate() {
-                    r[j] = decode_unorm(v[0]);
-                    g[j] = decode_unorm(v[1]);
-                    b[j] = decode_unorm(v[2]);
-                }
-            }
-        }
+    for &(start, at, len) in runs {
+        let run = [
+            &mut r[at..at + len],
+            &mut g[at..at + len],
+            &mut b[at..at + len],
+        ];
+        rgb.decode_rgb_into(start, run);
     }
 }
 

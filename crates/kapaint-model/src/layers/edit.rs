@@ -233,37 +233,40 @@ impl Slot<'_> {
         match self {
             Self::Paint(slot, pre, written) => {
                 let target = &target.value;
+                // The texel before the operation, read before the tile is written.
+                let p = match *pre {
+                    Pre::Before(p) => p,
+                    Pre::InPlace => slot.as_ref(),
+                };
+                let (mut pre_alpha, mut pre_value) = ([0.0; 3], [0.0; 7]);
+                if let Some(p) = p.map(|p| p.get()) {
+                    for (ch, range) in RANGES.iter().enumerate() {
+                        if edit.channels[ch] {
+                            pre_alpha[ch] = decode_unorm(p.alpha[ch].get(i));
+                            for k in range.clone() {
+                                pre_value[k] = decode(ch, component(&p.value, k, i));
+                            }
+                        }
+                    }
+                }
+                let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                 for (ch, range) in RANGES.iter().enumerate() {
                     if !edit.channels[ch] {
                         continue;
                     }
-                    // The texel before the operation, read before the tile is written.
-                    let p = match *pre {
-                        Pre::Before(p) => p,
-                        Pre::InPlace => slot.as_ref(),
-                    };
-                    let pre_alpha = p.map_or(0.0, |p| decode_unorm(p.get().alpha[ch].get(i)));
-                    let pre_values: [f32; 3] = std::array::from_fn(|s| match p {
-                        Some(p) if s < range.len() => {
-                            decode(ch, component(&p.get().value, range.start + s, i))
-                        }
-                        _ => 0.0,
-                    });
-                    let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
-                    let mut alpha = pre_alpha;
+                    let mut alpha = pre_alpha[ch];
                     let mut values = [0_u16; 3];
-                    for (slot, k) in range.clone().enumerate() {
-                        let pre_value = pre_values[slot];
+                    for (s, k) in range.clone().enumerate() {
                         let out = edit.stroke.apply(
                             LayerValue {
-                                value: pre_value,
-                                alpha: pre_alpha,
+                                value: pre_value[k],
+                                alpha: pre_alpha[ch],
                             },
                             target.c[k],
                             a,
                         );
                         alpha = out.alpha;
-                        values[slot] = encode(ch, out.value);
+                        values[s] = encode(ch, out.value);
                     }
                     tile.alpha[ch].data_mut()[i] = encode_unorm(alpha);
                     match ch {
@@ -272,7 +275,6 @@ impl Slot<'_> {
                         _ => tile.value.n.data_mut()[i] = values[0],
                     }
                 }
-                let tile = writable(slot.get_or_insert_with(empty_paint_tile), written);
                 if edit.energy_guard {
                     guard_texel(tile, edit.channels, i);
                 }

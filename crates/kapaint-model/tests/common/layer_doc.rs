@@ -35,3 +35,11 @@ pub fn run(doc: &mut Document, script: &str) {
             .unwrap_or_else(|e| panic!("{}: {e}", &what[..what.len().min(80)]));
     }
 }
+
+/// The selected layer's mask at texel `(x, y)`: its stored gray (0 hides, 1 shows).
+pub fn mask_gray(doc: &Document, x: u32, y: u32) -> f32 {
+    let layer = doc.stack().layer(&doc.selection().path).expect("layer");
+    let mask = layer.mask.as_ref().expect("a mask");
+    let (id, i) = doc.maps().locate(x, y);
+    f32::from(mask.tiles[id].get().get(i)) / 65535.0
+}

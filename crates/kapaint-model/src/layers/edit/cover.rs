@@ -78,53 +78,6 @@ impl<R: Raise> crate::simd::Kernel for CoverTile<'_, '_, R> {
     }
 }
 
-/// Decodes `len` texels of `plane` from texel `start` into `out` through `f`.
-#[inline(always)]
-fn decode_run<T: Copy + PartialEq>(
-    plane: &Plane<T>,
-    start: usize,
-    out: &mut [f32],
-    f: impl Fn(T) -> f32,
-) {
-    match plane {
-        Plane::Uniform(v) => out.fill(f(*v)),
-        Plane::Data(d) => {
-            let len = out.len();
-            for (o, &v) in out.iter_mut().zip(&d[start..start + len]) {
-                *o = f(v);
-            }
-        }
-    }
-}
-
-/// Decodes `len` texels of an RGB `plane` from texel `start` into `out`, a component each.
-#[inline(always)]
-fn decode_rgb_run(
-    plane: &Plane<[u16; 3]>,
-    start: usize,
-    len: usize,
-    out: &mut [[f32; TILE_SIZE]; 3],
-) {
-    let [r, g, b] = out;
-    match plane {
-        Plane::Uniform(v) => {
-            r[..len].fill(decode_unorm(v[0]));
-            g[..len].fill(decode_unorm(v[1]));
-            b[..len].fill(decode_unorm(v[2]));
-        }
-        Plane::Data(d) => {
-            for (((v, r), g), b) in d[start..start + len]
-                .iter()
-                .zip(r.iter_mut())
-                .zip(g.iter_mut())
-                .zip(b.iter_mut())
-            {
-                (*r, *g, *b) = (decode_unorm(v[0]), decode_unorm(v[1]), decode_unorm(v[2]));
-            }
-        }
-    }
-}
-
 /// The coverage of a transparent texel after a brush at `cover`, at texels `spans` of a
 /// channel's coverage plane (the value is the target's: see [`Slot::write_cover`]).
 #[inline(always)]
@@ -191,7 +144,7 @@ pub(super) fn cover_channel(
             Pre::InPlace => Some(&*tile),
         };
         if let Some(p) = pre {
-            decode_run(&p.alpha[ch], start, pre_alpha, decode_unorm);
+            p.alpha[ch].decode_into(start, pre_alpha, decode_unorm);
         }
         for j in 0..width {
             let aj = cov[j].clamp(0.0, 1.0);
@@ -209,11 +162,16 @@ pub(super) fn cover_channel(
         });
         if let Some(p) = pre {
             match ch {
-                0 => decode_rgb_run(&p.value.kd, start, width, &mut pre_value),
-                1 => decode_rgb_run(&p.value.ks, start, width, &mut pre_value),
-                _ => decode_run(&p.value.n, start, &mut pre_value[0][..width], |bits| {
-                    table[bits as usize]
-                }),
+                0 | 1 => {
+                    let plane = if ch == 0 { &p.value.kd } else { &p.value.ks };
+                    plane.decode_rgb_into(start, pre_value.each_mut().map(|v| &mut v[..width]));
+                }
+                _ => p
+                    .value
+                    .n
+                    .decode_into(start, &mut pre_value[0][..width], |bits| {
+                        table[bits as usize]
+                    }),
             }
         }
         for c in 0..components {
