@@ -524,57 +524,43 @@ fn projections(c: &mut Criterion) {
             doc.apply(HistoryCommand::Undo).expect("undo");
         });
     });
-    mesh_copy_dabs(&mut group, &mut doc);
     group.finish();
 }
 
 /// Clone and smudge on the mesh (object space, the source found through the baked texels):
-/// the brush's 128-texel dab at spacing 10 %, around the sphere's equator of `doc`.
-fn mesh_copy_dabs(
-    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
-    doc: &mut Document,
-) {
-    doc.apply(SettingsCommand::SetBrush(BrushSettings {
-        spacing_percent: 10.0,
-        ..brush128()
-    }))
-    .expect("brush");
+/// the brush's 128-texel dab at spacing 10 %, around the sphere's equator of
+/// [`typical::mesh_tool_dab_document`] (what `examples/tool_dab_profile mesh` profiles).
+fn mesh_copy_dabs(c: &mut Criterion) {
+    use kapaint::report::typical;
+    let mut group = c.benchmark_group("tools_4096");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(5));
+    let mut doc = typical::mesh_tool_dab_document().expect("document");
     let units = doc.surface().map_or(1.0, |s| s.units_per_texel);
-    let on_equator = |k: u32| {
-        let phi = k as f32 * 12.8 * units;
-        let p = Vec3::new(phi.cos(), 0.0, -phi.sin());
-        kapaint::model::brush::SurfacePoint {
-            pos: kapaint::model::brush::SurfacePos {
-                point: p,
-                normal: p,
-            },
-            pressure: 1.0,
-        }
-    };
-    // The source a little above the stroke's start, as an artist picks one.
-    doc.apply(SettingsCommand::SetSurfaceCloneSource(
-        Vec3::new(1.0, 0.3, 0.0).normalize(),
-    ))
-    .expect("source");
     for (name, tool) in [
+        ("brush_dab_on_mesh_128px", StrokeTool::Brush),
         ("clone_dab_on_mesh_128px", StrokeTool::Clone),
         ("smudge_dab_on_mesh_128px", StrokeTool::Smudge),
     ] {
         let mut k = 0u32;
         group.bench_function(name, |b| {
             b.iter(|| {
-                if k.is_multiple_of(200) {
+                if k.is_multiple_of(250) {
                     doc.apply(StrokeCommand::EndStroke).expect("end");
                     doc.apply(StrokeCommand::BeginStroke(tool)).expect("begin");
                 }
+                doc.apply(StrokeCommand::SurfaceStrokeTo(
+                    typical::mesh_tool_dab_point(k, units),
+                ))
+                .expect("dab");
                 k += 1;
-                doc.apply(StrokeCommand::SurfaceStrokeTo(on_equator(k % 200)))
-                    .expect("dab");
                 doc.maps().version()
             });
         });
         doc.apply(StrokeCommand::EndStroke).expect("end");
     }
+    group.finish();
 }
 
 /// Saving and opening a 16-layer 4096^2 project (the stack of [`layered_stack`]: every
@@ -704,6 +690,7 @@ criterion_group!(
     layered_project_io,
     generators,
     tool_dabs,
-    projections
+    projections,
+    mesh_copy_dabs
 );
 criterion_main!(benches);

@@ -5,32 +5,57 @@
 //! interleaved round by round, so their ratios hold on a noisy machine; the fastest stroke's
 //! dabs are the least disturbed by the machine's other work).
 //!
-//! Usage: `cargo run --release --example tool_dab_profile [brush|clone|smudge|stencil|all]
-//! [DABS]`
+//! The same dabs on the mesh (`mesh-brush`, `mesh-clone`, `mesh-smudge`, or `mesh` for the
+//! three): around the equator of the built-in sphere baked at 4096^2, 200 dabs a stroke.
+//!
+//! Usage: `cargo run --release --example tool_dab_profile
+//! [brush|clone|smudge|stencil|all|mesh|mesh-brush|mesh-clone|mesh-smudge] [DABS]`
 
 use kapaint::model::StrokeCommand;
 use kapaint::model::StrokeTool;
 use kapaint::model::brush::StrokePoint;
-use kapaint::report::typical::{tool_dab_document, tool_dab_path as path};
+use kapaint::report::typical::{
+    mesh_tool_dab_document, mesh_tool_dab_point, tool_dab_document, tool_dab_path as path,
+};
 
 /// The benchmark's document for `tool`, and the tool its strokes use.
 fn prepared(tool: &str) -> Result<(kapaint::model::Document, StrokeTool), String> {
-    let stroke_tool = match tool {
+    let stroke_tool = match tool.trim_start_matches("mesh-") {
         "clone" => StrokeTool::Clone,
         "smudge" => StrokeTool::Smudge,
         _ => StrokeTool::Brush,
     };
-    Ok((tool_dab_document(tool == "stencil")?, stroke_tool))
+    let doc = if tool.starts_with("mesh-") {
+        mesh_tool_dab_document()?
+    } else {
+        tool_dab_document(tool == "stencil")?
+    };
+    Ok((doc, stroke_tool))
+}
+
+/// Dab `k` of a stroke of `tool` on `doc`.
+fn dab(doc: &mut kapaint::model::Document, tool: &str, k: u32) -> Result<(), String> {
+    let command = if tool.starts_with("mesh-") {
+        let units = doc.surface().map_or(1.0, |s| s.units_per_texel);
+        StrokeCommand::SurfaceStrokeTo(mesh_tool_dab_point(k, units))
+    } else {
+        StrokeCommand::StrokeTo(StrokePoint {
+            pos: path(k),
+            pressure: 1.0,
+        })
+    };
+    doc.apply(command).map_err(|e| e.to_string())?;
+    Ok(())
 }
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let which = args.next().unwrap_or_else(|| "all".into());
     let dabs: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(3000);
-    let names: Vec<&str> = if which == "all" {
-        vec!["brush", "clone", "smudge", "stencil"]
-    } else {
-        vec![which.as_str()]
+    let names: Vec<&str> = match which.as_str() {
+        "all" => vec!["brush", "clone", "smudge", "stencil"],
+        "mesh" => vec!["mesh-brush", "mesh-clone", "mesh-smudge"],
+        one => vec![one],
     };
     let mut docs = names
         .iter()
@@ -40,16 +65,12 @@ fn main() -> Result<(), String> {
     let mut strokes = vec![Vec::new(); names.len()];
     // Rounds of 250 dabs (one stroke), the tools taking turns.
     for round in 0..dabs.div_ceil(250) {
-        for ((doc, tool), times) in docs.iter_mut().zip(&mut strokes) {
+        for (((doc, tool), times), name) in docs.iter_mut().zip(&mut strokes).zip(&names) {
             let start = std::time::Instant::now();
             doc.apply(StrokeCommand::BeginStroke(*tool))
                 .map_err(|e| e.to_string())?;
             for k in round * 250..(round + 1) * 250 {
-                doc.apply(StrokeCommand::StrokeTo(StrokePoint {
-                    pos: path(k),
-                    pressure: 1.0,
-                }))
-                .map_err(|e| e.to_string())?;
+                dab(doc, name, k)?;
             }
             doc.apply(StrokeCommand::EndStroke)
                 .map_err(|e| e.to_string())?;

@@ -54,13 +54,17 @@ pub fn uv_sphere(segments: u32, rings: u32) -> Mesh {
     grid("sphere", segments, rings, |i, j| {
         let u = i as f32 / segments as f32;
         let v = j as f32 / rings as f32;
-        let (theta, phi) = (PI * v, TAU * u);
-        // j = 0 is the north pole (v = 1 in OBJ convention, the top of the texture).
-        let p = Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            -theta.sin() * phi.sin(),
-        );
+        // The seam's two columns at the same points, bit for bit (the angle of the last
+        // column is the first's), so that the surface is one piece across it.
+        let phi = TAU * (i % segments) as f32 / segments as f32;
+        // j = 0 is the north pole (v = 1 in OBJ convention, the top of the texture); each
+        // pole's ring at the pole exactly (sin(PI) is not zero in f32).
+        let (sin, cos) = match j {
+            0 => (0.0, 1.0),
+            j if j == rings => (0.0, -1.0),
+            _ => (PI * v).sin_cos(),
+        };
+        let p = Vec3::new(sin * phi.cos(), cos, -sin * phi.sin());
         (p, p, Vec2::new(u, 1.0 - v))
     })
 }
@@ -127,8 +131,12 @@ pub fn torus(major: f32, minor: f32, segments: u32, sides: u32) -> Mesh {
     let (segments, sides) = (segments.max(3), sides.max(3));
     grid("torus", segments, sides, |i, j| {
         let (u, v) = (i as f32 / segments as f32, j as f32 / sides as f32);
-        // The tube angle runs backwards so that the grid winds outwards.
-        let (a, b) = (TAU * u, -TAU * v);
+        // The tube angle runs backwards so that the grid winds outwards; the seams' columns
+        // and rows at the same points, bit for bit, as for the sphere.
+        let (a, b) = (
+            TAU * (i % segments) as f32 / segments as f32,
+            -TAU * (j % sides) as f32 / sides as f32,
+        );
         let ring = Vec3::new(a.cos(), 0.0, -a.sin());
         let n = ring * b.cos() + Vec3::Y * b.sin();
         (ring * major + n * minor, n, Vec2::new(u, v))

@@ -51,8 +51,16 @@ impl Aabb {
 
     /// Whether the box meets the ball (empty boxes never do).
     fn meets_ball(&self, center: Vec3, r2: f32) -> bool {
-        let nearest = center.clamp(self.min, self.max.max(self.min));
-        self.min.cmple(self.max).all() && nearest.distance_squared(center) <= r2
+        self.distance_squared(center) <= r2
+    }
+
+    /// The squared distance from `p` to the box (infinite for an empty box).
+    fn distance_squared(&self, p: Vec3) -> f32 {
+        if self.min.cmple(self.max).all() {
+            p.clamp(self.min, self.max).distance_squared(p)
+        } else {
+            f32::INFINITY
+        }
     }
 }
 
@@ -188,47 +196,74 @@ impl Surface {
     }
 
     /// The index of the baked surface texel nearest `point` within `radius`.
+    ///
+    /// Nearest first: the tiles, then each tile's blocks, in the order of their boxes'
+    /// distances, until the next box lies farther than the nearest texel found, so a query
+    /// reads the texels of a block or two however large `radius` is.
     pub fn nearest_texel(&self, point: Vec3, radius: f32) -> Option<usize> {
-        let mut best: Option<(f32, usize)> = None;
-        self.visit_near(point, radius, |i, p| {
-            let d2 = p.distance_squared(point);
-            if best.is_none_or(|(bd, _)| d2 < bd) {
-                best = Some((d2, i));
+        let mut best = (radius * radius, None);
+        if best.0.is_nan() {
+            return None;
+        }
+        let mut tiles: Vec<(f32, usize)> = (self.tile_boxes.iter().enumerate())
+            .map(|(id, b)| (b.distance_squared(point), id))
+            .filter(|&(d2, _)| d2 <= best.0)
+            .collect();
+        while let Some(k) = (0..tiles.len()).min_by(|&a, &b| tiles[a].0.total_cmp(&tiles[b].0)) {
+            let (d2, id) = tiles.swap_remove(k);
+            if d2 > best.0 {
+                break;
             }
-        });
-        best.map(|(_, i)| i)
+            let mut blocks: [(f32, usize); BLOCKS_PER_TILE * BLOCKS_PER_TILE] =
+                std::array::from_fn(|b| (self.block_boxes[id][b].distance_squared(point), b));
+            blocks.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            for (d2, b) in blocks {
+                if d2 > best.0 {
+                    break;
+                }
+                self.visit_block(id, b, |i, p| {
+                    let d2 = p.distance_squared(point);
+                    if d2 < best.0 || (best.1.is_none() && d2 <= best.0) {
+                        best = (d2, Some(i));
+                    }
+                });
+            }
+        }
+        best.1
+    }
+
+    /// Calls `f` with the index and position of every baked surface texel (not padding) of
+    /// block `b` of tile `id`.
+    #[inline]
+    fn visit_block(&self, id: usize, b: usize, mut f: impl FnMut(usize, Vec3)) {
+        let w = self.bake.width as usize;
+        let bx = (id % self.tiles_x) * TILE_SIZE + (b % BLOCKS_PER_TILE) * BLOCK;
+        let by = (id / self.tiles_x) * TILE_SIZE + (b / BLOCKS_PER_TILE) * BLOCK;
+        for y in by..(by + BLOCK).min(self.bake.height as usize) {
+            for x in bx..(bx + BLOCK).min(w) {
+                let i = y * w + x;
+                if self.bake.coverage(i) == Coverage::Surface {
+                    f(i, self.bake.position(i));
+                }
+            }
+        }
     }
 
     /// Calls `f` with the index and position of every baked surface texel (not padding)
     /// within `radius` of `point`.
     pub fn visit_near(&self, point: Vec3, radius: f32, mut f: impl FnMut(usize, Vec3)) {
         let r2 = radius * radius;
-        let w = self.bake.width as usize;
         for (id, tile) in self.tile_boxes.iter().enumerate() {
             if !tile.meets_ball(point, r2) {
                 continue;
             }
-            let (x0, y0) = (
-                (id % self.tiles_x) * TILE_SIZE,
-                (id / self.tiles_x) * TILE_SIZE,
-            );
             for (b, block) in self.block_boxes[id].iter().enumerate() {
-                if !block.meets_ball(point, r2) {
-                    continue;
-                }
-                let bx = x0 + (b % BLOCKS_PER_TILE) * BLOCK;
-                let by = y0 + (b / BLOCKS_PER_TILE) * BLOCK;
-                for y in by..(by + BLOCK).min(self.bake.height as usize) {
-                    for x in bx..(bx + BLOCK).min(w) {
-                        let i = y * w + x;
-                        if self.bake.coverage(i) != Coverage::Surface {
-                            continue;
-                        }
-                        let p = self.bake.position(i);
+                if block.meets_ball(point, r2) {
+                    self.visit_block(id, b, |i, p| {
                         if p.distance_squared(point) <= r2 {
                             f(i, p);
                         }
-                    }
+                    });
                 }
             }
         }
@@ -300,7 +335,10 @@ fn triangle_neighbours(mesh: &Mesh) -> Vec<[u32; 3]> {
         .iter()
         .map(|p| {
             let next = welded.len() as u32;
-            *welded.entry(p.to_array().map(f32::to_bits)).or_insert(next)
+            // -0 and +0 are one point (adding zero turns -0 into +0).
+            *welded
+                .entry(p.to_array().map(|c| (c + 0.0).to_bits()))
+                .or_insert(next)
         })
         .collect();
     let mut open: std::collections::HashMap<(u32, u32), (u32, usize)> =

@@ -332,3 +332,36 @@ pub fn tool_dab_document(stencil: bool) -> Result<Document, String> {
     }
     Ok(doc)
 }
+
+/// Dab `k` of the painting tools' benchmark on the mesh: around the equator of
+/// [`mesh_tool_dab_document`]'s sphere, 12.8 texels apart (10 % of a 128 px radius, in object
+/// units through the surface's texel size `units`), 200 dabs a stroke.
+pub fn mesh_tool_dab_point(k: u32, units: f32) -> kapaint_model::brush::SurfacePoint {
+    let phi = (k % 250) as f32 * 12.8 * units;
+    let p = Vec3::new(phi.cos(), 0.0, -phi.sin());
+    kapaint_model::brush::SurfacePoint {
+        pos: kapaint_model::brush::SurfacePos {
+            point: p,
+            normal: p,
+        },
+        pressure: 1.0,
+    }
+}
+
+/// The painting tools' benchmark document on the mesh: [`tool_dab_document`] (4096^2, every
+/// texel different, the 128 px brush at 10 % spacing) on the built-in UV sphere (128 x 64),
+/// with a clone source on the sphere a little above the strokes' start, as an artist picks
+/// one.
+///
+/// # Errors
+/// When the bake or a command is refused.
+pub fn mesh_tool_dab_document() -> Result<Document, String> {
+    let surface =
+        kapaint_model::surface::Surface::new(kapaint_mesh::uv_sphere(128, 64), 4096, 4096)?;
+    let mut doc = tool_dab_document(false)?
+        .with_surface(Some(std::sync::Arc::new(surface)))
+        .map_err(|e| e.to_string())?;
+    let source = SettingsCommand::SetSurfaceCloneSource(Vec3::new(1.0, 0.3, 0.0).normalize());
+    doc.apply(source).map_err(|e| e.to_string())?;
+    Ok(doc)
+}

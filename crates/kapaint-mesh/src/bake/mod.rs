@@ -82,6 +82,7 @@ impl UvBake {
     }
 
     /// Coverage of texel `i`.
+    #[inline]
     pub fn coverage(&self, i: usize) -> Coverage {
         match self.cells[i] {
             EMPTY => Coverage::Empty,
@@ -91,6 +92,7 @@ impl UvBake {
     }
 
     /// The triangle texel `i` paints (padding: its neighbour's), if any.
+    #[inline]
     pub fn triangle(&self, i: usize) -> Option<u32> {
         let c = self.cells[i];
         (c != EMPTY).then_some(c & !PADDING)
@@ -102,6 +104,7 @@ impl UvBake {
     }
 
     /// The barycentric weights of texel `i`'s point on its triangle.
+    #[inline]
     pub fn barycentric(&self, i: usize) -> Vec3 {
         let [b, c] = self.weights[i].map(|w| f32::from(w) / 65535.0);
         Vec3::new((1.0 - b - c).max(0.0), b, c)
@@ -109,16 +112,19 @@ impl UvBake {
 
     /// The object-space corners of triangle `t` (neighbouring texels mostly share one: a loop
     /// over texels keeps them while the triangle stays the same).
+    #[inline]
     pub fn corners(&self, t: u32) -> [Vec3; 3] {
         self.triangles[t as usize].map(|v| self.positions[v as usize])
     }
 
     /// The unit normals at the corners of triangle `t` (see [`UvBake::corners`]).
+    #[inline]
     pub fn corner_normals(&self, t: u32) -> [Vec3; 3] {
         self.triangles[t as usize].map(|v| self.normals[v as usize])
     }
 
     /// Object-space position of texel `i` (zero where it is empty).
+    #[inline]
     pub fn position(&self, i: usize) -> Vec3 {
         self.triangle(i).map_or(Vec3::ZERO, |t| {
             let w = self.barycentric(i);
@@ -128,6 +134,7 @@ impl UvBake {
     }
 
     /// Unit object-space normal of texel `i` (zero where it is empty).
+    #[inline]
     pub fn normal(&self, i: usize) -> Vec3 {
         self.triangle(i).map_or(Vec3::ZERO, |t| {
             let w = self.barycentric(i);
