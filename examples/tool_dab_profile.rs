@@ -8,8 +8,11 @@
 //! The same dabs on the mesh (`mesh-brush`, `mesh-clone`, `mesh-smudge`, or `mesh` for the
 //! three): around the equator of the built-in sphere baked at 4096^2, 200 dabs a stroke.
 //!
+//! `decal` places the `place_decal_1024px_image` benchmark's decal (a 1024^2 image, 0.5 units
+//! wide) on the same sphere and undoes it, `DABS` times.
+//!
 //! Usage: `cargo run --release --example tool_dab_profile
-//! [brush|clone|smudge|stencil|all|mesh|mesh-brush|mesh-clone|mesh-smudge] [DABS]`
+//! [brush|clone|smudge|stencil|all|mesh|mesh-brush|mesh-clone|mesh-smudge|decal] [DABS]`
 
 use kapaint::model::StrokeCommand;
 use kapaint::model::StrokeTool;
@@ -48,10 +51,43 @@ fn dab(doc: &mut kapaint::model::Document, tool: &str, k: u32) -> Result<(), Str
     Ok(())
 }
 
+/// `times` placements of the decal benchmark's decal on the mesh document, each undone.
+fn decals(times: u32) -> Result<(), String> {
+    use kapaint::model::{HistoryCommand, PaintCommand};
+    let mut doc = mesh_tool_dab_document()?;
+    let logo = image::DynamicImage::ImageRgba8(image::RgbaImage::from_fn(1024, 1024, |x, y| {
+        let alpha = if (x / 64 + y / 64) % 3 == 0 { 0 } else { 255 };
+        image::Rgba([(x / 4) as u8, (y / 4) as u8, 128, alpha])
+    }));
+    let image =
+        kapaint::model::paint_image::PaintImage::decoded(std::path::Path::new("logo.png"), &logo)
+            .map_err(|e| e.to_string())?;
+    let mut fastest = f64::INFINITY;
+    for _ in 0..times {
+        let start = std::time::Instant::now();
+        let place = PaintCommand::PlaceDecal {
+            image: image.clone(),
+            at: glam::Vec3::new(0.3, 0.4, 1.2),
+            size: 0.5,
+            rotation: 20.0,
+            channels: kapaint::model::Channels::ALL,
+            opacity: 1.0,
+        };
+        doc.apply(place).map_err(|e| e.to_string())?;
+        fastest = fastest.min(start.elapsed().as_secs_f64());
+        doc.apply(HistoryCommand::Undo).map_err(|e| e.to_string())?;
+    }
+    println!("decal: fastest placement {:.1} ms", fastest * 1e3);
+    Ok(())
+}
+
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let which = args.next().unwrap_or_else(|| "all".into());
     let dabs: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(3000);
+    if which == "decal" {
+        return decals(dabs);
+    }
     let names: Vec<&str> = match which.as_str() {
         "all" => vec!["brush", "clone", "smudge", "stencil"],
         "mesh" => vec!["mesh-brush", "mesh-clone", "mesh-smudge"],

@@ -261,8 +261,8 @@ impl Pixels {
         if alpha <= 1e-6 {
             return NONE;
         }
-        let alpha_sum = sum[5];
-        let un = |v: f32| (v / alpha_sum).clamp(0.0, 1.0);
+        let per_alpha = 1.0 / sum[5];
+        let un = |v: f32| (v * per_alpha).clamp(0.0, 1.0);
         Sample {
             rgb: Vec3::new(un(sum[0]), un(sum[1]), un(sum[2])),
             gray: un(sum[3]),

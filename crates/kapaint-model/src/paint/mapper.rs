@@ -74,21 +74,32 @@ impl Kind {
         })
     }
 
-    /// The image at a texel: `uv` its place on the map (in maps), `p` and `n` its baked
-    /// position and normal.
-    fn sample(&self, image: &Pixels, uv: Vec2, p: Vec3, n: Vec3, mask: bool) -> ([f32; 7], f32) {
+    /// The image at a texel: `uv` its place on the map (in maps), `p` and `normal` its baked
+    /// position and normal (the normal asked for only where the image reaches the texel).
+    fn sample(
+        &self,
+        image: &Pixels,
+        (uv, p): (Vec2, Vec3),
+        normal: impl FnOnce() -> Vec3,
+        mask: bool,
+    ) -> ([f32; 7], f32) {
         const NONE: ([f32; 7], f32) = ([0.0; 7], 0.0);
-        match self {
-            Self::Planar(frame, depth) => {
-                if !frame.faces(n) {
-                    return NONE;
-                }
-                let (at, d) = frame.image_uv(p);
-                if !depth.visible(frame, at, d, n) {
-                    return NONE;
-                }
-                target(&image.sample(at, false), mask)
+        if let Self::Planar(frame, depth) = self {
+            // Off the image first: a decal's ball reaches a third more surface than its square.
+            let (at, d) = frame.image_uv(p);
+            if !(at.cmpge(Vec2::ZERO).all() && at.cmple(Vec2::ONE).all()) {
+                return NONE;
             }
+            let n = normal();
+            if !frame.faces(n) || !depth.visible(frame, at, d, n) {
+                return NONE;
+            }
+            return target(&image.sample(at, false), mask);
+        }
+        let n = normal();
+        match self {
+            // Laid above.
+            Self::Planar(..) => NONE,
             Self::Cylindrical(origin, frame, height) => {
                 let d = p - *origin;
                 let along = d.dot(frame.pole);
@@ -216,7 +227,7 @@ impl Mapper {
         let mut spans = TileSpans::EMPTY;
         for (i, x, y) in tile_texels(w, h, id) {
             let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-            let (p, n) = match &self.surface {
+            let (p, t) = match &self.surface {
                 Some(s) => {
                     let t = y as usize * w as usize + x as usize;
                     if s.bake.coverage(t) == Coverage::Empty {
@@ -227,11 +238,12 @@ impl Mapper {
                     if self.ball.is_some_and(|(c, r2)| p.distance_squared(c) > r2) {
                         continue;
                     }
-                    (p, s.bake.normal(t))
+                    (p, t)
                 }
-                None => (Vec3::ZERO, Vec3::Z),
+                None => (Vec3::ZERO, 0),
             };
-            let (c, a) = self.kind.sample(&self.pixels, uv, p, n, mask);
+            let normal = || self.surface.as_ref().map_or(Vec3::Z, |s| s.bake.normal(t));
+            let (c, a) = self.kind.sample(&self.pixels, (uv, p), normal, mask);
             let a = (a * opacity).min(1.0);
             if a > 0.0 {
                 cover[i] = a;

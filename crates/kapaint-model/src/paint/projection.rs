@@ -168,18 +168,24 @@ impl DepthMap {
             if area.abs() < 1e-12 {
                 continue;
             }
+            // A corner's weight is linear in the cell's centre p: (e.x, e.y) . p + e.z, so a
+            // row is one multiply-add a weight a cell.
+            let inv = 1.0 / area;
+            let edge = |b: Vec2, c: Vec2| Vec3::new(b.y - c.y, c.x - b.x, b.perp_dot(c)) * inv;
+            let (e0, e1) = (edge(b, c), edge(c, a));
+            let (x0, x1) = (lo.x as usize, hi.x as usize);
             for y in lo.y as usize..hi.y as usize {
-                for x in lo.x as usize..hi.x as usize {
-                    let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                    let w0 = (b - p).perp_dot(c - p) / area;
-                    let w1 = (c - p).perp_dot(a - p) / area;
+                let py = y as f32 + 0.5;
+                let (r0, r1) = (e0.y * py + e0.z, e1.y * py + e1.z);
+                let row = &mut depth[y * side + x0..y * side + x1];
+                for (k, cell) in row.iter_mut().enumerate() {
+                    let px = (x0 + k) as f32 + 0.5;
+                    let (w0, w1) = (e0.x * px + r0, e1.x * px + r1);
                     let w2 = 1.0 - w0 - w1;
-                    if w0 < -1e-4 || w1 < -1e-4 || w2 < -1e-4 {
-                        continue;
+                    if w0 >= -1e-4 && w1 >= -1e-4 && w2 >= -1e-4 {
+                        let d = v[0].1 * w0 + v[1].1 * w1 + v[2].1 * w2;
+                        *cell = cell.max(d);
                     }
-                    let d = v[0].1 * w0 + v[1].1 * w1 + v[2].1 * w2;
-                    let cell = &mut depth[y * side + x];
-                    *cell = cell.max(d);
                 }
             }
         }
