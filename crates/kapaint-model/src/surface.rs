@@ -385,16 +385,22 @@ pub struct BallFootprint<'a> {
 }
 
 impl BallFootprint<'_> {
-    /// The weight of a texel at squared distance `d2` with normal `n` (before facing).
+    /// The weight of a texel at squared distance `d2` whose normal is `blend` made unit
+    /// (`fallback` where it has no length).
     #[inline]
-    fn weight(&self, d2: f32, r2: f32, n: Vec3) -> f32 {
+    fn weight(&self, d2: f32, r2: f32, (blend, fallback): (Vec3, Vec3)) -> f32 {
         let w = self.brush.falloff_sq(d2, r2);
         if self.normal == Vec3::ZERO || w == 0.0 {
             return w;
         }
-        // Full weight where the normals are within ~75 degrees, fading to zero at 90.
-        let facing = (n.dot(self.normal) * 4.0).clamp(0.0, 1.0);
-        w * facing
+        // Full weight where the normals are within ~75 degrees (the unit normal's dot at
+        // least 1/4, told without a square root: most texels), fading to zero at 90.
+        let (dot, len2) = (blend.dot(self.normal), blend.length_squared());
+        if dot > 0.0 && len2.is_normal() && 16.0 * dot * dot >= len2 {
+            return w;
+        }
+        let n = blend.try_normalize().unwrap_or(fallback);
+        w * (n.dot(self.normal) * 4.0).clamp(0.0, 1.0)
     }
 }
 
@@ -467,10 +473,7 @@ impl Footprint for BallFootprint<'_> {
                         *wt = if d2 < r2 {
                             // As the bake's normal: the corners' blend, made unit.
                             let [na, nb, nc] = corners.2;
-                            let n = (na * b.x + nb * b.y + nc * b.z)
-                                .try_normalize()
-                                .unwrap_or(na);
-                            self.weight(d2, r2, n)
+                            self.weight(d2, r2, (na * b.x + nb * b.y + nc * b.z, na))
                         } else {
                             0.0
                         };
