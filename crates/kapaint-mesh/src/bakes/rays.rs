@@ -13,6 +13,65 @@ use obvhs::triangle::Triangle;
 use crate::Mesh;
 use crate::frame::UnitFrame;
 
+/// Triangle `k` of `mesh` with its corners from `local` (the mesh's positions in the BVH's
+/// frame); none where a corner is missing or not finite.
+fn local_triangle(mesh: &Mesh, local: &[Vec3], k: u32) -> Option<Triangle> {
+    let t = mesh.triangles.get(k as usize)?;
+    let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
+    let (v0, v1, v2) = (v0?, v1?, v2?);
+    (v0.is_finite() && v1.is_finite() && v2.is_finite()).then_some(Triangle { v0, v1, v2 })
+}
+
+/// The BVH of `triangles`, built as obvhs's `build_cwbvh_from_tris` builds it with its slow
+/// preset (spatial pre-splits, PLOC, reinsertion, eight children a node; a slower build for
+/// fewer node visits: a mesh is built once and cast millions of rays at), in steps that free
+/// each input once used: the triangles before PLOC, the boxes after it, so the build's peak
+/// holds neither (about 48 and 32 bytes a triangle). The Morton codes are 64-bit (21 bits an
+/// axis is ample for the millions of triangles a sculpt has, and the sort's memory halves).
+fn build_bvh(triangles: Vec<Triangle>) -> CwBvh {
+    let params = obvhs::BvhBuildParams {
+        sort_precision: obvhs::ploc::SortPrecision::U64,
+        ..obvhs::BvhBuildParams::slow_build()
+    };
+    if triangles.is_empty() {
+        return CwBvh::default();
+    }
+    let (mut largest, mut total) = (0.0_f32, 0.0_f32);
+    let mut aabbs: Vec<obvhs::aabb::Aabb> = triangles
+        .iter()
+        .map(|t| {
+            let b = t.aabb();
+            largest = largest.max(b.half_area());
+            total += b.half_area();
+            b
+        })
+        .collect();
+    let mut indices: Vec<u32> = (0..triangles.len() as u32).collect();
+    let average = total / triangles.len() as f32;
+    obvhs::splits::split_aabbs_preset(&mut aabbs, &mut indices, &triangles, average, largest);
+    drop(triangles);
+    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
+        params.ploc_search_distance,
+        &aabbs,
+        indices,
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    drop(aabbs);
+    bvh2.uses_spatial_splits = true;
+    obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
+        &mut bvh2,
+        params.reinsertion_batch_ratio,
+        None,
+    );
+    obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+        &bvh2,
+        params.max_prims_per_leaf.clamp(1, 3),
+        true,
+        false,
+    )
+}
+
 /// A BVH of the mesh for occlusion and distance rays.
 pub struct RayMesh {
     bvh: CwBvh,
@@ -67,25 +126,18 @@ impl RayMesh {
         which: impl Iterator<Item = u32>,
     ) -> Self {
         let (kept, triangles): (Vec<u32>, Vec<Triangle>) = which
-            .filter_map(|k| {
-                let t = mesh.triangles.get(k as usize)?;
-                let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
-                let (v0, v1, v2) = (v0?, v1?, v2?);
-                (v0.is_finite() && v1.is_finite() && v2.is_finite())
-                    .then_some((k, Triangle { v0, v1, v2 }))
-            })
+            .filter_map(|k| Some((k, local_triangle(mesh, local, k)?)))
             .unzip();
-        // A slower build for fewer node visits: a mesh is built once and cast millions of
-        // rays at.
-        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-            &triangles,
-            obvhs::BvhBuildParams::slow_build(),
-            &mut std::time::Duration::default(),
-        );
+        let bvh = build_bvh(triangles);
+        // The triangles again, in the BVH's order (a triangle split by the build appears
+        // once for each of its pieces).
         let (sources, triangles) = bvh
             .primitive_indices
             .iter()
-            .map(|&i| (kept[i as usize], triangles[i as usize]))
+            .filter_map(|&i| {
+                let k = kept[i as usize];
+                Some((k, local_triangle(mesh, local, k)?))
+            })
             .unzip();
         Self {
             bvh,
