@@ -84,27 +84,25 @@ impl Kind {
         mask: bool,
     ) -> ([f32; 7], f32) {
         const NONE: ([f32; 7], f32) = ([0.0; 7], 0.0);
-        if let Self::Planar(frame, depth) = self {
-            // Off the image first: a decal's ball reaches a third more surface than its square.
-            let (at, d) = frame.image_uv(p);
-            if !(at.cmpge(Vec2::ZERO).all() && at.cmple(Vec2::ONE).all()) {
-                return NONE;
-            }
-            let n = normal();
-            if !frame.faces(n) || !depth.visible(frame, at, d, n) {
-                return NONE;
-            }
-            return target(&image.sample(at, false), mask);
-        }
-        let n = normal();
         match self {
-            // Laid above.
-            Self::Planar(..) => NONE,
+            Self::Planar(frame, depth) => {
+                // Off the image first: a decal's ball reaches a third more surface than its
+                // square.
+                let (at, d) = frame.image_uv(p);
+                if !(at.cmpge(Vec2::ZERO).all() && at.cmple(Vec2::ONE).all()) {
+                    return NONE;
+                }
+                let n = normal();
+                if !frame.faces(n) || !depth.visible(frame, at, d, n) {
+                    return NONE;
+                }
+                target(&image.sample(at, false), mask)
+            }
             Self::Cylindrical(origin, frame, height) => {
                 let d = p - *origin;
                 let along = d.dot(frame.pole);
                 let radial = d - frame.pole * along;
-                if n.dot(radial) <= 0.0 {
+                if normal().dot(radial) <= 0.0 {
                     return NONE;
                 }
                 let at = Vec2::new(frame.around(radial), 0.5 - along / height);
@@ -114,7 +112,7 @@ impl Kind {
                 let Some(d) = (p - *origin).try_normalize() else {
                     return NONE;
                 };
-                if n.dot(d) <= 0.0 {
+                if normal().dot(d) <= 0.0 {
                     return NONE;
                 }
                 let latitude = d.dot(frame.pole).clamp(-1.0, 1.0).asin();
@@ -122,7 +120,7 @@ impl Kind {
                 target(&image.sample(at, false), mask)
             }
             Self::Triplanar(scale, blend) => {
-                let a = n.abs();
+                let a = normal().abs();
                 let top = a.max_element();
                 let w = (a - Vec3::splat((1.0 - blend) * top)).max(Vec3::ZERO);
                 let sum = w.element_sum();

@@ -3,9 +3,10 @@
 //! stroke's offset; a smudge texel moves towards what the composite holds now one dab-step
 //! (object space) behind it. Each dab's centre, moved so, is put back on the surface first,
 //! and its texels read at their displacement from there (see [`SourceGrid`]). The source is
-//! found in object space, so both run across UV seams: the nearest baked texel names the
-//! triangle, the point is projected onto that triangle, and its UV is read bilinearly from
-//! the composite.
+//! found in object space, so both run across UV seams: the triangle under the moved point is
+//! followed across the mesh from texel to texel (`walk`; where that finds nothing, the
+//! nearest baked texel names it), the point is projected onto that triangle, and its UV is
+//! read bilinearly from the composite (`sample`).
 
 mod cells;
 mod sample;
@@ -118,12 +119,7 @@ pub(super) fn surface_clone_dab(
         PrePlanes::Mask(m) => Some(m),
         PrePlanes::Paint(_) => None,
     };
-    let sampler = Sampler {
-        tiles: &source.tiles,
-        mask,
-        maps,
-        blend: crate::paint::n_blend_table(),
-    };
+    let sampler = Sampler::new(&source.tiles, mask, maps);
     let w = maps.width() as usize;
     let prepare = |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
         let rose = raise.raise(id, cover);
@@ -178,12 +174,7 @@ fn surface_smudge_tile<'a>(
     (fp, strength): (&'a impl Footprint, f32),
     grid: &'a SourceGrid<'_>,
 ) -> impl Fn(usize, &mut [f32], &mut TileTargets) -> TileSpans + Sync + 'a {
-    let sampler = Sampler {
-        tiles: maps.tiles(),
-        mask,
-        maps,
-        blend: crate::paint::n_blend_table(),
-    };
+    let sampler = Sampler::new(maps.tiles(), mask, maps);
     let w = maps.width() as usize;
     move |id: usize, cover: &mut [f32], targets: &mut TileTargets| {
         let rect = maps.tile_rect(id);

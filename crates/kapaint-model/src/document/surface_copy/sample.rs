@@ -14,22 +14,36 @@ use crate::tile::{Plane, TILE_SIZE, Tile};
 /// The composite's tiles (or a mask's), read bilinearly between texel centres as the layer
 /// kernels blend them (`k_d`, `k_s`, `n` in blend space; a mask's gray in the first
 /// component), clamped to the map.
-pub(in crate::document) struct Sampler<'a> {
-    pub(in crate::document) tiles: &'a [Arc<Tile>],
-    pub(in crate::document) mask: Option<&'a [SharedMaskTile]>,
-    pub(in crate::document) maps: &'a MaterialMaps,
+pub(super) struct Sampler<'a> {
+    tiles: &'a [Arc<Tile>],
+    mask: Option<&'a [SharedMaskTile]>,
+    maps: &'a MaterialMaps,
     /// `n`'s blend space, by its stored bits.
-    pub(in crate::document) blend: &'a [f32],
+    blend: &'static [f32],
 }
 
-impl Sampler<'_> {
+impl<'a> Sampler<'a> {
+    /// Reads `tiles` (composite tiles of `maps`), or `mask`'s gray where one is given.
+    pub(super) fn new(
+        tiles: &'a [Arc<Tile>],
+        mask: Option<&'a [SharedMaskTile]>,
+        maps: &'a MaterialMaps,
+    ) -> Self {
+        Self {
+            tiles,
+            mask,
+            maps,
+            blend: crate::paint::n_blend_table(),
+        }
+    }
+
     /// The value at texel-unit point `at` (texel `(x, y)`'s centre at `(x + 0.5, y + 0.5)`).
     ///
     /// Most points have their four texels in one tile: that tile is found once and its four
     /// texels read directly; the others (a tile's last row or column, the map's border) read
     /// texel by texel, clamped to the map.
     #[inline]
-    pub(in crate::document) fn sample(&self, at: Vec2) -> [f32; 7] {
+    pub(super) fn sample(&self, at: Vec2) -> [f32; 7] {
         let p = at - 0.5;
         let (x, y) = (floor(p.x), floor(p.y));
         let (fx, fy) = (p.x - x as f32, p.y - y as f32);

@@ -143,17 +143,23 @@ impl<'g, 'a> Walker<'g, 'a> {
 
     /// Where on the map (texel units) the source of texel `i` (its index in the map) lies;
     /// none for a texel off the mesh or a source off the surface.
+    ///
+    /// On the triangle before when the moved point projects inside it within the grid's
+    /// reach of its plane (most texels, here in line), else [`Self::find`]. The reach, not a
+    /// texel: a patch moved across a coarse mesh meets facets tilted unlike its own, up to a
+    /// texel or more off them (the sphere's 32 x 64-texel facets at 4096^2: 0.8 texel), and
+    /// the same surface followed texel after texel is the source, where the nearest texel
+    /// might jump to another sheet.
     #[inline]
     pub(in crate::document) fn source(&mut self, i: usize) -> Option<Vec2> {
         let q = self.moved_point(i)?;
-        // Most texels: on the triangle before (see `find`), here in line.
-        if !self.run_start
-            && let Some(src) = &self.src
-            && let Locate::Inside(w) = src.locate(q, self.grid.reach)
-        {
-            return Some(src.texel_at(w));
-        }
-        let found = self.find(q);
+        let here = self
+            .src
+            .and_then(|src| match src.locate(q, self.grid.reach) {
+                Locate::Inside(w) => Some(src.texel_at(w)),
+                Locate::Beyond(_) | Locate::Away => None,
+            });
+        let found = here.or_else(|| self.find(q));
         if found.is_some() && self.run_start {
             self.run_seed = self.src;
             self.run_start = false;
@@ -179,34 +185,27 @@ impl<'g, 'a> Walker<'g, 'a> {
         Some(a * w.x + b * w.y + c * w.z)
     }
 
-    /// Where on the map the surface under `q` lies: on the triangle before when `q` projects
-    /// inside it within the grid's reach of its plane (most texels), else a walk from there,
-    /// else the triangle of the nearest baked texel. The reach, not a texel: a patch moved
-    /// across a coarse mesh meets facets tilted unlike its own, up to a texel or more off
-    /// them (the sphere's 32 x 64-texel facets at 4096^2: 0.8 texel), and the same surface
-    /// followed texel after texel is the source, where the nearest texel might jump to
-    /// another sheet.
+    /// Where on the map the surface under `q` lies when it is not on the triangle before: a
+    /// walk from there (from the anchor's triangle at a tile's start), else the triangle of
+    /// the nearest baked texel.
     #[inline(never)]
     fn find(&mut self, q: Vec3) -> Option<Vec2> {
         let surface = self.grid.surface;
-        let near = self.grid.reach;
-        if let Some(src) = &self.src
-            && let Locate::Inside(w) = src.locate(q, near)
-        {
-            return Some(src.texel_at(w));
-        }
         let start = match self.src {
             Some(s) => Some((
-                s.t,
+                s,
                 if self.run_start {
                     LONG_WALK
                 } else {
                     SHORT_WALK
                 },
             )),
-            None => self.grid.anchor_triangle.map(|t| (t, LONG_WALK)),
+            None => (self.grid.anchor_triangle)
+                .and_then(|t| SourceTriangle::new(surface, t))
+                .map(|s| (s, LONG_WALK)),
         };
-        if let Some((tri, w)) = start.and_then(|(t, steps)| walk(surface, q, t, steps, near)) {
+        let walked = start.and_then(|(from, steps)| walk(surface, q, from, steps, self.grid.reach));
+        if let Some((tri, w)) = walked {
             self.src = Some(tri);
             return Some(tri.texel_at(w));
         }
@@ -220,24 +219,24 @@ impl<'g, 'a> Walker<'g, 'a> {
 }
 
 /// The triangle `q` projects inside, within `near` of its plane, found by walking from
-/// triangle `t` across the edge `q` lies beyond, `steps` triangles at most; with `q`'s
-/// barycentric weights there.
+/// `from` across the edge `q` lies beyond, `steps` triangles at most; with `q`'s barycentric
+/// weights there.
 fn walk(
     surface: &Surface,
     q: Vec3,
-    mut t: u32,
+    mut tri: SourceTriangle,
     steps: usize,
     near: f32,
 ) -> Option<(SourceTriangle, Vec3)> {
     for _ in 0..steps {
-        let tri = SourceTriangle::new(surface, t)?;
         match tri.locate(q, near) {
             Locate::Inside(w) => return Some((tri, w)),
             Locate::Beyond(k) => {
-                t = *surface.neighbours().get(t as usize)?.get(k)?;
-                if t == u32::MAX {
+                let next = *surface.neighbours().get(tri.t as usize)?.get(k)?;
+                if next == u32::MAX {
                     return None;
                 }
+                tri = SourceTriangle::new(surface, next)?;
             }
             Locate::Away => return None,
         }
