@@ -205,7 +205,7 @@ impl TabViewer for Tabs<'_> {
                 s.viewport_input(&response, rect);
             }
             Tab::Canvas => {
-                let lines = std::mem::take(&mut s.mesh.uv_lines);
+                let lines = Arc::clone(&s.mesh.uv_lines);
                 // A bake the project no longer keeps (undone, or its mesh replaced): k_d again.
                 if let CanvasChannel::Bake(map) = s.canvas.channel
                     && s.doc.bake_of(map).is_none()
@@ -219,7 +219,6 @@ impl TabViewer for Tabs<'_> {
                 let maps = s.layers_panel.view_maps.get(&s.doc, s.shown_layer_view());
                 let (response, rect) = s.canvas.show(ui, &s.doc, maps, &lines);
                 s.canvas.channel = channel;
-                s.mesh.uv_lines = lines;
                 s.layers_panel.painting_label(&s.doc, ui, rect);
                 s.canvas_input(&response, rect);
             }

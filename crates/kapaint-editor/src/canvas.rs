@@ -74,6 +74,8 @@ pub struct Canvas {
     pub(crate) stencil: crate::stencil_view::StencilOverlay,
     /// What the texture shows.
     mirrored: Option<Mirrored>,
+    /// The UV wireframe as last tessellated.
+    wire: crate::uv_wire::WireCache,
 }
 
 /// What the canvas texture shows: which maps at which version, in which channel and shading,
@@ -106,6 +108,7 @@ impl Default for Canvas {
             texture: None,
             stencil: crate::stencil_view::StencilOverlay::default(),
             mirrored: None,
+            wire: crate::uv_wire::WireCache::default(),
         }
     }
 }
@@ -294,7 +297,7 @@ impl Canvas {
         ui: &mut egui::Ui,
         doc: &Document,
         (maps, source): (&MaterialMaps, u64),
-        uv_lines: &[[glam::Vec2; 2]],
+        uv_lines: &crate::uv_wire::UvLines,
     ) -> (egui::Response, Rect) {
         self.sync(ui.ctx(), doc, maps, source);
         let (panel, response) =
@@ -350,11 +353,8 @@ impl Canvas {
             });
         }
         if self.wireframe {
-            let stroke = egui::Stroke::new(1.0, Color32::from_white_alpha(70));
-            let at = |uv: glam::Vec2| rect.min + Vec2::new(uv.x, uv.y) * rect.size();
-            for [a, b] in uv_lines {
-                painter.line_segment([at(*a), at(*b)], stroke);
-            }
+            let mesh = self.wire.mesh(ui.ctx(), uv_lines, (rect, panel));
+            painter.add(egui::Shape::Mesh(mesh));
         }
         (response, rect)
     }

@@ -40,6 +40,7 @@ mod results;
 pub mod screen_brush;
 mod stencil_view;
 mod tool_overlays;
+mod uv_wire;
 pub mod viewport;
 
 pub use app::{Editor, run};

@@ -16,7 +16,7 @@ pub(crate) struct MeshState {
     pub(crate) mesh: Arc<Mesh>,
     pub(crate) bvh: Bvh,
     /// UV edges in map fractions (u, 1 - v), for the canvas wireframe.
-    pub(crate) uv_lines: Vec<[Vec2; 2]>,
+    pub(crate) uv_lines: crate::uv_wire::UvLines,
 }
 
 impl MeshState {
@@ -39,7 +39,7 @@ impl MeshState {
             from: std::sync::Weak::new(),
             mesh: Arc::new(mesh),
             bvh,
-            uv_lines,
+            uv_lines: uv_lines.into(),
         }
     }
 }
