@@ -16,6 +16,7 @@ use glam::Vec3;
 use kapaint_base::task::Progress;
 use rayon::prelude::*;
 
+mod bvh_build;
 mod high;
 mod rays;
 pub use high::{

@@ -10,66 +10,23 @@ use obvhs::cwbvh::CwBvh;
 use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 
+use super::bvh_build::build_bvh;
 use crate::Mesh;
 use crate::frame::UnitFrame;
 
-/// Triangle `k` of `mesh` with its corners from `local` (the mesh's positions in the BVH's
-/// frame); none where a corner is missing or not finite.
-fn local_triangle(mesh: &Mesh, local: &[Vec3], k: u32) -> Option<Triangle> {
+/// Triangle `k` of `mesh` with its corners in `frame` (the BVH's); none where a corner is
+/// missing or not finite.
+fn local_triangle(mesh: &Mesh, frame: &UnitFrame, k: u32) -> Option<Triangle> {
     let t = mesh.triangles.get(k as usize)?;
-    let [v0, v1, v2] = t.map(|i| local.get(i as usize).copied().map(Vec3A::from));
-    let (v0, v1, v2) = (v0?, v1?, v2?);
-    (v0.is_finite() && v1.is_finite() && v2.is_finite()).then_some(Triangle { v0, v1, v2 })
-}
-
-/// The BVH of `triangles`, built as obvhs's `build_cwbvh_from_tris` builds it with its slow
-/// preset (spatial pre-splits, PLOC, reinsertion, eight children a node; a slower build for
-/// fewer node visits: a mesh is built once and cast millions of rays at), in steps that free
-/// each input once used: the triangles before PLOC, the boxes after it, so the build's peak
-/// holds neither (about 48 and 32 bytes a triangle). The Morton codes are 64-bit (21 bits an
-/// axis is ample for the millions of triangles a sculpt has, and the sort's memory halves).
-fn build_bvh(triangles: Vec<Triangle>) -> CwBvh {
-    let params = obvhs::BvhBuildParams {
-        sort_precision: obvhs::ploc::SortPrecision::U64,
-        ..obvhs::BvhBuildParams::slow_build()
+    let corner = |i: u32| {
+        let p = frame.local_from_object(*mesh.positions.get(i as usize)?);
+        p.is_finite().then(|| Vec3A::from(p))
     };
-    if triangles.is_empty() {
-        return CwBvh::default();
-    }
-    let (mut largest, mut total) = (0.0_f32, 0.0_f32);
-    let mut aabbs: Vec<obvhs::aabb::Aabb> = triangles
-        .iter()
-        .map(|t| {
-            let b = t.aabb();
-            largest = largest.max(b.half_area());
-            total += b.half_area();
-            b
-        })
-        .collect();
-    let mut indices: Vec<u32> = (0..triangles.len() as u32).collect();
-    let average = total / triangles.len() as f32;
-    obvhs::splits::split_aabbs_preset(&mut aabbs, &mut indices, &triangles, average, largest);
-    drop(triangles);
-    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(aabbs.len()).build(
-        params.ploc_search_distance,
-        &aabbs,
-        indices,
-        params.sort_precision,
-        params.search_depth_threshold,
-    );
-    drop(aabbs);
-    bvh2.uses_spatial_splits = true;
-    obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
-        &mut bvh2,
-        params.reinsertion_batch_ratio,
-        None,
-    );
-    obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
-        &bvh2,
-        params.max_prims_per_leaf.clamp(1, 3),
-        true,
-        false,
-    )
+    Some(Triangle {
+        v0: corner(t[0])?,
+        v1: corner(t[1])?,
+        v2: corner(t[2])?,
+    })
 }
 
 /// A BVH of the mesh for occlusion and distance rays.
@@ -91,9 +48,7 @@ impl RayMesh {
     /// the same: triangles with a non-finite corner are left out (no ray meets them), and
     /// lengths saturate where its box is too large to measure.
     pub fn new(mesh: &Mesh) -> Self {
-        let frame = UnitFrame::of(&mesh.positions);
-        let local = frame.local_positions(&mesh.positions);
-        Self::of_triangles(mesh, &frame, &local, 0..mesh.triangles.len() as u32)
+        Self::of_triangles(mesh, &UnitFrame::of(&mesh.positions), None)
     }
 
     /// One BVH per group of `mesh`'s triangles, `group_of` naming each triangle's (none where
@@ -101,7 +56,6 @@ impl RayMesh {
     /// triangle. All share the mesh's frame.
     pub fn split(mesh: &Mesh, group_of: &[u32], groups: usize) -> Vec<Option<Self>> {
         let frame = UnitFrame::of(&mesh.positions);
-        let local = frame.local_positions(&mesh.positions);
         // The triangles of each group, in one pass over the mesh.
         let mut members = vec![Vec::new(); groups];
         for (k, &g) in (0u32..).zip(group_of) {
@@ -111,23 +65,41 @@ impl RayMesh {
         }
         members
             .into_iter()
-            .map(|m| {
-                (!m.is_empty()).then(|| Self::of_triangles(mesh, &frame, &local, m.into_iter()))
-            })
+            .map(|m| (!m.is_empty()).then(|| Self::of_triangles(mesh, &frame, Some(m))))
             .collect()
     }
 
-    /// The BVH of the triangles `which` names, in `frame`, `local` being the mesh's positions
-    /// in it.
-    fn of_triangles(
-        mesh: &Mesh,
-        frame: &UnitFrame,
-        local: &[Vec3],
-        which: impl Iterator<Item = u32>,
-    ) -> Self {
-        let (kept, triangles): (Vec<u32>, Vec<Triangle>) = which
-            .filter_map(|k| Some((k, local_triangle(mesh, local, k)?)))
-            .unzip();
+    /// The BVH of the triangles `which` names (all of the mesh's: `None`), in `frame`. Only
+    /// their positions are held beside the build (no copy of the mesh's positions, no list
+    /// of the triangles kept where all are): a sculpt's build holds little else at its peak.
+    fn of_triangles(mesh: &Mesh, frame: &UnitFrame, which: Option<Vec<u32>>) -> Self {
+        let mut triangles =
+            Vec::with_capacity(which.as_ref().map_or(mesh.triangles.len(), Vec::len));
+        // The mesh's index of each triangle built, where it is not its place in `triangles`.
+        let kept = if let Some(mut listed) = which {
+            listed.retain(|&k| {
+                local_triangle(mesh, frame, k)
+                    .map(|t| triangles.push(t))
+                    .is_some()
+            });
+            Some(listed)
+        } else {
+            let mut kept: Option<Vec<u32>> = None;
+            for k in 0..mesh.triangles.len() as u32 {
+                match local_triangle(mesh, frame, k) {
+                    Some(t) => {
+                        triangles.push(t);
+                        if let Some(kept) = &mut kept {
+                            kept.push(k);
+                        }
+                    }
+                    // The first left out: those before it were all kept.
+                    None if kept.is_none() => kept = Some((0..k).collect()),
+                    None => {}
+                }
+            }
+            kept
+        };
         let bvh = build_bvh(triangles);
         // The triangles again, in the BVH's order (a triangle split by the build appears
         // once for each of its pieces).
@@ -135,8 +107,10 @@ impl RayMesh {
             .primitive_indices
             .iter()
             .filter_map(|&i| {
-                let k = kept[i as usize];
-                Some((k, local_triangle(mesh, local, k)?))
+                let k = kept
+                    .as_ref()
+                    .map_or(Some(i), |kept| kept.get(i as usize).copied())?;
+                Some((k, local_triangle(mesh, frame, k)?))
             })
             .unzip();
         Self {

@@ -279,3 +279,38 @@ fn a_mesh_too_large_to_measure_is_refused_not_baked() {
         ao.stats(&uv)
     );
 }
+
+#[test]
+fn a_triangle_with_a_nan_corner_is_left_out_and_the_others_keep_their_names() {
+    // Three triangles in a row along x at y = 0, the middle one with a NaN corner.
+    let quad = |x: f32| {
+        [
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x + 1.0, 0.0, 0.0),
+            Vec3::new(x, 0.0, 1.0),
+        ]
+    };
+    let mut positions = [quad(0.0), quad(2.0), quad(4.0)].concat();
+    positions[4].x = f32::NAN;
+    let mesh = Mesh {
+        name: "row".into(),
+        normals: vec![Vec3::Y; 9],
+        positions,
+        uvs: None,
+        triangles: vec![[0, 2, 1], [3, 5, 4], [6, 8, 7]],
+        had_normals: true,
+        labels: crate::Labels::default(),
+    };
+    let down = Vec3::NEG_Y;
+    for rays in [
+        RayMesh::new(&mesh),
+        RayMesh::split(&mesh, &[0, 0, 0], 1).remove(0).unwrap(),
+    ] {
+        let hit = |x: f32| rays.nearest(Vec3::new(x, 1.0, 0.2), down, 10.0);
+        assert_eq!(hit(0.2).map(|(_, t)| t), Some(0));
+        assert_eq!(hit(2.2), None, "the NaN triangle is met by no ray");
+        let (d, t) = hit(4.2).expect("the last triangle is met");
+        assert_eq!(t, 2, "named as in the mesh, after the one left out");
+        assert!((d - 1.0).abs() < 1e-5, "{d}");
+    }
+}
