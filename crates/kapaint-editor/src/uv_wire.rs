@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use egui::epaint::{Mesh, Tessellator};
+use egui::epaint::{Mesh, TessellationOptions, Tessellator};
 use egui::{Color32, Rect, Stroke};
 use glam::Vec2;
 
@@ -18,16 +18,17 @@ fn stroke() -> Stroke {
 }
 
 /// What a tessellated wireframe was made for.
-#[derive(Clone)]
 struct Made {
     lines: UvLines,
     /// The map's rect and the panel's, and the points' pixel size, as bits.
     view: [u32; 9],
+    /// The context's tessellation options (feathering, rounding to pixels).
+    options: TessellationOptions,
 }
 
 impl Made {
-    fn same(&self, lines: &UvLines, view: &[u32; 9]) -> bool {
-        Arc::ptr_eq(&self.lines, lines) && &self.view == view
+    fn same(&self, lines: &UvLines, view: &[u32; 9], options: &TessellationOptions) -> bool {
+        Arc::ptr_eq(&self.lines, lines) && &self.view == view && &self.options == options
     }
 }
 
@@ -59,27 +60,31 @@ impl WireCache {
             ppp,
         ]
         .map(f32::to_bits);
+        let options = ctx.tessellation_options(|o| *o);
         if let Some((made, mesh)) = &self.made
-            && made.same(lines, &view)
+            && made.same(lines, &view, &options)
         {
             return Arc::clone(mesh);
         }
-        let options = ctx.tessellation_options(|o| *o);
-        let mut tessellator = Tessellator::new(ppp, options, [1, 1], Vec::new());
+        // The tessellator leaves out the edges outside its clip rect (the panel): asked for
+        // here whatever the context's setting.
+        let culling = TessellationOptions {
+            coarse_tessellation_culling: true,
+            ..options
+        };
+        let mut tessellator = Tessellator::new(ppp, culling, [1, 1], Vec::new());
         tessellator.set_clip_rect(panel);
         let at = |uv: Vec2| map.min + egui::Vec2::new(uv.x, uv.y) * map.size();
         let mut mesh = Mesh::default();
         let stroke = stroke();
         for [a, b] in lines.iter() {
-            let (a, b) = (at(*a), at(*b));
-            if panel.intersects(Rect::from_two_pos(a, b).expand(1.0)) {
-                tessellator.tessellate_line_segment([a, b], stroke, &mut mesh);
-            }
+            tessellator.tessellate_line_segment([at(*a), at(*b)], stroke, &mut mesh);
         }
         let mesh = Arc::new(mesh);
         let made = Made {
             lines: Arc::clone(lines),
             view,
+            options,
         };
         self.made = Some((made, Arc::clone(&mesh)));
         mesh
@@ -123,6 +128,15 @@ mod tests {
         let half = cache.mesh(&ctx, &other, (panned, panel));
         assert!(half.indices.len() < first.indices.len(), "culled");
         assert!(half.vertices.iter().all(|v| v.pos.x >= 240.0));
+        // Other tessellation options (no feathering): made again, not the feathered mesh.
+        let feathered = cache.mesh(&ctx, &other, (panned, panel));
+        ctx.tessellation_options_mut(|o| o.feathering = false);
+        let sharp = cache.mesh(&ctx, &other, (panned, panel));
+        assert!(!Arc::ptr_eq(&feathered, &sharp), "made for the new options");
+        assert!(
+            sharp.vertices.len() < feathered.vertices.len(),
+            "no feathering"
+        );
     }
 
     #[test]

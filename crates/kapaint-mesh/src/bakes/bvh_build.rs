@@ -47,7 +47,8 @@ pub(super) fn build_bvh(triangles: Vec<Triangle>) -> CwBvh {
     let average = total / triangles.len() as f32;
     obvhs::splits::split_aabbs_preset(&mut aabbs, &mut indices, &triangles, average, largest);
     drop(triangles);
-    let mut bvh2 = build_in_parts(&params, aabbs, indices);
+    let cuts = cuts(aabbs.len());
+    let mut bvh2 = build_in_parts(&params, aabbs, indices, cuts);
     bvh2.uses_spatial_splits = true;
     obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
         &mut bvh2,
@@ -71,11 +72,15 @@ fn cuts(count: usize) -> u32 {
     cuts
 }
 
-/// The binary tree of `aabbs` (whose `indices` name the primitives), built by PLOC, in parts
-/// when there are many (see the module's notes). The boxes are freed on return.
-fn build_in_parts(params: &obvhs::BvhBuildParams, aabbs: Vec<Aabb>, indices: Vec<u32>) -> Bvh2 {
+/// The binary tree of `aabbs` (whose `indices` name the primitives), built by PLOC, in
+/// `2^cuts` parts (see the module's notes). The boxes are freed on return.
+fn build_in_parts(
+    params: &obvhs::BvhBuildParams,
+    aabbs: Vec<Aabb>,
+    indices: Vec<u32>,
+    cuts: u32,
+) -> Bvh2 {
     let count = aabbs.len();
-    let cuts = cuts(count);
     let mut ploc = PlocBuilder::new();
     if cuts == 0 {
         return ploc.build(
@@ -247,24 +252,8 @@ mod tests {
         let aabbs: Vec<Aabb> = triangles.iter().map(Triangle::aabb).collect();
         let count = aabbs.len();
         let params = obvhs::BvhBuildParams::slow_build();
-        let identity: Vec<u32> = (0..count as u32).collect();
-        let (sorted, indices) = cut(aabbs, &identity, 3);
-        let mut whole = Bvh2 {
-            nodes: Vec::with_capacity(2 * count - 1),
-            primitive_indices: identity,
-            ..Bvh2::default()
-        };
-        let mut parts = Parts {
-            ploc: PlocBuilder::new(),
-            part: Bvh2::default(),
-            params: &params,
-            aabbs: &sorted,
-            indices: &indices,
-            whole: &mut whole,
-            depth: 0,
-        };
-        parts.whole.nodes.push(Bvh2Node::default());
-        parts.place(0, 0..count, 3);
+        let whole = build_in_parts(&params, aabbs, (0..count as u32).collect(), 3);
+        assert!(whole.children_are_ordered_after_parents);
         assert_eq!(
             whole.nodes.len(),
             2 * count - 1,
