@@ -21,7 +21,7 @@ pub mod project;
 pub mod provenance;
 pub mod recovery;
 pub mod resize;
-pub mod simd;
+pub use kapaint_base::simd;
 pub mod stats;
 pub mod surface;
 pub mod texel;

@@ -18,6 +18,7 @@ use rayon::prelude::*;
 
 mod bvh_build;
 mod high;
+mod occlusion;
 mod rays;
 pub use high::{
     DEFAULT_DISTANCE, HighBake, HighMap, HighOptions, HighRays, HighSource, IdSource, Matching,

@@ -7,10 +7,10 @@
 
 use glam::{Vec3, Vec3A};
 use obvhs::cwbvh::CwBvh;
-use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 
 use super::bvh_build::build_bvh;
+use super::occlusion::{Facet, Occluders, ray};
 use crate::Mesh;
 use crate::frame::UnitFrame;
 
@@ -35,6 +35,8 @@ pub struct RayMesh {
     /// The triangles in the BVH's order (no lookup through its primitive indices per test), in
     /// local coordinates.
     triangles: Vec<Triangle>,
+    /// The same triangles as the occlusion walk reads them.
+    facets: Vec<Facet>,
     /// Per triangle (in the BVH's order), its index in the mesh.
     sources: Vec<u32>,
     /// Where the triangles are.
@@ -103,7 +105,7 @@ impl RayMesh {
         let bvh = build_bvh(triangles);
         // The triangles again, in the BVH's order (a triangle split by the build appears
         // once for each of its pieces).
-        let (sources, triangles) = bvh
+        let (sources, triangles): (_, Vec<_>) = bvh
             .primitive_indices
             .iter()
             .filter_map(|&i| {
@@ -113,9 +115,11 @@ impl RayMesh {
                 Some((k, local_triangle(mesh, frame, k)?))
             })
             .unzip();
+        let facets = triangles.iter().map(Facet::new).collect();
         Self {
             bvh,
             triangles,
+            facets,
             sources,
             diagonal: frame.diagonal(),
             frame: *frame,
@@ -208,10 +212,39 @@ impl RayMesh {
 
     /// [`RayMesh::occluded`] in local units.
     pub(super) fn occluded_local(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
-        let ray = ray(origin, dir, far);
+        self.occluders()
+            .occluded(&ray(origin, dir, far), &mut Vec::new())
+    }
+
+    /// [`RayMesh::occluded_local`] through obvhs's own traversal and triangle test: the
+    /// reference the occlusion walk answers as, ray for ray.
+    #[cfg(test)]
+    pub(super) fn obvhs_occluded(&self, origin: Vec3, dir: Vec3, far: f32) -> bool {
         !self
             .bvh
-            .ray_traverse_miss(ray, |ray, id| self.triangles[id].intersect(ray))
+            .ray_traverse_miss(ray(origin, dir, far), |ray, id| {
+                self.triangles[id].intersect(ray)
+            })
+    }
+
+    /// The BVH as the occlusion walk reads it.
+    fn occluders(&self) -> Occluders<'_> {
+        Occluders {
+            nodes: &self.bvh.nodes,
+            facets: &self.facets,
+        }
+    }
+
+    /// How many of the directions of `set` turned into `frame` (`[t, b, n]`: a direction `d` is
+    /// `t d.x + b d.y + n d.z`) from `origin` meet nothing before `far` (local units).
+    pub(super) fn open_count(
+        &self,
+        origin: Vec3,
+        frame: [Vec3; 3],
+        set: &[Vec3],
+        far: f32,
+    ) -> usize {
+        self.occluders().open_count(origin, frame, set, far)
     }
 
     /// [`RayMesh::distance`] in local units.
@@ -233,10 +266,8 @@ impl RayMesh {
         turn: f32,
     ) -> f32 {
         let origin = point + normal * self.offset();
-        let open = set
-            .around(normal, turn)
-            .filter(|&dir| !self.occluded_local(origin, dir, far))
-            .count();
+        let (t, b) = Directions::turned_frame(normal, turn);
+        let open = self.open_count(origin, [t, b, normal], set.as_slice(), far);
         open as f32 / set.len() as f32
     }
 
@@ -328,13 +359,6 @@ impl RayMesh {
             .collect();
         (nodes, triangles)
     }
-}
-
-/// A ray from `origin` along unit `dir` to `far` (local units). A direction's negative zero is
-/// made positive: the BVH's traversal takes a component's sign from its bits and misses every
-/// triangle for a ray with a `-0.0` component (a ray straight down, `-Y`, met nothing).
-fn ray(origin: Vec3, dir: Vec3, far: f32) -> Ray {
-    Ray::new(origin.into(), (dir + Vec3::ZERO).into(), 0.0, far)
 }
 
 /// A cosine-weighted Hammersley set of directions about `+z`, made once per bake; each texel
@@ -463,14 +487,12 @@ impl RayCaster for CpuCaster<'_> {
                 let Some(Some(mesh)) = self.0.get(q.group as usize) else {
                     return 1.0;
                 };
-                let dirs = set.iter().map(|d| q.t * d.x + q.b * d.y + q.n * d.z);
                 match batch.kind {
                     RayKind::Open => {
-                        dirs.filter(|&dir| !mesh.occluded_local(q.origin, dir, batch.far))
-                            .count() as f32
-                            / count
+                        mesh.open_count(q.origin, [q.t, q.b, q.n], set, batch.far) as f32 / count
                     }
                     RayKind::Depth => {
+                        let dirs = set.iter().map(|d| q.t * d.x + q.b * d.y + q.n * d.z);
                         dirs.map(|dir| {
                             mesh.distance_local(q.origin, dir, batch.far)
                                 .map_or(1.0, |t| t / batch.far)

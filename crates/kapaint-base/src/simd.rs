@@ -1,4 +1,4 @@
-//! The paint and compositing loops compiled for the CPU at hand.
+//! Hot loops (painting, compositing, the bakes' rays) compiled for the CPU at hand.
 //!
 //! The release build targets baseline x86-64 (SSE2: four floats a step). Most x86-64 CPUs
 //! since 2013 have AVX2 and FMA (eight a step, and conversions between 16- and 32-bit lanes
@@ -13,6 +13,9 @@
 /// closure's body, or a function called through `FnOnce`, is a function of its own that is
 /// compiled for the baseline).
 pub use pulp::WithSimd as Kernel;
+
+/// The instruction set a [`Kernel`] is handed (its `with_simd`'s type parameter).
+pub use pulp::Simd;
 
 /// `kernel` run compiled for the widest vector instructions the CPU has (see the module).
 #[inline(always)]
