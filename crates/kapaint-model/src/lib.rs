@@ -21,7 +21,6 @@ pub mod project;
 pub mod provenance;
 pub mod recovery;
 pub mod resize;
-pub use kapaint_base::simd;
 pub mod stats;
 pub mod surface;
 pub mod texel;

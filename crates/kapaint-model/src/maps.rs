@@ -398,7 +398,7 @@ impl MaterialMaps {
         out.par_chunks_mut(TILE_TEXELS)
             .zip(ids)
             .for_each(|(out, &id)| {
-                crate::simd::vectorized(DeriveTile(&self.tiles[id], lut, diffuse, out));
+                kapaint_base::simd::vectorized(DeriveTile(&self.tiles[id], lut, diffuse, out));
             });
     }
 
@@ -435,7 +435,7 @@ impl MaterialMaps {
 /// texel.
 struct DeriveTile<'a>(&'a Tile, &'a [[f32; 2]], f32, &'a mut [Vec3]);
 
-impl crate::simd::Kernel for DeriveTile<'_> {
+impl kapaint_base::simd::Kernel for DeriveTile<'_> {
     type Output = ();
 
     #[inline(always)]

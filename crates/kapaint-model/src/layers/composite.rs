@@ -21,12 +21,12 @@
 
 use super::{Covered, Layer, LayerContent, LayerStack, PaintTile, SharedPaintTile};
 use crate::paint::n_bits_from_blend;
-use crate::simd::Kernel;
 use crate::texel::{
     Texel, decode_n, decode_rgb, decode_unorm, encode_rgb, encode_unorm, n_to_blend,
 };
 use crate::tile::{Plane, TILE_SIZE, TILE_TEXELS, Tile, TileSpans};
 use glam::Vec3;
+use kapaint_base::simd::Kernel;
 
 /// The components of `k_d`, `k_s` and `n` in a [`State`].
 const PARTS: [std::ops::Range<usize>; 3] = [0..3, 3..6, 6..7];

@@ -13,9 +13,9 @@ use rayon::prelude::*;
 use super::{Active, CompositeTile, active_at, composite_spans, runs};
 use crate::layers::LayerStack;
 use crate::maps::MaterialMaps;
-use crate::simd::{Kernel, vectorized};
 use crate::texel::{Channels, Texel};
 use crate::tile::{Plane, Tile, TileSpans};
+use kapaint_base::simd::{Kernel, vectorized};
 
 /// Hashes what the composite of tile `id` depends on: per active layer, in order, its
 /// settings, its fill value or its tile's stamp, its mask's switches and tile stamp, and its

@@ -304,7 +304,7 @@ proptest! {
         let mut rng = Rng(seed);
         let (stack, _, _) = composited_stack(&mut rng, (192, 130));
         for id in 0..stack.tile_count() {
-            let wide = crate::simd::vectorized(CompositeTile(&stack, id));
+            let wide = kapaint_base::simd::vectorized(CompositeTile(&stack, id));
             prop_assert_eq!(&wide, &composite_tile(&stack, id), "tile {}", id);
         }
     }

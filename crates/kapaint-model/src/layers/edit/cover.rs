@@ -1,6 +1,6 @@
 //! Brush and eraser dabs on a paint layer or mask: the stroke's coverage raised, then the
 //! texels it rose at written, a row at a time (the loops run through
-//! [`vectorized`](crate::simd::vectorized)).
+//! [`vectorized`](kapaint_base::simd::vectorized)).
 #![expect(
     clippy::inline_always,
     reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
@@ -30,7 +30,7 @@ pub fn edit_cover(
         .zip(covers)
         .zip(ids)
         .map(|((slot, cover), &id)| {
-            crate::simd::vectorized(CoverTile {
+            kapaint_base::simd::vectorized(CoverTile {
                 slot,
                 edit,
                 id,
@@ -44,7 +44,7 @@ pub fn edit_cover(
 /// What a dab does to the stroke's coverage, for [`edit_cover`].
 pub trait Raise: Sync {
     /// Raises the coverage `cover` of tile `id`; returns the texels where it rose. Mark it
-    /// `#[inline(always)]`: it runs inside [`vectorized`](crate::simd::vectorized).
+    /// `#[inline(always)]`: it runs inside [`vectorized`](kapaint_base::simd::vectorized).
     fn raise(&self, id: usize, cover: &mut [f32]) -> TileSpans;
 }
 
@@ -57,7 +57,7 @@ struct CoverTile<'a, 'b, R> {
     raise: &'b R,
 }
 
-impl<R: Raise> crate::simd::Kernel for CoverTile<'_, '_, R> {
+impl<R: Raise> kapaint_base::simd::Kernel for CoverTile<'_, '_, R> {
     type Output = TileSpans;
 
     #[inline(always)]

@@ -12,7 +12,7 @@ use crate::tile::{TILE_SIZE, TileSpans, select_mut};
 /// (`prepare(id, cover, targets)`, see there); a closure is one.
 pub trait Prepare: Sync {
     /// Sets tile `id`'s coverage and targets; returns the texels to write. Mark it
-    /// `#[inline(always)]`: it runs inside [`vectorized`](crate::simd::vectorized) (a
+    /// `#[inline(always)]`: it runs inside [`vectorized`](kapaint_base::simd::vectorized) (a
     /// closure's body stays compiled for the baseline).
     fn prepare(&self, id: usize, cover: &mut [f32], targets: &mut TileTargets) -> TileSpans;
 }
@@ -106,7 +106,7 @@ fn write_varying<P: Prepare>(
     prepare: &P,
 ) -> TileSpans {
     TARGETS.with_borrow_mut(|targets| {
-        crate::simd::vectorized(VaryingWrite {
+        kapaint_base::simd::vectorized(VaryingWrite {
             slot,
             edit,
             id,
@@ -127,7 +127,7 @@ struct VaryingWrite<'s, 'a, P> {
     prepare: &'s P,
 }
 
-impl<P: Prepare> crate::simd::Kernel for VaryingWrite<'_, '_, P> {
+impl<P: Prepare> kapaint_base::simd::Kernel for VaryingWrite<'_, '_, P> {
     type Output = TileSpans;
 
     #[inline(always)]
