@@ -388,7 +388,9 @@ mod tests {
             let origin = point(120_000 + i);
             let normal = point(150_000 + i).normalize_or(Vec3::Z);
             let (t, b) = Directions::turned_frame(normal, unit(180_000 + i));
-            let open = mesh.open_count(origin, [t, b, normal], set.as_slice(), 0.8);
+            let open = mesh
+                .occluders()
+                .open_count(origin, [t, b, normal], set.as_slice(), 0.8);
             let expected = set
                 .as_slice()
                 .iter()

@@ -228,23 +228,11 @@ impl RayMesh {
     }
 
     /// The BVH as the occlusion walk reads it.
-    fn occluders(&self) -> Occluders<'_> {
+    pub(super) fn occluders(&self) -> Occluders<'_> {
         Occluders {
             nodes: &self.bvh.nodes,
             facets: &self.facets,
         }
-    }
-
-    /// How many of the directions of `set` turned into `frame` (`[t, b, n]`: a direction `d` is
-    /// `t d.x + b d.y + n d.z`) from `origin` meet nothing before `far` (local units).
-    pub(super) fn open_count(
-        &self,
-        origin: Vec3,
-        frame: [Vec3; 3],
-        set: &[Vec3],
-        far: f32,
-    ) -> usize {
-        self.occluders().open_count(origin, frame, set, far)
     }
 
     /// [`RayMesh::distance`] in local units.
@@ -267,7 +255,9 @@ impl RayMesh {
     ) -> f32 {
         let origin = point + normal * self.offset();
         let (t, b) = Directions::turned_frame(normal, turn);
-        let open = self.open_count(origin, [t, b, normal], set.as_slice(), far);
+        let open = self
+            .occluders()
+            .open_count(origin, [t, b, normal], set.as_slice(), far);
         open as f32 / set.len() as f32
     }
 
@@ -489,7 +479,10 @@ impl RayCaster for CpuCaster<'_> {
                 };
                 match batch.kind {
                     RayKind::Open => {
-                        mesh.open_count(q.origin, [q.t, q.b, q.n], set, batch.far) as f32 / count
+                        mesh.occluders()
+                            .open_count(q.origin, [q.t, q.b, q.n], set, batch.far)
+                            as f32
+                            / count
                     }
                     RayKind::Depth => {
                         let dirs = set.iter().map(|d| q.t * d.x + q.b * d.y + q.n * d.z);
