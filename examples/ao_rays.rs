@@ -3,9 +3,11 @@
 //! cosine-weighted directions about each point's geometric normal from 1e-5 of the box's
 //! diagonal off the surface, unbounded, one thread, the occlusion queries timed and nothing
 //! else (the BVH is built before the clock starts). Prints rays per second (the fastest of
-//! `ROUNDS` rounds over the same points) and the mean open fraction.
+//! `ROUNDS` rounds over the same points) and the mean open fraction. With `coherent` the
+//! points are walked in Morton order (near points one after another, as a bake walks its
+//! texels); without it in the order they were drawn (each query far from the last).
 //!
-//! Usage: `cargo run --release --example ao_rays MESH.obj [POINTS] [ROUNDS]`
+//! Usage: `cargo run --release --example ao_rays MESH.obj [POINTS] [ROUNDS] [coherent]`
 
 use std::time::Instant;
 
@@ -46,11 +48,29 @@ fn surface_points(mesh: &kapaint::mesh::Mesh, count: usize) -> Vec<(Vec3, Vec3)>
         .collect()
 }
 
+/// `x`'s low 21 bits spread to every third bit.
+fn spread(x: u64) -> u64 {
+    (0..21).fold(0, |code, bit| code | ((x >> bit) & 1) << (3 * bit))
+}
+
+/// `points` ordered along a Morton curve through their bounding box.
+fn morton_order(points: &mut [(Vec3, Vec3)]) {
+    let (lo, hi) = points.iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), (p, _)| (lo.min(*p), hi.max(*p)),
+    );
+    let scale = ((1u64 << 21) - 1) as f32 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
+    points.sort_by_cached_key(|(p, _)| {
+        let q = ((*p - lo) * scale).as_uvec3();
+        spread(u64::from(q.x)) << 2 | spread(u64::from(q.y)) << 1 | spread(u64::from(q.z))
+    });
+}
+
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args
         .first()
-        .ok_or("usage: ao_rays MESH.obj [POINTS] [ROUNDS]")?;
+        .ok_or("usage: ao_rays MESH.obj [POINTS] [ROUNDS] [coherent]")?;
     let count: usize = args
         .get(1)
         .map_or(Ok(150_000), |a| a.parse())
@@ -67,7 +87,19 @@ fn main() -> Result<(), String> {
         mesh.triangles.len(),
         start.elapsed().as_secs_f64()
     );
-    let points = surface_points(&mesh, count);
+    let mut points = surface_points(&mesh, count);
+    let coherent = match args.get(3).map(String::as_str) {
+        None => false,
+        Some("coherent") => true,
+        Some(other) => {
+            return Err(format!(
+                "the fourth argument is `coherent` or nothing, not `{other}`"
+            ));
+        }
+    };
+    if coherent {
+        morton_order(&mut points);
+    }
     let set = Directions::new(64);
     let mut best = f64::INFINITY;
     let mut open = 0.0;
@@ -84,8 +116,9 @@ fn main() -> Result<(), String> {
     }
     let cast = points.len() * set.len();
     println!(
-        "kapaint: {cast} rays in {best:.2} s, {:.2} M rays/s (one thread), mean open fraction {:.4}",
+        "kapaint: {cast} rays in {best:.2} s, {:.2} M rays/s (one thread{}), mean open fraction {:.4}",
         cast as f64 / best / 1e6,
+        if coherent { ", Morton order" } else { "" },
         open / points.len() as f64
     );
     Ok(())

@@ -7,7 +7,10 @@ the surface (1e-5 of the bounding box's diagonal, as kapaint does), and times Em
 occlusion queries alone (ray generation excluded), one thread. It prints rays per second and
 the mean open fraction, which should match kapaint's mean AO on the same mesh.
 
-    python ao_embree.py MESH.obj TOTAL_RAYS [RAYS_PER_POINT]
+    python ao_embree.py MESH.obj TOTAL_RAYS [RAYS_PER_POINT] [coherent]
+
+With `coherent` each chunk's points are cast in Morton order (near points one after another, as
+a bake walks its texels), as `examples/ao_rays.rs` orders its points with the same word.
 """
 
 import sys
@@ -34,9 +37,21 @@ def load_obj(path):
     return np.array(vertices, dtype=np.float32), np.array(faces, dtype=np.int64)
 
 
+def morton_codes(points, lo, hi):
+    """Each point's place along a Morton curve through the box `lo`..`hi` (21 bits an axis)."""
+    scale = ((1 << 21) - 1) / max(float((hi - lo).max()), 1e-30)
+    q = np.clip(((points - lo) * scale).astype(np.uint64), 0, (1 << 21) - 1)
+    codes = np.zeros(len(points), dtype=np.uint64)
+    for bit in range(21):
+        for axis in range(3):
+            codes |= ((q[:, axis] >> np.uint64(bit)) & np.uint64(1)) << np.uint64(3 * bit + 2 - axis)
+    return codes
+
+
 def main():
     path, total = sys.argv[1], int(sys.argv[2])
     per_point = int(sys.argv[3]) if len(sys.argv) > 3 else 64
+    coherent = len(sys.argv) > 4 and sys.argv[4] == "coherent"
     v, f = load_obj(path)
     tris = v[f]
     scene = rtcore_scene.EmbreeScene()
@@ -60,6 +75,9 @@ def main():
         bary = np.stack([1 - s, s * (1 - r2), s * r2], axis=1).astype(np.float32)
         p = np.einsum("nk,nkj->nj", bary, tris_k[t])
         nrm = normals[t]
+        if coherent:
+            order = np.argsort(morton_codes(p, v.min(axis=0), v.max(axis=0)), kind="stable")
+            p, nrm = p[order], nrm[order]
         origin = p + nrm * (1e-5 * diagonal)
         # A frame per point, then cosine-weighted directions.
         helper = np.where(np.abs(nrm[:, :1]) > 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
@@ -83,7 +101,7 @@ def main():
         done += n
     print(
         f"embree: {cast} rays in {seconds:.2f} s, {cast / seconds / 1e6:.2f} M rays/s "
-        f"(one thread), mean open fraction {open_rays / cast:.4f}"
+        f"(one thread{', Morton order' if coherent else ''}), mean open fraction {open_rays / cast:.4f}"
     )
 
 

@@ -31,4 +31,7 @@ if [ -x "$ao_rays" ]; then
     "$ao_rays" "$tmp/sculpt.obj" $((rays / 64)) 1 2>/dev/null
     echo "== Embree again"
     "$py" "$here/ao_embree.py" "$tmp/sculpt.obj" $((rays / 64 * 64)) 64
+    echo "== both again, the points in Morton order (near points one after another, as a bake's texels)"
+    "$ao_rays" "$tmp/sculpt.obj" $((rays / 64)) 1 coherent 2>/dev/null
+    "$py" "$here/ao_embree.py" "$tmp/sculpt.obj" $((rays / 64 * 64)) 64 coherent
 fi
