@@ -458,4 +458,6 @@ mod high_pairs_tests;
 #[cfg(test)]
 mod high_tests;
 #[cfg(test)]
+mod occlusion_tests;
+#[cfg(test)]
 mod tests;

@@ -1,15 +1,20 @@
-//! Occlusion rays through the BVH, compiled for the CPU's widest vectors: an AO query's rays
-//! (one origin, a set of directions) one after another through one traversal.
+//! Rays through the BVH, compiled for the CPU's widest vectors: an AO query's rays (one
+//! origin, a set of directions) one after another through one traversal, which ends at the
+//! first triangle met; and the same walk for the nearest triangle (thickness, the surface
+//! points of the bakes from a high mesh), which shortens the ray at each triangle met.
 //!
-//! The answer is obvhs's `CwBvh::ray_traverse_miss` with its Möller–Trumbore test, ray for
-//! ray: the same box arithmetic (the ray moved into each node's quantised grid, slabs clipped
-//! to `[1e-4, far]`) and the same triangle arithmetic (its edges and normal made once instead
-//! of per test), so the bits agree (the tests compare every ray). What differs is how it runs:
+//! The answer is obvhs's (`CwBvh::ray_traverse_miss`, `ray_traverse`) with its
+//! Möller–Trumbore test, ray for ray: the same box arithmetic (the ray moved into each node's
+//! quantised grid, slabs clipped to `[1e-4, far]`) and the same triangle arithmetic (its edges
+//! and normal made once instead of per test), so the bits agree (the tests compare every ray's
+//! answer and every nearest distance). Where triangles are met at the same distance (a shared
+//! edge), the nearest is the first in the mesh, not the first the walk meets. What differs is
+//! how it runs:
 //! the eight children of a node are tested as one eight-lane loop, the whole walk is inlined
 //! into a kernel that [`kapaint_base::simd::vectorized`] compiles for AVX2 where the CPU has
-//! it, and a triangle's sums are read, not made. Any hit ends a ray, so the order the
-//! children are visited in changes only the speed: nearest first by the ray's octant, as the
-//! wide BVH's slots are laid out for.
+//! it, and a triangle's sums are read, not made. The order the children are visited in
+//! changes only the speed: nearest first by the ray's octant, as the wide BVH's slots are laid
+//! out for.
 
 use glam::{Vec3, Vec3A};
 use kapaint_base::simd;
@@ -41,13 +46,13 @@ impl Facet {
         }
     }
 
-    /// Whether `ray` meets the triangle at a distance in `[tmin, tmax)`.
+    /// The distance at which `ray` meets the triangle, where it lies in `[tmin, tmax)`.
     #[inline(always)]
     #[expect(
         clippy::inline_always,
         reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
     )]
-    fn meets(&self, ray: &Ray) -> bool {
+    pub(super) fn distance(&self, ray: &Ray) -> Option<f32> {
         let (e1, e2) = (Vec3A::from(self.e1), Vec3A::from(self.e2));
         let n = e1.cross(e2);
         let c = Vec3A::from(self.v0) - ray.origin;
@@ -59,10 +64,10 @@ impl Facet {
         // Any barycentric's sign bit set (a -0 too) is outside.
         let signs = u.to_bits() | v.to_bits() | w.to_bits();
         if inv_det == 0.0 || signs & 0x8000_0000 != 0 {
-            return false;
+            return None;
         }
         let t = n.dot(c) * inv_det;
-        t >= ray.tmin && t < ray.tmax
+        (t >= ray.tmin && t < ray.tmax).then_some(t)
     }
 }
 
@@ -194,6 +199,9 @@ fn leaf_slots(meta: u64, inner: u32) -> u32 {
 pub(super) struct Occluders<'a> {
     pub nodes: &'a [CwBvhNode],
     pub facets: &'a [Facet],
+    /// Per facet, the mesh's index of its triangle (the pieces the build split a triangle
+    /// into share it).
+    pub sources: &'a [u32],
 }
 
 impl Occluders<'_> {
@@ -204,8 +212,34 @@ impl Occluders<'_> {
         reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
     )]
     pub(super) fn occluded(&self, ray: &Ray, stack: &mut Vec<u32>) -> bool {
+        self.walk::<true>(*ray, stack).is_some()
+    }
+
+    /// The nearest triangle `ray` meets: the distance to it and its index in the mesh;
+    /// `stack` is scratch.
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    pub(super) fn nearest(&self, ray: &Ray, stack: &mut Vec<u32>) -> Option<(f32, u32)> {
+        self.walk::<false>(*ray, stack)
+    }
+
+    /// The walk: with `ANY`, the first triangle met ends it; without, each one met shortens
+    /// the ray to just past it (boxes beyond are not entered) and the nearest is the answer
+    /// (with its index in the mesh), among as near ones the first in the mesh: the
+    /// geometry's answer, not the order the walk happened to meet them in (but for a box
+    /// whose entry, worked out in floats, rounds past a tie). With `ANY` the index is the
+    /// facet's.
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn walk<const ANY: bool>(&self, mut ray: Ray, stack: &mut Vec<u32>) -> Option<(f32, u32)> {
         if self.nodes.is_empty() {
-            return false;
+            return None;
         }
         // A slot's order for this ray: the higher `slot ^ flip`, the nearer (the slots are
         // laid out by the direction their child lies in from the node's centre).
@@ -213,6 +247,7 @@ impl Occluders<'_> {
             | u32::from(ray.direction.y >= 0.0) << 1
             | u32::from(ray.direction.z >= 0.0);
         stack.clear();
+        let mut met = None;
         // The node walked next: the nearest child crossed, else the top of the stack.
         let mut next = Some(0);
         while let Some(index) = next.take().or_else(|| stack.pop()) {
@@ -221,7 +256,7 @@ impl Occluders<'_> {
             };
             let meta = u64::from_le_bytes(node.child_meta);
             let inner = u32::from(node.imask);
-            let hits = child_hits(node, ray);
+            let hits = child_hits(node, &ray);
             let mut leaves = hits & leaf_slots(meta, inner);
             while leaves != 0 {
                 let slot = leaves.trailing_zeros();
@@ -230,9 +265,21 @@ impl Occluders<'_> {
                 let first = node.primitive_base_idx + (byte & 0x1f);
                 let count = (byte >> 5).count_ones();
                 for k in first..first + count {
-                    if self.facets.get(k as usize).is_some_and(|f| f.meets(ray)) {
-                        return true;
+                    let Some(t) = self.facets.get(k as usize).and_then(|f| f.distance(&ray)) else {
+                        continue;
+                    };
+                    if ANY {
+                        return Some((t, k));
                     }
+                    // The nearest so far; at the same distance (an edge or a corner
+                    // triangles share, a doubled face), the one first in the mesh, whichever
+                    // the walk meets first (the pieces of one triangle are one).
+                    let source = self.sources.get(k as usize).copied().unwrap_or(u32::MAX);
+                    if met.is_none_or(|(near, s)| t < near || (t == near && source < s)) {
+                        met = Some((t, source));
+                    }
+                    // The ray ends just past it: after it, only as near triangles are met.
+                    ray.tmax = t.next_up();
                 }
             }
             // The nearest child crossed is walked next, the others pushed far first.
@@ -253,7 +300,7 @@ impl Occluders<'_> {
             }
             next = Some(child(nearest));
         }
-        false
+        met
     }
 
     /// How many of the directions `t d.x + b d.y + n d.z` (`d` each of `set`, `[t, b, n]` the
@@ -273,6 +320,74 @@ impl Occluders<'_> {
             set,
             far,
         })
+    }
+
+    /// The sum over the directions `t d.x + b d.y + n d.z` (`d` each of `set`, `[t, b, n]`
+    /// the `frame`) from `origin` of the distance to the nearest triangle over `far` (1 where
+    /// none is met before `far`; local units), the walk compiled for the CPU's widest vectors.
+    pub(super) fn depth_sum(&self, origin: Vec3, frame: [Vec3; 3], set: &[Vec3], far: f32) -> f32 {
+        simd::vectorized(DepthSum(OpenCount {
+            occluders: *self,
+            origin,
+            frame,
+            set,
+            far,
+        }))
+    }
+
+    /// [`Occluders::nearest`] compiled for the CPU's widest vectors, for one ray.
+    pub(super) fn nearest_one(&self, ray: &Ray) -> Option<(f32, u32)> {
+        simd::vectorized(NearestOne {
+            occluders: *self,
+            ray,
+        })
+    }
+}
+
+/// [`Occluders::depth_sum`] as a kernel (the same query as an open count).
+struct DepthSum<'a>(OpenCount<'a>);
+
+impl simd::Kernel for DepthSum<'_> {
+    type Output = f32;
+
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn with_simd<S: simd::Simd>(self, _: S) -> f32 {
+        let q = self.0;
+        let [t, b, n] = q.frame;
+        let mut stack = Vec::with_capacity(64);
+        q.set
+            .iter()
+            .map(|d| {
+                let dir = t * d.x + b * d.y + n * d.z;
+                q.occluders
+                    .nearest(&ray(q.origin, dir, q.far), &mut stack)
+                    .map_or(1.0, |(t, _)| t / q.far)
+            })
+            .sum()
+    }
+}
+
+/// [`Occluders::nearest_one`] as a kernel.
+struct NearestOne<'a> {
+    occluders: Occluders<'a>,
+    ray: &'a Ray,
+}
+
+impl simd::Kernel for NearestOne<'_> {
+    type Output = Option<(f32, u32)>;
+
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn with_simd<S: simd::Simd>(self, _: S) -> Option<(f32, u32)> {
+        self.occluders
+            .nearest(self.ray, &mut Vec::with_capacity(64))
     }
 }
 
@@ -305,98 +420,5 @@ impl simd::Kernel for OpenCount<'_> {
                     .occluded(&ray(self.origin, dir, self.far), &mut stack)
             })
             .count()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use glam::Vec3;
-
-    use crate::Mesh;
-    use crate::bakes::{Directions, RayMesh};
-
-    /// A number in `[0, 1)` from a hash of `i`.
-    fn unit(i: u32) -> f32 {
-        super::super::rays::turn_of(i as usize)
-    }
-
-    /// A point in `[-1, 1]^3` from three hashes.
-    fn point(i: u32) -> Vec3 {
-        Vec3::new(unit(3 * i), unit(3 * i + 1), unit(3 * i + 2)) * 2.0 - 1.0
-    }
-
-    /// `count` small triangles scattered through a cube, some on its axes' planes (rays along
-    /// and across them, edges at zero), with tilts of every kind.
-    fn soup(count: u32) -> Mesh {
-        let mut positions = Vec::new();
-        let mut triangles = Vec::new();
-        for k in 0..count {
-            let c = point(k);
-            let c = if k % 7 == 0 { c.with_y(0.0) } else { c };
-            let size = 0.05 + 0.3 * unit(10_000 + k);
-            let first = positions.len() as u32;
-            positions.push(c);
-            positions.push(c + point(20_000 + k) * size);
-            positions.push(c + point(40_000 + k) * size);
-            triangles.push([first, first + 1, first + 2]);
-        }
-        Mesh {
-            name: "soup".into(),
-            normals: vec![Vec3::Z; positions.len()],
-            positions,
-            uvs: None,
-            triangles,
-            had_normals: false,
-            labels: crate::Labels::default(),
-        }
-    }
-
-    #[test]
-    fn every_ray_is_met_or_missed_as_obvhs_traversal_says() {
-        let mesh = RayMesh::new(&soup(12_000));
-        let (mut met, mut rays) = (0, 0);
-        for i in 0..20_000u32 {
-            let origin = point(60_000 + i) * 1.2;
-            let mut dir = (point(90_000 + i)).normalize_or(Vec3::Z);
-            // Axis-aligned rays, negative zeros among them.
-            if i % 11 == 0 {
-                dir = [Vec3::X, Vec3::NEG_Y, Vec3::Z, Vec3::new(-0.0, -1.0, 0.0)]
-                    [(i / 11 % 4) as usize];
-            }
-            let far = [0.05, 0.5, 4.0, f32::INFINITY][(i % 4) as usize];
-            let ours = mesh.occluded_local(origin, dir, far);
-            assert_eq!(
-                ours,
-                mesh.obvhs_occluded(origin, dir, far),
-                "ray {i} from {origin} along {dir} to {far}"
-            );
-            met += usize::from(ours);
-            rays += 1;
-        }
-        // Both answers are common, so the comparison can fail either way.
-        assert!(
-            met > rays / 10 && met < rays * 9 / 10,
-            "{met} of {rays} met"
-        );
-    }
-
-    #[test]
-    fn a_query_counts_the_open_directions_of_its_set_turned_about_its_normal() {
-        let mesh = RayMesh::new(&soup(2_000));
-        let set = Directions::new(64);
-        for i in 0..300u32 {
-            let origin = point(120_000 + i);
-            let normal = point(150_000 + i).normalize_or(Vec3::Z);
-            let (t, b) = Directions::turned_frame(normal, unit(180_000 + i));
-            let open = mesh
-                .occluders()
-                .open_count(origin, [t, b, normal], set.as_slice(), 0.8);
-            let expected = set
-                .as_slice()
-                .iter()
-                .filter(|d| !mesh.obvhs_occluded(origin, t * d.x + b * d.y + normal * d.z, 0.8))
-                .count();
-            assert_eq!(open, expected, "query {i}");
-        }
     }
 }

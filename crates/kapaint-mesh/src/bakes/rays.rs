@@ -33,9 +33,10 @@ fn local_triangle(mesh: &Mesh, frame: &UnitFrame, k: u32) -> Option<Triangle> {
 pub struct RayMesh {
     bvh: CwBvh,
     /// The triangles in the BVH's order (no lookup through its primitive indices per test), in
-    /// local coordinates.
+    /// local coordinates: their corners, for a GPU and for obvhs's own traversal (the tests'
+    /// reference).
     triangles: Vec<Triangle>,
-    /// The same triangles as the occlusion walk reads them.
+    /// The same triangles as the walk reads them.
     facets: Vec<Facet>,
     /// Per triangle (in the BVH's order), its index in the mesh.
     sources: Vec<u32>,
@@ -192,22 +193,16 @@ impl RayMesh {
     }
 
     /// The nearest triangle a ray from `origin` along unit `dir` meets before `far` (object
-    /// units): the distance to it (object units) and its index in the mesh.
+    /// units): the distance to it (object units) and its index in the mesh (of triangles met
+    /// as near, the first in the mesh).
     pub fn nearest(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<(f32, u32)> {
         let ray = ray(
             self.frame.local_from_object(origin),
             dir,
             self.frame.local_length(far),
         );
-        let mut hit = obvhs::ray::RayHit::none();
-        self.bvh
-            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
-            .then(|| {
-                (
-                    self.frame.object_length(hit.t),
-                    self.sources[hit.primitive_id as usize],
-                )
-            })
+        let (t, source) = self.occluders().nearest_one(&ray)?;
+        Some((self.frame.object_length(t), source))
     }
 
     /// [`RayMesh::occluded`] in local units.
@@ -232,15 +227,24 @@ impl RayMesh {
         Occluders {
             nodes: &self.bvh.nodes,
             facets: &self.facets,
+            sources: &self.sources,
         }
     }
 
     /// [`RayMesh::distance`] in local units.
     pub(super) fn distance_local(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
-        let ray = ray(origin, dir, far);
+        Some(self.occluders().nearest_one(&ray(origin, dir, far))?.0)
+    }
+
+    /// [`RayMesh::distance_local`] through obvhs's own traversal and triangle test: the
+    /// reference the closest-hit walk answers as, ray for ray.
+    #[cfg(test)]
+    pub(super) fn obvhs_distance(&self, origin: Vec3, dir: Vec3, far: f32) -> Option<f32> {
         let mut hit = obvhs::ray::RayHit::none();
         self.bvh
-            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
+            .ray_traverse(ray(origin, dir, far), &mut hit, |ray, id| {
+                self.triangles[id].intersect(ray)
+            })
             .then_some(hit.t)
     }
 
@@ -271,19 +275,16 @@ impl RayMesh {
         turn: f32,
     ) -> f32 {
         let origin = point + normal * self.offset();
-        let sum: f32 = set
-            .around(normal, turn)
-            .map(|dir| {
-                self.distance_local(origin, dir, far)
-                    .map_or(1.0, |t| t / far)
-            })
-            .sum();
+        let (t, b) = Directions::turned_frame(normal, turn);
+        let sum = self
+            .occluders()
+            .depth_sum(origin, [t, b, normal], set.as_slice(), far);
         sum / set.len() as f32
     }
 
     /// How far a ray starts off the surface (local units): clear of the triangle it leaves,
     /// close enough to see a neighbour.
-    fn offset(&self) -> f32 {
+    pub(super) fn offset(&self) -> f32 {
         self.frame.local_diagonal() * 1e-5
     }
 
@@ -379,12 +380,6 @@ impl Directions {
     /// Whether there are none.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
-    }
-
-    /// The set about unit `normal`, turned by `turn` (a fraction of a full turn).
-    pub(super) fn around(&self, normal: Vec3, turn: f32) -> impl Iterator<Item = Vec3> + '_ {
-        let (t, b) = Self::turned_frame(normal, turn);
-        self.0.iter().map(move |d| t * d.x + b * d.y + normal * d.z)
     }
 
     /// The tangents `(t, b)` the set's `x` and `y` turn into about unit `normal`, turned by
@@ -485,12 +480,8 @@ impl RayCaster for CpuCaster<'_> {
                             / count
                     }
                     RayKind::Depth => {
-                        let dirs = set.iter().map(|d| q.t * d.x + q.b * d.y + q.n * d.z);
-                        dirs.map(|dir| {
-                            mesh.distance_local(q.origin, dir, batch.far)
-                                .map_or(1.0, |t| t / batch.far)
-                        })
-                        .sum::<f32>()
+                        mesh.occluders()
+                            .depth_sum(q.origin, [q.t, q.b, q.n], set, batch.far)
                             / count
                     }
                 }
