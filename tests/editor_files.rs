@@ -29,7 +29,7 @@ fn untitled_work_is_saved_through_the_in_app_file_dialog() {
     );
     harness.get_by_label_contains("Save project");
     harness.get_by_role_and_label(Role::Button, "Save").click();
-    harness.run();
+    harness.step();
     let saved = dir.join("material.kapaint");
     wait_until(&mut harness, "saved", |e| !e.state.dirty());
     assert_eq!(harness.state().state.path(), Some(saved.as_path()));
@@ -80,7 +80,9 @@ fn a_project_opens_through_the_in_app_file_dialog() {
     harness.get_by_label_contains("other.kapaint").click();
     harness.run();
     harness.get_by_role_and_label(Role::Button, "Open").click();
-    harness.run();
+    // The project opens as a job (a spinner repaints until it is done): stepped until it
+    // is, not run to a still frame within a fixed count (a busy machine took longer).
+    harness.step();
     wait_until(&mut harness, "opened", |e| {
         e.state.path() == Some(project.as_path())
     });
@@ -320,7 +322,7 @@ fn the_first_save_of_untitled_work_takes_its_recovery_copy_along() {
     harness.key_press_modifiers(Modifiers::COMMAND, egui::Key::S);
     harness.run();
     harness.get_by_role_and_label(Role::Button, "Save").click();
-    harness.run();
+    harness.step();
     let saved = dir.join("material.kapaint");
     wait_until(&mut harness, "saved", |e| !e.state.dirty());
     // A second stroke, autosaved: its copy is the project's now, the untitled one is gone.
@@ -537,7 +539,7 @@ fn a_project_another_kapaint_has_open_asks_and_opens_read_only() {
     harness
         .get_by_role_and_label(Role::Button, "Open read-only")
         .click();
-    harness.run();
+    harness.step();
     wait_until(&mut harness, "opened", |e| {
         e.state.opening().is_none() && e.state.doc().maps().width() == 64
     });
@@ -586,7 +588,7 @@ fn new_offers_save_then_create_and_any_width_and_height() {
     harness
         .get_by_role_and_label(Role::Button, "Save, then create")
         .click();
-    harness.run();
+    harness.step();
     wait_until(&mut harness, "saved and created", |e| {
         let maps = e.state.doc().maps();
         (maps.width(), maps.height()) == (512, 256)
