@@ -230,8 +230,7 @@ impl Occluders<'_> {
     /// the ray to just past it (boxes beyond are not entered) and the nearest is the answer
     /// (with its index in the mesh), among as near ones the first in the mesh: the
     /// geometry's answer, not the order the walk happened to meet them in (but for a box
-    /// whose entry, worked out in floats, rounds past a tie). With `ANY` the index is the
-    /// facet's.
+    /// whose entry, worked out in floats, rounds past a tie).
     #[inline(always)]
     #[expect(
         clippy::inline_always,
@@ -268,13 +267,13 @@ impl Occluders<'_> {
                     let Some(t) = self.facets.get(k as usize).and_then(|f| f.distance(&ray)) else {
                         continue;
                     };
+                    let source = self.sources.get(k as usize).copied().unwrap_or(u32::MAX);
                     if ANY {
-                        return Some((t, k));
+                        return Some((t, source));
                     }
                     // The nearest so far; at the same distance (an edge or a corner
                     // triangles share, a doubled face), the one first in the mesh, whichever
                     // the walk meets first (the pieces of one triangle are one).
-                    let source = self.sources.get(k as usize).copied().unwrap_or(u32::MAX);
                     if met.is_none_or(|(near, s)| t < near || (t == near && source < s)) {
                         met = Some((t, source));
                     }
@@ -313,26 +312,28 @@ impl Occluders<'_> {
         set: &[Vec3],
         far: f32,
     ) -> usize {
-        simd::vectorized(OpenCount {
-            occluders: *self,
-            origin,
-            frame,
-            set,
-            far,
-        })
+        simd::vectorized(OpenCount(self.query(origin, frame, set, far)))
     }
 
     /// The sum over the directions `t d.x + b d.y + n d.z` (`d` each of `set`, `[t, b, n]`
     /// the `frame`) from `origin` of the distance to the nearest triangle over `far` (1 where
     /// none is met before `far`; local units), the walk compiled for the CPU's widest vectors.
     pub(super) fn depth_sum(&self, origin: Vec3, frame: [Vec3; 3], set: &[Vec3], far: f32) -> f32 {
-        simd::vectorized(DepthSum(OpenCount {
+        simd::vectorized(DepthSum(self.query(origin, frame, set, far)))
+    }
+
+    /// The rays of `set` turned into `frame` from `origin` to `far`, against this BVH.
+    fn query<'a>(&self, origin: Vec3, frame: [Vec3; 3], set: &'a [Vec3], far: f32) -> SetQuery<'a>
+    where
+        Self: 'a,
+    {
+        SetQuery {
             occluders: *self,
             origin,
             frame,
             set,
             far,
-        }))
+        }
     }
 
     /// [`Occluders::nearest`] compiled for the CPU's widest vectors, for one ray.
@@ -344,8 +345,54 @@ impl Occluders<'_> {
     }
 }
 
-/// [`Occluders::depth_sum`] as a kernel (the same query as an open count).
-struct DepthSum<'a>(OpenCount<'a>);
+/// A set of directions turned into a frame, cast from one origin against one BVH: an AO or a
+/// thickness query.
+#[derive(Clone, Copy)]
+struct SetQuery<'a> {
+    occluders: Occluders<'a>,
+    origin: Vec3,
+    frame: [Vec3; 3],
+    set: &'a [Vec3],
+    far: f32,
+}
+
+impl SetQuery<'_> {
+    /// The query's rays, direction by direction (`t d.x + b d.y + n d.z`).
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn rays(self) -> impl Iterator<Item = Ray> {
+        let [t, b, n] = self.frame;
+        self.set
+            .iter()
+            .map(move |d| ray(self.origin, t * d.x + b * d.y + n * d.z, self.far))
+    }
+}
+
+/// [`Occluders::open_count`] as a kernel.
+struct OpenCount<'a>(SetQuery<'a>);
+
+impl simd::Kernel for OpenCount<'_> {
+    type Output = usize;
+
+    #[inline(always)]
+    #[expect(
+        clippy::inline_always,
+        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
+    )]
+    fn with_simd<S: simd::Simd>(self, _: S) -> usize {
+        let q = self.0;
+        let mut stack = Vec::with_capacity(64);
+        q.rays()
+            .filter(|r| !q.occluders.occluded(r, &mut stack))
+            .count()
+    }
+}
+
+/// [`Occluders::depth_sum`] as a kernel.
+struct DepthSum<'a>(SetQuery<'a>);
 
 impl simd::Kernel for DepthSum<'_> {
     type Output = f32;
@@ -357,14 +404,11 @@ impl simd::Kernel for DepthSum<'_> {
     )]
     fn with_simd<S: simd::Simd>(self, _: S) -> f32 {
         let q = self.0;
-        let [t, b, n] = q.frame;
         let mut stack = Vec::with_capacity(64);
-        q.set
-            .iter()
-            .map(|d| {
-                let dir = t * d.x + b * d.y + n * d.z;
+        q.rays()
+            .map(|r| {
                 q.occluders
-                    .nearest(&ray(q.origin, dir, q.far), &mut stack)
+                    .nearest(&r, &mut stack)
                     .map_or(1.0, |(t, _)| t / q.far)
             })
             .sum()
@@ -388,37 +432,5 @@ impl simd::Kernel for NearestOne<'_> {
     fn with_simd<S: simd::Simd>(self, _: S) -> Option<(f32, u32)> {
         self.occluders
             .nearest(self.ray, &mut Vec::with_capacity(64))
-    }
-}
-
-/// [`Occluders::open_count`] as a kernel.
-struct OpenCount<'a> {
-    occluders: Occluders<'a>,
-    origin: Vec3,
-    frame: [Vec3; 3],
-    set: &'a [Vec3],
-    far: f32,
-}
-
-impl simd::Kernel for OpenCount<'_> {
-    type Output = usize;
-
-    #[inline(always)]
-    #[expect(
-        clippy::inline_always,
-        reason = "compiled into a `simd::vectorized` kernel: only code inlined there is vectorised for the wider instructions"
-    )]
-    fn with_simd<S: simd::Simd>(self, _: S) -> usize {
-        let [t, b, n] = self.frame;
-        let mut stack = Vec::with_capacity(64);
-        self.set
-            .iter()
-            .filter(|d| {
-                let dir = t * d.x + b * d.y + n * d.z;
-                !self
-                    .occluders
-                    .occluded(&ray(self.origin, dir, self.far), &mut stack)
-            })
-            .count()
     }
 }
