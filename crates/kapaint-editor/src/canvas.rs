@@ -352,9 +352,11 @@ impl Canvas {
                 egui::WidgetInfo::labeled(egui::WidgetType::Other, true, PBR_ERROR_SCALE_LABEL)
             });
         }
-        if self.wireframe {
-            let mesh = self.wire.mesh(ui.ctx(), uv_lines, (rect, panel));
-            painter.add(egui::Shape::Mesh(mesh));
+        if self.wireframe
+            && let Some((wire, at)) = self.wire.image(ui.ctx(), uv_lines, (rect, panel))
+        {
+            let whole = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+            painter.image(wire, at, whole, Color32::WHITE);
         }
         (response, rect)
     }
