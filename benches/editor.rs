@@ -127,6 +127,16 @@ fn frames(c: &mut Criterion) {
     let _ = std::fs::remove_file(&path);
 }
 
+/// The middle button pressed (or released) at `at`: a pan on the canvas while it is held.
+fn middle_button(harness: &mut Harness<'static, Editor>, at: Pos2, pressed: bool) {
+    harness.event(egui::Event::PointerButton {
+        pos: at,
+        button: egui::PointerButton::Middle,
+        pressed,
+        modifiers: egui::Modifiers::NONE,
+    });
+}
+
 /// Frames over the UV canvas of a project on a 1M-triangle mesh (see the module's notes).
 fn huge_mesh_frames(c: &mut Criterion) {
     let dir = std::env::temp_dir().join(format!("kapaint-bench-mesh-{}", std::process::id()));
@@ -151,12 +161,7 @@ fn huge_mesh_frames(c: &mut Criterion) {
         });
     });
     harness.hover_at(canvas);
-    harness.event(egui::Event::PointerButton {
-        pos: canvas,
-        button: egui::PointerButton::Middle,
-        pressed: true,
-        modifiers: egui::Modifiers::NONE,
-    });
+    middle_button(&mut harness, canvas, true);
     group.bench_function("canvas_pan", |b| {
         b.iter(|| {
             // Back and forth, 3 points a frame.
@@ -166,12 +171,7 @@ fn huge_mesh_frames(c: &mut Criterion) {
             harness.step();
         });
     });
-    harness.event(egui::Event::PointerButton {
-        pos: canvas,
-        button: egui::PointerButton::Middle,
-        pressed: false,
-        modifiers: egui::Modifiers::NONE,
-    });
+    middle_button(&mut harness, canvas, false);
     group.bench_function("canvas_zoom", |b| {
         b.iter(|| {
             // In and out in turn: the view changes every frame.
